@@ -1,0 +1,117 @@
+#include "core/diagnostics.h"
+
+#include <algorithm>
+#include <limits>
+
+namespace sprig {
+
+namespace {
+
+const char* severityName(Severity s) {
+  switch (s) {
+    case Severity::Error: return "error";
+    case Severity::Warning: return "warning";
+    case Severity::Note: return "note";
+  }
+  return "error";
+}
+
+std::string formatAll(const std::vector<Diagnostic>& ds) {
+  std::string out;
+  for (size_t i = 0; i < ds.size(); ++i) {
+    if (i) out += '\n';
+    out += ds[i].format();
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string Diagnostic::format() const {
+  std::string out;
+  if (!loc.file.empty()) {
+    out += loc.file;
+    if (loc.line > 0) {
+      out += ':' + std::to_string(loc.line);
+      if (loc.col > 0) out += ':' + std::to_string(loc.col);
+    }
+    out += ": ";
+  }
+  out += severityName(severity);
+  out += ": ";
+  out += message;
+  if (!sourceLine.empty() && loc.col > 0) {
+    out += "\n  ";
+    out += sourceLine;
+    out += "\n  ";
+    // Keep tabs so the caret lines up under tab-indented text.
+    for (int i = 0; i + 1 < loc.col && i < static_cast<int>(sourceLine.size()); ++i)
+      out += sourceLine[i] == '\t' ? '\t' : ' ';
+    out += '^';
+  }
+  return out;
+}
+
+InputError::InputError(std::vector<Diagnostic> diagnostics)
+    : std::runtime_error(formatAll(diagnostics)), diagnostics_(std::move(diagnostics)) {}
+
+InputError::InputError(SourceLoc loc, std::string message, std::string sourceLine)
+    : InputError(std::vector<Diagnostic>{Diagnostic{Severity::Error, std::move(loc), std::move(message), std::move(sourceLine)}}) {}
+
+void DiagnosticList::error(SourceLoc loc, std::string message, std::string sourceLine) {
+  items_.push_back({Severity::Error, std::move(loc), std::move(message), std::move(sourceLine)});
+}
+
+void DiagnosticList::warning(SourceLoc loc, std::string message, std::string sourceLine) {
+  items_.push_back({Severity::Warning, std::move(loc), std::move(message), std::move(sourceLine)});
+}
+
+bool DiagnosticList::hasErrors() const {
+  return std::any_of(items_.begin(), items_.end(), [](const Diagnostic& d) { return d.severity == Severity::Error; });
+}
+
+void DiagnosticList::throwIfErrors() const {
+  if (hasErrors()) throw InputError(items_);
+}
+
+std::string lineOf(std::string_view text, int line) {
+  if (line < 1) return {};
+  size_t pos = 0;
+  for (int l = 1; l < line; ++l) {
+    pos = text.find('\n', pos);
+    if (pos == std::string_view::npos) return {};
+    ++pos;
+  }
+  size_t end = text.find('\n', pos);
+  std::string_view s = text.substr(pos, end == std::string_view::npos ? std::string_view::npos : end - pos);
+  if (!s.empty() && s.back() == '\r') s.remove_suffix(1);
+  return std::string(s);
+}
+
+int editDistance(std::string_view a, std::string_view b) {
+  std::vector<int> prev(b.size() + 1), cur(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) prev[j] = static_cast<int>(j);
+  for (size_t i = 1; i <= a.size(); ++i) {
+    cur[0] = static_cast<int>(i);
+    for (size_t j = 1; j <= b.size(); ++j) {
+      int sub = prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1);
+      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, sub});
+    }
+    std::swap(prev, cur);
+  }
+  return prev[b.size()];
+}
+
+std::string didYouMean(std::string_view word, const std::vector<std::string>& candidates) {
+  int best = std::numeric_limits<int>::max();
+  const std::string* bestName = nullptr;
+  for (const auto& c : candidates) {
+    int d = editDistance(word, c);
+    if (d < best) { best = d; bestName = &c; }
+  }
+  int limit = std::max<int>(2, static_cast<int>(word.size()) / 3);
+  if (!bestName || best > limit) return {};
+  return " (did you mean '" + *bestName + "'?)";
+}
+
+}  // namespace sprig

@@ -1,0 +1,75 @@
+#pragma once
+/// Source locations, diagnostics and the InputError every parser throws.
+///
+/// A diagnostic prints as `path:line:col: error: message` (1-based line and column),
+/// followed, when the source line is known, by that line and a caret under the column.
+/// Parsers collect diagnostics in a DiagnosticList and throw once with all of them.
+
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace sprig {
+
+/// A position in a user's file. line and col are 1-based; 0 means unknown.
+struct SourceLoc {
+  std::string file;
+  int line = 0;
+  int col = 0;
+};
+
+enum class Severity { Error, Warning, Note };
+
+/// One message about a user's input.
+struct Diagnostic {
+  Severity severity = Severity::Error;
+  SourceLoc loc;
+  std::string message;
+  std::string sourceLine;  ///< the text of loc.line, without its newline; may be empty
+
+  /// `path:line:col: error: message`, plus the source line and a caret when known.
+  std::string format() const;
+};
+
+/// Bad user input (grammar, species file, texture, command-line value).
+/// what() returns every diagnostic formatted, one after another.
+class InputError : public std::runtime_error {
+ public:
+  explicit InputError(std::vector<Diagnostic> diagnostics);
+  /// One error at loc.
+  InputError(SourceLoc loc, std::string message, std::string sourceLine = {});
+
+  const std::vector<Diagnostic>& diagnostics() const { return diagnostics_; }
+
+ private:
+  std::vector<Diagnostic> diagnostics_;
+};
+
+/// Collects diagnostics while a file is parsed; throwIfErrors() throws them all at once.
+class DiagnosticList {
+ public:
+  void error(SourceLoc loc, std::string message, std::string sourceLine = {});
+  void warning(SourceLoc loc, std::string message, std::string sourceLine = {});
+  void add(Diagnostic d) { items_.push_back(std::move(d)); }
+  void append(const std::vector<Diagnostic>& ds) { items_.insert(items_.end(), ds.begin(), ds.end()); }
+
+  bool hasErrors() const;
+  const std::vector<Diagnostic>& items() const { return items_; }
+  /// Throws InputError holding every diagnostic when any is an error.
+  void throwIfErrors() const;
+
+ private:
+  std::vector<Diagnostic> items_;
+};
+
+/// The 1-based line `line` of text, without its line ending; empty if out of range.
+std::string lineOf(std::string_view text, int line);
+
+/// Levenshtein distance between a and b.
+int editDistance(std::string_view a, std::string_view b);
+
+/// " (did you mean 'x'?)" for the closest candidate within a small edit distance, else "".
+std::string didYouMean(std::string_view word, const std::vector<std::string>& candidates);
+
+}  // namespace sprig

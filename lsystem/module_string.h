@@ -1,0 +1,62 @@
+#pragma once
+/// The module string: structure of arrays, no heap object per module.
+///
+/// Module i has symbol id symbols[i] and parameters params[offsets[i] .. offsets[i+1]).
+/// Derivation rewrites one ModuleString into a second buffer each step (clear() keeps
+/// capacity). Symbol ids index a SymbolTable: built-in turtle symbols first, then the
+/// grammar's own symbols in order of appearance.
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <string_view>
+#include <unordered_map>
+#include <vector>
+
+namespace sprig::lsystem {
+
+using SymbolId = uint16_t;
+
+/// Names of every module symbol a grammar uses ("F", "+", "Apex", ...).
+class SymbolTable {
+ public:
+  /// The id of name, adding it when new.
+  SymbolId intern(std::string_view name);
+  /// The id of name, or -1 when absent.
+  int find(std::string_view name) const;
+  const std::string& name(SymbolId id) const { return names_[id]; }
+  size_t size() const { return names_.size(); }
+
+ private:
+  std::vector<std::string> names_;
+  std::unordered_map<std::string, SymbolId> ids_;
+};
+
+struct ModuleString {
+  std::vector<SymbolId> symbols;
+  std::vector<uint32_t> offsets{0};  ///< size() + 1 entries
+  std::vector<double> params;
+
+  size_t size() const { return symbols.size(); }
+  bool empty() const { return symbols.empty(); }
+  void clear() {
+    symbols.clear();
+    offsets.assign(1, 0);
+    params.clear();
+  }
+  void reserve(size_t modules, size_t parameters) {
+    symbols.reserve(modules);
+    offsets.reserve(modules + 1);
+    params.reserve(parameters);
+  }
+  uint32_t paramCount(size_t i) const { return offsets[i + 1] - offsets[i]; }
+  std::span<const double> paramsOf(size_t i) const { return {params.data() + offsets[i], paramCount(i)}; }
+  /// Appends one module.
+  void push(SymbolId s, std::span<const double> p = {}) {
+    symbols.push_back(s);
+    params.insert(params.end(), p.begin(), p.end());
+    offsets.push_back(static_cast<uint32_t>(params.size()));
+  }
+};
+
+}  // namespace sprig::lsystem

@@ -1,0 +1,131 @@
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+
+#include "core/atomic_file.h"
+#include "core/diagnostics.h"
+#include "core/mesh.h"
+#include "core/parallel.h"
+#include "core/rng.h"
+
+using namespace sprig;
+
+TEST_CASE("Diagnostic::format", "[core]") {
+  SECTION("location, message, source line and caret") {
+    Diagnostic d{Severity::Error, {"a.lsys", 3, 5}, "unexpected ')'", "A(x))"};
+    CHECK(d.format() == "a.lsys:3:5: error: unexpected ')'\n  A(x))\n      ^");
+  }
+  SECTION("no source line") {
+    Diagnostic d{Severity::Error, {"s.yaml", 1, 1}, "bad", ""};
+    CHECK(d.format() == "s.yaml:1:1: error: bad");
+  }
+  SECTION("InputError collects every diagnostic") {
+    DiagnosticList list;
+    list.error({"f", 1, 2}, "one");
+    list.error({"f", 4, 1}, "two");
+    try {
+      list.throwIfErrors();
+      FAIL("no throw");
+    } catch (const InputError& e) {
+      CHECK(std::string(e.what()) == "f:1:2: error: one\nf:4:1: error: two");
+      CHECK(e.diagnostics().size() == 2);
+    }
+  }
+  SECTION("lineOf and didYouMean") {
+    CHECK(lineOf("a\nbc\r\nd", 2) == "bc");
+    CHECK(lineOf("a\nbc", 3).empty());
+    CHECK(didYouMean("grammer", {"grammar", "kind", "seed"}) == " (did you mean 'grammar'?)");
+    CHECK(didYouMean("zzzzzz", {"grammar", "kind"}).empty());
+  }
+}
+
+TEST_CASE("Rng", "[core]") {
+  SECTION("the sequence is fixed by the seed") {
+    Rng a(42), b(42), c(43);
+    uint32_t x = a.next32();
+    CHECK(x == b.next32());
+    CHECK(x != c.next32());
+  }
+  SECTION("uniform lies in [0,1) with the right mean") {
+    Rng r(7);
+    double sum = 0;
+    for (int i = 0; i < 100000; ++i) {
+      double u = r.uniform();
+      REQUIRE(u >= 0.0);
+      REQUIRE(u < 1.0);
+      sum += u;
+    }
+    CHECK(sum / 100000 == Approx(0.5).margin(0.005));
+  }
+  SECTION("normal has the requested mean and deviation") {
+    Rng r(9);
+    double s = 0, s2 = 0;
+    const int n = 200000;
+    for (int i = 0; i < n; ++i) {
+      double v = r.normal(3.0, 2.0);
+      s += v;
+      s2 += v * v;
+    }
+    double mean = s / n;
+    CHECK(mean == Approx(3.0).margin(0.02));
+    CHECK(std::sqrt(s2 / n - mean * mean) == Approx(2.0).margin(0.02));
+  }
+  SECTION("derived seeds depend on every id") {
+    CHECK(deriveSeed(1, {2, 3}) != deriveSeed(1, {3, 2}));
+    CHECK(deriveSeed(1, {2, 3}) == deriveSeed(1, {2, 3}));
+  }
+}
+
+TEST_CASE("parallelFor", "[core]") {
+  std::vector<int> v(10000, 0);
+  parallelFor(0, v.size(), [&](size_t i) { v[i] = static_cast<int>(i) * 2; }, 64);
+  for (size_t i = 0; i < v.size(); ++i) REQUIRE(v[i] == static_cast<int>(i) * 2);
+  {
+    ThreadLimit one(1);
+    CHECK(threadCount() == 1);
+  }
+}
+
+TEST_CASE("writeFileAtomic", "[core]") {
+  namespace fs = std::filesystem;
+  fs::path dir = fs::temp_directory_path() / "sprig_core_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  SECTION("writes and replaces") {
+    writeFileAtomic(dir / "a.txt", "one");
+    writeFileAtomic(dir / "a.txt", "two");
+    CHECK(readFile(dir / "a.txt") == "two");
+  }
+  SECTION("an uncommitted temporary leaves nothing") {
+    {
+      TempPath tmp(dir / "b.png");
+      writeFileAtomic(tmp.path(), "partial");
+      CHECK(tmp.path().extension() == ".png");
+    }
+    CHECK(!fs::exists(dir / "b.png"));
+    int n = 0;
+    for ([[maybe_unused]] auto& e : fs::directory_iterator(dir)) ++n;
+    CHECK(n == 0);
+  }
+  SECTION("a missing folder is an error, not a crash") {
+    CHECK_THROWS_AS(writeFileAtomic(dir / "no" / "such" / "x", "y"), std::runtime_error);
+  }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("analyzeTopology", "[core]") {
+  // A tetrahedron, outward oriented.
+  Mesh m;
+  m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+  m.triangles = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+  auto t = analyzeTopology(m);
+  CHECK(t.closed());
+  CHECK(t.manifold());
+  CHECK(signedVolume(m) == Approx(1.0 / 6.0));
+  m.triangles.pop_back();
+  t = analyzeTopology(m);
+  CHECK(t.boundaryEdges == 3);
+  m.triangles.push_back({1, 3, 2});  // flipped
+  t = analyzeTopology(m);
+  CHECK(t.inconsistentEdges == 3);
+}
