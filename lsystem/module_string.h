@@ -5,6 +5,9 @@
 /// Derivation rewrites one ModuleString into a second buffer each step (clear() keeps
 /// capacity). Symbol ids index a SymbolTable: built-in turtle symbols first, then the
 /// grammar's own symbols in order of appearance.
+///
+/// birthSteps is optional: empty unless the derivation was asked to track the step that
+/// created each module (DeriveOptions::trackBirthSteps); then it has size() entries.
 
 #include <cstdint>
 #include <span>
@@ -36,13 +39,19 @@ struct ModuleString {
   std::vector<SymbolId> symbols;
   std::vector<uint32_t> offsets{0};  ///< size() + 1 entries
   std::vector<double> params;
+  std::vector<int32_t> birthSteps;  ///< empty, or the creating step of each module (0 = axiom)
 
+  /// True when birthSteps holds one entry per module.
+  bool hasBirthSteps() const { return !symbols.empty() && birthSteps.size() == symbols.size(); }
+  /// The step that created module i, or 0 when birth steps are not tracked.
+  int32_t birthStep(size_t i) const { return i < birthSteps.size() ? birthSteps[i] : 0; }
   size_t size() const { return symbols.size(); }
   bool empty() const { return symbols.empty(); }
   void clear() {
     symbols.clear();
     offsets.assign(1, 0);
     params.clear();
+    birthSteps.clear();
   }
   void reserve(size_t modules, size_t parameters) {
     symbols.reserve(modules);
@@ -51,7 +60,7 @@ struct ModuleString {
   }
   uint32_t paramCount(size_t i) const { return offsets[i + 1] - offsets[i]; }
   std::span<const double> paramsOf(size_t i) const { return {params.data() + offsets[i], paramCount(i)}; }
-  /// Appends one module.
+  /// Appends one module (birthSteps is left alone; callers tracking births push there too).
   void push(SymbolId s, std::span<const double> p = {}) {
     symbols.push_back(s);
     params.insert(params.end(), p.begin(), p.end());

@@ -1,0 +1,98 @@
+#pragma once
+/// Derivation: rewriting a ModuleString with a Grammar's productions, step by step.
+///
+/// Each step reads the current string and writes the next one into a second buffer
+/// (structure of arrays, no heap object per module); the buffers then swap. Productions
+/// are found through a table indexed by symbol id; successors are templates whose
+/// parameter expressions run on a small bytecode VM (lsystem/detail/program.h).
+/// Stochastic choices and `ran`/`nran` draw from an Rng seeded per module with
+/// deriveSeed(seed, {step, moduleIndex}), so results never depend on thread count.
+/// After each step the `decomposition:` rules are applied (depth-limited) and `%` cuts
+/// remove the rest of their branch.
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <optional>
+#include <string>
+
+#include "lsystem/grammar.h"
+#include "lsystem/module_string.h"
+
+namespace sprig::lsystem {
+
+/// Settings for one derivation. Unset optionals take the grammar's values.
+struct DeriveOptions {
+  std::optional<int> steps;       ///< number of steps; default Grammar::derivationLength()
+  std::optional<uint64_t> seed;   ///< default Grammar::seed()
+  /// Limit on modules in any string; exceeding it throws InputError
+  /// "derivation would exceed N modules at step k" before the memory is allocated.
+  size_t maxModules = 50'000'000;
+  /// Record in ModuleString::birthSteps the step that created each module (0 = axiom).
+  /// Off by default: it then costs nothing.
+  bool trackBirthSteps = false;
+  /// Called after every completed step with (step, module count); may be empty.
+  std::function<void(int step, size_t modules)> onStep;
+};
+
+/// Derives a grammar step by step. Not thread-safe; cheap to construct.
+///
+/// Errors (InputError): a module limit overrun ("derivation would exceed N modules at step
+/// k"), a non-finite parameter ("production at file:line:col produced a non-finite value
+/// (nan) at step k").
+class Deriver {
+ public:
+  /// Starts from the grammar's axiom (decomposed, cut). The grammar must outlive the Deriver.
+  explicit Deriver(const Grammar& grammar, DeriveOptions options = {});
+  ~Deriver();
+  Deriver(Deriver&&) noexcept;
+  Deriver& operator=(Deriver&&) noexcept;
+
+  /// Performs one derivation step (even past steps()); returns the new string.
+  const ModuleString& step();
+  /// Performs the remaining steps up to steps() and returns the final string.
+  const ModuleString& derive();
+  /// The current string (the axiom before any step).
+  const ModuleString& current() const;
+  /// Steps performed so far.
+  int stepsDone() const;
+  /// Target number of steps (options or grammar).
+  int steps() const;
+  /// The seed in use.
+  uint64_t seed() const;
+  /// The grammar's symbol table (ids in every string this Deriver produces).
+  const SymbolTable& symbols() const;
+  /// Applies the `interpretation:` (homomorphism) rules to s, recursively up to the
+  /// block's `maximum depth` (default 1), as the turtle reads it; the result keeps
+  /// birth steps when s has them. Returns a copy of s when there are no such rules.
+  /// Random draws use deriveSeed(seed, {kInterpretStream, moduleIndex}).
+  ModuleString interpret(const ModuleString& s) const;
+  /// Modules written in total over every step so far (the benchmark's throughput count).
+  uint64_t modulesWritten() const;
+
+  /// Stream id mixed into interpretation seeds (distinct from any step number).
+  static constexpr uint64_t kInterpretStream = 0xfffffffffffffff0ull;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// One-call form: derives grammar with options and returns the final string.
+ModuleString derive(const Grammar& grammar, const DeriveOptions& options = {});
+
+/// Options for formatModuleString.
+struct FormatOptions {
+  /// Characters per line before wrapping at a module boundary; 0 = one line.
+  size_t wrapColumn = 0;
+};
+
+/// s in the grammar's own notation: `F(1.5)[+A(2,3)]`. Numbers print in their shortest
+/// round-trip form; a space separates a multi-character name from a following module
+/// whose name would otherwise merge with it.
+std::string formatModuleString(const ModuleString& s, const SymbolTable& symbols, const FormatOptions& options = {});
+
+/// Number of modules with symbol name in s (0 if the symbol is unknown).
+size_t countSymbol(const ModuleString& s, const SymbolTable& symbols, std::string_view name);
+
+}  // namespace sprig::lsystem

@@ -1,0 +1,102 @@
+#pragma once
+/// The L-system grammar language: parsing a cpfg-compatible `.lsys` file into a Grammar.
+///
+/// A Grammar is immutable once parsed: the symbol table, the axiom, the compiled
+/// productions (successor templates and expression bytecode, see lsystem/detail/program.h)
+/// and the header values (name, derivation length, seed, angle). Copies are cheap: they
+/// share the compiled program. The language is documented in docs/GRAMMAR.md.
+///
+/// Symbols: the table starts with the built-in turtle symbols (kTurtleSymbols, in that
+/// order), then the grammar's own symbols in order of first appearance. Multi-character
+/// names are declared with `module Apex, Leaf`; strings are tokenized by longest match
+/// against the declared and built-in multi-character names, otherwise one character is
+/// one symbol. `~` followed by a letter is one symbol (`~l`, a named predefined surface).
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/diagnostics.h"
+#include "lsystem/module_string.h"
+
+namespace sprig::lsystem {
+
+namespace detail {
+struct Program;
+}
+
+/// Built-in turtle symbols, interned first in this order in every grammar's SymbolTable
+/// (so their ids are 0, 1, 2, ...). The turtle is documented in docs/TURTLE.md.
+inline constexpr const char* kTurtleSymbols[] = {
+    "F", "f", "G", "g", "+", "-", "&", "^", "\\", "/", "|", "$", "[", "]",
+    "!", "'", "{", ".", "}", "~", "%", "@Ts", "@v", "@O", "@Tf", "@o", "@c",
+};
+
+/// One `#define` constant replaced from outside the grammar (`-D NAME=VALUE`, a species file).
+struct DefineOverride {
+  std::string name;
+  double value = 0;
+  SourceLoc loc;  ///< where the override was written (command line, species file), for errors
+};
+
+/// Values that replace what a grammar file says.
+struct GrammarOverrides {
+  /// Replace `#define NAME` values; an unknown NAME is an InputError (with "did you mean").
+  std::vector<DefineOverride> defines;
+  std::optional<int> derivationLength;  ///< replaces `derivation length:`
+  std::optional<uint64_t> seed;         ///< replaces `seed:`
+};
+
+/// A parsed, compiled L-system.
+class Grammar {
+ public:
+  Grammar();
+
+  /// `lsystem:` name, or the file's stem when absent.
+  const std::string& name() const;
+  /// The file name the grammar was parsed from (used in every diagnostic).
+  const std::string& fileName() const;
+  /// `derivation length:` after overrides (0 when absent).
+  int derivationLength() const;
+  /// `seed:` after overrides (0 when absent).
+  uint64_t seed() const;
+  /// `angle:` in degrees, the turtle's default turn angle; nullopt when the file has none.
+  std::optional<double> angleDeg() const;
+  /// Every symbol the grammar names (built-ins first).
+  const SymbolTable& symbols() const;
+  /// The axiom with its parameters evaluated.
+  const ModuleString& axiom() const;
+  /// Value of a `#define` constant after overrides, nullopt if undefined.
+  std::optional<double> define(std::string_view name) const;
+  /// Names of every `#define`, in file order.
+  std::vector<std::string> defineNames() const;
+  /// Number of productions in the main block (not decomposition or interpretation rules).
+  size_t productionCount() const;
+  /// True when the grammar has `interpretation:` (homomorphism) rules.
+  bool hasInterpretation() const;
+
+  /// The compiled program (internal; used by Deriver).
+  const detail::Program& program() const { return *program_; }
+
+ private:
+  friend Grammar parseGrammar(std::string_view, const std::string&, const GrammarOverrides&);
+  std::shared_ptr<const detail::Program> program_;
+};
+
+/// Parses and compiles a grammar. Every error in the text is collected and thrown together
+/// as one InputError with `fileName:line:col` positions (1-based).
+/// Throws InputError also for an override naming an unknown `#define`.
+Grammar parseGrammar(std::string_view text, const std::string& fileName, const GrammarOverrides& overrides = {});
+
+/// Reads path and parses it; a missing or unreadable file is an InputError at `path`.
+Grammar loadGrammar(const std::string& path, const GrammarOverrides& overrides = {});
+
+/// Tokenizes a module string written in grammar notation (`F(1)[+A(2,3)]`), parameters
+/// being constant expressions, interning new single-character symbols into symbols.
+/// Throws InputError (positions relative to text, reported in fileName).
+ModuleString parseModuleString(std::string_view text, SymbolTable& symbols, const std::string& fileName = "<string>");
+
+}  // namespace sprig::lsystem
