@@ -1,0 +1,318 @@
+#include "core/mesh_io.h"
+
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+#include "core/atomic_file.h"
+
+namespace sprig {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// Throws std::invalid_argument when an index or an optional array does not fit the mesh.
+void validate(const Mesh& mesh) {
+  size_t n = mesh.positions.size();
+  auto check = [&](size_t size, const char* what) {
+    if (size != 0 && size != n)
+      throw std::invalid_argument(std::string("mesh has ") + std::to_string(size) + " " + what + " for " +
+                                  std::to_string(n) + " vertices");
+  };
+  check(mesh.normals.size(), "normals");
+  check(mesh.uvs.size(), "uvs");
+  check(mesh.colors.size(), "colors");
+  if (!mesh.materials.empty() && mesh.materials.size() != mesh.triangles.size())
+    throw std::invalid_argument("mesh has " + std::to_string(mesh.materials.size()) + " material ids for " +
+                                std::to_string(mesh.triangles.size()) + " triangles");
+  for (const auto& t : mesh.triangles)
+    if (t.x >= n || t.y >= n || t.z >= n)
+      throw std::invalid_argument("mesh triangle index out of range (" + std::to_string(n) + " vertices)");
+}
+
+// Linear RGB -> sRGB encoding (IEC 61966-2-1).
+float srgbEncode(float c) {
+  c = std::clamp(c, 0.0f, 1.0f);
+  return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
+}
+
+uint8_t toByte(float c) { return static_cast<uint8_t>(std::lround(srgbEncode(c) * 255.0f)); }
+
+// Appends little-endian raw bytes of a trivially copyable value (x86-64 is little-endian).
+template <class T>
+void putRaw(std::string& out, const T& v) {
+  char bytes[sizeof(T)];
+  std::memcpy(bytes, &v, sizeof(T));
+  out.append(bytes, sizeof(T));
+}
+
+// Appends a float in its shortest round-trip decimal form.
+void putFloat(std::string& out, float v) {
+  char buf[32];
+  auto res = std::to_chars(buf, buf + sizeof buf, v);
+  out.append(buf, res.ptr);
+}
+
+void putUint(std::string& out, uint64_t v) {
+  char buf[24];
+  auto res = std::to_chars(buf, buf + sizeof buf, v);
+  out.append(buf, res.ptr);
+}
+
+void writeAtomic(const fs::path& path, const std::string& bytes) {
+  TempPath tmp(path);
+  {
+    std::ofstream f(tmp.path(), std::ios::binary | std::ios::trunc);
+    if (!f) throw std::runtime_error("cannot write '" + path.string() + "': cannot create a file in its folder");
+    f.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    f.flush();
+    if (!f) throw std::runtime_error("cannot write '" + path.string() + "': write failed");
+  }
+  tmp.commit();
+}
+
+std::string lowerExtension(const fs::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext;
+}
+
+// Materials used by the mesh, in first-use order of sorted ids (deterministic).
+std::vector<uint32_t> materialIds(const Mesh& mesh) {
+  std::vector<uint32_t> ids(mesh.materials.begin(), mesh.materials.end());
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  return ids;
+}
+
+// A distinct, muted colour for material id i (golden-ratio hue walk), mixed with base.
+Vec3 materialColor(const Vec3& base, uint32_t id) {
+  if (id == 0) return base;
+  float h = std::fmod(0.61803398875f * float(id), 1.0f) * 6.0f;
+  float x = 1.0f - std::fabs(std::fmod(h, 2.0f) - 1.0f);
+  Vec3 rgb = h < 1 ? Vec3(1, x, 0) : h < 2 ? Vec3(x, 1, 0) : h < 3 ? Vec3(0, 1, x)
+           : h < 4 ? Vec3(0, x, 1) : h < 5 ? Vec3(x, 0, 1) : Vec3(1, 0, x);
+  return 0.5f * base + 0.5f * rgb;
+}
+
+}  // namespace
+
+MeshFormat meshFormatFor(const fs::path& path) {
+  std::string ext = lowerExtension(path);
+  if (ext == ".ply") return MeshFormat::Ply;
+  if (ext == ".obj") return MeshFormat::Obj;
+  if (ext == ".glb") return MeshFormat::Glb;
+  throw std::invalid_argument("cannot tell the mesh format of '" + path.string() +
+                              "': use the extension .ply, .obj or .glb");
+}
+
+void writeMesh(const Mesh& mesh, const fs::path& path, const MeshWriteOptions& options) {
+  switch (meshFormatFor(path)) {
+    case MeshFormat::Ply: writePly(mesh, path); break;
+    case MeshFormat::Obj: writeObj(mesh, path, options); break;
+    case MeshFormat::Glb: writeGlb(mesh, path, options); break;
+  }
+}
+
+void writePly(const Mesh& mesh, const fs::path& path) {
+  validate(mesh);
+  size_t n = mesh.positions.size();
+  bool hasN = !mesh.normals.empty(), hasUv = !mesh.uvs.empty(), hasC = !mesh.colors.empty();
+  bool hasM = !mesh.materials.empty();
+
+  std::string out = "ply\nformat binary_little_endian 1.0\ncomment written by Sprig\n";
+  out += "element vertex " + std::to_string(n) + "\n";
+  out += "property float x\nproperty float y\nproperty float z\n";
+  if (hasN) out += "property float nx\nproperty float ny\nproperty float nz\n";
+  if (hasUv) out += "property float s\nproperty float t\n";
+  if (hasC) out += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
+  out += "element face " + std::to_string(mesh.triangles.size()) + "\n";
+  out += "property list uchar uint vertex_indices\n";
+  if (hasM) out += "property uint material\n";
+  out += "end_header\n";
+
+  size_t vertexBytes = 12 + (hasN ? 12 : 0) + (hasUv ? 8 : 0) + (hasC ? 3 : 0);
+  out.reserve(out.size() + n * vertexBytes + mesh.triangles.size() * (13 + (hasM ? 4 : 0)));
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3& p = mesh.positions[i];
+    putRaw(out, p.x), putRaw(out, p.y), putRaw(out, p.z);
+    if (hasN) putRaw(out, mesh.normals[i].x), putRaw(out, mesh.normals[i].y), putRaw(out, mesh.normals[i].z);
+    if (hasUv) putRaw(out, mesh.uvs[i].x), putRaw(out, mesh.uvs[i].y);
+    if (hasC) {
+      out.push_back(char(toByte(mesh.colors[i].x)));
+      out.push_back(char(toByte(mesh.colors[i].y)));
+      out.push_back(char(toByte(mesh.colors[i].z)));
+    }
+  }
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    out.push_back(char(3));
+    putRaw(out, mesh.triangles[t].x), putRaw(out, mesh.triangles[t].y), putRaw(out, mesh.triangles[t].z);
+    if (hasM) putRaw(out, mesh.materials[t]);
+  }
+  writeAtomic(path, out);
+}
+
+void writeObj(const Mesh& mesh, const fs::path& path, const MeshWriteOptions& options) {
+  validate(mesh);
+  bool hasN = !mesh.normals.empty(), hasUv = !mesh.uvs.empty(), hasC = !mesh.colors.empty();
+  bool hasM = !mesh.materials.empty();
+  fs::path mtlPath = path;
+  mtlPath.replace_extension(".mtl");
+  std::vector<uint32_t> ids = hasM ? materialIds(mesh) : std::vector<uint32_t>{};
+  auto nameOf = [&](uint32_t id) {
+    return hasM ? options.materialName + "_" + std::to_string(id) : options.materialName;
+  };
+
+  // The MTL: one entry, or one per material id.
+  std::string mtl = "# written by Sprig\n";
+  auto putMaterial = [&](const std::string& name, const Vec3& c) {
+    mtl += "newmtl " + name + "\nKa 0 0 0\nKd ";
+    putFloat(mtl, c.x), mtl += ' ', putFloat(mtl, c.y), mtl += ' ', putFloat(mtl, c.z);
+    mtl += "\nKs 0.04 0.04 0.04\nNs 32\nd 1\nillum 2\n\n";
+  };
+  if (hasM)
+    for (uint32_t id : ids) putMaterial(nameOf(id), materialColor(options.baseColor, id));
+  else
+    putMaterial(nameOf(0), options.baseColor);
+
+  std::string out = "# written by Sprig\nmtllib " + mtlPath.filename().string() + "\n";
+  out.reserve(mesh.positions.size() * (hasC ? 90 : 40) * (1 + hasN + hasUv) + mesh.triangles.size() * 40);
+  for (size_t i = 0; i < mesh.positions.size(); ++i) {
+    const Vec3& p = mesh.positions[i];
+    out += "v ";
+    putFloat(out, p.x), out += ' ', putFloat(out, p.y), out += ' ', putFloat(out, p.z);
+    if (hasC) {
+      out += ' ';
+      putFloat(out, srgbEncode(mesh.colors[i].x)), out += ' ';
+      putFloat(out, srgbEncode(mesh.colors[i].y)), out += ' ';
+      putFloat(out, srgbEncode(mesh.colors[i].z));
+    }
+    out += '\n';
+  }
+  if (hasUv)
+    for (const auto& uv : mesh.uvs) out += "vt ", putFloat(out, uv.x), out += ' ', putFloat(out, uv.y), out += '\n';
+  if (hasN)
+    for (const auto& nm : mesh.normals) {
+      out += "vn ";
+      putFloat(out, nm.x), out += ' ', putFloat(out, nm.y), out += ' ', putFloat(out, nm.z);
+      out += '\n';
+    }
+  if (!hasM) out += "usemtl " + nameOf(0) + "\n";
+  uint32_t current = ~0u;
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    if (hasM && mesh.materials[t] != current) {
+      current = mesh.materials[t];
+      out += "usemtl " + nameOf(current) + "\n";
+    }
+    out += 'f';
+    for (int k = 0; k < 3; ++k) {
+      uint64_t idx = uint64_t(mesh.triangles[t][k]) + 1;
+      out += ' ';
+      putUint(out, idx);
+      if (hasUv || hasN) {
+        out += '/';
+        if (hasUv) putUint(out, idx);
+        if (hasN) out += '/', putUint(out, idx);
+      }
+    }
+    out += '\n';
+  }
+  writeAtomic(mtlPath, mtl);
+  writeAtomic(path, out);
+}
+
+void writeGlb(const Mesh& mesh, const fs::path& path, const MeshWriteOptions& options) {
+  validate(mesh);
+  tinygltf::Model model;
+  model.asset.version = "2.0";
+  model.asset.generator = "Sprig";
+
+  tinygltf::Material mat;
+  mat.name = options.materialName;
+  mat.pbrMetallicRoughness.baseColorFactor = {options.baseColor.x, options.baseColor.y, options.baseColor.z, 1.0};
+  mat.pbrMetallicRoughness.metallicFactor = 0.0;
+  mat.pbrMetallicRoughness.roughnessFactor = options.roughness;
+  model.materials.push_back(mat);
+
+  tinygltf::Scene scene;
+  scene.name = "Sprig";
+  if (!mesh.triangles.empty()) {
+    tinygltf::Buffer buffer;
+    std::vector<unsigned char>& data = buffer.data;
+    // Appends one attribute or index array as its own buffer view and accessor.
+    auto addAccessor = [&](const void* bytes, size_t byteLength, size_t count, int type, int componentType,
+                           int target) {
+      while (data.size() % 4) data.push_back(0);
+      tinygltf::BufferView view;
+      view.buffer = 0;
+      view.byteOffset = data.size();
+      view.byteLength = byteLength;
+      view.target = target;
+      auto* b = static_cast<const unsigned char*>(bytes);
+      data.insert(data.end(), b, b + byteLength);
+      model.bufferViews.push_back(view);
+      tinygltf::Accessor acc;
+      acc.bufferView = int(model.bufferViews.size() - 1);
+      acc.byteOffset = 0;
+      acc.componentType = componentType;
+      acc.count = count;
+      acc.type = type;
+      model.accessors.push_back(acc);
+      return int(model.accessors.size() - 1);
+    };
+    size_t n = mesh.positions.size();
+    tinygltf::Primitive prim;
+    prim.mode = TINYGLTF_MODE_TRIANGLES;
+    prim.material = 0;
+    int pos = addAccessor(mesh.positions.data(), n * sizeof(Vec3), n, TINYGLTF_TYPE_VEC3,
+                          TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+    Box3 box = mesh.bounds();
+    model.accessors[pos].minValues = {box.lo.x, box.lo.y, box.lo.z};
+    model.accessors[pos].maxValues = {box.hi.x, box.hi.y, box.hi.z};
+    prim.attributes["POSITION"] = pos;
+    if (!mesh.normals.empty())
+      prim.attributes["NORMAL"] = addAccessor(mesh.normals.data(), n * sizeof(Vec3), n, TINYGLTF_TYPE_VEC3,
+                                              TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+    if (!mesh.uvs.empty()) {
+      std::vector<Vec2> flipped(mesh.uvs.size());
+      for (size_t i = 0; i < n; ++i) flipped[i] = {mesh.uvs[i].x, 1.0f - mesh.uvs[i].y};
+      prim.attributes["TEXCOORD_0"] = addAccessor(flipped.data(), n * sizeof(Vec2), n, TINYGLTF_TYPE_VEC2,
+                                                  TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+    }
+    if (!mesh.colors.empty())
+      prim.attributes["COLOR_0"] = addAccessor(mesh.colors.data(), n * sizeof(Vec3), n, TINYGLTF_TYPE_VEC3,
+                                               TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+    prim.indices = addAccessor(mesh.triangles.data(), mesh.triangles.size() * sizeof(glm::uvec3),
+                               mesh.triangles.size() * 3, TINYGLTF_TYPE_SCALAR,
+                               TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+    model.buffers.push_back(std::move(buffer));
+
+    tinygltf::Mesh gm;
+    gm.name = "Sprig mesh";
+    gm.primitives.push_back(prim);
+    model.meshes.push_back(gm);
+    tinygltf::Node node;
+    node.mesh = 0;
+    model.nodes.push_back(node);
+    scene.nodes.push_back(0);
+  }
+  model.scenes.push_back(scene);
+  model.defaultScene = 0;
+
+  std::ostringstream stream;
+  tinygltf::TinyGLTF writer;
+  if (!writer.WriteGltfSceneToStream(&model, stream, false, true))
+    throw std::runtime_error("cannot write '" + path.string() + "': glTF serialization failed");
+  writeAtomic(path, stream.str());
+}
+
+}  // namespace sprig

@@ -1,0 +1,267 @@
+#include <catch2/catch.hpp>
+
+#include <tiny_gltf.h>
+#include <unistd.h>
+
+#include <cstring>
+#include <filesystem>
+#include <sstream>
+
+#include "core/atomic_file.h"
+#include "core/mesh_io.h"
+
+using namespace sprig;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A unit cube with 8 shared vertices, 12 outward triangles and every optional array.
+Mesh cube(bool attributes) {
+  Mesh m;
+  for (int i = 0; i < 8; ++i) m.positions.push_back(Vec3(i & 1, (i >> 1) & 1, (i >> 2) & 1));
+  const uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (auto& q : quads) {
+    m.triangles.push_back({q[0], q[1], q[2]});
+    m.triangles.push_back({q[0], q[2], q[3]});
+  }
+  if (attributes) {
+    for (const auto& p : m.positions) {
+      m.normals.push_back(glm::normalize(p - Vec3(0.5f)));
+      m.uvs.push_back(Vec2(p.x, 0.25f + 0.5f * p.y));
+      m.colors.push_back(Vec3(p.x, 0.5f, p.z));
+    }
+    for (size_t t = 0; t < m.triangles.size(); ++t) m.materials.push_back(uint32_t(t / 4));
+  }
+  return m;
+}
+
+struct TempDir {
+  fs::path path;
+  TempDir() {
+    path = fs::temp_directory_path() / ("sprig_mesh_io_test_" + std::to_string(getpid()));
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~TempDir() { fs::remove_all(path); }
+  size_t entries() const { return size_t(std::distance(fs::directory_iterator(path), fs::directory_iterator())); }
+};
+
+template <class T>
+T readRaw(const std::string& bytes, size_t offset) {
+  T v;
+  std::memcpy(&v, bytes.data() + offset, sizeof(T));
+  return v;
+}
+
+}  // namespace
+
+TEST_CASE("writePly", "[core]") {
+  TempDir dir;
+  Mesh m = cube(true);
+  fs::path file = dir.path / "cube.PLY";
+  writeMesh(m, file);
+  std::string bytes = readFile(file);
+
+  size_t end = bytes.find("end_header\n");
+  REQUIRE(end != std::string::npos);
+  std::string header = bytes.substr(0, end);
+  size_t body = end + std::strlen("end_header\n");
+  CHECK(header.rfind("ply\nformat binary_little_endian 1.0\n", 0) == 0);
+  CHECK(header.find("element vertex 8\n") != std::string::npos);
+  CHECK(header.find("element face 12\n") != std::string::npos);
+  CHECK(header.find("property float nx\n") != std::string::npos);
+  CHECK(header.find("property float s\n") != std::string::npos);
+  CHECK(header.find("property uchar red\n") != std::string::npos);
+  CHECK(header.find("property uint material\n") != std::string::npos);
+
+  // x y z nx ny nz s t (4 bytes each) r g b (1 byte each); faces: count, 3 indices, material.
+  size_t vertexBytes = 8 * 4 + 3, faceBytes = 1 + 12 + 4;
+  REQUIRE(bytes.size() == body + 8 * vertexBytes + 12 * faceBytes);
+  for (size_t i = 0; i < 8; ++i) {
+    size_t o = body + i * vertexBytes;
+    CHECK(readRaw<float>(bytes, o) == m.positions[i].x);
+    CHECK(readRaw<float>(bytes, o + 4) == m.positions[i].y);
+    CHECK(readRaw<float>(bytes, o + 8) == m.positions[i].z);
+    CHECK(readRaw<float>(bytes, o + 12) == m.normals[i].x);
+    CHECK(readRaw<float>(bytes, o + 28) == m.uvs[i].y);
+    CHECK(uint8_t(bytes[o + 32]) == (m.colors[i].x > 0 ? 255 : 0));
+    CHECK(uint8_t(bytes[o + 33]) == 188);  // sRGB(0.5) = 0.7354 -> 188
+  }
+  for (size_t t = 0; t < 12; ++t) {
+    size_t o = body + 8 * vertexBytes + t * faceBytes;
+    CHECK(uint8_t(bytes[o]) == 3);
+    CHECK(readRaw<uint32_t>(bytes, o + 1) == m.triangles[t].x);
+    CHECK(readRaw<uint32_t>(bytes, o + 5) == m.triangles[t].y);
+    CHECK(readRaw<uint32_t>(bytes, o + 9) == m.triangles[t].z);
+    CHECK(readRaw<uint32_t>(bytes, o + 13) == m.materials[t]);
+  }
+
+  SECTION("without optional arrays only positions and faces are written") {
+    writePly(cube(false), file);
+    std::string plain = readFile(file);
+    size_t e = plain.find("end_header\n") + std::strlen("end_header\n");
+    CHECK(plain.find("nx") == std::string::npos);
+    CHECK(plain.size() == e + 8 * 12 + 12 * 13);
+  }
+  SECTION("same mesh, same bytes") {
+    writeMesh(m, dir.path / "again.ply");
+    CHECK(readFile(dir.path / "again.ply") == bytes);
+  }
+}
+
+TEST_CASE("writeObj", "[core]") {
+  TempDir dir;
+  Mesh m = cube(true);
+  writeMesh(m, dir.path / "cube.obj");
+  REQUIRE(fs::exists(dir.path / "cube.mtl"));
+  CHECK(dir.entries() == 2);
+
+  std::istringstream in(readFile(dir.path / "cube.obj"));
+  std::vector<Vec3> v, vn;
+  std::vector<Vec2> vt;
+  std::vector<std::array<int, 9>> faces;
+  std::vector<std::string> used;
+  std::string line, mtllib;
+  while (std::getline(in, line)) {
+    std::istringstream ls(line);
+    std::string tag;
+    ls >> tag;
+    if (tag == "v") {
+      Vec3 p, c;
+      ls >> p.x >> p.y >> p.z >> c.x >> c.y >> c.z;
+      CHECK(!ls.fail());
+      v.push_back(p);
+    } else if (tag == "vt") {
+      Vec2 t;
+      ls >> t.x >> t.y;
+      vt.push_back(t);
+    } else if (tag == "vn") {
+      Vec3 n;
+      ls >> n.x >> n.y >> n.z;
+      vn.push_back(n);
+    } else if (tag == "f") {
+      std::array<int, 9> f{};
+      char slash;
+      for (int k = 0; k < 3; ++k) ls >> f[3 * k] >> slash >> f[3 * k + 1] >> slash >> f[3 * k + 2];
+      CHECK(!ls.fail());
+      faces.push_back(f);
+    } else if (tag == "mtllib") {
+      ls >> mtllib;
+    } else if (tag == "usemtl") {
+      std::string name;
+      ls >> name;
+      used.push_back(name);
+    }
+  }
+  CHECK(mtllib == "cube.mtl");
+  REQUIRE(v.size() == 8);
+  REQUIRE(vt.size() == 8);
+  REQUIRE(vn.size() == 8);
+  REQUIRE(faces.size() == 12);
+  for (size_t i = 0; i < 8; ++i) {
+    CHECK(v[i] == m.positions[i]);  // shortest round-trip text parses back exactly
+    CHECK(vt[i] == m.uvs[i]);
+    CHECK(vn[i] == m.normals[i]);
+  }
+  for (size_t t = 0; t < 12; ++t)
+    for (int k = 0; k < 3; ++k) {
+      CHECK(faces[t][3 * k] == int(m.triangles[t][k]) + 1);
+      CHECK(faces[t][3 * k + 1] == faces[t][3 * k]);
+      CHECK(faces[t][3 * k + 2] == faces[t][3 * k]);
+    }
+  CHECK(used == std::vector<std::string>{"sprig_0", "sprig_1", "sprig_2"});
+  std::string mtl = readFile(dir.path / "cube.mtl");
+  for (const auto& name : used) CHECK(mtl.find("newmtl " + name + "\n") != std::string::npos);
+
+  SECTION("plain mesh: v and f only, one material") {
+    writeObj(cube(false), dir.path / "plain.obj");
+    std::string text = readFile(dir.path / "plain.obj");
+    CHECK(text.find("vn ") == std::string::npos);
+    CHECK(text.find("\nf 1 3 4\n") != std::string::npos);
+    CHECK(text.find("usemtl sprig\n") != std::string::npos);
+    CHECK(readFile(dir.path / "plain.mtl").find("newmtl sprig\nKa 0 0 0\nKd 0.8 0.8 0.8\n") != std::string::npos);
+  }
+}
+
+TEST_CASE("writeGlb", "[core]") {
+  TempDir dir;
+  Mesh m = cube(true);
+  fs::path file = dir.path / "cube.glb";
+  MeshWriteOptions opt;
+  opt.baseColor = Vec3(0.25f, 0.5f, 0.75f);
+  writeMesh(m, file, opt);
+  std::string bytes = readFile(file);
+  REQUIRE(bytes.size() > 20);
+  CHECK(bytes.substr(0, 4) == "glTF");
+  CHECK(readRaw<uint32_t>(bytes, 4) == 2);
+  CHECK(readRaw<uint32_t>(bytes, 8) == bytes.size());
+
+  tinygltf::Model model;
+  tinygltf::TinyGLTF loader;
+  std::string err, warn;
+  REQUIRE(loader.LoadBinaryFromFile(&model, &err, &warn, file.string()));
+  CHECK(err.empty());
+  REQUIRE(model.meshes.size() == 1);
+  REQUIRE(model.meshes[0].primitives.size() == 1);
+  const auto& prim = model.meshes[0].primitives[0];
+  CHECK(prim.mode == TINYGLTF_MODE_TRIANGLES);
+  for (const char* attr : {"POSITION", "NORMAL", "TEXCOORD_0", "COLOR_0"}) {
+    INFO(attr);
+    REQUIRE(prim.attributes.count(attr) == 1);
+    CHECK(model.accessors[prim.attributes.at(attr)].count == 8);
+  }
+  const auto& idx = model.accessors[prim.indices];
+  CHECK(idx.count == 36);
+  CHECK(idx.componentType == TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT);
+  const auto& pos = model.accessors[prim.attributes.at("POSITION")];
+  CHECK(pos.minValues == std::vector<double>{0, 0, 0});
+  CHECK(pos.maxValues == std::vector<double>{1, 1, 1});
+
+  // The index data reads back exactly.
+  const auto& view = model.bufferViews[idx.bufferView];
+  const auto& data = model.buffers[view.buffer].data;
+  std::vector<uint32_t> indices(36);
+  std::memcpy(indices.data(), data.data() + view.byteOffset + idx.byteOffset, 36 * 4);
+  for (size_t t = 0; t < 12; ++t)
+    for (int k = 0; k < 3; ++k) CHECK(indices[3 * t + k] == m.triangles[t][k]);
+
+  REQUIRE(model.materials.size() == 1);
+  CHECK(model.materials[0].pbrMetallicRoughness.baseColorFactor[2] == Approx(0.75));
+  CHECK(prim.material == 0);
+
+  SECTION("an empty mesh still writes a valid file") {
+    writeGlb(Mesh{}, dir.path / "empty.glb");
+    tinygltf::Model empty;
+    CHECK(loader.LoadBinaryFromFile(&empty, &err, &warn, (dir.path / "empty.glb").string()));
+    CHECK(empty.meshes.empty());
+  }
+}
+
+TEST_CASE("writeMesh::failures", "[core]") {
+  TempDir dir;
+  Mesh m = cube(true);
+  SECTION("a missing folder throws and leaves nothing") {
+    for (const char* name : {"a.ply", "a.obj", "a.glb"}) {
+      INFO(name);
+      CHECK_THROWS_AS(writeMesh(m, dir.path / "missing" / name), std::runtime_error);
+      CHECK(!fs::exists(dir.path / "missing"));
+      CHECK(dir.entries() == 0);
+    }
+  }
+  SECTION("an unknown extension throws before writing") {
+    CHECK_THROWS_AS(writeMesh(m, dir.path / "a.stl"), std::invalid_argument);
+    CHECK(dir.entries() == 0);
+  }
+  SECTION("an invalid mesh throws and leaves an existing file as it was") {
+    writeMesh(m, dir.path / "a.ply");
+    std::string before = readFile(dir.path / "a.ply");
+    Mesh bad = m;
+    bad.triangles.push_back({0, 1, 8});
+    CHECK_THROWS_AS(writeMesh(bad, dir.path / "a.ply"), std::invalid_argument);
+    bad = m;
+    bad.normals.pop_back();
+    CHECK_THROWS_AS(writeMesh(bad, dir.path / "a.ply"), std::invalid_argument);
+    CHECK(readFile(dir.path / "a.ply") == before);
+    CHECK(dir.entries() == 1);
+  }
+}
