@@ -1,0 +1,96 @@
+#pragma once
+/// Options of the BlobTree tree builder ("BlobTree Trees", Galbraith, MacMurchy, Wyvill),
+/// with their documented defaults. The species file's `tree:` section fills this struct
+/// (app/species_tree.h); every field here has a key of the same name in snake_case.
+
+#include <cstdint>
+#include <vector>
+
+namespace sprig::organisms {
+
+/// How the branches of a junction combine with each other (§3.3 vs §3.4).
+enum class JunctionModel {
+  Smooth,  ///< summation blend of basal and branches, δA of Eq. 4 (§3.2-3.3)
+  Pcm,     ///< branches combined by Precise Contact Modeling, then summed with the basal (Eq. 5-8)
+};
+
+/// How terminal internodes end.
+enum class TipStyle {
+  Hemisphere,  ///< the cone's own cap of the tip radius, as in the paper
+  Taper,       ///< the tip radius shrinks to tipTaper·r and the cap ends at the end point
+};
+
+/// Which lateral branches a rule (pruning, scars) applies to. A lateral branch is named by
+/// its first internode: one whose order is higher than its parent's.
+struct BranchSelector {
+  std::vector<int> orders;       ///< branch orders it applies to; empty = every order >= 1
+  double belowHeight = 1e300;    ///< only branches whose base lies below this height (world Y)
+  double aboveHeight = -1e300;   ///< only branches whose base lies above this height
+  double probability = 0.0;      ///< chance each candidate is chosen (seeded per internode)
+  std::vector<int> internodes;   ///< skeleton indices always chosen (figure files, tests)
+};
+
+/// CSG pruning (§3.5, Fig. 14): the branch is sawn off, leaving a flat face.
+struct PruneOptions {
+  bool fromGrammar = true;       ///< honour internodes the grammar marked `cut`
+  BranchSelector select;         ///< branches the species file prunes
+  double cutFraction = 0.5;      ///< where along the branch's first internode the saw cuts (0..1)
+  double minCutDistance = 2.0;   ///< the cut lies at least this many base radii from the junction
+};
+
+/// Negative-field scars where a branch was lost (§3.5, Fig. 15).
+struct ScarOptions {
+  BranchSelector select;         ///< branches replaced by a scar
+  double stubLength = 1.5;       ///< stub length in units of the branch's base radius
+  double stubRadius = 1.0;       ///< stub radius in units of the branch's base radius
+  double negativeRadius = 0.8;   ///< radius of the negative field in units of the branch's base radius
+  double negativeWeight = 1.0;   ///< weight of the negative field (field subtracted = w·f)
+};
+
+/// Endpoint-preserving bends per internode (§3.6, Fig. 16).
+struct BendOptions {
+  double angleDeg = 0.0;         ///< bend angle (tangent turn at the start) for order-1 laterals; 0 = off
+  double orderScale = 1.0;       ///< factor per extra order: angle·orderScale^(order-1)
+  double randomness = 0.0;       ///< relative random spread of the angle, uniform in ±randomness
+  double minBranchAngleDeg = 5;  ///< internodes within this angle of their basal axis are not bent
+  bool trunk = false;            ///< also bend order-0 internodes (in a seeded random plane)
+};
+
+/// Bark texture mapping (§3.7).
+struct BarkOptions {
+  bool enabled = true;
+  int texture = 1;               ///< texture id given to every internode primitive
+  double uScale = 1.0;           ///< texture u per full turn around the branch
+  double vScale = 1.0;           ///< texture v per world unit along the axis (continuous from the root)
+};
+
+/// Leaf geometry from the grammar's organs.
+struct LeafOptions {
+  bool enabled = true;
+  double scale = 1.0;            ///< size multiplier for `~` surfaces
+  uint32_t material = 2;         ///< material id of leaf triangles
+};
+
+/// Everything the tree builder reads.
+struct TreeOptions {
+  JunctionModel junctions = JunctionModel::Smooth;
+  double deltaA = 1.75;          ///< Eq. 4 factor: δA = deltaA·r_B at one-child joints
+  double deltaAMulti = 2.75;     ///< Eq. 8 factor: δA = deltaAMulti·max(r_i) − r_A (PCM, several branches)
+  bool basalOffset = true;       ///< apply δA at all (off re-creates the bulge of Fig. 9 left)
+  bool branchOffset = true;      ///< PCM: displace branches by δB_i = r_A − r_i (Eq. 7; off = Fig. 12 left)
+  double pcmPropagation = 1.0;   ///< PCM propagation width in units of the smaller branch radius
+  double pcmBulge = 0.4;         ///< PCM maximal bulge (field units) in the propagation region
+  bool controlledBlend = true;   ///< non-neighbour internodes meet as a union, not a blend
+  TipStyle tips = TipStyle::Taper;
+  double tipTaper = 0.35;        ///< Taper: tip radius as a fraction of the terminal internode's base radius
+  double radiusScale = 1.0;      ///< multiplies every skeleton radius
+  double minRadius = 0.0;        ///< radii below this are raised to it (world units)
+  uint64_t seed = 1;             ///< seed of every random choice (pruning, scars, bends)
+  PruneOptions prune;
+  ScarOptions scars;
+  BendOptions bends;
+  BarkOptions bark;
+  LeafOptions leaves;
+};
+
+}  // namespace sprig::organisms

@@ -1,0 +1,220 @@
+#include "organisms/tree_plan.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/rng.h"
+
+namespace sprig::organisms {
+
+namespace {
+
+// Purposes mixed into deriveSeed so each random choice has its own stream.
+constexpr uint64_t kSeedPrune = 0x5052554eull;
+constexpr uint64_t kSeedScar = 0x53434152ull;
+constexpr uint64_t kSeedBend = 0x42454e44ull;
+
+bool isLateralStart(const lsystem::Skeleton& sk, size_t i) {
+  const auto& in = sk.internodes[i];
+  return in.parent >= 0 && in.order > sk.internodes[in.parent].order;
+}
+
+bool selects(const BranchSelector& sel, const lsystem::Skeleton& sk, size_t i, uint64_t seed, uint64_t purpose) {
+  if (std::find(sel.internodes.begin(), sel.internodes.end(), static_cast<int>(i)) != sel.internodes.end())
+    return true;
+  if (sel.probability <= 0 || !isLateralStart(sk, i)) return false;
+  const auto& in = sk.internodes[i];
+  if (!sel.orders.empty() && std::find(sel.orders.begin(), sel.orders.end(), in.order) == sel.orders.end())
+    return false;
+  if (in.start.y >= sel.belowHeight || in.start.y <= sel.aboveHeight) return false;
+  Rng rng(deriveSeed(seed, {purpose, static_cast<uint64_t>(i)}));
+  return rng.uniform() < sel.probability;
+}
+
+DVec3 safeDir(const DVec3& a, const DVec3& b) {
+  DVec3 d = b - a;
+  double l = glm::length(d);
+  return l > 0 ? d / l : DVec3(0, 1, 0);
+}
+
+// Any unit vector perpendicular to d.
+DVec3 perpendicular(const DVec3& d) {
+  DVec3 t = std::abs(d.x) < 0.9 ? DVec3(1, 0, 0) : DVec3(0, 1, 0);
+  return glm::normalize(glm::cross(d, t));
+}
+
+// Bend angle and direction of one part (§3.6, Fig. 16); d is the internode's unit axis.
+void applyBend(ConePart& p, const lsystem::Skeleton& sk, const TreeOptions& opt, const DVec3& d) {
+  if (p.kind != ConePart::Kind::Internode || opt.bends.angleDeg == 0) return;
+  const auto& in = sk.internodes[p.internode];
+  Rng rng(deriveSeed(opt.seed, {kSeedBend, static_cast<uint64_t>(p.internode)}));
+  const double jitter = 1.0 + opt.bends.randomness * rng.uniform(-1.0, 1.0);
+  if (in.order == 0 || in.parent < 0) {
+    if (!opt.bends.trunk) return;
+    const DVec3 u = perpendicular(d), w = glm::cross(d, u);
+    const double phi = rng.uniform(0.0, 2.0 * kPi);
+    p.bendToward = std::cos(phi) * u + std::sin(phi) * w;
+    p.bendAngle = radians(opt.bends.angleDeg) * 0.5 * jitter;
+    return;
+  }
+  const auto& parent = sk.internodes[in.parent];
+  const DVec3 a = safeDir(parent.start, parent.end);
+  // Bow toward n = the part of "away from A's axis" perpendicular to the internode, so the
+  // internode first grows more directly away from the axis, then returns to its end point.
+  const DVec3 away = d - glm::dot(d, a) * a;
+  const double sinPhi = glm::length(away);
+  if (sinPhi < std::sin(radians(opt.bends.minBranchAngleDeg))) return;
+  DVec3 nrm = away / sinPhi;
+  nrm = nrm - glm::dot(nrm, d) * d;
+  if (glm::length(nrm) < 1e-9) return;
+  p.bendToward = glm::normalize(nrm);
+  p.bendAngle = radians(opt.bends.angleDeg) * std::pow(opt.bends.orderScale, in.order - 1) * jitter;
+}
+
+}  // namespace
+
+double deltaASingle(double rB, double factor) { return factor * rB; }
+
+double deltaAMultiple(double rA, double rMax, double factor) { return factor * rMax - rA; }
+
+double deltaB(double rA, double ri) { return std::max(0.0, rA - ri); }
+
+TreePlan planTree(const lsystem::Skeleton& sk, const TreeOptions& opt) {
+  const size_t n = sk.internodes.size();
+  auto radius = [&](double r) { return std::max(opt.minRadius, r * opt.radiusScale); };
+  const auto children = sk.children();
+
+  // Step 1: what each internode becomes (kept, pruned, stub, dropped), root to tips.
+  enum class Fate { Keep, Prune, Stub, Drop };
+  std::vector<Fate> fate(n, Fate::Keep);
+  std::vector<double> vFromRoot(n, 0.0);
+  std::vector<size_t> order;  // parents before children
+  order.reserve(n);
+  for (size_t i = 0; i < n; ++i)
+    if (sk.internodes[i].parent < 0) order.push_back(i);
+  for (size_t k = 0; k < order.size(); ++k)
+    for (int32_t c : children[order[k]]) order.push_back(static_cast<size_t>(c));
+  for (size_t i : order) {
+    const auto& in = sk.internodes[i];
+    if (in.parent >= 0) {
+      vFromRoot[i] = vFromRoot[in.parent] + sk.internodes[in.parent].length();
+      if (fate[in.parent] != Fate::Keep) {
+        fate[i] = Fate::Drop;
+        continue;
+      }
+    }
+    if ((opt.prune.fromGrammar && in.cut) || selects(opt.prune.select, sk, i, opt.seed, kSeedPrune))
+      fate[i] = Fate::Prune;
+    else if (selects(opt.scars.select, sk, i, opt.seed, kSeedScar))
+      fate[i] = Fate::Stub;
+  }
+
+  // Step 2: one part per surviving internode.
+  TreePlan plan;
+  plan.partOfInternode.assign(n, -1);
+  for (size_t i : order) {
+    if (fate[i] == Fate::Drop) continue;
+    const auto& in = sk.internodes[i];
+    ConePart p;
+    p.kind = fate[i] == Fate::Prune  ? ConePart::Kind::Pruned
+             : fate[i] == Fate::Stub ? ConePart::Kind::Stub
+                                     : ConePart::Kind::Internode;
+    p.internode = static_cast<int32_t>(i);
+    p.start = in.start;
+    p.end = in.end;
+    p.startRadius = radius(in.baseRadius);
+    p.endRadius = radius(in.tipRadius);
+    p.vStart = vFromRoot[i];
+    plan.partOfInternode[i] = static_cast<int32_t>(plan.parts.size());
+    plan.parts.push_back(p);
+  }
+
+  // Step 3: junctions and their offsets (Eq. 4, 7, 8).
+  std::vector<double> startOffset(plan.parts.size(), 0.0), endOffset(plan.parts.size(), 0.0);
+  for (size_t pi = 0; pi < plan.parts.size(); ++pi) {
+    ConePart& a = plan.parts[pi];
+    if (a.kind != ConePart::Kind::Internode) continue;
+    Junction j;
+    j.basal = static_cast<int32_t>(pi);
+    j.point = a.end;
+    for (int32_t c : children[a.internode])
+      if (plan.partOfInternode[c] >= 0) j.branches.push_back(plan.partOfInternode[c]);
+    if (j.branches.empty()) continue;
+    const double rA = a.endRadius;
+    double rMax = 0;
+    for (int32_t b : j.branches) rMax = std::max(rMax, plan.parts[b].startRadius);
+    j.pcm = opt.junctions == JunctionModel::Pcm && j.branches.size() > 1;
+    if (opt.basalOffset) {
+      j.deltaA = j.pcm ? deltaAMultiple(rA, rMax, opt.deltaAMulti) : deltaASingle(rMax, opt.deltaA);
+      // A never grows past P by more than its own radius: its cap would poke out.
+      j.deltaA = std::max(j.deltaA, -0.5 * rA);
+    }
+    if (j.pcm && opt.branchOffset)
+      for (int32_t b : j.branches)
+        if (plan.parts[b].kind != ConePart::Kind::Stub)
+          startOffset[b] = deltaB(rA, plan.parts[b].startRadius);
+    endOffset[pi] = j.deltaA;
+    const auto ji = static_cast<int32_t>(plan.junctions.size());
+    a.junctionAtEnd = ji;
+    for (int32_t b : j.branches) plan.parts[b].junctionAtStart = ji;
+    plan.junctions.push_back(std::move(j));
+  }
+
+  // Step 4: apply offsets, tips, cuts, stubs and bends to each part.
+  for (size_t pi = 0; pi < plan.parts.size(); ++pi) {
+    ConePart& p = plan.parts[pi];
+    const DVec3 d = safeDir(p.start, p.end);
+    const double len = glm::length(p.end - p.start);
+    const double rb = p.startRadius, rt = p.endRadius;
+    auto radiusAt = [&](double t) { return len > 0 ? rb + (rt - rb) * (t / len) : rb; };
+    const DVec3 origin = p.start;
+
+    if (p.kind == ConePart::Kind::Stub) {
+      const double ls = opt.scars.stubLength * rb;
+      p.end = origin + ls * d;
+      p.startRadius = opt.scars.stubRadius * rb;
+      p.endRadius = opt.scars.stubRadius * rb;
+      p.negativeCenter = p.end;
+      p.negativeRadius = opt.scars.negativeRadius * rb;
+      p.negativeWeight = opt.scars.negativeWeight;
+      continue;
+    }
+
+    double s0 = startOffset[pi], s1 = endOffset[pi];
+    // Offsets may not eat the whole internode: keep at least 10% of it.
+    if (s0 + s1 > 0.9 * len) {
+      const double k = 0.9 * len / (s0 + s1);
+      s0 *= k;
+      s1 *= k;
+    }
+    double t0 = s0, t1 = len - s1;
+
+    if (p.kind == ConePart::Kind::Pruned) {
+      const double cut = std::min(std::max(opt.prune.cutFraction * len, opt.prune.minCutDistance * rb + s0), len);
+      p.cutPoint = origin + cut * d;
+      p.cutNormal = d;
+      // The cone runs past the saw by more than its radius so the cap is cut away.
+      t1 = std::max(len, cut + 2.0 * radiusAt(cut));
+    } else if (p.junctionAtEnd < 0 && opt.tips == TipStyle::Taper) {
+      // A natural tip: the radius shrinks and the cap closes exactly at the end point.
+      const double tipR = std::min(rt, opt.tipTaper * rb);
+      p.start = origin + t0 * d;
+      p.startRadius = radiusAt(t0);
+      p.endRadius = tipR;
+      p.end = origin + std::max(t0 + 0.1 * len, len - tipR) * d;
+      p.vStart += t0;
+      applyBend(p, sk, opt, d);
+      continue;
+    }
+    p.start = origin + t0 * d;
+    p.end = origin + t1 * d;
+    p.startRadius = radiusAt(t0);
+    p.endRadius = std::max(1e-6, radiusAt(t1));
+    p.vStart += t0;
+
+    applyBend(p, sk, opt, d);
+  }
+  return plan;
+}
+
+}  // namespace sprig::organisms
