@@ -1,0 +1,118 @@
+#pragma once
+/// The 3D turtle: reads a module string and draws a Skeleton.
+///
+/// Frame convention (docs/TURTLE.md has the full table): the turtle carries a
+/// right-handed orthonormal frame H (heading), L (left), U (up) with H x L = U. It
+/// starts at the origin with H = +Y, L = -X, U = +Z, so a 2D ABOP figure grows upward
+/// in the XY plane and `+` turns counter-clockwise as seen from +Z. Every rotation
+/// command is a right-handed rotation about one frame axis:
+///   `+` about U by +a, `-` about U by -a, `&` about L by +a (pitch down, H toward -U),
+///   `^` about L by -a, `\` about H by +a, `/` about H by -a, `|` about U by 180.
+///
+/// Interpretation is one pass over the structure-of-arrays string with a per-symbol
+/// command table built once from the SymbolTable; branch state lives on an explicit
+/// stack, so there is no allocation per module beyond the output vectors.
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "core/types.h"
+#include "lsystem/module_string.h"
+#include "lsystem/skeleton.h"
+
+namespace sprig::lsystem {
+
+/// How internode radii are chosen.
+enum class RadiusModel {
+  Width,  ///< from the turtle's line width (`!`): radius = 0.5 * width * widthScale
+  Pipe,   ///< pipe model: parent radius^e = sum of child radii^e, tips get tipRadius
+};
+
+/// Turtle options; defaults are documented per field.
+struct TurtleSettings {
+  double stepLength = 1.0;        ///< length of `F f G g` without a parameter (world units)
+  double angleDeg = 90.0;         ///< turn of `+ - & ^ \ /` without a parameter (the grammar's `angle:`)
+  double initialWidth = 0.1;      ///< line width (diameter, ABOP's `!` units) at the start
+  double widthScale = 1.0;        ///< world units per width unit; radius = 0.5 * width * widthScale
+  double widthFactor = 0.7;       ///< `!` without a parameter multiplies the width by this
+  DVec3 tropism{0, -1, 0};        ///< tropism vector T (ABOP section 2.2); need not be unit length
+  double elasticity = 0.0;        ///< initial susceptibility e to tropism; `@Ts(e)` changes it
+  RadiusModel radii = RadiusModel::Width;  ///< where radii come from
+  double pipeExponent = 2.0;      ///< e of the pipe model (2 = da Vinci's rule)
+  double tipRadius = 0.01;        ///< pipe model: radius of every branch tip (world units)
+  bool taper = true;              ///< width model: an internode's tip radius is its continuation's base radius
+  double surfaceScale = 1.0;      ///< scale of a `~` surface without a parameter
+  DVec3 origin{0};                ///< start position
+};
+
+/// Position and orientation of the turtle.
+struct TurtleFrame {
+  DVec3 position{0};
+  DVec3 heading{0, 1, 0};   ///< H
+  DVec3 left{-1, 0, 0};     ///< L
+  DVec3 up{0, 0, 1};        ///< U = H x L
+};
+
+/// Everything `[` saves and `]` restores.
+struct TurtleState {
+  TurtleFrame frame;
+  double width = 0.1;         ///< current line width (diameter units, see TurtleSettings::widthScale)
+  double elasticity = 0.0;    ///< current tropism susceptibility
+  int color = 0;              ///< color index (`'`)
+  int order = 0;              ///< branch order: +1 per `[` entered
+  int32_t internode = -1;     ///< last internode drawn on this branch (parent of the next), -1 for none
+};
+
+/// Interprets module strings of one grammar. Construction builds the symbol -> command
+/// table; run() may be called many times (not concurrently on one object).
+class Turtle {
+ public:
+  /// Binds the turtle commands to the symbols of `symbols` by name ("F", "+", "@Ts", ...).
+  /// Symbols that are no command are ignored when read.
+  explicit Turtle(const SymbolTable& symbols, TurtleSettings settings = {});
+
+  /// Draws `modules`. `moduleSteps`, when not empty, holds for each module the derivation
+  /// step that created it (copied into Internode::step / Organ::step), else steps are 0.
+  /// Cost: O(modules), one pass, no per-module allocation.
+  Skeleton run(const ModuleString& modules, std::span<const int32_t> moduleSteps = {});
+
+  /// The turtle's state after the last module of the last run().
+  const TurtleState& endState() const { return end_; }
+
+  const TurtleSettings& settings() const { return settings_; }
+
+  /// What each symbol does. Public so tests and tools can ask how a symbol is read.
+  enum class Command : uint8_t {
+    None, Forward, Move, ForwardNoVertex, MoveNoVertex, TurnLeft, TurnRight, PitchDown, PitchUp,
+    RollLeft, RollRight, TurnAround, RollToVertical, Push, Pop, Width, Color, PolygonBegin, Vertex,
+    PolygonEnd, Surface, SurfaceNamed, Cut, Tropism, Sphere
+  };
+  /// The command bound to symbol id `s` (None for ids outside the table).
+  Command commandOf(SymbolId s) const { return s < commands_.size() ? commands_[s] : Command::None; }
+
+ private:
+  const SymbolTable& symbols_;
+  TurtleSettings settings_;
+  std::vector<Command> commands_;
+  TurtleState end_;
+};
+
+/// Convenience: Turtle(symbols, settings).run(modules, moduleSteps).
+Skeleton interpret(const ModuleString& modules, const SymbolTable& symbols, const TurtleSettings& settings = {},
+                   std::span<const int32_t> moduleSteps = {});
+
+/// Rotates `frame` right-handedly by angleDeg about its up vector (the `+` command).
+void turnAboutUp(TurtleFrame& frame, double angleDeg);
+/// Rotates `frame` right-handedly by angleDeg about its left vector (the `&` command).
+void turnAboutLeft(TurtleFrame& frame, double angleDeg);
+/// Rotates `frame` right-handedly by angleDeg about its heading (the `\` command).
+void turnAboutHeading(TurtleFrame& frame, double angleDeg);
+/// ABOP's `$`: rolls about H so that L is horizontal (L = V x H / |V x H|, V = +Y),
+/// U = H x L. Leaves the frame unchanged when H is vertical.
+void rollToVertical(TurtleFrame& frame);
+/// ABOP section 2.2 tropism: rotates the frame about H x T by e * |H x T| radians,
+/// bending the heading toward T. No-op when H is parallel to T or e = 0.
+void applyTropism(TurtleFrame& frame, const DVec3& tropism, double elasticity);
+
+}  // namespace sprig::lsystem

@@ -1,0 +1,359 @@
+#include <catch2/catch.hpp>
+
+#include <cctype>
+#include <cmath>
+#include <string>
+
+#include "lsystem/turtle.h"
+
+using namespace sprig;
+using namespace sprig::lsystem;
+
+namespace {
+
+/// Builds a module string from a compact notation: one character per symbol, `@X` plus
+/// following lowercase letters for `@` names (`@Ts`, `@v`, `@O`), `<name>` for any
+/// multi-character name, and `(a,b)` parameter lists.
+ModuleString modules(SymbolTable& table, std::string_view text) {
+  ModuleString ms;
+  size_t i = 0;
+  while (i < text.size()) {
+    if (text[i] == ' ') {
+      ++i;
+      continue;
+    }
+    size_t begin = i, end = i + 1;
+    if (text[i] == '@') {
+      end = i + 2;
+      while (end < text.size() && std::islower(static_cast<unsigned char>(text[end]))) ++end;
+      i = end;
+    } else if (text[i] == '<') {
+      begin = i + 1;
+      end = text.find('>', i);
+      i = end + 1;
+    } else {
+      ++i;
+    }
+    std::string_view name = text.substr(begin, end - begin);
+    std::vector<double> p;
+    if (i < text.size() && text[i] == '(') {
+      size_t close = text.find(')', i);
+      std::string inner(text.substr(i + 1, close - i - 1));
+      size_t pos = 0;
+      while (pos < inner.size()) {
+        size_t comma = inner.find(',', pos);
+        if (comma == std::string::npos) comma = inner.size();
+        p.push_back(std::stod(inner.substr(pos, comma - pos)));
+        pos = comma + 1;
+      }
+      i = close + 1;
+    }
+    ms.push(table.intern(name), p);
+  }
+  return ms;
+}
+
+struct Run {
+  Skeleton skeleton;
+  TurtleState end;
+};
+
+Run draw(std::string_view text, TurtleSettings settings = {}) {
+  SymbolTable table;
+  ModuleString ms = modules(table, text);
+  Turtle turtle(table, settings);
+  Skeleton sk = turtle.run(ms);
+  return {std::move(sk), turtle.endState()};
+}
+
+void checkVec(const DVec3& got, const DVec3& want, double tol = 1e-9) {
+  INFO("got (" << got.x << ", " << got.y << ", " << got.z << ") want (" << want.x << ", " << want.y << ", "
+               << want.z << ")");
+  CHECK(glm::length(got - want) < tol);
+}
+
+void checkFrame(const TurtleFrame& f, DVec3 h, DVec3 l, DVec3 u) {
+  checkVec(f.heading, h);
+  checkVec(f.left, l);
+  checkVec(f.up, u);
+  // Always right-handed and orthonormal.
+  checkVec(glm::cross(f.heading, f.left), f.up);
+}
+
+const DVec3 X{1, 0, 0}, Y{0, 1, 0}, Z{0, 0, 1};
+
+}  // namespace
+
+TEST_CASE("Turtle::frame commands", "[lsystem]") {
+  TurtleSettings s;
+  s.angleDeg = 90;
+  SECTION("initial frame: H = +Y, L = -X, U = +Z") { checkFrame(draw("", s).end.frame, Y, -X, Z); }
+  SECTION("+ turns left about U: H toward L") { checkFrame(draw("+", s).end.frame, -X, -Y, Z); }
+  SECTION("- turns right about U") { checkFrame(draw("-", s).end.frame, X, Y, Z); }
+  SECTION("& pitches down about L: H toward -U") { checkFrame(draw("&", s).end.frame, -Z, -X, Y); }
+  SECTION("^ pitches up about L: H toward U") { checkFrame(draw("^", s).end.frame, Z, -X, -Y); }
+  SECTION("\\ rolls about H: L toward U") { checkFrame(draw("\\", s).end.frame, Y, Z, X); }
+  SECTION("/ rolls about H: L toward -U") { checkFrame(draw("/", s).end.frame, Y, -Z, -X); }
+  SECTION("| turns around") { checkFrame(draw("|", s).end.frame, -Y, X, Z); }
+  SECTION("parameters give the angle in degrees") {
+    double c = std::cos(radians(30)), sn = std::sin(radians(30));
+    checkFrame(draw("+(30)", s).end.frame, {-sn, c, 0}, {-c, -sn, 0}, Z);
+    checkFrame(draw("-(30)", s).end.frame, {sn, c, 0}, {-c, sn, 0}, Z);
+    checkFrame(draw("&(30)", s).end.frame, {0, c, -sn}, -X, {0, sn, c});
+    checkFrame(draw("^(30)", s).end.frame, {0, c, sn}, -X, {0, -sn, c});
+    checkFrame(draw("\\(30)", s).end.frame, Y, {-c, 0, sn}, {sn, 0, c});
+    checkFrame(draw("/(30)", s).end.frame, Y, {-c, 0, -sn}, {-sn, 0, c});
+    checkFrame(draw("+(-30)", s).end.frame, {sn, c, 0}, {-c, sn, 0}, Z);
+  }
+  SECTION("the default angle comes from the settings") {
+    s.angleDeg = 60;
+    double c = std::cos(radians(60)), sn = std::sin(radians(60));
+    checkFrame(draw("+", s).end.frame, {-sn, c, 0}, {-c, -sn, 0}, Z);
+  }
+  SECTION("$ and @v roll so that L is horizontal") {
+    for (const char* cmd : {"$", "@v"}) {
+      Run r = draw(std::string("\\(30)&(40)+(20)") + cmd, s);
+      Run before = draw("\\(30)&(40)+(20)", s);
+      const TurtleFrame& f = r.end.frame;
+      checkVec(f.heading, before.end.frame.heading);
+      CHECK(std::abs(f.left.y) < 1e-9);
+      CHECK(std::abs(glm::length(f.left) - 1) < 1e-9);
+      checkVec(glm::cross(f.heading, f.left), f.up);
+      checkVec(f.left, glm::normalize(glm::cross(Y, f.heading)));
+    }
+    // Pitched straight down: L = V x H = (0,1,0) x (0,0,-1) = (-1,0,0).
+    checkFrame(draw("&$", s).end.frame, {0, 0, -1}, {-1, 0, 0}, {0, 1, 0});
+  }
+  SECTION("$ leaves a vertical heading alone") { checkFrame(draw("\\(50)$", s).end.frame, Y, {-std::cos(radians(50)), 0, std::sin(radians(50))}, {std::sin(radians(50)), 0, std::cos(radians(50))}); }
+}
+
+TEST_CASE("Turtle::moves and internodes", "[lsystem]") {
+  TurtleSettings s;
+  s.stepLength = 2;
+  s.angleDeg = 90;
+  SECTION("F draws a step; F(l) draws l") {
+    Run r = draw("FF(3)", s);
+    REQUIRE(r.skeleton.internodes.size() == 2);
+    checkVec(r.skeleton.internodes[0].start, {0, 0, 0});
+    checkVec(r.skeleton.internodes[0].end, {0, 2, 0});
+    checkVec(r.skeleton.internodes[1].end, {0, 5, 0});
+    checkVec(r.end.frame.position, {0, 5, 0});
+    CHECK(r.skeleton.internodes[0].parent == -1);
+    CHECK(r.skeleton.internodes[1].parent == 0);  // consecutive F's are separate, chained
+    CHECK(r.skeleton.internodes[1].module == 1);
+  }
+  SECTION("f and g move without drawing and break the chain") {
+    Run r = draw("FfFg(1)G", s);
+    REQUIRE(r.skeleton.internodes.size() == 3);
+    checkVec(r.skeleton.internodes[1].start, {0, 4, 0});
+    CHECK(r.skeleton.internodes[1].parent == -1);
+    CHECK(r.skeleton.internodes[2].parent == -1);
+    checkVec(r.skeleton.internodes[2].start, {0, 7, 0});
+    checkVec(r.end.frame.position, {0, 9, 0});
+  }
+  SECTION("G draws") {
+    Run r = draw("GG", s);
+    REQUIRE(r.skeleton.internodes.size() == 2);
+    CHECK(r.skeleton.internodes[1].parent == 0);
+  }
+  SECTION("[ ] save and restore the state; order counts brackets") {
+    Run r = draw("F[+F[-F]]F", s);
+    auto& in = r.skeleton.internodes;
+    REQUIRE(in.size() == 4);
+    CHECK(in[1].parent == 0);
+    CHECK(in[2].parent == 1);
+    CHECK(in[3].parent == 0);
+    CHECK(in[0].order == 0);
+    CHECK(in[1].order == 1);
+    CHECK(in[2].order == 2);
+    CHECK(in[3].order == 0);
+    checkVec(in[1].end, {-2, 2, 0});
+    checkVec(in[2].end, {-2, 4, 0});
+    checkVec(in[3].end, {0, 4, 0});
+    checkFrame(r.end.frame, Y, -X, Z);
+    auto children = r.skeleton.children();
+    CHECK(children[0] == std::vector<int32_t>{1, 3});
+  }
+  SECTION("an unmatched ] is ignored") { CHECK(draw("]F", s).skeleton.internodes.size() == 1); }
+  SECTION("symbols that are no command are skipped") {
+    Run r = draw("AF(1)B(2,3)<Apex>F", s);
+    REQUIRE(r.skeleton.internodes.size() == 2);
+    CHECK(r.skeleton.internodes[1].module == 4);
+  }
+  SECTION("steps are copied from the per-module steps") {
+    SymbolTable table;
+    ModuleString ms = modules(table, "F[F]");
+    std::vector<int32_t> steps{3, 4, 5, 6};
+    Skeleton sk = interpret(ms, table, s, steps);
+    CHECK(sk.internodes[0].step == 3);
+    CHECK(sk.internodes[1].step == 5);
+  }
+}
+
+TEST_CASE("Turtle::width and color", "[lsystem]") {
+  TurtleSettings s;
+  s.initialWidth = 1;
+  s.widthScale = 0.5;
+  s.taper = false;
+  SECTION("!(w) sets the width; radius = 0.5 * width * widthScale") {
+    Run r = draw("F!(4)F", s);
+    CHECK(r.skeleton.internodes[0].baseRadius == Approx(0.25));
+    CHECK(r.skeleton.internodes[1].baseRadius == Approx(1.0));
+    CHECK(r.skeleton.internodes[1].tipRadius == Approx(1.0));
+  }
+  SECTION("! alone multiplies by widthFactor") {
+    s.widthFactor = 0.5;
+    Run r = draw("!!F", s);
+    CHECK(r.skeleton.internodes[0].baseRadius == Approx(0.25 * 0.25));
+    CHECK(r.end.width == Approx(0.25));
+  }
+  SECTION("taper: tip radius is the continuation's base radius") {
+    s.taper = true;
+    Run r = draw("!(4)F[!(1)F]!(2)F!(1)F", s);
+    auto& in = r.skeleton.internodes;
+    CHECK(in[0].tipRadius == Approx(0.5));   // continuation is in[2], not the branch in[1]
+    CHECK(in[2].tipRadius == Approx(0.25));
+    CHECK(in[3].tipRadius == Approx(0.25));  // a tip keeps its own radius
+  }
+  SECTION("' increments or sets the color index") {
+    Run r = draw("''{.F.F.}'(7)@O(1)", s);
+    REQUIRE(r.skeleton.organs.size() == 2);
+    CHECK(r.skeleton.organs[0].color == 2);
+    CHECK(r.skeleton.organs[1].color == 7);
+  }
+}
+
+TEST_CASE("Turtle::pipe model", "[lsystem]") {
+  TurtleSettings s;
+  s.radii = RadiusModel::Pipe;
+  s.tipRadius = 1;
+  s.angleDeg = 30;
+  SECTION("parent^e = sum of children^e, exact for e = 2 and e = 3") {
+    for (double e : {2.0, 3.0}) {
+      s.pipeExponent = e;
+      Run r = draw("FF[+F][-F[+F]F]", s);
+      auto& in = r.skeleton.internodes;
+      REQUIRE(in.size() == 6);
+      CHECK(in[2].baseRadius == Approx(1));
+      CHECK(in[4].baseRadius == Approx(1));
+      CHECK(in[3].baseRadius == Approx(std::pow(2.0, 1 / e)));
+      CHECK(in[1].baseRadius == Approx(std::pow(3.0, 1 / e)));
+      CHECK(in[0].baseRadius == Approx(std::pow(3.0, 1 / e)));  // a single child keeps the radius
+      CHECK(in[1].tipRadius == Approx(std::pow(2.0, 1 / e)));   // the thickest child
+      CHECK(in[5].tipRadius == Approx(1));
+    }
+  }
+}
+
+TEST_CASE("Turtle::organs", "[lsystem]") {
+  TurtleSettings s;
+  s.angleDeg = 90;
+  SECTION("{ . } records a polygon; F and f add vertices, G and g do not; nothing is drawn inside") {
+    Run r = draw("F{.+F.f-G.g}F", s);
+    REQUIRE(r.skeleton.internodes.size() == 2);
+    REQUIRE(r.skeleton.organs.size() == 1);
+    const Organ& o = r.skeleton.organs[0];
+    CHECK(o.kind == Organ::Kind::Polygon);
+    REQUIRE(o.points.size() == 5);
+    checkVec(o.points[0], {0, 1, 0});
+    checkVec(o.points[1], {-1, 1, 0});  // F adds one
+    checkVec(o.points[2], {-1, 1, 0});  // .
+    checkVec(o.points[3], {-2, 1, 0});  // f adds one
+    checkVec(o.points[4], {-2, 2, 0});  // G moved, then .
+    CHECK(o.internode == 0);
+    checkVec(r.skeleton.internodes[1].start, {-2, 3, 0});
+    CHECK(r.skeleton.internodes[1].parent == -1);  // the turtle moved: a new axis
+  }
+  SECTION("polygons span brackets and nest; fewer than 3 vertices make no organ") {
+    Run r = draw("{.[+f.][-f.{.}]}", s);
+    REQUIRE(r.skeleton.organs.size() == 1);
+    CHECK(r.skeleton.organs[0].points.size() == 5);
+  }
+  SECTION("@O(r) places a sphere; without a parameter its radius is the line radius") {
+    s.initialWidth = 0.5;
+    Run r = draw("F@O(2)F@O", s);
+    REQUIRE(r.skeleton.organs.size() == 2);
+    CHECK(r.skeleton.organs[0].kind == Organ::Kind::Sphere);
+    CHECK(r.skeleton.organs[0].radius == 2);
+    checkVec(r.skeleton.organs[0].position, {0, 1, 0});
+    CHECK(r.skeleton.organs[0].internode == 0);
+    CHECK(r.skeleton.organs[1].radius == Approx(0.25));
+  }
+  SECTION("~ names a surface with the next module; ~name is one module") {
+    Run r = draw("F~l(2)F~(3)<leaf>+<~petal>(0.5)<~bud>", s);
+    auto& o = r.skeleton.organs;
+    REQUIRE(o.size() == 4);
+    CHECK(o[0].kind == Organ::Kind::Surface);
+    CHECK(o[0].name == "l");
+    CHECK(o[0].radius == 2);
+    CHECK(o[1].name == "leaf");
+    CHECK(o[1].radius == 3);
+    CHECK(o[2].name == "petal");
+    CHECK(o[2].radius == 0.5);
+    checkVec(o[2].heading, -X);
+    CHECK(o[3].name == "bud");
+    CHECK(o[3].radius == 1);
+    CHECK(r.skeleton.internodes.size() == 2);  // the name module is consumed, not interpreted
+  }
+}
+
+TEST_CASE("Turtle::cut", "[lsystem]") {
+  SECTION("% ends the branch and marks its last internode") {
+    Run r = draw("F[F%F[F]F]F");
+    auto& in = r.skeleton.internodes;
+    REQUIRE(in.size() == 3);
+    CHECK(in[1].cut);
+    CHECK(!in[0].cut);
+    CHECK(in[2].parent == 0);
+    checkVec(r.end.frame.position, {0, 2, 0});
+  }
+  SECTION("% outside a branch ends the string") { CHECK(draw("FF%FFF").skeleton.internodes.size() == 2); }
+}
+
+TEST_CASE("Turtle::tropism", "[lsystem]") {
+  TurtleSettings s;
+  s.angleDeg = 90;
+  s.tropism = {0, -1, 0};
+  SECTION("alpha = e |H x T| about H x T, after each segment (ABOP section 2.2)") {
+    s.elasticity = 0.1;
+    Run r = draw("-F", s);  // H = +X, |H x T| = 1
+    checkVec(r.end.frame.heading, {std::cos(0.1), -std::sin(0.1), 0});
+    checkVec(glm::cross(r.end.frame.heading, r.end.frame.left), r.end.frame.up);
+    checkVec(r.skeleton.internodes[0].end, {1, 0, 0});  // the segment is drawn before bending
+  }
+  SECTION("|T| scales the bend; a heading along T is unchanged") {
+    s.elasticity = 0.1;
+    s.tropism = {0, -2, 0};
+    checkVec(draw("-F", s).end.frame.heading, {std::cos(0.2), -std::sin(0.2), 0});
+    checkVec(draw("|F", s).end.frame.heading, -Y);
+  }
+  SECTION("@Ts(e) sets the elasticity for the rest of the branch") {
+    Run r = draw("-[@Ts(0.3)F]F", s);
+    checkVec(r.end.frame.heading, X);
+    Run r2 = draw("-@Ts(0.3)F", s);
+    checkVec(r2.end.frame.heading, {std::cos(0.3), -std::sin(0.3), 0});
+  }
+  SECTION("the frame stays orthonormal over many bends") {
+    s.elasticity = 0.05;
+    std::string text = "-";
+    for (int i = 0; i < 500; ++i) text += "F\\(13)&(7)";
+    const TurtleFrame& f = draw(text, s).end.frame;
+    CHECK(std::abs(glm::length(f.heading) - 1) < 1e-9);
+    CHECK(std::abs(glm::dot(f.heading, f.left)) < 1e-9);
+    checkVec(glm::cross(f.heading, f.left), f.up);
+  }
+}
+
+TEST_CASE("Turtle::commandOf", "[lsystem]") {
+  SymbolTable t;
+  for (const char* n : {"F", "+", "@Ts", "@v", "@O", "~leaf", "A"}) t.intern(n);
+  Turtle turtle(t);
+  CHECK(turtle.commandOf(0) == Turtle::Command::Forward);
+  CHECK(turtle.commandOf(1) == Turtle::Command::TurnLeft);
+  CHECK(turtle.commandOf(2) == Turtle::Command::Tropism);
+  CHECK(turtle.commandOf(3) == Turtle::Command::RollToVertical);
+  CHECK(turtle.commandOf(4) == Turtle::Command::Sphere);
+  CHECK(turtle.commandOf(5) == Turtle::Command::SurfaceNamed);
+  CHECK(turtle.commandOf(6) == Turtle::Command::None);
+  CHECK(turtle.commandOf(100) == Turtle::Command::None);
+}
