@@ -1,0 +1,248 @@
+#pragma once
+/// A checked YAML reader on yaml-cpp 0.7 for species files and the sections other
+/// parts of Sprig own (`tree:`, `shell:`, `blob:`, ...).
+///
+/// yaml-cpp alone is lenient in ways that hide mistakes: its marks are 0-based, duplicate
+/// keys pass silently (both pairs are kept), `.nan`/`.inf` read as numbers, a missing key
+/// throws without a position, and anchors/aliases can expand a tiny file into billions of
+/// nodes. This reader closes each hole:
+///
+/// - YamlFile::load / YamlFile::parse read the text, convert yaml-cpp parse errors to
+///   `file:line:col` (1-based), and walk the whole document once with a cap on nodes
+///   visited (defeats alias bombs and self-referencing aliases). Duplicate keys in any
+///   map are reported during that walk.
+/// - YNode is a yaml-cpp node plus its file: loc() gives the 1-based SourceLoc, and the
+///   typed accessors (asNumber, asInteger, ...) report wrong types, NaN/inf and range
+///   errors into a DiagnosticList.
+/// - MapReader reads one YAML map key by key with defaults, remembers which keys were
+///   read, and finish() reports every key nobody asked for, with "did you mean".
+///
+/// Every error is collected, not thrown: call DiagnosticList::throwIfErrors() once the
+/// whole file is read so the user sees all of them together.
+///
+/// Typical use:
+/// ```
+///   DiagnosticList diags;
+///   auto file = YamlFile::load("species/fern.yaml", diags);   // nullptr on syntax error
+///   MapReader top(file->rootNode(), diags, "species file");
+///   int steps = top.integer("steps", 5, 0, 1000);
+///   if (auto t = top.section("turtle")) {
+///     MapReader turtle(*t, diags, "turtle");
+///     double angle = turtle.number("angle", 25.0, -360.0, 360.0);
+///     turtle.finish();
+///   }
+///   top.finish();
+///   diags.throwIfErrors();
+/// ```
+///
+/// Messages (tests/bad_inputs checks them verbatim):
+///   unknown key 'stpes' in species file (did you mean 'steps'?)
+///   duplicate key 'seed' (first defined at line 3)
+///   'steps' must be an integer, got 'abc'
+///   'steps' must be a map / a sequence / a string / true or false / [x, y, z]
+///   'angle' must be a finite number, got '.nan'
+///   'steps' is 5000, out of range [0, 1000]
+///   YAML document has more than N nodes (alias bomb?)
+
+#include <yaml-cpp/yaml.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <memory>
+#include <optional>
+#include <set>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/diagnostics.h"
+#include "core/types.h"
+
+namespace sprig {
+
+class YNode;
+
+/// Options for loading a YAML file.
+struct YamlLoadOptions {
+  /// Cap on nodes visited while walking the document (aliases count each time they are
+  /// reached). Real species files have a few hundred nodes.
+  int64_t maxNodes = 1'000'000;
+  /// Files larger than this are refused before parsing.
+  std::uintmax_t maxBytes = 64u << 20;
+};
+
+/// One parsed YAML document with the text it came from (for source lines in diagnostics).
+class YamlFile {
+ public:
+  /// Reads and parses `path`. `displayPath` (default: path as given) is what diagnostics
+  /// print. Returns nullptr after adding diagnostics when the file cannot be read or
+  /// parsed, or is too large / too deep / an alias bomb; duplicate keys are added to
+  /// diags but the file is still returned.
+  static std::shared_ptr<const YamlFile> load(const std::filesystem::path& path, DiagnosticList& diags,
+                                              const YamlLoadOptions& options = {});
+  /// Parses in-memory text as if it were the file `displayPath` (tests, inline sections).
+  static std::shared_ptr<const YamlFile> parse(std::string text, std::string displayPath, DiagnosticList& diags,
+                                               const YamlLoadOptions& options = {});
+
+  const std::filesystem::path& path() const { return path_; }
+  const std::string& displayPath() const { return displayPath_; }
+  const std::string& text() const { return text_; }
+  const YAML::Node& root() const { return root_; }
+  /// The root as a YNode (needs the shared_ptr that owns this file).
+  YNode rootNode() const;
+
+  /// 1-based location of a yaml-cpp mark in this file.
+  SourceLoc loc(const YAML::Mark& mark) const;
+  /// Text of 1-based line `line`, for carets.
+  std::string sourceLine(int line) const { return lineOf(text_, line); }
+  /// Adds an error at mark.
+  void error(DiagnosticList& diags, const YAML::Mark& mark, std::string message) const;
+
+ private:
+  YamlFile() = default;
+  static std::shared_ptr<const YamlFile> parseAt(std::string text, std::string displayPath,
+                                                 const std::filesystem::path& path, DiagnosticList& diags,
+                                                 const YamlLoadOptions& options);
+  std::filesystem::path path_;
+  std::string displayPath_;
+  std::string text_;
+  YAML::Node root_;
+  std::weak_ptr<const YamlFile> self_;
+};
+
+/// A YAML node together with the file it came from.
+class YNode {
+ public:
+  YNode(std::shared_ptr<const YamlFile> file, YAML::Node node) : file_(std::move(file)), node_(std::move(node)) {}
+
+  const YAML::Node& node() const { return node_; }
+  const YamlFile& file() const { return *file_; }
+  const std::shared_ptr<const YamlFile>& fileHandle() const { return file_; }
+  /// 1-based position of the node's first character.
+  SourceLoc loc() const { return file_->loc(node_.Mark()); }
+  /// Adds an error at this node.
+  void error(DiagnosticList& diags, std::string message) const { file_->error(diags, node_.Mark(), std::move(message)); }
+
+  bool isMap() const { return node_.IsMap(); }
+  bool isSequence() const { return node_.IsSequence(); }
+  bool isScalar() const { return node_.IsScalar(); }
+  bool isNull() const { return node_.IsNull(); }
+  /// True for a plain (unquoted) scalar; quoted scalars are always strings.
+  bool isPlainScalar() const { return node_.IsScalar() && node_.Tag() != "!"; }
+  /// The scalar text (empty for non-scalars).
+  std::string scalar() const { return node_.IsScalar() ? node_.Scalar() : std::string(); }
+  /// Elements of a sequence (empty otherwise).
+  std::vector<YNode> items() const;
+  /// Key/value pairs of a map in file order, duplicates included (empty otherwise).
+  std::vector<std::pair<YNode, YNode>> pairs() const;
+
+  // Typed reads. `what` names the value in messages ("'steps'"); on error they add a
+  // diagnostic at this node and return nullopt.
+  /// A finite real number (plain scalar; .nan/.inf refused) within [min, max].
+  std::optional<double> asNumber(DiagnosticList& diags, std::string_view what,
+                                 double min = -std::numeric_limits<double>::infinity(),
+                                 double max = std::numeric_limits<double>::infinity()) const;
+  /// An integer (plain scalar, no fraction) within [min, max].
+  std::optional<int64_t> asInteger(DiagnosticList& diags, std::string_view what,
+                                   int64_t min = std::numeric_limits<int64_t>::min(),
+                                   int64_t max = std::numeric_limits<int64_t>::max()) const;
+  /// true/false (also yes/no, on/off).
+  std::optional<bool> asBoolean(DiagnosticList& diags, std::string_view what) const;
+  /// Any scalar as text (numbers too); null, maps and sequences are errors.
+  std::optional<std::string> asString(DiagnosticList& diags, std::string_view what) const;
+  /// `[x, y, z]` of finite numbers, each within [min, max].
+  std::optional<Vec3> asVec3(DiagnosticList& diags, std::string_view what,
+                             double min = -std::numeric_limits<double>::infinity(),
+                             double max = std::numeric_limits<double>::infinity()) const;
+  /// A colour: `[r, g, b]` in [0, 1] or `"#rrggbb"`.
+  std::optional<Vec3> asColor(DiagnosticList& diags, std::string_view what) const;
+
+ private:
+  std::shared_ptr<const YamlFile> file_;
+  YAML::Node node_;
+};
+
+/// Where referenced files (grammars, textures, ...) may come from.
+struct PathPolicy {
+  /// The library root: references must resolve inside it (`--root`, default ".").
+  std::filesystem::path root = ".";
+  /// `--allow-outside-paths`: accept absolute paths and escapes above the root.
+  bool allowOutside = false;
+};
+
+/// Resolves `ref` (as written at `at`) relative to the folder of at's file. Refuses URI
+/// schemes (`http://...`, `file:...`), absolute paths and paths that leave policy.root
+/// unless policy.allowOutside; with mustExist, a missing file is an error too. Returns
+/// the resolved path (relative to the current folder when possible) or nullopt after
+/// adding a diagnostic at `at`.
+std::optional<std::filesystem::path> resolveReference(const YNode& at, std::string_view ref, const PathPolicy& policy,
+                                                      DiagnosticList& diags, bool mustExist = true);
+
+/// Reads one YAML map key by key. Every getter marks its key as known; finish() reports
+/// the keys of the map that no getter asked for. Getters return the default when the key
+/// is absent and also when its value is wrong (after adding a diagnostic), so reading
+/// can go on and collect every error of the file.
+class MapReader {
+ public:
+  /// `node` should be a map (anything else adds "<context> must be a map"; an empty or
+  /// null node reads as an empty map). `context` names the map in messages
+  /// ("species file", "turtle").
+  MapReader(YNode node, DiagnosticList& diags, std::string context);
+
+  const YNode& node() const { return node_; }
+  DiagnosticList& diagnostics() const { return *diags_; }
+  /// True if the map has `key` (does not mark it as read).
+  bool has(std::string_view key) const;
+  /// The value node of `key` (marks it as known), nullopt when absent.
+  std::optional<YNode> get(std::string_view key);
+  /// The key node of `key` (for locations of the key itself).
+  std::optional<YNode> keyNode(std::string_view key) const;
+  /// Marks keys as known without reading them (keys another reader handles).
+  void allow(std::initializer_list<std::string_view> keys);
+
+  /// A finite real number within [min, max]; `def` when absent.
+  double number(std::string_view key, double def, double min = -std::numeric_limits<double>::infinity(),
+                double max = std::numeric_limits<double>::infinity());
+  /// An integer within [min, max]; `def` when absent.
+  int64_t integer(std::string_view key, int64_t def, int64_t min = std::numeric_limits<int64_t>::min(),
+                  int64_t max = std::numeric_limits<int64_t>::max());
+  /// A scalar as text; `def` when absent.
+  std::string string(std::string_view key, std::string def = {});
+  /// A required scalar: adds "missing required key 'K' in <context>" at the map when absent.
+  std::optional<std::string> requiredString(std::string_view key);
+  /// true/false; `def` when absent.
+  bool boolean(std::string_view key, bool def);
+  /// `[x, y, z]`; `def` when absent.
+  Vec3 vec3(std::string_view key, Vec3 def, double min = -std::numeric_limits<double>::infinity(),
+            double max = std::numeric_limits<double>::infinity());
+  /// A colour `[r, g, b]` in [0, 1] or `"#rrggbb"`; `def` when absent.
+  Vec3 color(std::string_view key, Vec3 def);
+  /// One of `choices` (did-you-mean on a miss); `def` when absent.
+  std::string choice(std::string_view key, std::string def, const std::vector<std::string>& choices);
+  /// A nested map; nullopt when absent or not a map (the latter adds an error).
+  std::optional<YNode> section(std::string_view key);
+  /// A sequence's elements; empty when absent or not a sequence (the latter adds an error).
+  std::vector<YNode> sequence(std::string_view key);
+  /// A file reference resolved with resolveReference; nullopt when absent or refused.
+  std::optional<std::filesystem::path> path(std::string_view key, const PathPolicy& policy, bool mustExist = true);
+
+  /// Reports every key of the map not read or allowed: "unknown key 'K' in <context>"
+  /// plus "did you mean" among the known keys. Call once, after all getters.
+  void finish();
+
+ private:
+  struct Entry {
+    YNode key;
+    YNode value;
+  };
+  YNode node_;
+  DiagnosticList* diags_;
+  std::string context_;
+  std::vector<Entry> entries_;          // first occurrence of each key, file order
+  std::map<std::string, size_t, std::less<>> index_;
+  std::set<std::string, std::less<>> known_;
+};
+
+}  // namespace sprig
