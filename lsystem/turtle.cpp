@@ -139,6 +139,7 @@ Skeleton Turtle::run(const ModuleString& ms, std::span<const int32_t> moduleStep
   const double* prm = ms.params.data();
   const Command* cmd = commands_.data();
   const size_t ncmd = commands_.size();
+  if (moduleSteps.empty() && ms.hasBirthSteps()) moduleSteps = ms.birthSteps;
   const bool haveSteps = moduleSteps.size() >= n;
 
   TurtleState st;

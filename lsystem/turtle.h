@@ -73,7 +73,8 @@ class Turtle {
   explicit Turtle(const SymbolTable& symbols, TurtleSettings settings = {});
 
   /// Draws `modules`. `moduleSteps`, when not empty, holds for each module the derivation
-  /// step that created it (copied into Internode::step / Organ::step), else steps are 0.
+  /// step that created it (copied into Internode::step / Organ::step); when empty, the
+  /// string's own birthSteps are used if it has them, else steps are 0.
   /// Cost: O(modules), one pass, no per-module allocation.
   Skeleton run(const ModuleString& modules, std::span<const int32_t> moduleSteps = {});
 
