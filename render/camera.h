@@ -1,0 +1,51 @@
+#pragma once
+/// Pinhole camera and automatic framing of a model from its bounds.
+///
+/// World space is Y up. A camera is a position, a target, an up vector and a vertical
+/// field of view; film coordinates are pixels with (0,0) at the top-left corner. Framing
+/// depends only on the box, the view and the aspect ratio, so every stage of a growth
+/// sequence framed with the final stage's box shares one camera.
+
+#include "core/types.h"
+
+namespace sprig::render {
+
+/// A ray: origin and unit direction.
+struct Ray {
+  Vec3 origin{0};
+  Vec3 direction{0, 0, -1};
+};
+
+/// Pinhole camera looking from `position` toward `target`.
+struct Camera {
+  Vec3 position{0, 0, 5};
+  Vec3 target{0};
+  Vec3 up{0, 1, 0};
+  float fovYDeg = 35.0f;  ///< vertical field of view, degrees
+
+  /// Primary ray through film point (px, py) in pixels of a width x height image (y down).
+  Ray generateRay(float px, float py, int width, int height) const;
+  /// Projects a world point to film pixels; returns false when it lies behind the camera.
+  bool project(const Vec3& p, int width, int height, Vec2& film) const;
+};
+
+/// A viewing direction for automatic framing.
+struct ViewSpec {
+  double azimuthDeg = 30.0;    ///< around +Y, measured from +Z toward +X (0 = camera on +Z looking at -Z)
+  double elevationDeg = 15.0;  ///< above the horizontal plane
+  double fovYDeg = 35.0;       ///< vertical field of view
+  double margin = 0.06;        ///< fraction of the half-frame left free on each side, in [0, 0.9]
+};
+
+/// Unit vector from a target toward a viewer at (azimuth, elevation), Y up.
+Vec3 directionFromAngles(double azimuthDeg, double elevationDeg);
+
+/// Camera at (azimuth, elevation, distance) from target, looking at it.
+Camera orbitCamera(const Vec3& target, double azimuthDeg, double elevationDeg, double distance, double fovYDeg);
+
+/// Camera looking along the view direction that tightly fits the eight corners of box in
+/// a width/height = aspect frame, leaving `margin` free on every side. The camera is panned
+/// (not turned) to center the projected box. An empty box frames the unit cube.
+Camera frameBounds(const Box3& box, const ViewSpec& view, double aspect);
+
+}  // namespace sprig::render

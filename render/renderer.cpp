@@ -1,0 +1,276 @@
+#include "render/renderer.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+
+#include "core/parallel.h"
+#include "core/progress.h"
+#include "core/rng.h"
+
+namespace sprig::render {
+
+namespace {
+
+constexpr int kTile = 32;
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+/// Orthonormal basis around unit n (Duff et al. 2017, "Building an orthonormal basis, revisited").
+void basisAround(const Vec3& n, Vec3& a, Vec3& b) {
+  float sign = std::copysign(1.0f, n.z);
+  float p = -1.0f / (sign + n.z);
+  float q = n.x * n.y * p;
+  a = Vec3(1.0f + sign * n.x * n.x * p, sign * q, -sign * n.x);
+  b = Vec3(q, sign + n.y * n.y * p, -n.y);
+}
+
+float next(Rng& rng) { return static_cast<float>(rng.uniform()); }
+
+/// Uniform direction within a cone of half-angle with cosine cosMax around axis.
+Vec3 sampleCone(const Vec3& axis, float cosMax, Rng& rng) {
+  float u1 = next(rng), u2 = next(rng);
+  float cosT = 1.0f - u1 * (1.0f - cosMax);
+  float sinT = std::sqrt(std::max(0.0f, 1.0f - cosT * cosT));
+  float phi = static_cast<float>(2.0 * kPi) * u2;
+  Vec3 a, b;
+  basisAround(axis, a, b);
+  return glm::normalize(cosT * axis + sinT * (std::cos(phi) * a + std::sin(phi) * b));
+}
+
+/// Cosine-weighted direction in the hemisphere around n.
+Vec3 sampleCosine(const Vec3& n, Rng& rng) {
+  float u1 = next(rng), u2 = next(rng);
+  float r = std::sqrt(u1), phi = static_cast<float>(2.0 * kPi) * u2;
+  Vec3 a, b;
+  basisAround(n, a, b);
+  return glm::normalize(r * std::cos(phi) * a + r * std::sin(phi) * b + std::sqrt(std::max(0.0f, 1.0f - u1)) * n);
+}
+
+struct Counters {
+  uint64_t camera = 0, shadow = 0, sky = 0;
+};
+
+/// Per-render constants and the shading of one camera sample.
+class Integrator {
+ public:
+  Integrator(const Scene& scene, const Camera& camera, const RenderSettings& s) : scene_(scene), camera_(camera), s_(s) {
+    Box3 b = scene.bounds();
+    if (b.empty()) b = Box3{Vec3(-0.5f), Vec3(0.5f)};
+    center_ = b.center();
+    radius_ = std::max(0.5f * glm::length(b.size()), 1e-6f);
+    eps_ = 2e-4f * radius_ + 1e-6f * glm::length(center_);
+    groundY_ = s.groundAtModelBase ? b.lo.y : s.groundHeight;
+    sunDir_ = directionFromAngles(s.sunAzimuthDeg, s.sunElevationDeg);
+    sunCos_ = static_cast<float>(std::cos(radians(std::max(0.0, s.sunAngleDeg))));
+  }
+
+  /// Radiance and alpha seen through film point (fx, fy).
+  Vec4 sample(float fx, float fy, Rng& rng, Counters& c) const {
+    Ray ray = camera_.generateRay(fx, fy, s_.width, s_.height);
+    ++c.camera;
+    Vec3 bg = background(fy);
+    float bgAlpha = s_.background == Background::Transparent ? 0.0f : 1.0f;
+
+    std::optional<SurfaceHit> hit = scene_.intersect(ray.origin, ray.direction, 0.0f, kInf);
+    float tGround = groundHit(ray.origin, ray.direction);
+    if (hit && hit->t <= tGround) {
+      const Material& m = scene_.material(hit->material);
+      return Vec4(shade(*hit, m, ray.direction, rng, c), 1.0f);
+    }
+    if (tGround < kInf) {
+      SurfaceHit g;
+      g.t = tGround;
+      g.position = ray.origin + tGround * ray.direction;
+      g.position.y = groundY_;
+      g.normal = g.geometricNormal = Vec3(0, 1, 0);
+      g.color = s_.groundColor;
+      Material m;
+      m.roughness = 1.0f;
+      m.specular = 0.0f;
+      Vec3 lit = shade(g, m, ray.direction, rng, c);
+      // Fade the far ground into the background so the horizon is soft.
+      float dist = glm::length(Vec3(g.position.x - center_.x, 0, g.position.z - center_.z)) / radius_;
+      float f = std::clamp((dist - s_.groundFade) / (3.0f * s_.groundFade), 0.0f, 1.0f);
+      f = f * f * (3.0f - 2.0f * f);
+      return Vec4(glm::mix(lit, bg, f), bgAlpha + (1.0f - bgAlpha) * (1.0f - f));
+    }
+    return Vec4(bg, bgAlpha);
+  }
+
+ private:
+  Vec3 background(float fy) const {
+    switch (s_.background) {
+      case Background::Color: return s_.backgroundColor;
+      case Background::Gradient: return glm::mix(s_.backgroundTop, s_.backgroundBottom, std::clamp(fy / s_.height, 0.0f, 1.0f));
+      case Background::Transparent: return Vec3(0);
+    }
+    return Vec3(0);
+  }
+
+  float groundHit(const Vec3& o, const Vec3& d) const {
+    if (!s_.ground || o.y <= groundY_ || d.y >= 0.0f) return kInf;
+    return (groundY_ - o.y) / d.y;
+  }
+
+  /// Sky radiance arriving from unit direction d (below the horizon: light bounced by the ground).
+  Vec3 sky(const Vec3& d, const Vec3& from) const {
+    if (d.y < 0.0f && s_.ground && from.y > groundY_ - eps_) {
+      Vec3 avgSky = 0.5f * (s_.skyZenith + s_.skyHorizon);
+      float sunOnGround = s_.sun ? std::max(0.0f, sunDir_.y) * s_.sunStrength / s_.skyStrength : 0.0f;
+      return s_.groundColor * avgSky * (0.5f + 0.5f * sunOnGround);
+    }
+    float t = std::sqrt(std::max(0.0f, d.y));
+    return glm::mix(s_.skyHorizon, s_.skyZenith, t);
+  }
+
+  Vec3 shade(SurfaceHit h, const Material& m, const Vec3& dir, Rng& rng, Counters& c) const {
+    // Face both normals toward the viewer: leaves and thin parts are two-sided.
+    if (glm::dot(h.geometricNormal, dir) > 0.0f) h.geometricNormal = -h.geometricNormal;
+    if (glm::dot(h.normal, dir) > 0.0f) h.normal = -h.normal;
+    const Vec3 n = h.normal, ng = h.geometricNormal, v = -dir;
+    const Vec3 origin = h.position + eps_ * ng;
+    const Vec3 albedo = glm::clamp(h.color, Vec3(0), Vec3(1));
+    Vec3 radiance(0);
+
+    if (s_.sun) {
+      Vec3 l = sunCos_ < 1.0f ? sampleCone(sunDir_, sunCos_, rng) : sunDir_;
+      float cosL = glm::dot(n, l);
+      if (cosL > 0.0f && glm::dot(ng, l) > -0.05f) {
+        bool lit = true;
+        if (s_.shadows) {
+          ++c.shadow;
+          lit = !scene_.occluded(origin, l, 0.0f, kInf);
+        }
+        if (lit) {
+          // Normalized Blinn-Phong; exponent from roughness (Walter et al. 2007 mapping).
+          float r4 = std::max(std::pow(std::clamp(m.roughness, 0.02f, 1.0f), 4.0f), 1e-4f);
+          float e = 2.0f / r4 - 2.0f;
+          Vec3 hv = glm::normalize(l + v);
+          float spec = e > 0.0f ? m.specular * (e + 8.0f) / 8.0f * std::pow(std::max(0.0f, glm::dot(n, hv)), e) : 0.0f;
+          radiance += s_.sunColor * s_.sunStrength * cosL * (albedo + Vec3(spec));
+        }
+      }
+    }
+    if (s_.skyStrength > 0.0f) {
+      Vec3 skyLight(0);
+      if (s_.skySamples <= 0) {
+        skyLight = sky(n, h.position);
+      } else {
+        for (int k = 0; k < s_.skySamples; ++k) {
+          Vec3 d = sampleCosine(n, rng);
+          if (glm::dot(d, ng) <= 0.0f) continue;
+          ++c.sky;
+          if (!scene_.occluded(origin, d, 0.0f, kInf)) skyLight += sky(d, h.position);
+        }
+        skyLight /= static_cast<float>(s_.skySamples);
+      }
+      radiance += albedo * skyLight * s_.skyStrength;
+    }
+    if (s_.fillStrength > 0.0f) radiance += albedo * s_.fillStrength * std::max(0.0f, glm::dot(n, v));
+    return radiance;
+  }
+
+  const Scene& scene_;
+  const Camera& camera_;
+  const RenderSettings& s_;
+  Vec3 center_{0};
+  float radius_ = 1;
+  float eps_ = 1e-4f;
+  float groundY_ = 0;
+  Vec3 sunDir_{0, 1, 0};
+  float sunCos_ = 1;
+};
+
+struct FilmSample {
+  float x, y;
+  Vec4 value;
+};
+
+}  // namespace
+
+Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings& s, RenderStats* stats) {
+  if (s.width < 1 || s.height < 1) throw std::invalid_argument("render: image size must be at least 1x1");
+  if (s.spp < 1) throw std::invalid_argument("render: samples per pixel must be at least 1");
+  auto start = std::chrono::steady_clock::now();
+  std::unique_ptr<ThreadLimit> limit;
+  if (s.threads > 0) limit = std::make_unique<ThreadLimit>(s.threads);
+
+  Integrator integrator(scene, camera, s);
+  const bool tent = s.filter == Filter::Tent && s.filterRadius > 0.5f;
+  const float radius = tent ? s.filterRadius : 0.5f;
+  const int apron = tent ? static_cast<int>(std::ceil(radius - 0.5f)) : 0;
+  const int spp = s.spp;
+  const int gx = std::max(1, static_cast<int>(std::floor(std::sqrt(static_cast<double>(spp)))));
+  const int gy = (spp + gx - 1) / gx;
+
+  const int tilesX = (s.width + kTile - 1) / kTile, tilesY = (s.height + kTile - 1) / kTile;
+  const size_t tileCount = static_cast<size_t>(tilesX) * tilesY;
+  Image image(s.width, s.height);
+  std::atomic<uint64_t> cameraRays{0}, shadowRays{0}, skyRays{0};
+  std::optional<Progress> progress;
+  if (s.progress) progress.emplace(s.progressLabel, tileCount);
+  const float scale = std::exp2(s.exposure);
+
+  parallelFor(0, tileCount, [&](size_t tile) {
+    const int x0 = static_cast<int>(tile % tilesX) * kTile, y0 = static_cast<int>(tile / tilesX) * kTile;
+    const int x1 = std::min(x0 + kTile, s.width), y1 = std::min(y0 + kTile, s.height);
+    const int ax0 = std::max(0, x0 - apron), ay0 = std::max(0, y0 - apron);
+    const int ax1 = std::min(s.width, x1 + apron), ay1 = std::min(s.height, y1 + apron);
+    const int aw = ax1 - ax0;
+    std::vector<FilmSample> samples(static_cast<size_t>(aw) * (ay1 - ay0) * spp);
+    Counters c;
+    for (int y = ay0; y < ay1; ++y) {
+      for (int x = ax0; x < ax1; ++x) {
+        Rng rng(deriveSeed(s.seed, {static_cast<uint64_t>(x), static_cast<uint64_t>(y)}));
+        FilmSample* out = &samples[(static_cast<size_t>(y - ay0) * aw + (x - ax0)) * spp];
+        for (int k = 0; k < spp; ++k) {
+          float jx = next(rng), jy = next(rng);
+          float fx = static_cast<float>(x) + (static_cast<float>(k % gx) + jx) / static_cast<float>(gx);
+          float fy = static_cast<float>(y) + (static_cast<float>(k / gx) + jy) / static_cast<float>(gy);
+          out[k] = {fx, fy, integrator.sample(fx, fy, rng, c)};
+        }
+      }
+    }
+    for (int y = y0; y < y1; ++y) {
+      for (int x = x0; x < x1; ++x) {
+        Vec4 sum(0);
+        float wsum = 0;
+        const float cx = static_cast<float>(x) + 0.5f, cy = static_cast<float>(y) + 0.5f;
+        for (int ny = std::max(ay0, y - apron); ny <= std::min(ay1 - 1, y + apron); ++ny) {
+          for (int nx = std::max(ax0, x - apron); nx <= std::min(ax1 - 1, x + apron); ++nx) {
+            const FilmSample* in = &samples[(static_cast<size_t>(ny - ay0) * aw + (nx - ax0)) * spp];
+            for (int k = 0; k < spp; ++k) {
+              float w = 1.0f;
+              if (tent)
+                w = std::max(0.0f, 1.0f - std::abs(in[k].x - cx) / radius) *
+                    std::max(0.0f, 1.0f - std::abs(in[k].y - cy) / radius);
+              sum += w * in[k].value;
+              wsum += w;
+            }
+          }
+        }
+        Vec4 v = wsum > 0 ? sum / wsum : Vec4(0);
+        image.set(x, y, Vec4(Vec3(v) * scale, v.a));
+      }
+    }
+    cameraRays += c.camera;
+    shadowRays += c.shadow;
+    skyRays += c.sky;
+    if (progress) progress->advance();
+  });
+  if (progress) progress->finish();
+
+  if (stats) {
+    stats->cameraRays = cameraRays;
+    stats->shadowRays = shadowRays;
+    stats->skyRays = skyRays;
+    stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  }
+  return image;
+}
+
+}  // namespace sprig::render

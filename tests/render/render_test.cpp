@@ -1,0 +1,262 @@
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include "render/camera.h"
+#include "render/image.h"
+#include "render/renderer.h"
+#include "render/scene.h"
+
+using namespace sprig;
+using namespace sprig::render;
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path scratchDir(const std::string& name) {
+  fs::path dir = fs::temp_directory_path() / ("sprig-render-test-" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+/// A Y-shaped skeleton: a two-internode trunk and one branch.
+lsystem::Skeleton smallTree() {
+  lsystem::Skeleton s;
+  auto add = [&](DVec3 a, DVec3 b, double r0, double r1, int parent) {
+    lsystem::Internode n;
+    n.start = a;
+    n.end = b;
+    n.baseRadius = r0;
+    n.tipRadius = r1;
+    n.parent = parent;
+    s.internodes.push_back(n);
+  };
+  add({0, 0, 0}, {0, 1, 0}, 0.12, 0.1, -1);
+  add({0, 1, 0}, {0, 2, 0}, 0.1, 0.06, 0);
+  add({0, 1, 0}, {0.6, 1.6, 0}, 0.05, 0.03, 0);
+  lsystem::Organ leaf;
+  leaf.points = {{0.6, 1.6, 0}, {0.9, 1.7, 0.1}, {0.8, 2.0, 0}};
+  s.organs.push_back(leaf);
+  lsystem::Organ fruit;
+  fruit.kind = lsystem::Organ::Kind::Sphere;
+  fruit.position = {0, 2.1, 0};
+  fruit.radius = 0.1;
+  s.organs.push_back(fruit);
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("frameBounds", "[render]") {
+  Box3 box{Vec3(-1, 0, -0.5f), Vec3(2, 5, 0.5f)};
+  for (double az : {0.0, 30.0, 135.0}) {
+    for (double aspect : {0.75, 1.5}) {
+      ViewSpec view;
+      view.azimuthDeg = az;
+      view.elevationDeg = 20;
+      view.margin = 0.1;
+      Camera cam = frameBounds(box, view, aspect);
+      int h = 400, w = static_cast<int>(std::lround(400 * aspect));
+      float lo = 1e9f, hi = -1e9f, top = 1e9f, bottom = -1e9f;
+      for (int i = 0; i < 8; ++i) {
+        Vec3 p((i & 1) ? box.hi.x : box.lo.x, (i & 2) ? box.hi.y : box.lo.y, (i & 4) ? box.hi.z : box.lo.z);
+        Vec2 f;
+        REQUIRE(cam.project(p, w, h, f));
+        lo = std::min(lo, f.x);
+        hi = std::max(hi, f.x);
+        top = std::min(top, f.y);
+        bottom = std::max(bottom, f.y);
+      }
+      // Every corner lies inside the frame less the margin (5% of the width/height each side)...
+      CHECK(lo >= 0.05f * w - 0.5f);
+      CHECK(hi <= 0.95f * w + 0.5f);
+      CHECK(top >= 0.05f * h - 0.5f);
+      CHECK(bottom <= 0.95f * h + 0.5f);
+      // ...and the fit is tight on at least one axis, centered on both.
+      bool tightX = std::abs(lo - 0.05f * w) < 1.0f && std::abs(hi - 0.95f * w) < 1.0f;
+      bool tightY = std::abs(top - 0.05f * h) < 1.0f && std::abs(bottom - 0.95f * h) < 1.0f;
+      CHECK((tightX || tightY));
+      CHECK(std::abs((lo + hi) - w) < 1.0f);
+      CHECK(std::abs((top + bottom) - h) < 1.0f);
+    }
+  }
+  SECTION("framing depends only on the box") {
+    Camera a = frameBounds(box, ViewSpec{}, 1.0), b = frameBounds(box, ViewSpec{}, 1.0);
+    CHECK(a.position == b.position);
+    CHECK(a.target == b.target);
+  }
+}
+
+TEST_CASE("Scene::addSkeleton", "[render]") {
+  Scene scene;
+  lsystem::Skeleton tree = smallTree();
+  auto ids = scene.addSkeleton(tree);
+  scene.commit();
+  CHECK(ids.size() == 3);  // curves, leaf triangles, spheres
+  CHECK(scene.stats().curveSegments == 3);
+  CHECK(scene.stats().triangles == 1);
+  CHECK(scene.stats().spheres == 1);
+  Box3 b = scene.bounds();
+  CHECK(b.lo.y == Approx(-0.12f));
+  CHECK(b.hi.y == Approx(2.2f));
+
+  SECTION("a ray hits the tapered trunk at its radius") {
+    // At height 0.5 the trunk radius is 0.11 (linear from 0.12 to 0.1).
+    auto hit = scene.intersect(Vec3(0, 0.5f, 5), Vec3(0, 0, -1), 0, 100);
+    REQUIRE(hit);
+    CHECK(hit->t == Approx(5.0 - 0.11).margin(2e-3));
+    CHECK(hit->normal.z == Approx(1.0).margin(0.02));
+    CHECK(hit->geometry == ids[0]);
+  }
+  SECTION("the sphere organ and the leaf are hit") {
+    auto s = scene.intersect(Vec3(0, 2.1f, 5), Vec3(0, 0, -1), 0, 100);
+    REQUIRE(s);
+    CHECK(s->t == Approx(4.9).margin(1e-3));
+    CHECK(s->geometry == ids[2]);
+    auto l = scene.intersect(Vec3(0.75f, 1.75f, 5), Vec3(0, 0, -1), 0, 100);
+    REQUIRE(l);
+    CHECK(l->geometry == ids[1]);
+    CHECK(std::abs(l->normal.z) > 0.9f);
+  }
+  SECTION("occlusion") {
+    CHECK(scene.occluded(Vec3(0, 0.5f, 5), Vec3(0, 0, -1), 0, 100));
+    CHECK_FALSE(scene.occluded(Vec3(0, 0.5f, 5), Vec3(0, 0, -1), 0, 4));
+    CHECK_FALSE(scene.occluded(Vec3(3, 0.5f, 5), Vec3(0, 0, -1), 0, 100));
+  }
+}
+
+TEST_CASE("render::sphere silhouette", "[render]") {
+  // A sphere organ of radius R at distance D from the camera, on the optical axis,
+  // projects to a disc of radius (H/2) tan(asin(R/D)) / tan(fov/2) pixels.
+  lsystem::Skeleton s;
+  lsystem::Organ ball;
+  ball.kind = lsystem::Organ::Kind::Sphere;
+  ball.radius = 1.0;
+  s.organs.push_back(ball);
+  Scene scene;
+  scene.addSkeleton(s);
+  scene.commit();
+  Camera cam = orbitCamera(Vec3(0), 20, 10, 6.0, 30.0);
+  RenderSettings rs;
+  rs.width = rs.height = 200;
+  rs.spp = 16;
+  rs.background = Background::Transparent;
+  rs.ground = false;
+  rs.progress = false;
+  Image img = renderImage(scene, cam, rs);
+  double area = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) area += img.at(x, y).a;
+  double expected = 100.0 * std::tan(std::asin(1.0 / 6.0)) / std::tan(radians(15.0));
+  CHECK(std::sqrt(area / kPi) == Approx(expected).margin(0.25));
+  CHECK(img.at(100, 100).a == 1.0f);
+  CHECK(img.at(2, 2).a == 0.0f);
+}
+
+TEST_CASE("render::determinism", "[render]") {
+  Scene scene;
+  scene.addSkeleton(smallTree());
+  scene.commit();
+  ViewSpec view;
+  RenderSettings rs;
+  rs.width = 96;
+  rs.height = 80;
+  rs.spp = 4;
+  rs.progress = false;
+  Camera cam = frameBounds(scene.bounds(), view, 96.0 / 80.0);
+  rs.threads = 2;
+  RenderStats stats;
+  Image a = renderImage(scene, cam, rs, &stats);
+  Image b = renderImage(scene, cam, rs);
+  rs.threads = 1;
+  Image c = renderImage(scene, cam, rs);
+  CHECK(a.pixels == b.pixels);
+  CHECK(a.pixels == c.pixels);
+  CHECK(stats.cameraRays >= 96u * 80u * 4u);
+  CHECK(stats.shadowRays > 0);
+  CHECK(stats.skyRays > 0);
+  CHECK(stats.raysPerSecond() > 0);
+
+  fs::path dir = scratchDir("determinism");
+  writeImage(a, dir / "a.png");
+  writeImage(c, dir / "c.png");
+  CHECK(slurp(dir / "a.png") == slurp(dir / "c.png"));
+  CHECK(slurp(dir / "a.png").size() > 100);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("writeImage", "[render]") {
+  Image img(8, 4, Vec4(0.5f, 0.25f, 1.0f, 1.0f));
+  fs::path dir = scratchDir("write");
+  SECTION("formats by extension") {
+    writeImage(img, dir / "x.png");
+    writeImage(img, dir / "x.JPG");
+    writeImage(img, dir / "x.exr");
+    CHECK(fs::file_size(dir / "x.png") > 0);
+    CHECK(fs::file_size(dir / "x.JPG") > 0);
+    CHECK(fs::file_size(dir / "x.exr") > 0);
+    // Only the three images: no temporaries left behind.
+    CHECK(std::distance(fs::directory_iterator(dir), fs::directory_iterator()) == 3);
+  }
+  SECTION("sRGB encoding") {
+    auto bytes = toSrgb8(img, 4);
+    REQUIRE(bytes.size() == 8 * 4 * 4);
+    CHECK(bytes[0] == 188);  // 0.5 linear -> 0.7354 sRGB
+    CHECK(bytes[1] == 137);  // 0.25 -> 0.5371
+    CHECK(bytes[2] == 255);
+    CHECK(bytes[3] == 255);
+  }
+  SECTION("unknown extension fails and writes nothing") {
+    CHECK_THROWS_AS(writeImage(img, dir / "x.bmpx"), std::invalid_argument);
+    CHECK_THROWS_WITH(writeImage(img, dir / "x.tga"), Catch::Contains("unknown extension '.tga'"));
+    CHECK(fs::is_empty(dir));
+  }
+  SECTION("missing folder fails and writes nothing") {
+    CHECK_THROWS_AS(writeImage(img, dir / "nope" / "x.png"), std::runtime_error);
+    CHECK(fs::is_empty(dir));
+    CHECK_FALSE(fs::exists(dir / "nope"));
+  }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("render::shadows", "[render]") {
+  // A sphere floating above the ground with the sun overhead shades the ground below it.
+  lsystem::Skeleton s;
+  lsystem::Organ ball;
+  ball.kind = lsystem::Organ::Kind::Sphere;
+  ball.position = {0, 2, 0};
+  ball.radius = 1.0;
+  s.organs.push_back(ball);
+  Scene scene;
+  scene.addSkeleton(s);
+  scene.commit();
+  Camera cam = orbitCamera(Vec3(0, 1, 0), 0, 30, 8.0, 40.0);
+  RenderSettings rs;
+  rs.width = rs.height = 120;
+  rs.spp = 4;
+  rs.progress = false;
+  rs.groundAtModelBase = false;
+  rs.groundHeight = 0.0f;
+  rs.sunElevationDeg = 90.0;
+  Vec2 under, aside;
+  REQUIRE(cam.project(Vec3(0, 0, 0), rs.width, rs.height, under));
+  REQUIRE(cam.project(Vec3(3.5f, 0, 0), rs.width, rs.height, aside));
+  Image lit = renderImage(scene, cam, rs);
+  rs.shadows = false;
+  Image unlit = renderImage(scene, cam, rs);
+  auto lum = [](const Image& im, Vec2 f) {
+    Vec4 v = im.at(static_cast<int>(f.x), static_cast<int>(f.y));
+    return 0.2126f * v.r + 0.7152f * v.g + 0.0722f * v.b;
+  };
+  CHECK(lum(lit, under) < 0.5f * lum(unlit, under));
+  CHECK(lum(lit, aside) == Approx(lum(unlit, aside)).epsilon(0.02));
+}
