@@ -1,0 +1,553 @@
+#include "lsystem/derive.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <optional>
+
+#include "core/rng.h"
+#include "lsystem/detail/program.h"
+
+namespace sprig::lsystem {
+
+using detail::Arg;
+using detail::ArgKind;
+using detail::Instr;
+using detail::PatternItem;
+using detail::Production;
+using detail::Program;
+using detail::RuleSet;
+using detail::SuccModule;
+
+namespace {
+
+std::string numberText(double v) {
+  char buf[64];
+  auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+
+/// Writes modules into a ModuleString through raw pointers, growing it geometrically and
+/// never past the module limit.
+class Writer {
+ public:
+  Writer(ModuleString& s, bool births, size_t maxModules, const std::string& file, int step)
+      : s_(s), births_(births), maxModules_(maxModules), file_(file), step_(step) {
+    s_.symbols.resize(std::max(s_.symbols.capacity(), size_t(16)));
+    s_.offsets.resize(s_.symbols.size() + 1);
+    s_.params.resize(std::max(s_.params.capacity(), size_t(16)));
+    if (births_) s_.birthSteps.resize(s_.symbols.size());
+    else s_.birthSteps.clear();
+    refresh();
+    off_[0] = 0;
+  }
+
+  /// Makes room for m more modules and p more parameters.
+  void reserve(size_t m, size_t p) {
+    if (n_ + m > capM_) growModules(n_ + m);
+    if (np_ + p > capP_) growParams(np_ + p);
+  }
+
+  /// Appends a module whose parameters the caller writes next with param().
+  void begin(SymbolId s, int32_t birth) {
+    sym_[n_] = s;
+    if (births_) birth_[n_] = birth;
+  }
+  void param(double v) { par_[np_++] = v; }
+  void end() { off_[++n_] = static_cast<uint32_t>(np_); }
+
+  /// Appends a module with parameters p (room must be reserved).
+  void copy(SymbolId s, const double* p, uint32_t count, int32_t birth) {
+    begin(s, birth);
+    for (uint32_t k = 0; k < count; ++k) par_[np_ + k] = p[k];
+    np_ += count;
+    end();
+  }
+
+  size_t modules() const { return n_; }
+
+  /// Shrinks the string to what was written.
+  void finish() {
+    s_.symbols.resize(n_);
+    s_.offsets.resize(n_ + 1);
+    s_.params.resize(np_);
+    if (births_) s_.birthSteps.resize(n_);
+  }
+
+  [[noreturn]] void overLimit() const {
+    throw InputError(SourceLoc{file_, 0, 0},
+                     "derivation would exceed " + std::to_string(maxModules_) + " modules at step " + std::to_string(step_));
+  }
+
+ private:
+  void refresh() {
+    sym_ = s_.symbols.data();
+    off_ = s_.offsets.data();
+    par_ = s_.params.data();
+    birth_ = s_.birthSteps.data();
+    capM_ = s_.symbols.size();
+    capP_ = s_.params.size();
+  }
+
+  void growModules(size_t need) {
+    if (need > maxModules_) overLimit();
+    size_t cap = std::min(maxModules_, std::max(need, capM_ * 2));
+    s_.symbols.resize(cap);
+    s_.offsets.resize(cap + 1);
+    if (births_) s_.birthSteps.resize(cap);
+    refresh();
+    capP_ = s_.params.size();
+  }
+
+  void growParams(size_t need) {
+    s_.params.resize(std::max(need, capP_ * 2));
+    refresh();
+  }
+
+  ModuleString& s_;
+  bool births_;
+  size_t maxModules_;
+  const std::string& file_;
+  int step_;
+  SymbolId* sym_ = nullptr;
+  uint32_t* off_ = nullptr;
+  double* par_ = nullptr;
+  int32_t* birth_ = nullptr;
+  size_t n_ = 0, np_ = 0, capM_ = 0, capP_ = 0;
+};
+
+}  // namespace
+
+struct Deriver::Impl {
+  Grammar grammar;  // keeps the program alive
+  const Program* prog = nullptr;
+  DeriveOptions opt;
+  int steps = 0;
+  uint64_t seed = 0;
+  int done = 0;
+  uint64_t written = 0;
+  ModuleString cur, next;
+  std::vector<int32_t> match;  ///< bracket partner per module (context-sensitive grammars)
+  std::vector<std::vector<double>> scratch;  ///< successor parameters per decomposition depth
+
+  // Per-module random stream, created on first use.
+  Rng rng;
+  bool rngReady = false;
+  uint64_t rngStream = 0, rngItem = 0;
+
+  Rng* moduleRng() {
+    if (!rngReady) {
+      rng.reseed(deriveSeed(seed, {rngStream, rngItem}));
+      rngReady = true;
+    }
+    return &rng;
+  }
+
+  // ---- matching -------------------------------------------------------------------------
+
+  void computeBrackets(const ModuleString& s) {
+    size_t n = s.size();
+    match.assign(n, -1);
+    std::vector<int32_t> stack;
+    for (size_t i = 0; i < n; ++i) {
+      SymbolId c = s.symbols[i];
+      if (c == prog->openBracket) {
+        stack.push_back(static_cast<int32_t>(i));
+        match[i] = static_cast<int32_t>(n);  // unmatched: its branch runs to the end
+      } else if (c == prog->closeBracket && !stack.empty()) {
+        match[i] = stack.back();
+        match[stack.back()] = static_cast<int32_t>(i);
+        stack.pop_back();
+      }
+    }
+  }
+
+  static void bind(const ModuleString& s, size_t i, uint16_t firstVar, uint16_t count, double* vars) {
+    const double* p = s.params.data() + s.offsets[i];
+    for (uint16_t k = 0; k < count; ++k) vars[firstVar + k] = p[k];
+  }
+
+  /// lpfg right context: skips ignored symbols and whole [...] branches; fails at `]`.
+  bool matchRight(const ModuleString& s, size_t i, const std::vector<PatternItem>& pat, double* vars) const {
+    const size_t n = s.size();
+    size_t j = i + 1;
+    for (const PatternItem& it : pat) {
+      if (it.closeBracket) {  // skip the rest of the current branch, consume its `]`
+        while (j < n && s.symbols[j] != prog->closeBracket) {
+          if (s.symbols[j] == prog->openBracket) j = static_cast<size_t>(match[j]);
+          ++j;
+        }
+        if (j >= n) return false;
+        ++j;
+        continue;
+      }
+      for (;;) {
+        if (j >= n) return false;
+        SymbolId c = s.symbols[j];
+        if (c == prog->openBracket) {
+          if (it.openBracket) break;
+          j = static_cast<size_t>(match[j]) + 1;
+        } else if (c == prog->closeBracket) {
+          return false;
+        } else if (prog->ignored[c]) {
+          ++j;
+        } else {
+          break;
+        }
+      }
+      if (it.openBracket) {
+        ++j;
+        continue;
+      }
+      if (s.symbols[j] != it.symbol || s.paramCount(j) != it.paramCount) return false;
+      bind(s, j, it.firstVar, it.paramCount, vars);
+      ++j;
+    }
+    return true;
+  }
+
+  /// lpfg left context: skips ignored symbols, `[`, and whole branches that end in `]`.
+  bool matchLeft(const ModuleString& s, size_t i, const std::vector<PatternItem>& pat, double* vars) const {
+    ptrdiff_t j = static_cast<ptrdiff_t>(i) - 1;
+    for (auto it = pat.rbegin(); it != pat.rend(); ++it) {
+      for (;;) {
+        if (j < 0) return false;
+        SymbolId c = s.symbols[j];
+        if (c == prog->closeBracket) {
+          if (match[j] < 0) return false;
+          j = match[j] - 1;
+        } else if (c == prog->openBracket || prog->ignored[c]) {
+          --j;
+        } else {
+          break;
+        }
+      }
+      if (s.symbols[j] != it->symbol || s.paramCount(j) != it->paramCount) return false;
+      bind(s, static_cast<size_t>(j), it->firstVar, it->paramCount, vars);
+      --j;
+    }
+    return true;
+  }
+
+  /// Binds p's formal parameters at module i when the predecessor and contexts match.
+  bool matches(const Production& p, const ModuleString& s, size_t i, double* vars) const {
+    if (s.paramCount(i) != p.predParams) return false;
+    bind(s, i, p.predFirstVar, p.predParams, vars);
+    if (!p.left.empty() && !matchLeft(s, i, p.left, vars)) return false;
+    if (!p.right.empty() && !matchRight(s, i, p.right, vars)) return false;
+    return true;
+  }
+
+  bool condition(const Production& p, const double* vars, int step) {
+    if (p.condition.empty()) return true;
+    const Instr* code = prog->code.data();
+    double v = detail::evalCode(code + p.condition.begin, code + p.condition.end, vars, p.usesRandom ? moduleRng() : nullptr);
+    if (std::isnan(v))
+      throw InputError(p.loc, "the condition of production '" + p.text + "' is not a number (nan) at step " + std::to_string(step), p.sourceLine);
+    return v != 0.0;
+  }
+
+  /// The production applied to module i of s, with its parameters bound in vars; null to copy.
+  const Production* choose(const RuleSet& rs, const ModuleString& s, size_t i, double* vars, int step) {
+    const std::vector<uint32_t>& cand = rs.bySymbol[s.symbols[i]];
+    for (size_t k = 0; k < cand.size(); ++k) {
+      const Production& p = rs.productions[cand[k]];
+      if (!matches(p, s, i, vars) || !condition(p, vars, step)) continue;
+      if (!p.stochastic) return &p;
+      // Stochastic: choose among every matching weighted production from here on,
+      // with probability proportional to its weight.
+      double weights[64];
+      uint32_t ids[64];
+      int count = 0;
+      double total = 0;
+      for (size_t q = k; q < cand.size() && count < 64; ++q) {
+        const Production& pq = rs.productions[cand[q]];
+        if (!pq.stochastic) continue;
+        if (q != k && (!matches(pq, s, i, vars) || !condition(pq, vars, step))) continue;
+        weights[count] = pq.weight;
+        ids[count++] = cand[q];
+        total += pq.weight;
+      }
+      if (total <= 0) return nullptr;
+      double r = moduleRng()->uniform() * total;
+      int pick = count - 1;
+      for (int c = 0; c < count; ++c) {
+        if (r < weights[c]) {
+          pick = c;
+          break;
+        }
+        r -= weights[c];
+      }
+      const Production& chosen = rs.productions[ids[pick]];
+      matches(chosen, s, i, vars);  // rebind its parameters
+      return &chosen;
+    }
+    return nullptr;
+  }
+
+  // ---- successors -------------------------------------------------------------------------
+
+  [[noreturn]] void nonFinite(const Production& p, const SuccModule& m, int argIndex, double v, int step) const {
+    throw InputError(p.loc,
+                     "non-finite parameter value (" + numberText(v) + ") in production '" + p.text + "' at step " + std::to_string(step) +
+                         " (parameter " + std::to_string(argIndex + 1) + " of '" + prog->symbols.name(m.symbol) + "')",
+                     p.sourceLine);
+  }
+
+  double evalArg(const Production& p, const SuccModule& m, int k, const double* vars, int step) {
+    const Arg& a = p.args[m.firstArg + k];
+    double v;
+    switch (a.kind) {
+      case ArgKind::Const: return a.c;
+      case ArgKind::Var: return vars[a.var];
+      case ArgKind::VarAddConst: v = vars[a.var] + a.c; break;
+      case ArgKind::VarMulConst: v = vars[a.var] * a.c; break;
+      case ArgKind::VarDivConst: v = vars[a.var] / a.c; break;
+      default: {
+        const Instr* code = prog->code.data();
+        v = detail::evalCode(code + a.code.begin, code + a.code.end, vars, p.usesRandom ? moduleRng() : nullptr);
+      }
+    }
+    if (!std::isfinite(v)) [[unlikely]]
+      nonFinite(p, m, k, v, step);
+    return v;
+  }
+
+  /// Writes p's successor (decomposing it when the grammar has decomposition rules).
+  void emit(Writer& w, const Production& p, const double* vars, int32_t birth, int step, int depth) {
+    if (prog->decomposition.empty()) {
+      w.reserve(p.successor.size(), p.args.size());
+      for (const SuccModule& m : p.successor) {
+        w.begin(m.symbol, birth);
+        for (int k = 0; k < m.argCount; ++k) w.param(evalArg(p, m, k, vars, step));
+        w.end();
+      }
+      return;
+    }
+    if (scratch.size() <= static_cast<size_t>(depth)) scratch.resize(depth + 1);
+    for (const SuccModule& m : p.successor) {
+      std::vector<double>& tmp = scratch[depth];
+      tmp.resize(m.argCount);
+      for (int k = 0; k < m.argCount; ++k) tmp[k] = evalArg(p, m, k, vars, step);
+      emitDecomposed(w, m.symbol, tmp.data(), m.argCount, birth, step, depth);
+    }
+  }
+
+  /// Writes one module, replacing it by its decomposition (recursively, up to maximum depth).
+  void emitDecomposed(Writer& w, SymbolId sym, const double* params, uint32_t count, int32_t birth, int step, int depth) {
+    const RuleSet& rs = prog->decomposition;
+    if (depth < rs.maxDepth && !rs.bySymbol[sym].empty()) {
+      double vars[detail::kMaxVars];
+      for (uint32_t idx : rs.bySymbol[sym]) {
+        const Production& p = rs.productions[idx];
+        if (count != p.predParams) continue;
+        for (uint32_t k = 0; k < count; ++k) vars[p.predFirstVar + k] = params[k];
+        if (!condition(p, vars, step)) continue;
+        // Stochastic decomposition rules: weighted choice among the matching ones.
+        const Production* chosen = &p;
+        if (p.stochastic) {
+          ModuleString one;
+          one.push(sym, {params, count});
+          chosen = choose(rs, one, 0, vars, step);
+          if (!chosen) break;
+        }
+        emit(w, *chosen, vars, birth, step, depth + 1);
+        return;
+      }
+    }
+    w.reserve(1, count);
+    w.copy(sym, params, count, birth);
+  }
+
+  // ---- steps ----------------------------------------------------------------------------
+
+  /// Rewrites cur into next with rules rs (one derivation step when rs is the main block).
+  void rewrite(const RuleSet& rs, int step, uint64_t stream, bool productionStep) {
+    const ModuleString& in = cur;
+    const size_t n = in.size();
+    const bool births = opt.trackBirthSteps;
+    Writer w(next, births, opt.maxModules, prog->fileName, step);
+    if (rs.anyContext) computeBrackets(in);
+    double vars[detail::kMaxVars];
+    const bool decompose = !prog->decomposition.empty();
+    const SymbolId* syms = in.symbols.data();
+    const uint32_t* offs = in.offsets.data();
+    const double* pars = in.params.data();
+    rngStream = stream;
+    for (size_t i = 0; i < n; ++i) {
+      SymbolId sym = syms[i];
+      int32_t birth = births ? in.birthSteps[i] : 0;
+      rngReady = false;
+      rngItem = i;
+      const Production* p = rs.bySymbol[sym].empty() ? nullptr : choose(rs, in, i, vars, step);
+      if (!p) {
+        if (decompose && productionStep) {
+          emitDecomposed(w, sym, pars + offs[i], offs[i + 1] - offs[i], birth, step, 0);
+        } else {
+          uint32_t count = offs[i + 1] - offs[i];
+          w.reserve(1, count);
+          w.copy(sym, pars + offs[i], count, birth);
+        }
+        continue;
+      }
+      emit(w, *p, vars, productionStep ? step : birth, step, 0);
+    }
+    w.finish();
+    written += w.modules();
+    std::swap(cur, next);
+    if (prog->usesCut) applyCuts(cur);
+  }
+
+  /// Removes every `%` and the rest of its branch (up to, not including, the closing `]`).
+  void applyCuts(ModuleString& s) const {
+    const size_t n = s.size();
+    const bool births = s.birthSteps.size() == n && n > 0;
+    size_t j = 0, pj = 0;
+    size_t i = 0;
+    bool any = false;
+    while (i < n) {
+      if (s.symbols[i] == prog->cut) {
+        any = true;
+        int depth = 0;
+        ++i;
+        for (; i < n; ++i) {
+          SymbolId c = s.symbols[i];
+          if (c == prog->openBracket) ++depth;
+          else if (c == prog->closeBracket && depth-- == 0) break;
+        }
+        continue;
+      }
+      uint32_t b = s.offsets[i], e = s.offsets[i + 1];
+      s.symbols[j] = s.symbols[i];
+      if (births) s.birthSteps[j] = s.birthSteps[i];
+      for (uint32_t k = b; k < e; ++k) s.params[pj++] = s.params[k];
+      s.offsets[j + 1] = static_cast<uint32_t>(pj);
+      ++j;
+      ++i;
+    }
+    if (!any) return;
+    s.symbols.resize(j);
+    s.offsets.resize(j + 1);
+    s.params.resize(pj);
+    if (births) s.birthSteps.resize(j);
+  }
+
+  void start() {
+    cur = prog->axiom;
+    if (cur.size() > opt.maxModules)
+      throw InputError(SourceLoc{prog->fileName, 0, 0},
+                       "derivation would exceed " + std::to_string(opt.maxModules) + " modules at step 0");
+    if (opt.trackBirthSteps) cur.birthSteps.assign(cur.size(), 0);
+    if (!prog->decomposition.empty()) {
+      RuleSet none;
+      none.bySymbol.assign(prog->symbols.size(), {});
+      rewrite(none, 0, 0, true);
+    } else if (prog->usesCut) {
+      applyCuts(cur);
+    }
+    written = 0;
+  }
+};
+
+Deriver::Deriver(const Grammar& grammar, DeriveOptions options) : impl_(std::make_unique<Impl>()) {
+  impl_->grammar = grammar;
+  impl_->prog = &grammar.program();
+  impl_->steps = options.steps.value_or(grammar.derivationLength());
+  impl_->seed = options.seed.value_or(grammar.seed());
+  impl_->opt = std::move(options);
+  impl_->start();
+}
+
+Deriver::~Deriver() = default;
+Deriver::Deriver(Deriver&&) noexcept = default;
+Deriver& Deriver::operator=(Deriver&&) noexcept = default;
+
+const ModuleString& Deriver::step() {
+  Impl& m = *impl_;
+  int step = m.done + 1;
+  m.rewrite(m.prog->productions, step, static_cast<uint64_t>(step), true);
+  m.done = step;
+  if (m.opt.onStep) m.opt.onStep(step, m.cur.size());
+  return m.cur;
+}
+
+const ModuleString& Deriver::derive() {
+  while (impl_->done < impl_->steps) step();
+  return impl_->cur;
+}
+
+const ModuleString& Deriver::current() const { return impl_->cur; }
+int Deriver::stepsDone() const { return impl_->done; }
+int Deriver::steps() const { return impl_->steps; }
+uint64_t Deriver::seed() const { return impl_->seed; }
+const SymbolTable& Deriver::symbols() const { return impl_->prog->symbols; }
+uint64_t Deriver::modulesWritten() const { return impl_->written; }
+
+ModuleString Deriver::interpret(const ModuleString& s) const {
+  const Program& prog = *impl_->prog;
+  if (prog.interpretation.empty()) return s;
+  // A private Impl shares the program and seed so interpret() stays const on this Deriver.
+  Impl tmp;
+  tmp.prog = impl_->prog;
+  tmp.seed = impl_->seed;
+  tmp.opt.maxModules = impl_->opt.maxModules;
+  tmp.opt.trackBirthSteps = s.hasBirthSteps();
+  tmp.cur = s;
+  // Interpretation recursion: depth 1 is one rewrite; deeper levels rewrite what the
+  // previous level produced (modules no rule matches stay as they are).
+  const RuleSet& rs = prog.interpretation;
+  for (int depth = 0; depth < rs.maxDepth; ++depth) {
+    bool any = false;
+    for (SymbolId id : tmp.cur.symbols)
+      if (!rs.bySymbol[id].empty()) {
+        any = true;
+        break;
+      }
+    if (!any) break;
+    tmp.rewrite(rs, impl_->done, kInterpretStream - static_cast<uint64_t>(depth), false);
+  }
+  return std::move(tmp.cur);
+}
+
+ModuleString derive(const Grammar& grammar, const DeriveOptions& options) {
+  Deriver d(grammar, options);
+  return d.derive();
+}
+
+std::string formatModuleString(const ModuleString& s, const SymbolTable& symbols, const FormatOptions& options) {
+  std::string out;
+  size_t lineStart = 0;
+  char buf[64];
+  for (size_t i = 0; i < s.size(); ++i) {
+    const std::string& name = symbols.name(s.symbols[i]);
+    if (options.wrapColumn && out.size() - lineStart >= options.wrapColumn) {
+      out += '\n';
+      lineStart = out.size();
+    } else if (i > 0 && s.paramCount(i - 1) == 0) {
+      const std::string& prev = symbols.name(s.symbols[i - 1]);
+      bool prevWord = prev.size() > 1 && std::isalnum(static_cast<unsigned char>(prev.back()));
+      if (prevWord && std::isalnum(static_cast<unsigned char>(name[0]))) out += ' ';
+    }
+    out += name;
+    uint32_t count = s.paramCount(i);
+    if (count) {
+      out += '(';
+      auto p = s.paramsOf(i);
+      for (uint32_t k = 0; k < count; ++k) {
+        if (k) out += ',';
+        auto r = std::to_chars(buf, buf + sizeof buf, p[k]);
+        out.append(buf, r.ptr);
+      }
+      out += ')';
+    }
+  }
+  return out;
+}
+
+size_t countSymbol(const ModuleString& s, const SymbolTable& symbols, std::string_view name) {
+  int id = symbols.find(name);
+  if (id < 0) return 0;
+  return static_cast<size_t>(std::count(s.symbols.begin(), s.symbols.end(), static_cast<SymbolId>(id)));
+}
+
+}  // namespace sprig::lsystem

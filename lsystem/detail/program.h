@@ -1,0 +1,171 @@
+#pragma once
+/// The compiled form of a Grammar: productions with successor templates and expression
+/// bytecode. Private to lsystem/; parseGrammar writes it, Deriver reads it.
+///
+/// Expressions compile to a flat postfix tape (Instr) evaluated on a small value stack;
+/// constants (`#define`s included) are folded at compile time, and the common argument
+/// shapes `x`, `c`, `x op c` bypass the VM entirely (ArgKind). Formal parameters of a
+/// production (left context, predecessor, right context, in textual order) live in one
+/// register file `vars` of at most kMaxVars doubles.
+
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/diagnostics.h"
+#include "core/rng.h"
+#include "core/types.h"
+#include "lsystem/module_string.h"
+
+namespace sprig::lsystem::detail {
+
+inline constexpr int kMaxVars = 64;   ///< formal parameters per production
+inline constexpr int kMaxStack = 64;  ///< expression nesting depth
+
+enum class Op : uint8_t {
+  Const, Var, Add, Sub, Mul, Div, Pow, Neg, Not, Lt, Le, Gt, Ge, Eq, Ne, And, Or,
+  Sin, Cos, Tan, Asin, Acos, Atan, Atan2, Sqrt, Exp, Log, PowFn, Abs, Min, Max, Floor, Ceil, Sign,
+  Ran, Nran,
+};
+
+/// One bytecode instruction: push a constant or variable, or pop operands and push a result.
+struct Instr {
+  Op op = Op::Const;
+  uint16_t var = 0;  ///< Var: register index
+  double c = 0;      ///< Const: the value
+};
+
+/// A range [begin, end) of Program::code.
+struct CodeRange {
+  uint32_t begin = 0;
+  uint32_t end = 0;
+  bool empty() const { return begin == end; }
+};
+
+/// Evaluates one expression. rng is used only by Ran/Nran (never null when the
+/// expression draws: the compiler marks such productions usesRandom).
+inline double evalCode(const Instr* code, const Instr* end, const double* vars, Rng* rng) {
+  double stack[kMaxStack];
+  int sp = 0;
+  constexpr double kDeg = kPi / 180.0;
+  for (const Instr* in = code; in != end; ++in) {
+    switch (in->op) {
+      case Op::Const: stack[sp++] = in->c; break;
+      case Op::Var: stack[sp++] = vars[in->var]; break;
+      case Op::Add: --sp; stack[sp - 1] += stack[sp]; break;
+      case Op::Sub: --sp; stack[sp - 1] -= stack[sp]; break;
+      case Op::Mul: --sp; stack[sp - 1] *= stack[sp]; break;
+      case Op::Div: --sp; stack[sp - 1] /= stack[sp]; break;
+      case Op::Pow: case Op::PowFn: --sp; stack[sp - 1] = std::pow(stack[sp - 1], stack[sp]); break;
+      case Op::Neg: stack[sp - 1] = -stack[sp - 1]; break;
+      case Op::Not: stack[sp - 1] = stack[sp - 1] == 0.0 ? 1.0 : 0.0; break;
+      case Op::Lt: --sp; stack[sp - 1] = stack[sp - 1] < stack[sp] ? 1.0 : 0.0; break;
+      case Op::Le: --sp; stack[sp - 1] = stack[sp - 1] <= stack[sp] ? 1.0 : 0.0; break;
+      case Op::Gt: --sp; stack[sp - 1] = stack[sp - 1] > stack[sp] ? 1.0 : 0.0; break;
+      case Op::Ge: --sp; stack[sp - 1] = stack[sp - 1] >= stack[sp] ? 1.0 : 0.0; break;
+      case Op::Eq: --sp; stack[sp - 1] = stack[sp - 1] == stack[sp] ? 1.0 : 0.0; break;
+      case Op::Ne: --sp; stack[sp - 1] = stack[sp - 1] != stack[sp] ? 1.0 : 0.0; break;
+      case Op::And: --sp; stack[sp - 1] = (stack[sp - 1] != 0.0 && stack[sp] != 0.0) ? 1.0 : 0.0; break;
+      case Op::Or: --sp; stack[sp - 1] = (stack[sp - 1] != 0.0 || stack[sp] != 0.0) ? 1.0 : 0.0; break;
+      case Op::Sin: stack[sp - 1] = std::sin(stack[sp - 1] * kDeg); break;
+      case Op::Cos: stack[sp - 1] = std::cos(stack[sp - 1] * kDeg); break;
+      case Op::Tan: stack[sp - 1] = std::tan(stack[sp - 1] * kDeg); break;
+      case Op::Asin: stack[sp - 1] = std::asin(stack[sp - 1]) / kDeg; break;
+      case Op::Acos: stack[sp - 1] = std::acos(stack[sp - 1]) / kDeg; break;
+      case Op::Atan: stack[sp - 1] = std::atan(stack[sp - 1]) / kDeg; break;
+      case Op::Atan2: --sp; stack[sp - 1] = std::atan2(stack[sp - 1], stack[sp]) / kDeg; break;
+      case Op::Sqrt: stack[sp - 1] = std::sqrt(stack[sp - 1]); break;
+      case Op::Exp: stack[sp - 1] = std::exp(stack[sp - 1]); break;
+      case Op::Log: stack[sp - 1] = std::log(stack[sp - 1]); break;
+      case Op::Abs: stack[sp - 1] = std::fabs(stack[sp - 1]); break;
+      case Op::Min: --sp; stack[sp - 1] = std::fmin(stack[sp - 1], stack[sp]); break;
+      case Op::Max: --sp; stack[sp - 1] = std::fmax(stack[sp - 1], stack[sp]); break;
+      case Op::Floor: stack[sp - 1] = std::floor(stack[sp - 1]); break;
+      case Op::Ceil: stack[sp - 1] = std::ceil(stack[sp - 1]); break;
+      case Op::Sign: stack[sp - 1] = stack[sp - 1] > 0 ? 1.0 : (stack[sp - 1] < 0 ? -1.0 : 0.0); break;
+      case Op::Ran: stack[sp - 1] = rng->uniform() * stack[sp - 1]; break;
+      case Op::Nran: --sp; stack[sp - 1] = rng->normal(stack[sp - 1], stack[sp]); break;
+    }
+  }
+  return stack[0];
+}
+
+/// How one successor parameter is computed.
+enum class ArgKind : uint8_t { Const, Var, VarAddConst, VarMulConst, VarDivConst, Expr };
+
+struct Arg {
+  ArgKind kind = ArgKind::Const;
+  uint16_t var = 0;
+  double c = 0;
+  CodeRange code;  ///< Expr only
+};
+
+/// One module of a successor template: its symbol and its arguments
+/// Production::args[firstArg .. firstArg + argCount).
+struct SuccModule {
+  SymbolId symbol = 0;
+  uint16_t argCount = 0;
+  uint32_t firstArg = 0;
+};
+
+/// One item of a context pattern: a symbol with its formal parameters, or a bracket.
+struct PatternItem {
+  SymbolId symbol = 0;
+  uint16_t paramCount = 0;
+  uint16_t firstVar = 0;  ///< register of its first formal parameter
+  bool openBracket = false;
+  bool closeBracket = false;
+};
+
+/// One compiled production `lc < pred > rc : cond --> succ : weight`.
+struct Production {
+  SourceLoc loc;          ///< position of the predecessor
+  std::string text;       ///< the predecessor as written (for messages)
+  std::string sourceLine; ///< the production's line (for messages)
+  SymbolId predecessor = 0;
+  uint16_t predParams = 0;
+  uint16_t predFirstVar = 0;
+  std::vector<PatternItem> left;   ///< in textual order
+  std::vector<PatternItem> right;  ///< in textual order
+  CodeRange condition;             ///< empty: always true
+  std::vector<SuccModule> successor;
+  std::vector<Arg> args;
+  bool stochastic = false;
+  double weight = 1;
+  bool usesRandom = false;  ///< condition or successor calls ran/nran
+  bool hasContext() const { return !left.empty() || !right.empty(); }
+};
+
+/// A block of productions with a lookup table by predecessor symbol.
+struct RuleSet {
+  std::vector<Production> productions;
+  /// bySymbol[s] lists indices into productions whose predecessor is s, in file order.
+  std::vector<std::vector<uint32_t>> bySymbol;
+  int maxDepth = 1;  ///< decomposition / interpretation recursion depth
+  bool anyContext = false;
+  bool empty() const { return productions.empty(); }
+};
+
+/// A compiled grammar.
+struct Program {
+  std::string fileName;
+  std::string name;
+  int derivationLength = 0;
+  uint64_t seed = 0;
+  bool hasAngle = false;
+  double angleDeg = 0;
+  SymbolTable symbols;
+  ModuleString axiom;
+  std::vector<std::pair<std::string, double>> defines;
+  std::vector<Instr> code;
+  RuleSet productions;
+  RuleSet decomposition;
+  RuleSet interpretation;
+  std::vector<uint8_t> ignored;  ///< per symbol: skipped by context matching
+  SymbolId openBracket = 0, closeBracket = 0, cut = 0;
+  /// True when some successor or the axiom contains the cut symbol `%`.
+  bool usesCut = false;
+};
+
+}  // namespace sprig::lsystem::detail
