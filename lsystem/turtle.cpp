@@ -4,6 +4,10 @@
 #include <cmath>
 #include <string_view>
 
+#ifdef __linux__
+#include <sys/mman.h>
+#endif
+
 namespace sprig::lsystem {
 
 namespace {
@@ -39,6 +43,22 @@ class SinCosCache {
   };
   Entry entries_[kSize];
 };
+
+/// Large fresh outputs are dominated by first-touch page faults (about half the time
+/// for a 2-million-internode skeleton); asking Linux for transparent huge pages on the
+/// buffer cuts the number of faults 512-fold. A hint only: failure changes nothing.
+void adviseHugePages(void* data, size_t bytes) {
+#ifdef __linux__
+  constexpr uintptr_t kHuge = uintptr_t(2) << 20;
+  if (bytes < 4 * kHuge) return;
+  uintptr_t begin = (reinterpret_cast<uintptr_t>(data) + kHuge - 1) & ~(kHuge - 1);
+  uintptr_t end = (reinterpret_cast<uintptr_t>(data) + bytes) & ~(kHuge - 1);
+  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
+#else
+  (void)data;
+  (void)bytes;
+#endif
+}
 
 void orthonormalize(TurtleFrame& f) {
   f.heading = glm::normalize(f.heading);
@@ -133,6 +153,13 @@ Turtle::Turtle(const SymbolTable& symbols, TurtleSettings settings) : symbols_(s
 
 Skeleton Turtle::run(const ModuleString& ms, std::span<const int32_t> moduleSteps) {
   Skeleton sk;
+  run(ms, sk, moduleSteps);
+  return sk;
+}
+
+void Turtle::run(const ModuleString& ms, Skeleton& sk, std::span<const int32_t> moduleSteps) {
+  sk.internodes.clear();
+  sk.organs.clear();
   const size_t n = ms.size();
   const SymbolId* sym = ms.symbols.data();
   const uint32_t* off = ms.offsets.data();
@@ -141,6 +168,17 @@ Skeleton Turtle::run(const ModuleString& ms, std::span<const int32_t> moduleStep
   const size_t ncmd = commands_.size();
   if (moduleSteps.empty() && ms.hasBirthSteps()) moduleSteps = ms.birthSteps;
   const bool haveSteps = moduleSteps.size() >= n;
+
+  {
+    // Reserve the exact number of drawing modules: cheaper than growing the vector.
+    size_t draws = 0;
+    for (size_t i = 0; i < n; ++i) {
+      Command c = sym[i] < ncmd ? cmd[sym[i]] : Command::None;
+      draws += c == Command::Forward || c == Command::ForwardNoVertex;
+    }
+    sk.internodes.reserve(draws);
+    adviseHugePages(sk.internodes.data(), sk.internodes.capacity() * sizeof(Internode));
+  }
 
   TurtleState st;
   st.frame.position = settings_.origin;
@@ -343,7 +381,6 @@ Skeleton Turtle::run(const ModuleString& ms, std::span<const int32_t> moduleStep
       }
     }
   }
-  return sk;
 }
 
 Skeleton interpret(const ModuleString& modules, const SymbolTable& symbols, const TurtleSettings& settings,

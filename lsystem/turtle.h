@@ -77,6 +77,8 @@ class Turtle {
   /// string's own birthSteps are used if it has them, else steps are 0.
   /// Cost: O(modules), one pass, no per-module allocation.
   Skeleton run(const ModuleString& modules, std::span<const int32_t> moduleSteps = {});
+  /// As above, drawing into `out` (cleared first, capacity kept): repeated runs reuse memory.
+  void run(const ModuleString& modules, Skeleton& out, std::span<const int32_t> moduleSteps = {});
 
   /// The turtle's state after the last module of the last run().
   const TurtleState& endState() const { return end_; }
