@@ -30,9 +30,17 @@ void basisAround(const Vec3& n, Vec3& a, Vec3& b) {
 
 float next(Rng& rng) { return static_cast<float>(rng.uniform()); }
 
+/// A 2D point in stratum j of an n-point near-square jittered grid.
+Vec2 stratified(int j, int n, Rng& rng) {
+  int gx = std::max(1, static_cast<int>(std::floor(std::sqrt(static_cast<double>(n)))));
+  int gy = (n + gx - 1) / gx;
+  float jx = next(rng), jy = next(rng);
+  return {(static_cast<float>(j % gx) + jx) / static_cast<float>(gx), (static_cast<float>(j / gx) + jy) / static_cast<float>(gy)};
+}
+
 /// Uniform direction within a cone of half-angle with cosine cosMax around axis.
-Vec3 sampleCone(const Vec3& axis, float cosMax, Rng& rng) {
-  float u1 = next(rng), u2 = next(rng);
+Vec3 sampleCone(const Vec3& axis, float cosMax, Vec2 u) {
+  float u1 = u.x, u2 = u.y;
   float cosT = 1.0f - u1 * (1.0f - cosMax);
   float sinT = std::sqrt(std::max(0.0f, 1.0f - cosT * cosT));
   float phi = static_cast<float>(2.0 * kPi) * u2;
@@ -42,8 +50,8 @@ Vec3 sampleCone(const Vec3& axis, float cosMax, Rng& rng) {
 }
 
 /// Cosine-weighted direction in the hemisphere around n.
-Vec3 sampleCosine(const Vec3& n, Rng& rng) {
-  float u1 = next(rng), u2 = next(rng);
+Vec3 sampleCosine(const Vec3& n, Vec2 u) {
+  float u1 = u.x, u2 = u.y;
   float r = std::sqrt(u1), phi = static_cast<float>(2.0 * kPi) * u2;
   Vec3 a, b;
   basisAround(n, a, b);
@@ -52,6 +60,16 @@ Vec3 sampleCosine(const Vec3& n, Rng& rng) {
 
 struct Counters {
   uint64_t camera = 0, shadow = 0, sky = 0;
+};
+
+/// Which strata of the pixel's light samples one camera sample uses: the sun disc and
+/// the sky hemisphere are stratified over all samples of a pixel, with a per-pixel
+/// cyclic shift so light strata do not follow the film strata.
+struct Strata {
+  int sample = 0;     ///< camera sample index k in [0, spp)
+  int spp = 1;
+  int sunShift = 0;   ///< per-pixel shift of the sun stratum
+  int skyShift = 0;   ///< per-pixel shift of the sky strata
 };
 
 /// Per-render constants and the shading of one camera sample.
@@ -69,7 +87,7 @@ class Integrator {
   }
 
   /// Radiance and alpha seen through film point (fx, fy).
-  Vec4 sample(float fx, float fy, Rng& rng, Counters& c) const {
+  Vec4 sample(float fx, float fy, const Strata& st, Rng& rng, Counters& c) const {
     Ray ray = camera_.generateRay(fx, fy, s_.width, s_.height);
     ++c.camera;
     Vec3 bg = background(fy);
@@ -79,7 +97,7 @@ class Integrator {
     float tGround = groundHit(ray.origin, ray.direction);
     if (hit && hit->t <= tGround) {
       const Material& m = scene_.material(hit->material);
-      return Vec4(shade(*hit, m, ray.direction, rng, c), 1.0f);
+      return Vec4(shade(*hit, m, ray.direction, st, rng, c), 1.0f);
     }
     if (tGround < kInf) {
       SurfaceHit g;
@@ -91,7 +109,7 @@ class Integrator {
       Material m;
       m.roughness = 1.0f;
       m.specular = 0.0f;
-      Vec3 lit = shade(g, m, ray.direction, rng, c);
+      Vec3 lit = shade(g, m, ray.direction, st, rng, c);
       // Fade the far ground into the background so the horizon is soft.
       float dist = glm::length(Vec3(g.position.x - center_.x, 0, g.position.z - center_.z)) / radius_;
       float f = std::clamp((dist - s_.groundFade) / (3.0f * s_.groundFade), 0.0f, 1.0f);
@@ -127,7 +145,7 @@ class Integrator {
     return glm::mix(s_.skyHorizon, s_.skyZenith, t);
   }
 
-  Vec3 shade(SurfaceHit h, const Material& m, const Vec3& dir, Rng& rng, Counters& c) const {
+  Vec3 shade(SurfaceHit h, const Material& m, const Vec3& dir, const Strata& st, Rng& rng, Counters& c) const {
     // Face both normals toward the viewer: leaves and thin parts are two-sided.
     if (glm::dot(h.geometricNormal, dir) > 0.0f) h.geometricNormal = -h.geometricNormal;
     if (glm::dot(h.normal, dir) > 0.0f) h.normal = -h.normal;
@@ -137,7 +155,8 @@ class Integrator {
     Vec3 radiance(0);
 
     if (s_.sun) {
-      Vec3 l = sunCos_ < 1.0f ? sampleCone(sunDir_, sunCos_, rng) : sunDir_;
+      Vec2 u = stratified((st.sample + st.sunShift) % st.spp, st.spp, rng);
+      Vec3 l = sunCos_ < 1.0f ? sampleCone(sunDir_, sunCos_, u) : sunDir_;
       float cosL = glm::dot(n, l);
       if (cosL > 0.0f && glm::dot(ng, l) > -0.05f) {
         bool lit = true;
@@ -161,7 +180,8 @@ class Integrator {
         skyLight = sky(n, h.position);
       } else {
         for (int k = 0; k < s_.skySamples; ++k) {
-          Vec3 d = sampleCosine(n, rng);
+          int total = st.spp * s_.skySamples;
+          Vec3 d = sampleCosine(n, stratified((st.sample * s_.skySamples + k + st.skyShift) % total, total, rng));
           if (glm::dot(d, ng) <= 0.0f) continue;
           ++c.sky;
           if (!scene_.occluded(origin, d, 0.0f, kInf)) skyLight += sky(d, h.position);
@@ -226,12 +246,17 @@ Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings
     for (int y = ay0; y < ay1; ++y) {
       for (int x = ax0; x < ax1; ++x) {
         Rng rng(deriveSeed(s.seed, {static_cast<uint64_t>(x), static_cast<uint64_t>(y)}));
+        Strata st;
+        st.spp = spp;
+        st.sunShift = static_cast<int>(rng.below(static_cast<uint32_t>(spp)));
+        st.skyShift = static_cast<int>(rng.below(static_cast<uint32_t>(spp * std::max(1, s.skySamples))));
         FilmSample* out = &samples[(static_cast<size_t>(y - ay0) * aw + (x - ax0)) * spp];
         for (int k = 0; k < spp; ++k) {
           float jx = next(rng), jy = next(rng);
           float fx = static_cast<float>(x) + (static_cast<float>(k % gx) + jx) / static_cast<float>(gx);
           float fy = static_cast<float>(y) + (static_cast<float>(k / gx) + jy) / static_cast<float>(gy);
-          out[k] = {fx, fy, integrator.sample(fx, fy, rng, c)};
+          st.sample = k;
+          out[k] = {fx, fy, integrator.sample(fx, fy, st, rng, c)};
         }
       }
     }

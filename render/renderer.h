@@ -45,21 +45,21 @@ struct RenderSettings {
   bool sun = true;
   double sunAzimuthDeg = -50.0;   ///< direction toward the sun, same convention as ViewSpec
   double sunElevationDeg = 50.0;
-  double sunAngleDeg = 1.5;       ///< angular radius of the sun disc (0 = hard shadows)
+  double sunAngleDeg = 0.6;       ///< angular radius of the sun disc (0 = hard shadows)
   Vec3 sunColor{1.0f, 0.95f, 0.88f};
-  float sunStrength = 2.4f;       ///< irradiance scale of the sun
+  float sunStrength = 1.6f;       ///< irradiance scale of the sun
   bool shadows = true;            ///< cast shadow rays toward the sun
 
   Vec3 skyZenith{0.50f, 0.65f, 0.95f};   ///< sky radiance overhead (before skyStrength)
   Vec3 skyHorizon{0.90f, 0.93f, 1.00f};  ///< sky radiance at the horizon
-  float skyStrength = 0.55f;      ///< scale of the sky light
+  float skyStrength = 0.5f;      ///< scale of the sky light
   int skySamples = 1;             ///< ambient-occlusion rays per camera sample (0 = unoccluded sky)
   float fillStrength = 0.0f;      ///< unshadowed light from the camera direction (0 = off)
 
   bool ground = true;             ///< analytic ground plane under the model
   bool groundAtModelBase = true;  ///< put the plane at the scene's lowest y (else at groundHeight)
   float groundHeight = 0.0f;
-  Vec3 groundColor{0.45f, 0.42f, 0.37f};
+  Vec3 groundColor{0.34f, 0.31f, 0.26f};
   float groundFade = 6.0f;        ///< ground fades into the background beyond this many model radii
 
   float exposure = 0.0f;          ///< stops; linear values are multiplied by 2^exposure

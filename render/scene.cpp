@@ -111,13 +111,17 @@ std::vector<uint32_t> Scene::addSkeleton(const lsystem::Skeleton& skeleton, cons
     // shared vertices of one curve rather than two overlapping caps.
     std::vector<int32_t> next(nodes.size(), -1);
     std::vector<char> continues(nodes.size(), 0);
-    for (size_t i = 0; i < nodes.size(); ++i) {
-      int32_t p = nodes[i].parent;
-      if (p < 0 || static_cast<size_t>(p) >= nodes.size() || next[p] >= 0) continue;
-      double tol = 1e-6 * std::max(1.0, nodes[p].length());
-      if (glm::length(nodes[i].start - nodes[p].end) <= tol) {
-        next[p] = static_cast<int32_t>(i);
-        continues[i] = 1;
+    // First pass: continuations of the same branch order; second pass: any child.
+    for (int pass = 0; pass < 2; ++pass) {
+      for (size_t i = 0; i < nodes.size(); ++i) {
+        int32_t p = nodes[i].parent;
+        if (p < 0 || static_cast<size_t>(p) >= nodes.size() || next[p] >= 0 || continues[i]) continue;
+        if (pass == 0 && nodes[i].order != nodes[p].order) continue;
+        double tol = 1e-6 * std::max(1.0, nodes[p].length());
+        if (glm::length(nodes[i].start - nodes[p].end) <= tol) {
+          next[p] = static_cast<int32_t>(i);
+          continues[i] = 1;
+        }
       }
     }
     std::vector<glm::vec4> vertices;
