@@ -4,6 +4,8 @@
 #include <cmath>
 #include <string>
 
+#include "lsystem/derive.h"
+#include "lsystem/grammar.h"
 #include "lsystem/turtle.h"
 
 using namespace sprig;
@@ -356,4 +358,66 @@ TEST_CASE("Turtle::commandOf", "[lsystem]") {
   CHECK(turtle.commandOf(5) == Turtle::Command::SurfaceNamed);
   CHECK(turtle.commandOf(6) == Turtle::Command::None);
   CHECK(turtle.commandOf(100) == Turtle::Command::None);
+}
+
+namespace {
+
+struct Drawn {
+  size_t modules = 0;
+  Skeleton skeleton;
+  TurtleState end;
+};
+
+Drawn drawGrammar(const std::string& name, TurtleSettings settings = {}) {
+  Grammar g = loadGrammar(std::string(SPRIG_SOURCE_DIR) + "/grammars/" + name);
+  DeriveOptions options;
+  options.trackBirthSteps = true;
+  ModuleString s = derive(g, options);
+  settings.angleDeg = g.angleDeg().value_or(settings.angleDeg);
+  Turtle turtle(g.symbols(), settings);
+  Drawn d;
+  d.modules = s.size();
+  d.skeleton = turtle.run(s);
+  d.end = turtle.endState();
+  return d;
+}
+
+}  // namespace
+
+TEST_CASE("Turtle::shipped grammars", "[lsystem]") {
+  SECTION("ABOP 1.24a at n = 5: 7811 modules, 3125 segments, main axis 3^5 long") {
+    Drawn d = drawGrammar("abop_1_24a.lsys");
+    CHECK(d.modules == 7811);
+    CHECK(d.skeleton.internodes.size() == 3125);
+    CHECK(d.skeleton.totalLength() == Approx(3125));
+    checkVec(d.end.frame.position, {0, 243, 0}, 1e-7);
+    DBox3 b = d.skeleton.bounds();
+    CHECK(b.hi.y == Approx(243 + 0.05));
+    CHECK(std::abs(b.hi.z) < 0.06);  // a planar figure
+    // Birth steps: every F of the final string was written by step 5.
+    CHECK(d.skeleton.internodes.back().step == 5);
+  }
+  SECTION("ABOP 1.24b-f segment counts and axes") {
+    CHECK(drawGrammar("abop_1_24b.lsys").skeleton.internodes.size() == 3125);  // 5^5
+    CHECK(drawGrammar("abop_1_24c.lsys").skeleton.internodes.size() == 4096);  // 8^4
+    Drawn e = drawGrammar("abop_1_24e.lsys");
+    checkVec(e.end.frame.position, {0, 254, 0}, 1e-7);  // sum of 2^k F's along the main axis
+  }
+  SECTION("ABOP 2.6a: 2^10 - 1 internodes; the trunk is sum 0.9^k long") {
+    Drawn d = drawGrammar("abop_2_6.lsys");
+    CHECK(d.skeleton.internodes.size() == 1023);
+    checkVec(d.end.frame.position, {0, (1 - std::pow(0.9, 10)) / 0.1, 0}, 1e-9);
+    CHECK(d.skeleton.internodes[0].baseRadius == Approx(0.5 * 10));  // !(10) with widthScale 1
+  }
+  SECTION("ABOP 2.8a: 1 + 4 (3^6 - 1)/2 internodes, bent by tropism") {
+    TurtleSettings s;
+    s.elasticity = 0.22;
+    Drawn d = drawGrammar("abop_2_8.lsys", s);
+    CHECK(d.skeleton.internodes.size() == 1457);
+    CHECK(d.skeleton.internodes[0].length() == Approx(200 * std::pow(1.109, 6)));
+    // Tropism pulls every lateral below its straight path: some tips end below their base.
+    size_t drooping = 0;
+    for (const auto& in : d.skeleton.internodes) drooping += in.end.y < in.start.y;
+    CHECK(drooping > 0);
+  }
 }
