@@ -78,8 +78,9 @@ struct TreeOptions {
   double deltaAMulti = 2.75;     ///< Eq. 8 factor: δA = deltaAMulti·max(r_i) − r_A (PCM, several branches)
   bool basalOffset = true;       ///< apply δA at all (off re-creates the bulge of Fig. 9 left)
   bool branchOffset = true;      ///< PCM: displace branches by δB_i = r_A − r_i (Eq. 7; off = Fig. 12 left)
-  double pcmPropagation = 1.0;   ///< PCM propagation width in units of the smaller branch radius
-  double pcmBulge = 0.4;         ///< PCM maximal bulge (field units) in the propagation region
+  double pcmWidth = 0.15;        ///< PCM propagation width w in field units (blobtree::PcmParams::width)
+  double pcmBulge = 1.0;         ///< PCM bulge scale: a₀ = pcmBulge·w/4 (blobtree::PcmParams::bulgeScale)
+  bool softKernel = false;       ///< use the soft-object kernel instead of Wyvill's (1−s)³
   bool controlledBlend = true;   ///< non-neighbour internodes meet as a union, not a blend
   TipStyle tips = TipStyle::Taper;
   double tipTaper = 0.35;        ///< Taper: tip radius as a fraction of the terminal internode's base radius

@@ -1,0 +1,232 @@
+#include "organisms/tree_builder.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/diagnostics.h"
+#include "core/rng.h"
+
+namespace sprig::organisms {
+
+namespace bt = blobtree;
+
+namespace {
+
+Vec3 f(const DVec3& v) { return Vec3(v); }
+
+// The cone of one part, bent when the plan says so.
+bt::NodeId partNode(bt::BlobTree& tree, const ConePart& p, const lsystem::Skeleton& sk, const TreeOptions& opt) {
+  bt::TextureAttr tex;
+  if (opt.bark.enabled) {
+    tex.textureId = static_cast<uint16_t>(opt.bark.texture);
+    tex.uvScale = Vec2(static_cast<float>(opt.bark.uScale), static_cast<float>(opt.bark.vScale));
+    tex.vOffset = static_cast<float>(p.vStart);
+    tex.refDir = f(sk.internodes[p.internode].up);
+  }
+  const float r0 = static_cast<float>(std::max(p.startRadius, 1e-6));
+  const float r1 = static_cast<float>(std::max(p.endRadius, 1e-6));
+  DVec3 b = p.end;
+  if (glm::length(b - p.start) < 1e-9) b = p.start + DVec3(0, 1e-6, 0);
+  bt::NodeId id = tree.cone(f(p.start), f(b), r0, r1, tex);
+
+  if (p.bendAngle > 0) {
+    // Keep the support inside the bend radius (ρ = L / (2 sin θ) for tangent angle θ).
+    const double len = glm::length(b - p.start);
+    const double support = bt::supportRadius(tree.kernel(), std::max(r0, r1));
+    double theta = std::min(p.bendAngle, 0.45 * kPi);
+    const double maxSin = len / (2.0 * support * 1.25);
+    if (std::sin(theta) > maxSin) theta = maxSin < 1 ? std::asin(maxSin) : theta;
+    if (theta > 1e-4) {
+      const auto bend = bt::Bend::fromAngle(f(p.start), f(b), f(p.bendToward), static_cast<float>(2.0 * theta));
+      id = tree.bend(id, bend);
+    }
+  }
+  if (p.kind == ConePart::Kind::Pruned) {
+    const bt::NodeId saw = tree.halfspace(f(p.cutPoint), f(p.cutNormal));
+    const bt::NodeId both[2] = {id, saw};
+    id = tree.intersect(both);
+  }
+  return id;
+}
+
+}  // namespace
+
+TreeBlob buildTreeBlob(const lsystem::Skeleton& skeleton, const TreeOptions& opt) {
+  if (skeleton.internodes.empty()) throw InputError(SourceLoc{}, "tree skeleton has no internode");
+  TreeBlob out{bt::BlobTree(opt.softKernel ? bt::Kernel::SoftObject : bt::Kernel::Wyvill), 0,
+               planTree(skeleton, opt), {}};
+  bt::BlobTree& tree = out.tree;
+  const TreePlan& plan = out.plan;
+
+  out.partNodes.reserve(plan.parts.size());
+  for (const ConePart& p : plan.parts) out.partNodes.push_back(partNode(tree, p, skeleton, opt));
+
+  std::vector<bt::NodeId> negatives;
+  for (const ConePart& p : plan.parts)
+    if (p.kind == ConePart::Kind::Stub && p.negativeRadius > 0 && p.negativeWeight > 0)
+      negatives.push_back(tree.negative(tree.point(f(p.negativeCenter), static_cast<float>(p.negativeRadius)),
+                                        static_cast<float>(p.negativeWeight)));
+
+  bt::NodeId body;
+  if (!opt.controlledBlend) {
+    // Everything blends with everything (the comparison case of controlled blending).
+    body = tree.blend(out.partNodes);
+  } else {
+    bt::PcmParams pcm;
+    pcm.width = static_cast<float>(opt.pcmWidth);
+    pcm.bulgeScale = static_cast<float>(opt.pcmBulge);
+    std::vector<bt::NodeId> groups;
+    groups.reserve(plan.junctions.size() + 1);
+    for (const Junction& j : plan.junctions) {
+      std::vector<bt::NodeId> sum{out.partNodes[j.basal]}, contact;
+      for (int32_t b : j.branches) {
+        if (j.pcm && plan.parts[b].kind != ConePart::Kind::Stub)
+          contact.push_back(out.partNodes[b]);
+        else
+          sum.push_back(out.partNodes[b]);
+      }
+      if (contact.size() == 1) sum.push_back(contact[0]);
+      if (contact.size() > 1) sum.push_back(tree.pcm(contact, pcm));  // Eq. 5
+      groups.push_back(tree.blend(sum));                              // Eq. 6
+    }
+    // Parts in no junction (a lone internode) are their own group.
+    for (size_t i = 0; i < plan.parts.size(); ++i)
+      if (plan.parts[i].junctionAtStart < 0 && plan.parts[i].junctionAtEnd < 0) groups.push_back(out.partNodes[i]);
+    body = groups.size() == 1 ? groups[0] : tree.unite(groups);
+  }
+  if (negatives.empty()) {
+    out.root = body;
+  } else {
+    negatives.insert(negatives.begin(), body);
+    out.root = tree.blend(negatives);
+  }
+  return out;
+}
+
+namespace {
+
+struct LeafWriter {
+  Mesh& mesh;
+  uint32_t material;
+
+  uint32_t vertex(const DVec3& p, const DVec3& n, Vec2 uv, Vec3 color) {
+    mesh.positions.push_back(f(p));
+    mesh.normals.push_back(glm::normalize(f(n)));
+    mesh.uvs.push_back(uv);
+    mesh.colors.push_back(color);
+    return static_cast<uint32_t>(mesh.positions.size() - 1);
+  }
+  void tri(uint32_t a, uint32_t b, uint32_t c) {
+    mesh.triangles.emplace_back(a, b, c);
+    mesh.materials.push_back(material);
+  }
+};
+
+Vec3 leafColor(int colorIndex, Rng& rng) {
+  static const Vec3 kPalette[] = {{0.16f, 0.40f, 0.09f}, {0.35f, 0.52f, 0.12f}, {0.70f, 0.12f, 0.10f},
+                                  {0.92f, 0.90f, 0.85f}, {0.90f, 0.55f, 0.70f}, {0.85f, 0.70f, 0.10f}};
+  const Vec3 base = kPalette[static_cast<size_t>(std::clamp(colorIndex, 0, 5))];
+  const float k = static_cast<float>(rng.uniform(0.85, 1.15));
+  return glm::clamp(base * k, Vec3(0.0f), Vec3(1.0f));
+}
+
+// Ovate blade: half-width at fraction y of the length.
+double bladeHalfWidth(double y) { return 0.38 * std::pow(std::sin(kPi * std::pow(y, 0.75)), 0.9); }
+
+void addBlade(LeafWriter& w, const lsystem::Organ& o, double scale, Vec3 color) {
+  constexpr int kRows = 8;
+  const DVec3 h = glm::normalize(o.heading), right = -glm::normalize(o.left), up = glm::normalize(o.up);
+  const double s = (o.radius > 0 ? o.radius : 1.0) * scale;
+  auto at = [&](double x, double y) { return o.position + s * (y * h + x * right); };
+  auto uv = [](double x, double y) { return Vec2(static_cast<float>(0.5 + x), static_cast<float>(y)); };
+  const uint32_t base = w.vertex(at(0, 0), up, uv(0, 0), color);
+  std::vector<uint32_t> L, M, R;
+  for (int k = 1; k < kRows; ++k) {
+    const double y = static_cast<double>(k) / kRows, hw = bladeHalfWidth(y);
+    L.push_back(w.vertex(at(-hw, y), up, uv(-hw, y), color));
+    M.push_back(w.vertex(at(0, y), up, uv(0, y), color));
+    R.push_back(w.vertex(at(hw, y), up, uv(hw, y), color));
+  }
+  const uint32_t tip = w.vertex(at(0, 1), up, uv(0, 1), color);
+  w.tri(base, R[0], M[0]);
+  w.tri(base, M[0], L[0]);
+  for (size_t k = 0; k + 1 < M.size(); ++k) {
+    w.tri(M[k], R[k], R[k + 1]);
+    w.tri(M[k], R[k + 1], M[k + 1]);
+    w.tri(M[k], M[k + 1], L[k + 1]);
+    w.tri(M[k], L[k + 1], L[k]);
+  }
+  w.tri(M.back(), R.back(), tip);
+  w.tri(M.back(), tip, L.back());
+}
+
+void addPolygon(LeafWriter& w, const lsystem::Organ& o, Vec3 color) {
+  if (o.points.size() < 3) return;
+  DVec3 n(0);  // Newell normal
+  for (size_t i = 0; i < o.points.size(); ++i) {
+    const DVec3& a = o.points[i];
+    const DVec3& b = o.points[(i + 1) % o.points.size()];
+    n += DVec3((a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y));
+  }
+  if (glm::length(n) < 1e-20) return;
+  n = glm::normalize(n);
+  const DVec3 e0 = glm::length(o.points[1] - o.points[0]) > 0 ? glm::normalize(o.points[1] - o.points[0])
+                                                                : DVec3(1, 0, 0);
+  const DVec3 e1 = glm::cross(n, e0);
+  DBox3 box;
+  std::vector<DVec3> plane;
+  for (const DVec3& p : o.points) {
+    const DVec3 q(glm::dot(p - o.points[0], e0), glm::dot(p - o.points[0], e1), 0);
+    plane.push_back(q);
+    box.extend(q);
+  }
+  const DVec3 size = glm::max(box.size(), DVec3(1e-12));
+  const uint32_t first = static_cast<uint32_t>(w.mesh.positions.size());
+  for (size_t i = 0; i < o.points.size(); ++i) {
+    const DVec3 t = (plane[i] - box.lo) / size;
+    w.vertex(o.points[i], n, Vec2(static_cast<float>(t.x), static_cast<float>(t.y)), color);
+  }
+  for (uint32_t i = 1; i + 1 < o.points.size(); ++i) w.tri(first, first + i, first + i + 1);
+}
+
+void addSphere(LeafWriter& w, const lsystem::Organ& o, Vec3 color) {
+  constexpr int kLat = 6, kLon = 10;
+  const uint32_t first = static_cast<uint32_t>(w.mesh.positions.size());
+  for (int i = 0; i <= kLat; ++i) {
+    const double th = kPi * i / kLat;
+    for (int j = 0; j <= kLon; ++j) {
+      const double ph = 2.0 * kPi * j / kLon;
+      const DVec3 n(std::sin(th) * std::cos(ph), std::cos(th), std::sin(th) * std::sin(ph));
+      w.vertex(o.position + o.radius * n, n,
+               Vec2(static_cast<float>(j) / kLon, static_cast<float>(i) / kLat), color);
+    }
+  }
+  for (int i = 0; i < kLat; ++i)
+    for (int j = 0; j < kLon; ++j) {
+      const uint32_t a = first + static_cast<uint32_t>(i * (kLon + 1) + j), b = a + kLon + 1;
+      if (i > 0) w.tri(a, a + 1, b);
+      if (i + 1 < kLat) w.tri(a + 1, b + 1, b);
+    }
+}
+
+}  // namespace
+
+Mesh buildLeafMesh(const lsystem::Skeleton& skeleton, const TreeOptions& opt) {
+  Mesh mesh;
+  if (!opt.leaves.enabled) return mesh;
+  LeafWriter w{mesh, opt.leaves.material};
+  constexpr uint64_t kSeedLeaf = 0x4c454146ull;
+  for (size_t i = 0; i < skeleton.organs.size(); ++i) {
+    const auto& o = skeleton.organs[i];
+    Rng rng(deriveSeed(opt.seed, {kSeedLeaf, static_cast<uint64_t>(i)}));
+    const Vec3 color = leafColor(o.color, rng);
+    switch (o.kind) {
+      case lsystem::Organ::Kind::Polygon: addPolygon(w, o, color); break;
+      case lsystem::Organ::Kind::Sphere: addSphere(w, o, color); break;
+      case lsystem::Organ::Kind::Surface: addBlade(w, o, opt.leaves.scale, color); break;
+    }
+  }
+  return mesh;
+}
+
+}  // namespace sprig::organisms

@@ -1,0 +1,47 @@
+#pragma once
+/// BlobTree trees: a Skeleton becomes a skeletal implicit tree ("BlobTree Trees",
+/// Galbraith, MacMurchy, Wyvill), and its leaf organs become a textured leaf Mesh.
+///
+/// Structure of the BlobTree (built from the TreePlan of tree_plan.h):
+///   root  = Σ( ∪_J F_J ,  −w·f_scar … )                    scars dent everything near them
+///   F_J   = f_A + PCM(f_B0 … f_Bm−1) + Σ f_stub             PCM junction (Eq. 5-6)
+///   F_J   = f_A + Σ f_Bi                                     smooth junction (§3.3)
+/// where J runs over the junctions (a basal internode A and the branches at its tip). An
+/// internode belongs to at most two groups (as a branch at its base, as the basal at its
+/// tip); the union (max) over groups is the controlled blend: internodes that are not
+/// neighbours in the skeleton meet in a crease. Each f is a cone primitive (Fig. 7),
+/// wrapped in an endpoint-preserving bend (§3.6) when the plan bends it and intersected
+/// with a half-space when it is pruned (§3.5). Every cone carries its bark coordinates:
+/// u around the axis from the turtle's up vector, v = distance from the root (§3.7).
+
+#include <cstdint>
+
+#include "blobtree/blobtree.h"
+#include "core/mesh.h"
+#include "lsystem/skeleton.h"
+#include "organisms/tree_options.h"
+#include "organisms/tree_plan.h"
+
+namespace sprig::organisms {
+
+/// A built tree: the BlobTree pool, its root node and the plan it came from.
+struct TreeBlob {
+  blobtree::BlobTree tree;
+  blobtree::NodeId root = 0;
+  TreePlan plan;
+  /// Node of each plan part (the cone after its bend / cut), for tests and tools.
+  std::vector<blobtree::NodeId> partNodes;
+};
+
+/// Builds the implicit tree of `skeleton`. Throws InputError when the skeleton has no
+/// internode. Cost: O(internodes) nodes; evaluation cost is the compiled tape's.
+TreeBlob buildTreeBlob(const lsystem::Skeleton& skeleton, const TreeOptions& options);
+
+/// Leaf geometry for the skeleton's organs: polygons `{ . }` are fan-triangulated, spheres
+/// become small UV spheres, named surfaces `~` become an ovate leaf blade in the turtle frame
+/// (heading along the midrib, up as the normal). uvs map the blade's unit square; colours
+/// are a seeded green per organ; every triangle gets options.leaves.material. Empty when
+/// leaves are disabled or there are no organs. Deterministic.
+Mesh buildLeafMesh(const lsystem::Skeleton& skeleton, const TreeOptions& options);
+
+}  // namespace sprig::organisms

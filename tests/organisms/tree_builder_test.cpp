@@ -1,0 +1,319 @@
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdio>
+
+#include "organisms/tree_builder.h"
+
+using namespace sprig;
+using namespace sprig::organisms;
+using lsystem::Internode;
+using lsystem::Skeleton;
+
+namespace {
+
+Internode seg(DVec3 a, DVec3 b, double r0, double r1, int parent, int order, bool cut = false) {
+  Internode in;
+  in.start = a;
+  in.end = b;
+  in.baseRadius = r0;
+  in.tipRadius = r1;
+  in.parent = parent;
+  in.order = order;
+  in.cut = cut;
+  return in;
+}
+
+// The tree's field through the reference evaluator (tiny test trees).
+struct Field {
+  TreeBlob blob;
+  float value(Vec3 p) const { return blob.tree.value(blob.root, p); }
+};
+
+Field compiled(TreeBlob t) { return Field{std::move(t)}; }
+
+// Distance from `origin` along unit `dir` to the outermost F = 0.5 crossing within maxDist.
+double surfaceDistance(const Field& blob, Vec3 origin, Vec3 dir, double maxDist) {
+  const int kSteps = 400;
+  double prev = maxDist;
+  for (int i = kSteps - 1; i >= 0; --i) {
+    const double t = maxDist * i / kSteps;
+    if (blob.value(origin + float(t) * dir) > 0.5f) {
+      double lo = t, hi = prev;  // F(lo) > 0.5 >= F(hi)
+      for (int k = 0; k < 40; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        (blob.value(origin + float(mid) * dir) > 0.5f ? lo : hi) = mid;
+      }
+      return 0.5 * (lo + hi);
+    }
+    prev = t;
+  }
+  return 0.0;
+}
+
+// Largest relative deviation of the surface radius from r over heights [y0, y1] on a
+// vertical axis through the origin (measured along +X and +Z).
+double maxRadiusDeviation(const Field& blob, double r, double y0, double y1) {
+  double worst = 0;
+  for (int i = 0; i <= 80; ++i) {
+    const float y = float(y0 + (y1 - y0) * i / 80.0);
+    for (Vec3 dir : {Vec3(1, 0, 0), Vec3(0, 0, 1)}) {
+      const double d = surfaceDistance(blob, Vec3(0, y, 0), dir, 4 * r);
+      worst = std::max(worst, std::abs(d / r - 1.0));
+    }
+  }
+  return worst;
+}
+
+
+// A basal internode along +Y ending at P = (0,1,0) and two branches in the XY plane at
+// ±angle from the vertical, each followed by a second internode.
+Skeleton yJunction(double rA, double rB, double angleDeg) {
+  Skeleton sk;
+  sk.internodes.push_back(seg({0, 0, 0}, {0, 1, 0}, rA, rA, -1, 0));
+  const double a = radians(angleDeg);
+  const DVec3 d0(std::sin(a), std::cos(a), 0), d1(-std::sin(a), std::cos(a), 0), p(0, 1, 0);
+  sk.internodes.push_back(seg(p, p + d0, rB, rB, 0, 0));
+  sk.internodes.push_back(seg(p, p + d1, rB, rB, 0, 1));
+  return sk;
+}
+
+}  // namespace
+
+TEST_CASE("buildTreeBlob::one-child joint (Eq. 4)", "[organisms]") {
+  Skeleton sk;
+  const double r = 0.1;
+  sk.internodes.push_back(seg({0, 0, 0}, {0, 1, 0}, r, r, -1, 0));
+  sk.internodes.push_back(seg({0, 1, 0}, {0, 2, 0}, r, r, 0, 0));
+  TreeOptions opt;
+  opt.tips = TipStyle::Hemisphere;
+  const double withOffset = maxRadiusDeviation(compiled(buildTreeBlob(sk, opt)), r, 0.5, 1.5);
+  opt.basalOffset = false;
+  const double without = maxRadiusDeviation(compiled(buildTreeBlob(sk, opt)), r, 0.5, 1.5);
+  std::printf("one-child joint: max radius deviation %.2f%% with δA = 1.75 r_B, %.2f%% without\n",
+              100 * withOffset, 100 * without);
+  CHECK(withOffset < 0.03);
+  CHECK(without > 0.10);
+}
+
+TEST_CASE("buildTreeBlob::controlled blending", "[organisms]") {
+  // Two separate roots crossing at right angles at (0, 0.5, 0): not neighbours.
+  Skeleton sk;
+  const double r = 0.1;
+  sk.internodes.push_back(seg({0, 0, 0}, {0, 1, 0}, r, r, -1, 0));
+  sk.internodes.push_back(seg({-0.5, 0.5, 0}, {0.5, 0.5, 0}, r, r, -1, 0));
+  TreeOptions opt;
+  opt.tips = TipStyle::Hemisphere;
+  const auto uni = compiled(buildTreeBlob(sk, opt));
+  opt.controlledBlend = false;
+  const auto all = compiled(buildTreeBlob(sk, opt));
+  // In the corner between the two axes, at equal distance from both: the union stays
+  // outside (a crease), the blend fills the corner.
+  const float s = float(1.1 * r);
+  const Vec3 corner(s, 0.5f + s, 0);
+  CHECK(uni.value(corner) < 0.5f);
+  CHECK(all.value(corner) > 0.5f);
+  // Away from the corner both agree (each internode alone).
+  CHECK(uni.value({0, 0.2f, float(0.9 * r)}) == Approx(all.value({0, 0.2f, float(0.9 * r)})).margin(1e-6));
+}
+
+TEST_CASE("buildTreeBlob::PCM junction (Eq. 5-8)", "[organisms]") {
+  const double rA = 0.1, rB = 0.08;
+  Skeleton sk = yJunction(rA, rB, 35);
+  TreeOptions opt;
+  opt.tips = TipStyle::Hemisphere;
+  const auto smooth = compiled(buildTreeBlob(sk, opt));
+  opt.junctions = JunctionModel::Pcm;
+  const auto pcm = compiled(buildTreeBlob(sk, opt));
+  TreeOptions noOffset = opt;
+  noOffset.branchOffset = false;
+  const auto pcmNoOffset = compiled(buildTreeBlob(sk, noOffset));
+  TreeOptions noBulge = opt;
+  noBulge.pcmBulge = 0;
+  const auto contact = compiled(buildTreeBlob(sk, noBulge));
+
+  SECTION("no bulge below the junction with the branch offset (Fig. 12)") {
+    // Largest radius of the basal internode from well below P up to P, across and in
+    // the branching plane.
+    auto widest = [&](const Field& b) {
+      double w = 0;
+      for (int i = 0; i <= 50; ++i) {
+        const float y = float(0.5 + 0.5 * i / 50.0);
+        w = std::max(w, surfaceDistance(b, {0, y, 0}, {0, 0, 1}, 0.5));
+      }
+      return w / rA - 1.0;
+    };
+    const double dev = widest(pcm), devNo = widest(pcmNoOffset), devSmooth = widest(smooth);
+    std::printf("Y junction below P: bulge %.2f%% PCM with δB (Eq. 7), %.2f%% PCM without, %.2f%% smooth\n",
+                100 * dev, 100 * devNo, 100 * devSmooth);
+    CHECK(dev < 0.01);
+    CHECK(devNo > 0.03);
+    CHECK(devSmooth > 0.05);
+  }
+  SECTION("a ridge along the seam between the branches") {
+    // Across the branching plane at the seam x = 0 above P: the PCM bulge pushes the
+    // surface out beyond the bare contact of the two branches (the branch bark ridge).
+    double minGain = 1e9, maxGain = 0;
+    for (double y = 1.02; y <= 1.08; y += 0.02) {
+      const double zPcm = surfaceDistance(pcm, {0, float(y), 0}, {0, 0, 1}, 0.5);
+      const double zContact = surfaceDistance(contact, {0, float(y), 0}, {0, 0, 1}, 0.5);
+      const double zSmooth = surfaceDistance(smooth, {0, float(y), 0}, {0, 0, 1}, 0.5);
+      std::printf("seam at y = P + %.2f: PCM %.4f, contact without bulge %.4f, smooth %.4f\n", y - 1, zPcm,
+                  zContact, zSmooth);
+      minGain = std::min(minGain, zPcm - zContact);
+      maxGain = std::max(maxGain, zPcm - zContact);
+    }
+    CHECK(minGain >= 0.0);
+    CHECK(maxGain > 0.02 * rA);
+  }
+}
+
+TEST_CASE("buildTreeBlob::bend keeps both endpoints (§3.6)", "[organisms]") {
+  const double r = 0.05;
+  Skeleton sk;
+  sk.internodes.push_back(seg({0, 0, 0}, {0, 1, 0}, 0.1, 0.1, -1, 0));
+  const DVec3 p(0, 1, 0), d = glm::normalize(DVec3(1, 1, 0));
+  sk.internodes.push_back(seg(p, p + d, r, r, 0, 1));
+  TreeOptions opt;
+  opt.tips = TipStyle::Hemisphere;
+  opt.bends.angleDeg = 30;
+  TreeBlob blob = buildTreeBlob(sk, opt);
+  const ConePart& part = blob.plan.parts[1];
+  REQUIRE(part.bendAngle == Approx(radians(30)));
+  const blobtree::NodeId bent = blob.partNodes[1];
+  auto f = [&](DVec3 q) { return blob.tree.value(bent, Vec3(q)); };
+  // Both endpoints stay inside, and the surface still reaches one radius past each end
+  // along the arc's end tangents (the cap of the bent cone).
+  CHECK(f(part.start) > 0.5f);
+  CHECK(f(part.end) > 0.5f);
+  const DVec3 n = part.bendToward;
+  const double th = part.bendAngle;
+  const DVec3 tStart = std::cos(th) * d + std::sin(th) * n, tEnd = std::cos(th) * d - std::sin(th) * n;
+  CHECK(f(part.start - 0.9 * r * tStart) > 0.5f);
+  CHECK(f(part.end + 0.9 * r * tEnd) > 0.5f);
+  CHECK(f(part.end + 1.1 * r * tEnd) < 0.5f);
+  // The middle has moved off the chord by the sagitta L/2·tan(θ/2).
+  const double L = part.length(), sag = 0.5 * L * std::tan(th / 2);
+  const DVec3 mid = 0.5 * (part.start + part.end);
+  CHECK(f(mid) < 0.5f);
+  CHECK(f(mid + sag * n) > 0.5f);
+  CHECK(f(mid + (sag + 1.1 * r) * n) < 0.5f);
+  CHECK(f(mid + (sag + 0.9 * r) * n) > 0.5f);
+}
+
+TEST_CASE("buildTreeBlob::pruning leaves a planar face (§3.5, Fig. 14)", "[organisms]") {
+  Skeleton sk;
+  sk.internodes.push_back(seg({0, 0, 0}, {0, 2, 0}, 0.1, 0.1, -1, 0));
+  const DVec3 p(0, 1, 0), d = glm::normalize(DVec3(1, 0.5, 0));
+  sk.internodes.push_back(seg(p, p + d, 0.06, 0.05, 0, 1, true));
+  sk.internodes.push_back(seg(p + d, p + 2.0 * d, 0.05, 0.04, 1, 1));
+  sk.internodes[0].end = {0, 1, 0};
+  sk.internodes.push_back(seg({0, 1, 0}, {0, 2, 0}, 0.1, 0.1, 0, 0));
+  TreeBlob blob = buildTreeBlob(sk, TreeOptions{});
+  const Field field{std::move(blob)};
+  const ConePart& cutPart = field.blob.plan.parts[field.blob.plan.partOfInternode[1]];
+  REQUIRE(cutPart.kind == ConePart::Kind::Pruned);
+  CHECK(field.blob.plan.partOfInternode[2] == -1);
+  // Points on a disc in the cut plane: just before the plane inside, just after outside,
+  // so the face is the plane itself.
+  const DVec3 u = glm::normalize(glm::cross(d, DVec3(0, 0, 1))), w = glm::cross(d, u);
+  int checked = 0;
+  for (int i = 0; i < 12; ++i) {
+    const double ang = 2 * kPi * i / 12;
+    for (double rho : {0.0, 0.02, 0.035}) {
+      const DVec3 q = cutPart.cutPoint + rho * (std::cos(ang) * u + std::sin(ang) * w);
+      CHECK(field.value(Vec3(q - 1e-3 * d)) > 0.5f);
+      CHECK(field.value(Vec3(q + 1e-3 * d)) < 0.5f);
+      ++checked;
+    }
+  }
+  CHECK(checked == 36);
+  // Nothing of the removed branch is left beyond the cut.
+  CHECK(field.value(Vec3(p + 1.5 * d)) == 0.0f);
+}
+
+TEST_CASE("buildTreeBlob::scars dent the stub (§3.5, Fig. 15)", "[organisms]") {
+  Skeleton sk;
+  sk.internodes.push_back(seg({0, 0, 0}, {0, 1, 0}, 0.1, 0.1, -1, 0));
+  sk.internodes.push_back(seg({0, 1, 0}, {0, 2, 0}, 0.1, 0.1, 0, 0));
+  sk.internodes.push_back(seg({0, 1, 0}, {1, 1, 0}, 0.06, 0.05, 0, 1));
+  TreeOptions opt;
+  opt.scars.select.internodes = {2};
+  opt.scars.stubLength = 1.5;
+  const Field scar{buildTreeBlob(sk, opt)};
+  opt.scars.negativeWeight = 0;
+  const Field stub{buildTreeBlob(sk, opt)};
+  // Along the stub's axis: the plain stub reaches its end plus cap; the negative field
+  // hollows it back toward the trunk.
+  const double reachStub = surfaceDistance(stub, {0, 1, 0}, {1, 0, 0}, 0.5);
+  const double reachScar = surfaceDistance(scar, {0, 1, 0}, {1, 0, 0}, 0.5);
+  std::printf("scar: stub reaches %.4f from the trunk axis, with the negative field %.4f\n", reachStub, reachScar);
+  CHECK(reachStub > 1.5 * 0.06 + 0.06);
+  CHECK(reachScar < reachStub - 0.02);
+  // a bigger negative field makes a bigger scar
+  opt.scars.negativeWeight = 1;
+  opt.scars.negativeRadius = 1.2;
+  const Field bigger{buildTreeBlob(sk, opt)};
+  CHECK(surfaceDistance(bigger, {0, 1, 0}, {1, 0, 0}, 0.5) < reachScar);
+  // the rest of the branch is gone
+  CHECK(stub.value({0.8f, 1, 0}) == 0.0f);
+}
+
+TEST_CASE("buildTreeBlob::deterministic", "[organisms]") {
+  Skeleton sk = yJunction(0.1, 0.07, 30);
+  TreeOptions opt;
+  opt.junctions = JunctionModel::Pcm;
+  opt.bends.angleDeg = 20;
+  opt.bends.randomness = 0.5;
+  TreeBlob a = buildTreeBlob(sk, opt), b = buildTreeBlob(sk, opt);
+  REQUIRE(a.tree.size() == b.tree.size());
+  CHECK(a.root == b.root);
+  for (int i = 0; i < 200; ++i) {
+    const Vec3 q(float(std::sin(i) * 0.3), float(0.8 + 0.003 * i), float(std::cos(i * 1.7) * 0.2));
+    CHECK(a.tree.value(a.root, q) == b.tree.value(b.root, q));
+  }
+}
+
+TEST_CASE("buildLeafMesh", "[organisms]") {
+  Skeleton sk;
+  lsystem::Organ blade;
+  blade.kind = lsystem::Organ::Kind::Surface;
+  blade.position = {1, 2, 3};
+  blade.heading = {0, 1, 0};
+  blade.left = {-1, 0, 0};
+  blade.up = {0, 0, 1};
+  blade.radius = 0.5;
+  sk.organs.push_back(blade);
+  lsystem::Organ quad;
+  quad.kind = lsystem::Organ::Kind::Polygon;
+  quad.points = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0}};
+  sk.organs.push_back(quad);
+  TreeOptions opt;
+  Mesh m = buildLeafMesh(sk, opt);
+  SECTION("counts, normals and extent") {
+    // blade: base + 7 rows of 3 + tip = 23 vertices, 28 triangles; quad: 4 and 2
+    CHECK(m.vertexCount() == 23 + 4);
+    CHECK(m.triangleCount() == 28 + 2);
+    CHECK(m.uvs.size() == m.vertexCount());
+    CHECK(m.colors.size() == m.vertexCount());
+    CHECK(m.materials.size() == m.triangleCount());
+    CHECK(m.materials[0] == opt.leaves.material);
+    for (size_t i = 0; i < 23; ++i) CHECK(m.normals[i].z == Approx(1.0f));
+    CHECK(m.positions[22].y == Approx(2.5f));  // tip at position + scale·heading
+    // triangles face their normal (counter-clockwise seen from up)
+    for (size_t t = 0; t < m.triangleCount(); ++t) {
+      const auto& tri = m.triangles[t];
+      const Vec3 n = glm::cross(m.positions[tri.y] - m.positions[tri.x], m.positions[tri.z] - m.positions[tri.x]);
+      CHECK(glm::dot(n, m.normals[tri.x]) > 0);
+    }
+  }
+  SECTION("disabled leaves") {
+    opt.leaves.enabled = false;
+    CHECK(buildLeafMesh(sk, opt).triangleCount() == 0);
+  }
+  SECTION("same seed same bytes") {
+    Mesh m2 = buildLeafMesh(sk, opt);
+    CHECK(m2.positions == m.positions);
+    CHECK(m2.colors == m.colors);
+  }
+}
