@@ -1,0 +1,1149 @@
+#include "blobtree/compiled.h"
+
+#include "blobtree/detail/tape.h"
+#include "core/parallel.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+#include <unordered_map>
+
+namespace sprig::blobtree {
+
+using namespace detail;
+
+namespace detail {
+
+// ---- BVH -------------------------------------------------------------------------------
+
+namespace {
+constexpr uint32_t kBvhLeaf = 4;
+constexpr uint32_t kBvhMinChildren = 9;  ///< n-ary nodes with at least this many children get a BVH
+
+void buildRec(Tape& tape, uint32_t nodeIndex, std::vector<uint32_t>& order, uint32_t begin, uint32_t end,
+              const std::vector<Box3>& boxes, const std::vector<Vec3>& centers) {
+  Box3 b, cb;
+  for (uint32_t i = begin; i < end; ++i) {
+    b.extend(boxes[order[i]]);
+    cb.extend(centers[order[i]]);
+  }
+  tape.bvh[nodeIndex].box = b;
+  if (end - begin <= kBvhLeaf) {
+    tape.bvh[nodeIndex].first = uint32_t(tape.bvhItems.size());
+    tape.bvh[nodeIndex].count = end - begin;
+    for (uint32_t i = begin; i < end; ++i) tape.bvhItems.push_back(order[i]);
+    return;
+  }
+  Vec3 ext = cb.size();
+  int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
+  uint32_t mid = (begin + end) / 2;
+  std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end,
+                   [&](uint32_t a, uint32_t c) { return centers[a][axis] < centers[c][axis]; });
+  uint32_t left = uint32_t(tape.bvh.size());
+  tape.bvh.emplace_back();
+  tape.bvh.emplace_back();
+  tape.bvh[nodeIndex].first = left;
+  tape.bvh[nodeIndex].count = 0;
+  buildRec(tape, left, order, begin, mid, boxes, centers);
+  buildRec(tape, left + 1, order, mid, end, boxes, centers);
+}
+}  // namespace
+
+int32_t buildBvh(Tape& tape, const std::vector<Box3>& boxes, const std::vector<uint32_t>& items) {
+  std::vector<uint32_t> order(boxes.size());
+  std::iota(order.begin(), order.end(), 0u);
+  std::vector<Vec3> centers(boxes.size());
+  for (size_t i = 0; i < boxes.size(); ++i) {
+    // Unbounded boxes (cutters) sort by the origin.
+    centers[i] = isHuge(boxes[i]) || boxes[i].empty() ? Vec3(0.0f) : boxes[i].center();
+  }
+  int32_t root = int32_t(tape.bvh.size());
+  tape.bvh.emplace_back();
+  size_t firstItem = tape.bvhItems.size();
+  buildRec(tape, uint32_t(root), order, 0, uint32_t(boxes.size()), boxes, centers);
+  // Map local indices to the caller's items.
+  for (size_t i = firstItem; i < tape.bvhItems.size(); ++i) tape.bvhItems[i] = items[tape.bvhItems[i]];
+  return root;
+}
+
+}  // namespace detail
+
+namespace {
+
+// ---- Traversal helpers -------------------------------------------------------------------
+
+/// Calls f(item) for the BVH items whose box passes test(box).
+template <class Test, class F>
+inline void walkBvh(const Tape& T, int32_t root, Test&& test, F&& f) {
+  uint32_t stack[64];
+  int sp = 0;
+  stack[sp++] = uint32_t(root);
+  while (sp > 0) {
+    const BvhNode& b = T.bvh[stack[--sp]];
+    if (!test(b.box)) continue;
+    if (b.count > 0) {
+      for (uint32_t i = 0; i < b.count; ++i) f(T.bvhItems[b.first + i]);
+    } else {
+      stack[sp++] = b.first + 1;
+      stack[sp++] = b.first;
+    }
+  }
+}
+
+/// Calls f(childTapeIndex) for the children of n that may be non-zero at p.
+template <class F>
+inline void childrenAt(const Tape& T, const TNode& n, Vec3 p, F&& f) {
+  if (n.bvh >= 0) {
+    walkBvh(T, n.bvh, [&](const Box3& b) { return b.contains(p); }, f);
+  } else {
+    for (uint32_t i = 0; i < n.count; ++i) f(T.kids[n.first + i]);
+  }
+}
+
+/// Calls f(child) for the children of n whose support overlaps box.
+template <class F>
+inline void childrenIn(const Tape& T, const TNode& n, const Box3& box, F&& f) {
+  if (n.bvh >= 0) {
+    walkBvh(T, n.bvh, [&](const Box3& b) { return b.overlaps(box); }, f);
+  } else {
+    for (uint32_t i = 0; i < n.count; ++i) {
+      uint32_t c = T.kids[n.first + i];
+      if (T.nodes[c].box.overlaps(box)) f(c);
+    }
+  }
+}
+
+/// Streaming super-elliptic sum: m = max f, s = Σ (f/m)^n.
+struct RicciAcc {
+  float m = 0.0f, s = 0.0f;
+  void add(float f, float n) {
+    if (f <= 0.0f) return;
+    if (f > m) {
+      s = (m > 0.0f ? s * std::pow(m / f, n) : 0.0f) + 1.0f;
+      m = f;
+    } else {
+      s += std::pow(f / m, n);
+    }
+  }
+  float value(float n) const { return m > 0.0f ? m * std::pow(s, 1.0f / n) : 0.0f; }
+};
+
+// ---- Value ---------------------------------------------------------------------------------
+
+float evalV(const Tape& T, uint32_t ni, Vec3 p, bool cull);
+
+inline Vec3 warpLocal(const TNode& n, Vec3 p, Mat3* jt) {
+  switch (n.kind) {
+    case NodeKind::Transform:
+      if (jt) *jt = n.jt;
+      return Vec3(n.localFromWorld * Vec4(p, 1.0f));
+    case NodeKind::Bend: return n.bend.localFromWorld(p, jt);
+    case NodeKind::Twist: return twistLocal(n.twist, p, jt);
+    case NodeKind::Taper: return taperLocal(n.taper, p, jt);
+    default: return p;
+  }
+}
+
+float evalV(const Tape& T, uint32_t ni, Vec3 p, bool cull) {
+  const TNode& n = T.nodes[ni];
+  if (cull && !n.box.contains(p)) return 0.0f;
+  switch (n.kind) {
+    case NodeKind::Point:
+    case NodeKind::Segment:
+    case NodeKind::Cone:
+    case NodeKind::Torus:
+    case NodeKind::Halfspace:
+    case NodeKind::Box: return primValue(T.prims[n.prim], p, nullptr);
+    case NodeKind::Blend: {
+      float s = 0.0f;
+      if (cull) childrenAt(T, n, p, [&](uint32_t c) { s += evalV(T, c, p, cull); });
+      else for (uint32_t i = 0; i < n.count; ++i) s += evalV(T, T.kids[n.first + i], p, cull);
+      return s;
+    }
+    case NodeKind::Ricci: {
+      RicciAcc acc;
+      if (cull) childrenAt(T, n, p, [&](uint32_t c) { acc.add(evalV(T, c, p, cull), n.exponent); });
+      else for (uint32_t i = 0; i < n.count; ++i) acc.add(evalV(T, T.kids[n.first + i], p, cull), n.exponent);
+      return acc.value(n.exponent);
+    }
+    case NodeKind::Union: {
+      float m = 0.0f;
+      if (cull) childrenAt(T, n, p, [&](uint32_t c) { m = std::max(m, evalV(T, c, p, cull)); });
+      else for (uint32_t i = 0; i < n.count; ++i) m = std::max(m, evalV(T, T.kids[n.first + i], p, cull));
+      return m;
+    }
+    case NodeKind::Intersect: {
+      float m = std::numeric_limits<float>::max();
+      for (uint32_t i = 0; i < n.count; ++i) m = std::min(m, evalV(T, T.kids[n.first + i], p, cull));
+      return std::max(0.0f, m);
+    }
+    case NodeKind::Difference: {
+      float a = evalV(T, T.kids[n.first], p, cull);
+      if (a <= 0.0f) return 0.0f;
+      return std::max(0.0f, std::min(a, 1.0f - evalV(T, T.kids[n.first + 1], p, cull)));
+    }
+    case NodeKind::Pcm: {
+      float fmax = 0.0f, dsum = 0.0f, dmax = 0.0f;
+      auto add = [&](uint32_t c) {
+        float f = std::max(0.0f, evalV(T, c, p, cull));
+        float d = pcmD(n.pcm, f, nullptr);
+        dsum += d;
+        if (f > fmax) { fmax = f; dmax = d; }
+      };
+      if (cull) childrenAt(T, n, p, add);
+      else for (uint32_t i = 0; i < n.count; ++i) add(T.kids[n.first + i]);
+      return fmax > 0.0f ? std::max(0.0f, fmax + dsum - dmax) : 0.0f;
+    }
+    case NodeKind::Negative: return -n.weight * evalV(T, T.kids[n.first], p, cull);
+    case NodeKind::Transform:
+    case NodeKind::Bend:
+    case NodeKind::Twist:
+    case NodeKind::Taper: return evalV(T, T.kids[n.first], warpLocal(n, p, nullptr), cull);
+  }
+  return 0.0f;
+}
+
+// ---- Sample (value, gradient, attributes) --------------------------------------------------
+
+struct AttrAcc {
+  Vec2 uvSum{0.0f};
+  float wSum = 0.0f;
+  std::array<uint16_t, Attributes::kMaxTextures> ids{};
+  std::array<float, Attributes::kMaxTextures> w{};
+  int count = 0;
+
+  void addTexture(uint16_t id, float weight) {
+    for (int i = 0; i < count; ++i)
+      if (ids[size_t(i)] == id) { w[size_t(i)] += weight; return; }
+    if (count < Attributes::kMaxTextures) {
+      ids[size_t(count)] = id;
+      w[size_t(count)] = weight;
+      ++count;
+      return;
+    }
+    // Replace the lightest when heavier.
+    int k = 0;
+    for (int i = 1; i < count; ++i)
+      if (w[size_t(i)] < w[size_t(k)]) k = i;
+    if (w[size_t(k)] < weight) { ids[size_t(k)] = id; w[size_t(k)] = weight; }
+  }
+  void merge(const AttrAcc& o) {
+    uvSum += o.uvSum;
+    wSum += o.wSum;
+    for (int i = 0; i < o.count; ++i) addTexture(o.ids[size_t(i)], o.w[size_t(i)]);
+  }
+};
+
+struct SV {
+  float v = 0.0f;
+  Vec3 g{0.0f};
+  AttrAcc acc;
+};
+
+SV evalS(const Tape& T, uint32_t ni, Vec3 p) {
+  const TNode& n = T.nodes[ni];
+  SV r;
+  if (!n.box.contains(p)) return r;
+  switch (n.kind) {
+    case NodeKind::Point:
+    case NodeKind::Segment:
+    case NodeKind::Cone:
+    case NodeKind::Torus:
+    case NodeKind::Halfspace:
+    case NodeKind::Box: {
+      const Prim& P = T.prims[n.prim];
+      r.v = primValue(P, p, &r.g);
+      if (P.hasAttributes && r.v > 0.0f) {
+        r.acc.uvSum = r.v * primUv(P, p);
+        r.acc.wSum = r.v;
+        r.acc.addTexture(P.tex.textureId, r.v);
+      }
+      return r;
+    }
+    case NodeKind::Blend:
+      childrenAt(T, n, p, [&](uint32_t c) {
+        SV s = evalS(T, c, p);
+        r.v += s.v;
+        r.g += s.g;
+        r.acc.merge(s.acc);
+      });
+      return r;
+    case NodeKind::Ricci: {
+      // F = m·S^(1/n); ∇F = Σ (fᵢ/F)^(n−1) ∇fᵢ = G·S^(−(n−1)/n), G = Σ (fᵢ/m)^(n−1) ∇fᵢ.
+      float m = 0.0f, S = 0.0f, e = n.exponent;
+      Vec3 G{0.0f};
+      childrenAt(T, n, p, [&](uint32_t c) {
+        SV s = evalS(T, c, p);
+        if (s.v <= 0.0f) return;
+        r.acc.merge(s.acc);
+        if (s.v > m) {
+          float k = m > 0.0f ? m / s.v : 0.0f;
+          S = S * std::pow(k, e) + 1.0f;
+          G = G * std::pow(k, e - 1.0f) + s.g;
+          m = s.v;
+        } else {
+          float q = s.v / m;
+          S += std::pow(q, e);
+          G += std::pow(q, e - 1.0f) * s.g;
+        }
+      });
+      if (m > 0.0f) {
+        r.v = m * std::pow(S, 1.0f / e);
+        r.g = G * std::pow(S, -(e - 1.0f) / e);
+      }
+      return r;
+    }
+    case NodeKind::Union:
+      childrenAt(T, n, p, [&](uint32_t c) {
+        SV s = evalS(T, c, p);
+        if (s.v > r.v) r = s;
+      });
+      return r;
+    case NodeKind::Intersect: {
+      SV best;
+      best.v = std::numeric_limits<float>::max();
+      AttrAcc first;
+      for (uint32_t i = 0; i < n.count; ++i) {
+        SV s = evalS(T, T.kids[n.first + i], p);
+        if (i == 0) first = s.acc;
+        if (s.v < best.v) best = s;
+      }
+      if (best.v <= 0.0f) return r;
+      r.v = best.v;
+      r.g = best.g;
+      r.acc = first;
+      return r;
+    }
+    case NodeKind::Difference: {
+      SV a = evalS(T, T.kids[n.first], p);
+      if (a.v <= 0.0f) return r;
+      SV b = evalS(T, T.kids[n.first + 1], p);
+      float nb = 1.0f - b.v;
+      if (nb <= 0.0f) return r;
+      r.acc = a.acc;
+      if (a.v <= nb) { r.v = a.v; r.g = a.g; }
+      else { r.v = nb; r.g = -b.g; }
+      return r;
+    }
+    case NodeKind::Pcm: {
+      // F = f_max + Σ_{j≠max} d(f_j); ∇F = ∇f_max + Σ_{j≠max} d'(f_j)∇f_j.
+      float fmax = 0.0f, dsum = 0.0f, dmax = 0.0f, dpmax = 0.0f;
+      Vec3 gsum{0.0f}, gmax{0.0f};
+      childrenAt(T, n, p, [&](uint32_t c) {
+        SV s = evalS(T, c, p);
+        float f = std::max(0.0f, s.v);
+        if (s.v < 0.0f) s.g = Vec3(0.0f);
+        float dp;
+        float d = pcmD(n.pcm, f, &dp);
+        dsum += d;
+        gsum += dp * s.g;
+        r.acc.merge(s.acc);
+        if (f > fmax) { fmax = f; dmax = d; dpmax = dp; gmax = s.g; }
+      });
+      if (fmax <= 0.0f) return r;
+      r.v = fmax + dsum - dmax;
+      if (r.v <= 0.0f) { r.v = 0.0f; return r; }
+      r.g = gmax + gsum - dpmax * gmax;
+      return r;
+    }
+    case NodeKind::Negative: {
+      SV s = evalS(T, T.kids[n.first], p);
+      r.v = -n.weight * s.v;
+      r.g = -n.weight * s.g;
+      return r;
+    }
+    case NodeKind::Transform:
+    case NodeKind::Bend:
+    case NodeKind::Twist:
+    case NodeKind::Taper: {
+      Mat3 jt;
+      Vec3 q = warpLocal(n, p, &jt);
+      SV s = evalS(T, T.kids[n.first], q);
+      s.g = jt * s.g;
+      return s;
+    }
+  }
+  return r;
+}
+
+// ---- Intervals and Lipschitz bounds over boxes ---------------------------------------------
+
+Box3 localBoxOf(const TNode& n, const Tape& T, const Box3& box) {
+  const Box3& cb = T.nodes[T.kids[n.first]].box;
+  switch (n.kind) {
+    case NodeKind::Transform: return transformBox(n.localFromWorld, box);
+    case NodeKind::Bend: return n.bend.localBox(box, cb);
+    case NodeKind::Twist: {
+      float h0, h1, r;
+      axialExtent(box, n.twist.origin, n.twist.axis, h0, h1, r);
+      return cylinderBox(n.twist.origin, n.twist.axis, h0, h1, r).intersected(cb);
+    }
+    case NodeKind::Taper: {
+      float h0, h1, r;
+      axialExtent(box, n.taper.origin, n.taper.axis, h0, h1, r);
+      float smin = std::min(taperScale(n.taper, h0), taperScale(n.taper, h1));
+      if (smin <= 0.0f) return cb;
+      return cylinderBox(n.taper.origin, n.taper.axis, h0, h1, r / smin).intersected(cb);
+    }
+    default: return box;
+  }
+}
+
+Interval evalI(const Tape& T, uint32_t ni, const Box3& box) {
+  const TNode& n = T.nodes[ni];
+  if (box.empty() || !box.overlaps(n.box)) return {0.0f, 0.0f};
+  switch (n.kind) {
+    case NodeKind::Point:
+    case NodeKind::Segment:
+    case NodeKind::Cone:
+    case NodeKind::Torus:
+    case NodeKind::Halfspace:
+    case NodeKind::Box: {
+      Interval r = primInterval(T.prims[n.prim], box);
+      if (!n.box.contains(box.lo) || !n.box.contains(box.hi)) r.lo = std::min(r.lo, 0.0f);
+      return r;
+    }
+    case NodeKind::Blend: {
+      Interval r{0.0f, 0.0f};
+      childrenIn(T, n, box, [&](uint32_t c) {
+        Interval i = evalI(T, c, box);
+        r.lo += i.lo;
+        r.hi += i.hi;
+      });
+      return r;
+    }
+    case NodeKind::Ricci: {
+      RicciAcc lo, hi;
+      childrenIn(T, n, box, [&](uint32_t c) {
+        Interval i = evalI(T, c, box);
+        lo.add(i.lo, n.exponent);
+        hi.add(i.hi, n.exponent);
+      });
+      return {lo.value(n.exponent), hi.value(n.exponent)};
+    }
+    case NodeKind::Union: {
+      Interval r{0.0f, 0.0f};
+      childrenIn(T, n, box, [&](uint32_t c) {
+        Interval i = evalI(T, c, box);
+        r.lo = std::max(r.lo, i.lo);
+        r.hi = std::max(r.hi, i.hi);
+      });
+      return r;
+    }
+    case NodeKind::Intersect: {
+      Interval r{std::numeric_limits<float>::max(), std::numeric_limits<float>::max()};
+      for (uint32_t k = 0; k < n.count; ++k) {
+        Interval i = evalI(T, T.kids[n.first + k], box);
+        r.lo = std::min(r.lo, i.lo);
+        r.hi = std::min(r.hi, i.hi);
+      }
+      return {std::max(0.0f, r.lo), std::max(0.0f, r.hi)};
+    }
+    case NodeKind::Difference: {
+      Interval a = evalI(T, T.kids[n.first], box);
+      Interval b = evalI(T, T.kids[n.first + 1], box);
+      return {std::max(0.0f, std::min(a.lo, 1.0f - b.hi)), std::max(0.0f, std::min(a.hi, 1.0f - b.lo))};
+    }
+    case NodeKind::Pcm: {
+      float maxLo = 0.0f, maxHi = 0.0f, dLo = 0.0f, dHi = 0.0f;
+      const PcmDerived& d = n.pcm;
+      childrenIn(T, n, box, [&](uint32_t c) {
+        Interval i = evalI(T, c, box);
+        float lo = std::max(0.0f, i.lo), hi = std::max(0.0f, i.hi);
+        maxLo = std::max(maxLo, lo);
+        maxHi = std::max(maxHi, hi);
+        dLo += std::min(0.0f, d.c - hi);
+        if (hi > d.c - d.w && lo < d.c) dHi += d.a0;
+      });
+      return {std::max(0.0f, maxLo + dLo), std::max(0.0f, maxHi + dHi)};
+    }
+    case NodeKind::Negative: {
+      Interval i = evalI(T, T.kids[n.first], box);
+      return {-n.weight * i.hi, -n.weight * i.lo};
+    }
+    case NodeKind::Transform:
+    case NodeKind::Bend:
+    case NodeKind::Twist:
+    case NodeKind::Taper: return evalI(T, T.kids[n.first], localBoxOf(n, T, box));
+  }
+  return {0.0f, 0.0f};
+}
+
+float evalL(const Tape& T, uint32_t ni, const Box3& box) {
+  const TNode& n = T.nodes[ni];
+  if (box.empty() || !box.overlaps(n.box)) return 0.0f;
+  switch (n.kind) {
+    case NodeKind::Point:
+    case NodeKind::Segment:
+    case NodeKind::Cone:
+    case NodeKind::Torus:
+    case NodeKind::Halfspace:
+    case NodeKind::Box: return n.lip;
+    case NodeKind::Blend:
+    case NodeKind::Ricci:
+    case NodeKind::Pcm: {
+      float s = 0.0f;
+      childrenIn(T, n, box, [&](uint32_t c) { s += evalL(T, c, box); });
+      return n.kind == NodeKind::Pcm ? s * (1.0f + n.pcm.maxSlope) : s;
+    }
+    case NodeKind::Union:
+    case NodeKind::Intersect:
+    case NodeKind::Difference: {
+      float m = 0.0f;
+      for (uint32_t k = 0; k < n.count; ++k) m = std::max(m, evalL(T, T.kids[n.first + k], box));
+      return m;
+    }
+    case NodeKind::Negative: return n.weight * evalL(T, T.kids[n.first], box);
+    case NodeKind::Transform: return n.jNorm * evalL(T, T.kids[n.first], transformBox(n.localFromWorld, box));
+    case NodeKind::Bend:
+      return n.bend.jacobianBound(box) * evalL(T, T.kids[n.first], n.bend.localBox(box, T.nodes[T.kids[n.first]].box));
+    case NodeKind::Twist: {
+      float h0, h1, r;
+      axialExtent(box, n.twist.origin, n.twist.axis, h0, h1, r);
+      return (1.0f + std::abs(n.twist.rateRadPerUnit) * r) * evalL(T, T.kids[n.first], localBoxOf(n, T, box));
+    }
+    case NodeKind::Taper: {
+      float h0, h1, r;
+      axialExtent(box, n.taper.origin, n.taper.axis, h0, h1, r);
+      float smin = std::min(taperScale(n.taper, h0), taperScale(n.taper, h1));
+      if (smin <= 0.0f) return n.lip;
+      float ds = std::abs(n.taper.scale1 - n.taper.scale0) / n.taper.length;
+      return (1.0f / smin + 1.0f + ds * r / (smin * smin)) * evalL(T, T.kids[n.first], localBoxOf(n, T, box));
+    }
+  }
+  return n.lip;
+}
+
+// ---- Batched values ------------------------------------------------------------------------
+
+constexpr int kBlock = 128;  ///< points per batch (a multiple of 8)
+
+struct Pts {
+  const float* x;
+  const float* y;
+  const float* z;
+  int n;   ///< real count
+  int n8;  ///< padded count (multiple of 8, <= kBlock)
+};
+
+/// out[i] (+)= cone/segment field; vectorizable inner loop.
+template <Kernel K, bool Add>
+void coneBatch(const Prim& P, const Pts& pts, float* __restrict out) {
+  const float ax = P.a.x, ay = P.a.y, az = P.a.z;
+  const float bx = P.ab.x, by = P.ab.y, bz = P.ab.z;
+  const float il = P.invLen2, R0 = P.R0, dR = P.dR, w = P.weight;
+  const float* __restrict X = pts.x;
+  const float* __restrict Y = pts.y;
+  const float* __restrict Z = pts.z;
+  for (int i0 = 0; i0 < pts.n8; i0 += 8) {
+    for (int j = 0; j < 8; ++j) {
+      int i = i0 + j;
+      float px = X[i] - ax, py = Y[i] - ay, pz = Z[i] - az;
+      float t = (px * bx + py * by + pz * bz) * il;
+      t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
+      float dx = px - t * bx, dy = py - t * by, dz = pz - t * bz;
+      float d2 = dx * dx + dy * dy + dz * dz;
+      float R = R0 + dR * t;
+      float s = d2 / (R * R);
+      s = s > 1.0f ? 1.0f : s;
+      float g;
+      if constexpr (K == Kernel::Wyvill) {
+        float u = 1.0f - s;
+        g = u * u * u;
+      } else {
+        g = 1.0f + s * (-22.0f / 9.0f + s * (17.0f / 9.0f - s * (4.0f / 9.0f)));
+      }
+      if constexpr (Add) out[i] += w * g;
+      else out[i] = w * g;
+    }
+  }
+}
+
+template <Kernel K, bool Add>
+void pointBatch(const Prim& P, const Pts& pts, float* __restrict out) {
+  const float ax = P.a.x, ay = P.a.y, az = P.a.z, iR2 = 1.0f / (P.R0 * P.R0), w = P.weight;
+  for (int i0 = 0; i0 < pts.n8; i0 += 8) {
+    for (int j = 0; j < 8; ++j) {
+      int i = i0 + j;
+      float dx = pts.x[i] - ax, dy = pts.y[i] - ay, dz = pts.z[i] - az;
+      float s = (dx * dx + dy * dy + dz * dz) * iR2;
+      s = s > 1.0f ? 1.0f : s;
+      float g;
+      if constexpr (K == Kernel::Wyvill) {
+        float u = 1.0f - s;
+        g = u * u * u;
+      } else {
+        g = 1.0f + s * (-22.0f / 9.0f + s * (17.0f / 9.0f - s * (4.0f / 9.0f)));
+      }
+      if constexpr (Add) out[i] += w * g;
+      else out[i] = w * g;
+    }
+  }
+}
+
+template <bool Add>
+void primBatch(const Prim& P, const Pts& pts, float* out) {
+  bool wy = P.kernel == Kernel::Wyvill;
+  switch (P.kind) {
+    case NodeKind::Segment:
+    case NodeKind::Cone:
+      if (wy) coneBatch<Kernel::Wyvill, Add>(P, pts, out);
+      else coneBatch<Kernel::SoftObject, Add>(P, pts, out);
+      return;
+    case NodeKind::Point:
+      if (wy) pointBatch<Kernel::Wyvill, Add>(P, pts, out);
+      else pointBatch<Kernel::SoftObject, Add>(P, pts, out);
+      return;
+    default:
+      for (int i = 0; i < pts.n; ++i) {
+        float f = primValue(P, Vec3(pts.x[i], pts.y[i], pts.z[i]), nullptr);
+        if constexpr (Add) out[i] += f;
+        else out[i] = f;
+      }
+      return;
+  }
+}
+
+void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* out) {
+  const TNode& n = T.nodes[ni];
+  if (!pbox.overlaps(n.box)) {
+    std::fill(out, out + pts.n8, 0.0f);
+    return;
+  }
+  if (isPrimitive(n.kind)) {
+    primBatch<false>(T.prims[n.prim], pts, out);
+    return;
+  }
+  alignas(32) float tmp[kBlock];
+  switch (n.kind) {
+    case NodeKind::Blend:
+      std::fill(out, out + pts.n8, 0.0f);
+      childrenIn(T, n, pbox, [&](uint32_t c) {
+        const TNode& cn = T.nodes[c];
+        if (isPrimitive(cn.kind)) {
+          primBatch<true>(T.prims[cn.prim], pts, out);
+        } else {
+          evalB(T, c, pts, pbox, tmp);
+          for (int i = 0; i < pts.n8; ++i) out[i] += tmp[i];
+        }
+      });
+      return;
+    case NodeKind::Union:
+      std::fill(out, out + pts.n8, 0.0f);
+      childrenIn(T, n, pbox, [&](uint32_t c) {
+        evalB(T, c, pts, pbox, tmp);
+        for (int i = 0; i < pts.n8; ++i) out[i] = std::max(out[i], tmp[i]);
+      });
+      return;
+    case NodeKind::Intersect:
+      std::fill(out, out + pts.n8, std::numeric_limits<float>::max());
+      for (uint32_t k = 0; k < n.count; ++k) {
+        evalB(T, T.kids[n.first + k], pts, pbox, tmp);
+        for (int i = 0; i < pts.n8; ++i) out[i] = std::min(out[i], tmp[i]);
+      }
+      for (int i = 0; i < pts.n8; ++i) out[i] = std::max(0.0f, out[i]);
+      return;
+    case NodeKind::Difference:
+      evalB(T, T.kids[n.first], pts, pbox, out);
+      evalB(T, T.kids[n.first + 1], pts, pbox, tmp);
+      for (int i = 0; i < pts.n8; ++i) out[i] = std::max(0.0f, std::min(out[i], 1.0f - tmp[i]));
+      return;
+    case NodeKind::Ricci: {
+      alignas(32) float S[kBlock];
+      std::fill(out, out + pts.n8, 0.0f);  // running max m
+      std::fill(S, S + pts.n8, 0.0f);
+      childrenIn(T, n, pbox, [&](uint32_t c) {
+        evalB(T, c, pts, pbox, tmp);
+        for (int i = 0; i < pts.n; ++i) {
+          RicciAcc a{out[i], S[i]};
+          a.add(tmp[i], n.exponent);
+          out[i] = a.m;
+          S[i] = a.s;
+        }
+      });
+      for (int i = 0; i < pts.n; ++i) out[i] = out[i] > 0.0f ? out[i] * std::pow(S[i], 1.0f / n.exponent) : 0.0f;
+      return;
+    }
+    case NodeKind::Pcm: {
+      alignas(32) float dsum[kBlock], dmax[kBlock];
+      std::fill(out, out + pts.n8, 0.0f);
+      std::fill(dsum, dsum + pts.n8, 0.0f);
+      std::fill(dmax, dmax + pts.n8, 0.0f);
+      childrenIn(T, n, pbox, [&](uint32_t c) {
+        evalB(T, c, pts, pbox, tmp);
+        for (int i = 0; i < pts.n; ++i) {
+          float f = std::max(0.0f, tmp[i]);
+          float d = pcmD(n.pcm, f, nullptr);
+          dsum[i] += d;
+          if (f > out[i]) { out[i] = f; dmax[i] = d; }
+        }
+      });
+      for (int i = 0; i < pts.n; ++i) out[i] = out[i] > 0.0f ? std::max(0.0f, out[i] + dsum[i] - dmax[i]) : 0.0f;
+      return;
+    }
+    case NodeKind::Negative:
+      evalB(T, T.kids[n.first], pts, pbox, out);
+      for (int i = 0; i < pts.n8; ++i) out[i] *= -n.weight;
+      return;
+    case NodeKind::Transform:
+    case NodeKind::Bend:
+    case NodeKind::Twist:
+    case NodeKind::Taper: {
+      alignas(32) float lx[kBlock], ly[kBlock], lz[kBlock];
+      Box3 lb;
+      for (int i = 0; i < pts.n8; ++i) {
+        Vec3 q = warpLocal(n, Vec3(pts.x[i], pts.y[i], pts.z[i]), nullptr);
+        lx[i] = q.x;
+        ly[i] = q.y;
+        lz[i] = q.z;
+        lb.extend(q);
+      }
+      Pts lp{lx, ly, lz, pts.n, pts.n8};
+      evalB(T, T.kids[n.first], lp, lb, out);
+      return;
+    }
+    default: std::fill(out, out + pts.n8, 0.0f); return;
+  }
+}
+
+// ---- Compilation ---------------------------------------------------------------------------
+
+struct Compiler {
+  const BlobTree& tree;
+  Tape& T;
+  std::unordered_map<NodeId, uint32_t> done;
+
+  uint32_t visit(NodeId id) {
+    if (auto it = done.find(id); it != done.end()) return it->second;
+    const Node& src = tree.node(id);
+    std::vector<uint32_t> kids;
+    kids.reserve(src.children.size());
+    for (NodeId c : src.children) kids.push_back(visit(c));
+    TNode n;
+    n.kind = src.kind;
+    n.box = src.bounds;
+    n.lip = src.lipschitz;
+    n.weight = src.weight;
+    n.exponent = src.exponent;
+    if (isPrimitive(src.kind)) {
+      n.prim = uint32_t(T.prims.size());
+      T.prims.push_back(makePrim(src, tree.kernel()));
+    }
+    if (src.kind == NodeKind::Pcm) n.pcm = derivePcm(src.pcm);
+    if (src.kind == NodeKind::Transform) {
+      n.localFromWorld = src.localFromWorld;
+      n.worldFromLocal = src.worldFromLocal;
+      n.jt = glm::transpose(Mat3(src.localFromWorld));
+      n.jNorm = spectralNorm(Mat3(src.localFromWorld));
+    }
+    if (src.kind == NodeKind::Bend) n.bend = makeBendFrame(src.bend, tree.node(src.children[0]).bounds);
+    n.twist = src.twist;
+    n.taper = src.taper;
+    n.first = uint32_t(T.kids.size());
+    n.count = uint32_t(kids.size());
+    T.kids.insert(T.kids.end(), kids.begin(), kids.end());
+    bool nary = src.kind == NodeKind::Blend || src.kind == NodeKind::Ricci || src.kind == NodeKind::Union ||
+                src.kind == NodeKind::Pcm;
+    if (nary && kids.size() >= kBvhMinChildren) {
+      std::vector<Box3> boxes;
+      for (uint32_t k : kids) boxes.push_back(T.nodes[k].box);
+      n.bvh = buildBvh(T, boxes, kids);
+    }
+    uint32_t idx = uint32_t(T.nodes.size());
+    T.nodes.push_back(n);
+    done[id] = idx;
+    return idx;
+  }
+
+  /// Forward (local to world) box map of a warp/transform node.
+  static Box3 forward(const TNode& n, const Box3& b) {
+    switch (n.kind) {
+      case NodeKind::Transform: return transformBox(n.worldFromLocal, b);
+      case NodeKind::Bend: return n.bend.worldBox(b);
+      case NodeKind::Twist: {
+        float h0, h1, r;
+        axialExtent(b, n.twist.origin, n.twist.axis, h0, h1, r);
+        return isHuge(b) ? b : cylinderBox(n.twist.origin, n.twist.axis, h0, h1, r);
+      }
+      case NodeKind::Taper: {
+        float h0, h1, r;
+        axialExtent(b, n.taper.origin, n.taper.axis, h0, h1, r);
+        float smax = std::max(taperScale(n.taper, h0), taperScale(n.taper, h1));
+        return isHuge(b) ? b : cylinderBox(n.taper.origin, n.taper.axis, h0, h1, r * smax);
+      }
+      default: return b;
+    }
+  }
+
+  void instances(uint32_t ni, std::vector<uint32_t>& chain, const Box3& clip) {
+    const TNode& n = T.nodes[ni];
+    if (isPrimitive(n.kind)) {
+      Box3 b = n.box;
+      for (size_t k = chain.size(); k-- > 0;) b = forward(T.nodes[chain[k]], b);
+      b = b.intersected(clip);
+      if (b.empty()) return;
+      T.instBox.push_back(b);
+      T.instPrim.push_back(n.prim);
+      return;
+    }
+    bool warp = n.kind == NodeKind::Transform || n.kind == NodeKind::Bend || n.kind == NodeKind::Twist ||
+                n.kind == NodeKind::Taper;
+    if (warp) chain.push_back(ni);
+    for (uint32_t k = 0; k < n.count; ++k) instances(T.kids[n.first + k], chain, clip);
+    if (warp) chain.pop_back();
+  }
+};
+
+float modelSize(const Tape& T) {
+  const Box3& b = T.nodes[T.root].box;
+  if (b.empty() || isHuge(b)) return 1.0f;
+  return std::max(glm::length(b.size()), 1e-20f);
+}
+
+}  // namespace
+
+// ---- CompiledBlob ------------------------------------------------------------------------
+
+CompiledBlob::CompiledBlob() : tape_(std::make_shared<Tape>()) {}
+CompiledBlob::~CompiledBlob() = default;
+CompiledBlob::CompiledBlob(const CompiledBlob&) = default;
+CompiledBlob& CompiledBlob::operator=(const CompiledBlob&) = default;
+CompiledBlob::CompiledBlob(CompiledBlob&&) noexcept = default;
+CompiledBlob& CompiledBlob::operator=(CompiledBlob&&) noexcept = default;
+
+CompiledBlob compile(const BlobTree& tree, NodeId root) {
+  if (root >= tree.size()) throw std::invalid_argument("compile: unknown root node");
+  auto tape = std::make_shared<Tape>();
+  Compiler c{tree, *tape, {}};
+  tape->root = c.visit(root);
+  tape->empty = false;
+  std::vector<uint32_t> chain;
+  c.instances(tape->root, chain, tape->nodes[tape->root].box);
+  if (!tape->instBox.empty()) {
+    std::vector<uint32_t> items(tape->instBox.size());
+    std::iota(items.begin(), items.end(), 0u);
+    tape->instBvh = buildBvh(*tape, tape->instBox, items);
+  }
+  float mf = 0.0f;
+  for (const Prim& P : tape->prims)
+    if (P.isoRadiusMin > 0.0f) mf = mf == 0.0f ? P.isoRadiusMin : std::min(mf, P.isoRadiusMin);
+  tape->minFeature = mf;
+  CompiledBlob b;
+  b.tape_ = std::move(tape);
+  return b;
+}
+
+float CompiledBlob::value(Vec3 p) const { return tape_->empty ? 0.0f : evalV(*tape_, tape_->root, p, true); }
+float CompiledBlob::valueNoCulling(Vec3 p) const { return tape_->empty ? 0.0f : evalV(*tape_, tape_->root, p, false); }
+
+Vec3 CompiledBlob::gradient(Vec3 p) const { return tape_->empty ? Vec3(0.0f) : evalS(*tape_, tape_->root, p).g; }
+
+Sample CompiledBlob::sample(Vec3 p) const {
+  Sample s;
+  if (tape_->empty) return s;
+  SV r = evalS(*tape_, tape_->root, p);
+  s.value = r.v;
+  s.gradient = r.g;
+  if (r.acc.wSum > 0.0f) {
+    s.attributes.uv = r.acc.uvSum / r.acc.wSum;
+    // Sort textures by decreasing weight; normalize.
+    std::array<int, Attributes::kMaxTextures> order{0, 1, 2, 3};
+    for (int i = 1; i < r.acc.count; ++i)  // insertion sort, at most 4 entries
+      for (int j = i; j > 0 && r.acc.w[size_t(order[size_t(j)])] > r.acc.w[size_t(order[size_t(j - 1)])]; --j)
+        std::swap(order[size_t(j)], order[size_t(j - 1)]);
+    float total = 0.0f;
+    for (int i = 0; i < r.acc.count; ++i) total += r.acc.w[size_t(i)];
+    for (int i = 0; i < r.acc.count; ++i) {
+      s.attributes.textureIds[size_t(i)] = r.acc.ids[size_t(order[size_t(i)])];
+      s.attributes.textureWeights[size_t(i)] = r.acc.w[size_t(order[size_t(i)])] / total;
+    }
+    s.attributes.textureCount = uint8_t(r.acc.count);
+  }
+  return s;
+}
+
+void CompiledBlob::values(std::span<const Vec3> points, std::span<float> out) const {
+  assert(out.size() >= points.size());
+  if (tape_->empty) {
+    std::fill(out.begin(), out.begin() + long(points.size()), 0.0f);
+    return;
+  }
+  alignas(32) float x[kBlock], y[kBlock], z[kBlock], r[kBlock];
+  for (size_t b = 0; b < points.size(); b += kBlock) {
+    int n = int(std::min<size_t>(kBlock, points.size() - b));
+    int n8 = (n + 7) & ~7;
+    Box3 box;
+    for (int i = 0; i < n; ++i) {
+      const Vec3& p = points[b + size_t(i)];
+      x[i] = p.x;
+      y[i] = p.y;
+      z[i] = p.z;
+      box.extend(p);
+    }
+    for (int i = n; i < n8; ++i) {
+      x[i] = x[n - 1];
+      y[i] = y[n - 1];
+      z[i] = z[n - 1];
+    }
+    Pts pts{x, y, z, n, n8};
+    evalB(*tape_, tape_->root, pts, box, r);
+    std::copy(r, r + n, out.begin() + long(b));
+  }
+}
+
+void CompiledBlob::valuesInCell(const Cell& cell, std::span<const Vec3> points, std::span<float> out) const {
+  (void)cell;  // the batch's own bounding box (inside the cell) culls at least as well
+  values(points, out);
+}
+
+Box3 CompiledBlob::bounds() const { return tape_->empty ? Box3{} : tape_->nodes[tape_->root].box; }
+
+Interval CompiledBlob::valueBounds(const Box3& box) const {
+  return tape_->empty ? Interval{} : evalI(*tape_, tape_->root, box);
+}
+
+float CompiledBlob::lipschitz(const Box3& box) const { return tape_->empty ? 0.0f : evalL(*tape_, tape_->root, box); }
+float CompiledBlob::lipschitz() const { return tape_->empty ? 0.0f : tape_->nodes[tape_->root].lip; }
+
+size_t CompiledBlob::primitiveCount() const { return tape_->instBox.size(); }
+Box3 CompiledBlob::primitiveBounds(uint32_t i) const { return tape_->instBox.at(i); }
+float CompiledBlob::smallestFeature() const { return tape_->minFeature; }
+
+// ---- Ray intersection ------------------------------------------------------------------------
+
+namespace {
+
+/// Clips [s0, s1] of a unit-direction ray to box; false when empty.
+bool clipToBox(const Box3& b, Vec3 o, Vec3 d, float& s0, float& s1) {
+  for (int a = 0; a < 3; ++a) {
+    if (std::abs(d[a]) < 1e-30f) {
+      if (o[a] < b.lo[a] || o[a] > b.hi[a]) return false;
+      continue;
+    }
+    float inv = 1.0f / d[a];
+    float ta = (b.lo[a] - o[a]) * inv, tb = (b.hi[a] - o[a]) * inv;
+    if (ta > tb) std::swap(ta, tb);
+    s0 = std::max(s0, ta);
+    s1 = std::min(s1, tb);
+    if (s0 > s1) return false;
+  }
+  return true;
+}
+
+/// Refines a bracketed crossing of F − iso in [a, b] (fa, fb on opposite sides) by the
+/// Illinois variant of regula falsi with a bisection safeguard.
+float refine(const CompiledBlob& blob, Vec3 o, Vec3 d, float a, float b, float fa, float fb, float tol) {
+  fa -= kIso;
+  fb -= kIso;
+  int side = 0;
+  for (int it = 0; it < 60 && b - a > tol; ++it) {
+    float m = (it % 4 == 3) ? 0.5f * (a + b) : (a * fb - b * fa) / (fb - fa);
+    if (!(m > a && m < b)) m = 0.5f * (a + b);
+    float fm = blob.value(o + m * d) - kIso;
+    if ((fm > 0.0f) == (fa > 0.0f)) {
+      a = m;
+      fa = fm;
+      if (side == -1) fb *= 0.5f;
+      side = -1;
+    } else {
+      b = m;
+      fb = fm;
+      if (side == 1) fa *= 0.5f;
+      side = 1;
+    }
+  }
+  return std::abs(fa) < std::abs(fb) ? a : b;
+}
+
+std::optional<Hit> makeHit(const CompiledBlob& blob, const Ray& ray, Vec3 o, Vec3 d, float s, float dirLen) {
+  Hit h;
+  h.t = s / dirLen;
+  h.point = o + s * d;
+  Sample smp = blob.sample(h.point);
+  float gl = glm::length(smp.gradient);
+  h.normal = gl > 0.0f ? -smp.gradient / gl : -d;
+  h.attributes = smp.attributes;
+  (void)ray;
+  return h;
+}
+
+}  // namespace
+
+std::optional<Hit> CompiledBlob::intersect(const Ray& ray, float tmin, float tmax, const TraceOptions& opt) const {
+  if (tape_->empty) return std::nullopt;
+  float dirLen = glm::length(ray.direction);
+  if (!(dirLen > 0.0f)) return std::nullopt;
+  Vec3 d = ray.direction / dirLen, o = ray.origin;
+  float s0 = tmin * dirLen, s1 = tmax * dirLen;
+  Box3 root = bounds();
+  if (!isHuge(root) && !clipToBox(root, o, d, s0, s1)) return std::nullopt;
+  if (!(s1 > s0) && !(s1 == s0)) return std::nullopt;
+  float size = isHuge(root) ? std::max(1.0f, s1 - s0) : modelSize(*tape_);
+  float eps = std::max(opt.relativeTolerance * size, 1e-30f);
+  float s = s0;
+  float f = value(o + s * d);
+  bool inside = f > kIso;
+  float W = std::max(s1 - s0, eps);
+  float wMin = 4.0f * eps;
+  for (int step = 0; step < opt.maxSteps; ++step) {
+    if (s >= s1) return std::nullopt;
+    W = std::min(W, s1 - s);
+    Vec3 pa = o + s * d, pb = o + (s + W) * d;
+    Box3 box{glm::min(pa, pb), glm::max(pa, pb)};
+    Interval iv = valueBounds(box);
+    if ((!inside && iv.hi < kIso) || (inside && iv.lo > kIso)) {
+      s += W;
+      if (s >= s1) return std::nullopt;
+      f = value(o + s * d);
+      W *= 2.0f;
+      continue;
+    }
+    float L = lipschitz(box);
+    float safe = L > 0.0f ? std::abs(f - kIso) / L : W;
+    if (safe >= W) {
+      s += W;
+      if (s >= s1) return std::nullopt;
+      f = value(o + s * d);
+      W *= 2.0f;
+      continue;
+    }
+    if (W > 4.0f * safe && W > wMin) {
+      W = std::max(4.0f * safe, wMin);
+      continue;
+    }
+    if (safe < eps) {
+      float s2 = std::min(s + 2.0f * eps, s1);
+      float f2 = value(o + s2 * d);
+      if ((f2 > kIso) != inside) return makeHit(*this, ray, o, d, refine(*this, o, d, s, s2, f, f2, eps * 1e-3f), dirLen);
+      s = s2;
+      f = f2;
+      continue;
+    }
+    s += safe;
+    f = value(o + s * d);
+    if ((f > kIso) != inside) {
+      // A crossing can only be reached at the end of a safe step when |f − iso| was 0.
+      return makeHit(*this, ray, o, d, s, dirLen);
+    }
+  }
+  return std::nullopt;
+}
+
+std::optional<Hit> CompiledBlob::intersectCell(const Cell& cell, const Ray& ray, float tmin, float tmax,
+                                               const TraceOptions& opt) const {
+  if (tape_->empty) return std::nullopt;
+  float dirLen = glm::length(ray.direction);
+  if (!(dirLen > 0.0f)) return std::nullopt;
+  Vec3 d = ray.direction / dirLen, o = ray.origin;
+  float s0 = tmin * dirLen, s1 = tmax * dirLen;
+  if (!clipToBox(cell.box, o, d, s0, s1)) return std::nullopt;
+  float eps = std::max(opt.relativeTolerance * modelSize(*tape_), 1e-30f);
+  float L = std::max(cell.lipschitz, 1e-30f);
+  float s = s0;
+  float f = value(o + s * d);
+  bool inside = f > kIso;
+  for (int step = 0; step < opt.maxSteps; ++step) {
+    float safe = std::abs(f - kIso) / L;
+    if (s + safe > s1) return std::nullopt;
+    if (safe < eps) {
+      float s2 = s + 2.0f * eps;
+      if (s2 > s1) s2 = s1;
+      if (s2 <= s) return std::nullopt;
+      float f2 = value(o + s2 * d);
+      if ((f2 > kIso) != inside) return makeHit(*this, ray, o, d, refine(*this, o, d, s, s2, f, f2, eps * 1e-3f), dirLen);
+      s = s2;
+      f = f2;
+      continue;
+    }
+    s += safe;
+    f = value(o + s * d);
+    if ((f > kIso) != inside) return makeHit(*this, ray, o, d, s, dirLen);
+  }
+  return std::nullopt;
+}
+
+// ---- Surface cells ---------------------------------------------------------------------------
+
+CellSet CompiledBlob::surfaceCells(float cellSize) const {
+  if (!(cellSize > 0.0f)) throw std::invalid_argument("surfaceCells: cellSize must be positive");
+  CellSet out;
+  if (tape_->empty) return out;
+  Box3 rb = bounds();
+  if (rb.empty()) return out;
+  if (isHuge(rb)) throw std::invalid_argument("surfaceCells: the model is unbounded (a bare cutter)");
+  float E = std::max(rb.size().x, std::max(rb.size().y, rb.size().z)) * 1.0001f + 1e-20f;
+  int depth = std::max(0, int(std::ceil(std::log2(E / cellSize))));
+  if (depth > 20) throw std::invalid_argument("surfaceCells: cellSize too small for the model");
+  float edge = E / float(1 << depth);
+  out.origin = rb.center() - Vec3(0.5f * E);
+  out.cellSize = edge;
+  const Tape& T = *tape_;
+
+  struct Item {
+    std::array<int32_t, 3> idx;
+    int level;
+  };
+  auto boxOf = [&](const Item& it) {
+    float e = E / float(1 << it.level);
+    Vec3 lo = out.origin + Vec3(float(it.idx[0]), float(it.idx[1]), float(it.idx[2])) * e;
+    return Box3{lo, lo + Vec3(e)};
+  };
+  // Top levels sequentially, so each subtree below is an independent task.
+  int split = std::min(depth, 3);
+  std::vector<Item> frontier{{{0, 0, 0}, 0}};
+  for (int l = 0; l < split; ++l) {
+    std::vector<Item> next;
+    for (const Item& it : frontier) {
+      if (!valueBounds(boxOf(it)).contains(kIso)) continue;
+      for (int c = 0; c < 8; ++c)
+        next.push_back({{it.idx[0] * 2 + (c & 1), it.idx[1] * 2 + ((c >> 1) & 1), it.idx[2] * 2 + ((c >> 2) & 1)}, l + 1});
+    }
+    frontier = std::move(next);
+  }
+  std::vector<std::vector<Cell>> cellsOf(frontier.size());
+  std::vector<std::vector<uint32_t>> primsOf(frontier.size());
+  parallelFor(0, frontier.size(), [&](size_t k) {
+    std::vector<Item> stack{frontier[k]};
+    auto& cells = cellsOf[k];
+    auto& prims = primsOf[k];
+    while (!stack.empty()) {
+      Item it = stack.back();
+      stack.pop_back();
+      Box3 b = boxOf(it);
+      Interval iv = valueBounds(b);
+      if (!iv.contains(kIso)) continue;
+      if (it.level < depth) {
+        for (int c = 7; c >= 0; --c)
+          stack.push_back({{it.idx[0] * 2 + (c & 1), it.idx[1] * 2 + ((c >> 1) & 1), it.idx[2] * 2 + ((c >> 2) & 1)},
+                           it.level + 1});
+        continue;
+      }
+      Cell cell;
+      cell.box = b;
+      cell.index = it.idx;
+      cell.bounds = iv;
+      cell.lipschitz = evalL(T, T.root, b);
+      cell.firstPrimitive = uint32_t(prims.size());
+      if (T.instBvh >= 0)
+        walkBvh(T, T.instBvh, [&](const Box3& bb) { return bb.overlaps(b); }, [&](uint32_t i) {
+          if (T.instBox[i].overlaps(b)) prims.push_back(i);
+        });
+      cell.primitiveCount = uint32_t(prims.size()) - cell.firstPrimitive;
+      cells.push_back(cell);
+    }
+  }, 1);
+  for (size_t k = 0; k < frontier.size(); ++k) {
+    uint32_t base = uint32_t(out.primitives.size());
+    for (Cell c : cellsOf[k]) {
+      c.firstPrimitive += base;
+      out.cells.push_back(c);
+    }
+    out.primitives.insert(out.primitives.end(), primsOf[k].begin(), primsOf[k].end());
+  }
+  return out;
+}
+
+}  // namespace sprig::blobtree
