@@ -1,0 +1,422 @@
+#include "blobtree/polygonize.h"
+
+#include <tbb/parallel_sort.h>
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <optional>
+#include <stdexcept>
+#include <string>
+
+#include "core/parallel.h"
+#include "core/progress.h"
+
+namespace sprig::blobtree {
+
+namespace {
+
+// Grid points are keyed by their integer coordinates, 20 bits per axis; an edge of the
+// Kuhn triangulation by (key of its low end) · 8 + (its direction as corner bits).
+constexpr int kAxisBits = 20;
+constexpr int64_t kAxisLimit = int64_t(1) << kAxisBits;
+constexpr uint64_t kAxisMask = uint64_t(kAxisLimit - 1);
+
+uint64_t pointKey(int64_t i, int64_t j, int64_t k) {
+  return (uint64_t(i) << (2 * kAxisBits)) | (uint64_t(j) << kAxisBits) | uint64_t(k);
+}
+
+glm::ivec3 keyCoords(uint64_t key) {
+  return {int((key >> (2 * kAxisBits)) & kAxisMask), int((key >> kAxisBits) & kAxisMask), int(key & kAxisMask)};
+}
+
+// Corner c of a cell (bit 0: +x, bit 1: +y, bit 2: +z).
+glm::ivec3 cornerOffset(int c) { return {c & 1, (c >> 1) & 1, (c >> 2) & 1}; }
+
+// The six Kuhn tetrahedra of a cube: monotone corner paths 0 -> 7, one per axis order.
+// Every face of the cube is split along the diagonal from its lowest to its highest
+// corner, so neighbouring cubes agree.
+constexpr int kTets[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7}, {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
+
+struct CornerRef {
+  uint64_t key;
+  uint32_t slot;  // cell · 8 + corner
+  bool operator<(const CornerRef& o) const { return key != o.key ? key < o.key : slot < o.slot; }
+};
+
+// A surface-crossing grid edge: its key and its inside / outside grid points.
+struct EdgeRec {
+  uint64_t key;
+  uint32_t inside, outside;  // distinct grid point indices
+  bool operator<(const EdgeRec& o) const { return key < o.key; }
+};
+
+using TriKeys = std::array<uint64_t, 3>;
+
+Vec3 gridPosition(const CellSet& cs, glm::ivec3 g) {
+  return cs.origin + Vec3(float(g.x) * cs.cellSize, float(g.y) * cs.cellSize, float(g.z) * cs.cellSize);
+}
+
+// Triangles of one tetrahedron (corner codes t, inside flags), as edge keys, oriented from
+// inside to outside using the edges' midpoints (never degenerate).
+struct TetEmitter {
+  glm::ivec3 cell;
+  const uint32_t* cornerPoint;  // the cell's 8 grid point indices
+  std::vector<TriKeys>* tris;
+  std::vector<EdgeRec>* edges;
+
+  uint64_t edge(int a, int b, bool aInside) const {
+    int lo = a & b, hi = a | b;
+    glm::ivec3 g = cell + cornerOffset(lo);
+    uint64_t key = (pointKey(g.x, g.y, g.z) << 3) | uint64_t(hi ^ lo);
+    edges->push_back({key, cornerPoint[aInside ? a : b], cornerPoint[aInside ? b : a]});
+    return key;
+  }
+
+  static Vec3 mid(int a, int b) { return 0.5f * Vec3(cornerOffset(a) + cornerOffset(b)); }
+
+  // Emits triangle (e0,e1,e2) with midpoints (m0,m1,m2), flipped so its normal points along outward.
+  void emit(uint64_t e0, uint64_t e1, uint64_t e2, Vec3 m0, Vec3 m1, Vec3 m2, Vec3 outward) const {
+    Vec3 n = glm::cross(m1 - m0, m2 - m0);
+    if (glm::dot(n, outward) >= 0.0f) tris->push_back({e0, e1, e2});
+    else tris->push_back({e0, e2, e1});
+  }
+
+  void run(const int t[4], const bool in[4]) const {
+    int count = in[0] + in[1] + in[2] + in[3];
+    if (count == 0 || count == 4) return;
+    if (count == 1 || count == 3) {
+      // The lone vertex s against the other three.
+      bool loneInside = count == 1;
+      int s = 0;
+      while (in[s] != loneInside) ++s;
+      int o[3], n = 0;
+      for (int k = 0; k < 4; ++k)
+        if (k != s) o[n++] = k;
+      Vec3 ps = Vec3(cornerOffset(t[s]));
+      Vec3 po = (Vec3(cornerOffset(t[o[0]])) + Vec3(cornerOffset(t[o[1]])) + Vec3(cornerOffset(t[o[2]]))) / 3.0f;
+      Vec3 outward = loneInside ? po - ps : ps - po;
+      uint64_t e[3];
+      for (int k = 0; k < 3; ++k) e[k] = edge(t[s], t[o[k]], loneInside);
+      emit(e[0], e[1], e[2], mid(t[s], t[o[0]]), mid(t[s], t[o[1]]), mid(t[s], t[o[2]]), outward);
+      return;
+    }
+    // Two inside (a, b), two outside (c, d): the quad ac, ad, bd, bc.
+    int ins[2], outs[2], ni = 0, no = 0;
+    for (int k = 0; k < 4; ++k) (in[k] ? ins[ni++] : outs[no++]) = t[k];
+    int a = ins[0], b = ins[1], c = outs[0], d = outs[1];
+    Vec3 outward = 0.5f * (Vec3(cornerOffset(c)) + Vec3(cornerOffset(d))) -
+                   0.5f * (Vec3(cornerOffset(a)) + Vec3(cornerOffset(b)));
+    uint64_t ac = edge(a, c, true), ad = edge(a, d, true), bd = edge(b, d, true), bc = edge(b, c, true);
+    emit(ac, ad, bd, mid(a, c), mid(a, d), mid(b, d), outward);
+    emit(ac, bd, bc, mid(a, c), mid(b, d), mid(b, c), outward);
+  }
+};
+
+// Concatenates per-chunk vectors in chunk order.
+template <class T>
+std::vector<T> concat(std::vector<std::vector<T>>& parts) {
+  size_t total = 0;
+  for (const auto& p : parts) total += p.size();
+  std::vector<T> out;
+  out.reserve(total);
+  for (auto& p : parts) {
+    out.insert(out.end(), p.begin(), p.end());
+    std::vector<T>().swap(p);
+  }
+  return out;
+}
+
+}  // namespace
+
+float resolveCellSize(const CompiledBlob& blob, const PolygonizeOptions& options) {
+  if (options.cellSize > 0.0f) return options.cellSize;
+  if (!(options.featureFraction > 0.0f) || !(options.sizeDivisions > 0.0f))
+    throw std::invalid_argument("polygonize: featureFraction and sizeDivisions must be positive");
+  Box3 b = blob.bounds();
+  if (b.empty()) return 0.0f;
+  Vec3 size = b.size();
+  if (!std::isfinite(size.x) || !std::isfinite(size.y) || !std::isfinite(size.z) || size.x > 1e30f)
+    throw std::invalid_argument("polygonize: the blob is unbounded (a bare cutter); give a cell size and a bounded model");
+  float h = glm::length(size) / options.sizeDivisions;
+  float feature = blob.smallestFeature();
+  if (feature > 0.0f) h = std::min(h, options.featureFraction * feature);
+  return h;
+}
+
+PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOptions& options) {
+  PolygonizeResult res;
+  float requested = resolveCellSize(blob, options);
+  if (requested <= 0.0f || blob.bounds().empty()) return res;
+
+  // ---- 1. Cells that may hold the surface ------------------------------------------
+  CellSet cs = blob.surfaceCells(requested);
+  res.cellSize = cs.cellSize;
+  res.surfaceCells = cs.cells.size();
+  const size_t nCells = cs.cells.size();
+  if (nCells == 0) return res;
+  if (nCells >= (size_t(1) << 29)) throw std::invalid_argument("polygonize: too many surface cells; use a larger cell size");
+  for (const Cell& c : cs.cells)
+    for (int a = 0; a < 3; ++a)
+      if (c.index[a] < 0 || c.index[a] + 1 >= kAxisLimit)
+        throw std::invalid_argument("polygonize: the grid has more than 2^20 cells on an axis; use a larger cell size");
+
+  // ---- 2. One sample per distinct cell corner ---------------------------------------
+  std::vector<CornerRef> refs(nCells * 8);
+  parallelFor(0, nCells, [&](size_t i) {
+    const auto& idx = cs.cells[i].index;
+    for (int c = 0; c < 8; ++c) {
+      glm::ivec3 g = glm::ivec3(idx[0], idx[1], idx[2]) + cornerOffset(c);
+      refs[i * 8 + c] = {pointKey(g.x, g.y, g.z), uint32_t(i * 8 + c)};
+    }
+  }, 1024);
+  tbb::parallel_sort(refs.begin(), refs.end());
+
+  std::vector<uint32_t> cornerPoint(nCells * 8);
+  std::vector<uint64_t> pointKeys;
+  std::vector<uint32_t> pointOwner;  // the lowest-index cell holding the point evaluates it
+  pointKeys.reserve(nCells * 2);
+  pointOwner.reserve(nCells * 2);
+  for (size_t r = 0; r < refs.size(); ++r) {
+    if (r == 0 || refs[r].key != refs[r - 1].key) {
+      pointKeys.push_back(refs[r].key);
+      pointOwner.push_back(refs[r].slot / 8);
+    }
+    cornerPoint[refs[r].slot] = uint32_t(pointKeys.size() - 1);
+  }
+  std::vector<CornerRef>().swap(refs);
+  const size_t nPoints = pointKeys.size();
+  res.gridSamples = nPoints;
+
+  // Points grouped by owning cell (counting sort, stable in point order).
+  std::vector<uint32_t> ownedStart(nCells + 1, 0), owned(nPoints);
+  for (uint32_t owner : pointOwner) ++ownedStart[owner + 1];
+  for (size_t i = 0; i < nCells; ++i) ownedStart[i + 1] += ownedStart[i];
+  {
+    std::vector<uint32_t> fill(ownedStart.begin(), ownedStart.end() - 1);
+    for (size_t u = 0; u < nPoints; ++u) owned[fill[pointOwner[u]]++] = uint32_t(u);
+  }
+  std::vector<uint32_t>().swap(pointOwner);
+
+  std::vector<float> values(nPoints);
+  parallelForRange(0, nCells, [&](size_t begin, size_t end) {
+    std::array<Vec3, 8> pts;
+    std::array<float, 8> out;
+    for (size_t i = begin; i < end; ++i) {
+      uint32_t b = ownedStart[i], n = ownedStart[i + 1] - b;
+      if (n == 0) continue;
+      for (uint32_t k = 0; k < n; ++k) pts[k] = gridPosition(cs, keyCoords(pointKeys[owned[b + k]]));
+      blob.valuesInCell(cs.cells[i], std::span<const Vec3>(pts.data(), n), std::span<float>(out.data(), n));
+      for (uint32_t k = 0; k < n; ++k) values[owned[b + k]] = out[k];
+    }
+  }, 256);
+  if (options.progress && ProgressSettings::cancelRequested()) throw Cancelled();
+
+  // ---- 3. Cells with a sign change ----------------------------------------------------
+  std::vector<uint8_t> insideMask(nCells);
+  parallelFor(0, nCells, [&](size_t i) {
+    uint8_t m = 0;
+    for (int c = 0; c < 8; ++c)
+      if (values[cornerPoint[i * 8 + c]] > kIso) m |= uint8_t(1u << c);
+    insideMask[i] = m;
+  }, 4096);
+  std::vector<uint32_t> active;
+  for (size_t i = 0; i < nCells; ++i)
+    if (insideMask[i] != 0 && insideMask[i] != 0xff) active.push_back(uint32_t(i));
+
+  // Closure: a cell whose face carries a sign change needs the neighbour across that face
+  // triangulated too, or the mesh would have a hole there. Interval bounds keep every
+  // such neighbour up to rounding (a corner exactly on F = 0.5 can fall just outside a
+  // neighbour's bound), so the rare missing ones are added here, with their corners
+  // sampled once and shared through the same point table.
+  std::vector<glm::ivec3> cellCoords(nCells);
+  for (size_t i = 0; i < nCells; ++i) cellCoords[i] = {cs.cells[i].index[0], cs.cells[i].index[1], cs.cells[i].index[2]};
+  size_t extraCells = 0;
+  {
+    std::vector<uint64_t> known(nCells);
+    for (size_t i = 0; i < nCells; ++i) known[i] = pointKey(cellCoords[i].x, cellCoords[i].y, cellCoords[i].z);
+    std::sort(known.begin(), known.end());
+    std::map<uint64_t, uint32_t> extraPoints, addedCells;
+    auto pointIndex = [&](glm::ivec3 g) -> uint32_t {
+      uint64_t key = pointKey(g.x, g.y, g.z);
+      auto it = std::lower_bound(pointKeys.begin(), pointKeys.begin() + nPoints, key);
+      if (it != pointKeys.begin() + nPoints && *it == key) return uint32_t(it - pointKeys.begin());
+      auto [e, inserted] = extraPoints.emplace(key, uint32_t(pointKeys.size()));
+      if (inserted) {
+        pointKeys.push_back(key);
+        values.push_back(blob.value(gridPosition(cs, g)));
+      }
+      return e->second;
+    };
+    // Face f = 2·axis + side; its four corners are those with bit `axis` equal to side.
+    std::vector<uint32_t> frontier = active;
+    while (!frontier.empty()) {
+      std::vector<uint64_t> wanted;
+      for (uint32_t i : frontier) {
+        uint8_t m = insideMask[i];
+        for (int axis = 0; axis < 3; ++axis)
+          for (int side = 0; side < 2; ++side) {
+            int in = 0;
+            for (int c = 0; c < 8; ++c)
+              if (((c >> axis) & 1) == side) in += (m >> c) & 1;
+            if (in == 0 || in == 4) continue;
+            glm::ivec3 n = cellCoords[i];
+            n[axis] += side ? 1 : -1;
+            if (n[axis] < 0 || n[axis] + 1 >= kAxisLimit) continue;
+            uint64_t key = pointKey(n.x, n.y, n.z);
+            if (!std::binary_search(known.begin(), known.end(), key) && !addedCells.count(key)) wanted.push_back(key);
+          }
+      }
+      std::sort(wanted.begin(), wanted.end());
+      wanted.erase(std::unique(wanted.begin(), wanted.end()), wanted.end());
+      frontier.clear();
+      for (uint64_t key : wanted) {
+        glm::ivec3 g = keyCoords(key);
+        uint32_t id = uint32_t(cellCoords.size());
+        addedCells.emplace(key, id);
+        cellCoords.push_back(g);
+        uint8_t m = 0;
+        for (int c = 0; c < 8; ++c) {
+          uint32_t u = pointIndex(g + cornerOffset(c));
+          cornerPoint.push_back(u);
+          if (values[u] > kIso) m |= uint8_t(1u << c);
+        }
+        insideMask.push_back(m);
+        if (m != 0 && m != 0xff) {
+          active.push_back(id);
+          frontier.push_back(id);
+        }
+      }
+      extraCells += wanted.size();
+    }
+  }
+  res.gridSamples = pointKeys.size();
+  res.activeCells = active.size();
+  res.extraCells = extraCells;
+  if (active.empty()) return res;
+
+  // ---- 4. Marching tetrahedra, per chunk of active cells -------------------------------
+  constexpr size_t kChunk = 2048;
+  size_t nChunks = (active.size() + kChunk - 1) / kChunk;
+  std::vector<std::vector<TriKeys>> triParts(nChunks);
+  std::vector<std::vector<EdgeRec>> edgeParts(nChunks);
+  parallelFor(0, nChunks, [&](size_t ch) {
+    size_t begin = ch * kChunk, end = std::min(active.size(), begin + kChunk);
+    auto& tris = triParts[ch];
+    auto& edges = edgeParts[ch];
+    tris.reserve((end - begin) * 6);
+    edges.reserve((end - begin) * 12);
+    for (size_t a = begin; a < end; ++a) {
+      uint32_t i = active[a];
+      TetEmitter em{cellCoords[i], &cornerPoint[size_t(i) * 8], &tris, &edges};
+      uint8_t m = insideMask[i];
+      for (const auto& t : kTets) {
+        bool in[4] = {bool(m >> t[0] & 1), bool(m >> t[1] & 1), bool(m >> t[2] & 1), bool(m >> t[3] & 1)};
+        em.run(t, in);
+      }
+    }
+  });
+  std::vector<TriKeys> triKeys = concat(triParts);
+  std::vector<EdgeRec> edges = concat(edgeParts);
+  tbb::parallel_sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end(), [](const EdgeRec& x, const EdgeRec& y) { return x.key == y.key; }),
+              edges.end());
+  const size_t nVerts = edges.size();
+
+  Mesh& mesh = res.mesh;
+  mesh.triangles.resize(triKeys.size());
+  parallelFor(0, triKeys.size(), [&](size_t t) {
+    glm::uvec3 tri;
+    for (int k = 0; k < 3; ++k) {
+      auto it = std::lower_bound(edges.begin(), edges.end(), EdgeRec{triKeys[t][k], 0, 0});
+      tri[k] = uint32_t(it - edges.begin());
+    }
+    mesh.triangles[t] = tri;
+  }, 4096);
+  std::vector<TriKeys>().swap(triKeys);
+
+  // ---- 5. Vertices: root search along each edge, then normal and attributes ----------
+  std::unique_ptr<Progress> bar;
+  if (options.progress) bar = std::make_unique<Progress>("polygonize", nVerts);
+  mesh.positions.resize(nVerts);
+  if (options.normals) mesh.normals.resize(nVerts);
+  if (options.attributes) {
+    mesh.uvs.resize(nVerts);
+    res.attributes.resize(nVerts);
+  }
+  std::vector<uint8_t> evals(nVerts, 0);
+  std::vector<uint8_t> flatGradient(nVerts, 0);
+  parallelForRange(0, nVerts, [&](size_t begin, size_t end) {
+    for (size_t v = begin; v < end; ++v) {
+      const EdgeRec& e = edges[v];
+      Vec3 pIn = gridPosition(cs, keyCoords(pointKeys[e.inside]));
+      Vec3 pOut = gridPosition(cs, keyCoords(pointKeys[e.outside]));
+      // Illinois regula falsi on g(t) = F(lerp(pIn, pOut, t)) − 0.5, g(0) > 0 >= g(1).
+      double a = 0.0, b = 1.0;
+      double fa = double(values[e.inside]) - kIso, fb = double(values[e.outside]) - kIso;
+      double t = fa / (fa - fb);
+      int side = 0, n = 0;
+      for (; n < options.refineSteps; ++n) {
+        float f = blob.value(pIn + float(t) * (pOut - pIn)) - kIso;
+        if (std::fabs(f) < options.fieldTolerance) { ++n; break; }
+        if (f > 0.0f) {
+          a = t, fa = f;
+          if (side == 1) fb *= 0.5;
+          side = 1;
+        } else {
+          b = t, fb = f;
+          if (side == -1) fa *= 0.5;
+          side = -1;
+        }
+        if (b - a < 1e-7) { ++n; break; }
+        t = a + fa * (b - a) / (fa - fb);
+      }
+      evals[v] = uint8_t(n);
+      Vec3 p = pIn + float(t) * (pOut - pIn);
+      mesh.positions[v] = p;
+      if (options.normals || options.attributes) {
+        Sample s = blob.sample(p);
+        if (options.normals) {
+          float len = glm::length(s.gradient);
+          if (len > 1e-20f && std::isfinite(len)) mesh.normals[v] = -s.gradient / len;
+          else flatGradient[v] = 1;
+        }
+        if (options.attributes) {
+          mesh.uvs[v] = s.attributes.uv;
+          res.attributes[v] = s.attributes;
+        }
+      }
+    }
+    if (bar) bar->advance(end - begin);
+  }, 512);
+  if (bar) bar->finish();
+
+  // Vertices where the gradient vanishes take the area-weighted normal of their triangles.
+  if (options.normals && std::find(flatGradient.begin(), flatGradient.end(), 1) != flatGradient.end()) {
+    std::vector<Vec3> acc(nVerts, Vec3(0.0f));
+    for (const auto& tri : mesh.triangles) {
+      Vec3 n = glm::cross(mesh.positions[tri.y] - mesh.positions[tri.x], mesh.positions[tri.z] - mesh.positions[tri.x]);
+      for (int k = 0; k < 3; ++k)
+        if (flatGradient[tri[k]]) acc[tri[k]] += n;
+    }
+    for (size_t v = 0; v < nVerts; ++v)
+      if (flatGradient[v]) {
+        float len = glm::length(acc[v]);
+        mesh.normals[v] = len > 0.0f ? acc[v] / len : Vec3(0, 1, 0);
+      }
+  }
+
+  size_t total = pointKeys.size() + (options.normals || options.attributes ? nVerts : 0);
+  for (uint8_t n : evals) total += n;
+  res.fieldEvaluations = total;
+  return res;
+}
+
+Mesh polygonize(const CompiledBlob& blob, const PolygonizeOptions& options) {
+  return std::move(polygonizeDetailed(blob, options).mesh);
+}
+
+}  // namespace sprig::blobtree

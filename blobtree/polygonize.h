@@ -1,0 +1,87 @@
+#pragma once
+/// Polygonization of a compiled BlobTree: sparse, near-surface only, watertight.
+///
+/// Method (work proportional to surface area, not volume):
+///  1. Cells: CompiledBlob::surfaceCells(cellSize) finds, by interval bounds and octree
+///     subdivision, the cube cells of a regular grid that may hold the F = 0.5 surface.
+///     No other cell is visited.
+///  2. Samples: the field is sampled once at every distinct corner of those cells, each
+///     corner evaluated in a batch with the other corners of one owning cell over that
+///     cell's short primitive list (CompiledBlob::valuesInCell). One value per grid point
+///     keeps neighbouring cells consistent.
+///  3. Closure: a kept cell whose face shows a sign change gets its neighbour across that
+///     face added when the bounds dropped it (rounding at corners exactly on F = 0.5).
+///  4. Marching tetrahedra: each cell with a sign change is split into the six Kuhn
+///     tetrahedra around its main diagonal (the split of every cube face matches its
+///     neighbour's), and each tetrahedron yields 0, 1 or 2 triangles. Vertices are keyed
+///     by their grid edge, so they are shared exactly: the result is closed and
+///     2-manifold by construction for a closed surface, and triangles are oriented from
+///     inside (F > 0.5) to outside, decided combinatorially on edge midpoints (degenerate
+///     triangles get the right orientation too).
+///  5. Projection: every vertex is moved onto the exact F = 0.5 surface by a bracketed
+///     root search (Illinois regula falsi) along its grid edge, which keeps it inside its
+///     cell, so projection never folds the mesh. Normals are −∇F/|∇F| and uv the blended
+///     primitive (u,v) from CompiledBlob::sample.
+/// Every step runs in parallel over index ranges and merges in sorted key order: the same
+/// blob and options give the same mesh bytes at any thread count.
+///
+/// Cells with an edge exactly on the surface lean outward (a corner with F = 0.5 counts
+/// as outside), which keeps the topology well defined.
+
+#include <cstddef>
+#include <vector>
+
+#include "blobtree/compiled.h"
+#include "core/mesh.h"
+
+namespace sprig::blobtree {
+
+/// Options of polygonize(); defaults give a mesh within 1% of a sphere's volume.
+struct PolygonizeOptions {
+  /// Requested cell edge length in world units; 0 = automatic: the smaller of
+  /// featureFraction · smallestFeature() (so the thinnest twig gets several cells across)
+  /// and the model's bounds diagonal / sizeDivisions. The grid may use a slightly smaller
+  /// cell (surfaceCells rounds to the root cube / 2^k).
+  float cellSize = 0.0f;
+  /// Automatic cell size as a fraction of the smallest primitive radius.
+  float featureFraction = 0.5f;
+  /// Automatic cell size at most the bounds diagonal divided by this.
+  float sizeDivisions = 64.0f;
+  /// Maximum root-search iterations per vertex (0 = keep the linear interpolation).
+  int refineSteps = 12;
+  /// Root search stops when |F − 0.5| falls below this.
+  float fieldTolerance = 1e-6f;
+  /// Fill Mesh::normals from the gradient.
+  bool normals = true;
+  /// Fill Mesh::uvs from the blended primitive (u,v) (and the per-vertex attributes of
+  /// PolygonizeResult).
+  bool attributes = true;
+  /// Report progress on a terminal (core/progress.h); cancellation throws Cancelled.
+  bool progress = false;
+};
+
+/// A mesh with per-vertex attributes and statistics.
+struct PolygonizeResult {
+  Mesh mesh;
+  std::vector<Attributes> attributes;  ///< per vertex, when options.attributes
+  float cellSize = 0.0f;        ///< the grid's actual cell edge
+  size_t surfaceCells = 0;      ///< cells the interval bounds kept
+  size_t activeCells = 0;       ///< cells with a sign change (the ones triangulated)
+  size_t extraCells = 0;        ///< neighbours added where rounding left a face's sign change uncovered
+  size_t gridSamples = 0;       ///< distinct grid points sampled
+  size_t fieldEvaluations = 0;  ///< every field value computed (grid + root search + samples)
+};
+
+/// The cell size polygonize() requests for these options (resolves the automatic size).
+/// Throws std::invalid_argument when the blob is empty or unbounded and no size is given.
+float resolveCellSize(const CompiledBlob& blob, const PolygonizeOptions& options = {});
+
+/// Polygonizes the F = 0.5 surface of blob (see the file comment). An empty blob gives an
+/// empty mesh. Throws std::invalid_argument for an unbounded blob or a grid over 2^20
+/// cells on an axis, and Cancelled when cancellation is requested with progress on.
+PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOptions& options = {});
+
+/// polygonizeDetailed(...).mesh.
+Mesh polygonize(const CompiledBlob& blob, const PolygonizeOptions& options = {});
+
+}  // namespace sprig::blobtree

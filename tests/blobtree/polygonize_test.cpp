@@ -1,0 +1,171 @@
+#include <catch2/catch.hpp>
+
+#include <cstring>
+#include <map>
+#include <set>
+
+#include "blobtree/blobtree.h"
+#include "blobtree/compiled.h"
+#include "blobtree/polygonize.h"
+#include "core/parallel.h"
+#include "core/rng.h"
+
+using namespace sprig;
+using namespace sprig::blobtree;
+
+namespace {
+
+// Euler characteristic V − E + F of a closed mesh (2 − 2·genus per component).
+long euler(const Mesh& m) {
+  std::set<std::pair<uint32_t, uint32_t>> edges;
+  for (const auto& t : m.triangles)
+    for (int k = 0; k < 3; ++k) edges.insert(std::minmax(t[k], t[(k + 1) % 3]));
+  return long(m.vertexCount()) - long(edges.size()) + long(m.triangleCount());
+}
+
+void requireClosedManifold(const Mesh& m) {
+  MeshTopology topo = analyzeTopology(m);
+  CHECK(m.triangleCount() > 0);
+  CHECK(topo.boundaryEdges == 0);
+  CHECK(topo.nonManifoldEdges == 0);
+  CHECK(topo.inconsistentEdges == 0);
+  CHECK(topo.degenerateTriangles == 0);
+}
+
+// Largest |F − 0.5| over the mesh vertices.
+float maxFieldError(const CompiledBlob& blob, const Mesh& m) {
+  float worst = 0.0f;
+  for (const auto& p : m.positions) worst = std::max(worst, std::fabs(blob.value(p) - kIso));
+  return worst;
+}
+
+}  // namespace
+
+TEST_CASE("polygonize::sphere", "[blobtree]") {
+  BlobTree tree;
+  NodeId s = tree.point(Vec3(0.3f, -0.2f, 0.1f), 1.0f);
+  CompiledBlob blob = compile(tree, s);
+  PolygonizeResult r = polygonizeDetailed(blob);
+  const Mesh& m = r.mesh;
+  requireClosedManifold(m);
+  CHECK(euler(m) == 2);
+
+  SECTION("volume within 1% of 4/3 pi r^3 at default settings, oriented outward") {
+    double exact = 4.0 / 3.0 * kPi;
+    double v = signedVolume(m);
+    INFO("volume " << v << " exact " << exact << " cell " << r.cellSize);
+    CHECK(v > 0.0);
+    CHECK(std::fabs(v - exact) / exact < 0.01);
+  }
+  SECTION("vertices lie on the surface, normals point out") {
+    CHECK(maxFieldError(blob, m) < 1e-4f);
+    for (size_t i = 0; i < m.vertexCount(); ++i) {
+      Vec3 radial = m.positions[i] - Vec3(0.3f, -0.2f, 0.1f);
+      CHECK(std::fabs(glm::length(radial) - 1.0f) < 1e-4f);
+      CHECK(glm::dot(m.normals[i], glm::normalize(radial)) > 0.999f);
+    }
+  }
+  SECTION("only near-surface cells are visited") {
+    CHECK(r.activeCells <= r.surfaceCells);
+    // A dense grid over the bounds would sample (size/cell)^3 points.
+    Vec3 size = blob.bounds().size();
+    double dense = double(size.x / r.cellSize) * double(size.y / r.cellSize) * double(size.z / r.cellSize);
+    CHECK(double(r.gridSamples) < 0.2 * dense);
+  }
+}
+
+TEST_CASE("polygonize::capsule", "[blobtree]") {
+  BlobTree tree;
+  float radius = 0.5f, length = 2.0f;
+  NodeId c = tree.segment(Vec3(0, 0, 0), Vec3(0, length, 0), radius);
+  CompiledBlob blob = compile(tree, c);
+  Mesh m = polygonize(blob);
+  requireClosedManifold(m);
+  CHECK(euler(m) == 2);
+  double exact = kPi * radius * radius * length + 4.0 / 3.0 * kPi * radius * radius * radius;
+  double v = signedVolume(m);
+  INFO("volume " << v << " exact " << exact);
+  CHECK(std::fabs(v - exact) / exact < 0.01);
+  CHECK(maxFieldError(blob, m) < 1e-4f);
+}
+
+TEST_CASE("polygonize::topology", "[blobtree]") {
+  SECTION("a torus has genus 1") {
+    BlobTree tree;
+    NodeId t = tree.torus(Vec3(0), glm::normalize(Vec3(0.2f, 1, 0.1f)), 1.0f, 0.3f);
+    Mesh m = polygonize(compile(tree, t));
+    requireClosedManifold(m);
+    CHECK(euler(m) == 0);
+    double exact = 2.0 * kPi * kPi * 1.0 * 0.3 * 0.3;
+    CHECK(signedVolume(m) == Approx(exact).epsilon(0.01));
+  }
+  SECTION("two separate spheres give two closed components") {
+    BlobTree tree;
+    std::vector<NodeId> kids = {tree.point(Vec3(-2, 0, 0), 0.5f), tree.point(Vec3(2, 0, 0), 0.5f)};
+    Mesh m = polygonize(compile(tree, tree.blend(kids)));
+    requireClosedManifold(m);
+    CHECK(euler(m) == 4);
+  }
+  SECTION("CSG with a box cutter stays closed and manifold") {
+    BlobTree tree;
+    NodeId ball = tree.point(Vec3(0), 1.0f);
+    NodeId cut = tree.box(Vec3(0, 0, 0), Vec3(2, 2, 2));
+    Mesh m = polygonize(compile(tree, tree.difference(ball, cut)));
+    requireClosedManifold(m);
+    CHECK(euler(m) == 2);
+    double exact = 7.0 / 8.0 * 4.0 / 3.0 * kPi;
+    CHECK(signedVolume(m) == Approx(exact).epsilon(0.02));
+  }
+  SECTION("an empty blob gives an empty mesh") {
+    CompiledBlob empty;
+    CHECK(polygonize(empty).triangleCount() == 0);
+  }
+}
+
+TEST_CASE("polygonize::thin twig survives", "[blobtree]") {
+  // A twig of radius 0.01 reaching across a model of size 10, on a small knob.
+  BlobTree tree;
+  std::vector<NodeId> kids = {tree.point(Vec3(0), 0.2f), tree.segment(Vec3(0), Vec3(9.8f, 0, 0), 0.01f)};
+  CompiledBlob blob = compile(tree, tree.blend(kids));
+  PolygonizeResult r = polygonizeDetailed(blob);
+  const Mesh& m = r.mesh;
+  INFO("cell " << r.cellSize << " triangles " << m.triangleCount());
+  CHECK(r.cellSize <= 0.005f);
+  requireClosedManifold(m);
+  CHECK(euler(m) == 2);  // one piece: the twig is not broken anywhere
+  CHECK(m.bounds().hi.x == Approx(9.81f).margin(2e-3));
+  // Along its whole length the twig's cross-section radius stays close to 0.01.
+  for (const auto& p : m.positions)
+    if (p.x > 1.0f && p.x < 9.7f) CHECK(std::hypot(p.y, p.z) == Approx(0.01f).margin(1e-3));
+}
+
+TEST_CASE("polygonize::deterministic", "[blobtree]") {
+  Rng rng(deriveSeed(1234, {7}));
+  BlobTree tree;
+  std::vector<NodeId> kids;
+  Vec3 at(0);
+  for (int i = 0; i < 40; ++i) {
+    Vec3 next = at + Vec3(rng.uniform(-0.5f, 0.5f), rng.uniform(0.2f, 0.6f), rng.uniform(-0.5f, 0.5f));
+    kids.push_back(tree.cone(at, next, rng.uniform(0.08f, 0.15f), rng.uniform(0.05f, 0.08f)));
+    at = i % 10 == 9 ? Vec3(rng.uniform(-1.0f, 1.0f), 0, rng.uniform(-1.0f, 1.0f)) : next;
+  }
+  CompiledBlob blob = compile(tree, tree.blend(kids));
+  PolygonizeOptions opt;
+  opt.cellSize = 0.02f;
+  Mesh one, two;
+  {
+    ThreadLimit limit(1);
+    one = polygonize(blob, opt);
+  }
+  {
+    ThreadLimit limit(2);
+    two = polygonize(blob, opt);
+  }
+  REQUIRE(one.vertexCount() == two.vertexCount());
+  REQUIRE(one.triangleCount() == two.triangleCount());
+  CHECK(std::memcmp(one.positions.data(), two.positions.data(), one.vertexCount() * sizeof(Vec3)) == 0);
+  CHECK(std::memcmp(one.normals.data(), two.normals.data(), one.vertexCount() * sizeof(Vec3)) == 0);
+  CHECK(std::memcmp(one.triangles.data(), two.triangles.data(), one.triangleCount() * sizeof(glm::uvec3)) == 0);
+  requireClosedManifold(one);
+  CHECK(signedVolume(one) > 0.0);
+}
