@@ -1,6 +1,6 @@
 #include "render/scene.h"
 
-#include <embree3/rtcore.h>
+#include "render/detail/scene_impl.h"
 
 #include <algorithm>
 #include <cmath>
@@ -10,19 +10,9 @@
 
 namespace sprig::render {
 
-namespace {
+using detail::GeometryRecord;
 
-/// What the renderer needs to know about one Embree geometry to shade its hits.
-struct GeometryRecord {
-  enum class Kind { Curves, Triangles, Spheres } kind = Kind::Triangles;
-  uint32_t material = 0;
-  std::vector<Vec3> positions;            ///< triangles
-  std::vector<glm::uvec3> triangles;      ///< triangles
-  std::vector<Vec3> normals;              ///< optional per-vertex normals (triangles)
-  std::vector<Vec3> vertexColors;         ///< optional per-vertex colors (triangles)
-  std::vector<Vec3> primitiveColors;      ///< optional per-primitive colors (any kind)
-  std::vector<uint32_t> primitiveMaterials;  ///< optional per-primitive material ids
-};
+namespace {
 
 void onEmbreeError(void* userPtr, RTCError code, const char* str) {
   auto* message = static_cast<std::string*>(userPtr);
@@ -33,48 +23,37 @@ Vec3 toVec3(const DVec3& v) { return Vec3(static_cast<float>(v.x), static_cast<f
 
 }  // namespace
 
-struct Scene::Impl {
-  RTCDevice device = nullptr;
-  RTCScene scene = nullptr;
-  std::string error;
-  std::vector<Material> materials;
-  std::vector<GeometryRecord> records;
-  Box3 bounds;
-  SceneStats stats;
-  bool committed = false;
+uint32_t Scene::Impl::attach(RTCGeometry geometry, GeometryRecord record) {
+  rtcCommitGeometry(geometry);
+  uint32_t id = static_cast<uint32_t>(records.size());
+  rtcAttachGeometryByID(scene, geometry, id);
+  rtcReleaseGeometry(geometry);
+  records.push_back(std::move(record));
+  if (!error.empty()) throw std::runtime_error(error);
+  return id;
+}
 
-  uint32_t attach(RTCGeometry geometry, GeometryRecord record) {
-    rtcCommitGeometry(geometry);
-    uint32_t id = static_cast<uint32_t>(records.size());
-    rtcAttachGeometryByID(scene, geometry, id);
-    rtcReleaseGeometry(geometry);
-    records.push_back(std::move(record));
-    if (!error.empty()) throw std::runtime_error(error);
-    return id;
+uint32_t Scene::Impl::addTriangles(GeometryRecord record) {
+  RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
+  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
+                                                        3 * sizeof(float), record.positions.size()));
+  for (size_t i = 0; i < record.positions.size(); ++i) {
+    v[3 * i] = record.positions[i].x;
+    v[3 * i + 1] = record.positions[i].y;
+    v[3 * i + 2] = record.positions[i].z;
+    bounds.extend(record.positions[i]);
   }
-
-  uint32_t addTriangles(GeometryRecord record) {
-    RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
-    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
-                                                          3 * sizeof(float), record.positions.size()));
-    for (size_t i = 0; i < record.positions.size(); ++i) {
-      v[3 * i] = record.positions[i].x;
-      v[3 * i + 1] = record.positions[i].y;
-      v[3 * i + 2] = record.positions[i].z;
-      bounds.extend(record.positions[i]);
-    }
-    auto* t = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
-                                                             3 * sizeof(uint32_t), record.triangles.size()));
-    for (size_t i = 0; i < record.triangles.size(); ++i) {
-      t[3 * i] = record.triangles[i].x;
-      t[3 * i + 1] = record.triangles[i].y;
-      t[3 * i + 2] = record.triangles[i].z;
-    }
-    stats.triangles += record.triangles.size();
-    record.kind = GeometryRecord::Kind::Triangles;
-    return attach(g, std::move(record));
+  auto* t = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                                           3 * sizeof(uint32_t), record.triangles.size()));
+  for (size_t i = 0; i < record.triangles.size(); ++i) {
+    t[3 * i] = record.triangles[i].x;
+    t[3 * i + 1] = record.triangles[i].y;
+    t[3 * i + 2] = record.triangles[i].z;
   }
-};
+  stats.triangles += record.triangles.size();
+  record.kind = GeometryRecord::Kind::Triangles;
+  return attach(g, std::move(record));
+}
 
 Scene::Scene() : impl_(std::make_unique<Impl>()) {
   impl_->device = rtcNewDevice(nullptr);
@@ -238,6 +217,7 @@ uint32_t Scene::addMesh(const Mesh& mesh, uint32_t material) {
   rec.triangles = mesh.triangles;
   if (mesh.normals.size() == mesh.positions.size()) rec.normals = mesh.normals;
   if (mesh.colors.size() == mesh.positions.size()) rec.vertexColors = mesh.colors;
+  if (mesh.uvs.size() == mesh.positions.size() && impl_->materials[material].texture >= 0) rec.uvs = mesh.uvs;
   if (mesh.materials.size() == mesh.triangles.size()) {
     for (uint32_t m : mesh.materials)
       if (m >= impl_->materials.size()) throw std::invalid_argument("Scene::addMesh: unknown per-triangle material id");
@@ -247,6 +227,26 @@ uint32_t Scene::addMesh(const Mesh& mesh, uint32_t material) {
     if (t.x >= mesh.positions.size() || t.y >= mesh.positions.size() || t.z >= mesh.positions.size())
       throw std::invalid_argument("Scene::addMesh: triangle index out of range");
   return impl_->addTriangles(std::move(rec));
+}
+
+uint32_t Scene::addTexture(ColorTexture texture) {
+  if (!texture) throw std::invalid_argument("Scene::addTexture: empty texture");
+  impl_->textures.push_back(std::move(texture));
+  return static_cast<uint32_t>(impl_->textures.size() - 1);
+}
+
+Vec3 Scene::attributeColor(const blobtree::Attributes& a, const Vec3& p, const Material& material) const {
+  if (a.textureCount == 0 || impl_->textures.empty()) return material.baseColor;
+  Vec3 sum(0);
+  float wsum = 0;
+  for (int i = 0; i < a.textureCount && i < blobtree::Attributes::kMaxTextures; ++i) {
+    float w = a.textureWeights[i];
+    if (!(w > 0)) continue;
+    uint16_t id = a.textureIds[i];
+    sum += w * (id < impl_->textures.size() ? impl_->textures[id](a.uv, p) : material.baseColor);
+    wsum += w;
+  }
+  return wsum > 0 ? sum / wsum : material.baseColor;
 }
 
 void Scene::commit() {
@@ -260,8 +260,8 @@ Box3 Scene::bounds() const { return impl_->bounds; }
 SceneStats Scene::stats() const { return impl_->stats; }
 
 std::optional<SurfaceHit> Scene::intersect(const Vec3& origin, const Vec3& direction, float tnear, float tfar) const {
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
+  detail::HitContext context;
+  rtcInitIntersectContext(&context.base);
   RTCRayHit rh{};
   rh.ray.org_x = origin.x;
   rh.ray.org_y = origin.y;
@@ -274,7 +274,7 @@ std::optional<SurfaceHit> Scene::intersect(const Vec3& origin, const Vec3& direc
   rh.ray.mask = 0xffffffffu;
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(impl_->scene, &context, &rh);
+  rtcIntersect1(impl_->scene, &context.base, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return std::nullopt;
 
   const GeometryRecord& rec = impl_->records[rh.hit.geomID];
@@ -286,6 +286,13 @@ std::optional<SurfaceHit> Scene::intersect(const Vec3& origin, const Vec3& direc
   hit.material = rec.primitiveMaterials.empty() ? rec.material : rec.primitiveMaterials[prim];
   hit.color = impl_->materials[hit.material].baseColor;
   Vec3 ng(rh.hit.Ng_x, rh.hit.Ng_y, rh.hit.Ng_z);
+  if (rec.kind == GeometryRecord::Kind::Implicit) {
+    const blobtree::Hit& ih = context.implicitHit;
+    hit.position = ih.point;
+    hit.normal = hit.geometricNormal = ih.normal;
+    hit.color = attributeColor(ih.attributes, ih.point, impl_->materials[hit.material]);
+    return hit;
+  }
   if (rec.kind == GeometryRecord::Kind::Triangles) {
     const glm::uvec3& tri = rec.triangles[prim];
     const Vec3 &p0 = rec.positions[tri.x], &p1 = rec.positions[tri.y], &p2 = rec.positions[tri.z];
@@ -299,6 +306,9 @@ std::optional<SurfaceHit> Scene::intersect(const Vec3& origin, const Vec3& direc
     }
     if (!rec.vertexColors.empty())
       hit.color = w * rec.vertexColors[tri.x] + u * rec.vertexColors[tri.y] + v * rec.vertexColors[tri.z];
+    int tex = impl_->materials[hit.material].texture;
+    if (!rec.uvs.empty() && tex >= 0 && static_cast<size_t>(tex) < impl_->textures.size())
+      hit.color = impl_->textures[tex](w * rec.uvs[tri.x] + u * rec.uvs[tri.y] + v * rec.uvs[tri.z], hit.position);
   }
   if (!rec.primitiveColors.empty()) hit.color = rec.primitiveColors[prim];
   float len = glm::length(ng);

@@ -7,13 +7,19 @@
 /// intersect()/occluded() may be called from any number of threads.
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <vector>
 
+#include "blobtree/compiled.h"
 #include "core/mesh.h"
 #include "core/types.h"
 #include "lsystem/skeleton.h"
+
+namespace sprig::blobtree {
+struct PolygonizeResult;
+}
 
 namespace sprig::render {
 
@@ -23,6 +29,19 @@ struct Material {
   float roughness = 0.6f;   ///< 0 = mirror-like highlight, 1 = no highlight
   float specular = 0.04f;   ///< highlight strength (reflectance at normal incidence)
   int texture = -1;         ///< texture id for textured models, -1 for none
+};
+
+/// A color texture: linear RGB at natural coordinates uv (and world position, for solid
+/// textures). Must be thread-safe; the textures module's textures are wrapped into this.
+using ColorTexture = std::function<Vec3(Vec2 uv, const Vec3& position)>;
+
+/// How a compiled BlobTree becomes exact Embree user geometry.
+struct ImplicitOptions {
+  /// Edge of the surface cells (one Embree user primitive each), world units; 0 = automatic:
+  /// 1.5x the smallest feature radius, clamped to [diagonal/400, diagonal/40].
+  float cellSize = 0.0f;
+  /// Root-finding tolerance and step cap of the exact intersection.
+  blobtree::TraceOptions trace;
 };
 
 /// How a skeleton becomes preview geometry.
@@ -77,6 +96,26 @@ class Scene {
   /// name scene material ids instead). Vertex normals give smooth shading, vertex colors
   /// replace the material's base color. Returns the geometry id.
   uint32_t addMesh(const Mesh& mesh, uint32_t material);
+
+  /// Registers a texture; returns its id. Ids are what blob primitives' TextureAttr::textureId
+  /// and Material::texture refer to.
+  uint32_t addTexture(ColorTexture texture);
+
+  /// Adds a compiled BlobTree as exact implicit geometry: one Embree user primitive per
+  /// surface cell (bounds = the cell box); intersection and occlusion rays call
+  /// CompiledBlob::intersectCell, which marches with the cell's local Lipschitz bound.
+  /// Hit colors blend the primitives' textures by field weight (attributeColor); blobs
+  /// without textures use the material's base color. Returns the geometry id.
+  uint32_t addImplicit(const blobtree::CompiledBlob& blob, uint32_t material, const ImplicitOptions& options = {});
+
+  /// Adds a polygonized BlobTree (mesh mode): triangles with the mesh's normals, and vertex
+  /// colors from the per-vertex attributes through the same texture blend as exact mode.
+  uint32_t addPolygonized(const blobtree::PolygonizeResult& result, uint32_t material);
+
+  /// Color of blended attributes at p: Σ wᵢ·Tᵢ(uv, p) over the attribute's textures
+  /// (weights from the field, seeds' texturing); the material's base color for a texture
+  /// id without a registered texture, or when there is none.
+  Vec3 attributeColor(const blobtree::Attributes& attributes, const Vec3& p, const Material& material) const;
 
   /// Builds the acceleration structure. Throws std::runtime_error on an Embree error.
   void commit();

@@ -1,0 +1,61 @@
+#pragma once
+/// Private: the state behind render::Scene, shared by scene.cpp and implicit.cpp.
+
+#include <embree3/rtcore.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "blobtree/compiled.h"
+#include "render/scene.h"
+
+namespace sprig::render::detail {
+
+/// A compiled blob with its surface cells, the payload of one Embree user geometry.
+/// Defined in implicit.cpp only: other files hold it through a shared_ptr.
+struct ImplicitData;
+
+/// What the renderer needs to know about one Embree geometry to shade its hits.
+struct GeometryRecord {
+  enum class Kind { Curves, Triangles, Spheres, Implicit } kind = Kind::Triangles;
+  uint32_t material = 0;
+  std::vector<Vec3> positions;               ///< triangles
+  std::vector<glm::uvec3> triangles;         ///< triangles
+  std::vector<Vec3> normals;                 ///< optional per-vertex normals (triangles)
+  std::vector<Vec3> vertexColors;            ///< optional per-vertex colors (triangles)
+  std::vector<Vec2> uvs;                     ///< optional per-vertex uvs (triangles, textured material)
+  std::vector<Vec3> primitiveColors;         ///< optional per-primitive colors (any kind)
+  std::vector<uint32_t> primitiveMaterials;  ///< optional per-primitive material ids
+  std::shared_ptr<const ImplicitData> implicit;  ///< Implicit
+};
+
+/// Embree intersect context extended with the last implicit hit (its normal and blended
+/// attributes), so the user-geometry callback hands them to Scene::intersect.
+struct HitContext {
+  RTCIntersectContext base;  ///< must stay first: Embree passes &base to callbacks
+  blobtree::Hit implicitHit;
+};
+
+}  // namespace sprig::render::detail
+
+namespace sprig::render {
+
+struct Scene::Impl {
+  RTCDevice device = nullptr;
+  RTCScene scene = nullptr;
+  std::string error;
+  std::vector<Material> materials;
+  std::vector<ColorTexture> textures;
+  std::vector<detail::GeometryRecord> records;
+  Box3 bounds;
+  SceneStats stats;
+  bool committed = false;
+
+  /// Commits geometry, attaches it under the next id and records how to shade it.
+  uint32_t attach(RTCGeometry geometry, detail::GeometryRecord record);
+  /// Adds record's triangles as Embree triangle geometry.
+  uint32_t addTriangles(detail::GeometryRecord record);
+};
+
+}  // namespace sprig::render
