@@ -472,7 +472,14 @@ Interval evalI(const Tape& T, uint32_t ni, const Box3& box) {
   return {0.0f, 0.0f};
 }
 
+float evalLocalL(const Tape& T, uint32_t ni, const Box3& box);
+
+/// Local Lipschitz bound, never above the node's global bound (both are sound).
 float evalL(const Tape& T, uint32_t ni, const Box3& box) {
+  return std::min(evalLocalL(T, ni, box), T.nodes[ni].lip);
+}
+
+float evalLocalL(const Tape& T, uint32_t ni, const Box3& box) {
   const TNode& n = T.nodes[ni];
   if (box.empty() || !box.overlaps(n.box)) return 0.0f;
   switch (n.kind) {

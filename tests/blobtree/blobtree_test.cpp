@@ -2,13 +2,293 @@
 
 #include "blobtree/blobtree.h"
 #include "blobtree/compiled.h"
+#include "core/rng.h"
+
+#include <cmath>
+#include <cstdio>
+#include <vector>
 
 using namespace sprig;
 using namespace sprig::blobtree;
 
-TEST_CASE("BlobTree::point", "[blobtree]") {
+namespace {
+
+constexpr float kWyvillIsoFactor = 0.45420202f;
+
+float wyvill(float r, float R) {
+  float s = r * r / (R * R);
+  return s >= 1.0f ? 0.0f : (1.0f - s) * (1.0f - s) * (1.0f - s);
+}
+
+/// Distance along dir from origin at which F crosses 0.5 going outwards (bisection).
+float isoDistance(const CompiledBlob& b, Vec3 origin, Vec3 dir, float maxDist) {
+  float lo = 0.0f, hi = maxDist;
+  for (int i = 0; i < 60; ++i) {
+    float m = 0.5f * (lo + hi);
+    (b.value(origin + m * dir) > kIso ? lo : hi) = m;
+  }
+  return 0.5f * (lo + hi);
+}
+
+Vec3 randomIn(Rng& rng, Vec3 lo, Vec3 hi) {
+  return Vec3(float(rng.uniform(lo.x, hi.x)), float(rng.uniform(lo.y, hi.y)), float(rng.uniform(lo.z, hi.z)));
+}
+
+}  // namespace
+
+TEST_CASE("BlobTree::primitives", "[blobtree]") {
+  SECTION("Wyvill point: (1 - r²/R²)³ with R = r/0.4542, 0.5 at the radius") {
+    BlobTree t;
+    NodeId p = t.point(Vec3(1, 2, 3), 0.8f);
+    CompiledBlob b = compile(t, p);
+    float R = 0.8f / kWyvillIsoFactor;
+    CHECK(supportRadius(Kernel::Wyvill, 0.8f) == Approx(R));
+    for (float r : {0.0f, 0.3f, 0.8f, 1.2f, R * 0.999f, R * 1.01f})
+      CHECK(b.value(Vec3(1, 2, 3) + r * glm::normalize(Vec3(1, -2, 0.5f))) == Approx(wyvill(r, R)).margin(1e-6));
+    CHECK(b.value(Vec3(1.8f, 2, 3)) == Approx(0.5f).margin(1e-5));
+    CHECK(b.bounds().lo.x == Approx(1 - R));
+    CHECK(b.lipschitz() == Approx(1.7173f / R).epsilon(1e-4));
+  }
+  SECTION("soft-object point: iso radius exactly R/2, value 1 at the centre") {
+    BlobTree t(Kernel::SoftObject);
+    NodeId p = t.point(Vec3(0), 1.0f);
+    CompiledBlob b = compile(t, p);
+    CHECK(supportRadius(Kernel::SoftObject, 1.0f) == 2.0f);
+    CHECK(b.value(Vec3(0)) == Approx(1.0f));
+    CHECK(b.value(Vec3(0, 1, 0)) == Approx(0.5f).margin(1e-6));
+    CHECK(b.value(Vec3(0, 2.0001f, 0)) == 0.0f);
+    // 1 - 4/9 x^6 + 17/9 x^4 - 22/9 x^2 at x = 0.75
+    double x = 0.75;
+    CHECK(b.value(Vec3(1.5f, 0, 0)) == Approx(1 - 4.0 / 9 * std::pow(x, 6) + 17.0 / 9 * std::pow(x, 4) - 22.0 / 9 * x * x));
+  }
+  SECTION("segment: field of the distance to the segment") {
+    BlobTree t;
+    NodeId s = t.segment(Vec3(0), Vec3(0, 4, 0), 0.5f);
+    CompiledBlob b = compile(t, s);
+    float R = 0.5f / kWyvillIsoFactor;
+    CHECK(b.value(Vec3(0.5f, 2, 0)) == Approx(0.5f).margin(1e-5));
+    CHECK(b.value(Vec3(0.3f, 1, 0.2f)) == Approx(wyvill(std::sqrt(0.13f), R)));
+    CHECK(b.value(Vec3(0, 4.4f, 0.3f)) == Approx(wyvill(0.5f, R)));  // cap: distance to the end point
+  }
+  SECTION("cone: the 0.5 iso radius is radiusA at a, radiusB at b, linear between") {
+    BlobTree t;
+    NodeId c = t.cone(Vec3(0), Vec3(0, 0, 3), 0.6f, 0.2f);
+    CompiledBlob b = compile(t, c);
+    CHECK(b.value(Vec3(0.6f, 0, 0)) == Approx(0.5f).margin(1e-5));
+    CHECK(b.value(Vec3(0, 0.2f, 3)) == Approx(0.5f).margin(1e-5));
+    CHECK(b.value(Vec3(0.4f, 0, 1.5f)) == Approx(0.5f).margin(1e-5));
+    CHECK(b.value(Vec3(0, 0, 3.2f)) == Approx(0.5f).margin(1e-5));  // spherical cap of radius rb
+    CHECK(b.value(Vec3(0, 0, -0.6f)) == Approx(0.5f).margin(1e-5));
+  }
+  SECTION("torus: 0.5 at the tube radius from the core circle") {
+    BlobTree t;
+    NodeId r = t.torus(Vec3(0, 1, 0), Vec3(0, 1, 0), 2.0f, 0.25f);
+    CompiledBlob b = compile(t, r);
+    CHECK(b.value(Vec3(2.25f, 1, 0)) == Approx(0.5f).margin(1e-5));
+    CHECK(b.value(Vec3(0, 1.25f, -2.0f)) == Approx(0.5f).margin(1e-5));
+    CHECK(b.value(Vec3(0, 1, 0)) == 0.0f);
+  }
+  SECTION("cutters: 1 inside, 0 outside, 0.5 exactly on the boundary") {
+    BlobTree t;
+    NodeId h = t.halfspace(Vec3(0, 1, 0), Vec3(0, 1, 0), 0.1f);
+    NodeId bx = t.box(Vec3(-1), Vec3(1), 0.1f);
+    CompiledBlob bh = compile(t, h), bb = compile(t, bx);
+    CHECK(bh.value(Vec3(5, 1, 7)) == Approx(0.5f));
+    CHECK(bh.value(Vec3(5, 0.9f, 7)) == Approx(1.0f));
+    CHECK(bh.value(Vec3(5, 1.02f, 7)) == Approx(0.3f));
+    CHECK(bb.value(Vec3(1, 0.3f, 0)) == Approx(0.5f));
+    CHECK(bb.value(Vec3(0, 0, 0)) == 1.0f);
+    CHECK(bb.value(Vec3(1.03f, 1.04f, 0)) == Approx(0.0f).margin(1e-6));  // sd = 0.05
+    CHECK(bb.value(Vec3(1.03f, 0, 0)) == Approx(0.2f));
+  }
+  SECTION("invalid parameters throw InputError") {
+    BlobTree t;
+    t.setSourceLoc(SourceLoc{"blob.yaml", 3, 5});
+    CHECK_THROWS_AS(t.point(Vec3(0), -1.0f), InputError);
+    CHECK_THROWS_AS(t.cone(Vec3(1), Vec3(1), 1.0f, 1.0f), InputError);
+    CHECK_THROWS_AS(t.ricci(std::vector<NodeId>{}, 0.5f), InputError);
+    CHECK_THROWS_WITH(t.blend(std::vector<NodeId>{42}), Catch::Contains("blob.yaml:3:5") && Catch::Contains("unknown node"));
+  }
+}
+
+TEST_CASE("BlobTree::operators", "[blobtree]") {
   BlobTree t;
-  NodeId p = t.point(Vec3(0), 1.0f);
-  CompiledBlob b = compile(t, p);
-  CHECK(b.value(Vec3(1, 0, 0)) == Approx(0.5f).margin(1e-5));
+  NodeId a = t.point(Vec3(0), 1.0f), b = t.point(Vec3(1.2f, 0, 0), 0.8f);
+  std::vector<NodeId> ab{a, b};
+  Rng rng(7);
+  SECTION("blend, union, intersection and difference against their closed forms") {
+    NodeId sum = t.blend(ab), uni = t.unite(ab), inter = t.intersect(ab), diff = t.difference(a, b);
+    CompiledBlob cs = compile(t, sum), cu = compile(t, uni), ci = compile(t, inter), cd = compile(t, diff);
+    CompiledBlob ca = compile(t, a), cb = compile(t, b);
+    for (int i = 0; i < 500; ++i) {
+      Vec3 p = randomIn(rng, Vec3(-2.5f), Vec3(3.0f));
+      float fa = ca.value(p), fb = cb.value(p);
+      CHECK(cs.value(p) == Approx(fa + fb).margin(1e-6));
+      CHECK(cu.value(p) == Approx(std::max(fa, fb)).margin(1e-6));
+      CHECK(ci.value(p) == Approx(std::min(fa, fb)).margin(1e-6));
+      CHECK(cd.value(p) == Approx(std::min(fa, 1.0f - fb)).margin(1e-6));
+    }
+  }
+  SECTION("Ricci blend: the sum at n=1, decreasing towards max as n grows, no underflow at n=400") {
+    std::vector<CompiledBlob> r;
+    for (float n : {1.0f, 2.0f, 4.0f, 10.0f, 400.0f}) r.push_back(compile(t, t.ricci(ab, n)));
+    CompiledBlob ca = compile(t, a), cb = compile(t, b);
+    for (int i = 0; i < 300; ++i) {
+      Vec3 p = randomIn(rng, Vec3(-1.5f, -1, -1), Vec3(2.5f, 1, 1));
+      float fa = ca.value(p), fb = cb.value(p), m = std::max(fa, fb);
+      CHECK(r[0].value(p) == Approx(fa + fb).margin(1e-6));
+      for (size_t k = 1; k < r.size(); ++k) CHECK(r[k].value(p) <= r[k - 1].value(p) + 1e-6f);
+      CHECK(r.back().value(p) >= m - 1e-6f);
+      CHECK(r.back().value(p) <= m * std::pow(2.0f, 1.0f / 400.0f) + 1e-6f);
+    }
+    // Both fields are below 0.3, so f^400 underflows naively; the stable form does not.
+    Vec3 p(0.6f, 1.2f, 0);
+    float fa = ca.value(p);
+    REQUIRE(fa > 0.0f);
+    REQUIRE(cb.value(p) > 0.0f);
+    REQUIRE(std::pow(fa, 400.0f) == 0.0f);
+    CHECK(r.back().value(p) == Approx(std::max(fa, cb.value(p))).epsilon(2e-3));
+  }
+  SECTION("controlled blending: neighbours blend, others meet as a union") {
+    NodeId c = t.point(Vec3(2.4f, 0, 0), 0.8f);
+    std::vector<NodeId> abc{a, b, c};
+    NodeId cbn = t.controlledBlend(abc, {{0, 1}, {1, 2}});
+    CompiledBlob k = compile(t, cbn), ca = compile(t, a), cb = compile(t, b), cc = compile(t, c);
+    for (int i = 0; i < 300; ++i) {
+      Vec3 p = randomIn(rng, Vec3(-1.5f, -1, -1), Vec3(3.5f, 1, 1));
+      float fa = ca.value(p), fb = cb.value(p), fc = cc.value(p);
+      CHECK(k.value(p) == Approx(std::max(fa + fb, fb + fc)).margin(1e-6));
+    }
+  }
+  SECTION("negative primitives subtract, transforms move fields") {
+    NodeId scar = t.negative(t.point(Vec3(1, 0, 0), 0.3f), 0.7f);
+    CompiledBlob k = compile(t, t.blend(std::vector<NodeId>{a, scar}));
+    CompiledBlob ca = compile(t, a);
+    CHECK(k.value(Vec3(1, 0, 0)) == Approx(ca.value(Vec3(1, 0, 0)) - 0.7f));
+    CompiledBlob moved = compile(t, t.translate(a, Vec3(5, 0, 0)));
+    CHECK(moved.value(Vec3(6, 0, 0)) == Approx(0.5f).margin(1e-5));
+    CompiledBlob scaled = compile(t, t.scale(a, Vec3(2, 1, 1)));
+    CHECK(scaled.value(Vec3(2, 0, 0)) == Approx(0.5f).margin(1e-5));
+    CHECK(scaled.value(Vec3(0, 1, 0)) == Approx(0.5f).margin(1e-5));
+    CompiledBlob rot = compile(t, t.rotate(t.segment(Vec3(0), Vec3(2, 0, 0), 0.2f), Vec3(0, 0, 1), float(kPi / 2)));
+    CHECK(rot.value(Vec3(0.2f, 1, 0)) == Approx(0.5f).margin(1e-5));
+  }
+}
+
+TEST_CASE("BlobTree::pcm", "[blobtree]") {
+  PcmParams pp;
+  pp.width = 0.2f;
+  SECTION("the deformation is C1 with the documented shape") {
+    float c = pp.iso, w = pp.width;
+    CHECK(pcmBulgeMax(pp) == Approx(pp.slope * w / 4));
+    CHECK(pcmDeform(pp, c - w / 2) == Approx(pcmBulgeMax(pp)));
+    CHECK(pcmDeform(pp, c - w) == Approx(0.0f).margin(1e-7));
+    CHECK(pcmDeform(pp, c - w - 0.01f) == 0.0f);
+    CHECK(pcmDeform(pp, c + 0.1f) == Approx(-0.1f));  // compression c - f_other
+    for (float f : {c - w, c - w / 2, c}) {  // derivative continuous across the joins
+      CHECK(pcmDeformDerivative(pp, f - 1e-4f) == Approx(pcmDeformDerivative(pp, f + 1e-4f)).margin(1e-2));
+      CHECK(pcmDeform(pp, f - 1e-4f) == Approx(pcmDeform(pp, f + 1e-4f)).margin(2e-4));
+    }
+    for (float f = 0.0f; f < 1.0f; f += 0.01f) CHECK(pcmDeform(pp, f) <= pcmBulgeMax(pp) + 1e-7f);
+  }
+  SECTION("deformed objects do not interpenetrate; the contact surface is f_a = f_b; bulge only within w") {
+    BlobTree t;
+    NodeId a = t.point(Vec3(-0.7f, 0, 0), 1.0f), b = t.point(Vec3(0.7f, 0, 0), 1.0f);
+    CompiledBlob F = compile(t, t.pcm(a, b, pp)), ca = compile(t, a), cb = compile(t, b);
+    Rng rng(11);
+    int bulged = 0, interp = 0;
+    for (int i = 0; i < 20000; ++i) {
+      Vec3 p = randomIn(rng, Vec3(-2.5f), Vec3(2.5f));
+      float fa = ca.value(p), fb = cb.value(p);
+      float da = fa + pcmDeform(pp, fb), db = fb + pcmDeform(pp, fa);
+      CHECK_FALSE((da > kIso && db > kIso));
+      if (fa > kIso && fb > kIso) ++interp;
+      float f = F.value(p);
+      if (std::max(fa, fb) > 0.0f && std::min(fa, fb) <= kIso - pp.width) {
+        CHECK(f == Approx(std::max(fa, fb)).margin(1e-6));
+      }
+      if (f > std::max(fa, fb) + 1e-4f) {
+        ++bulged;
+        CHECK(std::min(fa, fb) > kIso - pp.width);
+        CHECK(std::min(fa, fb) < kIso);
+      }
+    }
+    CHECK(interp > 50);
+    CHECK(bulged > 100);
+    // On the bisector plane inside both, each deformed field equals c exactly.
+    for (float y : {0.0f, 0.3f, 0.5f}) {
+      Vec3 p(0, y, 0.1f);
+      float fa = ca.value(p), fb = cb.value(p);
+      REQUIRE(fa > kIso);
+      CHECK(fa + pcmDeform(pp, fb) == Approx(kIso).margin(1e-6));
+    }
+  }
+}
+
+TEST_CASE("BlobTree::bend", "[blobtree]") {
+  Vec3 a(1, 0, 0), b(1, 4, 0);
+  float size = 4.0f;
+  SECTION("endpoints stay fixed within 1e-5 of the model size; maps invert") {
+    for (float sag : {0.1f, 0.5f, 1.0f, 2.0f}) {
+      Bend bd;
+      bd.a = a;
+      bd.b = b;
+      bd.direction = Vec3(1, 0, 0.3f);
+      bd.sagitta = sag;
+      CHECK(glm::length(bd.worldFromLocal(a) - a) < 1e-5f * size);
+      CHECK(glm::length(bd.worldFromLocal(b) - b) < 1e-5f * size);
+      CHECK(glm::length(bd.localFromWorld(a) - a) < 1e-5f * size);
+      Vec3 mid = bd.worldFromLocal(0.5f * (a + b));
+      Vec3 dir = glm::normalize(Vec3(1, 0, 0.3f));
+      CHECK(glm::dot(mid - 0.5f * (a + b), dir) == Approx(sag).epsilon(1e-4));
+      Vec3 q(1.2f, 2.5f, 0.1f);
+      CHECK(glm::length(bd.localFromWorld(bd.worldFromLocal(q)) - q) < 1e-5f * size);
+    }
+    Bend ang = Bend::fromAngle(a, b, Vec3(1, 0, 0), float(kPi / 3));
+    CHECK(ang.radius() == Approx(4.0f));  // chord 4 subtending 60°: radius = chord
+  }
+  SECTION("a bent segment: F = 1 at both endpoints and at the arc's apex") {
+    BlobTree t;
+    NodeId s = t.segment(a, b, 0.3f);
+    CompiledBlob k = compile(t, t.bend(s, a, b, 1.0f, Vec3(1, 0, 0)));
+    CHECK(k.value(a) == Approx(1.0f).margin(1e-5));
+    CHECK(k.value(b) == Approx(1.0f).margin(1e-5));
+    CHECK(k.value(Vec3(2, 2, 0)) == Approx(1.0f).margin(1e-5));
+    CHECK(k.value(Vec3(1, 2, 0)) < 0.5f);  // the straight middle is now outside
+  }
+  SECTION("a support that would reach the bend centre is refused") {
+    BlobTree t;
+    NodeId s = t.segment(a, b, 0.9f);
+    CHECK_THROWS_AS(t.bend(s, a, b, 2.0f, Vec3(1, 0, 0)), InputError);
+  }
+}
+
+TEST_CASE("BlobTree::joint bulge", "[blobtree]") {
+  // Tree paper §3.2, Fig. 8-9: two collinear summed line primitives sharing an endpoint
+  // bulge at the joint; shortening the basal one by δA = 1.75·r_B (Eq. 4) removes most of it.
+  const float r = 0.5f, L = 5.0f;
+  auto measure = [&](float deltaA, float* at) {
+    BlobTree t;
+    NodeId A = t.cone(Vec3(0, -L, 0), Vec3(0, -deltaA, 0), r, r);
+    NodeId B = t.cone(Vec3(0), Vec3(0, L, 0), r, r);
+    CompiledBlob k = compile(t, t.blend(std::vector<NodeId>{A, B}));
+    float worst = 0.0f;
+    for (float y = -4.0f * r; y <= 4.0f * r; y += r / 64.0f) {
+      float rad = isoDistance(k, Vec3(0, y, 0), Vec3(1, 0, 0), 4.0f * r);
+      if (std::abs(rad - r) > std::abs(worst)) {
+        worst = rad - r;
+        *at = y;
+      }
+    }
+    return worst / r;
+  };
+  float y0 = 0.0f, y1 = 0.0f;
+  float plain = measure(0.0f, &y0);
+  float offset = measure(1.75f * r, &y1);
+  std::printf("joint bulge: shared endpoint %+.1f%% of r (at y=%.3f), with δA = 1.75 r: %+.1f%% (at y=%.3f)\n",
+              100.0 * plain, double(y0), 100.0 * offset, double(y1));
+  // Closed form at the joint: 2(1−s)³ = 0.5 → radius 0.6082·R = 1.339·r.
+  CHECK(plain == Approx(0.339f).margin(0.005f));
+  CHECK(y0 == Approx(0.0f).margin(r / 32));
+  CHECK(std::abs(offset) < 0.05f);
 }

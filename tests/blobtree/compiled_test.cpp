@@ -1,0 +1,277 @@
+#include <catch2/catch.hpp>
+
+#include "blobtree/blobtree.h"
+#include "blobtree/compiled.h"
+#include "core/rng.h"
+
+#include <cmath>
+#include <vector>
+
+using namespace sprig;
+using namespace sprig::blobtree;
+
+namespace {
+
+Vec3 randomIn(Rng& rng, Vec3 lo, Vec3 hi) {
+  return Vec3(float(rng.uniform(lo.x, hi.x)), float(rng.uniform(lo.y, hi.y)), float(rng.uniform(lo.z, hi.z)));
+}
+
+/// A branching structure of cones (a crude tree): `count` cones, each starting at the end of
+/// an earlier one, radii shrinking with depth.
+NodeId branching(BlobTree& t, Rng& rng, int count, std::vector<NodeId>* cones = nullptr, float scale = 1.0f) {
+  struct Tip {
+    Vec3 p, dir;
+    float r;
+  };
+  std::vector<Tip> tips{{Vec3(0), Vec3(0, 1, 0), 0.3f * scale}};
+  std::vector<NodeId> kids;
+  for (int i = 0; i < count; ++i) {
+    Tip base = tips[rng.below(uint32_t(tips.size()))];
+    Vec3 jitter = randomIn(rng, Vec3(-0.6f), Vec3(0.6f));
+    Vec3 dir = glm::normalize(base.dir + jitter);
+    float len = scale * float(rng.uniform(0.6, 1.2));
+    float r1 = std::max(0.02f * scale, base.r * 0.85f);
+    Vec3 end = base.p + len * dir;
+    TextureAttr tex;
+    tex.textureId = uint16_t(i % 3);
+    kids.push_back(t.cone(base.p, end, base.r, r1, tex));
+    tips.push_back({end, dir, r1});
+  }
+  if (cones) *cones = kids;
+  return t.blend(kids);
+}
+
+/// A scene exercising every operator.
+NodeId scene(BlobTree& t, Rng& rng) {
+  NodeId trunk = branching(t, rng, 30);
+  NodeId ballA = t.point(Vec3(2, 0.5f, 0), 0.5f), ballB = t.point(Vec3(2.6f, 0.5f, 0), 0.45f);
+  PcmParams pp;
+  NodeId contact = t.pcm(ballA, ballB, pp);
+  NodeId ring = t.rotate(t.torus(Vec3(0), Vec3(0, 1, 0), 0.8f, 0.15f), Vec3(1, 0, 0), 0.7f);
+  NodeId ringMoved = t.translate(ring, Vec3(-2, 1, 0.5f));
+  NodeId pts = t.ricci(std::vector<NodeId>{t.point(Vec3(0, -1.5f, 0), 0.4f), t.point(Vec3(0.5f, -1.5f, 0), 0.4f)}, 4.0f);
+  NodeId seg = t.segment(Vec3(-1, -2, 1), Vec3(1, -2, 1), 0.2f);
+  NodeId bent = t.bend(seg, Vec3(-1, -2, 1), Vec3(1, -2, 1), 0.4f, Vec3(0, 1, 0));
+  Twist tw;
+  tw.origin = Vec3(3, -1, 0);
+  tw.axis = Vec3(0, 1, 0);
+  tw.rateRadPerUnit = 1.2f;
+  NodeId twisted = t.twist(t.segment(Vec3(3.3f, -2, 0), Vec3(3.3f, 0, 0), 0.15f), tw);
+  Taper tp;
+  tp.origin = Vec3(-3, -2, 0);
+  tp.axis = Vec3(0, 1, 0);
+  tp.length = 2.0f;
+  tp.scale0 = 1.0f;
+  tp.scale1 = 0.5f;
+  NodeId tapered = t.taper(t.segment(Vec3(-3, -2, 0), Vec3(-3, 0, 0), 0.3f), tp);
+  NodeId scar = t.negative(t.point(Vec3(0, 0.3f, 0.3f), 0.15f), 0.5f);
+  NodeId blend = t.blend(std::vector<NodeId>{trunk, contact, ringMoved, pts, bent, twisted, tapered, scar});
+  NodeId cut = t.box(Vec3(-10, -10, 1.2f), Vec3(10, 10, 10), 0.01f);
+  return t.difference(blend, cut);
+}
+
+}  // namespace
+
+TEST_CASE("CompiledBlob::value", "[blobtree]") {
+  uint64_t seed = GENERATE(1u, 2u, 3u);
+  INFO("seed " << seed);
+  Rng rng(seed);
+  BlobTree t;
+  NodeId root = scene(t, rng);
+  CompiledBlob b = compile(t, root);
+  Box3 box = b.bounds().expanded(0.5f);
+  SECTION("culled tape equals the reference evaluator and the unculled tape") {
+    for (int i = 0; i < 3000; ++i) {
+      Vec3 p = randomIn(rng, box.lo, box.hi);
+      float ref = t.value(root, p);
+      CHECK(b.value(p) == Approx(ref).margin(1e-5));
+      CHECK(b.valueNoCulling(p) == Approx(ref).margin(1e-5));
+      CHECK(b.sample(p).value == Approx(ref).margin(1e-5));
+    }
+  }
+  SECTION("batched values equal point values, coherent and scattered batches") {
+    std::vector<Vec3> pts;
+    Vec3 c = randomIn(rng, box.lo, box.hi);
+    for (int i = 0; i < 500; ++i) pts.push_back(c + randomIn(rng, Vec3(-0.3f), Vec3(0.3f)));
+    for (int i = 0; i < 500; ++i) pts.push_back(randomIn(rng, box.lo, box.hi));
+    std::vector<float> out(pts.size());
+    b.values(pts, out);
+    for (size_t i = 0; i < pts.size(); ++i) CHECK(out[i] == Approx(b.value(pts[i])).margin(1e-5));
+  }
+  SECTION("support bounds: every node's field is 0 outside its box") {
+    for (NodeId id = 0; id < t.size(); ++id) {
+      Box3 nb = t.node(id).bounds;
+      if (nb.empty() || nb.size().x > 1e30f) continue;
+      Box3 around = nb.expanded(1.0f);
+      for (int i = 0; i < 200; ++i) {
+        Vec3 p = randomIn(rng, around.lo, around.hi);
+        if (nb.contains(p)) continue;
+        CHECK(t.value(id, p) == 0.0f);
+      }
+    }
+  }
+  SECTION("interval bounds and local Lipschitz bounds are sound on random boxes") {
+    for (int i = 0; i < 200; ++i) {
+      Vec3 c = randomIn(rng, box.lo, box.hi);
+      float e = float(rng.uniform(0.01, 1.0));
+      Box3 q{c - e, c + e};
+      Interval iv = b.valueBounds(q);
+      float L = b.lipschitz(q);
+      CHECK(L <= b.lipschitz() * 1.0001f);
+      for (int k = 0; k < 40; ++k) {
+        Vec3 p = randomIn(rng, q.lo, q.hi), r = randomIn(rng, q.lo, q.hi);
+        float fp = b.value(p), fr = b.value(r);
+        CHECK(fp >= iv.lo - 1e-5f);
+        CHECK(fp <= iv.hi + 1e-5f);
+        CHECK(std::abs(fp - fr) <= L * glm::length(p - r) * 1.001f + 1e-5f);
+      }
+    }
+  }
+}
+
+TEST_CASE("CompiledBlob::gradient", "[blobtree]") {
+  uint64_t seed = GENERATE(11u, 12u, 13u);
+  INFO("seed " << seed);
+  Rng rng(seed);
+  BlobTree t;
+  NodeId root = scene(t, rng);
+  CompiledBlob b = compile(t, root);
+  Box3 box = b.bounds();
+  const float h = 3e-4f;
+  int compared = 0;
+  for (int i = 0; i < 20000 && compared < 1500; ++i) {
+    Vec3 p = randomIn(rng, box.lo, box.hi);
+    float f = b.value(p);
+    if (f < 0.02f || f > 1.5f) continue;
+    Vec3 g = b.gradient(p);
+    Vec3 fd(0.0f), fwd(0.0f), bwd(0.0f);
+    bool kink = false;
+    for (int a = 0; a < 3; ++a) {
+      Vec3 e(0.0f);
+      e[a] = h;
+      double fp = b.value(p + e), fm = b.value(p - e);
+      fd[a] = float((fp - fm) / (2.0 * h));
+      fwd[a] = float((fp - f) / h);
+      bwd[a] = float((f - fm) / h);
+      // Skip points next to a kink (max/min switch, clamp): one-sided slopes disagree.
+      if (std::abs(fwd[a] - bwd[a]) > 0.05f * (1.0f + std::abs(fd[a]))) kink = true;
+    }
+    if (kink) continue;
+    ++compared;
+    INFO("p = (" << p.x << ", " << p.y << ", " << p.z << ") f = " << f);
+    CHECK(glm::length(g - fd) <= 0.01f * (1.0f + glm::length(fd)));
+  }
+  CHECK(compared > 500);
+}
+
+TEST_CASE("CompiledBlob::sample attributes", "[blobtree]") {
+  BlobTree t;
+  TextureAttr ta, tb;
+  ta.textureId = 3;
+  tb.textureId = 5;
+  tb.vOffset = 10.0f;
+  NodeId a = t.cone(Vec3(0), Vec3(0, 2, 0), 0.5f, 0.5f, ta);
+  NodeId c = t.cone(Vec3(0, 2, 0), Vec3(0, 4, 0), 0.5f, 0.5f, tb);
+  CompiledBlob b = compile(t, t.blend(std::vector<NodeId>{a, c}));
+  Sample low = b.sample(Vec3(0.5f, 1.0f, 0));
+  REQUIRE(low.attributes.textureCount == 1);
+  CHECK(low.attributes.textureIds[0] == 3);
+  CHECK(low.attributes.uv.y == Approx(1.0f));  // v = distance along the axis
+  Sample joint = b.sample(Vec3(0.5f, 2.0f, 0));
+  REQUIRE(joint.attributes.textureCount == 2);
+  CHECK(joint.attributes.textureWeights[0] == Approx(0.5f));
+  CHECK(joint.attributes.uv.y == Approx(0.5f * (2.0f + 10.0f)));  // Σ f·v / Σ f
+  CHECK(glm::dot(-joint.gradient, Vec3(1, 0, 0)) > 0.0f);  // outward normal points away
+}
+
+TEST_CASE("CompiledBlob::intersect", "[blobtree]") {
+  uint64_t seed = GENERATE(21u, 22u);
+  INFO("seed " << seed);
+  Rng rng(seed);
+  BlobTree t;
+  NodeId root = scene(t, rng);
+  CompiledBlob b = compile(t, root);
+  Box3 box = b.bounds();
+  float size = glm::length(box.size());
+  SECTION("every hit lies on the surface within 1e-4 of the model size and is the first crossing") {
+    int hits = 0;
+    for (int i = 0; i < 400; ++i) {
+      Vec3 o = box.center() + glm::normalize(randomIn(rng, Vec3(-1), Vec3(1))) * size;
+      Vec3 target = randomIn(rng, box.lo * 0.5f, box.hi * 0.5f);
+      Ray ray{o, target - o};
+      auto hit = b.intersect(ray, 0.0f, 10.0f);
+      if (!hit) continue;
+      ++hits;
+      Sample s = b.sample(hit->point);
+      CHECK(std::abs(s.value - kIso) / glm::length(s.gradient) < 1e-4f * size);
+      CHECK(glm::length(hit->point - (o + hit->t * ray.direction)) < 1e-4f * size);
+      CHECK(glm::dot(hit->normal, ray.direction) < 0.0f);  // entering from outside
+      // No crossing before the hit: sample the ray densely.
+      for (int k = 1; k < 200; ++k) CHECK(b.value(o + (hit->t * float(k) / 200.0f) * ray.direction) < kIso);
+    }
+    CHECK(hits > 100);
+  }
+  SECTION("per-cell intersection over surface cells finds the same first hit") {
+    CellSet cells = b.surfaceCells(0.1f);
+    REQUIRE(!cells.cells.empty());
+    for (const Cell& c : cells.cells) CHECK(c.bounds.contains(kIso));
+    for (int i = 0; i < 60; ++i) {
+      Vec3 o = box.center() + glm::normalize(randomIn(rng, Vec3(-1), Vec3(1))) * size;
+      Ray ray{o, randomIn(rng, box.lo * 0.5f, box.hi * 0.5f) - o};
+      auto hit = b.intersect(ray, 0.0f, 10.0f);
+      std::optional<Hit> best;
+      for (const Cell& c : cells.cells) {
+        auto h = b.intersectCell(c, ray, 0.0f, 10.0f);
+        if (h && (!best || h->t < best->t)) best = h;
+      }
+      REQUIRE(bool(hit) == bool(best));
+      if (hit) CHECK(glm::length(hit->point - best->point) < 1e-4f * size);
+    }
+  }
+}
+
+TEST_CASE("CompiledBlob::intersect thin cone", "[blobtree]") {
+  // A cone of radius 0.01 inside a model of size 10 is never stepped over.
+  BlobTree t;
+  NodeId big1 = t.point(Vec3(-4, -4, -4), 1.0f), big2 = t.point(Vec3(4, 4, 4), 1.0f);
+  NodeId thin = t.cone(Vec3(-3, 0, 0), Vec3(3, 0, 0), 0.01f, 0.01f);
+  CompiledBlob b = compile(t, t.blend(std::vector<NodeId>{big1, big2, thin}));
+  Rng rng(5);
+  for (int i = 0; i < 200; ++i) {
+    float x = float(rng.uniform(-2.9, 2.9));
+    Vec3 target(x, float(rng.uniform(-0.008, 0.008)), 0.0f);
+    Vec3 o = target + glm::normalize(randomIn(rng, Vec3(-1), Vec3(1)) + Vec3(0, 0, 3)) * 9.0f;
+    auto hit = b.intersect(Ray{o, target - o}, 0.0f, 2.0f);
+    REQUIRE(hit);
+    CHECK(std::abs(hit->point.y) < 0.011f);
+    CHECK(std::abs(hit->point.z) < 0.011f);
+  }
+}
+
+TEST_CASE("CompiledBlob::surfaceCells", "[blobtree]") {
+  BlobTree t;
+  CompiledBlob b = compile(t, t.point(Vec3(0.1f, 0.2f, 0.3f), 1.0f));
+  CellSet coarse = b.surfaceCells(0.1f), fine = b.surfaceCells(0.05f);
+  CHECK(coarse.cellSize <= 0.1f);
+  CHECK(fine.cellSize == Approx(coarse.cellSize * 0.5f));
+  // Work follows the area: halving the cell size multiplies the count by about 4.
+  double ratio = double(fine.cells.size()) / double(coarse.cells.size());
+  CHECK(ratio > 3.2);
+  CHECK(ratio < 4.8);
+  // Every surface point lies in some cell; each cell lists the primitive.
+  for (const Cell& c : coarse.cells) {
+    CHECK(c.primitiveCount == 1);
+    CHECK(c.box.size().x == Approx(coarse.cellSize));
+  }
+  Rng rng(3);
+  for (int i = 0; i < 300; ++i) {
+    Vec3 p = Vec3(0.1f, 0.2f, 0.3f) + glm::normalize(randomIn(rng, Vec3(-1), Vec3(1)));
+    bool found = false;
+    for (const Cell& c : coarse.cells) found = found || c.box.contains(p);
+    CHECK(found);
+  }
+  // Deterministic.
+  CellSet again = b.surfaceCells(0.1f);
+  REQUIRE(again.cells.size() == coarse.cells.size());
+  for (size_t i = 0; i < again.cells.size(); ++i) CHECK(again.cells[i].index == coarse.cells[i].index);
+}
