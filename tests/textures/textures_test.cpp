@@ -1,0 +1,290 @@
+#include <catch2/catch.hpp>
+
+#include <OpenImageIO/imageio.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+#include "core/atomic_file.h"
+#include "core/parallel.h"
+#include "core/rng.h"
+#include "textures/maps.h"
+#include "textures/noise.h"
+#include "textures/procedural.h"
+#include "textures/registry.h"
+
+using namespace sprig;
+using namespace sprig::textures;
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path scratchDir() {
+  fs::path d = fs::path(SPRIG_BINARY_DIR) / "test_textures_tmp";
+  fs::create_directories(d);
+  return d;
+}
+
+/// Writes a width x height float image with the given pixels (RGB, rows top to bottom).
+void writeFloatImage(const fs::path& path, int w, int h, const std::vector<float>& rgb, OIIO::TypeDesc format) {
+  auto out = OIIO::ImageOutput::create(path.string());
+  REQUIRE(out);
+  OIIO::ImageSpec spec(w, h, 3, format);
+  REQUIRE(out->open(path.string(), spec));
+  REQUIRE(out->write_image(OIIO::TypeDesc::FLOAT, rgb.data()));
+  REQUIRE(out->close());
+}
+
+double maxDiff(const Vec3& a, const Vec3& b) {
+  return std::max({std::abs(a.x - b.x), std::abs(a.y - b.y), std::abs(a.z - b.z)});
+}
+
+}  // namespace
+
+TEST_CASE("PerlinNoise", "[textures]") {
+  SECTION("the same seed gives the same values; another seed differs") {
+    PerlinNoise a(5), b(5), c(6);
+    int differ = 0;
+    Rng rng(1);
+    for (int i = 0; i < 1000; ++i) {
+      DVec3 p(rng.uniform(-50, 50), rng.uniform(-50, 50), rng.uniform(-50, 50));
+      CHECK(a(p) == b(p));
+      differ += a(p) != c(p);
+    }
+    CHECK(differ > 900);
+  }
+  SECTION("zero on the lattice, in [-1, 1], fbm in [-1, 1], turbulence in [0, 1]") {
+    PerlinNoise n(3);
+    CHECK(n(DVec3(3, -7, 12)) == 0.0);
+    Rng rng(2);
+    double lo = 1, hi = -1;
+    for (int i = 0; i < 200000; ++i) {
+      DVec3 p(rng.uniform(-300, 300), rng.uniform(-300, 300), rng.uniform(-300, 300));
+      double v = n(p);
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+      double f = n.fbm(p);
+      double t = n.turbulence(p);
+      REQUIRE(std::abs(f) <= 1.0);
+      REQUIRE(t >= 0.0);
+      REQUIRE(t <= 1.0);
+    }
+    CHECK(lo >= -1.0);
+    CHECK(hi <= 1.0);
+    CHECK(lo < -0.6);  // the range is used
+    CHECK(hi > 0.6);
+  }
+  SECTION("continuous: a step of 1e-5 changes the value by less than 1e-4") {
+    PerlinNoise n(9);
+    Rng rng(3);
+    for (int i = 0; i < 10000; ++i) {
+      DVec3 p(rng.uniform(-20, 20), rng.uniform(-20, 20), rng.uniform(-20, 20));
+      DVec3 d(rng.uniform(-1, 1), rng.uniform(-1, 1), rng.uniform(-1, 1));
+      d = glm::normalize(d) * 1e-5;
+      INFO("seed 3, sample " << i);
+      REQUIRE(std::abs(n(p + d) - n(p)) < 1e-4);
+      REQUIRE(std::abs(n.fbm(p + d) - n.fbm(p)) < 2e-4);
+    }
+  }
+}
+
+TEST_CASE("BarkTexture", "[textures]") {
+  BarkOptions o;
+  o.seed = 4;
+  BarkTexture bark(o);
+  SECTION("periodic in u with period 1") {
+    Rng rng(4);
+    for (int i = 0; i < 2000; ++i) {
+      Vec2 uv(static_cast<float>(rng.uniform()), static_cast<float>(rng.uniform(-3, 3)));
+      INFO("u " << uv.x << " v " << uv.y);
+      REQUIRE(std::abs(bark.height(uv) - bark.height(uv + Vec2(1, 0))) < 1e-4);
+      REQUIRE(maxDiff(bark.color(uv), bark.color(uv + Vec2(-1, 0))) < 1e-4);
+    }
+  }
+  SECTION("without warp there are exactly `furrows` ridges and furrows around") {
+    o.warp = 0;
+    o.furrows = 7;
+    BarkTexture straight(o);
+    int ridges = 0;
+    double minH = 1, maxH = 0;
+    const int n = 7000;
+    for (int i = 0; i < n; ++i) {
+      double h0 = straight.height(Vec2(float(i) / n, 0.3f));
+      double h1 = straight.height(Vec2(float(i + 1) / n, 0.3f));
+      double h2 = straight.height(Vec2(float(i + 2) / n, 0.3f));
+      ridges += h1 > h0 && h1 >= h2;
+      minH = std::min(minH, h1);
+      maxH = std::max(maxH, h1);
+    }
+    CHECK(ridges == 7);
+    CHECK(minH < 0.01);
+    CHECK(maxH > 0.99);
+  }
+  SECTION("colors lie between the furrow and ridge colors (up to grain)") {
+    for (int i = 0; i < 500; ++i) {
+      Vec3 c = bark.color(Vec2(i / 500.0f, i * 0.01f));
+      CHECK(c.x >= 0);
+      CHECK(c.x <= o.ridgeColor.x * (1 + o.grain) + 1e-5);
+    }
+  }
+}
+
+TEST_CASE("StripesTexture and SpotsTexture", "[textures]") {
+  SECTION("stripes without wobble: band centers and gaps, exactly periodic") {
+    StripesOptions o;
+    o.wobble = 0;
+    o.frequency = 4;
+    o.duty = 0.5;
+    StripesTexture s(o);
+    CHECK(maxDiff(s.color(Vec2(0.3f, 0.25f / 4)), o.stripeColor) < 1e-6);  // center of band 0
+    CHECK(maxDiff(s.color(Vec2(0.3f, 0.75f / 4)), o.baseColor) < 1e-6);    // center of gap 0
+    CHECK(maxDiff(s.color(Vec2(0.9f, 0.25f / 4 + 2 * 0.25f)), o.stripeColor) < 1e-6);
+    o.spiral = true;
+    StripesTexture sp(o);
+    CHECK(maxDiff(sp.color(Vec2(0.25f / 4, 0.7f)), o.stripeColor) < 1e-6);
+  }
+  SECTION("spots are deterministic; density 0 leaves the base color; coverage is sensible") {
+    SpotsOptions o;
+    o.seed = 8;
+    SpotsTexture a(o), b(o);
+    int covered = 0;
+    const int n = 100;
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        Vec2 uv(i / float(n), j / float(n));
+        Vec3 c = a.color(uv);
+        REQUIRE(c == b.color(uv));
+        covered += maxDiff(c, o.spotColor) < 0.05;
+      }
+    // Expected: density * pi r^2 per cell = 0.8 * 0.28 ~ 0.23 of the area.
+    CHECK(covered > n * n * 0.12);
+    CHECK(covered < n * n * 0.35);
+    o.density = 0;
+    SpotsTexture none(o);
+    CHECK(none.color(Vec2(0.31f, 0.77f)) == o.baseColor);
+  }
+}
+
+TEST_CASE("ImageTexture", "[textures]") {
+  fs::path dir = scratchDir();
+  SECTION("texel centers of a linear EXR return the texel colors") {
+    const int w = 4, h = 2;
+    std::vector<float> rgb(w * h * 3);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        float* p = &rgb[(y * w + x) * 3];
+        p[0] = 0.1f * x;
+        p[1] = 0.5f * y;
+        p[2] = 0.25f + 0.125f * x * y;
+      }
+    fs::path file = dir / "texels_4x2.exr";
+    writeFloatImage(file, w, h, rgb, OIIO::TypeDesc::FLOAT);
+    ImageTexture t = ImageTexture::open(file.string(), {"s.yaml", 1, 1});
+    CHECK(t.width() == 4);
+    CHECK(t.height() == 2);
+    CHECK(!t.srgb());
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        Vec3 c = t.color(Vec2((x + 0.5f) / w, (y + 0.5f) / h));
+        const float* p = &rgb[(y * w + x) * 3];
+        INFO("texel " << x << "," << y);
+        CHECK(maxDiff(c, Vec3(p[0], p[1], p[2])) < 1e-5);
+      }
+    // Halfway between texels (0,0) and (1,0): bilinear average.
+    Vec3 mid = t.color(Vec2(1.0f / w, 0.5f / h));
+    CHECK(mid.x == Approx(0.05f).margin(1e-5));
+  }
+  SECTION("8-bit PNG values are sRGB, returned linear") {
+    std::vector<float> rgb(2 * 2 * 3, 0.5f);
+    rgb[0] = 1.0f;
+    fs::path file = dir / "srgb_2x2.png";
+    writeFloatImage(file, 2, 2, rgb, OIIO::TypeDesc::UINT8);
+    ImageTexture t = ImageTexture::open(file.string(), {"s.yaml", 1, 1});
+    CHECK(t.srgb());
+    Vec3 c = t.color(Vec2(0.25f, 0.25f));
+    CHECK(c.x == Approx(1.0f).margin(1e-5));
+    CHECK(c.y == Approx(srgbToLinear(128 / 255.0)).margin(1e-4));
+  }
+  SECTION("a missing file is an InputError at the referencing location") {
+    SourceLoc where{"species/oak.yaml", 7, 14};
+    try {
+      ImageTexture::open((dir / "no_such_bark.png").string(), where);
+      FAIL("no throw");
+    } catch (const InputError& e) {
+      std::string msg = e.what();
+      CHECK(msg.rfind("species/oak.yaml:7:14: error: cannot read texture '", 0) == 0);
+      CHECK(msg.find("no_such_bark.png': no such file") != std::string::npos);
+    }
+  }
+  SECTION("an unreadable file is an InputError too") {
+    fs::path file = dir / "garbage.png";
+    writeFileAtomic(file, "this is not a PNG");
+    CHECK_THROWS_AS(ImageTexture::open(file.string(), {"a.yaml", 2, 3}), InputError);
+    TextureRegistry reg;
+    CHECK_THROWS_AS(reg.addImage(file.string(), {"a.yaml", 2, 3}), InputError);
+    CHECK(reg.size() == 0);
+  }
+}
+
+TEST_CASE("TextureRegistry", "[textures]") {
+  TextureRegistry reg;
+  TextureId c = reg.add(ConstantTexture{Vec3(0.2f, 0.3f, 0.4f)});
+  BarkOptions bo;
+  TextureId b = reg.add(BarkTexture(bo));
+  NoiseColorOptions no;
+  no.solid = true;
+  TextureId n = reg.add(NoiseTexture(no));
+  CHECK(c == 0);
+  CHECK(b == 1);
+  CHECK(n == 2);
+  CHECK(reg.color(c, Vec2(0.5f)) == Vec3(0.2f, 0.3f, 0.4f));
+  CHECK(reg.color(b, Vec2(0.1f, 0.2f)) == BarkTexture(bo).color(Vec2(0.1f, 0.2f)));
+  // A solid texture follows the position, not uv.
+  CHECK(reg.color(n, Vec2(0.1f), Vec3(1.3f, 2.1f, 0.7f)) == reg.color(n, Vec2(0.9f), Vec3(1.3f, 2.1f, 0.7f)));
+  CHECK_THROWS_AS(reg.color(7, Vec2(0)), std::out_of_range);
+}
+
+TEST_CASE("texture maps", "[textures]") {
+  SECTION("bake is the same at any thread count") {
+    TextureRegistry reg;
+    TextureId id = reg.add(LeafTexture());
+    ImageRgb one, two;
+    {
+      ThreadLimit limit(1);
+      one = bake(reg, id, 64, 48);
+    }
+    two = bake(reg, id, 64, 48);
+    CHECK(one.rgb == two.rgb);
+  }
+  SECTION("the shipped maps are Sprig's own output, small, and up to date") {
+    for (const MapSpec& m : shippedMaps()) {
+      fs::path file = fs::path(SPRIG_SOURCE_DIR) / "textures" / "maps" / m.file;
+      INFO(file);
+      REQUIRE(fs::exists(file));
+      CHECK(fs::file_size(file) < 300 * 1024);
+      ImageTexture t = ImageTexture::open(file.string(), {"test", 1, 1});
+      CHECK(t.width() == m.size);
+      // Re-bake a few rows and compare with the file's pixels (8-bit sRGB: within 1/255).
+      auto in = OIIO::ImageInput::open(file.string());
+      REQUIRE(in);
+      std::vector<float> pixels(static_cast<size_t>(m.size) * m.size * 3);
+      REQUIRE(in->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, pixels.data()));
+      TextureRegistry reg;
+      TextureId id = reg.add(m.texture);
+      ImageRgb baked = bake(reg, id, m.size, m.size);
+      double worst = 0;
+      for (size_t i = 0; i < pixels.size(); i += 97) worst = std::max(worst, std::abs(pixels[i] - linearToSrgb(baked.rgb[i])));
+      CHECK(worst <= 1.0 / 255 + 1e-6);
+    }
+  }
+}
+
+/// Regenerates textures/maps/ (hidden: run `test_textures "[.maps]"`).
+TEST_CASE("texture maps: regenerate", "[.maps]") {
+  for (const MapSpec& m : shippedMaps()) {
+    TextureRegistry reg;
+    TextureId id = reg.add(m.texture);
+    writeImage(bake(reg, id, m.size, m.size), (fs::path(SPRIG_SOURCE_DIR) / "textures" / "maps" / m.file).string());
+  }
+}
