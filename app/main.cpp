@@ -4,19 +4,59 @@
 #include <CLI/CLI.hpp>
 
 #include <iostream>
+#include <optional>
 
+#include "app/commands.h"
 #include "core/atomic_file.h"
 #include "core/diagnostics.h"
+#include "core/parallel.h"
+#include "core/progress.h"
 
 int main(int argc, char** argv) {
-  sprig::installSignalCleanup();
-  CLI::App app{"Sprig: procedural botanical modeling", "sprig"};
+  using namespace sprig;
+  installSignalCleanup();
+  CLI::App app{"Sprig: procedural botanical modeling (L-systems, skeletons, BlobTree surfaces, shells)", "sprig"};
   app.set_version_flag("--version", SPRIG_VERSION);
+  app.require_subcommand(1);
+  app.fallthrough();
+
+  GlobalOptions global;
+  app.add_flag("-q,--quiet", global.quiet, "no progress bars or summaries");
+  app.add_option("--threads", global.threads, "worker threads (0 = all cores)")->check(CLI::Range(0, 4096));
+  app.add_option("--root", global.root, "library root: species may only reference files inside it")
+      ->check(CLI::ExistingDirectory);
+  app.add_flag("--allow-outside-paths", global.allowOutsidePaths,
+               "let species reference absolute paths and files outside the root");
+
+  CommandRun run;
+  addDeriveCommand(app, global, run);
+  addCheckCommand(app, global, run);
+  addPreviewCommand(app, global, run);
+  addGalleryCommand(app, global, run);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     int rc = app.exit(e);
-    return rc == 0 ? 0 : 2;
+    return rc == 0 ? kExitOk : kExitUsage;
   }
-  return 0;
+
+  try {
+    ProgressSettings::setQuiet(global.quiet);
+    std::optional<ThreadLimit> limit;
+    if (global.threads > 0) limit.emplace(global.threads);
+    return run ? run() : kExitUsage;
+  } catch (const InputError& e) {
+    std::cerr << e.what() << "\n";
+    return kExitBadInput;
+  } catch (const UsageError& e) {
+    std::cerr << "sprig: error: " << e.what() << "\n";
+    return kExitUsage;
+  } catch (const Cancelled&) {
+    std::cerr << "sprig: cancelled\n";
+    return 130;
+  } catch (const std::exception& e) {
+    std::cerr << "sprig: internal error: " << e.what() << "\n";
+    return kExitInternal;
+  }
 }

@@ -1,0 +1,51 @@
+/// Helpers shared by the subcommands: output extension checks and `-D NAME=VALUE` parsing.
+
+#include "app/cmd_common.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+
+namespace sprig {
+
+void requireExtension(const std::string& flag, const std::string& path, std::initializer_list<const char*> allowed) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::string list;
+  for (const char* a : allowed) {
+    if (ext == a) return;
+    list += std::string(list.empty() ? "" : ", ") + a;
+  }
+  throw UsageError(flag + ": unknown output extension '" + std::filesystem::path(path).extension().string() +
+                   "' for '" + path + "' (use " + list + ")");
+}
+
+std::optional<double> parseFiniteNumber(std::string_view text) {
+  if (!text.empty() && text[0] == '+') text.remove_prefix(1);
+  double v = 0;
+  auto res = std::from_chars(text.data(), text.data() + text.size(), v, std::chars_format::general);
+  if (text.empty() || res.ec != std::errc() || res.ptr != text.data() + text.size() || !std::isfinite(v))
+    return std::nullopt;
+  return v;
+}
+
+lsystem::GrammarOverrides commandLineOverrides(const std::vector<std::string>& defines, int steps, int64_t seed) {
+  lsystem::GrammarOverrides o;
+  for (const std::string& d : defines) {
+    size_t eq = d.find('=');
+    std::string name = eq == std::string::npos ? std::string() : d.substr(0, eq);
+    auto value = eq == std::string::npos ? std::nullopt : parseFiniteNumber(std::string_view(d).substr(eq + 1));
+    bool nameOk = !name.empty() && std::all_of(name.begin(), name.end(), [](unsigned char c) {
+      return std::isalnum(c) || c == '_';
+    });
+    if (!nameOk || !value)
+      throw UsageError("-D " + d + ": expected NAME=VALUE with a finite number, e.g. -D LENGTH=2.5");
+    o.defines.push_back(lsystem::DefineOverride{name, *value, SourceLoc{"-D " + d, 0, 0}});
+  }
+  if (steps >= 0) o.derivationLength = steps;
+  if (seed >= 0) o.seed = static_cast<uint64_t>(seed);
+  return o;
+}
+
+}  // namespace sprig

@@ -1,0 +1,111 @@
+/// `sprig derive FILE [--steps N] [--seed S] [-D NAME=VALUE] [--print] [--json] [--skeleton OUT.json]`
+
+#include <iostream>
+#include <map>
+#include <sstream>
+
+#include "app/cmd_common.h"
+#include "app/json_writer.h"
+#include "app/species.h"
+#include "app/tree_pipeline.h"
+#include "core/atomic_file.h"
+#include "lsystem/derive.h"
+
+namespace sprig {
+
+namespace {
+
+struct DeriveArgs {
+  std::string file;
+  int steps = -1;
+  int64_t seed = -1;
+  std::vector<std::string> defines;
+  bool print = false;
+  bool json = false;
+  std::string skeletonOut;
+};
+
+/// The `--json` report: steps, modules, symbol counts, internodes, total length, bounds, end.
+std::string reportJson(const GrownTree& t) {
+  std::vector<size_t> counts(t.symbols.size(), 0);
+  for (lsystem::SymbolId s : t.modules.symbols) ++counts[s];
+  std::ostringstream o;
+  o << "{\"steps\": " << t.steps << ", \"modules\": " << t.modules.size() << ", \"symbols\": {";
+  bool first = true;
+  for (size_t s = 0; s < counts.size(); ++s) {
+    if (!counts[s]) continue;
+    o << (first ? "" : ", ") << json::string(t.symbols.name(static_cast<lsystem::SymbolId>(s))) << ": " << counts[s];
+    first = false;
+  }
+  DBox3 b = t.skeleton.bounds();
+  if (b.empty()) b = DBox3{DVec3(0), DVec3(0)};
+  o << "}, \"internodes\": " << t.skeleton.internodes.size()
+    << ", \"total_length\": " << json::number(t.skeleton.totalLength()) << ", \"bounds\": {\"min\": " << json::vec3(b.lo)
+    << ", \"max\": " << json::vec3(b.hi) << "}, \"end\": " << json::vec3(t.end.frame.position) << "}";
+  return o.str();
+}
+
+/// The `--skeleton` file: every internode and a summary of organs.
+std::string skeletonJson(const GrownTree& t) {
+  std::string out;
+  out.reserve(t.skeleton.internodes.size() * 160 + 256);
+  out += "{\"steps\": " + std::to_string(t.steps) + ", \"seed\": " + std::to_string(t.seed) + ",\n \"internodes\": [";
+  for (size_t i = 0; i < t.skeleton.internodes.size(); ++i) {
+    const auto& n = t.skeleton.internodes[i];
+    out += i ? ",\n  " : "\n  ";
+    out += "{\"start\": " + json::vec3(n.start) + ", \"end\": " + json::vec3(n.end) +
+           ", \"base_radius\": " + json::number(n.baseRadius) + ", \"tip_radius\": " + json::number(n.tipRadius) +
+           ", \"parent\": " + std::to_string(n.parent) + ", \"order\": " + std::to_string(n.order) +
+           ", \"step\": " + std::to_string(n.step) + "}";
+  }
+  out += "],\n \"organs\": [";
+  static const char* kinds[] = {"polygon", "sphere", "surface"};
+  for (size_t i = 0; i < t.skeleton.organs.size(); ++i) {
+    const auto& g = t.skeleton.organs[i];
+    out += i ? ",\n  " : "\n  ";
+    out += "{\"kind\": \"" + std::string(kinds[static_cast<int>(g.kind)]) + "\", \"position\": " +
+           json::vec3(g.position) + ", \"radius\": " + json::number(g.radius) +
+           ", \"internode\": " + std::to_string(g.internode) + ", \"step\": " + std::to_string(g.step);
+    if (g.kind == lsystem::Organ::Kind::Polygon) {
+      out += ", \"points\": [";
+      for (size_t k = 0; k < g.points.size(); ++k) out += (k ? ", " : "") + json::vec3(g.points[k]);
+      out += "]";
+    }
+    if (g.kind == lsystem::Organ::Kind::Surface) out += ", \"name\": " + json::string(g.name);
+    out += "}";
+  }
+  out += "]}\n";
+  return out;
+}
+
+int runDerive(const DeriveArgs& a, const GlobalOptions& g) {
+  if (!a.skeletonOut.empty()) requireExtension("--skeleton", a.skeletonOut, {".json"});
+  lsystem::GrammarOverrides extra = commandLineOverrides(a.defines, a.steps, a.seed);
+  Species species = loadSpecies(a.file, g.pathPolicy());
+  GrownTree t = growTree(species, GrowOptions{extra, {}, true});
+  if (a.print) std::cout << lsystem::formatModuleString(t.modules, t.symbols) << "\n";
+  if (a.json) std::cout << reportJson(t) << "\n";
+  if (!a.print && !a.json)
+    std::cout << species.name << ": " << t.steps << " steps, " << t.modules.size() << " modules, "
+              << t.skeleton.internodes.size() << " internodes, total length " << json::number(t.skeleton.totalLength())
+              << "\n";
+  if (!a.skeletonOut.empty()) writeFileAtomic(a.skeletonOut, skeletonJson(t));
+  return kExitOk;
+}
+
+}  // namespace
+
+void addDeriveCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run) {
+  auto args = std::make_shared<DeriveArgs>();
+  CLI::App* sub = app.add_subcommand("derive", "Derive a grammar or tree species and report the result");
+  sub->add_option("FILE", args->file, "species file (.yaml) or grammar (.lsys)")->required();
+  sub->add_option("--steps", args->steps, "derivation steps (default: species/grammar)")->check(CLI::Range(0, 100000));
+  sub->add_option("--seed", args->seed, "random seed (default: species/grammar)")->check(CLI::NonNegativeNumber);
+  sub->add_option("-D,--define", args->defines, "override a #define: NAME=VALUE (repeatable)");
+  sub->add_flag("--print", args->print, "print the final module string in grammar notation");
+  sub->add_flag("--json", args->json, "print a JSON report (steps, modules, symbols, internodes, ...)");
+  sub->add_option("--skeleton", args->skeletonOut, "write every internode to this JSON file");
+  sub->callback([args, &global, &run] { run = [args, &global] { return runDerive(*args, global); }; });
+}
+
+}  // namespace sprig

@@ -1,0 +1,59 @@
+#pragma once
+/// The subcommands of the `sprig` binary, one `cmd_<verb>.cpp` each.
+///
+/// main.cpp builds the CLI11 application, asks each add*Command to register its
+/// subcommand, parses the command line and then calls the chosen command's run function.
+/// A run function returns the exit code (0 success); bad input throws InputError (exit 1),
+/// a bad flag value throws UsageError (exit 2), anything else is an internal error (3).
+
+#include <CLI/CLI.hpp>
+
+#include <functional>
+#include <stdexcept>
+#include <string>
+
+#include "app/yaml_reader.h"
+
+namespace sprig {
+
+/// Exit codes of `sprig`.
+enum ExitCode : int { kExitOk = 0, kExitBadInput = 1, kExitUsage = 2, kExitInternal = 3 };
+
+/// A bad command-line value found after parsing (unknown output extension, malformed -D).
+/// main prints `sprig: error: <what>` and exits with 2.
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// Options every subcommand shares (`--quiet`, `--threads`, `--root`, `--allow-outside-paths`).
+struct GlobalOptions {
+  bool quiet = false;
+  int threads = 0;  ///< 0 = all cores
+  std::string root = ".";
+  bool allowOutsidePaths = false;
+
+  /// Where species files may reference files from.
+  PathPolicy pathPolicy() const {
+    PathPolicy p;
+    p.root = root;
+    p.allowOutside = allowOutsidePaths;
+    return p;
+  }
+};
+
+/// What main calls after parsing when a subcommand was chosen.
+using CommandRun = std::function<int()>;
+
+/// `sprig derive FILE ...` (app/cmd_derive.cpp).
+void addDeriveCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run);
+/// `sprig check FILE...` (app/cmd_check.cpp).
+void addCheckCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run);
+/// `sprig preview FILE -o OUT` (app/cmd_preview.cpp).
+void addPreviewCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run);
+/// `sprig gallery [FILES...] -o DIR` (app/cmd_gallery.cpp).
+void addGalleryCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run);
+
+/// Throws UsageError unless path's extension is one of `allowed` (lower case, with dot).
+void requireExtension(const std::string& flag, const std::string& path, std::initializer_list<const char*> allowed);
+
+}  // namespace sprig

@@ -1,0 +1,139 @@
+#include "app/gallery.h"
+
+#include <chrono>
+#include <cstdio>
+
+#include "app/preview.h"
+#include "app/species.h"
+#include "app/tree_pipeline.h"
+#include "render/image.h"
+
+namespace sprig {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::string html(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&': out += "&amp;"; break;
+      case '<': out += "&lt;"; break;
+      case '>': out += "&gt;"; break;
+      case '"': out += "&quot;"; break;
+      default: out.push_back(c);
+    }
+  }
+  return out;
+}
+
+std::string fixed(double v, int digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+  return buf;
+}
+
+}  // namespace
+
+GalleryItem renderGalleryItem(const fs::path& speciesFile, const fs::path& outDir, GalleryQuality quality,
+                              const PathPolicy& policy) {
+  GalleryItem item;
+  item.source = speciesFile.string();
+  item.name = speciesFile.stem().string();
+  try {
+    Species species = loadSpecies(speciesFile, policy);
+    item.name = species.name;
+    item.description = species.description;
+    item.kind = speciesKindName(species.kind);
+    if (species.kind != SpeciesKind::Tree) {
+      item.error = "the gallery does not render " + item.kind + " species yet";
+      return item;
+    }
+    SpeciesRender look = species.render;
+    int width = look.width, height = look.height;
+    if (quality == GalleryQuality::Draft) {
+      // Draft: about 0.25 megapixel, 4 samples; keeps the whole shipped gallery fast.
+      double scale = std::min(1.0, std::sqrt(250000.0 / (static_cast<double>(width) * height)));
+      width = std::max(16, static_cast<int>(width * scale));
+      height = std::max(16, static_cast<int>(height * scale));
+      look.samples = std::min(look.samples, 4);
+    }
+    const std::string stem = speciesFile.stem().string();
+    item.preview = stem + ".png";
+    item.strip = stem + "_stages.png";
+
+    // One derivation gives the final skeleton and every stage.
+    lsystem::GrammarOverrides none;
+    Species probe = species;
+    lsystem::Grammar g = speciesGrammar(species);
+    item.stages = growthStages(species, g.derivationLength());
+    GrowOptions opt;
+    opt.stageSteps = item.stages;
+    GrownTree t = growTree(species, opt);
+    item.steps = t.steps;
+    item.modules = t.modules.size();
+    item.internodes = t.skeleton.internodes.size();
+    item.deriveSeconds = t.deriveSeconds + t.turtleSeconds;
+
+    auto r0 = std::chrono::steady_clock::now();
+    const DBox3 frame = framingBox(t.skeleton);
+    render::Image preview = renderSkeletonImage(t.skeleton, look, frame, width, height, "render " + stem);
+    render::writeImage(preview, outDir / item.preview);
+    std::vector<const lsystem::Skeleton*> stages;
+    for (const auto& st : t.stages) stages.push_back(&st.skeleton);
+    const int stripHeight = std::max(16, height * 2 / 3);
+    const int cellWidth = std::max(16, stripHeight * 3 / 4);
+    SpeciesRender stripLook = look;
+    stripLook.view.margin = std::max(look.view.margin, 0.04);
+    render::Image strip = renderGrowthStrip(stages, stripLook, frame, cellWidth, stripHeight, "stages " + stem);
+    render::writeImage(strip, outDir / item.strip);
+    item.renderSeconds = secondsSince(r0);
+  } catch (const InputError& e) {
+    item.error = e.what();
+    item.preview.clear();
+    item.strip.clear();
+  }
+  return item;
+}
+
+std::string galleryIndexHtml(const std::vector<GalleryItem>& items) {
+  std::string o;
+  o += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>Sprig gallery</title>\n<style>\n"
+       "body{font-family:system-ui,sans-serif;margin:24px;background:#f4f3ef;color:#222}\n"
+       "h1{font-weight:600}\n.item{background:#fff;border-radius:8px;padding:16px;margin:0 0 20px;"
+       "box-shadow:0 1px 3px rgba(0,0,0,.15);display:flex;gap:20px;flex-wrap:wrap}\n"
+       ".item img{border-radius:4px;display:block}\n.preview img{height:300px}\n.strip img{height:200px}\n"
+       ".meta{min-width:240px;max-width:420px}\n.meta h2{margin:0 0 6px}\n.figs{color:#555;font-size:14px}\n"
+       ".figs td{padding:1px 10px 1px 0}\n.error{color:#a00;white-space:pre-wrap;font-family:monospace}\n"
+       "</style>\n</head>\n<body>\n<h1>Sprig gallery</h1>\n<p>" +
+       std::to_string(items.size()) + " species. Each shows the final stage and a strip of growth stages.</p>\n";
+  for (const auto& it : items) {
+    o += "<div class=\"item\" id=\"" + html(fs::path(it.source).stem().string()) + "\">\n<div class=\"meta\">\n<h2>" +
+         html(it.name) + "</h2>\n<p>" + html(it.description) + "</p>\n";
+    if (!it.error.empty()) {
+      o += "<p class=\"error\">" + html(it.error) + "</p>\n</div>\n</div>\n";
+      continue;
+    }
+    std::string stages;
+    for (size_t i = 0; i < it.stages.size(); ++i) stages += (i ? ", " : "") + std::to_string(it.stages[i]);
+    o += "<table class=\"figs\">\n<tr><td>source</td><td>" + html(it.source) + "</td></tr>\n<tr><td>kind</td><td>" +
+         html(it.kind) + "</td></tr>\n<tr><td>steps</td><td>" + std::to_string(it.steps) +
+         "</td></tr>\n<tr><td>modules</td><td>" + std::to_string(it.modules) + "</td></tr>\n<tr><td>internodes</td><td>" +
+         std::to_string(it.internodes) + "</td></tr>\n<tr><td>derive + turtle</td><td>" + fixed(it.deriveSeconds, 3) +
+         " s</td></tr>\n<tr><td>render</td><td>" + fixed(it.renderSeconds, 2) + " s</td></tr>\n<tr><td>stages</td><td>" +
+         stages + "</td></tr>\n</table>\n</div>\n";
+    o += "<div class=\"preview\"><a href=\"" + html(it.preview) + "\"><img src=\"" + html(it.preview) + "\" alt=\"" +
+         html(it.name) + "\"></a></div>\n";
+    o += "<div class=\"strip\"><a href=\"" + html(it.strip) + "\"><img src=\"" + html(it.strip) + "\" alt=\"" +
+         html(it.name) + " growth stages\"></a></div>\n</div>\n";
+  }
+  o += "</body>\n</html>\n";
+  return o;
+}
+
+}  // namespace sprig
