@@ -1,0 +1,110 @@
+#include "organisms/shell_paint.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace sprig::organisms {
+
+ShellPainter::ShellPainter(const ShellParams& params, const ShellModel& model, ShellTextureOptions options)
+    : options_(std::move(options)),
+      spiral_(params.spiral),
+      startDeg_(params.startDeg),
+      endDeg_(model.endDeg),
+      fullEndDeg_(params.whorls * params.whorlDeg),
+      varixSpacingDeg_(params.varices.spacingDeg),
+      varices_(params.varices.enabled),
+      spineLength_(params.varices.spineLength),
+      axialLength_(params.axialSpines.length),
+      shellFromWorld_(glm::inverse(model.worldFromShell)) {
+  if (options_.pigment)
+    pigment_ = std::make_shared<const textures::PigmentPattern>(textures::simulatePigment(options_.pigmentOptions));
+}
+
+HelicoCoords ShellPainter::helicoCoords(Vec3 q) const {
+  const DVec3 p(q);
+  const double phi = std::atan2(-p.z, p.x) * 180.0 / kPi;  // θ modulo 360
+  HelicoCoords best;
+  best.radial = std::numeric_limits<double>::max();
+  const double kLo = std::floor((startDeg_ - 360.0 - phi) / 360.0);
+  const double kHi = std::ceil((std::max(endDeg_, fullEndDeg_) + 360.0 - phi) / 360.0);
+  for (double k = kLo; k <= kHi; k += 1.0) {
+    const double th = phi + 360.0 * k;
+    const DVec3 c = spiral_.point(th);
+    const double d = spiral_.curveSize(th);
+    const DVec3 e = glm::normalize(DVec3(c.x, 0.0, c.z));
+    const double x = glm::dot(p - c, e) / d;
+    const double y = (p.y - c.y) / d;
+    const double r = std::hypot(x, y);
+    if (r < best.radial) {
+      best.radial = r;
+      best.thetaDeg = th;
+      best.aroundDeg = std::atan2(-y, x) * 180.0 / kPi;  // positive towards the apex (−y)
+    }
+  }
+  return best;
+}
+
+Vec3 ShellPainter::whorlColor(Vec3 shellPoint) const {
+  const HelicoCoords h = helicoCoords(shellPoint);
+  const ShellTextureOptions& o = options_;
+  Vec3 c = o.whorlColor;
+  // Spiral cords: bands that follow the spiral (constant angle around the curve).
+  if (o.cords > 0 && o.cordStrength > 0.0f) {
+    const double s = 0.5 + 0.5 * std::cos(radians(h.aroundDeg) * o.cords);
+    c = glm::mix(c, o.cordColor, static_cast<float>(o.cordStrength * std::pow(s, 3.0)));
+  }
+  // Growth lines across the whorl.
+  if (o.growthLineDeg > 0.0f && o.growthLineStrength > 0.0f) {
+    const double f = std::abs(std::remainder(h.thetaDeg, static_cast<double>(o.growthLineDeg))) / o.growthLineDeg;
+    c *= 1.0f - o.growthLineStrength * static_cast<float>(std::max(0.0, 1.0 - 6.0 * f));
+  }
+  // Reaction-diffusion pigment, one row per growth stage of the fully grown shell.
+  if (pigment_) {
+    const double v = (h.thetaDeg - startDeg_) / std::max(1.0, fullEndDeg_ - startDeg_);
+    const double u = h.aroundDeg / 360.0;
+    const float a = pigment_->sample(u, v);
+    c = glm::mix(c, o.pigmentColor, o.pigmentStrength * a);
+  }
+  // Pale bands where varices were laid down.
+  if (varices_ && varixSpacingDeg_ > 0.0) {
+    const double dv = std::abs(std::remainder(h.thetaDeg - startDeg_, varixSpacingDeg_));
+    if (h.thetaDeg > startDeg_ + 0.5 * varixSpacingDeg_ && dv < 4.0)
+      c = glm::mix(c, o.varixColor, static_cast<float>(0.6 * (1.0 - dv / 4.0)));
+  }
+  return c;
+}
+
+Vec3 ShellPainter::partColor(ShellPart part, Vec3 worldPoint, Vec2 uv) const {
+  const ShellTextureOptions& o = options_;
+  switch (part) {
+    case ShellPart::Whorl: return whorlColor(Vec3(shellFromWorld_ * glm::dvec4(DVec3(worldPoint), 1.0)));
+    case ShellPart::VarixSpine: {
+      // Cone natural v runs from the spine base; tips darken.
+      const float t = std::clamp(uv.y / std::max(1e-6f, spineLength_), 0.0f, 1.0f);
+      return glm::mix(o.varixColor, o.spineTipColor, t * t * t);
+    }
+    case ShellPart::AxialSpine: {
+      const float t = std::clamp(uv.y / std::max(1e-6f, axialLength_), 0.0f, 1.0f);
+      return glm::mix(o.axialColor, o.spineTipColor, t * t);
+    }
+    case ShellPart::Bump: return o.bumpColor;
+    case ShellPart::Inside: return o.insideColor;
+  }
+  return o.whorlColor;
+}
+
+Vec3 ShellPainter::color(Vec3 worldPoint, const blobtree::Attributes& a) const {
+  if (a.textureCount == 0) return options_.whorlColor;
+  Vec3 c(0.0f);
+  float w = 0.0f;
+  for (int i = 0; i < a.textureCount; ++i) {
+    const uint16_t id = a.textureIds[size_t(i)];
+    const ShellPart part = id <= static_cast<uint16_t>(ShellPart::Inside) ? static_cast<ShellPart>(id) : ShellPart::Whorl;
+    c += a.textureWeights[size_t(i)] * partColor(part, worldPoint, a.uv);
+    w += a.textureWeights[size_t(i)];
+  }
+  return w > 0.0f ? c / w : options_.whorlColor;
+}
+
+}  // namespace sprig::organisms

@@ -1,0 +1,256 @@
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstring>
+#include <optional>
+
+#include "blobtree/compiled.h"
+#include "organisms/shell.h"
+
+using namespace sprig;
+using namespace sprig::organisms;
+using blobtree::compile;
+using blobtree::CompiledBlob;
+
+namespace {
+
+Vec3 f3(const DVec3& v) { return Vec3(v); }
+
+/// A shell of point primitives only (Fig. 4-5).
+ShellParams pointShell(int whorls = 4) {
+  ShellParams p;
+  p.whorls = whorls;
+  return p;
+}
+
+/// Distance from `from` along unit `dir` to the last crossing of the iso surface in [0, maxT],
+/// found on a fine grid and refined by bisection. nullopt when the field is never above 0.5.
+std::optional<float> lastCrossing(const CompiledBlob& b, Vec3 from, Vec3 dir, float maxT, int steps = 4000) {
+  std::optional<float> last;
+  float prev = b.value(from);
+  for (int i = 1; i <= steps; ++i) {
+    const float t = maxT * i / steps;
+    const float v = b.value(from + t * dir);
+    if ((prev > 0.5f) != (v > 0.5f) && prev > 0.5f) {
+      float lo = maxT * (i - 1) / steps, hi = t;
+      for (int k = 0; k < 40; ++k) {
+        const float mid = 0.5f * (lo + hi);
+        (b.value(from + mid * dir) > 0.5f ? lo : hi) = mid;
+      }
+      last = 0.5f * (lo + hi);
+    }
+    prev = v;
+  }
+  return last;
+}
+
+}  // namespace
+
+TEST_CASE("buildShell::main body follows the spiral", "[organisms]") {
+  const ShellParams p = pointShell(4);
+  ShellModel m = buildShell(p);
+  const CompiledBlob body = compile(m.tree, m.mainBody);
+  REQUIRE(m.sections.size() == size_t(4 * 3));
+  CHECK(m.endDeg == Approx(4 * 348.0));
+  for (double th : {500.0, 700.0, 1000.0}) {
+    // The spiral point is inside; the surface lies D(θ) from it, in the generating plane,
+    // away from the axis (the calibrated sum of the row of points).
+    const DVec3 c = p.spiral.point(th);
+    CHECK(body.value(f3(c)) > 0.5f);
+    const DVec3 out = glm::normalize(DVec3(c.x, 0.0, c.z));
+    const double d = p.spiral.curveSize(th);
+    auto r = lastCrossing(body, f3(c), Vec3(out), static_cast<float>(2.0 * d));
+    REQUIRE(r);
+    CHECK(*r == Approx(d).epsilon(0.03));
+  }
+}
+
+TEST_CASE("buildShell::controlled blending keeps whorls apart", "[organisms]") {
+  ShellParams p = pointShell(5);
+  ShellModel controlled = buildShell(p);
+  p.controlledBlending = false;
+  ShellModel summed = buildShell(p);
+  const CompiledBlob bc = compile(controlled.tree, controlled.mainBody);
+  const CompiledBlob bs = compile(summed.tree, summed.mainBody);
+  for (double th : {400.0, 650.0, 900.0}) {
+    // Eq. 3: the generating circles one turn apart are tangent at the contact point.
+    const DVec3 c1 = p.spiral.point(th), c2 = p.spiral.point(th + 360.0);
+    const double d1 = p.spiral.curveSize(th), d2 = p.spiral.curveSize(th + 360.0);
+    REQUIRE(glm::length(c2 - c1) == Approx(d1 + d2).epsilon(1e-9));
+    const DVec3 u = glm::normalize(c2 - c1);
+    const Vec3 contact = f3(c1 + d1 * u);
+    // The whorls touch: just inside either circle the field is inside the surface.
+    CHECK(bc.value(f3(c1 + 0.9 * d1 * u)) > 0.5f);
+    CHECK(bc.value(f3(c2 - 0.9 * d2 * u)) > 0.5f);
+    // Controlled blending: no blend between whorls, the contact stays at the iso level
+    // (a crease) ...
+    const float vc = bc.value(contact);
+    CHECK(vc == Approx(0.5f).margin(0.1f));
+    // ... and beside the contact, along the common tangent plane, the crease is open
+    // (outside), while the plain sum of Fig. 5 (left) fills it with a blend.
+    const DVec3 side = glm::normalize(glm::cross(u, p.spiral.tangent(th)));
+    const Vec3 beside = contact + Vec3(0.5 * d1 * side);
+    CHECK(bc.value(beside) < 0.5f);
+    CHECK(bs.value(contact) > vc + 0.2f);
+    CHECK(bs.value(beside) > 0.5f);
+  }
+}
+
+TEST_CASE("buildShell::varices", "[organisms]") {
+  ShellParams p = murexCabritii();
+  p.bumps.enabled = false;
+  p.opening.enabled = false;
+  p.axialSpines.enabled = false;
+  SECTION("varices lie 116 degrees apart, three per 348-degree whorl, the last at the lip") {
+    p.varices.spinesByWhorl = {{{0.0f, 1.0f}}};
+    ShellModel m = buildShell(p);
+    REQUIRE(m.varixDeg.size() == 21);
+    for (size_t i = 1; i < m.varixDeg.size(); ++i) CHECK(m.varixDeg[i] - m.varixDeg[i - 1] == Approx(116.0).margin(1e-9));
+    CHECK(m.varixDeg.back() == Approx(m.endDeg).margin(1e-9));
+    // Spines point away from their generating centre in the generating plane of their angle.
+    for (const SpineRecord& s : m.spines) {
+      const DVec3 c = p.spiral.point(s.thetaDeg);
+      CHECK(std::atan2(-double(s.base.z), double(s.base.x)) ==
+            Approx(std::remainder(radians(s.thetaDeg), 2 * kPi)).margin(1e-4));
+      CHECK(glm::length(DVec3(s.tip) - c) > glm::length(DVec3(s.base) - c));
+    }
+  }
+  SECTION("Table 1 spine lengths measured on the model") {
+    // A round aperture, so no canal lies along the spines pointing down.
+    p.generating = GeneratingSurface::point();
+    ShellModel m = buildShell(p);
+    const CompiledBlob b = compile(m.tree, m.shellRoot);
+    // Spines in a ridge are summed with their neighbours (Eq. 12), which lengthens a short
+    // spine beside a long one by up to ~12%; on average the table's lengths hold to 5%.
+    int measured = 0;
+    double sumDev = 0.0;
+    for (const SpineRecord& s : m.spines) {
+      if (s.varix < 19) continue;  // the last whorl's three varices: 18 spines each
+      const Vec3 dir = glm::normalize(s.tip - s.base);
+      const float expect = s.lengthShell + s.tipRadius;
+      auto r = lastCrossing(b, s.base, dir, 2.0f * expect, 1500);
+      REQUIRE(r);
+      INFO("varix " << s.varix << " spine " << s.index << " size " << s.size);
+      CHECK(*r == Approx(expect).epsilon(0.15));
+      sumDev += std::abs(*r - expect) / expect;
+      ++measured;
+    }
+    CHECK(measured == 3 * 18);
+    CHECK(sumDev / measured < 0.05);
+    // The table's sizes are the spines' lengths relative to L·D(θ).
+    const auto table = murexTable1();
+    for (const SpineRecord& s : m.spines)
+      if (s.varix >= 19)
+        CHECK(s.lengthShell / (p.varices.spineLength * p.spiral.curveSize(s.thetaDeg)) ==
+              Approx(table[6][size_t(s.index)].size).epsilon(1e-5));
+  }
+}
+
+TEST_CASE("buildShell::axial spines follow Table 2", "[organisms]") {
+  ShellParams p = murexCabritii();
+  p.bumps.enabled = false;
+  p.opening.enabled = false;
+  p.varices.spinesByWhorl = {{}};
+  p.varices.tori = false;
+  ShellModel m = buildShell(p);
+  const CompiledBlob b = compile(m.tree, m.shellRoot);
+  const auto table = murexTable2();
+  std::vector<int> perRow(3, 0);
+  for (const SpineRecord& s : m.spines) {
+    REQUIRE(s.part == ShellPart::AxialSpine);
+    REQUIRE(s.varix >= 19);
+    const size_t row = size_t(s.varix - 19);
+    ++perRow[row];
+    CHECK(s.size == table[row][size_t(s.index)]);
+    // Bends keep the tip; the surface ends one tip radius past it.
+    const Vec3 dir = glm::normalize(s.tip - s.base);
+    const float expect = s.lengthShell + s.tipRadius;
+    auto r = lastCrossing(b, s.base, dir, 2.0f * expect, 1500);
+    REQUIRE(r);
+    INFO("row " << row << " spine " << s.index);
+    CHECK(*r == Approx(expect).epsilon(0.1));
+  }
+  CHECK(perRow == std::vector<int>{6, 6, 5});
+}
+
+TEST_CASE("buildShell::opening has walls of positive thickness", "[organisms]") {
+  ShellParams p = pointShell(4);
+  p.opening.enabled = true;
+  ShellModel m = buildShell(p);
+  const CompiledBlob b = compile(m.tree, m.shellRoot);
+  for (double back : {30.0, 120.0, 250.0}) {
+    const double th = m.endDeg - back;
+    const DVec3 c = p.spiral.point(th);
+    const double d = p.spiral.curveSize(th);
+    CHECK(b.value(f3(c)) < 0.5f);  // hollow inside
+    const DVec3 out = glm::normalize(DVec3(c.x, 0.0, c.z));
+    // Walk outwards: hollow, then the wall, then outside.
+    float inner = -1, outer = -1;
+    float prev = b.value(f3(c));
+    for (int i = 1; i <= 400; ++i) {
+      const float t = static_cast<float>(1.5 * d * i / 400);
+      const float v = b.value(f3(c + double(t) * out));
+      if (prev <= 0.5f && v > 0.5f && inner < 0) inner = t;
+      if (prev > 0.5f && v <= 0.5f) outer = t;
+      prev = v;
+    }
+    INFO("theta " << th);
+    REQUIRE(inner > 0);
+    REQUIRE(outer > inner);
+    CHECK((outer - inner) / d > 0.1);
+    CHECK((outer - inner) / d < 0.4);
+  }
+  // The previous whorl is intact under the opening (Eq. 14 subtracts it from the cutter).
+  const double th = m.endDeg - 360.0 - 60.0;
+  CHECK(b.value(f3(p.spiral.point(th))) > 0.5f);
+}
+
+TEST_CASE("buildShell::growth", "[organisms]") {
+  ShellParams p = pointShell(5);
+  p.varices.enabled = true;
+  p.varices.spinesByWhorl = {{{30.0f, 1.0f}}};
+  ShellModel full = buildShell(p);
+  p.ageDeg = 2.5 * 348.0;
+  ShellModel young = buildShell(p);
+  // The young shell ends with a varix at its growing edge ...
+  REQUIRE(!young.varixDeg.empty());
+  CHECK(young.varixDeg.back() == Approx(2.5 * 348.0));
+  CHECK(young.endDeg == Approx(2.5 * 348.0));
+  // ... and is the old shell stopped early: the first whorl is the same field.
+  const CompiledBlob bf = compile(full.tree, full.mainBody), by = compile(young.tree, young.mainBody);
+  for (double th = 10.0; th < 300.0; th += 17.0) {
+    const Vec3 q = f3(p.spiral.point(th)) + Vec3(0.01f, 0.02f, 0.0f);
+    CHECK(bf.value(q) == by.value(q));
+  }
+}
+
+TEST_CASE("buildShell::determinism and errors", "[organisms]") {
+  ShellParams p = murexCabritii();
+  p.ageDeg = 3 * 348.0;
+  ShellModel a = buildShell(p), b = buildShell(p);
+  REQUIRE(a.tree.size() == b.tree.size());
+  const CompiledBlob ca = compile(a.tree, a.root), cb = compile(b.tree, b.root);
+  const Box3 box = ca.bounds();
+  std::vector<Vec3> pts;
+  for (int i = 0; i < 12; ++i)
+    for (int j = 0; j < 12; ++j)
+      for (int k = 0; k < 12; ++k) pts.push_back(box.lo + box.size() * Vec3((i + 0.5f) / 12, (j + 0.5f) / 12, (k + 0.5f) / 12));
+  std::vector<float> va(pts.size()), vb(pts.size());
+  ca.values(pts, va);
+  cb.values(pts, vb);
+  CHECK(std::memcmp(va.data(), vb.data(), va.size() * sizeof(float)) == 0);
+  // Another seed draws other bump sizes and spine bends: the same nodes, other transforms.
+  p.seed = 2;
+  ShellModel c = buildShell(p);
+  int differing = 0;
+  for (blobtree::NodeId i = 0; i < std::min(a.tree.size(), c.tree.size()); ++i)
+    differing += a.tree.node(i).worldFromLocal != c.tree.node(i).worldFromLocal;
+  CHECK(differing > int(a.bumpCount) / 2);
+
+  ShellParams bad;
+  bad.spiral.lambda = 1.0;
+  CHECK_THROWS_AS(buildShell(bad), InputError);
+  bad = ShellParams{};
+  bad.generating.primitives.clear();
+  CHECK_THROWS_AS(buildShell(bad), InputError);
+}
