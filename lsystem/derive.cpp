@@ -31,11 +31,12 @@ std::string numberText(double v) {
 /// never past the module limit.
 class Writer {
  public:
-  Writer(ModuleString& s, bool births, size_t maxModules, const std::string& file, int step)
+  /// Starts writing s from empty, with room for at least modules and params.
+  Writer(ModuleString& s, bool births, size_t maxModules, const std::string& file, int step, size_t modules, size_t params)
       : s_(s), births_(births), maxModules_(maxModules), file_(file), step_(step) {
-    s_.symbols.resize(std::max(s_.symbols.capacity(), size_t(16)));
+    s_.symbols.resize(std::max({s_.symbols.capacity(), modules, size_t(16)}));
     s_.offsets.resize(s_.symbols.size() + 1);
-    s_.params.resize(std::max(s_.params.capacity(), size_t(16)));
+    s_.params.resize(std::max({s_.params.capacity(), params, size_t(16)}));
     if (births_) s_.birthSteps.resize(s_.symbols.size());
     else s_.birthSteps.clear();
     refresh();
@@ -44,8 +45,9 @@ class Writer {
 
   /// Makes room for m more modules and p more parameters.
   void reserve(size_t m, size_t p) {
-    if (n_ + m > capM_) growModules(n_ + m);
-    if (np_ + p > capP_) growParams(np_ + p);
+    if (n_ + m > capM_) [[unlikely]] growModules(n_ + m);
+    if (np_ + p > capP_) [[unlikely]]
+      growParams(np_ + p);
   }
 
   /// Appends a module whose parameters the caller writes next with param().
@@ -74,9 +76,9 @@ class Writer {
     if (births_) s_.birthSteps.resize(n_);
   }
 
-  [[noreturn]] void overLimit() const {
-    throw InputError(SourceLoc{file_, 0, 0},
-                     "derivation would exceed " + std::to_string(maxModules_) + " modules at step " + std::to_string(step_));
+  [[noreturn]] static void overLimit(size_t maxModules, const std::string& file, int step) {
+    throw InputError(SourceLoc{file, 0, 0},
+                     "derivation would exceed " + std::to_string(maxModules) + " modules at step " + std::to_string(step));
   }
 
  private:
@@ -90,7 +92,7 @@ class Writer {
   }
 
   void growModules(size_t need) {
-    if (need > maxModules_) overLimit();
+    if (need > maxModules_) overLimit(maxModules_, file_, step_);
     size_t cap = std::min(maxModules_, std::max(need, capM_ * 2));
     s_.symbols.resize(cap);
     s_.offsets.resize(cap + 1);
@@ -145,10 +147,13 @@ struct Deriver::Impl {
 
   // ---- matching -------------------------------------------------------------------------
 
+  std::vector<int32_t> bracketStack;
+
   void computeBrackets(const ModuleString& s) {
     size_t n = s.size();
     match.assign(n, -1);
-    std::vector<int32_t> stack;
+    std::vector<int32_t>& stack = bracketStack;
+    stack.clear();
     for (size_t i = 0; i < n; ++i) {
       SymbolId c = s.symbols[i];
       if (c == prog->openBracket) {
@@ -167,10 +172,54 @@ struct Deriver::Impl {
     for (uint16_t k = 0; k < count; ++k) vars[firstVar + k] = p[k];
   }
 
+  // The first context neighbour on each side of the current module, computed once per
+  // module and shared by every production tried there.
+  bool leftCached = false, rightCached = false;
+  ptrdiff_t leftNeighbour = -1;
+  size_t rightNeighbour = 0;
+
+  /// Position of the first module a symbol pattern item compares with, walking right
+  /// from j; n when the walk fails (end of string or a `]`).
+  size_t walkRight(const ModuleString& s, size_t j) const {
+    const size_t n = s.size();
+    for (;;) {
+      if (j >= n) return n;
+      SymbolId c = s.symbols[j];
+      if (c == prog->openBracket) j = static_cast<size_t>(match[j]) + 1;
+      else if (c == prog->closeBracket) return n;
+      else if (prog->ignored[c]) ++j;
+      else return j;
+    }
+  }
+
+  /// Position of the first module a left pattern item compares with, walking left from j; -1 on failure.
+  ptrdiff_t walkLeft(const ModuleString& s, ptrdiff_t j) const {
+    for (;;) {
+      if (j < 0) return -1;
+      SymbolId c = s.symbols[j];
+      if (c == prog->closeBracket) {
+        if (match[j] < 0) return -1;
+        j = match[j] - 1;
+      } else if (c == prog->openBracket || prog->ignored[c]) {
+        --j;
+      } else {
+        return j;
+      }
+    }
+  }
+
   /// lpfg right context: skips ignored symbols and whole [...] branches; fails at `]`.
-  bool matchRight(const ModuleString& s, size_t i, const std::vector<PatternItem>& pat, double* vars) const {
+  bool matchRight(const ModuleString& s, size_t i, const std::vector<PatternItem>& pat, double* vars) {
     const size_t n = s.size();
     size_t j = i + 1;
+    if (!pat[0].openBracket && !pat[0].closeBracket) {  // shared first step
+      if (!rightCached) {
+        rightNeighbour = walkRight(s, i + 1);
+        rightCached = true;
+      }
+      j = rightNeighbour;
+      if (j >= n) return false;
+    }
     for (const PatternItem& it : pat) {
       if (it.closeBracket) {  // skip the rest of the current branch, consume its `]`
         while (j < n && s.symbols[j] != prog->closeBracket) {
@@ -196,6 +245,7 @@ struct Deriver::Impl {
         }
       }
       if (it.openBracket) {
+        if (s.symbols[j] != prog->openBracket) return false;
         ++j;
         continue;
       }
@@ -207,21 +257,19 @@ struct Deriver::Impl {
   }
 
   /// lpfg left context: skips ignored symbols, `[`, and whole branches that end in `]`.
-  bool matchLeft(const ModuleString& s, size_t i, const std::vector<PatternItem>& pat, double* vars) const {
+  bool matchLeft(const ModuleString& s, size_t i, const std::vector<PatternItem>& pat, double* vars) {
     ptrdiff_t j = static_cast<ptrdiff_t>(i) - 1;
     for (auto it = pat.rbegin(); it != pat.rend(); ++it) {
-      for (;;) {
-        if (j < 0) return false;
-        SymbolId c = s.symbols[j];
-        if (c == prog->closeBracket) {
-          if (match[j] < 0) return false;
-          j = match[j] - 1;
-        } else if (c == prog->openBracket || prog->ignored[c]) {
-          --j;
-        } else {
-          break;
+      if (it == pat.rbegin()) {
+        if (!leftCached) {
+          leftNeighbour = walkLeft(s, j);
+          leftCached = true;
         }
+        j = leftNeighbour;
+      } else {
+        j = walkLeft(s, j);
       }
+      if (j < 0) return false;
       if (s.symbols[j] != it->symbol || s.paramCount(j) != it->paramCount) return false;
       bind(s, static_cast<size_t>(j), it->firstVar, it->paramCount, vars);
       --j;
@@ -230,9 +278,30 @@ struct Deriver::Impl {
   }
 
   /// Binds p's formal parameters at module i when the predecessor and contexts match.
-  bool matches(const Production& p, const ModuleString& s, size_t i, double* vars) const {
+  bool matches(const Production& p, const ModuleString& s, size_t i, double* vars) {
     if (s.paramCount(i) != p.predParams) return false;
     bind(s, i, p.predFirstVar, p.predParams, vars);
+    if (p.simpleCtx) {
+      if (!p.left.empty()) {
+        const PatternItem& it = p.left[0];
+        if (!leftCached) {
+          leftNeighbour = walkLeft(s, static_cast<ptrdiff_t>(i) - 1);
+          leftCached = true;
+        }
+        if (leftNeighbour < 0 || s.symbols[leftNeighbour] != it.symbol || s.paramCount(leftNeighbour) != it.paramCount) return false;
+        bind(s, static_cast<size_t>(leftNeighbour), it.firstVar, it.paramCount, vars);
+      }
+      if (!p.right.empty()) {
+        const PatternItem& it = p.right[0];
+        if (!rightCached) {
+          rightNeighbour = walkRight(s, i + 1);
+          rightCached = true;
+        }
+        if (rightNeighbour >= s.size() || s.symbols[rightNeighbour] != it.symbol || s.paramCount(rightNeighbour) != it.paramCount) return false;
+        bind(s, rightNeighbour, it.firstVar, it.paramCount, vars);
+      }
+      return true;
+    }
     if (!p.left.empty() && !matchLeft(s, i, p.left, vars)) return false;
     if (!p.right.empty() && !matchRight(s, i, p.right, vars)) return false;
     return true;
@@ -313,15 +382,28 @@ struct Deriver::Impl {
     return v;
   }
 
+  /// Writes p's successor without decomposition.
+  [[gnu::always_inline]] inline void emitPlain(Writer& w, const Production& p, const double* vars, int32_t birth, int step) {
+    w.reserve(p.successor.size(), p.args.size());
+    const Arg* args = p.args.data();
+    for (const SuccModule& m : p.successor) {
+      w.begin(m.symbol, birth);
+      for (int k = 0; k < m.argCount; ++k) {
+        const Arg& a = args[m.firstArg + k];
+        switch (a.kind) {
+          case ArgKind::Const: w.param(a.c); break;
+          case ArgKind::Var: w.param(vars[a.var]); break;
+          default: w.param(evalArg(p, m, k, vars, step));
+        }
+      }
+      w.end();
+    }
+  }
+
   /// Writes p's successor (decomposing it when the grammar has decomposition rules).
   void emit(Writer& w, const Production& p, const double* vars, int32_t birth, int step, int depth) {
     if (prog->decomposition.empty()) {
-      w.reserve(p.successor.size(), p.args.size());
-      for (const SuccModule& m : p.successor) {
-        w.begin(m.symbol, birth);
-        for (int k = 0; k < m.argCount; ++k) w.param(evalArg(p, m, k, vars, step));
-        w.end();
-      }
+      emitPlain(w, p, vars, birth, step);
       return;
     }
     if (scratch.size() <= static_cast<size_t>(depth)) scratch.resize(depth + 1);
@@ -366,20 +448,69 @@ struct Deriver::Impl {
     const ModuleString& in = cur;
     const size_t n = in.size();
     const bool births = opt.trackBirthSteps;
-    Writer w(next, births, opt.maxModules, prog->fileName, step);
-    if (rs.anyContext) computeBrackets(in);
-    double vars[detail::kMaxVars];
-    const bool decompose = !prog->decomposition.empty();
+    const bool decompose = !prog->decomposition.empty() && productionStep;
     const SymbolId* syms = in.symbols.data();
     const uint32_t* offs = in.offsets.data();
     const double* pars = in.params.data();
+    const detail::SymbolRules* rules = rs.rules.data();
+    // Size pass: an upper bound on the output (exact when every rule is `simple`), so the
+    // buffers are allocated once and a limit overrun is caught before allocating.
+    size_t reserveModules = 0, reserveParams = 0;
+    if (!decompose) {
+      size_t boundM = 0, boundP = 0;
+      bool exact = true;
+      for (size_t i = 0; i < n; ++i) {
+        const detail::SymbolRules& r = rules[syms[i]];
+        uint32_t count = offs[i + 1] - offs[i];
+        boundM += r.maxModules;
+        boundP += std::max(r.maxParams, count);
+        exact &= r.simple != nullptr || r.count == 0;
+      }
+      if (boundM > opt.maxModules && exact) Writer::overLimit(opt.maxModules, prog->fileName, step);
+      reserveModules = std::min(boundM, opt.maxModules);
+      reserveParams = boundP;
+    }
+    Writer w(next, births, opt.maxModules, prog->fileName, step, reserveModules, reserveParams);
+    if (rs.anyContext) computeBrackets(in);
+    double vars[detail::kMaxVars];
     rngStream = stream;
     for (size_t i = 0; i < n; ++i) {
       SymbolId sym = syms[i];
       int32_t birth = births ? in.birthSteps[i] : 0;
+      const detail::SymbolRules& r = rules[sym];
+      if (r.simple && !decompose) {
+        const Production& p = *r.simple;
+        uint32_t count = offs[i + 1] - offs[i];
+        if (count == p.predParams) {
+          const double* q = pars + offs[i];
+          for (uint32_t k = 0; k < count; ++k) vars[p.predFirstVar + k] = q[k];
+          if (p.usesRandom) {
+            rngReady = false;
+            rngItem = i;
+          }
+          emitPlain(w, p, vars, productionStep ? step : birth, step);
+          continue;
+        }
+      }
+      if (r.dispatch >= 0 && !decompose && offs[i + 1] == offs[i]) {
+        const detail::ContextDispatch& d = rs.dispatches[r.dispatch];
+        ptrdiff_t ln = walkLeft(in, static_cast<ptrdiff_t>(i) - 1);
+        size_t rn = walkRight(in, i + 1);
+        uint32_t li = ln >= 0 && in.paramCount(static_cast<size_t>(ln)) == 0 ? d.index[syms[ln]] : 0;
+        uint32_t ri = rn < n && in.paramCount(rn) == 0 ? d.index[syms[rn]] : 0;
+        int32_t idx = d.table[li * d.width + ri];
+        if (idx < 0) {
+          w.reserve(1, 0);
+          w.copy(sym, nullptr, 0, birth);
+        } else {
+          emitPlain(w, rs.productions[static_cast<size_t>(idx)], vars, productionStep ? step : birth, step);
+        }
+        continue;
+      }
       rngReady = false;
       rngItem = i;
-      const Production* p = rs.bySymbol[sym].empty() ? nullptr : choose(rs, in, i, vars, step);
+      leftCached = rightCached = false;
+      const Production* p = r.count == 0 ? nullptr : choose(rs, in, i, vars, step);
       if (!p) {
         if (decompose && productionStep) {
           emitDecomposed(w, sym, pars + offs[i], offs[i + 1] - offs[i], birth, step, 0);
@@ -461,6 +592,11 @@ Deriver::Deriver(const Grammar& grammar, DeriveOptions options) : impl_(std::mak
 Deriver::~Deriver() = default;
 Deriver::Deriver(Deriver&&) noexcept = default;
 Deriver& Deriver::operator=(Deriver&&) noexcept = default;
+
+void Deriver::restart() {
+  impl_->done = 0;
+  impl_->start();
+}
 
 const ModuleString& Deriver::step() {
   Impl& m = *impl_;

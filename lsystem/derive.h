@@ -48,6 +48,8 @@ class Deriver {
   Deriver(Deriver&&) noexcept;
   Deriver& operator=(Deriver&&) noexcept;
 
+  /// Starts again from the axiom, keeping the buffers' memory (derive again, cheaply).
+  void restart();
   /// Performs one derivation step (even past steps()); returns the new string.
   const ModuleString& step();
   /// Performs the remaining steps up to steps() and returns the final string.

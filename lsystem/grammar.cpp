@@ -1080,6 +1080,7 @@ class Parser {
         rs->bySymbol[rs->productions[i].predecessor].push_back(i);
         rs->anyContext |= rs->productions[i].hasContext();
       }
+      rs->finalize();
     }
   }
 

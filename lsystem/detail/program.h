@@ -8,6 +8,7 @@
 /// production (left context, predecessor, right context, in textual order) live in one
 /// register file `vars` of at most kMaxVars doubles.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <string>
@@ -134,7 +135,32 @@ struct Production {
   bool stochastic = false;
   double weight = 1;
   bool usesRandom = false;  ///< condition or successor calls ran/nran
+  bool simpleCtx = false;   ///< simpleContext(), cached by RuleSet::finalize()
   bool hasContext() const { return !left.empty() || !right.empty(); }
+  /// Contexts of at most one symbol on each side (no brackets): matched against the
+  /// cached neighbours directly.
+  bool simpleContext() const {
+    auto plain = [](const std::vector<PatternItem>& v) { return v.size() <= 1 && (v.empty() || (!v[0].openBracket && !v[0].closeBracket)); };
+    return plain(left) && plain(right);
+  }
+};
+
+/// Per predecessor symbol: its productions and what the size pass may assume.
+struct SymbolRules {
+  const Production* simple = nullptr;  ///< the only production, context-free, unconditional, deterministic
+  uint32_t maxModules = 1;             ///< most modules any of its successors (or a copy) writes
+  uint32_t maxParams = 0;              ///< most parameters any of its successors writes
+  uint32_t count = 0;                  ///< number of productions with this predecessor
+  int32_t dispatch = -1;               ///< index into RuleSet::dispatches, or -1
+};
+
+/// Context dispatch for a predecessor whose productions are all parameterless, unconditional,
+/// deterministic and have at most one symbol of context per side (ABOP 1.31-style signal
+/// grammars): the production is looked up from the two neighbours' symbols in one step.
+struct ContextDispatch {
+  std::vector<uint16_t> index;    ///< per symbol: 1 + its rank among context symbols, 0 if unused
+  uint32_t width = 1;             ///< context symbols + 1
+  std::vector<int32_t> table;     ///< [leftIndex * width + rightIndex] -> production, -1 none
 };
 
 /// A block of productions with a lookup table by predecessor symbol.
@@ -142,6 +168,61 @@ struct RuleSet {
   std::vector<Production> productions;
   /// bySymbol[s] lists indices into productions whose predecessor is s, in file order.
   std::vector<std::vector<uint32_t>> bySymbol;
+  std::vector<SymbolRules> rules;  ///< per symbol (filled by finalize())
+  std::vector<ContextDispatch> dispatches;
+  /// Fills rules from productions and bySymbol.
+  void finalize() {
+    for (Production& p : productions) p.simpleCtx = p.simpleContext();
+    rules.assign(bySymbol.size(), {});
+    dispatches.clear();
+    for (size_t s = 0; s < bySymbol.size(); ++s) {
+      SymbolRules& r = rules[s];
+      r.count = static_cast<uint32_t>(bySymbol[s].size());
+      for (uint32_t idx : bySymbol[s]) {
+        const Production& p = productions[idx];
+        r.maxModules = std::max<uint32_t>(r.maxModules, static_cast<uint32_t>(p.successor.size()));
+        r.maxParams = std::max<uint32_t>(r.maxParams, static_cast<uint32_t>(p.args.size()));
+      }
+      if (bySymbol[s].size() == 1) {
+        const Production& p = productions[bySymbol[s][0]];
+        if (!p.hasContext() && p.condition.empty() && !p.stochastic) r.simple = &p;
+      }
+      if (!r.simple && r.count) buildDispatch(s, r);
+    }
+  }
+  void buildDispatch(size_t s, SymbolRules& r) {
+    ContextDispatch d;
+    d.index.assign(bySymbol.size(), 0);
+    std::vector<SymbolId> used;
+    for (uint32_t idx : bySymbol[s]) {
+      const Production& p = productions[idx];
+      if (!p.simpleCtx || !p.condition.empty() || p.stochastic || p.predParams) return;
+      for (const auto* side : {&p.left, &p.right})
+        for (const PatternItem& it : *side) {
+          if (it.paramCount) return;
+          if (!d.index[it.symbol]) {
+            used.push_back(it.symbol);
+            d.index[it.symbol] = static_cast<uint16_t>(used.size());
+          }
+        }
+    }
+    d.width = static_cast<uint32_t>(used.size()) + 1;
+    d.table.assign(static_cast<size_t>(d.width) * d.width, -1);
+    for (uint32_t li = 0; li < d.width; ++li)
+      for (uint32_t ri = 0; ri < d.width; ++ri)
+        for (uint32_t idx : bySymbol[s]) {
+          const Production& p = productions[idx];
+          bool leftOk = p.left.empty() || (li && d.index[p.left[0].symbol] == li);
+          bool rightOk = p.right.empty() || (ri && d.index[p.right[0].symbol] == ri);
+          if (leftOk && rightOk) {
+            d.table[li * d.width + ri] = static_cast<int32_t>(idx);
+            break;
+          }
+        }
+    r.dispatch = static_cast<int32_t>(dispatches.size());
+    dispatches.push_back(std::move(d));
+  }
+
   int maxDepth = 1;  ///< decomposition / interpretation recursion depth
   bool anyContext = false;
   bool empty() const { return productions.empty(); }
