@@ -1,5 +1,7 @@
 #include "app/species_tree.h"
 
+#include "textures/procedural.h"
+
 namespace sprig {
 
 namespace {
@@ -105,6 +107,39 @@ TreeOptions parseTreeOptions(std::string text, const std::string& displayPath) {
   if (file) o = readTreeOptions(file->rootNode(), diags);
   diags.throwIfErrors();
   return o;
+}
+
+TreeModel buildTreeModel(const Species& species, const lsystem::Skeleton& skeleton) {
+  TreeModel m;
+  if (species.treeSection) {
+    DiagnosticList diags;
+    m.options = readTreeOptions(*species.treeSection, diags);
+    diags.throwIfErrors();
+  }
+  m.blob = organisms::buildTreeBlob(skeleton, m.options);
+  m.compiled = blobtree::compile(m.blob.tree, m.blob.root);
+  m.leaves = organisms::buildLeafMesh(skeleton, m.options);
+  return m;
+}
+
+uint32_t addTreeToScene(render::Scene& scene, const TreeModel& model, const SpeciesRender& look,
+                        const render::ImplicitOptions& implicit) {
+  if (model.options.bark.enabled) {
+    textures::BarkOptions bo;
+    bo.seed = model.options.seed;
+    bo.ridgeColor = look.style.wood.baseColor;
+    bo.furrowColor = look.style.wood.baseColor * 0.3f;
+    auto bark = std::make_shared<textures::BarkTexture>(bo);
+    scene.addTexture([bark](Vec2 uv, const Vec3&) { return bark->color(uv); });
+  }
+  const uint32_t wood = scene.addMaterial(look.style.wood);
+  const uint32_t id = scene.addImplicit(model.compiled, wood, implicit);
+  if (model.leaves.triangleCount() > 0) {
+    Mesh leaves = model.leaves;
+    leaves.materials.clear();  // one leaf material; the vertex colors carry each leaf's tint
+    scene.addMesh(leaves, scene.addMaterial(look.style.leaf));
+  }
+  return id;
 }
 
 }  // namespace sprig

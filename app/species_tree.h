@@ -17,9 +17,14 @@
 ///     leaves: {enabled: true, scale: 1}
 /// ```
 
+#include "app/species.h"
 #include "app/yaml_reader.h"
+#include "blobtree/compiled.h"
 #include "core/diagnostics.h"
+#include "core/mesh.h"
+#include "organisms/tree_builder.h"
 #include "organisms/tree_options.h"
+#include "render/scene.h"
 
 namespace sprig {
 
@@ -31,5 +36,26 @@ organisms::TreeOptions readTreeOptions(const YNode& section, DiagnosticList& dia
 /// Parses text holding one `tree:` map (the section itself, not the whole species file)
 /// as if it were the file displayPath. Throws InputError with every diagnostic (tests).
 organisms::TreeOptions parseTreeOptions(std::string text, const std::string& displayPath);
+
+/// A tree species built into geometry: the BlobTree (and its compiled form) for the wood,
+/// a Mesh for the leaves.
+struct TreeModel {
+  organisms::TreeOptions options;
+  organisms::TreeBlob blob;
+  blobtree::CompiledBlob compiled;
+  Mesh leaves;
+};
+
+/// Reads species.treeSection (defaults when absent) and builds the tree of `skeleton`.
+/// Throws InputError for a bad `tree:` section or an empty skeleton.
+TreeModel buildTreeModel(const Species& species, const lsystem::Skeleton& skeleton);
+
+/// Adds a tree to a scene for an exact render: registers the bark texture
+/// (textures::BarkTexture, id options.bark.texture must be the scene's next texture id,
+/// which holds for a fresh scene and the default id 0), a wood material with look.style.wood,
+/// the wood as implicit geometry and the leaves as a mesh with look.style.leaf (vertex
+/// colors win when present). Returns the wood's geometry id.
+uint32_t addTreeToScene(render::Scene& scene, const TreeModel& model, const SpeciesRender& look,
+                        const render::ImplicitOptions& implicit = {});
 
 }  // namespace sprig

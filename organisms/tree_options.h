@@ -59,7 +59,7 @@ struct BendOptions {
 /// Bark texture mapping (§3.7).
 struct BarkOptions {
   bool enabled = true;
-  int texture = 1;               ///< texture id given to every internode primitive
+  int texture = 0;               ///< texture id of every internode primitive (0: a fresh scene's first texture)
   double uScale = 1.0;           ///< texture u per full turn around the branch
   double vScale = 1.0;           ///< texture v per world unit along the axis (continuous from the root)
 };
