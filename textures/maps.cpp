@@ -11,8 +11,9 @@ std::vector<MapSpec> shippedMaps() {
   bark.alongFrequency = 2.0;
   bark.sharpness = 2.2;
   bark.seed = 1;
+  bark.tileV = 1;  // the map tiles in v too
   maps.push_back({"bark.png", 512, BarkTexture(bark),
-                  "ridged bark, 8 furrows around (u, periodic), plates along v"});
+                  "ridged bark, 8 furrows around; tiles in u and v"});
 
   StripesOptions stripes;
   stripes.frequency = 9;

@@ -33,13 +33,23 @@ class PerlinNoise {
   /// 2D slice at z = 0.
   double operator()(double x, double y) const { return (*this)(DVec3(x, y, 0)); }
 
+  /// Noise that repeats with an integer period on each axis (a period in [1, 256]; 0 keeps
+  /// the lattice's own 256): lattice corners are wrapped modulo the period (tileable noise).
+  /// Equals operator() when every period is 0.
+  double periodic(const DVec3& p, const glm::ivec3& period) const;
+
   /// Fractal Brownian motion: sum_k gain^k noise(lacunarity^k p), divided by sum_k gain^k
   /// so the result stays in [-1, 1].
   double fbm(const DVec3& p, const FractalOptions& options = {}) const;
+  /// fBm whose octave k uses periodic() with period * lacunarity^k (rounded): the sum
+  /// repeats with `period` when lacunarity is an integer.
+  double fbm(const DVec3& p, const FractalOptions& options, const glm::ivec3& period) const;
   /// Turbulence: the same sum of |noise|, normalized to [0, 1].
   double turbulence(const DVec3& p, const FractalOptions& options = {}) const;
 
  private:
+  double eval(const DVec3& p, const glm::ivec3& period) const;
+
   std::array<uint8_t, 512> perm_;  ///< the permutation, twice, so hashes need no wrap
 };
 

@@ -31,17 +31,28 @@ Vec3 NoiseTexture::color(const DVec3& p) const {
   return mix(o.colorA, o.colorB, std::clamp(t, 0.0, 1.0));
 }
 
+namespace {
+
+/// A frequency along v rounded to whole cycles per tile (unchanged when tile <= 0).
+double tiled(double freq, int tile) { return tile > 0 ? std::max(1.0, std::round(freq * tile)) / tile : freq; }
+/// The lattice period along an axis sampled at freq * v, for a tile (0 = none).
+int period(double freq, int tile) { return tile > 0 ? static_cast<int>(std::lround(freq * tile)) : 0; }
+
+}  // namespace
+
 double BarkTexture::height(Vec2 uv) const {
   const BarkOptions& o = options_;
   const int furrows = std::max(1, o.furrows);
+  const double v = uv.y;
   // A point on a cylinder of circumference `furrows`: periodic in u, one unit per ridge.
   double a = 2 * kPi * static_cast<double>(uv.x);
   double r = furrows / (2 * kPi);
-  DVec3 p(r * std::cos(a), r * std::sin(a), o.alongFrequency * static_cast<double>(uv.y));
+  double along = tiled(o.alongFrequency, o.tileV);
+  DVec3 p(r * std::cos(a), r * std::sin(a), along * v);
   FractalOptions f;
   f.octaves = 4;
-  double ridge = static_cast<double>(uv.x) * furrows + o.warp * noise_.fbm(p, f);
-  double h = 1 - std::abs(2 * fract(ridge) - 1);      // 1 on a ridge, 0 in a furrow
+  double ridge = static_cast<double>(uv.x) * furrows + o.warp * noise_.fbm(p, f, glm::ivec3(0, 0, period(along, o.tileV)));
+  double h = 1 - std::abs(2 * fract(ridge) - 1);           // 1 on a ridge, 0 in a furrow
   h = 1 - std::pow(1 - h, std::max(1e-3, o.sharpness));  // sharpness > 1 narrows the furrows
   if (o.cracks > 0) {
     // Cross cracks split each ridge into plates. The plate coordinate q depends on the
@@ -50,9 +61,10 @@ double BarkTexture::height(Vec2 uv) const {
     double index = std::fmod(std::floor(ridge), static_cast<double>(furrows));
     if (index < 0) index += furrows;
     double phase = Rng(deriveSeed(o.seed, {0xba4cu, static_cast<uint64_t>(index)})).uniform();
-    double plates = 1.5 * o.alongFrequency;
-    double q = static_cast<double>(uv.y) * plates + phase +
-               0.35 * noise_(DVec3(index * 7.31 + 0.5, static_cast<double>(uv.y) * plates * 0.6, 3.7));
+    double plates = tiled(1.5 * o.alongFrequency, o.tileV);
+    double wave = tiled(0.9 * o.alongFrequency, o.tileV);
+    double q = v * plates + phase +
+               0.35 * noise_.periodic(DVec3(index * 7.31 + 0.5, v * wave, 3.7), glm::ivec3(0, period(wave, o.tileV), 0));
     double d = std::abs(q - std::round(q));  // distance to the nearest crack, in plate lengths
     h *= 1 - o.cracks * (1 - smoothstep(0.01, 0.035, d));
   }
@@ -66,10 +78,11 @@ Vec3 BarkTexture::color(Vec2 uv) const {
   double a = 2 * kPi * static_cast<double>(uv.x);
   double r = 4 * furrows / (2 * kPi);
   // Fine lengthwise grain: four times finer across than the ridges, stretched along v.
-  DVec3 p(r * std::cos(a) + 17.3, r * std::sin(a), 0.5 * o.alongFrequency * static_cast<double>(uv.y));
+  double along = tiled(0.5 * o.alongFrequency, o.tileV);
+  DVec3 p(r * std::cos(a) + 17.3, r * std::sin(a), along * static_cast<double>(uv.y));
   FractalOptions f;
   f.octaves = 3;
-  double grain = 1 + o.grain * noise_.fbm(p, f);
+  double grain = 1 + o.grain * noise_.fbm(p, f, glm::ivec3(0, 0, period(along, o.tileV)));
   return mix(o.furrowColor, o.ridgeColor, h) * static_cast<float>(std::max(0.0, grain));
 }
 

@@ -65,6 +65,9 @@ struct BarkOptions {
   double sharpness = 1.8;              ///< ridge profile exponent (> 1: narrow dark furrows)
   double grain = 0.25;                 ///< strength of the fine grain
   double cracks = 0.8;                 ///< depth of the cross cracks that split ridges into plates (0 = none)
+  /// > 0: the pattern also repeats every tileV units of v (for tileable image maps); each
+  /// frequency along v is then rounded to a whole number of cycles per tile. 0: no tiling.
+  int tileV = 0;
   Vec3 ridgeColor{0.20f, 0.14f, 0.09f};
   Vec3 furrowColor{0.035f, 0.025f, 0.018f};
   uint64_t seed = 0;

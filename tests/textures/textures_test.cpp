@@ -89,6 +89,19 @@ TEST_CASE("PerlinNoise", "[textures]") {
   }
 }
 
+TEST_CASE("PerlinNoise::periodic", "[textures]") {
+  PerlinNoise n(11);
+  Rng rng(5);
+  for (int i = 0; i < 2000; ++i) {
+    DVec3 p(rng.uniform(-30, 30), rng.uniform(-30, 30), rng.uniform(-30, 30));
+    INFO("seed 5, sample " << i);
+    REQUIRE(n.periodic(p, glm::ivec3(0)) == n(p));
+    REQUIRE(std::abs(n.periodic(p + DVec3(5, 0, 3), glm::ivec3(5, 0, 3)) - n.periodic(p, glm::ivec3(5, 0, 3))) < 1e-9);
+    FractalOptions f;
+    REQUIRE(std::abs(n.fbm(p + DVec3(0, 7, 0), f, glm::ivec3(0, 7, 0)) - n.fbm(p, f, glm::ivec3(0, 7, 0))) < 1e-9);
+  }
+}
+
 TEST_CASE("BarkTexture", "[textures]") {
   BarkOptions o;
   o.seed = 4;
@@ -100,6 +113,17 @@ TEST_CASE("BarkTexture", "[textures]") {
       INFO("u " << uv.x << " v " << uv.y);
       REQUIRE(std::abs(bark.height(uv) - bark.height(uv + Vec2(1, 0))) < 1e-4);
       REQUIRE(maxDiff(bark.color(uv), bark.color(uv + Vec2(-1, 0))) < 1e-4);
+    }
+  }
+  SECTION("with tileV = 1 it also repeats in v") {
+    o.tileV = 1;
+    BarkTexture tile(o);
+    Rng rng(6);
+    for (int i = 0; i < 2000; ++i) {
+      Vec2 uv(static_cast<float>(rng.uniform()), static_cast<float>(rng.uniform()));
+      INFO("u " << uv.x << " v " << uv.y);
+      REQUIRE(std::abs(tile.height(uv) - tile.height(uv + Vec2(0, 1))) < 1e-4);
+      REQUIRE(maxDiff(tile.color(uv), tile.color(uv + Vec2(0, -1))) < 1e-4);
     }
   }
   SECTION("without warp there are exactly `furrows` ridges and furrows around") {
