@@ -1,0 +1,487 @@
+#include "app/species_blob.h"
+
+#include <cmath>
+#include <functional>
+#include <map>
+#include <utility>
+
+namespace sprig {
+
+namespace {
+
+using blobtree::BlobTree;
+using blobtree::NodeId;
+
+constexpr int kMaxDepth = 200;
+
+const std::vector<std::string> kKinds = {
+    "point",  "segment",   "cone",      "torus",    "halfspace", "box",       "spiral_points",
+    "blend",  "ricci",     "union",     "intersect", "difference", "controlled", "pcm",
+    "negative", "translate", "scale",   "rotate",   "bend",      "twist",     "taper"};
+
+std::string inQuotes(std::string_view s) {
+  std::string out(1, '\'');
+  out.append(s);
+  out.push_back('\'');
+  return out;
+}
+
+// Reads nested blob nodes into one tree, collecting diagnostics.
+class NodeReader {
+ public:
+  NodeReader(BlobTree& tree, DiagnosticList& diags) : tree_(tree), diags_(diags) {}
+
+  std::optional<NodeId> read(const YNode& node) {
+    if (depth_ >= kMaxDepth) {
+      node.error(diags_, "blob nodes are nested more than " + std::to_string(kMaxDepth) + " deep");
+      return std::nullopt;
+    }
+    if (!node.isMap() || node.pairs().size() != 1 || !node.pairs()[0].first.isScalar()) {
+      node.error(diags_, "a blob node must be a map with one key naming its kind, e.g. {point: {radius: 1}}");
+      return std::nullopt;
+    }
+    auto [keyNode, value] = node.pairs()[0];
+    std::string kind = keyNode.scalar();
+    ++depth_;
+    std::optional<NodeId> id = dispatch(kind, keyNode, value);
+    --depth_;
+    return id;
+  }
+
+ private:
+  std::optional<NodeId> dispatch(const std::string& kind, const YNode& key, const YNode& v) {
+    if (kind == "point") return primitive(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      Vec3 c = m.vec3("center", Vec3(0.0f));
+      auto r = required(m, "radius");
+      auto tex = texture(m);
+      if (!r) return std::nullopt;
+      return build(key, [&] { return tree_.point(c, float(*r), tex); });
+    });
+    if (kind == "segment") return primitive(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      auto a = requiredVec3(m, "a"), b = requiredVec3(m, "b");
+      auto r = required(m, "radius");
+      auto tex = texture(m);
+      if (!a || !b || !r) return std::nullopt;
+      return build(key, [&] { return tree_.segment(*a, *b, float(*r), tex); });
+    });
+    if (kind == "cone") return primitive(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      auto a = requiredVec3(m, "a"), b = requiredVec3(m, "b");
+      std::optional<double> ra, rb;
+      if (m.has("radius")) {
+        ra = rb = m.number("radius", 0.0);
+      } else {
+        ra = required(m, "radius_a");
+        rb = required(m, "radius_b");
+      }
+      double deltaA = m.number("delta_a", 0.0, 0.0);
+      auto tex = texture(m);
+      if (!a || !b || !ra || !rb) return std::nullopt;
+      // Tree paper Eq. 4: the basal internode is shortened at its tip by δA = 1.75·r_B.
+      Vec3 tip = *b;
+      double rTip = *rb;
+      if (deltaA > 0) {
+        float len = glm::length(*b - *a);
+        float cut = float(1.75 * deltaA);
+        if (cut >= len) {
+          m.get("delta_a")->error(diags_, "'delta_a' shortens the cone by 1.75*" + std::to_string(deltaA) +
+                                              ", more than its length " + std::to_string(len));
+          return std::nullopt;
+        }
+        float t = 1.0f - cut / len;
+        tip = *a + t * (*b - *a);
+        rTip = *ra + t * (*rb - *ra);
+      }
+      return build(key, [&] { return tree_.cone(*a, tip, float(*ra), float(rTip), tex); });
+    });
+    if (kind == "torus") return primitive(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      Vec3 c = m.vec3("center", Vec3(0.0f));
+      Vec3 axis = m.vec3("axis", Vec3(0, 1, 0));
+      auto major = required(m, "major"), minor = required(m, "minor");
+      auto tex = texture(m);
+      if (!major || !minor) return std::nullopt;
+      return build(key, [&] { return tree_.torus(c, axis, float(*major), float(*minor), tex); });
+    });
+    if (kind == "halfspace") return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      Vec3 p = m.vec3("point", Vec3(0.0f));
+      auto n = requiredVec3(m, "normal");
+      double ramp = m.number("ramp", 1e-3, 1e-9);
+      if (!n) return std::nullopt;
+      return build(key, [&] { return tree_.halfspace(p, *n, float(ramp)); });
+    });
+    if (kind == "box") return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      auto lo = requiredVec3(m, "lo"), hi = requiredVec3(m, "hi");
+      double ramp = m.number("ramp", 1e-3, 1e-9);
+      if (!lo || !hi) return std::nullopt;
+      return build(key, [&] { return tree_.box(*lo, *hi, float(ramp)); });
+    });
+    if (kind == "spiral_points") return operands(key, v, kind, [&](MapReader& m) { return spiral(key, m); });
+
+    if (kind == "blend" || kind == "union" || kind == "intersect") {
+      auto kids = childList(v, kind);
+      if (!kids) return std::nullopt;
+      return build(key, [&] {
+        return kind == "blend" ? tree_.blend(*kids) : kind == "union" ? tree_.unite(*kids) : tree_.intersect(*kids);
+      });
+    }
+    if (kind == "difference") {
+      auto kids = childList(v, kind);
+      if (!kids) return std::nullopt;
+      if (kids->size() != 2) {
+        v.error(diags_, "'difference' takes exactly two nodes [a, b] (a minus b), got " +
+                            std::to_string(kids->size()));
+        return std::nullopt;
+      }
+      return build(key, [&] { return tree_.difference((*kids)[0], (*kids)[1]); });
+    }
+    if (kind == "ricci") return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      auto n = required(m, "n", 1.0, 1e4);
+      auto kids = children(m, kind);
+      if (!n || !kids) return std::nullopt;
+      return build(key, [&] { return tree_.ricci(*kids, float(*n)); });
+    });
+    if (kind == "controlled") return operands(key, v, kind, [&](MapReader& m) { return controlled(key, m); });
+    if (kind == "pcm") return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      blobtree::PcmParams p;
+      p.width = float(m.number("width", p.width, 1e-6, 1.0));
+      p.slope = float(m.number("slope", p.slope, 0.0, 10.0));
+      p.bulgeScale = float(m.number("bulge", p.bulgeScale, 0.0, 10.0));
+      auto kids = children(m, kind);
+      if (!kids) return std::nullopt;
+      return build(key, [&] { return tree_.pcm(*kids, p); });
+    });
+    if (kind == "negative") return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      double w = m.number("weight", 1.0, 0.0, 1e3);
+      auto c = child(m, kind);
+      if (!c) return std::nullopt;
+      return build(key, [&] { return tree_.negative(*c, float(w)); });
+    });
+    if (kind == "translate") return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      auto off = requiredVec3(m, "offset");
+      auto c = child(m, kind);
+      if (!off || !c) return std::nullopt;
+      return build(key, [&] { return tree_.translate(*c, *off); });
+    });
+    if (kind == "scale") return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      std::optional<Vec3> f;
+      if (auto fv = m.get("factors")) {
+        if (fv->isSequence())
+          f = fv->asVec3(diags_, "'factors'", 1e-6, 1e6);
+        else if (auto s = fv->asNumber(diags_, "'factors'", 1e-6, 1e6))
+          f = Vec3(float(*s));
+      } else {
+        m.node().error(diags_, "missing required key 'factors' in scale");
+      }
+      auto c = child(m, kind);
+      if (!f || !c) return std::nullopt;
+      return build(key, [&] { return tree_.scale(*c, *f); });
+    });
+    if (kind == "rotate") return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      Vec3 axis = m.vec3("axis", Vec3(0, 1, 0));
+      auto deg = required(m, "angle_deg", -3600.0, 3600.0);
+      auto c = child(m, kind);
+      if (!deg || !c) return std::nullopt;
+      return build(key, [&] { return tree_.rotate(*c, axis, float(radians(*deg))); });
+    });
+    if (kind == "bend") return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      blobtree::Bend bend;
+      auto a = requiredVec3(m, "a"), b = requiredVec3(m, "b");
+      bend.direction = m.vec3("direction", bend.direction);
+      bool hasAngle = m.has("angle_deg"), hasSagitta = m.has("sagitta");
+      double angle = m.number("angle_deg", 0.0, 0.0, 180.0);
+      double sagitta = m.number("sagitta", 0.0, 0.0);
+      if (hasAngle == hasSagitta)
+        m.node().error(diags_, "bend needs exactly one of 'sagitta' and 'angle_deg'");
+      auto c = child(m, kind);
+      if (!a || !b || !c || hasAngle == hasSagitta) return std::nullopt;
+      if (hasAngle) bend = blobtree::Bend::fromAngle(*a, *b, bend.direction, float(radians(angle)));
+      else bend.a = *a, bend.b = *b, bend.sagitta = float(sagitta);
+      return build(key, [&] { return tree_.bend(*c, bend); });
+    });
+    if (kind == "twist") return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      blobtree::Twist t;
+      t.origin = m.vec3("origin", t.origin);
+      t.axis = m.vec3("axis", t.axis);
+      auto rate = required(m, "rate_deg", -1e6, 1e6);
+      auto c = child(m, kind);
+      if (!rate || !c) return std::nullopt;
+      t.rateRadPerUnit = float(radians(*rate));
+      return build(key, [&] { return tree_.twist(*c, t); });
+    });
+    if (kind == "taper") return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      blobtree::Taper t;
+      t.origin = m.vec3("origin", t.origin);
+      t.axis = m.vec3("axis", t.axis);
+      auto len = required(m, "length", 0.0);
+      t.scale0 = float(m.number("scale0", 1.0, 0.0));
+      t.scale1 = float(m.number("scale1", 1.0, 0.0));
+      auto c = child(m, kind);
+      if (!len || !c) return std::nullopt;
+      t.length = float(*len);
+      return build(key, [&] { return tree_.taper(*c, t); });
+    });
+    key.error(diags_, "unknown blob node " + inQuotes(kind) + didYouMean(kind, kKinds));
+    return std::nullopt;
+  }
+
+  // A node whose value is a parameter map; reads it with f and reports unknown keys.
+  template <class F>
+  std::optional<NodeId> operands(const YNode& key, const YNode& v, const std::string& kind, F&& f) {
+    (void)key;
+    if (!v.isMap()) {
+      v.error(diags_, inQuotes(kind) + " must be a map of its parameters");
+      return std::nullopt;
+    }
+    MapReader m(v, diags_, kind);
+    std::string outer = std::exchange(context_, kind);
+    std::optional<NodeId> id = f(m);
+    context_ = outer;
+    m.finish();
+    return id;
+  }
+
+  // A primitive: as operands, plus the field `weight`.
+  template <class F>
+  std::optional<NodeId> primitive(const YNode& key, const YNode& v, const std::string& kind, F&& f) {
+    return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      double w = m.number("weight", 1.0, 0.0, 1e3);
+      auto id = f(m);
+      if (id && w != 1.0) return build(key, [&] { return tree_.setWeight(*id, float(w)); });
+      return id;
+    });
+  }
+
+  // Runs a builder call with the key's location attached to its errors.
+  template <class F>
+  std::optional<NodeId> build(const YNode& at, F&& f) {
+    tree_.setSourceLoc(at.loc());
+    try {
+      return f();
+    } catch (const InputError& e) {
+      for (Diagnostic d : e.diagnostics()) {
+        if (d.loc.file.empty()) d.loc = at.loc();
+        if (d.sourceLine.empty() && d.loc.file == at.loc().file) d.sourceLine = at.file().sourceLine(d.loc.line);
+        diags_.add(std::move(d));
+      }
+    } catch (const std::exception& e) {
+      at.error(diags_, e.what());
+    }
+    return std::nullopt;
+  }
+
+  std::optional<double> required(MapReader& m, std::string_view key, double min = 0.0,
+                                 double max = std::numeric_limits<double>::infinity()) {
+    auto v = m.get(key);
+    if (!v) {
+      m.node().error(diags_, "missing required key " + inQuotes(key) + " in " + kindOf(m));
+      return std::nullopt;
+    }
+    return v->asNumber(diags_, inQuotes(key), min, max);
+  }
+
+  std::optional<Vec3> requiredVec3(MapReader& m, std::string_view key) {
+    auto v = m.get(key);
+    if (!v) {
+      m.node().error(diags_, "missing required key " + inQuotes(key) + " in " + kindOf(m));
+      return std::nullopt;
+    }
+    return v->asVec3(diags_, inQuotes(key));
+  }
+
+  std::string kindOf(MapReader& m) const {
+    (void)m;
+    return context_;
+  }
+
+  blobtree::TextureAttr texture(MapReader& m) {
+    blobtree::TextureAttr t;
+    auto tv = m.section("texture");
+    if (!tv) return t;
+    MapReader tm(*tv, diags_, "texture");
+    t.textureId = uint16_t(tm.integer("id", 0, 0, 65535));
+    t.uvScale = Vec2(float(tm.number("u_scale", 1.0)), float(tm.number("v_scale", 1.0)));
+    t.uvOffset = Vec2(float(tm.number("u_offset", 0.0)), float(tm.number("v_offset", 0.0)));
+    t.refDir = tm.vec3("ref_dir", t.refDir);
+    tm.finish();
+    return t;
+  }
+
+  // A sequence of nodes (the value itself); nullopt after an error.
+  std::optional<std::vector<NodeId>> childList(const YNode& seq, const std::string& kind) {
+    if (!seq.isSequence()) {
+      seq.error(diags_, inQuotes(kind) + " must be a sequence of blob nodes");
+      return std::nullopt;
+    }
+    auto items = seq.items();
+    if (items.empty()) {
+      seq.error(diags_, inQuotes(kind) + " needs at least one node");
+      return std::nullopt;
+    }
+    std::vector<NodeId> ids;
+    bool ok = true;
+    for (const auto& item : items) {
+      auto id = read(item);
+      if (id) ids.push_back(*id);
+      else ok = false;
+    }
+    if (!ok) return std::nullopt;
+    return ids;
+  }
+
+  std::optional<std::vector<NodeId>> children(MapReader& m, const std::string& kind) {
+    auto v = m.get("children");
+    if (!v) {
+      m.node().error(diags_, "missing required key 'children' in " + kind);
+      return std::nullopt;
+    }
+    return childList(*v, kind + " children");
+  }
+
+  std::optional<NodeId> child(MapReader& m, const std::string& kind) {
+    auto v = m.get("child");
+    if (!v) {
+      m.node().error(diags_, "missing required key 'child' in " + kind);
+      return std::nullopt;
+    }
+    return read(*v);
+  }
+
+  // Controlled blending (murex paper Eq. 6): children blend only within the listed groups.
+  std::optional<NodeId> controlled(const YNode& key, MapReader& m) {
+    auto kids = children(m, "controlled");
+    std::vector<std::vector<uint32_t>> groups;
+    auto gv = m.get("groups");
+    if (!gv) {
+      m.node().error(diags_, "missing required key 'groups' in controlled (a list of index lists, or chain)");
+      return std::nullopt;
+    }
+    if (!kids) return std::nullopt;
+    uint32_t n = uint32_t(kids->size());
+    if (gv->isScalar()) {
+      if (gv->scalar() != "chain") {
+        gv->error(diags_, "'groups' must be a list of index lists or 'chain', got '" + gv->scalar() + "'");
+        return std::nullopt;
+      }
+      for (uint32_t i = 0; i + 1 < n; ++i) groups.push_back({i, i + 1});
+      if (n == 1) groups.push_back({0});
+    } else if (gv->isSequence()) {
+      bool ok = true;
+      for (const auto& g : gv->items()) {
+        if (!g.isSequence()) {
+          g.error(diags_, "each group must be a list of child indices, e.g. [0, 1]");
+          ok = false;
+          continue;
+        }
+        std::vector<uint32_t> group;
+        for (const auto& i : g.items()) {
+          auto idx = i.asInteger(diags_, "a child index", 0, int64_t(n) - 1);
+          if (idx) group.push_back(uint32_t(*idx));
+          else ok = false;
+        }
+        groups.push_back(std::move(group));
+      }
+      if (!ok) return std::nullopt;
+    } else {
+      gv->error(diags_, "'groups' must be a list of index lists or 'chain'");
+      return std::nullopt;
+    }
+    return build(key, [&] { return tree_.controlledBlend(*kids, groups); });
+  }
+
+  // Points on a logarithmic helico-spiral (murex paper Eq. 1-3), blended by summation.
+  // R(θ) = r0·λ^(θ/360°), H(θ) = R(θ)·cot β (the shell grows downwards, apex at the
+  // origin, axis +Y), and the tangent-circle size D(θ) = R(θ)(λ−1)/((λ+1) sin β) scaled
+  // by `size`.
+  std::optional<NodeId> spiral(const YNode& key, MapReader& m) {
+    double r0 = m.number("r0", 1.0, 1e-6);
+    double lambda = m.number("lambda", 1.3, 1.0 + 1e-6, 100.0);
+    double beta = radians(m.number("beta_deg", 22.5, 1e-3, 90.0));
+    double theta0 = m.number("theta_deg", 0.0, -1e5, 1e5);
+    double step = m.number("step_deg", 20.0, -360.0, 360.0);
+    int64_t count = m.integer("count", 6, 1, 100000);
+    double size = m.number("size", 1.0, 1e-6, 100.0);
+    std::vector<NodeId> ids;
+    for (int64_t i = 0; i < count; ++i) {
+      double thetaDeg = theta0 + double(i) * step;
+      double R = r0 * std::pow(lambda, thetaDeg / 360.0);
+      double H = R / std::tan(beta);
+      double D = R * (lambda - 1.0) / ((lambda + 1.0) * std::sin(beta));
+      double th = radians(thetaDeg);
+      Vec3 c(float(R * std::cos(th)), float(-H), float(R * std::sin(th)));
+      auto id = build(key, [&] { return tree_.point(c, float(size * D)); });
+      if (!id) return std::nullopt;
+      ids.push_back(*id);
+    }
+    if (ids.size() == 1) return ids[0];
+    return build(key, [&] { return tree_.blend(ids); });
+  }
+
+  BlobTree& tree_;
+  DiagnosticList& diags_;
+  int depth_ = 0;
+  std::string context_;  // the kind whose parameter map is being read
+};
+
+}  // namespace
+
+std::optional<blobtree::NodeId> readBlobNode(const YNode& node, blobtree::BlobTree& tree, DiagnosticList& diags) {
+  NodeReader reader(tree, diags);
+  return reader.read(node);
+}
+
+std::optional<BlobSpecies> readBlobSpecies(MapReader& top, DiagnosticList& diags) {
+  std::string kernel = top.choice("kernel", "wyvill", {"wyvill", "soft"});
+  float cell = 0.0f;
+  if (auto mesh = top.section("mesh")) {
+    MapReader mm(*mesh, diags, "mesh");
+    cell = float(mm.number("cell", 0.0, 0.0, 1e6));
+    mm.finish();
+  }
+  auto blob = top.get("blob");
+  if (!blob) {
+    top.node().error(diags, "missing required key 'blob' in species file (the BlobTree of a kind: blob species)");
+    return std::nullopt;
+  }
+  BlobSpecies s{.name = {},
+                .tree = blobtree::BlobTree(kernel == "soft" ? blobtree::Kernel::SoftObject : blobtree::Kernel::Wyvill),
+                .root = 0,
+                .cellSize = cell};
+  auto root = readBlobNode(*blob, s.tree, diags);
+  if (!root) return std::nullopt;
+  s.root = *root;
+  return s;
+}
+
+namespace {
+
+BlobSpecies readWhole(const std::shared_ptr<const YamlFile>& file, DiagnosticList& diags, const std::string& stem) {
+  if (!file) diags.throwIfErrors();
+  MapReader top(file->rootNode(), diags, "species file");
+  auto kind = top.requiredString("kind");
+  if (kind && *kind != "blob")
+    top.get("kind")->error(diags, "this reader takes kind: blob species, got kind: " + *kind);
+  std::string name = top.string("name", stem);
+  top.string("description");
+  std::optional<BlobSpecies> s;
+  if (!kind || *kind == "blob") s = readBlobSpecies(top, diags);
+  top.finish();
+  diags.throwIfErrors();
+  if (!s) throw InputError(file->rootNode().loc(), "invalid blob species");
+  s->name = name;
+  return std::move(*s);
+}
+
+}  // namespace
+
+BlobSpecies loadBlobSpecies(const std::filesystem::path& path) {
+  DiagnosticList diags;
+  auto file = YamlFile::load(path, diags);
+  return readWhole(file, diags, path.stem().string());
+}
+
+BlobSpecies parseBlobSpecies(std::string text, const std::string& displayPath) {
+  DiagnosticList diags;
+  auto file = YamlFile::parse(std::move(text), displayPath, diags);
+  return readWhole(file, diags, std::filesystem::path(displayPath).stem().string());
+}
+
+}  // namespace sprig
