@@ -22,6 +22,7 @@ using detail::SuccModule;
 namespace {
 
 std::string numberText(double v) {
+  if (std::isnan(v)) return "nan";
   char buf[64];
   auto r = std::to_chars(buf, buf + sizeof buf, v);
   return std::string(buf, r.ptr);
@@ -572,6 +573,7 @@ struct Deriver::Impl {
     if (!prog->decomposition.empty()) {
       RuleSet none;
       none.bySymbol.assign(prog->symbols.size(), {});
+      none.finalize();
       rewrite(none, 0, 0, true);
     } else if (prog->usesCut) {
       applyCuts(cur);
