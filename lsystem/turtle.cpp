@@ -193,6 +193,7 @@ void Turtle::run(const ModuleString& ms, Skeleton& sk, std::span<const int32_t> 
   std::vector<OpenPolygon> polygons;  // open `{` polygons, innermost last
 
   const double radiusScale = 0.5 * settings_.widthScale;
+  const bool taper = settings_.taper && settings_.radii == RadiusModel::Width;
   const DVec3 tropism = settings_.tropism;
   const double defS = std::sin(radians(settings_.angleDeg));
   const double defC = std::cos(radians(settings_.angleDeg));
@@ -233,6 +234,10 @@ void Turtle::run(const ModuleString& ms, Skeleton& sk, std::span<const int32_t> 
         in.step = stepOf(i);
         in.module = static_cast<uint32_t>(i);
         in.up = st.frame.up;
+        // Taper: the continuation of an axis (the child drawn at the parent's own order; a
+        // parent has at most one, since `[` raises the order) ends the parent's radius.
+        if (taper && in.parent >= 0 && sk.internodes[in.parent].order == in.order)
+          sk.internodes[in.parent].tipRadius = in.baseRadius;
         st.internode = static_cast<int32_t>(sk.internodes.size());
         sk.internodes.push_back(in);
         if (st.elasticity != 0) applyTropism(st.frame, tropism, st.elasticity);
@@ -368,16 +373,6 @@ void Turtle::run(const ModuleString& ms, Skeleton& sk, std::span<const int32_t> 
       if (int32_t p = ins[k].parent; p >= 0) {
         sum[p] += std::pow(r, e);
         maxChild[p] = std::max(maxChild[p], r);
-      }
-    }
-  } else if (settings_.taper) {
-    // The continuation of an axis is its parent's first child of the same order.
-    std::vector<uint8_t> done(m, 0);
-    for (size_t k = 0; k < m; ++k) {
-      int32_t p = ins[k].parent;
-      if (p >= 0 && !done[p] && ins[p].order == ins[k].order) {
-        ins[p].tipRadius = ins[k].baseRadius;
-        done[p] = 1;
       }
     }
   }
