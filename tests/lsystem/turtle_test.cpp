@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/rng.h"
 #include "lsystem/derive.h"
 #include "lsystem/grammar.h"
 #include "lsystem/turtle.h"
@@ -419,5 +420,48 @@ TEST_CASE("Turtle::shipped grammars", "[lsystem]") {
     size_t drooping = 0;
     for (const auto& in : d.skeleton.internodes) drooping += in.end.y < in.start.y;
     CHECK(drooping > 0);
+  }
+}
+
+TEST_CASE("Turtle::random strings keep the invariants", "[lsystem]") {
+  // Seeded property test: random command strings with balanced brackets.
+  const uint64_t seed = 20261122;
+  Rng rng(seed);
+  const char* alphabet[] = {"F", "F(0.5)", "f", "G", "g(2)", "+", "-(33)", "&", "^(12)", "\\", "/(77)", "|",
+                            "$", "!(0.3)", "'", "@Ts(0.2)", "A", "[", "]"};
+  for (int trial = 0; trial < 200; ++trial) {
+    std::string text;
+    int depth = 0;
+    for (int i = 0; i < 300; ++i) {
+      std::string cmd = alphabet[rng.below(19)];
+      if (cmd == "]" && depth == 0) continue;
+      depth += cmd == "[" ? 1 : cmd == "]" ? -1 : 0;
+      text += cmd;
+    }
+    text.append(static_cast<size_t>(depth), ']');
+    TurtleSettings s;
+    s.angleDeg = 25;
+    s.elasticity = 0.05;
+    Run r = draw(text, s);
+    INFO("seed " << seed << " trial " << trial << ": " << text);
+    size_t draws = 0;
+    for (char c : text) draws += c == 'F' || c == 'G';
+    REQUIRE(r.skeleton.internodes.size() == draws);
+    for (size_t k = 0; k < r.skeleton.internodes.size(); ++k) {
+      const Internode& in = r.skeleton.internodes[k];
+      REQUIRE(in.parent < static_cast<int32_t>(k));
+      if (in.parent >= 0) {
+        const Internode& p = r.skeleton.internodes[in.parent];
+        REQUIRE(glm::length(p.end - in.start) < 1e-9);  // a child starts where its parent ends
+        REQUIRE(in.order >= p.order);
+      }
+      double len = in.length();
+      REQUIRE((std::abs(len - 1) < 1e-9 || std::abs(len - 0.5) < 1e-9));
+      REQUIRE(std::abs(glm::length(in.up) - 1) < 1e-9);
+    }
+    const TurtleFrame& f = r.end.frame;
+    REQUIRE(std::abs(glm::length(f.heading) - 1) < 1e-9);
+    REQUIRE(std::abs(glm::dot(f.heading, f.left)) < 1e-9);
+    REQUIRE(glm::length(glm::cross(f.heading, f.left) - f.up) < 1e-9);
   }
 }
