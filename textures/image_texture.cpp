@@ -41,7 +41,8 @@ ImageTexture ImageTexture::open(const std::string& path, const SourceLoc& where)
     throw InputError(where, "cannot read texture '" + path + "': " + reason);
   };
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) return fail("no such file");
+  if (!std::filesystem::exists(path, ec)) return fail("no such file");
+  if (!std::filesystem::is_regular_file(path, ec)) return fail("not a regular file");
   auto in = OIIO::ImageInput::open(path);
   if (!in) {
     std::string err = OIIO::geterror();
