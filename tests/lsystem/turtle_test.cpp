@@ -410,6 +410,22 @@ TEST_CASE("Turtle::shipped grammars", "[lsystem]") {
     checkVec(d.end.frame.position, {0, (1 - std::pow(0.9, 10)) / 0.1, 0}, 1e-9);
     CHECK(d.skeleton.internodes[0].baseRadius == Approx(0.5 * 10));  // !(10) with widthScale 1
   }
+  SECTION("ABOP 1.31a and the original plants draw one connected plant") {
+    for (const char* name : {"abop_1_31a.lsys", "shrub.lsys", "conifer.lsys", "abop_2_7.lsys"}) {
+      INFO(name);
+      TurtleSettings s;
+      s.elasticity = 0.05;
+      Drawn d = drawGrammar(name, s);
+      REQUIRE(d.skeleton.internodes.size() > 100);
+      size_t roots = 0;
+      for (const auto& in : d.skeleton.internodes) roots += in.parent < 0;
+      // The shrub's axiom starts four stems at the origin; everything else has one root.
+      CHECK(roots == (std::string(name) == "shrub.lsys" ? 4u : 1u));
+      for (const auto& in : d.skeleton.internodes)
+        if (in.parent >= 0) REQUIRE(glm::length(d.skeleton.internodes[in.parent].end - in.start) < 1e-9);
+    }
+    CHECK(!drawGrammar("conifer.lsys").skeleton.organs.empty());
+  }
   SECTION("ABOP 2.8a: 1 + 4 (3^6 - 1)/2 internodes, bent by tropism") {
     TurtleSettings s;
     s.elasticity = 0.22;
