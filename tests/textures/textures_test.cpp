@@ -219,6 +219,20 @@ TEST_CASE("ImageTexture", "[textures]") {
     Vec3 mid = t.color(Vec2(1.0f / w, 0.5f / h));
     CHECK(mid.x == Approx(0.05f).margin(1e-5));
   }
+  SECTION("a wide footprint reads a coarse mip level: a checkerboard filters to its mean") {
+    const int w = 64;
+    std::vector<float> rgb(w * w * 3);
+    for (int y = 0; y < w; ++y)
+      for (int x = 0; x < w; ++x)
+        for (int k = 0; k < 3; ++k) rgb[(y * w + x) * 3 + k] = ((x + y) & 1) ? 1.0f : 0.0f;
+    fs::path file = dir / "checker_64.exr";
+    writeFloatImage(file, w, w, rgb, OIIO::TypeDesc::FLOAT);
+    ImageTexture t = ImageTexture::open(file.string(), {"s.yaml", 1, 1});
+    Vec3 sharp = t.color(Vec2(0.5f / w, 0.5f / w));
+    CHECK(sharp.x == Approx(0.0f).margin(1e-5));  // texel (0,0) exactly at the finest level
+    Vec3 wide = t.color(Vec2(0.37f, 0.61f), Vec2(0.25f, 0), Vec2(0, 0.25f));
+    CHECK(wide.x == Approx(0.5f).margin(0.02));
+  }
   SECTION("8-bit PNG values are sRGB, returned linear") {
     std::vector<float> rgb(2 * 2 * 3, 0.5f);
     rgb[0] = 1.0f;
