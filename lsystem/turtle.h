@@ -69,7 +69,8 @@ struct TurtleState {
 class Turtle {
  public:
   /// Binds the turtle commands to the symbols of `symbols` by name ("F", "+", "@Ts", ...).
-  /// Symbols that are no command are ignored when read.
+  /// Symbols that are no command are ignored when read. `symbols` must outlive the turtle
+  /// (surface names are read from it).
   explicit Turtle(const SymbolTable& symbols, TurtleSettings settings = {});
 
   /// Draws `modules`. `moduleSteps`, when not empty, holds for each module the derivation
