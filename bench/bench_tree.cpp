@@ -1,0 +1,138 @@
+// Benchmark of BlobTree trees ("BlobTree Trees", Galbraith, MacMurchy, Wyvill): the poplar of
+// grammars/tree_poplar.lsys with PCM junctions, grown to >= 2,000 internodes.
+//
+// Prints: derivation + turtle time, BlobTree build time, compile time, exact render time
+// (Embree user geometry over surface cells, default 1536x2048 at 9 samples per pixel, the
+// paper's Fig. 17-18 setting), and polygonization time. Baseline in the same process:
+// field evaluations per second with culling (compiled tape + BVH) against the
+// brute-force evaluator that visits every primitive.
+//
+// Usage: bench_tree [steps=11] [width=1536] [height=2048] [spp=9] [out.png]
+//   (run from the repository root; width 0 skips the render)
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include "blobtree/compiled.h"
+#include "blobtree/polygonize.h"
+#include "core/atomic_file.h"
+#include "core/rng.h"
+#include "lsystem/derive.h"
+#include "lsystem/grammar.h"
+#include "lsystem/turtle.h"
+#include "organisms/tree_builder.h"
+#include "render/camera.h"
+#include "render/image.h"
+#include "render/renderer.h"
+#include "render/scene.h"
+#include "textures/procedural.h"
+
+using namespace sprig;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int steps = argc > 1 ? std::atoi(argv[1]) : 11;
+  const int width = argc > 2 ? std::atoi(argv[2]) : 1536;
+  const int height = argc > 3 ? std::atoi(argv[3]) : 2048;
+  const int spp = argc > 4 ? std::atoi(argv[4]) : 9;
+  const std::string out = argc > 5 ? argv[5] : "";
+  try {
+    // Grow the skeleton.
+    auto t = Clock::now();
+    const std::string text = readFile("grammars/tree_poplar.lsys");
+    lsystem::GrammarOverrides ov;
+    ov.derivationLength = steps;
+    const lsystem::Grammar grammar = lsystem::parseGrammar(text, "grammars/tree_poplar.lsys", ov);
+    lsystem::Deriver deriver(grammar);
+    const lsystem::ModuleString& modules = deriver.derive();
+    lsystem::TurtleSettings ts;
+    ts.widthScale = 0.02;
+    ts.tropism = DVec3(0, 1, 0);
+    ts.elasticity = 0.04;
+    lsystem::Skeleton skeleton = lsystem::interpret(deriver.interpret(modules), deriver.symbols(), ts);
+    const double growS = since(t);
+
+    // Build the BlobTree (PCM junctions, bends, bark).
+    organisms::TreeOptions opt;
+    opt.junctions = organisms::JunctionModel::Pcm;
+    opt.bends.angleDeg = 8;
+    opt.bends.orderScale = 0.8;
+    opt.bends.randomness = 0.5;
+    opt.bark.vScale = 6;
+    t = Clock::now();
+    organisms::TreeBlob blob = organisms::buildTreeBlob(skeleton, opt);
+    const double buildS = since(t);
+    t = Clock::now();
+    blobtree::CompiledBlob compiled = blobtree::compile(blob.tree, blob.root);
+    const double compileS = since(t);
+    std::printf("poplar, %d steps: %zu internodes, %zu BlobTree nodes, %zu primitives\n", steps,
+                skeleton.internodes.size(), blob.tree.size(), compiled.primitiveCount());
+    std::printf("grow (derive + turtle) %.3f s, BlobTree build %.3f s, compile %.3f s\n", growS, buildS, compileS);
+
+    // Baseline: culled field evaluation vs visiting every primitive, same points.
+    const Box3 b = compiled.bounds();
+    std::vector<Vec3> pts(20000);
+    Rng rng(7);
+    for (auto& p : pts)
+      p = b.lo + Vec3(float(rng.uniform()), float(rng.uniform()), float(rng.uniform())) * b.size();
+    double sink = 0;
+    t = Clock::now();
+    for (const auto& p : pts) sink += compiled.value(p);
+    const double culledS = since(t);
+    const size_t bruteN = 2000;
+    t = Clock::now();
+    for (size_t i = 0; i < bruteN; ++i) sink -= compiled.valueNoCulling(pts[i]);
+    const double bruteS = since(t);
+    const double culledRate = pts.size() / culledS, bruteRate = bruteN / bruteS;
+    std::printf("field evaluations: culled %.3g /s, brute force %.3g /s, ratio %.1fx (checksum %.3g)\n", culledRate,
+                bruteRate, culledRate / bruteRate, sink);
+
+    // Exact render.
+    if (width > 0) {
+      t = Clock::now();
+      render::Scene scene;
+      auto bark = std::make_shared<textures::BarkTexture>(textures::BarkOptions{});
+      scene.addTexture([bark](Vec2 uv, const Vec3&) { return bark->color(uv); });
+      const uint32_t wood = scene.addMaterial(render::Material{Vec3(0.62f, 0.60f, 0.52f), 0.7f, 0.03f, 0});
+      scene.addImplicit(compiled, wood);
+      scene.commit();
+      const double sceneS = since(t);
+      render::ViewSpec view;
+      view.azimuthDeg = 20;
+      view.elevationDeg = 8;
+      const render::Camera camera = render::frameBounds(b, view, double(width) / height);
+      render::RenderSettings rs;
+      rs.width = width;
+      rs.height = height;
+      rs.spp = spp;
+      rs.progress = false;
+      render::RenderStats stats;
+      t = Clock::now();
+      render::Image image = render::renderImage(scene, camera, rs, &stats);
+      const double renderS = since(t);
+      std::printf("exact render %dx%d, %d spp: scene (surface cells) %.2f s, %zu cells; render %.2f s, %.3g rays/s\n",
+                  width, height, spp, sceneS, scene.stats().implicitCells, renderS, stats.raysPerSecond());
+      if (!out.empty()) render::writeImage(image, out);
+    }
+
+    // Mesh.
+    t = Clock::now();
+    blobtree::PolygonizeOptions po;
+    const blobtree::PolygonizeResult mesh = blobtree::polygonizeDetailed(compiled, po);
+    const double meshS = since(t);
+    std::printf("polygonize: %.2f s, cell %.4g, %zu triangles, %zu field evaluations\n", meshS, mesh.cellSize,
+                mesh.mesh.triangleCount(), mesh.fieldEvaluations);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_tree: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,63 @@
+#include <catch2/catch.hpp>
+
+#include "app/species_tree.h"
+
+using namespace sprig;
+using organisms::JunctionModel;
+using organisms::TipStyle;
+
+TEST_CASE("readTreeOptions", "[app]") {
+  SECTION("defaults from an empty section") {
+    auto o = parseTreeOptions("{}", "t.yaml");
+    CHECK(o.junctions == JunctionModel::Smooth);
+    CHECK(o.deltaA == 1.75);
+    CHECK(o.deltaAMulti == 2.75);
+    CHECK(o.tips == TipStyle::Taper);
+    CHECK(o.bends.angleDeg == 0.0);
+  }
+  SECTION("every group of keys") {
+    auto o = parseTreeOptions(R"(junctions: pcm
+delta_a: 1.7
+branch_offset: false
+tips: hemisphere
+seed: 9
+prune: {orders: [1, 2], below_height: 2.5, probability: 1, cut_fraction: 0.3}
+scars: {internodes: [4, 7], stub_length: 2, negative_radius: 0.6}
+bends: {angle: 15, order_scale: 0.8, randomness: 0.3, trunk: true}
+bark: {enabled: false, v_scale: 3}
+leaves: {scale: 1.5}
+)", "t.yaml");
+    CHECK(o.junctions == JunctionModel::Pcm);
+    CHECK(o.deltaA == 1.7);
+    CHECK_FALSE(o.branchOffset);
+    CHECK(o.tips == TipStyle::Hemisphere);
+    CHECK(o.seed == 9);
+    CHECK(o.prune.select.orders == std::vector<int>{1, 2});
+    CHECK(o.prune.select.belowHeight == 2.5);
+    CHECK(o.prune.select.probability == 1.0);
+    CHECK(o.prune.cutFraction == 0.3);
+    CHECK(o.scars.select.internodes == std::vector<int>{4, 7});
+    CHECK(o.scars.stubLength == 2.0);
+    CHECK(o.scars.negativeRadius == 0.6);
+    CHECK(o.bends.angleDeg == 15.0);
+    CHECK(o.bends.trunk);
+    CHECK_FALSE(o.bark.enabled);
+    CHECK(o.bark.vScale == 3.0);
+    CHECK(o.leaves.scale == 1.5);
+  }
+  SECTION("errors carry positions and did-you-mean, all at once") {
+    try {
+      parseTreeOptions("junctions: pcmm\ndelta_aa: 2\nbends: {angel: 3}\n", "t.yaml");
+      FAIL("no throw");
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      CHECK(msg.find("t.yaml:1:12: error:") != std::string::npos);
+      CHECK(msg.find("t.yaml:2:1: error: unknown key 'delta_aa' in tree (did you mean 'delta_a'?)") != std::string::npos);
+      CHECK(msg.find("unknown key 'angel' in bends (did you mean 'angle'?)") != std::string::npos);
+    }
+  }
+  SECTION("ranges") {
+    CHECK_THROWS_AS(parseTreeOptions("prune: {probability: 2}", "t.yaml"), InputError);
+    CHECK_THROWS_AS(parseTreeOptions("bends: {angle: 100}", "t.yaml"), InputError);
+  }
+}
