@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <limits>
 #include <cmath>
 #include <optional>
 
@@ -103,7 +104,11 @@ class Writer {
   }
 
   void growParams(size_t need) {
-    s_.params.resize(std::max(need, capP_ * 2));
+    constexpr size_t kMaxParams = std::numeric_limits<uint32_t>::max();  // offsets are 32-bit
+    if (need > kMaxParams)
+      throw InputError(SourceLoc{file_, 0, 0},
+                       "derivation would exceed " + std::to_string(kMaxParams) + " parameters at step " + std::to_string(step_));
+    s_.params.resize(std::min(kMaxParams, std::max(need, capP_ * 2)));
     refresh();
   }
 
@@ -132,6 +137,7 @@ struct Deriver::Impl {
   ModuleString cur, next;
   std::vector<int32_t> match;  ///< bracket partner per module (context-sensitive grammars)
   std::vector<std::vector<double>> scratch;  ///< successor parameters per decomposition depth
+  ModuleString oneScratch;                   ///< a one-module string for stochastic decomposition
 
   // Per-module random stream, created on first use.
   Rng rng;
@@ -276,6 +282,17 @@ struct Deriver::Impl {
       --j;
     }
     return true;
+  }
+
+  std::vector<int32_t> choices;  ///< productions found by context dispatch in the size pass
+
+  /// The production context dispatch d selects for parameterless module i, or -1.
+  int32_t dispatchAt(const detail::ContextDispatch& d, const ModuleString& s, size_t i) const {
+    ptrdiff_t ln = walkLeft(s, static_cast<ptrdiff_t>(i) - 1);
+    size_t rn = walkRight(s, i + 1);
+    uint32_t li = ln >= 0 && s.paramCount(static_cast<size_t>(ln)) == 0 ? d.index[s.symbols[ln]] : 0;
+    uint32_t ri = rn < s.size() && s.paramCount(rn) == 0 ? d.index[s.symbols[rn]] : 0;
+    return d.table[li * d.width + ri];
   }
 
   /// Binds p's formal parameters at module i when the predecessor and contexts match.
@@ -429,7 +446,8 @@ struct Deriver::Impl {
         // Stochastic decomposition rules: weighted choice among the matching ones.
         const Production* chosen = &p;
         if (p.stochastic) {
-          ModuleString one;
+          ModuleString& one = oneScratch;
+          one.clear();
           one.push(sym, {params, count});
           chosen = choose(rs, one, 0, vars, step);
           if (!chosen) break;
@@ -454,31 +472,59 @@ struct Deriver::Impl {
     const uint32_t* offs = in.offsets.data();
     const double* pars = in.params.data();
     const detail::SymbolRules* rules = rs.rules.data();
-    // Size pass: an upper bound on the output (exact when every rule is `simple`), so the
-    // buffers are allocated once and a limit overrun is caught before allocating.
+    // Size pass: the exact output size when every module's production is known without
+    // evaluating anything (simple productions, copies, context dispatch), else an upper
+    // bound. The buffers are then allocated once, and a limit overrun is caught before
+    // allocating.
+    if (rs.anyContext) computeBrackets(in);
     size_t reserveModules = 0, reserveParams = 0;
+    choices.clear();
     if (!decompose) {
       size_t boundM = 0, boundP = 0;
       bool exact = true;
       for (size_t i = 0; i < n; ++i) {
         const detail::SymbolRules& r = rules[syms[i]];
         uint32_t count = offs[i + 1] - offs[i];
-        boundM += r.maxModules;
-        boundP += std::max(r.maxParams, count);
-        exact &= r.simple != nullptr || r.count == 0;
+        if (r.count == 0 || (r.simple && count != r.simple->predParams)) {
+          boundM += 1;
+          boundP += count;
+        } else if (r.simple) {
+          boundM += r.simple->successor.size();
+          boundP += r.simple->args.size();
+        } else if (r.dispatch >= 0 && count == 0) {
+          int32_t idx = dispatchAt(rs.dispatches[r.dispatch], in, i);
+          choices.push_back(idx);
+          boundM += idx < 0 ? 1 : rs.productions[static_cast<size_t>(idx)].successor.size();
+          boundP += idx < 0 ? 0 : rs.productions[static_cast<size_t>(idx)].args.size();
+        } else {
+          boundM += r.maxModules;
+          boundP += std::max(r.maxParams, count);
+          exact = false;
+        }
       }
       if (boundM > opt.maxModules && exact) Writer::overLimit(opt.maxModules, prog->fileName, step);
-      reserveModules = std::min(boundM, opt.maxModules);
-      reserveParams = boundP;
+      if (exact) {
+        reserveModules = boundM;
+        reserveParams = boundP;
+      } else {  // a loose bound (conditions, contexts, choices): start modestly, grow on demand
+        reserveModules = std::min({boundM, opt.maxModules, 2 * n + 16});
+        reserveParams = std::min(boundP, 2 * in.params.size() + 16);
+      }
     }
     Writer w(next, births, opt.maxModules, prog->fileName, step, reserveModules, reserveParams);
-    if (rs.anyContext) computeBrackets(in);
     double vars[detail::kMaxVars];
     rngStream = stream;
+    size_t nextChoice = 0;
     for (size_t i = 0; i < n; ++i) {
       SymbolId sym = syms[i];
       int32_t birth = births ? in.birthSteps[i] : 0;
       const detail::SymbolRules& r = rules[sym];
+      if (r.count == 0 && !decompose) {
+        uint32_t count = offs[i + 1] - offs[i];
+        w.reserve(1, count);
+        w.copy(sym, pars + offs[i], count, birth);
+        continue;
+      }
       if (r.simple && !decompose) {
         const Production& p = *r.simple;
         uint32_t count = offs[i + 1] - offs[i];
@@ -494,12 +540,7 @@ struct Deriver::Impl {
         }
       }
       if (r.dispatch >= 0 && !decompose && offs[i + 1] == offs[i]) {
-        const detail::ContextDispatch& d = rs.dispatches[r.dispatch];
-        ptrdiff_t ln = walkLeft(in, static_cast<ptrdiff_t>(i) - 1);
-        size_t rn = walkRight(in, i + 1);
-        uint32_t li = ln >= 0 && in.paramCount(static_cast<size_t>(ln)) == 0 ? d.index[syms[ln]] : 0;
-        uint32_t ri = rn < n && in.paramCount(rn) == 0 ? d.index[syms[rn]] : 0;
-        int32_t idx = d.table[li * d.width + ri];
+        int32_t idx = choices[nextChoice++];
         if (idx < 0) {
           w.reserve(1, 0);
           w.copy(sym, nullptr, 0, birth);
