@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -41,20 +43,54 @@ glm::ivec3 cornerOffset(int c) { return {c & 1, (c >> 1) & 1, (c >> 2) & 1}; }
 // corner, so neighbouring cubes agree.
 constexpr int kTets[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7}, {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
 
+constexpr uint32_t kNoCell = ~0u;
+
+// Open-addressing map from a cell's key to its active index.
+class CellHash {
+ public:
+  explicit CellHash(size_t n) {
+    size_t cap = 16;
+    while (cap < 2 * n) cap <<= 1;
+    keys_.assign(cap, kEmpty);
+    ids_.assign(cap, kNoCell);
+    mask_ = cap - 1;
+  }
+  void insert(uint64_t key, uint32_t id) {
+    size_t i = slot(key);
+    while (keys_[i] != kEmpty && keys_[i] != key) i = (i + 1) & mask_;
+    keys_[i] = key;
+    ids_[i] = id;
+  }
+  uint32_t find(uint64_t key) const {
+    for (size_t i = slot(key);; i = (i + 1) & mask_) {
+      if (keys_[i] == key) return ids_[i];
+      if (keys_[i] == kEmpty) return kNoCell;
+    }
+  }
+
+ private:
+  static constexpr uint64_t kEmpty = ~uint64_t(0);
+  size_t slot(uint64_t k) const {
+    k ^= k >> 33;
+    k *= 0xff51afd7ed558ccdULL;
+    k ^= k >> 33;
+    return size_t(k) & mask_;
+  }
+  std::vector<uint64_t> keys_;
+  std::vector<uint32_t> ids_;
+  size_t mask_ = 0;
+};
+
 struct CornerRef {
   uint64_t key;
   uint32_t slot;  // cell · 8 + corner
   bool operator<(const CornerRef& o) const { return key != o.key ? key < o.key : slot < o.slot; }
 };
 
-// A surface-crossing grid edge: its key and its inside / outside grid points.
+// A surface-crossing grid edge: its inside and outside grid point indices.
 struct EdgeRec {
-  uint64_t key;
-  uint32_t inside, outside;  // distinct grid point indices
-  bool operator<(const EdgeRec& o) const { return key < o.key; }
+  uint32_t inside, outside;
 };
-
-using TriKeys = std::array<uint64_t, 3>;
 
 Vec3 gridPosition(const CellSet& cs, glm::ivec3 g) {
   return cs.origin + Vec3(float(g.x) * cs.cellSize, float(g.y) * cs.cellSize, float(g.z) * cs.cellSize);
@@ -63,23 +99,25 @@ Vec3 gridPosition(const CellSet& cs, glm::ivec3 g) {
 // Triangles of one tetrahedron (corner codes t, inside flags), as edge keys, oriented from
 // inside to outside using the edges' midpoints (never degenerate).
 struct TetEmitter {
-  glm::ivec3 cell;
-  const uint32_t* cornerPoint;  // the cell's 8 grid point indices
-  std::vector<TriKeys>* tris;
-  std::vector<EdgeRec>* edges;
+  // Vertex of the crossing edge a-b (corner codes of this cell): owned by the cell whose
+  // low corner is the edge's low end, numbered vertexBase + rank of its direction.
+  const uint32_t* owners;      // this cell's owner cells by low-corner code (0 = itself)
+  const uint32_t* vertexBase;  // per active cell
+  const uint8_t* crossMask;    // per active cell: bit d set when edge 0 -> d crosses
+  std::vector<glm::uvec3>* tris;
 
-  uint64_t edge(int a, int b, bool aInside) const {
-    int lo = a & b, hi = a | b;
-    glm::ivec3 g = cell + cornerOffset(lo);
-    uint64_t key = (pointKey(g.x, g.y, g.z) << 3) | uint64_t(hi ^ lo);
-    edges->push_back({key, cornerPoint[aInside ? a : b], cornerPoint[aInside ? b : a]});
-    return key;
+  uint32_t edge(int a, int b, bool) const {
+    int lo = a & b, d = (a | b) ^ lo;
+    uint32_t owner = owners[lo];
+    uint8_t m = crossMask[owner];
+    if (owner == kNoCell || !((m >> d) & 1)) throw std::logic_error("polygonize: crossing edge without an owner cell");
+    return vertexBase[owner] + uint32_t(std::popcount(unsigned(m) & ((1u << d) - 1u)));
   }
 
   static Vec3 mid(int a, int b) { return 0.5f * Vec3(cornerOffset(a) + cornerOffset(b)); }
 
   // Emits triangle (e0,e1,e2) with midpoints (m0,m1,m2), flipped so its normal points along outward.
-  void emit(uint64_t e0, uint64_t e1, uint64_t e2, Vec3 m0, Vec3 m1, Vec3 m2, Vec3 outward) const {
+  void emit(uint32_t e0, uint32_t e1, uint32_t e2, Vec3 m0, Vec3 m1, Vec3 m2, Vec3 outward) const {
     Vec3 n = glm::cross(m1 - m0, m2 - m0);
     if (glm::dot(n, outward) >= 0.0f) tris->push_back({e0, e1, e2});
     else tris->push_back({e0, e2, e1});
@@ -99,7 +137,7 @@ struct TetEmitter {
       Vec3 ps = Vec3(cornerOffset(t[s]));
       Vec3 po = (Vec3(cornerOffset(t[o[0]])) + Vec3(cornerOffset(t[o[1]])) + Vec3(cornerOffset(t[o[2]]))) / 3.0f;
       Vec3 outward = loneInside ? po - ps : ps - po;
-      uint64_t e[3];
+      uint32_t e[3];
       for (int k = 0; k < 3; ++k) e[k] = edge(t[s], t[o[k]], loneInside);
       emit(e[0], e[1], e[2], mid(t[s], t[o[0]]), mid(t[s], t[o[1]]), mid(t[s], t[o[2]]), outward);
       return;
@@ -110,7 +148,7 @@ struct TetEmitter {
     int a = ins[0], b = ins[1], c = outs[0], d = outs[1];
     Vec3 outward = 0.5f * (Vec3(cornerOffset(c)) + Vec3(cornerOffset(d))) -
                    0.5f * (Vec3(cornerOffset(a)) + Vec3(cornerOffset(b)));
-    uint64_t ac = edge(a, c, true), ad = edge(a, d, true), bd = edge(b, d, true), bc = edge(b, c, true);
+    uint32_t ac = edge(a, c, true), ad = edge(a, d, true), bd = edge(b, d, true), bc = edge(b, c, true);
     emit(ac, ad, bd, mid(a, c), mid(a, d), mid(b, d), outward);
     emit(ac, bd, bc, mid(a, c), mid(b, d), mid(b, c), outward);
   }
@@ -153,7 +191,15 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
   if (requested <= 0.0f || blob.bounds().empty()) return res;
 
   // ---- 1. Cells that may hold the surface ------------------------------------------
+  auto clock = std::chrono::steady_clock::now();
+  auto lap = [&clock] {
+    auto now = std::chrono::steady_clock::now();
+    double s = std::chrono::duration<double>(now - clock).count();
+    clock = now;
+    return s;
+  };
   CellSet cs = blob.surfaceCells(requested);
+  res.cellSeconds = lap();
   res.cellSize = cs.cellSize;
   res.surfaceCells = cs.cells.size();
   const size_t nCells = cs.cells.size();
@@ -215,6 +261,8 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
   }, 256);
   if (options.progress && ProgressSettings::cancelRequested()) throw Cancelled();
 
+  res.sampleSeconds = lap();
+
   // ---- 3. Cells with a sign change ----------------------------------------------------
   std::vector<uint8_t> insideMask(nCells);
   parallelFor(0, nCells, [&](size_t i) {
@@ -235,11 +283,12 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
   std::vector<glm::ivec3> cellCoords(nCells);
   for (size_t i = 0; i < nCells; ++i) cellCoords[i] = {cs.cells[i].index[0], cs.cells[i].index[1], cs.cells[i].index[2]};
   size_t extraCells = 0;
+  std::map<uint64_t, uint32_t> extraPoints;  // grid points sampled for added cells
   {
     std::vector<uint64_t> known(nCells);
     for (size_t i = 0; i < nCells; ++i) known[i] = pointKey(cellCoords[i].x, cellCoords[i].y, cellCoords[i].z);
     std::sort(known.begin(), known.end());
-    std::map<uint64_t, uint32_t> extraPoints, addedCells;
+    std::map<uint64_t, uint32_t> addedCells;
     auto pointIndex = [&](glm::ivec3 g) -> uint32_t {
       uint64_t key = pointKey(g.x, g.y, g.z);
       auto it = std::lower_bound(pointKeys.begin(), pointKeys.begin() + nPoints, key);
@@ -298,45 +347,66 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
   res.extraCells = extraCells;
   if (active.empty()) return res;
 
-  // ---- 4. Marching tetrahedra, per chunk of active cells -------------------------------
+  // ---- 4. Vertex numbering and marching tetrahedra -----------------------------------
+  // Every crossing edge P -> P + d (d a corner code) belongs to the cell with low corner P;
+  // that cell has the crossing between its corners 0 and d, so it is active (kept by the
+  // bounds or added by the closure). Vertices are numbered by owner cell, then by d.
+  const size_t nActive = active.size();
+  CellHash activeIndex(nActive);
+  for (size_t a = 0; a < nActive; ++a) {
+    glm::ivec3 g = cellCoords[active[a]];
+    activeIndex.insert(pointKey(g.x, g.y, g.z), uint32_t(a));
+  }
+  std::vector<uint8_t> crossMask(nActive);
+  std::vector<uint32_t> vertexBase(nActive + 1, 0);
+  std::vector<uint32_t> owners(nActive * 8);
+  parallelFor(0, nActive, [&](size_t a) {
+    uint8_t m = insideMask[active[a]], cross = 0;
+    for (int d = 1; d < 8; ++d)
+      if (((m >> d) & 1) != (m & 1)) cross |= uint8_t(1u << d);
+    crossMask[a] = cross;
+    vertexBase[a + 1] = uint32_t(std::popcount(unsigned(cross)));
+    glm::ivec3 g = cellCoords[active[a]];
+    owners[a * 8] = uint32_t(a);
+    for (int lo = 1; lo < 8; ++lo) {
+      glm::ivec3 n = g + cornerOffset(lo);
+      owners[a * 8 + size_t(lo)] = activeIndex.find(pointKey(n.x, n.y, n.z));
+    }
+  }, 2048);
+  for (size_t a = 0; a < nActive; ++a) vertexBase[a + 1] += vertexBase[a];
+  const size_t nVerts = vertexBase[nActive];
+
   constexpr size_t kChunk = 2048;
-  size_t nChunks = (active.size() + kChunk - 1) / kChunk;
-  std::vector<std::vector<TriKeys>> triParts(nChunks);
-  std::vector<std::vector<EdgeRec>> edgeParts(nChunks);
+  size_t nChunks = (nActive + kChunk - 1) / kChunk;
+  std::vector<std::vector<glm::uvec3>> triParts(nChunks);
   parallelFor(0, nChunks, [&](size_t ch) {
-    size_t begin = ch * kChunk, end = std::min(active.size(), begin + kChunk);
+    size_t begin = ch * kChunk, end = std::min(nActive, begin + kChunk);
     auto& tris = triParts[ch];
-    auto& edges = edgeParts[ch];
     tris.reserve((end - begin) * 6);
-    edges.reserve((end - begin) * 12);
     for (size_t a = begin; a < end; ++a) {
-      uint32_t i = active[a];
-      TetEmitter em{cellCoords[i], &cornerPoint[size_t(i) * 8], &tris, &edges};
-      uint8_t m = insideMask[i];
+      TetEmitter em{&owners[a * 8], vertexBase.data(), crossMask.data(), &tris};
+      uint8_t m = insideMask[active[a]];
       for (const auto& t : kTets) {
         bool in[4] = {bool(m >> t[0] & 1), bool(m >> t[1] & 1), bool(m >> t[2] & 1), bool(m >> t[3] & 1)};
         em.run(t, in);
       }
     }
   });
-  std::vector<TriKeys> triKeys = concat(triParts);
-  std::vector<EdgeRec> edges = concat(edgeParts);
-  tbb::parallel_sort(edges.begin(), edges.end());
-  edges.erase(std::unique(edges.begin(), edges.end(), [](const EdgeRec& x, const EdgeRec& y) { return x.key == y.key; }),
-              edges.end());
-  const size_t nVerts = edges.size();
-
   Mesh& mesh = res.mesh;
-  mesh.triangles.resize(triKeys.size());
-  parallelFor(0, triKeys.size(), [&](size_t t) {
-    glm::uvec3 tri;
-    for (int k = 0; k < 3; ++k) {
-      auto it = std::lower_bound(edges.begin(), edges.end(), EdgeRec{triKeys[t][k], 0, 0});
-      tri[k] = uint32_t(it - edges.begin());
-    }
-    mesh.triangles[t] = tri;
-  }, 4096);
-  std::vector<TriKeys>().swap(triKeys);
+  mesh.triangles = concat(triParts);
+  std::vector<uint32_t>().swap(owners);
+
+  // The inside and outside grid point of each vertex's edge.
+  std::vector<EdgeRec> edges(nVerts);
+  parallelFor(0, nActive, [&](size_t a) {
+    const uint32_t* cp = &cornerPoint[size_t(active[a]) * 8];
+    bool lowInside = insideMask[active[a]] & 1;
+    uint32_t v = vertexBase[a];
+    for (int d = 1; d < 8; ++d)
+      if ((crossMask[a] >> d) & 1) edges[v++] = lowInside ? EdgeRec{cp[0], cp[d]} : EdgeRec{cp[d], cp[0]};
+  }, 2048);
+
+  res.triangulateSeconds = lap();
 
   // ---- 5. Vertices: root search along each edge, then normal and attributes ----------
   std::unique_ptr<Progress> bar;
@@ -349,49 +419,76 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
   }
   std::vector<uint8_t> evals(nVerts, 0);
   std::vector<uint8_t> flatGradient(nVerts, 0);
-  parallelForRange(0, nVerts, [&](size_t begin, size_t end) {
-    for (size_t v = begin; v < end; ++v) {
-      const EdgeRec& e = edges[v];
-      Vec3 pIn = gridPosition(cs, keyCoords(pointKeys[e.inside]));
-      Vec3 pOut = gridPosition(cs, keyCoords(pointKeys[e.outside]));
-      // Illinois regula falsi on g(t) = F(lerp(pIn, pOut, t)) − 0.5, g(0) > 0 >= g(1).
-      double a = 0.0, b = 1.0;
-      double fa = double(values[e.inside]) - kIso, fb = double(values[e.outside]) - kIso;
-      double t = fa / (fa - fb);
-      int side = 0, n = 0;
-      for (; n < options.refineSteps; ++n) {
-        float f = blob.value(pIn + float(t) * (pOut - pIn)) - kIso;
-        if (std::fabs(f) < options.fieldTolerance) { ++n; break; }
-        if (f > 0.0f) {
-          a = t, fa = f;
-          if (side == 1) fb *= 0.5;
-          side = 1;
-        } else {
-          b = t, fb = f;
-          if (side == -1) fa *= 0.5;
-          side = -1;
-        }
-        if (b - a < 1e-7) { ++n; break; }
-        t = a + fa * (b - a) / (fa - fb);
+  // Fixed blocks of vertices (consecutive edge keys: spatially coherent rows) iterate in
+  // lockstep, each step one batched values() call over the block's unconverged vertices.
+  // Blocks do not depend on the thread count, so neither do the results.
+  constexpr size_t kBlock = 64;
+  size_t nBlocks = (nVerts + kBlock - 1) / kBlock;
+  parallelFor(0, nBlocks, [&](size_t blk) {
+    size_t begin = blk * kBlock, end = std::min(nVerts, begin + kBlock);
+    size_t n = end - begin;
+    // Illinois regula falsi on g(t) = F(lerp(pIn, pOut, t)) − 0.5 with g(0) > 0 >= g(1).
+    std::array<Vec3, kBlock> pIn, pOut, pts;
+    std::array<double, kBlock> a, b, fa, fb, t;
+    std::array<int8_t, kBlock> side;
+    std::array<float, kBlock> out;
+    std::array<uint32_t, kBlock> live;
+    size_t nLive = 0;
+    for (size_t k = 0; k < n; ++k) {
+      const EdgeRec& e = edges[begin + k];
+      pIn[k] = gridPosition(cs, keyCoords(pointKeys[e.inside]));
+      pOut[k] = gridPosition(cs, keyCoords(pointKeys[e.outside]));
+      a[k] = 0.0, b[k] = 1.0, side[k] = 0;
+      fa[k] = double(values[e.inside]) - kIso, fb[k] = double(values[e.outside]) - kIso;
+      t[k] = fa[k] / (fa[k] - fb[k]);
+      if (options.refineSteps > 0) live[nLive++] = uint32_t(k);
+    }
+    for (int step = 0; step < options.refineSteps && nLive > 0; ++step) {
+      for (size_t j = 0; j < nLive; ++j) {
+        uint32_t k = live[j];
+        pts[j] = pIn[k] + float(t[k]) * (pOut[k] - pIn[k]);
       }
-      evals[v] = uint8_t(n);
-      Vec3 p = pIn + float(t) * (pOut - pIn);
+      blob.values(std::span<const Vec3>(pts.data(), nLive), std::span<float>(out.data(), nLive));
+      size_t kept = 0;
+      for (size_t j = 0; j < nLive; ++j) {
+        uint32_t k = live[j];
+        ++evals[begin + k];
+        float f = out[j] - kIso;
+        if (std::fabs(f) < options.fieldTolerance) continue;
+        if (f > 0.0f) {
+          a[k] = t[k], fa[k] = f;
+          if (side[k] == 1) fb[k] *= 0.5;
+          side[k] = 1;
+        } else {
+          b[k] = t[k], fb[k] = f;
+          if (side[k] == -1) fa[k] *= 0.5;
+          side[k] = -1;
+        }
+        if (b[k] - a[k] < 1e-7) continue;
+        t[k] = a[k] + fa[k] * (b[k] - a[k]) / (fa[k] - fb[k]);
+        live[kept++] = k;
+      }
+      nLive = kept;
+    }
+    for (size_t k = 0; k < n; ++k) {
+      size_t v = begin + k;
+      Vec3 p = pIn[k] + float(t[k]) * (pOut[k] - pIn[k]);
       mesh.positions[v] = p;
       if (options.normals || options.attributes) {
-        Sample s = blob.sample(p);
+        Sample smp = blob.sample(p);
         if (options.normals) {
-          float len = glm::length(s.gradient);
-          if (len > 1e-20f && std::isfinite(len)) mesh.normals[v] = -s.gradient / len;
+          float len = glm::length(smp.gradient);
+          if (len > 1e-20f && std::isfinite(len)) mesh.normals[v] = -smp.gradient / len;
           else flatGradient[v] = 1;
         }
         if (options.attributes) {
-          mesh.uvs[v] = s.attributes.uv;
-          res.attributes[v] = s.attributes;
+          mesh.uvs[v] = smp.attributes.uv;
+          res.attributes[v] = smp.attributes;
         }
       }
     }
-    if (bar) bar->advance(end - begin);
-  }, 512);
+    if (bar) bar->advance(n);
+  });
   if (bar) bar->finish();
 
   // Vertices where the gradient vanishes take the area-weighted normal of their triangles.
@@ -409,6 +506,7 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
       }
   }
 
+  res.vertexSeconds = lap();
   size_t total = pointKeys.size() + (options.normals || options.attributes ? nVerts : 0);
   for (uint8_t n : evals) total += n;
   res.fieldEvaluations = total;

@@ -13,17 +13,18 @@
 ///     face added when the bounds dropped it (rounding at corners exactly on F = 0.5).
 ///  4. Marching tetrahedra: each cell with a sign change is split into the six Kuhn
 ///     tetrahedra around its main diagonal (the split of every cube face matches its
-///     neighbour's), and each tetrahedron yields 0, 1 or 2 triangles. Vertices are keyed
-///     by their grid edge, so they are shared exactly: the result is closed and
-///     2-manifold by construction for a closed surface, and triangles are oriented from
-///     inside (F > 0.5) to outside, decided combinatorially on edge midpoints (degenerate
-///     triangles get the right orientation too).
+///     neighbour's), and each tetrahedron yields 0, 1 or 2 triangles. A vertex belongs to
+///     its grid edge, and the edge to the cell whose low corner is the edge's low end, so
+///     vertices are numbered once (owner cell order, then edge direction) and shared
+///     exactly: the result is closed and 2-manifold by construction for a closed surface.
+///     Triangles are oriented from inside (F > 0.5) to outside, decided combinatorially on
+///     edge midpoints (degenerate triangles get the right orientation too).
 ///  5. Projection: every vertex is moved onto the exact F = 0.5 surface by a bracketed
-///     root search (Illinois regula falsi) along its grid edge, which keeps it inside its
-///     cell, so projection never folds the mesh. Normals are −∇F/|∇F| and uv the blended
+///     root search (Illinois regula falsi) along its grid edge (batched values() over
+///     fixed blocks of 64 vertices), so it never leaves its edge or its cell. Normals are −∇F/|∇F| and uv the blended
 ///     primitive (u,v) from CompiledBlob::sample.
-/// Every step runs in parallel over index ranges and merges in sorted key order: the same
-/// blob and options give the same mesh bytes at any thread count.
+/// Every step runs in parallel over fixed index blocks and merges in sorted or index order:
+/// the same blob and options give the same mesh bytes at any thread count.
 ///
 /// Cells with an edge exactly on the surface lean outward (a corner with F = 0.5 counts
 /// as outside), which keeps the topology well defined.
@@ -50,7 +51,7 @@ struct PolygonizeOptions {
   /// Maximum root-search iterations per vertex (0 = keep the linear interpolation).
   int refineSteps = 12;
   /// Root search stops when |F − 0.5| falls below this.
-  float fieldTolerance = 1e-6f;
+  float fieldTolerance = 1e-5f;
   /// Fill Mesh::normals from the gradient.
   bool normals = true;
   /// Fill Mesh::uvs from the blended primitive (u,v) (and the per-vertex attributes of
@@ -70,6 +71,10 @@ struct PolygonizeResult {
   size_t extraCells = 0;        ///< neighbours added where rounding left a face's sign change uncovered
   size_t gridSamples = 0;       ///< distinct grid points sampled
   size_t fieldEvaluations = 0;  ///< every field value computed (grid + root search + samples)
+  double cellSeconds = 0;         ///< time in surfaceCells
+  double sampleSeconds = 0;       ///< grid corner sampling (with the corner table)
+  double triangulateSeconds = 0;  ///< closure, marching tetrahedra, vertex merge
+  double vertexSeconds = 0;       ///< root search, normals and attributes
 };
 
 /// The cell size polygonize() requests for these options (resolves the automatic size).
