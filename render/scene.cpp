@@ -235,6 +235,14 @@ uint32_t Scene::addTexture(ColorTexture texture) {
   return static_cast<uint32_t>(impl_->textures.size() - 1);
 }
 
+uint32_t Scene::addTextures(std::shared_ptr<const textures::TextureRegistry> registry) {
+  if (!registry) throw std::invalid_argument("Scene::addTextures: null registry");
+  uint32_t base = static_cast<uint32_t>(impl_->textures.size());
+  for (textures::TextureId id = 0; id < registry->size(); ++id)
+    impl_->textures.push_back([registry, id](Vec2 uv, const Vec3& p) { return registry->color(id, uv, p); });
+  return base;
+}
+
 Vec3 Scene::attributeColor(const blobtree::Attributes& a, const Vec3& p, const Material& material) const {
   if (a.textureCount == 0 || impl_->textures.empty()) return material.baseColor;
   Vec3 sum(0);

@@ -16,6 +16,7 @@
 #include "core/mesh.h"
 #include "core/types.h"
 #include "lsystem/skeleton.h"
+#include "textures/registry.h"
 
 namespace sprig::blobtree {
 struct PolygonizeResult;
@@ -40,8 +41,11 @@ struct ImplicitOptions {
   /// Edge of the surface cells (one Embree user primitive each), world units; 0 = automatic:
   /// 1.5x the smallest feature radius, clamped to [diagonal/400, diagonal/40].
   float cellSize = 0.0f;
-  /// Root-finding tolerance and step cap of the exact intersection.
+  /// Root-finding tolerance (relative to the model's bounds diagonal) and step cap.
   blobtree::TraceOptions trace;
+  /// March eight samples at a time with batched field evaluation (the same Lipschitz
+  /// guarantee, several times faster); false calls CompiledBlob::intersectCell per cell.
+  bool batched = true;
 };
 
 /// How a skeleton becomes preview geometry.
@@ -100,6 +104,11 @@ class Scene {
   /// Registers a texture; returns its id. Ids are what blob primitives' TextureAttr::textureId
   /// and Material::texture refer to.
   uint32_t addTexture(ColorTexture texture);
+
+  /// Registers every texture of registry, in id order (the registry is shared, not copied);
+  /// returns the scene id of the registry's texture 0. Into an empty texture table, the
+  /// scene ids equal the registry ids that blob primitives carry.
+  uint32_t addTextures(std::shared_ptr<const textures::TextureRegistry> registry);
 
   /// Adds a compiled BlobTree as exact implicit geometry: one Embree user primitive per
   /// surface cell (bounds = the cell box); intersection and occlusion rays call

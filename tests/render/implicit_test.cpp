@@ -1,0 +1,231 @@
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "blobtree/blobtree.h"
+#include "blobtree/compiled.h"
+#include "blobtree/polygonize.h"
+#include "core/rng.h"
+#include "textures/registry.h"
+#include "render/camera.h"
+#include "render/renderer.h"
+#include "render/scene.h"
+
+using namespace sprig;
+using namespace sprig::render;
+
+namespace {
+
+/// A small branch: a trunk cone, two side cones blended in, and a bud.
+blobtree::CompiledBlob branchBlob() {
+  blobtree::BlobTree t;
+  std::vector<blobtree::NodeId> parts;
+  parts.push_back(t.cone(Vec3(0, 0, 0), Vec3(0, 1.2f, 0), 0.16f, 0.11f));
+  parts.push_back(t.cone(Vec3(0, 1.2f, 0), Vec3(0.5f, 1.8f, 0.1f), 0.10f, 0.06f));
+  parts.push_back(t.cone(Vec3(0, 1.2f, 0), Vec3(-0.3f, 2.0f, -0.2f), 0.09f, 0.05f));
+  parts.push_back(t.point(Vec3(0.5f, 1.8f, 0.1f), 0.1f));
+  return blobtree::compile(t, t.blend(parts));
+}
+
+RenderSettings quietSettings(int w, int h) {
+  RenderSettings rs;
+  rs.width = w;
+  rs.height = h;
+  rs.progress = false;
+  return rs;
+}
+
+}  // namespace
+
+TEST_CASE("Scene::addImplicit", "[render]") {
+  blobtree::BlobTree t;
+  auto sphere = t.point(Vec3(0), 1.0f);
+  blobtree::CompiledBlob blob = blobtree::compile(t, sphere);
+  Scene scene;
+  uint32_t id = scene.addImplicit(blob, scene.addMaterial(Material{}));
+  scene.commit();
+  CHECK(scene.stats().implicitCells > 0);
+
+  SECTION("exact hits on the sphere") {
+    for (Vec3 dir : {Vec3(0, 0, -1), glm::normalize(Vec3(-1, -0.5f, -2))}) {
+      Vec3 origin = -6.0f * dir;
+      auto hit = scene.intersect(origin, dir, 0, 100);
+      REQUIRE(hit);
+      CHECK(hit->geometry == id);
+      CHECK(hit->t == Approx(5.0).margin(1e-4));
+      CHECK(glm::length(hit->position) == Approx(1.0).margin(1e-4));
+      CHECK(glm::dot(hit->normal, -dir) == Approx(1.0).margin(1e-3));
+    }
+    CHECK(scene.occluded(Vec3(0, 0, 6), Vec3(0, 0, -1), 0, 100));
+    CHECK_FALSE(scene.occluded(Vec3(0, 0, 6), Vec3(0, 0, -1), 0, 4.9f));
+    CHECK_FALSE(scene.occluded(Vec3(1.05f, 0, 6), Vec3(0, 0, -1), 0, 100));
+  }
+  SECTION("silhouette matches the analytic projection") {
+    // Radius R at distance D projects to a disc of radius (H/2) tan(asin(R/D)) / tan(fov/2).
+    Camera cam = orbitCamera(Vec3(0), 20, 10, 6.0, 30.0);
+    RenderSettings rs = quietSettings(200, 200);
+    rs.spp = 16;
+    rs.background = Background::Transparent;
+    rs.ground = false;
+    Image img = renderImage(scene, cam, rs);
+    double area = 0;
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x < img.width; ++x) area += img.at(x, y).a;
+    double expected = 100.0 * std::tan(std::asin(1.0 / 6.0)) / std::tan(radians(15.0));
+    CHECK(std::sqrt(area / kPi) == Approx(expected).margin(0.25));
+  }
+}
+
+TEST_CASE("render::exact and mesh modes agree", "[render]") {
+  blobtree::CompiledBlob blob = branchBlob();
+  blobtree::PolygonizeOptions po;
+  po.cellSize = 0.01f;
+  blobtree::PolygonizeResult poly = blobtree::polygonizeDetailed(blob, po);
+  REQUIRE(poly.mesh.triangleCount() > 1000);
+
+  Scene exact, mesh;
+  exact.addImplicit(blob, exact.addMaterial(Material{}));
+  mesh.addPolygonized(poly, mesh.addMaterial(Material{}));
+  exact.commit();
+  mesh.commit();
+  Camera cam = frameBounds(exact.bounds(), ViewSpec{}, 1.0);
+  RenderSettings rs = quietSettings(120, 120);
+  rs.background = Background::Transparent;
+  rs.ground = false;
+  Image a = renderImage(exact, cam, rs);
+  Image b = renderImage(mesh, cam, rs);
+
+  // Interior pixels: fully covered in both images over the whole 3x3 neighbourhood.
+  auto covered = [&](int x, int y) {
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        int u = std::clamp(x + dx, 0, 119), v = std::clamp(y + dy, 0, 119);
+        if (a.at(u, v).a < 1.0f || b.at(u, v).a < 1.0f) return false;
+      }
+    return true;
+  };
+  int interior = 0, large = 0;
+  double sum = 0;
+  for (int y = 0; y < 120; ++y)
+    for (int x = 0; x < 120; ++x) {
+      if (!covered(x, y)) continue;
+      Vec4 d = glm::abs(a.at(x, y) - b.at(x, y));
+      float m = std::max({d.r, d.g, d.b});
+      sum += m;
+      large += m > 0.05f;
+      ++interior;
+    }
+  REQUIRE(interior > 500);
+  CHECK(sum / interior < 0.01);
+  CHECK(large < interior / 50);
+  // Coverage agrees too: total alpha within 2%.
+  double ca = 0, cb = 0;
+  for (size_t i = 3; i < a.pixels.size(); i += 4) {
+    ca += a.pixels[i];
+    cb += b.pixels[i];
+  }
+  CHECK(ca == Approx(cb).epsilon(0.02));
+}
+
+TEST_CASE("render::blended textures", "[render]") {
+  // Two blended spheres with different textures: the color varies continuously through the
+  // neck, a field-weighted mix of the two.
+  blobtree::BlobTree t;
+  blobtree::TextureAttr red, blue;
+  red.textureId = 0;
+  blue.textureId = 1;
+  std::vector<blobtree::NodeId> parts{t.point(Vec3(-0.6f, 0, 0), 0.6f, red), t.point(Vec3(0.6f, 0, 0), 0.6f, blue)};
+  blobtree::CompiledBlob blob = blobtree::compile(t, t.blend(parts));
+  Scene scene;
+  scene.addTexture([](Vec2, const Vec3&) { return Vec3(1, 0, 0); });
+  scene.addTexture([](Vec2, const Vec3&) { return Vec3(0, 0, 1); });
+  scene.addImplicit(blob, scene.addMaterial(Material{}));
+  scene.commit();
+  float previous = -1;
+  for (int i = 0; i <= 20; ++i) {
+    float x = -1.0f + 0.1f * static_cast<float>(i);
+    auto hit = scene.intersect(Vec3(x, 0, 5), Vec3(0, 0, -1), 0, 100);
+    REQUIRE(hit);
+    CHECK(hit->color.r + hit->color.b == Approx(1.0f).margin(1e-4));
+    CHECK(hit->color.b >= previous - 1e-4f);  // monotone from red to blue
+    if (i > 0) CHECK(hit->color.b - previous < 0.35f);  // no jump
+    previous = hit->color.b;
+  }
+  auto mid = scene.intersect(Vec3(0, 0, 5), Vec3(0, 0, -1), 0, 100);
+  REQUIRE(mid);
+  CHECK(mid->color.r == Approx(0.5f).margin(0.01));
+}
+
+TEST_CASE("render::exact mode determinism", "[render]") {
+  Scene scene;
+  scene.addImplicit(branchBlob(), scene.addMaterial(Material{}));
+  scene.commit();
+  Camera cam = frameBounds(scene.bounds(), ViewSpec{}, 1.0);
+  RenderSettings rs = quietSettings(64, 64);
+  rs.threads = 2;
+  Image a = renderImage(scene, cam, rs);
+  rs.threads = 1;
+  Image b = renderImage(scene, cam, rs);
+  CHECK(a.pixels == b.pixels);
+}
+
+TEST_CASE("Scene::addImplicit batched tracing", "[render]") {
+  // The batched cell tracer and CompiledBlob::intersectCell find the same first hits.
+  blobtree::CompiledBlob blob = branchBlob();
+  Scene batched, reference;
+  ImplicitOptions opt;
+  batched.addImplicit(blob, batched.addMaterial(Material{}), opt);
+  opt.batched = false;
+  reference.addImplicit(blob, reference.addMaterial(Material{}), opt);
+  batched.commit();
+  reference.commit();
+  const uint64_t seed = 20261122;
+  INFO("seed " << seed);
+  Rng rng(seed);
+  Box3 b = blob.bounds();
+  int hits = 0;
+  for (int i = 0; i < 400; ++i) {
+    Vec3 target = b.lo + Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * b.size() * 0.6f + 0.2f * b.size();
+    Vec3 origin = target + 4.0f * glm::normalize(Vec3(rng.normal(), rng.normal(), rng.normal()));
+    Vec3 dir = glm::normalize(target - origin);
+    auto a = batched.intersect(origin, dir, 0, 100);
+    auto r = reference.intersect(origin, dir, 0, 100);
+    REQUIRE(a.has_value() == r.has_value());
+    CHECK(batched.occluded(origin, dir, 0, 100) == a.has_value());
+    if (!a) continue;
+    ++hits;
+    CHECK(a->t == Approx(r->t).margin(1e-4));
+    CHECK(std::abs(blob.value(a->position) - 0.5f) < 1e-3f);
+    CHECK(glm::dot(a->normal, r->normal) > 0.999f);
+  }
+  CHECK(hits > 50);
+}
+
+TEST_CASE("Scene::addTextures", "[render]") {
+  // Registry textures color blob primitives by id; two models side by side in one scene.
+  auto registry = std::make_shared<textures::TextureRegistry>();
+  registry->add(textures::ConstantTexture{Vec3(0.8f, 0.1f, 0.1f)});
+  registry->add(textures::ConstantTexture{Vec3(0.1f, 0.7f, 0.2f)});
+  blobtree::BlobTree t;
+  blobtree::TextureAttr green;
+  green.textureId = 1;
+  blobtree::CompiledBlob left = blobtree::compile(t, t.point(Vec3(-2, 0, 0), 1.0f));
+  blobtree::CompiledBlob right = blobtree::compile(t, t.point(Vec3(2, 0, 0), 1.0f, green));
+  Scene scene;
+  CHECK(scene.addTextures(registry) == 0);
+  uint32_t m = scene.addMaterial(Material{});
+  uint32_t a = scene.addImplicit(left, m), b = scene.addImplicit(right, m);
+  scene.commit();
+  auto hl = scene.intersect(Vec3(-2, 0, 5), Vec3(0, 0, -1), 0, 100);
+  auto hr = scene.intersect(Vec3(2, 0, 5), Vec3(0, 0, -1), 0, 100);
+  REQUIRE(hl);
+  REQUIRE(hr);
+  CHECK(hl->geometry == a);
+  CHECK(hr->geometry == b);
+  CHECK(hl->color.r == Approx(0.8f));
+  CHECK(hr->color.g == Approx(0.7f));
+  CHECK(scene.bounds().lo.x < -2.9f);
+  CHECK(scene.bounds().hi.x > 2.9f);
+}
