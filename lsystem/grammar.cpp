@@ -508,8 +508,8 @@ class Parser {
       }
       once(block == Block::Decomposition ? "decomposition maximum depth" : "interpretation maximum depth", line, b);
       if (auto d = constantExpr(value, "maximum depth")) {
-        if (*d < 1 || *d != std::floor(*d) || *d > 10000)
-          error(line, value.b, "maximum depth must be a whole number from 1 to 10000, got " + formatNumber(*d));
+        if (*d < 1 || *d != std::floor(*d) || *d > 256)
+          error(line, value.b, "maximum depth must be a whole number from 1 to 256, got " + formatNumber(*d));
         else
           (block == Block::Decomposition ? prog_.decomposition : prog_.interpretation).maxDepth = static_cast<int>(*d);
       }
@@ -713,7 +713,9 @@ class Parser {
     std::vector<Node> nodes;
     Tok tok;
     int pos = 0;
+    int depth = 0;  ///< nesting of unary operators and parentheses
   };
+  static constexpr int kMaxNesting = 48;
 
   void lex(ExprState& st) {
     const std::string& s = clean_[st.span.line - 1];
@@ -814,6 +816,14 @@ class Parser {
   }
 
   int parseUnary(ExprState& st) {
+    if (++st.depth > kMaxNesting) {
+      error(st.span.line, st.tok.col, "expression is nested too deeply (more than " + std::to_string(kMaxNesting) + " levels)");
+      throw ExprFail{};
+    }
+    struct Leave {
+      int& d;
+      ~Leave() { --d; }
+    } leave{st.depth};
     if (isPunct(st, "-")) {
       lex(st);
       return node(st, Op::Neg, parseUnary(st));

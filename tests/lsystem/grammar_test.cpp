@@ -139,7 +139,7 @@ TEST_CASE("parseGrammar errors: exact messages and positions", "[lsystem]") {
       {"ignore: [\naxiom: F\n", "g.lsys:1:9: error: brackets cannot be ignored or considered: context matching always follows them"},
       {"ignore: F\nconsider: G\naxiom: F\n", "g.lsys:2:1: error: use either 'ignore:' or 'consider:', not both"},
       {"maximum depth: 2\naxiom: F\n", "g.lsys:1:1: error: 'maximum depth:' belongs in a 'decomposition:' or 'interpretation:' block"},
-      {"axiom: F\ndecomposition:\nmaximum depth: 0\n", "g.lsys:3:16: error: maximum depth must be a whole number from 1 to 10000, got 0"},
+      {"axiom: F\ndecomposition:\nmaximum depth: 0\n", "g.lsys:3:16: error: maximum depth must be a whole number from 1 to 256, got 0"},
       {"axiom: F\n --> F\n", "g.lsys:2:2: error: missing predecessor before '-->'"},
       {"axiom: F\nAB --> F\n", "g.lsys:2:2: error: a predecessor must be a single module"},
       {"axiom: F\n[ --> F\n", "g.lsys:2:1: error: a bracket cannot be a predecessor"},
@@ -176,6 +176,13 @@ TEST_CASE("parseGrammar errors: exact messages and positions", "[lsystem]") {
     INFO(c.text);
     CHECK(errorsOf(c.text) == c.message);
   }
+}
+
+TEST_CASE("parseGrammar deep nesting is an error, not a crash", "[lsystem]") {
+  std::string text = "axiom: F\nA(x) --> B(" + std::string(50, '(') + "x" + std::string(50, ')') + ")\n";
+  CHECK(errorsOf(text) == "g.lsys:2:60: error: expression is nested too deeply (more than 48 levels)");
+  std::string minus = "axiom: F\nA(x) --> B(" + std::string(5000, '-') + "x)\n";
+  CHECK(errorsOf(minus) == "g.lsys:2:60: error: expression is nested too deeply (more than 48 levels)");
 }
 
 TEST_CASE("parseGrammar collects every error before throwing", "[lsystem]") {
