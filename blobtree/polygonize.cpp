@@ -1,7 +1,5 @@
 #include "blobtree/polygonize.h"
 
-#include <tbb/parallel_sort.h>
-
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -79,12 +77,6 @@ class CellHash {
   std::vector<uint64_t> keys_;
   std::vector<uint32_t> ids_;
   size_t mask_ = 0;
-};
-
-struct CornerRef {
-  uint64_t key;
-  uint32_t slot;  // cell · 8 + corner
-  bool operator<(const CornerRef& o) const { return key != o.key ? key < o.key : slot < o.slot; }
 };
 
 // A surface-crossing grid edge: its inside and outside grid point indices.
@@ -211,52 +203,68 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
         throw std::invalid_argument("polygonize: the grid has more than 2^20 cells on an axis; use a larger cell size");
 
   // ---- 2. One sample per distinct cell corner ---------------------------------------
-  std::vector<CornerRef> refs(nCells * 8);
+  // A grid point g belongs to the kept cell g − offset(c') with the smallest corner code c'
+  // (the cell whose low corner it is, when kept). Points are numbered by owner cell, then
+  // by corner code: no sort, and the numbering does not depend on the thread count.
+  CellHash cellIndex(nCells);
+  for (size_t i = 0; i < nCells; ++i) {
+    const auto& idx = cs.cells[i].index;
+    cellIndex.insert(pointKey(idx[0], idx[1], idx[2]), uint32_t(i));
+  }
+  // The owner slot (cell · 8 + corner) of grid point g, or kNoCell when no kept cell holds it.
+  auto ownerSlot = [&](glm::ivec3 g) -> uint32_t {
+    for (int c = 0; c < 8; ++c) {
+      glm::ivec3 lo = g - cornerOffset(c);
+      if (lo.x < 0 || lo.y < 0 || lo.z < 0) continue;
+      uint32_t j = cellIndex.find(pointKey(lo.x, lo.y, lo.z));
+      if (j != kNoCell) return j * 8 + uint32_t(c);
+    }
+    return kNoCell;
+  };
+  std::vector<uint32_t> cornerPoint(nCells * 8);  // first the owner slot, then the point index
+  std::vector<uint8_t> ownedMask(nCells);
+  std::vector<uint32_t> pointBase(nCells + 1, 0);
+  parallelFor(0, nCells, [&](size_t i) {
+    const auto& idx = cs.cells[i].index;
+    uint8_t owned = 0;
+    for (int c = 0; c < 8; ++c) {
+      uint32_t slot = ownerSlot(glm::ivec3(idx[0], idx[1], idx[2]) + cornerOffset(c));
+      cornerPoint[i * 8 + size_t(c)] = slot;
+      if (slot == uint32_t(i * 8 + size_t(c))) owned |= uint8_t(1u << c);
+    }
+    ownedMask[i] = owned;
+    pointBase[i + 1] = uint32_t(std::popcount(unsigned(owned)));
+  }, 1024);
+  for (size_t i = 0; i < nCells; ++i) pointBase[i + 1] += pointBase[i];
+  auto pointOfSlot = [&](uint32_t slot) {
+    uint32_t j = slot / 8, c = slot % 8;
+    return pointBase[j] + uint32_t(std::popcount(unsigned(ownedMask[j]) & ((1u << c) - 1u)));
+  };
+  const size_t nPoints = pointBase[nCells];
+  std::vector<uint64_t> pointKeys(nPoints);
   parallelFor(0, nCells, [&](size_t i) {
     const auto& idx = cs.cells[i].index;
     for (int c = 0; c < 8; ++c) {
-      glm::ivec3 g = glm::ivec3(idx[0], idx[1], idx[2]) + cornerOffset(c);
-      refs[i * 8 + c] = {pointKey(g.x, g.y, g.z), uint32_t(i * 8 + c)};
+      uint32_t& cp = cornerPoint[i * 8 + size_t(c)];
+      cp = pointOfSlot(cp);
+      if ((ownedMask[i] >> c) & 1) {
+        glm::ivec3 g = glm::ivec3(idx[0], idx[1], idx[2]) + cornerOffset(c);
+        pointKeys[cp] = pointKey(g.x, g.y, g.z);
+      }
     }
   }, 1024);
-  tbb::parallel_sort(refs.begin(), refs.end());
-
-  std::vector<uint32_t> cornerPoint(nCells * 8);
-  std::vector<uint64_t> pointKeys;
-  std::vector<uint32_t> pointOwner;  // the lowest-index cell holding the point evaluates it
-  pointKeys.reserve(nCells * 2);
-  pointOwner.reserve(nCells * 2);
-  for (size_t r = 0; r < refs.size(); ++r) {
-    if (r == 0 || refs[r].key != refs[r - 1].key) {
-      pointKeys.push_back(refs[r].key);
-      pointOwner.push_back(refs[r].slot / 8);
-    }
-    cornerPoint[refs[r].slot] = uint32_t(pointKeys.size() - 1);
-  }
-  std::vector<CornerRef>().swap(refs);
-  const size_t nPoints = pointKeys.size();
   res.gridSamples = nPoints;
-
-  // Points grouped by owning cell (counting sort, stable in point order).
-  std::vector<uint32_t> ownedStart(nCells + 1, 0), owned(nPoints);
-  for (uint32_t owner : pointOwner) ++ownedStart[owner + 1];
-  for (size_t i = 0; i < nCells; ++i) ownedStart[i + 1] += ownedStart[i];
-  {
-    std::vector<uint32_t> fill(ownedStart.begin(), ownedStart.end() - 1);
-    for (size_t u = 0; u < nPoints; ++u) owned[fill[pointOwner[u]]++] = uint32_t(u);
-  }
-  std::vector<uint32_t>().swap(pointOwner);
 
   std::vector<float> values(nPoints);
   parallelForRange(0, nCells, [&](size_t begin, size_t end) {
     std::array<Vec3, 8> pts;
     std::array<float, 8> out;
     for (size_t i = begin; i < end; ++i) {
-      uint32_t b = ownedStart[i], n = ownedStart[i + 1] - b;
+      uint32_t b = pointBase[i], n = pointBase[i + 1] - b;
       if (n == 0) continue;
-      for (uint32_t k = 0; k < n; ++k) pts[k] = gridPosition(cs, keyCoords(pointKeys[owned[b + k]]));
+      for (uint32_t k = 0; k < n; ++k) pts[k] = gridPosition(cs, keyCoords(pointKeys[b + k]));
       blob.valuesInCell(cs.cells[i], std::span<const Vec3>(pts.data(), n), std::span<float>(out.data(), n));
-      for (uint32_t k = 0; k < n; ++k) values[owned[b + k]] = out[k];
+      for (uint32_t k = 0; k < n; ++k) values[b + k] = out[k];
     }
   }, 256);
   if (options.progress && ProgressSettings::cancelRequested()) throw Cancelled();
@@ -285,14 +293,11 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
   size_t extraCells = 0;
   std::map<uint64_t, uint32_t> extraPoints;  // grid points sampled for added cells
   {
-    std::vector<uint64_t> known(nCells);
-    for (size_t i = 0; i < nCells; ++i) known[i] = pointKey(cellCoords[i].x, cellCoords[i].y, cellCoords[i].z);
-    std::sort(known.begin(), known.end());
     std::map<uint64_t, uint32_t> addedCells;
     auto pointIndex = [&](glm::ivec3 g) -> uint32_t {
       uint64_t key = pointKey(g.x, g.y, g.z);
-      auto it = std::lower_bound(pointKeys.begin(), pointKeys.begin() + nPoints, key);
-      if (it != pointKeys.begin() + nPoints && *it == key) return uint32_t(it - pointKeys.begin());
+      uint32_t slot = ownerSlot(g);
+      if (slot != kNoCell) return pointOfSlot(slot);
       auto [e, inserted] = extraPoints.emplace(key, uint32_t(pointKeys.size()));
       if (inserted) {
         pointKeys.push_back(key);
@@ -316,7 +321,7 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
             n[axis] += side ? 1 : -1;
             if (n[axis] < 0 || n[axis] + 1 >= kAxisLimit) continue;
             uint64_t key = pointKey(n.x, n.y, n.z);
-            if (!std::binary_search(known.begin(), known.end(), key) && !addedCells.count(key)) wanted.push_back(key);
+            if (cellIndex.find(key) == kNoCell && !addedCells.count(key)) wanted.push_back(key);
           }
       }
       std::sort(wanted.begin(), wanted.end());

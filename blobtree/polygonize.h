@@ -5,10 +5,11 @@
 ///  1. Cells: CompiledBlob::surfaceCells(cellSize) finds, by interval bounds and octree
 ///     subdivision, the cube cells of a regular grid that may hold the F = 0.5 surface.
 ///     No other cell is visited.
-///  2. Samples: the field is sampled once at every distinct corner of those cells, each
-///     corner evaluated in a batch with the other corners of one owning cell over that
-///     cell's short primitive list (CompiledBlob::valuesInCell). One value per grid point
-///     keeps neighbouring cells consistent.
+///  2. Samples: the field is sampled once at every distinct corner of those cells. A grid
+///     point belongs to the kept cell holding it with the smallest corner code (found in a
+///     hash of cell keys, no sort) and is evaluated in a batch with that cell's other owned
+///     corners over the cell's short primitive list (CompiledBlob::valuesInCell). One
+///     value per grid point keeps neighbouring cells consistent.
 ///  3. Closure: a kept cell whose face shows a sign change gets its neighbour across that
 ///     face added when the bounds dropped it (rounding at corners exactly on F = 0.5).
 ///  4. Marching tetrahedra: each cell with a sign change is split into the six Kuhn
