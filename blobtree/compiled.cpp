@@ -3,6 +3,8 @@
 #include "blobtree/detail/tape.h"
 #include "core/parallel.h"
 
+#include <immintrin.h>
+
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -69,6 +71,82 @@ int32_t buildBvh(Tape& tape, const std::vector<Box3>& boxes, const std::vector<u
   return root;
 }
 
+namespace {
+inline uint64_t cellKey(int x, int y, int z) {
+  return (uint64_t(uint32_t(x + (1 << 20)) & 0x1FFFFF) << 42) | (uint64_t(uint32_t(y + (1 << 20)) & 0x1FFFFF) << 21) |
+         uint64_t(uint32_t(z + (1 << 20)) & 0x1FFFFF);
+}
+inline uint32_t hashKey(uint64_t k) {
+  k ^= k >> 33;
+  k *= 0xff51afd7ed558ccdULL;
+  k ^= k >> 33;
+  return uint32_t(k);
+}
+}  // namespace
+
+int32_t buildGrid(Tape& tape, const std::vector<Box3>& boxes, const std::vector<uint32_t>& items) {
+  PointGrid g;
+  std::vector<float> ext;
+  Box3 all;
+  for (const Box3& b : boxes) {
+    if (b.empty() || isHuge(b)) continue;
+    Vec3 e = b.size();
+    ext.push_back(std::max(e.x, std::max(e.y, e.z)));
+    all.extend(b);
+  }
+  if (ext.empty()) return -1;
+  std::nth_element(ext.begin(), ext.begin() + long(ext.size() / 2), ext.end());
+  float cell = std::max(ext[ext.size() / 2], 1e-6f);
+  // Keep the grid's key range within 21 bits per axis.
+  Vec3 span = all.size();
+  cell = std::max(cell, std::max(span.x, std::max(span.y, span.z)) / float(1 << 19));
+  g.origin = all.lo;
+  g.bounds = all;
+  g.invCell = 1.0f / cell;
+  std::vector<std::pair<uint64_t, uint32_t>> pairs;
+  for (size_t i = 0; i < boxes.size(); ++i) {
+    const Box3& b = boxes[i];
+    if (b.empty()) continue;
+    if (isHuge(b)) {
+      g.always.push_back(items[i]);
+      continue;
+    }
+    glm::ivec3 lo = glm::ivec3(glm::floor((b.lo - g.origin) * g.invCell));
+    glm::ivec3 hi = glm::ivec3(glm::floor((b.hi - g.origin) * g.invCell));
+    glm::ivec3 n = hi - lo + 1;
+    if (int64_t(n.x) * n.y * n.z > 512) {
+      g.always.push_back(items[i]);
+      continue;
+    }
+    for (int z = lo.z; z <= hi.z; ++z)
+      for (int y = lo.y; y <= hi.y; ++y)
+        for (int x = lo.x; x <= hi.x; ++x) pairs.push_back({cellKey(x, y, z), items[i]});
+  }
+  std::sort(pairs.begin(), pairs.end());
+  size_t unique = 0;
+  for (size_t i = 0; i < pairs.size(); ++i)
+    if (i == 0 || pairs[i].first != pairs[i - 1].first) ++unique;
+  uint32_t cap = 16;
+  while (cap < 2 * unique) cap *= 2;
+  g.mask = cap - 1;
+  g.tableKey.assign(cap, PointGrid::kEmptyKey);
+  g.tableFirst.assign(cap, 0);
+  g.tableCount.assign(cap, 0);
+  for (size_t i = 0; i < pairs.size();) {
+    size_t j = i;
+    while (j < pairs.size() && pairs[j].first == pairs[i].first) ++j;
+    uint32_t slot = hashKey(pairs[i].first) & g.mask;
+    while (g.tableKey[slot] != PointGrid::kEmptyKey) slot = (slot + 1) & g.mask;
+    g.tableKey[slot] = pairs[i].first;
+    g.tableFirst[slot] = uint32_t(g.items.size());
+    g.tableCount[slot] = uint32_t(j - i);
+    for (size_t k = i; k < j; ++k) g.items.push_back(pairs[k].second);
+    i = j;
+  }
+  tape.grids.push_back(std::move(g));
+  return int32_t(tape.grids.size() - 1);
+}
+
 }  // namespace detail
 
 namespace {
@@ -96,6 +174,24 @@ inline void walkBvh(const Tape& T, int32_t root, Test&& test, F&& f) {
 /// Calls f(childTapeIndex) for the children of n that may be non-zero at p.
 template <class F>
 inline void childrenAt(const Tape& T, const TNode& n, Vec3 p, F&& f) {
+  if (n.grid >= 0) {
+    const PointGrid& g = T.grids[size_t(n.grid)];
+    for (uint32_t c : g.always) f(c);
+    if (!g.bounds.contains(p)) return;
+    Vec3 q = glm::floor((p - g.origin) * g.invCell);
+    uint64_t key = cellKey(int(q.x), int(q.y), int(q.z));
+    uint32_t slot = hashKey(key) & g.mask;
+    while (true) {
+      uint64_t k = g.tableKey[slot];
+      if (k == key) {
+        const uint32_t* it = g.items.data() + g.tableFirst[slot];
+        for (uint32_t i = 0, e = g.tableCount[slot]; i < e; ++i) f(it[i]);
+        return;
+      }
+      if (k == PointGrid::kEmptyKey) return;
+      slot = (slot + 1) & g.mask;
+    }
+  }
   if (n.bvh >= 0) {
     walkBvh(T, n.bvh, [&](const Box3& b) { return b.contains(p); }, f);
   } else {
@@ -133,16 +229,20 @@ struct RicciAcc {
 
 // ---- Value ---------------------------------------------------------------------------------
 
+/// The heavy parameters of an operator node.
+inline const TParams& params(const Tape& T, const TNode& n) { return T.params[n.prim]; }
+
 float evalV(const Tape& T, uint32_t ni, Vec3 p, bool cull);
 
-inline Vec3 warpLocal(const TNode& n, Vec3 p, Mat3* jt) {
+inline Vec3 warpLocal(const Tape& T, const TNode& n, Vec3 p, Mat3* jt) {
+  const TParams& P = params(T, n);
   switch (n.kind) {
     case NodeKind::Transform:
-      if (jt) *jt = n.jt;
-      return Vec3(n.localFromWorld * Vec4(p, 1.0f));
-    case NodeKind::Bend: return n.bend.localFromWorld(p, jt);
-    case NodeKind::Twist: return twistLocal(n.twist, p, jt);
-    case NodeKind::Taper: return taperLocal(n.taper, p, jt);
+      if (jt) *jt = P.jt;
+      return Vec3(P.localFromWorld * Vec4(p, 1.0f));
+    case NodeKind::Bend: return P.bend.localFromWorld(p, jt);
+    case NodeKind::Twist: return twistLocal(P.twist, p, jt);
+    case NodeKind::Taper: return taperLocal(P.taper, p, jt);
     default: return p;
   }
 }
@@ -189,7 +289,7 @@ float evalV(const Tape& T, uint32_t ni, Vec3 p, bool cull) {
       float fmax = 0.0f, dsum = 0.0f, dmax = 0.0f;
       auto add = [&](uint32_t c) {
         float f = std::max(0.0f, evalV(T, c, p, cull));
-        float d = pcmD(n.pcm, f, nullptr);
+        float d = pcmD(params(T, n).pcm, f, nullptr);
         dsum += d;
         if (f > fmax) { fmax = f; dmax = d; }
       };
@@ -201,7 +301,7 @@ float evalV(const Tape& T, uint32_t ni, Vec3 p, bool cull) {
     case NodeKind::Transform:
     case NodeKind::Bend:
     case NodeKind::Twist:
-    case NodeKind::Taper: return evalV(T, T.kids[n.first], warpLocal(n, p, nullptr), cull);
+    case NodeKind::Taper: return evalV(T, T.kids[n.first], warpLocal(T, n, p, nullptr), cull);
   }
   return 0.0f;
 }
@@ -337,7 +437,7 @@ SV evalS(const Tape& T, uint32_t ni, Vec3 p) {
         float f = std::max(0.0f, s.v);
         if (s.v < 0.0f) s.g = Vec3(0.0f);
         float dp;
-        float d = pcmD(n.pcm, f, &dp);
+        float d = pcmD(params(T, n).pcm, f, &dp);
         dsum += d;
         gsum += dp * s.g;
         r.acc.merge(s.acc);
@@ -360,7 +460,7 @@ SV evalS(const Tape& T, uint32_t ni, Vec3 p) {
     case NodeKind::Twist:
     case NodeKind::Taper: {
       Mat3 jt;
-      Vec3 q = warpLocal(n, p, &jt);
+      Vec3 q = warpLocal(T, n, p, &jt);
       SV s = evalS(T, T.kids[n.first], q);
       s.g = jt * s.g;
       return s;
@@ -374,19 +474,19 @@ SV evalS(const Tape& T, uint32_t ni, Vec3 p) {
 Box3 localBoxOf(const TNode& n, const Tape& T, const Box3& box) {
   const Box3& cb = T.nodes[T.kids[n.first]].box;
   switch (n.kind) {
-    case NodeKind::Transform: return transformBox(n.localFromWorld, box);
-    case NodeKind::Bend: return n.bend.localBox(box, cb);
+    case NodeKind::Transform: return transformBox(params(T, n).localFromWorld, box);
+    case NodeKind::Bend: return params(T, n).bend.localBox(box, cb);
     case NodeKind::Twist: {
       float h0, h1, r;
-      axialExtent(box, n.twist.origin, n.twist.axis, h0, h1, r);
-      return cylinderBox(n.twist.origin, n.twist.axis, h0, h1, r).intersected(cb);
+      axialExtent(box, params(T, n).twist.origin, params(T, n).twist.axis, h0, h1, r);
+      return cylinderBox(params(T, n).twist.origin, params(T, n).twist.axis, h0, h1, r).intersected(cb);
     }
     case NodeKind::Taper: {
       float h0, h1, r;
-      axialExtent(box, n.taper.origin, n.taper.axis, h0, h1, r);
-      float smin = std::min(taperScale(n.taper, h0), taperScale(n.taper, h1));
+      axialExtent(box, params(T, n).taper.origin, params(T, n).taper.axis, h0, h1, r);
+      float smin = std::min(taperScale(params(T, n).taper, h0), taperScale(params(T, n).taper, h1));
       if (smin <= 0.0f) return cb;
-      return cylinderBox(n.taper.origin, n.taper.axis, h0, h1, r / smin).intersected(cb);
+      return cylinderBox(params(T, n).taper.origin, params(T, n).taper.axis, h0, h1, r / smin).intersected(cb);
     }
     default: return box;
   }
@@ -449,7 +549,7 @@ Interval evalI(const Tape& T, uint32_t ni, const Box3& box) {
     }
     case NodeKind::Pcm: {
       float maxLo = 0.0f, maxHi = 0.0f, dLo = 0.0f, dHi = 0.0f;
-      const PcmDerived& d = n.pcm;
+      const PcmDerived& d = params(T, n).pcm;
       childrenIn(T, n, box, [&](uint32_t c) {
         Interval i = evalI(T, c, box);
         float lo = std::max(0.0f, i.lo), hi = std::max(0.0f, i.hi);
@@ -494,7 +594,7 @@ float evalLocalL(const Tape& T, uint32_t ni, const Box3& box) {
     case NodeKind::Pcm: {
       float s = 0.0f;
       childrenIn(T, n, box, [&](uint32_t c) { s += evalL(T, c, box); });
-      return n.kind == NodeKind::Pcm ? s * (1.0f + n.pcm.maxSlope) : s;
+      return n.kind == NodeKind::Pcm ? s * (1.0f + params(T, n).pcm.maxSlope) : s;
     }
     case NodeKind::Union:
     case NodeKind::Intersect:
@@ -504,20 +604,20 @@ float evalLocalL(const Tape& T, uint32_t ni, const Box3& box) {
       return m;
     }
     case NodeKind::Negative: return n.weight * evalL(T, T.kids[n.first], box);
-    case NodeKind::Transform: return n.jNorm * evalL(T, T.kids[n.first], transformBox(n.localFromWorld, box));
+    case NodeKind::Transform: return params(T, n).jNorm * evalL(T, T.kids[n.first], transformBox(params(T, n).localFromWorld, box));
     case NodeKind::Bend:
-      return n.bend.jacobianBound(box) * evalL(T, T.kids[n.first], n.bend.localBox(box, T.nodes[T.kids[n.first]].box));
+      return params(T, n).bend.jacobianBound(box) * evalL(T, T.kids[n.first], params(T, n).bend.localBox(box, T.nodes[T.kids[n.first]].box));
     case NodeKind::Twist: {
       float h0, h1, r;
-      axialExtent(box, n.twist.origin, n.twist.axis, h0, h1, r);
-      return (1.0f + std::abs(n.twist.rateRadPerUnit) * r) * evalL(T, T.kids[n.first], localBoxOf(n, T, box));
+      axialExtent(box, params(T, n).twist.origin, params(T, n).twist.axis, h0, h1, r);
+      return (1.0f + std::abs(params(T, n).twist.rateRadPerUnit) * r) * evalL(T, T.kids[n.first], localBoxOf(n, T, box));
     }
     case NodeKind::Taper: {
       float h0, h1, r;
-      axialExtent(box, n.taper.origin, n.taper.axis, h0, h1, r);
-      float smin = std::min(taperScale(n.taper, h0), taperScale(n.taper, h1));
+      axialExtent(box, params(T, n).taper.origin, params(T, n).taper.axis, h0, h1, r);
+      float smin = std::min(taperScale(params(T, n).taper, h0), taperScale(params(T, n).taper, h1));
       if (smin <= 0.0f) return n.lip;
-      float ds = std::abs(n.taper.scale1 - n.taper.scale0) / n.taper.length;
+      float ds = std::abs(params(T, n).taper.scale1 - params(T, n).taper.scale0) / params(T, n).taper.length;
       return (1.0f / smin + 1.0f + ds * r / (smin * smin)) * evalL(T, T.kids[n.first], localBoxOf(n, T, box));
     }
   }
@@ -526,7 +626,7 @@ float evalLocalL(const Tape& T, uint32_t ni, const Box3& box) {
 
 // ---- Batched values ------------------------------------------------------------------------
 
-constexpr int kBlock = 128;  ///< points per batch (a multiple of 8)
+constexpr int kBlock = 256;  ///< points per batch (a multiple of 8)
 
 struct Pts {
   const float* x;
@@ -536,58 +636,59 @@ struct Pts {
   int n8;  ///< padded count (multiple of 8, <= kBlock)
 };
 
-/// out[i] (+)= cone/segment field; vectorizable inner loop.
+/// g(s) for 4 lanes, s already clamped to [0, 1].
+template <Kernel K>
+inline __m128 kernel4(__m128 s) {
+  const __m128 one = _mm_set1_ps(1.0f);
+  if constexpr (K == Kernel::Wyvill) {
+    __m128 u = _mm_sub_ps(one, s);
+    return _mm_mul_ps(_mm_mul_ps(u, u), u);
+  } else {
+    __m128 q = _mm_sub_ps(_mm_set1_ps(17.0f / 9.0f), _mm_mul_ps(s, _mm_set1_ps(4.0f / 9.0f)));
+    q = _mm_add_ps(_mm_set1_ps(-22.0f / 9.0f), _mm_mul_ps(s, q));
+    return _mm_add_ps(one, _mm_mul_ps(s, q));
+  }
+}
+
+/// out[i] (+)= cone/segment field over the batch, 4 points per SSE step (the batch is
+/// padded to a multiple of 8).
 template <Kernel K, bool Add>
 void coneBatch(const Prim& P, const Pts& pts, float* __restrict out) {
-  const float ax = P.a.x, ay = P.a.y, az = P.a.z;
-  const float bx = P.ab.x, by = P.ab.y, bz = P.ab.z;
-  const float il = P.invLen2, R0 = P.R0, dR = P.dR, w = P.weight;
-  const float* __restrict X = pts.x;
-  const float* __restrict Y = pts.y;
-  const float* __restrict Z = pts.z;
-  for (int i0 = 0; i0 < pts.n8; i0 += 8) {
-    for (int j = 0; j < 8; ++j) {
-      int i = i0 + j;
-      float px = X[i] - ax, py = Y[i] - ay, pz = Z[i] - az;
-      float t = (px * bx + py * by + pz * bz) * il;
-      t = t < 0.0f ? 0.0f : (t > 1.0f ? 1.0f : t);
-      float dx = px - t * bx, dy = py - t * by, dz = pz - t * bz;
-      float d2 = dx * dx + dy * dy + dz * dz;
-      float R = R0 + dR * t;
-      float s = d2 / (R * R);
-      s = s > 1.0f ? 1.0f : s;
-      float g;
-      if constexpr (K == Kernel::Wyvill) {
-        float u = 1.0f - s;
-        g = u * u * u;
-      } else {
-        g = 1.0f + s * (-22.0f / 9.0f + s * (17.0f / 9.0f - s * (4.0f / 9.0f)));
-      }
-      if constexpr (Add) out[i] += w * g;
-      else out[i] = w * g;
-    }
+  const __m128 ax = _mm_set1_ps(P.a.x), ay = _mm_set1_ps(P.a.y), az = _mm_set1_ps(P.a.z);
+  const __m128 bx = _mm_set1_ps(P.ab.x), by = _mm_set1_ps(P.ab.y), bz = _mm_set1_ps(P.ab.z);
+  const __m128 il = _mm_set1_ps(P.invLen2), R0 = _mm_set1_ps(P.R0), dR = _mm_set1_ps(P.dR), w = _mm_set1_ps(P.weight);
+  const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
+  for (int i = 0; i < pts.n8; i += 4) {
+    __m128 px = _mm_sub_ps(_mm_loadu_ps(pts.x + i), ax);
+    __m128 py = _mm_sub_ps(_mm_loadu_ps(pts.y + i), ay);
+    __m128 pz = _mm_sub_ps(_mm_loadu_ps(pts.z + i), az);
+    __m128 t = _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(px, bx), _mm_mul_ps(py, by)), _mm_mul_ps(pz, bz)), il);
+    t = _mm_min_ps(_mm_max_ps(t, zero), one);
+    __m128 dx = _mm_sub_ps(px, _mm_mul_ps(t, bx));
+    __m128 dy = _mm_sub_ps(py, _mm_mul_ps(t, by));
+    __m128 dz = _mm_sub_ps(pz, _mm_mul_ps(t, bz));
+    __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+    __m128 R = _mm_add_ps(R0, _mm_mul_ps(dR, t));
+    __m128 s = _mm_min_ps(_mm_div_ps(d2, _mm_mul_ps(R, R)), one);
+    __m128 f = _mm_mul_ps(w, kernel4<K>(s));
+    if constexpr (Add) f = _mm_add_ps(f, _mm_loadu_ps(out + i));
+    _mm_storeu_ps(out + i, f);
   }
 }
 
 template <Kernel K, bool Add>
 void pointBatch(const Prim& P, const Pts& pts, float* __restrict out) {
-  const float ax = P.a.x, ay = P.a.y, az = P.a.z, iR2 = 1.0f / (P.R0 * P.R0), w = P.weight;
-  for (int i0 = 0; i0 < pts.n8; i0 += 8) {
-    for (int j = 0; j < 8; ++j) {
-      int i = i0 + j;
-      float dx = pts.x[i] - ax, dy = pts.y[i] - ay, dz = pts.z[i] - az;
-      float s = (dx * dx + dy * dy + dz * dz) * iR2;
-      s = s > 1.0f ? 1.0f : s;
-      float g;
-      if constexpr (K == Kernel::Wyvill) {
-        float u = 1.0f - s;
-        g = u * u * u;
-      } else {
-        g = 1.0f + s * (-22.0f / 9.0f + s * (17.0f / 9.0f - s * (4.0f / 9.0f)));
-      }
-      if constexpr (Add) out[i] += w * g;
-      else out[i] = w * g;
-    }
+  const __m128 ax = _mm_set1_ps(P.a.x), ay = _mm_set1_ps(P.a.y), az = _mm_set1_ps(P.a.z);
+  const __m128 iR2 = _mm_set1_ps(1.0f / (P.R0 * P.R0)), w = _mm_set1_ps(P.weight), one = _mm_set1_ps(1.0f);
+  for (int i = 0; i < pts.n8; i += 4) {
+    __m128 dx = _mm_sub_ps(_mm_loadu_ps(pts.x + i), ax);
+    __m128 dy = _mm_sub_ps(_mm_loadu_ps(pts.y + i), ay);
+    __m128 dz = _mm_sub_ps(_mm_loadu_ps(pts.z + i), az);
+    __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+    __m128 s = _mm_min_ps(_mm_mul_ps(d2, iR2), one);
+    __m128 f = _mm_mul_ps(w, kernel4<K>(s));
+    if constexpr (Add) f = _mm_add_ps(f, _mm_loadu_ps(out + i));
+    _mm_storeu_ps(out + i, f);
   }
 }
 
@@ -683,7 +784,7 @@ void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* 
         evalB(T, c, pts, pbox, tmp);
         for (int i = 0; i < pts.n; ++i) {
           float f = std::max(0.0f, tmp[i]);
-          float d = pcmD(n.pcm, f, nullptr);
+          float d = pcmD(params(T, n).pcm, f, nullptr);
           dsum[i] += d;
           if (f > out[i]) { out[i] = f; dmax[i] = d; }
         }
@@ -702,7 +803,7 @@ void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* 
       alignas(32) float lx[kBlock], ly[kBlock], lz[kBlock];
       Box3 lb;
       for (int i = 0; i < pts.n8; ++i) {
-        Vec3 q = warpLocal(n, Vec3(pts.x[i], pts.y[i], pts.z[i]), nullptr);
+        Vec3 q = warpLocal(T, n, Vec3(pts.x[i], pts.y[i], pts.z[i]), nullptr);
         lx[i] = q.x;
         ly[i] = q.y;
         lz[i] = q.z;
@@ -738,17 +839,21 @@ struct Compiler {
     if (isPrimitive(src.kind)) {
       n.prim = uint32_t(T.prims.size());
       T.prims.push_back(makePrim(src, tree.kernel()));
+    } else {
+      TParams P;
+      if (src.kind == NodeKind::Pcm) P.pcm = derivePcm(src.pcm);
+      if (src.kind == NodeKind::Transform) {
+        P.localFromWorld = src.localFromWorld;
+        P.worldFromLocal = src.worldFromLocal;
+        P.jt = glm::transpose(Mat3(src.localFromWorld));
+        P.jNorm = spectralNorm(Mat3(src.localFromWorld));
+      }
+      if (src.kind == NodeKind::Bend) P.bend = makeBendFrame(src.bend, tree.node(src.children[0]).bounds);
+      P.twist = src.twist;
+      P.taper = src.taper;
+      n.prim = uint32_t(T.params.size());
+      T.params.push_back(P);
     }
-    if (src.kind == NodeKind::Pcm) n.pcm = derivePcm(src.pcm);
-    if (src.kind == NodeKind::Transform) {
-      n.localFromWorld = src.localFromWorld;
-      n.worldFromLocal = src.worldFromLocal;
-      n.jt = glm::transpose(Mat3(src.localFromWorld));
-      n.jNorm = spectralNorm(Mat3(src.localFromWorld));
-    }
-    if (src.kind == NodeKind::Bend) n.bend = makeBendFrame(src.bend, tree.node(src.children[0]).bounds);
-    n.twist = src.twist;
-    n.taper = src.taper;
     n.first = uint32_t(T.kids.size());
     n.count = uint32_t(kids.size());
     T.kids.insert(T.kids.end(), kids.begin(), kids.end());
@@ -758,6 +863,7 @@ struct Compiler {
       std::vector<Box3> boxes;
       for (uint32_t k : kids) boxes.push_back(T.nodes[k].box);
       n.bvh = buildBvh(T, boxes, kids);
+      n.grid = buildGrid(T, boxes, kids);
     }
     uint32_t idx = uint32_t(T.nodes.size());
     T.nodes.push_back(n);
@@ -766,20 +872,20 @@ struct Compiler {
   }
 
   /// Forward (local to world) box map of a warp/transform node.
-  static Box3 forward(const TNode& n, const Box3& b) {
+  Box3 forward(const TNode& n, const Box3& b) const {
     switch (n.kind) {
-      case NodeKind::Transform: return transformBox(n.worldFromLocal, b);
-      case NodeKind::Bend: return n.bend.worldBox(b);
+      case NodeKind::Transform: return transformBox(params(T, n).worldFromLocal, b);
+      case NodeKind::Bend: return params(T, n).bend.worldBox(b);
       case NodeKind::Twist: {
         float h0, h1, r;
-        axialExtent(b, n.twist.origin, n.twist.axis, h0, h1, r);
-        return isHuge(b) ? b : cylinderBox(n.twist.origin, n.twist.axis, h0, h1, r);
+        axialExtent(b, params(T, n).twist.origin, params(T, n).twist.axis, h0, h1, r);
+        return isHuge(b) ? b : cylinderBox(params(T, n).twist.origin, params(T, n).twist.axis, h0, h1, r);
       }
       case NodeKind::Taper: {
         float h0, h1, r;
-        axialExtent(b, n.taper.origin, n.taper.axis, h0, h1, r);
-        float smax = std::max(taperScale(n.taper, h0), taperScale(n.taper, h1));
-        return isHuge(b) ? b : cylinderBox(n.taper.origin, n.taper.axis, h0, h1, r * smax);
+        axialExtent(b, params(T, n).taper.origin, params(T, n).taper.axis, h0, h1, r);
+        float smax = std::max(taperScale(params(T, n).taper, h0), taperScale(params(T, n).taper, h1));
+        return isHuge(b) ? b : cylinderBox(params(T, n).taper.origin, params(T, n).taper.axis, h0, h1, r * smax);
       }
       default: return b;
     }
