@@ -36,9 +36,11 @@ class Writer {
   /// Starts writing s from empty, with room for at least modules and params.
   Writer(ModuleString& s, bool births, size_t maxModules, const std::string& file, int step, size_t modules, size_t params)
       : s_(s), births_(births), maxModules_(maxModules), file_(file), step_(step) {
-    s_.symbols.resize(std::max({s_.symbols.capacity(), modules, size_t(16)}));
+    // Only the reserved part is sized (and zero-filled where new): sizing to the whole
+    // capacity would cost O(largest string) per step.
+    s_.symbols.resize(std::max(modules, size_t(16)));
     s_.offsets.resize(s_.symbols.size() + 1);
-    s_.params.resize(std::max({s_.params.capacity(), params, size_t(16)}));
+    s_.params.resize(std::max(params, size_t(16)));
     if (births_) s_.birthSteps.resize(s_.symbols.size());
     else s_.birthSteps.clear();
     refresh();
@@ -285,10 +287,11 @@ struct Deriver::Impl {
   }
 
   std::vector<int32_t> choices;  ///< productions found by context dispatch in the size pass
+  std::vector<ptrdiff_t> leftStack;
 
   /// The production context dispatch d selects for parameterless module i, or -1.
-  int32_t dispatchAt(const detail::ContextDispatch& d, const ModuleString& s, size_t i) const {
-    ptrdiff_t ln = walkLeft(s, static_cast<ptrdiff_t>(i) - 1);
+  /// ln is the module's left-context neighbour (walkLeft from i - 1), or -1.
+  int32_t dispatchAt(const detail::ContextDispatch& d, const ModuleString& s, size_t i, ptrdiff_t ln) const {
     size_t rn = walkRight(s, i + 1);
     uint32_t li = ln >= 0 && s.paramCount(static_cast<size_t>(ln)) == 0 ? d.index[s.symbols[ln]] : 0;
     uint32_t ri = rn < s.size() && s.paramCount(rn) == 0 ? d.index[s.symbols[rn]] : 0;
@@ -482,9 +485,27 @@ struct Deriver::Impl {
     if (!decompose) {
       size_t boundM = 0, boundP = 0;
       bool exact = true;
+      // The left-context neighbour of each module, kept incrementally: the last module
+      // neither ignored nor a bracket on the path from the root, restored after each
+      // branch (the same answer as walkLeft, in O(1) per module).
+      ptrdiff_t lastSeen = -1;
+      leftStack.clear();
+      const bool trackLeft = !rs.dispatches.empty();
+      const uint8_t* ignored = prog->ignored.data();
       for (size_t i = 0; i < n; ++i) {
         const detail::SymbolRules& r = rules[syms[i]];
         uint32_t count = offs[i + 1] - offs[i];
+        if (trackLeft && i > 0) {
+          SymbolId c = syms[i - 1];
+          if (c == prog->openBracket) {
+            leftStack.push_back(lastSeen);
+          } else if (c == prog->closeBracket) {
+            lastSeen = leftStack.empty() ? -1 : leftStack.back();
+            if (!leftStack.empty()) leftStack.pop_back();
+          } else if (!ignored[c]) {
+            lastSeen = static_cast<ptrdiff_t>(i - 1);
+          }
+        }
         if (r.count == 0 || (r.simple && count != r.simple->predParams)) {
           boundM += 1;
           boundP += count;
@@ -492,7 +513,7 @@ struct Deriver::Impl {
           boundM += r.simple->successor.size();
           boundP += r.simple->args.size();
         } else if (r.dispatch >= 0 && count == 0) {
-          int32_t idx = dispatchAt(rs.dispatches[r.dispatch], in, i);
+          int32_t idx = dispatchAt(rs.dispatches[r.dispatch], in, i, lastSeen);
           choices.push_back(idx);
           boundM += idx < 0 ? 1 : rs.productions[static_cast<size_t>(idx)].successor.size();
           boundP += idx < 0 ? 0 : rs.productions[static_cast<size_t>(idx)].args.size();
