@@ -125,7 +125,7 @@ TEST_CASE("polygonize::topology", "[blobtree]") {
 TEST_CASE("polygonize::thin twig survives", "[blobtree]") {
   // A twig of radius 0.01 reaching across a model of size 10, on a small knob.
   BlobTree tree;
-  std::vector<NodeId> kids = {tree.point(Vec3(0), 0.2f), tree.segment(Vec3(0), Vec3(9.8f, 0, 0), 0.01f)};
+  std::vector<NodeId> kids = {tree.point(Vec3(0), 0.05f), tree.segment(Vec3(0), Vec3(9.8f, 0, 0), 0.01f)};
   CompiledBlob blob = compile(tree, tree.blend(kids));
   PolygonizeResult r = polygonizeDetailed(blob);
   const Mesh& m = r.mesh;
@@ -151,7 +151,7 @@ TEST_CASE("polygonize::deterministic", "[blobtree]") {
   }
   CompiledBlob blob = compile(tree, tree.blend(kids));
   PolygonizeOptions opt;
-  opt.cellSize = 0.02f;
+  opt.cellSize = 0.04f;
   Mesh one, two;
   {
     ThreadLimit limit(1);
