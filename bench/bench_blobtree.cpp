@@ -1,7 +1,7 @@
 /// BlobTree evaluation benchmark: culled vs brute-force field evaluation, batched per-cell
 /// evaluation, ray casting, and the cost of an n-ary blend at fixed local overlap.
 ///
-/// Usage: bench_blobtree [--quick]
+/// Usage: bench_blobtree [--quick] | --image OUT.ppm
 /// Prints throughputs and ratios against baselines computed in the same process.
 
 #include "blobtree/blobtree.h"
@@ -9,7 +9,9 @@
 #include "core/parallel.h"
 #include "core/rng.h"
 
+#include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -221,11 +223,71 @@ void benchOverlap(int n) {
   std::printf("n-ary blend of %5d cones (same local overlap): %.1f ns per point (1 thread)\n", n, s / double(m) * 1e9);
 }
 
+/// Renders a small demo scene (branching cones, PCM pair, torus, bent segment, CSG cut)
+/// with intersect() and writes a binary PPM: a visual check of hits and normals.
+void renderImage(const char* path) {
+  BlobTree t;
+  std::vector<NodeId> kids;
+  Rng rng(5);
+  struct Tip { Vec3 p, dir; float r; };
+  std::vector<Tip> tips{{Vec3(0, -2, 0), Vec3(0, 1, 0), 0.3f}};
+  for (int i = 0; i < 40; ++i) {
+    Tip b = tips[rng.below(uint32_t(tips.size()))];
+    Vec3 dir = glm::normalize(b.dir + randomIn(rng, Vec3(-0.6f), Vec3(0.6f)));
+    float r1 = std::max(0.03f, b.r * 0.8f);
+    Vec3 end = b.p + float(rng.uniform(0.5, 1.0)) * dir;
+    TextureAttr tex;
+    tex.textureId = uint16_t(i % 3);
+    kids.push_back(t.cone(b.p, end, b.r, r1, tex));
+    tips.push_back({end, dir, r1});
+  }
+  NodeId tree = t.blend(kids);
+  NodeId pcm = t.pcm(t.point(Vec3(2.2f, -1.2f, 0), 0.6f), t.point(Vec3(2.9f, -1.2f, 0), 0.5f));
+  NodeId ring = t.translate(t.rotate(t.torus(Vec3(0), Vec3(0, 1, 0), 0.7f, 0.15f), Vec3(1, 0, 0), 1.0f), Vec3(-2.3f, -1.0f, 0));
+  NodeId bent = t.bend(t.segment(Vec3(-2.8f, 1.0f, 0), Vec3(-1.2f, 1.0f, 0), 0.15f), Vec3(-2.8f, 1.0f, 0),
+                       Vec3(-1.2f, 1.0f, 0), 0.5f, Vec3(0, 1, 0));
+  NodeId all = t.blend(std::vector<NodeId>{tree, pcm, ring, bent});
+  NodeId cut = t.difference(all, t.halfspace(Vec3(0, 0, 0.25f), Vec3(0, 0, -1), 0.01f));
+  CompiledBlob blob = compile(t, cut);
+  const int w = 320, h = 320;
+  std::vector<unsigned char> img(size_t(w * h * 3));
+  Vec3 eye(0.5f, 0.5f, 9.0f);
+  parallelFor(0, size_t(h), [&](size_t y) {
+    for (int x = 0; x < w; ++x) {
+      Vec3 dir(float(x - w / 2) / float(w) * 0.8f, -float(int(y) - h / 2) / float(h) * 0.8f, -1.0f);
+      auto hit = blob.intersect(Ray{eye, dir}, 0.0f, 100.0f);
+      Vec3 c(0.15f, 0.17f, 0.2f);
+      if (hit) {
+        float l = std::max(0.0f, glm::dot(hit->normal, glm::normalize(Vec3(0.5f, 0.8f, 0.6f))));
+        static const Vec3 pal[3] = {Vec3(0.8f, 0.55f, 0.35f), Vec3(0.45f, 0.7f, 0.4f), Vec3(0.4f, 0.55f, 0.85f)};
+        Vec3 base(0.0f);
+        for (int k = 0; k < hit->attributes.textureCount; ++k)
+          base += hit->attributes.textureWeights[size_t(k)] * pal[hit->attributes.textureIds[size_t(k)] % 3];
+        if (hit->attributes.textureCount == 0) base = Vec3(0.7f);
+        float stripe = 0.85f + 0.15f * std::sin(hit->attributes.uv.y * 12.0f);
+        c = base * (0.2f + 0.8f * l) * stripe;
+      }
+      for (int k = 0; k < 3; ++k)
+        img[(y * size_t(w) + size_t(x)) * 3 + size_t(k)] = (unsigned char)(std::clamp(c[k], 0.0f, 1.0f) * 255.0f);
+    }
+  });
+  FILE* f = std::fopen(path, "wb");
+  if (!f) return;
+  std::fprintf(f, "P6\n%d %d\n255\n", w, h);
+  std::fwrite(img.data(), 1, img.size(), f);
+  std::fclose(f);
+  std::printf("wrote %s\n", path);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   bool quick = argc > 1 && std::strcmp(argv[1], "--quick") == 0;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  if (argc > 2 && std::strcmp(argv[1], "--image") == 0) {
+    renderImage(argv[2]);
+    return 0;
+  }
   std::printf("bench_blobtree: %s\n", quick ? "quick" : "full");
   benchOverlap(100);
   benchOverlap(10000);
