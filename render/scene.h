@@ -39,7 +39,7 @@ using ColorTexture = std::function<Vec3(Vec2 uv, const Vec3& position)>;
 /// How a compiled BlobTree becomes exact Embree user geometry.
 struct ImplicitOptions {
   /// Edge of the surface cells (one Embree user primitive each), world units; 0 = automatic:
-  /// 1.5x the smallest feature radius, clamped to [diagonal/400, diagonal/40].
+  /// 1.5x the smallest feature radius, clamped to [diagonal/1000, diagonal/40].
   float cellSize = 0.0f;
   /// Root-finding tolerance (relative to the model's bounds diagonal) and step cap.
   blobtree::TraceOptions trace;
