@@ -308,22 +308,29 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
     // Face f = 2·axis + side; its four corners are those with bit `axis` equal to side.
     std::vector<uint32_t> frontier = active;
     while (!frontier.empty()) {
-      std::vector<uint64_t> wanted;
-      for (uint32_t i : frontier) {
-        uint8_t m = insideMask[i];
-        for (int axis = 0; axis < 3; ++axis)
-          for (int side = 0; side < 2; ++side) {
-            int in = 0;
-            for (int c = 0; c < 8; ++c)
-              if (((c >> axis) & 1) == side) in += (m >> c) & 1;
-            if (in == 0 || in == 4) continue;
-            glm::ivec3 n = cellCoords[i];
-            n[axis] += side ? 1 : -1;
-            if (n[axis] < 0 || n[axis] + 1 >= kAxisLimit) continue;
-            uint64_t key = pointKey(n.x, n.y, n.z);
-            if (cellIndex.find(key) == kNoCell && !addedCells.count(key)) wanted.push_back(key);
-          }
-      }
+      // Neighbours across sign-changing faces that no cell covers (read-only scan, in chunks).
+      constexpr size_t kScan = 4096;
+      std::vector<std::vector<uint64_t>> wantedParts((frontier.size() + kScan - 1) / kScan);
+      parallelFor(0, wantedParts.size(), [&](size_t ch) {
+        size_t end = std::min(frontier.size(), (ch + 1) * kScan);
+        for (size_t f = ch * kScan; f < end; ++f) {
+          uint32_t i = frontier[f];
+          uint8_t m = insideMask[i];
+          for (int axis = 0; axis < 3; ++axis)
+            for (int side = 0; side < 2; ++side) {
+              int in = 0;
+              for (int c = 0; c < 8; ++c)
+                if (((c >> axis) & 1) == side) in += (m >> c) & 1;
+              if (in == 0 || in == 4) continue;
+              glm::ivec3 n = cellCoords[i];
+              n[axis] += side ? 1 : -1;
+              if (n[axis] < 0 || n[axis] + 1 >= kAxisLimit) continue;
+              uint64_t key = pointKey(n.x, n.y, n.z);
+              if (cellIndex.find(key) == kNoCell && !addedCells.count(key)) wantedParts[ch].push_back(key);
+            }
+        }
+      });
+      std::vector<uint64_t> wanted = concat(wantedParts);
       std::sort(wanted.begin(), wanted.end());
       wanted.erase(std::unique(wanted.begin(), wanted.end()), wanted.end());
       frontier.clear();
