@@ -287,6 +287,7 @@ struct Deriver::Impl {
   }
 
   std::vector<int32_t> choices;  ///< productions found by context dispatch in the size pass
+  std::vector<uint32_t> stochasticIds;  ///< matching stochastic productions of one module
   std::vector<ptrdiff_t> leftStack;
 
   /// The production context dispatch d selects for parameterless module i, or -1.
@@ -346,27 +347,26 @@ struct Deriver::Impl {
       if (!p.stochastic) return &p;
       // Stochastic: choose among every matching weighted production from here on,
       // with probability proportional to its weight.
-      double weights[64];
-      uint32_t ids[64];
-      int count = 0;
+      std::vector<uint32_t>& ids = stochasticIds;
+      ids.clear();
       double total = 0;
-      for (size_t q = k; q < cand.size() && count < 64; ++q) {
+      for (size_t q = k; q < cand.size(); ++q) {
         const Production& pq = rs.productions[cand[q]];
         if (!pq.stochastic) continue;
         if (q != k && (!matches(pq, s, i, vars) || !condition(pq, vars, step))) continue;
-        weights[count] = pq.weight;
-        ids[count++] = cand[q];
+        ids.push_back(cand[q]);
         total += pq.weight;
       }
       if (total <= 0) return nullptr;
       double r = moduleRng()->uniform() * total;
-      int pick = count - 1;
-      for (int c = 0; c < count; ++c) {
-        if (r < weights[c]) {
+      size_t pick = ids.size() - 1;
+      for (size_t c = 0; c < ids.size(); ++c) {
+        double w = rs.productions[ids[c]].weight;
+        if (r < w) {
           pick = c;
           break;
         }
-        r -= weights[c];
+        r -= w;
       }
       const Production& chosen = rs.productions[ids[pick]];
       matches(chosen, s, i, vars);  // rebind its parameters

@@ -211,6 +211,17 @@ A --> C : 75
     CHECK(countSymbol(s, g.symbols(), "B") + countSymbol(s, g.symbols(), "C") == 20000);
     CHECK(std::abs(b / 20000 - 0.25) < 0.02);  // 6.5 standard deviations
   }
+  SECTION("any number of alternatives") {
+    std::string t = "axiom: ";
+    for (int i = 0; i < 5000; ++i) t += 'A';
+    t += '\n';
+    for (int k = 0; k < 100; ++k) t += "A --> B(" + std::to_string(k) + ") : 1\n";
+    Grammar g = parseGrammar(t, "t.lsys");
+    ModuleString s = derive(g, DeriveOptions{.steps = 1, .seed = 2});
+    std::map<double, int> seen;
+    for (size_t i = 0; i < s.size(); ++i) ++seen[s.paramsOf(i)[0]];
+    CHECK(seen.size() == 100);  // each has probability 1 - 0.99^5000 of appearing
+  }
   SECTION("a condition narrows the stochastic choice to the matching productions") {
     std::string t = "axiom: A(1)A(1)A(1)A(1)A(1)A(1)A(1)A(1)\nA(x) : x>5 --> B : 1\nA(x) : x<5 --> C : 1\n";
     CHECK(deriveText(t, 1, 4) == "CCCCCCCC");
