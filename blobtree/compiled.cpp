@@ -96,7 +96,8 @@ int32_t buildGrid(Tape& tape, const std::vector<Box3>& boxes, const std::vector<
   }
   if (ext.empty()) return -1;
   std::nth_element(ext.begin(), ext.begin() + long(ext.size() / 2), ext.end());
-  float cell = std::max(ext[ext.size() / 2], 1e-6f);
+  // Half the median child extent: a child spans 2-4 cells per axis, a cell lists few children.
+  float cell = std::max(0.5f * ext[ext.size() / 2], 1e-6f);
   // Keep the grid's key range within 21 bits per axis.
   Vec3 span = all.size();
   cell = std::max(cell, std::max(span.x, std::max(span.y, span.z)) / float(1 << 19));
