@@ -42,8 +42,8 @@ namespace sprig::blobtree {
 struct PolygonizeOptions {
   /// Requested cell edge length in world units; 0 = automatic: the smaller of
   /// featureFraction · smallestFeature() (so the thinnest twig gets several cells across)
-  /// and the model's bounds diagonal / sizeDivisions. The grid may use a slightly smaller
-  /// cell (surfaceCells rounds to the root cube / 2^k).
+  /// and the model's bounds diagonal / sizeDivisions. The grid uses a cell between half
+  /// and all of this (surfaceCells rounds down to the root cube / 2^k).
   float cellSize = 0.0f;
   /// Automatic cell size as a fraction of the smallest primitive radius.
   float featureFraction = 0.5f;
