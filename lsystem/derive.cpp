@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cstring>
 #include <limits>
 #include <cmath>
 #include <optional>
@@ -68,6 +69,20 @@ class Writer {
     for (uint32_t k = 0; k < count; ++k) par_[np_ + k] = p[k];
     np_ += count;
     end();
+  }
+
+  /// Appends the m modules whose symbols start at s and offsets at o (into pars), and their
+  /// birth steps when tracked: one bulk copy for a run of modules no production touches.
+  void copyRun(const SymbolId* s, const uint32_t* o, const double* pars, size_t m, const int32_t* births) {
+    uint32_t pb = o[0], pe = o[m];
+    reserve(m, pe - pb);
+    std::memcpy(sym_ + n_, s, m * sizeof(SymbolId));
+    if (births_) std::memcpy(birth_ + n_, births, m * sizeof(int32_t));
+    std::memcpy(par_ + np_, pars + pb, (pe - pb) * sizeof(double));
+    const uint32_t delta = static_cast<uint32_t>(np_) - pb;  // modular: offsets stay below 2^32
+    for (size_t k = 1; k <= m; ++k) off_[n_ + k] = o[k] + delta;
+    n_ += m;
+    np_ += pe - pb;
   }
 
   size_t modules() const { return n_; }
@@ -541,9 +556,18 @@ struct Deriver::Impl {
       int32_t birth = births ? in.birthSteps[i] : 0;
       const detail::SymbolRules& r = rules[sym];
       if (r.count == 0 && !decompose) {
-        uint32_t count = offs[i + 1] - offs[i];
-        w.reserve(1, count);
-        w.copy(sym, pars + offs[i], count, birth);
+        size_t j = i + 1;
+        while (j < n && rules[syms[j]].count == 0) ++j;
+        if (j - i >= 8) {  // a long run: bulk copies pay off
+          w.copyRun(syms + i, offs + i, pars, j - i, births ? in.birthSteps.data() + i : nullptr);
+        } else {
+          for (size_t k = i; k < j; ++k) {
+            uint32_t count = offs[k + 1] - offs[k];
+            w.reserve(1, count);
+            w.copy(syms[k], pars + offs[k], count, births ? in.birthSteps[k] : 0);
+          }
+        }
+        i = j - 1;
         continue;
       }
       if (r.simple && !decompose) {

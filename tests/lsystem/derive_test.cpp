@@ -459,6 +459,13 @@ TEST_CASE("Deriver::derive birth steps", "[lsystem]") {
     CHECK(s.birthSteps == std::vector<int32_t>{0, 1, 2, 3, 3});
     CHECK(d.interpret(s).birthSteps == s.birthSteps);
   }
+  SECTION("long runs of untouched modules (bulk copies) keep parameters and birth steps") {
+    Grammar h = parseGrammar("axiom: F(1)F(2)F(3)F(4)F(5)F(6)F(7)F(8)F(9)A(0)\nA(x) --> F(x)+(x)!A(x+1)\n", "t.lsys");
+    Deriver d(h, DeriveOptions{.steps = 3, .trackBirthSteps = true});
+    const ModuleString& s = d.derive();
+    CHECK(formatModuleString(s, d.symbols()) == "F(1)F(2)F(3)F(4)F(5)F(6)F(7)F(8)F(9)F(0)+(0)!F(1)+(1)!F(2)+(2)!A(3)");
+    CHECK(s.birthSteps == std::vector<int32_t>{0, 0, 0, 0, 0, 0, 0, 0, 0, 1, 1, 1, 2, 2, 2, 3, 3, 3, 3});
+  }
 }
 
 TEST_CASE("Deriver::derive module limit", "[lsystem]") {
