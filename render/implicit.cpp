@@ -191,6 +191,28 @@ float autoCellSize(const blobtree::CompiledBlob& blob) {
   return std::clamp(1.5f * feature, diag / 1000.0f, diag / 40.0f);
 }
 
+/// Shrinks box (which holds the whole F = 0.5 surface) face by face: bisection finds the
+/// thickest slab at each face whose interval bound stays below 0.5, which is sound (no
+/// surface there). Brings the bounds from the cells' outer faces to within about the
+/// interval bound's slack of the surface, so exact and mesh modes frame alike.
+Box3 tightenBounds(const blobtree::CompiledBlob& blob, Box3 box) {
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int side = 0; side < 2; ++side) {
+      float lo = 0.0f, hi = box.hi[axis] - box.lo[axis];
+      for (int it = 0; it < 24; ++it) {
+        float mid = 0.5f * (lo + hi);
+        Box3 slab = box;
+        if (side == 0) slab.hi[axis] = box.lo[axis] + mid;
+        else slab.lo[axis] = box.hi[axis] - mid;
+        (blob.valueBounds(slab).hi < kIso ? lo : hi) = mid;
+      }
+      if (side == 0) box.lo[axis] += lo;
+      else box.hi[axis] -= lo;
+    }
+  }
+  return box;
+}
+
 }  // namespace
 
 uint32_t Scene::addImplicit(const blobtree::CompiledBlob& blob, uint32_t material, const ImplicitOptions& options) {
@@ -212,7 +234,9 @@ uint32_t Scene::addImplicit(const blobtree::CompiledBlob& blob, uint32_t materia
   rtcSetGeometryBoundsFunction(g, cellBounds, nullptr);
   rtcSetGeometryIntersectFunction(g, cellIntersect);
   rtcSetGeometryOccludedFunction(g, cellOccluded);
-  for (const auto& c : data->cells.cells) impl_->bounds.extend(c.box);
+  Box3 cellBox;
+  for (const auto& c : data->cells.cells) cellBox.extend(c.box);
+  if (!cellBox.empty()) impl_->bounds.extend(tightenBounds(blob, cellBox.intersected(support)));
   impl_->stats.implicitCells += data->cells.cells.size();
   detail::GeometryRecord rec;
   rec.kind = detail::GeometryRecord::Kind::Implicit;

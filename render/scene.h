@@ -129,7 +129,8 @@ class Scene {
   /// Builds the acceleration structure. Throws std::runtime_error on an Embree error.
   void commit();
 
-  /// Bounds of everything added.
+  /// Bounds of everything added (implicit models: their surface cells, shrunk by interval
+  /// bounds to nearly the surface).
   Box3 bounds() const;
   SceneStats stats() const;
 

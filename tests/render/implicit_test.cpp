@@ -47,6 +47,11 @@ TEST_CASE("Scene::addImplicit", "[render]") {
   uint32_t id = scene.addImplicit(blob, scene.addMaterial(Material{}));
   scene.commit();
   CHECK(scene.stats().implicitCells > 0);
+  // Bounds hug the surface (cells reach up to a cell beyond it; intervals shrink them).
+  CHECK(scene.bounds().lo.x == Approx(-1.0f).margin(0.03));
+  CHECK(scene.bounds().hi.y == Approx(1.0f).margin(0.03));
+  CHECK(scene.bounds().lo.x <= -1.0f);
+  CHECK(scene.bounds().hi.z >= 1.0f);
 
   SECTION("exact hits on the sphere") {
     for (Vec3 dir : {Vec3(0, 0, -1), glm::normalize(Vec3(-1, -0.5f, -2))}) {
