@@ -1,5 +1,6 @@
 #include "lsystem/turtle.h"
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <string_view>
@@ -108,6 +109,12 @@ void applyTropism(TurtleFrame& f, const DVec3& t, double e) {
   orthonormalize(f);
 }
 
+double TurtleSettings::growthScale() const {
+  const double f = std::clamp(growthFraction, 0.0, 1.0);
+  const double s0 = std::clamp(growthStart, 0.0, 1.0);
+  return s0 + (1.0 - s0) * f;
+}
+
 Turtle::Turtle(const SymbolTable& symbols, TurtleSettings settings) : symbols_(symbols), settings_(settings) {
   commands_.assign(symbols.size(), Command::None);
   for (size_t i = 0; i < symbols.size(); ++i) {
@@ -208,7 +215,19 @@ void Turtle::run(const ModuleString& ms, Skeleton& sk, std::span<const int32_t> 
     }
   };
   auto stepOf = [&](size_t i) { return haveSteps ? moduleSteps[i] : 0; };
-  auto length = [&](size_t i) { return off[i + 1] > off[i] ? prm[off[i]] : settings_.stepLength; };
+  // Growth: the scale of module i (1 = full size, 0 = not yet drawn).
+  const bool growing = settings_.growthStep >= 0 && haveSteps;
+  const double partial = settings_.growthScale();
+  auto growth = [&](size_t i) {
+    if (!growing) return 1.0;
+    const int32_t born = moduleSteps[i];
+    return born < settings_.growthStep ? 1.0 : born == settings_.growthStep ? partial : 0.0;
+  };
+  std::vector<double> internodeGrowth;  // per internode, for the pipe model's radii (growth only)
+  auto length = [&](size_t i) {
+    const double l = off[i + 1] > off[i] ? prm[off[i]] : settings_.stepLength;
+    return growing ? l * growth(i) : l;
+  };
 
   for (size_t i = 0; i < n; ++i) {
     const SymbolId s = sym[i];
@@ -225,10 +244,13 @@ void Turtle::run(const ModuleString& ms, Skeleton& sk, std::span<const int32_t> 
           st.internode = -1;  // outlines are not drawn; the next segment starts a new axis
           break;
         }
+        const double g = growth(i);
+        if (g <= 0) break;  // not grown yet: nothing drawn, no bend; the axis carries on from its parent
         Internode in;
         in.start = start;
         in.end = st.frame.position;
-        in.baseRadius = in.tipRadius = st.width * radiusScale;
+        in.baseRadius = in.tipRadius = st.width * radiusScale * g;
+        if (growing) internodeGrowth.push_back(g);
         in.parent = st.internode;
         in.order = st.order;
         in.step = stepOf(i);
@@ -240,7 +262,8 @@ void Turtle::run(const ModuleString& ms, Skeleton& sk, std::span<const int32_t> 
           sk.internodes[in.parent].tipRadius = in.baseRadius;
         st.internode = static_cast<int32_t>(sk.internodes.size());
         sk.internodes.push_back(in);
-        if (st.elasticity != 0) applyTropism(st.frame, tropism, st.elasticity);
+        // A growing internode bends in proportion to its growth, so frames change smoothly.
+        if (st.elasticity != 0) applyTropism(st.frame, tropism, st.elasticity * g);
         break;
       }
       case Command::Move:
@@ -280,7 +303,7 @@ void Turtle::run(const ModuleString& ms, Skeleton& sk, std::span<const int32_t> 
         break;
       case Command::PolygonEnd:
         if (!polygons.empty()) {
-          if (polygons.back().points.size() >= 3) {
+          if (polygons.back().points.size() >= 3 && growth(i) > 0) {
             Organ o;
             o.kind = Organ::Kind::Polygon;
             o.points = std::move(polygons.back().points);
@@ -311,6 +334,8 @@ void Turtle::run(const ModuleString& ms, Skeleton& sk, std::span<const int32_t> 
         } else {
           break;
         }
+        o.radius *= growth(i);
+        if (o.radius <= 0 && growing) break;
         o.position = st.frame.position;
         o.heading = st.frame.heading;
         o.left = st.frame.left;
@@ -324,7 +349,8 @@ void Turtle::run(const ModuleString& ms, Skeleton& sk, std::span<const int32_t> 
       case Command::Sphere: {
         Organ o;
         o.kind = Organ::Kind::Sphere;
-        o.radius = off[i + 1] > off[i] ? prm[off[i]] : st.width * radiusScale;
+        o.radius = (off[i + 1] > off[i] ? prm[off[i]] : st.width * radiusScale) * growth(i);
+        if (o.radius <= 0 && growing) break;
         o.position = st.frame.position;
         o.heading = st.frame.heading;
         o.left = st.frame.left;
@@ -375,6 +401,12 @@ void Turtle::run(const ModuleString& ms, Skeleton& sk, std::span<const int32_t> 
         maxChild[p] = std::max(maxChild[p], r);
       }
     }
+    // Growing internodes thicken with their growth, like the width model's radii.
+    if (growing)
+      for (size_t k = 0; k < m; ++k) {
+        ins[k].baseRadius *= internodeGrowth[k];
+        ins[k].tipRadius *= internodeGrowth[k];
+      }
   }
 }
 

@@ -44,6 +44,15 @@ struct TurtleSettings {
   bool taper = true;              ///< width model: an internode's tip radius is its continuation's base radius
   double surfaceScale = 1.0;      ///< scale of a `~` surface without a parameter
   DVec3 origin{0};                ///< start position
+  /// Growth animation (docs/GRAMMAR.md, "Growth over time"): modules whose birth step is
+  /// growthStep are drawn partly grown, scaled by growthScale(); modules born later are
+  /// not drawn. -1 (the default) draws every module at full size.
+  int growthStep = -1;
+  double growthFraction = 1.0;    ///< how far the modules of growthStep have grown, 0..1
+  double growthStart = 0.0;       ///< their scale at fraction 0 (0 = they grow from nothing)
+
+  /// Scale of modules born in growthStep: start + (1 - start) * fraction, clamped to [0, 1].
+  double growthScale() const;
 };
 
 /// Position and orientation of the turtle.
