@@ -52,6 +52,8 @@ void addCheckCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run
 void addPreviewCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run);
 /// `sprig gallery [FILES...] -o DIR` (app/cmd_gallery.cpp).
 void addGalleryCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run);
+/// `sprig animate SPECIES -o OUT` (app/cmd_animate.cpp).
+void addAnimateCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run);
 
 /// Throws UsageError unless path's extension is one of `allowed` (lower case, with dot).
 void requireExtension(const std::string& flag, const std::string& path, std::initializer_list<const char*> allowed);

@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cstdio>
 
+#include "app/animate.h"
 #include "app/preview.h"
 #include "app/species.h"
 #include "app/tree_pipeline.h"
@@ -68,8 +69,6 @@ GalleryItem renderGalleryItem(const fs::path& speciesFile, const fs::path& outDi
     item.strip = stem + "_stages.png";
 
     // One derivation gives the final skeleton and every stage.
-    lsystem::GrammarOverrides none;
-    Species probe = species;
     lsystem::Grammar g = speciesGrammar(species);
     item.stages = growthStages(species, g.derivationLength());
     GrowOptions opt;
@@ -92,11 +91,18 @@ GalleryItem renderGalleryItem(const fs::path& speciesFile, const fs::path& outDi
     stripLook.view.margin = std::max(look.view.margin, 0.04);
     render::Image strip = renderGrowthStrip(stages, stripLook, frame, cellWidth, stripHeight, "stages " + stem);
     render::writeImage(strip, outDir / item.strip);
+    const SkeletonFigures figures = skeletonFigures(t.skeleton);
+    item.primitives = figures.primitives;
+    item.triangles = figures.triangles;
+    item.animation = stem + ".gif";
+    item.frames = renderGalleryAnimation(species, outDir / item.animation, look, width, height,
+                                         quality == GalleryQuality::Final);
     item.renderSeconds = secondsSince(r0);
   } catch (const InputError& e) {
     item.error = e.what();
     item.preview.clear();
     item.strip.clear();
+    item.animation.clear();
   }
   return item;
 }
@@ -108,10 +114,13 @@ std::string galleryIndexHtml(const std::vector<GalleryItem>& items) {
        "h1{font-weight:600}\n.item{background:#fff;border-radius:8px;padding:16px;margin:0 0 20px;"
        "box-shadow:0 1px 3px rgba(0,0,0,.15);display:flex;gap:20px;flex-wrap:wrap}\n"
        ".item img{border-radius:4px;display:block}\n.preview img{height:300px}\n.strip img{height:200px}\n"
+       ".animation img{height:200px}\n"
        ".meta{min-width:240px;max-width:420px}\n.meta h2{margin:0 0 6px}\n.figs{color:#555;font-size:14px}\n"
        ".figs td{padding:1px 10px 1px 0}\n.error{color:#a00;white-space:pre-wrap;font-family:monospace}\n"
        "</style>\n</head>\n<body>\n<h1>Sprig gallery</h1>\n<p>" +
-       std::to_string(items.size()) + " species. Each shows the final stage and a strip of growth stages.</p>\n";
+       std::to_string(items.size()) +
+       " species. Each shows the final stage, a strip of growth stages and its growth animation. "
+       "<a href=\"contact_sheet.png\">Contact sheet</a>.</p>\n";
   for (const auto& it : items) {
     o += "<div class=\"item\" id=\"" + html(fs::path(it.source).stem().string()) + "\">\n<div class=\"meta\">\n<h2>" +
          html(it.name) + "</h2>\n<p>" + html(it.description) + "</p>\n";
@@ -124,13 +133,20 @@ std::string galleryIndexHtml(const std::vector<GalleryItem>& items) {
     o += "<table class=\"figs\">\n<tr><td>source</td><td>" + html(it.source) + "</td></tr>\n<tr><td>kind</td><td>" +
          html(it.kind) + "</td></tr>\n<tr><td>steps</td><td>" + std::to_string(it.steps) +
          "</td></tr>\n<tr><td>modules</td><td>" + std::to_string(it.modules) + "</td></tr>\n<tr><td>internodes</td><td>" +
-         std::to_string(it.internodes) + "</td></tr>\n<tr><td>derive + turtle</td><td>" + fixed(it.deriveSeconds, 3) +
-         " s</td></tr>\n<tr><td>render</td><td>" + fixed(it.renderSeconds, 2) + " s</td></tr>\n<tr><td>stages</td><td>" +
+         std::to_string(it.internodes) + "</td></tr>\n<tr><td>primitives</td><td>" + std::to_string(it.primitives) +
+         "</td></tr>\n<tr><td>triangles</td><td>" + std::to_string(it.triangles) +
+         "</td></tr>\n<tr><td>derive + turtle</td><td class=\"time\">" + fixed(it.deriveSeconds, 3) +
+         " s</td></tr>\n<tr><td>render</td><td class=\"time\">" + fixed(it.renderSeconds, 2) +
+         " s</td></tr>\n<tr><td>stages</td><td>" +
          stages + "</td></tr>\n</table>\n</div>\n";
     o += "<div class=\"preview\"><a href=\"" + html(it.preview) + "\"><img src=\"" + html(it.preview) + "\" alt=\"" +
          html(it.name) + "\"></a></div>\n";
     o += "<div class=\"strip\"><a href=\"" + html(it.strip) + "\"><img src=\"" + html(it.strip) + "\" alt=\"" +
-         html(it.name) + " growth stages\"></a></div>\n</div>\n";
+         html(it.name) + " growth stages\"></a></div>\n";
+    if (!it.animation.empty())
+      o += "<div class=\"animation\"><a href=\"" + html(it.animation) + "\"><img src=\"" + html(it.animation) +
+           "\" alt=\"" + html(it.name) + " growing (" + std::to_string(it.frames) + " frames)\"></a></div>\n";
+    o += "</div>\n";
   }
   o += "</body>\n</html>\n";
   return o;

@@ -23,6 +23,10 @@ struct GalleryItem {
   std::string kind;
   std::string preview;      ///< file name of the final-stage image inside the gallery folder
   std::string strip;        ///< file name of the growth-stage strip
+  std::string animation;    ///< file name of the growth animation (GIF, app/animate.h)
+  int frames = 0;           ///< frames in the animation
+  size_t primitives = 0;    ///< render primitives of the final stage (internodes + organs)
+  size_t triangles = 0;     ///< triangles of the final stage's polygon organs
   std::vector<int> stages;  ///< derivation steps shown in the strip
   size_t modules = 0;
   size_t internodes = 0;

@@ -33,6 +33,7 @@ int main(int argc, char** argv) {
   addCheckCommand(app, global, run);
   addPreviewCommand(app, global, run);
   addGalleryCommand(app, global, run);
+  addAnimateCommand(app, global, run);
 
   try {
     app.parse(argc, argv);
