@@ -12,15 +12,15 @@ namespace sprig::render {
 
 /// A ray: origin and unit direction.
 struct Ray {
-  Vec3 origin{0};
-  Vec3 direction{0, 0, -1};
+  Vec3 origin{0};            ///< world position
+  Vec3 direction{0, 0, -1};  ///< unit direction
 };
 
 /// Pinhole camera looking from `position` toward `target`.
 struct Camera {
-  Vec3 position{0, 0, 5};
-  Vec3 target{0};
-  Vec3 up{0, 1, 0};
+  Vec3 position{0, 0, 5};  ///< eye, world units
+  Vec3 target{0};          ///< point at the image center
+  Vec3 up{0, 1, 0};        ///< approximate up; the camera is rolled so it projects vertical
   float fovYDeg = 35.0f;  ///< vertical field of view, degrees
 
   /// Primary ray through film point (px, py) in pixels of a width x height image (y down).

@@ -24,7 +24,9 @@ struct Image {
   /// An image filled with `fill`.
   Image(int w, int h, Vec4 fill = Vec4(0, 0, 0, 1));
 
+  /// Pixel (x, y), (0, 0) top-left; no bounds check.
   Vec4 at(int x, int y) const;
+  /// Sets pixel (x, y); no bounds check.
   void set(int x, int y, const Vec4& v);
 };
 
@@ -35,7 +37,11 @@ float linearToSrgb(float v);
 std::vector<uint8_t> toSrgb8(const Image& image, int channels);
 
 /// Output encodings chosen from the file extension.
-enum class ImageFormat { Png, Jpeg, Exr };
+enum class ImageFormat {
+  Png,   ///< 8-bit sRGB RGBA
+  Jpeg,  ///< 8-bit sRGB RGB, quality 92
+  Exr,   ///< linear half-float RGBA, zip compression
+};
 
 /// Format for a path's extension (.png, .jpg/.jpeg, .exr; case-insensitive).
 /// Throws std::invalid_argument naming the extension and the supported ones.

@@ -21,15 +21,22 @@
 namespace sprig::render {
 
 /// What the film shows where a camera ray hits nothing.
-enum class Background { Color, Gradient, Transparent };
+enum class Background {
+  Color,        ///< RenderSettings::backgroundColor
+  Gradient,     ///< backgroundTop at the top row to backgroundBottom at the bottom
+  Transparent,  ///< alpha 0 (color 0) where nothing is hit
+};
 
 /// Pixel reconstruction filter.
-enum class Filter { Box, Tent };
+enum class Filter {
+  Box,   ///< average of the pixel's own samples
+  Tent,  ///< separable tent of radius filterRadius over the samples of neighbouring pixels too
+};
 
 /// Everything that controls one render. Defaults give a clean daylight preview.
 struct RenderSettings {
-  int width = 800;
-  int height = 600;
+  int width = 800;      ///< pixels
+  int height = 600;     ///< pixels
   int spp = 4;          ///< camera samples per pixel (stratified on a near-square grid)
   int threads = 0;      ///< 0 = all cores
   uint64_t seed = 0;    ///< base seed of every per-pixel generator
@@ -42,11 +49,11 @@ struct RenderSettings {
   Vec3 backgroundTop{0.42f, 0.58f, 0.80f};    ///< Gradient background at the top row
   Vec3 backgroundBottom{0.85f, 0.88f, 0.92f}; ///< Gradient background at the bottom row
 
-  bool sun = true;
+  bool sun = true;                ///< light from a sun disc
   double sunAzimuthDeg = -50.0;   ///< direction toward the sun, same convention as ViewSpec
-  double sunElevationDeg = 50.0;
+  double sunElevationDeg = 50.0;  ///< sun height above the horizon
   double sunAngleDeg = 0.6;       ///< angular radius of the sun disc (0 = hard shadows)
-  Vec3 sunColor{1.0f, 0.95f, 0.88f};
+  Vec3 sunColor{1.0f, 0.95f, 0.88f};  ///< linear RGB tint of the sun
   float sunStrength = 1.6f;       ///< irradiance scale of the sun
   bool shadows = true;            ///< cast shadow rays toward the sun
 
@@ -58,22 +65,24 @@ struct RenderSettings {
 
   bool ground = true;             ///< analytic ground plane under the model
   bool groundAtModelBase = true;  ///< put the plane at the scene's lowest y (else at groundHeight)
-  float groundHeight = 0.0f;
-  Vec3 groundColor{0.34f, 0.31f, 0.26f};
+  float groundHeight = 0.0f;      ///< plane height when groundAtModelBase is false
+  Vec3 groundColor{0.34f, 0.31f, 0.26f};  ///< linear albedo of the ground
   float groundFade = 6.0f;        ///< ground fades into the background beyond this many model radii
 
   float exposure = 0.0f;          ///< stops; linear values are multiplied by 2^exposure
   bool progress = true;           ///< show a progress bar over tiles (silent when not a terminal)
-  std::string progressLabel = "render";
+  std::string progressLabel = "render";  ///< text before the progress bar
 };
 
 /// Counts and time of one render.
 struct RenderStats {
-  uint64_t cameraRays = 0;
-  uint64_t shadowRays = 0;
-  uint64_t skyRays = 0;
-  double seconds = 0;
+  uint64_t cameraRays = 0;  ///< primary rays, including the filter apron's re-traced samples
+  uint64_t shadowRays = 0;  ///< occlusion rays toward the sun
+  uint64_t skyRays = 0;     ///< ambient-occlusion rays
+  double seconds = 0;       ///< wall time of renderImage
+  /// All rays cast.
   uint64_t rays() const { return cameraRays + shadowRays + skyRays; }
+  /// Rays per wall-clock second.
   double raysPerSecond() const { return seconds > 0 ? static_cast<double>(rays()) / seconds : 0.0; }
 };
 

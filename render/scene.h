@@ -73,10 +73,10 @@ struct SurfaceHit {
 
 /// Counts of what a scene holds.
 struct SceneStats {
-  size_t curveSegments = 0;
-  size_t triangles = 0;
-  size_t spheres = 0;
-  size_t implicitCells = 0;
+  size_t curveSegments = 0;  ///< skeleton internodes (round linear curve segments)
+  size_t triangles = 0;      ///< mesh and leaf triangles
+  size_t spheres = 0;        ///< sphere organs
+  size_t implicitCells = 0;  ///< surface cells of implicit models (Embree user primitives)
 };
 
 /// Materials and geometry behind an Embree 3 device and scene.
@@ -89,6 +89,7 @@ class Scene {
 
   /// Adds a material; returns its id.
   uint32_t addMaterial(const Material& m);
+  /// Material `id`; throws std::out_of_range for an unknown id.
   const Material& material(uint32_t id) const;
 
   /// Adds a skeleton: internodes as round linear curves (tapered cones; an internode that
@@ -132,6 +133,7 @@ class Scene {
   /// Bounds of everything added (implicit models: their surface cells, shrunk by interval
   /// bounds to nearly the surface).
   Box3 bounds() const;
+  /// What the scene holds.
   SceneStats stats() const;
 
   /// Closest hit along origin + t*direction for t in [tnear, tfar], or nothing.
@@ -139,7 +141,7 @@ class Scene {
   /// True when anything lies along origin + t*direction for t in [tnear, tfar].
   bool occluded(const Vec3& origin, const Vec3& direction, float tnear, float tfar) const;
 
-  struct Impl;
+  struct Impl;  ///< Embree state (render/detail/scene_impl.h)
 
  private:
   std::unique_ptr<Impl> impl_;
