@@ -5,6 +5,8 @@
 #include <fstream>
 #include <iterator>
 
+#include <OpenImageIO/imageio.h>
+
 #include "render/camera.h"
 #include "render/image.h"
 #include "render/renderer.h"
@@ -206,6 +208,20 @@ TEST_CASE("writeImage", "[render]") {
     CHECK(fs::file_size(dir / "x.exr") > 0);
     // Only the three images: no temporaries left behind.
     CHECK(std::distance(fs::directory_iterator(dir), fs::directory_iterator()) == 3);
+  }
+  SECTION("EXR keeps linear values") {
+    writeImage(img, dir / "lin.exr");
+    auto in = OIIO::ImageInput::open((dir / "lin.exr").string());
+    REQUIRE(in);
+    CHECK(in->spec().width == 8);
+    CHECK(in->spec().nchannels == 4);
+    std::vector<float> px(8 * 4 * 4);
+    REQUIRE(in->read_image(0, 0, 0, 4, OIIO::TypeDesc::FLOAT, px.data()));
+    in->close();
+    CHECK(px[0] == 0.5f);
+    CHECK(px[1] == 0.25f);
+    CHECK(px[2] == 1.0f);
+    CHECK(px[3] == 1.0f);
   }
   SECTION("sRGB encoding") {
     auto bytes = toSrgb8(img, 4);
