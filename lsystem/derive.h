@@ -37,12 +37,14 @@ struct DeriveOptions {
 
 /// Derives a grammar step by step. Not thread-safe; cheap to construct.
 ///
-/// Errors (InputError): a module limit overrun ("derivation would exceed N modules at step
-/// k"), a non-finite parameter ("production at file:line:col produced a non-finite value
-/// (nan) at step k").
+/// Errors (InputError): a module limit overrun (`file: error: derivation would exceed N
+/// modules at step k`), a non-finite parameter (`file:line:col: error: non-finite parameter
+/// value (inf) in production 'A(x)' at step k (parameter 1 of 'B')`, at the production),
+/// a NaN condition. After an error the Deriver keeps the string of the last completed step.
 class Deriver {
  public:
-  /// Starts from the grammar's axiom (decomposed, cut). The grammar must outlive the Deriver.
+  /// Starts from the grammar's axiom (decomposed, cut). The Deriver shares the grammar's
+  /// compiled program, so the Grammar object itself may go away.
   explicit Deriver(const Grammar& grammar, DeriveOptions options = {});
   ~Deriver();
   Deriver(Deriver&&) noexcept;
