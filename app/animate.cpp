@@ -166,6 +166,7 @@ int renderGalleryAnimation(const Species& species, const fs::path& out, const Sp
   const int steps = std::max(1, probe.lastStage());
   opt.framesPerStage = std::clamp((final ? 120 : 36) / steps, 1, final ? 8 : 4);
   opt.fps = final ? 12 : 8;
+  opt.holdSeconds = 1;
   opt.width = std::max(16, width / 2);
   opt.height = std::max(16, height / 2);
   opt.samples = final ? look.samples : std::min(look.samples, 2);
@@ -286,7 +287,17 @@ AnimateResult animateSpecies(const Species& species, const fs::path& out, const 
     if (bar) bar->finish();
   }
 
-  if (format == AnimationFormat::Gif) writeAnimatedGif(gifFrames, options.fps, out);
+  // The hold: the last frame repeated (GIF and MP4 have no per-frame duration here).
+  const size_t hold = format == AnimationFormat::Frames
+                          ? 0
+                          : static_cast<size_t>(std::lround(std::max(0.0, options.holdSeconds) * options.fps));
+  if (format == AnimationFormat::Gif) {
+    for (size_t i = 0; i < hold; ++i) gifFrames.push_back(gifFrames.back());
+    writeAnimatedGif(gifFrames, options.fps, out);
+  }
+  if (format == AnimationFormat::Mp4)
+    for (size_t i = 0; i < hold; ++i)
+      fs::copy_file(frameFolder / frameName(frames.size() - 1), frameFolder / frameName(frames.size() + i));
   if (format == AnimationFormat::Mp4) {
     TempPath tmp(out);
     char rate[32];

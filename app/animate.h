@@ -90,6 +90,7 @@ struct AnimateOptions {
   int lastStage = -1;       ///< -1 = the species' steps
   int framesPerStage = 6;   ///< frames over which one step's new modules grow in
   double fps = 12;          ///< GIF and MP4 frame rate
+  double holdSeconds = 0;   ///< GIF and MP4: show the last frame this much longer before looping
   int width = 0;            ///< 0 = the species' render width
   int height = 0;           ///< 0 = the species' render height
   int samples = 0;          ///< camera samples per pixel; 0 = the species' own

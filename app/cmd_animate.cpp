@@ -21,6 +21,7 @@ struct AnimateArgs {
   std::string at;
   int framesPerStage = 6;
   double fps = 12;
+  double hold = 0;
   int width = 0;
   int height = 0;
   int samples = 0;
@@ -65,6 +66,7 @@ int runAnimate(const AnimateArgs& a, const GlobalOptions& g) {
   opt.extra = commandLineOverrides(a.defines, a.steps, a.seed);
   opt.framesPerStage = a.framesPerStage;
   opt.fps = a.fps;
+  opt.holdSeconds = a.hold;
   opt.samples = a.samples;
   if (!a.stages.empty()) parseStages(a.stages, opt.firstStage, opt.lastStage);
   std::optional<GrowthFrame> single;
@@ -115,6 +117,8 @@ void addAnimateCommand(CLI::App& app, const GlobalOptions& global, CommandRun& r
   sub->add_option("--frames-per-stage", args->framesPerStage, "frames over which one step's new organs grow in")
       ->check(CLI::Range(1, 1000));
   sub->add_option("--fps", args->fps, "frames per second of the GIF or MP4")->check(CLI::Range(0.1, 240.0));
+  sub->add_option("--hold", args->hold, "GIF and MP4: seconds to show the grown plant before looping")
+      ->check(CLI::Range(0.0, 60.0));
   sub->add_option("--at", args->at, "render the single frame STAGE[:FRACTION] to a PNG instead");
   sub->add_option("--width", args->width, "frame width in pixels")->check(CLI::Range(16, 8192));
   sub->add_option("--height", args->height, "frame height in pixels")->check(CLI::Range(16, 8192));

@@ -269,7 +269,7 @@ GalleryRunResult renderGallery(std::vector<fs::path> files, const fs::path& outD
   for (Manifest& m : loadManifests(outDir))
     for (ManifestEntry& e : m.entries) previous[e.item.source] = std::move(e);
 
-  const std::string optionText = "gallery-format=1;quality=" + qualityName(options.quality);
+  const std::string optionText = "gallery-format=2;quality=" + qualityName(options.quality);
   Manifest manifest;
   manifest.shard = options.shard;
   manifest.quality = qualityName(options.quality);

@@ -198,6 +198,16 @@ TEST_CASE("animateSpecies", "[app]") {
     int n = 0;
     while (in->seek_subimage(n, 0)) ++n;
     CHECK(n == r.frames);
+    SECTION("a hold repeats the last frame hold * fps times") {
+      opt.holdSeconds = 0.5;
+      opt.fps = 8;
+      animateSpecies(s, tmp.path / "held.gif", opt);
+      auto held = OIIO::ImageInput::open((tmp.path / "held.gif").string());
+      REQUIRE(held);
+      int m = 0;
+      while (held->seek_subimage(m, 0)) ++m;
+      CHECK(m == r.frames + 4);
+    }
     REQUIRE(in->seek_subimage(0, 0));
     CHECK(in->spec().width == 40);
     in->close();
