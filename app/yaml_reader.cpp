@@ -66,6 +66,11 @@ const char* kindName(const YAML::Node& n) {
   }
 }
 
+/// sRGB transfer inverse (IEC 61966-2-1): hex colours are sRGB, the renderer works in linear light.
+float srgbToLinear(float v) {
+  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+}
+
 /// "got 'text'" for scalars, "got a map" otherwise.
 std::string gotText(const YNode& n) {
   if (n.isScalar()) return "got '" + n.scalar() + "'";
@@ -328,7 +333,7 @@ std::optional<Vec3> YNode::asColor(DiagnosticList& diags, std::string_view what)
     for (int i = 0; ok && i < 3; ++i) {
       int hi = hex(s[1 + 2 * i]), lo = hex(s[2 + 2 * i]);
       if (hi < 0 || lo < 0) ok = false;
-      else c[i] = static_cast<float>(hi * 16 + lo) / 255.0f;
+      else c[i] = srgbToLinear(static_cast<float>(hi * 16 + lo) / 255.0f);
     }
     if (ok) return c;
     error(diags, std::string(what) + " must be a colour [r, g, b] in [0, 1] or \"#rrggbb\", got '" + s + "'");

@@ -156,7 +156,7 @@ class YNode {
   std::optional<Vec3> asVec3(DiagnosticList& diags, std::string_view what,
                              double min = -std::numeric_limits<double>::infinity(),
                              double max = std::numeric_limits<double>::infinity()) const;
-  /// A colour: `[r, g, b]` in [0, 1] or `"#rrggbb"`.
+  /// A colour in linear RGB: `[r, g, b]` in [0, 1] (linear) or `"#rrggbb"` (sRGB, converted to linear).
   std::optional<Vec3> asColor(DiagnosticList& diags, std::string_view what) const;
 
  private:
@@ -217,7 +217,7 @@ class MapReader {
   /// `[x, y, z]`; `def` when absent.
   Vec3 vec3(std::string_view key, Vec3 def, double min = -std::numeric_limits<double>::infinity(),
             double max = std::numeric_limits<double>::infinity());
-  /// A colour `[r, g, b]` in [0, 1] or `"#rrggbb"`; `def` when absent.
+  /// A colour: `[r, g, b]` linear in [0, 1] or `"#rrggbb"` sRGB (returned linear); `def` when absent.
   Vec3 color(std::string_view key, Vec3 def);
   /// One of `choices` (did-you-mean on a miss); `def` when absent.
   std::string choice(std::string_view key, std::string def, const std::vector<std::string>& choices);

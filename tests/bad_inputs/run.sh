@@ -1,0 +1,67 @@
+#!/usr/bin/env bash
+# Runs every case of tests/bad_inputs/cases.txt against the sprig binary given as $1.
+# Run from the repository root (ctest does). For each case it checks:
+#   - the exit code is exactly the expected one (so no crash, no signal),
+#   - stderr holds the expected line exactly (`file:line:col: error: ...`),
+#   - nothing was written: the case's output folder $OUT is empty afterwards and no
+#     temporary (.sprig-tmp-*) file is left beside the inputs.
+# A case is a block of lines `name:`, `args:` (split on spaces; $OUT is a fresh empty
+# folder), `exit:` and one or more `expect:` lines; blocks are separated by blank lines.
+set -u
+SPRIG=${1:?usage: run.sh PATH/TO/sprig}
+HERE=$(cd "$(dirname "$0")" && pwd)
+CASES="$HERE/cases.txt"
+WORK=$(mktemp -d)
+trap 'rm -rf "$WORK"' EXIT
+
+pass=0
+fail=0
+name="" args="" code="" expects=()
+
+run_case() {
+  [ -z "$name" ] && return
+  local out="$WORK/$name"
+  mkdir -p "$out"
+  local expanded=${args//\$OUT/$out}
+  local stderr_file="$WORK/$name.stderr"
+  # shellcheck disable=SC2086
+  timeout 120 "$SPRIG" --quiet $expanded >"$WORK/$name.stdout" 2>"$stderr_file"
+  local rc=$?
+  local ok=1 why=""
+  if [ "$rc" != "$code" ]; then ok=0; why="exit code $rc, expected $code"; fi
+  for e in "${expects[@]}"; do
+    e=${e//\$OUT/$out}
+    if ! grep -qxF -- "$e" "$stderr_file"; then ok=0; why="$why${why:+; }missing line: $e"; fi
+  done
+  if [ -n "$(find "$out" -mindepth 1 -print -quit)" ]; then
+    ok=0; why="$why${why:+; }left files: $(find "$out" -mindepth 1 | tr '\n' ' ')"
+  fi
+  if [ -n "$(find "$HERE" -name '.sprig-tmp-*' -print -quit)" ]; then
+    ok=0; why="$why${why:+; }left temporaries beside the inputs"
+  fi
+  if [ $ok = 1 ]; then
+    pass=$((pass + 1))
+  else
+    fail=$((fail + 1))
+    echo "FAIL $name: $why"
+    echo "  command: sprig --quiet $expanded"
+    sed 's/^/  stderr: /' "$stderr_file"
+  fi
+  name="" args="" code="" expects=()
+}
+
+while IFS= read -r line || [ -n "$line" ]; do
+  case "$line" in
+    "#"*) ;;
+    "") run_case ;;
+    name:\ *) name=${line#name: } ;;
+    args:\ *) args=${line#args: } ;;
+    exit:\ *) code=${line#exit: } ;;
+    expect:\ *) expects+=("${line#expect: }") ;;
+    *) echo "cases.txt: cannot read line: $line"; exit 2 ;;
+  esac
+done <"$CASES"
+run_case
+
+echo "bad_inputs: $pass passed, $fail failed"
+[ $fail = 0 ]
