@@ -512,7 +512,7 @@ ShellModel buildShell(const ShellParams& p, const SourceLoc& loc) {
   if (p.whorls < 1 || !(p.whorlDeg > 0.0) || !(p.sectionDeg > 0.0) || p.surfacesPerSection < 1)
     fail("whorls, whorl angle, section angle and surfaces per section must be positive");
   if (p.generating.primitives.empty()) fail("the generating surface has no primitive");
-  if (p.endDeg() < p.startDeg + p.stepDeg()) fail("age (theta_end) must be at least one step past the start");
+  if (!(p.endDeg() >= p.startDeg)) fail("age (theta_end) must not be below the start angle");
   if (p.varices.enabled && !(p.varices.spacingDeg > 0.0)) fail("varix spacing must be > 0");
   if (p.axialSpines.enabled && (p.axialSpines.bendsMin < 0 || p.axialSpines.bendsMax < p.axialSpines.bendsMin))
     fail("axial spine bend counts must satisfy 0 <= min <= max");

@@ -196,7 +196,7 @@ struct ShellModel {
 
 /// Builds the shell. Throws InputError (at `loc`, e.g. the species file's `shell:` key) when
 /// parameters are out of range: λ <= 1, β outside (0°, 90°], R₀ <= 0, no generating
-/// primitive, θ_end < one Δθ. Deterministic: the same params give the same tree.
+/// primitive, θ_end below the start angle (θ_end = start gives one generating surface). Deterministic: the same params give the same tree.
 ShellModel buildShell(const ShellParams& params, const SourceLoc& loc = {});
 
 /// The Murex cabritii of the paper: λ = 1.3, β = 22.5°, R₀ = 0.2, seven whorls of 348°,

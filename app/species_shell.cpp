@@ -1,0 +1,371 @@
+#include "app/species_shell.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace sprig {
+
+using organisms::GeneratingPrimitive;
+using organisms::GeneratingSurface;
+using organisms::ShellParams;
+using organisms::VarixSpine;
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// `'key'` for messages (appended piecewise: GCC 12 warns falsely on "'" + string + "'").
+std::string quoted(std::string_view key) {
+  std::string q;
+  q.reserve(key.size() + 2);
+  q.push_back('\'');
+  q.append(key);
+  q.push_back('\'');
+  return q;
+}
+
+float num(MapReader& r, std::string_view key, float def, double lo = -kInf, double hi = kInf) {
+  return static_cast<float>(r.number(key, def, lo, hi));
+}
+
+/// A part section: absent (keeps `enabled`), `true`/`false`, or a map (enables it).
+std::optional<YNode> partSection(MapReader& top, std::string_view key, bool& enabled, DiagnosticList& diags) {
+  auto n = top.get(key);
+  if (!n) return std::nullopt;
+  if (n->isScalar()) {
+    if (auto b = n->asBoolean(diags, quoted(key))) enabled = *b;
+    return std::nullopt;
+  }
+  if (!n->isMap() && !n->isNull()) {
+    n->error(diags, quoted(key) + " must be a map or true/false");
+    return std::nullopt;
+  }
+  enabled = true;
+  return n;
+}
+
+std::vector<float> floatList(const YNode& n, DiagnosticList& diags, std::string_view what, double lo, double hi) {
+  std::vector<float> out;
+  if (!n.isSequence()) {
+    n.error(diags, quoted(what) + " must be a sequence");
+    return out;
+  }
+  for (const YNode& v : n.items())
+    if (auto x = v.asNumber(diags, quoted(what) + " entry", lo, hi)) out.push_back(static_cast<float>(*x));
+  return out;
+}
+
+void readGenerating(MapReader& top, ShellParams& p, DiagnosticList& diags) {
+  auto g = top.get("generating");
+  if (!g) return;
+  if (g->isScalar()) {
+    static const std::vector<std::string> kinds = {"point", "murex"};
+    const std::string k = g->scalar();
+    if (k == "point")
+      p.generating = GeneratingSurface::point();
+    else if (k == "murex")
+      p.generating = GeneratingSurface::murex(1.333 * p.whorlDeg);
+    else
+      g->error(diags, "unknown generating surface '" + k + "' (point, murex or a map of primitives)" + didYouMean(k, kinds));
+    return;
+  }
+  MapReader gen(*g, diags, "generating");
+  p.generating.primitives.clear();
+  for (const YNode& item : gen.sequence("primitives")) {
+    if (!item.isMap() || item.pairs().size() != 1) {
+      item.error(diags, "a generating primitive must be a map with one key: point or cone");
+      continue;
+    }
+    const auto& [keyNode, value] = item.pairs().front();
+    const std::string kind = keyNode.scalar();
+    GeneratingPrimitive prim;
+    MapReader r(value, diags, kind);
+    if (kind == "point") {
+      prim.kind = GeneratingPrimitive::Kind::Point;
+      prim.a = r.vec3("center", Vec3(0.0f), -100, 100);
+      prim.radiusA = prim.radiusB = num(r, "radius", 1.0f, 1e-4, 100);
+    } else if (kind == "cone") {
+      prim.kind = GeneratingPrimitive::Kind::Cone;
+      prim.a = r.vec3("a", Vec3(0.0f), -100, 100);
+      prim.b = r.vec3("b", Vec3(0.0f, 1.0f, 0.0f), -100, 100);
+      prim.radiusA = num(r, "radius_a", 0.3f, 1e-4, 100);
+      prim.radiusB = num(r, "radius_b", 0.2f, 1e-4, 100);
+      prim.bendDeg = num(r, "bend", 0.0f, 0.0, 180.0);
+      prim.bendDirection = r.vec3("bend_direction", Vec3(1, 0, 0), -1e3, 1e3);
+      prim.canal = r.boolean("canal", false);
+      if (glm::length(prim.b - prim.a) < 1e-4f) value.error(diags, "cone 'a' and 'b' must differ");
+    } else {
+      static const std::vector<std::string> kinds = {"point", "cone"};
+      keyNode.error(diags, "unknown generating primitive '" + kind + "' (point or cone)" + didYouMean(kind, kinds));
+      continue;
+    }
+    prim.lastDeg = r.number("last", 0.0, 0.0, 1e6);
+    r.finish();
+    p.generating.primitives.push_back(prim);
+  }
+  if (p.generating.primitives.empty()) g->error(diags, "'generating' needs at least one primitive");
+  gen.finish();
+}
+
+void readVarices(MapReader& top, ShellParams& p, DiagnosticList& diags) {
+  auto sec = partSection(top, "varices", p.varices.enabled, diags);
+  if (!sec) return;
+  auto& v = p.varices;
+  MapReader r(*sec, diags, "varices");
+  v.enabled = r.boolean("enabled", true);
+  v.spacingDeg = r.number("spacing", v.spacingDeg, 1.0, 3600.0);
+  if (auto spines = r.get("spines")) {
+    if (spines->isScalar() && spines->scalar() == "murex_table1") {
+      v.spinesByWhorl = organisms::murexTable1();
+    } else if (!spines->isSequence()) {
+      spines->error(diags, "'spines' must be murex_table1 or a sequence of rows (one per whorl) of [angle, size]");
+    } else {
+      v.spinesByWhorl.clear();
+      for (const YNode& row : spines->items()) {
+        std::vector<VarixSpine> out;
+        if (!row.isSequence()) {
+          row.error(diags, "a spine row must be a sequence of [angle, size] pairs");
+        } else {
+          for (const YNode& pair : row.items()) {
+            auto xs = floatList(pair, diags, "spine", -180.0, 180.0);
+            if (xs.size() != 2) {
+              pair.error(diags, "a spine must be [angle, size]");
+              continue;
+            }
+            if (!(xs[1] > 0.0f)) {
+              pair.error(diags, "spine size must be > 0");
+              continue;
+            }
+            out.push_back({xs[0], xs[1]});
+          }
+        }
+        v.spinesByWhorl.push_back(std::move(out));
+      }
+    }
+  }
+  v.spineLength = num(r, "spine_length", v.spineLength, 0.0, 20.0);
+  v.baseRadius = num(r, "base_radius", v.baseRadius, 1e-3, 5.0);
+  v.tipRadius = num(r, "tip_radius", v.tipRadius, 1e-3, 5.0);
+  v.shortTipRadius = num(r, "short_tip_radius", v.shortTipRadius, 1e-3, 5.0);
+  v.shortSize = num(r, "short_size", v.shortSize, 0.0, 100.0);
+  v.bendDeg = num(r, "bend", v.bendDeg, 0.0, 170.0);
+  v.edge = num(r, "edge", v.edge, 0.0, 3.0);
+  v.widenAcross = r.boolean("widen_across", v.widenAcross);
+  v.tori = r.boolean("tori", v.tori);
+  v.torusRadius = num(r, "torus_radius", v.torusRadius, 1e-3, 2.0);
+  v.torusOuter = num(r, "torus_outer", v.torusOuter, 0.0, 5.0);
+  v.lipVarix = r.boolean("lip", v.lipVarix);
+  r.finish();
+}
+
+void readBumps(MapReader& top, ShellParams& p, DiagnosticList& diags) {
+  auto sec = partSection(top, "bumps", p.bumps.enabled, diags);
+  if (!sec) return;
+  auto& b = p.bumps;
+  MapReader r(*sec, diags, "bumps");
+  b.enabled = r.boolean("enabled", true);
+  b.setsPerSection = static_cast<int>(r.integer("sets", b.setsPerSection, 0, 100));
+  b.size = num(r, "size", b.size, 1e-3, 5.0);
+  b.sdFraction = num(r, "sd", b.sdFraction, 0.0, 1.0);
+  b.elongation = num(r, "elongation", b.elongation, 0.0, 10.0);
+  b.blendN = num(r, "blend_n", b.blendN, 1.0, 1000.0);
+  b.random = r.boolean("random", b.random);
+  b.edge = num(r, "edge", b.edge, 0.0, 3.0);
+  r.finish();
+}
+
+void readAxial(MapReader& top, ShellParams& p, DiagnosticList& diags) {
+  auto sec = partSection(top, "axial_spines", p.axialSpines.enabled, diags);
+  if (!sec) return;
+  auto& a = p.axialSpines;
+  MapReader r(*sec, diags, "axial_spines");
+  a.enabled = r.boolean("enabled", true);
+  if (auto rows = r.get("rows")) {
+    if (rows->isScalar() && rows->scalar() == "murex_table2") {
+      a.rows = organisms::murexTable2();
+    } else if (!rows->isSequence()) {
+      rows->error(diags, "'rows' must be murex_table2 or a sequence of rows of relative sizes");
+    } else {
+      a.rows.clear();
+      for (const YNode& row : rows->items()) a.rows.push_back(floatList(row, diags, "rows", 1e-3, 20.0));
+    }
+  }
+  a.length = num(r, "length", a.length, 0.0, 20.0);
+  a.baseRadius = num(r, "base_radius", a.baseRadius, 1e-3, 5.0);
+  a.tipRadius = num(r, "tip_radius", a.tipRadius, 1e-3, 5.0);
+  a.firstT = num(r, "first", a.firstT, 0.0, 1.0);
+  a.lastT = num(r, "last", a.lastT, 0.0, 1.0);
+  a.downTilt = num(r, "tilt", a.downTilt, -10.0, 10.0);
+  a.randomBends = r.boolean("random_bends", a.randomBends);
+  a.bendMinDeg = num(r, "bend_min", a.bendMinDeg, 0.0, 45.0);
+  a.bendMaxDeg = num(r, "bend_max", a.bendMaxDeg, 0.0, 45.0);
+  a.bendsMin = static_cast<int>(r.integer("bends_min", a.bendsMin, 0, 10));
+  a.bendsMax = static_cast<int>(r.integer("bends_max", a.bendsMax, 0, 10));
+  if (a.bendsMax < a.bendsMin) sec->error(diags, "'bends_max' must be >= 'bends_min'");
+  if (a.bendMaxDeg < a.bendMinDeg) sec->error(diags, "'bend_max' must be >= 'bend_min'");
+  r.finish();
+}
+
+void readOpening(MapReader& top, ShellParams& p, DiagnosticList& diags) {
+  auto sec = partSection(top, "opening", p.opening.enabled, diags);
+  if (!sec) return;
+  auto& o = p.opening;
+  MapReader r(*sec, diags, "opening");
+  o.enabled = r.boolean("enabled", true);
+  o.innerScale = num(r, "inner_scale", o.innerScale, 0.05, 0.98);
+  o.depthDeg = r.number("depth", o.depthDeg, 0.0, 3600.0);
+  o.extendDeg = r.number("extend", o.extendDeg, 0.0, 360.0);
+  o.insideWall = r.boolean("inside_wall", o.insideWall);
+  o.subtractPrevious = r.boolean("subtract_previous", o.subtractPrevious);
+  r.finish();
+}
+
+void readTextures(MapReader& top, organisms::ShellTextureOptions& t, DiagnosticList& diags) {
+  if (auto sec = top.section("textures")) {
+    MapReader r(*sec, diags, "textures");
+    t.whorlColor = r.color("whorl", t.whorlColor);
+    t.cordColor = r.color("cord_color", t.cordColor);
+    t.cords = static_cast<int>(r.integer("cords", t.cords, 0, 200));
+    t.cordStrength = num(r, "cord_strength", t.cordStrength, 0.0, 1.0);
+    t.growthLineDeg = num(r, "growth_lines", t.growthLineDeg, 0.0, 360.0);
+    t.growthLineStrength = num(r, "growth_line_strength", t.growthLineStrength, 0.0, 1.0);
+    t.varixColor = r.color("varix", t.varixColor);
+    t.spineTipColor = r.color("spine_tip", t.spineTipColor);
+    t.axialColor = r.color("axial", t.axialColor);
+    t.bumpColor = r.color("bump", t.bumpColor);
+    t.insideColor = r.color("inside", t.insideColor);
+    r.finish();
+  }
+  bool on = t.pigment;
+  auto sec = partSection(top, "pigment", on, diags);
+  t.pigment = on;
+  if (!sec) return;
+  auto& o = t.pigmentOptions;
+  MapReader r(*sec, diags, "pigment");
+  o.cells = static_cast<int>(r.integer("cells", o.cells, 3, 4096));
+  o.rows = static_cast<int>(r.integer("rows", o.rows, 1, 8192));
+  o.stepsPerRow = static_cast<int>(r.integer("steps_per_row", o.stepsPerRow, 1, 1000));
+  o.warmupRows = static_cast<int>(r.integer("warmup", o.warmupRows, 0, 10000));
+  o.dt = r.number("dt", o.dt, 1e-4, 10.0);
+  o.diffusionA = r.number("da", o.diffusionA, 0.0, 10.0);
+  o.diffusionB = r.number("db", o.diffusionB, 0.0, 10.0);
+  o.decayA = r.number("ra", o.decayA, 1e-6, 10.0);
+  o.decayB = r.number("rb", o.decayB, 1e-6, 10.0);
+  o.baseA = r.number("ba", o.baseA, 0.0, 10.0);
+  o.baseB = r.number("bb", o.baseB, 0.0, 10.0);
+  o.saturation = r.number("saturation", o.saturation, 0.0, 100.0);
+  o.sourceNoise = r.number("noise", o.sourceNoise, 0.0, 1.0);
+  o.seed = static_cast<uint64_t>(r.integer("seed", static_cast<int64_t>(o.seed), 0));
+  t.pigmentColor = r.color("color", t.pigmentColor);
+  t.pigmentStrength = num(r, "strength", t.pigmentStrength, 0.0, 1.0);
+  if (o.dt * std::max(o.diffusionA, o.diffusionB) >= 0.5)
+    sec->error(diags, "pigment: dt * max(da, db) must stay below 0.5 (explicit integration is unstable)");
+  r.finish();
+}
+
+}  // namespace
+
+std::optional<ShellSpecies> readShellSpecies(const YNode& section, DiagnosticList& diags) {
+  if (!section.isMap()) {
+    section.error(diags, "'shell' must be a map");
+    return std::nullopt;
+  }
+  ShellSpecies s;
+  s.loc = section.loc();
+  MapReader top(section, diags, "shell");
+  const std::string preset = top.choice("preset", "none", {"none", "murex_cabritii"});
+  ShellParams& p = s.params;
+  if (preset == "murex_cabritii") {
+    p = organisms::murexCabritii();
+    s.textures.pigment = false;
+  }
+  p.spiral.lambda = top.number("lambda", p.spiral.lambda, 1.0001, 100.0);
+  p.spiral.betaDeg = top.number("beta", p.spiral.betaDeg, 0.1, 90.0);
+  p.spiral.r0 = top.number("r0", p.spiral.r0, 1e-6, 1e6);
+  p.whorls = static_cast<int>(top.integer("whorls", p.whorls, 1, 40));
+  p.whorlDeg = top.number("whorl_angle", p.whorlDeg, 1.0, 3600.0);
+  p.sectionDeg = top.number("section_angle", p.sectionDeg, 1.0, 3600.0);
+  p.surfacesPerSection = static_cast<int>(top.integer("surfaces_per_section", p.surfacesPerSection, 1, 1000));
+  p.startDeg = top.number("start", p.startDeg, -36000.0, 36000.0);
+  if (top.has("age")) p.ageDeg = top.number("age", p.whorls * p.whorlDeg, 0.0, 40 * 3600.0);
+  for (const YNode& st : top.sequence("stages"))
+    if (auto v = st.asNumber(diags, "'stages' entry", 0.0, 40 * 3600.0)) s.stages.push_back(*v);
+  p.seed = static_cast<uint64_t>(top.integer("seed", static_cast<int64_t>(p.seed), 0));
+  p.controlledBlending = top.boolean("controlled_blending", p.controlledBlending);
+  p.calibrateSize = top.boolean("calibrate", p.calibrateSize);
+  p.apexUp = top.boolean("apex_up", p.apexUp);
+  readGenerating(top, p, diags);
+  readVarices(top, p, diags);
+  readBumps(top, p, diags);
+  readAxial(top, p, diags);
+  readOpening(top, p, diags);
+  readTextures(top, s.textures, diags);
+  top.finish();
+  const double end = p.endDeg();
+  if (end < p.startDeg) section.error(diags, "shell 'age' must not be below 'start'");
+  return s;
+}
+
+ShellSpecies parseShellSpecies(std::string text, const std::string& displayPath) {
+  DiagnosticList diags;
+  auto file = YamlFile::parse(std::move(text), displayPath, diags);
+  std::optional<ShellSpecies> out;
+  if (file) {
+    MapReader top(file->rootNode(), diags, "species file");
+    top.allow({"name", "description", "render", "kind"});
+    if (auto sec = top.get("shell"))
+      out = readShellSpecies(*sec, diags);
+    else
+      file->rootNode().error(diags, "missing required key 'shell' in species file");
+    top.finish();
+  }
+  diags.throwIfErrors();
+  return *out;
+}
+
+std::vector<double> shellGrowthStages(const ShellSpecies& species, int count) {
+  if (!species.stages.empty()) return species.stages;
+  const auto& p = species.params;
+  const double end = p.endDeg();
+  std::vector<double> out;
+  for (int i = 1; i <= count; ++i) {
+    const double age = p.startDeg + (end - p.startDeg) * i / count;
+    if (age >= p.startDeg + p.stepDeg()) out.push_back(age);
+  }
+  return out;
+}
+
+ShellBuild buildShellSpecies(const ShellSpecies& species, std::optional<double> ageDeg) {
+  organisms::ShellParams p = species.params;
+  if (ageDeg) p.ageDeg = *ageDeg;
+  ShellBuild b;
+  b.model = organisms::buildShell(p, species.loc);
+  b.blob = blobtree::compile(b.model.tree, b.model.root);
+  b.painter = std::make_shared<const organisms::ShellPainter>(p, b.model, species.textures);
+  return b;
+}
+
+uint32_t addShellToScene(render::Scene& scene, const ShellBuild& shell, const render::ImplicitOptions& options) {
+  using organisms::ShellPart;
+  render::Material porcelain;
+  porcelain.baseColor = shell.painter->options().whorlColor;
+  porcelain.roughness = 0.35f;
+  porcelain.specular = 0.05f;
+  const uint32_t material = scene.addMaterial(porcelain);
+  for (ShellPart part : {ShellPart::Whorl, ShellPart::VarixSpine, ShellPart::AxialSpine, ShellPart::Bump, ShellPart::Inside}) {
+    std::shared_ptr<const organisms::ShellPainter> painter = shell.painter;
+    const uint32_t id = scene.addTexture([painter, part](Vec2 uv, const Vec3& p) { return painter->partColor(part, p, uv); });
+    if (id != static_cast<uint32_t>(part)) throw std::logic_error("addShellToScene: the scene already holds textures");
+  }
+  render::ImplicitOptions opt = options;
+  if (opt.cellSize <= 0.0f) {
+    // The renderer's automatic size follows the smallest feature (the apex's tiny spine
+    // tips), which makes hundreds of thousands of cells; a fixed fraction of the model's
+    // diagonal renders the Murex faster (docs/perf/shells.md).
+    opt.cellSize = glm::length(shell.blob.bounds().size()) / 120.0f;
+  }
+  return scene.addImplicit(shell.blob, material, opt);
+}
+
+}  // namespace sprig
