@@ -1181,7 +1181,7 @@ std::optional<Hit> CompiledBlob::intersectCell(const Cell& cell, const Ray& ray,
 
 // ---- Surface cells ---------------------------------------------------------------------------
 
-CellSet CompiledBlob::surfaceCells(float cellSize) const {
+CellSet CompiledBlob::surfaceCells(float cellSize, const SurfaceCellOptions& options) const {
   if (!(cellSize > 0.0f)) throw std::invalid_argument("surfaceCells: cellSize must be positive");
   CellSet out;
   if (tape_->empty) return out;
@@ -1191,6 +1191,7 @@ CellSet CompiledBlob::surfaceCells(float cellSize) const {
   float E = std::max(rb.size().x, std::max(rb.size().y, rb.size().z)) * 1.0001f + 1e-20f;
   int depth = std::max(0, int(std::ceil(std::log2(E / cellSize))));
   if (depth > 20) throw std::invalid_argument("surfaceCells: cellSize too small for the model");
+  if (options.exactCellSize) E = cellSize * float(1 << depth);
   float edge = E / float(1 << depth);
   out.origin = rb.center() - Vec3(0.5f * E);
   out.cellSize = edge;
@@ -1239,9 +1240,9 @@ CellSet CompiledBlob::surfaceCells(float cellSize) const {
       cell.box = b;
       cell.index = it.idx;
       cell.bounds = iv;
-      cell.lipschitz = evalL(T, T.root, b);
+      if (options.lipschitz) cell.lipschitz = evalL(T, T.root, b);
       cell.firstPrimitive = uint32_t(prims.size());
-      if (T.instBvh >= 0)
+      if (options.primitiveLists && T.instBvh >= 0)
         walkBvh(T, T.instBvh, [&](const Box3& bb) { return bb.overlaps(b); }, [&](uint32_t i) {
           if (T.instBox[i].overlaps(b)) prims.push_back(i);
         });

@@ -98,6 +98,18 @@ struct TraceOptions {
   int maxSteps = 100000;
 };
 
+/// What CompiledBlob::surfaceCells computes besides the cells themselves.
+struct SurfaceCellOptions {
+  /// Cells of exactly the requested edge: the root cube grows to cellSize·2^k around the
+  /// bounds. false: the bounds' cube divided by 2^k (an edge between half and all of the
+  /// request).
+  bool exactCellSize = false;
+  /// Fill Cell::lipschitz (the renderer's tracer needs it; the polygonizer does not).
+  bool lipschitz = true;
+  /// Fill Cell::firstPrimitive/primitiveCount and CellSet::primitives.
+  bool primitiveLists = true;
+};
+
 namespace detail { struct Tape; }
 
 /// The compiled, immutable evaluation form of a BlobTree node. Cheap to move; copies share
@@ -144,11 +156,12 @@ class CompiledBlob {
   /// cell's stored Lipschitz bound (the renderer's Embree user-geometry callback).
   std::optional<Hit> intersectCell(const Cell& cell, const Ray& ray, float tmin, float tmax,
                                    const TraceOptions& opt = {}) const;
-  /// The cells of a regular grid over bounds() (cube cells of edge <= cellSize) whose
-  /// interval bound may contain 0.5, found by recursive octree subdivision from the root:
-  /// work proportional to the surface area. Parallel and deterministic.
-  /// Throws std::invalid_argument when cellSize <= 0 or bounds() is unbounded.
-  CellSet surfaceCells(float cellSize) const;
+  /// The cells of a regular grid over bounds() (cube cells of edge <= cellSize, or exactly
+  /// cellSize with options.exactCellSize) whose interval bound may contain 0.5, found by
+  /// recursive octree subdivision from the root: work proportional to the surface area.
+  /// Parallel and deterministic. Throws std::invalid_argument when cellSize <= 0 or
+  /// bounds() is unbounded.
+  CellSet surfaceCells(float cellSize, const SurfaceCellOptions& options = {}) const;
 
   /// Number of primitives (leaves) in the tape.
   size_t primitiveCount() const;

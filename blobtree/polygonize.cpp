@@ -43,39 +43,49 @@ constexpr int kTets[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7}, {0, 2, 6,
 
 constexpr uint32_t kNoCell = ~0u;
 
-// Open-addressing map from a cell's key to its active index.
+// Open-addressing map from a cell's key to its index. The slot of a cell is a hash of its
+// 4x4x4 block, then its place in the block: the neighbours a cell looks up (and the next
+// cells in octree order) mostly lie in the same few cache lines, where a plain hash of the
+// key would cost a cache miss per lookup in tables of millions of cells.
 class CellHash {
  public:
   explicit CellHash(size_t n) {
-    size_t cap = 16;
+    size_t cap = 64;
     while (cap < 2 * n) cap <<= 1;
-    keys_.assign(cap, kEmpty);
-    ids_.assign(cap, kNoCell);
+    slots_.assign(cap, Slot{kEmpty, kNoCell});
     mask_ = cap - 1;
   }
   void insert(uint64_t key, uint32_t id) {
     size_t i = slot(key);
-    while (keys_[i] != kEmpty && keys_[i] != key) i = (i + 1) & mask_;
-    keys_[i] = key;
-    ids_[i] = id;
+    while (slots_[i].key != kEmpty && slots_[i].key != key) i = (i + 1) & mask_;
+    slots_[i] = Slot{key, id};
   }
   uint32_t find(uint64_t key) const {
     for (size_t i = slot(key);; i = (i + 1) & mask_) {
-      if (keys_[i] == key) return ids_[i];
-      if (keys_[i] == kEmpty) return kNoCell;
+      const Slot& s = slots_[i];
+      if (s.key == key) return s.id;
+      if (s.key == kEmpty) return kNoCell;
     }
   }
 
  private:
   static constexpr uint64_t kEmpty = ~uint64_t(0);
-  size_t slot(uint64_t k) const {
-    k ^= k >> 33;
-    k *= 0xff51afd7ed558ccdULL;
-    k ^= k >> 33;
-    return size_t(k) & mask_;
+  struct Slot {
+    uint64_t key;
+    uint32_t id;
+  };
+  size_t slot(uint64_t key) const {
+    // Key bits: i (20) | j (20) | k (20); the low 2 bits of each axis place the cell in
+    // its block, the rest name the block.
+    constexpr uint64_t kLow = 3;
+    uint64_t local = (key & kLow) | ((key >> kAxisBits & kLow) << 2) | ((key >> (2 * kAxisBits) & kLow) << 4);
+    uint64_t block = key & ~((kLow << (2 * kAxisBits)) | (kLow << kAxisBits) | kLow);
+    block ^= block >> 33;
+    block *= 0xff51afd7ed558ccdULL;
+    block ^= block >> 33;
+    return size_t((block << 6) | local) & mask_;
   }
-  std::vector<uint64_t> keys_;
-  std::vector<uint32_t> ids_;
+  std::vector<Slot> slots_;
   size_t mask_ = 0;
 };
 
@@ -190,7 +200,10 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
     clock = now;
     return s;
   };
-  CellSet cs = blob.surfaceCells(requested);
+  // Cells of exactly the requested edge; no Lipschitz bounds or primitive lists (the
+  // tracer's needs, not ours).
+  CellSet cs = blob.surfaceCells(requested, SurfaceCellOptions{.exactCellSize = true, .lipschitz = false,
+                                                               .primitiveLists = false});
   res.cellSeconds = lap();
   res.cellSize = cs.cellSize;
   res.surfaceCells = cs.cells.size();
@@ -225,10 +238,30 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
   std::vector<uint8_t> ownedMask(nCells);
   std::vector<uint32_t> pointBase(nCells + 1, 0);
   parallelFor(0, nCells, [&](size_t i) {
-    const auto& idx = cs.cells[i].index;
+    const glm::ivec3 idx(cs.cells[i].index[0], cs.cells[i].index[1], cs.cells[i].index[2]);
+    // Corner c is owned by the neighbour idx + offset(c) − offset(c') with the smallest
+    // c' < c that is kept, else by this cell. Neighbours by displacement (27 of them),
+    // each looked up at most once.
+    std::array<uint32_t, 27> neighbour;
+    neighbour.fill(kNoCell - 1);  // not looked up yet
+    auto find = [&](glm::ivec3 d) {
+      uint32_t& n = neighbour[size_t((d.x + 1) + 3 * (d.y + 1) + 9 * (d.z + 1))];
+      if (n == kNoCell - 1) {
+        glm::ivec3 g = idx + d;
+        n = g.x < 0 || g.y < 0 || g.z < 0 ? kNoCell : cellIndex.find(pointKey(g.x, g.y, g.z));
+      }
+      return n;
+    };
     uint8_t owned = 0;
     for (int c = 0; c < 8; ++c) {
-      uint32_t slot = ownerSlot(glm::ivec3(idx[0], idx[1], idx[2]) + cornerOffset(c));
+      uint32_t slot = uint32_t(i * 8 + size_t(c));
+      for (int c2 = 0; c2 < c; ++c2) {
+        uint32_t j = find(cornerOffset(c) - cornerOffset(c2));
+        if (j != kNoCell) {
+          slot = j * 8 + uint32_t(c2);
+          break;
+        }
+      }
       cornerPoint[i * 8 + size_t(c)] = slot;
       if (slot == uint32_t(i * 8 + size_t(c))) owned |= uint8_t(1u << c);
     }
@@ -255,18 +288,20 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
   }, 1024);
   res.gridSamples = nPoints;
 
+  // Points are numbered in cell order and the cells come in recursive octree order, so a
+  // run of consecutive points is a compact cluster: batches of kSampleBatch of them share
+  // one tree walk and evaluate each nearby primitive over the whole batch.
   std::vector<float> values(nPoints);
-  parallelForRange(0, nCells, [&](size_t begin, size_t end) {
-    std::array<Vec3, 8> pts;
-    std::array<float, 8> out;
-    for (size_t i = begin; i < end; ++i) {
-      uint32_t b = pointBase[i], n = pointBase[i + 1] - b;
-      if (n == 0) continue;
-      for (uint32_t k = 0; k < n; ++k) pts[k] = gridPosition(cs, keyCoords(pointKeys[b + k]));
-      blob.valuesInCell(cs.cells[i], std::span<const Vec3>(pts.data(), n), std::span<float>(out.data(), n));
-      for (uint32_t k = 0; k < n; ++k) values[b + k] = out[k];
-    }
-  }, 256);
+  {
+    constexpr size_t kSampleBatch = 128;
+    size_t nBatches = (nPoints + kSampleBatch - 1) / kSampleBatch;
+    parallelFor(0, nBatches, [&](size_t bi) {
+      std::array<Vec3, kSampleBatch> pts;
+      size_t b = bi * kSampleBatch, n = std::min(kSampleBatch, nPoints - b);
+      for (size_t k = 0; k < n; ++k) pts[k] = gridPosition(cs, keyCoords(pointKeys[b + k]));
+      blob.values(std::span<const Vec3>(pts.data(), n), std::span<float>(values.data() + b, n));
+    }, 16);
+  }
   if (options.progress && ProgressSettings::cancelRequested()) throw Cancelled();
 
   res.sampleSeconds = lap();

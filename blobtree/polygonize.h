@@ -3,13 +3,15 @@
 ///
 /// Method (work proportional to surface area, not volume):
 ///  1. Cells: CompiledBlob::surfaceCells(cellSize) finds, by interval bounds and octree
-///     subdivision, the cube cells of a regular grid that may hold the F = 0.5 surface.
-///     No other cell is visited.
+///     subdivision, the cube cells (of exactly the requested edge) of a regular grid that
+///     may hold the F = 0.5 surface. No other cell is visited.
 ///  2. Samples: the field is sampled once at every distinct corner of those cells. A grid
 ///     point belongs to the kept cell holding it with the smallest corner code (found in a
-///     hash of cell keys, no sort) and is evaluated in a batch with that cell's other owned
-///     corners over the cell's short primitive list (CompiledBlob::valuesInCell). One
-///     value per grid point keeps neighbouring cells consistent.
+///     hash of cell keys, no sort); points are numbered by owner cell, and the cells come
+///     in octree order, so each run of 128 consecutive points is a compact cluster
+///     evaluated in one batched values() call (one tree walk, each nearby primitive over
+///     the whole batch, vectorized). One value per grid point keeps neighbouring cells
+///     consistent.
 ///  3. Closure: a kept cell whose face shows a sign change gets its neighbour across that
 ///     face added when the bounds dropped it (rounding at corners exactly on F = 0.5).
 ///  4. Marching tetrahedra: each cell with a sign change is split into the six Kuhn
@@ -42,8 +44,8 @@ namespace sprig::blobtree {
 struct PolygonizeOptions {
   /// Requested cell edge length in world units; 0 = automatic: the smaller of
   /// featureFraction · smallestFeature() (so the thinnest twig gets several cells across)
-  /// and the model's bounds diagonal / sizeDivisions. The grid uses a cell between half
-  /// and all of this (surfaceCells rounds down to the root cube / 2^k).
+  /// and the model's bounds diagonal / sizeDivisions. The grid's cells have exactly this
+  /// edge.
   float cellSize = 0.0f;
   /// Automatic cell size as a fraction of the smallest primitive radius.
   float featureFraction = 0.5f;
