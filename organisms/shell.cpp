@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 #include <string>
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -57,6 +58,8 @@ class ShellBuilder {
   const std::vector<VarixSpine>& spineRow(double theta) const;
   int whorlOf(double theta) const;
   Bend canalBend(const GeneratingPrimitive& g) const;
+  NodeId arcCone(Vec3 a, Vec3 b, float radiusA, float radiusB, std::span<const Bend> bends, double totalDeg,
+                 const glm::dmat4& m, ShellPart part);
 
   const ShellParams& p_;
   ShellModel& m_;
@@ -81,6 +84,34 @@ const std::vector<VarixSpine>& ShellBuilder::spineRow(double theta) const {
 
 Bend ShellBuilder::canalBend(const GeneratingPrimitive& g) const {
   return Bend::fromAngle(g.a, g.b, g.bendDirection, static_cast<float>(radians(g.bendDeg)));
+}
+
+NodeId ShellBuilder::arcCone(Vec3 a, Vec3 b, float radiusA, float radiusB, std::span<const Bend> bends,
+                             double totalDeg, const glm::dmat4& m, ShellPart part) {
+  // A cone bent by `bends` (applied in order, each endpoint-preserving) as a polyline of
+  // straight cones through points of the bent axis, one per kMaxArcDeg of turning, united
+  // (max: no bulge at the joints, and a Lipschitz bound of one cone). The polyline strays
+  // from the arc by at most chord·tan(kMaxArcDeg/4)/2 (0.4% of a segment's length) and
+  // evaluates as SSE cone batches, where a bend warp costs a scalar atan2 per point.
+  // m (a similarity of uniform scale) places the result; radii scale with it.
+  constexpr double kMaxArcDeg = 10.0;
+  const int segments = std::max(1, static_cast<int>(std::ceil(totalDeg / kMaxArcDeg - 1e-9)));
+  const float scale = static_cast<float>(glm::length(DVec3(m[0])));
+  auto axis = [&](float t) {
+    Vec3 q = a + t * (b - a);
+    for (const Bend& bend : bends) q = bend.worldFromLocal(q);
+    return apply(m, q);
+  };
+  std::vector<NodeId> cones;
+  Vec3 prev = axis(0.0f);
+  for (int i = 1; i <= segments; ++i) {
+    const float t0 = static_cast<float>(i - 1) / segments, t1 = static_cast<float>(i) / segments;
+    const Vec3 next = axis(t1);
+    cones.push_back(t_.cone(prev, next, scale * (radiusA + t0 * (radiusB - radiusA)),
+                            scale * (radiusA + t1 * (radiusB - radiusA)), partTexture(part)));
+    prev = next;
+  }
+  return cones.size() == 1 ? cones[0] : t_.unite(cones);
 }
 
 ShellBuilder::Calibration ShellBuilder::calibrate(float relativeSize) const {
@@ -182,9 +213,9 @@ void ShellBuilder::placeGenerating(std::vector<NodeId>& out, double theta, const
       out.push_back(t_.cone(apply(m, g.a), apply(m, g.b), static_cast<float>(g.radiusA * radiusScale * d),
                             static_cast<float>(g.radiusB * radiusScale * d), partTexture(part)));
     } else {
-      NodeId c = t_.cone(g.a, g.b, g.radiusA * radiusScale, g.radiusB * radiusScale, partTexture(part));
-      c = t_.bend(c, canalBend(g));
-      out.push_back(t_.transform(c, toFloat(m)));
+      const Bend bend = canalBend(g);
+      out.push_back(arcCone(g.a, g.b, g.radiusA * radiusScale, g.radiusB * radiusScale, std::span(&bend, 1),
+                            std::abs(g.bendDeg), m, part));
     }
   }
 }
@@ -202,10 +233,10 @@ void ShellBuilder::varix(std::vector<NodeId>& parts, int number, double theta) {
   for (size_t i = 0; i < row.size(); ++i) {
     const VarixSpine& sp = row[i];
     const float tip = sp.size < v.shortSize ? v.shortTipRadius : v.tipRadius;
-    NodeId c = t_.cone(Vec3(0.0f), Vec3(len, 0.0f, 0.0f), v.baseRadius, tip, partTexture(ShellPart::VarixSpine));
-    if (v.bendDeg > 0.0f)
-      c = t_.bend(c, Bend::fromAngle(Vec3(0.0f), Vec3(len, 0.0f, 0.0f), Vec3(0, 1, 0),
-                                     static_cast<float>(radians(v.bendDeg))));
+    const Bend bend = Bend::fromAngle(Vec3(0.0f), Vec3(len, 0.0f, 0.0f), Vec3(0, 1, 0),
+                                      static_cast<float>(radians(std::max(v.bendDeg, 0.0f))));
+    const NodeId c = arcCone(Vec3(0.0f), Vec3(len, 0.0f, 0.0f), v.baseRadius, tip, std::span(&bend, 1),
+                             std::max(v.bendDeg, 0.0f), glm::dmat4(1.0), ShellPart::VarixSpine);
     const double across = v.widenAcross ? sigmaMax : sp.size;
     const glm::dmat4 varixFromSpine = rotateZDeg(sp.angleDeg) *
                                       glm::translate(glm::dmat4(1.0), glm::dvec3(v.edge, 0, 0)) *
@@ -250,21 +281,24 @@ void ShellBuilder::axialRow(std::vector<NodeId>& out, int number, double theta, 
     const Vec3 base = canal->bendDeg != 0.0f ? cb.worldFromLocal(onAxis) : onAxis;
     const float size = sizes[j];
     const Vec3 tip = base + dir * (a.length * size);
-    NodeId c = t_.cone(base, tip, a.baseRadius * size, a.tipRadius * size, partTexture(ShellPart::AxialSpine));
+    std::vector<Bend> bends;
+    double turning = 0.0;
     if (a.randomBends) {
       // Fig. 9: each spine bent 3°-9° one to three times, per-spine seeded.
       Rng rng(deriveSeed(p_.seed, {0xA71A1ull, static_cast<uint64_t>(number), j}));
       const int n = a.bendsMin + static_cast<int>(rng.below(static_cast<uint32_t>(a.bendsMax - a.bendsMin + 1)));
       for (int b = 0; b < n; ++b) {
         const double phi = rng.uniform(0.0, 2.0 * kPi);
-        const float ang = static_cast<float>(radians(rng.uniform(a.bendMinDeg, a.bendMaxDeg)));
+        const double angDeg = rng.uniform(a.bendMinDeg, a.bendMaxDeg);
+        const float ang = static_cast<float>(radians(angDeg));
         const Vec3 u = glm::normalize(glm::cross(dir, Vec3(0, 0, 1)));
         const Vec3 w = glm::cross(dir, u);
         const Vec3 bendDir = static_cast<float>(std::cos(phi)) * u + static_cast<float>(std::sin(phi)) * w;
-        c = t_.bend(c, Bend::fromAngle(base, tip, bendDir, ang));
+        bends.push_back(Bend::fromAngle(base, tip, bendDir, ang));
+        turning += angDeg;
       }
     }
-    out.push_back(t_.transform(c, toFloat(m)));
+    out.push_back(arcCone(base, tip, a.baseRadius * size, a.tipRadius * size, bends, turning, m, ShellPart::AxialSpine));
     SpineRecord rec;
     rec.part = ShellPart::AxialSpine;
     rec.varix = number;
@@ -503,6 +537,8 @@ ShellParams murexCabritii() {
   p.seed = 1;
   return p;
 }
+
+float shellCellSize(const blobtree::CompiledBlob& blob) { return glm::length(blob.bounds().size()) / 120.0f; }
 
 ShellModel buildShell(const ShellParams& p, const SourceLoc& loc) {
   auto fail = [&](const std::string& msg) { throw InputError(loc, "shell: " + msg); };

@@ -35,6 +35,7 @@
 #include <glm/mat4x4.hpp>
 
 #include "blobtree/blobtree.h"
+#include "blobtree/compiled.h"
 #include "core/types.h"
 #include "organisms/shell_spiral.h"
 
@@ -198,6 +199,11 @@ struct ShellModel {
 /// parameters are out of range: λ <= 1, β outside (0°, 90°], R₀ <= 0, no generating
 /// primitive, θ_end below the start angle (θ_end = start gives one generating surface). Deterministic: the same params give the same tree.
 ShellModel buildShell(const ShellParams& params, const SourceLoc& loc = {});
+
+/// Edge of the surface cells for exact rendering of a compiled shell (render::ImplicitOptions):
+/// a fixed fraction of the bounds' diagonal (docs/perf/shells.md). The renderer's automatic
+/// size follows the smallest feature (the apex's tiny spine tips) and makes far more cells.
+float shellCellSize(const blobtree::CompiledBlob& blob);
 
 /// The Murex cabritii of the paper: λ = 1.3, β = 22.5°, R₀ = 0.2, seven whorls of 348°,
 /// three varices per whorl with spines per Table 1, bumps, axial spines per Table 2, the

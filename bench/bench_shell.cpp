@@ -1,0 +1,163 @@
+// Benchmark of the Murex cabritii shell (Galbraith, Prusinkiewicz, Wyvill, seed 000): the
+// paper's parameters (organisms::murexCabritii: seven whorls, Table 1 varices, bumps with
+// the n = 400 blend, Table 2 axial spines, the CSG opening).
+//
+// Prints: BlobTree build time, compile time, surface-cell time, exact render time and
+// rays/s at 1536x2048 (the target: under 2 minutes on 2 cores). Baseline in the
+// same process: the smooth point-primitive shell (same spiral, no varices, bumps, canal,
+// spines or opening) rendered the same way; the ratio says what the Murex's detail costs
+// per ray.
+//
+// Usage: bench_shell [--width 1536] [--height 2048] [--spp 9] [--cell-div 0]
+//                    [--baseline 1] [--image OUT.png] [--age DEG]
+//   --cell-div N: surface cells of diagonal/N (0 = organisms::shellCellSize's choice)
+//   --baseline 0 skips the baseline render
+//   --without LIST leaves parts out of the Murex (cost breakdown): any of varices, bumps,
+//     axial, opening, tori, spinebend, canalbend, canal, axialbend
+
+#include <chrono>
+#include <ctime>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <string>
+
+#include "blobtree/compiled.h"
+#include "organisms/shell.h"
+#include "organisms/shell_paint.h"
+#include "render/camera.h"
+#include "render/image.h"
+#include "render/renderer.h"
+#include "render/scene.h"
+
+using namespace sprig;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+struct Args {
+  int width = 1536, height = 2048, spp = 9;
+  float cellDiv = 0.0f;
+  bool baseline = true;
+  std::string image;
+  double age = 0.0;
+  std::string without;  ///< parts left out of the Murex, for a cost breakdown
+};
+
+struct Result {
+  double buildS = 0, compileS = 0, sceneS = 0, renderS = 0, renderCpuS = 0, raysPerS = 0;
+  size_t primitives = 0, cells = 0;
+  uint64_t rays = 0;
+};
+
+Result run(const organisms::ShellParams& params, const Args& a, const std::string& image, const char* label) {
+  Result r;
+  auto t = Clock::now();
+  organisms::ShellModel model = organisms::buildShell(params);
+  r.buildS = since(t);
+  t = Clock::now();
+  blobtree::CompiledBlob blob = blobtree::compile(model.tree, model.root);
+  r.compileS = since(t);
+  r.primitives = blob.primitiveCount();
+  auto painter = std::make_shared<const organisms::ShellPainter>(params, model, organisms::ShellTextureOptions{});
+
+  t = Clock::now();
+  render::Scene scene;
+  const uint32_t material = scene.addMaterial(render::Material{painter->options().whorlColor, 0.35f, 0.05f, 0});
+  for (auto part : {organisms::ShellPart::Whorl, organisms::ShellPart::VarixSpine, organisms::ShellPart::AxialSpine,
+                    organisms::ShellPart::Bump, organisms::ShellPart::Inside})
+    scene.addTexture([painter, part](Vec2 uv, const Vec3& p) { return painter->partColor(part, p, uv); });
+  render::ImplicitOptions opt;
+  opt.cellSize = a.cellDiv > 0 ? glm::length(blob.bounds().size()) / a.cellDiv : organisms::shellCellSize(blob);
+  scene.addImplicit(blob, material, opt);
+  scene.commit();
+  r.sceneS = since(t);
+  r.cells = scene.stats().implicitCells;
+
+  render::ViewSpec view;
+  view.azimuthDeg = 25;
+  view.elevationDeg = 10;
+  const render::Camera camera = render::frameBounds(scene.bounds(), view, double(a.width) / a.height);
+  render::RenderSettings rs;
+  rs.width = a.width;
+  rs.height = a.height;
+  rs.spp = a.spp;
+  rs.progress = false;
+  render::RenderStats stats;
+  t = Clock::now();
+  const std::clock_t cpu0 = std::clock();
+  render::Image img = render::renderImage(scene, camera, rs, &stats);
+  r.renderS = since(t);
+  r.renderCpuS = double(std::clock() - cpu0) / CLOCKS_PER_SEC;
+  r.rays = stats.rays();
+  r.raysPerS = stats.raysPerSecond();
+  std::printf("%s: %zu primitives; build %.3f s, compile %.3f s, surface cells %.2f s (%zu cells, cell %.4g)\n", label,
+              r.primitives, r.buildS, r.compileS, r.sceneS, r.cells, opt.cellSize);
+  std::printf("%s: exact render %dx%d, %d spp: %.2f s (%.2f CPU-s), %.3g rays, %.3g rays/s, %.3g rays per CPU-s\n",
+              label, a.width, a.height, a.spp, r.renderS, r.renderCpuS, double(r.rays), r.raysPerS,
+              double(r.rays) / r.renderCpuS);
+  if (!image.empty()) render::writeImage(img, image);
+  return r;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::setvbuf(stdout, nullptr, _IOLBF, 0);
+  Args a;
+  for (int i = 1; i < argc; ++i) {
+    auto next = [&](const char* name) -> const char* {
+      if (i + 1 >= argc) {
+        std::fprintf(stderr, "bench_shell: %s needs a value\n", name);
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (!std::strcmp(argv[i], "--width")) a.width = std::atoi(next("--width"));
+    else if (!std::strcmp(argv[i], "--height")) a.height = std::atoi(next("--height"));
+    else if (!std::strcmp(argv[i], "--spp")) a.spp = std::atoi(next("--spp"));
+    else if (!std::strcmp(argv[i], "--cell-div")) a.cellDiv = static_cast<float>(std::atof(next("--cell-div")));
+    else if (!std::strcmp(argv[i], "--baseline")) a.baseline = std::atoi(next("--baseline")) != 0;
+    else if (!std::strcmp(argv[i], "--image")) a.image = next("--image");
+    else if (!std::strcmp(argv[i], "--age")) a.age = std::atof(next("--age"));
+    else if (!std::strcmp(argv[i], "--without")) a.without = next("--without");
+    else {
+      std::fprintf(stderr, "bench_shell: unknown argument %s\n", argv[i]);
+      return 2;
+    }
+  }
+  try {
+    organisms::ShellParams murex = organisms::murexCabritii();
+    if (a.age > 0) murex.ageDeg = a.age;
+    auto has = [&](const std::string& w) { return ("," + a.without + ",").find("," + w + ",") != std::string::npos; };
+    if (has("varices")) murex.varices.enabled = false;
+    if (has("bumps")) murex.bumps.enabled = false;
+    if (has("axial")) murex.axialSpines.enabled = false;
+    if (has("opening")) murex.opening.enabled = false;
+    if (has("spinebend")) murex.varices.bendDeg = 0.0f;
+    if (has("tori")) murex.varices.tori = false;
+    if (has("canalbend")) murex.generating.primitives[1].bendDeg = 0.0f;
+    if (has("canal")) murex.generating = organisms::GeneratingSurface::point();
+    if (has("axialbend")) murex.axialSpines.randomBends = false;
+    const auto total = Clock::now();
+    const Result m = run(murex, a, a.image, "murex");
+    std::printf("murex: build + compile + cells + render %.2f s\n", since(total));
+    if (a.baseline) {
+      organisms::ShellParams smooth;
+      smooth.spiral = murex.spiral;
+      smooth.whorls = murex.whorls;
+      smooth.whorlDeg = murex.whorlDeg;
+      smooth.ageDeg = murex.ageDeg;
+      const Result b = run(smooth, a, "", "smooth point shell (baseline)");
+      std::printf("ratio: murex rays/s / smooth rays/s = %.2f; render time ratio %.2f\n", m.raysPerS / b.raysPerS,
+                  m.renderS / b.renderS);
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_shell: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
