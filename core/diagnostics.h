@@ -66,7 +66,8 @@ class DiagnosticList {
 /// The 1-based line `line` of text, without its line ending; empty if out of range.
 std::string lineOf(std::string_view text, int line);
 
-/// Levenshtein distance between a and b.
+/// Edit distance between a and b: insertions, deletions, substitutions and transpositions
+/// of two adjacent characters each count 1 (optimal string alignment, Damerau 1964).
 int editDistance(std::string_view a, std::string_view b);
 
 /// " (did you mean 'x'?)" for the closest candidate within a small edit distance, else "".

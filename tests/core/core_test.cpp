@@ -39,6 +39,40 @@ TEST_CASE("Diagnostic::format", "[core]") {
   }
 }
 
+TEST_CASE("editDistance", "[core]") {
+  SECTION("Levenshtein edits count one each") {
+    CHECK(editDistance("", "") == 0);
+    CHECK(editDistance("abc", "") == 3);
+    CHECK(editDistance("", "ab") == 2);
+    CHECK(editDistance("kitten", "sitting") == 3);
+    CHECK(editDistance("steps", "steeps") == 1);
+    CHECK(editDistance("seed", "sed") == 1);
+  }
+  SECTION("an adjacent transposition is one edit") {
+    CHECK(editDistance("ab", "ba") == 1);
+    CHECK(editDistance("steps", "setps") == 1);
+    CHECK(editDistance("angle", "angel") == 1);
+    CHECK(editDistance("grammar", "gramamr") == 1);
+    CHECK(editDistance("abcdef", "badcfe") == 3);
+  }
+  SECTION("optimal string alignment: a transposed pair is not edited again") {
+    // Full Damerau distance of ("ca", "abc") is 2; OSA, which never edits a
+    // transposed pair again, gives 3.
+    CHECK(editDistance("ca", "abc") == 3);
+  }
+  SECTION("symmetric") {
+    for (auto [a, b] : {std::pair{"tropism", "tropsim"}, std::pair{"radii", "raddi"}, std::pair{"x", "yxz"}})
+      CHECK(editDistance(a, b) == editDistance(b, a));
+  }
+  SECTION("didYouMean finds a swapped pair of letters in a short word") {
+    // "widht" is 2 Levenshtein edits from both "wide" and "width" (the first listed won);
+    // with transpositions "width" is 1 edit away and wins.
+    CHECK(didYouMean("widht", {"wide", "width"}) == " (did you mean 'width'?)");
+    CHECK(didYouMean("kidn", {"seed", "kind"}) == " (did you mean 'kind'?)");
+    CHECK(didYouMean("agnle", {"angle", "axiom"}) == " (did you mean 'angle'?)");
+  }
+}
+
 TEST_CASE("Rng", "[core]") {
   SECTION("the sequence is fixed by the seed") {
     Rng a(42), b(42), c(43);
