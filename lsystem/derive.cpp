@@ -35,8 +35,9 @@ std::string numberText(double v) {
 class Writer {
  public:
   /// Starts writing s from empty, with room for at least modules and params.
-  Writer(ModuleString& s, bool births, size_t maxModules, const std::string& file, int step, size_t modules, size_t params)
-      : s_(s), births_(births), maxModules_(maxModules), file_(file), step_(step) {
+  /// limitAt is where a limit error points (its message is ignored).
+  Writer(ModuleString& s, bool births, size_t maxModules, const Diagnostic& limitAt, int step, size_t modules, size_t params)
+      : s_(s), births_(births), maxModules_(maxModules), limitAt_(limitAt), step_(step) {
     // Only the reserved part is sized (and zero-filled where new): sizing to the whole
     // capacity would cost O(largest string) per step.
     s_.symbols.resize(std::max(modules, size_t(16)));
@@ -95,9 +96,9 @@ class Writer {
     if (births_) s_.birthSteps.resize(n_);
   }
 
-  [[noreturn]] static void overLimit(size_t maxModules, const std::string& file, int step) {
-    throw InputError(SourceLoc{file, 0, 0},
-                     "derivation would exceed " + std::to_string(maxModules) + " modules at step " + std::to_string(step));
+  [[noreturn]] static void overLimit(size_t maxModules, const Diagnostic& at, int step) {
+    throw InputError(at.loc, "derivation would exceed " + std::to_string(maxModules) + " modules at step " + std::to_string(step),
+                     at.sourceLine);
   }
 
  private:
@@ -111,7 +112,7 @@ class Writer {
   }
 
   void growModules(size_t need) {
-    if (need > maxModules_) overLimit(maxModules_, file_, step_);
+    if (need > maxModules_) overLimit(maxModules_, limitAt_, step_);
     size_t cap = std::min(maxModules_, std::max(need, capM_ * 2));
     s_.symbols.resize(cap);
     s_.offsets.resize(cap + 1);
@@ -123,8 +124,9 @@ class Writer {
   void growParams(size_t need) {
     constexpr size_t kMaxParams = std::numeric_limits<uint32_t>::max();  // offsets are 32-bit
     if (need > kMaxParams)
-      throw InputError(SourceLoc{file_, 0, 0},
-                       "derivation would exceed " + std::to_string(kMaxParams) + " parameters at step " + std::to_string(step_));
+      throw InputError(limitAt_.loc,
+                       "derivation would exceed " + std::to_string(kMaxParams) + " parameters at step " + std::to_string(step_),
+                       limitAt_.sourceLine);
     s_.params.resize(std::min(kMaxParams, std::max(need, capP_ * 2)));
     refresh();
   }
@@ -132,7 +134,7 @@ class Writer {
   ModuleString& s_;
   bool births_;
   size_t maxModules_;
-  const std::string& file_;
+  const Diagnostic& limitAt_;
   int step_;
   SymbolId* sym_ = nullptr;
   uint32_t* off_ = nullptr;
@@ -155,6 +157,17 @@ struct Deriver::Impl {
   std::vector<int32_t> match;  ///< bracket partner per module (context-sensitive grammars)
   std::vector<std::vector<double>> scratch;  ///< successor parameters per decomposition depth
   ModuleString oneScratch;                   ///< a one-module string for stochastic decomposition
+  /// Where module-limit errors point: the grammar's `derivation length:` when it sets the
+  /// number of steps, else its axiom, else just the file.
+  Diagnostic limitAt;
+
+  void locateLimit() {
+    limitAt = Diagnostic{};
+    bool ownLength = !opt.steps && prog->lengthLoc.line > 0;
+    limitAt.loc = ownLength ? prog->lengthLoc : prog->axiomLoc;
+    limitAt.sourceLine = ownLength ? prog->lengthLine : prog->axiomLine;
+    if (limitAt.loc.file.empty()) limitAt.loc.file = prog->fileName;
+  }
 
   // Per-module random stream, created on first use.
   Rng rng;
@@ -538,7 +551,7 @@ struct Deriver::Impl {
           exact = false;
         }
       }
-      if (boundM > opt.maxModules && exact) Writer::overLimit(opt.maxModules, prog->fileName, step);
+      if (boundM > opt.maxModules && exact) Writer::overLimit(opt.maxModules, limitAt, step);
       if (exact) {
         reserveModules = boundM;
         reserveParams = boundP;
@@ -547,7 +560,7 @@ struct Deriver::Impl {
         reserveParams = std::min(boundP, 2 * in.params.size() + 16);
       }
     }
-    Writer w(next, births, opt.maxModules, prog->fileName, step, reserveModules, reserveParams);
+    Writer w(next, births, opt.maxModules, limitAt, step, reserveModules, reserveParams);
     double vars[detail::kMaxVars];
     rngStream = stream;
     size_t nextChoice = 0;
@@ -652,9 +665,7 @@ struct Deriver::Impl {
 
   void start() {
     cur = prog->axiom;
-    if (cur.size() > opt.maxModules)
-      throw InputError(SourceLoc{prog->fileName, 0, 0},
-                       "derivation would exceed " + std::to_string(opt.maxModules) + " modules at step 0");
+    if (cur.size() > opt.maxModules) Writer::overLimit(opt.maxModules, limitAt, 0);
     if (opt.trackBirthSteps) cur.birthSteps.assign(cur.size(), 0);
     if (!prog->decomposition.empty()) {
       RuleSet none;
@@ -674,6 +685,7 @@ Deriver::Deriver(const Grammar& grammar, DeriveOptions options) : impl_(std::mak
   impl_->steps = options.steps.value_or(grammar.derivationLength());
   impl_->seed = options.seed.value_or(grammar.seed());
   impl_->opt = std::move(options);
+  impl_->locateLimit();
   impl_->start();
 }
 
@@ -715,6 +727,7 @@ ModuleString Deriver::interpret(const ModuleString& s) const {
   tmp.prog = impl_->prog;
   tmp.seed = impl_->seed;
   tmp.opt.maxModules = impl_->opt.maxModules;
+  tmp.limitAt = impl_->limitAt;
   tmp.opt.trackBirthSteps = s.hasBirthSteps();
   tmp.cur = s;
   // Interpretation recursion: depth 1 is one rewrite; deeper levels rewrite what the

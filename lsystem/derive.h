@@ -26,7 +26,8 @@ struct DeriveOptions {
   std::optional<int> steps;       ///< number of steps; default Grammar::derivationLength()
   std::optional<uint64_t> seed;   ///< default Grammar::seed()
   /// Limit on modules in any string; exceeding it throws InputError
-  /// "derivation would exceed N modules at step k" before the memory is allocated.
+  /// "derivation would exceed N modules at step k" before the memory is allocated
+  /// (located at the grammar's `derivation length:` or, with steps set, its `axiom:`).
   size_t maxModules = 50'000'000;
   /// Record in ModuleString::birthSteps the step that created each module (0 = axiom).
   /// Off by default: it then costs nothing.
@@ -37,8 +38,9 @@ struct DeriveOptions {
 
 /// Derives a grammar step by step. Not thread-safe; cheap to construct.
 ///
-/// Errors (InputError): a module limit overrun (`file: error: derivation would exceed N
-/// modules at step k`), a non-finite parameter (`file:line:col: error: non-finite parameter
+/// Errors (InputError): a module limit overrun (`file:line:col: error: derivation would
+/// exceed N modules at step k`, at the grammar's `derivation length:` header when that sets
+/// the number of steps, else at its `axiom:`), a non-finite parameter (`file:line:col: error: non-finite parameter
 /// value (inf) in production 'A(x)' at step k (parameter 1 of 'B')`, at the production),
 /// a NaN condition. After an error the Deriver keeps the string of the last completed step.
 class Deriver {

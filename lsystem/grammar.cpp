@@ -104,6 +104,7 @@ class Parser {
     splitLines();
     firstPass();
     secondPass();
+    checkArities();
     finish();
     diags_.throwIfErrors();
     return std::make_shared<Program>(std::move(prog_));
@@ -452,10 +453,13 @@ class Parser {
     } else if (h.key == "derivation length") {
       once(h.key, line, b);
       if (auto d = constantExpr(value, "derivation length")) {
-        if (*d < 0 || *d != std::floor(*d) || *d > 1e6)
+        if (*d < 0 || *d != std::floor(*d) || *d > 1e6) {
           error(line, value.b, "derivation length must be a whole number from 0 to 1000000, got " + formatNumber(*d));
-        else
+        } else {
           prog_.derivationLength = static_cast<int>(*d);
+          prog_.lengthLoc = SourceLoc{prog_.fileName, line, b + 1};
+          prog_.lengthLine = raw_[line - 1];
+        }
       }
     } else if (h.key == "seed") {
       once(h.key, line, b);
@@ -475,9 +479,12 @@ class Parser {
       once(h.key, line, b);
       std::vector<RawModule> mods;
       if (value.b == value.e) error(line, value.b, "the axiom is empty");
-      else if (tokenizeModules(line, value.b, value.e, mods)) {
+      else if (tokenizeModules(line, value.b, value.e, mods) && checkBrackets(line, mods, "the axiom")) {
+        noteWritten(line, mods);
         axiomModules_ = std::move(mods);
         axiomLine_ = line;
+        prog_.axiomLoc = SourceLoc{prog_.fileName, line, b + 1};
+        prog_.axiomLine = raw_[line - 1];
       }
     } else if (h.key == "ignore" || h.key == "consider") {
       once(h.key, line, b);
@@ -597,6 +604,7 @@ class Parser {
     p.predecessor = prog_.symbols.intern(predMods[0].name);
     p.predFirstVar = static_cast<uint16_t>(varNames.size());
     p.predParams = static_cast<uint16_t>(formals(predMods[0], varNames));
+    arityUses_.push_back({predMods[0].name, p.predParams, line, predMods[0].col, moduleText(line, predMods[0]), false});
     if (rc.b != rc.e && !isStar(rc)) {
       if (block != Block::Main) error(line, rc.b, std::string("context is not allowed in ") + blockName(block) + " rules");
       else p.right = pattern(rc, varNames, false);
@@ -618,7 +626,8 @@ class Parser {
     if (succ.b == succ.e) error(line, succ.b, "missing successor (write '*' for the empty string)");
     else if (!isStar(succ)) {
       std::vector<RawModule> mods;
-      if (tokenizeModules(line, succ.b, succ.e, mods)) {
+      if (tokenizeModules(line, succ.b, succ.e, mods) && checkBrackets(line, mods, "the successor")) {
+        noteWritten(line, mods);
         for (const RawModule& m : mods) {
           SuccModule sm;
           sm.symbol = prog_.symbols.intern(m.name);
@@ -642,6 +651,67 @@ class Parser {
     p.usesRandom = usesRandom_;
     RuleSet& rs = block == Block::Main ? prog_.productions : block == Block::Decomposition ? prog_.decomposition : prog_.interpretation;
     rs.productions.push_back(std::move(p));
+  }
+
+  /// The module m as written (name and parameter list).
+  std::string moduleText(int line, const RawModule& m) const {
+    if (!m.hasParens) return m.name;
+    const std::string& s = clean_[line - 1];
+    int end = m.args.empty() ? static_cast<int>(s.find(')', m.col)) : m.args.back().e;
+    return s.substr(m.col, end + 1 - m.col);
+  }
+
+  /// Reports brackets that do not pair up in mods (an axiom or a successor, named by where).
+  bool checkBrackets(int line, const std::vector<RawModule>& mods, const char* where) {
+    std::vector<int> open;
+    bool ok = true;
+    for (const RawModule& m : mods) {
+      if (m.name == "[") {
+        open.push_back(m.col);
+      } else if (m.name == "]") {
+        if (open.empty()) {
+          error(line, m.col, std::string("unmatched ']' in ") + where);
+          ok = false;
+        } else {
+          open.pop_back();
+        }
+      }
+    }
+    for (int col : open) {
+      error(line, col, std::string("unclosed '[' in ") + where + " (no matching ']')");
+      ok = false;
+    }
+    return ok;
+  }
+
+  /// Records the parameter count of every module written in an axiom or successor.
+  void noteWritten(int line, const std::vector<RawModule>& mods) {
+    for (const RawModule& m : mods) written_[m.name].emplace(static_cast<int>(m.args.size()), std::pair{line, m.col});
+  }
+
+  /// A predecessor or context module whose parameter count no written module of its symbol
+  /// has can never match (cpfg and lpfg match a module only with the same number of
+  /// parameters): report it. Symbols never written at all are left alone.
+  void checkArities() {
+    for (const ArityUse& u : arityUses_) {
+      auto it = written_.find(u.name);
+      if (it == written_.end() || it->second.count(u.arity)) continue;
+      const auto& counts = it->second;
+      std::string list;
+      size_t k = 0;
+      for (const auto& entry : counts) {
+        if (k > 0) list += k + 1 == counts.size() ? " or " : ", ";
+        list += std::to_string(entry.first);
+        ++k;
+      }
+      bool one = counts.size() == 1 && counts.begin()->first == 1;
+      const auto& first = counts.begin()->second;
+      error(u.line, u.col,
+            std::string(u.context ? "context '" : "predecessor '") + u.text + "' has " + std::to_string(u.arity) +
+                " parameter" + (u.arity == 1 ? "" : "s") + ", but '" + u.name + "' is only written with " + list +
+                (one ? " parameter" : " parameters") + " (as at line " + std::to_string(first.first) + ":" +
+                std::to_string(first.second + 1) + "), so this production never applies");
+    }
   }
 
   static const char* blockName(Block b) {
@@ -685,6 +755,7 @@ class Parser {
         it.symbol = prog_.symbols.intern(m.name);
         it.firstVar = static_cast<uint16_t>(varNames.size());
         it.paramCount = static_cast<uint16_t>(formals(m, varNames));
+        arityUses_.push_back({m.name, it.paramCount, sp.line, m.col, moduleText(sp.line, m), true});
       }
       items.push_back(it);
     }
@@ -1061,6 +1132,8 @@ class Parser {
 
   void finish() {
     if (overrides_.derivationLength) {
+      prog_.lengthLoc = SourceLoc{};  // the length no longer comes from the file
+      prog_.lengthLine.clear();
       if (*overrides_.derivationLength < 0) diags_.error(SourceLoc{prog_.fileName, 0, 0}, "derivation length override must not be negative");
       prog_.derivationLength = *overrides_.derivationLength;
     }
@@ -1106,6 +1179,17 @@ class Parser {
   int axiomLine_ = 0;
   std::vector<SymbolId> ignoreList_, considerList_;
   std::pair<int, int> pendingComment_{0, 0};
+  /// A predecessor or context module with its parameter count, checked by checkArities().
+  struct ArityUse {
+    std::string name;
+    int arity;
+    int line, col;  ///< col 0-based
+    std::string text;
+    bool context;
+  };
+  std::vector<ArityUse> arityUses_;
+  /// Per symbol: the parameter counts it is written with, each with its first (line, col).
+  std::map<std::string, std::map<int, std::pair<int, int>>> written_;
   bool usesRandom_ = false;
 };
 

@@ -247,6 +247,14 @@ struct Program {
   SymbolId openBracket = 0, closeBracket = 0, cut = 0;
   /// True when some successor or the axiom contains the cut symbol `%`.
   bool usesCut = false;
+  /// The `derivation length:` header (line 0 when the file has none), with its line's text;
+  /// module-limit errors point here when the grammar's own length is used.
+  SourceLoc lengthLoc;
+  std::string lengthLine;
+  /// The `axiom:` header and its line's text; module-limit errors point here when the
+  /// number of steps comes from elsewhere (an override, --steps).
+  SourceLoc axiomLoc;
+  std::string axiomLine;
 };
 
 }  // namespace sprig::lsystem::detail

@@ -158,7 +158,7 @@ B(x) : x>=1 -> B(x-1)
 TEST_CASE("Deriver::derive first match wins, unmatched modules are copied", "[lsystem]") {
   CHECK(deriveText("axiom: A(1)B\nA(x) : x>0 --> X\nA(x) --> Y\n", 1) == "XB");
   CHECK(deriveText("axiom: A(0)B\nA(x) : x>0 --> X\nA(x) --> Y\n", 1) == "YB");
-  CHECK(deriveText("axiom: A(1,2)\nA(x) --> X\n", 1) == "A(1,2)");  // parameter count differs: no match
+  CHECK(deriveText("axiom: A(1,2)A(3)\nA(x) --> X\n", 1) == "A(1,2)X");  // parameter count differs: no match
   CHECK(deriveText("axiom: AB\nA --> *\n", 1) == "B");               // `*` successor: erase
   CHECK(deriveText("axiom: A(3)\nA(x) : * --> A(x+1)\n", 4) == "A(7)");
 }
@@ -261,7 +261,7 @@ TEST_CASE("Deriver::derive context matching across brackets (lpfg rules)", "[lsy
     CHECK(deriveText("axiom: A[B]C\nA > [D]C --> X\n", 1) == "A[B]C");
     CHECK(deriveText("axiom: A[BE]C\nA > [B]C --> X\n", 1) == "X[BE]C");
     CHECK(deriveText("axiom: A(1)B(2)C(4)\nA(x) < B(y) > C(z) --> B(x+y+z)\n", 1) == "A(1)B(7)C(4)");
-    CHECK(deriveText("axiom: A(1)B(2)C\nA(x) < B(y) > C(z) --> X\n", 1) == "A(1)B(2)C");  // C has no parameter
+    CHECK(deriveText("axiom: A(1)B(2)C C(3)\nA(x) < B(y) > C(z) --> X\n", 1) == "A(1)B(2)CC(3)");  // C has no parameter
   }
   SECTION("contexts read the old string, not the one being written") {
     CHECK(deriveText("axiom: AAB\nA > A --> B\nA > B --> C\n", 1) == "BCB");
@@ -406,7 +406,7 @@ endlsystem
     CHECK(deriveText("axiom: A\nA --> BA\ndecomposition:\nB --> CD\nC --> X\n", 1) == "CDA");
   }
   SECTION("the axiom is decomposed too") {
-    CHECK(deriveText("axiom: BB\ndecomposition:\nB(x) --> X\nB --> Y\n", 0) == "YY");
+    CHECK(deriveText("axiom: BB(1)\ndecomposition:\nB(x) --> X\nB --> Y\n", 0) == "YX");
   }
   SECTION("interpretation rules apply only when the turtle reads the string") {
     const char* text = R"(
@@ -472,13 +472,27 @@ TEST_CASE("Deriver::derive module limit", "[lsystem]") {
   SECTION("a deterministic grammar stops before allocating the step that overflows") {
     Grammar g = parseGrammar("axiom: F\nF --> FF\n", "grow.lsys");
     CHECK(errorOf([&] { derive(g, DeriveOptions{.steps = 10, .maxModules = 100}); }) ==
-          "grow.lsys: error: derivation would exceed 100 modules at step 7");
+          "grow.lsys:1:1: error: derivation would exceed 100 modules at step 7\n  axiom: F\n  ^");
     CHECK(derive(g, DeriveOptions{.steps = 6, .maxModules = 64}).size() == 64);
   }
   SECTION("a stochastic grammar stops while writing") {
     Grammar g = parseGrammar("axiom: F\nF --> FF : 1\nF --> FFF : 1\n", "grow.lsys");
     std::string msg = errorOf([&] { derive(g, DeriveOptions{.steps = 30, .maxModules = 1000}); });
-    CHECK(msg.rfind("grow.lsys: error: derivation would exceed 1000 modules at step ", 0) == 0);
+    CHECK(msg.rfind("grow.lsys:1:1: error: derivation would exceed 1000 modules at step ", 0) == 0);
+  }
+  SECTION("the error points at 'derivation length:' when the grammar's own length is used") {
+    Grammar g = parseGrammar("axiom: F\n  derivation length: 12\nF --> FF\n", "grow.lsys");
+    CHECK(errorOf([&] { derive(g, DeriveOptions{.maxModules = 100}); }) ==
+          "grow.lsys:2:3: error: derivation would exceed 100 modules at step 7\n    derivation length: 12\n    ^");
+    // --steps (or an override of the length) makes the axiom the place to look.
+    CHECK(errorOf([&] { derive(g, DeriveOptions{.steps = 9, .maxModules = 100}); }).rfind("grow.lsys:1:1: error: derivation", 0) == 0);
+    Grammar h = parseGrammar("axiom: F\nderivation length: 12\nF --> FF\n", "grow.lsys", GrammarOverrides{.derivationLength = 9});
+    CHECK(errorOf([&] { derive(h, DeriveOptions{.maxModules = 100}); }).rfind("grow.lsys:1:1: error: derivation", 0) == 0);
+  }
+  SECTION("an axiom longer than the limit fails at step 0") {
+    Grammar g = parseGrammar("axiom: FFFF\n", "long.lsys");
+    CHECK(errorOf([&] { derive(g, DeriveOptions{.maxModules = 3}); }) ==
+          "long.lsys:1:1: error: derivation would exceed 3 modules at step 0\n  axiom: FFFF\n  ^");
   }
   SECTION("the default limit is 50 million") { CHECK(DeriveOptions{}.maxModules == 50'000'000); }
 }

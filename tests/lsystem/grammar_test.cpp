@@ -178,6 +178,51 @@ TEST_CASE("parseGrammar errors: exact messages and positions", "[lsystem]") {
   }
 }
 
+TEST_CASE("parseGrammar unbalanced brackets", "[lsystem]") {
+  SECTION("in the axiom") {
+    CHECK(errorsOf("axiom: F[+F\n") == "g.lsys:1:9: error: unclosed '[' in the axiom (no matching ']')");
+    CHECK(errorsOf("axiom: F]F\n") == "g.lsys:1:9: error: unmatched ']' in the axiom");
+    CHECK(errorsOf("axiom: [F[F]\n") == "g.lsys:1:8: error: unclosed '[' in the axiom (no matching ']')");
+  }
+  SECTION("in a successor, in every block") {
+    CHECK(errorsOf("axiom: A\nA --> F[+A][-A\n") == "g.lsys:2:12: error: unclosed '[' in the successor (no matching ']')");
+    CHECK(errorsOf("axiom: A\nA --> F]+A[\n") ==
+          "g.lsys:2:8: error: unmatched ']' in the successor\n"
+          "g.lsys:2:11: error: unclosed '[' in the successor (no matching ']')");
+    CHECK(errorsOf("axiom: A\ninterpretation:\nA --> [F\n") == "g.lsys:3:7: error: unclosed '[' in the successor (no matching ']')");
+    CHECK(errorsOf("axiom: A\ndecomposition:\nA --> F]\n") == "g.lsys:3:8: error: unmatched ']' in the successor");
+  }
+  SECTION("balanced strings and the empty successor parse") {
+    CHECK(errorsOf("axiom: [F][[F]F]\nA --> [F[+A]][-A]\nB --> *\n").empty());
+  }
+}
+
+TEST_CASE("parseGrammar parameter counts that never match", "[lsystem]") {
+  SECTION("a predecessor whose parameter count no written module has") {
+    CHECK(errorsOf("axiom: A\nA(x) --> F(x)B(x)\n") ==
+          "g.lsys:2:1: error: predecessor 'A(x)' has 1 parameter, but 'A' is only written with 0 parameters "
+          "(as at line 1:8), so this production never applies");
+    CHECK(errorsOf("axiom: B(1,2)\nB(a,b) --> A(a)B(a,b)A(a,b,a)\nA(x, y) --> F\n") ==
+          "g.lsys:3:1: error: predecessor 'A(x, y)' has 2 parameters, but 'A' is only written with 1 or 3 parameters "
+          "(as at line 2:12), so this production never applies");
+    CHECK(errorsOf("axiom: F(1)\nF --> GG\n") ==
+          "g.lsys:2:1: error: predecessor 'F' has 0 parameters, but 'F' is only written with 1 parameter "
+          "(as at line 1:8), so this production never applies");
+  }
+  SECTION("a context whose parameter count no written module has") {
+    CHECK(errorsOf("axiom: B(1)A\nB(x) < A --> A\nB --> C\n") ==
+          "g.lsys:3:1: error: predecessor 'B' has 0 parameters, but 'B' is only written with 1 parameter "
+          "(as at line 1:8), so this production never applies");
+    CHECK(errorsOf("axiom: BA\nB(x) < A --> A\n") ==
+          "g.lsys:2:1: error: context 'B(x)' has 1 parameter, but 'B' is only written with 0 parameters "
+          "(as at line 1:8), so this production never applies");
+  }
+  SECTION("any matching count is enough; symbols never written are left alone") {
+    CHECK(errorsOf("axiom: A A(1)\nA --> B\nA(x) --> A(x+1)\nC(x,y) --> D\n").empty());
+    CHECK(errorsOf("axiom: A\nA --> B(1)\ninterpretation:\nB(x) --> F(x)\n").empty());
+  }
+}
+
 TEST_CASE("parseGrammar deep nesting is an error, not a crash", "[lsystem]") {
   std::string text = "axiom: F\nA(x) --> B(" + std::string(50, '(') + "x" + std::string(50, ')') + ")\n";
   CHECK(errorsOf(text) == "g.lsys:2:60: error: expression is nested too deeply (more than 48 levels)");
