@@ -13,7 +13,8 @@
 //   --cell-div N: surface cells of diagonal/N (0 = organisms::shellCellSize's choice)
 //   --baseline 0 skips the baseline render
 //   --without LIST leaves parts out of the Murex (cost breakdown): any of varices, bumps,
-//     axial, opening, tori, spinebend, canalbend, canal, axialbend
+//     axial, opening, tori, spinebend, canalbend, canal, axialbend,
+//     ricci (bumps summed instead of the n = 400 blend)
 
 #include <chrono>
 #include <ctime>
@@ -142,6 +143,7 @@ int main(int argc, char** argv) {
     if (has("canalbend")) murex.generating.primitives[1].bendDeg = 0.0f;
     if (has("canal")) murex.generating = organisms::GeneratingSurface::point();
     if (has("axialbend")) murex.axialSpines.randomBends = false;
+    if (has("ricci")) murex.bumps.blendN = 1.0f;
     const auto total = Clock::now();
     const Result m = run(murex, a, a.image, "murex");
     std::printf("murex: build + compile + cells + render %.2f s\n", since(total));

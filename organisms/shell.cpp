@@ -337,11 +337,18 @@ NodeId ShellBuilder::bumps() {
         sx = std::max(sx, 0.2);
         sy = std::max(sy, 0.2);
         sz = std::max(sz, 0.2) + b.elongation;
-        const glm::dmat4 localFromBump = rotateZDeg(row[i].angleDeg) *
-                                         glm::translate(glm::dmat4(1.0), glm::dvec3(b.edge, 0, 0)) *
-                                         glm::scale(glm::dmat4(1.0), glm::dvec3(sx, sy, sz));
-        NodeId pt = t_.point(Vec3(0.0f), b.size, partTexture(ShellPart::Bump));
-        all.push_back(t_.transform(pt, toFloat(shellFromLocal * localFromBump)));
+        // The paper's point scaled by (σx, σy, σz + 0.8) is an ellipsoid; we use the capsule
+        // (a cone of equal radii along z) with the same extents: radius s·(σx + σy)/2 across,
+        // s·σz' half-length along the spiral. Same look under the n = 400 blend, and a
+        // transform-free SSE primitive (a warp per bump doubled the Murex's tracing time).
+        const double r = 0.5 * (sx + sy) * b.size;
+        const double half = std::max(0.0, sz * b.size - r);
+        const glm::dmat4 shellFromBump =
+            shellFromLocal * rotateZDeg(row[i].angleDeg) * glm::translate(glm::dmat4(1.0), glm::dvec3(b.edge, 0, 0));
+        const float radius = static_cast<float>(r * s_.curveSize(theta));
+        all.push_back(t_.cone(apply(shellFromBump, Vec3(0.0f, 0.0f, static_cast<float>(-half))),
+                              apply(shellFromBump, Vec3(0.0f, 0.0f, static_cast<float>(half))), radius, radius,
+                              partTexture(ShellPart::Bump)));
       }
     }
   }

@@ -103,7 +103,7 @@ struct BumpOptions {
   int setsPerSection = 5;   ///< rows of bumps between two varices
   float size = 0.1f;        ///< s: mean bump radius, unit frame
   float sdFraction = 0.1f;  ///< σ of the normal distribution as a fraction of s
-  float elongation = 0.8f;  ///< added to the scale along the spiral (σ_z + 0.8)
+  float elongation = 0.8f;  ///< added to the scale along the spiral (σ_z + 0.8); bumps are capsules of these extents
   float blendN = 400.0f;    ///< super-elliptic blend exponent with the shell; 1 = plain sum
   bool random = true;       ///< draw sizes from n(s, s/10); false: all equal
   float edge = 0.95f;       ///< distance of bump centres from the generating centre
