@@ -200,6 +200,7 @@ void Turtle::run(const ModuleString& ms, Skeleton& sk, std::span<const int32_t> 
   std::vector<OpenPolygon> polygons;  // open `{` polygons, innermost last
 
   const double radiusScale = 0.5 * settings_.widthScale;
+  const double maxRadiusPerLength = settings_.radii == RadiusModel::Width ? 0.5 * settings_.maxWidthToLength : 0.0;
   const bool taper = settings_.taper && settings_.radii == RadiusModel::Width;
   const DVec3 tropism = settings_.tropism;
   const double defS = std::sin(radians(settings_.angleDeg));
@@ -250,6 +251,8 @@ void Turtle::run(const ModuleString& ms, Skeleton& sk, std::span<const int32_t> 
         in.start = start;
         in.end = st.frame.position;
         in.baseRadius = in.tipRadius = st.width * radiusScale * g;
+        if (maxRadiusPerLength > 0)
+          in.baseRadius = in.tipRadius = std::min(in.baseRadius, maxRadiusPerLength * glm::length(in.end - in.start));
         if (growing) internodeGrowth.push_back(g);
         in.parent = st.internode;
         in.order = st.order;

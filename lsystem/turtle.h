@@ -42,6 +42,11 @@ struct TurtleSettings {
   double pipeExponent = 2.0;      ///< e of the pipe model (2 = da Vinci's rule)
   double tipRadius = 0.01;        ///< pipe model: radius of every branch tip (world units)
   bool taper = true;              ///< width model: an internode's tip radius is its continuation's base radius
+  /// Width model: when > 0, no internode is drawn thicker (diameter) than this times its
+  /// length; 0 (the default) leaves radii alone. For bare grammars whose `!` widths are
+  /// ABOP's pixel widths (figure 2.6 starts at `!(10)` with `F(1)`): 0.12 draws them as the
+  /// shipped species files do. Local to each internode, so every growth stage agrees.
+  double maxWidthToLength = 0.0;
   double surfaceScale = 1.0;      ///< scale of a `~` surface without a parameter
   DVec3 origin{0};                ///< start position
   /// Growth animation (docs/GRAMMAR.md, "Growth over time"): modules whose birth step is

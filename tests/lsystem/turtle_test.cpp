@@ -218,6 +218,18 @@ TEST_CASE("Turtle::width and color", "[lsystem]") {
     CHECK(in[2].tipRadius == Approx(0.25));
     CHECK(in[3].tipRadius == Approx(0.25));  // a tip keeps its own radius
   }
+  SECTION("maxWidthToLength caps each internode's diameter at that multiple of its length") {
+    s.maxWidthToLength = 0.1;
+    Run r = draw("!(4)F(10)!(4)F(1)!(0.01)F(1)[!(4)F(30)]", s);
+    auto& in = r.skeleton.internodes;
+    REQUIRE(in.size() == 4);
+    CHECK(in[0].baseRadius == Approx(0.5));     // 0.5 * 10 * 0.1 < 0.5 * 4 * 0.5: capped
+    CHECK(in[1].baseRadius == Approx(0.05));    // a short internode is capped harder
+    CHECK(in[2].baseRadius == Approx(0.0025));  // thinner than the cap: unchanged
+    CHECK(in[3].baseRadius == Approx(1.0));     // 0.5 * 4 * 0.5 < 0.5 * 30 * 0.1: unchanged
+    s.maxWidthToLength = 0;
+    CHECK(draw("!(4)F(1)", s).skeleton.internodes[0].baseRadius == Approx(1.0));  // 0 = off
+  }
   SECTION("' increments or sets the color index") {
     Run r = draw("''{.F.F.}'(7)@O(1)", s);
     REQUIRE(r.skeleton.organs.size() == 2);
@@ -409,6 +421,13 @@ TEST_CASE("Turtle::shipped grammars", "[lsystem]") {
     CHECK(d.skeleton.internodes.size() == 1023);
     checkVec(d.end.frame.position, {0, (1 - std::pow(0.9, 10)) / 0.1, 0}, 1e-9);
     CHECK(d.skeleton.internodes[0].baseRadius == Approx(0.5 * 10));  // !(10) with widthScale 1
+    // ABOP's widths are pixel widths: a bare grammar caps them to a tree-like 0.12 of each
+    // internode's length, so no internode is wider than its length.
+    TurtleSettings capped;
+    capped.maxWidthToLength = 0.12;
+    Drawn c = drawGrammar("abop_2_6.lsys", capped);
+    CHECK(c.skeleton.internodes[0].baseRadius == Approx(0.06));
+    for (const auto& in : c.skeleton.internodes) REQUIRE(2 * in.baseRadius <= 0.12 * in.length() + 1e-12);
   }
   SECTION("ABOP 1.31a and the original plants draw one connected plant") {
     for (const char* name : {"abop_1_31a.lsys", "shrub.lsys", "conifer.lsys", "abop_2_7.lsys"}) {
