@@ -200,9 +200,33 @@ inline void childrenAt(const Tape& T, const TNode& n, Vec3 p, F&& f) {
   }
 }
 
-/// Calls f(child) for the children of n whose support overlaps box.
+/// Calls f(child) for the children of n whose support overlaps box. A box inside one cell
+/// of the node's point grid (a batch of nearby points, a surface cell) reads that cell's
+/// short list in O(1); larger boxes walk the BVH.
 template <class F>
 inline void childrenIn(const Tape& T, const TNode& n, const Box3& box, F&& f) {
+  if (n.grid >= 0) {
+    const PointGrid& g = T.grids[size_t(n.grid)];
+    if (g.bounds.contains(box.lo) && g.bounds.contains(box.hi)) {
+      Vec3 qlo = glm::floor((box.lo - g.origin) * g.invCell), qhi = glm::floor((box.hi - g.origin) * g.invCell);
+      if (qlo == qhi) {
+        // Every child overlapping box overlaps this grid cell, so it is listed here.
+        for (uint32_t c : g.always)
+          if (T.nodes[c].box.overlaps(box)) f(c);
+        uint64_t key = cellKey(int(qlo.x), int(qlo.y), int(qlo.z));
+        for (uint32_t slot = hashKey(key) & g.mask;; slot = (slot + 1) & g.mask) {
+          uint64_t k = g.tableKey[slot];
+          if (k == key) {
+            const uint32_t* it = g.items.data() + g.tableFirst[slot];
+            for (uint32_t i = 0, e = g.tableCount[slot]; i < e; ++i)
+              if (T.nodes[it[i]].box.overlaps(box)) f(it[i]);
+            return;
+          }
+          if (k == PointGrid::kEmptyKey) return;
+        }
+      }
+    }
+  }
   if (n.bvh >= 0) {
     walkBvh(T, n.bvh, [&](const Box3& b) { return b.overlaps(box); }, f);
   } else {
