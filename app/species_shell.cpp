@@ -346,7 +346,8 @@ ShellBuild buildShellSpecies(const ShellSpecies& species, std::optional<double> 
   return b;
 }
 
-uint32_t addShellToScene(render::Scene& scene, const ShellBuild& shell, const render::ImplicitOptions& options) {
+uint32_t addShellToScene(render::Scene& scene, const ShellBuild& shell, const render::ImplicitOptions& options,
+                         const blobtree::PolygonizeResult* mesh) {
   using organisms::ShellPart;
   render::Material porcelain;
   porcelain.baseColor = shell.painter->options().whorlColor;
@@ -358,12 +359,13 @@ uint32_t addShellToScene(render::Scene& scene, const ShellBuild& shell, const re
     const uint32_t id = scene.addTexture([painter, part](Vec2 uv, const Vec3& p) { return painter->partColor(part, p, uv); });
     if (id != static_cast<uint32_t>(part)) throw std::logic_error("addShellToScene: the scene already holds textures");
   }
+  if (mesh) return scene.addPolygonized(*mesh, material);
   render::ImplicitOptions opt = options;
   if (opt.cellSize <= 0.0f) {
     // The renderer's automatic size follows the smallest feature (the apex's tiny spine
     // tips), which makes hundreds of thousands of cells; a fixed fraction of the model's
     // diagonal renders the Murex faster (docs/perf/shells.md).
-    opt.cellSize = glm::length(shell.blob.bounds().size()) / 120.0f;
+    opt.cellSize = organisms::shellCellSize(shell.blob);
   }
   return scene.addImplicit(shell.blob, material, opt);
 }

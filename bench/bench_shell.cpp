@@ -12,6 +12,7 @@
 //                    [--baseline 1] [--image OUT.png] [--age DEG]
 //   --cell-div N: surface cells of diagonal/N (0 = organisms::shellCellSize's choice)
 //   --baseline 0 skips the baseline render
+//   --canal ax,ay,bx,by,ra,rb,bend: another canal cone for the Murex (unit generating frame)
 //   --without LIST leaves parts out of the Murex (cost breakdown): any of varices, bumps,
 //     axial, opening, tori, spinebend, canalbend, canal, axialbend,
 //     ricci (bumps summed instead of the n = 400 blend)
@@ -46,6 +47,7 @@ struct Args {
   std::string image;
   double age = 0.0;
   std::string without;  ///< parts left out of the Murex, for a cost breakdown
+  std::string canal;    ///< canal cone override "ax,ay,bx,by,ra,rb,bend" (unit frame)
 };
 
 struct Result {
@@ -125,6 +127,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--image")) a.image = next("--image");
     else if (!std::strcmp(argv[i], "--age")) a.age = std::atof(next("--age"));
     else if (!std::strcmp(argv[i], "--without")) a.without = next("--without");
+    else if (!std::strcmp(argv[i], "--canal")) a.canal = next("--canal");
     else {
       std::fprintf(stderr, "bench_shell: unknown argument %s\n", argv[i]);
       return 2;
@@ -144,6 +147,19 @@ int main(int argc, char** argv) {
     if (has("canal")) murex.generating = organisms::GeneratingSurface::point();
     if (has("axialbend")) murex.axialSpines.randomBends = false;
     if (has("ricci")) murex.bumps.blendN = 1.0f;
+    if (!a.canal.empty()) {
+      organisms::GeneratingPrimitive& c = murex.generating.primitives[1];
+      float v[7] = {};
+      if (std::sscanf(a.canal.c_str(), "%f,%f,%f,%f,%f,%f,%f", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5], &v[6]) != 7) {
+        std::fprintf(stderr, "bench_shell: --canal needs ax,ay,bx,by,ra,rb,bend\n");
+        return 2;
+      }
+      c.a = Vec3(v[0], v[1], 0.0f);
+      c.b = Vec3(v[2], v[3], 0.0f);
+      c.radiusA = v[4];
+      c.radiusB = v[5];
+      c.bendDeg = v[6];
+    }
     const auto total = Clock::now();
     const Result m = run(murex, a, a.image, "murex");
     std::printf("murex: build + compile + cells + render %.2f s\n", since(total));

@@ -490,11 +490,15 @@ GeneratingSurface GeneratingSurface::murex(double canalDeg) {
   GeneratingSurface g = point();
   GeneratingPrimitive c;
   c.kind = GeneratingPrimitive::Kind::Cone;
+  // The canal runs from below the aperture's centre down to the shell axis (R/D = 2.93 for
+  // the Murex, so x = −2.8 ends just beside the axis): the copies swept over the last
+  // 1⅓ whorls converge into one slender canal along the columella instead of hanging as a
+  // comb of separate fingers around the body whorl.
   c.a = Vec3(-0.35f, 0.4f, 0.0f);
-  c.b = Vec3(-0.55f, 2.6f, 0.0f);
-  c.radiusA = 0.42f;
-  c.radiusB = 0.2f;
-  c.bendDeg = 25.0f;
+  c.b = Vec3(-2.8f, 5.5f, 0.0f);
+  c.radiusA = 0.45f;
+  c.radiusB = 0.16f;
+  c.bendDeg = 15.0f;
   c.bendDirection = Vec3(1.0f, 0.0f, 0.0f);
   c.lastDeg = canalDeg;
   c.canal = true;
