@@ -98,6 +98,21 @@ TEST_CASE("CompiledBlob::value", "[blobtree]") {
     b.values(pts, out);
     for (size_t i = 0; i < pts.size(); ++i) CHECK(out[i] == Approx(b.value(pts[i])).margin(1e-5));
   }
+  SECTION("tiny batches (one point-grid cell: the O(1) child list) equal point values; tiny boxes' bounds are sound") {
+    for (int k = 0; k < 300; ++k) {
+      Vec3 c = randomIn(rng, box.lo, box.hi);
+      std::vector<Vec3> pts;
+      for (int i = 0; i < 8; ++i) pts.push_back(c + randomIn(rng, Vec3(0.0f), Vec3(0.02f)));
+      std::vector<float> out(pts.size());
+      b.values(pts, out);
+      Interval iv = b.valueBounds(Box3{c, c + Vec3(0.02f)});
+      for (size_t i = 0; i < pts.size(); ++i) {
+        CHECK(out[i] == Approx(b.value(pts[i])).margin(1e-5));
+        CHECK(out[i] >= iv.lo - 1e-5f);
+        CHECK(out[i] <= iv.hi + 1e-5f);
+      }
+    }
+  }
   SECTION("support bounds: every node's field is 0 outside its box") {
     for (NodeId id = 0; id < t.size(); ++id) {
       Box3 nb = t.node(id).bounds;
@@ -269,6 +284,24 @@ TEST_CASE("CompiledBlob::surfaceCells", "[blobtree]") {
     bool found = false;
     for (const Cell& c : coarse.cells) found = found || c.box.contains(p);
     CHECK(found);
+  }
+  SECTION("exact cell size; no Lipschitz bounds or primitive lists when not asked for") {
+    SurfaceCellOptions o;
+    o.exactCellSize = true;
+    o.lipschitz = false;
+    o.primitiveLists = false;
+    CellSet exact = b.surfaceCells(0.0731f, o);
+    CHECK(exact.cellSize == 0.0731f);
+    CHECK(exact.primitives.empty());
+    REQUIRE(!exact.cells.empty());
+    for (const Cell& c : exact.cells) {
+      CHECK(c.lipschitz == 0.0f);
+      CHECK(c.primitiveCount == 0);
+      CHECK(c.box.size().x == Approx(0.0731f));
+    }
+    double exactRatio = double(exact.cells.size()) / double(coarse.cells.size());
+    double expected = std::pow(double(coarse.cellSize) / 0.0731, 2.0);
+    CHECK(exactRatio == Approx(expected).epsilon(0.2));
   }
   // Deterministic.
   CellSet again = b.surfaceCells(0.1f);

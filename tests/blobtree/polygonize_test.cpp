@@ -152,6 +152,7 @@ TEST_CASE("polygonize::deterministic", "[blobtree]") {
   CompiledBlob blob = compile(tree, tree.blend(kids));
   PolygonizeOptions opt;
   opt.cellSize = 0.04f;
+  CHECK(polygonizeDetailed(blob, opt).cellSize == 0.04f);  // cells of exactly the requested edge
   Mesh one, two;
   {
     ThreadLimit limit(1);
