@@ -788,16 +788,22 @@ void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* 
       alignas(32) float S[kBlock];
       std::fill(out, out + pts.n8, 0.0f);  // running max m
       std::fill(S, S + pts.n8, 0.0f);
+      // S >= 1 once a child contributes, so a term (f/m)^n < 2^-25 cannot change it in float:
+      // f < m·2^(-25/n) skips the pow with the same bits (most points of a shell with small
+      // bumps under n = 400). Likewise S == 1 (one contributor) gives m exactly.
+      const float negligible = std::exp2(-25.0f / n.exponent);
       childrenIn(T, n, pbox, [&](uint32_t c) {
         evalB(T, c, pts, pbox, tmp);
         for (int i = 0; i < pts.n; ++i) {
+          if (tmp[i] < out[i] * negligible) continue;
           RicciAcc a{out[i], S[i]};
           a.add(tmp[i], n.exponent);
           out[i] = a.m;
           S[i] = a.s;
         }
       });
-      for (int i = 0; i < pts.n; ++i) out[i] = out[i] > 0.0f ? out[i] * std::pow(S[i], 1.0f / n.exponent) : 0.0f;
+      for (int i = 0; i < pts.n; ++i)
+        out[i] = out[i] > 0.0f ? (S[i] == 1.0f ? out[i] : out[i] * std::pow(S[i], 1.0f / n.exponent)) : 0.0f;
       return;
     }
     case NodeKind::Pcm: {
