@@ -1,7 +1,8 @@
 /// Polygonization benchmark: sparse near-surface polygonization of a synthetic branching
 /// structure of 2,000 cones, against a dense-grid baseline computed in the same run.
 ///
-/// Usage: bench_polygonize [--quick] [--cones N] [--no-baseline]
+/// Usage: bench_polygonize [--quick] [--cones N] [--no-baseline] [--cell H]
+/// (--cell replaces the target cell, half the smallest radius.)
 /// Prints time, triangles/s, cells and field evaluations; the ratio compares the sparse
 /// polygonizer with sampling every grid point of the bounds (the least any dense-grid
 /// mesher must do) at the same cell size.
@@ -95,9 +96,11 @@ double denseSampling(const CompiledBlob& blob, float h, size_t& points, double& 
 int main(int argc, char** argv) {
   bool quick = false, baseline = true;
   int cones = 2000;
+  float cellOverride = 0.0f;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--quick")) quick = true;
     else if (!std::strcmp(argv[i], "--no-baseline")) baseline = false;
+    else if (!std::strcmp(argv[i], "--cell") && i + 1 < argc) cellOverride = float(std::atof(argv[++i]));
     else if (!std::strcmp(argv[i], "--cones") && i + 1 < argc) cones = std::atoi(argv[++i]);
   }
   if (quick) cones = std::min(cones, 300);
@@ -115,7 +118,7 @@ int main(int argc, char** argv) {
   // 1. Target: cells half the smallest radius (the automatic default).
   {
     PolygonizeOptions opt;
-    opt.cellSize = 0.5f * rMin;
+    opt.cellSize = cellOverride > 0.0f ? cellOverride : 0.5f * rMin;
     auto t0 = Clock::now();
     double c0 = cpuSeconds();
     PolygonizeResult r = polygonizeDetailed(blob, opt);

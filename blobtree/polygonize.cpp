@@ -106,7 +106,7 @@ struct TetEmitter {
   const uint32_t* owners;      // this cell's owner cells by low-corner code (0 = itself)
   const uint32_t* vertexBase;  // per active cell
   const uint8_t* crossMask;    // per active cell: bit d set when edge 0 -> d crosses
-  std::vector<glm::uvec3>* tris;
+  glm::uvec3* out;  // next triangle slot
 
   uint32_t edge(int a, int b, bool) const {
     int lo = a & b, d = (a | b) ^ lo;
@@ -119,13 +119,12 @@ struct TetEmitter {
   static Vec3 mid(int a, int b) { return 0.5f * Vec3(cornerOffset(a) + cornerOffset(b)); }
 
   // Emits triangle (e0,e1,e2) with midpoints (m0,m1,m2), flipped so its normal points along outward.
-  void emit(uint32_t e0, uint32_t e1, uint32_t e2, Vec3 m0, Vec3 m1, Vec3 m2, Vec3 outward) const {
+  void emit(uint32_t e0, uint32_t e1, uint32_t e2, Vec3 m0, Vec3 m1, Vec3 m2, Vec3 outward) {
     Vec3 n = glm::cross(m1 - m0, m2 - m0);
-    if (glm::dot(n, outward) >= 0.0f) tris->push_back({e0, e1, e2});
-    else tris->push_back({e0, e2, e1});
+    *out++ = glm::dot(n, outward) >= 0.0f ? glm::uvec3(e0, e1, e2) : glm::uvec3(e0, e2, e1);
   }
 
-  void run(const int t[4], const bool in[4]) const {
+  void run(const int t[4], const bool in[4]) {
     int count = in[0] + in[1] + in[2] + in[3];
     if (count == 0 || count == 4) return;
     if (count == 1 || count == 3) {
@@ -155,6 +154,18 @@ struct TetEmitter {
     emit(ac, bd, bc, mid(a, c), mid(b, d), mid(b, c), outward);
   }
 };
+
+// Triangles marching tetrahedra emit for a cell, by its inside-corner mask: a tetrahedron
+// with 1 or 3 corners inside gives one, with 2 gives two.
+constexpr std::array<uint8_t, 256> kTriangleCount = [] {
+  std::array<uint8_t, 256> n{};
+  for (int m = 0; m < 256; ++m)
+    for (const auto& t : kTets) {
+      int in = ((m >> t[0]) & 1) + ((m >> t[1]) & 1) + ((m >> t[2]) & 1) + ((m >> t[3]) & 1);
+      n[size_t(m)] = uint8_t(n[size_t(m)] + (in == 2 ? 2 : (in == 1 || in == 3 ? 1 : 0)));
+    }
+  return n;
+}();
 
 // Concatenates per-chunk vectors in chunk order.
 template <class T>
@@ -425,22 +436,29 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
 
   constexpr size_t kChunk = 2048;
   size_t nChunks = (nActive + kChunk - 1) / kChunk;
-  std::vector<std::vector<glm::uvec3>> triParts(nChunks);
+  // Triangles are counted per chunk first, then written in place (no per-chunk buffers).
+  std::vector<size_t> triBase(nChunks + 1, 0);
+  parallelFor(0, nChunks, [&](size_t ch) {
+    size_t begin = ch * kChunk, end = std::min(nActive, begin + kChunk), n = 0;
+    for (size_t a = begin; a < end; ++a) n += kTriangleCount[insideMask[active[a]]];
+    triBase[ch + 1] = n;
+  });
+  for (size_t ch = 0; ch < nChunks; ++ch) triBase[ch + 1] += triBase[ch];
+  Mesh& mesh = res.mesh;
+  mesh.triangles.resize(triBase[nChunks]);
   parallelFor(0, nChunks, [&](size_t ch) {
     size_t begin = ch * kChunk, end = std::min(nActive, begin + kChunk);
-    auto& tris = triParts[ch];
-    tris.reserve((end - begin) * 6);
+    TetEmitter em{nullptr, vertexBase.data(), crossMask.data(), mesh.triangles.data() + triBase[ch]};
     for (size_t a = begin; a < end; ++a) {
-      TetEmitter em{&owners[a * 8], vertexBase.data(), crossMask.data(), &tris};
+      em.owners = &owners[a * 8];
       uint8_t m = insideMask[active[a]];
       for (const auto& t : kTets) {
         bool in[4] = {bool(m >> t[0] & 1), bool(m >> t[1] & 1), bool(m >> t[2] & 1), bool(m >> t[3] & 1)};
         em.run(t, in);
       }
     }
+    if (em.out != mesh.triangles.data() + triBase[ch + 1]) throw std::logic_error("polygonize: triangle count mismatch");
   });
-  Mesh& mesh = res.mesh;
-  mesh.triangles = concat(triParts);
   std::vector<uint32_t>().swap(owners);
 
   // The inside and outside grid point of each vertex's edge.
