@@ -3,16 +3,21 @@
 //
 // Prints: derivation + turtle time, BlobTree build time, compile time, exact render time
 // (Embree user geometry over surface cells, default 1536x2048 at 9 samples per pixel, the
-// paper's Fig. 17-18 setting), and polygonization time. Baseline in the same process:
-// field evaluations per second with culling (compiled tape + BVH) against the
-// brute-force evaluator that visits every primitive.
+// paper's Fig. 17-18 setting), and polygonization time; wall time and process CPU time
+// (all threads: on a shared machine CPU/2 estimates an idle 2-core wall time). Baselines in
+// the same process: field evaluations per second with culling (compiled tape + BVH) against
+// the brute-force evaluator that visits every primitive, and the exact render's rays/s
+// against the reference per-cell tracer (ImplicitOptions::batched = false) on a 1/6-size
+// image at 1 spp.
 //
-// Usage: bench_tree [steps=11] [width=1536] [height=2048] [spp=9] [out.png]
-//   polygonization uses cells of 1/400 of the bounds diagonal
-//   (run from the repository root; width 0 skips the render)
+// Usage: bench_tree [steps=11] [width=1536] [height=2048] [spp=9] [out.png] [cell=0]
+//   cell: surface cell edge of the exact render in world units (0 = the renderer's
+//   automatic size); polygonization uses cells of 1/400 of the bounds diagonal
+//   (run from the repository root; width 0 skips the render; out "-" writes no image)
 
 #include <chrono>
 #include <cstdio>
+#include <ctime>
 #include <cstdlib>
 #include <string>
 
@@ -37,6 +42,13 @@ namespace {
 
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
+// CPU seconds of the whole process (all threads).
+double cpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -44,7 +56,8 @@ int main(int argc, char** argv) {
   const int width = argc > 2 ? std::atoi(argv[2]) : 1536;
   const int height = argc > 3 ? std::atoi(argv[3]) : 2048;
   const int spp = argc > 4 ? std::atoi(argv[4]) : 9;
-  const std::string out = argc > 5 ? argv[5] : "";
+  const std::string out = argc > 5 && std::string(argv[5]) != "-" ? argv[5] : "";
+  const float cell = argc > 6 ? float(std::atof(argv[6])) : 0.0f;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   try {
     // Grow the skeleton.
@@ -99,14 +112,17 @@ int main(int argc, char** argv) {
 
     // Exact render.
     if (width > 0) {
-      t = Clock::now();
       render::Scene scene;
       auto bark = std::make_shared<textures::BarkTexture>(textures::BarkOptions{});
       scene.addTexture([bark](Vec2 uv, const Vec3&) { return bark->color(uv); });
       const uint32_t wood = scene.addMaterial(render::Material{Vec3(0.62f, 0.60f, 0.52f), 0.7f, 0.03f, 0});
-      scene.addImplicit(compiled, wood);
+      render::ImplicitOptions io;
+      io.cellSize = cell;
+      t = Clock::now();
+      double c0 = cpuSeconds();
+      scene.addImplicit(compiled, wood, io);
       scene.commit();
-      const double sceneS = since(t);
+      const double sceneS = since(t), sceneCpu = cpuSeconds() - c0;
       render::ViewSpec view;
       view.azimuthDeg = 20;
       view.elevationDeg = 8;
@@ -118,23 +134,52 @@ int main(int argc, char** argv) {
       rs.progress = false;
       render::RenderStats stats;
       t = Clock::now();
+      c0 = cpuSeconds();
       render::Image image = render::renderImage(scene, camera, rs, &stats);
-      const double renderS = since(t);
-      std::printf("exact render %dx%d, %d spp: scene (surface cells) %.2f s, %zu cells; render %.2f s, %.3g rays/s\n",
-                  width, height, spp, sceneS, scene.stats().implicitCells, renderS, stats.raysPerSecond());
+      const double renderS = since(t), renderCpu = cpuSeconds() - c0;
+      std::printf("exact render %dx%d, %d spp: surface cells %.2f s (CPU %.2f s), %zu cells; render %.2f s "
+                  "(CPU %.2f s), %.3g rays (%.3g camera), %.3g rays/s, %.3g rays per CPU s\n",
+                  width, height, spp, sceneS, sceneCpu, scene.stats().implicitCells, renderS, renderCpu,
+                  double(stats.rays()), double(stats.cameraRays), stats.raysPerSecond(),
+                  double(stats.rays()) / renderCpu);
+      std::printf("  total exact (cells + render): %.2f s wall, %.2f s CPU (idle 2-core estimate %.1f s)\n",
+                  sceneS + renderS, sceneCpu + renderCpu, 0.5 * (sceneCpu + renderCpu));
       if (!out.empty()) render::writeImage(image, out);
+
+      // Baseline: the reference per-cell tracer vs the batched one, same scene, small image.
+      render::Scene ref;
+      ref.addTexture([bark](Vec2 uv, const Vec3&) { return bark->color(uv); });
+      ref.addMaterial(render::Material{Vec3(0.62f, 0.60f, 0.52f), 0.7f, 0.03f, 0});
+      render::ImplicitOptions refOpt = io;
+      refOpt.batched = false;
+      ref.addImplicit(compiled, wood, refOpt);
+      ref.commit();
+      rs.width = std::max(16, width / 6);
+      rs.height = std::max(16, height / 6);
+      rs.spp = 1;
+      render::RenderStats fast, slow;
+      c0 = cpuSeconds();
+      render::renderImage(scene, camera, rs, &fast);
+      const double fastCpu = cpuSeconds() - c0;
+      c0 = cpuSeconds();
+      render::renderImage(ref, camera, rs, &slow);
+      const double slowCpu = cpuSeconds() - c0;
+      const double fastRate = double(fast.rays()) / fastCpu, slowRate = double(slow.rays()) / slowCpu;
+      std::printf("  baseline %dx%d, 1 spp: batched %.3g rays per CPU s, per-cell reference %.3g, ratio %.2fx\n",
+                  rs.width, rs.height, fastRate, slowRate, fastRate / slowRate);
     }
 
     // Mesh.
     t = Clock::now();
+    const double meshCpu0 = cpuSeconds();
     // Cells at 1/400 of the diagonal: the automatic size follows the thinnest twig tip and
     // would ask for billions of cells on a 2,000-internode tree.
     blobtree::PolygonizeOptions po;
     po.cellSize = glm::length(b.size()) / 400.0f;
     const blobtree::PolygonizeResult mesh = blobtree::polygonizeDetailed(compiled, po);
-    const double meshS = since(t);
-    std::printf("polygonize: %.2f s, cell %.4g, %zu triangles, %zu field evaluations\n", meshS, mesh.cellSize,
-                mesh.mesh.triangleCount(), mesh.fieldEvaluations);
+    const double meshS = since(t), meshCpu = cpuSeconds() - meshCpu0;
+    std::printf("polygonize: %.2f s (CPU %.2f s), cell %.4g, %zu triangles, %zu field evaluations\n", meshS, meshCpu,
+                mesh.cellSize, mesh.mesh.triangleCount(), mesh.fieldEvaluations);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_tree: %s\n", e.what());
     return 1;

@@ -78,8 +78,13 @@ struct TreeOptions {
   double deltaAMulti = 2.75;     ///< Eq. 8 factor: δA = deltaAMulti·max(r_i) − r_A (PCM, several branches)
   bool basalOffset = true;       ///< apply δA at all (off re-creates the bulge of Fig. 9 left)
   bool branchOffset = true;      ///< PCM: displace branches by δB_i = r_A − r_i (Eq. 7; off = Fig. 12 left)
-  double pcmWidth = 0.15;        ///< PCM propagation width w in field units (blobtree::PcmParams::width)
-  double pcmBulge = 1.0;         ///< PCM bulge scale: a₀ = pcmBulge·w/4 (blobtree::PcmParams::bulgeScale)
+  /// PCM propagation width w in field units (blobtree::PcmParams::width). With the Wyvill
+  /// kernel, w = 0.25 reaches from the other branch's surface out to 1.3x its radius.
+  double pcmWidth = 0.25;
+  /// PCM bulge scale: a₀ = pcmBulge·w/4 (blobtree::PcmParams::bulgeScale). The default
+  /// a₀ = 0.125 raises a visible branch bark ridge between the branches (a crest along
+  /// their seam) while the basal internode below P keeps its radius (docs/TREES.md).
+  double pcmBulge = 2.0;
   bool softKernel = false;       ///< use the soft-object kernel instead of Wyvill's (1−s)³
   bool controlledBlend = true;   ///< non-neighbour internodes meet as a union, not a blend
   TipStyle tips = TipStyle::Taper;
