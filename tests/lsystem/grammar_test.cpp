@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
 
+#include <filesystem>
+
 #include "lsystem/derive.h"
 #include "lsystem/grammar.h"
 
@@ -272,4 +274,20 @@ TEST_CASE("parseGrammar production forms", "[lsystem]") {
     Grammar g = parseGrammar("axiom: A\r\nA --> BB\r\n", "g.lsys");
     CHECK(formatModuleString(derive(g, DeriveOptions{.steps = 1}), g.symbols()) == "BB");
   }
+}
+
+TEST_CASE("loadGrammar every shipped grammar", "[lsystem]") {
+  // Every grammars/*.lsys parses (brackets balanced, every predecessor can match) and has
+  // a derivation length; a grammar edit that breaks one fails here, not in the gallery.
+  size_t count = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(std::string(SPRIG_SOURCE_DIR) + "/grammars")) {
+    if (entry.path().extension() != ".lsys") continue;
+    INFO(entry.path().string());
+    Grammar g = loadGrammar(entry.path().string());
+    CHECK(g.axiom().size() > 0);
+    CHECK(g.derivationLength() > 0);
+    CHECK(g.productionCount() > 0);
+    ++count;
+  }
+  CHECK(count >= 12);  // ABOP 1.24a-f, 1.31a, 2.6-2.8, shrub, conifer, ...
 }
