@@ -226,6 +226,27 @@ TEST_CASE("buildShell::growth", "[organisms]") {
   }
 }
 
+TEST_CASE("buildShell::growth of the Murex", "[organisms]") {
+  // A young Murex is the old one stopped at θ_end: its latest varix and its hollow aperture
+  // sit at its own growing edge, where the grown shell is still a solid older whorl.
+  ShellParams p = murexCabritii();
+  ShellModel full = buildShell(p);
+  for (double age : {1044.0, 1740.0}) {
+    p.ageDeg = age;
+    ShellModel young = buildShell(p);
+    INFO("age " << age);
+    REQUIRE(!young.varixDeg.empty());
+    CHECK(young.varixDeg.back() == Approx(age));
+    CHECK(young.varixDeg.size() == size_t(std::lround(age / 116.0)));
+    const CompiledBlob by = compile(young.tree, young.shellRoot), bf = compile(full.tree, full.shellRoot);
+    const Vec3 centre = f3(p.spiral.point(age - 40.0));
+    CHECK(by.value(centre) < 0.5f);  // the young shell's opening
+    CHECK(bf.value(centre) > 0.5f);  // the same place inside the grown shell's solid whorl
+    // Varices already grown are the same in both shells.
+    for (size_t i = 0; i + 1 < young.varixDeg.size(); ++i) CHECK(young.varixDeg[i] == full.varixDeg[i]);
+  }
+}
+
 TEST_CASE("buildShell::determinism and errors", "[organisms]") {
   ShellParams p = murexCabritii();
   p.ageDeg = 3 * 348.0;
