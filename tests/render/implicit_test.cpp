@@ -80,6 +80,21 @@ TEST_CASE("Scene::addImplicit", "[render]") {
       for (int x = 0; x < img.width; ++x) area += img.at(x, y).a;
     double expected = 100.0 * std::tan(std::asin(1.0 / 6.0)) / std::tan(radians(15.0));
     CHECK(std::sqrt(area / kPi) == Approx(expected).margin(0.25));
+    // Per pixel: the silhouette is the analytic circle (centered: the camera looks at the
+    // sphere). The separable tent filter reads samples up to one pixel away on each axis (a
+    // square footprint, √2 on the diagonal), so pixels whose centers lie more than that
+    // inside the circle are fully covered and those more than that outside are empty.
+    const double reach = std::sqrt(2.0);
+    int edge = 0;
+    for (int y = 0; y < img.height; ++y)
+      for (int x = 0; x < img.width; ++x) {
+        double d = std::hypot(x + 0.5 - 100.0, y + 0.5 - 100.0);
+        float a = img.at(x, y).a;
+        if (d < expected - reach) CHECK(a > 0.9999f);
+        else if (d > expected + reach) CHECK(a < 1e-4f);
+        else edge += a > 0.0f && a < 1.0f;
+      }
+    CHECK(edge > 100);  // the antialiased rim lies in that band
   }
 }
 
