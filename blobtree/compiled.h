@@ -124,7 +124,8 @@ class CompiledBlob {
   CompiledBlob(CompiledBlob&&) noexcept;
   CompiledBlob& operator=(CompiledBlob&&) noexcept;
 
-  /// F(p). Cost: the primitives whose support contains p, plus a BVH walk.
+  /// F(p). Cost: the primitives whose support contains p, plus one point-grid lookup per
+  /// n-ary node (a BVH walk for nodes with few children).
   float value(Vec3 p) const;
   /// ∇F(p), analytic everywhere (warps by their Jacobians). Where F is not differentiable
   /// (max/min switches, clamp kinks) a one-sided gradient is returned.
