@@ -125,7 +125,7 @@ class CompiledBlob {
   CompiledBlob& operator=(CompiledBlob&&) noexcept;
 
   /// F(p). Cost: the primitives whose support contains p, plus one point-grid lookup per
-  /// n-ary node (a BVH walk for nodes with few children).
+  /// n-ary node with many children (nodes with few children test each child's box).
   float value(Vec3 p) const;
   /// ∇F(p), analytic everywhere (warps by their Jacobians). Where F is not differentiable
   /// (max/min switches, clamp kinks) a one-sided gradient is returned.
