@@ -13,6 +13,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "app/model.h"
 #include "app/preview.h"
 #include "core/atomic_file.h"
 #include "core/diagnostics.h"
@@ -161,18 +162,46 @@ SkeletonFigures skeletonFigures(const lsystem::Skeleton& skeleton) {
 
 int renderGalleryAnimation(const Species& species, const fs::path& out, const SpeciesRender& look, int width,
                            int height, bool final) {
-  AnimateOptions opt;
-  GrowthSequence probe(species);
-  const int steps = std::max(1, probe.lastStage());
-  opt.framesPerStage = std::clamp((final ? 120 : 36) / steps, 1, final ? 8 : 4);
-  opt.fps = final ? 12 : 8;
-  opt.holdSeconds = 1;
-  opt.width = std::max(16, width / 2);
-  opt.height = std::max(16, height / 2);
-  opt.samples = final ? look.samples : std::min(look.samples, 2);
-  opt.progressLabel = "animate " + species.name;
   Species shown = species;
   shown.render = look;
+  const int w = std::max(16, width / 2), h = std::max(16, height / 2);
+  const int samples = final ? look.samples : std::min(look.samples, 2);
+  if (species.kind == SpeciesKind::Blob) {
+    // A blob does not grow: a turntable around it instead, one camera distance throughout.
+    SpeciesModel model(shown);
+    const int n = final ? 48 : 16;
+    std::vector<render::Image> frames;
+    Progress bar("turntable " + species.name, static_cast<size_t>(n));
+    for (int i = 0; i < n; ++i) {
+      SpeciesRender turn = look;
+      turn.view.azimuthDeg = look.view.azimuthDeg + 360.0 * i / n;
+      RenderJob job;
+      job.width = w;
+      job.height = h;
+      job.samples = samples;
+      job.mode = GeometryMode::Exact;
+      job.progress = false;
+      frames.push_back(renderModel(model, turn, job));
+      bar.advance();
+    }
+    bar.finish();
+    writeAnimatedGif(frames, final ? 16 : 8, out);
+    return n;
+  }
+  AnimateOptions opt;
+  if (species.kind == SpeciesKind::Shell) {
+    opt.framesPerStage = final ? 6 : 2;  // per whorl
+  } else {
+    GrowthSequence probe(species);
+    const int steps = std::max(1, probe.lastStage());
+    opt.framesPerStage = std::clamp((final ? 120 : 36) / steps, 1, final ? 8 : 4);
+  }
+  opt.fps = final ? 12 : 8;
+  opt.holdSeconds = 1;
+  opt.width = w;
+  opt.height = h;
+  opt.samples = samples;
+  opt.progressLabel = "animate " + species.name;
   return animateSpecies(shown, out, opt).frames;
 }
 
@@ -247,12 +276,13 @@ AnimateResult animateSpecies(const Species& species, const fs::path& out, const 
   if (options.framesPerStage < 1) throw std::invalid_argument("--frames-per-stage must be at least 1");
   if (!(options.fps > 0)) throw std::invalid_argument("--fps must be positive");
 
-  GrowthSequence seq(species, options.lastStage, options.extra);
+  SpeciesModel model(species, options.extra, options.lastStage);
   AnimateResult result;
-  result.lastStage = seq.lastStage();
+  result.lastStage = std::max(0, model.finalStage().step);
   result.firstStage = std::clamp(options.firstStage, 0, result.lastStage);
-  const std::vector<GrowthFrame> frames = growthFrames(result.firstStage, result.lastStage, options.framesPerStage);
+  const std::vector<Stage> frames = model.animationFrames(options.framesPerStage, result.firstStage, result.lastStage);
   result.frames = static_cast<int>(frames.size());
+  const GeometryMode mode = options.mode ? *options.mode : model.defaultMode();
 
   SpeciesRender look = species.render;
   if (options.samples > 0) look.samples = options.samples;
@@ -277,7 +307,13 @@ AnimateResult animateSpecies(const Species& species, const fs::path& out, const 
     if (!options.progressLabel.empty()) bar.emplace(options.progressLabel, frames.size());
     for (size_t i = 0; i < frames.size(); ++i) {
       if (ProgressSettings::cancelRequested()) throw Cancelled();
-      render::Image img = renderGrowthFrame(seq, look, frames[i], width, height);
+      RenderJob job;
+      job.width = width;
+      job.height = height;
+      job.mode = mode;
+      job.stage = frames[i];
+      job.progress = false;
+      render::Image img = renderModel(model, look, job);
       if (format == AnimationFormat::Gif)
         gifFrames.push_back(std::move(img));
       else

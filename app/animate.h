@@ -13,9 +13,11 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "app/model.h"
 #include "app/species.h"
 #include "lsystem/derive.h"
 #include "lsystem/skeleton.h"
@@ -96,6 +98,9 @@ struct AnimateOptions {
   int samples = 0;          ///< camera samples per pixel; 0 = the species' own
   lsystem::GrammarOverrides extra;  ///< -D, --steps, --seed on top of the species
   std::string progressLabel = "animate";  ///< empty = no progress bar
+  /// How frames show the species; unset = SpeciesModel::defaultMode() (exact surfaces for
+  /// trees with a `tree:` section, shells and blobs; skeleton previews for other trees).
+  std::optional<GeometryMode> mode;
 };
 
 /// What animateSpecies did.
@@ -106,7 +111,8 @@ struct AnimateResult {
   double seconds = 0;
 };
 
-/// Renders the growth of species to out (format from animationFormatFor): a folder of
+/// Renders the growth of species to out (frames from SpeciesModel::animationFrames: trees
+/// grow step by step, shells whorl by whorl, each frame through renderModel) (format from animationFormatFor): a folder of
 /// frame_NNNNN.png (each frame written atomically), or an animated GIF / MP4 renamed into
 /// place only when complete. MP4 needs the `ffmpeg` command. Throws InputError for bad
 /// species or a missing ffmpeg, std::invalid_argument for bad options, Cancelled on a signal.

@@ -5,6 +5,7 @@
 
 #include "app/animate.h"
 #include "app/cmd_common.h"
+#include "app/model.h"
 #include "app/species.h"
 #include "render/image.h"
 
@@ -89,13 +90,18 @@ int runAnimate(const AnimateArgs& a, const GlobalOptions& g) {
   opt.progressLabel = "animate " + species.name;
 
   if (single) {
-    GrowthSequence seq(species, opt.lastStage, opt.extra);
-    if (single->stage > seq.lastStage())
-      throw UsageError("--at " + a.at + ": the species grows for " + std::to_string(seq.lastStage()) + " steps");
+    SpeciesModel model(species, opt.extra, opt.lastStage);
     SpeciesRender frameLook = look;
     if (a.samples > 0) frameLook.samples = a.samples;
-    render::writeImage(renderGrowthFrame(seq, frameLook, *single, opt.width, opt.height), a.out);
-    if (!g.quiet) std::cerr << a.out << ": stage " << single->stage << " grown " << single->fraction << "\n";
+    RenderJob job;
+    job.width = opt.width;
+    job.height = opt.height;
+    job.mode = model.defaultMode();
+    job.stage = model.stageFromIndex(single->stage);
+    job.stage.fraction = single->fraction;
+    job.progress = false;
+    render::writeImage(renderModel(model, frameLook, job), a.out);
+    if (!g.quiet) std::cerr << a.out << ": " << model.stageName(job.stage) << "\n";
     return kExitOk;
   }
   AnimateResult r = animateSpecies(species, a.out, opt);

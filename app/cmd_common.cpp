@@ -2,6 +2,8 @@
 
 #include "app/cmd_common.h"
 
+#include <sstream>
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -46,6 +48,25 @@ lsystem::GrammarOverrides commandLineOverrides(const std::vector<std::string>& d
   if (steps >= 0) o.derivationLength = steps;
   if (seed >= 0) o.seed = static_cast<uint64_t>(seed);
   return o;
+}
+
+/// Parses `AZ,EL` or `AZ,EL,FOV` (degrees) into view.
+void parseView(const std::string& text, render::ViewSpec& view) {
+  std::vector<double> values;
+  std::stringstream ss(text);
+  std::string part;
+  while (std::getline(ss, part, ',')) {
+    auto v = parseFiniteNumber(part);
+    if (!v) values.clear(), values.push_back(1e300);
+    else values.push_back(*v);
+  }
+  bool ok = (values.size() == 2 || values.size() == 3) && values[0] >= -360 && values[0] <= 360 &&
+            values[1] >= -89 && values[1] <= 89 && (values.size() == 2 || (values[2] >= 1 && values[2] <= 150));
+  if (!ok)
+    throw UsageError("--view " + text + ": expected AZIMUTH,ELEVATION[,FOV] in degrees (elevation in [-89, 89], fov in [1, 150])");
+  view.azimuthDeg = values[0];
+  view.elevationDeg = values[1];
+  if (values.size() == 3) view.fovYDeg = values[2];
 }
 
 }  // namespace sprig

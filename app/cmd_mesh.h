@@ -5,8 +5,9 @@
 
 namespace sprig {
 
-/// Registers `sprig mesh`: polygonizes a kind: blob species (blobtree/polygonize.h) and
-/// writes the mesh atomically (core/mesh_io.h), printing the triangle count and the time.
+/// Registers `sprig mesh`: polygonizes the surface of a species of any kind at a stage
+/// (app/model.h, blobtree/polygonize.h) and writes the mesh atomically (core/mesh_io.h),
+/// printing the triangle count and the time.
 void addMeshCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run);
 
 }  // namespace sprig

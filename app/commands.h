@@ -55,6 +55,9 @@ void addGalleryCommand(CLI::App& app, const GlobalOptions& global, CommandRun& r
 /// `sprig animate SPECIES -o OUT` (app/cmd_animate.cpp).
 void addAnimateCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run);
 
+/// `sprig render SPECIES -o OUT` (app/cmd_render.cpp).
+void addRenderCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run);
+
 /// Throws UsageError unless path's extension is one of `allowed` (lower case, with dot).
 void requireExtension(const std::string& flag, const std::string& path, std::initializer_list<const char*> allowed);
 

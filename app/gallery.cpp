@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "app/animate.h"
+#include "app/model.h"
 #include "app/preview.h"
 #include "app/species.h"
 #include "app/tree_pipeline.h"
@@ -51,10 +52,9 @@ GalleryItem renderGalleryItem(const fs::path& speciesFile, const fs::path& outDi
     item.name = species.name;
     item.description = species.description;
     item.kind = speciesKindName(species.kind);
-    if (species.kind != SpeciesKind::Tree) {
-      item.error = "the gallery does not render " + item.kind + " species yet";
-      return item;
-    }
+    SpeciesModel model(species);
+    const GeometryMode mode = model.defaultMode();
+    item.mode = geometryModeName(mode);
     SpeciesRender look = species.render;
     int width = look.width, height = look.height;
     if (quality == GalleryQuality::Draft) {
@@ -68,32 +68,45 @@ GalleryItem renderGalleryItem(const fs::path& speciesFile, const fs::path& outDi
     item.preview = stem + ".png";
     item.strip = stem + "_stages.png";
 
-    // One derivation gives the final skeleton and every stage.
-    lsystem::Grammar g = speciesGrammar(species);
-    item.stages = growthStages(species, g.derivationLength());
-    GrowOptions opt;
-    opt.stageSteps = item.stages;
-    GrownTree t = growTree(species, opt);
-    item.steps = t.steps;
-    item.modules = t.modules.size();
-    item.internodes = t.skeleton.internodes.size();
-    item.deriveSeconds = t.deriveSeconds + t.turtleSeconds;
-
+    // The final stage, full size.
     auto r0 = std::chrono::steady_clock::now();
-    const DBox3 frame = framingBox(t.skeleton);
-    render::Image preview = renderSkeletonImage(t.skeleton, look, frame, width, height, "render " + stem);
+    RenderJob job;
+    job.width = width;
+    job.height = height;
+    job.mode = mode;
+    job.stage = model.finalStage();
+    job.progressLabel = "render " + stem;
+    ModelFigures fig;
+    render::Image preview = renderModel(model, look, job, &fig);
     render::writeImage(preview, outDir / item.preview);
-    std::vector<const lsystem::Skeleton*> stages;
-    for (const auto& st : t.stages) stages.push_back(&st.skeleton);
+    item.steps = std::max(0, job.stage.step);
+    item.modules = fig.modules;
+    item.internodes = fig.internodes;
+    item.primitives = fig.primitives;
+    item.triangles = fig.triangles;
+    item.deriveSeconds = fig.buildSeconds;
+
+    // The growth strip: every stage framed like the final one.
+    const std::vector<Stage> stages = model.stripStages(5);
+    for (const Stage& st : stages)
+      item.stages.push_back(species.kind == SpeciesKind::Shell ? static_cast<int>(std::lround(st.age)) : st.step);
     const int stripHeight = std::max(16, height * 2 / 3);
     const int cellWidth = std::max(16, stripHeight * 3 / 4);
     SpeciesRender stripLook = look;
     stripLook.view.margin = std::max(look.view.margin, 0.04);
-    render::Image strip = renderGrowthStrip(stages, stripLook, frame, cellWidth, stripHeight, "stages " + stem);
+    render::Image strip(cellWidth * static_cast<int>(stages.size()), stripHeight);
+    for (size_t i = 0; i < stages.size(); ++i) {
+      RenderJob cellJob = job;
+      cellJob.width = cellWidth;
+      cellJob.height = stripHeight;
+      cellJob.stage = stages[i];
+      cellJob.progressLabel = "stages " + stem + " " + std::to_string(i + 1) + "/" + std::to_string(stages.size());
+      render::Image cell = renderModel(model, stripLook, cellJob);
+      for (int y = 0; y < stripHeight; ++y)
+        for (int x = 0; x < cellWidth; ++x) strip.set(static_cast<int>(i) * cellWidth + x, y, cell.at(x, y));
+    }
     render::writeImage(strip, outDir / item.strip);
-    const SkeletonFigures figures = skeletonFigures(t.skeleton);
-    item.primitives = figures.primitives;
-    item.triangles = figures.triangles;
+
     item.animation = stem + ".gif";
     item.frames = renderGalleryAnimation(species, outDir / item.animation, look, width, height,
                                          quality == GalleryQuality::Final);
@@ -131,11 +144,11 @@ std::string galleryIndexHtml(const std::vector<GalleryItem>& items) {
     std::string stages;
     for (size_t i = 0; i < it.stages.size(); ++i) stages += (i ? ", " : "") + std::to_string(it.stages[i]);
     o += "<table class=\"figs\">\n<tr><td>source</td><td>" + html(it.source) + "</td></tr>\n<tr><td>kind</td><td>" +
-         html(it.kind) + "</td></tr>\n<tr><td>steps</td><td>" + std::to_string(it.steps) +
+         html(it.kind) + "</td></tr>\n<tr><td>render mode</td><td>" + html(it.mode) + "</td></tr>\n<tr><td>steps</td><td>" + std::to_string(it.steps) +
          "</td></tr>\n<tr><td>modules</td><td>" + std::to_string(it.modules) + "</td></tr>\n<tr><td>internodes</td><td>" +
          std::to_string(it.internodes) + "</td></tr>\n<tr><td>primitives</td><td>" + std::to_string(it.primitives) +
          "</td></tr>\n<tr><td>triangles</td><td>" + std::to_string(it.triangles) +
-         "</td></tr>\n<tr><td>derive + turtle</td><td class=\"time\">" + fixed(it.deriveSeconds, 3) +
+         "</td></tr>\n<tr><td>build</td><td class=\"time\">" + fixed(it.deriveSeconds, 3) +
          " s</td></tr>\n<tr><td>render</td><td class=\"time\">" + fixed(it.renderSeconds, 2) +
          " s</td></tr>\n<tr><td>stages</td><td>" +
          stages + "</td></tr>\n</table>\n</div>\n";

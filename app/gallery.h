@@ -21,17 +21,18 @@ struct GalleryItem {
   std::string name;
   std::string description;
   std::string kind;
+  std::string mode;         ///< how the final image was rendered: exact, mesh or skeleton
   std::string preview;      ///< file name of the final-stage image inside the gallery folder
   std::string strip;        ///< file name of the growth-stage strip
   std::string animation;    ///< file name of the growth animation (GIF, app/animate.h)
   int frames = 0;           ///< frames in the animation
   size_t primitives = 0;    ///< render primitives of the final stage (internodes + organs)
   size_t triangles = 0;     ///< triangles of the final stage's polygon organs
-  std::vector<int> stages;  ///< derivation steps shown in the strip
+  std::vector<int> stages;  ///< stages shown in the strip: derivation steps (trees) or ages in degrees (shells)
   size_t modules = 0;
   size_t internodes = 0;
   int steps = 0;
-  double deriveSeconds = 0;
+  double deriveSeconds = 0;  ///< building the final stage: derivation, turtle, BlobTree, compile
   double renderSeconds = 0;
   std::string error;        ///< non-empty when the species failed (the diagnostics)
 };

@@ -6,6 +6,7 @@
 #include <iostream>
 #include <optional>
 
+#include "app/cmd_mesh.h"
 #include "app/commands.h"
 #include "core/atomic_file.h"
 #include "core/diagnostics.h"
@@ -32,6 +33,8 @@ int main(int argc, char** argv) {
   addDeriveCommand(app, global, run);
   addCheckCommand(app, global, run);
   addPreviewCommand(app, global, run);
+  addRenderCommand(app, global, run);
+  addMeshCommand(app, global, run);
   addGalleryCommand(app, global, run);
   addAnimateCommand(app, global, run);
 

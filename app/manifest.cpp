@@ -40,7 +40,7 @@ std::string manifestJson(const Manifest& m) {
     o += i ? ",\n  {" : "\n  {";
     o += "\"source\": " + json::string(it.source) + ", \"hash\": " + json::string(e.hash) +
          ", \"name\": " + json::string(it.name) + ", \"description\": " + json::string(it.description) +
-         ", \"kind\": " + json::string(it.kind) + ", \"preview\": " + json::string(it.preview) +
+         ", \"kind\": " + json::string(it.kind) + ", \"mode\": " + json::string(it.mode) + ", \"preview\": " + json::string(it.preview) +
          ", \"strip\": " + json::string(it.strip) + ", \"animation\": " + json::string(it.animation) +
          ", \"stages\": " + intList(it.stages) + ", \"modules\": " + std::to_string(it.modules) +
          ", \"internodes\": " + std::to_string(it.internodes) + ", \"primitives\": " + std::to_string(it.primitives) +
@@ -72,6 +72,7 @@ Manifest parseManifest(const std::string& text, const std::string& displayPath) 
       it.name = n["name"].as<std::string>();
       it.description = n["description"].as<std::string>();
       it.kind = n["kind"].as<std::string>();
+      if (n["mode"]) it.mode = n["mode"].as<std::string>();
       it.preview = n["preview"].as<std::string>();
       it.strip = n["strip"].as<std::string>();
       it.animation = n["animation"].as<std::string>();

@@ -49,6 +49,25 @@ void readRender(MapReader& m, SpeciesRender& r, DiagnosticList& diags) {
     sun.finish();
   }
   r.exposure = static_cast<float>(m.number("exposure", r.exposure, -10.0, 10.0));
+  if (auto c = m.section("camera")) {
+    MapReader cam(*c, diags, "render.camera");
+    CameraSpec spec;
+    if (cam.has("position")) spec.position = cam.vec3("position", Vec3(0), -1e6f, 1e6f);
+    else cam.allow({"position"});
+    if (cam.has("target")) spec.target = cam.vec3("target", Vec3(0), -1e6f, 1e6f);
+    else cam.allow({"target"});
+    if (cam.has("distance")) spec.distance = cam.number("distance", 1.0, 1e-6, 1e6);
+    else cam.allow({"distance"});
+    if (spec.position && spec.distance)
+      c->error(diags, "render.camera: give either 'position' or 'distance', not both");
+    cam.finish();
+    r.camera = spec;
+  }
+  r.fill = static_cast<float>(m.number("fill", r.fill, 0.0, 10.0));
+  r.sky = static_cast<float>(m.number("sky", r.sky, 0.0, 10.0));
+  r.surface.baseColor = m.color("color", r.surface.baseColor);
+  r.surface.roughness = static_cast<float>(m.number("roughness", r.surface.roughness, 0.0, 1.0));
+  r.surface.specular = static_cast<float>(m.number("specular", r.surface.specular, 0.0, 1.0));
   r.style.wood.baseColor = m.color("wood", r.style.wood.baseColor);
   r.style.leaf.baseColor = m.color("leaf", r.style.leaf.baseColor);
   r.style.fruit.baseColor = m.color("fruit", r.style.fruit.baseColor);
@@ -249,6 +268,8 @@ render::RenderSettings SpeciesRender::settings(int imageWidth, int imageHeight) 
   rs.sunAzimuthDeg = sunAzimuthDeg;
   rs.sunElevationDeg = sunElevationDeg;
   rs.exposure = exposure;
+  rs.fillStrength = fill;
+  rs.skyStrength = sky;
   return rs;
 }
 

@@ -35,6 +35,13 @@ enum class SpeciesKind { Tree, Shell, Blob, Organism, Solid };
 /// "tree", "shell", ...
 const char* speciesKindName(SpeciesKind kind);
 
+/// An explicit camera (`render.camera:`); unset parts come from the automatic framing.
+struct CameraSpec {
+  std::optional<Vec3> position;    ///< `position: [x, y, z]`, the eye
+  std::optional<Vec3> target;      ///< `target: [x, y, z]` (default: the center of the framed box)
+  std::optional<double> distance;  ///< `distance`: eye at view.azimuth/elevation this far from target
+};
+
 /// How a species is shown: image size, camera, colors, light.
 struct SpeciesRender {
   int width = 800;                     ///< `width`, pixels
@@ -49,6 +56,10 @@ struct SpeciesRender {
   double sunAzimuthDeg = -50.0;        ///< `sun: {azimuth, elevation}`
   double sunElevationDeg = 50.0;
   float exposure = 0.0f;               ///< `exposure`, stops
+  std::optional<CameraSpec> camera;    ///< `camera: {position, target, distance}`
+  float fill = 0.0f;                   ///< `fill`: strength of an unshadowed light from the camera
+  float sky = 0.5f;                    ///< `sky`: strength of the sky light
+  render::Material surface{Vec3(0.72f, 0.60f, 0.48f), 0.45f, 0.05f};  ///< `color`, `roughness`, `specular`: blob surfaces
 
   /// Renderer settings for an image of width x height (threads 0 = all).
   render::RenderSettings settings(int imageWidth, int imageHeight) const;

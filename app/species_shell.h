@@ -74,6 +74,8 @@ ShellBuild buildShellSpecies(const ShellSpecies& species, std::optional<double> 
 /// part textures take texture ids 0-4 (organisms::ShellPart), so the scene must hold no
 /// texture yet (throws std::logic_error otherwise). options.cellSize 0 picks 1/120 of the
 /// model's diagonal. Returns the geometry id.
-uint32_t addShellToScene(render::Scene& scene, const ShellBuild& shell, const render::ImplicitOptions& options = {});
+/// With `mesh` (the polygonized shell) the shell goes in as triangles instead (mesh mode).
+uint32_t addShellToScene(render::Scene& scene, const ShellBuild& shell, const render::ImplicitOptions& options = {},
+                         const blobtree::PolygonizeResult* mesh = nullptr);
 
 }  // namespace sprig

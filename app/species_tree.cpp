@@ -123,7 +123,7 @@ TreeModel buildTreeModel(const Species& species, const lsystem::Skeleton& skelet
 }
 
 uint32_t addTreeToScene(render::Scene& scene, const TreeModel& model, const SpeciesRender& look,
-                        const render::ImplicitOptions& implicit) {
+                        const render::ImplicitOptions& implicit, const blobtree::PolygonizeResult* mesh) {
   if (model.options.bark.enabled) {
     textures::BarkOptions bo;
     bo.seed = model.options.seed;
@@ -133,7 +133,7 @@ uint32_t addTreeToScene(render::Scene& scene, const TreeModel& model, const Spec
     scene.addTexture([bark](Vec2 uv, const Vec3&) { return bark->color(uv); });
   }
   const uint32_t wood = scene.addMaterial(look.style.wood);
-  const uint32_t id = scene.addImplicit(model.compiled, wood, implicit);
+  const uint32_t id = mesh ? scene.addPolygonized(*mesh, wood) : scene.addImplicit(model.compiled, wood, implicit);
   if (model.leaves.triangleCount() > 0) {
     Mesh leaves = model.leaves;
     leaves.materials.clear();  // one leaf material; the vertex colors carry each leaf's tint

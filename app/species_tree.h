@@ -55,7 +55,9 @@ TreeModel buildTreeModel(const Species& species, const lsystem::Skeleton& skelet
 /// which holds for a fresh scene and the default id 0), a wood material with look.style.wood,
 /// the wood as implicit geometry and the leaves as a mesh with look.style.leaf (vertex
 /// colors win when present). Returns the wood's geometry id.
+/// With `mesh` (the polygonized wood) the wood goes in as triangles instead (mesh mode).
 uint32_t addTreeToScene(render::Scene& scene, const TreeModel& model, const SpeciesRender& look,
-                        const render::ImplicitOptions& implicit = {});
+                        const render::ImplicitOptions& implicit = {},
+                        const blobtree::PolygonizeResult* mesh = nullptr);
 
 }  // namespace sprig

@@ -1,0 +1,126 @@
+/// `sprig render SPECIES -o OUT.{png,exr,jpg} [--width W --height H --spp N --mode exact|mesh|skeleton
+///  --stage K --fraction F --age DEG --view AZ,EL[,FOV] --camera X,Y,Z[,TX,TY,TZ]]`
+
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+
+#include "app/cmd_common.h"
+#include "app/model.h"
+#include "app/species.h"
+#include "render/image.h"
+
+namespace sprig {
+
+namespace {
+
+struct RenderArgs {
+  std::string file;
+  std::string out;
+  int width = 0;
+  int height = 0;
+  int spp = 0;
+  std::string mode = "exact";
+  int stage = -1;
+  double fraction = 1.0;
+  double age = -1.0;
+  std::string view;
+  std::string camera;
+  int steps = -1;
+  int64_t seed = -1;
+  std::vector<std::string> defines;
+};
+
+/// Parses `X,Y,Z` (eye) or `X,Y,Z,TX,TY,TZ` (eye and target) into look.camera.
+void parseCamera(const std::string& text, SpeciesRender& look) {
+  std::vector<double> v;
+  std::stringstream ss(text);
+  std::string part;
+  bool ok = true;
+  while (std::getline(ss, part, ',')) {
+    auto n = parseFiniteNumber(part);
+    if (!n || std::abs(*n) > 1e6) ok = false;
+    else v.push_back(*n);
+  }
+  if (!ok || (v.size() != 3 && v.size() != 6))
+    throw UsageError("--camera " + text + ": expected X,Y,Z or X,Y,Z,TX,TY,TZ (eye, then target)");
+  CameraSpec c;
+  c.position = Vec3(float(v[0]), float(v[1]), float(v[2]));
+  if (v.size() == 6) c.target = Vec3(float(v[3]), float(v[4]), float(v[5]));
+  else if (look.camera && look.camera->target) c.target = look.camera->target;
+  look.camera = c;
+}
+
+int runRender(const RenderArgs& a, const GlobalOptions& g) {
+  requireExtension("-o", a.out, {".png", ".jpg", ".jpeg", ".exr"});
+  GeometryMode mode = a.mode == "mesh" ? GeometryMode::Mesh
+                      : a.mode == "skeleton" ? GeometryMode::Skeleton
+                                             : GeometryMode::Exact;
+  Species species = loadSpecies(a.file, g.pathPolicy());
+  SpeciesRender look = species.render;
+  if (!a.view.empty()) parseView(a.view, look.view);
+  if (!a.camera.empty()) parseCamera(a.camera, look);
+
+  SpeciesModel model(species, commandLineOverrides(a.defines, a.steps, a.seed));
+  RenderJob job;
+  job.width = a.width;
+  job.height = a.height;
+  job.samples = a.spp;
+  job.mode = mode;
+  job.stage = a.stage >= 0 ? model.stageFromIndex(a.stage) : model.finalStage();
+  job.stage.fraction = a.fraction;
+  if (a.age >= 0) {
+    if (species.kind != SpeciesKind::Shell) throw UsageError("--age applies to shell species only");
+    job.stage.age = std::min(a.age, model.finalStage().age);
+  }
+  job.progress = !g.quiet;
+  job.progressLabel = "render " + species.name;
+
+  ModelFigures fig;
+  render::RenderStats stats;
+  render::Image image = renderModel(model, look, job, &fig, &stats);
+  render::writeImage(image, a.out);
+  if (!g.quiet) {
+    char line[512];
+    std::snprintf(line, sizeof line,
+                  "%s: %dx%d, %d spp, %s mode%s%s; %zu primitives, %zu cells, %zu triangles; build %.2f s, render %.2f s, "
+                  "%.2f Mrays/s",
+                  a.out.c_str(), image.width, image.height, job.samples > 0 ? job.samples : look.samples,
+                  geometryModeName(mode), model.stageName(job.stage).empty() ? "" : ", ",
+                  model.stageName(job.stage).c_str(), fig.primitives, fig.cells, fig.triangles, fig.buildSeconds,
+                  stats.seconds, stats.raysPerSecond() / 1e6);
+    std::cerr << line << "\n";
+  }
+  return kExitOk;
+}
+
+}  // namespace
+
+void addRenderCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run) {
+  auto args = std::make_shared<RenderArgs>();
+  CLI::App* sub = app.add_subcommand("render", "Render a species: exact implicit surface, its mesh, or the skeleton");
+  sub->add_option("SPECIES", args->file, "species file (.yaml) or grammar (.lsys)")->required();
+  sub->add_option("-o,--output", args->out, "output image (.png, .jpg, .exr; EXR keeps linear values)")->required();
+  sub->add_option("--width", args->width, "image width in pixels (default: the species' render.width)")
+      ->check(CLI::Range(16, 16384));
+  sub->add_option("--height", args->height, "image height in pixels (default: the species' render.height)")
+      ->check(CLI::Range(16, 16384));
+  sub->add_option("--spp,--samples", args->spp, "camera samples per pixel (default: the species' render.samples)")
+      ->check(CLI::Range(1, 4096));
+  sub->add_option("--mode", args->mode, "exact (ray cast the implicit surface), mesh (polygonize first) or skeleton")
+      ->check(CLI::IsMember({"exact", "mesh", "skeleton"}));
+  sub->add_option("--stage", args->stage, "tree: derivation step; shell: number of whorls grown")
+      ->check(CLI::Range(0, 100000));
+  sub->add_option("--fraction", args->fraction, "tree: growth of the stage's newest modules, 0..1 (default 1)")
+      ->check(CLI::Range(0.0, 1.0));
+  sub->add_option("--age", args->age, "shell: age θ_end in degrees (default: the species' age)")
+      ->check(CLI::Range(1.0, 1e6));
+  sub->add_option("--view", args->view, "camera direction AZIMUTH,ELEVATION[,FOV] in degrees (automatic framing)");
+  sub->add_option("--camera", args->camera, "explicit eye X,Y,Z or eye and target X,Y,Z,TX,TY,TZ");
+  sub->add_option("--steps", args->steps, "derivation steps (trees)")->check(CLI::Range(0, 100000));
+  sub->add_option("--seed", args->seed, "random seed (trees)")->check(CLI::NonNegativeNumber);
+  sub->add_option("-D,--define", args->defines, "override a #define: NAME=VALUE (repeatable)");
+  sub->callback([args, &global, &run] { run = [args, &global] { return runRender(*args, global); }; });
+}
+
+}  // namespace sprig
