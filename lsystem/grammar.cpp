@@ -104,7 +104,9 @@ class Parser {
     splitLines();
     firstPass();
     secondPass();
-    checkArities();
+    // Only on an otherwise clean file: a successor that failed to parse wrote nothing, and
+    // its modules' parameter counts would be missed.
+    if (!diags_.hasErrors()) checkArities();
     finish();
     diags_.throwIfErrors();
     return std::make_shared<Program>(std::move(prog_));

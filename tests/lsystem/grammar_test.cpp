@@ -219,6 +219,9 @@ TEST_CASE("parseGrammar parameter counts that never match", "[lsystem]") {
           "g.lsys:2:1: error: context 'B(x)' has 1 parameter, but 'B' is only written with 0 parameters "
           "(as at line 1:8), so this production never applies");
   }
+  SECTION("checked only when the rest of the file parses (no follow-on errors)") {
+    CHECK(errorsOf("axiom: B\nA --> B(1,)\nB(x) --> C\n") == "g.lsys:2:11: error: empty parameter in 'B'");
+  }
   SECTION("any matching count is enough; symbols never written are left alone") {
     CHECK(errorsOf("axiom: A A(1)\nA --> B\nA(x) --> A(x+1)\nC(x,y) --> D\n").empty());
     CHECK(errorsOf("axiom: A\nA --> B(1)\ninterpretation:\nB(x) --> F(x)\n").empty());
