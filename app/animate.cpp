@@ -165,11 +165,12 @@ int renderGalleryAnimation(const Species& species, const fs::path& out, const Sp
   Species shown = species;
   shown.render = look;
   const int w = std::max(16, width / 2), h = std::max(16, height / 2);
-  const int samples = final ? look.samples : std::min(look.samples, 2);
+  const bool exact = species.kind != SpeciesKind::Tree || species.treeSection.has_value();
+  const int samples = final ? look.samples : std::min(look.samples, exact ? 1 : 2);
   if (species.kind == SpeciesKind::Blob) {
     // A blob does not grow: a turntable around it instead, one camera distance throughout.
     SpeciesModel model(shown);
-    const int n = final ? 48 : 16;
+    const int n = final ? 48 : 8;
     std::vector<render::Image> frames;
     Progress bar("turntable " + species.name, static_cast<size_t>(n));
     for (int i = 0; i < n; ++i) {
@@ -190,11 +191,12 @@ int renderGalleryAnimation(const Species& species, const fs::path& out, const Sp
   }
   AnimateOptions opt;
   if (species.kind == SpeciesKind::Shell) {
-    opt.framesPerStage = final ? 6 : 2;  // per whorl
+    opt.framesPerStage = final ? 6 : 1;  // per whorl
   } else {
     GrowthSequence probe(species);
     const int steps = std::max(1, probe.lastStage());
-    opt.framesPerStage = std::clamp((final ? 120 : 36) / steps, 1, final ? 8 : 4);
+    // Exact frames rebuild the BlobTree each time: drafts show one frame per step.
+    opt.framesPerStage = exact && !final ? 1 : std::clamp((final ? 120 : 36) / steps, 1, final ? 8 : 4);
   }
   opt.fps = final ? 12 : 8;
   opt.holdSeconds = 1;

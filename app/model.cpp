@@ -83,7 +83,8 @@ SpeciesModel::SpeciesModel(const Species& species, const lsystem::GrammarOverrid
     case SpeciesKind::Blob: {
       DiagnosticList diags;
       MapReader top(species_.yaml->rootNode(), diags, "species file");
-      impl_->blob = readBlobSpecies(top, diags);  // the other keys were checked by loadSpecies
+      // The other keys were checked by loadSpecies; texture images are opened here.
+      impl_->blob = readBlobSpecies(top, diags, species_.policy);
       diags.throwIfErrors();
       if (!impl_->blob) throw InputError(speciesLoc(species_), "invalid blob species");
       impl_->blobCompiled = blobtree::compile(impl_->blob->tree, impl_->blob->root);
@@ -255,7 +256,7 @@ ModelFigures SpeciesModel::addToScene(render::Scene& scene, const Stage& stage, 
     std::optional<blobtree::PolygonizeResult> mesh;
     if (mode == GeometryMode::Mesh) {
       blobtree::PolygonizeOptions po;
-      po.cellSize = glm::length(shell->blob.bounds().size()) / 240.0f;
+      po.cellSize = glm::length(shell->blob.bounds().size()) / 340.0f;
       mesh = blobtree::polygonizeDetailed(shell->blob, po);
       fig.triangles = mesh->mesh.triangleCount();
     }
@@ -265,6 +266,7 @@ ModelFigures SpeciesModel::addToScene(render::Scene& scene, const Stage& stage, 
     if (mode == GeometryMode::Skeleton) throw UsageError("blob species have no skeleton: use --mode exact or mesh");
     const blobtree::CompiledBlob& blob = *impl_->blobCompiled;
     fig.primitives = blob.primitiveCount();
+    if (impl_->blob->textures) scene.addTextures(impl_->blob->textures);  // ids = the primitives' texture ids
     const uint32_t material = scene.addMaterial(look.surface);
     if (mode == GeometryMode::Mesh) {
       blobtree::PolygonizeOptions po;
@@ -303,7 +305,7 @@ Mesh SpeciesModel::buildMesh(const Stage& stage, float cellSize, bool progress, 
   } else if (impl_->shell) {
     const ShellBuild shell = buildShellSpecies(*impl_->shell, stage.age < 0 ? std::nullopt : std::optional(stage.age));
     fig.primitives = shell.blob.primitiveCount();
-    if (po.cellSize <= 0) po.cellSize = glm::length(shell.blob.bounds().size()) / 240.0f;
+    if (po.cellSize <= 0) po.cellSize = glm::length(shell.blob.bounds().size()) / 340.0f;
     out = blobtree::polygonize(shell.blob, po);
   } else {
     fig.primitives = impl_->blobCompiled->primitiveCount();

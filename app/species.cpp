@@ -98,6 +98,7 @@ void readTurtle(MapReader& m, Species& s) {
   t.tipRadius = m.number("tip_radius", t.tipRadius, 1e-9, 1e9);
   t.taper = m.boolean("taper", t.taper);
   t.surfaceScale = m.number("surface_scale", t.surfaceScale, 1e-9, 1e9);
+  t.maxWidthToLength = m.number("max_width_to_length", t.maxWidthToLength, 0.0, 1e6);
   m.finish();
 }
 
@@ -157,6 +158,7 @@ Species readSpecies(std::shared_ptr<const YamlFile> yaml, const PathPolicy& poli
   Species s;
   s.yaml = yaml;
   s.file = yaml->path();
+  s.policy = policy;
   YNode root = yaml->rootNode();
   if (root.isNull() || !root.node().IsDefined()) {
     diags.error(SourceLoc{yaml->displayPath(), 1, 1}, "species file is empty");
@@ -220,7 +222,7 @@ Species readSpecies(std::shared_ptr<const YamlFile> yaml, const PathPolicy& poli
       break;
     case SpeciesKind::Blob:
       // Read by app/species_blob (readBlobSpecies) where a command needs the BlobTree.
-      top.allow({"kernel", "blob", "mesh"});
+      top.allow({"kernel", "blob", "mesh", "textures"});
       if (!top.has("blob")) root.error(diags, "missing required key 'blob' in species file");
       break;
     default: break;
@@ -240,6 +242,8 @@ Species speciesFromGrammarFile(const fs::path& path) {
     throw InputError(SourceLoc{path.string(), 0, 0}, "cannot open file");
   }
   s.grammarFile = path.string();
+  // ABOP widths are pixel widths: keep a bare grammar's internodes slender (lsystem/turtle.h).
+  s.turtle.maxWidthToLength = 0.12;
   return s;
 }
 
