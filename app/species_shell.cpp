@@ -367,6 +367,8 @@ uint32_t addShellToScene(render::Scene& scene, const ShellBuild& shell, const re
     // diagonal renders the Murex faster (docs/perf/shells.md).
     opt.cellSize = organisms::shellCellSize(shell.blob);
   }
+  if (opt.trace.relativeTolerance == blobtree::TraceOptions{}.relativeTolerance)
+    opt.trace.relativeTolerance = organisms::kShellTraceTolerance;
   return scene.addImplicit(shell.blob, material, opt);
 }
 

@@ -72,8 +72,9 @@ ShellBuild buildShellSpecies(const ShellSpecies& species, std::optional<double> 
 
 /// Adds a built shell to a scene as exact implicit geometry with its part textures. The
 /// part textures take texture ids 0-4 (organisms::ShellPart), so the scene must hold no
-/// texture yet (throws std::logic_error otherwise). options.cellSize 0 picks 1/120 of the
-/// model's diagonal. Returns the geometry id.
+/// texture yet (throws std::logic_error otherwise). options.cellSize 0 picks
+/// organisms::shellCellSize; the default root tolerance becomes
+/// organisms::kShellTraceTolerance. Returns the geometry id.
 /// With `mesh` (the polygonized shell) the shell goes in as triangles instead (mesh mode).
 uint32_t addShellToScene(render::Scene& scene, const ShellBuild& shell, const render::ImplicitOptions& options = {},
                          const blobtree::PolygonizeResult* mesh = nullptr);

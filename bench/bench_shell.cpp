@@ -13,6 +13,8 @@
 //   --cell-div N: surface cells of diagonal/N (0 = organisms::shellCellSize's choice)
 //   --baseline 0 skips the baseline render
 //   --canal ax,ay,bx,by,ra,rb,bend: another canal cone for the Murex (unit generating frame)
+//   --tolerance T: relative root tolerance (default organisms::kShellTraceTolerance = 1e-4)
+//   --canal-deg DEG: sweep the canal over the last DEG degrees (the paper: 464)
 //   --without LIST leaves parts out of the Murex (cost breakdown): any of varices, bumps,
 //     axial, opening, tori, spinebend, canalbend, canal, axialbend,
 //     ricci (bumps summed instead of the n = 400 blend)
@@ -48,6 +50,8 @@ struct Args {
   double age = 0.0;
   std::string without;  ///< parts left out of the Murex, for a cost breakdown
   std::string canal;    ///< canal cone override "ax,ay,bx,by,ra,rb,bend" (unit frame)
+  double canalDeg = 0;  ///< canal sweep override (degrees before θ_end)
+  float tolerance = 0;  ///< relative root tolerance (0 = organisms::kShellTraceTolerance)
 };
 
 struct Result {
@@ -75,6 +79,7 @@ Result run(const organisms::ShellParams& params, const Args& a, const std::strin
     scene.addTexture([painter, part](Vec2 uv, const Vec3& p) { return painter->partColor(part, p, uv); });
   render::ImplicitOptions opt;
   opt.cellSize = a.cellDiv > 0 ? glm::length(blob.bounds().size()) / a.cellDiv : organisms::shellCellSize(blob);
+  opt.trace.relativeTolerance = a.tolerance > 0 ? a.tolerance : organisms::kShellTraceTolerance;
   scene.addImplicit(blob, material, opt);
   scene.commit();
   r.sceneS = since(t);
@@ -128,6 +133,8 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--age")) a.age = std::atof(next("--age"));
     else if (!std::strcmp(argv[i], "--without")) a.without = next("--without");
     else if (!std::strcmp(argv[i], "--canal")) a.canal = next("--canal");
+    else if (!std::strcmp(argv[i], "--canal-deg")) a.canalDeg = std::atof(next("--canal-deg"));
+    else if (!std::strcmp(argv[i], "--tolerance")) a.tolerance = static_cast<float>(std::atof(next("--tolerance")));
     else {
       std::fprintf(stderr, "bench_shell: unknown argument %s\n", argv[i]);
       return 2;
@@ -147,6 +154,7 @@ int main(int argc, char** argv) {
     if (has("canal")) murex.generating = organisms::GeneratingSurface::point();
     if (has("axialbend")) murex.axialSpines.randomBends = false;
     if (has("ricci")) murex.bumps.blendN = 1.0f;
+    if (a.canalDeg > 0 && murex.generating.primitives.size() > 1) murex.generating.primitives[1].lastDeg = a.canalDeg;
     if (!a.canal.empty()) {
       organisms::GeneratingPrimitive& c = murex.generating.primitives[1];
       float v[7] = {};
