@@ -90,6 +90,7 @@ struct Species {
   std::optional<YNode> treeSection;   ///< `tree:` (BlobTree tree builder options)
   std::optional<YNode> shellSection;  ///< `shell:`
   std::optional<YNode> kindNode;      ///< the `kind:` value, for errors about the kind
+  PathPolicy policy;  ///< the policy it was loaded with; readers of raw sections resolve files with it
 };
 
 /// Reads a species file or a bare grammar (chosen by extension: .yaml/.yml or .lsys).

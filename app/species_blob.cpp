@@ -1,5 +1,6 @@
 #include "app/species_blob.h"
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <map>
@@ -29,7 +30,8 @@ std::string inQuotes(std::string_view s) {
 // Reads nested blob nodes into one tree, collecting diagnostics.
 class NodeReader {
  public:
-  NodeReader(BlobTree& tree, DiagnosticList& diags) : tree_(tree), diags_(diags) {}
+  NodeReader(BlobTree& tree, DiagnosticList& diags, int textureCount)
+      : tree_(tree), diags_(diags), textureCount_(textureCount) {}
 
   std::optional<NodeId> read(const YNode& node) {
     if (depth_ >= kMaxDepth) {
@@ -292,12 +294,24 @@ class NodeReader {
     return context_;
   }
 
+  // A primitive's `texture: {id, u_scale, ...}`; without it the primitive carries
+  // kNoTexture and shows the material color.
   blobtree::TextureAttr texture(MapReader& m) {
     blobtree::TextureAttr t;
+    t.textureId = kNoTexture;
     auto tv = m.section("texture");
     if (!tv) return t;
     MapReader tm(*tv, diags_, "texture");
-    t.textureId = uint16_t(tm.integer("id", 0, 0, 65535));
+    if (auto idNode = tm.get("id")) {
+      if (textureCount_ == 0) {
+        idNode->error(diags_, "texture id " + idNode->scalar() +
+                                  " names no texture: the species has no 'textures:' list");
+      } else if (auto id = idNode->asInteger(diags_, "'id'", 0, textureCount_ < 0 ? kNoTexture - 1 : textureCount_ - 1)) {
+        t.textureId = uint16_t(*id);
+      }
+    } else {
+      tm.node().error(diags_, "missing required key 'id' in texture (an index into the species' 'textures:' list)");
+    }
     t.uvScale = Vec2(float(tm.number("u_scale", 1.0)), float(tm.number("v_scale", 1.0)));
     t.uvOffset = Vec2(float(tm.number("u_offset", 0.0)), float(tm.number("v_offset", 0.0)));
     t.refDir = tm.vec3("ref_dir", t.refDir);
@@ -407,7 +421,9 @@ class NodeReader {
       double D = R * (lambda - 1.0) / ((lambda + 1.0) * std::sin(beta));
       double th = radians(thetaDeg);
       Vec3 c(float(R * std::cos(th)), float(-H), float(R * std::sin(th)));
-      auto id = build(key, [&] { return tree_.point(c, float(size * D)); });
+      blobtree::TextureAttr none;
+      none.textureId = kNoTexture;
+      auto id = build(key, [&] { return tree_.point(c, float(size * D), none); });
       if (!id) return std::nullopt;
       ids.push_back(*id);
     }
@@ -417,18 +433,156 @@ class NodeReader {
 
   BlobTree& tree_;
   DiagnosticList& diags_;
+  int textureCount_ = -1;  // textures the ids may name; -1: any id
   int depth_ = 0;
   std::string context_;  // the kind whose parameter map is being read
 };
 
 }  // namespace
 
-std::optional<blobtree::NodeId> readBlobNode(const YNode& node, blobtree::BlobTree& tree, DiagnosticList& diags) {
-  NodeReader reader(tree, diags);
+std::optional<blobtree::NodeId> readBlobNode(const YNode& node, blobtree::BlobTree& tree, DiagnosticList& diags,
+                                             int textureCount) {
+  NodeReader reader(tree, diags, textureCount);
   return reader.read(node);
 }
 
-std::optional<BlobSpecies> readBlobSpecies(MapReader& top, DiagnosticList& diags) {
+namespace {
+
+const std::vector<std::string> kTextureKinds = {"image", "color", "noise", "bark", "stripes", "spots", "leaf"};
+
+uint64_t readSeed(MapReader& m) { return uint64_t(m.integer("seed", 0, 0)); }
+
+// One procedural texture's options map (null reads as all defaults).
+std::optional<textures::Texture> readProcedural(const std::string& kind, const YNode& v, DiagnosticList& diags) {
+  if (!v.isMap() && !v.isNull()) {
+    v.error(diags, inQuotes(kind) + " must be a map of its options, e.g. {" + kind + ": {seed: 1}}");
+    return std::nullopt;
+  }
+  MapReader m(v, diags, kind);
+  std::optional<textures::Texture> out;
+  if (kind == "noise") {
+    textures::NoiseColorOptions o;
+    o.colorA = m.color("color_a", o.colorA);
+    o.colorB = m.color("color_b", o.colorB);
+    o.scale = m.number("scale", o.scale, 1e-6, 1e6);
+    o.fractal.octaves = int(m.integer("octaves", o.fractal.octaves, 1, 16));
+    o.fractal.lacunarity = m.number("lacunarity", o.fractal.lacunarity, 1.0, 16.0);
+    o.fractal.gain = m.number("gain", o.fractal.gain, 0.0, 1.0);
+    o.turbulence = m.boolean("turbulence", o.turbulence);
+    o.solid = m.boolean("solid", o.solid);
+    o.seed = readSeed(m);
+    out = textures::NoiseTexture(o);
+  } else if (kind == "bark") {
+    textures::BarkOptions o;
+    o.furrows = int(m.integer("furrows", o.furrows, 1, 1000));
+    o.warp = m.number("warp", o.warp, 0.0, 100.0);
+    o.alongFrequency = m.number("along_frequency", o.alongFrequency, 0.0, 1e4);
+    o.sharpness = m.number("sharpness", o.sharpness, 1e-3, 100.0);
+    o.grain = m.number("grain", o.grain, 0.0, 10.0);
+    o.cracks = m.number("cracks", o.cracks, 0.0, 10.0);
+    o.tileV = int(m.integer("tile_v", o.tileV, 0, 100000));
+    o.ridgeColor = m.color("ridge_color", o.ridgeColor);
+    o.furrowColor = m.color("furrow_color", o.furrowColor);
+    o.seed = readSeed(m);
+    out = textures::BarkTexture(o);
+  } else if (kind == "stripes") {
+    textures::StripesOptions o;
+    o.frequency = m.number("frequency", o.frequency, 0.0, 1e6);
+    o.duty = m.number("duty", o.duty, 0.0, 1.0);
+    o.wobble = m.number("wobble", o.wobble, 0.0, 100.0);
+    o.softness = m.number("softness", o.softness, 0.0, 1.0);
+    o.spiral = m.boolean("spiral", o.spiral);
+    o.baseColor = m.color("base_color", o.baseColor);
+    o.stripeColor = m.color("stripe_color", o.stripeColor);
+    o.seed = readSeed(m);
+    out = textures::StripesTexture(o);
+  } else if (kind == "spots") {
+    textures::SpotsOptions o;
+    o.frequency = m.number("frequency", o.frequency, 0.0, 1e6);
+    o.radius = m.number("radius", o.radius, 0.0, 2.0);
+    o.radiusJitter = m.number("radius_jitter", o.radiusJitter, 0.0, 1.0);
+    o.jitter = m.number("jitter", o.jitter, 0.0, 1.0);
+    o.softness = m.number("softness", o.softness, 0.0, 1.0);
+    o.density = m.number("density", o.density, 0.0, 1.0);
+    o.baseColor = m.color("base_color", o.baseColor);
+    o.spotColor = m.color("spot_color", o.spotColor);
+    o.seed = readSeed(m);
+    out = textures::SpotsTexture(o);
+  } else {  // leaf
+    textures::LeafOptions o;
+    o.veins = int(m.integer("veins", o.veins, 0, 1000));
+    o.veinAngleDeg = m.number("vein_angle_deg", o.veinAngleDeg, 0.0, 90.0);
+    o.veinWidth = m.number("vein_width", o.veinWidth, 0.0, 0.5);
+    o.bladeColor = m.color("blade_color", o.bladeColor);
+    o.veinColor = m.color("vein_color", o.veinColor);
+    o.mottle = m.number("mottle", o.mottle, 0.0, 10.0);
+    o.seed = readSeed(m);
+    out = textures::LeafTexture(o);
+  }
+  m.finish();
+  return out;
+}
+
+// `image: PATH`: resolved against the species file with policy, opened now so a missing
+// or unreadable file is reported at the path before anything is rendered.
+std::optional<textures::Texture> readImage(const YNode& v, const PathPolicy& policy, DiagnosticList& diags) {
+  if (!v.isScalar()) {
+    v.error(diags, "'image' must be a file name (a path relative to the species file)");
+    return std::nullopt;
+  }
+  auto path = resolveReference(v, v.scalar(), policy, diags, /*mustExist=*/false);
+  if (!path) return std::nullopt;
+  try {
+    return textures::ImageTexture::open(path->string(), v.loc());
+  } catch (const InputError& e) {
+    for (Diagnostic d : e.diagnostics()) {
+      if (d.sourceLine.empty() && d.loc.file == v.loc().file) d.sourceLine = v.file().sourceLine(d.loc.line);
+      diags.add(std::move(d));
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::shared_ptr<const textures::TextureRegistry> readBlobTextures(const YNode& list, const PathPolicy& policy,
+                                                                  DiagnosticList& diags) {
+  auto registry = std::make_shared<textures::TextureRegistry>();
+  if (!list.isSequence()) {
+    list.error(diags, "'textures' must be a sequence of textures, e.g. [{image: maps/bark.png}, {stripes: {}}]");
+    return registry;
+  }
+  const auto items = list.items();
+  if (items.size() >= kNoTexture) {
+    list.error(diags, "'textures' holds " + std::to_string(items.size()) + " textures, more than " +
+                          std::to_string(kNoTexture - 1));
+    return registry;
+  }
+  for (const YNode& entry : items) {
+    if (!entry.isMap() || entry.pairs().size() != 1 || !entry.pairs()[0].first.isScalar()) {
+      entry.error(diags, "a texture must be a map with one key naming its kind, e.g. {image: maps/bark.png} "
+                         "or {stripes: {frequency: 8}}");
+      continue;
+    }
+    const auto [key, value] = entry.pairs()[0];  // a copy: pairs() is a temporary
+    const std::string kind = key.scalar();
+    std::optional<textures::Texture> t;
+    if (kind == "image") {
+      t = readImage(value, policy, diags);
+    } else if (kind == "color") {
+      if (auto c = value.asColor(diags, "'color'")) t = textures::ConstantTexture{*c};
+    } else if (std::find(kTextureKinds.begin(), kTextureKinds.end(), kind) != kTextureKinds.end()) {
+      t = readProcedural(kind, value, diags);
+    } else {
+      key.error(diags, "unknown texture kind " + inQuotes(kind) + didYouMean(kind, kTextureKinds) +
+                           " (image, color, noise, bark, stripes, spots or leaf)");
+    }
+    if (t) registry->add(std::move(*t));
+  }
+  return registry;
+}
+
+std::optional<BlobSpecies> readBlobSpecies(MapReader& top, DiagnosticList& diags, const PathPolicy& policy) {
   std::string kernel = top.choice("kernel", "wyvill", {"wyvill", "soft"});
   float cell = 0.0f;
   if (auto mesh = top.section("mesh")) {
@@ -441,11 +595,22 @@ std::optional<BlobSpecies> readBlobSpecies(MapReader& top, DiagnosticList& diags
     top.node().error(diags, "missing required key 'blob' in species file (the BlobTree of a kind: blob species)");
     return std::nullopt;
   }
+  // Textures first, so primitives' texture ids can be checked against their count.
+  std::shared_ptr<const textures::TextureRegistry> registry;
+  int textureCount = 0;
+  if (auto list = top.get("textures")) {
+    registry = readBlobTextures(*list, policy, diags);
+    // Ids are checked against the list's length (not the registry's, which leaves out
+    // broken entries), so one mistake is reported once; no list checks nothing more.
+    textureCount = list->isSequence() ? int(list->items().size()) : -1;
+    if (registry->size() == 0) registry.reset();
+  }
   BlobSpecies s{.name = {},
                 .tree = blobtree::BlobTree(kernel == "soft" ? blobtree::Kernel::SoftObject : blobtree::Kernel::Wyvill),
                 .root = 0,
-                .cellSize = cell};
-  auto root = readBlobNode(*blob, s.tree, diags);
+                .cellSize = cell,
+                .textures = registry};
+  auto root = readBlobNode(*blob, s.tree, diags, textureCount);
   if (!root) return std::nullopt;
   s.root = *root;
   return s;
@@ -453,7 +618,8 @@ std::optional<BlobSpecies> readBlobSpecies(MapReader& top, DiagnosticList& diags
 
 namespace {
 
-BlobSpecies readWhole(const std::shared_ptr<const YamlFile>& file, DiagnosticList& diags, const std::string& stem) {
+BlobSpecies readWhole(const std::shared_ptr<const YamlFile>& file, DiagnosticList& diags, const std::string& stem,
+                      const PathPolicy& policy) {
   if (!file) diags.throwIfErrors();
   MapReader top(file->rootNode(), diags, "species file");
   auto kind = top.requiredString("kind");
@@ -461,8 +627,9 @@ BlobSpecies readWhole(const std::shared_ptr<const YamlFile>& file, DiagnosticLis
     top.get("kind")->error(diags, "this reader takes kind: blob species, got kind: " + *kind);
   std::string name = top.string("name", stem);
   top.string("description");
+  top.allow({"render", "stages"});  // shared species keys, read and checked by loadSpecies
   std::optional<BlobSpecies> s;
-  if (!kind || *kind == "blob") s = readBlobSpecies(top, diags);
+  if (!kind || *kind == "blob") s = readBlobSpecies(top, diags, policy);
   top.finish();
   diags.throwIfErrors();
   if (!s) throw InputError(file->rootNode().loc(), "invalid blob species");
@@ -472,16 +639,16 @@ BlobSpecies readWhole(const std::shared_ptr<const YamlFile>& file, DiagnosticLis
 
 }  // namespace
 
-BlobSpecies loadBlobSpecies(const std::filesystem::path& path) {
+BlobSpecies loadBlobSpecies(const std::filesystem::path& path, const PathPolicy& policy) {
   DiagnosticList diags;
   auto file = YamlFile::load(path, diags);
-  return readWhole(file, diags, path.stem().string());
+  return readWhole(file, diags, path.stem().string(), policy);
 }
 
-BlobSpecies parseBlobSpecies(std::string text, const std::string& displayPath) {
+BlobSpecies parseBlobSpecies(std::string text, const std::string& displayPath, const PathPolicy& policy) {
   DiagnosticList diags;
   auto file = YamlFile::parse(std::move(text), displayPath, diags);
-  return readWhole(file, diags, std::filesystem::path(displayPath).stem().string());
+  return readWhole(file, diags, std::filesystem::path(displayPath).stem().string(), policy);
 }
 
 }  // namespace sprig
