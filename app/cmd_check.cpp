@@ -3,7 +3,9 @@
 #include <iostream>
 
 #include "app/cmd_common.h"
+#include "app/model.h"
 #include "app/species.h"
+#include "app/species_tree.h"
 
 namespace sprig {
 
@@ -22,6 +24,18 @@ std::string checkOne(const std::string& file, const GlobalOptions& g, std::strin
       lsystem::Grammar grammar = speciesGrammar(s);
       summary += " '" + s.name + "', " + std::to_string(grammar.productionCount()) + " productions, " +
                  std::to_string(grammar.derivationLength()) + " steps";
+      if (s.treeSection) {
+        DiagnosticList diags;
+        readTreeOptions(*s.treeSection, diags);
+        diags.throwIfErrors();
+        summary += ", BlobTree surface";
+      }
+    } else {
+      // Shells and blobs: read their sections and build the final model (cheap for both),
+      // so builder errors such as invalid parameters show here too.
+      SpeciesModel model(s);
+      model.frameBox();
+      summary += " '" + s.name + "'";
     }
     return {};
   } catch (const InputError& e) {

@@ -10,9 +10,10 @@
 // against the reference per-cell tracer (ImplicitOptions::batched = false) on a 1/6-size
 // image at 1 spp.
 //
-// Usage: bench_tree [steps=11] [width=1536] [height=2048] [spp=9] [out.png] [cell=0]
+// Usage: bench_tree [steps=11] [width=1536] [height=2048] [spp=9] [out.png] [cell=0] [bend=8]
 //   cell: surface cell edge of the exact render in world units (0 = the renderer's
-//   automatic size); polygonization uses cells of 1/400 of the bounds diagonal
+//   automatic size); bend: the bend angle of order-1 laterals in degrees (0 = no bends);
+//   polygonization uses cells of 1/400 of the bounds diagonal
 //   (run from the repository root; width 0 skips the render; out "-" writes no image)
 
 #include <chrono>
@@ -58,6 +59,7 @@ int main(int argc, char** argv) {
   const int spp = argc > 4 ? std::atoi(argv[4]) : 9;
   const std::string out = argc > 5 && std::string(argv[5]) != "-" ? argv[5] : "";
   const float cell = argc > 6 ? float(std::atof(argv[6])) : 0.0f;
+  const double bendDeg = argc > 7 ? std::atof(argv[7]) : 8.0;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   try {
     // Grow the skeleton.
@@ -78,7 +80,7 @@ int main(int argc, char** argv) {
     // Build the BlobTree (PCM junctions, bends, bark).
     organisms::TreeOptions opt;
     opt.junctions = organisms::JunctionModel::Pcm;
-    opt.bends.angleDeg = 8;
+    opt.bends.angleDeg = bendDeg;
     opt.bends.orderScale = 0.8;
     opt.bends.randomness = 0.5;
     opt.bark.vScale = 6;

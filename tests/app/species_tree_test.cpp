@@ -74,7 +74,10 @@ namespace {
 // Grows a tree species at `steps`, polygonizes its wood on a fixed grid and returns the
 // bytes of the PLY file written from that mesh.
 std::string treePlyBytes(const std::string& speciesFile, int steps, const std::filesystem::path& out) {
-  const Species species = loadSpecies(std::filesystem::path(SPRIG_SOURCE_DIR) / "species" / speciesFile);
+  PathPolicy policy;
+  policy.root = SPRIG_SOURCE_DIR;  // ctest runs in the build folder; the grammar is ../grammars
+  const Species species =
+      loadSpecies(std::filesystem::path(SPRIG_SOURCE_DIR) / "species" / speciesFile, policy);
   GrowOptions grow;
   grow.extra.derivationLength = steps;
   grow.progress = false;
