@@ -38,6 +38,16 @@ std::string string(std::string_view s) {
   return out;
 }
 
-std::string vec3(const DVec3& v) { return "[" + number(v.x) + ", " + number(v.y) + ", " + number(v.z) + "]"; }
+std::string vec3(const DVec3& v) {
+  // Appended piece by piece: GCC 12's -Wrestrict misfires on `"[" + std::string&&`.
+  std::string out = "[";
+  out += number(v.x);
+  out += ", ";
+  out += number(v.y);
+  out += ", ";
+  out += number(v.z);
+  out += ']';
+  return out;
+}
 
 }  // namespace sprig::json
