@@ -827,8 +827,16 @@ void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* 
       evalB(T, T.kids[n.first], pts, pbox, out);
       for (int i = 0; i < pts.n8; ++i) out[i] *= -n.weight;
       return;
+    case NodeKind::Bend: {
+      alignas(32) float lx[kBlock], ly[kBlock], lz[kBlock];
+      params(T, n).bend.localFromWorld(pts.x, pts.y, pts.z, lx, ly, lz, pts.n8);
+      Box3 lb;
+      for (int i = 0; i < pts.n8; ++i) lb.extend(Vec3(lx[i], ly[i], lz[i]));
+      Pts lp{lx, ly, lz, pts.n, pts.n8};
+      evalB(T, T.kids[n.first], lp, lb, out);
+      return;
+    }
     case NodeKind::Transform:
-    case NodeKind::Bend:
     case NodeKind::Twist:
     case NodeKind::Taper: {
       alignas(32) float lx[kBlock], ly[kBlock], lz[kBlock];

@@ -204,6 +204,9 @@ struct BendFrame {
   float yMinChild = 0.0f;  ///< child's support y lower bound in the frame (≥ −ρ)
 
   Vec3 localFromWorld(Vec3 p, Mat3* jacobianT = nullptr) const;
+  /// localFromWorld of `count` points given as coordinate arrays; same bits as one by one.
+  void localFromWorld(const float* x, const float* y, const float* z, float* lx, float* ly, float* lz,
+                      int count) const;
   Vec3 worldFromLocal(Vec3 q) const;
   /// Local box of the child space covering the world box's preimage (conservative).
   Box3 localBox(const Box3& worldBox, const Box3& childBox) const;
@@ -217,6 +220,8 @@ struct BendFrame {
 /// support would reach the bend centre or wrap past a half turn.
 BendFrame makeBendFrame(const Bend& b, const Box3& childBox);
 
+/// The bend's atan2: within 2.4e-7 relative of std::atan2 (exposed for its test).
+float atan2Approx(float y, float x);
 /// Twist map pieces.
 Vec3 twistLocal(const Twist& t, Vec3 p, Mat3* jacobianT);
 /// Taper map pieces.

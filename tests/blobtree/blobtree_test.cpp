@@ -2,6 +2,7 @@
 
 #include "blobtree/blobtree.h"
 #include "blobtree/compiled.h"
+#include "blobtree/detail/field.h"
 #include "core/rng.h"
 
 #include <cmath>
@@ -223,6 +224,30 @@ TEST_CASE("BlobTree::pcm", "[blobtree]") {
       CHECK(fa + pcmDeform(pp, fb) == Approx(kIso).margin(1e-6));
     }
   }
+}
+
+TEST_CASE("bend atan2 matches std::atan2 to float precision", "[blobtree]") {
+  // Every direction around the circle at several radii, plus the axes and tiny angles.
+  double worst = 0.0;
+  auto check = [&](float y, float x) {
+    const double ref = std::atan2(double(y), double(x));
+    const double err = std::abs(double(detail::atan2Approx(y, x)) - ref) / std::max(std::abs(ref), 1e-30);
+    worst = std::max(worst, err);
+  };
+  for (int i = 0; i < 200000; ++i) {
+    const double a = -kPi + 2.0 * kPi * (i + 0.5) / 200000.0;
+    for (double r : {1e-3, 1.0, 37.0}) check(float(r * std::sin(a)), float(r * std::cos(a)));
+  }
+  for (float t : {1e-7f, 1e-4f, 0.01f, 0.4142f, 0.4143f, 1.0f, 2.414f, 1e4f}) {
+    check(t, 1.0f);
+    check(-t, 1.0f);
+    check(t, -1.0f);
+    check(1.0f, t);
+  }
+  CHECK(detail::atan2Approx(0.0f, 1.0f) == 0.0f);
+  CHECK(detail::atan2Approx(1.0f, 0.0f) == Approx(kPi / 2).epsilon(1e-7));
+  CHECK(detail::atan2Approx(0.0f, -1.0f) == Approx(kPi).epsilon(1e-7));
+  CHECK(worst < 2.4e-7);
 }
 
 TEST_CASE("BlobTree::bend", "[blobtree]") {
