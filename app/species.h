@@ -2,7 +2,7 @@
 /// Species files (`species/*.yaml`) and bare grammars as the input of every `sprig` command.
 ///
 /// A species file names its kind and holds everything needed to grow and show one
-/// organism; docs/readme/species.md lists every key with its default. For `kind: tree`
+/// organism; README.md ("Species files") lists every key with its default. For `kind: tree`
 /// the file names a grammar (a path relative to the species file, or inline text with
 /// `grammar: |`), overrides of its `#define` constants, derivation steps and seed,
 /// turtle settings, render settings and growth stages. Sections that other parts of

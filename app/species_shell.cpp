@@ -364,7 +364,7 @@ uint32_t addShellToScene(render::Scene& scene, const ShellBuild& shell, const re
   if (opt.cellSize <= 0.0f) {
     // The renderer's automatic size follows the smallest feature (the apex's tiny spine
     // tips), which makes hundreds of thousands of cells; a fixed fraction of the model's
-    // diagonal renders the Murex faster (docs/perf/shells.md).
+    // diagonal renders the Murex faster (docs/PERFORMANCE.md, Shells).
     opt.cellSize = organisms::shellCellSize(shell.blob);
   }
   if (opt.trace.relativeTolerance == blobtree::TraceOptions{}.relativeTolerance)

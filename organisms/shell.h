@@ -201,14 +201,14 @@ struct ShellModel {
 ShellModel buildShell(const ShellParams& params, const SourceLoc& loc = {});
 
 /// Edge of the surface cells for exact rendering of a compiled shell (render::ImplicitOptions):
-/// a fixed fraction of the bounds' diagonal (docs/perf/shells.md). The renderer's automatic
+/// a fixed fraction of the bounds' diagonal (docs/PERFORMANCE.md, Shells). The renderer's automatic
 /// size follows the smallest feature (the apex's tiny spine tips) and makes far more cells.
 float shellCellSize(const blobtree::CompiledBlob& blob);
 
 /// Root tolerance for exact renders of shells (blobtree::TraceOptions::relativeTolerance,
 /// relative to the bounds' diagonal). 1e-4 brackets each hit within about a quarter pixel
 /// at 1536x2048 before the final interpolation, changes 0.03% of a render's pixels by at
-/// most 5/255, and traces the Murex 25% faster than the default 1e-6 (docs/perf/shells.md).
+/// most 5/255, and traces the Murex 25% faster than the default 1e-6 (docs/PERFORMANCE.md, Shells).
 inline constexpr float kShellTraceTolerance = 1e-4f;
 
 /// The Murex cabritii of the paper: λ = 1.3, β = 22.5°, R₀ = 0.2, seven whorls of 348°,
