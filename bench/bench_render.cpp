@@ -228,8 +228,26 @@ int main(int argc, char** argv) {
     if (!std::strcmp(argv[i], "--quick")) quick = true;
     else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
     else if (!std::strcmp(argv[i], "--images") && i + 1 < argc) {
-      inspectionImages(argv[++i]);
+      fs::path dir = argv[++i];
+      std::error_code ec;
+      fs::create_directories(dir, ec);
+      if (ec) {
+        std::fprintf(stderr, "bench_render: error: cannot create folder '%s': %s\n", dir.c_str(), ec.message().c_str());
+        return 2;
+      }
+      inspectionImages(dir);
       return 0;
+    } else {
+      std::fprintf(stderr, "bench_render: error: unknown argument '%s' (use --quick, --out DIR, --images DIR)\n", argv[i]);
+      return 2;
+    }
+  }
+  if (!out.empty()) {
+    std::error_code ec;
+    fs::create_directories(out, ec);
+    if (ec) {
+      std::fprintf(stderr, "bench_render: error: cannot create folder '%s': %s\n", out.c_str(), ec.message().c_str());
+      return 2;
     }
   }
   // 1. Skeleton preview of ABOP 2.6.

@@ -68,6 +68,9 @@ class CellTracer {
   /// First crossing in [t0, t1] (clipped to the cell), or a negative value.
   float trace(float t0, float t1) {
     if (!clipToBox(cell_.box, o_, d_, t0, t1)) return -1.0f;
+    // A tolerance below the spacing of floats near t can never be reached (the samples
+    // stop moving): far from the camera, 8 float steps at t bound it from below.
+    tol_ = std::max(data_.tolerance, 8.0f * std::numeric_limits<float>::epsilon() * std::max(std::abs(t0), std::abs(t1)));
     return first(t0, t1, 0);
   }
 
@@ -88,7 +91,7 @@ class CellTracer {
     float step = evaluate(a, b, ts, f);
     for (int i = 0; i + 1 < kLanes; ++i) {
       if ((f[i] > kIso) != (f[i + 1] > kIso)) return anyHit_ ? ts[i] : refine(ts[i], ts[i + 1], f[i], f[i + 1]);
-      if (depth < kMaxDepth && step > data_.tolerance &&
+      if (depth < kMaxDepth && step > tol_ &&
           std::abs(f[i] - kIso) + std::abs(f[i + 1] - kIso) <= L_ * step) {
         float t = first(ts[i], ts[i + 1], depth + 1);
         if (t >= 0.0f) return t;
@@ -100,7 +103,7 @@ class CellTracer {
   float refine(float lo, float hi, float flo, float fhi) const {
     float ts[kLanes], f[kLanes];
     const bool insideLo = flo > kIso;
-    while (hi - lo > data_.tolerance) {
+    while (hi - lo > tol_) {
       evaluate(lo, hi, ts, f);
       int k = 0;
       while (k + 2 < kLanes && (f[k + 1] > kIso) == insideLo) ++k;
@@ -119,6 +122,7 @@ class CellTracer {
   Vec3 o_, d_;
   float L_;
   bool anyHit_;
+  float tol_ = 0.0f;
 };
 
 void cellBounds(const RTCBoundsFunctionArguments* args) {

@@ -257,3 +257,22 @@ TEST_CASE("Scene::addTextures", "[render]") {
   CHECK(scene.bounds().lo.x < -2.9f);
   CHECK(scene.bounds().hi.x > 2.9f);
 }
+
+TEST_CASE("Scene::addImplicit far from the camera", "[render]") {
+  // The root tolerance scales with the model (a unit sphere: about 1e-4), but at t = 1e5
+  // floats are 0.0078 apart: the tracer must stop at the float spacing instead of
+  // subdividing forever (a one-internode tree framed for its grown stage did hang).
+  blobtree::BlobTree t;
+  blobtree::CompiledBlob blob = blobtree::compile(t, t.point(Vec3(0), 1.0f));
+  Scene scene;
+  scene.addImplicit(blob, scene.addMaterial(Material{}));
+  scene.commit();
+  for (float dist : {1.0e4f, 1.0e5f, 1.0e6f}) {
+    INFO("distance " << dist);
+    Vec3 dir = glm::normalize(Vec3(0.3f, -0.2f, -1.0f));
+    auto hit = scene.intersect(-dist * dir, dir, 0, 2.0f * dist);
+    REQUIRE(hit);
+    CHECK(hit->t == Approx(dist - 1.0f).margin(dist * 4e-6f));
+    CHECK(scene.occluded(-dist * dir, dir, 0, 2.0f * dist));
+  }
+}
