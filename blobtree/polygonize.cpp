@@ -195,6 +195,7 @@ float resolveCellSize(const CompiledBlob& blob, const PolygonizeOptions& options
   float h = glm::length(size) / options.sizeDivisions;
   float feature = blob.smallestFeature();
   if (feature > 0.0f) h = std::min(h, options.featureFraction * feature);
+  if (options.maxDivisions > 0.0f) h = std::max(h, glm::length(size) / options.maxDivisions);
   return h;
 }
 

@@ -170,3 +170,23 @@ TEST_CASE("polygonize::deterministic", "[blobtree]") {
   requireClosedManifold(one);
   CHECK(signedVolume(one) > 0.0);
 }
+
+TEST_CASE("polygonize::automatic cell size bounds", "[blobtree]") {
+  // A sphere of radius 1 with a speck of radius 0.01: the feature rule asks for 0.005.
+  BlobTree tree;
+  std::vector<NodeId> kids = {tree.point(Vec3(0), 1.0f), tree.point(Vec3(1.5f, 0, 0), 0.01f)};
+  CompiledBlob blob = compile(tree, tree.blend(kids));
+  const float diag = glm::length(blob.bounds().size());
+  PolygonizeOptions opt;
+  opt.maxDivisions = 100.0f;  // the floor binds: diag / 100 is about 0.03
+  PolygonizeResult r = polygonizeDetailed(blob, opt);
+  CHECK(r.cellSize == Approx(diag / 100.0f).epsilon(1e-6));
+  CHECK(r.mesh.triangleCount() > 0);
+  opt.cellSize = 0.02f;  // an explicit cell is never clamped
+  CHECK(polygonizeDetailed(blob, opt).cellSize == 0.02f);
+  opt.cellSize = 0.0f;
+  opt.maxDivisions = 0.0f;  // no floor: half the smallest radius
+  opt.sizeDivisions = 64.0f;
+  CHECK(resolveCellSize(blob, opt) == Approx(0.005f));
+  CHECK(resolveCellSize(blob) == Approx(0.005f));  // the default floor (diag / 2500) is finer
+}

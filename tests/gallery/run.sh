@@ -68,11 +68,16 @@ gallery -o out1 2> log4 || { cat log4; fail "run after a grammar change failed";
 grep -q "1 rendered, 2 up to date" log4 || { cat log4; fail "a changed grammar should re-render its species alone"; }
 
 # 4. Killed mid-render: completed outputs are whole, the rest absent or temporaries; a re-run
-#    resumes. The kill comes later and later until a run completes, so some kills land
-#    mid-item whatever the machine's speed.
+#    resumes. The kill comes later and later until a run completes. The steps are a fiftieth
+#    of a measured full run starting from half of it: start-up is most of a run here and the
+#    three items take a few hundredths of a second each, so fixed steps of 0.05 s sometimes
+#    landed no kill between the first item and the last (a flaky "no kill landed mid-run").
+t0=$(date +%s.%N)
+"$SPRIG" --root . --threads 1 -q gallery species/*.yaml -o out-timed || fail "timed gallery run failed"
+full=$(awk -v a="$t0" -v b="$(date +%s.%N)" 'BEGIN{print b - a}')
 partial=0
-for i in $(seq 1 60); do
-  delay=$(awk "BEGIN{print 0.05*$i}")
+for i in $(seq 0 150); do
+  delay=$(awk -v t="$full" -v i="$i" 'BEGIN{printf "%.3f", t * (0.5 + 0.02 * i)}')
   rm -rf out3
   ( timeout -s KILL "$delay" "$SPRIG" --root . --threads 1 -q gallery species/*.yaml -o out3 || true ) 2>/dev/null
   [ -f out3/index.html ] && break
