@@ -218,6 +218,14 @@ void inspectionImages(const fs::path& dir) {
   }
 }
 
+/// Creates an output folder (and its parents); false, with a message, when it cannot.
+bool makeFolder(const fs::path& dir) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) std::fprintf(stderr, "bench_render: error: cannot create folder '%s': %s\n", dir.c_str(), ec.message().c_str());
+  return !ec;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -229,12 +237,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--out") && i + 1 < argc) out = argv[++i];
     else if (!std::strcmp(argv[i], "--images") && i + 1 < argc) {
       fs::path dir = argv[++i];
-      std::error_code ec;
-      fs::create_directories(dir, ec);
-      if (ec) {
-        std::fprintf(stderr, "bench_render: error: cannot create folder '%s': %s\n", dir.c_str(), ec.message().c_str());
-        return 2;
-      }
+      if (!makeFolder(dir)) return 2;
       inspectionImages(dir);
       return 0;
     } else {
@@ -242,14 +245,7 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  if (!out.empty()) {
-    std::error_code ec;
-    fs::create_directories(out, ec);
-    if (ec) {
-      std::fprintf(stderr, "bench_render: error: cannot create folder '%s': %s\n", out.c_str(), ec.message().c_str());
-      return 2;
-    }
-  }
+  if (!out.empty() && !makeFolder(out)) return 2;
   // 1. Skeleton preview of ABOP 2.6.
   {
     lsystem::Skeleton sk = Abop26{}.build();

@@ -256,11 +256,12 @@ BendFrame makeBendFrame(const Bend& b, const Box3& childBox) {
 
 namespace {
 
-/// atan2 with a relative error below 2.4e-7 (about 2 float ulps) over the
-/// whole plane; tests/blobtree checks it against std::atan2), written as selects so that
-/// loops over points vectorize. The bend evaluates it once per point and libm's atan2f
-/// was a quarter of the time of a bent tree's render. The polynomial is the minimax
-/// fit of atan on [0, tan(π/8)] after the usual octant reductions.
+/// atan2 with a relative error below 2.4e-7 (about 2 float ulps) over the whole plane
+/// (tests/blobtree checks it against std::atan2). The bend evaluates it once per point and
+/// libm's atan2f was a quarter of the time of a bent tree's render. The polynomial is the
+/// minimax fit of atan on [0, tan(π/8)] after the usual octant reductions; the branches are
+/// selects, though GCC 12 vectorizes them only with -fno-trapping-math, which measured no
+/// faster (docs/PERFORMANCE.md, Trees).
 inline float atan2Fast(float y, float x) {
   const float ax = std::abs(x), ay = std::abs(y);
   const float mx = std::max(ax, ay), mn = std::min(ax, ay);
@@ -276,19 +277,24 @@ inline float atan2Fast(float y, float x) {
   return y < 0.0f ? -r : r;
 }
 
+/// A point's coordinates in the bend plane: along u, along n, and the distance from C.
+struct BendPolar {
+  float uu, vv, rp;
+};
+
 /// The bend's world → local map of one point; shared by the scalar and batched paths so
-/// both give the same bits.
-inline void bendLocal(const BendFrame& f, float px, float py, float pz, float& ox, float& oy, float& oz, float& uu,
-                      float& vv, float& rp) {
+/// both give the same bits. Returns the plane coordinates the Jacobian needs.
+inline BendPolar bendLocal(const BendFrame& f, float px, float py, float pz, float& ox, float& oy, float& oz) {
   const float rx = px - f.C.x, ry = py - f.C.y, rz = pz - f.C.z;
-  uu = rx * f.u.x + ry * f.u.y + rz * f.u.z;
-  vv = rx * f.n.x + ry * f.n.y + rz * f.n.z;
+  const float uu = rx * f.u.x + ry * f.u.y + rz * f.u.z;
+  const float vv = rx * f.n.x + ry * f.n.y + rz * f.n.z;
   const float ww = rx * f.z.x + ry * f.z.y + rz * f.z.z;
-  rp = std::sqrt(uu * uu + vv * vv);
+  const float rp = std::sqrt(uu * uu + vv * vv);
   const float x = atan2Fast(uu, vv) * (f.rho * f.stretch), y = rp - f.rho;
   ox = f.M.x + x * f.u.x + y * f.n.x + ww * f.z.x;
   oy = f.M.y + x * f.u.y + y * f.n.y + ww * f.z.y;
   oz = f.M.z + x * f.u.z + y * f.n.z + ww * f.z.z;
+  return {uu, vv, rp};
 }
 
 }  // namespace
@@ -301,8 +307,7 @@ Vec3 BendFrame::localFromWorld(Vec3 p, Mat3* jt) const {
     return p;
   }
   Vec3 q;
-  float uu, vv, rp;
-  bendLocal(*this, p.x, p.y, p.z, q.x, q.y, q.z, uu, vv, rp);
+  const auto [uu, vv, rp] = bendLocal(*this, p.x, p.y, p.z, q.x, q.y, q.z);
   if (jt) {
     float inv = rp > 1e-20f ? 1.0f / rp : 0.0f;
     Vec3 A = (stretch * rho * inv * inv) * (vv * u - uu * n);
@@ -320,10 +325,7 @@ void BendFrame::localFromWorld(const float* x, const float* y, const float* z, f
     std::copy(z, z + count, lz);
     return;
   }
-  for (int i = 0; i < count; ++i) {
-    float uu, vv, rp;
-    bendLocal(*this, x[i], y[i], z[i], lx[i], ly[i], lz[i], uu, vv, rp);
-  }
+  for (int i = 0; i < count; ++i) bendLocal(*this, x[i], y[i], z[i], lx[i], ly[i], lz[i]);
 }
 
 Vec3 BendFrame::worldFromLocal(Vec3 q) const {

@@ -192,10 +192,11 @@ float resolveCellSize(const CompiledBlob& blob, const PolygonizeOptions& options
   Vec3 size = b.size();
   if (!std::isfinite(size.x) || !std::isfinite(size.y) || !std::isfinite(size.z) || size.x > 1e30f)
     throw std::invalid_argument("polygonize: the blob is unbounded (a bare cutter); give a cell size and a bounded model");
-  float h = glm::length(size) / options.sizeDivisions;
+  const float diag = glm::length(size);
+  float h = diag / options.sizeDivisions;
   float feature = blob.smallestFeature();
   if (feature > 0.0f) h = std::min(h, options.featureFraction * feature);
-  if (options.maxDivisions > 0.0f) h = std::max(h, glm::length(size) / options.maxDivisions);
+  if (options.maxDivisions > 0.0f) h = std::max(h, diag / options.maxDivisions);
   return h;
 }
 

@@ -186,7 +186,6 @@ TEST_CASE("polygonize::automatic cell size bounds", "[blobtree]") {
   CHECK(polygonizeDetailed(blob, opt).cellSize == 0.02f);
   opt.cellSize = 0.0f;
   opt.maxDivisions = 0.0f;  // no floor: half the smallest radius
-  opt.sizeDivisions = 64.0f;
   CHECK(resolveCellSize(blob, opt) == Approx(0.005f));
   CHECK(resolveCellSize(blob) == Approx(0.005f));  // the default floor (diag / 2500) is finer
 }
