@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config
   libglm-dev libembree-dev libtbb-dev libopenimageio-dev openimageio-tools
-  libosd-dev libyaml-cpp-dev catch2 libcli11-dev libtinygltf-dev libopenvdb-dev libboost-iostreams-dev
+  libosd-dev libyaml-cpp-dev catch2 libcli11-dev libtinygltf-dev libopenvdb-dev libboost-iostreams-dev zlib1g-dev
   libbenchmark-dev parallel
 )
 
