@@ -3,10 +3,11 @@
 
 #include <iostream>
 
-#include "app/animate.h"
+#include "model/animate.h"
+#include "model/tree_kind.h"
 #include "app/cmd_common.h"
-#include "app/model.h"
-#include "app/species.h"
+#include "model/model.h"
+#include "model/species.h"
 #include "render/image.h"
 
 namespace sprig {
@@ -83,16 +84,17 @@ int runAnimate(const AnimateArgs& a, const GlobalOptions& g) {
   }
   Species species = loadSpecies(a.file, g.pathPolicy());
   const SpeciesRender& look = species.render;
-  opt.width = a.width > 0 ? a.width : look.width;
-  opt.height = a.height > 0 ? a.height : look.height;
-  if (a.width > 0 && a.height <= 0) opt.height = std::max(16, look.height * a.width / look.width);
-  if (a.height > 0 && a.width <= 0) opt.width = std::max(16, look.width * a.height / look.height);
+  const int lookWidth = look.image.width, lookHeight = look.image.height;
+  opt.width = a.width > 0 ? a.width : lookWidth;
+  opt.height = a.height > 0 ? a.height : lookHeight;
+  if (a.width > 0 && a.height <= 0) opt.height = std::max(16, lookHeight * a.width / lookWidth);
+  if (a.height > 0 && a.width <= 0) opt.width = std::max(16, lookWidth * a.height / lookHeight);
   opt.progressLabel = "animate " + species.name;
 
   if (single) {
     SpeciesModel model(species, opt.extra, opt.lastStage);
     SpeciesRender frameLook = look;
-    if (a.samples > 0) frameLook.samples = a.samples;
+    if (a.samples > 0) frameLook.image.spp = a.samples;
     RenderJob job;
     job.width = opt.width;
     job.height = opt.height;

@@ -3,9 +3,8 @@
 #include <iostream>
 
 #include "app/cmd_common.h"
-#include "app/model.h"
-#include "app/species.h"
-#include "app/species_tree.h"
+#include "model/kinds.h"
+#include "model/species.h"
 
 namespace sprig {
 
@@ -18,25 +17,9 @@ struct CheckArgs {
 /// Checks one file; returns the diagnostics text (empty when it is fine).
 std::string checkOne(const std::string& file, const GlobalOptions& g, std::string& summary) {
   try {
+    // Loading reads every section of the species (and its grammar) and reports every error.
     Species s = loadSpecies(file, g.pathPolicy());
-    summary = std::string(speciesKindName(s.kind)) + (s.bareGrammar ? " grammar" : " species");
-    if (s.kind == SpeciesKind::Tree) {
-      lsystem::Grammar grammar = speciesGrammar(s);
-      summary += " '" + s.name + "', " + std::to_string(grammar.productionCount()) + " productions, " +
-                 std::to_string(grammar.derivationLength()) + " steps";
-      if (s.treeSection) {
-        DiagnosticList diags;
-        readTreeOptions(*s.treeSection, diags);
-        diags.throwIfErrors();
-        summary += ", BlobTree surface";
-      }
-    } else {
-      // Shells and blobs: read their sections and build the final model (cheap for both),
-      // so builder errors such as invalid parameters show here too.
-      SpeciesModel model(s);
-      model.frameBox();
-      summary += " '" + s.name + "'";
-    }
+    summary = s.kind + (s.bareGrammar ? " grammar" : " species") + s.spec->checkSummary(s);
     return {};
   } catch (const InputError& e) {
     return e.what();

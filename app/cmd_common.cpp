@@ -23,14 +23,6 @@ void requireExtension(const std::string& flag, const std::string& path, std::ini
                    "' for '" + path + "' (use " + list + ")");
 }
 
-std::optional<double> parseFiniteNumber(std::string_view text) {
-  if (!text.empty() && text[0] == '+') text.remove_prefix(1);
-  double v = 0;
-  auto res = std::from_chars(text.data(), text.data() + text.size(), v, std::chars_format::general);
-  if (text.empty() || res.ec != std::errc() || res.ptr != text.data() + text.size() || !std::isfinite(v))
-    return std::nullopt;
-  return v;
-}
 
 lsystem::GrammarOverrides commandLineOverrides(const std::vector<std::string>& defines, int steps, int64_t seed) {
   lsystem::GrammarOverrides o;

@@ -13,9 +13,6 @@
 
 namespace sprig {
 
-/// A whole string as a finite real number (`+`, exponents allowed), else nullopt.
-std::optional<double> parseFiniteNumber(std::string_view text);
-
 /// Overrides from `-D NAME=VALUE` flags, `--steps` (ignored when < 0) and `--seed`
 /// (ignored when < 0). Throws UsageError for a malformed -D.
 lsystem::GrammarOverrides commandLineOverrides(const std::vector<std::string>& defines, int steps, int64_t seed);

@@ -5,9 +5,9 @@
 #include <sstream>
 
 #include "app/cmd_common.h"
-#include "app/json_writer.h"
-#include "app/species.h"
-#include "app/tree_pipeline.h"
+#include "core/json_writer.h"
+#include "model/species.h"
+#include "model/growth.h"
 #include "core/atomic_file.h"
 #include "lsystem/derive.h"
 
@@ -25,8 +25,18 @@ struct DeriveArgs {
   std::string skeletonOut;
 };
 
+/// What `sprig derive` reports: the final string and its skeleton.
+struct Derived {
+  int steps = 0;
+  uint64_t seed = 0;
+  const lsystem::ModuleString& modules;
+  const lsystem::SymbolTable& symbols;
+  lsystem::Skeleton skeleton;
+  lsystem::TurtleState end;
+};
+
 /// The `--json` report: steps, modules, symbol counts, internodes, total length, bounds, end.
-std::string reportJson(const GrownTree& t) {
+std::string reportJson(const Derived& t) {
   std::vector<size_t> counts(t.symbols.size(), 0);
   for (lsystem::SymbolId s : t.modules.symbols) ++counts[s];
   std::ostringstream o;
@@ -46,7 +56,7 @@ std::string reportJson(const GrownTree& t) {
 }
 
 /// The `--skeleton` file: every internode and a summary of organs.
-std::string skeletonJson(const GrownTree& t) {
+std::string skeletonJson(const Derived& t) {
   std::string out;
   out.reserve(t.skeleton.internodes.size() * 160 + 256);
   out += "{\"steps\": " + std::to_string(t.steps) + ", \"seed\": " + std::to_string(t.seed) + ",\n \"internodes\": [";
@@ -82,7 +92,11 @@ int runDerive(const DeriveArgs& a, const GlobalOptions& g) {
   if (!a.skeletonOut.empty()) requireExtension("--skeleton", a.skeletonOut, {".json"});
   lsystem::GrammarOverrides extra = commandLineOverrides(a.defines, a.steps, a.seed);
   Species species = loadSpecies(a.file, g.pathPolicy());
-  GrownTree t = growTree(species, GrowOptions{extra, {}, true});
+  GrowthEngine engine(species, GrowthOptions{extra, -1, "derive " + species.name});
+  const int last = engine.lastStep();
+  const lsystem::ModuleString& modules = engine.modulesAt(last);
+  Derived t{last, engine.seed(), modules, engine.symbols(), {}, {}};
+  t.skeleton = engine.skeletonAt(last, &t.end);
   if (a.print) std::cout << lsystem::formatModuleString(t.modules, t.symbols) << "\n";
   if (a.json) std::cout << reportJson(t) << "\n";
   if (!a.print && !a.json)

@@ -4,9 +4,9 @@
 #include <iostream>
 
 #include "app/cmd_common.h"
-#include "app/gallery.h"
-#include "app/shard.h"
-#include "app/species.h"
+#include "gallery/gallery.h"
+#include "gallery/shard.h"
+#include "model/species.h"
 #include "core/atomic_file.h"
 #include "core/progress.h"
 
@@ -51,8 +51,7 @@ int runGallery(const GalleryArgs& a, const GlobalOptions& g) {
   int bad = 0;
   for (const fs::path& f : files) {
     try {
-      Species s = loadSpecies(f, g.pathPolicy());
-      if (s.kind == SpeciesKind::Tree) speciesGrammar(s);
+      loadSpecies(f, g.pathPolicy());  // reads every section, the grammar included
     } catch (const InputError& e) {
       std::cerr << e.what() << "\n";
       ++bad;

@@ -6,9 +6,9 @@
 #include <cstdio>
 #include <iostream>
 
-#include "app/species.h"
+#include "model/species.h"
 #include "app/cmd_common.h"
-#include "app/model.h"
+#include "model/model.h"
 #include "core/mesh_io.h"
 
 namespace sprig {
@@ -34,10 +34,7 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
   SpeciesModel model(species, commandLineOverrides(a.defines, a.steps, a.seed));
   Stage stage = a.stage >= 0 ? model.stageFromIndex(a.stage) : model.finalStage();
   stage.fraction = a.fraction;
-  if (a.age >= 0) {
-    if (species.kind != SpeciesKind::Shell) throw UsageError("--age applies to shell species only");
-    stage.age = std::min(a.age, model.finalStage().age);
-  }
+  if (a.age >= 0) stage.age = model.stageAtAge(a.age).age;
   ModelFigures fig;
   Mesh mesh = model.buildMesh(stage, static_cast<float>(a.cell), !g.quiet, &fig);
 

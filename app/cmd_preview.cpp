@@ -4,9 +4,11 @@
 #include <sstream>
 
 #include "app/cmd_common.h"
-#include "app/preview.h"
-#include "app/species.h"
-#include "app/tree_pipeline.h"
+#include "model/growth.h"
+#include "model/species.h"
+#include "model/tree_kind.h"
+#include "render/camera.h"
+#include "render/scene.h"
 #include "render/image.h"
 
 namespace sprig {
@@ -32,18 +34,28 @@ int runPreview(const PreviewArgs& a, const GlobalOptions& g) {
   Species species = loadSpecies(a.file, g.pathPolicy());
   SpeciesRender look = species.render;
   if (!a.view.empty()) parseView(a.view, look.view);
-  if (a.samples > 0) look.samples = a.samples;
-  int width = a.width > 0 ? a.width : look.width;
-  int height = a.height > 0 ? a.height : look.height;
-  if (a.width > 0 && a.height <= 0) height = std::max(16, look.height * a.width / look.width);
-  if (a.height > 0 && a.width <= 0) width = std::max(16, look.width * a.height / look.height);
+  if (a.samples > 0) look.image.spp = a.samples;
 
-  GrowOptions opt;
-  opt.extra = extra;
-  if (a.stage >= 0) opt.stageSteps = {a.stage};
-  GrownTree t = growTree(species, opt);
-  const lsystem::Skeleton& shown = a.stage >= 0 ? t.stages[0].skeleton : t.skeleton;
-  render::Image image = renderSkeletonImage(shown, look, framingBox(t.skeleton), width, height, "render " + species.name);
+  const int lookWidth = look.image.width, lookHeight = look.image.height;
+  int width = a.width > 0 ? a.width : lookWidth;
+  int height = a.height > 0 ? a.height : lookHeight;
+  if (a.width > 0 && a.height <= 0) height = std::max(16, lookHeight * a.width / lookWidth);
+  if (a.height > 0 && a.width <= 0) width = std::max(16, lookWidth * a.height / lookHeight);
+
+  // The skeleton as derived at the step shown, framed like the final step.
+  GrowthEngine engine(species, GrowthOptions{extra, -1, {}});
+  const int last = engine.lastStep();
+  const int step = a.stage >= 0 ? std::min(a.stage, last) : last;
+  const lsystem::Skeleton shown = engine.skeletonAt(step);
+  const DBox3 frame = framingBox(step == last ? shown : engine.skeletonAt(last));
+  render::Scene scene;
+  scene.add(skeletonPreview(shown, look.style));
+  scene.commit();
+  const render::Camera camera = render::frameBounds(Box3{Vec3(frame.lo), Vec3(frame.hi)}, look.view,
+                                                    static_cast<double>(width) / height);
+  render::RenderSettings rs = look.settings(width, height);
+  rs.progressLabel = "render " + species.name;
+  render::Image image = render::renderImage(scene, camera, rs);
   render::writeImage(image, a.out);
   if (!g.quiet)
     std::cerr << a.out << ": " << width << "x" << height << ", " << shown.internodes.size() << " internodes\n";

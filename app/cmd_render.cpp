@@ -6,8 +6,8 @@
 #include <sstream>
 
 #include "app/cmd_common.h"
-#include "app/model.h"
-#include "app/species.h"
+#include "model/model.h"
+#include "model/species.h"
 #include "render/image.h"
 
 namespace sprig {
@@ -69,10 +69,7 @@ int runRender(const RenderArgs& a, const GlobalOptions& g) {
   job.mode = mode;
   job.stage = a.stage >= 0 ? model.stageFromIndex(a.stage) : model.finalStage();
   job.stage.fraction = a.fraction;
-  if (a.age >= 0) {
-    if (species.kind != SpeciesKind::Shell) throw UsageError("--age applies to shell species only");
-    job.stage.age = std::min(a.age, model.finalStage().age);
-  }
+  if (a.age >= 0) job.stage.age = model.stageAtAge(a.age).age;
   job.progress = !g.quiet;
   job.progressLabel = "render " + species.name;
 
@@ -85,7 +82,7 @@ int runRender(const RenderArgs& a, const GlobalOptions& g) {
     std::snprintf(line, sizeof line,
                   "%s: %dx%d, %d spp, %s mode%s%s; %zu primitives, %zu cells, %zu triangles; build %.2f s, render %.2f s, "
                   "%.2f Mrays/s",
-                  a.out.c_str(), image.width, image.height, job.samples > 0 ? job.samples : look.samples,
+                  a.out.c_str(), image.width, image.height, job.samples > 0 ? job.samples : look.image.spp,
                   geometryModeName(mode), model.stageName(job.stage).empty() ? "" : ", ",
                   model.stageName(job.stage).c_str(), fig.primitives, fig.cells, fig.triangles, fig.buildSeconds,
                   stats.seconds, stats.raysPerSecond() / 1e6);

@@ -12,18 +12,13 @@
 #include <stdexcept>
 #include <string>
 
-#include "app/yaml_reader.h"
+#include "core/diagnostics.h"
+#include "model/yaml_reader.h"
 
 namespace sprig {
 
 /// Exit codes of `sprig`.
 enum ExitCode : int { kExitOk = 0, kExitBadInput = 1, kExitUsage = 2, kExitInternal = 3 };
-
-/// A bad command-line value found after parsing (unknown output extension, malformed -D).
-/// main prints `sprig: error: <what>` and exits with 2.
-struct UsageError : std::runtime_error {
-  using std::runtime_error::runtime_error;
-};
 
 /// Options every subcommand shares (`--quiet`, `--threads`, `--root`, `--allow-outside-paths`).
 struct GlobalOptions {

@@ -22,6 +22,7 @@
 #include "blobtree/polygonize.h"
 #include "core/parallel.h"
 #include "lsystem/skeleton.h"
+#include "model/tree_kind.h"
 #include "render/camera.h"
 #include "render/image.h"
 #include "render/renderer.h"
@@ -250,7 +251,7 @@ int main(int argc, char** argv) {
   {
     lsystem::Skeleton sk = Abop26{}.build();
     render::Scene scene;
-    scene.addSkeleton(sk);
+    scene.add(skeletonPreview(sk, SkeletonStyle{}));
     scene.commit();
     render::RenderSettings s;
     s.width = 800;

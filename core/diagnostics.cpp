@@ -1,6 +1,8 @@
 #include "core/diagnostics.h"
 
 #include <algorithm>
+#include <charconv>
+#include <cmath>
 #include <limits>
 
 namespace sprig {
@@ -117,6 +119,15 @@ std::string didYouMean(std::string_view word, const std::vector<std::string>& ca
   int limit = std::max<int>(2, static_cast<int>(word.size()) / 3);
   if (!bestName || best > limit) return {};
   return " (did you mean '" + *bestName + "'?)";
+}
+
+std::optional<double> parseFiniteNumber(std::string_view text) {
+  if (!text.empty() && text[0] == '+') text.remove_prefix(1);
+  double v = 0;
+  auto res = std::from_chars(text.data(), text.data() + text.size(), v, std::chars_format::general);
+  if (text.empty() || res.ec != std::errc() || res.ptr != text.data() + text.size() || !std::isfinite(v))
+    return std::nullopt;
+  return v;
 }
 
 }  // namespace sprig

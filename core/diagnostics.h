@@ -5,6 +5,7 @@
 /// followed, when the source line is known, by that line and a caret under the column.
 /// Parsers collect diagnostics in a DiagnosticList and throw once with all of them.
 
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -31,6 +32,16 @@ struct Diagnostic {
   /// `path:line:col: error: message`, plus the source line and a caret when known.
   std::string format() const;
 };
+
+/// A bad request from the command line found after parsing (a stage the species lacks, an
+/// unknown output extension, a malformed -D). The `sprig` binary prints
+/// `sprig: error: <what>` and exits with 2.
+struct UsageError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+/// A whole string as a finite real number (`+`, exponents allowed), else nullopt.
+std::optional<double> parseFiniteNumber(std::string_view text);
 
 /// Bad user input (grammar, species file, texture, command-line value).
 /// what() returns every diagnostic formatted, one after another.

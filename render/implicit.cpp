@@ -249,13 +249,16 @@ uint32_t Scene::addImplicit(const blobtree::CompiledBlob& blob, uint32_t materia
   return impl_->attach(g, std::move(rec));
 }
 
-uint32_t Scene::addPolygonized(const blobtree::PolygonizeResult& result, uint32_t material) {
+uint32_t Scene::addPolygonized(const blobtree::PolygonizeResult& result, uint32_t material, uint32_t textureBase,
+                               uint32_t textureCount) {
   if (material >= impl_->materials.size()) throw std::invalid_argument("Scene::addPolygonized: unknown material id");
   Mesh mesh = result.mesh;
-  if (!impl_->textures.empty() && result.attributes.size() == mesh.positions.size()) {
+  const size_t count = textureCount == kAllTextures ? impl_->textures.size() : textureCount;
+  if (count > 0 && result.attributes.size() == mesh.positions.size()) {
     mesh.colors.resize(mesh.positions.size());
     for (size_t i = 0; i < mesh.positions.size(); ++i)
-      mesh.colors[i] = attributeColor(result.attributes[i], mesh.positions[i], impl_->materials[material]);
+      mesh.colors[i] = attributeColor(result.attributes[i], mesh.positions[i], impl_->materials[material], textureBase,
+                                     textureCount);
   }
   return addMesh(mesh, material);
 }

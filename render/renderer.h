@@ -66,7 +66,7 @@ struct RenderSettings {
   bool ground = true;             ///< analytic ground plane under the model
   bool groundAtModelBase = true;  ///< put the plane at the scene's lowest y (else at groundHeight)
   float groundHeight = 0.0f;      ///< plane height when groundAtModelBase is false
-  Vec3 groundColor{0.34f, 0.31f, 0.26f};  ///< linear albedo of the ground
+  Vec3 groundColor{0.45f, 0.42f, 0.37f};  ///< linear albedo of the ground
   float groundFade = 6.0f;        ///< ground fades into the background beyond this many model radii
 
   float exposure = 0.0f;          ///< stops; linear values are multiplied by 2^exposure

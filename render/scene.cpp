@@ -19,8 +19,6 @@ void onEmbreeError(void* userPtr, RTCError code, const char* str) {
   if (code != RTC_ERROR_NONE && message->empty()) *message = "Embree error " + std::to_string(code) + ": " + (str ? str : "");
 }
 
-Vec3 toVec3(const DVec3& v) { return Vec3(static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)); }
-
 }  // namespace
 
 uint32_t Scene::Impl::attach(RTCGeometry geometry, GeometryRecord record) {
@@ -77,138 +75,93 @@ uint32_t Scene::addMaterial(const Material& m) {
 
 const Material& Scene::material(uint32_t id) const { return impl_->materials.at(id); }
 
-std::vector<uint32_t> Scene::addSkeleton(const lsystem::Skeleton& skeleton, const SkeletonStyle& style) {
-  if (impl_->committed) throw std::logic_error("Scene::addSkeleton after commit");
+uint32_t Scene::addCurves(const CurveSet& curves, uint32_t material) {
+  if (impl_->committed) throw std::logic_error("Scene::addCurves after commit");
+  if (material >= impl_->materials.size()) throw std::invalid_argument("Scene::addCurves: unknown material id");
+  RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE);
+  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
+                                                        4 * sizeof(float), curves.vertices.size()));
+  for (size_t i = 0; i < curves.vertices.size(); ++i) {
+    const Vec4& c = curves.vertices[i];
+    for (int k = 0; k < 4; ++k) v[4 * i + k] = c[k];
+    impl_->bounds.extend(Box3{Vec3(c) - c.w, Vec3(c) + c.w});
+  }
+  auto* s = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT,
+                                                           sizeof(uint32_t), curves.segments.size()));
+  std::copy(curves.segments.begin(), curves.segments.end(), s);
+  auto* fl = static_cast<uint8_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_FLAGS, 0, RTC_FORMAT_UCHAR,
+                                                           sizeof(uint8_t), curves.flags.size()));
+  for (size_t i = 0; i < curves.flags.size(); ++i) {
+    uint8_t f = 0;
+    if (curves.flags[i] & CurveSet::kJoinedBefore) f |= RTC_CURVE_FLAG_NEIGHBOR_LEFT;
+    if (curves.flags[i] & CurveSet::kJoinedAfter) f |= RTC_CURVE_FLAG_NEIGHBOR_RIGHT;
+    fl[i] = f;
+  }
+  impl_->stats.curveSegments += curves.segments.size();
+  GeometryRecord rec;
+  rec.kind = GeometryRecord::Kind::Curves;
+  rec.material = material;
+  return impl_->attach(g, std::move(rec));
+}
+
+uint32_t Scene::addSpheres(const SphereSet& spheres, uint32_t material) {
+  if (impl_->committed) throw std::logic_error("Scene::addSpheres after commit");
+  if (material >= impl_->materials.size()) throw std::invalid_argument("Scene::addSpheres: unknown material id");
+  if (spheres.colors.size() != spheres.spheres.size())
+    throw std::invalid_argument("Scene::addSpheres: one colour per sphere expected");
+  GeometryRecord rec;
+  rec.kind = GeometryRecord::Kind::Spheres;
+  rec.material = material;
+  rec.primitiveColors = spheres.colors;
+  RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
+  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
+                                                        4 * sizeof(float), spheres.spheres.size()));
+  for (size_t i = 0; i < spheres.spheres.size(); ++i) {
+    const Vec4& c = spheres.spheres[i];
+    for (int k = 0; k < 4; ++k) v[4 * i + k] = c[k];
+    impl_->bounds.extend(Box3{Vec3(c) - c.w, Vec3(c) + c.w});
+  }
+  impl_->stats.spheres += spheres.spheres.size();
+  return impl_->attach(g, std::move(rec));
+}
+
+uint32_t Scene::Impl::addTextureTable(const TextureTable& table) {
+  const uint32_t base = static_cast<uint32_t>(textures.size());
+  for (const ColorTexture& t : table) {
+    if (!t) throw std::invalid_argument("Scene::add: empty texture in a part's table");
+    textures.push_back(t);
+  }
+  return base;
+}
+
+std::vector<uint32_t> Scene::add(const Geometry& geometry) {
   std::vector<uint32_t> ids;
-  const auto& nodes = skeleton.internodes;
-  DBox3 box = skeleton.bounds();
-  double minRadius = box.empty() ? 0.0 : style.minRadiusFraction * glm::length(box.size());
-  auto radius = [&](double r) { return static_cast<float>(std::max(r * style.radiusScale, minRadius)); };
-
-  if (!nodes.empty()) {
-    // Chain each internode with the first child that starts where it ends, so joints are
-    // shared vertices of one curve rather than two overlapping caps.
-    std::vector<int32_t> next(nodes.size(), -1);
-    std::vector<char> continues(nodes.size(), 0);
-    // First pass: continuations of the same branch order; second pass: any child.
-    for (int pass = 0; pass < 2; ++pass) {
-      for (size_t i = 0; i < nodes.size(); ++i) {
-        int32_t p = nodes[i].parent;
-        if (p < 0 || static_cast<size_t>(p) >= nodes.size() || next[p] >= 0 || continues[i]) continue;
-        if (pass == 0 && nodes[i].order != nodes[p].order) continue;
-        double tol = 1e-6 * std::max(1.0, nodes[p].length());
-        if (glm::length(nodes[i].start - nodes[p].end) <= tol) {
-          next[p] = static_cast<int32_t>(i);
-          continues[i] = 1;
-        }
-      }
+  for (const GeometryPart& part : geometry.parts) {
+    if (const auto* c = std::get_if<CurvesPart>(&part)) {
+      ids.push_back(addCurves(c->curves, addMaterial(c->material)));
+    } else if (const auto* sp = std::get_if<SpheresPart>(&part)) {
+      ids.push_back(addSpheres(sp->spheres, addMaterial(sp->material)));
+    } else if (const auto* m = std::get_if<MeshPart>(&part)) {
+      const uint32_t base = impl_->addTextureTable(m->textures);
+      Material material = m->material;
+      if (material.texture >= 0) material.texture += static_cast<int>(base);
+      ids.push_back(addMesh(m->mesh, addMaterial(material), m->triangleColors));
+    } else if (const auto* im = std::get_if<ImplicitPart>(&part)) {
+      const uint32_t base = impl_->addTextureTable(im->textures);
+      const uint32_t id = addImplicit(*im->blob, addMaterial(im->material), im->options);
+      impl_->records[id].textureBase = base;
+      impl_->records[id].textureCount = static_cast<uint32_t>(im->textures.size());
+      ids.push_back(id);
+    } else if (const auto* pm = std::get_if<PolygonizedPart>(&part)) {
+      const uint32_t base = impl_->addTextureTable(pm->textures);
+      ids.push_back(addPolygonized(*pm->mesh, addMaterial(pm->material), base,
+                                   static_cast<uint32_t>(pm->textures.size())));
     }
-    std::vector<glm::vec4> vertices;
-    std::vector<uint32_t> segments;
-    std::vector<uint8_t> flags;
-    for (size_t i = 0; i < nodes.size(); ++i) {
-      if (continues[i]) continue;
-      const auto& first = nodes[i];
-      vertices.emplace_back(toVec3(first.start), radius(first.baseRadius));
-      bool firstInChain = true;
-      for (int32_t k = static_cast<int32_t>(i); k >= 0; k = next[k]) {
-        const auto& n = nodes[k];
-        double tip = next[k] >= 0 ? 0.5 * (n.tipRadius + nodes[next[k]].baseRadius) : n.tipRadius;
-        segments.push_back(static_cast<uint32_t>(vertices.size() - 1));
-        vertices.emplace_back(toVec3(n.end), radius(tip));
-        uint8_t f = 0;
-        if (!firstInChain) f |= RTC_CURVE_FLAG_NEIGHBOR_LEFT;
-        if (next[k] >= 0) f |= RTC_CURVE_FLAG_NEIGHBOR_RIGHT;
-        flags.push_back(f);
-        firstInChain = false;
-      }
-    }
-    RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE);
-    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
-                                                          4 * sizeof(float), vertices.size()));
-    for (size_t i = 0; i < vertices.size(); ++i) {
-      for (int c = 0; c < 4; ++c) v[4 * i + c] = vertices[i][c];
-      impl_->bounds.extend(Box3{Vec3(vertices[i]) - vertices[i].w, Vec3(vertices[i]) + vertices[i].w});
-    }
-    auto* s = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT,
-                                                             sizeof(uint32_t), segments.size()));
-    std::copy(segments.begin(), segments.end(), s);
-    auto* fl = static_cast<uint8_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_FLAGS, 0, RTC_FORMAT_UCHAR,
-                                                             sizeof(uint8_t), flags.size()));
-    std::copy(flags.begin(), flags.end(), fl);
-    impl_->stats.curveSegments += segments.size();
-    GeometryRecord rec;
-    rec.kind = GeometryRecord::Kind::Curves;
-    rec.material = addMaterial(style.wood);
-    ids.push_back(impl_->attach(g, std::move(rec)));
-  }
-  if (!style.organs) return ids;
-
-  auto organColor = [&](const lsystem::Organ& o, const Material& fallback) {
-    return o.color > 0 && static_cast<size_t>(o.color) < style.palette.size() ? style.palette[o.color] : fallback.baseColor;
-  };
-  // Polygons and named surfaces: one triangle geometry with per-triangle colors.
-  GeometryRecord leaves;
-  leaves.material = addMaterial(style.leaf);
-  auto addPolygon = [&](const std::vector<Vec3>& pts, const Vec3& color) {
-    if (pts.size() < 3) return;
-    Vec3 normal(0);
-    for (size_t k = 0; k < pts.size(); ++k) normal += glm::cross(pts[k], pts[(k + 1) % pts.size()]);  // Newell
-    float len = glm::length(normal);
-    if (!(len > 0)) return;
-    normal /= len;
-    uint32_t base = static_cast<uint32_t>(leaves.positions.size());
-    for (const Vec3& p : pts) {
-      leaves.positions.push_back(p);
-      leaves.normals.push_back(normal);
-    }
-    for (uint32_t k = 1; k + 1 < pts.size(); ++k) {
-      leaves.triangles.emplace_back(base, base + k, base + k + 1);
-      leaves.primitiveColors.push_back(color);
-    }
-  };
-  double surfaceScale = box.empty() ? 1.0 : 0.02 * glm::length(box.size());
-  for (const auto& o : skeleton.organs) {
-    if (o.kind == lsystem::Organ::Kind::Polygon) {
-      std::vector<Vec3> pts;
-      for (const auto& p : o.points) pts.push_back(toVec3(p));
-      addPolygon(pts, organColor(o, style.leaf));
-    } else if (o.kind == lsystem::Organ::Kind::Surface) {
-      // A named surface is drawn as a diamond leaf in the turtle's heading-left plane.
-      double s = o.radius > 0 ? o.radius : surfaceScale;
-      DVec3 h = o.heading * s, l = o.left * (0.35 * s);
-      addPolygon({toVec3(o.position), toVec3(o.position + 0.5 * h + l), toVec3(o.position + h),
-                  toVec3(o.position + 0.5 * h - l)},
-                 organColor(o, style.leaf));
-    }
-  }
-  if (!leaves.triangles.empty()) ids.push_back(impl_->addTriangles(std::move(leaves)));
-
-  // Spheres: Embree sphere points with per-primitive colors.
-  std::vector<glm::vec4> spheres;
-  GeometryRecord balls;
-  balls.kind = GeometryRecord::Kind::Spheres;
-  for (const auto& o : skeleton.organs) {
-    if (o.kind != lsystem::Organ::Kind::Sphere || !(o.radius > 0)) continue;
-    spheres.emplace_back(toVec3(o.position), static_cast<float>(o.radius * style.radiusScale));
-    balls.primitiveColors.push_back(organColor(o, style.fruit));
-  }
-  if (!spheres.empty()) {
-    balls.material = addMaterial(style.fruit);
-    RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
-    auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
-                                                          4 * sizeof(float), spheres.size()));
-    for (size_t i = 0; i < spheres.size(); ++i) {
-      for (int c = 0; c < 4; ++c) v[4 * i + c] = spheres[i][c];
-      impl_->bounds.extend(Box3{Vec3(spheres[i]) - spheres[i].w, Vec3(spheres[i]) + spheres[i].w});
-    }
-    impl_->stats.spheres += spheres.size();
-    ids.push_back(impl_->attach(g, std::move(balls)));
   }
   return ids;
 }
 
-uint32_t Scene::addMesh(const Mesh& mesh, uint32_t material) {
+uint32_t Scene::addMesh(const Mesh& mesh, uint32_t material, const std::vector<Vec3>& triangleColors) {
   if (impl_->committed) throw std::logic_error("Scene::addMesh after commit");
   if (material >= impl_->materials.size()) throw std::invalid_argument("Scene::addMesh: unknown material id");
   GeometryRecord rec;
@@ -222,6 +175,11 @@ uint32_t Scene::addMesh(const Mesh& mesh, uint32_t material) {
     for (uint32_t m : mesh.materials)
       if (m >= impl_->materials.size()) throw std::invalid_argument("Scene::addMesh: unknown per-triangle material id");
     rec.primitiveMaterials = mesh.materials;
+  }
+  if (!triangleColors.empty()) {
+    if (triangleColors.size() != mesh.triangles.size())
+      throw std::invalid_argument("Scene::addMesh: one colour per triangle expected");
+    rec.primitiveColors = triangleColors;
   }
   for (const auto& t : mesh.triangles)
     if (t.x >= mesh.positions.size() || t.y >= mesh.positions.size() || t.z >= mesh.positions.size())
@@ -243,15 +201,17 @@ uint32_t Scene::addTextures(std::shared_ptr<const textures::TextureRegistry> reg
   return base;
 }
 
-Vec3 Scene::attributeColor(const blobtree::Attributes& a, const Vec3& p, const Material& material) const {
-  if (a.textureCount == 0 || impl_->textures.empty()) return material.baseColor;
+Vec3 Scene::attributeColor(const blobtree::Attributes& a, const Vec3& p, const Material& material,
+                           uint32_t textureBase, uint32_t textureCount) const {
+  const size_t count = textureCount == kAllTextures ? impl_->textures.size() : textureCount;
+  if (a.textureCount == 0 || count == 0) return material.baseColor;
   Vec3 sum(0);
   float wsum = 0;
   for (int i = 0; i < a.textureCount && i < blobtree::Attributes::kMaxTextures; ++i) {
     float w = a.textureWeights[i];
     if (!(w > 0)) continue;
     uint16_t id = a.textureIds[i];
-    sum += w * (id < impl_->textures.size() ? impl_->textures[id](a.uv, p) : material.baseColor);
+    sum += w * (id < count ? impl_->textures[textureBase + id](a.uv, p) : material.baseColor);
     wsum += w;
   }
   return wsum > 0 ? sum / wsum : material.baseColor;
@@ -298,7 +258,8 @@ std::optional<SurfaceHit> Scene::intersect(const Vec3& origin, const Vec3& direc
     const blobtree::Hit& ih = context.implicitHit;
     hit.position = ih.point;
     hit.normal = hit.geometricNormal = ih.normal;
-    hit.color = attributeColor(ih.attributes, ih.point, impl_->materials[hit.material]);
+    hit.color = attributeColor(ih.attributes, ih.point, impl_->materials[hit.material], rec.textureBase,
+                               rec.textureCount);
     return hit;
   }
   if (rec.kind == GeometryRecord::Kind::Triangles) {

@@ -1,9 +1,9 @@
 #pragma once
 /// The renderable scene: materials and geometry held in an Embree 3 scene.
 ///
-/// Geometry comes in as neutral types (a lsystem::Skeleton, a Mesh, later compiled
-/// BlobTrees) and is turned into Embree geometry here; Embree itself stays behind this
-/// interface (only render/*.cpp include it). After commit() the scene is immutable and
+/// Geometry comes in as neutral types (render/geometry.h: curves, spheres, meshes, compiled
+/// BlobTrees, each with its own texture table) and is turned into Embree geometry here;
+/// Embree itself stays behind this interface (only render/*.cpp include it). After commit() the scene is immutable and
 /// intersect()/occluded() may be called from any number of threads.
 
 #include <cstdint>
@@ -14,8 +14,9 @@
 
 #include "blobtree/compiled.h"
 #include "core/mesh.h"
+#include "core/shapes.h"
 #include "core/types.h"
-#include "lsystem/skeleton.h"
+#include "render/geometry.h"
 #include "textures/registry.h"
 
 namespace sprig::blobtree {
@@ -23,42 +24,6 @@ struct PolygonizeResult;
 }
 
 namespace sprig::render {
-
-/// Surface appearance: a diffuse base color with a glossy highlight.
-struct Material {
-  Vec3 baseColor{0.6f};     ///< linear RGB albedo in [0, 1]
-  float roughness = 0.6f;   ///< 0 = mirror-like highlight, 1 = no highlight
-  float specular = 0.04f;   ///< highlight strength (reflectance at normal incidence)
-  int texture = -1;         ///< texture id for textured models, -1 for none
-};
-
-/// A color texture: linear RGB at natural coordinates uv (and world position, for solid
-/// textures). Must be thread-safe; the textures module's textures are wrapped into this.
-using ColorTexture = std::function<Vec3(Vec2 uv, const Vec3& position)>;
-
-/// How a compiled BlobTree becomes exact Embree user geometry.
-struct ImplicitOptions {
-  /// Edge of the surface cells (one Embree user primitive each), world units; 0 = automatic:
-  /// 1.5x the smallest feature radius, clamped to [diagonal/1000, diagonal/40].
-  float cellSize = 0.0f;
-  /// Root-finding tolerance (relative to the model's bounds diagonal) and step cap.
-  blobtree::TraceOptions trace;
-  /// March eight samples at a time with batched field evaluation (the same Lipschitz
-  /// guarantee, several times faster); false calls CompiledBlob::intersectCell per cell.
-  bool batched = true;
-};
-
-/// How a skeleton becomes preview geometry.
-struct SkeletonStyle {
-  double radiusScale = 1.0;          ///< multiplies every internode radius
-  double minRadiusFraction = 0.002;  ///< radius floor as a fraction of the skeleton's bounds diagonal
-  Material wood{Vec3(0.30f, 0.20f, 0.12f), 0.7f, 0.03f};  ///< internodes
-  Material leaf{Vec3(0.16f, 0.38f, 0.08f), 0.5f, 0.06f};  ///< polygons and named surfaces
-  Material fruit{Vec3(0.55f, 0.08f, 0.06f), 0.35f, 0.08f};  ///< spheres
-  /// Base colors by turtle color index (`'`); an organ whose index has an entry uses it.
-  std::vector<Vec3> palette;
-  bool organs = true;  ///< draw organs (polygons, spheres, named surfaces)
-};
 
 /// What a ray hit: position, unit normals (not yet facing the ray) and the surface color.
 struct SurfaceHit {
@@ -92,15 +57,21 @@ class Scene {
   /// Material `id`; throws std::out_of_range for an unknown id.
   const Material& material(uint32_t id) const;
 
-  /// Adds a skeleton: internodes as round linear curves (tapered cones; an internode that
-  /// continues its parent's end shares the joint), polygons fan-triangulated, spheres as
-  /// Embree sphere points, named surfaces as small diamond leaves. Returns geometry ids added.
-  std::vector<uint32_t> addSkeleton(const lsystem::Skeleton& skeleton, const SkeletonStyle& style = {});
+  /// Adds every part of geometry in order, each with a material of its own and its texture
+  /// table (part texture ids index that table). Returns the geometry ids, one per part.
+  std::vector<uint32_t> add(const Geometry& geometry);
+
+  /// Adds tapered round curves (Embree round linear curves) with one material.
+  uint32_t addCurves(const CurveSet& curves, uint32_t material);
+
+  /// Adds spheres (Embree sphere points), each with its own colour. Returns the geometry id.
+  uint32_t addSpheres(const SphereSet& spheres, uint32_t material);
 
   /// Adds a triangle mesh with one material (per-triangle `mesh.materials`, when present,
   /// name scene material ids instead). Vertex normals give smooth shading, vertex colors
   /// replace the material's base color. Returns the geometry id.
-  uint32_t addMesh(const Mesh& mesh, uint32_t material);
+  /// triangleColors, when not empty (one per triangle), replace both.
+  uint32_t addMesh(const Mesh& mesh, uint32_t material, const std::vector<Vec3>& triangleColors = {});
 
   /// Registers a texture; returns its id. Ids are what blob primitives' TextureAttr::textureId
   /// and Material::texture refer to.
@@ -120,12 +91,20 @@ class Scene {
 
   /// Adds a polygonized BlobTree (mesh mode): triangles with the mesh's normals, and vertex
   /// colors from the per-vertex attributes through the same texture blend as exact mode.
-  uint32_t addPolygonized(const blobtree::PolygonizeResult& result, uint32_t material);
+  /// textures: the part's texture table (scene ids textureBase..textureBase+textureCount-1);
+  /// the default is the scene's whole table.
+  uint32_t addPolygonized(const blobtree::PolygonizeResult& result, uint32_t material, uint32_t textureBase = 0,
+                          uint32_t textureCount = kAllTextures);
 
   /// Color of blended attributes at p: Σ wᵢ·Tᵢ(uv, p) over the attribute's textures
   /// (weights from the field, seeds' texturing); the material's base color for a texture
   /// id without a registered texture, or when there is none.
-  Vec3 attributeColor(const blobtree::Attributes& attributes, const Vec3& p, const Material& material) const;
+  /// textureBase/textureCount select a part's texture table (default: the scene's whole table).
+  Vec3 attributeColor(const blobtree::Attributes& attributes, const Vec3& p, const Material& material,
+                      uint32_t textureBase = 0, uint32_t textureCount = kAllTextures) const;
+
+  /// textureCount meaning "every texture of the scene" (geometry added without a table).
+  static constexpr uint32_t kAllTextures = 0xffffffffu;
 
   /// Builds the acceleration structure. Throws std::runtime_error on an Embree error.
   void commit();

@@ -28,6 +28,8 @@ struct GeometryRecord {
   std::vector<Vec3> primitiveColors;         ///< optional per-primitive colors (any kind)
   std::vector<uint32_t> primitiveMaterials;  ///< optional per-primitive material ids
   std::shared_ptr<const ImplicitData> implicit;  ///< Implicit
+  uint32_t textureBase = 0;                      ///< the part's texture table in Scene::Impl::textures
+  uint32_t textureCount = Scene::kAllTextures;   ///< its size (kAllTextures: the scene's whole table)
 };
 
 /// Embree intersect context extended with the last implicit hit (its normal and blended
@@ -54,6 +56,8 @@ struct Scene::Impl {
 
   /// Commits geometry, attaches it under the next id and records how to shade it.
   uint32_t attach(RTCGeometry geometry, detail::GeometryRecord record);
+  /// Appends a part's texture table; returns the scene id of its texture 0.
+  uint32_t addTextureTable(const TextureTable& table);
   /// Adds record's triangles as Embree triangle geometry.
   uint32_t addTriangles(detail::GeometryRecord record);
 };

@@ -1,0 +1,836 @@
+#include "model/blob_kind.h"
+
+#include "blobtree/polygonize.h"
+#include "render/scene.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <map>
+#include <utility>
+
+namespace sprig {
+
+namespace {
+
+using blobtree::BlobTree;
+using blobtree::NodeId;
+
+constexpr int kMaxDepth = 200;
+
+const std::vector<std::string> kKinds = {
+    "point",  "segment",   "cone",      "torus",    "halfspace", "box",       "spiral_points",
+    "blend",  "ricci",     "union",     "intersect", "difference", "controlled", "pcm",
+    "negative", "translate", "scale",   "rotate",   "bend",      "twist",     "taper"};
+
+std::string inQuotes(std::string_view s) {
+  std::string out(1, '\'');
+  out.append(s);
+  out.push_back('\'');
+  return out;
+}
+
+// Reads nested blob nodes into one tree, collecting diagnostics.
+class NodeReader {
+ public:
+  NodeReader(BlobTree& tree, DiagnosticList& diags, int textureCount)
+      : tree_(tree), diags_(diags), textureCount_(textureCount) {}
+
+  std::optional<NodeId> read(const YNode& node) {
+    if (depth_ >= kMaxDepth) {
+      node.error(diags_, "blob nodes are nested more than " + std::to_string(kMaxDepth) + " deep");
+      return std::nullopt;
+    }
+    if (!node.isMap() || node.pairs().size() != 1 || !node.pairs()[0].first.isScalar()) {
+      node.error(diags_, "a blob node must be a map with one key naming its kind, e.g. {point: {radius: 1}}");
+      return std::nullopt;
+    }
+    auto [keyNode, value] = node.pairs()[0];
+    std::string kind = keyNode.scalar();
+    ++depth_;
+    std::optional<NodeId> id = dispatch(kind, keyNode, value);
+    --depth_;
+    return id;
+  }
+
+ private:
+  using Handler = std::optional<NodeId> (NodeReader::*)(const std::string& kind, const YNode& key, const YNode& v);
+
+  /// Reads the node of kind `kind` (key) with value v through the kind's handler.
+  std::optional<NodeId> dispatch(const std::string& kind, const YNode& key, const YNode& v) {
+    static const std::map<std::string, Handler, std::less<>> kHandlers = {
+        {"point", &NodeReader::readPoint},
+        {"segment", &NodeReader::readSegment},
+        {"cone", &NodeReader::readCone},
+        {"torus", &NodeReader::readTorus},
+        {"halfspace", &NodeReader::readHalfspace},
+        {"box", &NodeReader::readBox},
+        {"spiral_points", &NodeReader::readSpiralPoints},
+        {"blend", &NodeReader::readCombination},
+        {"union", &NodeReader::readCombination},
+        {"intersect", &NodeReader::readCombination},
+        {"difference", &NodeReader::readDifference},
+        {"ricci", &NodeReader::readRicci},
+        {"controlled", &NodeReader::readControlled},
+        {"pcm", &NodeReader::readPcm},
+        {"negative", &NodeReader::readNegative},
+        {"translate", &NodeReader::readTranslate},
+        {"scale", &NodeReader::readScale},
+        {"rotate", &NodeReader::readRotate},
+        {"bend", &NodeReader::readBend},
+        {"twist", &NodeReader::readTwist},
+        {"taper", &NodeReader::readTaper},
+    };
+    if (auto it = kHandlers.find(kind); it != kHandlers.end()) return (this->*it->second)(kind, key, v);
+    key.error(diags_, "unknown blob node " + inQuotes(kind) + didYouMean(kind, kKinds));
+    return std::nullopt;
+  }
+
+  std::optional<NodeId> readPoint(const std::string& kind, const YNode& key, const YNode& v) {
+    return primitive(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      Vec3 c = m.vec3("center", Vec3(0.0f));
+      auto r = required(m, "radius");
+      auto tex = texture(m);
+      if (!r) return std::nullopt;
+      return build(key, [&] { return tree_.point(c, float(*r), tex); });
+    });
+  }
+
+  std::optional<NodeId> readSegment(const std::string& kind, const YNode& key, const YNode& v) {
+    return primitive(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      auto a = requiredVec3(m, "a"), b = requiredVec3(m, "b");
+      auto r = required(m, "radius");
+      auto tex = texture(m);
+      if (!a || !b || !r) return std::nullopt;
+      return build(key, [&] { return tree_.segment(*a, *b, float(*r), tex); });
+    });
+  }
+
+  std::optional<NodeId> readCone(const std::string& kind, const YNode& key, const YNode& v) {
+    return primitive(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      auto a = requiredVec3(m, "a"), b = requiredVec3(m, "b");
+      std::optional<double> ra, rb;
+      if (m.has("radius")) {
+        ra = rb = m.number("radius", 0.0);
+      } else {
+        ra = required(m, "radius_a");
+        rb = required(m, "radius_b");
+      }
+      // `delta_a` names the factor 1.75 in a tree: section; here the radius r_B had the name.
+      if (auto old = m.get("delta_a"))
+        old->error(diags_, "a blob cone's 'delta_a' is now 'offset_radius' (r_B of Eq. 4: the cone is shortened "
+                           "by 1.75*offset_radius); 'delta_a' is the factor 1.75 of a tree: section");
+      double offsetRadius = m.number("offset_radius", 0.0, 0.0);
+      auto tex = texture(m);
+      if (!a || !b || !ra || !rb) return std::nullopt;
+      // Tree paper Eq. 4: the basal internode is shortened at its tip by δA = 1.75·r_B.
+      Vec3 tip = *b;
+      double rTip = *rb;
+      if (offsetRadius > 0) {
+        float len = glm::length(*b - *a);
+        float cut = float(1.75 * offsetRadius);
+        if (cut >= len) {
+          m.get("offset_radius")->error(diags_, "'offset_radius' shortens the cone by 1.75*" +
+                                                    std::to_string(offsetRadius) + ", more than its length " +
+                                                    std::to_string(len));
+          return std::nullopt;
+        }
+        float t = 1.0f - cut / len;
+        tip = *a + t * (*b - *a);
+        rTip = *ra + t * (*rb - *ra);
+      }
+      return build(key, [&] { return tree_.cone(*a, tip, float(*ra), float(rTip), tex); });
+    });
+  }
+
+  std::optional<NodeId> readTorus(const std::string& kind, const YNode& key, const YNode& v) {
+    return primitive(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      Vec3 c = m.vec3("center", Vec3(0.0f));
+      Vec3 axis = m.vec3("axis", Vec3(0, 1, 0));
+      auto major = required(m, "major"), minor = required(m, "minor");
+      auto tex = texture(m);
+      if (!major || !minor) return std::nullopt;
+      return build(key, [&] { return tree_.torus(c, axis, float(*major), float(*minor), tex); });
+    });
+  }
+
+  std::optional<NodeId> readHalfspace(const std::string& kind, const YNode& key, const YNode& v) {
+    return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      Vec3 p = m.vec3("point", Vec3(0.0f));
+      auto n = requiredVec3(m, "normal");
+      double ramp = m.number("ramp", 1e-3, 1e-9);
+      if (!n) return std::nullopt;
+      return build(key, [&] { return tree_.halfspace(p, *n, float(ramp)); });
+    });
+  }
+
+  std::optional<NodeId> readBox(const std::string& kind, const YNode& key, const YNode& v) {
+    return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      auto lo = requiredVec3(m, "lo"), hi = requiredVec3(m, "hi");
+      double ramp = m.number("ramp", 1e-3, 1e-9);
+      if (!lo || !hi) return std::nullopt;
+      return build(key, [&] { return tree_.box(*lo, *hi, float(ramp)); });
+    });
+  }
+
+  std::optional<NodeId> readSpiralPoints(const std::string& kind, const YNode& key, const YNode& v) {
+    return operands(key, v, kind, [&](MapReader& m) { return spiral(key, m); });
+  }
+
+  std::optional<NodeId> readCombination(const std::string& kind, const YNode& key, const YNode& v) {
+      auto kids = childList(v, kind);
+      if (!kids) return std::nullopt;
+      return build(key, [&] {
+        return kind == "blend" ? tree_.blend(*kids) : kind == "union" ? tree_.unite(*kids) : tree_.intersect(*kids);
+      });
+  }
+
+  std::optional<NodeId> readDifference(const std::string& kind, const YNode& key, const YNode& v) {
+      auto kids = childList(v, kind);
+      if (!kids) return std::nullopt;
+      if (kids->size() != 2) {
+        v.error(diags_, "'difference' takes exactly two nodes [a, b] (a minus b), got " +
+                            std::to_string(kids->size()));
+        return std::nullopt;
+      }
+      return build(key, [&] { return tree_.difference((*kids)[0], (*kids)[1]); });
+  }
+
+  std::optional<NodeId> readRicci(const std::string& kind, const YNode& key, const YNode& v) {
+    return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      auto n = required(m, "n", 1.0, 1e4);
+      auto kids = children(m, kind);
+      if (!n || !kids) return std::nullopt;
+      return build(key, [&] { return tree_.ricci(*kids, float(*n)); });
+    });
+  }
+
+  std::optional<NodeId> readControlled(const std::string& kind, const YNode& key, const YNode& v) {
+    return operands(key, v, kind, [&](MapReader& m) { return controlled(key, m); });
+  }
+
+  std::optional<NodeId> readPcm(const std::string& kind, const YNode& key, const YNode& v) {
+    return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      blobtree::PcmParams p;
+      p.width = float(m.number("width", p.width, 1e-6, 1.0));
+      p.slope = float(m.number("slope", p.slope, 0.0, 10.0));
+      p.bulgeScale = float(m.number("bulge", p.bulgeScale, 0.0, 10.0));
+      auto kids = children(m, kind);
+      if (!kids) return std::nullopt;
+      return build(key, [&] { return tree_.pcm(*kids, p); });
+    });
+  }
+
+  std::optional<NodeId> readNegative(const std::string& kind, const YNode& key, const YNode& v) {
+    return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      double w = m.number("weight", 1.0, 0.0, 1e3);
+      auto c = child(m, kind);
+      if (!c) return std::nullopt;
+      return build(key, [&] { return tree_.negative(*c, float(w)); });
+    });
+  }
+
+  std::optional<NodeId> readTranslate(const std::string& kind, const YNode& key, const YNode& v) {
+    return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      auto off = requiredVec3(m, "offset");
+      auto c = child(m, kind);
+      if (!off || !c) return std::nullopt;
+      return build(key, [&] { return tree_.translate(*c, *off); });
+    });
+  }
+
+  std::optional<NodeId> readScale(const std::string& kind, const YNode& key, const YNode& v) {
+    return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      std::optional<Vec3> f;
+      if (auto fv = m.get("factors")) {
+        if (fv->isSequence())
+          f = fv->asVec3(diags_, "'factors'", 1e-6, 1e6);
+        else if (auto s = fv->asNumber(diags_, "'factors'", 1e-6, 1e6))
+          f = Vec3(float(*s));
+      } else {
+        m.node().error(diags_, "missing required key 'factors' in scale");
+      }
+      auto c = child(m, kind);
+      if (!f || !c) return std::nullopt;
+      return build(key, [&] { return tree_.scale(*c, *f); });
+    });
+  }
+
+  std::optional<NodeId> readRotate(const std::string& kind, const YNode& key, const YNode& v) {
+    return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      Vec3 axis = m.vec3("axis", Vec3(0, 1, 0));
+      auto deg = required(m, "angle_deg", -3600.0, 3600.0);
+      auto c = child(m, kind);
+      if (!deg || !c) return std::nullopt;
+      return build(key, [&] { return tree_.rotate(*c, axis, float(radians(*deg))); });
+    });
+  }
+
+  std::optional<NodeId> readBend(const std::string& kind, const YNode& key, const YNode& v) {
+    return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      blobtree::Bend bend;
+      auto a = requiredVec3(m, "a"), b = requiredVec3(m, "b");
+      bend.direction = m.vec3("direction", bend.direction);
+      bool hasAngle = m.has("angle_deg"), hasSagitta = m.has("sagitta");
+      double angle = m.number("angle_deg", 0.0, 0.0, 180.0);
+      double sagitta = m.number("sagitta", 0.0, 0.0);
+      if (hasAngle == hasSagitta)
+        m.node().error(diags_, "bend needs exactly one of 'sagitta' and 'angle_deg'");
+      auto c = child(m, kind);
+      if (!a || !b || !c || hasAngle == hasSagitta) return std::nullopt;
+      if (hasAngle) bend = blobtree::Bend::fromAngle(*a, *b, bend.direction, float(radians(angle)));
+      else bend.a = *a, bend.b = *b, bend.sagitta = float(sagitta);
+      return build(key, [&] { return tree_.bend(*c, bend); });
+    });
+  }
+
+  std::optional<NodeId> readTwist(const std::string& kind, const YNode& key, const YNode& v) {
+    return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      blobtree::Twist t;
+      t.origin = m.vec3("origin", t.origin);
+      t.axis = m.vec3("axis", t.axis);
+      auto rate = required(m, "rate_deg", -1e6, 1e6);
+      auto c = child(m, kind);
+      if (!rate || !c) return std::nullopt;
+      t.rateRadPerUnit = float(radians(*rate));
+      return build(key, [&] { return tree_.twist(*c, t); });
+    });
+  }
+
+  std::optional<NodeId> readTaper(const std::string& kind, const YNode& key, const YNode& v) {
+    return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      blobtree::Taper t;
+      t.origin = m.vec3("origin", t.origin);
+      t.axis = m.vec3("axis", t.axis);
+      auto len = required(m, "length", 0.0);
+      t.scale0 = float(m.number("scale0", 1.0, 0.0));
+      t.scale1 = float(m.number("scale1", 1.0, 0.0));
+      auto c = child(m, kind);
+      if (!len || !c) return std::nullopt;
+      t.length = float(*len);
+      return build(key, [&] { return tree_.taper(*c, t); });
+    });
+  }
+
+  // A node whose value is a parameter map; reads it with f and reports unknown keys.
+  template <class F>
+  std::optional<NodeId> operands(const YNode& key, const YNode& v, const std::string& kind, F&& f) {
+    (void)key;
+    if (!v.isMap()) {
+      v.error(diags_, inQuotes(kind) + " must be a map of its parameters");
+      return std::nullopt;
+    }
+    MapReader m(v, diags_, kind);
+    std::string outer = std::exchange(context_, kind);
+    std::optional<NodeId> id = f(m);
+    context_ = outer;
+    m.finish();
+    return id;
+  }
+
+  // A primitive: as operands, plus the field `weight`.
+  template <class F>
+  std::optional<NodeId> primitive(const YNode& key, const YNode& v, const std::string& kind, F&& f) {
+    return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
+      double w = m.number("weight", 1.0, 0.0, 1e3);
+      auto id = f(m);
+      if (id && w != 1.0) return build(key, [&] { return tree_.setWeight(*id, float(w)); });
+      return id;
+    });
+  }
+
+  // Runs a builder call with the key's location attached to its errors.
+  template <class F>
+  std::optional<NodeId> build(const YNode& at, F&& f) {
+    tree_.setSourceLoc(at.loc());
+    try {
+      return f();
+    } catch (const InputError& e) {
+      for (Diagnostic d : e.diagnostics()) {
+        if (d.loc.file.empty()) d.loc = at.loc();
+        if (d.sourceLine.empty() && d.loc.file == at.loc().file) d.sourceLine = at.file().sourceLine(d.loc.line);
+        diags_.add(std::move(d));
+      }
+    } catch (const std::exception& e) {
+      at.error(diags_, e.what());
+    }
+    return std::nullopt;
+  }
+
+  std::optional<double> required(MapReader& m, std::string_view key, double min = 0.0,
+                                 double max = std::numeric_limits<double>::infinity()) {
+    auto v = m.get(key);
+    if (!v) {
+      m.node().error(diags_, "missing required key " + inQuotes(key) + " in " + kindOf(m));
+      return std::nullopt;
+    }
+    return v->asNumber(diags_, inQuotes(key), min, max);
+  }
+
+  std::optional<Vec3> requiredVec3(MapReader& m, std::string_view key) {
+    auto v = m.get(key);
+    if (!v) {
+      m.node().error(diags_, "missing required key " + inQuotes(key) + " in " + kindOf(m));
+      return std::nullopt;
+    }
+    return v->asVec3(diags_, inQuotes(key));
+  }
+
+  std::string kindOf(MapReader& m) const {
+    (void)m;
+    return context_;
+  }
+
+  // A primitive's `texture: {id, u_scale, ...}`; without it the primitive carries
+  // kNoTexture and shows the material color.
+  blobtree::TextureAttr texture(MapReader& m) {
+    blobtree::TextureAttr t;
+    t.textureId = kNoTexture;
+    auto tv = m.section("texture");
+    if (!tv) return t;
+    MapReader tm(*tv, diags_, "texture");
+    if (auto idNode = tm.get("id")) {
+      if (textureCount_ == 0) {
+        idNode->error(diags_, "texture id " + idNode->scalar() +
+                                  " names no texture: the species has no 'textures:' list");
+      } else if (auto id = idNode->asInteger(diags_, "'id'", 0, textureCount_ < 0 ? kNoTexture - 1 : textureCount_ - 1)) {
+        t.textureId = uint16_t(*id);
+      }
+    } else {
+      tm.node().error(diags_, "missing required key 'id' in texture (an index into the species' 'textures:' list)");
+    }
+    t.uvScale = Vec2(float(tm.number("u_scale", 1.0)), float(tm.number("v_scale", 1.0)));
+    t.uvOffset = Vec2(float(tm.number("u_offset", 0.0)), float(tm.number("v_offset", 0.0)));
+    t.refDir = tm.vec3("ref_dir", t.refDir);
+    tm.finish();
+    return t;
+  }
+
+  // A sequence of nodes (the value itself); nullopt after an error.
+  std::optional<std::vector<NodeId>> childList(const YNode& seq, const std::string& kind) {
+    if (!seq.isSequence()) {
+      seq.error(diags_, inQuotes(kind) + " must be a sequence of blob nodes");
+      return std::nullopt;
+    }
+    auto items = seq.items();
+    if (items.empty()) {
+      seq.error(diags_, inQuotes(kind) + " needs at least one node");
+      return std::nullopt;
+    }
+    std::vector<NodeId> ids;
+    bool ok = true;
+    for (const auto& item : items) {
+      auto id = read(item);
+      if (id) ids.push_back(*id);
+      else ok = false;
+    }
+    if (!ok) return std::nullopt;
+    return ids;
+  }
+
+  std::optional<std::vector<NodeId>> children(MapReader& m, const std::string& kind) {
+    auto v = m.get("children");
+    if (!v) {
+      m.node().error(diags_, "missing required key 'children' in " + kind);
+      return std::nullopt;
+    }
+    return childList(*v, kind + " children");
+  }
+
+  std::optional<NodeId> child(MapReader& m, const std::string& kind) {
+    auto v = m.get("child");
+    if (!v) {
+      m.node().error(diags_, "missing required key 'child' in " + kind);
+      return std::nullopt;
+    }
+    return read(*v);
+  }
+
+  // Controlled blending (murex paper Eq. 6): children blend only within the listed groups.
+  std::optional<NodeId> controlled(const YNode& key, MapReader& m) {
+    auto kids = children(m, "controlled");
+    std::vector<std::vector<uint32_t>> groups;
+    auto gv = m.get("groups");
+    if (!gv) {
+      m.node().error(diags_, "missing required key 'groups' in controlled (a list of index lists, or chain)");
+      return std::nullopt;
+    }
+    if (!kids) return std::nullopt;
+    uint32_t n = uint32_t(kids->size());
+    if (gv->isScalar()) {
+      if (gv->scalar() != "chain") {
+        gv->error(diags_, "'groups' must be a list of index lists or 'chain', got '" + gv->scalar() + "'");
+        return std::nullopt;
+      }
+      for (uint32_t i = 0; i + 1 < n; ++i) groups.push_back({i, i + 1});
+      if (n == 1) groups.push_back({0});
+    } else if (gv->isSequence()) {
+      bool ok = true;
+      for (const auto& g : gv->items()) {
+        if (!g.isSequence()) {
+          g.error(diags_, "each group must be a list of child indices, e.g. [0, 1]");
+          ok = false;
+          continue;
+        }
+        std::vector<uint32_t> group;
+        for (const auto& i : g.items()) {
+          auto idx = i.asInteger(diags_, "a child index", 0, int64_t(n) - 1);
+          if (idx) group.push_back(uint32_t(*idx));
+          else ok = false;
+        }
+        groups.push_back(std::move(group));
+      }
+      if (!ok) return std::nullopt;
+    } else {
+      gv->error(diags_, "'groups' must be a list of index lists or 'chain'");
+      return std::nullopt;
+    }
+    return build(key, [&] { return tree_.controlledBlend(*kids, groups); });
+  }
+
+  // Points on a logarithmic helico-spiral (murex paper Eq. 1-3), blended by summation.
+  // R(θ) = r0·λ^(θ/360°), H(θ) = R(θ)·cot β (the shell grows downwards, apex at the
+  // origin, axis +Y), and the tangent-circle size D(θ) = R(θ)(λ−1)/((λ+1) sin β) scaled
+  // by `size`.
+  std::optional<NodeId> spiral(const YNode& key, MapReader& m) {
+    double r0 = m.number("r0", 1.0, 1e-6);
+    double lambda = m.number("lambda", 1.3, 1.0 + 1e-6, 100.0);
+    double beta = radians(m.number("beta_deg", 22.5, 1e-3, 90.0));
+    double theta0 = m.number("theta_deg", 0.0, -1e5, 1e5);
+    double step = m.number("step_deg", 20.0, -360.0, 360.0);
+    int64_t count = m.integer("count", 6, 1, 100000);
+    double size = m.number("size", 1.0, 1e-6, 100.0);
+    std::vector<NodeId> ids;
+    for (int64_t i = 0; i < count; ++i) {
+      double thetaDeg = theta0 + double(i) * step;
+      double R = r0 * std::pow(lambda, thetaDeg / 360.0);
+      double H = R / std::tan(beta);
+      double D = R * (lambda - 1.0) / ((lambda + 1.0) * std::sin(beta));
+      double th = radians(thetaDeg);
+      Vec3 c(float(R * std::cos(th)), float(-H), float(R * std::sin(th)));
+      blobtree::TextureAttr none;
+      none.textureId = kNoTexture;
+      auto id = build(key, [&] { return tree_.point(c, float(size * D), none); });
+      if (!id) return std::nullopt;
+      ids.push_back(*id);
+    }
+    if (ids.size() == 1) return ids[0];
+    return build(key, [&] { return tree_.blend(ids); });
+  }
+
+  BlobTree& tree_;
+  DiagnosticList& diags_;
+  int textureCount_ = -1;  // textures the ids may name; -1: any id
+  int depth_ = 0;
+  std::string context_;  // the kind whose parameter map is being read
+};
+
+}  // namespace
+
+std::optional<blobtree::NodeId> readBlobNode(const YNode& node, blobtree::BlobTree& tree, DiagnosticList& diags,
+                                             int textureCount) {
+  NodeReader reader(tree, diags, textureCount);
+  return reader.read(node);
+}
+
+namespace {
+
+const std::vector<std::string> kTextureKinds = {"image", "color", "noise", "bark", "stripes", "spots", "leaf"};
+
+uint64_t readSeed(MapReader& m) { return uint64_t(m.integer("seed", 0, 0)); }
+
+// One procedural texture's options map (null reads as all defaults).
+std::optional<textures::Texture> readProcedural(const std::string& kind, const YNode& v, DiagnosticList& diags) {
+  if (!v.isMap() && !v.isNull()) {
+    v.error(diags, inQuotes(kind) + " must be a map of its options, e.g. {" + kind + ": {seed: 1}}");
+    return std::nullopt;
+  }
+  MapReader m(v, diags, kind);
+  std::optional<textures::Texture> out;
+  if (kind == "noise") {
+    textures::NoiseColorOptions o;
+    o.colorA = m.color("color_a", o.colorA);
+    o.colorB = m.color("color_b", o.colorB);
+    o.scale = m.number("scale", o.scale, 1e-6, 1e6);
+    o.fractal.octaves = int(m.integer("octaves", o.fractal.octaves, 1, 16));
+    o.fractal.lacunarity = m.number("lacunarity", o.fractal.lacunarity, 1.0, 16.0);
+    o.fractal.gain = m.number("gain", o.fractal.gain, 0.0, 1.0);
+    o.turbulence = m.boolean("turbulence", o.turbulence);
+    o.solid = m.boolean("solid", o.solid);
+    o.seed = readSeed(m);
+    out = textures::NoiseTexture(o);
+  } else if (kind == "bark") {
+    textures::BarkOptions o;
+    o.furrows = int(m.integer("furrows", o.furrows, 1, 1000));
+    o.warp = m.number("warp", o.warp, 0.0, 100.0);
+    o.alongFrequency = m.number("along_frequency", o.alongFrequency, 0.0, 1e4);
+    o.sharpness = m.number("sharpness", o.sharpness, 1e-3, 100.0);
+    o.grain = m.number("grain", o.grain, 0.0, 10.0);
+    o.cracks = m.number("cracks", o.cracks, 0.0, 10.0);
+    o.tileV = int(m.integer("tile_v", o.tileV, 0, 100000));
+    o.ridgeColor = m.color("ridge_color", o.ridgeColor);
+    o.furrowColor = m.color("furrow_color", o.furrowColor);
+    o.seed = readSeed(m);
+    out = textures::BarkTexture(o);
+  } else if (kind == "stripes") {
+    textures::StripesOptions o;
+    o.frequency = m.number("frequency", o.frequency, 0.0, 1e6);
+    o.duty = m.number("duty", o.duty, 0.0, 1.0);
+    o.wobble = m.number("wobble", o.wobble, 0.0, 100.0);
+    o.softness = m.number("softness", o.softness, 0.0, 1.0);
+    o.spiral = m.boolean("spiral", o.spiral);
+    o.baseColor = m.color("base_color", o.baseColor);
+    o.stripeColor = m.color("stripe_color", o.stripeColor);
+    o.seed = readSeed(m);
+    out = textures::StripesTexture(o);
+  } else if (kind == "spots") {
+    textures::SpotsOptions o;
+    o.frequency = m.number("frequency", o.frequency, 0.0, 1e6);
+    o.radius = m.number("radius", o.radius, 0.0, 2.0);
+    o.radiusJitter = m.number("radius_jitter", o.radiusJitter, 0.0, 1.0);
+    o.jitter = m.number("jitter", o.jitter, 0.0, 1.0);
+    o.softness = m.number("softness", o.softness, 0.0, 1.0);
+    o.density = m.number("density", o.density, 0.0, 1.0);
+    o.baseColor = m.color("base_color", o.baseColor);
+    o.spotColor = m.color("spot_color", o.spotColor);
+    o.seed = readSeed(m);
+    out = textures::SpotsTexture(o);
+  } else {  // leaf
+    textures::LeafOptions o;
+    o.veins = int(m.integer("veins", o.veins, 0, 1000));
+    o.veinAngleDeg = m.number("vein_angle_deg", o.veinAngleDeg, 0.0, 90.0);
+    o.veinWidth = m.number("vein_width", o.veinWidth, 0.0, 0.5);
+    o.bladeColor = m.color("blade_color", o.bladeColor);
+    o.veinColor = m.color("vein_color", o.veinColor);
+    o.mottle = m.number("mottle", o.mottle, 0.0, 10.0);
+    o.seed = readSeed(m);
+    out = textures::LeafTexture(o);
+  }
+  m.finish();
+  return out;
+}
+
+// `image: PATH`: resolved against the species file with policy, opened now so a missing
+// or unreadable file is reported at the path before anything is rendered.
+std::optional<textures::Texture> readImage(const YNode& v, const PathPolicy& policy, DiagnosticList& diags) {
+  if (!v.isScalar()) {
+    v.error(diags, "'image' must be a file name (a path relative to the species file)");
+    return std::nullopt;
+  }
+  auto path = resolveReference(v, v.scalar(), policy, diags, /*mustExist=*/false);
+  if (!path) return std::nullopt;
+  try {
+    return textures::ImageTexture::open(path->string(), v.loc());
+  } catch (const InputError& e) {
+    for (Diagnostic d : e.diagnostics()) {
+      if (d.sourceLine.empty() && d.loc.file == v.loc().file) d.sourceLine = v.file().sourceLine(d.loc.line);
+      diags.add(std::move(d));
+    }
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::shared_ptr<const textures::TextureRegistry> readBlobTextures(const YNode& list, const PathPolicy& policy,
+                                                                  DiagnosticList& diags) {
+  auto registry = std::make_shared<textures::TextureRegistry>();
+  if (!list.isSequence()) {
+    list.error(diags, "'textures' must be a sequence of textures, e.g. [{image: maps/bark.png}, {stripes: {}}]");
+    return registry;
+  }
+  const auto items = list.items();
+  if (items.size() >= kNoTexture) {
+    list.error(diags, "'textures' holds " + std::to_string(items.size()) + " textures, more than " +
+                          std::to_string(kNoTexture - 1));
+    return registry;
+  }
+  for (const YNode& entry : items) {
+    if (!entry.isMap() || entry.pairs().size() != 1 || !entry.pairs()[0].first.isScalar()) {
+      entry.error(diags, "a texture must be a map with one key naming its kind, e.g. {image: maps/bark.png} "
+                         "or {stripes: {frequency: 8}}");
+      continue;
+    }
+    const auto [key, value] = entry.pairs()[0];  // a copy: pairs() is a temporary
+    const std::string kind = key.scalar();
+    std::optional<textures::Texture> t;
+    if (kind == "image") {
+      t = readImage(value, policy, diags);
+    } else if (kind == "color") {
+      if (auto c = value.asColor(diags, "'color'")) t = textures::ConstantTexture{*c};
+    } else if (std::find(kTextureKinds.begin(), kTextureKinds.end(), kind) != kTextureKinds.end()) {
+      t = readProcedural(kind, value, diags);
+    } else {
+      key.error(diags, "unknown texture kind " + inQuotes(kind) + didYouMean(kind, kTextureKinds) +
+                           " (image, color, noise, bark, stripes, spots or leaf)");
+    }
+    if (t) registry->add(std::move(*t));
+  }
+  return registry;
+}
+
+std::optional<BlobSpecies> readBlobSpecies(MapReader& top, DiagnosticList& diags, const PathPolicy& policy) {
+  std::string kernel = top.choice("kernel", "wyvill", {"wyvill", "soft"});
+  float cell = 0.0f;
+  if (auto mesh = top.section("mesh")) {
+    MapReader mm(*mesh, diags, "mesh");
+    cell = float(mm.number("cell", 0.0, 0.0, 1e6));
+    mm.finish();
+  }
+  auto blob = top.get("blob");
+  if (!blob) {
+    top.node().error(diags, "missing required key 'blob' in species file (the BlobTree of a kind: blob species)");
+    return std::nullopt;
+  }
+  // Textures first, so primitives' texture ids can be checked against their count.
+  std::shared_ptr<const textures::TextureRegistry> registry;
+  int textureCount = 0;
+  if (auto list = top.get("textures")) {
+    registry = readBlobTextures(*list, policy, diags);
+    // Ids are checked against the list's length (not the registry's, which leaves out
+    // broken entries), so one mistake is reported once; no list checks nothing more.
+    textureCount = list->isSequence() ? int(list->items().size()) : -1;
+    if (registry->size() == 0) registry.reset();
+  }
+  BlobSpecies s{.name = {},
+                .tree = blobtree::BlobTree(kernel == "soft" ? blobtree::Kernel::SoftObject : blobtree::Kernel::Wyvill),
+                .root = 0,
+                .cellSize = cell,
+                .textures = registry};
+  auto root = readBlobNode(*blob, s.tree, diags, textureCount);
+  if (!root) return std::nullopt;
+  s.root = *root;
+  return s;
+}
+
+namespace {
+
+BlobSpecies readWhole(const std::shared_ptr<const YamlFile>& file, DiagnosticList& diags, const std::string& stem,
+                      const PathPolicy& policy) {
+  if (!file) diags.throwIfErrors();
+  MapReader top(file->rootNode(), diags, "species file");
+  auto kind = top.requiredString("kind");
+  if (kind && *kind != "blob")
+    top.get("kind")->error(diags, "this reader takes kind: blob species, got kind: " + *kind);
+  std::string name = top.string("name", stem);
+  top.string("description");
+  top.allow({"render", "stages"});  // shared species keys, read and checked by loadSpecies
+  std::optional<BlobSpecies> s;
+  if (!kind || *kind == "blob") s = readBlobSpecies(top, diags, policy);
+  top.finish();
+  diags.throwIfErrors();
+  if (!s) throw InputError(file->rootNode().loc(), "invalid blob species");
+  s->name = name;
+  return std::move(*s);
+}
+
+}  // namespace
+
+BlobSpecies loadBlobSpecies(const std::filesystem::path& path, const PathPolicy& policy) {
+  DiagnosticList diags;
+  auto file = YamlFile::load(path, diags);
+  return readWhole(file, diags, path.stem().string(), policy);
+}
+
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// The blob's texture registry as a part's texture table (ids = the primitives' texture ids).
+render::TextureTable textureTable(const std::shared_ptr<const textures::TextureRegistry>& registry) {
+  render::TextureTable table;
+  if (!registry) return table;
+  for (textures::TextureId id = 0; id < registry->size(); ++id)
+    table.push_back([registry, id](Vec2 uv, const Vec3& p) { return registry->color(id, uv, p); });
+  return table;
+}
+
+/// A BlobTree written in the species file: one stage.
+class BlobModel final : public KindModel {
+ public:
+  explicit BlobModel(const BlobSpecies& blob)
+      : blob_(blob), compiled_(std::make_shared<const blobtree::CompiledBlob>(blobtree::compile(blob.tree, blob.root))) {}
+
+  bool hasSurface() const override { return true; }
+  Stage finalStage() const override { return {}; }
+  Stage stageFromIndex(int) const override { return {}; }
+  std::vector<Stage> stripStages(int) const override { return {Stage{}}; }
+  std::vector<Stage> animationFrames(int, int, int) const override { return {Stage{}}; }
+  std::string stageName(const Stage&) const override { return {}; }
+  int stageNumber(const Stage& stage) const override { return stage.step; }
+
+  Box3 frameBox() override {
+    if (frame_) return *frame_;
+    // The blob's surface lies inside its support; a scene shrinks the support to the
+    // surface with interval bounds, which is what the camera should frame.
+    render::Scene probe;
+    probe.addImplicit(*compiled_, probe.addMaterial({}));
+    Box3 box = probe.bounds();
+    frame_ = box.empty() ? Box3{Vec3(-0.5f), Vec3(0.5f)} : box;
+    return *frame_;
+  }
+
+  BuiltStage build(const Stage&, GeometryMode mode, const SpeciesRender& look) override {
+    if (mode == GeometryMode::Skeleton) throw UsageError("blob species have no skeleton: use --mode exact or mesh");
+    BuiltStage out;
+    const auto t0 = std::chrono::steady_clock::now();
+    out.figures.primitives = compiled_->primitiveCount();
+    if (mode == GeometryMode::Mesh) {
+      blobtree::PolygonizeOptions po;
+      po.cellSize = blob_.cellSize;
+      auto mesh = std::make_shared<blobtree::PolygonizeResult>(blobtree::polygonizeDetailed(*compiled_, po));
+      out.figures.triangles = mesh->mesh.triangleCount();
+      out.geometry.parts.push_back(render::PolygonizedPart{std::move(mesh), look.surface, textureTable(blob_.textures)});
+    } else {
+      out.geometry.parts.push_back(render::ImplicitPart{compiled_, look.surface, {}, textureTable(blob_.textures)});
+    }
+    out.figures.buildSeconds = secondsSince(t0);
+    return out;
+  }
+
+  Mesh buildMesh(const Stage&, float cellSize, bool progress, ModelFigures& fig) override {
+    fig.primitives = compiled_->primitiveCount();
+    blobtree::PolygonizeOptions po;
+    po.cellSize = cellSize > 0 ? cellSize : blob_.cellSize;
+    po.progress = progress;
+    return blobtree::polygonize(*compiled_, po);
+  }
+
+  GalleryMotion galleryMotion(bool) override {
+    GalleryMotion m;
+    m.turntable = true;  // a blob does not grow: the camera turns around it
+    return m;
+  }
+
+ private:
+  const BlobSpecies& blob_;
+  std::shared_ptr<const blobtree::CompiledBlob> compiled_;
+  std::optional<Box3> frame_;
+};
+
+}  // namespace
+
+std::shared_ptr<const KindSpec> readBlobSpec(MapReader& top, Species& species, DiagnosticList& diags) {
+  if (!top.has("blob")) {
+    top.allow({"kernel", "mesh", "textures"});
+    top.node().error(diags, "missing required key 'blob' in species file");
+    return nullptr;
+  }
+  std::optional<BlobSpecies> blob = readBlobSpecies(top, diags, species.policy);
+  if (!blob) return nullptr;
+  auto spec = std::make_shared<BlobSpec>();
+  spec->blob = std::move(*blob);
+  spec->blob.name = species.name;
+  return spec;
+}
+
+std::string BlobSpec::checkSummary(const Species& species) const { return " '" + species.name + "'"; }
+
+std::unique_ptr<KindModel> BlobSpec::makeModel(const Species&, const ModelOptions&) const {
+  return std::make_unique<BlobModel>(blob);
+}
+
+}  // namespace sprig

@@ -1,0 +1,90 @@
+#include "model/model.h"
+
+#include <algorithm>
+#include <chrono>
+
+#include "core/diagnostics.h"
+#include "render/camera.h"
+
+namespace sprig {
+
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+SpeciesModel::SpeciesModel(const Species& species, const ModelOptions& options) : species_(species) {
+  if (!species_.spec) throw InputError(species_.loc(), "invalid " + species_.kind + " species");
+  kind_ = species_.spec->makeModel(species_, options);
+}
+
+SpeciesModel::SpeciesModel(const Species& species, const lsystem::GrammarOverrides& extra, int lastStep)
+    : SpeciesModel(species, ModelOptions{extra, lastStep}) {}
+
+SpeciesModel::~SpeciesModel() = default;
+
+ModelFigures SpeciesModel::addToScene(render::Scene& scene, const Stage& stage, GeometryMode mode,
+                                      const SpeciesRender& look) {
+  BuiltStage built = kind_->build(stage, mode, look);
+  scene.add(built.geometry);
+  return built.figures;
+}
+
+Mesh SpeciesModel::buildMesh(const Stage& stage, float cellSize, bool progress, ModelFigures* figures) {
+  ModelFigures fig;
+  const auto t0 = std::chrono::steady_clock::now();
+  Mesh out = kind_->buildMesh(stage, cellSize, progress, fig);
+  fig.triangles = out.triangleCount();
+  fig.buildSeconds = secondsSince(t0);
+  if (figures) *figures = fig;
+  return out;
+}
+
+render::Camera modelCamera(const SpeciesRender& look, const Box3& box, int width, int height) {
+  const double aspect = static_cast<double>(width) / height;
+  if (!look.camera) return render::frameBounds(box, look.view, aspect);
+  const CameraSpec& c = *look.camera;
+  const Vec3 target = c.target ? *c.target : box.center();
+  if (c.position) {
+    render::Camera cam;
+    cam.position = *c.position;
+    cam.target = target;
+    cam.fovYDeg = static_cast<float>(look.view.fovYDeg);
+    return cam;
+  }
+  if (c.distance)
+    return render::orbitCamera(target, look.view.azimuthDeg, look.view.elevationDeg, *c.distance, look.view.fovYDeg);
+  // Only a target: the automatic distance, aimed at the target.
+  render::Camera cam = render::frameBounds(box, look.view, aspect);
+  cam.position += target - cam.target;
+  cam.target = target;
+  return cam;
+}
+
+render::Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job, ModelFigures* figures,
+                          render::RenderStats* stats) {
+  const int lookWidth = look.image.width, lookHeight = look.image.height;
+  int width = job.width > 0 ? job.width : lookWidth;
+  int height = job.height > 0 ? job.height : lookHeight;
+  if (job.width > 0 && job.height <= 0) height = std::max(16, lookHeight * job.width / lookWidth);
+  if (job.height > 0 && job.width <= 0) width = std::max(16, lookWidth * job.height / lookHeight);
+  const Box3 frame = job.frame ? *job.frame : model.frameBox();
+  render::Scene scene;
+  ModelFigures fig = model.addToScene(scene, job.stage, job.mode, look);
+  const auto t0 = std::chrono::steady_clock::now();
+  scene.commit();
+  fig.buildSeconds += secondsSince(t0);
+  fig.cells = scene.stats().implicitCells;
+  render::RenderSettings rs = look.settings(width, height);
+  if (job.samples > 0) rs.spp = job.samples;
+  rs.progress = job.progress;
+  rs.progressLabel = job.progressLabel;
+  render::Image image = render::renderImage(scene, modelCamera(look, frame, width, height), rs, stats);
+  if (figures) *figures = fig;
+  return image;
+}
+
+}  // namespace sprig

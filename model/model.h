@@ -1,0 +1,118 @@
+#pragma once
+/// One species of any kind as renderable geometry at any growth stage.
+///
+/// SpeciesModel is the layer between species files and the commands that show them
+/// (`sprig render`, `sprig mesh`, `sprig animate`, the gallery). It knows how each kind
+/// grows and what it becomes:
+///
+/// | kind  | stage                                  | geometry                                      |
+/// |-------|----------------------------------------|-----------------------------------------------|
+/// | tree  | derivation step + growth fraction      | BlobTree wood + leaf mesh (organisms/tree_builder), or the skeleton preview (model/tree_kind.h) |
+/// | shell | age θ_end in degrees (murex paper §3)  | the shell's BlobTree (model/shell_kind.h)     |
+/// | blob  | none (one stage)                       | the BlobTree written in the species file (model/blob_kind.h) |
+///
+/// Each kind lives in its own file pair behind the KindModel interface (model/kinds.h);
+/// SpeciesModel only forwards to it.
+///
+/// Every stage of a species is framed by one camera (the final stage's box), so strips and
+/// animations do not jump. Building is deterministic: the same species, stage and seed
+/// give the same geometry, and so the same image bytes, at any thread count.
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/mesh.h"
+#include "lsystem/grammar.h"
+#include "model/kinds.h"
+#include "model/species.h"
+#include "render/image.h"
+#include "render/renderer.h"
+#include "render/scene.h"
+
+namespace sprig {
+
+/// A species prepared to be built at any stage: the species and its kind's model.
+/// Not thread-safe; not copyable.
+class SpeciesModel {
+ public:
+  /// Makes the kind's model (a tree reads its grammar with options.extra on top, and grows
+  /// no further than options.lastStep). Throws InputError for bad input.
+  explicit SpeciesModel(const Species& species, const ModelOptions& options = {});
+  /// The same with a tree's command-line overrides and last step.
+  SpeciesModel(const Species& species, const lsystem::GrammarOverrides& extra, int lastStep = -1);
+  ~SpeciesModel();
+  SpeciesModel(const SpeciesModel&) = delete;
+  SpeciesModel& operator=(const SpeciesModel&) = delete;
+
+  const Species& species() const { return species_; }
+
+  /// True when the species says how to build its surface (a tree with a `tree:` section,
+  /// every shell and blob). Trees without one are shown as skeleton previews by the gallery.
+  bool hasSurfaceSettings() const { return kind_->hasSurface(); }
+  /// The mode the gallery uses: Exact with surface settings, else Skeleton.
+  GeometryMode defaultMode() const { return hasSurfaceSettings() ? GeometryMode::Exact : GeometryMode::Skeleton; }
+
+  /// The final stage (tree: last step, fraction 1; shell: the species' age).
+  Stage finalStage() const { return kind_->finalStage(); }
+  /// The stage of a command line `--stage K` (tree: step K; shell: the age after K whorls,
+  /// capped at the species' age). Throws UsageError for K beyond a tree's steps.
+  Stage stageFromIndex(int k) const { return kind_->stageFromIndex(k); }
+  /// The stage of `--age DEG` (capped at the species' age). Throws UsageError for kinds without age.
+  Stage stageAtAge(double ageDeg) const { return kind_->stageAtAge(ageDeg); }
+  /// Up to count growth stages ending at the final stage (species `stages:` when given).
+  std::vector<Stage> stripStages(int count = 5) const { return kind_->stripStages(count); }
+  /// The frames of a growth animation: trees run steps first..last (-1 = final) with
+  /// framesPerStage frames per step; shells grow from their first strip stage to the final
+  /// age in framesPerStage frames per whorl; blobs have one frame.
+  std::vector<Stage> animationFrames(int framesPerStage, int first = 0, int last = -1) const {
+    return kind_->animationFrames(framesPerStage, first, last);
+  }
+  /// Short text for a stage: "step 5", "step 5 at 50%", "age 1392 deg", "".
+  std::string stageName(const Stage& stage) const { return kind_->stageName(stage); }
+  /// The number the gallery shows for a stage (a step, or an age in degrees).
+  int stageNumber(const Stage& stage) const { return kind_->stageNumber(stage); }
+  /// The box the camera frames for every stage: the final stage's bounds (trees: the union
+  /// over their steps).
+  Box3 frameBox() { return kind_->frameBox(); }
+  /// How the gallery animates the species.
+  GalleryMotion galleryMotion(bool final) { return kind_->galleryMotion(final); }
+
+  /// The stage's geometry with look. Throws UsageError for a mode the kind lacks.
+  BuiltStage build(const Stage& stage, GeometryMode mode, const SpeciesRender& look) {
+    return kind_->build(stage, mode, look);
+  }
+  /// Builds stage into scene (a fresh one) with mode; returns its figures.
+  ModelFigures addToScene(render::Scene& scene, const Stage& stage, GeometryMode mode, const SpeciesRender& look);
+
+  /// The stage's surface as one closed triangle mesh (trees: wood and leaves together).
+  /// cellSize 0 = automatic. progress shows a bar on a terminal.
+  Mesh buildMesh(const Stage& stage, float cellSize, bool progress, ModelFigures* figures = nullptr);
+
+ private:
+  Species species_;
+  std::unique_ptr<KindModel> kind_;
+};
+
+/// What to render.
+struct RenderJob {
+  int width = 0;   ///< 0 = the species' render width (height keeps its aspect when only one is given)
+  int height = 0;  ///< 0 = the species' render height
+  int samples = 0;  ///< 0 = the species' samples
+  GeometryMode mode = GeometryMode::Exact;
+  Stage stage;
+  std::optional<Box3> frame;  ///< the box the camera frames (default: the model's frameBox())
+  bool progress = true;
+  std::string progressLabel = "render";
+};
+
+/// Renders one stage of model with look (camera framed on model.frameBox(), or the species'
+/// explicit camera). Fills figures and stats when given.
+render::Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job,
+                          ModelFigures* figures = nullptr, render::RenderStats* stats = nullptr);
+
+/// The camera for an image of width x height of a model framed on box with look.
+render::Camera modelCamera(const SpeciesRender& look, const Box3& box, int width, int height);
+
+}  // namespace sprig

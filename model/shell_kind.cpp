@@ -1,0 +1,510 @@
+#include "model/shell_kind.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <stdexcept>
+
+#include "blobtree/polygonize.h"
+
+namespace sprig {
+
+using organisms::GeneratingPrimitive;
+using organisms::GeneratingSurface;
+using organisms::ShellParams;
+using organisms::VarixSpine;
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+/// `'key'` for messages (appended piecewise: GCC 12 warns falsely on "'" + string + "'").
+std::string quoted(std::string_view key) {
+  std::string q;
+  q.reserve(key.size() + 2);
+  q.push_back('\'');
+  q.append(key);
+  q.push_back('\'');
+  return q;
+}
+
+float num(MapReader& r, std::string_view key, float def, double lo = -kInf, double hi = kInf) {
+  return static_cast<float>(r.number(key, def, lo, hi));
+}
+
+/// A part section: absent (keeps `enabled`), `true`/`false`, or a map (enables it).
+std::optional<YNode> partSection(MapReader& top, std::string_view key, bool& enabled, DiagnosticList& diags) {
+  auto n = top.get(key);
+  if (!n) return std::nullopt;
+  if (n->isScalar()) {
+    if (auto b = n->asBoolean(diags, quoted(key))) enabled = *b;
+    return std::nullopt;
+  }
+  if (!n->isMap() && !n->isNull()) {
+    n->error(diags, quoted(key) + " must be a map or true/false");
+    return std::nullopt;
+  }
+  enabled = true;
+  return n;
+}
+
+std::vector<float> floatList(const YNode& n, DiagnosticList& diags, std::string_view what, double lo, double hi) {
+  std::vector<float> out;
+  if (!n.isSequence()) {
+    n.error(diags, quoted(what) + " must be a sequence");
+    return out;
+  }
+  for (const YNode& v : n.items())
+    if (auto x = v.asNumber(diags, quoted(what) + " entry", lo, hi)) out.push_back(static_cast<float>(*x));
+  return out;
+}
+
+void readGenerating(MapReader& top, ShellParams& p, DiagnosticList& diags) {
+  auto g = top.get("generating");
+  if (!g) return;
+  if (g->isScalar()) {
+    static const std::vector<std::string> kinds = {"point", "murex"};
+    const std::string k = g->scalar();
+    if (k == "point")
+      p.generating = GeneratingSurface::point();
+    else if (k == "murex")
+      p.generating = GeneratingSurface::murex(1.333 * p.whorlDeg);
+    else
+      g->error(diags, "unknown generating surface '" + k + "' (point, murex or a map of primitives)" + didYouMean(k, kinds));
+    return;
+  }
+  MapReader gen(*g, diags, "generating");
+  p.generating.primitives.clear();
+  for (const YNode& item : gen.sequence("primitives")) {
+    if (!item.isMap() || item.pairs().size() != 1) {
+      item.error(diags, "a generating primitive must be a map with one key: point or cone");
+      continue;
+    }
+    const auto& [keyNode, value] = item.pairs().front();
+    const std::string kind = keyNode.scalar();
+    GeneratingPrimitive prim;
+    MapReader r(value, diags, kind);
+    if (kind == "point") {
+      prim.kind = GeneratingPrimitive::Kind::Point;
+      prim.a = r.vec3("center", Vec3(0.0f), -100, 100);
+      prim.radiusA = prim.radiusB = num(r, "radius", 1.0f, 1e-4, 100);
+    } else if (kind == "cone") {
+      prim.kind = GeneratingPrimitive::Kind::Cone;
+      prim.a = r.vec3("a", Vec3(0.0f), -100, 100);
+      prim.b = r.vec3("b", Vec3(0.0f, 1.0f, 0.0f), -100, 100);
+      prim.radiusA = num(r, "radius_a", 0.3f, 1e-4, 100);
+      prim.radiusB = num(r, "radius_b", 0.2f, 1e-4, 100);
+      prim.bendDeg = num(r, "bend", 0.0f, 0.0, 180.0);
+      prim.bendDirection = r.vec3("bend_direction", Vec3(1, 0, 0), -1e3, 1e3);
+      prim.canal = r.boolean("canal", false);
+      if (glm::length(prim.b - prim.a) < 1e-4f) value.error(diags, "cone 'a' and 'b' must differ");
+    } else {
+      static const std::vector<std::string> kinds = {"point", "cone"};
+      keyNode.error(diags, "unknown generating primitive '" + kind + "' (point or cone)" + didYouMean(kind, kinds));
+      continue;
+    }
+    prim.lastDeg = r.number("last", 0.0, 0.0, 1e6);
+    r.finish();
+    p.generating.primitives.push_back(prim);
+  }
+  if (p.generating.primitives.empty()) g->error(diags, "'generating' needs at least one primitive");
+  gen.finish();
+}
+
+void readVarices(MapReader& top, ShellParams& p, DiagnosticList& diags) {
+  auto sec = partSection(top, "varices", p.varices.enabled, diags);
+  if (!sec) return;
+  auto& v = p.varices;
+  MapReader r(*sec, diags, "varices");
+  v.enabled = r.boolean("enabled", true);
+  v.spacingDeg = r.number("spacing", v.spacingDeg, 1.0, 3600.0);
+  if (auto spines = r.get("spines")) {
+    if (spines->isScalar() && spines->scalar() == "murex_table1") {
+      v.spinesByWhorl = organisms::murexTable1();
+    } else if (!spines->isSequence()) {
+      spines->error(diags, "'spines' must be murex_table1 or a sequence of rows (one per whorl) of [angle, size]");
+    } else {
+      v.spinesByWhorl.clear();
+      for (const YNode& row : spines->items()) {
+        std::vector<VarixSpine> out;
+        if (!row.isSequence()) {
+          row.error(diags, "a spine row must be a sequence of [angle, size] pairs");
+        } else {
+          for (const YNode& pair : row.items()) {
+            auto xs = floatList(pair, diags, "spine", -180.0, 180.0);
+            if (xs.size() != 2) {
+              pair.error(diags, "a spine must be [angle, size]");
+              continue;
+            }
+            if (!(xs[1] > 0.0f)) {
+              pair.error(diags, "spine size must be > 0");
+              continue;
+            }
+            out.push_back({xs[0], xs[1]});
+          }
+        }
+        v.spinesByWhorl.push_back(std::move(out));
+      }
+    }
+  }
+  v.spineLength = num(r, "spine_length", v.spineLength, 0.0, 20.0);
+  v.baseRadius = num(r, "base_radius", v.baseRadius, 1e-3, 5.0);
+  v.tipRadius = num(r, "tip_radius", v.tipRadius, 1e-3, 5.0);
+  v.shortTipRadius = num(r, "short_tip_radius", v.shortTipRadius, 1e-3, 5.0);
+  v.shortSize = num(r, "short_size", v.shortSize, 0.0, 100.0);
+  v.bendDeg = num(r, "bend", v.bendDeg, 0.0, 170.0);
+  v.edge = num(r, "edge", v.edge, 0.0, 3.0);
+  v.widenAcross = r.boolean("widen_across", v.widenAcross);
+  v.tori = r.boolean("tori", v.tori);
+  v.torusRadius = num(r, "torus_radius", v.torusRadius, 1e-3, 2.0);
+  v.torusOuter = num(r, "torus_outer", v.torusOuter, 0.0, 5.0);
+  v.lipVarix = r.boolean("lip", v.lipVarix);
+  r.finish();
+}
+
+void readBumps(MapReader& top, ShellParams& p, DiagnosticList& diags) {
+  auto sec = partSection(top, "bumps", p.bumps.enabled, diags);
+  if (!sec) return;
+  auto& b = p.bumps;
+  MapReader r(*sec, diags, "bumps");
+  b.enabled = r.boolean("enabled", true);
+  b.setsPerSection = static_cast<int>(r.integer("sets", b.setsPerSection, 0, 100));
+  b.size = num(r, "size", b.size, 1e-3, 5.0);
+  b.sdFraction = num(r, "sd", b.sdFraction, 0.0, 1.0);
+  b.elongation = num(r, "elongation", b.elongation, 0.0, 10.0);
+  b.blendN = num(r, "blend_n", b.blendN, 1.0, 1000.0);
+  b.random = r.boolean("random", b.random);
+  b.edge = num(r, "edge", b.edge, 0.0, 3.0);
+  r.finish();
+}
+
+void readAxial(MapReader& top, ShellParams& p, DiagnosticList& diags) {
+  auto sec = partSection(top, "axial_spines", p.axialSpines.enabled, diags);
+  if (!sec) return;
+  auto& a = p.axialSpines;
+  MapReader r(*sec, diags, "axial_spines");
+  a.enabled = r.boolean("enabled", true);
+  if (auto rows = r.get("rows")) {
+    if (rows->isScalar() && rows->scalar() == "murex_table2") {
+      a.rows = organisms::murexTable2();
+    } else if (!rows->isSequence()) {
+      rows->error(diags, "'rows' must be murex_table2 or a sequence of rows of relative sizes");
+    } else {
+      a.rows.clear();
+      for (const YNode& row : rows->items()) a.rows.push_back(floatList(row, diags, "rows", 1e-3, 20.0));
+    }
+  }
+  a.length = num(r, "length", a.length, 0.0, 20.0);
+  a.baseRadius = num(r, "base_radius", a.baseRadius, 1e-3, 5.0);
+  a.tipRadius = num(r, "tip_radius", a.tipRadius, 1e-3, 5.0);
+  a.firstT = num(r, "first", a.firstT, 0.0, 1.0);
+  a.lastT = num(r, "last", a.lastT, 0.0, 1.0);
+  a.downTilt = num(r, "tilt", a.downTilt, -10.0, 10.0);
+  a.randomBends = r.boolean("random_bends", a.randomBends);
+  a.bendMinDeg = num(r, "bend_min", a.bendMinDeg, 0.0, 45.0);
+  a.bendMaxDeg = num(r, "bend_max", a.bendMaxDeg, 0.0, 45.0);
+  a.bendsMin = static_cast<int>(r.integer("bends_min", a.bendsMin, 0, 10));
+  a.bendsMax = static_cast<int>(r.integer("bends_max", a.bendsMax, 0, 10));
+  if (a.bendsMax < a.bendsMin) sec->error(diags, "'bends_max' must be >= 'bends_min'");
+  if (a.bendMaxDeg < a.bendMinDeg) sec->error(diags, "'bend_max' must be >= 'bend_min'");
+  r.finish();
+}
+
+void readOpening(MapReader& top, ShellParams& p, DiagnosticList& diags) {
+  auto sec = partSection(top, "opening", p.opening.enabled, diags);
+  if (!sec) return;
+  auto& o = p.opening;
+  MapReader r(*sec, diags, "opening");
+  o.enabled = r.boolean("enabled", true);
+  o.innerScale = num(r, "inner_scale", o.innerScale, 0.05, 0.98);
+  o.depthDeg = r.number("depth", o.depthDeg, 0.0, 3600.0);
+  o.extendDeg = r.number("extend", o.extendDeg, 0.0, 360.0);
+  o.insideWall = r.boolean("inside_wall", o.insideWall);
+  o.subtractPrevious = r.boolean("subtract_previous", o.subtractPrevious);
+  r.finish();
+}
+
+void readTextures(MapReader& top, organisms::ShellTextureOptions& t, DiagnosticList& diags) {
+  if (auto sec = top.section("textures")) {
+    MapReader r(*sec, diags, "textures");
+    t.whorlColor = r.color("whorl", t.whorlColor);
+    t.cordColor = r.color("cord_color", t.cordColor);
+    t.cords = static_cast<int>(r.integer("cords", t.cords, 0, 200));
+    t.cordStrength = num(r, "cord_strength", t.cordStrength, 0.0, 1.0);
+    t.growthLineDeg = num(r, "growth_lines", t.growthLineDeg, 0.0, 360.0);
+    t.growthLineStrength = num(r, "growth_line_strength", t.growthLineStrength, 0.0, 1.0);
+    t.varixColor = r.color("varix", t.varixColor);
+    t.spineTipColor = r.color("spine_tip", t.spineTipColor);
+    t.axialColor = r.color("axial", t.axialColor);
+    t.bumpColor = r.color("bump", t.bumpColor);
+    t.insideColor = r.color("inside", t.insideColor);
+    r.finish();
+  }
+  bool on = t.pigment;
+  auto sec = partSection(top, "pigment", on, diags);
+  t.pigment = on;
+  if (!sec) return;
+  auto& o = t.pigmentOptions;
+  MapReader r(*sec, diags, "pigment");
+  o.cells = static_cast<int>(r.integer("cells", o.cells, 3, 4096));
+  o.rows = static_cast<int>(r.integer("rows", o.rows, 1, 8192));
+  o.stepsPerRow = static_cast<int>(r.integer("steps_per_row", o.stepsPerRow, 1, 1000));
+  o.warmupRows = static_cast<int>(r.integer("warmup", o.warmupRows, 0, 10000));
+  o.dt = r.number("dt", o.dt, 1e-4, 10.0);
+  o.diffusionA = r.number("da", o.diffusionA, 0.0, 10.0);
+  o.diffusionB = r.number("db", o.diffusionB, 0.0, 10.0);
+  o.decayA = r.number("ra", o.decayA, 1e-6, 10.0);
+  o.decayB = r.number("rb", o.decayB, 1e-6, 10.0);
+  o.baseA = r.number("ba", o.baseA, 0.0, 10.0);
+  o.baseB = r.number("bb", o.baseB, 0.0, 10.0);
+  o.saturation = r.number("saturation", o.saturation, 0.0, 100.0);
+  o.sourceNoise = r.number("noise", o.sourceNoise, 0.0, 1.0);
+  o.seed = static_cast<uint64_t>(r.integer("seed", static_cast<int64_t>(o.seed), 0));
+  t.pigmentColor = r.color("color", t.pigmentColor);
+  t.pigmentStrength = num(r, "strength", t.pigmentStrength, 0.0, 1.0);
+  if (o.dt * std::max(o.diffusionA, o.diffusionB) >= 0.5)
+    sec->error(diags, "pigment: dt * max(da, db) must stay below 0.5 (explicit integration is unstable)");
+  r.finish();
+}
+
+}  // namespace
+
+std::optional<ShellSpec> readShellSection(const YNode& section, DiagnosticList& diags) {
+  if (!section.isMap()) {
+    section.error(diags, "'shell' must be a map");
+    return std::nullopt;
+  }
+  ShellSpec s;
+  s.loc = section.loc();
+  MapReader top(section, diags, "shell");
+  const std::string preset = top.choice("preset", "none", {"none", "murex_cabritii"});
+  ShellParams& p = s.params;
+  if (preset == "murex_cabritii") {
+    p = organisms::murexCabritii();
+    s.textures.pigment = false;
+  }
+  p.spiral.lambda = top.number("lambda", p.spiral.lambda, 1.0001, 100.0);
+  p.spiral.betaDeg = top.number("beta", p.spiral.betaDeg, 0.1, 90.0);
+  p.spiral.r0 = top.number("r0", p.spiral.r0, 1e-6, 1e6);
+  p.whorls = static_cast<int>(top.integer("whorls", p.whorls, 1, 40));
+  p.whorlDeg = top.number("whorl_angle", p.whorlDeg, 1.0, 3600.0);
+  p.sectionDeg = top.number("section_angle", p.sectionDeg, 1.0, 3600.0);
+  p.surfacesPerSection = static_cast<int>(top.integer("surfaces_per_section", p.surfacesPerSection, 1, 1000));
+  p.startDeg = top.number("start", p.startDeg, -36000.0, 36000.0);
+  if (top.has("age")) p.ageDeg = top.number("age", p.whorls * p.whorlDeg, 0.0, 40 * 3600.0);
+  for (const YNode& st : top.sequence("stages"))
+    if (auto v = st.asNumber(diags, "'stages' entry", 0.0, 40 * 3600.0)) s.stages.push_back(*v);
+  p.seed = static_cast<uint64_t>(top.integer("seed", static_cast<int64_t>(p.seed), 0));
+  p.controlledBlending = top.boolean("controlled_blending", p.controlledBlending);
+  p.calibrateSize = top.boolean("calibrate", p.calibrateSize);
+  p.apexUp = top.boolean("apex_up", p.apexUp);
+  readGenerating(top, p, diags);
+  readVarices(top, p, diags);
+  readBumps(top, p, diags);
+  readAxial(top, p, diags);
+  readOpening(top, p, diags);
+  readTextures(top, s.textures, diags);
+  top.finish();
+  const double end = p.endDeg();
+  if (end < p.startDeg) section.error(diags, "shell 'age' must not be below 'start'");
+  return s;
+}
+
+std::vector<double> shellGrowthStages(const ShellSpec& species, int count) {
+  if (!species.stages.empty()) return species.stages;
+  const auto& p = species.params;
+  const double end = p.endDeg();
+  std::vector<double> out;
+  for (int i = 1; i <= count; ++i) {
+    const double age = p.startDeg + (end - p.startDeg) * i / count;
+    if (age >= p.startDeg + p.stepDeg()) out.push_back(age);
+  }
+  return out;
+}
+
+ShellBuild buildShell(const ShellSpec& species, std::optional<double> ageDeg) {
+  organisms::ShellParams p = species.params;
+  if (ageDeg) p.ageDeg = *ageDeg;
+  ShellBuild b;
+  b.model = organisms::buildShell(p, species.loc);
+  b.blob = std::make_shared<const blobtree::CompiledBlob>(blobtree::compile(b.model.tree, b.model.root));
+  b.painter = std::make_shared<const organisms::ShellPainter>(p, b.model, species.textures);
+  return b;
+}
+
+render::Geometry shellGeometry(const ShellBuild& shell, std::shared_ptr<const blobtree::PolygonizeResult> mesh) {
+  using organisms::ShellPart;
+  render::Material porcelain;
+  porcelain.baseColor = shell.painter->options().whorlColor;
+  porcelain.roughness = 0.35f;
+  porcelain.specular = 0.05f;
+  // The table's ids are the parts' texture ids in the shell's BlobTree (organisms/shell_paint.h).
+  render::TextureTable textures;
+  for (ShellPart part : {ShellPart::Whorl, ShellPart::VarixSpine, ShellPart::AxialSpine, ShellPart::Bump, ShellPart::Inside}) {
+    std::shared_ptr<const organisms::ShellPainter> painter = shell.painter;
+    textures.push_back([painter, part](Vec2 uv, const Vec3& p) { return painter->partColor(part, p, uv); });
+  }
+  render::Geometry out;
+  if (mesh) {
+    out.parts.push_back(render::PolygonizedPart{std::move(mesh), porcelain, std::move(textures)});
+    return out;
+  }
+  render::ImplicitOptions opt;
+  // The renderer's automatic size follows the smallest feature (the apex's tiny spine
+  // tips), which makes hundreds of thousands of cells; a fixed fraction of the model's
+  // diagonal renders the Murex faster (docs/PERFORMANCE.md, Shells).
+  opt.cellSize = organisms::shellCellSize(*shell.blob);
+  opt.trace.relativeTolerance = organisms::kShellTraceTolerance;
+  out.parts.push_back(render::ImplicitPart{shell.blob, porcelain, opt, std::move(textures)});
+  return out;
+}
+
+namespace {
+
+double secondsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Mesh cell of a shell when none is asked for: 1/340 of its diagonal.
+float shellMeshCell(const blobtree::CompiledBlob& blob) { return glm::length(blob.bounds().size()) / 340.0f; }
+
+/// A shell grown to any age.
+class ShellModel final : public KindModel {
+ public:
+  explicit ShellModel(const ShellSpec& spec) : spec_(spec) {}
+
+  bool hasSurface() const override { return true; }
+
+  Stage finalStage() const override {
+    Stage s;
+    s.age = spec_.params.endDeg();
+    return s;
+  }
+
+  Stage stageFromIndex(int k) const override {
+    Stage s = finalStage();
+    s.age = std::min(s.age, std::max(1, k) * spec_.params.whorlDeg);
+    return s;
+  }
+
+  Stage stageAtAge(double ageDeg) const override {
+    Stage s = finalStage();
+    s.age = std::min(ageDeg, s.age);
+    return s;
+  }
+
+  std::vector<Stage> stripStages(int count) const override {
+    std::vector<Stage> out;
+    for (double age : shellGrowthStages(spec_, count)) {
+      Stage s;
+      s.age = age;
+      out.push_back(s);
+    }
+    return out;
+  }
+
+  std::vector<Stage> animationFrames(int framesPerStage, int, int) const override {
+    // From the youngest strip stage to the final age, framesPerStage frames per whorl.
+    const double end = finalStage().age;
+    const double whorl = spec_.params.whorlDeg;
+    const std::vector<double> stages = shellGrowthStages(spec_, 5);
+    const double begin = std::min(end, stages.empty() ? whorl : stages.front());
+    const int n = std::max(1, static_cast<int>(std::ceil((end - begin) / whorl * std::max(1, framesPerStage))));
+    std::vector<Stage> out;
+    for (int i = 0; i <= n; ++i) {
+      Stage s;
+      s.age = begin + (end - begin) * i / n;
+      out.push_back(s);
+    }
+    return out;
+  }
+
+  std::string stageName(const Stage& stage) const override {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "age %.0f deg", stage.age);
+    return buf;
+  }
+
+  int stageNumber(const Stage& stage) const override { return static_cast<int>(std::lround(stage.age)); }
+
+  Box3 frameBox() override {
+    Box3 box = finalShell().blob->bounds();
+    return box.empty() ? Box3{Vec3(-0.5f), Vec3(0.5f)} : box;
+  }
+
+  BuiltStage build(const Stage& stage, GeometryMode mode, const SpeciesRender&) override {
+    if (mode == GeometryMode::Skeleton) throw UsageError("shells have no skeleton: use --mode exact or mesh");
+    BuiltStage out;
+    const auto t0 = std::chrono::steady_clock::now();
+    const double age = stage.age < 0 ? finalStage().age : stage.age;
+    std::optional<ShellBuild> built;
+    const ShellBuild* shell = nullptr;
+    if (final_ && age == finalStage().age) {
+      shell = &*final_;
+    } else {
+      built = buildShell(spec_, age);
+      shell = &*built;
+    }
+    out.figures.primitives = shell->blob->primitiveCount();
+    std::shared_ptr<const blobtree::PolygonizeResult> mesh;
+    if (mode == GeometryMode::Mesh) {
+      blobtree::PolygonizeOptions po;
+      po.cellSize = shellMeshCell(*shell->blob);
+      mesh = std::make_shared<blobtree::PolygonizeResult>(blobtree::polygonizeDetailed(*shell->blob, po));
+      out.figures.triangles = mesh->mesh.triangleCount();
+    }
+    out.figures.buildSeconds = secondsSince(t0);
+    out.geometry = shellGeometry(*shell, std::move(mesh));
+    return out;
+  }
+
+  Mesh buildMesh(const Stage& stage, float cellSize, bool progress, ModelFigures& fig) override {
+    const ShellBuild shell = buildShell(spec_, stage.age < 0 ? std::nullopt : std::optional(stage.age));
+    fig.primitives = shell.blob->primitiveCount();
+    blobtree::PolygonizeOptions po;
+    po.cellSize = cellSize > 0 ? cellSize : shellMeshCell(*shell.blob);
+    po.progress = progress;
+    return blobtree::polygonize(*shell.blob, po);
+  }
+
+  GalleryMotion galleryMotion(bool final) override {
+    GalleryMotion m;
+    m.framesPerStage = final ? 6 : 1;  // per whorl
+    return m;
+  }
+
+ private:
+  /// The final shell, built once: it frames the camera and is reused for the final stage.
+  const ShellBuild& finalShell() {
+    if (!final_) final_ = buildShell(spec_);
+    return *final_;
+  }
+
+  const ShellSpec& spec_;
+  std::optional<ShellBuild> final_;
+};
+
+}  // namespace
+
+std::shared_ptr<const KindSpec> readShellSpec(MapReader& top, Species&, DiagnosticList& diags) {
+  std::optional<YNode> section = top.section("shell");
+  if (!section) {
+    if (!top.has("shell")) top.node().error(diags, "missing required key 'shell' in species file");
+    return nullptr;
+  }
+  std::optional<ShellSpec> spec = readShellSection(*section, diags);
+  if (!spec) return nullptr;
+  return std::make_shared<ShellSpec>(std::move(*spec));
+}
+
+std::string ShellSpec::checkSummary(const Species& species) const {
+  buildShell(*this);  // builder errors (invalid parameters) show here too; cheap
+  return " '" + species.name + "'";
+}
+
+std::unique_ptr<KindModel> ShellSpec::makeModel(const Species&, const ModelOptions&) const {
+  return std::make_unique<ShellModel>(*this);
+}
+
+}  // namespace sprig

@@ -1,0 +1,180 @@
+#include "model/species.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/atomic_file.h"
+#include "model/kinds.h"
+#include "model/tree_kind.h"
+
+namespace sprig {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string lowerExtension(const fs::path& p) {
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+void readView(MapReader& m, render::ViewSpec& v) {
+  v.azimuthDeg = m.number("azimuth", v.azimuthDeg, -360.0, 360.0);
+  v.elevationDeg = m.number("elevation", v.elevationDeg, -89.0, 89.0);
+  v.fovYDeg = m.number("fov", v.fovYDeg, 1.0, 150.0);
+  v.margin = m.number("margin", v.margin, 0.0, 0.9);
+  m.finish();
+}
+
+void readRender(MapReader& m, SpeciesRender& r, DiagnosticList& diags) {
+  render::RenderSettings& im = r.image;
+  im.width = static_cast<int>(m.integer("width", im.width, 16, 8192));
+  im.height = static_cast<int>(m.integer("height", im.height, 16, 8192));
+  im.spp = static_cast<int>(m.integer("samples", im.spp, 1, 1024));
+  if (auto v = m.section("view")) {
+    MapReader view(*v, diags, "render.view");
+    readView(view, r.view);
+  }
+  std::string bg = m.choice("background", "gradient", {"gradient", "color", "transparent"});
+  im.background = bg == "color" ? render::Background::Color
+                 : bg == "transparent" ? render::Background::Transparent
+                                       : render::Background::Gradient;
+  im.backgroundColor = m.color("background_color", im.backgroundColor);
+  im.ground = m.boolean("ground", im.ground);
+  im.groundColor = m.color("ground_color", im.groundColor);
+  if (auto s = m.section("sun")) {
+    MapReader sun(*s, diags, "render.sun");
+    im.sunAzimuthDeg = sun.number("azimuth", im.sunAzimuthDeg, -360.0, 360.0);
+    im.sunElevationDeg = sun.number("elevation", im.sunElevationDeg, 1.0, 90.0);
+    sun.finish();
+  }
+  im.exposure = static_cast<float>(m.number("exposure", im.exposure, -10.0, 10.0));
+  if (auto c = m.section("camera")) {
+    MapReader cam(*c, diags, "render.camera");
+    CameraSpec spec;
+    if (cam.has("position")) spec.position = cam.vec3("position", Vec3(0), -1e6f, 1e6f);
+    else cam.allow({"position"});
+    if (cam.has("target")) spec.target = cam.vec3("target", Vec3(0), -1e6f, 1e6f);
+    else cam.allow({"target"});
+    if (cam.has("distance")) spec.distance = cam.number("distance", 1.0, 1e-6, 1e6);
+    else cam.allow({"distance"});
+    if (spec.position && spec.distance)
+      c->error(diags, "render.camera: give either 'position' or 'distance', not both");
+    cam.finish();
+    r.camera = spec;
+  }
+  im.fillStrength = static_cast<float>(m.number("fill", im.fillStrength, 0.0, 10.0));
+  im.skyStrength = static_cast<float>(m.number("sky", im.skyStrength, 0.0, 10.0));
+  r.surface.baseColor = m.color("color", r.surface.baseColor);
+  r.surface.roughness = static_cast<float>(m.number("roughness", r.surface.roughness, 0.0, 1.0));
+  r.surface.specular = static_cast<float>(m.number("specular", r.surface.specular, 0.0, 1.0));
+  r.style.wood.baseColor = m.color("wood", r.style.wood.baseColor);
+  r.style.leaf.baseColor = m.color("leaf", r.style.leaf.baseColor);
+  r.style.fruit.baseColor = m.color("fruit", r.style.fruit.baseColor);
+  for (const YNode& c : m.sequence("palette"))
+    if (auto col = c.asColor(diags, "'palette' entry")) r.style.palette.push_back(*col);
+  r.style.radiusScale = m.number("radius_scale", r.style.radiusScale, 1e-6, 1e6);
+  r.style.organs = m.boolean("organs", r.style.organs);
+  m.finish();
+}
+
+/// Kinds Sprig names but does not build yet.
+const std::vector<std::string> kReservedKinds = {"organism", "solid"};
+
+Species readSpecies(std::shared_ptr<const YamlFile> yaml, const PathPolicy& policy, DiagnosticList& diags) {
+  Species s;
+  s.yaml = yaml;
+  s.file = yaml->path();
+  s.policy = policy;
+  YNode root = yaml->rootNode();
+  if (root.isNull() || !root.node().IsDefined()) {
+    diags.error(SourceLoc{yaml->displayPath(), 1, 1}, "species file is empty");
+    return s;
+  }
+  MapReader top(root, diags, "species file");
+  if (!root.isMap()) return s;
+
+  std::vector<std::string> names;
+  for (const KindEntry& k : speciesKinds()) names.push_back(k.name);
+  names.insert(names.end(), kReservedKinds.begin(), kReservedKinds.end());
+  std::string list;
+  for (size_t i = 0; i < names.size(); ++i)
+    list += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
+
+  s.name = top.string("name", yaml->path().stem().string());
+  s.description = top.string("description");
+  s.kind = "tree";
+  if (auto k = top.get("kind")) {
+    s.kindNode = k;
+    if (auto text = k->asString(diags, "'kind'")) s.kind = *text;
+  } else {
+    root.error(diags, "missing required key 'kind' in species file (" + list + ")");
+  }
+  const KindEntry* kind = findKind(s.kind);
+  if (!kind) {
+    if (std::find(kReservedKinds.begin(), kReservedKinds.end(), s.kind) != kReservedKinds.end())
+      s.kindNode->error(diags, "species kind '" + s.kind + "' is not supported by this version of Sprig");
+    else
+      s.kindNode->error(diags, "unknown species kind '" + s.kind + "' (" + list + ")" + didYouMean(s.kind, names));
+    return s;
+  }
+  if (auto r = top.section("render")) {
+    MapReader render(*r, diags, "render");
+    readRender(render, s.render, diags);
+  }
+  for (const YNode& st : top.sequence("stages"))
+    if (auto v = st.asInteger(diags, "'stages' entry", 0, 100000)) s.stages.push_back(static_cast<int>(*v));
+  s.spec = kind->read(top, s, diags);
+  top.finish();
+  return s;
+}
+
+}  // namespace
+
+SourceLoc Species::loc() const { return kindNode ? kindNode->loc() : SourceLoc{file.string(), 1, 1}; }
+
+render::RenderSettings SpeciesRender::settings(int imageWidth, int imageHeight) const {
+  render::RenderSettings rs = image;
+  rs.width = imageWidth;
+  rs.height = imageHeight;
+  return rs;
+}
+
+Species loadSpecies(const fs::path& path, const PathPolicy& policy) {
+  const std::string ext = lowerExtension(path);
+  if (ext == ".lsys") return speciesFromGrammarFile(path);  // model/tree_kind.h
+  if (ext != ".yaml" && ext != ".yml")
+    throw InputError(SourceLoc{path.string(), 0, 0},
+                     "unknown input extension '" + path.extension().string() +
+                         "' (expected a species file .yaml/.yml or a grammar .lsys)");
+  DiagnosticList diags;
+  auto yaml = YamlFile::load(path, diags);
+  if (!yaml) diags.throwIfErrors();
+  Species s = readSpecies(yaml, policy, diags);
+  diags.throwIfErrors();
+  return s;
+}
+
+Species parseSpecies(std::string text, const std::string& displayPath, const PathPolicy& policy) {
+  DiagnosticList diags;
+  auto yaml = YamlFile::parse(std::move(text), displayPath, diags);
+  if (!yaml) diags.throwIfErrors();
+  Species s = readSpecies(yaml, policy, diags);
+  diags.throwIfErrors();
+  return s;
+}
+
+std::vector<fs::path> listSpeciesFiles(const fs::path& folder) {
+  std::vector<fs::path> out;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(folder, ec)) {
+    if (!e.is_regular_file()) continue;
+    std::string ext = lowerExtension(e.path());
+    if (ext == ".yaml" || ext == ".yml") out.push_back(e.path());
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+}  // namespace sprig

@@ -1,0 +1,92 @@
+#pragma once
+/// Species files (`species/*.yaml`) and bare grammars, read completely when loaded.
+///
+/// A species file names its kind and holds everything needed to grow and show one organism;
+/// README.md ("Species files") lists every key with its default. The keys every kind shares
+/// (name, description, kind, render, stages) are read here; the kind's own keys are read by
+/// the kind (model/kinds.h) into its typed value, Species::spec, in the same pass, so one
+/// load reports every error of every section, each at its `file:line:col`.
+///
+/// A bare `.lsys` file is a tree species with default settings whose grammar is that file.
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "model/yaml_reader.h"
+#include "render/camera.h"
+#include "render/geometry.h"
+#include "render/renderer.h"
+
+namespace sprig {
+
+class KindSpec;
+
+/// An explicit camera (`render.camera:`); unset parts come from the automatic framing.
+struct CameraSpec {
+  std::optional<Vec3> position;    ///< `position: [x, y, z]`, the eye
+  std::optional<Vec3> target;      ///< `target: [x, y, z]` (default: the center of the framed box)
+  std::optional<double> distance;  ///< `distance`: eye at view.azimuth/elevation this far from target
+};
+
+/// How a skeleton preview is sized and coloured (`render:` keys `wood`, `leaf`, `fruit`,
+/// `palette`, `radius_scale`, `organs`).
+struct SkeletonStyle {
+  double radiusScale = 1.0;          ///< multiplies every internode radius
+  double minRadiusFraction = 0.002;  ///< radius floor as a fraction of the skeleton's bounds diagonal
+  render::Material wood{Vec3(0.30f, 0.20f, 0.12f), 0.7f, 0.03f};   ///< internodes
+  render::Material leaf{Vec3(0.16f, 0.38f, 0.08f), 0.5f, 0.06f};   ///< polygons and named surfaces
+  render::Material fruit{Vec3(0.55f, 0.08f, 0.06f), 0.35f, 0.08f};  ///< spheres
+  /// Base colors by turtle color index (`'`); an organ whose index has an entry uses it.
+  std::vector<Vec3> palette;
+  bool organs = true;  ///< draw organs (polygons, spheres, named surfaces)
+};
+
+/// How a species is shown (`render:`): the renderer's settings for its image, camera,
+/// preview style and surface material.
+struct SpeciesRender {
+  /// `width`, `height`, `samples`, `background`, `background_color`, `ground`,
+  /// `ground_color`, `sun: {azimuth, elevation}`, `exposure`, `fill`, `sky`.
+  render::RenderSettings image;
+  render::ViewSpec view;               ///< `view: {azimuth, elevation, fov, margin}`
+  SkeletonStyle style;                 ///< skeleton previews
+  std::optional<CameraSpec> camera;    ///< `camera: {position, target, distance}`
+  render::Material surface{Vec3(0.72f, 0.60f, 0.48f), 0.45f, 0.05f};  ///< `color`, `roughness`, `specular`: blob surfaces
+
+  /// Renderer settings for an image of width x height.
+  render::RenderSettings settings(int imageWidth, int imageHeight) const;
+};
+
+/// One species, read and checked.
+struct Species {
+  std::string kind;         ///< `kind` ("tree", "shell", "blob")
+  std::string name;         ///< `name` (default: the file's stem)
+  std::string description;  ///< `description`
+  std::filesystem::path file;  ///< the species (or grammar) file as given
+  bool bareGrammar = false;    ///< true when file is a `.lsys` grammar, not a species file
+  std::vector<int> stages;     ///< `stages`: steps of a tree's growth strip (empty = automatic)
+  SpeciesRender render;        ///< `render:`
+  std::shared_ptr<const KindSpec> spec;  ///< the kind's own keys, typed (model/kinds.h)
+
+  /// The parsed YAML (null for bare grammars), for positions in the file.
+  std::shared_ptr<const YamlFile> yaml;
+  std::optional<YNode> kindNode;  ///< the `kind:` value, for errors about the kind
+  PathPolicy policy;              ///< the policy it was loaded with
+
+  /// Where errors about the species as a whole point: its `kind:` value, else its first line.
+  SourceLoc loc() const;
+};
+
+/// Reads a species file or a bare grammar (chosen by extension: .yaml/.yml or .lsys).
+/// Referenced files must satisfy policy. Throws InputError with every diagnostic.
+Species loadSpecies(const std::filesystem::path& path, const PathPolicy& policy = {});
+
+/// Reads species text as if it were the file displayPath (tests). Throws as loadSpecies.
+Species parseSpecies(std::string text, const std::string& displayPath, const PathPolicy& policy = {});
+
+/// The species files of a folder (`*.yaml`, `*.yml`), sorted by name.
+std::vector<std::filesystem::path> listSpeciesFiles(const std::filesystem::path& folder);
+
+}  // namespace sprig

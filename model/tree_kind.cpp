@@ -1,0 +1,535 @@
+#include "model/tree_kind.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "blobtree/polygonize.h"
+#include "core/atomic_file.h"
+#include "core/progress.h"
+#include "model/growth.h"
+#include "organisms/skeleton_geometry.h"
+#include "textures/procedural.h"
+
+namespace sprig {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+using organisms::BranchSelector;
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+double secondsSince(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::vector<int> readInts(MapReader& m, std::string_view key, int64_t min, int64_t max) {
+  std::vector<int> out;
+  std::string what("'");
+  what.append(key).append("' element");
+  for (const YNode& item : m.sequence(key))
+    if (auto v = item.asInteger(m.diagnostics(), what, min, max))
+      out.push_back(static_cast<int>(*v));
+  return out;
+}
+
+void readSelector(MapReader& m, BranchSelector& s) {
+  if (m.has("orders")) s.orders = readInts(m, "orders", 0, 1000);
+  if (m.has("internodes")) s.internodes = readInts(m, "internodes", 0, std::numeric_limits<int32_t>::max());
+  s.belowHeight = m.number("below_height", s.belowHeight);
+  s.aboveHeight = m.number("above_height", s.aboveHeight);
+  s.probability = m.number("probability", s.probability, 0.0, 1.0);
+}
+
+void readTurtle(MapReader& m, TreeSpec& s) {
+  auto& t = s.turtle;
+  t.stepLength = m.number("step", t.stepLength, 1e-9, 1e9);
+  if (m.has("angle")) {
+    t.angleDeg = m.number("angle", t.angleDeg, -360.0, 360.0);
+    s.angleSet = true;
+  } else {
+    m.allow({"angle"});
+  }
+  t.initialWidth = m.number("width", t.initialWidth, 0.0, 1e9);
+  t.widthScale = m.number("width_scale", t.widthScale, 1e-9, 1e9);
+  t.widthFactor = m.number("width_factor", t.widthFactor, 1e-6, 1e6);
+  t.tropism = DVec3(m.vec3("tropism", Vec3(t.tropism), -1e6, 1e6));
+  t.elasticity = m.number("elasticity", t.elasticity, -10.0, 10.0);
+  std::string radii = m.choice("radii", "width", {"width", "pipe"});
+  t.radii = radii == "pipe" ? lsystem::RadiusModel::Pipe : lsystem::RadiusModel::Width;
+  t.pipeExponent = m.number("pipe_exponent", t.pipeExponent, 0.5, 10.0);
+  t.tipRadius = m.number("tip_radius", t.tipRadius, 1e-9, 1e9);
+  t.taper = m.boolean("taper", t.taper);
+  t.surfaceScale = m.number("surface_scale", t.surfaceScale, 1e-9, 1e9);
+  t.maxWidthToLength = m.number("max_width_to_length", t.maxWidthToLength, 0.0, 1e6);
+  m.finish();
+}
+
+/// Reads `grammar:`: inline text (contains a newline) or a path relative to the species file.
+void readGrammar(MapReader& top, const Species& sp, TreeSpec& s, DiagnosticList& diags) {
+  const PathPolicy& policy = sp.policy;
+  auto g = top.get("grammar");
+  if (!g) {
+    top.node().error(diags, "missing required key 'grammar' in species file");
+    return;
+  }
+  auto text = g->asString(diags, "'grammar'");
+  if (!text) return;
+  if (text->find('\n') != std::string::npos) {
+    s.grammarText = *text;
+    s.grammarFile = sp.yaml->displayPath();
+    // A block scalar's content starts on the line after its indicator; find that line's
+    // indentation so grammar positions map back into the species file.
+    SourceLoc at = g->loc();
+    const std::string indicatorLine = sp.yaml->sourceLine(at.line);
+    const bool block = at.col >= 1 && at.col <= static_cast<int>(indicatorLine.size()) &&
+                       (indicatorLine[at.col - 1] == '|' || indicatorLine[at.col - 1] == '>');
+    int line = block ? at.line + 1 : at.line;  // quoted multi-line strings map approximately
+    const std::string& yamlText = sp.yaml->text();
+    const int lines = static_cast<int>(std::count(yamlText.begin(), yamlText.end(), '\n')) + 1;
+    s.grammarLineOffset = line - 1;
+    for (int l = line; l <= lines; ++l) {
+      std::string src = sp.yaml->sourceLine(l);
+      size_t nonSpace = src.find_first_not_of(' ');
+      if (nonSpace != std::string::npos) {
+        s.grammarColOffset = static_cast<int>(nonSpace);
+        break;
+      }
+    }
+    return;
+  }
+  if (auto p = resolveReference(*g, *text, policy, diags)) {
+    try {
+      s.grammarText = readFile(*p);
+      s.grammarFile = p->string();
+    } catch (const std::exception& e) {
+      g->error(diags, "cannot read grammar file '" + p->string() + "'");
+    }
+  }
+}
+
+void readDefines(MapReader& top, TreeSpec& s, DiagnosticList& diags) {
+  auto d = top.section("defines");
+  if (!d) return;
+  for (auto& [k, v] : d->pairs()) {
+    if (!k.isScalar()) continue;
+    auto value = v.asNumber(diags, "'defines." + k.scalar() + "'");
+    if (value) s.overrides.defines.push_back(lsystem::DefineOverride{k.scalar(), *value, k.loc()});
+  }
+}
+
+/// Parses the grammar with the species' own overrides, for its errors and counts.
+void checkGrammar(const Species& species, TreeSpec& spec, DiagnosticList& diags) {
+  try {
+    lsystem::Grammar g = speciesGrammar(species);
+    spec.productions = g.productionCount();
+    spec.steps = g.derivationLength();
+  } catch (const InputError& e) {
+    diags.append(e.diagnostics());
+  }
+}
+
+/// Appends b's triangles to a (positions, normals, uvs and colors kept where both have them).
+void appendMesh(Mesh& a, const Mesh& b) {
+  const uint32_t base = static_cast<uint32_t>(a.positions.size());
+  const bool normals = a.normals.size() == a.positions.size() && b.normals.size() == b.positions.size();
+  const bool colors = (a.positions.empty() || a.colors.size() == a.positions.size()) && b.colors.size() == b.positions.size();
+  if (!normals) a.normals.clear();
+  if (!colors) a.colors.clear();
+  a.uvs.clear();
+  a.positions.insert(a.positions.end(), b.positions.begin(), b.positions.end());
+  if (normals) a.normals.insert(a.normals.end(), b.normals.begin(), b.normals.end());
+  if (colors) a.colors.insert(a.colors.end(), b.colors.begin(), b.colors.end());
+  for (const auto& t : b.triangles) a.triangles.push_back(t + glm::uvec3(base));
+  a.materials.clear();
+}
+
+/// The skeleton preview: internodes as curves, organs as flat leaves and spheres.
+}  // namespace
+
+render::Geometry skeletonPreview(const lsystem::Skeleton& skeleton, const SkeletonStyle& style) {
+  organisms::SkeletonGeometryOptions o;
+  o.radiusScale = style.radiusScale;
+  o.minRadiusFraction = style.minRadiusFraction;
+  o.organs = style.organs;
+  o.palette = style.palette;
+  o.leafColor = style.leaf.baseColor;
+  o.fruitColor = style.fruit.baseColor;
+  organisms::SkeletonGeometry g = organisms::buildSkeletonGeometry(skeleton, o);
+  render::Geometry out;
+  if (!g.internodes.empty()) out.parts.push_back(render::CurvesPart{std::move(g.internodes), style.wood});
+  if (!g.leaves.triangles.empty())
+    out.parts.push_back(render::MeshPart{std::move(g.leaves), style.leaf, std::move(g.leafColors), {}});
+  if (!g.fruit.empty()) out.parts.push_back(render::SpheresPart{std::move(g.fruit), style.fruit});
+  return out;
+}
+
+namespace {
+
+/// Primitives and triangles of a skeleton preview (internodes + organs; n - 2 per n-gon).
+void previewFigures(const lsystem::Skeleton& skeleton, ModelFigures& fig) {
+  fig.primitives = skeleton.internodes.size() + skeleton.organs.size();
+  fig.triangles = 0;
+  for (const auto& o : skeleton.organs)
+    if (o.kind == lsystem::Organ::Kind::Polygon && o.points.size() >= 3) fig.triangles += o.points.size() - 2;
+}
+
+/// The BlobTree tree as geometry: wood (exact or polygonized) with its bark texture, leaves.
+render::Geometry surfaceGeometry(const TreeSurface& tree, const SpeciesRender& look,
+                                 const std::shared_ptr<const blobtree::PolygonizeResult>& mesh) {
+  render::TextureTable textures;
+  if (tree.options.bark.enabled) {
+    textures::BarkOptions bo;
+    bo.seed = tree.options.seed;
+    bo.ridgeColor = look.style.wood.baseColor;
+    bo.furrowColor = look.style.wood.baseColor * 0.3f;
+    auto bark = std::make_shared<textures::BarkTexture>(bo);
+    textures.push_back([bark](Vec2 uv, const Vec3&) { return bark->color(uv); });
+  }
+  render::Geometry out;
+  if (mesh)
+    out.parts.push_back(render::PolygonizedPart{mesh, look.style.wood, std::move(textures)});
+  else
+    out.parts.push_back(render::ImplicitPart{tree.compiled, look.style.wood, {}, std::move(textures)});
+  if (tree.leaves.triangleCount() > 0) {
+    Mesh leaves = tree.leaves;
+    leaves.materials.clear();  // one leaf material; the vertex colors carry each leaf's tint
+    out.parts.push_back(render::MeshPart{std::move(leaves), look.style.leaf, {}, {}});
+  }
+  return out;
+}
+
+/// A tree species grown by the growth engine.
+class TreeModel final : public KindModel {
+ public:
+  TreeModel(const Species& species, const TreeSpec& spec, const ModelOptions& options)
+      : species_(species), spec_(spec), engine_(species, GrowthOptions{options.extra, options.lastStep, {}}) {}
+
+  bool hasSurface() const override { return spec_.surface.has_value(); }
+
+  Stage finalStage() const override {
+    Stage s;
+    s.step = engine_.lastStep();
+    return s;
+  }
+
+  Stage stageFromIndex(int k) const override {
+    if (k > engine_.lastStep())
+      throw UsageError("stage " + std::to_string(k) + ": the species grows for only " +
+                       std::to_string(engine_.lastStep()) + " steps");
+    Stage s;
+    s.step = k;
+    return s;
+  }
+
+  std::vector<Stage> stripStages(int count) const override {
+    std::vector<Stage> out;
+    for (int step : growthStages(species_, engine_.lastStep(), count)) {
+      Stage s;
+      s.step = step;
+      out.push_back(s);
+    }
+    return out;
+  }
+
+  std::vector<Stage> animationFrames(int framesPerStage, int first, int last) const override {
+    const int lastStep = last < 0 ? engine_.lastStep() : std::min(last, engine_.lastStep());
+    std::vector<Stage> out;
+    for (const GrowthFrame& f : growthFrames(std::clamp(first, 0, lastStep), lastStep, std::max(1, framesPerStage))) {
+      Stage s;
+      s.step = f.stage;
+      s.fraction = f.fraction;
+      out.push_back(s);
+    }
+    return out;
+  }
+
+  std::string stageName(const Stage& stage) const override {
+    char buf[64];
+    if (stage.fraction < 1.0)
+      std::snprintf(buf, sizeof buf, "step %d at %.0f%%", stage.step, stage.fraction * 100.0);
+    else
+      std::snprintf(buf, sizeof buf, "step %d", stage.step);
+    return buf;
+  }
+
+  int stageNumber(const Stage& stage) const override { return stage.step; }
+
+  Box3 frameBox() override {
+    const DBox3& b = engine_.frameBox();
+    Box3 box = b.empty() ? Box3{Vec3(-0.5f), Vec3(0.5f)} : Box3{Vec3(b.lo), Vec3(b.hi)};
+    return box.empty() ? Box3{Vec3(-0.5f), Vec3(0.5f)} : box;
+  }
+
+  BuiltStage build(const Stage& stage, GeometryMode mode, const SpeciesRender& look) override {
+    BuiltStage out;
+    ModelFigures& fig = out.figures;
+    const auto t0 = std::chrono::steady_clock::now();
+    const int step = stage.step < 0 ? engine_.lastStep() : stage.step;
+    lsystem::Skeleton skeleton = engine_.skeletonAt(step, stage.fraction);
+    fig.modules = engine_.moduleCount(step);
+    fig.internodes = skeleton.internodes.size();
+    if (mode == GeometryMode::Skeleton || skeleton.internodes.empty()) {
+      // Skeleton mode, or nothing to build a surface from yet (the axiom draws nothing):
+      // the preview shows the organs.
+      if (mode == GeometryMode::Skeleton) previewFigures(skeleton, fig);
+      fig.buildSeconds = secondsSince(t0);
+      out.geometry = skeletonPreview(skeleton, look.style);
+      return out;
+    }
+    TreeSurface tree = buildTreeSurface(skeleton, spec_.surface.value_or(organisms::TreeOptions{}));
+    fig.primitives = tree.compiled->primitiveCount();
+    fig.triangles = tree.leaves.triangleCount();
+    std::shared_ptr<const blobtree::PolygonizeResult> mesh;
+    if (mode == GeometryMode::Mesh) {
+      mesh = std::make_shared<blobtree::PolygonizeResult>(blobtree::polygonizeDetailed(*tree.compiled, {}));
+      fig.triangles += mesh->mesh.triangleCount();
+    }
+    fig.buildSeconds = secondsSince(t0);
+    out.geometry = surfaceGeometry(tree, look, mesh);
+    return out;
+  }
+
+  Mesh buildMesh(const Stage& stage, float cellSize, bool progress, ModelFigures& fig) override {
+    const int step = stage.step < 0 ? engine_.lastStep() : stage.step;
+    lsystem::Skeleton skeleton = engine_.skeletonAt(step, stage.fraction);
+    fig.modules = engine_.moduleCount(step);
+    fig.internodes = skeleton.internodes.size();
+    if (skeleton.internodes.empty())
+      throw InputError(species_.loc(), "the species draws no internodes at " + stageName(stage) +
+                                           ": there is no surface to mesh");
+    TreeSurface tree = buildTreeSurface(skeleton, spec_.surface.value_or(organisms::TreeOptions{}));
+    fig.primitives = tree.compiled->primitiveCount();
+    blobtree::PolygonizeOptions po;
+    po.cellSize = cellSize;
+    po.progress = progress;
+    Mesh out = blobtree::polygonize(*tree.compiled, po);
+    if (tree.leaves.triangleCount() > 0) appendMesh(out, tree.leaves);
+    return out;
+  }
+
+  GalleryMotion galleryMotion(bool final) override {
+    // Exact frames rebuild the BlobTree each time: drafts show one frame per step.
+    const int steps = std::max(1, engine_.lastStep());
+    GalleryMotion m;
+    m.framesPerStage = hasSurface() && !final ? 1 : std::clamp((final ? 120 : 36) / steps, 1, final ? 8 : 4);
+    return m;
+  }
+
+ private:
+  const Species& species_;
+  const TreeSpec& spec_;
+  mutable GrowthEngine engine_;
+};
+
+}  // namespace
+
+std::vector<GrowthFrame> growthFrames(int first, int last, int framesPerStage) {
+  std::vector<GrowthFrame> frames;
+  frames.push_back({first, 1.0});
+  const int k = std::max(framesPerStage, 1);
+  for (int stage = first + 1; stage <= last; ++stage)
+    for (int j = 1; j <= k; ++j) frames.push_back({stage, static_cast<double>(j) / k});
+  return frames;
+}
+
+std::shared_ptr<const KindSpec> readTreeSpec(MapReader& top, Species& species, DiagnosticList& diags) {
+  auto spec = std::make_shared<TreeSpec>();
+  TreeSpec& s = *spec;
+  readGrammar(top, species, s, diags);
+  readDefines(top, s, diags);
+  if (top.has("steps"))
+    s.overrides.derivationLength = static_cast<int>(top.integer("steps", 0, 0, 100000));
+  else
+    top.allow({"steps"});
+  if (top.has("seed"))
+    s.overrides.seed = static_cast<uint64_t>(top.integer("seed", 0, 0));
+  else
+    top.allow({"seed"});
+  s.maxModules = static_cast<size_t>(top.integer("max_modules", static_cast<int64_t>(s.maxModules), 1,
+                                                 int64_t(4'000'000'000)));
+  if (auto t = top.section("turtle")) {
+    MapReader turtle(*t, diags, "turtle");
+    readTurtle(turtle, s);
+  }
+  if (auto section = top.section("tree")) s.surface = readTreeOptions(*section, diags);
+  if (!s.grammarText.empty() || top.has("grammar")) {
+    species.spec = spec;  // speciesGrammar reads the spec through the species
+    checkGrammar(species, s, diags);
+  }
+  return spec;
+}
+
+Species speciesFromGrammarFile(const fs::path& path) {
+  Species s;
+  s.kind = "tree";
+  s.bareGrammar = true;
+  s.file = path;
+  s.name = path.stem().string();
+  auto spec = std::make_shared<TreeSpec>();
+  try {
+    spec->grammarText = readFile(path);
+  } catch (const std::exception&) {
+    throw InputError(SourceLoc{path.string(), 0, 0}, "cannot open file");
+  }
+  spec->grammarFile = path.string();
+  // ABOP widths are pixel widths: keep a bare grammar's internodes slender (lsystem/turtle.h).
+  spec->turtle.maxWidthToLength = 0.12;
+  s.spec = spec;
+  DiagnosticList diags;
+  checkGrammar(s, *spec, diags);
+  diags.throwIfErrors();
+  return s;
+}
+
+const TreeSpec& treeSpec(const Species& species) {
+  const auto* tree = dynamic_cast<const TreeSpec*>(species.spec.get());
+  if (!tree)
+    throw InputError(species.loc(), "a " + species.kind +
+                                        " species has no grammar (this command needs a tree species or a .lsys grammar)");
+  return *tree;
+}
+
+lsystem::Grammar speciesGrammar(const Species& species, const lsystem::GrammarOverrides& extra) {
+  const TreeSpec& tree = treeSpec(species);
+  lsystem::GrammarOverrides o = tree.overrides;
+  for (const auto& d : extra.defines) o.defines.push_back(d);
+  if (extra.derivationLength) o.derivationLength = extra.derivationLength;
+  if (extra.seed) o.seed = extra.seed;
+  try {
+    return lsystem::parseGrammar(tree.grammarText, tree.grammarFile, o);
+  } catch (const InputError& e) {
+    if (species.bareGrammar || !species.yaml || tree.grammarFile != species.yaml->displayPath()) throw;
+    // Inline grammar: move positions from the grammar text into the species file.
+    std::vector<Diagnostic> moved = e.diagnostics();
+    for (auto& d : moved) {
+      if (d.loc.file != tree.grammarFile || d.loc.line <= 0) continue;
+      d.loc.line += tree.grammarLineOffset;
+      if (d.loc.col > 0) d.loc.col += tree.grammarColOffset;
+      d.sourceLine = species.yaml->sourceLine(d.loc.line);
+    }
+    throw InputError(std::move(moved));
+  }
+}
+
+lsystem::TurtleSettings speciesTurtle(const Species& species, const lsystem::Grammar& grammar) {
+  const TreeSpec& tree = treeSpec(species);
+  lsystem::TurtleSettings t = tree.turtle;
+  if (!tree.angleSet) t.angleDeg = grammar.angleDeg().value_or(90.0);
+  return t;
+}
+
+std::vector<int> growthStages(const Species& species, int steps, int count) {
+  std::vector<int> out;
+  if (!species.stages.empty()) {
+    for (int st : species.stages) out.push_back(std::min(st, steps));
+    return out;
+  }
+  int k = std::max(1, std::min(steps, count));
+  for (int i = 1; i <= k; ++i) {
+    int st = static_cast<int>(std::lround(static_cast<double>(steps) * i / k));
+    if (out.empty() || st != out.back()) out.push_back(st);
+  }
+  return out;
+}
+
+organisms::TreeOptions readTreeOptions(const YNode& section, DiagnosticList& diags, const organisms::TreeOptions& defaults) {
+  organisms::TreeOptions o = defaults;
+  MapReader m(section, diags, "tree");
+  o.junctions = m.choice("junctions", o.junctions == organisms::JunctionModel::Pcm ? "pcm" : "smooth",
+                         {"smooth", "pcm"}) == "pcm"
+                    ? organisms::JunctionModel::Pcm
+                    : organisms::JunctionModel::Smooth;
+  o.deltaA = m.number("delta_a", o.deltaA, 0.0, 10.0);
+  o.deltaAMulti = m.number("delta_a_multi", o.deltaAMulti, 0.0, 10.0);
+  o.basalOffset = m.boolean("basal_offset", o.basalOffset);
+  o.branchOffset = m.boolean("branch_offset", o.branchOffset);
+  o.pcmWidth = m.number("pcm_width", o.pcmWidth, 1e-3, 0.5);
+  o.pcmBulge = m.number("pcm_bulge", o.pcmBulge, 0.0, 4.0);
+  o.softKernel = m.choice("kernel", o.softKernel ? "soft" : "wyvill", {"wyvill", "soft"}) == "soft";
+  o.controlledBlend = m.boolean("controlled_blend", o.controlledBlend);
+  o.tips = m.choice("tips", o.tips == organisms::TipStyle::Taper ? "taper" : "hemisphere",
+                    {"taper", "hemisphere"}) == "taper"
+               ? organisms::TipStyle::Taper
+               : organisms::TipStyle::Hemisphere;
+  o.tipTaper = m.number("tip_taper", o.tipTaper, 0.01, 1.0);
+  o.radiusScale = m.number("radius_scale", o.radiusScale, 1e-6, 1e6);
+  o.minRadius = m.number("min_radius", o.minRadius, 0.0, 1e6);
+  o.seed = static_cast<uint64_t>(m.integer("seed", static_cast<int64_t>(o.seed), 0));
+
+  if (auto s = m.section("prune")) {
+    MapReader p(*s, diags, "prune");
+    o.prune.fromGrammar = p.boolean("from_grammar", o.prune.fromGrammar);
+    o.prune.cutFraction = p.number("cut_fraction", o.prune.cutFraction, 0.0, 1.0);
+    o.prune.minCutDistance = p.number("min_cut_distance", o.prune.minCutDistance, 0.0, 100.0);
+    readSelector(p, o.prune.select);
+    p.finish();
+  }
+  if (auto s = m.section("scars")) {
+    MapReader p(*s, diags, "scars");
+    o.scars.stubLength = p.number("stub_length", o.scars.stubLength, 0.01, 100.0);
+    o.scars.stubRadius = p.number("stub_radius", o.scars.stubRadius, 0.01, 10.0);
+    o.scars.negativeRadius = p.number("negative_radius", o.scars.negativeRadius, 0.0, 10.0);
+    o.scars.negativeWeight = p.number("negative_weight", o.scars.negativeWeight, 0.0, 10.0);
+    readSelector(p, o.scars.select);
+    p.finish();
+  }
+  if (auto s = m.section("bends")) {
+    MapReader p(*s, diags, "bends");
+    o.bends.angleDeg = p.number("angle", o.bends.angleDeg, 0.0, 80.0);
+    o.bends.orderScale = p.number("order_scale", o.bends.orderScale, 0.0, 10.0);
+    o.bends.randomness = p.number("randomness", o.bends.randomness, 0.0, 1.0);
+    o.bends.minBranchAngleDeg = p.number("min_branch_angle", o.bends.minBranchAngleDeg, 0.0, 90.0);
+    o.bends.trunk = p.boolean("trunk", o.bends.trunk);
+    p.finish();
+  }
+  if (auto s = m.section("bark")) {
+    MapReader p(*s, diags, "bark");
+    o.bark.enabled = p.boolean("enabled", o.bark.enabled);
+    o.bark.texture = static_cast<int>(p.integer("texture", o.bark.texture, 0, 65535));
+    o.bark.uScale = p.number("u_scale", o.bark.uScale, -kInf, kInf);
+    o.bark.vScale = p.number("v_scale", o.bark.vScale, -kInf, kInf);
+    p.finish();
+  }
+  if (auto s = m.section("leaves")) {
+    MapReader p(*s, diags, "leaves");
+    o.leaves.enabled = p.boolean("enabled", o.leaves.enabled);
+    o.leaves.scale = p.number("scale", o.leaves.scale, 0.0, 1e6);
+    o.leaves.material = static_cast<uint32_t>(p.integer("material", o.leaves.material, 0, 65535));
+    p.finish();
+  }
+  m.finish();
+  return o;
+}
+
+organisms::TreeOptions parseTreeOptions(std::string text, const std::string& displayPath) {
+  DiagnosticList diags;
+  auto file = YamlFile::parse(std::move(text), displayPath, diags);
+  organisms::TreeOptions o;
+  if (file) o = readTreeOptions(file->rootNode(), diags);
+  diags.throwIfErrors();
+  return o;
+}
+
+TreeSurface buildTreeSurface(const lsystem::Skeleton& skeleton, const organisms::TreeOptions& options) {
+  TreeSurface m;
+  m.options = options;
+  m.blob = organisms::buildTreeBlob(skeleton, m.options);
+  m.compiled = std::make_shared<const blobtree::CompiledBlob>(blobtree::compile(m.blob.tree, m.blob.root));
+  m.leaves = organisms::buildLeafMesh(skeleton, m.options);
+  return m;
+}
+
+std::string TreeSpec::checkSummary(const Species& species) const {
+  return " '" + species.name + "', " + std::to_string(productions) + " productions, " + std::to_string(steps) +
+         " steps" + (surface ? ", BlobTree surface" : "");
+}
+
+std::unique_ptr<KindModel> TreeSpec::makeModel(const Species& species, const ModelOptions& options) const {
+  return std::make_unique<TreeModel>(species, *this, options);
+}
+
+}  // namespace sprig

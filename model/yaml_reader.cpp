@@ -1,0 +1,530 @@
+#include "model/yaml_reader.h"
+
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+namespace sprig {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr int kMaxDepth = 256;
+
+/// Shortest text of a double that reads back exactly ("0.5", "1000", "1e+20").
+std::string formatNumber(double v) {
+  char buf[64];
+  auto res = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, res.ptr);
+}
+
+std::string trim(std::string_view s) {
+  size_t b = 0, e = s.size();
+  while (b < e && (s[b] == ' ' || s[b] == '\t')) ++b;
+  while (e > b && (s[e - 1] == ' ' || s[e - 1] == '\t')) --e;
+  return std::string(s.substr(b, e - b));
+}
+
+bool isNonFiniteWord(std::string_view s) {
+  if (!s.empty() && (s[0] == '+' || s[0] == '-')) s.remove_prefix(1);
+  static const char* words[] = {".nan", ".NaN", ".NAN", ".inf", ".Inf", ".INF", "nan", "NaN", "NAN",
+                                "inf",  "Inf",  "INF",  "infinity", "Infinity", "INFINITY"};
+  for (const char* w : words)
+    if (s == w) return true;
+  return false;
+}
+
+/// Parses a whole string as a decimal real number (YAML core schema float, no specials).
+std::optional<double> parseReal(std::string_view s) {
+  if (s.empty()) return std::nullopt;
+  if (s[0] == '+') s.remove_prefix(1);
+  if (s.empty() || s[0] == '+') return std::nullopt;
+  double v = 0;
+  auto res = std::from_chars(s.data(), s.data() + s.size(), v, std::chars_format::general);
+  if (res.ec != std::errc() || res.ptr != s.data() + s.size()) return std::nullopt;
+  return v;
+}
+
+std::string rangeText(double v, double lo, double hi) {
+  std::string out = formatNumber(v) + ", ";
+  bool hasLo = std::isfinite(lo), hasHi = std::isfinite(hi);
+  if (hasLo && hasHi) return out + "out of range [" + formatNumber(lo) + ", " + formatNumber(hi) + "]";
+  if (hasLo) return out + "must be at least " + formatNumber(lo);
+  return out + "must be at most " + formatNumber(hi);
+}
+
+const char* kindName(const YAML::Node& n) {
+  switch (n.Type()) {
+    case YAML::NodeType::Map: return "a map";
+    case YAML::NodeType::Sequence: return "a sequence";
+    case YAML::NodeType::Null: return "nothing";
+    case YAML::NodeType::Scalar: return "a scalar";
+    default: return "nothing";
+  }
+}
+
+/// sRGB transfer inverse (IEC 61966-2-1): hex colours are sRGB, the renderer works in linear light.
+float srgbToLinear(float v) {
+  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
+}
+
+/// "got 'text'" for scalars, "got a map" otherwise.
+std::string gotText(const YNode& n) {
+  if (n.isScalar()) return "got '" + n.scalar() + "'";
+  return std::string("got ") + kindName(n.node());
+}
+
+/// Walks the document once: counts nodes (aliases count every time they are reached),
+/// limits depth and reports duplicate keys.
+class Walker {
+ public:
+  Walker(const YamlFile& file, DiagnosticList& diags, int64_t maxNodes)
+      : file_(file), diags_(diags), maxNodes_(maxNodes) {}
+
+  /// False when the cap on nodes or depth was hit (an error was added).
+  bool walk(const YAML::Node& n, int depth) {
+    if (++visited_ > maxNodes_) {
+      file_.error(diags_, n.Mark(),
+                  "YAML document has more than " + std::to_string(maxNodes_) + " nodes (alias bomb?)");
+      return false;
+    }
+    if (depth > kMaxDepth) {
+      file_.error(diags_, n.Mark(), "YAML document nests deeper than " + std::to_string(kMaxDepth) + " levels");
+      return false;
+    }
+    if (n.IsSequence()) {
+      for (const auto& child : n)
+        if (!walk(child, depth + 1)) return false;
+    } else if (n.IsMap()) {
+      std::map<std::string, int, std::less<>> firstLine;
+      for (auto it = n.begin(); it != n.end(); ++it) {
+        const YAML::Node& key = it->first;
+        if (!key.IsScalar()) {
+          report(key.Mark(), "map keys must be plain text, got " + std::string(kindName(key)));
+        } else {
+          int line = key.Mark().line + 1;
+          auto [pos, fresh] = firstLine.emplace(key.Scalar(), line);
+          if (!fresh)
+            report(key.Mark(), "duplicate key '" + key.Scalar() + "' (first defined at line " +
+                                   std::to_string(pos->second) + ")");
+        }
+        if (!walk(key, depth + 1) || !walk(it->second, depth + 1)) return false;
+      }
+    }
+    return true;
+  }
+
+ private:
+  /// Adds an error once per position (aliased maps are walked more than once).
+  void report(const YAML::Mark& mark, std::string message) {
+    if (reported_.insert({mark.line, mark.column}).second) file_.error(diags_, mark, std::move(message));
+  }
+
+  const YamlFile& file_;
+  DiagnosticList& diags_;
+  int64_t maxNodes_;
+  int64_t visited_ = 0;
+  std::set<std::pair<int, int>> reported_;
+};
+
+}  // namespace
+
+// ---- YamlFile ---------------------------------------------------------------------
+
+std::shared_ptr<const YamlFile> YamlFile::load(const fs::path& path, DiagnosticList& diags,
+                                               const YamlLoadOptions& options) {
+  std::string display = path.string();
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) {
+    diags.error(SourceLoc{display, 0, 0}, fs::exists(path, ec) ? "not a regular file" : "cannot open file");
+    return nullptr;
+  }
+  auto size = fs::file_size(path, ec);
+  if (!ec && size > options.maxBytes) {
+    diags.error(SourceLoc{display, 0, 0}, "file is larger than " + std::to_string(options.maxBytes) + " bytes");
+    return nullptr;
+  }
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    diags.error(SourceLoc{display, 0, 0}, "cannot open file");
+    return nullptr;
+  }
+  std::ostringstream ss;
+  ss << in.rdbuf();
+  return parseAt(ss.str(), display, path, diags, options);
+}
+
+std::shared_ptr<const YamlFile> YamlFile::parse(std::string text, std::string displayPath, DiagnosticList& diags,
+                                                const YamlLoadOptions& options) {
+  fs::path path(displayPath);
+  return parseAt(std::move(text), std::move(displayPath), path, diags, options);
+}
+
+std::shared_ptr<const YamlFile> YamlFile::parseAt(std::string text, std::string displayPath, const fs::path& path,
+                                                  DiagnosticList& diags, const YamlLoadOptions& options) {
+  auto file = std::shared_ptr<YamlFile>(new YamlFile());
+  file->path_ = path;
+  file->displayPath_ = std::move(displayPath);
+  file->text_ = std::move(text);
+  file->self_ = file;
+  try {
+    file->root_ = YAML::Load(file->text_);
+  } catch (const YAML::Exception& e) {
+    YAML::Mark mark = e.mark;
+    if (mark.line < 0) mark.line = 0, mark.column = 0;
+    file->error(diags, mark, "YAML syntax error: " + e.msg);
+    return nullptr;
+  }
+  Walker walker(*file, diags, options.maxNodes);
+  if (!walker.walk(file->root_, 0)) return nullptr;
+  return file;
+}
+
+YNode YamlFile::rootNode() const { return YNode(self_.lock(), root_); }
+
+SourceLoc YamlFile::loc(const YAML::Mark& mark) const {
+  if (mark.line < 0) return SourceLoc{displayPath_, 0, 0};
+  return SourceLoc{displayPath_, mark.line + 1, mark.column + 1};
+}
+
+void YamlFile::error(DiagnosticList& diags, const YAML::Mark& mark, std::string message) const {
+  SourceLoc l = loc(mark);
+  diags.error(l, std::move(message), sourceLine(l.line));
+}
+
+// ---- YNode ------------------------------------------------------------------------
+
+std::vector<YNode> YNode::items() const {
+  std::vector<YNode> out;
+  if (!node_.IsSequence()) return out;
+  for (const auto& child : node_) out.emplace_back(file_, child);
+  return out;
+}
+
+std::vector<std::pair<YNode, YNode>> YNode::pairs() const {
+  std::vector<std::pair<YNode, YNode>> out;
+  if (!node_.IsMap()) return out;
+  for (auto it = node_.begin(); it != node_.end(); ++it)
+    out.emplace_back(YNode(file_, it->first), YNode(file_, it->second));
+  return out;
+}
+
+std::optional<double> YNode::asNumber(DiagnosticList& diags, std::string_view what, double min, double max) const {
+  if (!isScalar()) {
+    error(diags, std::string(what) + " must be a number, " + gotText(*this));
+    return std::nullopt;
+  }
+  std::string text = trim(scalar());
+  if (isPlainScalar() && isNonFiniteWord(text)) {
+    error(diags, std::string(what) + " must be a finite number, got '" + text + "'");
+    return std::nullopt;
+  }
+  auto v = isPlainScalar() ? parseReal(text) : std::nullopt;
+  if (!v) {
+    error(diags, std::string(what) + " must be a number, got " + (isPlainScalar() ? "'" : "string '") + scalar() + "'");
+    return std::nullopt;
+  }
+  if (!std::isfinite(*v)) {
+    error(diags, std::string(what) + " must be a finite number, got '" + text + "'");
+    return std::nullopt;
+  }
+  if (*v < min || *v > max) {
+    error(diags, std::string(what) + " is " + rangeText(*v, min, max));
+    return std::nullopt;
+  }
+  return v;
+}
+
+std::optional<int64_t> YNode::asInteger(DiagnosticList& diags, std::string_view what, int64_t min,
+                                        int64_t max) const {
+  if (!isScalar()) {
+    error(diags, std::string(what) + " must be an integer, " + gotText(*this));
+    return std::nullopt;
+  }
+  std::string text = trim(scalar());
+  std::string_view s = text;
+  if (!s.empty() && s[0] == '+') s.remove_prefix(1);
+  int64_t v = 0;
+  auto res = std::from_chars(s.data(), s.data() + s.size(), v);
+  bool ok = isPlainScalar() && !s.empty() && res.ec == std::errc() && res.ptr == s.data() + s.size();
+  if (!ok && isPlainScalar()) {
+    // Accept integral reals written as 1e3; refuse 2.5 and anything out of int64 range.
+    auto r = parseReal(text);
+    if (r && std::isfinite(*r) && std::floor(*r) == *r && std::fabs(*r) < 9.0e18) {
+      v = static_cast<int64_t>(*r);
+      ok = true;
+    }
+  }
+  if (!ok) {
+    error(diags, std::string(what) + " must be an integer, got " + (isPlainScalar() ? "'" : "string '") + scalar() + "'");
+    return std::nullopt;
+  }
+  if (v < min || v > max) {
+    std::string range;
+    bool hasLo = min != std::numeric_limits<int64_t>::min(), hasHi = max != std::numeric_limits<int64_t>::max();
+    if (hasLo && hasHi)
+      range = "out of range [" + std::to_string(min) + ", " + std::to_string(max) + "]";
+    else if (hasLo)
+      range = "must be at least " + std::to_string(min);
+    else
+      range = "must be at most " + std::to_string(max);
+    error(diags, std::string(what) + " is " + std::to_string(v) + ", " + range);
+    return std::nullopt;
+  }
+  return v;
+}
+
+std::optional<bool> YNode::asBoolean(DiagnosticList& diags, std::string_view what) const {
+  if (isPlainScalar()) {
+    const std::string s = trim(scalar());
+    static const char* yes[] = {"true", "True", "TRUE", "yes", "Yes", "YES", "on", "On", "ON"};
+    static const char* no[] = {"false", "False", "FALSE", "no", "No", "NO", "off", "Off", "OFF"};
+    for (const char* w : yes)
+      if (s == w) return true;
+    for (const char* w : no)
+      if (s == w) return false;
+  }
+  error(diags, std::string(what) + " must be true or false, " + gotText(*this));
+  return std::nullopt;
+}
+
+std::optional<std::string> YNode::asString(DiagnosticList& diags, std::string_view what) const {
+  if (!isScalar()) {
+    error(diags, std::string(what) + " must be a string, " + gotText(*this));
+    return std::nullopt;
+  }
+  return scalar();
+}
+
+std::optional<Vec3> YNode::asVec3(DiagnosticList& diags, std::string_view what, double min, double max) const {
+  if (!isSequence() || node_.size() != 3) {
+    std::string got = isSequence() ? "got " + std::to_string(node_.size()) + " elements" : gotText(*this);
+    error(diags, std::string(what) + " must be [x, y, z], " + got);
+    return std::nullopt;
+  }
+  Vec3 out(0.0f);
+  bool ok = true;
+  auto elems = items();
+  for (int i = 0; i < 3; ++i) {
+    auto v = elems[i].asNumber(diags, std::string(what) + "[" + std::to_string(i) + "]", min, max);
+    if (v)
+      out[i] = static_cast<float>(*v);
+    else
+      ok = false;
+  }
+  if (!ok) return std::nullopt;
+  return out;
+}
+
+std::optional<Vec3> YNode::asColor(DiagnosticList& diags, std::string_view what) const {
+  if (isScalar()) {
+    const std::string s = trim(scalar());
+    auto hex = [](char c) -> int {
+      if (c >= '0' && c <= '9') return c - '0';
+      if (c >= 'a' && c <= 'f') return c - 'a' + 10;
+      if (c >= 'A' && c <= 'F') return c - 'A' + 10;
+      return -1;
+    };
+    bool ok = s.size() == 7 && s[0] == '#';
+    Vec3 c(0.0f);
+    for (int i = 0; ok && i < 3; ++i) {
+      int hi = hex(s[1 + 2 * i]), lo = hex(s[2 + 2 * i]);
+      if (hi < 0 || lo < 0) ok = false;
+      else c[i] = srgbToLinear(static_cast<float>(hi * 16 + lo) / 255.0f);
+    }
+    if (ok) return c;
+    error(diags, std::string(what) + " must be a colour [r, g, b] in [0, 1] or \"#rrggbb\", got '" + s + "'");
+    return std::nullopt;
+  }
+  if (isSequence()) return asVec3(diags, what, 0.0, 1.0);
+  error(diags, std::string(what) + " must be a colour [r, g, b] in [0, 1] or \"#rrggbb\", " + gotText(*this));
+  return std::nullopt;
+}
+
+// ---- File references ---------------------------------------------------------------
+
+std::optional<fs::path> resolveReference(const YNode& at, std::string_view ref, const PathPolicy& policy,
+                                         DiagnosticList& diags, bool mustExist) {
+  const std::string r(ref);
+  if (r.empty()) {
+    at.error(diags, "empty file reference");
+    return std::nullopt;
+  }
+  static const std::regex uri(R"(^[A-Za-z][A-Za-z0-9+.\-]+:)");
+  if (std::regex_search(r, uri)) {
+    at.error(diags, "refusing URI '" + r + "': only local files can be referenced");
+    return std::nullopt;
+  }
+  fs::path p(r);
+  if (p.is_absolute() && !policy.allowOutside) {
+    at.error(diags, "refusing absolute path '" + r + "' (write it relative to the species file, or pass --allow-outside-paths)");
+    return std::nullopt;
+  }
+  fs::path base = at.file().path().parent_path();
+  fs::path resolved = p.is_absolute() ? p.lexically_normal() : (base / p).lexically_normal();
+  if (resolved.empty()) resolved = ".";
+  if (!policy.allowOutside) {
+    std::error_code ec;
+    fs::path root = fs::weakly_canonical(policy.root.empty() ? fs::path(".") : policy.root, ec);
+    fs::path full = fs::weakly_canonical(resolved, ec);
+    fs::path rel = full.lexically_relative(root);
+    if (rel.empty() || *rel.begin() == "..") {
+      at.error(diags, "refusing path '" + r + "': it leaves the library root '" + policy.root.string() +
+                          "' (pass --allow-outside-paths to allow it)");
+      return std::nullopt;
+    }
+  }
+  if (mustExist) {
+    std::error_code ec;
+    if (!fs::is_regular_file(resolved, ec)) {
+      at.error(diags, "cannot find file '" + r + "' (looked for '" + resolved.string() + "')");
+      return std::nullopt;
+    }
+  }
+  return resolved;
+}
+
+// ---- MapReader ---------------------------------------------------------------------
+
+MapReader::MapReader(YNode node, DiagnosticList& diags, std::string context)
+    : node_(std::move(node)), diags_(&diags), context_(std::move(context)) {
+  if (node_.isMap()) {
+    for (auto& [k, v] : node_.pairs()) {
+      if (!k.isScalar()) continue;  // reported when the file was loaded
+      std::string name = k.scalar();
+      if (index_.count(name)) continue;  // duplicate: reported when the file was loaded
+      index_.emplace(name, entries_.size());
+      entries_.push_back(Entry{k, v});
+    }
+  } else if (!node_.isNull() && node_.node().IsDefined()) {
+    node_.error(diags, context_ + " must be a map, " + gotText(node_));
+  }
+}
+
+bool MapReader::has(std::string_view key) const { return index_.find(key) != index_.end(); }
+
+std::optional<YNode> MapReader::get(std::string_view key) {
+  known_.emplace(key);
+  auto it = index_.find(key);
+  if (it == index_.end()) return std::nullopt;
+  return entries_[it->second].value;
+}
+
+std::optional<YNode> MapReader::keyNode(std::string_view key) const {
+  auto it = index_.find(key);
+  if (it == index_.end()) return std::nullopt;
+  return entries_[it->second].key;
+}
+
+void MapReader::allow(std::initializer_list<std::string_view> keys) {
+  for (auto k : keys) known_.emplace(k);
+}
+
+static std::string quoted(std::string_view key) {
+  std::string out;
+  out.reserve(key.size() + 2);
+  out.push_back('\'');
+  out.append(key);
+  out.push_back('\'');
+  return out;
+}
+
+double MapReader::number(std::string_view key, double def, double min, double max) {
+  auto v = get(key);
+  if (!v) return def;
+  return v->asNumber(*diags_, quoted(key), min, max).value_or(def);
+}
+
+int64_t MapReader::integer(std::string_view key, int64_t def, int64_t min, int64_t max) {
+  auto v = get(key);
+  if (!v) return def;
+  return v->asInteger(*diags_, quoted(key), min, max).value_or(def);
+}
+
+std::string MapReader::string(std::string_view key, std::string def) {
+  auto v = get(key);
+  if (!v) return def;
+  return v->asString(*diags_, quoted(key)).value_or(def);
+}
+
+std::optional<std::string> MapReader::requiredString(std::string_view key) {
+  auto v = get(key);
+  if (!v) {
+    node_.error(*diags_, "missing required key '" + std::string(key) + "' in " + context_);
+    return std::nullopt;
+  }
+  return v->asString(*diags_, quoted(key));
+}
+
+bool MapReader::boolean(std::string_view key, bool def) {
+  auto v = get(key);
+  if (!v) return def;
+  return v->asBoolean(*diags_, quoted(key)).value_or(def);
+}
+
+Vec3 MapReader::vec3(std::string_view key, Vec3 def, double min, double max) {
+  auto v = get(key);
+  if (!v) return def;
+  return v->asVec3(*diags_, quoted(key), min, max).value_or(def);
+}
+
+Vec3 MapReader::color(std::string_view key, Vec3 def) {
+  auto v = get(key);
+  if (!v) return def;
+  return v->asColor(*diags_, quoted(key)).value_or(def);
+}
+
+std::string MapReader::choice(std::string_view key, std::string def, const std::vector<std::string>& choices) {
+  auto v = get(key);
+  if (!v) return def;
+  auto s = v->asString(*diags_, quoted(key));
+  if (!s) return def;
+  for (const auto& c : choices)
+    if (c == *s) return *s;
+  std::string list;
+  for (size_t i = 0; i < choices.size(); ++i) list += (i ? ", " : "") + choices[i];
+  v->error(*diags_, quoted(key) + " must be one of " + list + ", got '" + *s + "'" + didYouMean(*s, choices));
+  return def;
+}
+
+std::optional<YNode> MapReader::section(std::string_view key) {
+  auto v = get(key);
+  if (!v) return std::nullopt;
+  if (!v->isMap()) {
+    v->error(*diags_, quoted(key) + " must be a map, " + gotText(*v));
+    return std::nullopt;
+  }
+  return v;
+}
+
+std::vector<YNode> MapReader::sequence(std::string_view key) {
+  auto v = get(key);
+  if (!v) return {};
+  if (!v->isSequence()) {
+    v->error(*diags_, quoted(key) + " must be a sequence, " + gotText(*v));
+    return {};
+  }
+  return v->items();
+}
+
+std::optional<fs::path> MapReader::path(std::string_view key, const PathPolicy& policy, bool mustExist) {
+  auto v = get(key);
+  if (!v) return std::nullopt;
+  auto s = v->asString(*diags_, quoted(key));
+  if (!s) return std::nullopt;
+  return resolveReference(*v, *s, policy, *diags_, mustExist);
+}
+
+void MapReader::finish() {
+  std::vector<std::string> candidates(known_.begin(), known_.end());
+  for (const auto& e : entries_) {
+    const std::string name = e.key.scalar();
+    if (known_.count(name)) continue;
+    e.key.error(*diags_, "unknown key '" + name + "' in " + context_ + didYouMean(name, candidates));
+  }
+}
+
+}  // namespace sprig

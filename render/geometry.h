@@ -1,0 +1,98 @@
+#pragma once
+/// Neutral geometry: what a model hands the renderer.
+///
+/// A Geometry is a list of parts, each a curve set, sphere set, triangle mesh, compiled
+/// BlobTree (exact) or polygonized BlobTree (mesh mode), with its own material and its own
+/// texture table. Part texture ids (a material's `texture`, a blob primitive's texture
+/// attribute) index that part's table, so parts from different models never share ids.
+/// Scene::add turns a Geometry into Embree geometry; nothing here names Embree, a skeleton
+/// or a species.
+
+#include <functional>
+#include <memory>
+#include <variant>
+#include <vector>
+
+#include "blobtree/compiled.h"
+#include "core/mesh.h"
+#include "core/shapes.h"
+#include "core/types.h"
+
+namespace sprig::blobtree {
+struct PolygonizeResult;
+}
+
+namespace sprig::render {
+
+/// Surface appearance: a diffuse base color with a glossy highlight.
+struct Material {
+  Vec3 baseColor{0.6f};     ///< linear RGB albedo in [0, 1]
+  float roughness = 0.6f;   ///< 0 = mirror-like highlight, 1 = no highlight
+  float specular = 0.04f;   ///< highlight strength (reflectance at normal incidence)
+  int texture = -1;         ///< texture id for textured models, -1 for none
+};
+
+/// A color texture: linear RGB at natural coordinates uv (and world position, for solid
+/// textures). Must be thread-safe; the textures module's textures are wrapped into this.
+using ColorTexture = std::function<Vec3(Vec2 uv, const Vec3& position)>;
+
+/// How a compiled BlobTree becomes exact Embree user geometry.
+struct ImplicitOptions {
+  /// Edge of the surface cells (one Embree user primitive each), world units; 0 = automatic:
+  /// 1.5x the smallest feature radius, clamped to [diagonal/1000, diagonal/40].
+  float cellSize = 0.0f;
+  /// Root-finding tolerance (relative to the model's bounds diagonal) and step cap.
+  blobtree::TraceOptions trace;
+  /// March eight samples at a time with batched field evaluation (the same Lipschitz
+  /// guarantee, several times faster); false calls CompiledBlob::intersectCell per cell.
+  bool batched = true;
+};
+
+/// The textures a part's ids refer to, in id order.
+using TextureTable = std::vector<ColorTexture>;
+
+/// Tapered round curves with one material (a plant's internodes in skeleton previews).
+struct CurvesPart {
+  CurveSet curves;
+  Material material;
+};
+
+/// Spheres, coloured one by one (fruit), with one material.
+struct SpheresPart {
+  SphereSet spheres;
+  Material material;
+};
+
+/// A triangle mesh. triangleColors, when not empty (one per triangle), replace the
+/// material's and the vertices' colours; per-triangle `mesh.materials` are not used here.
+struct MeshPart {
+  Mesh mesh;
+  Material material;
+  std::vector<Vec3> triangleColors;
+  TextureTable textures;
+};
+
+/// A compiled BlobTree ray cast exactly; hit colours blend the table's textures.
+struct ImplicitPart {
+  std::shared_ptr<const blobtree::CompiledBlob> blob;
+  Material material;
+  ImplicitOptions options;
+  TextureTable textures;
+};
+
+/// A polygonized BlobTree: triangles, with vertex colours from its attributes and the table.
+struct PolygonizedPart {
+  std::shared_ptr<const blobtree::PolygonizeResult> mesh;
+  Material material;
+  TextureTable textures;
+};
+
+/// One part of a Geometry.
+using GeometryPart = std::variant<CurvesPart, SpheresPart, MeshPart, ImplicitPart, PolygonizedPart>;
+
+/// What a model builds for one stage: its parts, added to a scene in order.
+struct Geometry {
+  std::vector<GeometryPart> parts;
+};
+
+}  // namespace sprig::render

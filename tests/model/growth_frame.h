@@ -1,0 +1,29 @@
+#pragma once
+// Test helper: a growth frame rendered directly from the growth engine (skeleton preview,
+// camera framed on the engine's frame box), the path animations and renderModel must match.
+
+#include "model/growth.h"
+#include "model/species.h"
+#include "model/tree_kind.h"
+#include "render/camera.h"
+#include "render/image.h"
+#include "render/renderer.h"
+#include "render/scene.h"
+
+namespace sprig::test {
+
+inline render::Image growthFrameImage(GrowthEngine& engine, const SpeciesRender& look, const GrowthFrame& frame,
+                                      int width, int height) {
+  lsystem::Skeleton sk = engine.skeletonAt(frame.stage, frame.fraction);
+  render::Scene scene;
+  scene.add(skeletonPreview(sk, look.style));
+  scene.commit();
+  const DBox3& fb = engine.frameBox();
+  render::Camera camera =
+      render::frameBounds(Box3{Vec3(fb.lo), Vec3(fb.hi)}, look.view, static_cast<double>(width) / height);
+  render::RenderSettings rs = look.settings(width, height);
+  rs.progress = false;
+  return render::renderImage(scene, camera, rs);
+}
+
+}  // namespace sprig::test

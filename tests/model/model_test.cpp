@@ -1,0 +1,183 @@
+#include "model/model.h"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+#include "model/animate.h"
+#include "growth_frame.h"
+#include "model/tree_kind.h"
+#include "core/mesh.h"
+#include "core/parallel.h"
+
+using namespace sprig;
+
+namespace {
+
+/// A small tree with a `tree:` section: rendered as an exact BlobTree surface.
+const char* kSurfaceTree = R"(kind: tree
+grammar: |
+  lsystem: y
+  derivation length: 3
+  angle: 35
+  axiom: !(0.12)A
+  A --> F[+!(0.07)A][-!(0.07)A]
+steps: 3
+render: {width: 40, height: 32, samples: 1}
+tree: {junctions: smooth}
+)";
+
+/// The same tree without surface settings: the gallery shows its skeleton.
+const char* kSkeletonTree = R"(kind: tree
+grammar: |
+  lsystem: y
+  derivation length: 3
+  angle: 35
+  axiom: !(0.12)A
+  A --> F[+!(0.07)A][-!(0.07)A]
+steps: 3
+render: {width: 40, height: 32, samples: 1}
+)";
+
+/// Two spheres summed: a closed blob.
+const char* kBlob = R"(kind: blob
+blob:
+  blend:
+    - point: {center: [-0.4, 0, 0], radius: 0.6}
+    - point: {center: [0.4, 0, 0], radius: 0.5}
+render: {width: 40, height: 32, samples: 1}
+)";
+
+/// A smooth point-primitive shell, three whorls.
+const char* kShell = R"(kind: shell
+shell:
+  lambda: 1.3
+  beta: 22.5
+  r0: 0.2
+  whorls: 3
+  generating: point
+  varices: false
+render: {width: 40, height: 40, samples: 1}
+)";
+
+bool sameImage(const render::Image& a, const render::Image& b) {
+  return a.width == b.width && a.height == b.height && a.pixels == b.pixels;
+}
+
+}  // namespace
+
+TEST_CASE("SpeciesModel::modes", "[model]") {
+  SpeciesModel surface(parseSpecies(kSurfaceTree, "surface.yaml"));
+  SpeciesModel skeleton(parseSpecies(kSkeletonTree, "skeleton.yaml"));
+  SpeciesModel blob(parseSpecies(kBlob, "blob.yaml"));
+  CHECK(surface.defaultMode() == GeometryMode::Exact);
+  CHECK(skeleton.defaultMode() == GeometryMode::Skeleton);
+  CHECK(blob.defaultMode() == GeometryMode::Exact);
+  CHECK(surface.finalStage().step == 3);
+
+  render::Scene scene;
+  CHECK_THROWS_AS(blob.addToScene(scene, blob.finalStage(), GeometryMode::Skeleton, blob.species().render), UsageError);
+}
+
+TEST_CASE("SpeciesModel::stages", "[model]") {
+  SECTION("tree: strip ends at the last step, animation frames are growthFrames") {
+    SpeciesModel m(parseSpecies(kSurfaceTree, "surface.yaml"));
+    std::vector<Stage> strip = m.stripStages(5);
+    REQUIRE(!strip.empty());
+    CHECK(strip.back().step == 3);
+    std::vector<Stage> frames = m.animationFrames(2);
+    std::vector<GrowthFrame> expected = growthFrames(0, 3, 2);
+    REQUIRE(frames.size() == expected.size());
+    for (size_t i = 0; i < frames.size(); ++i) {
+      CHECK(frames[i].step == expected[i].stage);
+      CHECK(frames[i].fraction == expected[i].fraction);
+    }
+    CHECK_THROWS_AS(m.stageFromIndex(4), UsageError);
+  }
+  SECTION("shell: ages grow to the final age, one whorl per stage index") {
+    SpeciesModel m(parseSpecies(kShell, "shell.yaml"));
+    const double end = m.finalStage().age;
+    CHECK(end == Approx(3 * 348.0));
+    std::vector<Stage> frames = m.animationFrames(3);
+    REQUIRE(frames.size() >= 2);
+    for (size_t i = 1; i < frames.size(); ++i) CHECK(frames[i].age > frames[i - 1].age);
+    CHECK(frames.back().age == Approx(end));
+    CHECK(m.stageFromIndex(1).age == Approx(348.0));
+    CHECK(m.stageFromIndex(9).age == Approx(end));
+  }
+  SECTION("blob: one stage") {
+    SpeciesModel m(parseSpecies(kBlob, "blob.yaml"));
+    CHECK(m.stripStages(5).size() == 1);
+    CHECK(m.animationFrames(4).size() == 1);
+  }
+}
+
+TEST_CASE("renderModel::skeleton frames equal the growth engine's frames", "[model]") {
+  Species species = parseSpecies(kSkeletonTree, "skeleton.yaml");
+  SpeciesModel model(species);
+  GrowthEngine seq(species);
+  for (GrowthFrame f : {GrowthFrame{2, 0.5}, GrowthFrame{3, 1.0}}) {
+    RenderJob job;
+    job.width = 40;
+    job.height = 32;
+    job.mode = GeometryMode::Skeleton;
+    job.stage.step = f.stage;
+    job.stage.fraction = f.fraction;
+    job.progress = false;
+    CHECK(sameImage(renderModel(model, species.render, job), test::growthFrameImage(seq, species.render, f, 40, 32)));
+  }
+}
+
+TEST_CASE("renderModel::deterministic across threads", "[model]") {
+  for (const char* text : {kSurfaceTree, kBlob}) {
+    Species species = parseSpecies(text, "species.yaml");
+    RenderJob job;
+    job.width = 40;
+    job.height = 32;
+    job.progress = false;
+    render::Image one, two, again;
+    {
+      ThreadLimit limit(1);
+      SpeciesModel m(species);
+      one = renderModel(m, species.render, job);
+    }
+    {
+      ThreadLimit limit(2);
+      SpeciesModel m(species);
+      two = renderModel(m, species.render, job);
+      again = renderModel(m, species.render, job);
+    }
+    CHECK(sameImage(one, two));
+    CHECK(sameImage(two, again));
+    // Something was drawn: not every pixel is background.
+    size_t differing = 0;
+    const Vec4 corner = one.at(0, 0);
+    for (int y = 0; y < one.height; ++y)
+      for (int x = 0; x < one.width; ++x)
+        if (glm::length(one.at(x, y) - corner) > 0.05f) ++differing;
+    CHECK(differing > 20);
+  }
+}
+
+TEST_CASE("SpeciesModel::buildMesh", "[model]") {
+  SECTION("blob: closed and manifold, volume between the two spheres' union bounds") {
+    SpeciesModel m(parseSpecies(kBlob, "blob.yaml"));
+    ModelFigures fig;
+    Mesh mesh = m.buildMesh(m.finalStage(), 0.04f, false, &fig);
+    CHECK(fig.primitives == 2);
+    CHECK(fig.triangles == mesh.triangleCount());
+    MeshTopology topo = analyzeTopology(mesh);
+    CHECK(topo.closed());
+    CHECK(topo.manifold());
+    const double v = signedVolume(mesh);
+    const double big = 4.0 / 3.0 * kPi * 0.6 * 0.6 * 0.6;
+    CHECK(v > big);  // the blend swells beyond the larger sphere alone
+    CHECK(v < 4.0 * big);
+  }
+  SECTION("tree: the wood mesh is closed") {
+    SpeciesModel m(parseSpecies(kSurfaceTree, "surface.yaml"));
+    Mesh mesh = m.buildMesh(m.finalStage(), 0.02f, false);
+    CHECK(mesh.triangleCount() > 100);
+    CHECK(analyzeTopology(mesh).closed());
+  }
+}

@@ -1,0 +1,117 @@
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+
+#include "model/tree_kind.h"
+#include "model/growth.h"
+#include "blobtree/polygonize.h"
+#include "core/atomic_file.h"
+#include "core/mesh_io.h"
+#include "core/parallel.h"
+
+using namespace sprig;
+using organisms::JunctionModel;
+using organisms::TipStyle;
+
+TEST_CASE("readTreeOptions", "[model]") {
+  SECTION("defaults from an empty section") {
+    auto o = parseTreeOptions("{}", "t.yaml");
+    CHECK(o.junctions == JunctionModel::Smooth);
+    CHECK(o.deltaA == 1.75);
+    CHECK(o.deltaAMulti == 2.75);
+    CHECK(o.tips == TipStyle::Taper);
+    CHECK(o.bends.angleDeg == 0.0);
+  }
+  SECTION("every group of keys") {
+    auto o = parseTreeOptions(R"(junctions: pcm
+delta_a: 1.7
+branch_offset: false
+tips: hemisphere
+seed: 9
+prune: {orders: [1, 2], below_height: 2.5, probability: 1, cut_fraction: 0.3}
+scars: {internodes: [4, 7], stub_length: 2, negative_radius: 0.6}
+bends: {angle: 15, order_scale: 0.8, randomness: 0.3, trunk: true}
+bark: {enabled: false, v_scale: 3}
+leaves: {scale: 1.5}
+)", "t.yaml");
+    CHECK(o.junctions == JunctionModel::Pcm);
+    CHECK(o.deltaA == 1.7);
+    CHECK_FALSE(o.branchOffset);
+    CHECK(o.tips == TipStyle::Hemisphere);
+    CHECK(o.seed == 9);
+    CHECK(o.prune.select.orders == std::vector<int>{1, 2});
+    CHECK(o.prune.select.belowHeight == 2.5);
+    CHECK(o.prune.select.probability == 1.0);
+    CHECK(o.prune.cutFraction == 0.3);
+    CHECK(o.scars.select.internodes == std::vector<int>{4, 7});
+    CHECK(o.scars.stubLength == 2.0);
+    CHECK(o.scars.negativeRadius == 0.6);
+    CHECK(o.bends.angleDeg == 15.0);
+    CHECK(o.bends.trunk);
+    CHECK_FALSE(o.bark.enabled);
+    CHECK(o.bark.vScale == 3.0);
+    CHECK(o.leaves.scale == 1.5);
+  }
+  SECTION("errors carry positions and did-you-mean, all at once") {
+    try {
+      parseTreeOptions("junctions: pcmm\ndelta_aa: 2\nbends: {angel: 3}\n", "t.yaml");
+      FAIL("no throw");
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      CHECK(msg.find("t.yaml:1:12: error:") != std::string::npos);
+      CHECK(msg.find("t.yaml:2:1: error: unknown key 'delta_aa' in tree (did you mean 'delta_a'?)") != std::string::npos);
+      CHECK(msg.find("unknown key 'angel' in bends (did you mean 'angle'?)") != std::string::npos);
+    }
+  }
+  SECTION("ranges") {
+    CHECK_THROWS_AS(parseTreeOptions("prune: {probability: 2}", "t.yaml"), InputError);
+    CHECK_THROWS_AS(parseTreeOptions("bends: {angle: 100}", "t.yaml"), InputError);
+  }
+}
+
+namespace {
+
+// Grows a tree species at `steps`, polygonizes its wood on a fixed grid and returns the
+// bytes of the PLY file written from that mesh.
+std::string treePlyBytes(const std::string& speciesFile, int steps, const std::filesystem::path& out) {
+  PathPolicy policy;
+  policy.root = SPRIG_SOURCE_DIR;  // ctest runs in the build folder; the grammar is ../grammars
+  const Species species =
+      loadSpecies(std::filesystem::path(SPRIG_SOURCE_DIR) / "species" / speciesFile, policy);
+  GrowthOptions grow;
+  grow.extra.derivationLength = steps;
+  GrowthEngine engine(species, grow);
+  const lsystem::Skeleton skeleton = engine.skeletonAt(engine.lastStep());
+  const TreeSurface model = buildTreeSurface(skeleton, treeSpec(species).surface.value_or(organisms::TreeOptions{}));
+  blobtree::PolygonizeOptions po;
+  po.cellSize = 0.02f;
+  const Mesh mesh = blobtree::polygonize(*model.compiled, po);
+  REQUIRE(mesh.triangleCount() > 1000);
+  writePly(mesh, out);
+  return readFile(out);
+}
+
+}  // namespace
+
+TEST_CASE("tree species: same file and seed, same mesh bytes", "[model]") {
+  // PCM junctions, random bends and a leaf-less poplar: every seeded choice of the
+  // builder is on the way from the species file to the PLY bytes.
+  const auto dir = std::filesystem::temp_directory_path() / "sprig_tree_determinism";
+  std::filesystem::create_directories(dir);
+  const std::string a = treePlyBytes("tree_poplar_pcm.yaml", 5, dir / "a.ply");
+  const std::string b = treePlyBytes("tree_poplar_pcm.yaml", 5, dir / "b.ply");
+  std::string one, two;
+  {
+    ThreadLimit limit(1);
+    one = treePlyBytes("tree_poplar_pcm.yaml", 5, dir / "one.ply");
+  }
+  {
+    ThreadLimit limit(2);
+    two = treePlyBytes("tree_poplar_pcm.yaml", 5, dir / "two.ply");
+  }
+  CHECK(a.size() > 10000);
+  CHECK(a == b);
+  CHECK(one == a);
+  CHECK(two == a);
+  std::filesystem::remove_all(dir);
+}
