@@ -69,21 +69,6 @@ void orthonormalize(TurtleFrame& f) {
 
 }  // namespace
 
-void turnAboutUp(TurtleFrame& f, double angleDeg) {
-  double r = radians(angleDeg);
-  rotatePair(f.heading, f.left, std::cos(r), std::sin(r));
-}
-
-void turnAboutLeft(TurtleFrame& f, double angleDeg) {
-  double r = radians(angleDeg);
-  rotatePair(f.up, f.heading, std::cos(r), std::sin(r));
-}
-
-void turnAboutHeading(TurtleFrame& f, double angleDeg) {
-  double r = radians(angleDeg);
-  rotatePair(f.left, f.up, std::cos(r), std::sin(r));
-}
-
 void rollToVertical(TurtleFrame& f) {
   const DVec3 v{0, 1, 0};
   DVec3 l = glm::cross(v, f.heading);
