@@ -499,7 +499,7 @@ struct Deriver::Impl {
   /// production context dispatch selects for each dispatched module, in order. Throws the
   /// module-limit InputError when the exact size is over the limit, before any allocation.
   /// Returns {modules, parameters} to reserve.
-  std::pair<size_t, size_t> sizePass(const RuleSet& rs, int step) {
+  [[gnu::always_inline]] inline std::pair<size_t, size_t> sizePass(const RuleSet& rs, int step) {
     const ModuleString& in = cur;
     const size_t n = in.size();
     const SymbolId* syms = in.symbols.data();
