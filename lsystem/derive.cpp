@@ -493,6 +493,86 @@ struct Deriver::Impl {
 
   // ---- steps ----------------------------------------------------------------------------
 
+  /// Size pass over cur before rewriting it with rs: the exact output size when every
+  /// module's production is known without evaluating anything (simple productions, copies,
+  /// context dispatch), else a modest start that grows on demand. Appends to choices the
+  /// production context dispatch selects for each dispatched module, in order. Throws the
+  /// module-limit InputError when the exact size is over the limit, before any allocation.
+  /// Returns {modules, parameters} to reserve.
+  [[gnu::always_inline]] inline std::pair<size_t, size_t> sizePass(const RuleSet& rs, int step) {
+    const ModuleString& in = cur;
+    const size_t n = in.size();
+    const SymbolId* syms = in.symbols.data();
+    const uint32_t* offs = in.offsets.data();
+    const detail::SymbolRules* rules = rs.rules.data();
+    size_t boundM = 0, boundP = 0;
+    bool exact = true;
+    // The left-context neighbour of each module, kept incrementally: the last module
+    // neither ignored nor a bracket on the path from the root, restored after each
+    // branch (the same answer as walkLeft, in O(1) per module).
+    ptrdiff_t lastSeen = -1;
+    leftStack.clear();
+    const bool trackLeft = !rs.dispatches.empty();
+    const uint8_t* ignored = prog->ignored.data();
+    for (size_t i = 0; i < n; ++i) {
+      const detail::SymbolRules& r = rules[syms[i]];
+      uint32_t count = offs[i + 1] - offs[i];
+      if (trackLeft && i > 0) {
+        SymbolId c = syms[i - 1];
+        if (c == prog->openBracket) {
+          leftStack.push_back(lastSeen);
+        } else if (c == prog->closeBracket) {
+          lastSeen = leftStack.empty() ? -1 : leftStack.back();
+          if (!leftStack.empty()) leftStack.pop_back();
+        } else if (!ignored[c]) {
+          lastSeen = static_cast<ptrdiff_t>(i - 1);
+        }
+      }
+      if (r.count == 0 || (r.simple && count != r.simple->predParams)) {
+        boundM += 1;
+        boundP += count;
+      } else if (r.simple) {
+        boundM += r.simple->successor.size();
+        boundP += r.simple->args.size();
+      } else if (r.dispatch >= 0 && count == 0) {
+        int32_t idx = dispatchAt(rs.dispatches[r.dispatch], in, i, lastSeen);
+        choices.push_back(idx);
+        boundM += idx < 0 ? 1 : rs.productions[static_cast<size_t>(idx)].successor.size();
+        boundP += idx < 0 ? 0 : rs.productions[static_cast<size_t>(idx)].args.size();
+      } else {
+        boundM += r.maxModules;
+        boundP += std::max(r.maxParams, count);
+        exact = false;
+      }
+    }
+    if (boundM > opt.maxModules && exact) Writer::overLimit(opt.maxModules, limitAt, step);
+    if (exact) return {boundM, boundP};
+    // A loose bound (conditions, contexts, choices): start modestly, grow on demand.
+    return {std::min({boundM, opt.maxModules, 2 * n + 16}), std::min(boundP, 2 * in.params.size() + 16)};
+  }
+
+  /// Copies modules i, i+1, ... of cur that no production of rs touches (rules[s].count
+  /// is 0) into w; returns the index of the last one copied.
+  [[gnu::always_inline]] inline size_t copyUntouched(Writer& w, const detail::SymbolRules* rules, size_t i) {
+    const ModuleString& in = cur;
+    const size_t n = in.size();
+    const SymbolId* syms = in.symbols.data();
+    const uint32_t* offs = in.offsets.data();
+    const bool births = opt.trackBirthSteps;
+    size_t j = i + 1;
+    while (j < n && rules[syms[j]].count == 0) ++j;
+    if (j - i >= 8) {  // a long run: bulk copies pay off
+      w.copyRun(syms + i, offs + i, in.params.data(), j - i, births ? in.birthSteps.data() + i : nullptr);
+    } else {
+      for (size_t k = i; k < j; ++k) {
+        uint32_t count = offs[k + 1] - offs[k];
+        w.reserve(1, count);
+        w.copy(syms[k], in.params.data() + offs[k], count, births ? in.birthSteps[k] : 0);
+      }
+    }
+    return j - 1;
+  }
+
   /// Rewrites cur into next with rules rs (one derivation step when rs is the main block).
   void rewrite(const RuleSet& rs, int step, uint64_t stream, bool productionStep) {
     const ModuleString& in = cur;
@@ -503,63 +583,11 @@ struct Deriver::Impl {
     const uint32_t* offs = in.offsets.data();
     const double* pars = in.params.data();
     const detail::SymbolRules* rules = rs.rules.data();
-    // Size pass: the exact output size when every module's production is known without
-    // evaluating anything (simple productions, copies, context dispatch), else an upper
-    // bound. The buffers are then allocated once, and a limit overrun is caught before
-    // allocating.
+    // The buffers are allocated once from the size pass, and a limit overrun is caught
+    // before allocating.
     if (rs.anyContext) computeBrackets(in);
-    size_t reserveModules = 0, reserveParams = 0;
     choices.clear();
-    if (!decompose) {
-      size_t boundM = 0, boundP = 0;
-      bool exact = true;
-      // The left-context neighbour of each module, kept incrementally: the last module
-      // neither ignored nor a bracket on the path from the root, restored after each
-      // branch (the same answer as walkLeft, in O(1) per module).
-      ptrdiff_t lastSeen = -1;
-      leftStack.clear();
-      const bool trackLeft = !rs.dispatches.empty();
-      const uint8_t* ignored = prog->ignored.data();
-      for (size_t i = 0; i < n; ++i) {
-        const detail::SymbolRules& r = rules[syms[i]];
-        uint32_t count = offs[i + 1] - offs[i];
-        if (trackLeft && i > 0) {
-          SymbolId c = syms[i - 1];
-          if (c == prog->openBracket) {
-            leftStack.push_back(lastSeen);
-          } else if (c == prog->closeBracket) {
-            lastSeen = leftStack.empty() ? -1 : leftStack.back();
-            if (!leftStack.empty()) leftStack.pop_back();
-          } else if (!ignored[c]) {
-            lastSeen = static_cast<ptrdiff_t>(i - 1);
-          }
-        }
-        if (r.count == 0 || (r.simple && count != r.simple->predParams)) {
-          boundM += 1;
-          boundP += count;
-        } else if (r.simple) {
-          boundM += r.simple->successor.size();
-          boundP += r.simple->args.size();
-        } else if (r.dispatch >= 0 && count == 0) {
-          int32_t idx = dispatchAt(rs.dispatches[r.dispatch], in, i, lastSeen);
-          choices.push_back(idx);
-          boundM += idx < 0 ? 1 : rs.productions[static_cast<size_t>(idx)].successor.size();
-          boundP += idx < 0 ? 0 : rs.productions[static_cast<size_t>(idx)].args.size();
-        } else {
-          boundM += r.maxModules;
-          boundP += std::max(r.maxParams, count);
-          exact = false;
-        }
-      }
-      if (boundM > opt.maxModules && exact) Writer::overLimit(opt.maxModules, limitAt, step);
-      if (exact) {
-        reserveModules = boundM;
-        reserveParams = boundP;
-      } else {  // a loose bound (conditions, contexts, choices): start modestly, grow on demand
-        reserveModules = std::min({boundM, opt.maxModules, 2 * n + 16});
-        reserveParams = std::min(boundP, 2 * in.params.size() + 16);
-      }
-    }
+    auto [reserveModules, reserveParams] = decompose ? std::pair<size_t, size_t>{0, 0} : sizePass(rs, step);
     Writer w(next, births, opt.maxModules, limitAt, step, reserveModules, reserveParams);
     double vars[detail::kMaxVars];
     rngStream = stream;
@@ -569,18 +597,7 @@ struct Deriver::Impl {
       int32_t birth = births ? in.birthSteps[i] : 0;
       const detail::SymbolRules& r = rules[sym];
       if (r.count == 0 && !decompose) {
-        size_t j = i + 1;
-        while (j < n && rules[syms[j]].count == 0) ++j;
-        if (j - i >= 8) {  // a long run: bulk copies pay off
-          w.copyRun(syms + i, offs + i, pars, j - i, births ? in.birthSteps.data() + i : nullptr);
-        } else {
-          for (size_t k = i; k < j; ++k) {
-            uint32_t count = offs[k + 1] - offs[k];
-            w.reserve(1, count);
-            w.copy(syms[k], pars + offs[k], count, births ? in.birthSteps[k] : 0);
-          }
-        }
-        i = j - 1;
+        i = copyUntouched(w, rules, i);
         continue;
       }
       if (r.simple && !decompose) {

@@ -69,21 +69,6 @@ void orthonormalize(TurtleFrame& f) {
 
 }  // namespace
 
-void turnAboutUp(TurtleFrame& f, double angleDeg) {
-  double r = radians(angleDeg);
-  rotatePair(f.heading, f.left, std::cos(r), std::sin(r));
-}
-
-void turnAboutLeft(TurtleFrame& f, double angleDeg) {
-  double r = radians(angleDeg);
-  rotatePair(f.up, f.heading, std::cos(r), std::sin(r));
-}
-
-void turnAboutHeading(TurtleFrame& f, double angleDeg) {
-  double r = radians(angleDeg);
-  rotatePair(f.left, f.up, std::cos(r), std::sin(r));
-}
-
 void rollToVertical(TurtleFrame& f) {
   const DVec3 v{0, 1, 0};
   DVec3 l = glm::cross(v, f.heading);
@@ -158,241 +143,106 @@ Turtle::Turtle(const SymbolTable& symbols, TurtleSettings settings) : symbols_(s
   }
 }
 
-Skeleton Turtle::run(const ModuleString& ms, std::span<const int32_t> moduleSteps) {
-  Skeleton sk;
-  run(ms, sk, moduleSteps);
-  return sk;
-}
+namespace {
 
-void Turtle::run(const ModuleString& ms, Skeleton& sk, std::span<const int32_t> moduleSteps) {
-  sk.internodes.clear();
-  sk.organs.clear();
-  const size_t n = ms.size();
-  const SymbolId* sym = ms.symbols.data();
-  const uint32_t* off = ms.offsets.data();
-  const double* prm = ms.params.data();
-  const Command* cmd = commands_.data();
-  const size_t ncmd = commands_.size();
-  if (moduleSteps.empty() && ms.hasBirthSteps()) moduleSteps = ms.birthSteps;
-  const bool haveSteps = moduleSteps.size() >= n;
+/// An open `{` polygon.
+struct OpenPolygon {
+  std::vector<DVec3> points;
+  int32_t internode;  ///< the internode the polygon grows from (at its `{`)
+};
 
-  {
-    // Reserve the exact number of drawing modules: cheaper than growing the vector.
+/// The working buffers of one run, besides the skeleton it draws.
+struct WalkBuffers {
+  std::vector<TurtleState> stack;      ///< states saved by `[`
+  std::vector<OpenPolygon> polygons;   ///< open `{` polygons, innermost last
+  std::vector<double> internodeGrowth; ///< per internode, for the pipe model's radii (growth only)
+};
+
+/*
+ * TurtleWalk: one Turtle::run in progress. It holds the turtle's state and read-only
+ * views of the string (raw pointers into its arrays) and of the settings. walk() is the
+ * one pass over the string: a switch on each module's command that calls one small
+ * handler per command. The handlers are member functions in this file, inlined into the
+ * switch: the loop makes no indirect call and allocates nothing per module beyond the
+ * output vectors.
+ *
+ * Handlers change st_.frame in place: copying the frame out to a local and back (around
+ * `$`, say) made ABOP 2.6 a third slower in bench_turtle.
+ */
+class TurtleWalk {
+ public:
+  using Command = Turtle::Command;
+
+  TurtleWalk(const SymbolTable& symbols, const TurtleSettings& settings, const std::vector<Command>& commands,
+             const ModuleString& ms, Skeleton& sk, std::span<const int32_t> moduleSteps)
+      : symbols_(symbols), settings_(settings), sk_(sk), n_(ms.size()), sym_(ms.symbols.data()),
+        off_(ms.offsets.data()), prm_(ms.params.data()), cmd_(commands.data()), ncmd_(commands.size()),
+        steps_(moduleSteps), haveSteps_(moduleSteps.size() >= n_),
+        radiusScale_(0.5 * settings.widthScale),
+        maxRadiusPerLength_(settings.radii == RadiusModel::Width ? 0.5 * settings.maxWidthToLength : 0.0),
+        taper_(settings.taper && settings.radii == RadiusModel::Width),
+        tropism_(settings.tropism),
+        defS_(std::sin(radians(settings.angleDeg))),
+        defC_(std::cos(radians(settings.angleDeg))),
+        growing_(settings.growthStep >= 0 && haveSteps_),
+        partial_(settings.growthScale()) {
+    st_.frame.position = settings.origin;
+    st_.width = settings.initialWidth;
+    st_.elasticity = settings.elasticity;
+    buf_.stack.reserve(64);
+  }
+
+  /// Reserves the exact number of drawing modules: cheaper than growing the vector.
+  void reserveInternodes() {
     size_t draws = 0;
-    for (size_t i = 0; i < n; ++i) {
-      Command c = sym[i] < ncmd ? cmd[sym[i]] : Command::None;
+    for (size_t i = 0; i < n_; ++i) {
+      Command c = commandAt(i);
       draws += c == Command::Forward || c == Command::ForwardNoVertex;
     }
-    sk.internodes.reserve(draws);
-    adviseHugePages(sk.internodes.data(), sk.internodes.capacity() * sizeof(Internode));
+    sk_.internodes.reserve(draws);
+    adviseHugePages(sk_.internodes.data(), sk_.internodes.capacity() * sizeof(Internode));
   }
 
-  TurtleState st;
-  st.frame.position = settings_.origin;
-  st.width = settings_.initialWidth;
-  st.elasticity = settings_.elasticity;
-  std::vector<TurtleState> stack;
-  stack.reserve(64);
-  struct OpenPolygon {
-    std::vector<DVec3> points;
-    int32_t internode;  // the internode the polygon grows from (at its `{`)
-  };
-  std::vector<OpenPolygon> polygons;  // open `{` polygons, innermost last
-
-  const double radiusScale = 0.5 * settings_.widthScale;
-  const double maxRadiusPerLength = settings_.radii == RadiusModel::Width ? 0.5 * settings_.maxWidthToLength : 0.0;
-  const bool taper = settings_.taper && settings_.radii == RadiusModel::Width;
-  const DVec3 tropism = settings_.tropism;
-  const double defS = std::sin(radians(settings_.angleDeg));
-  const double defC = std::cos(radians(settings_.angleDeg));
-  SinCosCache trig;
-
-  auto angle = [&](size_t i, double& s, double& c) {
-    if (off[i + 1] > off[i]) {
-      trig.get(prm[off[i]], s, c);
-    } else {
-      s = defS;
-      c = defC;
-    }
-  };
-  auto stepOf = [&](size_t i) { return haveSteps ? moduleSteps[i] : 0; };
-  // Growth: the scale of module i (1 = full size, 0 = not yet drawn).
-  const bool growing = settings_.growthStep >= 0 && haveSteps;
-  const double partial = settings_.growthScale();
-  auto growth = [&](size_t i) {
-    if (!growing) return 1.0;
-    const int32_t born = moduleSteps[i];
-    return born < settings_.growthStep ? 1.0 : born == settings_.growthStep ? partial : 0.0;
-  };
-  std::vector<double> internodeGrowth;  // per internode, for the pipe model's radii (growth only)
-  auto length = [&](size_t i) {
-    const double l = off[i + 1] > off[i] ? prm[off[i]] : settings_.stepLength;
-    return growing ? l * growth(i) : l;
-  };
-
-  for (size_t i = 0; i < n; ++i) {
-    const SymbolId s = sym[i];
-    const Command c = s < ncmd ? cmd[s] : Command::None;
-    double sn, cs;
-    switch (c) {
-      case Command::None: break;
-      case Command::Forward:
-      case Command::ForwardNoVertex: {
-        DVec3 start = st.frame.position;
-        st.frame.position += st.frame.heading * length(i);
-        if (!polygons.empty()) {
-          if (c == Command::Forward) polygons.back().points.push_back(st.frame.position);
-          st.internode = -1;  // outlines are not drawn; the next segment starts a new axis
-          break;
-        }
-        const double g = growth(i);
-        if (g <= 0) break;  // not grown yet: nothing drawn, no bend; the axis carries on from its parent
-        Internode in;
-        in.start = start;
-        in.end = st.frame.position;
-        in.baseRadius = in.tipRadius = st.width * radiusScale * g;
-        if (maxRadiusPerLength > 0)
-          in.baseRadius = in.tipRadius = std::min(in.baseRadius, maxRadiusPerLength * glm::length(in.end - in.start));
-        if (growing) internodeGrowth.push_back(g);
-        in.parent = st.internode;
-        in.order = st.order;
-        in.step = stepOf(i);
-        in.module = static_cast<uint32_t>(i);
-        in.up = st.frame.up;
-        // Taper: the continuation of an axis (the child drawn at the parent's own order; a
-        // parent has at most one, since `[` raises the order) ends the parent's radius.
-        if (taper && in.parent >= 0 && sk.internodes[in.parent].order == in.order)
-          sk.internodes[in.parent].tipRadius = in.baseRadius;
-        st.internode = static_cast<int32_t>(sk.internodes.size());
-        sk.internodes.push_back(in);
-        // A growing internode bends in proportion to its growth, so frames change smoothly.
-        if (st.elasticity != 0) applyTropism(st.frame, tropism, st.elasticity * g);
-        break;
-      }
-      case Command::Move:
-      case Command::MoveNoVertex:
-        st.frame.position += st.frame.heading * length(i);
-        if (!polygons.empty() && c == Command::Move) polygons.back().points.push_back(st.frame.position);
-        st.internode = -1;  // the next segment starts a new, disconnected axis
-        break;
-      case Command::TurnLeft: angle(i, sn, cs); rotatePair(st.frame.heading, st.frame.left, cs, sn); break;
-      case Command::TurnRight: angle(i, sn, cs); rotatePair(st.frame.heading, st.frame.left, cs, -sn); break;
-      case Command::PitchDown: angle(i, sn, cs); rotatePair(st.frame.up, st.frame.heading, cs, sn); break;
-      case Command::PitchUp: angle(i, sn, cs); rotatePair(st.frame.up, st.frame.heading, cs, -sn); break;
-      case Command::RollLeft: angle(i, sn, cs); rotatePair(st.frame.left, st.frame.up, cs, sn); break;
-      case Command::RollRight: angle(i, sn, cs); rotatePair(st.frame.left, st.frame.up, cs, -sn); break;
-      case Command::TurnAround:
-        st.frame.heading = -st.frame.heading;
-        st.frame.left = -st.frame.left;
-        break;
-      case Command::RollToVertical: rollToVertical(st.frame); break;
-      case Command::Push:
-        stack.push_back(st);
-        ++st.order;
-        break;
-      case Command::Pop:
-        if (!stack.empty()) {
-          st = stack.back();
-          stack.pop_back();
-        }
-        break;
-      case Command::Width:
-        st.width = off[i + 1] > off[i] ? prm[off[i]] : st.width * settings_.widthFactor;
-        break;
-      case Command::Color: st.color = off[i + 1] > off[i] ? static_cast<int>(prm[off[i]]) : st.color + 1; break;
-      case Command::PolygonBegin: polygons.push_back({{}, st.internode}); break;
-      case Command::Vertex:
-        if (!polygons.empty()) polygons.back().points.push_back(st.frame.position);
-        break;
-      case Command::PolygonEnd:
-        if (!polygons.empty()) {
-          if (polygons.back().points.size() >= 3 && growth(i) > 0) {
-            Organ o;
-            o.kind = Organ::Kind::Polygon;
-            o.points = std::move(polygons.back().points);
-            o.position = o.points.front();
-            o.heading = st.frame.heading;
-            o.left = st.frame.left;
-            o.up = st.frame.up;
-            o.internode = polygons.back().internode;
-            o.step = stepOf(i);
-            o.color = st.color;
-            sk.organs.push_back(std::move(o));
-          }
-          polygons.pop_back();
-        }
-        break;
-      case Command::Surface:
-      case Command::SurfaceNamed: {
-        Organ o;
-        o.kind = Organ::Kind::Surface;
-        o.radius = off[i + 1] > off[i] ? prm[off[i]] : settings_.surfaceScale;
-        if (c == Command::SurfaceNamed) {
-          o.name = symbols_.name(s).substr(1);
-        } else if (i + 1 < n) {
-          // cpfg style `~l` or `~l(scale)`: the next module names the surface and is consumed.
-          ++i;
-          o.name = symbols_.name(sym[i]);
-          if (off[i] == off[i - 1] && off[i + 1] > off[i]) o.radius = prm[off[i]];
-        } else {
-          break;
-        }
-        o.radius *= growth(i);
-        if (o.radius <= 0 && growing) break;
-        o.position = st.frame.position;
-        o.heading = st.frame.heading;
-        o.left = st.frame.left;
-        o.up = st.frame.up;
-        o.internode = st.internode;
-        o.step = stepOf(i);
-        o.color = st.color;
-        sk.organs.push_back(std::move(o));
-        break;
-      }
-      case Command::Sphere: {
-        Organ o;
-        o.kind = Organ::Kind::Sphere;
-        o.radius = (off[i + 1] > off[i] ? prm[off[i]] : st.width * radiusScale) * growth(i);
-        if (o.radius <= 0 && growing) break;
-        o.position = st.frame.position;
-        o.heading = st.frame.heading;
-        o.left = st.frame.left;
-        o.up = st.frame.up;
-        o.internode = st.internode;
-        o.step = stepOf(i);
-        o.color = st.color;
-        sk.organs.push_back(std::move(o));
-        break;
-      }
-      case Command::Tropism:
-        if (off[i + 1] > off[i]) st.elasticity = prm[off[i]];
-        break;
-      case Command::Cut: {
-        // The branch ends here: mark its last internode as cut, skip to the matching `]`.
-        if (st.internode >= 0) sk.internodes[st.internode].cut = true;
-        int depth = 0;
-        size_t j = i + 1;
-        for (; j < n; ++j) {
-          Command cj = sym[j] < ncmd ? cmd[sym[j]] : Command::None;
-          if (cj == Command::Push) {
-            ++depth;
-          } else if (cj == Command::Pop) {
-            if (depth == 0) break;
-            --depth;
-          }
-        }
-        i = j - 1;  // the loop's ++i lands on the `]` (or the end)
-        break;
+  /// Interprets every module; returns the state after the last one.
+  const TurtleState& walk() {
+    for (size_t i = 0; i < n_; ++i) {
+      const Command c = commandAt(i);
+      switch (c) {
+        case Command::None: break;
+        case Command::Forward:
+        case Command::ForwardNoVertex: forward(i, c == Command::Forward); break;
+        case Command::Move:
+        case Command::MoveNoVertex: move(i, c == Command::Move); break;
+        case Command::TurnLeft: rotate(i, st_.frame.heading, st_.frame.left, false); break;
+        case Command::TurnRight: rotate(i, st_.frame.heading, st_.frame.left, true); break;
+        case Command::PitchDown: rotate(i, st_.frame.up, st_.frame.heading, false); break;
+        case Command::PitchUp: rotate(i, st_.frame.up, st_.frame.heading, true); break;
+        case Command::RollLeft: rotate(i, st_.frame.left, st_.frame.up, false); break;
+        case Command::RollRight: rotate(i, st_.frame.left, st_.frame.up, true); break;
+        case Command::TurnAround: turnAround(); break;
+        case Command::RollToVertical: rollToVertical(st_.frame); break;
+        case Command::Push: push(); break;
+        case Command::Pop: pop(); break;
+        case Command::Width: width(i); break;
+        case Command::Color: color(i); break;
+        case Command::PolygonBegin: buf_.polygons.push_back({{}, st_.internode}); break;
+        case Command::Vertex: vertex(); break;
+        case Command::PolygonEnd: polygonEnd(i); break;
+        case Command::Surface: i = surface(i); break;
+        case Command::SurfaceNamed: surfaceNamed(i); break;
+        case Command::Sphere: sphere(i); break;
+        case Command::Tropism: tropismChange(i); break;
+        case Command::Cut: i = cut(i); break;
       }
     }
+    return st_;
   }
-  end_ = st;
 
-  // Radii post-pass. Children always follow their parent in drawing order, so one
-  // backward sweep sees every child before its parent.
-  auto& ins = sk.internodes;
-  const size_t m = ins.size();
-  if (settings_.radii == RadiusModel::Pipe) {
+  /// Pipe model radii, after the walk. Children always follow their parent in drawing
+  /// order, so one backward sweep sees every child before its parent.
+  void pipeRadii() {
+    auto& ins = sk_.internodes;
+    const size_t m = ins.size();
     const double e = settings_.pipeExponent;
     std::vector<double> sum(m, 0.0), maxChild(m, 0.0);
     for (size_t k = m; k-- > 0;) {
@@ -405,12 +255,241 @@ void Turtle::run(const ModuleString& ms, Skeleton& sk, std::span<const int32_t> 
       }
     }
     // Growing internodes thicken with their growth, like the width model's radii.
-    if (growing)
+    if (growing_)
       for (size_t k = 0; k < m; ++k) {
-        ins[k].baseRadius *= internodeGrowth[k];
-        ins[k].tipRadius *= internodeGrowth[k];
+        ins[k].baseRadius *= buf_.internodeGrowth[k];
+        ins[k].tipRadius *= buf_.internodeGrowth[k];
       }
   }
+
+ private:
+  Command commandAt(size_t i) const { return sym_[i] < ncmd_ ? cmd_[sym_[i]] : Command::None; }
+  bool hasParam(size_t i) const { return off_[i + 1] > off_[i]; }
+  /// The first parameter of module i (which must have one).
+  double param(size_t i) const { return prm_[off_[i]]; }
+  int32_t stepOf(size_t i) const { return haveSteps_ ? steps_[i] : 0; }
+  /// Growth: the scale of module i (1 = full size, 0 = not yet drawn).
+  double growth(size_t i) const {
+    if (!growing_) return 1.0;
+    const int32_t born = steps_[i];
+    return born < settings_.growthStep ? 1.0 : born == settings_.growthStep ? partial_ : 0.0;
+  }
+  /// Length of the move of module i (its parameter, or the step length), scaled by growth.
+  double length(size_t i) const {
+    const double l = hasParam(i) ? param(i) : settings_.stepLength;
+    return growing_ ? l * growth(i) : l;
+  }
+
+  /// `F` and `G`: draws an internode (or, inside a polygon, adds an outline point when
+  /// withVertex). Growing modules draw shorter and thinner; unborn ones draw nothing.
+  void forward(size_t i, bool withVertex) {
+    DVec3 start = st_.frame.position;
+    st_.frame.position += st_.frame.heading * length(i);
+    if (!buf_.polygons.empty()) {
+      if (withVertex) addPolygonPoint(st_.frame.position);
+      st_.internode = -1;  // outlines are not drawn; the next segment starts a new axis
+      return;
+    }
+    const double g = growth(i);
+    if (g <= 0) return;  // not grown yet: nothing drawn, no bend; the axis carries on from its parent
+    Internode in;
+    in.start = start;
+    in.end = st_.frame.position;
+    in.baseRadius = in.tipRadius = st_.width * radiusScale_ * g;
+    if (maxRadiusPerLength_ > 0)
+      in.baseRadius = in.tipRadius = std::min(in.baseRadius, maxRadiusPerLength_ * glm::length(in.end - in.start));
+    if (growing_) buf_.internodeGrowth.push_back(g);
+    in.parent = st_.internode;
+    in.order = st_.order;
+    in.step = stepOf(i);
+    in.module = static_cast<uint32_t>(i);
+    in.up = st_.frame.up;
+    // Taper: the continuation of an axis (the child drawn at the parent's own order; a
+    // parent has at most one, since `[` raises the order) ends the parent's radius.
+    if (taper_ && in.parent >= 0 && sk_.internodes[in.parent].order == in.order)
+      sk_.internodes[in.parent].tipRadius = in.baseRadius;
+    st_.internode = static_cast<int32_t>(sk_.internodes.size());
+    sk_.internodes.push_back(in);
+    // A growing internode bends in proportion to its growth, so frames change smoothly.
+    if (st_.elasticity != 0) applyTropism(st_.frame, tropism_, st_.elasticity * g);
+  }
+
+  /// `f` and `g`: moves without drawing (`f` adds a polygon point when withVertex).
+  void move(size_t i, bool withVertex) {
+    st_.frame.position += st_.frame.heading * length(i);
+    if (!buf_.polygons.empty() && withVertex) addPolygonPoint(st_.frame.position);
+    st_.internode = -1;  // the next segment starts a new, disconnected axis
+  }
+
+  /// `+ - & ^ \ /`: rotates the plane (a, b) by module i's angle (or the default), moving
+  /// a toward b, or away from it when reverse.
+  void rotate(size_t i, DVec3& a, DVec3& b, bool reverse) {
+    double s, c;
+    if (hasParam(i)) {
+      trig_.get(param(i), s, c);
+    } else {
+      s = defS_;
+      c = defC_;
+    }
+    rotatePair(a, b, c, reverse ? -s : s);
+  }
+
+  /// `|`: turns about U by 180 degrees.
+  void turnAround() {
+    st_.frame.heading = -st_.frame.heading;
+    st_.frame.left = -st_.frame.left;
+  }
+
+  /// `[`: saves the state; the branch is one order higher.
+  void push() {
+    buf_.stack.push_back(st_);
+    ++st_.order;
+  }
+
+  /// `]`: restores the state of the matching `[` (an unmatched `]` is ignored).
+  void pop() {
+    if (!buf_.stack.empty()) {
+      st_ = buf_.stack.back();
+      buf_.stack.pop_back();
+    }
+  }
+
+  /// Adds p to the innermost open polygon.
+  void addPolygonPoint(DVec3 p) { buf_.polygons.back().points.push_back(p); }
+
+  /// `!`: sets the width, or multiplies it by the width factor.
+  void width(size_t i) { st_.width = hasParam(i) ? param(i) : st_.width * settings_.widthFactor; }
+  /// `'`: sets the color index, or increments it.
+  void color(size_t i) { st_.color = hasParam(i) ? static_cast<int>(param(i)) : st_.color + 1; }
+  /// `.`: adds the position to the innermost open polygon.
+  void vertex() {
+    if (!buf_.polygons.empty()) addPolygonPoint(st_.frame.position);
+  }
+  /// `@Ts(e)`: sets the tropism susceptibility.
+  void tropismChange(size_t i) {
+    if (hasParam(i)) st_.elasticity = param(i);
+  }
+
+  /// An organ of kind at the turtle, attached to the current internode, for module i.
+  Organ organHere(Organ::Kind kind, size_t i) const {
+    Organ o;
+    o.kind = kind;
+    o.position = st_.frame.position;
+    o.heading = st_.frame.heading;
+    o.left = st_.frame.left;
+    o.up = st_.frame.up;
+    o.internode = st_.internode;
+    o.step = stepOf(i);
+    o.color = st_.color;
+    return o;
+  }
+
+  /// `}`: closes the innermost polygon; one of at least 3 points (and grown) is an organ.
+  void polygonEnd(size_t i) {
+    if (buf_.polygons.empty()) return;
+    if (buf_.polygons.back().points.size() >= 3 && growth(i) > 0) {
+      Organ o = organHere(Organ::Kind::Polygon, i);
+      o.points = std::move(buf_.polygons.back().points);
+      o.position = o.points.front();
+      o.internode = buf_.polygons.back().internode;
+      sk_.organs.push_back(std::move(o));
+    }
+    buf_.polygons.pop_back();
+  }
+
+  /// Adds a surface organ named name with scale radius for module i (not when growth
+  /// leaves nothing of it).
+  [[gnu::always_inline]] void addSurface(size_t i, std::string name, double radius) {
+    radius *= growth(i);
+    if (radius <= 0 && growing_) return;
+    Organ o = organHere(Organ::Kind::Surface, i);
+    o.radius = radius;
+    o.name = std::move(name);
+    sk_.organs.push_back(std::move(o));
+  }
+
+  /// cpfg's `~l` or `~l(scale)` written as two modules: the module after `~` names the
+  /// surface and is consumed. Returns the index of the last module read.
+  size_t surface(size_t i) {
+    if (i + 1 >= n_) return i;
+    double radius = hasParam(i) ? param(i) : settings_.surfaceScale;
+    ++i;
+    if (off_[i] == off_[i - 1] && hasParam(i)) radius = param(i);
+    addSurface(i, symbols_.name(sym_[i]), radius);
+    return i;
+  }
+
+  /// `~l` as one symbol (`~` and a letter).
+  void surfaceNamed(size_t i) {
+    addSurface(i, symbols_.name(sym_[i]).substr(1), hasParam(i) ? param(i) : settings_.surfaceScale);
+  }
+
+  /// `@O(r)`: a sphere of radius r (default: half the line width).
+  void sphere(size_t i) {
+    const double radius = (hasParam(i) ? param(i) : st_.width * radiusScale_) * growth(i);
+    if (radius <= 0 && growing_) return;
+    Organ o = organHere(Organ::Kind::Sphere, i);
+    o.radius = radius;
+    sk_.organs.push_back(std::move(o));
+  }
+
+  /// `%`: the branch ends here: marks its last internode as cut and skips to the matching
+  /// `]`. Returns the index before that `]` (or the last index), for the loop's ++i.
+  size_t cut(size_t i) {
+    if (st_.internode >= 0) sk_.internodes[st_.internode].cut = true;
+    int depth = 0;
+    size_t j = i + 1;
+    for (; j < n_; ++j) {
+      Command cj = commandAt(j);
+      if (cj == Command::Push) {
+        ++depth;
+      } else if (cj == Command::Pop) {
+        if (depth == 0) break;
+        --depth;
+      }
+    }
+    return j - 1;
+  }
+
+  const SymbolTable& symbols_;
+  const TurtleSettings& settings_;
+  Skeleton& sk_;
+  WalkBuffers buf_;
+  const size_t n_;
+  const SymbolId* sym_;
+  const uint32_t* off_;
+  const double* prm_;
+  const Command* cmd_;
+  const size_t ncmd_;
+  const std::span<const int32_t> steps_;
+  const bool haveSteps_;
+  const double radiusScale_;
+  const double maxRadiusPerLength_;
+  const bool taper_;
+  const DVec3 tropism_;
+  const double defS_, defC_;
+  const bool growing_;
+  const double partial_;
+  SinCosCache trig_;
+  TurtleState st_;
+};
+
+}  // namespace
+
+Skeleton Turtle::run(const ModuleString& ms, std::span<const int32_t> moduleSteps) {
+  Skeleton sk;
+  run(ms, sk, moduleSteps);
+  return sk;
+}
+
+void Turtle::run(const ModuleString& ms, Skeleton& sk, std::span<const int32_t> moduleSteps) {
+  sk.internodes.clear();
+  sk.organs.clear();
+  if (moduleSteps.empty() && ms.hasBirthSteps()) moduleSteps = ms.birthSteps;
+  TurtleWalk walk(symbols_, settings_, commands_, ms, sk, moduleSteps);
+  walk.reserveInternodes();
+  end_ = walk.walk();
+  if (settings_.radii == RadiusModel::Pipe) walk.pipeRadii();
 }
 
 Skeleton interpret(const ModuleString& modules, const SymbolTable& symbols, const TurtleSettings& settings,

@@ -120,12 +120,6 @@ class Turtle {
 Skeleton interpret(const ModuleString& modules, const SymbolTable& symbols, const TurtleSettings& settings = {},
                    std::span<const int32_t> moduleSteps = {});
 
-/// Rotates `frame` right-handedly by angleDeg about its up vector (the `+` command).
-void turnAboutUp(TurtleFrame& frame, double angleDeg);
-/// Rotates `frame` right-handedly by angleDeg about its left vector (the `&` command).
-void turnAboutLeft(TurtleFrame& frame, double angleDeg);
-/// Rotates `frame` right-handedly by angleDeg about its heading (the `\` command).
-void turnAboutHeading(TurtleFrame& frame, double angleDeg);
 /// ABOP's `$`: rolls about H so that L is horizontal (L = V x H / |V x H|, V = +Y),
 /// U = H x L. Leaves the frame unchanged when H is vertical.
 void rollToVertical(TurtleFrame& frame);

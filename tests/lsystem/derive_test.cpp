@@ -26,6 +26,13 @@ std::string deriveText(const std::string& text, int steps, uint64_t seed = 0) {
   return formatModuleString(d.derive(), d.symbols());
 }
 
+/// A grammar and the string one derivation step gives, in a scenario.
+struct OneStep {
+  const char* scenario;
+  const char* grammar;
+  const char* expected;
+};
+
 /// The message of the InputError fn throws ("" when it does not throw).
 template <class Fn>
 std::string errorOf(Fn&& fn) {
@@ -229,42 +236,36 @@ A --> C : 75
 }
 
 TEST_CASE("Deriver::derive context matching across brackets (lpfg rules)", "[lsystem]") {
-  SECTION("right context skips whole branches") {
-    CHECK(deriveText("axiom: A[B]C\nA > C --> X\n", 1) == "X[B]C");
-    CHECK(deriveText("axiom: A[B]C\nA > B --> X\n", 1) == "A[B]C");
-    CHECK(deriveText("axiom: A[B][D]C\nA > C --> X\n", 1) == "X[B][D]C");
-  }
-  SECTION("right context fails at the end of the branch") {
-    CHECK(deriveText("axiom: [A]C\nA > C --> X\n", 1) == "[A]C");
-    CHECK(deriveText("axiom: [AB]C\nA > B --> X\n", 1) == "[XB]C");
-  }
-  SECTION("left context skips `[` into the parent") {
-    CHECK(deriveText("axiom: B[A]\nB < A --> X\n", 1) == "B[X]");
-    CHECK(deriveText("axiom: B[[A]]\nB < A --> X\n", 1) == "B[[X]]");
-  }
-  SECTION("left context skips whole branches that end in `]`") {
-    CHECK(deriveText("axiom: B[C]A\nB < A --> X\n", 1) == "B[C]X");
-    CHECK(deriveText("axiom: B[C]A\nC < A --> X\n", 1) == "B[C]A");
-    CHECK(deriveText("axiom: B[C][D[E]]A\nB < A --> X\n", 1) == "B[C][D[E]]X");
-  }
-  SECTION("ignore: and consider:") {
-    CHECK(deriveText("axiom: B+A\nB < A --> X\n", 1) == "B+A");
-    CHECK(deriveText("ignore: +\naxiom: B+A\nB < A --> X\n", 1) == "B+X");
-    CHECK(deriveText("ignore: +-\naxiom: A-+B\nA > B --> X\n", 1) == "X-+B");
-    CHECK(deriveText("consider: AB\naxiom: BFG+A\nB < A --> X\n", 1) == "BFG+X");
-    CHECK(deriveText("consider: AB\naxiom: BFC+A\nC < A --> X\n", 1) == "BFC+A");
-  }
-  SECTION("multi-module contexts, brackets in a right context, parameters from contexts") {
-    CHECK(deriveText("axiom: ABCDE\nA B < C > D E --> X\n", 1) == "ABXDE");
-    CHECK(deriveText("axiom: ABCDF\nA B < C > D E --> X\n", 1) == "ABCDF");
-    CHECK(deriveText("axiom: A[B]C\nA > [B]C --> X\n", 1) == "X[B]C");
-    CHECK(deriveText("axiom: A[B]C\nA > [D]C --> X\n", 1) == "A[B]C");
-    CHECK(deriveText("axiom: A[BE]C\nA > [B]C --> X\n", 1) == "X[BE]C");
-    CHECK(deriveText("axiom: A(1)B(2)C(4)\nA(x) < B(y) > C(z) --> B(x+y+z)\n", 1) == "A(1)B(7)C(4)");
-    CHECK(deriveText("axiom: A(1)B(2)C C(3)\nA(x) < B(y) > C(z) --> X\n", 1) == "A(1)B(2)CC(3)");  // C has no parameter
-  }
-  SECTION("contexts read the old string, not the one being written") {
-    CHECK(deriveText("axiom: AAB\nA > A --> B\nA > B --> C\n", 1) == "BCB");
+  SECTION("one step of small grammars (each row: scenario, grammar, result)") {
+    const OneStep rows[] = {
+        {"right context skips whole branches", "axiom: A[B]C\nA > C --> X\n", "X[B]C"},
+        {"right context skips whole branches", "axiom: A[B]C\nA > B --> X\n", "A[B]C"},
+        {"right context skips whole branches", "axiom: A[B][D]C\nA > C --> X\n", "X[B][D]C"},
+        {"right context fails at the end of the branch", "axiom: [A]C\nA > C --> X\n", "[A]C"},
+        {"right context fails at the end of the branch", "axiom: [AB]C\nA > B --> X\n", "[XB]C"},
+        {"left context skips `[` into the parent", "axiom: B[A]\nB < A --> X\n", "B[X]"},
+        {"left context skips `[` into the parent", "axiom: B[[A]]\nB < A --> X\n", "B[[X]]"},
+        {"left context skips whole branches that end in `]`", "axiom: B[C]A\nB < A --> X\n", "B[C]X"},
+        {"left context skips whole branches that end in `]`", "axiom: B[C]A\nC < A --> X\n", "B[C]A"},
+        {"left context skips whole branches that end in `]`", "axiom: B[C][D[E]]A\nB < A --> X\n", "B[C][D[E]]X"},
+        {"ignore: and consider:", "axiom: B+A\nB < A --> X\n", "B+A"},
+        {"ignore: and consider:", "ignore: +\naxiom: B+A\nB < A --> X\n", "B+X"},
+        {"ignore: and consider:", "ignore: +-\naxiom: A-+B\nA > B --> X\n", "X-+B"},
+        {"ignore: and consider:", "consider: AB\naxiom: BFG+A\nB < A --> X\n", "BFG+X"},
+        {"ignore: and consider:", "consider: AB\naxiom: BFC+A\nC < A --> X\n", "BFC+A"},
+        {"multi-module contexts", "axiom: ABCDE\nA B < C > D E --> X\n", "ABXDE"},
+        {"multi-module contexts", "axiom: ABCDF\nA B < C > D E --> X\n", "ABCDF"},
+        {"brackets in a right context", "axiom: A[B]C\nA > [B]C --> X\n", "X[B]C"},
+        {"brackets in a right context", "axiom: A[B]C\nA > [D]C --> X\n", "A[B]C"},
+        {"brackets in a right context", "axiom: A[BE]C\nA > [B]C --> X\n", "X[BE]C"},
+        {"parameters from contexts", "axiom: A(1)B(2)C(4)\nA(x) < B(y) > C(z) --> B(x+y+z)\n", "A(1)B(7)C(4)"},
+        {"parameters from contexts", "axiom: A(1)B(2)C C(3)\nA(x) < B(y) > C(z) --> X\n", "A(1)B(2)CC(3)"},  // C has no parameter
+        {"contexts read the old string, not the one being written", "axiom: AAB\nA > A --> B\nA > B --> C\n", "BCB"},
+    };
+    for (const OneStep& r : rows) {
+      INFO(r.scenario << ": " << r.grammar);
+      CHECK(deriveText(r.grammar, 1) == r.expected);
+    }
   }
   SECTION("ABOP 1.31a against an independent reference") {
     Grammar g = loadGrammar(asset("abop_1_31a.lsys"));
@@ -320,45 +321,63 @@ TEST_CASE("Deriver::derive expression functions", "[lsystem]") {
     REQUIRE(s.paramCount(0) == 1);
     return s.paramsOf(0)[0];
   };
-  CHECK(value("1+2*3") == 7);
-  CHECK(value("(1+2)*3") == 9);
-  CHECK(value("7-2-1") == 4);
-  CHECK(value("8/2/2") == 2);
-  CHECK(value("2^3^2") == 512);  // right-associative
-  CHECK(value("-2^2") == -4);    // ^ binds tighter than unary minus
-  CHECK(value("2^-1") == 0.5);
-  CHECK(value("3<4") == 1);
-  CHECK(value("3<=3") == 1);
-  CHECK(value("3>4") == 0);
-  CHECK(value("4>=5") == 0);
-  CHECK(value("2==2") == 1);
-  CHECK(value("2!=2") == 0);
-  CHECK(value("1&&0") == 0);
-  CHECK(value("1||0") == 1);
-  CHECK(value("!0") == 1);
-  CHECK(value("!3") == 0);
-  CHECK(value("1<2 && 2<3 || 0") == 1);
-  CHECK(value("sin(30)") == Approx(0.5));
-  CHECK(value("cos(60)") == Approx(0.5));
-  CHECK(value("tan(45)") == Approx(1));
-  CHECK(value("asin(0.5)") == Approx(30));
-  CHECK(value("acos(0.5)") == Approx(60));
-  CHECK(value("atan(1)") == Approx(45));
-  CHECK(value("atan2(1,-1)") == Approx(135));
-  CHECK(value("sqrt(16)") == 4);
-  CHECK(value("exp(0)") == 1);
-  CHECK(value("log(exp(2))") == Approx(2));
-  CHECK(value("pow(2,10)") == 1024);
-  CHECK(value("abs(-3)") == 3);
-  CHECK(value("min(2,-5)") == -5);
-  CHECK(value("max(2,-5)") == 2);
-  CHECK(value("floor(-1.5)") == -2);
-  CHECK(value("ceil(1.2)") == 2);
-  CHECK(value("sign(-2)") == -1);
-  CHECK(value("sign(0)") == 0);
-  CHECK(value("sign(3)") == 1);
-  CHECK(value("1.5e2") == 150);
-  CHECK(value(".5") == 0.5);
+  // Each {expression, value}: the expression as a successor parameter gives exactly (then
+  // approximately) the value.
+  struct Value {
+    const char* expr;
+    double value;
+  };
+  const Value exact[] = {
+      {"1+2*3", 7},
+      {"(1+2)*3", 9},
+      {"7-2-1", 4},
+      {"8/2/2", 2},
+      {"2^3^2", 512},           // right-associative
+      {"-2^2", -4},             // ^ binds tighter than unary minus
+      {"2^-1", 0.5},
+      {"3<4", 1},
+      {"3<=3", 1},
+      {"3>4", 0},
+      {"4>=5", 0},
+      {"2==2", 1},
+      {"2!=2", 0},
+      {"1&&0", 0},
+      {"1||0", 1},
+      {"!0", 1},
+      {"!3", 0},
+      {"1<2 && 2<3 || 0", 1},
+      {"sqrt(16)", 4},
+      {"exp(0)", 1},
+      {"pow(2,10)", 1024},
+      {"abs(-3)", 3},
+      {"min(2,-5)", -5},
+      {"max(2,-5)", 2},
+      {"floor(-1.5)", -2},
+      {"ceil(1.2)", 2},
+      {"sign(-2)", -1},
+      {"sign(0)", 0},
+      {"sign(3)", 1},
+      {"1.5e2", 150},
+      {".5", 0.5},
+  };
+  const Value approximate[] = {
+      {"sin(30)", 0.5},
+      {"cos(60)", 0.5},
+      {"tan(45)", 1},
+      {"asin(0.5)", 30},
+      {"acos(0.5)", 60},
+      {"atan(1)", 45},
+      {"atan2(1,-1)", 135},
+      {"log(exp(2))", 2},
+  };
+  for (const Value& v : exact) {
+    INFO(v.expr);
+    CHECK(value(v.expr) == v.value);
+  }
+  for (const Value& v : approximate) {
+    INFO(v.expr);
+    CHECK(value(v.expr) == Approx(v.value));
+  }
   SECTION("ran(x) is uniform in [0,x); nran(mean, sd) is normal; both seeded") {
     std::string axiom = "axiom: ";
     for (int i = 0; i < 4000; ++i) axiom += 'A';

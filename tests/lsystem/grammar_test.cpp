@@ -27,6 +27,10 @@ std::string errorsOf(const std::string& text, const GrammarOverrides& o = {}) {
   return "";
 }
 
+/// The error for a production that can never apply: `what` is its position and reason
+/// after "g.lsys:", as parseGrammar words them.
+std::string neverApplies(const std::string& what) { return "g.lsys:" + what + ", so this production never applies"; }
+
 }  // namespace
 
 TEST_CASE("parseGrammar headers", "[lsystem]") {
@@ -202,22 +206,18 @@ TEST_CASE("parseGrammar unbalanced brackets", "[lsystem]") {
 TEST_CASE("parseGrammar parameter counts that never match", "[lsystem]") {
   SECTION("a predecessor whose parameter count no written module has") {
     CHECK(errorsOf("axiom: A\nA(x) --> F(x)B(x)\n") ==
-          "g.lsys:2:1: error: predecessor 'A(x)' has 1 parameter, but 'A' is only written with 0 parameters "
-          "(as at line 1:8), so this production never applies");
+          neverApplies("2:1: error: predecessor 'A(x)' has 1 parameter, but 'A' is only written with 0 parameters (as at line 1:8)"));
     CHECK(errorsOf("axiom: B(1,2)\nB(a,b) --> A(a)B(a,b)A(a,b,a)\nA(x, y) --> F\n") ==
-          "g.lsys:3:1: error: predecessor 'A(x, y)' has 2 parameters, but 'A' is only written with 1 or 3 parameters "
-          "(as at line 2:12), so this production never applies");
+          neverApplies("3:1: error: predecessor 'A(x, y)' has 2 parameters, but 'A' is only written with 1 or 3 parameters "
+                       "(as at line 2:12)"));
     CHECK(errorsOf("axiom: F(1)\nF --> GG\n") ==
-          "g.lsys:2:1: error: predecessor 'F' has 0 parameters, but 'F' is only written with 1 parameter "
-          "(as at line 1:8), so this production never applies");
+          neverApplies("2:1: error: predecessor 'F' has 0 parameters, but 'F' is only written with 1 parameter (as at line 1:8)"));
   }
   SECTION("a context whose parameter count no written module has") {
     CHECK(errorsOf("axiom: B(1)A\nB(x) < A --> A\nB --> C\n") ==
-          "g.lsys:3:1: error: predecessor 'B' has 0 parameters, but 'B' is only written with 1 parameter "
-          "(as at line 1:8), so this production never applies");
+          neverApplies("3:1: error: predecessor 'B' has 0 parameters, but 'B' is only written with 1 parameter (as at line 1:8)"));
     CHECK(errorsOf("axiom: BA\nB(x) < A --> A\n") ==
-          "g.lsys:2:1: error: context 'B(x)' has 1 parameter, but 'B' is only written with 0 parameters "
-          "(as at line 1:8), so this production never applies");
+          neverApplies("2:1: error: context 'B(x)' has 1 parameter, but 'B' is only written with 0 parameters (as at line 1:8)"));
   }
   SECTION("checked only when the rest of the file parses (no follow-on errors)") {
     CHECK(errorsOf("axiom: B\nA --> B(1,)\nB(x) --> C\n") == "g.lsys:2:11: error: empty parameter in 'B'");

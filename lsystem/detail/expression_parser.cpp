@@ -1,0 +1,406 @@
+#include "lsystem/detail/expression_parser.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+
+namespace sprig::lsystem::detail {
+
+namespace {
+
+/// Thrown inside the expression parser once the error is reported; caught by compile().
+struct ExprFail {};
+
+struct FunctionInfo {
+  const char* name;
+  Op op;
+  int arity;
+};
+
+constexpr FunctionInfo kFunctions[] = {
+    {"sin", Op::Sin, 1},     {"cos", Op::Cos, 1},     {"tan", Op::Tan, 1},     {"asin", Op::Asin, 1},
+    {"acos", Op::Acos, 1},   {"atan", Op::Atan, 1},   {"atan2", Op::Atan2, 2}, {"sqrt", Op::Sqrt, 1},
+    {"exp", Op::Exp, 1},     {"log", Op::Log, 1},     {"pow", Op::PowFn, 2},   {"abs", Op::Abs, 1},
+    {"min", Op::Min, 2},     {"max", Op::Max, 2},     {"floor", Op::Floor, 1}, {"ceil", Op::Ceil, 1},
+    {"sign", Op::Sign, 1},   {"ran", Op::Ran, 1},     {"nran", Op::Nran, 2},
+};
+
+/// Nesting of unary operators and parentheses beyond which an expression is rejected.
+constexpr int kMaxNesting = 48;
+
+int arityOf(Op op) {
+  switch (op) {
+    case Op::Const: case Op::Var: return 0;
+    case Op::Neg: case Op::Not: case Op::Sin: case Op::Cos: case Op::Tan: case Op::Asin: case Op::Acos:
+    case Op::Atan: case Op::Sqrt: case Op::Exp: case Op::Log: case Op::Abs: case Op::Floor: case Op::Ceil:
+    case Op::Sign: case Op::Ran:
+      return 1;
+    default: return 2;
+  }
+}
+
+const std::vector<std::string> kNoVars;
+
+}  // namespace
+
+struct ExpressionParser::Node {
+  Op op = Op::Const;
+  double value = 0;
+  uint16_t var = 0;
+  int kids[2] = {-1, -1};
+};
+
+struct ExpressionParser::Token {
+  enum Kind { Num, Ident, Punct, End } kind = End;
+  std::string_view text;
+  double value = 0;
+  int col = 0;  ///< 0-based
+};
+
+struct ExpressionParser::State {
+  Span span;
+  const std::vector<std::string>* vars = nullptr;
+  std::vector<Node> nodes;
+  Token tok;
+  int pos = 0;
+  int depth = 0;  ///< nesting of unary operators and parentheses
+};
+
+// ---- tokens ------------------------------------------------------------------------------
+
+void ExpressionParser::lex(State& st) {
+  const std::string& s = scanner_.line(st.span.line);
+  int i = st.pos;
+  while (i < st.span.e && isSpace(s[i])) ++i;
+  Token t;
+  t.col = i;
+  if (i >= st.span.e) {
+    t.kind = Token::End;
+    st.pos = i;
+    st.tok = t;
+    return;
+  }
+  char c = s[i];
+  if (std::isdigit(static_cast<unsigned char>(c)) || (c == '.' && i + 1 < st.span.e && std::isdigit(static_cast<unsigned char>(s[i + 1])))) {
+    int j = i;
+    while (j < st.span.e && (std::isdigit(static_cast<unsigned char>(s[j])) || s[j] == '.')) ++j;
+    if (j < st.span.e && (s[j] == 'e' || s[j] == 'E')) {
+      int k = j + 1;
+      if (k < st.span.e && (s[k] == '+' || s[k] == '-')) ++k;
+      if (k < st.span.e && std::isdigit(static_cast<unsigned char>(s[k]))) {
+        j = k;
+        while (j < st.span.e && std::isdigit(static_cast<unsigned char>(s[j]))) ++j;
+      }
+    }
+    double v = 0;
+    auto r = std::from_chars(s.data() + i, s.data() + j, v);
+    if (r.ec != std::errc() || r.ptr != s.data() + j) {
+      scanner_.error(st.span.line, i, "malformed number '" + s.substr(i, j - i) + "'");
+      throw ExprFail{};
+    }
+    t.kind = Token::Num;
+    t.value = v;
+    t.text = std::string_view(s).substr(i, j - i);
+    st.pos = j;
+  } else if (isIdentStart(c)) {
+    int j = i;
+    while (j < st.span.e && isIdentChar(s[j])) ++j;
+    t.kind = Token::Ident;
+    t.text = std::string_view(s).substr(i, j - i);
+    st.pos = j;
+  } else {
+    static const char* two[] = {"<=", ">=", "==", "!=", "&&", "||"};
+    int len = 0;
+    for (const char* op : two)
+      if (i + 1 < st.span.e && s.compare(i, 2, op) == 0) len = 2;
+    if (!len) {
+      if (std::string_view("+-*/^<>!(),").find(c) == std::string_view::npos) {
+        scanner_.error(st.span.line, i, std::string("unexpected character '") + c + "' in expression");
+        throw ExprFail{};
+      }
+      len = 1;
+    }
+    t.kind = Token::Punct;
+    t.text = std::string_view(s).substr(i, len);
+    st.pos = i + len;
+  }
+  st.tok = t;
+}
+
+bool ExpressionParser::isPunct(const State& st, std::string_view p) const {
+  return st.tok.kind == Token::Punct && st.tok.text == p;
+}
+
+int ExpressionParser::node(State& st, Op op, int a, int b) {
+  Node n;
+  n.op = op;
+  n.kids[0] = a;
+  n.kids[1] = b;
+  st.nodes.push_back(n);
+  return static_cast<int>(st.nodes.size()) - 1;
+}
+
+void ExpressionParser::unexpected(State& st, const char* what) {
+  if (st.tok.kind == Token::End) scanner_.error(st.span.line, st.tok.col, std::string("expected ") + what + " at the end of the expression");
+  else scanner_.error(st.span.line, st.tok.col, std::string("expected ") + what + ", got '" + std::string(st.tok.text) + "'");
+  throw ExprFail{};
+}
+
+// ---- grammar of expressions --------------------------------------------------------------
+
+int ExpressionParser::parseBinary(State& st, int level) {
+  static const std::vector<std::vector<std::pair<const char*, Op>>> levels = {
+      {{"||", Op::Or}},
+      {{"&&", Op::And}},
+      {{"==", Op::Eq}, {"!=", Op::Ne}},
+      {{"<", Op::Lt}, {"<=", Op::Le}, {">", Op::Gt}, {">=", Op::Ge}},
+      {{"+", Op::Add}, {"-", Op::Sub}},
+      {{"*", Op::Mul}, {"/", Op::Div}},
+  };
+  if (level == static_cast<int>(levels.size())) return parseUnary(st);
+  int lhs = parseBinary(st, level + 1);
+  for (;;) {
+    const std::pair<const char*, Op>* hit = nullptr;
+    for (const auto& op : levels[level])
+      if (isPunct(st, op.first)) hit = &op;
+    if (!hit) return lhs;
+    lex(st);
+    int rhs = parseBinary(st, level + 1);
+    lhs = node(st, hit->second, lhs, rhs);
+  }
+}
+
+int ExpressionParser::parseUnary(State& st) {
+  if (++st.depth > kMaxNesting) {
+    scanner_.error(st.span.line, st.tok.col, "expression is nested too deeply (more than " + std::to_string(kMaxNesting) + " levels)");
+    throw ExprFail{};
+  }
+  struct Leave {
+    int& d;
+    ~Leave() { --d; }
+  } leave{st.depth};
+  if (isPunct(st, "-")) {
+    lex(st);
+    return node(st, Op::Neg, parseUnary(st));
+  }
+  if (isPunct(st, "+")) {
+    lex(st);
+    return parseUnary(st);
+  }
+  if (isPunct(st, "!")) {
+    lex(st);
+    return node(st, Op::Not, parseUnary(st));
+  }
+  int base = parsePrimary(st);
+  if (isPunct(st, "^")) {
+    lex(st);
+    return node(st, Op::Pow, base, parseUnary(st));
+  }
+  return base;
+}
+
+int ExpressionParser::parsePrimary(State& st) {
+  if (st.tok.kind == Token::Num) {
+    int n = node(st, Op::Const);
+    st.nodes[n].value = st.tok.value;
+    lex(st);
+    return n;
+  }
+  if (isPunct(st, "(")) {
+    lex(st);
+    int inner = parseBinary(st, 0);
+    if (!isPunct(st, ")")) unexpected(st, "')'");
+    lex(st);
+    return inner;
+  }
+  if (st.tok.kind == Token::Ident) {
+    Token id = st.tok;
+    lex(st);
+    return isPunct(st, "(") ? parseCall(st, id) : parseName(st, id);
+  }
+  unexpected(st, "a number, a name or '('");
+}
+
+/// A call `name(args)`; the current token is its `(`.
+int ExpressionParser::parseCall(State& st, const Token& id) {
+  std::string name(id.text);
+  const FunctionInfo* fn = nullptr;
+  for (const FunctionInfo& f : kFunctions)
+    if (name == f.name) fn = &f;
+  if (!fn) {
+    std::vector<std::string> names;
+    for (const FunctionInfo& f : kFunctions) names.emplace_back(f.name);
+    scanner_.error(st.span.line, id.col, "unknown function '" + name + "'" + didYouMean(name, names));
+    throw ExprFail{};
+  }
+  lex(st);
+  std::vector<int> args;
+  if (!isPunct(st, ")")) {
+    for (;;) {
+      args.push_back(parseBinary(st, 0));
+      if (isPunct(st, ",")) {
+        lex(st);
+        continue;
+      }
+      break;
+    }
+  }
+  if (!isPunct(st, ")")) unexpected(st, "')' or ','");
+  lex(st);
+  if (static_cast<int>(args.size()) != fn->arity) {
+    scanner_.error(st.span.line, id.col, "function '" + name + "' takes " + std::to_string(fn->arity) + " argument" +
+                                             (fn->arity == 1 ? "" : "s") + ", got " + std::to_string(args.size()));
+    throw ExprFail{};
+  }
+  if (fn->op == Op::Ran || fn->op == Op::Nran) usesRandom_ = true;
+  return node(st, fn->op, args[0], args.size() > 1 ? args[1] : -1);
+}
+
+/// A formal parameter or a `#define` (in that order of precedence).
+int ExpressionParser::parseName(State& st, const Token& id) {
+  std::string name(id.text);
+  if (st.vars) {
+    auto it = std::find(st.vars->begin(), st.vars->end(), name);
+    if (it != st.vars->end()) {
+      int n = node(st, Op::Var);
+      st.nodes[n].var = static_cast<uint16_t>(it - st.vars->begin());
+      return n;
+    }
+  }
+  auto d = defines_.find(name);
+  if (d != defines_.end()) {
+    int n = node(st, Op::Const);
+    st.nodes[n].value = d->second;
+    return n;
+  }
+  std::vector<std::string> names;
+  if (st.vars) names = *st.vars;
+  for (auto& [k, v] : defines_) names.push_back(k);
+  scanner_.error(st.span.line, id.col, "unknown name '" + name + "'" + didYouMean(name, names));
+  throw ExprFail{};
+}
+
+// ---- code --------------------------------------------------------------------------------
+
+/// Emits node n onto code_ with constant folding; returns true when it folded to one Const.
+bool ExpressionParser::emit(const State& st, int n, int& depth, int& maxDepth) {
+  const Node& nd = st.nodes[n];
+  int arity = arityOf(nd.op);
+  if (arity == 0) {
+    Instr in;
+    in.op = nd.op;
+    in.c = nd.value;
+    in.var = nd.var;
+    code_.push_back(in);
+    maxDepth = std::max(maxDepth, ++depth);
+    return nd.op == Op::Const;
+  }
+  bool allConst = true;
+  for (int k = 0; k < arity; ++k) allConst &= emit(st, nd.kids[k], depth, maxDepth);
+  Instr in;
+  in.op = nd.op;
+  code_.push_back(in);
+  depth -= arity - 1;
+  if (allConst && nd.op != Op::Ran && nd.op != Op::Nran) {
+    size_t first = code_.size() - 1 - arity;
+    double v = evalCode(code_.data() + first, code_.data() + code_.size(), nullptr, nullptr);
+    code_.resize(first);
+    Instr c;
+    c.c = v;
+    code_.push_back(c);
+    return true;
+  }
+  return false;
+}
+
+bool ExpressionParser::compile(Span sp, const std::vector<std::string>& vars, const char* what) {
+  State st;
+  st.span = sp;
+  st.vars = &vars;
+  st.pos = sp.b;
+  size_t before = code_.size();
+  try {
+    lex(st);
+    int root = parseBinary(st, 0);
+    if (st.tok.kind != Token::End) unexpected(st, "an operator");
+    int depth = 0, maxDepth = 0;
+    emit(st, root, depth, maxDepth);
+    if (maxDepth > kMaxStack) {
+      scanner_.error(sp.line, sp.b, std::string(what) + " is nested too deeply");
+      code_.resize(before);
+      return false;
+    }
+    if (code_.size() == before + 1 && code_.back().op == Op::Const && !std::isfinite(code_.back().c)) {
+      scanner_.error(sp.line, sp.b, std::string(what) + " is not finite (" + formatNumber(code_.back().c) + ")");
+      code_.resize(before);
+      return false;
+    }
+    return true;
+  } catch (const ExprFail&) {
+    code_.resize(before);
+    return false;
+  }
+}
+
+std::optional<double> ExpressionParser::constant(Span sp, const std::string& what) {
+  sp = scanner_.trim(sp);
+  if (sp.b == sp.e) {
+    scanner_.error(sp.line, sp.b, "missing value for " + what);
+    return std::nullopt;
+  }
+  size_t before = code_.size();
+  bool rnd = usesRandom_;
+  usesRandom_ = false;
+  bool ok = compile(sp, kNoVars, what.c_str());
+  bool drew = usesRandom_;
+  usesRandom_ = rnd;
+  if (!ok) return std::nullopt;
+  std::optional<double> v;
+  if (drew || code_.size() != before + 1) scanner_.error(sp.line, sp.b, what + " must be a constant");
+  else v = code_.back().c;
+  code_.resize(before);
+  return v;
+}
+
+Arg ExpressionParser::compileArg(Span sp, const std::vector<std::string>& vars) {
+  Arg a;
+  size_t before = code_.size();
+  if (!compile(sp, vars, "parameter")) return a;
+  const Instr* c = code_.data() + before;
+  size_t len = code_.size() - before;
+  if (len == 1 && c[0].op == Op::Const) a = Arg{ArgKind::Const, 0, c[0].c, {}};
+  else if (len == 1 && c[0].op == Op::Var) a = Arg{ArgKind::Var, c[0].var, 0, {}};
+  else if (len == 3 && c[0].op == Op::Var && c[1].op == Op::Const && c[2].op == Op::Add) a = Arg{ArgKind::VarAddConst, c[0].var, c[1].c, {}};
+  else if (len == 3 && c[0].op == Op::Var && c[1].op == Op::Const && c[2].op == Op::Sub) a = Arg{ArgKind::VarAddConst, c[0].var, -c[1].c, {}};
+  else if (len == 3 && c[0].op == Op::Var && c[1].op == Op::Const && c[2].op == Op::Mul) a = Arg{ArgKind::VarMulConst, c[0].var, c[1].c, {}};
+  else if (len == 3 && c[0].op == Op::Const && c[1].op == Op::Var && c[2].op == Op::Mul) a = Arg{ArgKind::VarMulConst, c[1].var, c[0].c, {}};
+  else if (len == 3 && c[0].op == Op::Var && c[1].op == Op::Const && c[2].op == Op::Div) a = Arg{ArgKind::VarDivConst, c[0].var, c[1].c, {}};
+  else {
+    a.kind = ArgKind::Expr;
+    a.code = CodeRange{static_cast<uint32_t>(before), static_cast<uint32_t>(code_.size())};
+    return a;
+  }
+  code_.resize(before);
+  return a;
+}
+
+std::optional<double> ExpressionParser::evaluate(Span sp, Rng* rng) {
+  size_t before = code_.size();
+  bool rnd = usesRandom_;
+  usesRandom_ = false;
+  std::optional<double> value;
+  if (compile(sp, kNoVars, "parameter")) {
+    if (usesRandom_ && !rng) {
+      scanner_.error(sp.line, sp.b, "random functions are not allowed here");
+    } else {
+      double v = evalCode(code_.data() + before, code_.data() + code_.size(), nullptr, rng);
+      if (std::isfinite(v)) value = v;
+      else scanner_.error(sp.line, sp.b, "parameter is not finite (" + formatNumber(v) + ")");
+    }
+  }
+  usesRandom_ = rnd;
+  code_.resize(before);
+  return value;
+}
+
+}  // namespace sprig::lsystem::detail

@@ -1,0 +1,80 @@
+#pragma once
+/// The grammar's arithmetic expressions (`x*0.9`, `t > 2 && ran(1) < 0.5`, `sin(a)`):
+/// parsing a Span of a cleaned line and compiling it to the bytecode of
+/// lsystem/detail/program.h. Private to lsystem/; the grammar parser calls it.
+
+#include <optional>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+#include "core/rng.h"
+#include "lsystem/detail/program.h"
+#include "lsystem/detail/scanner.h"
+
+namespace sprig::lsystem::detail {
+
+/*
+ * ExpressionParser: recursive descent over the tokens of one span (numbers, names,
+ * operators; precedence from `||` up to unary operators and right-associative `^`) into
+ * a small node tree, which is then emitted in postfix order onto a shared code vector
+ * with constant folding: a subtree of constants (`#define`s included) becomes one Const,
+ * except random draws. Names resolve to the production's formal parameters first, then
+ * to `#define`s. Errors are reported through the scanner, at the token's column; a failed
+ * expression leaves the code vector as it was.
+ *
+ * usesRandom() records whether anything compiled since clearRandom() calls `ran` or
+ * `nran` (a production that draws needs a random stream).
+ */
+class ExpressionParser {
+ public:
+  /// Reads text and reports errors through scanner, resolves names in defines, and
+  /// appends bytecode to code. All three must outlive the parser.
+  ExpressionParser(Scanner& scanner, const std::unordered_map<std::string, double>& defines, std::vector<Instr>& code)
+      : scanner_(scanner), defines_(defines), code_(code) {}
+
+  /// Compiles the expression in sp, with formal parameters vars (register i is vars[i]),
+  /// onto the code vector. `what` names the expression in errors ("condition"). Returns
+  /// false (error reported, code unchanged) on failure, also for an expression nested
+  /// deeper than the VM's stack or one that folds to a non-finite constant.
+  bool compile(Span sp, const std::vector<std::string>& vars, const char* what);
+  /// A constant expression (defines allowed, no parameters, no random draws): its value,
+  /// or nullopt with an error reported. The code vector is left unchanged.
+  std::optional<double> constant(Span sp, const std::string& what);
+  /// A successor parameter: as an Arg of the cheapest kind that computes it (a constant,
+  /// a register, `x op c`), or else an Expr range of newly appended code. A failed
+  /// compilation returns a Const 0 Arg (the error is reported).
+  Arg compileArg(Span sp, const std::vector<std::string>& vars);
+  /// A parameter of a module written with constant expressions (an axiom, a string given
+  /// to parseModuleString): its value, drawing from rng for `ran`/`nran`. nullopt with an
+  /// error reported when it fails to compile, draws without an rng, or is not finite.
+  /// The code vector is left unchanged; usesRandom() is not affected.
+  std::optional<double> evaluate(Span sp, Rng* rng);
+
+  /// Whether an expression compiled since clearRandom() draws random numbers.
+  bool usesRandom() const { return usesRandom_; }
+  void clearRandom() { usesRandom_ = false; }
+
+ private:
+  struct Node;
+  struct Token;
+  struct State;
+
+  void lex(State& st);
+  bool isPunct(const State& st, std::string_view p) const;
+  int node(State& st, Op op, int a = -1, int b = -1);
+  [[noreturn]] void unexpected(State& st, const char* what);
+  int parseBinary(State& st, int level);
+  int parseUnary(State& st);
+  int parsePrimary(State& st);
+  int parseCall(State& st, const Token& id);
+  int parseName(State& st, const Token& id);
+  bool emit(const State& st, int n, int& depth, int& maxDepth);
+
+  Scanner& scanner_;
+  const std::unordered_map<std::string, double>& defines_;
+  std::vector<Instr>& code_;
+  bool usesRandom_ = false;
+};
+
+}  // namespace sprig::lsystem::detail

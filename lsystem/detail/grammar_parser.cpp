@@ -1,0 +1,614 @@
+#include "lsystem/detail/grammar_parser.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <unordered_map>
+
+#include "core/rng.h"
+#include "lsystem/detail/expression_parser.h"
+#include "lsystem/detail/scanner.h"
+
+namespace sprig::lsystem::detail {
+
+namespace {
+
+/// Stream id for random draws in axiom parameters.
+constexpr uint64_t kAxiomStream = 0xfffffffffffffff1ull;
+
+const char* const kHeaders[] = {"lsystem", "derivation length", "seed", "angle", "axiom", "ignore", "consider",
+                                "decomposition", "interpretation", "homomorphism", "maximum depth", "endlsystem"};
+
+enum class Block { Main, Decomposition, Interpretation };
+
+/// True when line s, whose first non-space character is at b, declares modules
+/// (`module Apex, Leaf`) rather than being a production of a module named `module`.
+bool isModuleDeclaration(const std::string& s, int b) {
+  return s.compare(b, 6, "module") == 0 && (b + 6 == static_cast<int>(s.size()) || isSpace(s[b + 6])) &&
+         Scanner::findArrow(s).first < 0;
+}
+
+/*
+ * GrammarParser: two passes over the scanned lines of one file, then a check and the
+ * finishing touches, writing one Program.
+ *
+ *   pass 1   `#define` constants (with overrides) and `module` declarations, so that
+ *            every expression and every module string of pass 2 may use them wherever
+ *            they stand in the file;
+ *   pass 2   headers (`axiom:`, `ignore:`, `decomposition:`, ...) and productions,
+ *            each production compiled into its block's RuleSet;
+ *   check    predecessors and contexts whose parameter count no written module has
+ *            (only on an otherwise clean file);
+ *   finish   overrides, the axiom's constant parameters, the ignore table, the lookup
+ *            tables by symbol.
+ *
+ * Lines, spans and diagnostics belong to the Scanner; expressions to the
+ * ExpressionParser, which appends onto Program::code. Errors are collected and thrown
+ * once, at the end.
+ */
+class GrammarParser {
+ public:
+  GrammarParser(const std::string& fileName, const GrammarOverrides& overrides)
+      : overrides_(overrides), scanner_(fileName) {
+    prog_.fileName = fileName;
+    for (const char* s : kTurtleSymbols) prog_.symbols.intern(s);
+    prog_.openBracket = static_cast<SymbolId>(prog_.symbols.find("["));
+    prog_.closeBracket = static_cast<SymbolId>(prog_.symbols.find("]"));
+    prog_.cut = static_cast<SymbolId>(prog_.symbols.find("%"));
+    for (const char* s : kTurtleSymbols)
+      if (std::string_view(s).size() > 1) scanner_.addMultiName(s);
+  }
+
+  /// Parses and compiles a grammar file's text.
+  std::shared_ptr<Program> run(std::string_view text) {
+    scanner_.load(text);
+    firstPass();
+    secondPass();
+    // Only on an otherwise clean file: a successor that failed to parse wrote nothing, and
+    // its modules' parameter counts would be missed.
+    if (!diags().hasErrors()) checkArities();
+    finish();
+    diags().throwIfErrors();
+    return std::make_shared<Program>(std::move(prog_));
+  }
+
+  /// Tokenizes every line of text as a constant module string over symbols (for
+  /// parseModuleString); new symbols are interned into symbols.
+  ModuleString constantString(std::string_view text, SymbolTable& symbols) {
+    scanner_.load(text);
+    prog_.symbols = symbols;
+    scanner_.clearMultiNames();
+    for (size_t i = 0; i < symbols.size(); ++i)
+      if (symbols.name(static_cast<SymbolId>(i)).size() > 1 && symbols.name(static_cast<SymbolId>(i))[0] != '~')
+        scanner_.addMultiName(symbols.name(static_cast<SymbolId>(i)));
+    ModuleString out;
+    for (int line = 1; line <= scanner_.lineCount(); ++line) {
+      std::vector<RawModule> mods;
+      if (!scanner_.tokenizeModules(line, 0, static_cast<int>(scanner_.line(line).size()), mods)) continue;
+      appendConstant(mods, out, nullptr);
+    }
+    diags().throwIfErrors();
+    symbols = prog_.symbols;
+    return out;
+  }
+
+ private:
+  DiagnosticList& diags() { return scanner_.diagnostics(); }
+  void error(int line, int col0, std::string msg) { scanner_.error(line, col0, std::move(msg)); }
+
+  // ---- pass 1: module declarations and #defines -----------------------------------------
+
+  /// Pass 1 (see the class comment), then overrides naming no `#define`.
+  void firstPass() {
+    if (auto [line, col] = scanner_.unterminatedComment(); line) error(line, col, "unterminated comment '/*'");
+    std::map<std::string, int> defineLines;
+    for (int line = 1; line <= scanner_.lineCount(); ++line) {
+      const std::string& s = scanner_.line(line);
+      int b = Scanner::firstNonSpace(s);
+      if (b >= static_cast<int>(s.size())) continue;
+      if (s.compare(b, 10, "endlsystem") == 0) break;
+      if (s.compare(b, 7, "#define") == 0 && (b + 7 == static_cast<int>(s.size()) || isSpace(s[b + 7]))) {
+        defineConstant(line, b, defineLines);
+      } else if (s[b] == '#') {
+        int i = b + 1;
+        while (i < static_cast<int>(s.size()) && isIdentChar(s[i])) ++i;
+        std::string word = s.substr(b, i - b);
+        error(line, b, "unknown directive '" + word + "'" + didYouMean(word, {"#define"}));
+      } else if (isModuleDeclaration(s, b)) {
+        declareModules(line, b + 6);
+      }
+    }
+    for (const DefineOverride& o : overrides_.defines) {
+      if (defines_.count(o.name)) continue;
+      std::vector<std::string> names;
+      for (auto& [n, v] : prog_.defines) names.push_back(n);
+      SourceLoc loc = o.loc;
+      if (loc.file.empty()) loc.file = prog_.fileName;
+      diags().error(loc, "no '#define " + o.name + "' in " + prog_.fileName + didYouMean(o.name, names));
+    }
+  }
+
+  /// `#define NAME expr` at column b of line: NAME's value (an override wins). defineLines
+  /// maps each name defined so far to its line.
+  void defineConstant(int line, int b, std::map<std::string, int>& defineLines) {
+    const std::string& s = scanner_.line(line);
+    int i = b + 7;
+    while (i < static_cast<int>(s.size()) && isSpace(s[i])) ++i;
+    int nb = i;
+    while (i < static_cast<int>(s.size()) && isIdentChar(s[i])) ++i;
+    if (nb == i || !isIdentStart(s[nb])) {
+      error(line, nb, "expected a name after '#define'");
+      return;
+    }
+    std::string name = s.substr(nb, i - nb);
+    if (defineLines.count(name)) {
+      error(line, nb, "'" + name + "' is already defined at line " + std::to_string(defineLines[name]));
+      return;
+    }
+    defineLines[name] = line;
+    Span value = scanner_.trim(Span{line, i, static_cast<int>(s.size())});
+    if (value.b == value.e) {
+      error(line, i, "expected a value after '#define " + name + "'");
+      return;
+    }
+    double v = 0;
+    std::optional<double> compiled = expr_.constant(value, "#define " + name);
+    auto ov = std::find_if(overrides_.defines.rbegin(), overrides_.defines.rend(), [&](const DefineOverride& o) { return o.name == name; });
+    if (ov != overrides_.defines.rend()) v = ov->value;
+    else if (compiled) v = *compiled;
+    else return;
+    defines_[name] = v;
+    prog_.defines.emplace_back(name, v);
+  }
+
+  /// `module Apex, Leaf(float)` from column `from` of line: interns the names.
+  void declareModules(int line, int from) {
+    const std::string& s = scanner_.line(line);
+    int i = from;
+    int n = static_cast<int>(s.size());
+    bool any = false;
+    while (i < n) {
+      while (i < n && (isSpace(s[i]) || s[i] == ',')) ++i;
+      if (i >= n) break;
+      int nb = i;
+      while (i < n && !isSpace(s[i]) && s[i] != ',' && s[i] != '(') ++i;
+      std::string name = s.substr(nb, i - nb);
+      bool valid = !name.empty() && isIdentStart(name[0]) &&
+                   std::all_of(name.begin(), name.end(), [](char c) { return isIdentChar(c); });
+      if (!valid) {
+        error(line, nb, "invalid module name '" + name + "' (letters, digits and '_', starting with a letter)");
+      } else {
+        any = true;
+        prog_.symbols.intern(name);
+        if (name.size() > 1) scanner_.addMultiName(name);
+      }
+      while (i < n && isSpace(s[i])) ++i;
+      if (i < n && s[i] == '(') {  // lpfg-style `module Apex(float)`: the declaration's types are ignored
+        while (i < n && s[i] != ')') ++i;
+        if (i < n) ++i;
+      }
+    }
+    if (!any && diags().items().empty()) error(line, from, "expected module names after 'module'");
+  }
+
+  // ---- pass 2: headers and productions --------------------------------------------------
+
+  /// Pass 2: every line that is not a directive or a declaration.
+  void secondPass() {
+    Block block = Block::Main;
+    for (int line = 1; line <= scanner_.lineCount(); ++line) {
+      const std::string& s = scanner_.line(line);
+      int b = Scanner::firstNonSpace(s);
+      if (b >= static_cast<int>(s.size())) continue;
+      if (s.compare(b, 10, "endlsystem") == 0) {
+        Span rest = scanner_.trim(Span{line, b + 10, static_cast<int>(s.size())});
+        if (rest.b != rest.e) error(line, rest.b, "unexpected text after 'endlsystem'");
+        break;
+      }
+      if (s[b] == '#') continue;
+      if (isModuleDeclaration(s, b)) continue;
+      auto header = Scanner::headerOf(s, b);
+      bool known = header && std::find(std::begin(kHeaders), std::end(kHeaders), header->key) != std::end(kHeaders);
+      if (known) {
+        handleHeader(line, b, *header, block);
+        continue;
+      }
+      auto [arrow, arrowLen] = Scanner::findArrow(s);
+      if (arrow >= 0) {
+        parseProduction(line, b, arrow, arrowLen, block);
+        continue;
+      }
+      if (header) {
+        std::vector<std::string> keys(std::begin(kHeaders), std::end(kHeaders));
+        error(line, b, "unknown header '" + header->key + ":'" + didYouMean(header->key, keys));
+      } else {
+        error(line, b, "expected a production ('pred --> successor') or a header such as 'axiom:'");
+      }
+    }
+  }
+
+  /// Records header key at line; a second one is an error.
+  void once(const std::string& key, int line, int col) {
+    auto [it, inserted] = seen_.emplace(key, line);
+    if (!inserted) error(line, col, "duplicate '" + key + ":' (first at line " + std::to_string(it->second) + ")");
+  }
+
+  /// A known header h at column b of line (`decomposition:` and `interpretation:` switch block).
+  void handleHeader(int line, int b, const Header& h, Block& block) {
+    const std::string& s = scanner_.line(line);
+    Span value = scanner_.trim(Span{line, h.valueBegin, static_cast<int>(s.size())});
+    std::string_view v = scanner_.view(value);
+    if (h.key == "lsystem") {
+      once(h.key, line, b);
+      prog_.name = std::string(v);
+    } else if (h.key == "derivation length") {
+      once(h.key, line, b);
+      if (auto d = expr_.constant(value, "derivation length")) {
+        if (*d < 0 || *d != std::floor(*d) || *d > 1e6) {
+          error(line, value.b, "derivation length must be a whole number from 0 to 1000000, got " + formatNumber(*d));
+        } else {
+          prog_.derivationLength = static_cast<int>(*d);
+          prog_.lengthLoc = SourceLoc{prog_.fileName, line, b + 1};
+          prog_.lengthLine = scanner_.rawLine(line);
+        }
+      }
+    } else if (h.key == "seed") {
+      once(h.key, line, b);
+      uint64_t seed = 0;
+      auto r = std::from_chars(v.data(), v.data() + v.size(), seed);
+      if (v.empty() || r.ec != std::errc() || r.ptr != v.data() + v.size())
+        error(line, value.b, "seed must be a non-negative integer below 2^64, got '" + std::string(v) + "'");
+      else
+        prog_.seed = seed;
+    } else if (h.key == "angle") {
+      once(h.key, line, b);
+      if (auto d = expr_.constant(value, "angle")) {
+        prog_.hasAngle = true;
+        prog_.angleDeg = *d;
+      }
+    } else if (h.key == "axiom") {
+      once(h.key, line, b);
+      std::vector<RawModule> mods;
+      if (value.b == value.e) error(line, value.b, "the axiom is empty");
+      else if (scanner_.tokenizeModules(line, value.b, value.e, mods) && checkBrackets(line, mods, "the axiom")) {
+        noteWritten(line, mods);
+        axiomModules_ = std::move(mods);
+        axiomLine_ = line;
+        prog_.axiomLoc = SourceLoc{prog_.fileName, line, b + 1};
+        prog_.axiomLine = scanner_.rawLine(line);
+      }
+    } else if (h.key == "ignore" || h.key == "consider") {
+      once(h.key, line, b);
+      if (block != Block::Main) error(line, b, "'" + h.key + ":' belongs before the decomposition and interpretation blocks");
+      std::vector<RawModule> mods;
+      if (scanner_.tokenizeModules(line, value.b, value.e, mods)) {
+        for (const RawModule& m : mods) {
+          if (m.hasParens) error(line, m.col, "'" + h.key + ":' lists symbols without parameters");
+          else if (m.name == "[" || m.name == "]") error(line, m.col, "brackets cannot be ignored or considered: context matching always follows them");
+          else (h.key == "ignore" ? ignoreList_ : considerList_).push_back(prog_.symbols.intern(m.name));
+        }
+      }
+      if (seen_.count("ignore") && seen_.count("consider") && h.key == (seen_["ignore"] < seen_["consider"] ? "consider" : "ignore"))
+        error(line, b, "use either 'ignore:' or 'consider:', not both");
+    } else if (h.key == "decomposition") {
+      once(h.key, line, b);
+      if (value.b != value.e) error(line, value.b, "unexpected text after 'decomposition:'");
+      block = Block::Decomposition;
+    } else if (h.key == "interpretation" || h.key == "homomorphism") {
+      once("interpretation", line, b);
+      if (value.b != value.e && v != "no warnings" && v != "warnings")
+        error(line, value.b, "unexpected text after '" + h.key + ":'");
+      block = Block::Interpretation;
+    } else if (h.key == "maximum depth") {
+      if (block == Block::Main) {
+        error(line, b, "'maximum depth:' belongs in a 'decomposition:' or 'interpretation:' block");
+        return;
+      }
+      once(block == Block::Decomposition ? "decomposition maximum depth" : "interpretation maximum depth", line, b);
+      if (auto d = expr_.constant(value, "maximum depth")) {
+        if (*d < 1 || *d != std::floor(*d) || *d > 256)
+          error(line, value.b, "maximum depth must be a whole number from 1 to 256, got " + formatNumber(*d));
+        else
+          (block == Block::Decomposition ? prog_.decomposition : prog_.interpretation).maxDepth = static_cast<int>(*d);
+      }
+    }
+  }
+
+  /// The production of line (from column b, its arrow at `arrow`), compiled into block's RuleSet.
+  void parseProduction(int line, int b, int arrow, int arrowLen, Block block) {
+    const std::string& s = scanner_.line(line);
+    int n = static_cast<int>(s.size());
+    Production p;
+    size_t diagsBefore = diags().items().size();
+    // Split `lc < pred > rc : cond` and `succ : weight`.
+    int colon = scanner_.findTop(line, b, arrow, ':');
+    int headEnd = colon >= 0 ? colon : arrow;
+    Span lc{line, b, b}, pred{line, b, headEnd}, rc{line, headEnd, headEnd};
+    int lt = scanner_.findTop(line, b, headEnd, '<');
+    if (lt >= 0) {
+      lc = Span{line, b, lt};
+      pred.b = lt + 1;
+    }
+    int gt = scanner_.findTop(line, pred.b, headEnd, '>');
+    if (gt >= 0) {
+      rc = Span{line, gt + 1, headEnd};
+      pred.e = gt;
+    }
+    Span cond{line, colon >= 0 ? colon + 1 : arrow, arrow};
+    int succBegin = arrow + arrowLen;
+    int wcolon = scanner_.findTopLast(line, succBegin, n, ':');
+    Span succ{line, succBegin, wcolon >= 0 ? wcolon : n};
+    Span weight{line, wcolon >= 0 ? wcolon + 1 : n, n};
+
+    std::vector<std::string> varNames;
+    // Predecessor.
+    pred = scanner_.trim(pred);
+    std::vector<RawModule> predMods;
+    if (pred.b == pred.e) {
+      error(line, pred.b, "missing predecessor before '" + s.substr(arrow, arrowLen) + "'");
+      return;
+    }
+    if (!scanner_.tokenizeModules(line, pred.b, pred.e, predMods)) return;
+    if (predMods.size() != 1) {
+      error(line, predMods.size() > 1 ? predMods[1].col : pred.b, "a predecessor must be a single module");
+      return;
+    }
+    if (predMods[0].name == "[" || predMods[0].name == "]") {
+      error(line, predMods[0].col, "a bracket cannot be a predecessor");
+      return;
+    }
+    // Contexts (textual order: left, predecessor, right).
+    lc = scanner_.trim(lc);
+    rc = scanner_.trim(rc);
+    if (lc.b != lc.e && !scanner_.isStar(lc)) {
+      if (block != Block::Main) error(line, lc.b, std::string("context is not allowed in ") + blockName(block) + " rules");
+      else p.left = pattern(lc, varNames, true);
+    }
+    p.loc = SourceLoc{prog_.fileName, line, predMods[0].col + 1};
+    p.text = std::string(scanner_.view(pred));
+    p.sourceLine = scanner_.rawLine(line);
+    p.predecessor = prog_.symbols.intern(predMods[0].name);
+    p.predFirstVar = static_cast<uint16_t>(varNames.size());
+    p.predParams = static_cast<uint16_t>(formals(predMods[0], varNames));
+    arityUses_.push_back({predMods[0].name, p.predParams, line, predMods[0].col, scanner_.moduleText(line, predMods[0]), false});
+    if (rc.b != rc.e && !scanner_.isStar(rc)) {
+      if (block != Block::Main) error(line, rc.b, std::string("context is not allowed in ") + blockName(block) + " rules");
+      else p.right = pattern(rc, varNames, false);
+    }
+    if (diags().items().size() != diagsBefore) return;
+    expr_.clearRandom();
+    // Condition.
+    cond = scanner_.trim(cond);
+    if (colon >= 0 && cond.b == cond.e) error(line, colon, "missing condition after ':' (write '*' for none)");
+    else if (cond.b != cond.e && !scanner_.isStar(cond)) {
+      size_t before = prog_.code.size();
+      if (expr_.compile(cond, varNames, "condition")) {
+        if (prog_.code.size() == before + 1 && prog_.code.back().op == Op::Const && prog_.code.back().c != 0) prog_.code.pop_back();
+        else p.condition = CodeRange{static_cast<uint32_t>(before), static_cast<uint32_t>(prog_.code.size())};
+      }
+    }
+    // Successor.
+    succ = scanner_.trim(succ);
+    if (succ.b == succ.e) error(line, succ.b, "missing successor (write '*' for the empty string)");
+    else if (!scanner_.isStar(succ)) {
+      std::vector<RawModule> mods;
+      if (scanner_.tokenizeModules(line, succ.b, succ.e, mods) && checkBrackets(line, mods, "the successor")) {
+        noteWritten(line, mods);
+        for (const RawModule& m : mods) {
+          SuccModule sm;
+          sm.symbol = prog_.symbols.intern(m.name);
+          sm.firstArg = static_cast<uint32_t>(p.args.size());
+          sm.argCount = static_cast<uint16_t>(m.args.size());
+          for (const Span& a : m.args) p.args.push_back(expr_.compileArg(scanner_.trim(a), varNames));
+          p.successor.push_back(sm);
+        }
+      }
+    }
+    // Weight.
+    if (wcolon >= 0) {
+      weight = scanner_.trim(weight);
+      if (weight.b == weight.e) error(line, wcolon, "missing weight after ':'");
+      else if (auto w = expr_.constant(weight, "weight")) {
+        if (*w < 0) error(line, weight.b, "a weight must not be negative, got " + formatNumber(*w));
+        p.stochastic = true;
+        p.weight = *w;
+      }
+    }
+    p.usesRandom = expr_.usesRandom();
+    RuleSet& rs = block == Block::Main ? prog_.productions : block == Block::Decomposition ? prog_.decomposition : prog_.interpretation;
+    rs.productions.push_back(std::move(p));
+  }
+
+  /// Reports brackets that do not pair up in mods (an axiom or a successor, named by where).
+  bool checkBrackets(int line, const std::vector<RawModule>& mods, const char* where) {
+    std::vector<int> open;
+    bool ok = true;
+    for (const RawModule& m : mods) {
+      if (m.name == "[") {
+        open.push_back(m.col);
+      } else if (m.name == "]") {
+        if (open.empty()) {
+          error(line, m.col, std::string("unmatched ']' in ") + where);
+          ok = false;
+        } else {
+          open.pop_back();
+        }
+      }
+    }
+    for (int col : open) {
+      error(line, col, std::string("unclosed '[' in ") + where + " (no matching ']')");
+      ok = false;
+    }
+    return ok;
+  }
+
+  /// Records the parameter count of every module written in an axiom or successor.
+  void noteWritten(int line, const std::vector<RawModule>& mods) {
+    for (const RawModule& m : mods) written_[m.name].emplace(static_cast<int>(m.args.size()), std::pair{line, m.col});
+  }
+
+  /// A predecessor or context module whose parameter count no written module of its symbol
+  /// has can never match (cpfg and lpfg match a module only with the same number of
+  /// parameters): report it. Symbols never written at all are left alone.
+  void checkArities() {
+    for (const ArityUse& u : arityUses_) {
+      auto it = written_.find(u.name);
+      if (it == written_.end() || it->second.count(u.arity)) continue;
+      const auto& counts = it->second;
+      std::string list;
+      size_t k = 0;
+      for (const auto& entry : counts) {
+        if (k > 0) list += k + 1 == counts.size() ? " or " : ", ";
+        list += std::to_string(entry.first);
+        ++k;
+      }
+      bool one = counts.size() == 1 && counts.begin()->first == 1;
+      const auto& first = counts.begin()->second;
+      error(u.line, u.col,
+            std::string(u.context ? "context '" : "predecessor '") + u.text + "' has " + std::to_string(u.arity) +
+                " parameter" + (u.arity == 1 ? "" : "s") + ", but '" + u.name + "' is only written with " + list +
+                (one ? " parameter" : " parameters") + " (as at line " + std::to_string(first.first) + ":" +
+                std::to_string(first.second + 1) + "), so this production never applies");
+    }
+  }
+
+  static const char* blockName(Block b) {
+    return b == Block::Decomposition ? "decomposition" : b == Block::Interpretation ? "interpretation" : "main";
+  }
+
+  /// Registers m's formal parameter names; returns their count.
+  int formals(const RawModule& m, std::vector<std::string>& varNames) {
+    for (const Span& a0 : m.args) {
+      Span a = scanner_.trim(a0);
+      std::string name(scanner_.view(a));
+      bool valid = !name.empty() && isIdentStart(name[0]) && std::all_of(name.begin(), name.end(), [](char c) { return isIdentChar(c); });
+      if (!valid) {
+        error(a.line, a.b, "expected a parameter name, got '" + name + "'");
+      } else if (std::find(varNames.begin(), varNames.end(), name) != varNames.end()) {
+        error(a.line, a.b, "parameter '" + name + "' is already used in this production");
+      } else if (defines_.count(name)) {
+        error(a.line, a.b, "parameter '" + name + "' has the name of a #define");
+      } else if (varNames.size() >= static_cast<size_t>(detail::kMaxVars)) {
+        error(a.line, a.b, "too many parameters in one production (at most " + std::to_string(detail::kMaxVars) + ")");
+      }
+      varNames.push_back(name);
+    }
+    return static_cast<int>(m.args.size());
+  }
+
+  /// The context pattern sp (left or right of the predecessor), registering its formal parameters.
+  std::vector<PatternItem> pattern(Span sp, std::vector<std::string>& varNames, bool left) {
+    std::vector<RawModule> mods;
+    std::vector<PatternItem> items;
+    if (!scanner_.tokenizeModules(sp.line, sp.b, sp.e, mods)) return items;
+    for (const RawModule& m : mods) {
+      PatternItem it;
+      if (m.name == "[" || m.name == "]") {
+        if (left) {
+          error(sp.line, m.col, "brackets are not allowed in a left context");
+          continue;
+        }
+        it.openBracket = m.name == "[";
+        it.closeBracket = m.name == "]";
+      } else {
+        it.symbol = prog_.symbols.intern(m.name);
+        it.firstVar = static_cast<uint16_t>(varNames.size());
+        it.paramCount = static_cast<uint16_t>(formals(m, varNames));
+        arityUses_.push_back({m.name, it.paramCount, sp.line, m.col, scanner_.moduleText(sp.line, m), true});
+      }
+      items.push_back(it);
+    }
+    return items;
+  }
+
+  /// Appends modules whose parameters are constant expressions (random draws use rng).
+  void appendConstant(const std::vector<RawModule>& mods, ModuleString& out, Rng* rng) {
+    for (const RawModule& m : mods) {
+      SymbolId id = prog_.symbols.intern(m.name);
+      std::vector<double> params;
+      bool ok = true;
+      for (const Span& a : m.args) {
+        std::optional<double> v = expr_.evaluate(scanner_.trim(a), rng);
+        if (v) params.push_back(*v);
+        else ok = false;
+      }
+      if (ok) out.push(id, params);
+    }
+  }
+
+  // ---- end of file -------------------------------------------------------------------
+
+  /// Overrides, the axiom, the ignore table and the lookup tables (see the class comment).
+  void finish() {
+    if (overrides_.derivationLength) {
+      prog_.lengthLoc = SourceLoc{};  // the length no longer comes from the file
+      prog_.lengthLine.clear();
+      if (*overrides_.derivationLength < 0) diags().error(SourceLoc{prog_.fileName, 0, 0}, "derivation length override must not be negative");
+      prog_.derivationLength = *overrides_.derivationLength;
+    }
+    if (overrides_.seed) prog_.seed = *overrides_.seed;
+    if (prog_.name.empty()) prog_.name = std::filesystem::path(prog_.fileName).stem().string();
+    if (axiomLine_ == 0 && !seen_.count("axiom")) {
+      diags().error(SourceLoc{prog_.fileName, 0, 0}, "missing 'axiom:'");
+    } else if (axiomLine_) {
+      Rng rng(deriveSeed(prog_.seed, {kAxiomStream}));
+      appendConstant(axiomModules_, prog_.axiom, &rng);
+    }
+    // Ignore / consider table over every symbol, including ones interned late.
+    prog_.ignored.assign(prog_.symbols.size(), 0);
+    if (!considerList_.empty()) {
+      std::fill(prog_.ignored.begin(), prog_.ignored.end(), 1);
+      for (SymbolId id : considerList_) prog_.ignored[id] = 0;
+    }
+    for (SymbolId id : ignoreList_) prog_.ignored[id] = 1;
+    prog_.ignored[prog_.openBracket] = prog_.ignored[prog_.closeBracket] = 0;
+    for (SymbolId id : prog_.axiom.symbols) prog_.usesCut |= id == prog_.cut;
+    for (const RuleSet* rs : {&prog_.productions, &prog_.decomposition})
+      for (const Production& p : rs->productions)
+        for (const SuccModule& m : p.successor) prog_.usesCut |= m.symbol == prog_.cut;
+    for (RuleSet* rs : {&prog_.productions, &prog_.decomposition, &prog_.interpretation}) {
+      rs->bySymbol.assign(prog_.symbols.size(), {});
+      for (uint32_t i = 0; i < rs->productions.size(); ++i) {
+        rs->bySymbol[rs->productions[i].predecessor].push_back(i);
+        rs->anyContext |= rs->productions[i].hasContext();
+      }
+      rs->finalize();
+    }
+  }
+
+  GrammarOverrides overrides_;
+  Program prog_;
+  Scanner scanner_;
+  std::unordered_map<std::string, double> defines_;
+  ExpressionParser expr_{scanner_, defines_, prog_.code};
+  std::map<std::string, int> seen_;
+  std::vector<RawModule> axiomModules_;
+  int axiomLine_ = 0;
+  std::vector<SymbolId> ignoreList_, considerList_;
+  /// A predecessor or context module with its parameter count, checked by checkArities().
+  struct ArityUse {
+    std::string name;
+    int arity;
+    int line, col;  ///< col 0-based
+    std::string text;
+    bool context;
+  };
+  std::vector<ArityUse> arityUses_;
+  /// Per symbol: the parameter counts it is written with, each with its first (line, col).
+  std::map<std::string, std::map<int, std::pair<int, int>>> written_;
+};
+
+}  // namespace
+
+std::shared_ptr<Program> compileGrammar(std::string_view text, const std::string& fileName, const GrammarOverrides& overrides) {
+  return GrammarParser(fileName, overrides).run(text);
+}
+
+ModuleString compileModuleString(std::string_view text, SymbolTable& symbols, const std::string& fileName) {
+  return GrammarParser(fileName, {}).constantString(text, symbols);
+}
+
+}  // namespace sprig::lsystem::detail

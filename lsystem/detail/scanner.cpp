@@ -1,0 +1,215 @@
+#include "lsystem/detail/scanner.h"
+
+#include <algorithm>
+#include <charconv>
+
+namespace sprig::lsystem::detail {
+
+namespace {
+
+/// s cut at every `\n`, each line without a trailing `\r`.
+std::vector<std::string> splitAtNewlines(const std::string& s) {
+  std::vector<std::string> lines;
+  size_t start = 0;
+  for (;;) {
+    size_t nl = s.find('\n', start);
+    std::string l = s.substr(start, nl == std::string::npos ? std::string::npos : nl - start);
+    if (!l.empty() && l.back() == '\r') l.pop_back();
+    lines.push_back(std::move(l));
+    if (nl == std::string::npos) break;
+    start = nl + 1;
+  }
+  return lines;
+}
+
+}  // namespace
+
+std::string formatNumber(double v) {
+  char buf[64];
+  auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+
+void Scanner::load(std::string_view text) {
+  std::string clean(text);
+  size_t i = 0;
+  int line = 1;
+  size_t lineStart = 0;
+  while (i < clean.size()) {
+    char c = clean[i];
+    if (c == '\n') {
+      ++line;
+      lineStart = i + 1;
+      ++i;
+    } else if (c == '/' && i + 1 < clean.size() && clean[i + 1] == '/') {
+      while (i < clean.size() && clean[i] != '\n') clean[i++] = ' ';
+    } else if (c == '/' && i + 1 < clean.size() && clean[i + 1] == '*') {
+      int startLine = line;
+      int startCol = static_cast<int>(i - lineStart);
+      clean[i] = clean[i + 1] = ' ';
+      i += 2;
+      bool closed = false;
+      while (i < clean.size()) {
+        if (clean[i] == '*' && i + 1 < clean.size() && clean[i + 1] == '/') {
+          clean[i] = clean[i + 1] = ' ';
+          i += 2;
+          closed = true;
+          break;
+        }
+        if (clean[i] == '\n') {
+          ++line;
+          lineStart = i + 1;
+        } else {
+          clean[i] = ' ';
+        }
+        ++i;
+      }
+      if (!closed) pendingComment_ = {startLine, startCol};
+    } else {
+      ++i;
+    }
+  }
+  clean_ = splitAtNewlines(clean);
+  raw_ = splitAtNewlines(std::string(text));
+}
+
+void Scanner::error(int line, int col0, std::string msg) {
+  diags_.error(SourceLoc{fileName_, line, col0 + 1}, std::move(msg),
+               line >= 1 && line <= static_cast<int>(raw_.size()) ? raw_[line - 1] : "");
+}
+
+Span Scanner::trim(Span sp) const {
+  const std::string& s = clean_[sp.line - 1];
+  while (sp.b < sp.e && isSpace(s[sp.b])) ++sp.b;
+  while (sp.e > sp.b && isSpace(s[sp.e - 1])) --sp.e;
+  return sp;
+}
+
+void Scanner::addMultiName(std::string_view name) {
+  if (std::find(multiNames_.begin(), multiNames_.end(), name) == multiNames_.end()) multiNames_.emplace_back(name);
+}
+
+bool Scanner::tokenizeModules(int line, int b, int e, std::vector<RawModule>& out) {
+  const std::string& s = clean_[line - 1];
+  int i = b;
+  bool ok = true;
+  while (i < e) {
+    if (isSpace(s[i])) { ++i; continue; }
+    char c = s[i];
+    if (c == '(' || c == ')' || c == ',') {
+      error(line, i, c == ')' ? "unmatched ')'" : std::string("unexpected '") + c + "' (parameters must follow a module name)");
+      return false;
+    }
+    RawModule m;
+    m.col = i;
+    size_t best = 0;
+    for (const std::string& name : multiNames_)
+      if (name.size() > best && static_cast<int>(name.size()) <= e - i && s.compare(i, name.size(), name) == 0) best = name.size();
+    if (best) {
+      m.name = s.substr(i, best);
+      i += static_cast<int>(best);
+    } else if (c == '~' && i + 1 < e && std::isalpha(static_cast<unsigned char>(s[i + 1]))) {
+      m.name = s.substr(i, 2);
+      i += 2;
+    } else {
+      m.name = std::string(1, c);
+      ++i;
+    }
+    int j = i;
+    while (j < e && isSpace(s[j])) ++j;
+    if (j < e && s[j] == '(') {
+      m.hasParens = true;
+      int depth = 0;
+      int argStart = j + 1;
+      int k = j;
+      for (; k < e; ++k) {
+        if (s[k] == '(') ++depth;
+        else if (s[k] == ')') {
+          if (--depth == 0) break;
+        } else if (s[k] == ',' && depth == 1) {
+          m.args.push_back({line, argStart, k});
+          argStart = k + 1;
+        }
+      }
+      if (k >= e) {
+        error(line, j, "missing ')' after the parameters of '" + m.name + "'");
+        return false;
+      }
+      m.args.push_back({line, argStart, k});
+      if (m.args.size() == 1 && trim(m.args[0]).b == trim(m.args[0]).e) m.args.clear();  // `F()`
+      else
+        for (const Span& a : m.args)
+          if (trim(a).b == trim(a).e) {
+            error(line, a.b, "empty parameter in '" + m.name + "'");
+            ok = false;
+          }
+      i = k + 1;
+    }
+    out.push_back(std::move(m));
+  }
+  return ok;
+}
+
+std::string Scanner::moduleText(int line, const RawModule& m) const {
+  if (!m.hasParens) return m.name;
+  const std::string& s = clean_[line - 1];
+  int end = m.args.empty() ? static_cast<int>(s.find(')', m.col)) : m.args.back().e;
+  return s.substr(m.col, end + 1 - m.col);
+}
+
+std::optional<Header> Scanner::headerOf(const std::string& s, int b) {
+  int i = b;
+  std::string key;
+  while (i < static_cast<int>(s.size()) && (std::isalpha(static_cast<unsigned char>(s[i])) || s[i] == ' ' || s[i] == '\t')) {
+    char c = static_cast<char>(std::tolower(static_cast<unsigned char>(s[i])));
+    if (isSpace(c)) {
+      if (!key.empty() && key.back() != ' ') key += ' ';
+    } else {
+      key += c;
+    }
+    ++i;
+  }
+  if (i >= static_cast<int>(s.size()) || s[i] != ':' || key.empty()) return std::nullopt;
+  if (key.back() == ' ') key.pop_back();
+  if (key.find(' ') != std::string::npos && key.size() > 24) return std::nullopt;
+  return Header{key, i + 1};
+}
+
+int Scanner::firstNonSpace(const std::string& s) {
+  int i = 0;
+  while (i < static_cast<int>(s.size()) && isSpace(s[i])) ++i;
+  return i;
+}
+
+std::pair<int, int> Scanner::findArrow(const std::string& s) {
+  for (const char* arrow : {"-->", "->"}) {
+    int depth = 0;
+    int n = static_cast<int>(std::string_view(arrow).size());
+    for (int i = 0; i + n <= static_cast<int>(s.size()); ++i) {
+      if (s[i] == '(') ++depth;
+      else if (s[i] == ')') --depth;
+      else if (depth == 0 && s.compare(i, n, arrow) == 0) return {i, n};
+    }
+  }
+  return {-1, 0};
+}
+
+int Scanner::findTop(int line, int b, int e, char c) const {
+  const std::string& s = clean_[line - 1];
+  int depth = 0;
+  for (int i = b; i < e; ++i) {
+    if (s[i] == '(') ++depth;
+    else if (s[i] == ')') --depth;
+    else if (depth == 0 && s[i] == c) return i;
+  }
+  return -1;
+}
+
+int Scanner::findTopLast(int line, int b, int e, char c) const {
+  // A hit is at depth 0, so the search may go on from the next character.
+  int found = -1;
+  for (int i = findTop(line, b, e, c); i >= 0; i = findTop(line, i + 1, e, c)) found = i;
+  return found;
+}
+
+}  // namespace sprig::lsystem::detail

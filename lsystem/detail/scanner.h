@@ -1,0 +1,120 @@
+#pragma once
+/// The grammar file's scanner: its lines with comments blanked out, spans of them, the
+/// diagnostics every parser of the grammar language reports through, and the tokenizer
+/// that splits a module string (`F(1)[+A(x,2)]`) into modules with argument spans.
+/// Private to lsystem/; used by the expression parser and the grammar parser.
+
+#include <cctype>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "core/diagnostics.h"
+
+namespace sprig::lsystem::detail {
+
+inline bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; }
+inline bool isIdentStart(char c) { return std::isalpha(static_cast<unsigned char>(c)) || c == '_'; }
+inline bool isIdentChar(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+
+/// v in its shortest round-trip form (`0.5`, `1e+300`, `inf`), as diagnostics print numbers.
+std::string formatNumber(double v);
+
+/// A span [b, e) of one line (0-based offsets into the cleaned line).
+struct Span {
+  int line = 0;  ///< 1-based
+  int b = 0;
+  int e = 0;
+};
+
+/// One module as written: its name and, per argument, the span of the argument text.
+struct RawModule {
+  std::string name;
+  int col = 0;  ///< 0-based offset of the name
+  std::vector<Span> args;
+  bool hasParens = false;
+};
+
+/// A `key:` header at the start of a line.
+struct Header {
+  std::string key;  ///< lower-cased, single-spaced
+  int valueBegin = 0;
+};
+
+/*
+ * Scanner: the text of one grammar file held as two parallel arrays of lines, as written
+ * (`raw`, quoted under each diagnostic) and cleaned (`//` and block comments replaced by
+ * spaces, so a column in a cleaned line is the column in the file). Everything after
+ * load() works on cleaned lines through Spans, without copying text.
+ *
+ * Every diagnostic of the grammar language goes through error(), which adds
+ * `file:line:col` and the raw line; they are collected here and thrown once by the caller.
+ * The scanner also owns the multi-character module names (`Apex`, `@Ts`) the tokenizer
+ * matches longest first; any other character is a module of its own.
+ */
+class Scanner {
+ public:
+  /// fileName names the text in every diagnostic.
+  explicit Scanner(std::string fileName) : fileName_(std::move(fileName)) {}
+
+  /// Splits text into raw and cleaned lines (a trailing `\r` is dropped) and blanks out
+  /// comments. An unclosed block comment is remembered (see unterminatedComment()).
+  void load(std::string_view text);
+
+  /// Number of lines of the loaded text.
+  int lineCount() const { return static_cast<int>(clean_.size()); }
+  /// Cleaned line `line` (1-based).
+  const std::string& line(int line) const { return clean_[line - 1]; }
+  /// Line `line` (1-based) as written.
+  const std::string& rawLine(int line) const { return raw_[line - 1]; }
+  const std::string& fileName() const { return fileName_; }
+  /// (line, 0-based column) of a block comment that is never closed; line 0 when none.
+  std::pair<int, int> unterminatedComment() const { return pendingComment_; }
+
+  /// The diagnostics reported so far.
+  DiagnosticList& diagnostics() { return diags_; }
+  const DiagnosticList& diagnostics() const { return diags_; }
+  /// Reports an error at line (1-based), col0 (0-based), quoting the raw line.
+  void error(int line, int col0, std::string msg);
+
+  /// sp without leading and trailing white space.
+  Span trim(Span sp) const;
+  /// The text of sp.
+  std::string_view view(Span sp) const { return std::string_view(clean_[sp.line - 1]).substr(sp.b, sp.e - sp.b); }
+  /// True when sp holds just `*` (the empty context, condition or successor).
+  bool isStar(Span sp) const { return view(trim(sp)) == "*"; }
+
+  /// Adds a multi-character module name for tokenizeModules (no-op when already known).
+  void addMultiName(std::string_view name);
+  /// Forgets every multi-character module name.
+  void clearMultiNames() { multiNames_.clear(); }
+  /// Splits line(line)[b, e) into modules, appending them to out. Reports errors; returns
+  /// false on an error that stops the line (a stray `(`, `)` or `,`, a missing `)`) or
+  /// after reporting empty parameters.
+  bool tokenizeModules(int line, int b, int e, std::vector<RawModule>& out);
+  /// The module m of line `line` as written (its name and parameter list).
+  std::string moduleText(int line, const RawModule& m) const;
+
+  /// `key:` at s[b...] (letters and spaces before a colon), if any.
+  static std::optional<Header> headerOf(const std::string& s, int b);
+  /// Offset of the first non-space character of s (s.size() when none).
+  static int firstNonSpace(const std::string& s);
+  /// Position of the production arrow `-->` (or `->`) at parenthesis depth 0, with its
+  /// length; {-1, 0} when there is none.
+  static std::pair<int, int> findArrow(const std::string& s);
+  /// Index of the first c at parenthesis depth 0 in line(line)[b, e), or -1.
+  int findTop(int line, int b, int e, char c) const;
+  /// Index of the last c at parenthesis depth 0 in line(line)[b, e), or -1.
+  int findTopLast(int line, int b, int e, char c) const;
+
+ private:
+  std::string fileName_;
+  std::vector<std::string> raw_, clean_;
+  std::vector<std::string> multiNames_;
+  std::pair<int, int> pendingComment_{0, 0};
+  DiagnosticList diags_;
+};
+
+}  // namespace sprig::lsystem::detail
