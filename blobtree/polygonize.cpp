@@ -12,12 +12,19 @@
 #include <stdexcept>
 #include <string>
 
+#include "blobtree/detail/marching_tets.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 
 namespace sprig::blobtree {
 
 namespace {
+
+using detail::cornerOffset;
+using detail::kNoCell;
+using detail::kTets;
+using detail::kTriangleCount;
+using detail::TetEmitter;
 
 // Grid points are keyed by their integer coordinates, 20 bits per axis; an edge of the
 // Kuhn triangulation by (key of its low end) · 8 + (its direction as corner bits).
@@ -32,16 +39,6 @@ uint64_t pointKey(int64_t i, int64_t j, int64_t k) {
 glm::ivec3 keyCoords(uint64_t key) {
   return {int((key >> (2 * kAxisBits)) & kAxisMask), int((key >> kAxisBits) & kAxisMask), int(key & kAxisMask)};
 }
-
-// Corner c of a cell (bit 0: +x, bit 1: +y, bit 2: +z).
-glm::ivec3 cornerOffset(int c) { return {c & 1, (c >> 1) & 1, (c >> 2) & 1}; }
-
-// The six Kuhn tetrahedra of a cube: monotone corner paths 0 -> 7, one per axis order.
-// Every face of the cube is split along the diagonal from its lowest to its highest
-// corner, so neighbouring cubes agree.
-constexpr int kTets[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7}, {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
-
-constexpr uint32_t kNoCell = ~0u;
 
 // Open-addressing map from a cell's key to its index. The slot of a cell is a hash of its
 // 4x4x4 block, then its place in the block: the neighbours a cell looks up (and the next
@@ -97,75 +94,6 @@ struct EdgeRec {
 Vec3 gridPosition(const CellSet& cs, glm::ivec3 g) {
   return cs.origin + Vec3(float(g.x) * cs.cellSize, float(g.y) * cs.cellSize, float(g.z) * cs.cellSize);
 }
-
-// Triangles of one tetrahedron (corner codes t, inside flags), as edge keys, oriented from
-// inside to outside using the edges' midpoints (never degenerate).
-struct TetEmitter {
-  // Vertex of the crossing edge a-b (corner codes of this cell): owned by the cell whose
-  // low corner is the edge's low end, numbered vertexBase + rank of its direction.
-  const uint32_t* owners;      // this cell's owner cells by low-corner code (0 = itself)
-  const uint32_t* vertexBase;  // per active cell
-  const uint8_t* crossMask;    // per active cell: bit d set when edge 0 -> d crosses
-  glm::uvec3* out;  // next triangle slot
-
-  uint32_t edge(int a, int b, bool) const {
-    int lo = a & b, d = (a | b) ^ lo;
-    uint32_t owner = owners[lo];
-    uint8_t m = crossMask[owner];
-    if (owner == kNoCell || !((m >> d) & 1)) throw std::logic_error("polygonize: crossing edge without an owner cell");
-    return vertexBase[owner] + uint32_t(std::popcount(unsigned(m) & ((1u << d) - 1u)));
-  }
-
-  static Vec3 mid(int a, int b) { return 0.5f * Vec3(cornerOffset(a) + cornerOffset(b)); }
-
-  // Emits triangle (e0,e1,e2) with midpoints (m0,m1,m2), flipped so its normal points along outward.
-  void emit(uint32_t e0, uint32_t e1, uint32_t e2, Vec3 m0, Vec3 m1, Vec3 m2, Vec3 outward) {
-    Vec3 n = glm::cross(m1 - m0, m2 - m0);
-    *out++ = glm::dot(n, outward) >= 0.0f ? glm::uvec3(e0, e1, e2) : glm::uvec3(e0, e2, e1);
-  }
-
-  void run(const int t[4], const bool in[4]) {
-    int count = in[0] + in[1] + in[2] + in[3];
-    if (count == 0 || count == 4) return;
-    if (count == 1 || count == 3) {
-      // The lone vertex s against the other three.
-      bool loneInside = count == 1;
-      int s = 0;
-      while (in[s] != loneInside) ++s;
-      int o[3], n = 0;
-      for (int k = 0; k < 4; ++k)
-        if (k != s) o[n++] = k;
-      Vec3 ps = Vec3(cornerOffset(t[s]));
-      Vec3 po = (Vec3(cornerOffset(t[o[0]])) + Vec3(cornerOffset(t[o[1]])) + Vec3(cornerOffset(t[o[2]]))) / 3.0f;
-      Vec3 outward = loneInside ? po - ps : ps - po;
-      uint32_t e[3];
-      for (int k = 0; k < 3; ++k) e[k] = edge(t[s], t[o[k]], loneInside);
-      emit(e[0], e[1], e[2], mid(t[s], t[o[0]]), mid(t[s], t[o[1]]), mid(t[s], t[o[2]]), outward);
-      return;
-    }
-    // Two inside (a, b), two outside (c, d): the quad ac, ad, bd, bc.
-    int ins[2], outs[2], ni = 0, no = 0;
-    for (int k = 0; k < 4; ++k) (in[k] ? ins[ni++] : outs[no++]) = t[k];
-    int a = ins[0], b = ins[1], c = outs[0], d = outs[1];
-    Vec3 outward = 0.5f * (Vec3(cornerOffset(c)) + Vec3(cornerOffset(d))) -
-                   0.5f * (Vec3(cornerOffset(a)) + Vec3(cornerOffset(b)));
-    uint32_t ac = edge(a, c, true), ad = edge(a, d, true), bd = edge(b, d, true), bc = edge(b, c, true);
-    emit(ac, ad, bd, mid(a, c), mid(a, d), mid(b, d), outward);
-    emit(ac, bd, bc, mid(a, c), mid(b, d), mid(b, c), outward);
-  }
-};
-
-// Triangles marching tetrahedra emit for a cell, by its inside-corner mask: a tetrahedron
-// with 1 or 3 corners inside gives one, with 2 gives two.
-constexpr std::array<uint8_t, 256> kTriangleCount = [] {
-  std::array<uint8_t, 256> n{};
-  for (int m = 0; m < 256; ++m)
-    for (const auto& t : kTets) {
-      int in = ((m >> t[0]) & 1) + ((m >> t[1]) & 1) + ((m >> t[2]) & 1) + ((m >> t[3]) & 1);
-      n[size_t(m)] = uint8_t(n[size_t(m)] + (in == 2 ? 2 : (in == 1 || in == 3 ? 1 : 0)));
-    }
-  return n;
-}();
 
 // Concatenates per-chunk vectors in chunk order.
 template <class T>
