@@ -199,7 +199,6 @@ float CompiledBlob::lipschitz(const Box3& box) const { return tape_->empty ? 0.0
 float CompiledBlob::lipschitz() const { return tape_->empty ? 0.0f : tape_->nodes[tape_->root].lip; }
 
 size_t CompiledBlob::primitiveCount() const { return tape_->instBox.size(); }
-Box3 CompiledBlob::primitiveBounds(uint32_t i) const { return tape_->instBox.at(i); }
 float CompiledBlob::smallestFeature() const { return tape_->minFeature; }
 
 }  // namespace sprig::blobtree

@@ -84,7 +84,7 @@ struct CellSet {
   Vec3 origin{0.0f};     ///< grid origin (the root bounds' low corner)
   float cellSize = 0.0f; ///< actual edge length (<= the requested size: root cube / 2^k)
   std::vector<Cell> cells;           ///< in deterministic (Morton-like recursive) order
-  std::vector<uint32_t> primitives;  ///< primitive indices, see CompiledBlob::primitiveBounds
+  std::vector<uint32_t> primitives;  ///< primitive instance indices (a primitive under its chain of warps)
   /// The primitive list of one cell.
   std::span<const uint32_t> primitivesOf(const Cell& c) const {
     return {primitives.data() + c.firstPrimitive, c.primitiveCount};
@@ -169,8 +169,6 @@ class CompiledBlob {
 
   /// Number of primitives (leaves) in the tape.
   size_t primitiveCount() const;
-  /// Support box of primitive i (an index from CellSet::primitives).
-  Box3 primitiveBounds(uint32_t i) const;
   /// The smallest 0.5-iso radius of any point/segment/cone/torus primitive (0 if none):
   /// a natural scale for default cell sizes.
   float smallestFeature() const;
