@@ -85,6 +85,9 @@ Node operatorNode(NodeKind kind, std::span<const NodeId> children) {
   n.children.assign(children.begin(), children.end());
   return n;
 }
+
+/// An operator node of kind over one child (negative, transforms, warps).
+Node unaryNode(NodeKind kind, NodeId child) { return operatorNode(kind, std::span<const NodeId>(&child, 1)); }
 }  // namespace
 
 NodeId BlobTree::add(Node n) {
@@ -280,21 +283,17 @@ NodeId BlobTree::pcm(NodeId a, NodeId b, PcmParams params) {
 
 NodeId BlobTree::negative(NodeId child, float weight) {
   if (!(std::isfinite(weight) && weight >= 0.0f)) fail("negative: weight must be >= 0");
-  Node n;
-  n.kind = NodeKind::Negative;
+  Node n = unaryNode(NodeKind::Negative, child);
   n.weight = weight;
-  n.children = {child};
   return add(std::move(n));
 }
 
 NodeId BlobTree::transform(NodeId child, const Mat4& worldFromLocal) {
   float det = glm::determinant(worldFromLocal);
   if (!std::isfinite(det) || std::abs(det) < 1e-12f) fail("transform: the matrix is not invertible");
-  Node n;
-  n.kind = NodeKind::Transform;
+  Node n = unaryNode(NodeKind::Transform, child);
   n.worldFromLocal = worldFromLocal;
   n.localFromWorld = glm::inverse(worldFromLocal);
-  n.children = {child};
   return add(std::move(n));
 }
 
@@ -309,10 +308,8 @@ NodeId BlobTree::bend(NodeId child, const Bend& b) {
   if (!(b.sagitta >= 0.0f && std::isfinite(b.sagitta))) fail("bend: sagitta must be >= 0");
   if (!(glm::length(b.b - b.a) > 0.0f)) fail("bend: the segment a-b has zero length");
   if (b.sagitta > glm::length(b.b - b.a)) fail("bend: sagitta must not exceed the chord length");
-  Node n;
-  n.kind = NodeKind::Bend;
+  Node n = unaryNode(NodeKind::Bend, child);
   n.bend = b;
-  n.children = {child};
   return add(std::move(n));
 }
 
@@ -327,22 +324,18 @@ NodeId BlobTree::bend(NodeId child, Vec3 a, Vec3 b, float sagitta, Vec3 directio
 
 NodeId BlobTree::twist(NodeId child, const Twist& t) {
   if (!(glm::length(t.axis) > 0.0f)) fail("twist: the axis is zero");
-  Node n;
-  n.kind = NodeKind::Twist;
+  Node n = unaryNode(NodeKind::Twist, child);
   n.twist = t;
   n.twist.axis = glm::normalize(t.axis);
-  n.children = {child};
   return add(std::move(n));
 }
 
 NodeId BlobTree::taper(NodeId child, const Taper& t) {
   if (!(glm::length(t.axis) > 0.0f)) fail("taper: the axis is zero");
   if (!finitePositive(t.length)) fail("taper: length must be positive");
-  Node n;
-  n.kind = NodeKind::Taper;
+  Node n = unaryNode(NodeKind::Taper, child);
   n.taper = t;
   n.taper.axis = glm::normalize(t.axis);
-  n.children = {child};
   return add(std::move(n));
 }
 
