@@ -9,9 +9,11 @@
 /// visits only the children whose support can reach it: an n-ary blend of 10,000 cones
 /// costs about what one of 100 with the same local overlap costs.
 ///
-/// Modes (libfive style): value, value+gradient+attributes (`sample`), interval bounds
-/// over a box, local Lipschitz bound over a box, batched values (node by node over SoA
-/// point arrays, vectorized inner loops), and exact ray intersection.
+/// Modes (libfive style), one evaluator each under blobtree/detail/: value
+/// (point_eval), value+gradient+attributes (`sample`, gradient_eval), interval bounds and
+/// local Lipschitz bounds over a box (interval_eval), batched values (batch_eval: node by
+/// node over SoA point arrays, vectorized inner loops). Ray intersection is the batched
+/// segment tracer of blobtree/tracer.h; surface cells are found in surface_cells.cpp.
 ///
 /// Thread safety: a CompiledBlob is immutable after compile(); every const member function
 /// may be called from many threads at once.
@@ -82,19 +84,20 @@ struct CellSet {
   Vec3 origin{0.0f};     ///< grid origin (the root bounds' low corner)
   float cellSize = 0.0f; ///< actual edge length (<= the requested size: root cube / 2^k)
   std::vector<Cell> cells;           ///< in deterministic (Morton-like recursive) order
-  std::vector<uint32_t> primitives;  ///< primitive indices, see CompiledBlob::primitiveBounds
+  std::vector<uint32_t> primitives;  ///< primitive instance indices (a primitive under its chain of warps)
   /// The primitive list of one cell.
   std::span<const uint32_t> primitivesOf(const Cell& c) const {
     return {primitives.data() + c.firstPrimitive, c.primitiveCount};
   }
 };
 
-/// Options of CompiledBlob::intersect and intersectCell.
+/// Options of CompiledBlob::intersect and intersectCell (blobtree/tracer.h).
 struct TraceOptions {
   /// Convergence tolerance of the hit along the ray, relative to the model size
   /// (bounds' diagonal). The hit's |F − 0.5| / |∇F| is below this times the size.
   float relativeTolerance = 1e-6f;
-  /// Upper bound on marching steps per ray (a safety net; a miss is returned when hit).
+  /// Upper bound on the windows intersect() traces per ray (a safety net; a miss is
+  /// returned when hit). Within a window or a cell the tracer's recursion depth bounds the work.
   int maxSteps = 100000;
 };
 
@@ -149,12 +152,12 @@ class CompiledBlob {
   float lipschitz() const;
 
   /// The first surface crossing (F = 0.5, either direction) on the ray for t in
-  /// [tmin, tmax], or nothing. Segment tracing with local Lipschitz bounds over boxes of
-  /// the ray, empty space skipped by interval bounds, then bisection / regula falsi.
+  /// [tmin, tmax], or nothing: blobtree::traceRay (empty space skipped by interval bounds,
+  /// the rest by batched segment tracing with local Lipschitz bounds), then hitAt.
   /// Never steps over a sign change: a cone of radius 0.01 in a model of size 10 is hit.
   std::optional<Hit> intersect(const Ray& ray, float tmin, float tmax, const TraceOptions& opt = {}) const;
-  /// intersect() restricted to the part of the ray inside cell.box, marching with the
-  /// cell's stored Lipschitz bound (the renderer's Embree user-geometry callback).
+  /// intersect() restricted to the part of the ray inside cell.box, with the cell's stored
+  /// Lipschitz bound: blobtree::traceCell, then hitAt.
   std::optional<Hit> intersectCell(const Cell& cell, const Ray& ray, float tmin, float tmax,
                                    const TraceOptions& opt = {}) const;
   /// The cells of a regular grid over bounds() (cube cells of edge <= cellSize, or exactly
@@ -166,8 +169,6 @@ class CompiledBlob {
 
   /// Number of primitives (leaves) in the tape.
   size_t primitiveCount() const;
-  /// Support box of primitive i (an index from CellSet::primitives).
-  Box3 primitiveBounds(uint32_t i) const;
   /// The smallest 0.5-iso radius of any point/segment/cone/torus primitive (0 if none):
   /// a natural scale for default cell sizes.
   float smallestFeature() const;

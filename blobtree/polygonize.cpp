@@ -12,12 +12,20 @@
 #include <stdexcept>
 #include <string>
 
+#include "blobtree/cell_size.h"
+#include "blobtree/detail/marching_tets.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 
 namespace sprig::blobtree {
 
 namespace {
+
+using detail::cornerOffset;
+using detail::kNoCell;
+using detail::kTets;
+using detail::kTriangleCount;
+using detail::TetEmitter;
 
 // Grid points are keyed by their integer coordinates, 20 bits per axis; an edge of the
 // Kuhn triangulation by (key of its low end) · 8 + (its direction as corner bits).
@@ -32,16 +40,6 @@ uint64_t pointKey(int64_t i, int64_t j, int64_t k) {
 glm::ivec3 keyCoords(uint64_t key) {
   return {int((key >> (2 * kAxisBits)) & kAxisMask), int((key >> kAxisBits) & kAxisMask), int(key & kAxisMask)};
 }
-
-// Corner c of a cell (bit 0: +x, bit 1: +y, bit 2: +z).
-glm::ivec3 cornerOffset(int c) { return {c & 1, (c >> 1) & 1, (c >> 2) & 1}; }
-
-// The six Kuhn tetrahedra of a cube: monotone corner paths 0 -> 7, one per axis order.
-// Every face of the cube is split along the diagonal from its lowest to its highest
-// corner, so neighbouring cubes agree.
-constexpr int kTets[6][4] = {{0, 1, 3, 7}, {0, 1, 5, 7}, {0, 2, 3, 7}, {0, 2, 6, 7}, {0, 4, 5, 7}, {0, 4, 6, 7}};
-
-constexpr uint32_t kNoCell = ~0u;
 
 // Open-addressing map from a cell's key to its index. The slot of a cell is a hash of its
 // 4x4x4 block, then its place in the block: the neighbours a cell looks up (and the next
@@ -98,75 +96,6 @@ Vec3 gridPosition(const CellSet& cs, glm::ivec3 g) {
   return cs.origin + Vec3(float(g.x) * cs.cellSize, float(g.y) * cs.cellSize, float(g.z) * cs.cellSize);
 }
 
-// Triangles of one tetrahedron (corner codes t, inside flags), as edge keys, oriented from
-// inside to outside using the edges' midpoints (never degenerate).
-struct TetEmitter {
-  // Vertex of the crossing edge a-b (corner codes of this cell): owned by the cell whose
-  // low corner is the edge's low end, numbered vertexBase + rank of its direction.
-  const uint32_t* owners;      // this cell's owner cells by low-corner code (0 = itself)
-  const uint32_t* vertexBase;  // per active cell
-  const uint8_t* crossMask;    // per active cell: bit d set when edge 0 -> d crosses
-  glm::uvec3* out;  // next triangle slot
-
-  uint32_t edge(int a, int b, bool) const {
-    int lo = a & b, d = (a | b) ^ lo;
-    uint32_t owner = owners[lo];
-    uint8_t m = crossMask[owner];
-    if (owner == kNoCell || !((m >> d) & 1)) throw std::logic_error("polygonize: crossing edge without an owner cell");
-    return vertexBase[owner] + uint32_t(std::popcount(unsigned(m) & ((1u << d) - 1u)));
-  }
-
-  static Vec3 mid(int a, int b) { return 0.5f * Vec3(cornerOffset(a) + cornerOffset(b)); }
-
-  // Emits triangle (e0,e1,e2) with midpoints (m0,m1,m2), flipped so its normal points along outward.
-  void emit(uint32_t e0, uint32_t e1, uint32_t e2, Vec3 m0, Vec3 m1, Vec3 m2, Vec3 outward) {
-    Vec3 n = glm::cross(m1 - m0, m2 - m0);
-    *out++ = glm::dot(n, outward) >= 0.0f ? glm::uvec3(e0, e1, e2) : glm::uvec3(e0, e2, e1);
-  }
-
-  void run(const int t[4], const bool in[4]) {
-    int count = in[0] + in[1] + in[2] + in[3];
-    if (count == 0 || count == 4) return;
-    if (count == 1 || count == 3) {
-      // The lone vertex s against the other three.
-      bool loneInside = count == 1;
-      int s = 0;
-      while (in[s] != loneInside) ++s;
-      int o[3], n = 0;
-      for (int k = 0; k < 4; ++k)
-        if (k != s) o[n++] = k;
-      Vec3 ps = Vec3(cornerOffset(t[s]));
-      Vec3 po = (Vec3(cornerOffset(t[o[0]])) + Vec3(cornerOffset(t[o[1]])) + Vec3(cornerOffset(t[o[2]]))) / 3.0f;
-      Vec3 outward = loneInside ? po - ps : ps - po;
-      uint32_t e[3];
-      for (int k = 0; k < 3; ++k) e[k] = edge(t[s], t[o[k]], loneInside);
-      emit(e[0], e[1], e[2], mid(t[s], t[o[0]]), mid(t[s], t[o[1]]), mid(t[s], t[o[2]]), outward);
-      return;
-    }
-    // Two inside (a, b), two outside (c, d): the quad ac, ad, bd, bc.
-    int ins[2], outs[2], ni = 0, no = 0;
-    for (int k = 0; k < 4; ++k) (in[k] ? ins[ni++] : outs[no++]) = t[k];
-    int a = ins[0], b = ins[1], c = outs[0], d = outs[1];
-    Vec3 outward = 0.5f * (Vec3(cornerOffset(c)) + Vec3(cornerOffset(d))) -
-                   0.5f * (Vec3(cornerOffset(a)) + Vec3(cornerOffset(b)));
-    uint32_t ac = edge(a, c, true), ad = edge(a, d, true), bd = edge(b, d, true), bc = edge(b, c, true);
-    emit(ac, ad, bd, mid(a, c), mid(a, d), mid(b, d), outward);
-    emit(ac, bd, bc, mid(a, c), mid(b, d), mid(b, c), outward);
-  }
-};
-
-// Triangles marching tetrahedra emit for a cell, by its inside-corner mask: a tetrahedron
-// with 1 or 3 corners inside gives one, with 2 gives two.
-constexpr std::array<uint8_t, 256> kTriangleCount = [] {
-  std::array<uint8_t, 256> n{};
-  for (int m = 0; m < 256; ++m)
-    for (const auto& t : kTets) {
-      int in = ((m >> t[0]) & 1) + ((m >> t[1]) & 1) + ((m >> t[2]) & 1) + ((m >> t[3]) & 1);
-      n[size_t(m)] = uint8_t(n[size_t(m)] + (in == 2 ? 2 : (in == 1 || in == 3 ? 1 : 0)));
-    }
-  return n;
-}();
-
 // Concatenates per-chunk vectors in chunk order.
 template <class T>
 std::vector<T> concat(std::vector<std::vector<T>>& parts) {
@@ -192,53 +121,33 @@ float resolveCellSize(const CompiledBlob& blob, const PolygonizeOptions& options
   Vec3 size = b.size();
   if (!std::isfinite(size.x) || !std::isfinite(size.y) || !std::isfinite(size.z) || size.x > 1e30f)
     throw std::invalid_argument("polygonize: the blob is unbounded (a bare cutter); give a cell size and a bounded model");
-  const float diag = glm::length(size);
-  float h = diag / options.sizeDivisions;
-  float feature = blob.smallestFeature();
-  if (feature > 0.0f) h = std::min(h, options.featureFraction * feature);
-  if (options.maxDivisions > 0.0f) h = std::max(h, diag / options.maxDivisions);
-  return h;
+  return autoCellSize(blob, CellSizeRule{.featureFraction = options.featureFraction,
+                                         .coarsestDivisions = options.sizeDivisions,
+                                         .finestDivisions = options.maxDivisions,
+                                         .noFeatureDivisions = options.sizeDivisions});
 }
 
-PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOptions& options) {
-  PolygonizeResult res;
-  float requested = resolveCellSize(blob, options);
-  if (requested <= 0.0f || blob.bounds().empty()) return res;
+namespace {
 
-  // ---- 1. Cells that may hold the surface ------------------------------------------
-  auto clock = std::chrono::steady_clock::now();
-  auto lap = [&clock] {
-    auto now = std::chrono::steady_clock::now();
-    double s = std::chrono::duration<double>(now - clock).count();
-    clock = now;
-    return s;
-  };
-  // Cells of exactly the requested edge; no Lipschitz bounds or primitive lists (the
-  // tracer's needs, not ours).
-  CellSet cs = blob.surfaceCells(requested, SurfaceCellOptions{.exactCellSize = true, .lipschitz = false,
-                                                               .primitiveLists = false});
-  res.cellSeconds = lap();
-  res.cellSize = cs.cellSize;
-  res.surfaceCells = cs.cells.size();
-  const size_t nCells = cs.cells.size();
-  if (nCells == 0) return res;
-  if (nCells >= (size_t(1) << 29)) throw std::invalid_argument("polygonize: too many surface cells; use a larger cell size");
-  for (const Cell& c : cs.cells)
-    for (int a = 0; a < 3; ++a)
-      if (c.index[a] < 0 || c.index[a] + 1 >= kAxisLimit)
-        throw std::invalid_argument("polygonize: the grid has more than 2^20 cells on an axis; use a larger cell size");
+// The state the polygonizer's steps share: the kept cells, one sample per distinct grid
+// point, the cells' inside masks, and the active cells (those with a sign change).
+struct Grid {
+  explicit Grid(CellSet cells) : cs(std::move(cells)), cellIndex(cs.cells.size()) {}
 
-  // ---- 2. One sample per distinct cell corner ---------------------------------------
-  // A grid point g belongs to the kept cell g − offset(c') with the smallest corner code c'
-  // (the cell whose low corner it is, when kept). Points are numbered by owner cell, then
-  // by corner code: no sort, and the numbering does not depend on the thread count.
-  CellHash cellIndex(nCells);
-  for (size_t i = 0; i < nCells; ++i) {
-    const auto& idx = cs.cells[i].index;
-    cellIndex.insert(pointKey(idx[0], idx[1], idx[2]), uint32_t(i));
-  }
+  CellSet cs;
+  CellHash cellIndex;                    // kept cell key -> index into cs.cells
+  std::vector<uint32_t> cornerPoint;     // per cell (kept, then added) · 8 + corner: grid point index
+  std::vector<uint8_t> ownedMask;        // per kept cell: corners whose grid point it owns
+  std::vector<uint32_t> pointBase;       // per kept cell: its first owned point (prefix sums)
+  std::vector<uint64_t> pointKeys;       // per grid point: its key
+  std::vector<float> values;             // per grid point: F there
+  std::vector<uint8_t> insideMask;       // per cell: corners with F > 0.5
+  std::vector<glm::ivec3> cellCoords;    // per cell: integer grid coordinates
+  std::vector<uint32_t> active;          // cells with a sign change, kept ones first
+  size_t extraCells = 0;                 // cells the closure added
+
   // The owner slot (cell · 8 + corner) of grid point g, or kNoCell when no kept cell holds it.
-  auto ownerSlot = [&](glm::ivec3 g) -> uint32_t {
+  uint32_t ownerSlot(glm::ivec3 g) const {
     for (int c = 0; c < 8; ++c) {
       glm::ivec3 lo = g - cornerOffset(c);
       if (lo.x < 0 || lo.y < 0 || lo.z < 0) continue;
@@ -246,12 +155,42 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
       if (j != kNoCell) return j * 8 + uint32_t(c);
     }
     return kNoCell;
-  };
-  std::vector<uint32_t> cornerPoint(nCells * 8);  // first the owner slot, then the point index
-  std::vector<uint8_t> ownedMask(nCells);
-  std::vector<uint32_t> pointBase(nCells + 1, 0);
+  }
+  // The grid point index of an owner slot.
+  uint32_t pointOfSlot(uint32_t slot) const {
+    uint32_t j = slot / 8, c = slot % 8;
+    return pointBase[j] + uint32_t(std::popcount(unsigned(ownedMask[j]) & ((1u << c) - 1u)));
+  }
+};
+
+// Step 1: the cells of exactly the requested edge whose interval bound may hold the
+// surface; no Lipschitz bounds or primitive lists (the tracer's needs, not ours).
+CellSet keptCells(const CompiledBlob& blob, float requested) {
+  CellSet cs = blob.surfaceCells(requested, SurfaceCellOptions{.exactCellSize = true, .lipschitz = false,
+                                                               .primitiveLists = false});
+  if (cs.cells.size() >= (size_t(1) << 29)) throw std::invalid_argument("polygonize: too many surface cells; use a larger cell size");
+  for (const Cell& c : cs.cells)
+    for (int a = 0; a < 3; ++a)
+      if (c.index[a] < 0 || c.index[a] + 1 >= kAxisLimit)
+        throw std::invalid_argument("polygonize: the grid has more than 2^20 cells on an axis; use a larger cell size");
+  return cs;
+}
+
+// Step 2a: number the distinct cell corners. A grid point g belongs to the kept cell
+// g − offset(c') with the smallest corner code c' (the cell whose low corner it is, when
+// kept). Points are numbered by owner cell, then by corner code: no sort, and the
+// numbering does not depend on the thread count.
+void numberCorners(Grid& g) {
+  const size_t nCells = g.cs.cells.size();
+  for (size_t i = 0; i < nCells; ++i) {
+    const auto& idx = g.cs.cells[i].index;
+    g.cellIndex.insert(pointKey(idx[0], idx[1], idx[2]), uint32_t(i));
+  }
+  g.cornerPoint.resize(nCells * 8);  // first the owner slot, then the point index
+  g.ownedMask.resize(nCells);
+  g.pointBase.assign(nCells + 1, 0);
   parallelFor(0, nCells, [&](size_t i) {
-    const glm::ivec3 idx(cs.cells[i].index[0], cs.cells[i].index[1], cs.cells[i].index[2]);
+    const glm::ivec3 idx(g.cs.cells[i].index[0], g.cs.cells[i].index[1], g.cs.cells[i].index[2]);
     // Corner c is owned by the neighbour idx + offset(c) − offset(c') with the smallest
     // c' < c that is kept, else by this cell. Neighbours by displacement (27 of them),
     // each looked up at most once.
@@ -260,8 +199,8 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
     auto find = [&](glm::ivec3 d) {
       uint32_t& n = neighbour[size_t((d.x + 1) + 3 * (d.y + 1) + 9 * (d.z + 1))];
       if (n == kNoCell - 1) {
-        glm::ivec3 g = idx + d;
-        n = g.x < 0 || g.y < 0 || g.z < 0 ? kNoCell : cellIndex.find(pointKey(g.x, g.y, g.z));
+        glm::ivec3 q = idx + d;
+        n = q.x < 0 || q.y < 0 || q.z < 0 ? kNoCell : g.cellIndex.find(pointKey(q.x, q.y, q.z));
       }
       return n;
     };
@@ -275,207 +214,226 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
           break;
         }
       }
-      cornerPoint[i * 8 + size_t(c)] = slot;
+      g.cornerPoint[i * 8 + size_t(c)] = slot;
       if (slot == uint32_t(i * 8 + size_t(c))) owned |= uint8_t(1u << c);
     }
-    ownedMask[i] = owned;
-    pointBase[i + 1] = uint32_t(std::popcount(unsigned(owned)));
+    g.ownedMask[i] = owned;
+    g.pointBase[i + 1] = uint32_t(std::popcount(unsigned(owned)));
   }, 1024);
-  for (size_t i = 0; i < nCells; ++i) pointBase[i + 1] += pointBase[i];
-  auto pointOfSlot = [&](uint32_t slot) {
-    uint32_t j = slot / 8, c = slot % 8;
-    return pointBase[j] + uint32_t(std::popcount(unsigned(ownedMask[j]) & ((1u << c) - 1u)));
-  };
-  const size_t nPoints = pointBase[nCells];
-  std::vector<uint64_t> pointKeys(nPoints);
+  for (size_t i = 0; i < nCells; ++i) g.pointBase[i + 1] += g.pointBase[i];
+  g.pointKeys.resize(g.pointBase[nCells]);
   parallelFor(0, nCells, [&](size_t i) {
-    const auto& idx = cs.cells[i].index;
+    const auto& idx = g.cs.cells[i].index;
     for (int c = 0; c < 8; ++c) {
-      uint32_t& cp = cornerPoint[i * 8 + size_t(c)];
-      cp = pointOfSlot(cp);
-      if ((ownedMask[i] >> c) & 1) {
-        glm::ivec3 g = glm::ivec3(idx[0], idx[1], idx[2]) + cornerOffset(c);
-        pointKeys[cp] = pointKey(g.x, g.y, g.z);
+      uint32_t& cp = g.cornerPoint[i * 8 + size_t(c)];
+      cp = g.pointOfSlot(cp);
+      if ((g.ownedMask[i] >> c) & 1) {
+        glm::ivec3 q = glm::ivec3(idx[0], idx[1], idx[2]) + cornerOffset(c);
+        g.pointKeys[cp] = pointKey(q.x, q.y, q.z);
       }
     }
   }, 1024);
-  res.gridSamples = nPoints;
+}
 
-  // Points are numbered in cell order and the cells come in recursive octree order, so a
-  // run of consecutive points is a compact cluster: batches of kSampleBatch of them share
-  // one tree walk and evaluate each nearby primitive over the whole batch.
-  std::vector<float> values(nPoints);
-  {
-    constexpr size_t kSampleBatch = 128;
-    size_t nBatches = (nPoints + kSampleBatch - 1) / kSampleBatch;
-    parallelFor(0, nBatches, [&](size_t bi) {
-      std::array<Vec3, kSampleBatch> pts;
-      size_t b = bi * kSampleBatch, n = std::min(kSampleBatch, nPoints - b);
-      for (size_t k = 0; k < n; ++k) pts[k] = gridPosition(cs, keyCoords(pointKeys[b + k]));
-      blob.values(std::span<const Vec3>(pts.data(), n), std::span<float>(values.data() + b, n));
-    }, 16);
-  }
-  if (options.progress && ProgressSettings::cancelRequested()) throw Cancelled();
+// Step 2b: one sample per grid point. Points are numbered in cell order and the cells come
+// in recursive octree order, so a run of consecutive points is a compact cluster: batches
+// of kSampleBatch of them share one tree walk and evaluate each nearby primitive over the
+// whole batch.
+void sampleCorners(const CompiledBlob& blob, Grid& g) {
+  const size_t nPoints = g.pointKeys.size();
+  g.values.resize(nPoints);
+  constexpr size_t kSampleBatch = 128;
+  size_t nBatches = (nPoints + kSampleBatch - 1) / kSampleBatch;
+  parallelFor(0, nBatches, [&](size_t bi) {
+    std::array<Vec3, kSampleBatch> pts;
+    size_t b = bi * kSampleBatch, n = std::min(kSampleBatch, nPoints - b);
+    for (size_t k = 0; k < n; ++k) pts[k] = gridPosition(g.cs, keyCoords(g.pointKeys[b + k]));
+    blob.values(std::span<const Vec3>(pts.data(), n), std::span<float>(g.values.data() + b, n));
+  }, 16);
+}
 
-  res.sampleSeconds = lap();
-
-  // ---- 3. Cells with a sign change ----------------------------------------------------
-  std::vector<uint8_t> insideMask(nCells);
+// Step 3a: the inside mask of every kept cell and the active ones.
+void classifyCells(Grid& g) {
+  const size_t nCells = g.cs.cells.size();
+  g.insideMask.resize(nCells);
   parallelFor(0, nCells, [&](size_t i) {
     uint8_t m = 0;
     for (int c = 0; c < 8; ++c)
-      if (values[cornerPoint[i * 8 + c]] > kIso) m |= uint8_t(1u << c);
-    insideMask[i] = m;
+      if (g.values[g.cornerPoint[i * 8 + c]] > kIso) m |= uint8_t(1u << c);
+    g.insideMask[i] = m;
   }, 4096);
-  std::vector<uint32_t> active;
   for (size_t i = 0; i < nCells; ++i)
-    if (insideMask[i] != 0 && insideMask[i] != 0xff) active.push_back(uint32_t(i));
+    if (g.insideMask[i] != 0 && g.insideMask[i] != 0xff) g.active.push_back(uint32_t(i));
+  g.cellCoords.resize(nCells);
+  for (size_t i = 0; i < nCells; ++i)
+    g.cellCoords[i] = {g.cs.cells[i].index[0], g.cs.cells[i].index[1], g.cs.cells[i].index[2]};
+}
 
-  // Closure: a cell whose face carries a sign change needs the neighbour across that face
-  // triangulated too, or the mesh would have a hole there. Interval bounds keep every
-  // such neighbour up to rounding (a corner exactly on F = 0.5 can fall just outside a
-  // neighbour's bound), so the rare missing ones are added here, with their corners
-  // sampled once and shared through the same point table.
-  std::vector<glm::ivec3> cellCoords(nCells);
-  for (size_t i = 0; i < nCells; ++i) cellCoords[i] = {cs.cells[i].index[0], cs.cells[i].index[1], cs.cells[i].index[2]};
-  size_t extraCells = 0;
-  std::map<uint64_t, uint32_t> extraPoints;  // grid points sampled for added cells
-  {
-    std::map<uint64_t, uint32_t> addedCells;
-    auto pointIndex = [&](glm::ivec3 g) -> uint32_t {
-      uint64_t key = pointKey(g.x, g.y, g.z);
-      uint32_t slot = ownerSlot(g);
-      if (slot != kNoCell) return pointOfSlot(slot);
-      auto [e, inserted] = extraPoints.emplace(key, uint32_t(pointKeys.size()));
-      if (inserted) {
-        pointKeys.push_back(key);
-        values.push_back(blob.value(gridPosition(cs, g)));
-      }
-      return e->second;
-    };
-    // Face f = 2·axis + side; its four corners are those with bit `axis` equal to side.
-    std::vector<uint32_t> frontier = active;
-    while (!frontier.empty()) {
-      // Neighbours across sign-changing faces that no cell covers (read-only scan, in chunks).
-      constexpr size_t kScan = 4096;
-      std::vector<std::vector<uint64_t>> wantedParts((frontier.size() + kScan - 1) / kScan);
-      parallelFor(0, wantedParts.size(), [&](size_t ch) {
-        size_t end = std::min(frontier.size(), (ch + 1) * kScan);
-        for (size_t f = ch * kScan; f < end; ++f) {
-          uint32_t i = frontier[f];
-          uint8_t m = insideMask[i];
-          for (int axis = 0; axis < 3; ++axis)
-            for (int side = 0; side < 2; ++side) {
-              int in = 0;
-              for (int c = 0; c < 8; ++c)
-                if (((c >> axis) & 1) == side) in += (m >> c) & 1;
-              if (in == 0 || in == 4) continue;
-              glm::ivec3 n = cellCoords[i];
-              n[axis] += side ? 1 : -1;
-              if (n[axis] < 0 || n[axis] + 1 >= kAxisLimit) continue;
-              uint64_t key = pointKey(n.x, n.y, n.z);
-              if (cellIndex.find(key) == kNoCell && !addedCells.count(key)) wantedParts[ch].push_back(key);
-            }
+// The neighbours of the frontier's cells across sign-changing faces that no cell covers
+// yet, sorted and unique (a read-only scan, in chunks). Face f = 2·axis + side; its four
+// corners are those with bit `axis` equal to side.
+std::vector<uint64_t> uncoveredNeighbours(const Grid& g, const std::vector<uint32_t>& frontier,
+                                          const std::map<uint64_t, uint32_t>& addedCells) {
+  constexpr size_t kScan = 4096;
+  std::vector<std::vector<uint64_t>> wantedParts((frontier.size() + kScan - 1) / kScan);
+  parallelFor(0, wantedParts.size(), [&](size_t ch) {
+    size_t end = std::min(frontier.size(), (ch + 1) * kScan);
+    for (size_t f = ch * kScan; f < end; ++f) {
+      uint32_t i = frontier[f];
+      uint8_t m = g.insideMask[i];
+      for (int axis = 0; axis < 3; ++axis)
+        for (int side = 0; side < 2; ++side) {
+          int in = 0;
+          for (int c = 0; c < 8; ++c)
+            if (((c >> axis) & 1) == side) in += (m >> c) & 1;
+          if (in == 0 || in == 4) continue;
+          glm::ivec3 n = g.cellCoords[i];
+          n[axis] += side ? 1 : -1;
+          if (n[axis] < 0 || n[axis] + 1 >= kAxisLimit) continue;
+          uint64_t key = pointKey(n.x, n.y, n.z);
+          if (g.cellIndex.find(key) == kNoCell && !addedCells.count(key)) wantedParts[ch].push_back(key);
         }
-      });
-      std::vector<uint64_t> wanted = concat(wantedParts);
-      std::sort(wanted.begin(), wanted.end());
-      wanted.erase(std::unique(wanted.begin(), wanted.end()), wanted.end());
-      frontier.clear();
-      for (uint64_t key : wanted) {
-        glm::ivec3 g = keyCoords(key);
-        uint32_t id = uint32_t(cellCoords.size());
-        addedCells.emplace(key, id);
-        cellCoords.push_back(g);
-        uint8_t m = 0;
-        for (int c = 0; c < 8; ++c) {
-          uint32_t u = pointIndex(g + cornerOffset(c));
-          cornerPoint.push_back(u);
-          if (values[u] > kIso) m |= uint8_t(1u << c);
-        }
-        insideMask.push_back(m);
-        if (m != 0 && m != 0xff) {
-          active.push_back(id);
-          frontier.push_back(id);
-        }
-      }
-      extraCells += wanted.size();
     }
-  }
-  res.gridSamples = pointKeys.size();
-  res.activeCells = active.size();
-  res.extraCells = extraCells;
-  if (active.empty()) return res;
+  });
+  std::vector<uint64_t> wanted = concat(wantedParts);
+  std::sort(wanted.begin(), wanted.end());
+  wanted.erase(std::unique(wanted.begin(), wanted.end()), wanted.end());
+  return wanted;
+}
 
-  // ---- 4. Vertex numbering and marching tetrahedra -----------------------------------
-  // Every crossing edge P -> P + d (d a corner code) belongs to the cell with low corner P;
-  // that cell has the crossing between its corners 0 and d, so it is active (kept by the
-  // bounds or added by the closure). Vertices are numbered by owner cell, then by d.
-  const size_t nActive = active.size();
+// Step 3b, closure: a cell whose face carries a sign change needs the neighbour across
+// that face triangulated too, or the mesh would have a hole there. Interval bounds keep
+// every such neighbour up to rounding (a corner exactly on F = 0.5 can fall just outside a
+// neighbour's bound), so the rare missing ones are added here, with their corners sampled
+// once and shared through the same point table.
+void closeFaces(const CompiledBlob& blob, Grid& g) {
+  std::map<uint64_t, uint32_t> extraPoints;  // grid points sampled for added cells
+  std::map<uint64_t, uint32_t> addedCells;
+  auto pointIndex = [&](glm::ivec3 q) -> uint32_t {
+    uint64_t key = pointKey(q.x, q.y, q.z);
+    uint32_t slot = g.ownerSlot(q);
+    if (slot != kNoCell) return g.pointOfSlot(slot);
+    auto [e, inserted] = extraPoints.emplace(key, uint32_t(g.pointKeys.size()));
+    if (inserted) {
+      g.pointKeys.push_back(key);
+      g.values.push_back(blob.value(gridPosition(g.cs, q)));
+    }
+    return e->second;
+  };
+  std::vector<uint32_t> frontier = g.active;
+  while (!frontier.empty()) {
+    std::vector<uint64_t> wanted = uncoveredNeighbours(g, frontier, addedCells);
+    frontier.clear();
+    for (uint64_t key : wanted) {
+      glm::ivec3 q = keyCoords(key);
+      uint32_t id = uint32_t(g.cellCoords.size());
+      addedCells.emplace(key, id);
+      g.cellCoords.push_back(q);
+      uint8_t m = 0;
+      for (int c = 0; c < 8; ++c) {
+        uint32_t u = pointIndex(q + cornerOffset(c));
+        g.cornerPoint.push_back(u);
+        if (g.values[u] > kIso) m |= uint8_t(1u << c);
+      }
+      g.insideMask.push_back(m);
+      if (m != 0 && m != 0xff) {
+        g.active.push_back(id);
+        frontier.push_back(id);
+      }
+    }
+    g.extraCells += wanted.size();
+  }
+}
+
+// The mesh's vertices, one per crossing grid edge: numbered by owner cell, then by edge
+// direction, with the inside and outside grid point of each edge.
+struct Vertices {
+  std::vector<uint8_t> crossMask;    // per active cell: bit d set when edge 0 -> d crosses
+  std::vector<uint32_t> vertexBase;  // per active cell: its first vertex (prefix sums)
+  std::vector<uint32_t> owners;      // per active cell · 8 + low-corner code: the owning active cell
+  std::vector<EdgeRec> edges;        // per vertex
+};
+
+// Step 4a: every crossing edge P -> P + d (d a corner code) belongs to the cell with low
+// corner P; that cell has the crossing between its corners 0 and d, so it is active (kept
+// by the bounds or added by the closure). Vertices are numbered by owner cell, then by d.
+Vertices numberVertices(const Grid& g) {
+  const size_t nActive = g.active.size();
   CellHash activeIndex(nActive);
   for (size_t a = 0; a < nActive; ++a) {
-    glm::ivec3 g = cellCoords[active[a]];
-    activeIndex.insert(pointKey(g.x, g.y, g.z), uint32_t(a));
+    glm::ivec3 q = g.cellCoords[g.active[a]];
+    activeIndex.insert(pointKey(q.x, q.y, q.z), uint32_t(a));
   }
-  std::vector<uint8_t> crossMask(nActive);
-  std::vector<uint32_t> vertexBase(nActive + 1, 0);
-  std::vector<uint32_t> owners(nActive * 8);
+  Vertices v;
+  v.crossMask.resize(nActive);
+  v.vertexBase.assign(nActive + 1, 0);
+  v.owners.resize(nActive * 8);
   parallelFor(0, nActive, [&](size_t a) {
-    uint8_t m = insideMask[active[a]], cross = 0;
+    uint8_t m = g.insideMask[g.active[a]], cross = 0;
     for (int d = 1; d < 8; ++d)
       if (((m >> d) & 1) != (m & 1)) cross |= uint8_t(1u << d);
-    crossMask[a] = cross;
-    vertexBase[a + 1] = uint32_t(std::popcount(unsigned(cross)));
-    glm::ivec3 g = cellCoords[active[a]];
-    owners[a * 8] = uint32_t(a);
+    v.crossMask[a] = cross;
+    v.vertexBase[a + 1] = uint32_t(std::popcount(unsigned(cross)));
+    glm::ivec3 q = g.cellCoords[g.active[a]];
+    v.owners[a * 8] = uint32_t(a);
     for (int lo = 1; lo < 8; ++lo) {
-      glm::ivec3 n = g + cornerOffset(lo);
-      owners[a * 8 + size_t(lo)] = activeIndex.find(pointKey(n.x, n.y, n.z));
+      glm::ivec3 n = q + cornerOffset(lo);
+      v.owners[a * 8 + size_t(lo)] = activeIndex.find(pointKey(n.x, n.y, n.z));
     }
   }, 2048);
-  for (size_t a = 0; a < nActive; ++a) vertexBase[a + 1] += vertexBase[a];
-  const size_t nVerts = vertexBase[nActive];
+  for (size_t a = 0; a < nActive; ++a) v.vertexBase[a + 1] += v.vertexBase[a];
+  // The inside and outside grid point of each vertex's edge.
+  v.edges.resize(v.vertexBase[nActive]);
+  parallelFor(0, nActive, [&](size_t a) {
+    const uint32_t* cp = &g.cornerPoint[size_t(g.active[a]) * 8];
+    bool lowInside = g.insideMask[g.active[a]] & 1;
+    uint32_t k = v.vertexBase[a];
+    for (int d = 1; d < 8; ++d)
+      if ((v.crossMask[a] >> d) & 1) v.edges[k++] = lowInside ? EdgeRec{cp[0], cp[d]} : EdgeRec{cp[d], cp[0]};
+  }, 2048);
+  return v;
+}
 
+// Step 4b: marching tetrahedra over the active cells. Triangles are counted per chunk
+// first, then written in place (no per-chunk buffers).
+std::vector<glm::uvec3> triangulate(const Grid& g, const Vertices& v) {
+  const size_t nActive = g.active.size();
   constexpr size_t kChunk = 2048;
   size_t nChunks = (nActive + kChunk - 1) / kChunk;
-  // Triangles are counted per chunk first, then written in place (no per-chunk buffers).
   std::vector<size_t> triBase(nChunks + 1, 0);
   parallelFor(0, nChunks, [&](size_t ch) {
     size_t begin = ch * kChunk, end = std::min(nActive, begin + kChunk), n = 0;
-    for (size_t a = begin; a < end; ++a) n += kTriangleCount[insideMask[active[a]]];
+    for (size_t a = begin; a < end; ++a) n += kTriangleCount[g.insideMask[g.active[a]]];
     triBase[ch + 1] = n;
   });
   for (size_t ch = 0; ch < nChunks; ++ch) triBase[ch + 1] += triBase[ch];
-  Mesh& mesh = res.mesh;
-  mesh.triangles.resize(triBase[nChunks]);
+  std::vector<glm::uvec3> triangles(triBase[nChunks]);
   parallelFor(0, nChunks, [&](size_t ch) {
     size_t begin = ch * kChunk, end = std::min(nActive, begin + kChunk);
-    TetEmitter em{nullptr, vertexBase.data(), crossMask.data(), mesh.triangles.data() + triBase[ch]};
+    TetEmitter em{nullptr, v.vertexBase.data(), v.crossMask.data(), triangles.data() + triBase[ch]};
     for (size_t a = begin; a < end; ++a) {
-      em.owners = &owners[a * 8];
-      uint8_t m = insideMask[active[a]];
+      em.owners = &v.owners[a * 8];
+      uint8_t m = g.insideMask[g.active[a]];
       for (const auto& t : kTets) {
         bool in[4] = {bool(m >> t[0] & 1), bool(m >> t[1] & 1), bool(m >> t[2] & 1), bool(m >> t[3] & 1)};
         em.run(t, in);
       }
     }
-    if (em.out != mesh.triangles.data() + triBase[ch + 1]) throw std::logic_error("polygonize: triangle count mismatch");
+    if (em.out != triangles.data() + triBase[ch + 1]) throw std::logic_error("polygonize: triangle count mismatch");
   });
-  std::vector<uint32_t>().swap(owners);
+  return triangles;
+}
 
-  // The inside and outside grid point of each vertex's edge.
-  std::vector<EdgeRec> edges(nVerts);
-  parallelFor(0, nActive, [&](size_t a) {
-    const uint32_t* cp = &cornerPoint[size_t(active[a]) * 8];
-    bool lowInside = insideMask[active[a]] & 1;
-    uint32_t v = vertexBase[a];
-    for (int d = 1; d < 8; ++d)
-      if ((crossMask[a] >> d) & 1) edges[v++] = lowInside ? EdgeRec{cp[0], cp[d]} : EdgeRec{cp[d], cp[0]};
-  }, 2048);
-
-  res.triangulateSeconds = lap();
-
-  // ---- 5. Vertices: root search along each edge, then normal and attributes ----------
+// Step 5a: every vertex moved onto F = 0.5 along its edge, with its normal and attributes.
+// Fixed blocks of vertices (consecutive edge keys: spatially coherent rows) iterate in
+// lockstep, each step one batched values() call over the block's unconverged vertices.
+// Blocks do not depend on the thread count, so neither do the results. Returns the root
+// search's field evaluations per vertex; flatGradient marks vertices without a gradient.
+std::vector<uint8_t> placeVertices(const CompiledBlob& blob, const PolygonizeOptions& options, const Grid& g,
+                                   const std::vector<EdgeRec>& edges, PolygonizeResult& res,
+                                   std::vector<uint8_t>& flatGradient) {
+  const size_t nVerts = edges.size();
+  Mesh& mesh = res.mesh;
   std::unique_ptr<Progress> bar;
   if (options.progress) bar = std::make_unique<Progress>("polygonize", nVerts);
   mesh.positions.resize(nVerts);
@@ -485,10 +443,7 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
     res.attributes.resize(nVerts);
   }
   std::vector<uint8_t> evals(nVerts, 0);
-  std::vector<uint8_t> flatGradient(nVerts, 0);
-  // Fixed blocks of vertices (consecutive edge keys: spatially coherent rows) iterate in
-  // lockstep, each step one batched values() call over the block's unconverged vertices.
-  // Blocks do not depend on the thread count, so neither do the results.
+  flatGradient.assign(nVerts, 0);
   constexpr size_t kBlock = 64;
   size_t nBlocks = (nVerts + kBlock - 1) / kBlock;
   parallelFor(0, nBlocks, [&](size_t blk) {
@@ -503,10 +458,10 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
     size_t nLive = 0;
     for (size_t k = 0; k < n; ++k) {
       const EdgeRec& e = edges[begin + k];
-      pIn[k] = gridPosition(cs, keyCoords(pointKeys[e.inside]));
-      pOut[k] = gridPosition(cs, keyCoords(pointKeys[e.outside]));
+      pIn[k] = gridPosition(g.cs, keyCoords(g.pointKeys[e.inside]));
+      pOut[k] = gridPosition(g.cs, keyCoords(g.pointKeys[e.outside]));
       a[k] = 0.0, b[k] = 1.0, side[k] = 0;
-      fa[k] = double(values[e.inside]) - kIso, fb[k] = double(values[e.outside]) - kIso;
+      fa[k] = double(g.values[e.inside]) - kIso, fb[k] = double(g.values[e.outside]) - kIso;
       t[k] = fa[k] / (fa[k] - fb[k]);
       if (options.refineSteps > 0) live[nLive++] = uint32_t(k);
     }
@@ -557,24 +512,75 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
     if (bar) bar->advance(n);
   });
   if (bar) bar->finish();
+  return evals;
+}
 
-  // Vertices where the gradient vanishes take the area-weighted normal of their triangles.
-  if (options.normals && std::find(flatGradient.begin(), flatGradient.end(), 1) != flatGradient.end()) {
-    std::vector<Vec3> acc(nVerts, Vec3(0.0f));
-    for (const auto& tri : mesh.triangles) {
-      Vec3 n = glm::cross(mesh.positions[tri.y] - mesh.positions[tri.x], mesh.positions[tri.z] - mesh.positions[tri.x]);
-      for (int k = 0; k < 3; ++k)
-        if (flatGradient[tri[k]]) acc[tri[k]] += n;
-    }
-    for (size_t v = 0; v < nVerts; ++v)
-      if (flatGradient[v]) {
-        float len = glm::length(acc[v]);
-        mesh.normals[v] = len > 0.0f ? acc[v] / len : Vec3(0, 1, 0);
-      }
+// Step 5b: vertices where the gradient vanishes take the area-weighted normal of their
+// triangles.
+void fixFlatNormals(Mesh& mesh, const std::vector<uint8_t>& flatGradient) {
+  if (std::find(flatGradient.begin(), flatGradient.end(), 1) == flatGradient.end()) return;
+  std::vector<Vec3> acc(mesh.positions.size(), Vec3(0.0f));
+  for (const auto& tri : mesh.triangles) {
+    Vec3 n = glm::cross(mesh.positions[tri.y] - mesh.positions[tri.x], mesh.positions[tri.z] - mesh.positions[tri.x]);
+    for (int k = 0; k < 3; ++k)
+      if (flatGradient[tri[k]]) acc[tri[k]] += n;
   }
+  for (size_t v = 0; v < mesh.positions.size(); ++v)
+    if (flatGradient[v]) {
+      float len = glm::length(acc[v]);
+      mesh.normals[v] = len > 0.0f ? acc[v] / len : Vec3(0, 1, 0);
+    }
+}
 
+}  // namespace
+
+PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOptions& options) {
+  PolygonizeResult res;
+  float requested = resolveCellSize(blob, options);
+  if (requested <= 0.0f || blob.bounds().empty()) return res;
+  auto clock = std::chrono::steady_clock::now();
+  auto lap = [&clock] {
+    auto now = std::chrono::steady_clock::now();
+    double s = std::chrono::duration<double>(now - clock).count();
+    clock = now;
+    return s;
+  };
+
+  // 1. Cells that may hold the surface.
+  Grid g(keptCells(blob, requested));
+  res.cellSeconds = lap();
+  res.cellSize = g.cs.cellSize;
+  res.surfaceCells = g.cs.cells.size();
+  if (g.cs.cells.empty()) return res;
+
+  // 2. One sample per distinct cell corner.
+  numberCorners(g);
+  res.gridSamples = g.pointKeys.size();
+  sampleCorners(blob, g);
+  if (options.progress && ProgressSettings::cancelRequested()) throw Cancelled();
+  res.sampleSeconds = lap();
+
+  // 3. Cells with a sign change, closed across faces.
+  classifyCells(g);
+  closeFaces(blob, g);
+  res.gridSamples = g.pointKeys.size();
+  res.activeCells = g.active.size();
+  res.extraCells = g.extraCells;
+  if (g.active.empty()) return res;
+
+  // 4. Vertex numbering and marching tetrahedra.
+  Vertices v = numberVertices(g);
+  res.mesh.triangles = triangulate(g, v);
+  std::vector<uint32_t>().swap(v.owners);
+  res.triangulateSeconds = lap();
+
+  // 5. Vertices: root search along each edge, then normal and attributes.
+  std::vector<uint8_t> flatGradient;
+  std::vector<uint8_t> evals = placeVertices(blob, options, g, v.edges, res, flatGradient);
+  if (options.normals) fixFlatNormals(res.mesh, flatGradient);
   res.vertexSeconds = lap();
-  size_t total = pointKeys.size() + (options.normals || options.attributes ? nVerts : 0);
+  const size_t nVerts = v.edges.size();
+  size_t total = g.pointKeys.size() + (options.normals || options.attributes ? nVerts : 0);
   for (uint8_t n : evals) total += n;
   res.fieldEvaluations = total;
   return res;

@@ -68,13 +68,4 @@ double signedVolume(const Mesh& mesh) {
   return v / 6.0;
 }
 
-double surfaceArea(const Mesh& mesh) {
-  double s = 0;
-  for (const auto& t : mesh.triangles) {
-    glm::dvec3 a = mesh.positions[t.x], b = mesh.positions[t.y], c = mesh.positions[t.z];
-    s += 0.5 * glm::length(glm::cross(b - a, c - a));
-  }
-  return s;
-}
-
 }  // namespace sprig

@@ -43,7 +43,4 @@ MeshTopology analyzeTopology(const Mesh& mesh);
 /// Signed volume (divergence theorem); positive for a closed, outward-oriented mesh.
 double signedVolume(const Mesh& mesh);
 
-/// Total triangle area.
-double surfaceArea(const Mesh& mesh);
-
 }  // namespace sprig

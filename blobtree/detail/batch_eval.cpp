@@ -1,0 +1,246 @@
+#include "blobtree/detail/batch_eval.h"
+
+#include "blobtree/detail/traverse.h"
+
+#include <immintrin.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace sprig::blobtree::detail {
+
+namespace {
+
+constexpr int kBlock = 256;  ///< points per batch (a multiple of 8)
+
+struct Pts {
+  const float* x;
+  const float* y;
+  const float* z;
+  int n;   ///< real count
+  int n8;  ///< padded count (multiple of 8, <= kBlock)
+};
+
+/// g(s) for 4 lanes, s already clamped to [0, 1].
+template <Kernel K>
+inline __m128 kernel4(__m128 s) {
+  const __m128 one = _mm_set1_ps(1.0f);
+  if constexpr (K == Kernel::Wyvill) {
+    __m128 u = _mm_sub_ps(one, s);
+    return _mm_mul_ps(_mm_mul_ps(u, u), u);
+  } else {
+    __m128 q = _mm_sub_ps(_mm_set1_ps(17.0f / 9.0f), _mm_mul_ps(s, _mm_set1_ps(4.0f / 9.0f)));
+    q = _mm_add_ps(_mm_set1_ps(-22.0f / 9.0f), _mm_mul_ps(s, q));
+    return _mm_add_ps(one, _mm_mul_ps(s, q));
+  }
+}
+
+/// out[i] (+)= cone/segment field over the batch, 4 points per SSE step (the batch is
+/// padded to a multiple of 8).
+template <Kernel K, bool Add>
+void coneBatch(const Prim& P, const Pts& pts, float* __restrict out) {
+  const __m128 ax = _mm_set1_ps(P.a.x), ay = _mm_set1_ps(P.a.y), az = _mm_set1_ps(P.a.z);
+  const __m128 bx = _mm_set1_ps(P.ab.x), by = _mm_set1_ps(P.ab.y), bz = _mm_set1_ps(P.ab.z);
+  const __m128 il = _mm_set1_ps(P.invLen2), R0 = _mm_set1_ps(P.R0), dR = _mm_set1_ps(P.dR), w = _mm_set1_ps(P.weight);
+  const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
+  for (int i = 0; i < pts.n8; i += 4) {
+    __m128 px = _mm_sub_ps(_mm_loadu_ps(pts.x + i), ax);
+    __m128 py = _mm_sub_ps(_mm_loadu_ps(pts.y + i), ay);
+    __m128 pz = _mm_sub_ps(_mm_loadu_ps(pts.z + i), az);
+    __m128 t = _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_mul_ps(px, bx), _mm_mul_ps(py, by)), _mm_mul_ps(pz, bz)), il);
+    t = _mm_min_ps(_mm_max_ps(t, zero), one);
+    __m128 dx = _mm_sub_ps(px, _mm_mul_ps(t, bx));
+    __m128 dy = _mm_sub_ps(py, _mm_mul_ps(t, by));
+    __m128 dz = _mm_sub_ps(pz, _mm_mul_ps(t, bz));
+    __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+    __m128 R = _mm_add_ps(R0, _mm_mul_ps(dR, t));
+    __m128 s = _mm_min_ps(_mm_div_ps(d2, _mm_mul_ps(R, R)), one);
+    __m128 f = _mm_mul_ps(w, kernel4<K>(s));
+    if constexpr (Add) f = _mm_add_ps(f, _mm_loadu_ps(out + i));
+    _mm_storeu_ps(out + i, f);
+  }
+}
+
+template <Kernel K, bool Add>
+void pointBatch(const Prim& P, const Pts& pts, float* __restrict out) {
+  const __m128 ax = _mm_set1_ps(P.a.x), ay = _mm_set1_ps(P.a.y), az = _mm_set1_ps(P.a.z);
+  const __m128 iR2 = _mm_set1_ps(1.0f / (P.R0 * P.R0)), w = _mm_set1_ps(P.weight), one = _mm_set1_ps(1.0f);
+  for (int i = 0; i < pts.n8; i += 4) {
+    __m128 dx = _mm_sub_ps(_mm_loadu_ps(pts.x + i), ax);
+    __m128 dy = _mm_sub_ps(_mm_loadu_ps(pts.y + i), ay);
+    __m128 dz = _mm_sub_ps(_mm_loadu_ps(pts.z + i), az);
+    __m128 d2 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+    __m128 s = _mm_min_ps(_mm_mul_ps(d2, iR2), one);
+    __m128 f = _mm_mul_ps(w, kernel4<K>(s));
+    if constexpr (Add) f = _mm_add_ps(f, _mm_loadu_ps(out + i));
+    _mm_storeu_ps(out + i, f);
+  }
+}
+
+template <bool Add>
+void primBatch(const Prim& P, const Pts& pts, float* out) {
+  bool wy = P.kernel == Kernel::Wyvill;
+  switch (P.kind) {
+    case NodeKind::Segment:
+    case NodeKind::Cone:
+      if (wy) coneBatch<Kernel::Wyvill, Add>(P, pts, out);
+      else coneBatch<Kernel::SoftObject, Add>(P, pts, out);
+      return;
+    case NodeKind::Point:
+      if (wy) pointBatch<Kernel::Wyvill, Add>(P, pts, out);
+      else pointBatch<Kernel::SoftObject, Add>(P, pts, out);
+      return;
+    default:
+      for (int i = 0; i < pts.n; ++i) {
+        float f = primValue(P, Vec3(pts.x[i], pts.y[i], pts.z[i]), nullptr);
+        if constexpr (Add) out[i] += f;
+        else out[i] = f;
+      }
+      return;
+  }
+}
+
+void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* out) {
+  const TNode& n = T.nodes[ni];
+  if (!pbox.overlaps(n.box)) {
+    std::fill(out, out + pts.n8, 0.0f);
+    return;
+  }
+  if (isPrimitive(n.kind)) {
+    primBatch<false>(T.prims[n.prim], pts, out);
+    return;
+  }
+  alignas(32) float tmp[kBlock];
+  switch (n.kind) {
+    case NodeKind::Blend:
+      std::fill(out, out + pts.n8, 0.0f);
+      childrenIn(T, n, pbox, [&](uint32_t c) {
+        const TNode& cn = T.nodes[c];
+        if (isPrimitive(cn.kind)) {
+          primBatch<true>(T.prims[cn.prim], pts, out);
+        } else {
+          evalB(T, c, pts, pbox, tmp);
+          for (int i = 0; i < pts.n8; ++i) out[i] += tmp[i];
+        }
+      });
+      return;
+    case NodeKind::Union:
+      std::fill(out, out + pts.n8, 0.0f);
+      childrenIn(T, n, pbox, [&](uint32_t c) {
+        evalB(T, c, pts, pbox, tmp);
+        for (int i = 0; i < pts.n8; ++i) out[i] = std::max(out[i], tmp[i]);
+      });
+      return;
+    case NodeKind::Intersect:
+      std::fill(out, out + pts.n8, std::numeric_limits<float>::max());
+      for (uint32_t k = 0; k < n.count; ++k) {
+        evalB(T, T.kids[n.first + k], pts, pbox, tmp);
+        for (int i = 0; i < pts.n8; ++i) out[i] = std::min(out[i], tmp[i]);
+      }
+      for (int i = 0; i < pts.n8; ++i) out[i] = std::max(0.0f, out[i]);
+      return;
+    case NodeKind::Difference:
+      evalB(T, T.kids[n.first], pts, pbox, out);
+      evalB(T, T.kids[n.first + 1], pts, pbox, tmp);
+      for (int i = 0; i < pts.n8; ++i) out[i] = std::max(0.0f, std::min(out[i], 1.0f - tmp[i]));
+      return;
+    case NodeKind::Ricci: {
+      alignas(32) float S[kBlock];
+      std::fill(out, out + pts.n8, 0.0f);  // running max m
+      std::fill(S, S + pts.n8, 0.0f);
+      // S >= 1 once a child contributes, so a term (f/m)^n < 2^-25 cannot change it in float:
+      // f < m·2^(-25/n) skips the pow with the same bits (most points of a shell with small
+      // bumps under n = 400). Likewise S == 1 (one contributor) gives m exactly.
+      const float negligible = std::exp2(-25.0f / n.exponent);
+      childrenIn(T, n, pbox, [&](uint32_t c) {
+        evalB(T, c, pts, pbox, tmp);
+        for (int i = 0; i < pts.n; ++i) {
+          if (tmp[i] < out[i] * negligible) continue;
+          RicciAcc a{out[i], S[i]};
+          a.add(tmp[i], n.exponent);
+          out[i] = a.m;
+          S[i] = a.s;
+        }
+      });
+      for (int i = 0; i < pts.n; ++i)
+        out[i] = out[i] > 0.0f ? (S[i] == 1.0f ? out[i] : out[i] * std::pow(S[i], 1.0f / n.exponent)) : 0.0f;
+      return;
+    }
+    case NodeKind::Pcm: {
+      alignas(32) float dsum[kBlock], dmax[kBlock];
+      std::fill(out, out + pts.n8, 0.0f);
+      std::fill(dsum, dsum + pts.n8, 0.0f);
+      std::fill(dmax, dmax + pts.n8, 0.0f);
+      childrenIn(T, n, pbox, [&](uint32_t c) {
+        evalB(T, c, pts, pbox, tmp);
+        for (int i = 0; i < pts.n; ++i) {
+          float f = std::max(0.0f, tmp[i]);
+          float d = pcmD(params(T, n).pcm, f, nullptr);
+          dsum[i] += d;
+          if (f > out[i]) { out[i] = f; dmax[i] = d; }
+        }
+      });
+      for (int i = 0; i < pts.n; ++i) out[i] = out[i] > 0.0f ? std::max(0.0f, out[i] + dsum[i] - dmax[i]) : 0.0f;
+      return;
+    }
+    case NodeKind::Negative:
+      evalB(T, T.kids[n.first], pts, pbox, out);
+      for (int i = 0; i < pts.n8; ++i) out[i] *= -n.weight;
+      return;
+    case NodeKind::Bend: {
+      alignas(32) float lx[kBlock], ly[kBlock], lz[kBlock];
+      params(T, n).bend.localFromWorld(pts.x, pts.y, pts.z, lx, ly, lz, pts.n8);
+      Box3 lb;
+      for (int i = 0; i < pts.n8; ++i) lb.extend(Vec3(lx[i], ly[i], lz[i]));
+      Pts lp{lx, ly, lz, pts.n, pts.n8};
+      evalB(T, T.kids[n.first], lp, lb, out);
+      return;
+    }
+    case NodeKind::Transform:
+    case NodeKind::Twist:
+    case NodeKind::Taper: {
+      alignas(32) float lx[kBlock], ly[kBlock], lz[kBlock];
+      Box3 lb;
+      for (int i = 0; i < pts.n8; ++i) {
+        Vec3 q = warpLocal(T, n, Vec3(pts.x[i], pts.y[i], pts.z[i]), nullptr);
+        lx[i] = q.x;
+        ly[i] = q.y;
+        lz[i] = q.z;
+        lb.extend(q);
+      }
+      Pts lp{lx, ly, lz, pts.n, pts.n8};
+      evalB(T, T.kids[n.first], lp, lb, out);
+      return;
+    }
+    default: std::fill(out, out + pts.n8, 0.0f); return;
+  }
+}
+
+}  // namespace
+
+void evalBatch(const Tape& T, std::span<const Vec3> points, std::span<float> out) {
+  alignas(32) float x[kBlock], y[kBlock], z[kBlock], r[kBlock];
+  for (size_t b = 0; b < points.size(); b += kBlock) {
+    int n = int(std::min<size_t>(kBlock, points.size() - b));
+    int n8 = (n + 7) & ~7;
+    Box3 box;
+    for (int i = 0; i < n; ++i) {
+      const Vec3& p = points[b + size_t(i)];
+      x[i] = p.x;
+      y[i] = p.y;
+      z[i] = p.z;
+      box.extend(p);
+    }
+    for (int i = n; i < n8; ++i) {
+      x[i] = x[n - 1];
+      y[i] = y[n - 1];
+      z[i] = z[n - 1];
+    }
+    Pts pts{x, y, z, n, n8};
+    evalB(T, T.root, pts, box, r);
+    std::copy(r, r + n, out.begin() + long(b));
+  }
+}
+
+}  // namespace sprig::blobtree::detail

@@ -1,0 +1,172 @@
+#include "blobtree/detail/interval_eval.h"
+
+#include "blobtree/detail/traverse.h"
+
+#include <algorithm>
+#include <limits>
+
+namespace sprig::blobtree::detail {
+
+namespace {
+
+/// The child-space box covering the preimage of world box under warp node n.
+Box3 localBoxOf(const TNode& n, const Tape& T, const Box3& box) {
+  const Box3& cb = T.nodes[T.kids[n.first]].box;
+  switch (n.kind) {
+    case NodeKind::Transform: return transformBox(params(T, n).localFromWorld, box);
+    case NodeKind::Bend: return params(T, n).bend.localBox(box, cb);
+    case NodeKind::Twist: {
+      float h0, h1, r;
+      axialExtent(box, params(T, n).twist.origin, params(T, n).twist.axis, h0, h1, r);
+      return cylinderBox(params(T, n).twist.origin, params(T, n).twist.axis, h0, h1, r).intersected(cb);
+    }
+    case NodeKind::Taper: {
+      float h0, h1, r;
+      axialExtent(box, params(T, n).taper.origin, params(T, n).taper.axis, h0, h1, r);
+      float smin = std::min(taperScale(params(T, n).taper, h0), taperScale(params(T, n).taper, h1));
+      if (smin <= 0.0f) return cb;
+      return cylinderBox(params(T, n).taper.origin, params(T, n).taper.axis, h0, h1, r / smin).intersected(cb);
+    }
+    default: return box;
+  }
+}
+
+float evalLocalL(const Tape& T, uint32_t ni, const Box3& box);
+
+}  // namespace
+
+Interval evalI(const Tape& T, uint32_t ni, const Box3& box) {
+  const TNode& n = T.nodes[ni];
+  if (box.empty() || !box.overlaps(n.box)) return {0.0f, 0.0f};
+  switch (n.kind) {
+    case NodeKind::Point:
+    case NodeKind::Segment:
+    case NodeKind::Cone:
+    case NodeKind::Torus:
+    case NodeKind::Halfspace:
+    case NodeKind::Box: {
+      Interval r = primInterval(T.prims[n.prim], box);
+      if (!n.box.contains(box.lo) || !n.box.contains(box.hi)) r.lo = std::min(r.lo, 0.0f);
+      return r;
+    }
+    case NodeKind::Blend: {
+      Interval r{0.0f, 0.0f};
+      childrenIn(T, n, box, [&](uint32_t c) {
+        Interval i = evalI(T, c, box);
+        r.lo += i.lo;
+        r.hi += i.hi;
+      });
+      return r;
+    }
+    case NodeKind::Ricci: {
+      RicciAcc lo, hi;
+      childrenIn(T, n, box, [&](uint32_t c) {
+        Interval i = evalI(T, c, box);
+        lo.add(i.lo, n.exponent);
+        hi.add(i.hi, n.exponent);
+      });
+      return {lo.value(n.exponent), hi.value(n.exponent)};
+    }
+    case NodeKind::Union: {
+      Interval r{0.0f, 0.0f};
+      childrenIn(T, n, box, [&](uint32_t c) {
+        Interval i = evalI(T, c, box);
+        r.lo = std::max(r.lo, i.lo);
+        r.hi = std::max(r.hi, i.hi);
+      });
+      return r;
+    }
+    case NodeKind::Intersect: {
+      Interval r{std::numeric_limits<float>::max(), std::numeric_limits<float>::max()};
+      for (uint32_t k = 0; k < n.count; ++k) {
+        Interval i = evalI(T, T.kids[n.first + k], box);
+        r.lo = std::min(r.lo, i.lo);
+        r.hi = std::min(r.hi, i.hi);
+      }
+      return {std::max(0.0f, r.lo), std::max(0.0f, r.hi)};
+    }
+    case NodeKind::Difference: {
+      Interval a = evalI(T, T.kids[n.first], box);
+      Interval b = evalI(T, T.kids[n.first + 1], box);
+      return {std::max(0.0f, std::min(a.lo, 1.0f - b.hi)), std::max(0.0f, std::min(a.hi, 1.0f - b.lo))};
+    }
+    case NodeKind::Pcm: {
+      float maxLo = 0.0f, maxHi = 0.0f, dLo = 0.0f, dHi = 0.0f;
+      const PcmDerived& d = params(T, n).pcm;
+      childrenIn(T, n, box, [&](uint32_t c) {
+        Interval i = evalI(T, c, box);
+        float lo = std::max(0.0f, i.lo), hi = std::max(0.0f, i.hi);
+        maxLo = std::max(maxLo, lo);
+        maxHi = std::max(maxHi, hi);
+        dLo += std::min(0.0f, d.c - hi);
+        if (hi > d.c - d.w && lo < d.c) dHi += d.a0;
+      });
+      return {std::max(0.0f, maxLo + dLo), std::max(0.0f, maxHi + dHi)};
+    }
+    case NodeKind::Negative: {
+      Interval i = evalI(T, T.kids[n.first], box);
+      return {-n.weight * i.hi, -n.weight * i.lo};
+    }
+    case NodeKind::Transform:
+    case NodeKind::Bend:
+    case NodeKind::Twist:
+    case NodeKind::Taper: return evalI(T, T.kids[n.first], localBoxOf(n, T, box));
+  }
+  return {0.0f, 0.0f};
+}
+
+/// Local Lipschitz bound, never above the node's global bound (both are sound).
+float evalL(const Tape& T, uint32_t ni, const Box3& box) {
+  return std::min(evalLocalL(T, ni, box), T.nodes[ni].lip);
+}
+
+namespace {
+
+float evalLocalL(const Tape& T, uint32_t ni, const Box3& box) {
+  const TNode& n = T.nodes[ni];
+  if (box.empty() || !box.overlaps(n.box)) return 0.0f;
+  switch (n.kind) {
+    case NodeKind::Point:
+    case NodeKind::Segment:
+    case NodeKind::Cone:
+    case NodeKind::Torus:
+    case NodeKind::Halfspace:
+    case NodeKind::Box: return n.lip;
+    case NodeKind::Blend:
+    case NodeKind::Ricci:
+    case NodeKind::Pcm: {
+      float s = 0.0f;
+      childrenIn(T, n, box, [&](uint32_t c) { s += evalL(T, c, box); });
+      return n.kind == NodeKind::Pcm ? s * (1.0f + params(T, n).pcm.maxSlope) : s;
+    }
+    case NodeKind::Union:
+    case NodeKind::Intersect:
+    case NodeKind::Difference: {
+      float m = 0.0f;
+      for (uint32_t k = 0; k < n.count; ++k) m = std::max(m, evalL(T, T.kids[n.first + k], box));
+      return m;
+    }
+    case NodeKind::Negative: return n.weight * evalL(T, T.kids[n.first], box);
+    case NodeKind::Transform: return params(T, n).jNorm * evalL(T, T.kids[n.first], transformBox(params(T, n).localFromWorld, box));
+    case NodeKind::Bend:
+      return params(T, n).bend.jacobianBound(box) * evalL(T, T.kids[n.first], params(T, n).bend.localBox(box, T.nodes[T.kids[n.first]].box));
+    case NodeKind::Twist: {
+      float h0, h1, r;
+      axialExtent(box, params(T, n).twist.origin, params(T, n).twist.axis, h0, h1, r);
+      return (1.0f + std::abs(params(T, n).twist.rateRadPerUnit) * r) * evalL(T, T.kids[n.first], localBoxOf(n, T, box));
+    }
+    case NodeKind::Taper: {
+      float h0, h1, r;
+      axialExtent(box, params(T, n).taper.origin, params(T, n).taper.axis, h0, h1, r);
+      float smin = std::min(taperScale(params(T, n).taper, h0), taperScale(params(T, n).taper, h1));
+      if (smin <= 0.0f) return n.lip;
+      float ds = std::abs(params(T, n).taper.scale1 - params(T, n).taper.scale0) / params(T, n).taper.length;
+      return (1.0f / smin + 1.0f + ds * r / (smin * smin)) * evalL(T, T.kids[n.first], localBoxOf(n, T, box));
+    }
+  }
+  return n.lip;
+}
+
+}  // namespace
+
+}  // namespace sprig::blobtree::detail

@@ -1,0 +1,173 @@
+#include "blobtree/detail/primitive.h"
+
+#include "blobtree/detail/geometry.h"
+
+#include <cassert>
+
+namespace sprig::blobtree::detail {
+
+namespace {
+
+Box3 sphereBox(Vec3 c, float r) { return Box3{c - r, c + r}; }
+
+}  // namespace
+
+Prim makePrim(const Node& n, Kernel kernel) {
+  Prim P;
+  P.kind = n.kind;
+  P.kernel = kernel;
+  P.weight = n.weight;
+  P.tex = n.texture;
+  float slope = kernelSlope(kernel) * std::abs(n.weight);
+  switch (n.kind) {
+    case NodeKind::Point: {
+      P.a = n.p0;
+      P.R0 = supportRadius(kernel, n.ra);
+      P.box = sphereBox(P.a, P.R0);
+      P.lipschitz = slope / P.R0;
+      P.isoRadiusMin = n.ra;
+      P.axis = Vec3(0, 1, 0);
+      P.e1 = perpendicular(P.axis, n.texture.refDir);
+      P.e2 = glm::cross(P.axis, P.e1);
+      break;
+    }
+    case NodeKind::Segment:
+    case NodeKind::Cone: {
+      P.a = n.p0;
+      P.ab = n.p1 - n.p0;
+      P.len = glm::length(P.ab);
+      P.invLen2 = 1.0f / (P.len * P.len);
+      float rb = n.kind == NodeKind::Segment ? n.ra : n.rb;
+      P.R0 = supportRadius(kernel, n.ra);
+      float R1 = supportRadius(kernel, rb);
+      P.dR = R1 - P.R0;
+      P.box = sphereBox(n.p0, P.R0);
+      P.box.extend(sphereBox(n.p1, R1));
+      float m = P.dR / P.len;
+      P.lipschitz = slope * std::sqrt(1.0f + m * m) / std::min(P.R0, R1);
+      P.isoRadiusMin = std::min(n.ra, rb);
+      P.axis = P.ab / P.len;
+      P.e1 = perpendicular(P.axis, n.texture.refDir);
+      P.e2 = glm::cross(P.axis, P.e1);
+      break;
+    }
+    case NodeKind::Torus: {
+      P.a = n.p0;
+      P.axis = glm::normalize(n.p1);
+      P.major = n.ra;
+      P.R0 = supportRadius(kernel, n.rb);
+      P.box = cylinderBox(P.a, P.axis, -P.R0, P.R0, P.major + P.R0);
+      P.lipschitz = slope / P.R0;
+      P.isoRadiusMin = n.rb;
+      P.e1 = perpendicular(P.axis, n.texture.refDir);
+      P.e2 = glm::cross(P.axis, P.e1);
+      break;
+    }
+    case NodeKind::Halfspace:
+      P.a = n.p0;
+      P.axis = glm::normalize(n.p1);
+      P.invRamp = 1.0f / n.ra;
+      P.box = hugeBox();
+      P.lipschitz = P.invRamp * std::abs(n.weight);
+      P.hasAttributes = false;
+      break;
+    case NodeKind::Box:
+      P.lo = n.p0;
+      P.hi = n.p1;
+      P.invRamp = 1.0f / n.ra;
+      P.box = Box3{n.p0 - 0.5f * n.ra, n.p1 + 0.5f * n.ra};
+      P.lipschitz = P.invRamp * std::abs(n.weight);
+      P.hasAttributes = false;
+      break;
+    default: assert(false);
+  }
+  return P;
+}
+
+Vec2 primUv(const Prim& P, Vec3 p) {
+  Vec2 uv{0.0f};
+  switch (P.kind) {
+    case NodeKind::Point: {
+      Vec3 q = p - P.a;
+      float l = glm::length(q);
+      uv.x = std::atan2(glm::dot(q, P.e2), glm::dot(q, P.e1)) / kTwoPi + 0.5f;
+      uv.y = l > 0.0f ? std::acos(std::clamp(glm::dot(q, P.axis) / l, -1.0f, 1.0f)) / float(kPi) : 0.5f;
+      break;
+    }
+    case NodeKind::Segment:
+    case NodeKind::Cone: {
+      Vec3 ap = p - P.a;
+      float t = std::clamp(glm::dot(ap, P.ab) * P.invLen2, 0.0f, 1.0f);
+      Vec3 dv = ap - t * P.ab;
+      uv.x = std::atan2(glm::dot(dv, P.e2), glm::dot(dv, P.e1)) / kTwoPi + 0.5f;
+      uv.y = t * P.len + P.tex.vOffset;
+      break;
+    }
+    case NodeKind::Torus: {
+      Vec3 q = p - P.a;
+      float h = glm::dot(q, P.axis);
+      Vec3 perp = q - h * P.axis;
+      uv.x = std::atan2(glm::dot(perp, P.e2), glm::dot(perp, P.e1)) / kTwoPi + 0.5f;
+      uv.y = std::atan2(h, glm::length(perp) - P.major) / kTwoPi + 0.5f;
+      break;
+    }
+    default: break;
+  }
+  return uv * P.tex.uvScale + P.tex.uvOffset;
+}
+
+Interval primInterval(const Prim& P, const Box3& box) {
+  Vec3 c = box.center();
+  Vec3 h = 0.5f * box.size();
+  float hd = glm::length(h);
+  auto fromDistances = [&](float dmin, float dmax, float Rmin, float Rmax) {
+    float smin = dmin * dmin / (Rmax * Rmax), smax = dmax * dmax / (Rmin * Rmin);
+    float fhi = smin >= 1.0f ? 0.0f : kernelG(P.kernel, smin);
+    float flo = smax >= 1.0f ? 0.0f : kernelG(P.kernel, smax);
+    Interval r{flo * P.weight, fhi * P.weight};
+    if (P.weight < 0.0f) std::swap(r.lo, r.hi);
+    return r;
+  };
+  auto ramp = [&](float sdlo, float sdhi) {
+    Interval r{std::clamp(0.5f - sdhi * P.invRamp, 0.0f, 1.0f) * P.weight,
+               std::clamp(0.5f - sdlo * P.invRamp, 0.0f, 1.0f) * P.weight};
+    if (P.weight < 0.0f) std::swap(r.lo, r.hi);
+    return r;
+  };
+  switch (P.kind) {
+    case NodeKind::Point: {
+      Vec3 q = glm::clamp(P.a, box.lo, box.hi);
+      float dmin = glm::length(q - P.a);
+      float dmax = glm::length(glm::max(glm::abs(P.a - box.lo), glm::abs(P.a - box.hi)));
+      return fromDistances(dmin, dmax, P.R0, P.R0);
+    }
+    case NodeKind::Segment:
+    case NodeKind::Cone: {
+      float dc = distToSegment(c, P.a, P.ab, P.invLen2);
+      float tc = glm::dot(c - P.a, P.ab) * P.invLen2;
+      float te = glm::dot(h, glm::abs(P.ab)) * P.invLen2;
+      float t0 = std::clamp(tc - te, 0.0f, 1.0f), t1 = std::clamp(tc + te, 0.0f, 1.0f);
+      float Ra = P.R0 + P.dR * t0, Rb = P.R0 + P.dR * t1;
+      return fromDistances(std::max(0.0f, dc - hd), dc + hd, std::min(Ra, Rb), std::max(Ra, Rb));
+    }
+    case NodeKind::Torus: {
+      Vec3 q = c - P.a;
+      float hh = glm::dot(q, P.axis);
+      float rho = glm::length(q - hh * P.axis);
+      float dc = std::sqrt((rho - P.major) * (rho - P.major) + hh * hh);
+      return fromDistances(std::max(0.0f, dc - hd), dc + hd, P.R0, P.R0);
+    }
+    case NodeKind::Halfspace: {
+      float sd = glm::dot(c - P.a, P.axis);
+      float e = glm::dot(h, glm::abs(P.axis));
+      return ramp(sd - e, sd + e);
+    }
+    case NodeKind::Box: {
+      float sd = sdBox(c, P.lo, P.hi, nullptr);
+      return ramp(sd - hd, sd + hd);
+    }
+    default: return {};
+  }
+}
+
+}  // namespace sprig::blobtree::detail

@@ -1,0 +1,98 @@
+// CompiledBlob::surfaceCells (declared in blobtree/compiled.h): the sparse octree search for
+// the grid cells whose interval bound may hold the surface.
+
+#include "blobtree/compiled.h"
+#include "blobtree/detail/interval_eval.h"
+#include "blobtree/detail/tape.h"
+#include "blobtree/detail/traverse.h"
+#include "core/parallel.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace sprig::blobtree {
+
+using namespace detail;
+
+CellSet CompiledBlob::surfaceCells(float cellSize, const SurfaceCellOptions& options) const {
+  if (!(cellSize > 0.0f)) throw std::invalid_argument("surfaceCells: cellSize must be positive");
+  CellSet out;
+  if (tape_->empty) return out;
+  Box3 rb = bounds();
+  if (rb.empty()) return out;
+  if (isHuge(rb)) throw std::invalid_argument("surfaceCells: the model is unbounded (a bare cutter)");
+  float E = std::max(rb.size().x, std::max(rb.size().y, rb.size().z)) * 1.0001f + 1e-20f;
+  int depth = std::max(0, int(std::ceil(std::log2(E / cellSize))));
+  if (depth > 20) throw std::invalid_argument("surfaceCells: cellSize too small for the model");
+  if (options.exactCellSize) E = cellSize * float(1 << depth);
+  float edge = E / float(1 << depth);
+  out.origin = rb.center() - Vec3(0.5f * E);
+  out.cellSize = edge;
+  const Tape& T = *tape_;
+
+  struct Item {
+    std::array<int32_t, 3> idx;
+    int level;
+  };
+  auto boxOf = [&](const Item& it) {
+    float e = E / float(1 << it.level);
+    Vec3 lo = out.origin + Vec3(float(it.idx[0]), float(it.idx[1]), float(it.idx[2])) * e;
+    return Box3{lo, lo + Vec3(e)};
+  };
+  // Top levels sequentially, so each subtree below is an independent task.
+  int split = std::min(depth, 3);
+  std::vector<Item> frontier{{{0, 0, 0}, 0}};
+  for (int l = 0; l < split; ++l) {
+    std::vector<Item> next;
+    for (const Item& it : frontier) {
+      if (!valueBounds(boxOf(it)).contains(kIso)) continue;
+      for (int c = 0; c < 8; ++c)
+        next.push_back({{it.idx[0] * 2 + (c & 1), it.idx[1] * 2 + ((c >> 1) & 1), it.idx[2] * 2 + ((c >> 2) & 1)}, l + 1});
+    }
+    frontier = std::move(next);
+  }
+  std::vector<std::vector<Cell>> cellsOf(frontier.size());
+  std::vector<std::vector<uint32_t>> primsOf(frontier.size());
+  parallelFor(0, frontier.size(), [&](size_t k) {
+    std::vector<Item> stack{frontier[k]};
+    auto& cells = cellsOf[k];
+    auto& prims = primsOf[k];
+    while (!stack.empty()) {
+      Item it = stack.back();
+      stack.pop_back();
+      Box3 b = boxOf(it);
+      Interval iv = valueBounds(b);
+      if (!iv.contains(kIso)) continue;
+      if (it.level < depth) {
+        for (int c = 7; c >= 0; --c)
+          stack.push_back({{it.idx[0] * 2 + (c & 1), it.idx[1] * 2 + ((c >> 1) & 1), it.idx[2] * 2 + ((c >> 2) & 1)},
+                           it.level + 1});
+        continue;
+      }
+      Cell cell;
+      cell.box = b;
+      cell.index = it.idx;
+      cell.bounds = iv;
+      if (options.lipschitz) cell.lipschitz = evalL(T, T.root, b);
+      cell.firstPrimitive = uint32_t(prims.size());
+      if (options.primitiveLists && T.instBvh >= 0)
+        walkBvh(T, T.instBvh, [&](const Box3& bb) { return bb.overlaps(b); }, [&](uint32_t i) {
+          if (T.instBox[i].overlaps(b)) prims.push_back(i);
+        });
+      cell.primitiveCount = uint32_t(prims.size()) - cell.firstPrimitive;
+      cells.push_back(cell);
+    }
+  }, 1);
+  for (size_t k = 0; k < frontier.size(); ++k) {
+    uint32_t base = uint32_t(out.primitives.size());
+    for (Cell c : cellsOf[k]) {
+      c.firstPrimitive += base;
+      out.cells.push_back(c);
+    }
+    out.primitives.insert(out.primitives.end(), primsOf[k].begin(), primsOf[k].end());
+  }
+  return out;
+}
+
+}  // namespace sprig::blobtree
