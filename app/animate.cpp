@@ -1,6 +1,5 @@
 #include "app/animate.h"
 
-#include <OpenImageIO/imageio.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -17,6 +16,7 @@
 #include "app/preview.h"
 #include "core/atomic_file.h"
 #include "core/diagnostics.h"
+#include "core/paths.h"
 #include "core/progress.h"
 #include "lsystem/turtle.h"
 #include "render/camera.h"
@@ -103,7 +103,7 @@ lsystem::Skeleton GrowthSequence::skeletonAt(int stage, double fraction) {
   return lsystem::Turtle(deriver_->symbols(), ts).run(interpreted_, interpreted_.birthSteps);
 }
 
-render::Image renderGrowthFrame(GrowthSequence& seq, const SpeciesRender& look, const GrowthFrame& frame, int width,
+Image renderGrowthFrame(GrowthSequence& seq, const SpeciesRender& look, const GrowthFrame& frame, int width,
                                 int height) {
   lsystem::Skeleton sk = seq.skeletonAt(frame.stage, frame.fraction);
   render::Scene scene;
@@ -118,38 +118,12 @@ render::Image renderGrowthFrame(GrowthSequence& seq, const SpeciesRender& look, 
 }
 
 AnimationFormat animationFormatFor(const fs::path& out) {
-  std::string ext = out.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = lowerExtension(out);
   if (ext.empty() || fs::is_directory(out)) return AnimationFormat::Frames;
   if (ext == ".gif") return AnimationFormat::Gif;
   if (ext == ".mp4") return AnimationFormat::Mp4;
   throw std::invalid_argument("-o " + out.string() + ": unknown animation extension '" + ext +
                               "' (use a folder for PNG frames, .gif or .mp4)");
-}
-
-void writeAnimatedGif(const std::vector<render::Image>& frames, double fps, const fs::path& out) {
-  if (frames.empty()) throw std::runtime_error(out.string() + ": no frames to write");
-  TempPath tmp(out);
-  {
-    auto writer = OIIO::ImageOutput::create(tmp.path().string());
-    if (!writer) throw std::runtime_error(out.string() + ": cannot write GIF: " + OIIO::geterror());
-    OIIO::ImageSpec spec(frames.front().width, frames.front().height, 3, OIIO::TypeDesc::UINT8);
-    // GIF frame delays are centiseconds: FramesPerSecond as the rational 100 / delay.
-    const int delayCs = std::max(1, static_cast<int>(std::lround(100.0 / std::max(fps, 0.01))));
-    const int rate[2] = {100, delayCs};
-    spec.attribute("FramesPerSecond", OIIO::TypeRational, rate);
-    spec.attribute("oiio:LoopCount", 0);
-    for (size_t i = 0; i < frames.size(); ++i) {
-      const auto mode = i == 0 ? OIIO::ImageOutput::Create : OIIO::ImageOutput::AppendSubimage;
-      if (!writer->open(tmp.path().string(), spec, mode))
-        throw std::runtime_error(out.string() + ": cannot write GIF: " + writer->geterror());
-      std::vector<uint8_t> bytes = toSrgb8(frames[i], 3);
-      if (!writer->write_image(OIIO::TypeDesc::UINT8, bytes.data()))
-        throw std::runtime_error(out.string() + ": cannot write GIF frame: " + writer->geterror());
-    }
-    if (!writer->close()) throw std::runtime_error(out.string() + ": cannot write GIF: " + writer->geterror());
-  }
-  tmp.commit();
 }
 
 SkeletonFigures skeletonFigures(const lsystem::Skeleton& skeleton) {
@@ -171,7 +145,7 @@ int renderGalleryAnimation(const Species& species, const fs::path& out, const Sp
     // A blob does not grow: a turntable around it instead, one camera distance throughout.
     SpeciesModel model(shown);
     const int n = final ? 48 : 8;
-    std::vector<render::Image> frames;
+    std::vector<Image> frames;
     Progress bar("turntable " + species.name, static_cast<size_t>(n));
     for (int i = 0; i < n; ++i) {
       SpeciesRender turn = look;
@@ -303,7 +277,7 @@ AnimateResult animateSpecies(const Species& species, const fs::path& out, const 
     frameFolder = mp4Frames->path();
   }
 
-  std::vector<render::Image> gifFrames;
+  std::vector<Image> gifFrames;
   {
     std::optional<Progress> bar;
     if (!options.progressLabel.empty()) bar.emplace(options.progressLabel, frames.size());
@@ -315,11 +289,11 @@ AnimateResult animateSpecies(const Species& species, const fs::path& out, const 
       job.mode = mode;
       job.stage = frames[i];
       job.progress = false;
-      render::Image img = renderModel(model, look, job);
+      Image img = renderModel(model, look, job);
       if (format == AnimationFormat::Gif)
         gifFrames.push_back(std::move(img));
       else
-        render::writeImage(img, frameFolder / frameName(i));
+        writeImage(img, frameFolder / frameName(i));
       if (bar) bar->advance();
     }
     if (bar) bar->finish();

@@ -19,9 +19,9 @@
 
 #include "app/model.h"
 #include "app/species.h"
+#include "core/image.h"
 #include "lsystem/derive.h"
 #include "lsystem/skeleton.h"
-#include "render/image.h"
 
 namespace sprig {
 
@@ -76,7 +76,7 @@ class GrowthSequence {
 
 /// Renders frame (stage, fraction) of seq with the species' look, the camera framed on
 /// seq.frameBox(); no progress bar. Used by `sprig animate` and the gallery for every frame.
-render::Image renderGrowthFrame(GrowthSequence& seq, const SpeciesRender& look, const GrowthFrame& frame, int width,
+Image renderGrowthFrame(GrowthSequence& seq, const SpeciesRender& look, const GrowthFrame& frame, int width,
                                 int height);
 
 /// What `sprig animate` writes.
@@ -117,10 +117,6 @@ struct AnimateResult {
 /// place only when complete. MP4 needs the `ffmpeg` command. Throws InputError for bad
 /// species or a missing ffmpeg, std::invalid_argument for bad options, Cancelled on a signal.
 AnimateResult animateSpecies(const Species& species, const std::filesystem::path& out, const AnimateOptions& options);
-
-/// Writes frames as an animated GIF (looping forever) at fps, atomically.
-/// Throws std::runtime_error when OpenImageIO cannot write it.
-void writeAnimatedGif(const std::vector<render::Image>& frames, double fps, const std::filesystem::path& out);
 
 /// Counts shown in the gallery for a skeleton.
 struct SkeletonFigures {

@@ -7,7 +7,7 @@
 #include "app/preview.h"
 #include "app/species.h"
 #include "app/tree_pipeline.h"
-#include "render/image.h"
+#include "core/image.h"
 
 namespace sprig {
 
@@ -43,8 +43,8 @@ int runPreview(const PreviewArgs& a, const GlobalOptions& g) {
   if (a.stage >= 0) opt.stageSteps = {a.stage};
   GrownTree t = growTree(species, opt);
   const lsystem::Skeleton& shown = a.stage >= 0 ? t.stages[0].skeleton : t.skeleton;
-  render::Image image = renderSkeletonImage(shown, look, framingBox(t.skeleton), width, height, "render " + species.name);
-  render::writeImage(image, a.out);
+  Image image = renderSkeletonImage(shown, look, framingBox(t.skeleton), width, height, "render " + species.name);
+  writeImage(image, a.out);
   if (!g.quiet)
     std::cerr << a.out << ": " << width << "x" << height << ", " << shown.internodes.size() << " internodes\n";
   return kExitOk;

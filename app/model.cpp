@@ -13,15 +13,12 @@
 #include "app/species_tree.h"
 #include "blobtree/compiled.h"
 #include "blobtree/polygonize.h"
+#include "core/timer.h"
 #include "render/camera.h"
 
 namespace sprig {
 
 namespace {
-
-double secondsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 /// Where errors about the species as a whole point: its `kind:` value, else its first line.
 SourceLoc speciesLoc(const Species& s) {
@@ -339,7 +336,7 @@ render::Camera modelCamera(const SpeciesRender& look, const Box3& box, int width
   return cam;
 }
 
-render::Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job, ModelFigures* figures,
+Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job, ModelFigures* figures,
                           render::RenderStats* stats) {
   int width = job.width > 0 ? job.width : look.width;
   int height = job.height > 0 ? job.height : look.height;
@@ -356,7 +353,7 @@ render::Image renderModel(SpeciesModel& model, const SpeciesRender& look, const 
   if (job.samples > 0) rs.spp = job.samples;
   rs.progress = job.progress;
   rs.progressLabel = job.progressLabel;
-  render::Image image = render::renderImage(scene, modelCamera(look, frame, width, height), rs, stats);
+  Image image = render::renderImage(scene, modelCamera(look, frame, width, height), rs, stats);
   if (figures) *figures = fig;
   return image;
 }

@@ -21,9 +21,9 @@
 #include <vector>
 
 #include "app/species.h"
+#include "core/image.h"
 #include "core/mesh.h"
 #include "lsystem/grammar.h"
-#include "render/image.h"
 #include "render/renderer.h"
 #include "render/scene.h"
 
@@ -125,7 +125,7 @@ struct RenderJob {
 
 /// Renders one stage of model with look (camera framed on model.frameBox(), or the species'
 /// explicit camera). Fills figures and stats when given.
-render::Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job,
+Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job,
                           ModelFigures* figures = nullptr, render::RenderStats* stats = nullptr);
 
 /// The camera for an image of width x height of a model framed on box with look.

@@ -12,7 +12,7 @@ DBox3 framingBox(const lsystem::Skeleton& skeleton) {
   return b;
 }
 
-render::Image renderSkeletonImage(const lsystem::Skeleton& skeleton, const SpeciesRender& look, const DBox3& frameBox,
+Image renderSkeletonImage(const lsystem::Skeleton& skeleton, const SpeciesRender& look, const DBox3& frameBox,
                                   int width, int height, const std::string& label) {
   render::Scene scene;
   scene.addSkeleton(skeleton, look.style);
@@ -24,12 +24,12 @@ render::Image renderSkeletonImage(const lsystem::Skeleton& skeleton, const Speci
   return render::renderImage(scene, camera, rs);
 }
 
-render::Image renderGrowthStrip(const std::vector<const lsystem::Skeleton*>& stages, const SpeciesRender& look,
+Image renderGrowthStrip(const std::vector<const lsystem::Skeleton*>& stages, const SpeciesRender& look,
                                 const DBox3& frameBox, int cellWidth, int height, const std::string& label) {
   const int count = static_cast<int>(stages.size());
-  render::Image strip(cellWidth * std::max(count, 1), height);
+  Image strip(cellWidth * std::max(count, 1), height);
   for (int i = 0; i < count; ++i) {
-    render::Image cell = renderSkeletonImage(*stages[i], look, frameBox, cellWidth, height,
+    Image cell = renderSkeletonImage(*stages[i], look, frameBox, cellWidth, height,
                                              label + " " + std::to_string(i + 1) + "/" + std::to_string(count));
     for (int y = 0; y < height; ++y)
       for (int x = 0; x < cellWidth; ++x) strip.set(i * cellWidth + x, y, cell.at(x, y));

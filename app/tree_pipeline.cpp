@@ -3,14 +3,11 @@
 #include <algorithm>
 
 #include "core/progress.h"
+#include "core/timer.h"
 
 namespace sprig {
 
 namespace {
-
-double secondsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 }  // namespace
 

@@ -17,11 +17,6 @@
 
 namespace sprig::textures {
 
-/// Linear value from an sRGB-encoded value in [0, 1] (IEC 61966-2-1).
-double srgbToLinear(double c);
-/// sRGB-encoded value in [0, 1] from a linear value (clamped to [0, 1] first).
-double linearToSrgb(double c);
-
 /// Two-color noise: mix(colorA, colorB, t) with t = fbm (mapped to [0, 1]) or turbulence
 /// of the 3D point scale * p.
 struct NoiseColorOptions {

@@ -185,7 +185,7 @@ TEST_CASE("animateSpecies", "[app]") {
       char name[32];
       std::snprintf(name, sizeof name, "frame_%05zu.png", i);
       REQUIRE(fs::is_regular_file(tmp.path / "frames" / name));
-      render::writeImage(renderGrowthFrame(seq, s.render, frames[i], s.render.width, s.render.height),
+      writeImage(renderGrowthFrame(seq, s.render, frames[i], s.render.width, s.render.height),
                          tmp.path / "single.png");
       CHECK(readFile(tmp.path / "frames" / name) == readFile(tmp.path / "single.png"));
     }

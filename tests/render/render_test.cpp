@@ -5,25 +5,20 @@
 #include <fstream>
 #include <iterator>
 
-#include <OpenImageIO/imageio.h>
-
+#include "core/image.h"
 #include "render/camera.h"
-#include "render/image.h"
 #include "render/renderer.h"
 #include "render/scene.h"
+#include "tests/render/test_scenes.h"
+#include "tests/scratch_dir.h"
 
 using namespace sprig;
 using namespace sprig::render;
+using namespace sprig::render::test;
+using sprig::test::scratchDir;
 namespace fs = std::filesystem;
 
 namespace {
-
-fs::path scratchDir(const std::string& name) {
-  fs::path dir = fs::temp_directory_path() / ("sprig-render-test-" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
 
 std::string slurp(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
@@ -48,11 +43,7 @@ lsystem::Skeleton smallTree() {
   lsystem::Organ leaf;
   leaf.points = {{0.6, 1.6, 0}, {0.9, 1.7, 0.1}, {0.8, 2.0, 0}};
   s.organs.push_back(leaf);
-  lsystem::Organ fruit;
-  fruit.kind = lsystem::Organ::Kind::Sphere;
-  fruit.position = {0, 2.1, 0};
-  fruit.radius = 0.1;
-  s.organs.push_back(fruit);
+  s.organs.push_back(sphereOrgan({0, 2.1, 0}, 0.1));
   return s;
 }
 
@@ -140,24 +131,13 @@ TEST_CASE("render::sphere silhouette", "[render]") {
   // A sphere organ of radius R at distance D from the camera, on the optical axis,
   // projects to a disc of radius (H/2) tan(asin(R/D)) / tan(fov/2) pixels.
   lsystem::Skeleton s;
-  lsystem::Organ ball;
-  ball.kind = lsystem::Organ::Kind::Sphere;
-  ball.radius = 1.0;
-  s.organs.push_back(ball);
+  s.organs.push_back(sphereOrgan({0, 0, 0}, 1.0));
   Scene scene;
   scene.addSkeleton(s);
   scene.commit();
   Camera cam = orbitCamera(Vec3(0), 20, 10, 6.0, 30.0);
-  RenderSettings rs;
-  rs.width = rs.height = 200;
-  rs.spp = 16;
-  rs.background = Background::Transparent;
-  rs.ground = false;
-  rs.progress = false;
-  Image img = renderImage(scene, cam, rs);
-  double area = 0;
-  for (int y = 0; y < img.height; ++y)
-    for (int x = 0; x < img.width; ++x) area += img.at(x, y).a;
+  Image img = renderImage(scene, cam, silhouetteSettings(200, 200, 16));
+  double area = alphaArea(img);
   double expected = 100.0 * std::tan(std::asin(1.0 / 6.0)) / std::tan(radians(15.0));
   CHECK(std::sqrt(area / kPi) == Approx(expected).margin(0.25));
   CHECK(img.at(100, 100).a == 1.0f);
@@ -188,7 +168,7 @@ TEST_CASE("render::determinism", "[render]") {
   CHECK(stats.skyRays > 0);
   CHECK(stats.raysPerSecond() > 0);
 
-  fs::path dir = scratchDir("determinism");
+  fs::path dir = scratchDir("render-determinism");
   writeImage(a, dir / "a.png");
   writeImage(c, dir / "c.png");
   CHECK(slurp(dir / "a.png") == slurp(dir / "c.png"));
@@ -196,62 +176,10 @@ TEST_CASE("render::determinism", "[render]") {
   fs::remove_all(dir);
 }
 
-TEST_CASE("writeImage", "[render]") {
-  Image img(8, 4, Vec4(0.5f, 0.25f, 1.0f, 1.0f));
-  fs::path dir = scratchDir("write");
-  SECTION("formats by extension") {
-    writeImage(img, dir / "x.png");
-    writeImage(img, dir / "x.JPG");
-    writeImage(img, dir / "x.exr");
-    CHECK(fs::file_size(dir / "x.png") > 0);
-    CHECK(fs::file_size(dir / "x.JPG") > 0);
-    CHECK(fs::file_size(dir / "x.exr") > 0);
-    // Only the three images: no temporaries left behind.
-    CHECK(std::distance(fs::directory_iterator(dir), fs::directory_iterator()) == 3);
-  }
-  SECTION("EXR keeps linear values") {
-    writeImage(img, dir / "lin.exr");
-    auto in = OIIO::ImageInput::open((dir / "lin.exr").string());
-    REQUIRE(in);
-    CHECK(in->spec().width == 8);
-    CHECK(in->spec().nchannels == 4);
-    std::vector<float> px(8 * 4 * 4);
-    REQUIRE(in->read_image(0, 0, 0, 4, OIIO::TypeDesc::FLOAT, px.data()));
-    in->close();
-    CHECK(px[0] == 0.5f);
-    CHECK(px[1] == 0.25f);
-    CHECK(px[2] == 1.0f);
-    CHECK(px[3] == 1.0f);
-  }
-  SECTION("sRGB encoding") {
-    auto bytes = toSrgb8(img, 4);
-    REQUIRE(bytes.size() == 8 * 4 * 4);
-    CHECK(bytes[0] == 188);  // 0.5 linear -> 0.7354 sRGB
-    CHECK(bytes[1] == 137);  // 0.25 -> 0.5371
-    CHECK(bytes[2] == 255);
-    CHECK(bytes[3] == 255);
-  }
-  SECTION("unknown extension fails and writes nothing") {
-    CHECK_THROWS_AS(writeImage(img, dir / "x.bmpx"), std::invalid_argument);
-    CHECK_THROWS_WITH(writeImage(img, dir / "x.tga"), Catch::Contains("unknown extension '.tga'"));
-    CHECK(fs::is_empty(dir));
-  }
-  SECTION("missing folder fails and writes nothing") {
-    CHECK_THROWS_AS(writeImage(img, dir / "nope" / "x.png"), std::runtime_error);
-    CHECK(fs::is_empty(dir));
-    CHECK_FALSE(fs::exists(dir / "nope"));
-  }
-  fs::remove_all(dir);
-}
-
 TEST_CASE("render::shadows", "[render]") {
   // A sphere floating above the ground with the sun overhead shades the ground below it.
   lsystem::Skeleton s;
-  lsystem::Organ ball;
-  ball.kind = lsystem::Organ::Kind::Sphere;
-  ball.position = {0, 2, 0};
-  ball.radius = 1.0;
-  s.organs.push_back(ball);
+  s.organs.push_back(sphereOrgan({0, 2, 0}, 1.0));
   Scene scene;
   scene.addSkeleton(s);
   scene.commit();
