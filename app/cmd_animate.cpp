@@ -8,7 +8,7 @@
 #include "app/cmd_common.h"
 #include "model/model.h"
 #include "model/species.h"
-#include "render/image.h"
+#include "core/image.h"
 
 namespace sprig {
 
@@ -102,7 +102,7 @@ int runAnimate(const AnimateArgs& a, const GlobalOptions& g) {
     job.stage = model.stageFromIndex(single->stage);
     job.stage.fraction = single->fraction;
     job.progress = false;
-    render::writeImage(renderModel(model, frameLook, job), a.out);
+    writeImage(renderModel(model, frameLook, job), a.out);
     if (!g.quiet) std::cerr << a.out << ": " << model.stageName(job.stage) << "\n";
     return kExitOk;
   }

@@ -9,11 +9,12 @@
 #include <cmath>
 #include <filesystem>
 
+#include "core/paths.h"
+
 namespace sprig {
 
 void requireExtension(const std::string& flag, const std::string& path, std::initializer_list<const char*> allowed) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  const std::string ext = lowerExtension(path);
   std::string list;
   for (const char* a : allowed) {
     if (ext == a) return;

@@ -9,7 +9,7 @@
 #include "model/tree_kind.h"
 #include "render/camera.h"
 #include "render/scene.h"
-#include "render/image.h"
+#include "core/image.h"
 
 namespace sprig {
 
@@ -55,8 +55,8 @@ int runPreview(const PreviewArgs& a, const GlobalOptions& g) {
                                                     static_cast<double>(width) / height);
   render::RenderSettings rs = look.settings(width, height);
   rs.progressLabel = "render " + species.name;
-  render::Image image = render::renderImage(scene, camera, rs);
-  render::writeImage(image, a.out);
+  Image image = render::renderImage(scene, camera, rs);
+  writeImage(image, a.out);
   if (!g.quiet)
     std::cerr << a.out << ": " << width << "x" << height << ", " << shown.internodes.size() << " internodes\n";
   return kExitOk;

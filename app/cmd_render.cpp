@@ -8,7 +8,7 @@
 #include "app/cmd_common.h"
 #include "model/model.h"
 #include "model/species.h"
-#include "render/image.h"
+#include "core/image.h"
 
 namespace sprig {
 
@@ -75,8 +75,8 @@ int runRender(const RenderArgs& a, const GlobalOptions& g) {
 
   ModelFigures fig;
   render::RenderStats stats;
-  render::Image image = renderModel(model, look, job, &fig, &stats);
-  render::writeImage(image, a.out);
+  Image image = renderModel(model, look, job, &fig, &stats);
+  writeImage(image, a.out);
   if (!g.quiet) {
     char line[512];
     std::snprintf(line, sizeof line,

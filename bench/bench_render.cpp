@@ -20,11 +20,12 @@
 #include "blobtree/blobtree.h"
 #include "blobtree/compiled.h"
 #include "blobtree/polygonize.h"
+#include "core/image.h"
 #include "core/parallel.h"
+#include "core/timer.h"
 #include "lsystem/skeleton.h"
 #include "model/tree_kind.h"
 #include "render/camera.h"
-#include "render/image.h"
 #include "render/renderer.h"
 #include "render/scene.h"
 #include "textures/procedural.h"
@@ -145,10 +146,6 @@ struct ConeTree {
   }
 };
 
-double secondsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
 void report(const char* name, const render::RenderSettings& s, const render::RenderStats& st) {
   std::printf("%-28s %5dx%-5d spp %2d  %7.2f s  %8.2f Mrays  %6.2f Mrays/s  (%.2f Mrays/s/thread, %d threads)\n", name,
               s.width, s.height, s.spp, st.seconds, st.rays() * 1e-6, st.raysPerSecond() * 1e-6,
@@ -193,9 +190,9 @@ void inspectionImages(const fs::path& dir) {
       view.azimuthDeg = 10.0;
       render::Camera cam = render::frameBounds(scene.bounds(), view, 1.0);
       render::RenderStats st;
-      render::Image img = render::renderImage(scene, cam, s, &st);
+      Image img = render::renderImage(scene, cam, s, &st);
       std::string name = std::string(variant == 0 ? "blend_stripes" : "blend_stripes_spots") + (mode == 0 ? "_exact" : "_mesh") + ".png";
-      render::writeImage(img, dir / name);
+      writeImage(img, dir / name);
       report(name.c_str(), s, st);
     }
   }
@@ -213,8 +210,8 @@ void inspectionImages(const fs::path& dir) {
     view.margin = 0.3;
     render::Camera cam = render::frameBounds(scene.bounds(), view, 800.0 / 600.0);
     render::RenderStats st;
-    render::Image img = render::renderImage(scene, cam, g, &st);
-    render::writeImage(img, dir / "sphere_ground.png");
+    Image img = render::renderImage(scene, cam, g, &st);
+    writeImage(img, dir / "sphere_ground.png");
     report("sphere_ground.png", g, st);
   }
 }
@@ -261,11 +258,11 @@ int main(int argc, char** argv) {
     render::ViewSpec view;
     render::Camera cam = render::frameBounds(scene.bounds(), view, 1.0);
     render::RenderStats st;
-    render::Image img = render::renderImage(scene, cam, s, &st);
+    Image img = render::renderImage(scene, cam, s, &st);
     std::printf("ABOP 2.6 skeleton: %zu internodes, %zu curve segments\n", sk.internodes.size(),
                 scene.stats().curveSegments);
     report("preview abop 2.6", s, st);
-    if (!out.empty()) render::writeImage(img, out / "abop_2_6_preview.png");
+    if (!out.empty()) writeImage(img, out / "abop_2_6_preview.png");
   }
   // 2. A branching model of more than 2,000 cones, 1536x2048, 9 spp, shadows: exact and mesh.
   {
@@ -288,11 +285,11 @@ int main(int argc, char** argv) {
     render::Camera cam = render::frameBounds(exact.bounds(), render::ViewSpec{}, double(s.width) / s.height);
     render::RenderStats st;
     std::clock_t c0 = std::clock();
-    render::Image img = render::renderImage(exact, cam, s, &st);
+    Image img = render::renderImage(exact, cam, s, &st);
     report("cone tree exact", s, st);
     std::printf("  cpu %.1f s (%.2f Mrays per cpu-second)\n", double(std::clock() - c0) / CLOCKS_PER_SEC,
                 st.rays() * 1e-6 / (double(std::clock() - c0) / CLOCKS_PER_SEC));
-    if (!out.empty()) render::writeImage(img, out / "cone_tree_exact.png");
+    if (!out.empty()) writeImage(img, out / "cone_tree_exact.png");
 
     t0 = std::chrono::steady_clock::now();
     // Mesh mode at 1.4 cells per thinnest twig radius (the default half-radius cell gives
@@ -309,11 +306,11 @@ int main(int argc, char** argv) {
                 meshScene.stats().triangles, poly.cellSize, tPoly, secondsSince(t0));
     render::RenderStats sm;
     c0 = std::clock();
-    render::Image imgMesh = render::renderImage(meshScene, cam, s, &sm);
+    Image imgMesh = render::renderImage(meshScene, cam, s, &sm);
     report("cone tree mesh", s, sm);
     std::printf("  cpu %.1f s (%.2f Mrays per cpu-second)\n", double(std::clock() - c0) / CLOCKS_PER_SEC,
                 sm.rays() * 1e-6 / (double(std::clock() - c0) / CLOCKS_PER_SEC));
-    if (!out.empty()) render::writeImage(imgMesh, out / "cone_tree_mesh.png");
+    if (!out.empty()) writeImage(imgMesh, out / "cone_tree_mesh.png");
     std::printf("exact / mesh time ratio: %.2f\n", st.seconds / sm.seconds);
   }
   return 0;

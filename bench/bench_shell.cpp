@@ -28,10 +28,10 @@
 #include <string>
 
 #include "blobtree/compiled.h"
+#include "core/image.h"
 #include "organisms/shell.h"
 #include "organisms/shell_paint.h"
 #include "render/camera.h"
-#include "render/image.h"
 #include "render/renderer.h"
 #include "render/scene.h"
 
@@ -97,7 +97,7 @@ Result run(const organisms::ShellParams& params, const Args& a, const std::strin
   render::RenderStats stats;
   t = Clock::now();
   const std::clock_t cpu0 = std::clock();
-  render::Image img = render::renderImage(scene, camera, rs, &stats);
+  Image img = render::renderImage(scene, camera, rs, &stats);
   r.renderS = since(t);
   r.renderCpuS = double(std::clock() - cpu0) / CLOCKS_PER_SEC;
   r.rays = stats.rays();
@@ -107,7 +107,7 @@ Result run(const organisms::ShellParams& params, const Args& a, const std::strin
   std::printf("%s: exact render %dx%d, %d spp: %.2f s (%.2f CPU-s), %.3g rays, %.3g rays/s, %.3g rays per CPU-s\n",
               label, a.width, a.height, a.spp, r.renderS, r.renderCpuS, double(r.rays), r.raysPerS,
               double(r.rays) / r.renderCpuS);
-  if (!image.empty()) render::writeImage(img, image);
+  if (!image.empty()) writeImage(img, image);
   return r;
 }
 

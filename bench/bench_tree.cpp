@@ -25,13 +25,13 @@
 #include "blobtree/compiled.h"
 #include "blobtree/polygonize.h"
 #include "core/atomic_file.h"
+#include "core/image.h"
 #include "core/rng.h"
 #include "lsystem/derive.h"
 #include "lsystem/grammar.h"
 #include "lsystem/turtle.h"
 #include "organisms/tree_builder.h"
 #include "render/camera.h"
-#include "render/image.h"
 #include "render/renderer.h"
 #include "render/scene.h"
 #include "textures/procedural.h"
@@ -137,7 +137,7 @@ int main(int argc, char** argv) {
       render::RenderStats stats;
       t = Clock::now();
       c0 = cpuSeconds();
-      render::Image image = render::renderImage(scene, camera, rs, &stats);
+      Image image = render::renderImage(scene, camera, rs, &stats);
       const double renderS = since(t), renderCpu = cpuSeconds() - c0;
       std::printf("exact render %dx%d, %d spp: surface cells %.2f s (CPU %.2f s), %zu cells; render %.2f s "
                   "(CPU %.2f s), %.3g rays (%.3g camera), %.3g rays/s, %.3g rays per CPU s\n",
@@ -146,7 +146,7 @@ int main(int argc, char** argv) {
                   double(stats.rays()) / renderCpu);
       std::printf("  total exact (cells + render): %.2f s wall, %.2f s CPU (idle 2-core estimate %.1f s)\n",
                   sceneS + renderS, sceneCpu + renderCpu, 0.5 * (sceneCpu + renderCpu));
-      if (!out.empty()) render::writeImage(image, out);
+      if (!out.empty()) writeImage(image, out);
 
       // Baseline: the reference per-cell tracer vs the batched one, same scene, small image.
       render::Scene ref;

@@ -18,6 +18,7 @@ namespace sprig {
 /// without commit() deletes it.
 class TempPath {
  public:
+  /// Chooses a fresh `.sprig-tmp-PID-N` name beside destination (nothing is created yet).
   explicit TempPath(std::filesystem::path destination);
   ~TempPath();
   TempPath(const TempPath&) = delete;
@@ -25,6 +26,7 @@ class TempPath {
 
   /// Where to write.
   const std::filesystem::path& path() const { return temp_; }
+  /// Where commit() puts the file.
   const std::filesystem::path& destination() const { return destination_; }
   /// Renames the temporary onto the destination. Throws std::runtime_error on failure.
   void commit();

@@ -20,6 +20,7 @@ struct SourceLoc {
   int col = 0;
 };
 
+/// How serious a diagnostic is; only errors make DiagnosticList::throwIfErrors throw.
 enum class Severity { Error, Warning, Note };
 
 /// One message about a user's input.
@@ -47,10 +48,12 @@ std::optional<double> parseFiniteNumber(std::string_view text);
 /// what() returns every diagnostic formatted, one after another.
 class InputError : public std::runtime_error {
  public:
+  /// An error holding diagnostics (what() formats them all, one per line group).
   explicit InputError(std::vector<Diagnostic> diagnostics);
   /// One error at loc.
   InputError(SourceLoc loc, std::string message, std::string sourceLine = {});
 
+  /// Every diagnostic, in the order they were collected.
   const std::vector<Diagnostic>& diagnostics() const { return diagnostics_; }
 
  private:
@@ -60,12 +63,18 @@ class InputError : public std::runtime_error {
 /// Collects diagnostics while a file is parsed; throwIfErrors() throws them all at once.
 class DiagnosticList {
  public:
+  /// Adds an error at loc (sourceLine: the text of that line, for the caret).
   void error(SourceLoc loc, std::string message, std::string sourceLine = {});
+  /// Adds a warning at loc; warnings never make throwIfErrors throw.
   void warning(SourceLoc loc, std::string message, std::string sourceLine = {});
+  /// Adds d as it is.
   void add(Diagnostic d) { items_.push_back(std::move(d)); }
+  /// Adds every diagnostic of ds, in order.
   void append(const std::vector<Diagnostic>& ds) { items_.insert(items_.end(), ds.begin(), ds.end()); }
 
+  /// True when any collected diagnostic is an error.
   bool hasErrors() const;
+  /// Every collected diagnostic, in order.
   const std::vector<Diagnostic>& items() const { return items_; }
   /// Throws InputError holding every diagnostic when any is an error.
   void throwIfErrors() const;

@@ -11,6 +11,7 @@
 
 namespace sprig {
 
+/// An indexed triangle mesh; optional per-vertex arrays are empty or one entry per position.
 struct Mesh {
   std::vector<Vec3> positions;
   std::vector<Vec3> normals;     ///< optional, unit length
@@ -19,8 +20,11 @@ struct Mesh {
   std::vector<glm::uvec3> triangles;
   std::vector<uint32_t> materials;  ///< optional, one id per triangle
 
+  /// Number of vertices (positions).
   size_t vertexCount() const { return positions.size(); }
+  /// Number of triangles.
   size_t triangleCount() const { return triangles.size(); }
+  /// Bounding box of the positions (empty box for an empty mesh).
   Box3 bounds() const;
   /// Appends other, offsetting its indices. Optional arrays are kept only if both have them
   /// (or this mesh is empty).
@@ -33,7 +37,9 @@ struct MeshTopology {
   size_t nonManifoldEdges = 0;   ///< edges used by more than two triangles
   size_t inconsistentEdges = 0;  ///< edges two triangles traverse in the same direction
   size_t degenerateTriangles = 0;
+  /// No boundary edges.
   bool closed() const { return boundaryEdges == 0; }
+  /// Every edge has at most two triangles, traversed in opposite directions.
   bool manifold() const { return nonManifoldEdges == 0 && inconsistentEdges == 0; }
 };
 

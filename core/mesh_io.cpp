@@ -13,6 +13,8 @@
 #include <stdexcept>
 
 #include "core/atomic_file.h"
+#include "core/paths.h"
+#include "core/srgb.h"
 
 namespace sprig {
 
@@ -39,13 +41,7 @@ void validate(const Mesh& mesh) {
       throw std::invalid_argument("mesh triangle index out of range (" + std::to_string(n) + " vertices)");
 }
 
-// Linear RGB -> sRGB encoding (IEC 61966-2-1).
-float srgbEncode(float c) {
-  c = std::clamp(c, 0.0f, 1.0f);
-  return c <= 0.0031308f ? 12.92f * c : 1.055f * std::pow(c, 1.0f / 2.4f) - 0.055f;
-}
-
-uint8_t toByte(float c) { return static_cast<uint8_t>(std::lround(srgbEncode(c) * 255.0f)); }
+uint8_t toByte(float c) { return static_cast<uint8_t>(std::lround(linearToSrgb(c) * 255.0f)); }
 
 // Appends little-endian raw bytes of a trivially copyable value (x86-64 is little-endian).
 template <class T>
@@ -78,12 +74,6 @@ void writeAtomic(const fs::path& path, const std::string& bytes) {
     if (!f) throw std::runtime_error("cannot write '" + path.string() + "': write failed");
   }
   tmp.commit();
-}
-
-std::string lowerExtension(const fs::path& path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
-  return ext;
 }
 
 // Materials used by the mesh, in first-use order of sorted ids (deterministic).
@@ -192,9 +182,9 @@ void writeObj(const Mesh& mesh, const fs::path& path, const MeshWriteOptions& op
     putFloat(out, p.x), out += ' ', putFloat(out, p.y), out += ' ', putFloat(out, p.z);
     if (hasC) {
       out += ' ';
-      putFloat(out, srgbEncode(mesh.colors[i].x)), out += ' ';
-      putFloat(out, srgbEncode(mesh.colors[i].y)), out += ' ';
-      putFloat(out, srgbEncode(mesh.colors[i].z));
+      putFloat(out, linearToSrgb(mesh.colors[i].x)), out += ' ';
+      putFloat(out, linearToSrgb(mesh.colors[i].y)), out += ' ';
+      putFloat(out, linearToSrgb(mesh.colors[i].z));
     }
     out += '\n';
   }

@@ -16,6 +16,7 @@ namespace sprig {
 /// Limits every parallel loop to `threads` threads while alive (0 = all cores).
 class ThreadLimit {
  public:
+  /// Limits parallel loops to threads (0 = all cores) until destroyed.
   explicit ThreadLimit(int threads);
   ~ThreadLimit();
   ThreadLimit(const ThreadLimit&) = delete;

@@ -17,14 +17,17 @@ namespace sprig {
 struct ProgressSettings {
   /// Silences every bar (the CLI's --quiet).
   static void setQuiet(bool quiet);
+  /// True after setQuiet(true).
   static bool quiet();
   /// Asks long operations to stop at their next check (set from a signal handler too).
   static void requestCancel();
+  /// True once requestCancel() was called.
   static bool cancelRequested();
 };
 
 /// Thrown by long operations that noticed a cancellation request.
 struct Cancelled : std::exception {
+  /// "cancelled".
   const char* what() const noexcept override { return "cancelled"; }
 };
 

@@ -31,8 +31,10 @@ constexpr uint64_t deriveSeed(uint64_t seed, std::initializer_list<uint64_t> ids
 /// PCG32 generator with Sprig-specified derived distributions.
 class Rng {
  public:
+  /// A generator seeded with seed (equal seeds give equal sequences everywhere).
   explicit Rng(uint64_t seed = 0) { reseed(seed); }
 
+  /// Restarts the sequence from seed, as if newly constructed with it.
   void reseed(uint64_t seed) {
     state_ = 0;
     inc_ = (mix64(seed ^ 0xda3e39cb94b95bdbull) << 1u) | 1u;

@@ -12,6 +12,7 @@
 
 namespace sprig {
 
+/// GLM vectors and matrices under Sprig's names (D for double precision).
 using Vec2 = glm::vec2;
 using Vec3 = glm::vec3;
 using Vec4 = glm::vec4;
@@ -36,20 +37,27 @@ struct BasicBox {
   }
   /// Grows the box by r on every side.
   BasicBox expanded(typename V::value_type r) const { return empty() ? *this : BasicBox{lo - r, hi + r}; }
+  /// Midpoint of lo and hi.
   V center() const { return (lo + hi) * typename V::value_type(0.5); }
+  /// hi - lo; zero for an empty box.
   V size() const { return empty() ? V(0) : hi - lo; }
+  /// True when p lies inside or on the boundary.
   bool contains(const V& p) const {
     return p.x >= lo.x && p.y >= lo.y && p.z >= lo.z && p.x <= hi.x && p.y <= hi.y && p.z <= hi.z;
   }
+  /// True when the boxes share at least a boundary point.
   bool overlaps(const BasicBox& b) const {
     return !(b.lo.x > hi.x || b.hi.x < lo.x || b.lo.y > hi.y || b.hi.y < lo.y || b.lo.z > hi.z || b.hi.z < lo.z);
   }
+  /// The common part of the boxes (empty() when they do not overlap).
   BasicBox intersected(const BasicBox& b) const { return {glm::max(lo, b.lo), glm::min(hi, b.hi)}; }
 };
 
+/// Float and double axis-aligned boxes.
 using Box3 = BasicBox<Vec3>;
 using DBox3 = BasicBox<DVec3>;
 
+/// pi in double precision.
 constexpr double kPi = 3.14159265358979323846;
 
 /// Degrees to radians.

@@ -4,20 +4,17 @@
 #include <cstdio>
 
 #include "core/progress.h"
+#include "core/timer.h"
 #include "model/animate.h"
 #include "model/model.h"
 #include "model/species.h"
-#include "render/image.h"
+#include "core/image.h"
 
 namespace sprig {
 
 namespace fs = std::filesystem;
 
 namespace {
-
-double secondsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 std::string html(const std::string& s) {
   std::string out;
@@ -46,7 +43,7 @@ int renderGalleryAnimation(SpeciesModel& model, const fs::path& out, const Speci
   if (motion.turntable) {
     // A turntable around the one stage, one camera distance throughout.
     const int n = final ? 48 : 8;
-    std::vector<render::Image> frames;
+    std::vector<Image> frames;
     Progress bar("turntable " + name, static_cast<size_t>(n));
     for (int i = 0; i < n; ++i) {
       SpeciesRender turn = look;
@@ -123,8 +120,8 @@ GalleryItem renderGalleryItem(const fs::path& speciesFile, const fs::path& outDi
     job.stage = model.finalStage();
     job.progressLabel = "render " + stem;
     ModelFigures fig;
-    render::Image preview = renderModel(model, look, job, &fig);
-    render::writeImage(preview, outDir / item.preview);
+    Image preview = renderModel(model, look, job, &fig);
+    writeImage(preview, outDir / item.preview);
     item.steps = std::max(0, job.stage.step);
     item.modules = fig.modules;
     item.internodes = fig.internodes;
@@ -140,7 +137,7 @@ GalleryItem renderGalleryItem(const fs::path& speciesFile, const fs::path& outDi
     const int cellWidth = std::max(16, stripHeight * 3 / 4);
     SpeciesRender stripLook = look;
     stripLook.view.margin = std::max(look.view.margin, 0.04);
-    render::Image strip(cellWidth * static_cast<int>(stages.size()), stripHeight);
+    Image strip(cellWidth * static_cast<int>(stages.size()), stripHeight);
     for (size_t i = 0; i < stages.size(); ++i) {
       RenderJob cellJob = job;
       cellJob.width = cellWidth;
@@ -148,11 +145,11 @@ GalleryItem renderGalleryItem(const fs::path& speciesFile, const fs::path& outDi
       cellJob.stage = stages[i];
       if (draft && exact) cellJob.samples = 1;
       cellJob.progressLabel = "stages " + stem + " " + std::to_string(i + 1) + "/" + std::to_string(stages.size());
-      render::Image cell = renderModel(model, stripLook, cellJob);
+      Image cell = renderModel(model, stripLook, cellJob);
       for (int y = 0; y < stripHeight; ++y)
         for (int x = 0; x < cellWidth; ++x) strip.set(static_cast<int>(i) * cellWidth + x, y, cell.at(x, y));
     }
-    render::writeImage(strip, outDir / item.strip);
+    writeImage(strip, outDir / item.strip);
 
     item.animation = stem + ".gif";
     item.frames = renderGalleryAnimation(model, outDir / item.animation, look, width, height,

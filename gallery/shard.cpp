@@ -1,6 +1,5 @@
 #include "gallery/shard.h"
 
-#include <OpenImageIO/imageio.h>
 #include <signal.h>
 #include <yaml-cpp/yaml.h>
 
@@ -14,7 +13,7 @@
 #include "model/yaml_reader.h"
 #include "gallery/manifest.h"
 #include "core/atomic_file.h"
-#include "render/image.h"
+#include "core/image.h"
 
 namespace sprig {
 
@@ -33,17 +32,20 @@ std::optional<long> wholeNumber(std::string_view text) {
 struct Hasher {
   uint64_t a = 0xcbf29ce484222325ull;
   uint64_t b = 0x84222325cbf29ce4ull;
-  void add(std::string_view s) {
+  void bytes(std::string_view s) {
     for (unsigned char c : s) {
       a = (a ^ c) * 0x100000001b3ull;
       b = (b ^ c ^ 0x5a) * 0x100000001b3ull;
     }
-    // A length separator so ("ab", "c") and ("a", "bc") differ.
-    const std::string n = "\x1f" + std::to_string(s.size()) + "\x1e";
-    for (unsigned char c : n) {
-      a = (a ^ c) * 0x100000001b3ull;
-      b = (b ^ c ^ 0x5a) * 0x100000001b3ull;
-    }
+  }
+  void add(std::string_view s) {
+    bytes(s);
+    // A length separator so ("ab", "c") and ("a", "bc") differ (appended piecewise: GCC 12
+    // warns falsely on "..." + std::string).
+    std::string n = "\x1f";
+    n += std::to_string(s.size());
+    n += "\x1e";
+    bytes(n);
   }
   std::string hex() const {
     char buf[40];
@@ -81,31 +83,8 @@ bool outputsExist(const fs::path& outDir, const std::vector<std::string>& output
   return true;
 }
 
-/// Reads an 8-bit image file into linear floats (nullopt when it cannot be read).
-std::optional<render::Image> readImage(const fs::path& path) {
-  auto in = OIIO::ImageInput::open(path.string());
-  if (!in) return std::nullopt;
-  const OIIO::ImageSpec& spec = in->spec();
-  const int w = spec.width, h = spec.height, nc = spec.nchannels;
-  std::vector<uint8_t> bytes(static_cast<size_t>(w) * h * nc);
-  if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::UINT8, bytes.data())) return std::nullopt;
-  in->close();
-  auto toLinear = [](uint8_t v) {
-    const float c = v / 255.0f;
-    return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
-  };
-  render::Image img(w, h);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const uint8_t* p = &bytes[(static_cast<size_t>(y) * w + x) * nc];
-      Vec4 v(toLinear(p[0]), toLinear(p[nc > 1 ? 1 : 0]), toLinear(p[nc > 2 ? 2 : 0]), 1.0f);
-      img.set(x, y, v);
-    }
-  return img;
-}
-
 /// Box-filters src into a cw x ch cell at (ox, oy) of sheet, keeping the aspect ratio.
-void pasteScaled(const render::Image& src, render::Image& sheet, int ox, int oy, int cw, int ch) {
+void pasteScaled(const Image& src, Image& sheet, int ox, int oy, int cw, int ch) {
   const double scale = std::min(static_cast<double>(cw) / src.width, static_cast<double>(ch) / src.height);
   const int w = std::max(1, static_cast<int>(src.width * scale)), h = std::max(1, static_cast<int>(src.height * scale));
   const int x0 = ox + (cw - w) / 2, y0 = oy + (ch - h) / 2;
@@ -123,18 +102,23 @@ void pasteScaled(const render::Image& src, render::Image& sheet, int ox, int oy,
 /// The contact sheet: every item's final-stage image in a grid of 240 x 180 cells.
 void writeContactSheet(const std::vector<GalleryItem>& items, const fs::path& outDir) {
   constexpr int kCellW = 240, kCellH = 180, kGap = 8;
-  std::vector<render::Image> images;
+  std::vector<Image> images;
   for (const auto& it : items)
     if (!it.preview.empty())
-      if (auto img = readImage(outDir / it.preview)) images.push_back(std::move(*img));
+      try {
+        Image img = readImage(outDir / it.preview);
+        for (size_t i = 3; i < img.pixels.size(); i += 4) img.pixels[i] = 1.0f;  // shown opaque
+        images.push_back(std::move(img));
+      } catch (const ImageReadError&) {
+      }
   const int n = std::max<int>(1, static_cast<int>(images.size()));
   const int cols = std::min(6, n), rows = (n + cols - 1) / cols;
-  render::Image sheet(cols * (kCellW + kGap) + kGap, rows * (kCellH + kGap) + kGap, Vec4(0.9f, 0.9f, 0.88f, 1.0f));
+  Image sheet(cols * (kCellW + kGap) + kGap, rows * (kCellH + kGap) + kGap, Vec4(0.9f, 0.9f, 0.88f, 1.0f));
   for (size_t i = 0; i < images.size(); ++i) {
     const int c = static_cast<int>(i) % cols, r = static_cast<int>(i) / cols;
     pasteScaled(images[i], sheet, kGap + c * (kCellW + kGap), kGap + r * (kCellH + kGap), kCellW, kCellH);
   }
-  render::writeImage(sheet, outDir / "contact_sheet.png");
+  writeImage(sheet, outDir / "contact_sheet.png");
 }
 
 void writeIndex(std::vector<GalleryItem> items, const fs::path& outDir) {

@@ -1,6 +1,5 @@
 #include "model/animate.h"
 
-#include <OpenImageIO/imageio.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -16,6 +15,7 @@
 #include "model/model.h"
 #include "core/atomic_file.h"
 #include "core/diagnostics.h"
+#include "core/paths.h"
 #include "core/progress.h"
 #include "render/renderer.h"
 
@@ -26,38 +26,12 @@ namespace sprig {
 namespace fs = std::filesystem;
 
 AnimationFormat animationFormatFor(const fs::path& out) {
-  std::string ext = out.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = lowerExtension(out);
   if (ext.empty() || fs::is_directory(out)) return AnimationFormat::Frames;
   if (ext == ".gif") return AnimationFormat::Gif;
   if (ext == ".mp4") return AnimationFormat::Mp4;
   throw std::invalid_argument("-o " + out.string() + ": unknown animation extension '" + ext +
                               "' (use a folder for PNG frames, .gif or .mp4)");
-}
-
-void writeAnimatedGif(const std::vector<render::Image>& frames, double fps, const fs::path& out) {
-  if (frames.empty()) throw std::runtime_error(out.string() + ": no frames to write");
-  TempPath tmp(out);
-  {
-    auto writer = OIIO::ImageOutput::create(tmp.path().string());
-    if (!writer) throw std::runtime_error(out.string() + ": cannot write GIF: " + OIIO::geterror());
-    OIIO::ImageSpec spec(frames.front().width, frames.front().height, 3, OIIO::TypeDesc::UINT8);
-    // GIF frame delays are centiseconds: FramesPerSecond as the rational 100 / delay.
-    const int delayCs = std::max(1, static_cast<int>(std::lround(100.0 / std::max(fps, 0.01))));
-    const int rate[2] = {100, delayCs};
-    spec.attribute("FramesPerSecond", OIIO::TypeRational, rate);
-    spec.attribute("oiio:LoopCount", 0);
-    for (size_t i = 0; i < frames.size(); ++i) {
-      const auto mode = i == 0 ? OIIO::ImageOutput::Create : OIIO::ImageOutput::AppendSubimage;
-      if (!writer->open(tmp.path().string(), spec, mode))
-        throw std::runtime_error(out.string() + ": cannot write GIF: " + writer->geterror());
-      std::vector<uint8_t> bytes = toSrgb8(frames[i], 3);
-      if (!writer->write_image(OIIO::TypeDesc::UINT8, bytes.data()))
-        throw std::runtime_error(out.string() + ": cannot write GIF frame: " + writer->geterror());
-    }
-    if (!writer->close()) throw std::runtime_error(out.string() + ": cannot write GIF: " + writer->geterror());
-  }
-  tmp.commit();
 }
 
 fs::path findFfmpeg() {
@@ -172,7 +146,7 @@ AnimateResult animateModel(SpeciesModel& model, const SpeciesRender& baseLook, c
     frameFolder = mp4Frames->path();
   }
 
-  std::vector<render::Image> gifFrames;
+  std::vector<Image> gifFrames;
   {
     std::optional<Progress> bar;
     if (!options.progressLabel.empty()) bar.emplace(options.progressLabel, frames.size());
@@ -184,11 +158,11 @@ AnimateResult animateModel(SpeciesModel& model, const SpeciesRender& baseLook, c
       job.mode = mode;
       job.stage = frames[i];
       job.progress = false;
-      render::Image img = renderModel(model, look, job);
+      Image img = renderModel(model, look, job);
       if (format == AnimationFormat::Gif)
         gifFrames.push_back(std::move(img));
       else
-        render::writeImage(img, frameFolder / frameName(i));
+        writeImage(img, frameFolder / frameName(i));
       if (bar) bar->advance();
     }
     if (bar) bar->finish();

@@ -13,7 +13,7 @@
 #include "lsystem/grammar.h"
 #include "model/model.h"
 #include "model/species.h"
-#include "render/image.h"
+#include "core/image.h"
 
 namespace sprig {
 
@@ -60,10 +60,6 @@ AnimateResult animateSpecies(const Species& species, const std::filesystem::path
 /// model's; options.extra and lastStage are not read again), shown with look.
 AnimateResult animateModel(SpeciesModel& model, const SpeciesRender& look, const std::filesystem::path& out,
                            const AnimateOptions& options);
-
-/// Writes frames as an animated GIF (looping forever) at fps, atomically.
-/// Throws std::runtime_error when OpenImageIO cannot write it.
-void writeAnimatedGif(const std::vector<render::Image>& frames, double fps, const std::filesystem::path& out);
 
 /// The `ffmpeg` executable on PATH, or empty when there is none.
 std::filesystem::path findFfmpeg();

@@ -1,4 +1,5 @@
 #include "model/blob_kind.h"
+#include "core/timer.h"
 
 #include "blobtree/polygonize.h"
 #include "render/scene.h"
@@ -735,9 +736,6 @@ BlobSpecies loadBlobSpecies(const std::filesystem::path& path, const PathPolicy&
 
 namespace {
 
-double secondsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 /// The blob's texture registry as a part's texture table (ids = the primitives' texture ids).
 render::TextureTable textureTable(const std::shared_ptr<const textures::TextureRegistry>& registry) {

@@ -1,4 +1,5 @@
 #include "model/model.h"
+#include "core/timer.h"
 
 #include <algorithm>
 #include <chrono>
@@ -10,9 +11,6 @@ namespace sprig {
 
 namespace {
 
-double secondsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 }  // namespace
 
@@ -64,7 +62,7 @@ render::Camera modelCamera(const SpeciesRender& look, const Box3& box, int width
   return cam;
 }
 
-render::Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job, ModelFigures* figures,
+Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job, ModelFigures* figures,
                           render::RenderStats* stats) {
   const int lookWidth = look.image.width, lookHeight = look.image.height;
   int width = job.width > 0 ? job.width : lookWidth;
@@ -82,7 +80,7 @@ render::Image renderModel(SpeciesModel& model, const SpeciesRender& look, const 
   if (job.samples > 0) rs.spp = job.samples;
   rs.progress = job.progress;
   rs.progressLabel = job.progressLabel;
-  render::Image image = render::renderImage(scene, modelCamera(look, frame, width, height), rs, stats);
+  Image image = render::renderImage(scene, modelCamera(look, frame, width, height), rs, stats);
   if (figures) *figures = fig;
   return image;
 }

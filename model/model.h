@@ -27,7 +27,7 @@
 #include "lsystem/grammar.h"
 #include "model/kinds.h"
 #include "model/species.h"
-#include "render/image.h"
+#include "core/image.h"
 #include "render/renderer.h"
 #include "render/scene.h"
 
@@ -109,7 +109,7 @@ struct RenderJob {
 
 /// Renders one stage of model with look (camera framed on model.frameBox(), or the species'
 /// explicit camera). Fills figures and stats when given.
-render::Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job,
+Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job,
                           ModelFigures* figures = nullptr, render::RenderStats* stats = nullptr);
 
 /// The camera for an image of width x height of a model framed on box with look.

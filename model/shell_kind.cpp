@@ -1,4 +1,5 @@
 #include "model/shell_kind.h"
+#include "core/timer.h"
 
 #include <algorithm>
 #include <chrono>
@@ -362,9 +363,6 @@ render::Geometry shellGeometry(const ShellBuild& shell, std::shared_ptr<const bl
 
 namespace {
 
-double secondsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 /// Mesh cell of a shell when none is asked for: 1/340 of its diagonal.
 float shellMeshCell(const blobtree::CompiledBlob& blob) { return glm::length(blob.bounds().size()) / 340.0f; }

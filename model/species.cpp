@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/atomic_file.h"
+#include "core/paths.h"
 #include "model/kinds.h"
 #include "model/tree_kind.h"
 
@@ -12,12 +13,6 @@ namespace sprig {
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string lowerExtension(const fs::path& p) {
-  std::string ext = p.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  return ext;
-}
 
 void readView(MapReader& m, render::ViewSpec& v) {
   v.azimuthDeg = m.number("azimuth", v.azimuthDeg, -360.0, 360.0);

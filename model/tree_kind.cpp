@@ -1,4 +1,5 @@
 #include "model/tree_kind.h"
+#include "core/timer.h"
 
 #include <algorithm>
 #include <chrono>
@@ -22,9 +23,6 @@ using organisms::BranchSelector;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-double secondsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 std::vector<int> readInts(MapReader& m, std::string_view key, int64_t min, int64_t max) {
   std::vector<int> out;

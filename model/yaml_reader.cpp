@@ -6,6 +6,8 @@
 #include <regex>
 #include <sstream>
 
+#include "core/srgb.h"
+
 namespace sprig {
 
 namespace fs = std::filesystem;
@@ -64,11 +66,6 @@ const char* kindName(const YAML::Node& n) {
     case YAML::NodeType::Scalar: return "a scalar";
     default: return "nothing";
   }
-}
-
-/// sRGB transfer inverse (IEC 61966-2-1): hex colours are sRGB, the renderer works in linear light.
-float srgbToLinear(float v) {
-  return v <= 0.04045f ? v / 12.92f : std::pow((v + 0.055f) / 1.055f, 2.4f);
 }
 
 /// "got 'text'" for scalars, "got a map" otherwise.

@@ -14,8 +14,8 @@
 #include <cstdint>
 #include <string>
 
+#include "core/image.h"
 #include "render/camera.h"
-#include "render/image.h"
 #include "render/scene.h"
 
 namespace sprig::render {

@@ -1,14 +1,12 @@
 #include "textures/image_texture.h"
 
-#include <OpenImageIO/imageio.h>
 #include <OpenImageIO/texture.h>
 
 #include <algorithm>
-#include <cmath>
 #include <filesystem>
-#include <mutex>
 
-#include "textures/procedural.h"
+#include "core/image.h"
+#include "core/srgb.h"
 
 namespace sprig::textures {
 
@@ -43,22 +41,18 @@ ImageTexture ImageTexture::open(const std::string& path, const SourceLoc& where)
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) return fail("no such file");
   if (!std::filesystem::is_regular_file(path, ec)) return fail("not a regular file");
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) {
-    std::string err = OIIO::geterror();
-    return fail(err.empty() ? "not an image OpenImageIO can read" : err);
+  ImageInfo info;
+  try {
+    info = readImageInfo(path);
+  } catch (const ImageReadError& e) {
+    return fail(e.reason());
   }
-  const OIIO::ImageSpec& spec = in->spec();
   auto impl = std::make_shared<Impl>();
   impl->path = path;
-  impl->width = spec.width;
-  impl->height = spec.height;
-  impl->channels = spec.nchannels;
-  std::string cs = spec.get_string_attribute("oiio:ColorSpace");
-  std::transform(cs.begin(), cs.end(), cs.begin(), [](unsigned char c) { return std::tolower(c); });
-  bool integer = spec.format.basetype == OIIO::TypeDesc::UINT8 || spec.format.basetype == OIIO::TypeDesc::UINT16;
-  impl->srgb = cs == "srgb" || (cs.empty() && integer);
-  in->close();
+  impl->width = info.width;
+  impl->height = info.height;
+  impl->channels = info.channels;
+  impl->srgb = info.srgb;
   if (impl->width <= 0 || impl->height <= 0 || impl->channels <= 0) return fail("empty image");
 
   OIIO::TextureSystem* ts = textureSystem();
@@ -84,7 +78,7 @@ Vec3 ImageTexture::color(Vec2 uv, Vec2 duvdx, Vec2 duvdy) const {
   if (n == 2) rgb[2] = 0;
   Vec3 c(rgb[0], rgb[1], rgb[2]);
   if (m.srgb) {
-    for (int k = 0; k < 3; ++k) c[k] = static_cast<float>(srgbToLinear(std::clamp(c[k], 0.0f, 1.0f)));
+    for (int k = 0; k < 3; ++k) c[k] = static_cast<float>(srgbToLinear(static_cast<double>(std::clamp(c[k], 0.0f, 1.0f))));
   }
   return c;
 }

@@ -1,6 +1,10 @@
 #pragma once
 /// Image textures through OpenImageIO's TextureSystem: mip-mapped, filtered lookups.
 ///
+/// This is texture filtering, not image file I/O: reading and writing image files is
+/// core/image.h's alone (the header probe in open() goes through readImageInfo there), and
+/// image_texture.cpp is textures' one OpenImageIO file, for the TextureSystem only.
+///
 /// One process-wide TextureSystem (OIIO's shared instance, thread-safe) serves every
 /// ImageTexture; untiled images are mip-mapped on first use ("automip"). Coordinates are
 /// OIIO's (s, t): u = 0 is the image's left edge, v = 0 its top row, and both wrap
@@ -27,11 +31,15 @@ class ImageTexture {
   /// pixel along x and y); zero means the finest mip level with bilinear filtering.
   Vec3 color(Vec2 uv, Vec2 duvdx = Vec2(0), Vec2 duvdy = Vec2(0)) const;
 
+  /// Width of the file's finest level, in pixels.
   int width() const;
+  /// Height of the file's finest level, in pixels.
   int height() const;
+  /// Channels in the file (1 gray, 3 RGB, 4 RGBA, ...); lookups use the first three.
   int channels() const;
   /// True when the file's values are sRGB-encoded (converted to linear on lookup).
   bool srgb() const;
+  /// The path given to open().
   const std::string& path() const;
 
  private:

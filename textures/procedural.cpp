@@ -18,13 +18,6 @@ inline Vec3 mix(const Vec3& a, const Vec3& b, double t) { return a + (b - a) * s
 
 }  // namespace
 
-double srgbToLinear(double c) { return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4); }
-
-double linearToSrgb(double c) {
-  c = std::clamp(c, 0.0, 1.0);
-  return c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1 / 2.4) - 0.055;
-}
-
 Vec3 NoiseTexture::color(const DVec3& p) const {
   const NoiseColorOptions& o = options_;
   double t = o.turbulence ? noise_.turbulence(p * o.scale, o.fractal) : 0.5 + 0.5 * noise_.fbm(p * o.scale, o.fractal);

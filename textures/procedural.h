@@ -17,10 +17,21 @@
 
 namespace sprig::textures {
 
-/// Linear value from an sRGB-encoded value in [0, 1] (IEC 61966-2-1).
-double srgbToLinear(double c);
-/// sRGB-encoded value in [0, 1] from a linear value (clamped to [0, 1] first).
-double linearToSrgb(double c);
+/// What each noise-driven texture holds: its options and the Perlin noise seeded with
+/// options.seed. A plain base (no virtual functions): the registry holds the concrete
+/// texture types in a std::variant.
+template <class Options>
+class SeededTexture {
+ public:
+  /// The texture for `options`, its noise seeded with options.seed.
+  explicit SeededTexture(const Options& options = {}) : options_(options), noise_(options.seed) {}
+  /// The options the texture was made with.
+  const Options& options() const { return options_; }
+
+ protected:
+  Options options_;
+  PerlinNoise noise_;
+};
 
 /// Two-color noise: mix(colorA, colorB, t) with t = fbm (mapped to [0, 1]) or turbulence
 /// of the 3D point scale * p.
@@ -34,18 +45,14 @@ struct NoiseColorOptions {
   uint64_t seed = 0;
 };
 /// Two-color noise texture.
-class NoiseTexture {
+class NoiseTexture : public SeededTexture<NoiseColorOptions> {
  public:
-  explicit NoiseTexture(const NoiseColorOptions& options = {}) : options_(options), noise_(options.seed) {}
+  /// Made from its options (SeededTexture: the noise is seeded with options.seed).
+  using SeededTexture::SeededTexture;
   /// Color at a 3D point (solid texture).
   Vec3 color(const DVec3& p) const;
   /// Color at (u, v): the point (u, v, 0).
   Vec3 color(Vec2 uv) const { return color(DVec3(uv.x, uv.y, 0)); }
-  const NoiseColorOptions& options() const { return options_; }
-
- private:
-  NoiseColorOptions options_;
-  PerlinNoise noise_;
 };
 
 /// Bark: ridged furrows running along the branch.
@@ -73,18 +80,14 @@ struct BarkOptions {
   uint64_t seed = 0;
 };
 /// Bark texture.
-class BarkTexture {
+class BarkTexture : public SeededTexture<BarkOptions> {
  public:
-  explicit BarkTexture(const BarkOptions& options = {}) : options_(options), noise_(options.seed) {}
+  /// Made from its options (SeededTexture: the noise is seeded with options.seed).
+  using SeededTexture::SeededTexture;
   /// Ridge height in [0, 1] at (u, v) (1 = top of a ridge): the bark's bump map.
   double height(Vec2 uv) const;
   /// Bark color at (u, v).
   Vec3 color(Vec2 uv) const;
-  const BarkOptions& options() const { return options_; }
-
- private:
-  BarkOptions options_;
-  PerlinNoise noise_;
 };
 
 /// Shell stripes: bands at constant v (growth lines) or at constant u (spiral bands).
@@ -102,16 +105,12 @@ struct StripesOptions {
   uint64_t seed = 0;
 };
 /// Stripes texture.
-class StripesTexture {
+class StripesTexture : public SeededTexture<StripesOptions> {
  public:
-  explicit StripesTexture(const StripesOptions& options = {}) : options_(options), noise_(options.seed) {}
+  /// Made from its options (SeededTexture: the noise is seeded with options.seed).
+  using SeededTexture::SeededTexture;
   /// Stripe color at (u, v).
   Vec3 color(Vec2 uv) const;
-  const StripesOptions& options() const { return options_; }
-
- private:
-  StripesOptions options_;
-  PerlinNoise noise_;
 };
 
 /// Spots: one round spot per cell of a jittered grid (cells of size 1 / frequency); the
@@ -130,9 +129,11 @@ struct SpotsOptions {
 /// Spots texture.
 class SpotsTexture {
  public:
+  /// Made from its options (spots draw per-cell values from options.seed; no noise).
   explicit SpotsTexture(const SpotsOptions& options = {}) : options_(options) {}
   /// Spot color at (u, v). Cost: the 9 neighbouring cells.
   Vec3 color(Vec2 uv) const;
+  /// The options the texture was made with.
   const SpotsOptions& options() const { return options_; }
 
  private:
@@ -152,16 +153,12 @@ struct LeafOptions {
   uint64_t seed = 0;
 };
 /// Leaf texture.
-class LeafTexture {
+class LeafTexture : public SeededTexture<LeafOptions> {
  public:
-  explicit LeafTexture(const LeafOptions& options = {}) : options_(options), noise_(options.seed) {}
+  /// Made from its options (SeededTexture: the noise is seeded with options.seed).
+  using SeededTexture::SeededTexture;
   /// Leaf color at (u, v).
   Vec3 color(Vec2 uv) const;
-  const LeafOptions& options() const { return options_; }
-
- private:
-  LeafOptions options_;
-  PerlinNoise noise_;
 };
 
 }  // namespace sprig::textures

@@ -1,13 +1,7 @@
 #include "textures/registry.h"
 
-#include <OpenImageIO/imageio.h>
-
 #include <algorithm>
-#include <cmath>
-#include <filesystem>
-#include <stdexcept>
 
-#include "core/atomic_file.h"
 #include "core/parallel.h"
 
 namespace sprig::textures {
@@ -37,42 +31,15 @@ Vec3 TextureRegistry::color(TextureId id, Vec2 uv, const Vec3& position) const {
       t);
 }
 
-ImageRgb bake(const TextureRegistry& registry, TextureId id, int width, int height) {
-  ImageRgb img;
-  img.width = std::max(0, width);
-  img.height = std::max(0, height);
-  img.rgb.assign(static_cast<size_t>(img.width) * img.height * 3, 0.0f);
+Image bake(const TextureRegistry& registry, TextureId id, int width, int height) {
+  Image img(std::max(0, width), std::max(0, height));
   parallelFor(0, static_cast<size_t>(img.height), [&](size_t y) {
     for (int x = 0; x < img.width; ++x) {
       Vec2 uv((x + 0.5f) / img.width, (static_cast<float>(y) + 0.5f) / img.height);
-      Vec3 c = registry.color(id, uv);
-      float* p = &img.rgb[(y * img.width + x) * 3];
-      p[0] = c.x;
-      p[1] = c.y;
-      p[2] = c.z;
+      img.set(x, static_cast<int>(y), Vec4(registry.color(id, uv), 1.0f));
     }
   });
   return img;
-}
-
-void writeImage(const ImageRgb& image, const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  bool linear = ext == ".exr";
-  TempPath temp(path);
-  auto out = OIIO::ImageOutput::create(temp.path().string());
-  if (!out) throw std::runtime_error("cannot write '" + path + "': " + OIIO::geterror());
-  OIIO::ImageSpec spec(image.width, image.height, 3, linear ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::UINT8);
-  spec.attribute("oiio:ColorSpace", linear ? "Linear" : "sRGB");
-  std::vector<float> pixels = image.rgb;
-  if (!linear) {
-    for (float& v : pixels) v = static_cast<float>(linearToSrgb(v));
-  }
-  if (!out->open(temp.path().string(), spec) || !out->write_image(OIIO::TypeDesc::FLOAT, pixels.data()) ||
-      !out->close()) {
-    throw std::runtime_error("cannot write '" + path + "': " + out->geterror());
-  }
-  temp.commit();
 }
 
 }  // namespace sprig::textures

@@ -11,12 +11,14 @@
 #include <vector>
 
 #include "core/diagnostics.h"
+#include "core/image.h"
 #include "core/types.h"
 #include "textures/image_texture.h"
 #include "textures/procedural.h"
 
 namespace sprig::textures {
 
+/// Index of a registered texture (dense, from 0).
 using TextureId = uint32_t;
 
 /// A uniform color.
@@ -42,27 +44,19 @@ class TextureRegistry {
   /// error (std::out_of_range).
   Vec3 color(TextureId id, Vec2 uv, const Vec3& position = Vec3(0)) const;
 
+  /// The texture registered as id; std::out_of_range for an unknown id.
   const Texture& get(TextureId id) const { return textures_.at(id); }
+  /// Number of registered textures.
   size_t size() const { return textures_.size(); }
 
  private:
   std::vector<Texture> textures_;
 };
 
-/// An RGB float image in linear light, rows top to bottom.
-struct ImageRgb {
-  int width = 0;
-  int height = 0;
-  std::vector<float> rgb;  ///< width * height * 3 values
-};
-
 /// Samples texture `id` at pixel centers, u = (x + 0.5) / width, v = (y + 0.5) / height
-/// (v = 0 at the top, as in image lookups). Rows run in parallel; output is the same at
-/// any thread count.
-ImageRgb bake(const TextureRegistry& registry, TextureId id, int width, int height);
-
-/// Writes an image atomically (core/atomic_file.h): 8-bit sRGB for PNG and JPEG, linear
-/// half floats for EXR. Throws std::runtime_error when the file cannot be written.
-void writeImage(const ImageRgb& image, const std::string& path);
+/// (v = 0 at the top, as in image lookups), into linear RGB with alpha 1 (negative sizes
+/// count as 0). Rows run in parallel; output is the same at any thread count. Write it
+/// with writeImage(image, path, ImageEncoding::TextureMap) (core/image.h).
+Image bake(const TextureRegistry& registry, TextureId id, int width, int height);
 
 }  // namespace sprig::textures

@@ -186,7 +186,7 @@ TEST_CASE("animateSpecies", "[model]") {
       char name[32];
       std::snprintf(name, sizeof name, "frame_%05zu.png", i);
       REQUIRE(fs::is_regular_file(tmp.path / "frames" / name));
-      render::writeImage(test::growthFrameImage(seq, s.render, frames[i], s.render.image.width, s.render.image.height),
+      writeImage(test::growthFrameImage(seq, s.render, frames[i], s.render.image.width, s.render.image.height),
                          tmp.path / "single.png");
       CHECK(readFile(tmp.path / "frames" / name) == readFile(tmp.path / "single.png"));
     }

@@ -39,11 +39,7 @@ void write(const fs::path& p, const std::string& text) { std::ofstream(p, std::i
 
 // A uniform 8x4 PNG of the sRGB-exact linear color c.
 void writeUniformPng(const fs::path& p, Vec3 c) {
-  textures::ImageRgb img;
-  img.width = 8;
-  img.height = 4;
-  for (int i = 0; i < img.width * img.height; ++i) img.rgb.insert(img.rgb.end(), {c.x, c.y, c.z});
-  textures::writeImage(img, p.string());
+  writeImage(Image(8, 4, Vec4(c, 1.0f)), p, ImageEncoding::TextureMap);
 }
 
 // The InputError of loading `text` as species.yaml in dir (with the dir as library root).

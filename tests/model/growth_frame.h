@@ -6,13 +6,13 @@
 #include "model/species.h"
 #include "model/tree_kind.h"
 #include "render/camera.h"
-#include "render/image.h"
+#include "core/image.h"
 #include "render/renderer.h"
 #include "render/scene.h"
 
 namespace sprig::test {
 
-inline render::Image growthFrameImage(GrowthEngine& engine, const SpeciesRender& look, const GrowthFrame& frame,
+inline Image growthFrameImage(GrowthEngine& engine, const SpeciesRender& look, const GrowthFrame& frame,
                                       int width, int height) {
   lsystem::Skeleton sk = engine.skeletonAt(frame.stage, frame.fraction);
   render::Scene scene;

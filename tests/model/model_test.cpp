@@ -60,7 +60,7 @@ shell:
 render: {width: 40, height: 40, samples: 1}
 )";
 
-bool sameImage(const render::Image& a, const render::Image& b) {
+bool sameImage(const Image& a, const Image& b) {
   return a.width == b.width && a.height == b.height && a.pixels == b.pixels;
 }
 
@@ -135,7 +135,7 @@ TEST_CASE("renderModel::deterministic across threads", "[model]") {
     job.width = 40;
     job.height = 32;
     job.progress = false;
-    render::Image one, two, again;
+    Image one, two, again;
     {
       ThreadLimit limit(1);
       SpeciesModel m(species);

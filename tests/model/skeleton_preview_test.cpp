@@ -6,31 +6,35 @@
 #include <fstream>
 #include <iterator>
 
-#include <OpenImageIO/imageio.h>
-
-#include "render/camera.h"
-#include "render/image.h"
-#include "render/renderer.h"
-#include "render/scene.h"
+#include "core/image.h"
 #include "lsystem/skeleton.h"
 #include "model/tree_kind.h"
+#include "render/camera.h"
+#include "render/renderer.h"
+#include "render/scene.h"
+#include "tests/render/test_scenes.h"
+#include "tests/scratch_dir.h"
 
 using namespace sprig;
 using namespace sprig::render;
+using namespace sprig::render::test;
 namespace fs = std::filesystem;
+using sprig::test::scratchDir;
 
 namespace {
-
-fs::path scratchDir(const std::string& name) {
-  fs::path dir = fs::temp_directory_path() / ("sprig-render-test-" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
 
 std::string slurp(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+/// A sphere organ at position with radius (world units).
+inline lsystem::Organ sphereOrgan(DVec3 position, double radius) {
+  lsystem::Organ ball;
+  ball.kind = lsystem::Organ::Kind::Sphere;
+  ball.position = position;
+  ball.radius = radius;
+  return ball;
 }
 
 /// A Y-shaped skeleton: a two-internode trunk and one branch.
@@ -51,11 +55,7 @@ lsystem::Skeleton smallTree() {
   lsystem::Organ leaf;
   leaf.points = {{0.6, 1.6, 0}, {0.9, 1.7, 0.1}, {0.8, 2.0, 0}};
   s.organs.push_back(leaf);
-  lsystem::Organ fruit;
-  fruit.kind = lsystem::Organ::Kind::Sphere;
-  fruit.position = {0, 2.1, 0};
-  fruit.radius = 0.1;
-  s.organs.push_back(fruit);
+  s.organs.push_back(sphereOrgan({0, 2.1, 0}, 0.1));
   return s;
 }
 
@@ -108,24 +108,13 @@ TEST_CASE("render::sphere silhouette", "[render]") {
   // A sphere organ of radius R at distance D from the camera, on the optical axis,
   // projects to a disc of radius (H/2) tan(asin(R/D)) / tan(fov/2) pixels.
   lsystem::Skeleton s;
-  lsystem::Organ ball;
-  ball.kind = lsystem::Organ::Kind::Sphere;
-  ball.radius = 1.0;
-  s.organs.push_back(ball);
+  s.organs.push_back(sphereOrgan({0, 0, 0}, 1.0));
   Scene scene;
   addSkeleton(scene, s);
   scene.commit();
   Camera cam = orbitCamera(Vec3(0), 20, 10, 6.0, 30.0);
-  RenderSettings rs;
-  rs.width = rs.height = 200;
-  rs.spp = 16;
-  rs.background = Background::Transparent;
-  rs.ground = false;
-  rs.progress = false;
-  Image img = renderImage(scene, cam, rs);
-  double area = 0;
-  for (int y = 0; y < img.height; ++y)
-    for (int x = 0; x < img.width; ++x) area += img.at(x, y).a;
+  Image img = renderImage(scene, cam, silhouetteSettings(200, 200, 16));
+  double area = alphaArea(img);
   double expected = 100.0 * std::tan(std::asin(1.0 / 6.0)) / std::tan(radians(15.0));
   CHECK(std::sqrt(area / kPi) == Approx(expected).margin(0.25));
   CHECK(img.at(100, 100).a == 1.0f);
@@ -156,7 +145,7 @@ TEST_CASE("render::determinism", "[render]") {
   CHECK(stats.skyRays > 0);
   CHECK(stats.raysPerSecond() > 0);
 
-  fs::path dir = scratchDir("determinism");
+  fs::path dir = scratchDir("render-determinism");
   writeImage(a, dir / "a.png");
   writeImage(c, dir / "c.png");
   CHECK(slurp(dir / "a.png") == slurp(dir / "c.png"));
@@ -167,11 +156,7 @@ TEST_CASE("render::determinism", "[render]") {
 TEST_CASE("render::shadows", "[render]") {
   // A sphere floating above the ground with the sun overhead shades the ground below it.
   lsystem::Skeleton s;
-  lsystem::Organ ball;
-  ball.kind = lsystem::Organ::Kind::Sphere;
-  ball.position = {0, 2, 0};
-  ball.radius = 1.0;
-  s.organs.push_back(ball);
+  s.organs.push_back(sphereOrgan({0, 2, 0}, 1.0));
   Scene scene;
   addSkeleton(scene, s);
   scene.commit();

@@ -8,13 +8,15 @@
 #include "blobtree/compiled.h"
 #include "blobtree/polygonize.h"
 #include "core/rng.h"
-#include "textures/registry.h"
 #include "render/camera.h"
 #include "render/renderer.h"
 #include "render/scene.h"
+#include "tests/render/test_scenes.h"
+#include "textures/registry.h"
 
 using namespace sprig;
 using namespace sprig::render;
+using namespace sprig::render::test;
 
 namespace {
 
@@ -27,14 +29,6 @@ blobtree::CompiledBlob branchBlob() {
   parts.push_back(t.cone(Vec3(0, 1.2f, 0), Vec3(-0.3f, 2.0f, -0.2f), 0.09f, 0.05f));
   parts.push_back(t.point(Vec3(0.5f, 1.8f, 0.1f), 0.1f));
   return blobtree::compile(t, t.blend(parts));
-}
-
-RenderSettings quietSettings(int w, int h) {
-  RenderSettings rs;
-  rs.width = w;
-  rs.height = h;
-  rs.progress = false;
-  return rs;
 }
 
 }  // namespace
@@ -70,14 +64,8 @@ TEST_CASE("Scene::addImplicit", "[render]") {
   SECTION("silhouette matches the analytic projection") {
     // Radius R at distance D projects to a disc of radius (H/2) tan(asin(R/D)) / tan(fov/2).
     Camera cam = orbitCamera(Vec3(0), 20, 10, 6.0, 30.0);
-    RenderSettings rs = quietSettings(200, 200);
-    rs.spp = 16;
-    rs.background = Background::Transparent;
-    rs.ground = false;
-    Image img = renderImage(scene, cam, rs);
-    double area = 0;
-    for (int y = 0; y < img.height; ++y)
-      for (int x = 0; x < img.width; ++x) area += img.at(x, y).a;
+    Image img = renderImage(scene, cam, silhouetteSettings(200, 200, 16));
+    double area = alphaArea(img);
     double expected = 100.0 * std::tan(std::asin(1.0 / 6.0)) / std::tan(radians(15.0));
     CHECK(std::sqrt(area / kPi) == Approx(expected).margin(0.25));
     // Per pixel: the silhouette is the analytic circle (centered: the camera looks at the

@@ -5,25 +5,20 @@
 #include <fstream>
 #include <iterator>
 
-#include <OpenImageIO/imageio.h>
-
+#include "core/image.h"
 #include "render/camera.h"
-#include "render/image.h"
 #include "render/renderer.h"
 #include "render/scene.h"
+#include "tests/render/test_scenes.h"
+#include "tests/scratch_dir.h"
 
 using namespace sprig;
 using namespace sprig::render;
+using namespace sprig::render::test;
+using sprig::test::scratchDir;
 namespace fs = std::filesystem;
 
 namespace {
-
-fs::path scratchDir(const std::string& name) {
-  fs::path dir = fs::temp_directory_path() / ("sprig-render-test-" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
 
 }  // namespace
 
@@ -65,53 +60,5 @@ TEST_CASE("frameBounds", "[render]") {
     CHECK(a.position == b.position);
     CHECK(a.target == b.target);
   }
-}
-
-TEST_CASE("writeImage", "[render]") {
-  Image img(8, 4, Vec4(0.5f, 0.25f, 1.0f, 1.0f));
-  fs::path dir = scratchDir("write");
-  SECTION("formats by extension") {
-    writeImage(img, dir / "x.png");
-    writeImage(img, dir / "x.JPG");
-    writeImage(img, dir / "x.exr");
-    CHECK(fs::file_size(dir / "x.png") > 0);
-    CHECK(fs::file_size(dir / "x.JPG") > 0);
-    CHECK(fs::file_size(dir / "x.exr") > 0);
-    // Only the three images: no temporaries left behind.
-    CHECK(std::distance(fs::directory_iterator(dir), fs::directory_iterator()) == 3);
-  }
-  SECTION("EXR keeps linear values") {
-    writeImage(img, dir / "lin.exr");
-    auto in = OIIO::ImageInput::open((dir / "lin.exr").string());
-    REQUIRE(in);
-    CHECK(in->spec().width == 8);
-    CHECK(in->spec().nchannels == 4);
-    std::vector<float> px(8 * 4 * 4);
-    REQUIRE(in->read_image(0, 0, 0, 4, OIIO::TypeDesc::FLOAT, px.data()));
-    in->close();
-    CHECK(px[0] == 0.5f);
-    CHECK(px[1] == 0.25f);
-    CHECK(px[2] == 1.0f);
-    CHECK(px[3] == 1.0f);
-  }
-  SECTION("sRGB encoding") {
-    auto bytes = toSrgb8(img, 4);
-    REQUIRE(bytes.size() == 8 * 4 * 4);
-    CHECK(bytes[0] == 188);  // 0.5 linear -> 0.7354 sRGB
-    CHECK(bytes[1] == 137);  // 0.25 -> 0.5371
-    CHECK(bytes[2] == 255);
-    CHECK(bytes[3] == 255);
-  }
-  SECTION("unknown extension fails and writes nothing") {
-    CHECK_THROWS_AS(writeImage(img, dir / "x.bmpx"), std::invalid_argument);
-    CHECK_THROWS_WITH(writeImage(img, dir / "x.tga"), Catch::Contains("unknown extension '.tga'"));
-    CHECK(fs::is_empty(dir));
-  }
-  SECTION("missing folder fails and writes nothing") {
-    CHECK_THROWS_AS(writeImage(img, dir / "nope" / "x.png"), std::runtime_error);
-    CHECK(fs::is_empty(dir));
-    CHECK_FALSE(fs::exists(dir / "nope"));
-  }
-  fs::remove_all(dir);
 }
 

@@ -1,0 +1,151 @@
+#include <catch2/catch.hpp>
+
+#include <OpenImageIO/imageio.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include "core/image.h"
+#include "core/paths.h"
+#include "core/srgb.h"
+#include "core/timer.h"
+#include "tests/scratch_dir.h"
+
+using namespace sprig;
+namespace fs = std::filesystem;
+using sprig::test::scratchDir;
+
+TEST_CASE("writeImage", "[core]") {
+  Image img(8, 4, Vec4(0.5f, 0.25f, 1.0f, 1.0f));
+  fs::path dir = scratchDir("image-write");
+  SECTION("formats by extension") {
+    writeImage(img, dir / "x.png");
+    writeImage(img, dir / "x.JPG");
+    writeImage(img, dir / "x.exr");
+    CHECK(fs::file_size(dir / "x.png") > 0);
+    CHECK(fs::file_size(dir / "x.JPG") > 0);
+    CHECK(fs::file_size(dir / "x.exr") > 0);
+    // Only the three images: no temporaries left behind.
+    CHECK(std::distance(fs::directory_iterator(dir), fs::directory_iterator()) == 3);
+  }
+  SECTION("EXR keeps linear values") {
+    writeImage(img, dir / "lin.exr");
+    auto in = OIIO::ImageInput::open((dir / "lin.exr").string());
+    REQUIRE(in);
+    CHECK(in->spec().width == 8);
+    CHECK(in->spec().nchannels == 4);
+    std::vector<float> px(8 * 4 * 4);
+    REQUIRE(in->read_image(0, 0, 0, 4, OIIO::TypeDesc::FLOAT, px.data()));
+    in->close();
+    CHECK(px[0] == 0.5f);
+    CHECK(px[1] == 0.25f);
+    CHECK(px[2] == 1.0f);
+    CHECK(px[3] == 1.0f);
+  }
+  SECTION("sRGB encoding") {
+    auto bytes = toSrgb8(img, 4);
+    REQUIRE(bytes.size() == 8 * 4 * 4);
+    CHECK(bytes[0] == 188);  // 0.5 linear -> 0.7354 sRGB
+    CHECK(bytes[1] == 137);  // 0.25 -> 0.5371
+    CHECK(bytes[2] == 255);
+    CHECK(bytes[3] == 255);
+  }
+  SECTION("unknown extension fails and writes nothing") {
+    CHECK_THROWS_AS(writeImage(img, dir / "x.bmpx"), std::invalid_argument);
+    CHECK_THROWS_WITH(writeImage(img, dir / "x.tga"), Catch::Contains("unknown extension '.tga'"));
+    CHECK(fs::is_empty(dir));
+  }
+  SECTION("missing folder fails and writes nothing") {
+    CHECK_THROWS_AS(writeImage(img, dir / "nope" / "x.png"), std::runtime_error);
+    CHECK(fs::is_empty(dir));
+    CHECK_FALSE(fs::exists(dir / "nope"));
+  }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("readImage", "[core]") {
+  fs::path dir = scratchDir("image-read");
+  Image img(3, 2, Vec4(0.5f, 0.25f, 1.0f, 1.0f));
+  SECTION("a PNG reads back as the linear value of its sRGB bytes") {
+    writeImage(img, dir / "x.png");
+    ImageInfo info = readImageInfo(dir / "x.png");
+    CHECK(info.width == 3);
+    CHECK(info.height == 2);
+    CHECK(info.channels == 4);
+    CHECK(info.srgb);
+    Image back = readImage(dir / "x.png");
+    REQUIRE(back.pixels.size() == img.pixels.size());
+    CHECK(back.at(2, 1).r == srgbToLinear(188 / 255.0f));
+    CHECK(back.at(2, 1).b == 1.0f);
+    CHECK(back.at(2, 1).a == 1.0f);
+  }
+  SECTION("an EXR reads back linear, a texture-map PNG without alpha reads back opaque") {
+    writeImage(img, dir / "x.exr");
+    CHECK_FALSE(readImageInfo(dir / "x.exr").srgb);
+    CHECK(readImage(dir / "x.exr").pixels == img.pixels);
+    writeImage(img, dir / "map.png", ImageEncoding::TextureMap);
+    CHECK(readImageInfo(dir / "map.png").channels == 3);
+    CHECK(readImage(dir / "map.png").at(0, 0).a == 1.0f);
+  }
+  SECTION("a file that is not an image throws ImageReadError with OIIO's reason") {
+    { std::ofstream(dir / "bad.png") << "not a PNG"; }
+    CHECK_THROWS_AS(readImage(dir / "bad.png"), ImageReadError);
+    try {
+      readImageInfo(dir / "bad.png");
+      FAIL("no throw");
+    } catch (const ImageReadError& e) {
+      CHECK(std::string(e.what()).rfind("cannot read image '", 0) == 0);
+      CHECK_FALSE(e.reason().empty());
+    }
+  }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("writeAnimatedGif", "[core]") {
+  fs::path dir = scratchDir("image-gif");
+  std::vector<Image> frames{Image(4, 4, Vec4(1, 0, 0, 1)), Image(4, 4, Vec4(0, 0, 1, 1))};
+  writeAnimatedGif(frames, 10, dir / "a.gif");
+  auto in = OIIO::ImageInput::open((dir / "a.gif").string());
+  REQUIRE(in);
+  CHECK(in->spec().get_int_attribute("oiio:LoopCount", -1) == 0);
+  CHECK(in->seek_subimage(1, 0));
+  CHECK_FALSE(in->seek_subimage(2, 0));
+  in->close();
+  CHECK_THROWS_AS(writeAnimatedGif({}, 10, dir / "b.gif"), std::runtime_error);
+  CHECK_FALSE(fs::exists(dir / "b.gif"));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("linearToSrgb", "[core]") {
+  SECTION("float and double overloads are one formula") {
+    for (float v : {0.0f, 0.001f, 0.0031308f, 0.2f, 0.5f, 0.9f})
+      CHECK(linearToSrgb(v) == Approx(linearToSrgb(static_cast<double>(v))).margin(1e-6));
+    CHECK(linearToSrgb(2.0f) == linearToSrgb(1.0f));
+    CHECK(linearToSrgb(-1.0) == 0.0);
+  }
+  SECTION("srgbToLinear inverts it") {
+    for (double v : {0.0, 0.01, 0.04045, 0.3, 0.7, 1.0}) CHECK(srgbToLinear(linearToSrgb(v)) == Approx(v).margin(1e-12));
+  }
+  SECTION("toSrgb8 rounds, clamps, and maps NaN to 0") {
+    Image img(2, 1, Vec4(2.0f, -1.0f, std::nanf(""), 0.5f));
+    auto bytes = toSrgb8(img, 4);
+    CHECK(bytes == std::vector<uint8_t>{255, 0, 0, 128, 255, 0, 0, 128});
+  }
+}
+
+TEST_CASE("lowerExtension", "[core]") {
+  CHECK(lowerExtension("a/B.PNG") == ".png");
+  CHECK(lowerExtension("x.tar.GZ") == ".gz");
+  CHECK(lowerExtension("noext") == "");
+  CHECK(asciiLower("sRGB-\xC3\x89") == "srgb-\xC3\x89");
+}
+
+TEST_CASE("secondsSince", "[core]") {
+  auto t0 = std::chrono::steady_clock::now();
+  double s = secondsSince(t0);
+  CHECK(s >= 0.0);
+  CHECK(s < 60.0);
+}
