@@ -27,9 +27,7 @@ struct AnimateArgs {
   int width = 0;
   int height = 0;
   int samples = 0;
-  int steps = -1;
-  int64_t seed = -1;
-  std::vector<std::string> defines;
+  GrowthFlags growth;
 };
 
 /// Parses `A..B` (either side may be empty: `..B`, `A..`) into first/last (-1 = default).
@@ -65,7 +63,7 @@ GrowthFrame parseAt(const std::string& text) {
 
 int runAnimate(const AnimateArgs& a, const GlobalOptions& g) {
   AnimateOptions opt;
-  opt.extra = commandLineOverrides(a.defines, a.steps, a.seed);
+  opt.extra = a.growth.overrides();
   opt.framesPerStage = a.framesPerStage;
   opt.fps = a.fps;
   opt.holdSeconds = a.hold;
@@ -131,9 +129,7 @@ void addAnimateCommand(CLI::App& app, const GlobalOptions& global, CommandRun& r
   sub->add_option("--width", args->width, "frame width in pixels")->check(CLI::Range(16, 8192));
   sub->add_option("--height", args->height, "frame height in pixels")->check(CLI::Range(16, 8192));
   sub->add_option("--samples", args->samples, "camera samples per pixel")->check(CLI::Range(1, 1024));
-  sub->add_option("--steps", args->steps, "derivation steps")->check(CLI::Range(0, 100000));
-  sub->add_option("--seed", args->seed, "random seed")->check(CLI::NonNegativeNumber);
-  sub->add_option("-D,--define", args->defines, "override a #define: NAME=VALUE (repeatable)");
+  addGrowthFlags(*sub, args->growth);
   sub->callback([args, &global, &run] { run = [args, &global] { return runAnimate(*args, global); }; });
 }
 

@@ -62,4 +62,28 @@ void parseView(const std::string& text, render::ViewSpec& view) {
   if (values.size() == 3) view.fovYDeg = values[2];
 }
 
+void addGrowthFlags(CLI::App& sub, GrowthFlags& flags) {
+  sub.add_option("--steps", flags.steps, "derivation steps (trees; default: the species' or grammar's)")
+      ->check(CLI::Range(0, 100000));
+  sub.add_option("--seed", flags.seed, "random seed (trees; default: the species' or grammar's)")
+      ->check(CLI::NonNegativeNumber);
+  sub.add_option("-D,--define", flags.defines, "override a #define: NAME=VALUE (repeatable)");
+}
+
+void addStageFlags(CLI::App& sub, StageFlags& flags) {
+  sub.add_option("--stage", flags.stage, "tree: derivation step; shell: number of whorls grown")
+      ->check(CLI::Range(0, 100000));
+  sub.add_option("--fraction", flags.fraction, "tree: growth of the stage's newest modules, 0..1 (default 1)")
+      ->check(CLI::Range(0.0, 1.0));
+  sub.add_option("--age", flags.age, "shell: age θ_end in degrees (default: the species' age)")
+      ->check(CLI::Range(1.0, 1e6));
+}
+
+Stage StageFlags::resolve(const SpeciesModel& model) const {
+  Stage s = stage >= 0 ? model.stageFromIndex(stage) : model.finalStage();
+  s.fraction = fraction;
+  if (age >= 0) s.age = model.stageAtAge(age).age;
+  return s;
+}
+
 }  // namespace sprig

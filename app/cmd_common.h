@@ -9,6 +9,7 @@
 
 #include "app/commands.h"
 #include "lsystem/grammar.h"
+#include "model/model.h"
 #include "render/camera.h"
 
 namespace sprig {
@@ -16,6 +17,30 @@ namespace sprig {
 /// Overrides from `-D NAME=VALUE` flags, `--steps` (ignored when < 0) and `--seed`
 /// (ignored when < 0). Throws UsageError for a malformed -D.
 lsystem::GrammarOverrides commandLineOverrides(const std::vector<std::string>& defines, int steps, int64_t seed);
+
+/// `--steps`, `--seed` and `-D NAME=VALUE`: a tree's derivation overrides on the command line.
+struct GrowthFlags {
+  int steps = -1;      ///< -1 = the species' steps
+  int64_t seed = -1;   ///< -1 = the species' seed
+  std::vector<std::string> defines;  ///< NAME=VALUE
+  /// The overrides. Throws UsageError for a malformed -D.
+  lsystem::GrammarOverrides overrides() const { return commandLineOverrides(defines, steps, seed); }
+};
+
+/// Registers --steps, --seed and -D on sub.
+void addGrowthFlags(CLI::App& sub, GrowthFlags& flags);
+
+/// `--stage K`, `--fraction F` (trees) and `--age DEG` (shells): which stage to build.
+struct StageFlags {
+  int stage = -1;         ///< -1 = the final stage
+  double fraction = 1.0;  ///< growth of the stage's newest modules
+  double age = -1.0;      ///< -1 = the species' age
+  /// The stage of model these flags name. Throws UsageError for a stage or age the kind lacks.
+  Stage resolve(const SpeciesModel& model) const;
+};
+
+/// Registers --stage, --fraction and --age on sub.
+void addStageFlags(CLI::App& sub, StageFlags& flags);
 
 /// Parses `--view AZ,EL` or `AZ,EL,FOV` (degrees) into view. Throws UsageError.
 void parseView(const std::string& text, render::ViewSpec& view);

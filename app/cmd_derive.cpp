@@ -17,9 +17,7 @@ namespace {
 
 struct DeriveArgs {
   std::string file;
-  int steps = -1;
-  int64_t seed = -1;
-  std::vector<std::string> defines;
+  GrowthFlags growth;
   bool print = false;
   bool json = false;
   std::string skeletonOut;
@@ -90,7 +88,7 @@ std::string skeletonJson(const Derived& t) {
 
 int runDerive(const DeriveArgs& a, const GlobalOptions& g) {
   if (!a.skeletonOut.empty()) requireExtension("--skeleton", a.skeletonOut, {".json"});
-  lsystem::GrammarOverrides extra = commandLineOverrides(a.defines, a.steps, a.seed);
+  lsystem::GrammarOverrides extra = a.growth.overrides();
   Species species = loadSpecies(a.file, g.pathPolicy());
   GrowthEngine engine(species, GrowthOptions{extra, -1, "derive " + species.name});
   const int last = engine.lastStep();
@@ -113,9 +111,7 @@ void addDeriveCommand(CLI::App& app, const GlobalOptions& global, CommandRun& ru
   auto args = std::make_shared<DeriveArgs>();
   CLI::App* sub = app.add_subcommand("derive", "Derive a grammar or tree species and report the result");
   sub->add_option("FILE", args->file, "species file (.yaml) or grammar (.lsys)")->required();
-  sub->add_option("--steps", args->steps, "derivation steps (default: species/grammar)")->check(CLI::Range(0, 100000));
-  sub->add_option("--seed", args->seed, "random seed (default: species/grammar)")->check(CLI::NonNegativeNumber);
-  sub->add_option("-D,--define", args->defines, "override a #define: NAME=VALUE (repeatable)");
+  addGrowthFlags(*sub, args->growth);
   sub->add_flag("--print", args->print, "print the final module string in grammar notation");
   sub->add_flag("--json", args->json, "print a JSON report (steps, modules, symbols, internodes, ...)");
   sub->add_option("--skeleton", args->skeletonOut, "write every internode to this JSON file");

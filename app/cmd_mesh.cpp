@@ -19,22 +19,16 @@ struct MeshArgs {
   std::string file;
   std::string out;
   double cell = 0.0;
-  int stage = -1;
-  double fraction = 1.0;
-  double age = -1.0;
-  int steps = -1;
-  int64_t seed = -1;
-  std::vector<std::string> defines;
+  StageFlags stage;
+  GrowthFlags growth;
 };
 
 int runMesh(const MeshArgs& a, const GlobalOptions& g) {
   requireExtension("-o", a.out, {".ply", ".obj", ".glb"});
   auto start = std::chrono::steady_clock::now();
   Species species = loadSpecies(a.file, g.pathPolicy());
-  SpeciesModel model(species, commandLineOverrides(a.defines, a.steps, a.seed));
-  Stage stage = a.stage >= 0 ? model.stageFromIndex(a.stage) : model.finalStage();
-  stage.fraction = a.fraction;
-  if (a.age >= 0) stage.age = model.stageAtAge(a.age).age;
+  SpeciesModel model(species, a.growth.overrides());
+  const Stage stage = a.stage.resolve(model);
   ModelFigures fig;
   Mesh mesh = model.buildMesh(stage, static_cast<float>(a.cell), !g.quiet, &fig);
 
@@ -60,15 +54,8 @@ void addMeshCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run)
   sub->add_option("-o,--output", args->out, "output mesh (.ply, .obj + .mtl, .glb)")->required();
   sub->add_option("--cell", args->cell, "cell edge length in model units (default: automatic, from the smallest feature)")
       ->check(CLI::PositiveNumber);
-  sub->add_option("--stage", args->stage, "tree: derivation step; shell: number of whorls grown")
-      ->check(CLI::Range(0, 100000));
-  sub->add_option("--fraction", args->fraction, "tree: growth of the stage's newest modules, 0..1 (default 1)")
-      ->check(CLI::Range(0.0, 1.0));
-  sub->add_option("--age", args->age, "shell: age θ_end in degrees (default: the species' age)")
-      ->check(CLI::Range(1.0, 1e6));
-  sub->add_option("--steps", args->steps, "derivation steps (trees)")->check(CLI::Range(0, 100000));
-  sub->add_option("--seed", args->seed, "random seed (trees)")->check(CLI::NonNegativeNumber);
-  sub->add_option("-D,--define", args->defines, "override a #define: NAME=VALUE (repeatable)");
+  addStageFlags(*sub, args->stage);
+  addGrowthFlags(*sub, args->growth);
   sub->callback([args, &global, &run] { run = [args, &global] { return runMesh(*args, global); }; });
 }
 

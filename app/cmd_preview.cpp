@@ -23,14 +23,12 @@ struct PreviewArgs {
   int height = 0;
   int samples = 0;
   std::string view;
-  int steps = -1;
-  int64_t seed = -1;
-  std::vector<std::string> defines;
+  GrowthFlags growth;
 };
 
 int runPreview(const PreviewArgs& a, const GlobalOptions& g) {
   requireExtension("-o", a.out, {".png", ".jpg", ".jpeg", ".exr"});
-  lsystem::GrammarOverrides extra = commandLineOverrides(a.defines, a.steps, a.seed);
+  lsystem::GrammarOverrides extra = a.growth.overrides();
   Species species = loadSpecies(a.file, g.pathPolicy());
   SpeciesRender look = species.render;
   if (!a.view.empty()) parseView(a.view, look.view);
@@ -75,9 +73,7 @@ void addPreviewCommand(CLI::App& app, const GlobalOptions& global, CommandRun& r
   sub->add_option("--height", args->height, "image height in pixels")->check(CLI::Range(16, 8192));
   sub->add_option("--samples", args->samples, "camera samples per pixel")->check(CLI::Range(1, 1024));
   sub->add_option("--view", args->view, "camera direction AZIMUTH,ELEVATION[,FOV] in degrees");
-  sub->add_option("--steps", args->steps, "derivation steps")->check(CLI::Range(0, 100000));
-  sub->add_option("--seed", args->seed, "random seed")->check(CLI::NonNegativeNumber);
-  sub->add_option("-D,--define", args->defines, "override a #define: NAME=VALUE (repeatable)");
+  addGrowthFlags(*sub, args->growth);
   sub->callback([args, &global, &run] { run = [args, &global] { return runPreview(*args, global); }; });
 }
 

@@ -21,14 +21,10 @@ struct RenderArgs {
   int height = 0;
   int spp = 0;
   std::string mode = "exact";
-  int stage = -1;
-  double fraction = 1.0;
-  double age = -1.0;
+  StageFlags stage;
   std::string view;
   std::string camera;
-  int steps = -1;
-  int64_t seed = -1;
-  std::vector<std::string> defines;
+  GrowthFlags growth;
 };
 
 /// Parses `X,Y,Z` (eye) or `X,Y,Z,TX,TY,TZ` (eye and target) into look.camera.
@@ -61,15 +57,13 @@ int runRender(const RenderArgs& a, const GlobalOptions& g) {
   if (!a.view.empty()) parseView(a.view, look.view);
   if (!a.camera.empty()) parseCamera(a.camera, look);
 
-  SpeciesModel model(species, commandLineOverrides(a.defines, a.steps, a.seed));
+  SpeciesModel model(species, a.growth.overrides());
   RenderJob job;
   job.width = a.width;
   job.height = a.height;
   job.samples = a.spp;
   job.mode = mode;
-  job.stage = a.stage >= 0 ? model.stageFromIndex(a.stage) : model.finalStage();
-  job.stage.fraction = a.fraction;
-  if (a.age >= 0) job.stage.age = model.stageAtAge(a.age).age;
+  job.stage = a.stage.resolve(model);
   job.progress = !g.quiet;
   job.progressLabel = "render " + species.name;
 
@@ -106,17 +100,10 @@ void addRenderCommand(CLI::App& app, const GlobalOptions& global, CommandRun& ru
       ->check(CLI::Range(1, 4096));
   sub->add_option("--mode", args->mode, "exact (ray cast the implicit surface), mesh (polygonize first) or skeleton")
       ->check(CLI::IsMember({"exact", "mesh", "skeleton"}));
-  sub->add_option("--stage", args->stage, "tree: derivation step; shell: number of whorls grown")
-      ->check(CLI::Range(0, 100000));
-  sub->add_option("--fraction", args->fraction, "tree: growth of the stage's newest modules, 0..1 (default 1)")
-      ->check(CLI::Range(0.0, 1.0));
-  sub->add_option("--age", args->age, "shell: age θ_end in degrees (default: the species' age)")
-      ->check(CLI::Range(1.0, 1e6));
+  addStageFlags(*sub, args->stage);
   sub->add_option("--view", args->view, "camera direction AZIMUTH,ELEVATION[,FOV] in degrees (automatic framing)");
   sub->add_option("--camera", args->camera, "explicit eye X,Y,Z or eye and target X,Y,Z,TX,TY,TZ");
-  sub->add_option("--steps", args->steps, "derivation steps (trees)")->check(CLI::Range(0, 100000));
-  sub->add_option("--seed", args->seed, "random seed (trees)")->check(CLI::NonNegativeNumber);
-  sub->add_option("-D,--define", args->defines, "override a #define: NAME=VALUE (repeatable)");
+  addGrowthFlags(*sub, args->growth);
   sub->callback([args, &global, &run] { run = [args, &global] { return runRender(*args, global); }; });
 }
 
