@@ -114,11 +114,10 @@ int runAnimate(const AnimateArgs& a, const GlobalOptions& g) {
 }  // namespace
 
 void addAnimateCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run) {
-  auto args = std::make_shared<AnimateArgs>();
-  CLI::App* sub = app.add_subcommand("animate", "Render a species growing, stage by stage, with smooth growth between steps");
-  sub->add_option("SPECIES", args->file, "species file (.yaml) or grammar (.lsys)")->required();
-  sub->add_option("-o,--output", args->out, "a folder (PNG frames), .gif or .mp4 (needs ffmpeg); .png with --at")
-      ->required();
+  auto [sub, args] = subcommand<AnimateArgs>(app, global, run, "animate",
+                                          "Render a species growing, stage by stage, with smooth growth between steps", runAnimate);
+  addInputOutput(*sub, "SPECIES", args->file, args->out,
+                 "a folder (PNG frames), .gif or .mp4 (needs ffmpeg); .png with --at");
   sub->add_option("--stages", args->stages, "derivation steps shown, A..B (default: 0 to the species' steps)");
   sub->add_option("--frames-per-stage", args->framesPerStage, "frames over which one step's new organs grow in")
       ->check(CLI::Range(1, 1000));
@@ -130,7 +129,6 @@ void addAnimateCommand(CLI::App& app, const GlobalOptions& global, CommandRun& r
   sub->add_option("--height", args->height, "frame height in pixels")->check(CLI::Range(16, 8192));
   sub->add_option("--samples", args->samples, "camera samples per pixel")->check(CLI::Range(1, 1024));
   addGrowthFlags(*sub, args->growth);
-  sub->callback([args, &global, &run] { run = [args, &global] { return runAnimate(*args, global); }; });
 }
 
 }  // namespace sprig

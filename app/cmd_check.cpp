@@ -45,10 +45,9 @@ int runCheck(const CheckArgs& a, const GlobalOptions& g) {
 }  // namespace
 
 void addCheckCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run) {
-  auto args = std::make_shared<CheckArgs>();
-  CLI::App* sub = app.add_subcommand("check", "Validate species files and grammars, printing every diagnostic");
+  auto [sub, args] = subcommand<CheckArgs>(app, global, run, "check",
+                                          "Validate species files and grammars, printing every diagnostic", runCheck);
   sub->add_option("FILE", args->files, "species files (.yaml) or grammars (.lsys)")->required();
-  sub->callback([args, &global, &run] { run = [args, &global] { return runCheck(*args, global); }; });
 }
 
 }  // namespace sprig

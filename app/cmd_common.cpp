@@ -5,6 +5,8 @@
 #include <sstream>
 
 #include <algorithm>
+#include <cstdarg>
+#include <cstdio>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
@@ -84,6 +86,21 @@ Stage StageFlags::resolve(const SpeciesModel& model) const {
   s.fraction = fraction;
   if (age >= 0) s.age = model.stageAtAge(age).age;
   return s;
+}
+
+void addInputOutput(CLI::App& sub, const char* name, std::string& file, std::string& out, const char* outputHelp) {
+  sub.add_option(name, file, "species file (.yaml) or grammar (.lsys)")->required();
+  sub.add_option("-o,--output", out, outputHelp)->required();
+}
+
+void note(const GlobalOptions& g, std::ostream& os, const char* format, ...) {
+  if (g.quiet) return;
+  char line[1024];
+  va_list args;
+  va_start(args, format);
+  std::vsnprintf(line, sizeof line, format, args);
+  va_end(args);
+  os << line << "\n";
 }
 
 }  // namespace sprig

@@ -2,6 +2,7 @@
 /// Helpers shared by the `sprig` subcommands.
 
 #include <cstdint>
+#include <ostream>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -41,6 +42,9 @@ struct StageFlags {
 
 /// Registers --stage, --fraction and --age on sub.
 void addStageFlags(CLI::App& sub, StageFlags& flags);
+
+/// Prints one printf-formatted line (a command's summary) to os unless g.quiet.
+[[gnu::format(printf, 3, 4)]] void note(const GlobalOptions& g, std::ostream& os, const char* format, ...);
 
 /// Parses `--view AZ,EL` or `AZ,EL,FOV` (degrees) into view. Throws UsageError.
 void parseView(const std::string& text, render::ViewSpec& view);

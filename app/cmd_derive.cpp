@@ -108,14 +108,13 @@ int runDerive(const DeriveArgs& a, const GlobalOptions& g) {
 }  // namespace
 
 void addDeriveCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run) {
-  auto args = std::make_shared<DeriveArgs>();
-  CLI::App* sub = app.add_subcommand("derive", "Derive a grammar or tree species and report the result");
+  auto [sub, args] = subcommand<DeriveArgs>(app, global, run, "derive",
+                                          "Derive a grammar or tree species and report the result", runDerive);
   sub->add_option("FILE", args->file, "species file (.yaml) or grammar (.lsys)")->required();
   addGrowthFlags(*sub, args->growth);
   sub->add_flag("--print", args->print, "print the final module string in grammar notation");
   sub->add_flag("--json", args->json, "print a JSON report (steps, modules, symbols, internodes, ...)");
   sub->add_option("--skeleton", args->skeletonOut, "write every internode to this JSON file");
-  sub->callback([args, &global, &run] { run = [args, &global] { return runDerive(*args, global); }; });
 }
 
 }  // namespace sprig

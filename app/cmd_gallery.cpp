@@ -77,8 +77,8 @@ int runGallery(const GalleryArgs& a, const GlobalOptions& g) {
 }  // namespace
 
 void addGalleryCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run) {
-  auto args = std::make_shared<GalleryArgs>();
-  CLI::App* sub = app.add_subcommand("gallery", "Render every species (default: species/*.yaml) and write index.html");
+  auto [sub, args] = subcommand<GalleryArgs>(app, global, run, "gallery",
+                                          "Render every species (default: species/*.yaml) and write index.html", runGallery);
   sub->add_option("FILES", args->files, "species files (default: all in ROOT/species)");
   sub->add_option("-o,--output", args->out, "gallery folder (required unless --merge)");
   sub->add_option("--quality", args->quality, "draft (fast, small) or final (species' own size and samples)")
@@ -87,7 +87,6 @@ void addGalleryCommand(CLI::App& app, const GlobalOptions& global, CommandRun& r
                   "render only shard I of N (I/N, from 0; default from SLURM_ARRAY_TASK_ID/COUNT or "
                   "JOB_COMPLETION_INDEX and SPRIG_SHARD_COUNT)");
   sub->add_option("--merge", args->merge, "build DIR/index.html and the contact sheet from DIR's shard manifests");
-  sub->callback([args, &global, &run] { run = [args, &global] { return runGallery(*args, global); }; });
 }
 
 }  // namespace sprig

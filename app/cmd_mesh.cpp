@@ -36,27 +36,21 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
   wopt.materialName = species.name.empty() ? "sprig" : species.name;
   writeMesh(mesh, a.out, wopt);
   double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  if (!g.quiet) {
-    char line[256];
-    std::snprintf(line, sizeof line, "%s: %zu triangles, %zu vertices, %zu primitives, built in %.2f s (total %.2f s)",
-                  a.out.c_str(), mesh.triangleCount(), mesh.vertexCount(), fig.primitives, fig.buildSeconds, total);
-    std::cout << line << "\n";
-  }
+  note(g, std::cout, "%s: %zu triangles, %zu vertices, %zu primitives, built in %.2f s (total %.2f s)", a.out.c_str(),
+       mesh.triangleCount(), mesh.vertexCount(), fig.primitives, fig.buildSeconds, total);
   return kExitOk;
 }
 
 }  // namespace
 
 void addMeshCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run) {
-  auto args = std::make_shared<MeshArgs>();
-  CLI::App* sub = app.add_subcommand("mesh", "Polygonize a species' surface into a closed triangle mesh (.ply, .obj, .glb)");
-  sub->add_option("SPECIES", args->file, "species file (.yaml) or grammar (.lsys)")->required();
-  sub->add_option("-o,--output", args->out, "output mesh (.ply, .obj + .mtl, .glb)")->required();
+  auto [sub, args] = subcommand<MeshArgs>(app, global, run, "mesh",
+                                          "Polygonize a species' surface into a closed triangle mesh (.ply, .obj, .glb)", runMesh);
+  addInputOutput(*sub, "SPECIES", args->file, args->out, "output mesh (.ply, .obj + .mtl, .glb)");
   sub->add_option("--cell", args->cell, "cell edge length in model units (default: automatic, from the smallest feature)")
       ->check(CLI::PositiveNumber);
   addStageFlags(*sub, args->stage);
   addGrowthFlags(*sub, args->growth);
-  sub->callback([args, &global, &run] { run = [args, &global] { return runMesh(*args, global); }; });
 }
 
 }  // namespace sprig

@@ -55,18 +55,16 @@ int runPreview(const PreviewArgs& a, const GlobalOptions& g) {
   rs.progressLabel = "render " + species.name;
   Image image = render::renderImage(scene, camera, rs);
   writeImage(image, a.out);
-  if (!g.quiet)
-    std::cerr << a.out << ": " << width << "x" << height << ", " << shown.internodes.size() << " internodes\n";
+  note(g, std::cerr, "%s: %dx%d, %zu internodes", a.out.c_str(), width, height, shown.internodes.size());
   return kExitOk;
 }
 
 }  // namespace
 
 void addPreviewCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run) {
-  auto args = std::make_shared<PreviewArgs>();
-  CLI::App* sub = app.add_subcommand("preview", "Render a shaded 3D preview of a species or grammar");
-  sub->add_option("FILE", args->file, "species file (.yaml) or grammar (.lsys)")->required();
-  sub->add_option("-o,--output", args->out, "output image (.png, .jpg, .exr)")->required();
+  auto [sub, args] = subcommand<PreviewArgs>(app, global, run, "preview",
+                                          "Render a shaded 3D preview of a species or grammar", runPreview);
+  addInputOutput(*sub, "FILE", args->file, args->out, "output image (.png, .jpg, .exr)");
   sub->add_option("--stage", args->stage, "show the plant after this derivation step (framed as the final stage)")
       ->check(CLI::Range(0, 100000));
   sub->add_option("--width", args->width, "image width in pixels")->check(CLI::Range(16, 8192));
@@ -74,7 +72,6 @@ void addPreviewCommand(CLI::App& app, const GlobalOptions& global, CommandRun& r
   sub->add_option("--samples", args->samples, "camera samples per pixel")->check(CLI::Range(1, 1024));
   sub->add_option("--view", args->view, "camera direction AZIMUTH,ELEVATION[,FOV] in degrees");
   addGrowthFlags(*sub, args->growth);
-  sub->callback([args, &global, &run] { run = [args, &global] { return runPreview(*args, global); }; });
 }
 
 }  // namespace sprig

@@ -71,27 +71,21 @@ int runRender(const RenderArgs& a, const GlobalOptions& g) {
   render::RenderStats stats;
   Image image = renderModel(model, look, job, &fig, &stats);
   writeImage(image, a.out);
-  if (!g.quiet) {
-    char line[512];
-    std::snprintf(line, sizeof line,
-                  "%s: %dx%d, %d spp, %s mode%s%s; %zu primitives, %zu cells, %zu triangles; build %.2f s, render %.2f s, "
-                  "%.2f Mrays/s",
-                  a.out.c_str(), image.width, image.height, job.samples > 0 ? job.samples : look.image.spp,
-                  geometryModeName(mode), model.stageName(job.stage).empty() ? "" : ", ",
-                  model.stageName(job.stage).c_str(), fig.primitives, fig.cells, fig.triangles, fig.buildSeconds,
-                  stats.seconds, stats.raysPerSecond() / 1e6);
-    std::cerr << line << "\n";
-  }
+  note(g, std::cerr,
+       "%s: %dx%d, %d spp, %s mode%s%s; %zu primitives, %zu cells, %zu triangles; build %.2f s, render %.2f s, "
+       "%.2f Mrays/s",
+       a.out.c_str(), image.width, image.height, job.samples > 0 ? job.samples : look.image.spp, geometryModeName(mode),
+       model.stageName(job.stage).empty() ? "" : ", ", model.stageName(job.stage).c_str(), fig.primitives, fig.cells,
+       fig.triangles, fig.buildSeconds, stats.seconds, stats.raysPerSecond() / 1e6);
   return kExitOk;
 }
 
 }  // namespace
 
 void addRenderCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run) {
-  auto args = std::make_shared<RenderArgs>();
-  CLI::App* sub = app.add_subcommand("render", "Render a species: exact implicit surface, its mesh, or the skeleton");
-  sub->add_option("SPECIES", args->file, "species file (.yaml) or grammar (.lsys)")->required();
-  sub->add_option("-o,--output", args->out, "output image (.png, .jpg, .exr; EXR keeps linear values)")->required();
+  auto [sub, args] = subcommand<RenderArgs>(app, global, run, "render",
+                                          "Render a species: exact implicit surface, its mesh, or the skeleton", runRender);
+  addInputOutput(*sub, "SPECIES", args->file, args->out, "output image (.png, .jpg, .exr; EXR keeps linear values)");
   sub->add_option("--width", args->width, "image width in pixels (default: the species' render.width)")
       ->check(CLI::Range(16, 16384));
   sub->add_option("--height", args->height, "image height in pixels (default: the species' render.height)")
@@ -104,7 +98,6 @@ void addRenderCommand(CLI::App& app, const GlobalOptions& global, CommandRun& ru
   sub->add_option("--view", args->view, "camera direction AZIMUTH,ELEVATION[,FOV] in degrees (automatic framing)");
   sub->add_option("--camera", args->camera, "explicit eye X,Y,Z or eye and target X,Y,Z,TX,TY,TZ");
   addGrowthFlags(*sub, args->growth);
-  sub->callback([args, &global, &run] { run = [args, &global] { return runRender(*args, global); }; });
 }
 
 }  // namespace sprig

@@ -9,6 +9,8 @@
 #include <CLI/CLI.hpp>
 
 #include <functional>
+#include <memory>
+#include <utility>
 #include <stdexcept>
 #include <string>
 
@@ -52,6 +54,21 @@ void addAnimateCommand(CLI::App& app, const GlobalOptions& global, CommandRun& r
 
 /// `sprig render SPECIES -o OUT` (app/cmd_render.cpp).
 void addRenderCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run);
+
+/// Registers the required input `name` (a species file or grammar) and output `-o`.
+void addInputOutput(CLI::App& sub, const char* name, std::string& file, std::string& out, const char* outputHelp);
+
+/// Registers subcommand `name`: its flags fill an Args (returned for the caller to bind),
+/// and choosing it makes `run` call body(args, global).
+template <class Args>
+std::pair<CLI::App*, std::shared_ptr<Args>> subcommand(CLI::App& app, const GlobalOptions& global, CommandRun& run,
+                                                       const char* name, const char* description,
+                                                       int (*body)(const Args&, const GlobalOptions&)) {
+  auto args = std::make_shared<Args>();
+  CLI::App* sub = app.add_subcommand(name, description);
+  sub->callback([args, body, &global, &run] { run = [args, body, &global] { return body(*args, global); }; });
+  return {sub, args};
+}
 
 /// Throws UsageError unless path's extension is one of `allowed` (lower case, with dot).
 void requireExtension(const std::string& flag, const std::string& path, std::initializer_list<const char*> allowed);

@@ -31,6 +31,16 @@ uint32_t Scene::Impl::attach(RTCGeometry geometry, GeometryRecord record) {
   return id;
 }
 
+void Scene::Impl::setBallVertices(RTCGeometry geometry, const std::vector<Vec4>& balls) {
+  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geometry, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
+                                                        4 * sizeof(float), balls.size()));
+  for (size_t i = 0; i < balls.size(); ++i) {
+    const Vec4& c = balls[i];
+    for (int k = 0; k < 4; ++k) v[4 * i + k] = c[k];
+    bounds.extend(Box3{Vec3(c) - c.w, Vec3(c) + c.w});
+  }
+}
+
 uint32_t Scene::Impl::addTriangles(GeometryRecord record) {
   RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_TRIANGLE);
   auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
@@ -79,13 +89,7 @@ uint32_t Scene::addCurves(const CurveSet& curves, uint32_t material) {
   if (impl_->committed) throw std::logic_error("Scene::addCurves after commit");
   if (material >= impl_->materials.size()) throw std::invalid_argument("Scene::addCurves: unknown material id");
   RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE);
-  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
-                                                        4 * sizeof(float), curves.vertices.size()));
-  for (size_t i = 0; i < curves.vertices.size(); ++i) {
-    const Vec4& c = curves.vertices[i];
-    for (int k = 0; k < 4; ++k) v[4 * i + k] = c[k];
-    impl_->bounds.extend(Box3{Vec3(c) - c.w, Vec3(c) + c.w});
-  }
+  impl_->setBallVertices(g, curves.vertices);
   auto* s = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT,
                                                            sizeof(uint32_t), curves.segments.size()));
   std::copy(curves.segments.begin(), curves.segments.end(), s);
@@ -114,13 +118,7 @@ uint32_t Scene::addSpheres(const SphereSet& spheres, uint32_t material) {
   rec.material = material;
   rec.primitiveColors = spheres.colors;
   RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_SPHERE_POINT);
-  auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT4,
-                                                        4 * sizeof(float), spheres.spheres.size()));
-  for (size_t i = 0; i < spheres.spheres.size(); ++i) {
-    const Vec4& c = spheres.spheres[i];
-    for (int k = 0; k < 4; ++k) v[4 * i + k] = c[k];
-    impl_->bounds.extend(Box3{Vec3(c) - c.w, Vec3(c) + c.w});
-  }
+  impl_->setBallVertices(g, spheres.spheres);
   impl_->stats.spheres += spheres.spheres.size();
   return impl_->attach(g, std::move(rec));
 }

@@ -58,6 +58,9 @@ struct Scene::Impl {
   uint32_t attach(RTCGeometry geometry, detail::GeometryRecord record);
   /// Appends a part's texture table; returns the scene id of its texture 0.
   uint32_t addTextureTable(const TextureTable& table);
+  /// Fills geometry's vertex buffer with balls (xyz centre, w radius: curve vertices or
+  /// spheres) and grows the scene bounds by each ball.
+  void setBallVertices(RTCGeometry geometry, const std::vector<Vec4>& balls);
   /// Adds record's triangles as Embree triangle geometry.
   uint32_t addTriangles(detail::GeometryRecord record);
 };
