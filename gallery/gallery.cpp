@@ -1,7 +1,10 @@
 #include "gallery/gallery.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <iterator>
+#include <utility>
 
 #include "core/progress.h"
 #include "core/timer.h"
@@ -16,16 +19,14 @@ namespace fs = std::filesystem;
 
 namespace {
 
+/// s with HTML's special characters as entities.
 std::string html(const std::string& s) {
+  static const std::pair<char, const char*> kEntities[] = {{'&', "&amp;"}, {'<', "&lt;"}, {'>', "&gt;"}, {'"', "&quot;"}};
   std::string out;
   for (char c : s) {
-    switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      default: out.push_back(c);
-    }
+    const auto* e = std::find_if(std::begin(kEntities), std::end(kEntities), [c](const auto& p) { return p.first == c; });
+    if (e != std::end(kEntities)) out += e->second;
+    else out.push_back(c);
   }
   return out;
 }

@@ -25,12 +25,6 @@ const std::vector<std::string> kKinds = {
     "blend",  "ricci",     "union",     "intersect", "difference", "controlled", "pcm",
     "negative", "translate", "scale",   "rotate",   "bend",      "twist",     "taper"};
 
-std::string inQuotes(std::string_view s) {
-  std::string out(1, '\'');
-  out.append(s);
-  out.push_back('\'');
-  return out;
-}
 
 // Reads nested blob nodes into one tree, collecting diagnostics.
 class NodeReader {
@@ -84,7 +78,7 @@ class NodeReader {
         {"taper", &NodeReader::readTaper},
     };
     if (auto it = kHandlers.find(kind); it != kHandlers.end()) return (this->*it->second)(kind, key, v);
-    key.error(diags_, "unknown blob node " + inQuotes(kind) + didYouMean(kind, kKinds));
+    key.error(diags_, "unknown blob node " + sprig::quoted(kind) + didYouMean(kind, kKinds));
     return std::nullopt;
   }
 
@@ -319,7 +313,7 @@ class NodeReader {
   std::optional<NodeId> operands(const YNode& key, const YNode& v, const std::string& kind, F&& f) {
     (void)key;
     if (!v.isMap()) {
-      v.error(diags_, inQuotes(kind) + " must be a map of its parameters");
+      v.error(diags_, sprig::quoted(kind) + " must be a map of its parameters");
       return std::nullopt;
     }
     MapReader m(v, diags_, kind);
@@ -363,19 +357,19 @@ class NodeReader {
                                  double max = std::numeric_limits<double>::infinity()) {
     auto v = m.get(key);
     if (!v) {
-      m.node().error(diags_, "missing required key " + inQuotes(key) + " in " + kindOf(m));
+      m.node().error(diags_, "missing required key " + quoted(key) + " in " + kindOf(m));
       return std::nullopt;
     }
-    return v->asNumber(diags_, inQuotes(key), min, max);
+    return v->asNumber(diags_, quoted(key), min, max);
   }
 
   std::optional<Vec3> requiredVec3(MapReader& m, std::string_view key) {
     auto v = m.get(key);
     if (!v) {
-      m.node().error(diags_, "missing required key " + inQuotes(key) + " in " + kindOf(m));
+      m.node().error(diags_, "missing required key " + quoted(key) + " in " + kindOf(m));
       return std::nullopt;
     }
-    return v->asVec3(diags_, inQuotes(key));
+    return v->asVec3(diags_, quoted(key));
   }
 
   std::string kindOf(MapReader& m) const {
@@ -411,12 +405,12 @@ class NodeReader {
   // A sequence of nodes (the value itself); nullopt after an error.
   std::optional<std::vector<NodeId>> childList(const YNode& seq, const std::string& kind) {
     if (!seq.isSequence()) {
-      seq.error(diags_, inQuotes(kind) + " must be a sequence of blob nodes");
+      seq.error(diags_, sprig::quoted(kind) + " must be a sequence of blob nodes");
       return std::nullopt;
     }
     auto items = seq.items();
     if (items.empty()) {
-      seq.error(diags_, inQuotes(kind) + " needs at least one node");
+      seq.error(diags_, sprig::quoted(kind) + " needs at least one node");
       return std::nullopt;
     }
     std::vector<NodeId> ids;
@@ -544,7 +538,7 @@ uint64_t readSeed(MapReader& m) { return uint64_t(m.integer("seed", 0, 0)); }
 // One procedural texture's options map (null reads as all defaults).
 std::optional<textures::Texture> readProcedural(const std::string& kind, const YNode& v, DiagnosticList& diags) {
   if (!v.isMap() && !v.isNull()) {
-    v.error(diags, inQuotes(kind) + " must be a map of its options, e.g. {" + kind + ": {seed: 1}}");
+    v.error(diags, sprig::quoted(kind) + " must be a map of its options, e.g. {" + kind + ": {seed: 1}}");
     return std::nullopt;
   }
   MapReader m(v, diags, kind);
@@ -663,7 +657,7 @@ std::shared_ptr<const textures::TextureRegistry> readBlobTextures(const YNode& l
     } else if (std::find(kTextureKinds.begin(), kTextureKinds.end(), kind) != kTextureKinds.end()) {
       t = readProcedural(kind, value, diags);
     } else {
-      key.error(diags, "unknown texture kind " + inQuotes(kind) + didYouMean(kind, kTextureKinds) +
+      key.error(diags, "unknown texture kind " + sprig::quoted(kind) + didYouMean(kind, kTextureKinds) +
                            " (image, color, noise, bark, stripes, spots or leaf)");
     }
     if (t) registry->add(std::move(*t));

@@ -1,5 +1,7 @@
 #include "model/kinds.h"
 
+#include <iterator>
+
 #include "model/blob_kind.h"
 #include "model/shell_kind.h"
 #include "model/tree_kind.h"
@@ -22,12 +24,9 @@ const KindEntry* findKind(const std::string& name) {
 }
 
 const char* geometryModeName(GeometryMode mode) {
-  switch (mode) {
-    case GeometryMode::Exact: return "exact";
-    case GeometryMode::Mesh: return "mesh";
-    case GeometryMode::Skeleton: return "skeleton";
-  }
-  return "?";
+  static constexpr const char* kNames[] = {"exact", "mesh", "skeleton"};  // in enum order
+  const auto i = static_cast<size_t>(mode);
+  return i < std::size(kNames) ? kNames[i] : "?";
 }
 
 Stage KindModel::stageAtAge(double) const { throw UsageError("--age applies to shell species only"); }

@@ -20,15 +20,6 @@ namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
-/// `'key'` for messages (appended piecewise: GCC 12 warns falsely on "'" + string + "'").
-std::string quoted(std::string_view key) {
-  std::string q;
-  q.reserve(key.size() + 2);
-  q.push_back('\'');
-  q.append(key);
-  q.push_back('\'');
-  return q;
-}
 
 float num(MapReader& r, std::string_view key, float def, double lo = -kInf, double hi = kInf) {
   return static_cast<float>(r.number(key, def, lo, hi));

@@ -420,7 +420,7 @@ void MapReader::allow(std::initializer_list<std::string_view> keys) {
   for (auto k : keys) known_.emplace(k);
 }
 
-static std::string quoted(std::string_view key) {
+std::string quoted(std::string_view key) {
   std::string out;
   out.reserve(key.size() + 2);
   out.push_back('\'');

@@ -164,6 +164,9 @@ class YNode {
   YAML::Node node_;
 };
 
+/// `'text'` for messages (appended piecewise: GCC 12 warns falsely on "'" + string + "'").
+std::string quoted(std::string_view text);
+
 /// Where referenced files (grammars, textures, ...) may come from.
 struct PathPolicy {
   /// The library root: references must resolve inside it (`--root`, default ".").
