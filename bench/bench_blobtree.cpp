@@ -4,6 +4,8 @@
 /// Usage: bench_blobtree [--quick] | --image OUT.ppm
 /// Prints throughputs and ratios against baselines computed in the same process.
 
+#include "bench/bench_clock.h"
+#include "bench/bench_scenes.h"
 #include "blobtree/blobtree.h"
 #include "blobtree/compiled.h"
 #include "core/parallel.h"
@@ -15,52 +17,13 @@
 #include <chrono>
 #include <cstdio>
 #include <cstring>
-#include <ctime>
 #include <vector>
 
 using namespace sprig;
 using namespace sprig::blobtree;
+using namespace sprig::bench;
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double seconds(Clock::time_point a) { return std::chrono::duration<double>(Clock::now() - a).count(); }
-
-/// CPU seconds of the whole process (all threads): steadier than wall time on a shared
-/// machine; two idle cores give about twice the per-CPU-second rate in wall time.
-double cpuSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-}
-
-Vec3 randomIn(Rng& rng, Vec3 lo, Vec3 hi) {
-  return Vec3(float(rng.uniform(lo.x, hi.x)), float(rng.uniform(lo.y, hi.y)), float(rng.uniform(lo.z, hi.z)));
-}
-
-/// A synthetic branching structure of n cones: each cone starts at the tip of a random
-/// earlier cone; radii shrink along the branches. About 2 cones per unit volume overlap.
-NodeId branching(BlobTree& t, int n, uint64_t seed) {
-  Rng rng(seed);
-  struct Tip {
-    Vec3 p, dir;
-    float r;
-  };
-  std::vector<Tip> tips{{Vec3(0), Vec3(0, 1, 0), 0.35f}};
-  std::vector<NodeId> kids;
-  for (int i = 0; i < n; ++i) {
-    // Prefer recent tips so the structure spreads out like a tree rather than a ball.
-    uint32_t k = uint32_t(tips.size()) - 1 - rng.below(std::min<uint32_t>(uint32_t(tips.size()), 40));
-    Tip base = tips[k];
-    Vec3 dir = glm::normalize(base.dir + randomIn(rng, Vec3(-0.7f), Vec3(0.7f)));
-    float len = float(rng.uniform(0.7, 1.3));
-    float r1 = std::max(0.04f, base.r * 0.93f);
-    Vec3 end = base.p + len * dir;
-    kids.push_back(t.cone(base.p, end, base.r, r1));
-    tips.push_back({end, dir, r1});
-  }
-  return t.blend(kids);
-}
 
 /// Runs f(i) for i in [0, n) on all threads; returns elapsed seconds.
 template <class F>
@@ -72,14 +35,21 @@ double timedParallel(size_t n, F&& f) {
   return seconds(t0);
 }
 
+/// Calls f(p) for the points p of the g x g x g lattice spanning box, x fastest.
+template <class F>
+void forEachLatticePoint(const Box3& box, int g, F&& f) {
+  Vec3 step = box.size() / float(g - 1);
+  for (int z = 0; z < g; ++z)
+    for (int y = 0; y < g; ++y)
+      for (int x = 0; x < g; ++x) f(box.lo + Vec3(float(x), float(y), float(z)) * step);
+}
+
 std::atomic<float> sink{0.0f};
 
 void benchModel(int cones, bool quick) {
   BlobTree t;
-  NodeId root = branching(t, cones, 1234);
-  auto c0 = Clock::now();
-  CompiledBlob blob = compile(t, root);
-  double compileS = seconds(c0);
+  double compileS = 0;
+  CompiledBlob blob = timedCompile(t, branching(t, cones, 1234), compileS);
   Box3 box = blob.bounds();
   std::printf("\n== %d cones: bounds (%.1f %.1f %.1f) .. (%.1f %.1f %.1f), compile %.1f ms, %d threads\n", cones,
               double(box.lo.x), double(box.lo.y), double(box.lo.z), double(box.hi.x), double(box.hi.y),
@@ -129,33 +99,26 @@ void benchModel(int cones, bool quick) {
     const int g = 6;
     size_t nc = std::min<size_t>(cells.cells.size(), quick ? 20000 : 200000);
     auto b0 = Clock::now();
-    double bc0 = cpuSeconds();
+    double bc0 = processCpuSeconds();
     parallelForRange(0, nc, [&](size_t b, size_t e) {
       std::vector<Vec3> pts(g * g * g);
       std::vector<float> out(pts.size());
       for (size_t ci = b; ci < e; ++ci) {
         const Cell& c = cells.cells[ci];
-        Vec3 step = c.box.size() / float(g - 1);
-        int k = 0;
-        for (int z = 0; z < g; ++z)
-          for (int y = 0; y < g; ++y)
-            for (int x = 0; x < g; ++x) pts[size_t(k++)] = c.box.lo + Vec3(float(x), float(y), float(z)) * step;
+        size_t k = 0;
+        forEachLatticePoint(c.box, g, [&](Vec3 p) { pts[k++] = p; });
         blob.valuesInCell(c, pts, out);
         sink = sink + out[0];
       }
     }, 16);
-    double bs = seconds(b0), bcpu = cpuSeconds() - bc0;
+    double bs = seconds(b0), bcpu = processCpuSeconds() - bc0;
     size_t evals = nc * size_t(g * g * g);
     // Same lattice points one at a time, for the ratio.
     auto p0 = Clock::now();
     parallelForRange(0, nc, [&](size_t b, size_t e) {
       for (size_t ci = b; ci < e; ++ci) {
-        const Cell& c = cells.cells[ci];
-        Vec3 step = c.box.size() / float(g - 1);
         float acc = 0.0f;
-        for (int z = 0; z < g; ++z)
-          for (int y = 0; y < g; ++y)
-            for (int x = 0; x < g; ++x) acc += blob.value(c.box.lo + Vec3(float(x), float(y), float(z)) * step);
+        forEachLatticePoint(cells.cells[ci].box, g, [&](Vec3 p) { acc += blob.value(p); });
         sink = sink + acc;
       }
     }, 16);

@@ -13,25 +13,18 @@
 
 #include <algorithm>
 #include <memory>
-#include <ctime>
 #include <cstdio>
 #include <string>
 
+#include "bench/bench_clock.h"
 #include "lsystem/derive.h"
 #include "lsystem/grammar.h"
 
 using namespace sprig;
 using namespace sprig::lsystem;
+using sprig::bench::threadCpuSeconds;
 
 namespace {
-
-/// CPU time of this thread in seconds (the machine may be shared: wall time would count
-/// other processes' work).
-double cpuSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
 
 /// Best modules/s over runs of fn (which returns modules written), each run >= 0.2 s of CPU time.
 template <class Fn>
@@ -39,11 +32,11 @@ double rate(Fn&& fn, int rounds = 5) {
   double best = 0;
   for (int r = 0; r < rounds; ++r) {
     uint64_t modules = 0;
-    double t0 = cpuSeconds();
+    double t0 = threadCpuSeconds();
     double secs = 0;
     do {
       modules += fn();
-      secs = cpuSeconds() - t0;
+      secs = threadCpuSeconds() - t0;
     } while (secs < 0.2);
     best = std::max(best, static_cast<double>(modules) / secs);
   }

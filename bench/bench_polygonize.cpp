@@ -7,6 +7,8 @@
 /// polygonizer with sampling every grid point of the bounds (the least any dense-grid
 /// mesher must do) at the same cell size.
 
+#include "bench/bench_clock.h"
+#include "bench/bench_scenes.h"
 #include "blobtree/blobtree.h"
 #include "blobtree/compiled.h"
 #include "blobtree/polygonize.h"
@@ -18,50 +20,13 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <ctime>
 #include <vector>
 
 using namespace sprig;
 using namespace sprig::blobtree;
+using namespace sprig::bench;
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double seconds(Clock::time_point a) { return std::chrono::duration<double>(Clock::now() - a).count(); }
-
-/// CPU seconds of the whole process (all threads): on a shared, loaded machine this is
-/// the steadier measure; wall time on an idle machine is about cpu / threads.
-double cpuSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-}
-
-/// The branching structure of bench_blobtree: each cone starts at the tip of a recent
-/// earlier cone, radii shrink by 0.93 per cone down to 0.04.
-NodeId branching(BlobTree& t, int n, uint64_t seed) {
-  Rng rng(seed);
-  struct Tip {
-    Vec3 p, dir;
-    float r;
-  };
-  auto jitter = [&] {
-    return Vec3(float(rng.uniform(-0.7, 0.7)), float(rng.uniform(-0.7, 0.7)), float(rng.uniform(-0.7, 0.7)));
-  };
-  std::vector<Tip> tips{{Vec3(0), Vec3(0, 1, 0), 0.35f}};
-  std::vector<NodeId> kids;
-  for (int i = 0; i < n; ++i) {
-    uint32_t k = uint32_t(tips.size()) - 1 - rng.below(std::min<uint32_t>(uint32_t(tips.size()), 40));
-    Tip base = tips[k];
-    Vec3 dir = glm::normalize(base.dir + jitter());
-    float len = float(rng.uniform(0.7, 1.3));
-    float r1 = std::max(0.04f, base.r * 0.93f);
-    Vec3 end = base.p + len * dir;
-    kids.push_back(t.cone(base.p, end, base.r, r1));
-    tips.push_back({end, dir, r1});
-  }
-  return t.blend(kids);
-}
 
 std::atomic<size_t> sink{0};
 
@@ -72,7 +37,7 @@ double denseSampling(const CompiledBlob& blob, float h, size_t& points, double& 
   glm::ivec3 n = glm::ivec3(glm::ceil((b.hi - b.lo) / h)) + 1;
   points = size_t(n.x) * size_t(n.y) * size_t(n.z);
   auto t0 = Clock::now();
-  double c0 = cpuSeconds();
+  double c0 = processCpuSeconds();
   size_t slabs = (size_t(n.z) + size_t(slabStride) - 1) / size_t(slabStride);
   parallelFor(0, slabs, [&](size_t zi) {
     size_t z = zi * size_t(slabStride);
@@ -87,7 +52,7 @@ double denseSampling(const CompiledBlob& blob, float h, size_t& points, double& 
     sink += inside;
   });
   double scale = double(n.z) / double(slabs);  // extrapolated to every slab
-  cpu = (cpuSeconds() - c0) * scale;
+  cpu = (processCpuSeconds() - c0) * scale;
   return seconds(t0) * scale;
 }
 
@@ -106,10 +71,8 @@ int main(int argc, char** argv) {
   if (quick) cones = std::min(cones, 300);
 
   BlobTree tree;
-  NodeId root = branching(tree, cones, 1234);
-  auto tc = Clock::now();
-  CompiledBlob blob = compile(tree, root);
-  double compileS = seconds(tc);
+  double compileS = 0;
+  CompiledBlob blob = timedCompile(tree, branching(tree, cones, 1234), compileS);
   Box3 b = blob.bounds();
   float rMin = blob.smallestFeature();
   std::printf("== %d cones, bounds (%.1f %.1f %.1f) .. (%.1f %.1f %.1f), smallest radius %.3f, compile %.1f ms, %d threads\n",
@@ -120,9 +83,9 @@ int main(int argc, char** argv) {
     PolygonizeOptions opt;
     opt.cellSize = cellOverride > 0.0f ? cellOverride : 0.5f * rMin;
     auto t0 = Clock::now();
-    double c0 = cpuSeconds();
+    double c0 = processCpuSeconds();
     PolygonizeResult r = polygonizeDetailed(blob, opt);
-    double s = seconds(t0), cpu = cpuSeconds() - c0;
+    double s = seconds(t0), cpu = processCpuSeconds() - c0;
     MeshTopology topo = analyzeTopology(r.mesh);
     std::printf("sparse, cell %.4f (requested %.4f): %.2f s wall, %.2f s CPU, %zu triangles (%.2f M triangles/s wall, "
                 "%.2f M per CPU second), %zu vertices\n",
@@ -149,9 +112,9 @@ int main(int argc, char** argv) {
     PolygonizeOptions opt;
     opt.cellSize = quick ? 4.0f * rMin : 2.0f * rMin;
     auto t0 = Clock::now();
-    double c0 = cpuSeconds();
+    double c0 = processCpuSeconds();
     PolygonizeResult r = polygonizeDetailed(blob, opt);
-    double sparse = seconds(t0), sparseCpu = cpuSeconds() - c0;
+    double sparse = seconds(t0), sparseCpu = processCpuSeconds() - c0;
     size_t points = 0;
     double denseCpu = 0;
     double dense = denseSampling(blob, r.cellSize, points, denseCpu);

@@ -3,29 +3,19 @@
 /// baseline that only generates the (u, v) coordinates; rates are per thread CPU-second.
 /// Usage (from the repository root): bench_textures [lookups] [image]
 
-#include <ctime>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <functional>
 #include <string>
 
+#include "bench/bench_clock.h"
 #include "core/parallel.h"
 #include "textures/registry.h"
 
 using namespace sprig;
 using namespace sprig::textures;
-
-namespace {
-
-/// This thread's CPU time in seconds: unlike wall time it does not count the time the
-/// thread waits for a core, so numbers stay comparable on a busy machine.
-double cpuNow() {
-  timespec ts{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-}  // namespace
+using sprig::bench::threadCpuSeconds;
 
 int main(int argc, char** argv) {
   const long n = argc > 1 ? std::max(1000L, std::atol(argv[1])) : 2'000'000L;
@@ -47,18 +37,18 @@ int main(int argc, char** argv) {
   auto uvAt = [](long i) { return Vec2(static_cast<float>((i * 7919) % 100003) / 100003.0f, static_cast<float>(i) * 1e-6f); };
   double baseline = 0;
   {
-    auto t0 = cpuNow();
+    auto t0 = threadCpuSeconds();
     float acc = 0;
     for (long i = 0; i < n; ++i) acc += uvAt(i).x;
-    auto t1 = cpuNow();
+    auto t1 = threadCpuSeconds();
     baseline = t1 - t0;
     std::printf("baseline (uv only)            %8.1f M/s  [%g]\n", n / baseline * 1e-6, acc > -1 ? 0.0 : 1.0);
   }
   for (const Entry& e : entries) {
-    auto t0 = cpuNow();
+    auto t0 = threadCpuSeconds();
     float acc = 0;
     for (long i = 0; i < n; ++i) acc += reg.color(e.id, uvAt(i)).x;
-    auto t1 = cpuNow();
+    auto t1 = threadCpuSeconds();
     double s = t1 - t0;
     std::printf("%-29s %8.2f M lookups/s  (%.1fx the baseline time)  [%g]\n", e.name, n / s * 1e-6, s / baseline,
                 acc > -1 ? 0.0 : 1.0);

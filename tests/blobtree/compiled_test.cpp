@@ -70,15 +70,21 @@ NodeId scene(BlobTree& t, Rng& rng) {
   return t.difference(blend, cut);
 }
 
+/// scene() drawn from Rng(seed) and compiled; rng goes on from where the scene left it.
+struct SeededScene {
+  Rng rng;
+  BlobTree tree;
+  NodeId root;
+  CompiledBlob blob;
+  explicit SeededScene(uint64_t seed) : rng(seed), root(scene(tree, rng)), blob(compile(tree, root)) {}
+};
+
 }  // namespace
 
 TEST_CASE("CompiledBlob::value", "[blobtree]") {
   uint64_t seed = GENERATE(1u, 2u, 3u);
   INFO("seed " << seed);
-  Rng rng(seed);
-  BlobTree t;
-  NodeId root = scene(t, rng);
-  CompiledBlob b = compile(t, root);
+  auto&& [rng, t, root, b] = SeededScene(seed);
   Box3 box = b.bounds().expanded(0.5f);
   SECTION("culled tape equals the reference evaluator and the unculled tape") {
     for (int i = 0; i < 3000; ++i) {
@@ -147,10 +153,7 @@ TEST_CASE("CompiledBlob::value", "[blobtree]") {
 TEST_CASE("CompiledBlob::gradient", "[blobtree]") {
   uint64_t seed = GENERATE(11u, 12u, 13u);
   INFO("seed " << seed);
-  Rng rng(seed);
-  BlobTree t;
-  NodeId root = scene(t, rng);
-  CompiledBlob b = compile(t, root);
+  auto&& [rng, t, root, b] = SeededScene(seed);
   Box3 box = b.bounds();
   const float h = 3e-4f;
   int compared = 0;
@@ -202,10 +205,7 @@ TEST_CASE("CompiledBlob::sample attributes", "[blobtree]") {
 TEST_CASE("CompiledBlob::intersect", "[blobtree]") {
   uint64_t seed = GENERATE(21u, 22u);
   INFO("seed " << seed);
-  Rng rng(seed);
-  BlobTree t;
-  NodeId root = scene(t, rng);
-  CompiledBlob b = compile(t, root);
+  auto&& [rng, t, root, b] = SeededScene(seed);
   Box3 box = b.bounds();
   float size = glm::length(box.size());
   SECTION("every hit lies on the surface within 1e-4 of the model size and is the first crossing") {

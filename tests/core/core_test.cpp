@@ -1,6 +1,8 @@
 #include <catch2/catch.hpp>
 
 #include <filesystem>
+#include <initializer_list>
+#include <tuple>
 
 #include "core/atomic_file.h"
 #include "core/diagnostics.h"
@@ -39,21 +41,26 @@ TEST_CASE("Diagnostic::format", "[core]") {
   }
 }
 
+namespace {
+
+/// CHECKs editDistance(a, b) == distance for each {a, b, distance}.
+void checkDistances(std::initializer_list<std::tuple<const char*, const char*, int>> cases) {
+  for (auto [a, b, distance] : cases) {
+    CAPTURE(a, b);
+    CHECK(editDistance(a, b) == distance);
+  }
+}
+
+}  // namespace
+
 TEST_CASE("editDistance", "[core]") {
   SECTION("Levenshtein edits count one each") {
-    CHECK(editDistance("", "") == 0);
-    CHECK(editDistance("abc", "") == 3);
-    CHECK(editDistance("", "ab") == 2);
-    CHECK(editDistance("kitten", "sitting") == 3);
-    CHECK(editDistance("steps", "steeps") == 1);
-    CHECK(editDistance("seed", "sed") == 1);
+    checkDistances({{"", "", 0}, {"abc", "", 3}, {"", "ab", 2},
+                    {"kitten", "sitting", 3}, {"steps", "steeps", 1}, {"seed", "sed", 1}});
   }
   SECTION("an adjacent transposition is one edit") {
-    CHECK(editDistance("ab", "ba") == 1);
-    CHECK(editDistance("steps", "setps") == 1);
-    CHECK(editDistance("angle", "angel") == 1);
-    CHECK(editDistance("grammar", "gramamr") == 1);
-    CHECK(editDistance("abcdef", "badcfe") == 3);
+    checkDistances({{"ab", "ba", 1}, {"steps", "setps", 1}, {"angle", "angel", 1},
+                    {"grammar", "gramamr", 1}, {"abcdef", "badcfe", 3}});
   }
   SECTION("optimal string alignment: a transposed pair is not edited again") {
     // Full Damerau distance of ("ca", "abc") is 2; OSA, which never edits a

@@ -10,24 +10,13 @@
 #include "core/diagnostics.h"
 #include "gallery/manifest.h"
 #include "core/atomic_file.h"
+#include "tests/scratch_dir.h"
 
 using namespace sprig;
 namespace fs = std::filesystem;
+using test::TempDir;
 
 namespace {
-
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    std::string p = (fs::temp_directory_path() / "sprig-shard-test-XXXXXX").string();
-    REQUIRE(::mkdtemp(p.data()));
-    path = p;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-};
 
 void write(const fs::path& p, const std::string& text) {
   std::ofstream(p, std::ios::binary) << text;
@@ -51,12 +40,15 @@ TEST_CASE("shardFromEnvironment", "[gallery]") {
     return it == env.end() ? nullptr : it->second.c_str();
   };
   CHECK(!shardFromEnvironment(get));
-  SECTION("Slurm job arrays, with and without an offset") {
-    env = {{"SLURM_ARRAY_TASK_ID", "2"}, {"SLURM_ARRAY_TASK_COUNT", "4"}};
+  auto checkShard = [&](int index, int count) {  // env names shard index/count
     auto s = shardFromEnvironment(get);
     REQUIRE(s);
-    CHECK(s->index == 2);
-    CHECK(s->count == 4);
+    CHECK(s->index == index);
+    CHECK(s->count == count);
+  };
+  SECTION("Slurm job arrays, with and without an offset") {
+    env = {{"SLURM_ARRAY_TASK_ID", "2"}, {"SLURM_ARRAY_TASK_COUNT", "4"}};
+    checkShard(2, 4);
     env = {{"SLURM_ARRAY_TASK_ID", "5"}, {"SLURM_ARRAY_TASK_COUNT", "4"}, {"SLURM_ARRAY_TASK_MIN", "3"}};
     CHECK(shardFromEnvironment(get)->index == 2);
     env = {{"SLURM_ARRAY_TASK_ID", "4"}, {"SLURM_ARRAY_TASK_COUNT", "4"}};
@@ -66,10 +58,7 @@ TEST_CASE("shardFromEnvironment", "[gallery]") {
   }
   SECTION("Kubernetes indexed jobs") {
     env = {{"JOB_COMPLETION_INDEX", "1"}, {"SPRIG_SHARD_COUNT", "3"}};
-    auto s = shardFromEnvironment(get);
-    REQUIRE(s);
-    CHECK(s->index == 1);
-    CHECK(s->count == 3);
+    checkShard(1, 3);
     env = {{"JOB_COMPLETION_INDEX", "x"}, {"SPRIG_SHARD_COUNT", "3"}};
     CHECK_THROWS_WITH(shardFromEnvironment(get), Catch::Contains("expected a whole number"));
   }
@@ -89,7 +78,7 @@ TEST_CASE("shardItems", "[gallery]") {
 }
 
 TEST_CASE("galleryInputHash", "[gallery]") {
-  TempDir tmp;
+  TempDir tmp("shard-test");
   fs::create_directories(tmp.path / "species");
   write(tmp.path / "g.lsys", "axiom: F\n");
   write(tmp.path / "bark.png", "pixels");
@@ -151,7 +140,7 @@ TEST_CASE("manifestJson", "[gallery]") {
 }
 
 TEST_CASE("removeDeadTemporaries", "[gallery]") {
-  TempDir tmp;
+  TempDir tmp("shard-test");
   const std::string mine = ".sprig-tmp-" + std::to_string(getpid()) + "-0-a.png";
   write(tmp.path / mine, "live");
   write(tmp.path / ".sprig-tmp-999999999-0-b.png", "dead");  // no such process

@@ -163,13 +163,13 @@ TEST_CASE("Turtle::moves and internodes", "[lsystem]") {
     Run r = draw("F[+F[-F]]F", s);
     auto& in = r.skeleton.internodes;
     REQUIRE(in.size() == 4);
-    CHECK(in[1].parent == 0);
-    CHECK(in[2].parent == 1);
-    CHECK(in[3].parent == 0);
-    CHECK(in[0].order == 0);
-    CHECK(in[1].order == 1);
-    CHECK(in[2].order == 2);
-    CHECK(in[3].order == 0);
+    const int32_t parent[] = {-1, 0, 1, 0};
+    const int order[] = {0, 1, 2, 0};
+    for (size_t i = 0; i < 4; ++i) {
+      CAPTURE(i);
+      CHECK(in[i].parent == parent[i]);
+      CHECK(in[i].order == order[i]);
+    }
     checkVec(in[1].end, {-2, 2, 0});
     checkVec(in[2].end, {-2, 4, 0});
     checkVec(in[3].end, {0, 4, 0});

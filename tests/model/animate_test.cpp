@@ -6,7 +6,8 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <unistd.h>
+#include <string>
+#include <tuple>
 
 #include "growth_frame.h"
 #include "model/growth.h"
@@ -14,40 +15,43 @@
 #include "core/atomic_file.h"
 #include "core/progress.h"
 #include "lsystem/turtle.h"
+#include "tests/scratch_dir.h"
 
 using namespace sprig;
 namespace fs = std::filesystem;
+using test::TempDir;
 
 namespace {
 
+/// A `kind: tree` species: the lines of its grammar block (indented by two spaces) and the
+/// top-level keys that follow the grammar.
+std::string treeSpecies(const char* grammarLines, const char* keys) {
+  return std::string("kind: tree\ngrammar: |\n") + grammarLines + keys;
+}
+
 /// A node-rewriting plant: old internodes stay, each step adds new ones at the apices.
-const char* kNodeRewriting = R"(kind: tree
-grammar: |
-  lsystem: node
+const std::string kNodeRewriting = treeSpecies(R"(  lsystem: node
   derivation length: 4
   angle: 30
   axiom: A
   A --> F[+A][-A]FA
-steps: 4
+)",
+                                               R"(steps: 4
 turtle:
   width: 0.2
 render: {width: 48, height: 40, samples: 1}
-)";
+)");
 
 /// Edge rewriting: every F is rewritten into two new ones in every step.
-const char* kEdgeRewriting = R"(kind: tree
-grammar: |
-  lsystem: edge
+const std::string kEdgeRewriting = treeSpecies(R"(  lsystem: edge
   derivation length: 3
   axiom: F
   F --> FF
-render: {width: 32, height: 32, samples: 1}
-)";
+)",
+                                               "render: {width: 32, height: 32, samples: 1}\n");
 
 /// A stochastic bush: frames must keep the same branches from stage to stage.
-const char* kStochastic = R"(kind: tree
-grammar: |
-  lsystem: bush
+const std::string kStochastic = treeSpecies(R"(  lsystem: bush
   derivation length: 4
   seed: 7
   angle: 25
@@ -55,35 +59,21 @@ grammar: |
   A --> F[+A]A : 1
   A --> F[-A][&A]A : 1
   A --> F@O(0.2) : 1
-render: {width: 40, height: 32, samples: 1}
-)";
-
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    std::string p = (fs::temp_directory_path() / "sprig-animate-test-XXXXXX").string();
-    REQUIRE(::mkdtemp(p.data()));
-    path = p;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-};
+)",
+                                            "render: {width: 40, height: 32, samples: 1}\n");
 
 }  // namespace
 
 TEST_CASE("growthFrames", "[model]") {
   auto f = growthFrames(2, 5, 4);
   REQUIRE(f.size() == 1 + 3 * 4);
-  CHECK(f[0].stage == 2);
-  CHECK(f[0].fraction == 1.0);
-  CHECK(f[1].stage == 3);
-  CHECK(f[1].fraction == 0.25);
-  CHECK(f[4].stage == 3);
-  CHECK(f[4].fraction == 1.0);
-  CHECK(f.back().stage == 5);
-  CHECK(f.back().fraction == 1.0);
+  // {frame, stage, fraction}: the first frame, the next stage's first and last, the last.
+  const std::tuple<size_t, int, double> expected[] = {{0, 2, 1.0}, {1, 3, 0.25}, {4, 3, 1.0}, {f.size() - 1, 5, 1.0}};
+  for (auto [i, stage, fraction] : expected) {
+    CAPTURE(i);
+    CHECK(f[i].stage == stage);
+    CHECK(f[i].fraction == fraction);
+  }
   CHECK(growthFrames(3, 3, 6).size() == 1);
 }
 
@@ -170,7 +160,7 @@ TEST_CASE("GrowthEngine::growthStart", "[model]") {
 
 TEST_CASE("animateSpecies", "[model]") {
   ProgressSettings::setQuiet(true);
-  TempDir tmp;
+  TempDir tmp("animate-test");
   Species s = parseSpecies(kStochastic, "bush.yaml");
   AnimateOptions opt;
   opt.firstStage = 1;

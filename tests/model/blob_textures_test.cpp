@@ -7,7 +7,6 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
-#include <unistd.h>
 
 #include "model/model.h"
 #include "model/species.h"
@@ -16,24 +15,13 @@
 #include "render/scene.h"
 #include "textures/procedural.h"
 #include "textures/registry.h"
+#include "tests/scratch_dir.h"
 
 using namespace sprig;
 namespace fs = std::filesystem;
+using test::TempDir;
 
 namespace {
-
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    std::string p = (fs::temp_directory_path() / "sprig-blob-textures-test-XXXXXX").string();
-    REQUIRE(::mkdtemp(p.data()));
-    path = p;
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path, ec);
-  }
-};
 
 void write(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
 
@@ -60,7 +48,7 @@ bool near(Vec3 a, Vec3 b, float tol) { return glm::all(glm::lessThanEqual(glm::a
 }  // namespace
 
 TEST_CASE("readBlobSpecies::textures", "[model]") {
-  TempDir dir;
+  TempDir dir("blob-textures-test");
   fs::create_directory(dir.path / "maps");
   const Vec3 pink(0.8f, 0.2f, 0.4f);
   writeUniformPng(dir.path / "maps" / "pink.png", pink);
@@ -116,8 +104,15 @@ TEST_CASE("readBlobSpecies::textures", "[model]") {
 }
 
 TEST_CASE("readBlobSpecies::texture errors", "[model]") {
-  TempDir dir;
+  TempDir dir("blob-textures-test");
   const std::string blob = "blob:\n  point: {radius: 1, texture: {id: 0}}\n";
+  // Each case: the species text before `blob`, and what the error of loading it must contain.
+  auto checkErrors = [&](std::initializer_list<std::pair<std::string, std::string>> cases) {
+    for (const auto& [text, message] : cases) {
+      CAPTURE(text);
+      CHECK(loadError(dir, text + blob).find(message) != std::string::npos);
+    }
+  };
 
   SECTION("a missing image names the file at the path's line:col") {
     std::string e = loadError(dir, "kind: blob\ntextures:\n  - image: maps/missing.png\n" + blob);
@@ -138,28 +133,34 @@ TEST_CASE("readBlobSpecies::texture errors", "[model]") {
     CHECK(e.find("': not a regular file") != std::string::npos);
   }
   SECTION("image paths obey the path policy") {
-    std::string e = loadError(dir, "kind: blob\ntextures:\n  - image: ../outside.png\n" + blob);
-    CHECK(e.find(":3:12: error: refusing path '../outside.png': it leaves the library root") != std::string::npos);
-    e = loadError(dir, "kind: blob\ntextures:\n  - image: https://example.com/a.png\n" + blob);
-    CHECK(e.find(":3:12: error: refusing URI 'https://example.com/a.png'") != std::string::npos);
+    checkErrors({
+        {"kind: blob\ntextures:\n  - image: ../outside.png\n",
+         ":3:12: error: refusing path '../outside.png': it leaves the library root"},
+        {"kind: blob\ntextures:\n  - image: https://example.com/a.png\n",
+         ":3:12: error: refusing URI 'https://example.com/a.png'"},
+    });
   }
   SECTION("unknown texture kinds and options get did-you-mean") {
-    std::string e = loadError(dir, "kind: blob\ntextures:\n  - strpes: {}\n" + blob);
-    CHECK(e.find(":3:5: error: unknown texture kind 'strpes' (did you mean 'stripes'?)") != std::string::npos);
-    e = loadError(dir, "kind: blob\ntextures:\n  - spots: {frequncy: 4}\n" + blob);
-    CHECK(e.find(":3:13: error: unknown key 'frequncy' in spots (did you mean 'frequency'?)") != std::string::npos);
+    checkErrors({
+        {"kind: blob\ntextures:\n  - strpes: {}\n",
+         ":3:5: error: unknown texture kind 'strpes' (did you mean 'stripes'?)"},
+        {"kind: blob\ntextures:\n  - spots: {frequncy: 4}\n",
+         ":3:13: error: unknown key 'frequncy' in spots (did you mean 'frequency'?)"},
+    });
   }
   SECTION("wrong types and ranges are located") {
-    std::string e = loadError(dir, "kind: blob\ntextures:\n  - bark: {furrows: many}\n" + blob);
-    CHECK(e.find(":3:21: error: 'furrows' must be an integer, got 'many'") != std::string::npos);
-    e = loadError(dir, "kind: blob\ntextures:\n  - stripes: {duty: 2}\n" + blob);
-    CHECK(e.find(":3:21: error: 'duty' is 2, out of range [0, 1]") != std::string::npos);
-    e = loadError(dir, "kind: blob\ntextures: {image: a.png}\n" + blob);
-    CHECK(e.find(":2:11: error: 'textures' must be a sequence") != std::string::npos);
-    e = loadError(dir, "kind: blob\ntextures:\n  - image: {file: a.png}\n" + blob);
-    CHECK(e.find(":3:12: error: 'image' must be a file name") != std::string::npos);
-    e = loadError(dir, "kind: blob\ntextures:\n  - color: [0.1, 0.2, 0.3]\n    noise: {}\n" + blob);
-    CHECK(e.find(":3:5: error: a texture must be a map with one key naming its kind") != std::string::npos);
+    checkErrors({
+        {"kind: blob\ntextures:\n  - bark: {furrows: many}\n",
+         ":3:21: error: 'furrows' must be an integer, got 'many'"},
+        {"kind: blob\ntextures:\n  - stripes: {duty: 2}\n",
+         ":3:21: error: 'duty' is 2, out of range [0, 1]"},
+        {"kind: blob\ntextures: {image: a.png}\n",
+         ":2:11: error: 'textures' must be a sequence"},
+        {"kind: blob\ntextures:\n  - image: {file: a.png}\n",
+         ":3:12: error: 'image' must be a file name"},
+        {"kind: blob\ntextures:\n  - color: [0.1, 0.2, 0.3]\n    noise: {}\n",
+         ":3:5: error: a texture must be a map with one key naming its kind"},
+    });
   }
   SECTION("texture ids must name an entry of the list") {
     std::string e = loadError(dir, "kind: blob\ntextures:\n  - color: [1, 0, 0]\n"
@@ -207,7 +208,7 @@ TEST_CASE("SpeciesModel::addToScene blob textures", "[model]") {
 TEST_CASE("SpeciesModel::missing blob texture", "[model]") {
   // The error comes from loading the species (every section is read at load time), before
   // any model is built or anything is rendered or written.
-  TempDir dir;
+  TempDir dir("blob-textures-test");
   write(dir.path / "s.yaml",
         "kind: blob\ntextures:\n  - image: gone.png\nblob:\n  point: {radius: 1, texture: {id: 0}}\n");
   PathPolicy policy;

@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <string>
 
 #include "model/animate.h"
 #include "growth_frame.h"
@@ -14,8 +15,8 @@ using namespace sprig;
 
 namespace {
 
-/// A small tree with a `tree:` section: rendered as an exact BlobTree surface.
-const char* kSurfaceTree = R"(kind: tree
+/// A small tree without surface settings: the gallery shows its skeleton.
+const std::string kSkeletonTree = R"(kind: tree
 grammar: |
   lsystem: y
   derivation length: 3
@@ -24,23 +25,13 @@ grammar: |
   A --> F[+!(0.07)A][-!(0.07)A]
 steps: 3
 render: {width: 40, height: 32, samples: 1}
-tree: {junctions: smooth}
 )";
 
-/// The same tree without surface settings: the gallery shows its skeleton.
-const char* kSkeletonTree = R"(kind: tree
-grammar: |
-  lsystem: y
-  derivation length: 3
-  angle: 35
-  axiom: !(0.12)A
-  A --> F[+!(0.07)A][-!(0.07)A]
-steps: 3
-render: {width: 40, height: 32, samples: 1}
-)";
+/// The same tree with a `tree:` section: rendered as an exact BlobTree surface.
+const std::string kSurfaceTree = kSkeletonTree + "tree: {junctions: smooth}\n";
 
 /// Two spheres summed: a closed blob.
-const char* kBlob = R"(kind: blob
+const std::string kBlob = R"(kind: blob
 blob:
   blend:
     - point: {center: [-0.4, 0, 0], radius: 0.6}
@@ -129,7 +120,7 @@ TEST_CASE("renderModel::skeleton frames equal the growth engine's frames", "[mod
 }
 
 TEST_CASE("renderModel::deterministic across threads", "[model]") {
-  for (const char* text : {kSurfaceTree, kBlob}) {
+  for (const std::string& text : {kSurfaceTree, kBlob}) {
     Species species = parseSpecies(text, "species.yaml");
     RenderJob job;
     job.width = 40;

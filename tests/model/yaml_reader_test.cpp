@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <initializer_list>
 
 using namespace sprig;
 namespace fs = std::filesystem;
@@ -15,6 +16,23 @@ std::shared_ptr<const YamlFile> parseOk(const std::string& text, DiagnosticList&
   auto f = YamlFile::parse(text, "t.yaml", diags);
   REQUIRE(f);
   return f;
+}
+
+/// A file parsed from text and a MapReader over its top-level map, both reporting to diags.
+struct TopReader {
+  DiagnosticList diags;
+  std::shared_ptr<const YamlFile> file;
+  MapReader reader;
+  explicit TopReader(const std::string& text, std::string context = "test")
+      : file(parseOk(text, diags)), reader(file->rootNode(), diags, std::move(context)) {}
+};
+
+/// CHECKs that diags' messages from index `first` on are `expected`, one by one.
+void checkMessages(const DiagnosticList& diags, size_t first, std::initializer_list<const char*> expected) {
+  for (const char* message : expected) {
+    CAPTURE(first);
+    CHECK(diags.items()[first++].message == message);
+  }
 }
 
 }  // namespace
@@ -68,9 +86,7 @@ TEST_CASE("YamlFile::parse", "[model]") {
 }
 
 TEST_CASE("MapReader::number", "[model]") {
-  DiagnosticList diags;
-  auto f = parseOk("a: 2.5\nb: .nan\nc: -.inf\nd: 12\ne: abc\nf: \"3\"\ng: [1]\nh: 1e3\n", diags);
-  MapReader m(f->rootNode(), diags, "test");
+  auto&& [diags, f, m] = TopReader("a: 2.5\nb: .nan\nc: -.inf\nd: 12\ne: abc\nf: \"3\"\ng: [1]\nh: 1e3\n");
   CHECK(m.number("a", 0) == 2.5);
   CHECK(m.number("missing", 7.0) == 7.0);
   CHECK(m.number("b", 1.0) == 1.0);
@@ -83,32 +99,30 @@ TEST_CASE("MapReader::number", "[model]") {
   m.finish();
   REQUIRE(diags.items().size() == 6);
   CHECK(diags.items()[0].format().rfind("t.yaml:2:4: error: 'b' must be a finite number, got '.nan'", 0) == 0);
-  CHECK(diags.items()[1].message == "'c' must be a finite number, got '-.inf'");
-  CHECK(diags.items()[2].message == "'d' is 12, out of range [0, 10]");
-  CHECK(diags.items()[3].message == "'e' must be a number, got 'abc'");
-  CHECK(diags.items()[4].message == "'f' must be a number, got string '3'");
-  CHECK(diags.items()[5].message == "'g' must be a number, got a sequence");
+  checkMessages(diags, 1,
+                {"'c' must be a finite number, got '-.inf'",
+                 "'d' is 12, out of range [0, 10]",
+                 "'e' must be a number, got 'abc'",
+                 "'f' must be a number, got string '3'",
+                 "'g' must be a number, got a sequence"});
 }
 
 TEST_CASE("MapReader::integer", "[model]") {
-  DiagnosticList diags;
-  auto f = parseOk("a: 5\nb: 2.5\nc: -3\nd: 99999999999999999999\n", diags);
-  MapReader m(f->rootNode(), diags, "test");
+  auto&& [diags, f, m] = TopReader("a: 5\nb: 2.5\nc: -3\nd: 99999999999999999999\n");
   CHECK(m.integer("a", 0, 0, 10) == 5);
   CHECK(m.integer("b", 1) == 1);
   CHECK(m.integer("c", 1, 0) == 1);
   CHECK(m.integer("d", 1) == 1);
   m.finish();
   REQUIRE(diags.items().size() == 3);
-  CHECK(diags.items()[0].message == "'b' must be an integer, got '2.5'");
-  CHECK(diags.items()[1].message == "'c' is -3, must be at least 0");
-  CHECK(diags.items()[2].message == "'d' must be an integer, got '99999999999999999999'");
+  checkMessages(diags, 0,
+                {"'b' must be an integer, got '2.5'",
+                 "'c' is -3, must be at least 0",
+                 "'d' must be an integer, got '99999999999999999999'"});
 }
 
 TEST_CASE("MapReader::finish", "[model]") {
-  DiagnosticList diags;
-  auto f = parseOk("steps: 3\nsede: 4\nturtle:\n  angel: 20\n  extra: 1\n", diags);
-  MapReader top(f->rootNode(), diags, "species file");
+  auto&& [diags, f, top] = TopReader("steps: 3\nsede: 4\nturtle:\n  angel: 20\n  extra: 1\n", "species file");
   CHECK(top.integer("steps", 0) == 3);
   top.integer("seed", 0);
   auto t = top.section("turtle");
@@ -126,12 +140,9 @@ TEST_CASE("MapReader::finish", "[model]") {
 }
 
 TEST_CASE("MapReader::typed", "[model]") {
-  DiagnosticList diags;
-  auto f = parseOk(
+  auto&& [diags, f, m] = TopReader(
       "b1: yes\nb2: maybe\ns: hello\nv: [1, 2, 3]\nv2: [1, 2]\nc1: '#ff8000'\nc2: [0.5, 2, 0]\n"
-      "ch: rond\nsec: 5\nseq: [a, b]\nreq: ~\n",
-      diags);
-  MapReader m(f->rootNode(), diags, "test");
+      "ch: rond\nsec: 5\nseq: [a, b]\nreq: ~\n");
   CHECK(m.boolean("b1", false));
   CHECK(!m.boolean("b2", false));
   CHECK(m.string("s") == "hello");

@@ -4,25 +4,14 @@
 #include <cstdio>
 
 #include "organisms/tree_builder.h"
+#include "tests/organisms/internode.h"
 
 using namespace sprig;
 using namespace sprig::organisms;
-using lsystem::Internode;
 using lsystem::Skeleton;
+using test::seg;
 
 namespace {
-
-Internode seg(DVec3 a, DVec3 b, double r0, double r1, int parent, int order, bool cut = false) {
-  Internode in;
-  in.start = a;
-  in.end = b;
-  in.baseRadius = r0;
-  in.tipRadius = r1;
-  in.parent = parent;
-  in.order = order;
-  in.cut = cut;
-  return in;
-}
 
 // The tree's field through the reference evaluator (tiny test trees).
 struct Field {

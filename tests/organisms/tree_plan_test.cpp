@@ -3,25 +3,14 @@
 #include <cmath>
 
 #include "organisms/tree_plan.h"
+#include "tests/organisms/internode.h"
 
 using namespace sprig;
 using namespace sprig::organisms;
-using lsystem::Internode;
 using lsystem::Skeleton;
+using test::seg;
 
 namespace {
-
-Internode seg(DVec3 a, DVec3 b, double r0, double r1, int parent, int order, bool cut = false) {
-  Internode in;
-  in.start = a;
-  in.end = b;
-  in.baseRadius = r0;
-  in.tipRadius = r1;
-  in.parent = parent;
-  in.order = order;
-  in.cut = cut;
-  return in;
-}
 
 // A trunk of two internodes along +Y (0..1, 1..2) and, at y = 1, a lateral branch.
 Skeleton fork(double rA, double rLead, double rLat) {

@@ -1,0 +1,30 @@
+#pragma once
+/// Clocks for the benchmarks: wall time, and CPU time, which is the steadier measure on a
+/// shared, loaded machine (it does not count the time a thread waits for a core).
+
+#include <chrono>
+#include <ctime>
+
+namespace sprig::bench {
+
+using Clock = std::chrono::steady_clock;
+
+/// Wall seconds since start.
+inline double seconds(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+namespace detail {
+inline double cpuSeconds(clockid_t clock) {
+  timespec ts{};
+  clock_gettime(clock, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+}  // namespace detail
+
+/// CPU seconds of the whole process (all threads): on idle cores, wall time is about
+/// this divided by the number of threads.
+inline double processCpuSeconds() { return detail::cpuSeconds(CLOCK_PROCESS_CPUTIME_ID); }
+
+/// CPU seconds of the calling thread.
+inline double threadCpuSeconds() { return detail::cpuSeconds(CLOCK_THREAD_CPUTIME_ID); }
+
+}  // namespace sprig::bench
