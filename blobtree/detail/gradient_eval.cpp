@@ -9,8 +9,8 @@ namespace sprig::blobtree::detail {
 
 namespace {
 
-// The steps of evalS for the nodes that need more than a few lines. Each is called from one
-// place, so the compiler inlines it back into evalS.
+// The steps of evalS for the nodes that need more than a few lines, each called from one
+// place (GCC 12 inlines all but primitiveS; sample throughput is unchanged).
 
 /// A primitive's value and gradient, with its attributes weighted by the value.
 SV primitiveS(const Prim& P, Vec3 p) {
