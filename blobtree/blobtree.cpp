@@ -68,14 +68,7 @@ bool finiteVec(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std:
 
 /// A primitive node of kind with its geometry fields (see Node) and texture.
 Node primitiveNode(NodeKind kind, Vec3 p0, Vec3 p1, float ra, float rb, TextureAttr tex = {}) {
-  Node n;
-  n.kind = kind;
-  n.p0 = p0;
-  n.p1 = p1;
-  n.ra = ra;
-  n.rb = rb;
-  n.texture = tex;
-  return n;
+  return Node{.kind = kind, .p0 = p0, .p1 = p1, .ra = ra, .rb = rb, .texture = tex};
 }
 
 /// An operator node of kind over children.

@@ -38,17 +38,12 @@ float evalLocalL(const Tape& T, uint32_t ni, const Box3& box);
 Interval evalI(const Tape& T, uint32_t ni, const Box3& box) {
   const TNode& n = T.nodes[ni];
   if (box.empty() || !box.overlaps(n.box)) return {0.0f, 0.0f};
+  if (isPrimitive(n.kind)) {
+    Interval r = primInterval(T.prims[n.prim], box);
+    if (!n.box.contains(box.lo) || !n.box.contains(box.hi)) r.lo = std::min(r.lo, 0.0f);
+    return r;
+  }
   switch (n.kind) {
-    case NodeKind::Point:
-    case NodeKind::Segment:
-    case NodeKind::Cone:
-    case NodeKind::Torus:
-    case NodeKind::Halfspace:
-    case NodeKind::Box: {
-      Interval r = primInterval(T.prims[n.prim], box);
-      if (!n.box.contains(box.lo) || !n.box.contains(box.hi)) r.lo = std::min(r.lo, 0.0f);
-      return r;
-    }
     case NodeKind::Blend: {
       Interval r{0.0f, 0.0f};
       childrenIn(T, n, box, [&](uint32_t c) {
@@ -111,6 +106,7 @@ Interval evalI(const Tape& T, uint32_t ni, const Box3& box) {
     case NodeKind::Bend:
     case NodeKind::Twist:
     case NodeKind::Taper: return evalI(T, T.kids[n.first], localBoxOf(n, T, box));
+    default: break;  // the primitive kinds, bounded above
   }
   return {0.0f, 0.0f};
 }
@@ -125,13 +121,8 @@ namespace {
 float evalLocalL(const Tape& T, uint32_t ni, const Box3& box) {
   const TNode& n = T.nodes[ni];
   if (box.empty() || !box.overlaps(n.box)) return 0.0f;
+  if (isPrimitive(n.kind)) return n.lip;
   switch (n.kind) {
-    case NodeKind::Point:
-    case NodeKind::Segment:
-    case NodeKind::Cone:
-    case NodeKind::Torus:
-    case NodeKind::Halfspace:
-    case NodeKind::Box: return n.lip;
     case NodeKind::Blend:
     case NodeKind::Ricci:
     case NodeKind::Pcm: {
@@ -163,6 +154,7 @@ float evalLocalL(const Tape& T, uint32_t ni, const Box3& box) {
       float ds = std::abs(params(T, n).taper.scale1 - params(T, n).taper.scale0) / params(T, n).taper.length;
       return (1.0f / smin + 1.0f + ds * r / (smin * smin)) * evalL(T, T.kids[n.first], localBoxOf(n, T, box));
     }
+    default: break;  // the primitive kinds, bounded above
   }
   return n.lip;
 }

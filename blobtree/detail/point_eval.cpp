@@ -10,13 +10,8 @@ namespace sprig::blobtree::detail {
 float evalV(const Tape& T, uint32_t ni, Vec3 p, bool cull) {
   const TNode& n = T.nodes[ni];
   if (cull && !n.box.contains(p)) return 0.0f;
+  if (isPrimitive(n.kind)) return primValue(T.prims[n.prim], p, nullptr);
   switch (n.kind) {
-    case NodeKind::Point:
-    case NodeKind::Segment:
-    case NodeKind::Cone:
-    case NodeKind::Torus:
-    case NodeKind::Halfspace:
-    case NodeKind::Box: return primValue(T.prims[n.prim], p, nullptr);
     case NodeKind::Blend: {
       float s = 0.0f;
       if (cull) childrenAt(T, n, p, [&](uint32_t c) { s += evalV(T, c, p, cull); });
@@ -62,6 +57,7 @@ float evalV(const Tape& T, uint32_t ni, Vec3 p, bool cull) {
     case NodeKind::Bend:
     case NodeKind::Twist:
     case NodeKind::Taper: return evalV(T, T.kids[n.first], warpLocal(T, n, p, nullptr), cull);
+    default: break;  // the primitive kinds, evaluated above
   }
   return 0.0f;
 }
