@@ -122,9 +122,7 @@ void readDefines(MapReader& top, TreeSpec& s, DiagnosticList& diags) {
 /// Parses the grammar with the species' own overrides, for its errors and counts.
 void checkGrammar(const Species& species, TreeSpec& spec, DiagnosticList& diags) {
   try {
-    lsystem::Grammar g = speciesGrammar(species);
-    spec.productions = g.productionCount();
-    spec.steps = g.derivationLength();
+    spec.grammar = speciesGrammar(species);
   } catch (const InputError& e) {
     diags.append(e.diagnostics());
   }
@@ -393,6 +391,7 @@ const TreeSpec& treeSpec(const Species& species) {
 
 lsystem::Grammar speciesGrammar(const Species& species, const lsystem::GrammarOverrides& extra) {
   const TreeSpec& tree = treeSpec(species);
+  if (tree.grammar && extra.defines.empty() && !extra.derivationLength && !extra.seed) return *tree.grammar;
   lsystem::GrammarOverrides o = tree.overrides;
   for (const auto& d : extra.defines) o.defines.push_back(d);
   if (extra.derivationLength) o.derivationLength = extra.derivationLength;
@@ -522,6 +521,8 @@ TreeSurface buildTreeSurface(const lsystem::Skeleton& skeleton, const organisms:
 }
 
 std::string TreeSpec::checkSummary(const Species& species) const {
+  const size_t productions = grammar ? grammar->productionCount() : 0;
+  const int steps = grammar ? grammar->derivationLength() : 0;
   return " '" + species.name + "', " + std::to_string(productions) + " productions, " + std::to_string(steps) +
          " steps" + (surface ? ", BlobTree surface" : "");
 }

@@ -31,8 +31,9 @@ class TreeSpec : public KindSpec {
   lsystem::TurtleSettings turtle;       ///< `turtle:` (angle filled from the grammar when unset)
   bool angleSet = false;                ///< `turtle.angle` given in the species file
   std::optional<organisms::TreeOptions> surface;  ///< `tree:` (BlobTree tree builder options)
-  size_t productions = 0;               ///< productions of the grammar (checked at load)
-  int steps = 0;                        ///< its derivation length
+  /// The grammar parsed at load with the species' own overrides (shares its compiled form:
+  /// copies are free); speciesGrammar returns it when no command-line override is given.
+  std::optional<lsystem::Grammar> grammar;
 
   std::string checkSummary(const Species& species) const override;
   std::unique_ptr<KindModel> makeModel(const Species& species, const ModelOptions& options) const override;
