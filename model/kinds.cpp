@@ -3,6 +3,7 @@
 #include <iterator>
 
 #include "model/blob_kind.h"
+#include "model/organism_kind.h"
 #include "model/shell_kind.h"
 #include "model/tree_kind.h"
 
@@ -13,6 +14,7 @@ const std::vector<KindEntry>& speciesKinds() {
       {"tree", readTreeSpec},
       {"shell", readShellSpec},
       {"blob", readBlobSpec},
+      {"organism", readOrganismSpec},
   };
   return kinds;
 }

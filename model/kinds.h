@@ -32,11 +32,12 @@ enum class GeometryMode {
 /// "exact", "mesh", "skeleton".
 const char* geometryModeName(GeometryMode mode);
 
-/// A growth stage. Trees use step and fraction, shells use age; blobs have one stage.
+/// A growth stage. Trees use step and fraction, shells use age, organisms time; blobs have one stage.
 struct Stage {
   int step = -1;        ///< tree: derivation step (-1 = the species' last)
   double fraction = 1;  ///< tree: growth of the modules created in that step, 0..1
   double age = -1;      ///< shell: θ_end in degrees (-1 = the species' age)
+  double time = -1;     ///< organism: animation time 0..1 (-1 = the final time, 1)
 };
 
 /// Counts and times of one built stage (the gallery's figures).

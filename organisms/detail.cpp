@@ -179,7 +179,8 @@ class Tentacle final : public SeedFeature {
     const double magnitude = double(o_.length) * growth(o_.grow, time) * level;
     const double ph = (kPi / 3.0) * level;
     DVec3 displace(std::sin(theta + ph), std::cos(theta + ph), 1.0);
-    if (o_.alternate && level % 2 == 0) displace *= -1.0;
+    if (level % 2 == 0 && o_.alternate == Alternate::All) displace *= -1.0;
+    if (level % 2 == 0 && o_.alternate == Alternate::Tangent) displace.x = -displace.x, displace.y = -displace.y;
     return Vec3(displace * magnitude);
   }
 
@@ -222,11 +223,16 @@ class Mushroom final : public DetailProcedure {
             frames.push_back(view.frames[s.vertex]);
           }
         }
-        // Level first + k adds 2^-k / sum_j 2^-j of the profile's displacement.
+        // The feature's shape at level first + k: the reference surface moved by the share
+        // W_k = sum_{j<=k} 2^-j / sum_j 2^-j of the profile's displacement. The detail is the
+        // difference between that shape and the subdivided surface (§4.1: F is the difference
+        // between the feature at two successive levels), so the vertices of every level lie
+        // on the feature exactly and the finest level on the whole profile.
         const int k = view.level - o.levels.first;
-        double total = 0;
+        double total = 0, done = 0;
         for (int j = 0; j < levelsUsed; ++j) total += std::ldexp(1.0, -j);
-        const float w = float(std::ldexp(1.0, -k) / total) * growth(o.grow, view.time);
+        for (int j = 0; j <= k; ++j) done += std::ldexp(1.0, -j);
+        const float w = float(done / total) * growth(o.grow, view.time);
         const PointGrid grid(view.reference, o.footprint);
         for (size_t s = 0; s < origins.size(); ++s) {
           const Frame& fs = frames[s];
@@ -237,8 +243,8 @@ class Mushroom final : public DetailProcedure {
             if (rho >= o.footprint) return;
             const Vec2 c = mushroomProfile(o, rho);
             const Vec3 radial = rho > 1e-12f ? (xy.x * fs.t + xy.y * fs.b) / rho : Vec3(0.0f);
-            const Vec3 world = (c.x - rho) * radial + c.y * fs.n;
-            out.offset[v] += view.frames[v].toLocal(w * world);
+            const Vec3 target = view.reference[v] + w * ((c.x - rho) * radial + c.y * fs.n);
+            out.offset[v] += view.frames[v].toLocal(target - view.smooth[v]);
           });
         }
       }

@@ -61,15 +61,21 @@ std::shared_ptr<const DetailProcedure> makeBerry(const BerryOptions& options);
 
 /// §4.2.3 Tentacle, the paper's pseudo-code: at local level k = l - first + 1,
 ///   magnitude = length k;  ph = (pi/3) k;  d = (sin(theta + ph), cos(theta + ph), 1);
-///   if k is even: d = -d  (when alternate);  detail = d magnitude,
+///   if k is even: flip d;  detail = d magnitude,
 /// in the seed's local frame. theta = angle + spin time; length grows as
-/// min(1, time / grow) of its value (animation, Fig. 7).
+/// min(1, time / grow) of its value (animation, Fig. 7). What "flip" negates is a choice
+/// (the printed pseudo-code's sign is lost in the scanned text): Tangent (the default)
+/// negates the tangential part, so successive links swing to alternate sides ("grow in
+/// alternating directions") while the tentacle grows out; All negates the whole vector,
+/// whose normal parts sum to -2 length over four levels (a pit, not a tentacle); None
+/// keeps every link turning the same way.
+enum class Alternate { Tangent, All, None };
 struct TentacleOptions {
   float length = 0.05f;
   float angleDeg = 0;
   float spinDeg = 0;     ///< theta increase over time 0..1
   float grow = 0;        ///< 0: full length at every time; else full length from time = grow
-  bool alternate = true;
+  Alternate alternate = Alternate::Tangent;
   LevelRange levels{1, 4};
   Placement placement;
 };
@@ -86,9 +92,11 @@ std::shared_ptr<const DetailProcedure> makeSpur(const SpurOptions& options);
 
 /// §4.2.4 Mushroom cloud: around each seed, reference points at distance rho < footprint in
 /// the seed's tangent plane move onto a mushroom profile C(rho) = (radial, height) in the
-/// seed's frame (fixed at the first level: 3D coordinates around the seed). Level first + k
-/// adds the fraction w_k = 2^-k / sum 2^-j of the profile's displacement (proportional to
-/// scale). The profile is a simple curve whose z bands separate its four pieces (cap top
+/// seed's frame (fixed at the first level: 3D coordinates around the seed). At level first +
+/// k the vertices in the footprint move onto the reference moved by the share
+/// W_k = sum_{j<=k} 2^-j / sum_j 2^-j of the profile's displacement (the coarser levels take
+/// the larger shares: proportional to scale); the detail is that target minus the subdivided
+/// surface, so the mushroom owns its footprint (other detail there is replaced). The profile is a simple curve whose z bands separate its four pieces (cap top
 /// z >= H, underside H - t .. H, stalk 0 .. H - t, foot z = 0) for every growth fraction,
 /// so on a plane the target surface is embedded at every level (docs/ORGANISMS.md).
 struct MushroomOptions {

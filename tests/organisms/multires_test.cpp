@@ -197,8 +197,8 @@ TEST_CASE("Tentacle tip follows the pseudo-code", "[organisms]") {
   for (int k = 1; k <= 4; ++k) {
     std::vector<Frame> frames(sub.vertexCount(k));
     computeFrames(sub.topology(k), r.levelSmooth[size_t(k)], frames);
-    const double th = radians(30.0), ph = kPi / 3 * k, sign = k % 2 == 0 ? -1 : 1;
-    const Vec3 local = float(sign * o.length * k) * Vec3(float(std::sin(th + ph)), float(std::cos(th + ph)), 1.0f);
+    const double th = radians(30.0), ph = kPi / 3 * k, sign = k % 2 == 0 ? -1 : 1;  // tangential flip
+    const Vec3 local = float(o.length * k) * Vec3(float(sign * std::sin(th + ph)), float(sign * std::cos(th + ph)), 1.0f);
     const Vec3 expect = r.levelSmooth[size_t(k)][tip] + frames[tip].toWorld(local);
     INFO("level " << k);
     CHECK(glm::length(r.levelPositions[size_t(k)][tip] - expect) < 1e-6f);

@@ -1,0 +1,534 @@
+#include "model/organism_kind.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+#include "core/timer.h"
+#include "organisms/base_mesh.h"
+#include "organisms/detail.h"
+#include "organisms/placement.h"
+#include "textures/noise.h"
+
+namespace sprig {
+
+namespace {
+
+using namespace organisms;
+
+constexpr int kMaxLevels = 8;
+/// Faces of the finest level an organism may have (the memory of one synthesis is about
+/// 200 bytes per face): 16.8 million, 4^7 times a 1024-face control mesh.
+constexpr size_t kMaxFinestFaces = size_t(1) << 24;
+
+const std::vector<std::string> kBases = {"cube_sphere", "torus", "cylinder", "plane", "revolution"};
+const std::vector<std::string> kProcedures = {"rock", "berry", "tentacle", "spur", "mushroom"};
+
+/// Reads the organism section; every error goes to diags.
+class OrganismReader {
+ public:
+  OrganismReader(DiagnosticList& diags, OrganismSpec& spec) : diags_(diags), spec_(spec) {}
+
+  void read(const YNode& section) {
+    MapReader m(section, diags_, "organism");
+    spec_.levels = int(m.integer("levels", spec_.levels, 1, kMaxLevels));
+    if (auto b = m.get("base")) readBase(*b);
+    else m.node().error(diags_, "missing required key 'base' in organism (e.g. base: {cube_sphere: {radius: 1}})");
+    if (!spec_.base.faceSizes.empty()) {
+      size_t finest = 0;
+      for (uint32_t s : spec_.base.faceSizes) finest += s;  // faces of level 1
+      finest <<= 2 * (spec_.levels - 1);
+      if (finest > kMaxFinestFaces)
+        (m.get("levels") ? *m.get("levels") : m.node())
+            .error(diags_, "'levels' " + std::to_string(spec_.levels) + " makes " + std::to_string(finest) +
+                               " faces, more than the limit " + std::to_string(kMaxFinestFaces) +
+                               "; use fewer levels or a coarser base");
+    }
+    for (const YNode& item : m.sequence("detail")) readProcedure(item, spec_.detail);
+    if (auto b = m.section("blend")) readBlend(*b);
+    for (const YNode& item : m.sequence("modify")) readModification(item);
+    if (auto s = m.section("shader")) readShader(*s);
+    spec_.frames = int(m.integer("frames", spec_.animated ? 24 : 1, 1, 10000));
+    m.finish();
+    const bool scalar = std::any_of(spec_.detail.begin(), spec_.detail.end(), [](auto& p) { return p->writesScalar(); }) ||
+                        std::any_of(spec_.blendDetail.begin(), spec_.blendDetail.end(), [](auto& p) { return p->writesScalar(); });
+    if (scalar && !spec_.planet)
+      section.error(diags_, "a rock with 'output: scalar' needs a shader that uses the scalar (shader: {planet: {...}})");
+  }
+
+ private:
+  // ---- base ----
+  void readBase(const YNode& node) {
+    std::optional<std::pair<YNode, YNode>> one = single(node, "base", kBases);
+    if (!one) return;
+    const auto& [key, value] = *one;
+    const std::string kind = key.scalar();
+    MapReader m(value, diags_, kind);
+    try {
+      if (kind == "cube_sphere") {
+        spec_.base = cubeSphere(float(m.number("radius", 1.0, 1e-6)), int(m.integer("quads", 2, 1, 64)));
+      } else if (kind == "torus") {
+        spec_.base = torus(float(m.number("major", 1.0, 1e-6)), float(m.number("minor", 0.35, 1e-6)),
+                           int(m.integer("around", 12, 3, 1024)), int(m.integer("across", 8, 3, 1024)));
+      } else if (kind == "cylinder") {
+        spec_.base = cylinder(float(m.number("radius", 0.5, 1e-6)), float(m.number("height", 2.0, 1e-6)),
+                              int(m.integer("around", 8, 3, 1024)), int(m.integer("rings", 4, 1, 1024)),
+                              m.boolean("caps", true));
+      } else if (kind == "plane") {
+        spec_.base = plane(float(m.number("size", 2.0, 1e-6)), int(m.integer("quads", 8, 1, 1024)));
+      } else if (kind == "revolution") {
+        readRevolution(m);
+      }
+    } catch (const std::invalid_argument& e) {
+      value.error(diags_, e.what());
+    }
+    m.finish();
+  }
+
+  void readRevolution(MapReader& m) {
+    auto profile = m.get("profile");
+    std::optional<lsystem::Expression> r;
+    if (!profile) {
+      m.node().error(diags_, "missing required key 'profile' in revolution (the radius as an expression of t)");
+    } else if (auto text = profile->asString(diags_, "'profile'")) {
+      SourceLoc at = profile->loc();
+      const bool quoted = profile->node().Tag() == "!";
+      at.col += quoted ? 1 : 0;
+      try {
+        r = lsystem::Expression::compile(*text, {"t"}, at, profile->file().sourceLine(at.line));
+      } catch (const InputError& e) {
+        diags_.append(e.diagnostics());
+      }
+    }
+    double t0 = 0, t1 = 1;
+    if (auto range = m.get("t")) {
+      auto items = range->items();
+      std::optional<double> a, b;
+      if (items.size() == 2) a = items[0].asNumber(diags_, "'t'"), b = items[1].asNumber(diags_, "'t'");
+      if (!a || !b || !(*b > *a)) range->error(diags_, "'t' must be [t0, t1] with t1 > t0");
+      else t0 = *a, t1 = *b;
+    }
+    const int around = int(m.integer("around", 12, 3, 1024)), rings = int(m.integer("rings", 12, 1, 4096));
+    if (!r) return;
+    spec_.base = revolution([&](double t) { return (*r)({t}); }, t0, t1, around, rings);
+  }
+
+  // ---- detail procedures ----
+  void readProcedure(const YNode& item, DetailSet& into) {
+    std::optional<std::pair<YNode, YNode>> one = single(item, "detail entry", kProcedures);
+    if (!one) return;
+    const auto& [key, value] = *one;
+    const std::string kind = key.scalar();
+    MapReader m(value, diags_, kind);
+    std::shared_ptr<const DetailProcedure> p;
+    if (kind == "rock") {
+      RockOptions o;
+      o.amplitude = float(m.number("amplitude", o.amplitude, -1e6, 1e6));
+      o.frequency = float(m.number("frequency", o.frequency, 1e-6, 1e6));
+      o.gain = float(m.number("gain", o.gain, 0.0, 4.0));
+      o.lacunarity = float(m.number("lacunarity", o.lacunarity, 1.0, 8.0));
+      o.levels = levelRange(m, {1, spec_.levels});
+      o.seed = uint64_t(m.integer("seed", 1, 0));
+      o.scalar = m.choice("output", "displace", {"displace", "scalar"}) == "scalar";
+      p = makeRock(o);
+    } else if (kind == "berry") {
+      BerryOptions o;
+      o.radius = float(m.number("radius", o.radius, 1e-6, 1e6));
+      o.ratio = float(m.number("ratio", o.ratio, 0.05, 0.95));
+      o.height = float(m.number("height", o.height, -10.0, 10.0));
+      o.cluster = float(m.number("cluster", o.cluster, 0.05, 1.0));
+      o.levels = levelRange(m, {1, std::min(3, spec_.levels)});
+      o.placement = placement(m, 1.8f * o.radius);
+      p = makeBerry(o);
+    } else if (kind == "tentacle") {
+      TentacleOptions o;
+      o.length = float(m.number("length", o.length, -1e6, 1e6));
+      o.angleDeg = float(m.number("angle_deg", o.angleDeg, -3600.0, 3600.0));
+      o.spinDeg = float(m.number("spin_deg", o.spinDeg, -36000.0, 36000.0));
+      o.grow = float(m.number("grow", o.grow, 0.0, 1.0));
+      const std::string alt = m.choice("alternate", "tangent", {"tangent", "all", "none"});
+      o.alternate = alt == "all" ? Alternate::All : alt == "none" ? Alternate::None : Alternate::Tangent;
+      o.levels = levelRange(m, {1, std::min(4, spec_.levels)});
+      o.placement = placement(m, 0.3f);
+      spec_.animated |= o.spinDeg != 0 || o.grow > 0;
+      p = makeTentacle(o);
+    } else if (kind == "spur") {
+      SpurOptions o;
+      o.length = float(m.number("length", o.length, -1e6, 1e6));
+      o.levels = levelRange(m, {1, 1});
+      o.placement = placement(m, 0.3f);
+      p = makeSpur(o);
+    } else if (kind == "mushroom") {
+      MushroomOptions o;
+      o.height = float(m.number("height", o.height, 1e-6, 1e6));
+      o.capRadius = float(m.number("cap_radius", o.capRadius, 1e-6, 1e6));
+      o.capTop = float(m.number("cap_top", o.capTop, 0.0, 1e6));
+      o.capUnder = float(m.number("cap_under", o.capUnder, 0.0, 1e6));
+      o.stalkRadius = float(m.number("stalk_radius", o.stalkRadius, 1e-6, 1e6));
+      o.footprint = float(m.number("footprint", o.footprint, 1e-6, 1e6));
+      o.grow = float(m.number("grow", o.grow, 0.0, 1.0));
+      o.levels = levelRange(m, {1, std::min(4, spec_.levels)});
+      o.placement = placement(m, 2.5f * o.footprint);
+      if (!(o.stalkRadius < o.capRadius && o.capRadius < o.footprint))
+        m.node().error(diags_, "a mushroom needs stalk_radius < cap_radius < footprint");
+      if (!(o.capUnder < o.height)) m.node().error(diags_, "a mushroom needs cap_under < height");
+      spec_.animated |= o.grow > 0;
+      p = makeMushroom(o);
+    }
+    m.finish();
+    if (p) into.push_back(std::move(p));
+  }
+
+  /// `levels: [first, last]` within 0..spec levels.
+  LevelRange levelRange(MapReader& m, LevelRange def) {
+    auto node = m.get("levels");
+    if (!node) return def;
+    auto items = node->items();
+    std::optional<int64_t> a, b;
+    if (items.size() == 2) a = items[0].asInteger(diags_, "a level"), b = items[1].asInteger(diags_, "a level");
+    if (!a || !b || *a > *b) {
+      node->error(diags_, "'levels' must be [first, last] with first <= last");
+      return def;
+    }
+    if (*a < 0 || *b > spec_.levels) {
+      node->error(diags_, "level range [" + std::to_string(*a) + ", " + std::to_string(*b) +
+                              "] lies outside the organism's levels 0.." + std::to_string(spec_.levels));
+      return def;
+    }
+    return {int(*a), int(*b)};
+  }
+
+  /// `seeds: {spacing | control_vertices | points | faces, footprint, seed}`.
+  Placement placement(MapReader& parent, float defaultSpacing) {
+    Placement p;
+    p.spacing = defaultSpacing;
+    auto section = parent.section("seeds");
+    if (!section) return p;
+    MapReader m(*section, diags_, "seeds");
+    const int ways = int(m.has("spacing")) + int(m.has("control_vertices")) + int(m.has("points")) + int(m.has("faces"));
+    if (ways > 1) m.node().error(diags_, "seeds take one of 'spacing', 'control_vertices', 'points' and 'faces'");
+    p.seed = uint64_t(m.integer("seed", 1, 0));
+    p.surfaceFootprint = m.choice("footprint", "vertex", {"vertex", "surface"}) == "surface";
+    if (m.has("spacing")) {
+      p.kind = Placement::Kind::Spacing;
+      p.spacing = float(m.number("spacing", defaultSpacing, 1e-6, 1e6));
+    }
+    if (m.has("control_vertices")) {
+      if (m.boolean("control_vertices", true)) p.kind = Placement::Kind::ControlVertices;
+    }
+    if (auto pts = m.get("points")) {
+      p.kind = Placement::Kind::Points;
+      for (const YNode& q : pts->items())
+        if (auto v = q.asVec3(diags_, "a seed point")) p.points.push_back(*v);
+      if (p.points.empty()) pts->error(diags_, "'points' must be a list of [x, y, z]");
+    }
+    if (auto faces = m.get("faces")) {
+      p.kind = Placement::Kind::Points;
+      for (const YNode& q : faces->items()) facePoint(q, p.points);
+      if (p.points.empty()) faces->error(diags_, "'faces' must be a list of [face, u, v]");
+    }
+    m.finish();
+    return p;
+  }
+
+  /// [face, u, v] of a control quad: the bilinear point of its corners (projected to the
+  /// surface when the seed is placed).
+  void facePoint(const YNode& q, std::vector<Vec3>& out) {
+    auto items = q.items();
+    std::optional<int64_t> f;
+    std::optional<double> u, v;
+    if (items.size() == 3) {
+      f = items[0].asInteger(diags_, "a face", 0, int64_t(spec_.base.faceCount()) - 1);
+      u = items[1].asNumber(diags_, "u", 0.0, 1.0);
+      v = items[2].asNumber(diags_, "v", 0.0, 1.0);
+    } else {
+      q.error(diags_, "a face seed is [face, u, v]");
+    }
+    if (!f || !u || !v) return;
+    size_t first = 0;
+    for (int64_t i = 0; i < *f; ++i) first += spec_.base.faceSizes[size_t(i)];
+    if (spec_.base.faceSizes[size_t(*f)] != 4) {
+      q.error(diags_, "face " + std::to_string(*f) + " is not a quad: (u, v) seeds need quads");
+      return;
+    }
+    const auto corner = [&](int i) { return spec_.base.positions[spec_.base.faceVertices[first + size_t(i)]]; };
+    const float a = float(*u), b = float(*v);
+    out.push_back((1 - a) * (1 - b) * corner(0) + a * (1 - b) * corner(1) + a * b * corner(2) + (1 - a) * b * corner(3));
+  }
+
+  // ---- blend, modify, shader ----
+  void readBlend(const YNode& node) {
+    MapReader m(node, diags_, "blend");
+    for (const YNode& item : m.sequence("detail")) readProcedure(item, spec_.blendDetail);
+    if (auto c = m.get("color")) {
+      if (auto v = c->asColor(diags_, "'color'")) spec_.blendColor = *v;
+    }
+    if (auto a = m.get("alpha")) readAlpha(*a);
+    else m.node().error(diags_, "missing required key 'alpha' in blend (e.g. alpha: {plane: {normal: [1, 2, 0]}})");
+    m.finish();
+  }
+
+  void readAlpha(const YNode& node) {
+    std::optional<std::pair<YNode, YNode>> one = single(node, "alpha", {"plane", "noise"});
+    if (!one) return;
+    const auto& [key, value] = *one;
+    MapReader m(value, diags_, key.scalar());
+    if (key.scalar() == "plane") {
+      auto plane = std::make_shared<PlaneAlpha>();
+      plane->normal = m.vec3("normal", Vec3(1, 2, 0));
+      if (glm::length(plane->normal) == 0) value.error(diags_, "the blend plane's 'normal' must not be zero");
+      plane->offset = float(m.number("offset", 0.0));
+      plane->speed = float(m.number("speed", 0.0));
+      plane->width = float(m.number("width", 0.5, 0.0));
+      plane->sharp = m.choice("transition", "sharp", {"sharp", "soft"}) == "sharp";
+      spec_.animated |= plane->speed != 0;
+      spec_.alpha = plane;
+    } else {
+      // A procedural alpha: smoothstep of noise of the reference position, the transition
+      // narrowing per level like a sharp plane.
+      const double frequency = m.number("frequency", 1.0, 1e-6);
+      const double width = m.number("width", 0.3, 1e-6);
+      const double threshold = m.number("threshold", 0.0, -1.0, 1.0);
+      const uint64_t seed = uint64_t(m.integer("seed", 1, 0));
+      auto noise = std::make_shared<textures::PerlinNoise>(seed);
+      auto f = std::make_shared<FunctionAlpha>();
+      f->f = [noise, frequency, width, threshold](const Vec3& p, int level, double) {
+        const double w = width / double(1u << unsigned(std::max(0, level - 1)));
+        const double s = ((*noise)(frequency * DVec3(p)) - threshold) / w + 0.5;
+        const double x = std::clamp(s, 0.0, 1.0);
+        return float(x * x * (3 - 2 * x));
+      };
+      spec_.alpha = f;
+    }
+    m.finish();
+  }
+
+  void readModification(const YNode& node) {
+    MapReader m(node, diags_, "modify entry");
+    Modification mod;
+    mod.center = m.vec3("center", mod.center);
+    mod.radius = float(m.number("radius", mod.radius, 1e-6));
+    if (auto g = m.get("gains")) {
+      for (const YNode& x : g->items())
+        if (auto v = x.asNumber(diags_, "a gain", -100.0, 100.0)) mod.gains.push_back(float(*v));
+      if (mod.gains.empty()) g->error(diags_, "'gains' must be a list of numbers, one per level from 0");
+      if (mod.gains.size() > size_t(spec_.levels) + 1)
+        g->error(diags_, "'gains' lists " + std::to_string(mod.gains.size()) + " levels, the organism has 0.." +
+                             std::to_string(spec_.levels));
+    } else {
+      m.node().error(diags_, "missing required key 'gains' in modify entry");
+    }
+    m.finish();
+    spec_.modifications.push_back(mod);
+  }
+
+  void readShader(const YNode& node) {
+    std::optional<std::pair<YNode, YNode>> one = single(node, "shader", {"planet"});
+    if (!one) return;
+    MapReader m(one->second, diags_, "planet");
+    PlanetShader s;
+    s.relief = float(m.number("relief", s.relief));
+    s.seaLevel = float(m.number("sea_level", s.seaLevel));
+    s.mountain = float(m.number("mountain", s.mountain));
+    s.snow = float(m.number("snow", s.snow));
+    s.ocean = m.color("ocean", s.ocean);
+    s.lowland = m.color("lowland", s.lowland);
+    s.highland = m.color("highland", s.highland);
+    s.ice = m.color("ice", s.ice);
+    s.tint = m.color("tint", s.tint);
+    s.tintStrength = float(m.number("tint_strength", s.tintStrength, 0.0, 1.0));
+    m.finish();
+    spec_.planet = s;
+  }
+
+  /// A map with exactly one key among names: that pair, else an error.
+  std::optional<std::pair<YNode, YNode>> single(const YNode& node, const std::string& what,
+                                                const std::vector<std::string>& names) {
+    if (!node.isMap() || node.pairs().size() != 1) {
+      node.error(diags_, what + " must be a map with one key, one of: " + join(names));
+      return std::nullopt;
+    }
+    auto pair = node.pairs()[0];
+    const std::string k = pair.first.scalar();
+    if (std::find(names.begin(), names.end(), k) == names.end()) {
+      pair.first.error(diags_, "unknown " + what + " " + sprig::quoted(k) + didYouMean(k, names) + " (one of: " + join(names) + ")");
+      return std::nullopt;
+    }
+    return pair;
+  }
+
+  static std::string join(const std::vector<std::string>& names) {
+    std::string s;
+    for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
+    return s;
+  }
+
+  DiagnosticList& diags_;
+  OrganismSpec& spec_;
+};
+
+/// The planet shader's colour of scalar h and alpha a.
+Vec3 planetColor(const PlanetShader& s, float h, float a) {
+  Vec3 c = h < s.seaLevel ? s.ocean : h < s.mountain ? s.lowland : h < s.snow ? s.highland : s.ice;
+  if (h < s.seaLevel) c *= 0.6f + 0.4f * std::clamp(1.0f + (h - s.seaLevel) * 10.0f, 0.0f, 1.0f);  // deeper, darker
+  return glm::mix(c, c * (1.0f - s.tintStrength) + s.tint * s.tintStrength, a);
+}
+
+/// An organism: one synthesis per time.
+class OrganismModel final : public KindModel {
+ public:
+  explicit OrganismModel(const OrganismSpec& spec) : spec_(spec) {}
+
+  bool hasSurface() const override { return true; }
+  Stage finalStage() const override {
+    Stage s;
+    s.time = 1;
+    return s;
+  }
+  Stage stageFromIndex(int k) const override {
+    if (k < 0 || k >= spec_.frames)
+      throw UsageError("this organism has stages 0.." + std::to_string(spec_.frames - 1) + " (times 0..1), not " +
+                       std::to_string(k));
+    Stage s;
+    s.time = spec_.frames > 1 ? double(k) / double(spec_.frames - 1) : 1.0;
+    return s;
+  }
+  std::vector<Stage> stripStages(int count) const override {
+    if (!spec_.animated) return {finalStage()};
+    std::vector<Stage> out;
+    for (int i = 0; i < count; ++i) {
+      Stage s;
+      s.time = count > 1 ? double(i) / double(count - 1) : 1.0;
+      out.push_back(s);
+    }
+    return out;
+  }
+  std::vector<Stage> animationFrames(int framesPerStage, int, int) const override {
+    const int n = std::max(1, spec_.frames * std::max(1, framesPerStage));
+    std::vector<Stage> out;
+    for (int i = 0; i < n; ++i) {
+      Stage s;
+      s.time = n > 1 ? double(i) / double(n - 1) : 1.0;
+      out.push_back(s);
+    }
+    return out;
+  }
+  std::string stageName(const Stage& stage) const override {
+    if (!spec_.animated) return {};
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "time %.2f", timeOf(stage));
+    return buf;
+  }
+  int stageNumber(const Stage& stage) const override { return int(std::lround(timeOf(stage) * 100)); }
+
+  Box3 frameBox() override {
+    if (!frame_) {
+      // The final stage's box (time 0 is never larger for growing features).
+      Box3 box = mesh(1.0, Vec3(0.5f)).bounds();
+      frame_ = box.empty() ? Box3{Vec3(-1.0f), Vec3(1.0f)} : box;
+    }
+    return *frame_;
+  }
+
+  BuiltStage build(const Stage& stage, GeometryMode mode, const SpeciesRender& look) override {
+    if (mode == GeometryMode::Skeleton) throw UsageError("organisms have no skeleton: use --mode exact or mesh");
+    BuiltStage out;
+    const auto t0 = std::chrono::steady_clock::now();
+    render::MeshPart part;
+    part.mesh = mesh(timeOf(stage), look.surface.baseColor);
+    part.material = look.surface;
+    out.figures.triangles = part.mesh.triangleCount();
+    out.figures.primitives = spec_.base.faceCount();
+    out.geometry.parts.push_back(std::move(part));
+    out.figures.buildSeconds = secondsSince(t0);
+    return out;
+  }
+
+  Mesh buildMesh(const Stage& stage, float, bool, ModelFigures& figures) override {
+    Mesh m = mesh(timeOf(stage), Vec3(0.72f, 0.60f, 0.48f));
+    figures.triangles = m.triangleCount();
+    figures.primitives = spec_.base.faceCount();
+    return m;
+  }
+
+  GalleryMotion galleryMotion(bool) override {
+    GalleryMotion m;
+    m.turntable = !spec_.animated;
+    m.framesPerStage = 1;
+    return m;
+  }
+
+ private:
+  static double timeOf(const Stage& s) { return s.time < 0 ? 1.0 : s.time; }
+
+  Mesh mesh(double time, const Vec3& baseColor) { return buildOrganismMesh(spec_, time, baseColor); }
+
+  const OrganismSpec& spec_;
+  std::optional<Box3> frame_;
+};
+
+}  // namespace
+
+Mesh buildOrganismMesh(const OrganismSpec& spec, double time, const Vec3& baseColor) {
+  const Subdivision sub(spec.base, spec.levels);
+  SynthesisInput in;
+  in.shapeA = spec.detail;
+  in.shapeB = spec.blendDetail;
+  in.alpha = spec.alpha;
+  in.modifications = spec.modifications;
+  SynthesisOptions options;
+  options.time = time;
+  SynthesisResult r = synthesize(sub, spec.base.positions, in, options);
+  const size_t n = r.positions.size();
+  // The planet shader displaces along the smooth surface's normals by the relief of the
+  // height above the sea (oceans stay flat), then colours by height and alpha.
+  if (spec.planet) {
+    std::vector<Frame> frames(n);
+    computeFrames(sub.topology(sub.levels()), r.positions, frames);
+    for (size_t v = 0; v < n; ++v) {
+      const float h = r.scalar.empty() ? 0.0f : r.scalar[v];
+      r.positions[v] += frames[v].n * (spec.planet->relief * std::max(h, spec.planet->seaLevel));
+    }
+  }
+  Mesh m = limitMesh(sub, r.positions);
+  m.colors.assign(n, baseColor);
+  if (spec.planet) {
+    for (size_t v = 0; v < n; ++v)
+      m.colors[v] = planetColor(*spec.planet, r.scalar.empty() ? 0.0f : r.scalar[v], r.alpha.empty() ? 0.0f : r.alpha[v]);
+  } else if (spec.blendColor && !r.alpha.empty()) {
+    for (size_t v = 0; v < n; ++v) m.colors[v] = glm::mix(baseColor, *spec.blendColor, r.alpha[v]);
+  }
+  return m;
+}
+
+std::shared_ptr<const KindSpec> readOrganismSpec(MapReader& top, Species&, DiagnosticList& diags) {
+  std::optional<YNode> section = top.section("organism");
+  if (!section) {
+    if (!top.has("organism")) top.node().error(diags, "missing required key 'organism' in species file");
+    return nullptr;
+  }
+  auto spec = std::make_shared<OrganismSpec>();
+  spec->loc = section->loc();
+  const size_t before = diags.items().size();
+  OrganismReader(diags, *spec).read(*section);
+  for (size_t i = before; i < diags.items().size(); ++i)
+    if (diags.items()[i].severity == Severity::Error) return nullptr;
+  if (spec->base.faceSizes.empty()) return nullptr;
+  return spec;
+}
+
+std::string OrganismSpec::checkSummary(const Species& species) const {
+  size_t faces = 0;
+  for (uint32_t s : base.faceSizes) faces += s;
+  faces <<= 2 * (levels - 1);
+  return " '" + species.name + "', " + std::to_string(base.faceCount()) + " control faces, " + std::to_string(levels) +
+         " levels (" + std::to_string(faces) + " faces)";
+}
+
+std::unique_ptr<KindModel> OrganismSpec::makeModel(const Species&, const ModelOptions&) const {
+  return std::make_unique<OrganismModel>(*this);
+}
+
+}  // namespace sprig
