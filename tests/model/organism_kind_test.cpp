@@ -1,0 +1,125 @@
+#include <catch2/catch.hpp>
+
+#include <cstring>
+
+#include "core/mesh.h"
+#include "core/parallel.h"
+#include "model/model.h"
+#include "model/organism_kind.h"
+#include "model/species.h"
+
+using namespace sprig;
+
+namespace {
+
+/// The error text parseSpecies throws for text (empty when it loads).
+std::string errorOf(const std::string& text) {
+  try {
+    parseSpecies(text, "org.yaml");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return {};
+}
+
+const OrganismSpec& specOf(const Species& s) { return dynamic_cast<const OrganismSpec&>(*s.spec); }
+
+}  // namespace
+
+TEST_CASE("kind: organism reads its keys", "[model][organism]") {
+  const Species s = parseSpecies(R"(kind: organism
+organism:
+  base: {cube_sphere: {radius: 1, quads: 2}}
+  levels: 3
+  detail:
+    - rock: {amplitude: 0.05, levels: [1, 3]}
+    - tentacle: {length: 0.05, spin_deg: 90, seeds: {control_vertices: true}}
+  modify:
+    - {center: [0, 1, 0], radius: 0.3, gains: [1, 0, 1, 2]}
+)", "org.yaml");
+  const OrganismSpec& o = specOf(s);
+  CHECK(o.base.faceCount() == 24);
+  CHECK(o.levels == 3);
+  CHECK(o.detail.size() == 2);
+  CHECK(o.detail[0]->name() == "rock");
+  CHECK(o.animated);       // the tentacle spins
+  CHECK(o.frames == 24);   // animated organisms default to 24 stages
+  REQUIRE(o.modifications.size() == 1);
+  CHECK(o.modifications[0].gains.size() == 4);
+
+  SECTION("the mesh is closed with 2 triangles per finest quad and one colour per vertex") {
+    const Mesh m = buildOrganismMesh(o, 1.0, Vec3(0.5f));
+    CHECK(m.triangleCount() == 2u * 24u * 64u);
+    CHECK(m.colors.size() == m.vertexCount());
+    CHECK(m.normals.size() == m.vertexCount());
+    const MeshTopology topo = analyzeTopology(m);
+    CHECK(topo.closed());
+    CHECK(topo.manifold());
+    CHECK(signedVolume(m) > 0);
+  }
+  SECTION("same bytes at 1 and 2 threads") {
+    Mesh a, b;
+    {
+      ThreadLimit limit(1);
+      a = buildOrganismMesh(o, 0.5, Vec3(0.5f));
+    }
+    {
+      ThreadLimit limit(2);
+      b = buildOrganismMesh(o, 0.5, Vec3(0.5f));
+    }
+    REQUIRE(a.vertexCount() == b.vertexCount());
+    CHECK(std::memcmp(a.positions.data(), b.positions.data(), a.vertexCount() * sizeof(Vec3)) == 0);
+    CHECK(std::memcmp(a.normals.data(), b.normals.data(), a.vertexCount() * sizeof(Vec3)) == 0);
+  }
+  SECTION("stages are times") {
+    SpeciesModel model(s);
+    CHECK(model.finalStage().time == 1.0);
+    CHECK(model.stageFromIndex(0).time == 0.0);
+    CHECK(model.stageFromIndex(23).time == 1.0);
+    CHECK_THROWS_AS(model.stageFromIndex(24), UsageError);
+  }
+}
+
+TEST_CASE("kind: organism reports its mistakes at file:line:col", "[model][organism]") {
+  CHECK(errorOf("kind: organism\norganism:\n  base: {cube_sphere: {}}\n  detail:\n    - rok: {}\n")
+            .find("org.yaml:5:7: error: unknown detail entry 'rok' (did you mean 'rock'?)") != std::string::npos);
+  CHECK(errorOf("kind: organism\norganism:\n  levels: 3\n  base: {cube_sphere: {}}\n  detail:\n    - rock: {levels: [1, 5]}\n")
+            .find("org.yaml:6:22: error: level range [1, 5] lies outside the organism's levels 0..3") != std::string::npos);
+  CHECK(errorOf("kind: organism\norganism:\n  base: {sphere: {}}\n")
+            .find("org.yaml:3:10: error: unknown base 'sphere'") != std::string::npos);
+  CHECK(errorOf("kind: organism\norganism:\n  base: {cube_sphere: {radius: 1}}\n  levels: 9\n")
+            .find("org.yaml:4:11: error: 'levels' is 9, out of range [1, 8]") != std::string::npos);
+  CHECK(errorOf("kind: organism\norganism:\n  base: {cube_sphere: {quads: 64}}\n  levels: 8\n")
+            .find("more than the limit 16777216") != std::string::npos);
+  // A profile expression's error points into the expression.
+  const std::string e = errorOf(
+      "kind: organism\norganism:\n  base: {revolution: {profile: \"0.3 + sin(t\", t: [0, 1]}}\n");
+  CHECK(e.find("org.yaml:3:") != std::string::npos);
+  CHECK(e.find("error:") != std::string::npos);
+  CHECK(errorOf("kind: organism\norganism:\n  base: {revolution: {profile: \"0.3 - t\", t: [0, 1]}}\n")
+            .find("must be finite and >= 0") != std::string::npos);
+  CHECK(errorOf("kind: organism\norganism:\n  base: {plane: {}}\n  detail:\n    - rock: {output: scalar}\n")
+            .find("needs a shader that uses the scalar") != std::string::npos);
+  CHECK(errorOf("kind: organism\norganism:\n  base: {plane: {}}\n  detail:\n    - mushroom: {cap_radius: 0.5, footprint: 0.4}\n")
+            .find("stalk_radius < cap_radius < footprint") != std::string::npos);
+  CHECK(errorOf("kind: organism\norganism:\n  base: {plane: {}}\n  blend: {detail: []}\n")
+            .find("missing required key 'alpha' in blend") != std::string::npos);
+}
+
+TEST_CASE("Organism blends colour by alpha and the planet shader colours by height", "[model][organism]") {
+  const Species s = parseSpecies(R"(kind: organism
+organism:
+  base: {cube_sphere: {radius: 1, quads: 2}}
+  levels: 3
+  blend:
+    detail: []
+    alpha: {plane: {normal: [1, 0, 0], offset: 0, width: 0}}
+    color: [1, 0, 0]
+)", "org.yaml");
+  const Mesh m = buildOrganismMesh(specOf(s), 1.0, Vec3(0, 0, 1));
+  for (size_t v = 0; v < m.vertexCount(); ++v) {
+    if (std::abs(m.positions[v].x) < 0.05f) continue;  // the limit surface moves a little
+    INFO("vertex at x = " << m.positions[v].x);
+    REQUIRE(m.colors[v] == (m.positions[v].x > 0 ? Vec3(1, 0, 0) : Vec3(0, 0, 1)));
+  }
+}
