@@ -426,7 +426,7 @@ class OrganismModel final : public KindModel {
   Box3 frameBox() override {
     if (!frame_) {
       // The final stage's box (time 0 is never larger for growing features).
-      Box3 box = mesh(1.0, Vec3(0.5f)).bounds();
+      Box3 box = surface(1.0).mesh.bounds();
       frame_ = box.empty() ? Box3{Vec3(-1.0f), Vec3(1.0f)} : box;
     }
     return *frame_;
@@ -463,15 +463,31 @@ class OrganismModel final : public KindModel {
  private:
   static double timeOf(const Stage& s) { return s.time < 0 ? 1.0 : s.time; }
 
-  Mesh mesh(double time, const Vec3& baseColor) { return buildOrganismMesh(spec_, time, baseColor); }
+  /// The surface at time; the last one is kept (framing and the render of the final stage
+  /// use the same synthesis).
+  const OrganismSurface& surface(double time) {
+    if (!cached_ || cachedTime_ != time) {
+      cached_ = buildOrganismSurface(spec_, time);
+      cachedTime_ = time;
+    }
+    return *cached_;
+  }
+
+  Mesh mesh(double time, const Vec3& baseColor) {
+    Mesh m = surface(time).mesh;
+    m.colors = organismColors(spec_, *cached_, baseColor);
+    return m;
+  }
 
   const OrganismSpec& spec_;
   std::optional<Box3> frame_;
+  std::optional<OrganismSurface> cached_;
+  double cachedTime_ = 0;
 };
 
 }  // namespace
 
-Mesh buildOrganismMesh(const OrganismSpec& spec, double time, const Vec3& baseColor) {
+OrganismSurface buildOrganismSurface(const OrganismSpec& spec, double time) {
   const Subdivision sub(spec.base, spec.levels);
   SynthesisInput in;
   in.shapeA = spec.detail;
@@ -481,26 +497,37 @@ Mesh buildOrganismMesh(const OrganismSpec& spec, double time, const Vec3& baseCo
   SynthesisOptions options;
   options.time = time;
   SynthesisResult r = synthesize(sub, spec.base.positions, in, options);
-  const size_t n = r.positions.size();
-  // The planet shader displaces along the smooth surface's normals by the relief of the
-  // height above the sea (oceans stay flat), then colours by height and alpha.
-  if (spec.planet) {
-    std::vector<Frame> frames(n);
+  // The planet shader displaces along the surface's normals by the relief of the height
+  // above the sea (oceans stay flat at the sea level).
+  if (spec.planet && !r.scalar.empty()) {
+    std::vector<Frame> frames(r.positions.size());
     computeFrames(sub.topology(sub.levels()), r.positions, frames);
-    for (size_t v = 0; v < n; ++v) {
-      const float h = r.scalar.empty() ? 0.0f : r.scalar[v];
-      r.positions[v] += frames[v].n * (spec.planet->relief * std::max(h, spec.planet->seaLevel));
-    }
+    for (size_t v = 0; v < r.positions.size(); ++v)
+      r.positions[v] += frames[v].n * (spec.planet->relief * std::max(r.scalar[v], spec.planet->seaLevel));
   }
-  Mesh m = limitMesh(sub, r.positions);
-  m.colors.assign(n, baseColor);
+  OrganismSurface out;
+  out.mesh = limitMesh(sub, r.positions);
+  out.alpha = std::move(r.alpha);
+  out.scalar = std::move(r.scalar);
+  return out;
+}
+
+std::vector<Vec3> organismColors(const OrganismSpec& spec, const OrganismSurface& s, const Vec3& baseColor) {
+  const size_t n = s.mesh.vertexCount();
+  std::vector<Vec3> colors(n, baseColor);
   if (spec.planet) {
     for (size_t v = 0; v < n; ++v)
-      m.colors[v] = planetColor(*spec.planet, r.scalar.empty() ? 0.0f : r.scalar[v], r.alpha.empty() ? 0.0f : r.alpha[v]);
-  } else if (spec.blendColor && !r.alpha.empty()) {
-    for (size_t v = 0; v < n; ++v) m.colors[v] = glm::mix(baseColor, *spec.blendColor, r.alpha[v]);
+      colors[v] = planetColor(*spec.planet, s.scalar.empty() ? 0.0f : s.scalar[v], s.alpha.empty() ? 0.0f : s.alpha[v]);
+  } else if (spec.blendColor && !s.alpha.empty()) {
+    for (size_t v = 0; v < n; ++v) colors[v] = glm::mix(baseColor, *spec.blendColor, s.alpha[v]);
   }
-  return m;
+  return colors;
+}
+
+Mesh buildOrganismMesh(const OrganismSpec& spec, double time, const Vec3& baseColor) {
+  OrganismSurface s = buildOrganismSurface(spec, time);
+  s.mesh.colors = organismColors(spec, s, baseColor);
+  return std::move(s.mesh);
 }
 
 std::shared_ptr<const KindSpec> readOrganismSpec(MapReader& top, Species&, DiagnosticList& diags) {

@@ -70,8 +70,22 @@ class OrganismSpec : public KindSpec {
 /// Reads the `organism:` section of a species file (required), adding every error to diags.
 std::shared_ptr<const KindSpec> readOrganismSpec(MapReader& top, Species& species, DiagnosticList& diags);
 
+/// The synthesized organism at one time: its limit mesh (no colours yet) and the finest
+/// level's blend alpha and scalar (empty when unused).
+struct OrganismSurface {
+  Mesh mesh;
+  std::vector<float> alpha, scalar;
+};
+
+/// Synthesizes the organism at time t (0..1); the planet shader's relief is applied.
+OrganismSurface buildOrganismSurface(const OrganismSpec& spec, double time);
+
+/// Per-vertex colours of a surface: baseColor, blended toward the blend colour by alpha, or
+/// the planet shader's colours.
+std::vector<Vec3> organismColors(const OrganismSpec& spec, const OrganismSurface& surface, const Vec3& baseColor);
+
 /// The organism at time t (0..1) as a triangle mesh with limit normals and per-vertex
-/// colours (the material's base colour where nothing colours it). Throws InputError.
+/// colours (the material's base colour where nothing colours it).
 Mesh buildOrganismMesh(const OrganismSpec& spec, double time, const Vec3& baseColor);
 
 }  // namespace sprig
