@@ -7,6 +7,8 @@
 
 #include "core/mesh.h"
 #include "core/parallel.h"
+#include "core/rng.h"
+#include "organisms/analysis.h"
 #include "organisms/base_mesh.h"
 #include "organisms/detail.h"
 #include "organisms/multires.h"
@@ -352,5 +354,47 @@ TEST_CASE("The mushroom profile is a simple curve at every growth", "[organisms]
       }
     INFO("growth " << W);
     CHECK(crossings == 0);
+  }
+}
+
+TEST_CASE("Analysis then synthesis reproduces the resampled surface", "[organisms]") {
+  const ControlMesh ball = cubeSphere(1.0f, 2);
+  const Subdivision sub(ball, 5);
+  SECTION("arbitrary samples on the finest level") {
+    std::vector<Vec3> fine = referenceLevels(sub, ball.positions).back();
+    Rng rng(7);
+    for (Vec3& p : fine) p *= float(1.0 + 0.05 * rng.uniform(-1, 1));
+    const AnalysisResult a = decompose(sub, fine, 2);
+    SynthesisInput in;
+    in.shapeA = {makeStoredDetail(a.details)};
+    const SynthesisResult r = synthesize(sub, a.control, in);
+    float worst = 0;
+    for (size_t v = 0; v < fine.size(); ++v) worst = std::max(worst, glm::length(r.positions[v] - fine[v]));
+    INFO("worst " << worst);
+    CHECK(worst < 1e-5f * 2.0f);  // 1e-5 of the size (diameter 2)
+  }
+  SECTION("a captured sphere found by rays along the normals") {
+    const float R = 1.05f;
+    const SurfaceProbe sphere = [R](const Vec3& o, const Vec3& d, float maxDistance) -> std::optional<float> {
+      // |o + t d| = R, the root nearest t = 0.
+      const float b = glm::dot(o, d), c = glm::dot(o, o) - R * R, disc = b * b - c;
+      if (disc < 0) return std::nullopt;
+      const float t1 = -b + std::sqrt(disc), t2 = -b - std::sqrt(disc);
+      const float t = std::abs(t1) < std::abs(t2) ? t1 : t2;
+      return std::abs(t) <= maxDistance ? std::optional<float>(t) : std::nullopt;
+    };
+    AnalysisOptions o;
+    o.maxDistance = 0.5f;
+    const AnalysisResult a = analyze(sub, ball.positions, sphere, o);
+    CHECK(a.misses == 0);
+    for (const Vec3& p : a.resampled) REQUIRE(glm::length(p) == Approx(R).epsilon(1e-5));
+    SynthesisInput in;
+    in.shapeA = {makeStoredDetail(a.details)};
+    const SynthesisResult r = synthesize(sub, a.control, in);
+    float worst = 0;
+    for (size_t v = 0; v < r.positions.size(); ++v) worst = std::max(worst, glm::length(r.positions[v] - a.resampled[v]));
+    CHECK(worst < 2e-5f);
+    const SurfaceProbe nothing = [](const Vec3&, const Vec3&, float) { return std::optional<float>(); };
+    CHECK(analyze(sub, ball.positions, nothing, o).misses == sub.vertexCount(5));
   }
 }
