@@ -1,5 +1,6 @@
 #include <catch2/catch.hpp>
 
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <string>
@@ -446,4 +447,38 @@ TEST_CASE("checkPolyMesh", "[core]") {
     CHECK(d.items()[1].format() == "error: face 1: vertex index 7 is out of range (3 vertices)");
     CHECK(d.items()[2].format() == "error: face 2: a face needs at least 3 vertices, found 2");
   }
+}
+
+TEST_CASE("readPolyMesh of CGAL's free meshes", "[core]") {
+  const fs::path tarball = "/usr/share/doc/libcgal-demo/data.tar.gz";
+  if (!fs::exists(tarball)) {
+    WARN("SKIP: " << tarball << " is missing (scripts/install-deps.sh installs libcgal-demo)");
+    return;
+  }
+  test::TempDir dir("cgal-meshes");
+  fs::path out = dir.path / "meshes";
+  std::string cmd = "bash '" SPRIG_SOURCE_DIR "/scripts/extract-meshes.sh' '" + out.string() + "'";
+  REQUIRE(std::system(cmd.c_str()) == 0);
+  struct Expected {
+    const char* file;
+    size_t vertices, faces, boundaryEdges;
+  };
+  const Expected expected[] = {
+      {"mannequin-devil.off", 12977, 25888, 64}, {"head.off", 1487, 2918, 58},  {"fandisk.off", 6475, 12946, 0},
+      {"torus_quad.off", 25, 25, 0},             {"sphere.off", 162, 320, 0},   {"cactus.off", 620, 1236, 0},
+      {"mushroom.off", 2337, 4608, 64},
+  };
+  for (const Expected& e : expected) {
+    INFO(e.file);
+    PolyMesh m = readPolyMesh(out / e.file, e.file);
+    CHECK(m.positions.size() == e.vertices);
+    CHECK(m.faceCount() == e.faces);
+    PolyTopology t = topologyOf(m);
+    CHECK(t.boundaryEdges == e.boundaryEdges);
+    CHECK(t.manifold());
+  }
+  // A second run finds everything up to date and prints nothing.
+  std::string again = cmd + " > '" + (dir.path / "log").string() + "' 2>&1";
+  REQUIRE(std::system(again.c_str()) == 0);
+  CHECK(readFile(dir.path / "log").empty());
 }
