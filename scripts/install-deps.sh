@@ -8,6 +8,7 @@ packages=(
   libglm-dev libembree-dev libtbb-dev libopenimageio-dev openimageio-tools
   libosd-dev libyaml-cpp-dev catch2 libcli11-dev libtinygltf-dev libopenvdb-dev libboost-iostreams-dev zlib1g-dev
   libbenchmark-dev parallel
+  libmeshoptimizer-dev libcgal-demo
 )
 
 missing=()

@@ -9,31 +9,12 @@
 
 #include "core/atomic_file.h"
 #include "core/mesh_io.h"
+#include "tests/core/cube_mesh.h"
 
 using namespace sprig;
 namespace fs = std::filesystem;
 
 namespace {
-
-// A unit cube with 8 shared vertices, 12 outward triangles and every optional array.
-Mesh cube(bool attributes) {
-  Mesh m;
-  for (int i = 0; i < 8; ++i) m.positions.push_back(Vec3(i & 1, (i >> 1) & 1, (i >> 2) & 1));
-  const uint32_t quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (auto& q : quads) {
-    m.triangles.push_back({q[0], q[1], q[2]});
-    m.triangles.push_back({q[0], q[2], q[3]});
-  }
-  if (attributes) {
-    for (const auto& p : m.positions) {
-      m.normals.push_back(glm::normalize(p - Vec3(0.5f)));
-      m.uvs.push_back(Vec2(p.x, 0.25f + 0.5f * p.y));
-      m.colors.push_back(Vec3(p.x, 0.5f, p.z));
-    }
-    for (size_t t = 0; t < m.triangles.size(); ++t) m.materials.push_back(uint32_t(t / 4));
-  }
-  return m;
-}
 
 struct TempDir {
   fs::path path;
@@ -57,7 +38,7 @@ T readRaw(const std::string& bytes, size_t offset) {
 
 TEST_CASE("writePly", "[core]") {
   TempDir dir;
-  Mesh m = cube(true);
+  Mesh m = test::cube(true);
   fs::path file = dir.path / "cube.PLY";
   writeMesh(m, file);
   std::string bytes = readFile(file);
@@ -97,7 +78,7 @@ TEST_CASE("writePly", "[core]") {
   }
 
   SECTION("without optional arrays only positions and faces are written") {
-    writePly(cube(false), file);
+    writePly(test::cube(false), file);
     std::string plain = readFile(file);
     size_t e = plain.find("end_header\n") + std::strlen("end_header\n");
     CHECK(plain.find("nx") == std::string::npos);
@@ -111,7 +92,7 @@ TEST_CASE("writePly", "[core]") {
 
 TEST_CASE("writeObj", "[core]") {
   TempDir dir;
-  Mesh m = cube(true);
+  Mesh m = test::cube(true);
   writeMesh(m, dir.path / "cube.obj");
   REQUIRE(fs::exists(dir.path / "cube.mtl"));
   CHECK(dir.entries() == 2);
@@ -174,7 +155,7 @@ TEST_CASE("writeObj", "[core]") {
   for (const auto& name : used) CHECK(mtl.find("newmtl " + name + "\n") != std::string::npos);
 
   SECTION("plain mesh: v and f only, one material") {
-    writeObj(cube(false), dir.path / "plain.obj");
+    writeObj(test::cube(false), dir.path / "plain.obj");
     std::string text = readFile(dir.path / "plain.obj");
     CHECK(text.find("vn ") == std::string::npos);
     CHECK(text.find("\nf 1 3 4\n") != std::string::npos);
@@ -185,7 +166,7 @@ TEST_CASE("writeObj", "[core]") {
 
 TEST_CASE("writeGlb", "[core]") {
   TempDir dir;
-  Mesh m = cube(true);
+  Mesh m = test::cube(true);
   fs::path file = dir.path / "cube.glb";
   MeshWriteOptions opt;
   opt.baseColor = Vec3(0.25f, 0.5f, 0.75f);
@@ -239,7 +220,7 @@ TEST_CASE("writeGlb", "[core]") {
 
 TEST_CASE("writeMesh::failures", "[core]") {
   TempDir dir;
-  Mesh m = cube(true);
+  Mesh m = test::cube(true);
   SECTION("a missing folder throws and leaves nothing") {
     for (const char* name : {"a.ply", "a.obj", "a.glb"}) {
       INFO(name);

@@ -1,0 +1,134 @@
+#include "organisms/simplify.h"
+
+#include "organisms/edge_collapse.h"
+
+#include <meshoptimizer.h>
+
+#include <algorithm>
+#include <array>
+#include <utility>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace sprig::organisms {
+
+namespace {
+
+// Whether two triangles have the same three vertices. meshoptimizer 0.18 now and then
+// folds a flap onto its neighbour: a triangle and its reverse, back to back, which an
+// edge count does not always see (alone, such a pair is a closed two-face pillow).
+bool hasFoldedPair(const std::vector<unsigned int>& indices) {
+  std::vector<std::array<unsigned, 3>> keys(indices.size() / 3);
+  for (size_t f = 0; f < keys.size(); ++f) {
+    keys[f] = {indices[3 * f], indices[3 * f + 1], indices[3 * f + 2]};
+    std::sort(keys[f].begin(), keys[f].end());
+  }
+  std::sort(keys.begin(), keys.end());
+  return std::adjacent_find(keys.begin(), keys.end()) != keys.end();
+}
+
+// Edge counts of an index buffer of triangles.
+MeshTopology topologyOf(const std::vector<unsigned int>& indices) {
+  Mesh m;
+  m.triangles.resize(indices.size() / 3);
+  std::memcpy(m.triangles.data(), indices.data(), m.triangles.size() * sizeof(glm::uvec3));
+  return analyzeTopology(m);
+}
+
+}  // namespace
+
+SimplifiedMesh simplifyMesh(const Mesh& mesh, size_t targetFaces, float maxRelativeError) {
+  SimplifiedMesh out;
+  SimplifyReport& report = out.report;
+  report.inputTriangles = mesh.triangleCount();
+  size_t n = mesh.vertexCount();
+  bool hasColors = !mesh.colors.empty() && mesh.colors.size() == n;
+
+  // Positions with -0 made +0: welding compares bytes.
+  std::vector<Vec3> positions(n);
+  for (size_t i = 0; i < n; ++i) {
+    const Vec3& p = mesh.positions[i];
+    if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z))
+      throw std::invalid_argument("simplifyMesh: vertex " + std::to_string(i) + " has a position that is not finite");
+    positions[i] = p + Vec3(0.0f);
+  }
+  std::vector<unsigned int> indices;
+  indices.reserve(mesh.triangleCount() * 3);
+  for (const auto& t : mesh.triangles) {
+    if (t.x >= n || t.y >= n || t.z >= n)
+      throw std::invalid_argument("simplifyMesh: a triangle index is out of range (" + std::to_string(n) + " vertices)");
+    indices.insert(indices.end(), {t.x, t.y, t.z});
+  }
+
+  // 1. Weld coincident positions; drop triangles that weld to a line or a point.
+  std::vector<unsigned int> remap(n);
+  size_t welded = meshopt_generateVertexRemap(remap.data(), indices.data(), indices.size(), positions.data(), n, sizeof(Vec3));
+  meshopt_remapIndexBuffer(indices.data(), indices.data(), indices.size(), remap.data());
+  std::vector<Vec3> weldedPositions(welded), weldedColors(hasColors ? welded : 0);
+  meshopt_remapVertexBuffer(weldedPositions.data(), positions.data(), n, sizeof(Vec3), remap.data());
+  if (hasColors) meshopt_remapVertexBuffer(weldedColors.data(), mesh.colors.data(), n, sizeof(Vec3), remap.data());
+  size_t kept = 0;
+  for (size_t t = 0; t < indices.size(); t += 3) {
+    unsigned a = indices[t], b = indices[t + 1], c = indices[t + 2];
+    if (a == b || b == c || a == c) continue;
+    indices[kept++] = a, indices[kept++] = b, indices[kept++] = c;
+  }
+  indices.resize(kept);
+  report.weldedVertices = welded;
+  if (indices.empty()) return out;
+  const float* xyz = &weldedPositions[0].x;
+
+  // 2. Edge collapses down to the target, the border locked (meshoptimizer asserts that
+  // the target is no larger than the mesh). meshoptimizer 0.18 does not test the link
+  // condition, so a collapse now and then pinches the surface: an edge of four faces, or
+  // a triangle folded onto its reverse. A result of a manifold input that is pinched, or
+  // whose boundary changed, is replaced by Sprig's own link-checked collapses
+  // (organisms/edge_collapse.h).
+  size_t target = std::min(targetFaces, indices.size() / 3);
+  std::vector<unsigned int> simplified(indices.size());
+  float error = 0;
+  size_t count = meshopt_simplify(simplified.data(), indices.data(), indices.size(), xyz, welded, sizeof(Vec3),
+                                  target * 3, maxRelativeError, meshopt_SimplifyLockBorder, &error);
+  simplified.resize(count);
+  float scale = meshopt_simplifyScale(xyz, welded, sizeof(Vec3));
+  MeshTopology input = topologyOf(indices);
+  if (input.manifold()) {
+    MeshTopology result = topologyOf(simplified);
+    if (!result.manifold() || result.boundaryEdges != input.boundaryEdges || hasFoldedPair(simplified)) {
+      EdgeCollapseResult own = collapseEdges(weldedPositions, indices, target, maxRelativeError * scale);
+      simplified = std::move(own.indices);
+      count = simplified.size();
+      error = scale > 0 ? own.error / scale : 0;
+      report.linkChecked = true;
+    }
+  }
+
+  // 3. Compact: only used vertices, in order of first use.
+  std::vector<unsigned int> compact(welded);
+  size_t used = meshopt_optimizeVertexFetchRemap(compact.data(), simplified.data(), count, welded);
+  meshopt_remapIndexBuffer(simplified.data(), simplified.data(), count, compact.data());
+  PolyMesh& poly = out.mesh;
+  poly.positions.resize(used);
+  meshopt_remapVertexBuffer(poly.positions.data(), weldedPositions.data(), welded, sizeof(Vec3), compact.data());
+  if (hasColors) {
+    poly.colors.resize(used);
+    meshopt_remapVertexBuffer(poly.colors.data(), weldedColors.data(), welded, sizeof(Vec3), compact.data());
+  }
+  poly.faceVertices.assign(simplified.begin(), simplified.end());
+  poly.faceSizes.assign(count / 3, 3);
+
+  report.faces = count / 3;
+  report.vertices = used;
+  report.relativeError = error;
+  report.absoluteError = error * scale;
+  return out;
+}
+
+PolyMesh simplifyToFaceCount(const Mesh& mesh, size_t targetFaces, float maxRelativeError) {
+  return simplifyMesh(mesh, targetFaces, maxRelativeError).mesh;
+}
+
+}  // namespace sprig::organisms

@@ -1,0 +1,64 @@
+#pragma once
+/// Simplification of any Sprig mesh (a polygonized blob, shell or tree, or a read mesh) to
+/// a control mesh of about a chosen face count, for subdivision and procedural detail.
+///
+/// Three steps through meshoptimizer 0.18 (simplify.cpp is Sprig's only caller of it):
+///  1. weld: vertices at the same position become one (meshopt_generateVertexRemap on
+///     positions alone, -0 and +0 alike), so seams of normals, uvs or colors do not cut
+///     the surface; triangles that collapse to a line or a point by welding are dropped;
+///  2. simplify: meshopt_simplify's edge collapses with meshopt_SimplifyLockBorder, so the
+///     boundary of an open mesh stays where it is and a closed mesh stays closed; where
+///     its result is pinched, organisms/edge_collapse.h's link-checked collapses instead;
+///  3. compact: unused vertices are removed, the rest renumbered in order of first use.
+/// The result is deterministic: the same mesh gives the same bytes.
+
+#include <cstddef>
+
+#include "core/mesh.h"
+#include "core/polymesh.h"
+
+namespace sprig::organisms {
+
+/// What a simplification achieved.
+struct SimplifyReport {
+  size_t inputTriangles = 0;
+  size_t weldedVertices = 0;  ///< vertices after welding coincident positions
+  size_t faces = 0;           ///< triangles of the result
+  size_t vertices = 0;        ///< vertices of the result
+  /// meshoptimizer's error of the result, relative to the mesh's extent (the largest side
+  /// of its bounding box); absoluteError is the same in the mesh's units.
+  float relativeError = 0;
+  float absoluteError = 0;
+  /// meshoptimizer's result pinched the surface and Sprig's link-checked collapses
+  /// (organisms/edge_collapse.h) made this one instead (see simplifyMesh).
+  bool linkChecked = false;
+};
+
+/// A simplified mesh and its report.
+struct SimplifiedMesh {
+  PolyMesh mesh;  ///< triangles as faces; colors kept when the input has them; no faceLocs
+  SimplifyReport report;
+};
+
+/// Reduces mesh to about targetFaces triangles (fewer is never asked of meshoptimizer;
+/// it may stop above the target when topology or maxRelativeError, relative to the mesh
+/// extent, forbids more collapses). Normals, uvs and materials are dropped; colors are
+/// kept (at welded vertices, one of the coincident colors).
+///
+/// When the welded input is manifold, so is the result, and it has the same boundary
+/// edges (none for a closed input). meshoptimizer 0.18 alone does not promise that: its
+/// edge collapses do not test the link condition and now and then pinch the surface (an
+/// edge of four faces) or fold a triangle onto its reverse (for mannequin-devil.off at 43
+/// of 65 targets from 50 to 25,000 faces; 103 pinched edges reducing a 1.3 M-triangle
+/// sphere to 50,000).
+/// Such a result is replaced by Sprig's link-checked collapses (organisms/edge_collapse.h;
+/// report.linkChecked says so).
+/// Throws std::invalid_argument for an index out of range or a position that is not
+/// finite. Cost: O(T log T) for T triangles: 1.3 M triangles to 500 in 1.2-2.3 s on one
+/// core of a shared machine, 2.5-3.5 s more when the link-checked collapses run.
+SimplifiedMesh simplifyMesh(const Mesh& mesh, size_t targetFaces, float maxRelativeError = 1e-1f);
+
+/// simplifyMesh(...).mesh.
+PolyMesh simplifyToFaceCount(const Mesh& mesh, size_t targetFaces, float maxRelativeError = 1e-1f);
+
+}  // namespace sprig::organisms

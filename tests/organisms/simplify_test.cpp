@@ -1,0 +1,122 @@
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <optional>
+
+#include "core/polymesh.h"
+#include "organisms/simplify.h"
+#include "tests/organisms/meshes.h"
+#include "tests/scratch_dir.h"
+
+using namespace sprig;
+using namespace sprig::organisms;
+
+namespace {
+
+
+}  // namespace
+
+TEST_CASE("simplifyMesh", "[organisms]") {
+  const Vec3 center(1, 2, 3);
+  const float radius = 2.5f;
+  Mesh sphere = test::unwelded(test::icosphere(5, center, radius));
+  REQUIRE(sphere.triangleCount() == 20480);
+  REQUIRE(sphere.vertexCount() == 61440);
+
+  SECTION("a fine sphere to about 500 closed, manifold faces on the sphere") {
+    SimplifiedMesh s = simplifyMesh(sphere, 500);
+    CHECK(s.report.inputTriangles == 20480);
+    CHECK(s.report.weldedVertices == 10242);
+    CHECK(s.report.faces == s.mesh.faceCount());
+    CHECK(s.report.vertices == s.mesh.positions.size());
+    CHECK(s.mesh.faceCount() >= 400);
+    CHECK(s.mesh.faceCount() <= 600);
+    CHECK(s.report.relativeError > 0);
+    CHECK(s.report.relativeError <= 0.1f);
+    CHECK(s.report.absoluteError == Approx(s.report.relativeError * 2 * radius).epsilon(1e-3));
+    PolyTopology t = test::checked(s.mesh);
+    CHECK(t.closed());
+    CHECK(t.manifold());
+    // A closed genus-0 triangle mesh: V - E + F = 2 with E = 3F/2.
+    CHECK(s.mesh.positions.size() == s.mesh.faceCount() / 2 + 2);
+    for (const Vec3& p : s.mesh.positions) CHECK(std::fabs(glm::length(p - center) - radius) <= 0.02f * radius);
+    Mesh tri = triangulate(s.mesh);
+    double sphereVolume = 4.0 / 3.0 * kPi * radius * radius * radius;
+    CHECK(signedVolume(tri) > 0.95 * sphereVolume);
+    CHECK(signedVolume(tri) < sphereVolume);
+  }
+  SECTION("the same mesh gives the same bytes") {
+    PolyMesh a = simplifyToFaceCount(sphere, 500), b = simplifyToFaceCount(sphere, 500);
+    REQUIRE(a.positions.size() == b.positions.size());
+    REQUIRE(a.faceVertices.size() == b.faceVertices.size());
+    CHECK(std::memcmp(a.positions.data(), b.positions.data(), a.positions.size() * sizeof(Vec3)) == 0);
+    CHECK(a.faceVertices == b.faceVertices);
+    CHECK(a.faceSizes == b.faceSizes);
+  }
+  SECTION("maxRelativeError stops early") {
+    SimplifiedMesh s = simplifyMesh(sphere, 500, 1e-4f);
+    CHECK(s.mesh.faceCount() > 2000);
+    CHECK(s.report.relativeError <= 1e-4f);
+    CHECK(test::checked(s.mesh).closed());
+  }
+  SECTION("an open mesh keeps its border; colors are kept") {
+    // The upper half of the sphere (every triangle with a vertex above the centre).
+    Mesh full = test::icosphere(5, center, radius), cap;
+    cap.positions = full.positions;
+    for (const Vec3& p : cap.positions) cap.colors.push_back(Vec3((p.y - center.y) / radius, 0.5f, 0.25f));
+    for (const auto& t : full.triangles)
+      if (full.positions[t.x].y > center.y || full.positions[t.y].y > center.y || full.positions[t.z].y > center.y)
+        cap.triangles.push_back(t);
+    PolyTopology before = test::checked(toPolyMesh(cap));
+    REQUIRE(before.boundaryEdges > 0);
+    SimplifiedMesh s = simplifyMesh(cap, 300);
+    PolyTopology after = test::checked(s.mesh);
+    CHECK(after.boundaryEdges == before.boundaryEdges);
+    CHECK(after.manifold());
+    CHECK(s.mesh.faceCount() < cap.triangleCount() / 4);
+    REQUIRE(s.mesh.colors.size() == s.mesh.positions.size());
+    for (size_t i = 0; i < s.mesh.positions.size(); ++i)
+      CHECK(s.mesh.colors[i].x == Approx((s.mesh.positions[i].y - center.y) / radius).margin(1e-5));
+  }
+  SECTION("a target above the mesh's size keeps every welded triangle") {
+    SimplifiedMesh s = simplifyMesh(sphere, 1'000'000);
+    CHECK(s.mesh.faceCount() == 20480);
+    CHECK(s.mesh.positions.size() == 10242);
+    CHECK(s.report.relativeError == 0);
+  }
+  SECTION("an empty mesh gives an empty mesh") {
+    SimplifiedMesh s = simplifyMesh(Mesh{}, 100);
+    CHECK(s.mesh.faceCount() == 0);
+    CHECK(s.mesh.positions.empty());
+  }
+  SECTION("bad input") {
+    Mesh bad = test::icosphere(0, center, radius);
+    bad.triangles[3].y = 99;
+    CHECK_THROWS_WITH(simplifyMesh(bad, 10), "simplifyMesh: a triangle index is out of range (12 vertices)");
+    bad = test::icosphere(0, center, radius);
+    bad.positions[4].z = std::nanf("");
+    CHECK_THROWS_WITH(simplifyMesh(bad, 10), "simplifyMesh: vertex 4 has a position that is not finite");
+  }
+}
+
+TEST_CASE("simplifyMesh where meshoptimizer pinches", "[organisms]") {
+  test::TempDir dir("simplify-meshes");
+  std::optional<std::filesystem::path> meshes = test::freeMeshes(dir.path);
+  if (!meshes) return;
+  Mesh m = triangulate(readPolyMesh(*meshes / "mannequin-devil.off"));
+  // meshoptimizer 0.18 leaves an edge of four faces at this target; the link-checked
+  // collapses replace its result.
+  SimplifiedMesh s = simplifyMesh(m, 677);
+  CHECK(s.report.linkChecked);
+  CHECK(s.mesh.faceCount() <= 677);  // a collapse removes two faces
+  CHECK(s.mesh.faceCount() >= 676);
+  PolyTopology t = test::checked(s.mesh);
+  CHECK(t.manifold());
+  CHECK(t.boundaryEdges == 64);
+  CHECK(s.report.relativeError > 0);
+  CHECK(s.report.relativeError < 0.1f);
+  // And at the sphere's 500, meshoptimizer's own result stands.
+  CHECK(!simplifyMesh(test::icosphere(5, Vec3(0), 1), 500).report.linkChecked);
+}
