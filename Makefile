@@ -12,6 +12,7 @@ all: build
 
 deps:
 	@bash scripts/install-deps.sh
+	@bash scripts/extract-meshes.sh species/meshes
 
 configure: deps
 	@cmake -S . -B $(BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null

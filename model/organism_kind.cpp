@@ -6,8 +6,13 @@
 #include <cstdio>
 #include <map>
 
+#include "core/polymesh.h"
 #include "core/timer.h"
+#include "model/model.h"
+#include "organisms/analysis.h"
 #include "organisms/base_mesh.h"
+#include "organisms/simplify.h"
+#include "render/scene.h"
 #include "organisms/detail.h"
 #include "organisms/placement.h"
 #include "textures/noise.h"
@@ -23,13 +28,49 @@ constexpr int kMaxLevels = 8;
 /// 200 bytes per face): 16.8 million, 4^7 times a 1024-face control mesh.
 constexpr size_t kMaxFinestFaces = size_t(1) << 24;
 
-const std::vector<std::string> kBases = {"cube_sphere", "torus", "cylinder", "plane", "revolution"};
-const std::vector<std::string> kProcedures = {"rock", "berry", "tentacle", "spur", "mushroom"};
+const std::vector<std::string> kBases = {"cube_sphere", "torus", "cylinder", "plane", "revolution", "mesh", "species"};
+const std::vector<std::string> kProcedures = {"rock", "berry", "tentacle", "spur", "mushroom", "captured"};
+
+/// Organisms whose base is another species may nest this deep (a file naming itself fails).
+constexpr int kMaxSpeciesNesting = 4;
+thread_local int gSpeciesNesting = 0;
+
+/// `center`, `size` and `rotate` of a mesh read from a file: moved so its box is centred at
+/// the origin, scaled so its largest side is size (0 = as it is), then turned by angle_deg
+/// about axis (right-handed).
+struct MeshPlacement {
+  bool center = false;
+  float size = 0;
+  Vec3 axis{0, 1, 0};
+  float angleDeg = 0;
+  void apply(std::vector<Vec3>& positions, const Box3& box) const {
+    const Vec3 c = center ? 0.5f * (box.lo + box.hi) : Vec3(0.0f);
+    const Vec3 ext = box.hi - box.lo;
+    const float largest = std::max(ext.x, std::max(ext.y, ext.z));
+    const float k = size > 0 && largest > 0 ? size / largest : 1.0f;
+    // Rodrigues' rotation.
+    const Vec3 u = glm::normalize(axis);
+    const float th = float(radians(double(angleDeg))), cs = std::cos(th), sn = std::sin(th);
+    for (Vec3& p : positions) {
+      const Vec3 q = (p - c) * k;
+      p = angleDeg == 0 ? q : q * cs + glm::cross(u, q) * sn + u * glm::dot(u, q) * (1 - cs);
+    }
+  }
+};
+
+ControlMesh controlOf(const PolyMesh& m) {
+  ControlMesh c;
+  c.positions = m.positions;
+  c.faceSizes = m.faceSizes;
+  c.faceVertices = m.faceVertices;
+  return c;
+}
 
 /// Reads the organism section; every error goes to diags.
 class OrganismReader {
  public:
-  OrganismReader(DiagnosticList& diags, OrganismSpec& spec) : diags_(diags), spec_(spec) {}
+  OrganismReader(DiagnosticList& diags, OrganismSpec& spec, const PathPolicy& policy)
+      : diags_(diags), spec_(spec), policy_(policy) {}
 
   void read(const YNode& section) {
     MapReader m(section, diags_, "organism");
@@ -45,6 +86,10 @@ class OrganismReader {
             .error(diags_, "'levels' " + std::to_string(spec_.levels) + " makes " + std::to_string(finest) +
                                " faces, more than the limit " + std::to_string(kMaxFinestFaces) +
                                "; use fewer levels or a coarser base");
+    }
+    if (auto c = m.section("capture")) {
+      captureGiven_ = true;
+      readCapture(*c);
     }
     for (const YNode& item : m.sequence("detail")) readProcedure(item, spec_.detail);
     if (auto b = m.section("blend")) readBlend(*b);
@@ -80,11 +125,138 @@ class OrganismReader {
         spec_.base = plane(float(m.number("size", 2.0, 1e-6)), int(m.integer("quads", 8, 1, 1024)));
       } else if (kind == "revolution") {
         readRevolution(m);
+      } else if (kind == "mesh") {
+        readMeshBase(m);
+      } else if (kind == "species") {
+        readSpeciesBase(m);
       }
     } catch (const std::invalid_argument& e) {
       value.error(diags_, e.what());
     }
     m.finish();
+  }
+
+  MeshPlacement meshPlacement(MapReader& m) {
+    MeshPlacement p;
+    p.center = m.boolean("center", false);
+    p.size = float(m.number("size", 0.0, 0.0, 1e6));
+    if (auto r = m.section("rotate")) {
+      MapReader rm(*r, diags_, "rotate");
+      p.axis = rm.vec3("axis", p.axis);
+      p.angleDeg = float(rm.number("angle_deg", 0.0, -360.0, 360.0));
+      if (glm::length(p.axis) == 0) r->error(diags_, "the rotation 'axis' must not be zero");
+      rm.finish();
+    }
+    return p;
+  }
+
+  /// A polygon mesh file, checked (every error at its face's file:line:col), placed.
+  std::optional<PolyMesh> readMeshFile(MapReader& m, const MeshPlacement& place) {
+    auto file = m.path("file", policy_);
+    if (!file) {
+      if (!m.has("file")) m.node().error(diags_, "missing required key 'file' in " + std::string("mesh"));
+      return std::nullopt;
+    }
+    try {
+      PolyMesh mesh = readPolyMesh(*file);
+      const size_t before = diags_.items().size();
+      checkPolyMesh(mesh, diags_);
+      if (diags_.items().size() != before) return std::nullopt;
+      place.apply(mesh.positions, mesh.bounds());
+      return mesh;
+    } catch (const InputError& e) {
+      diags_.append(e.diagnostics());
+    } catch (const std::invalid_argument& e) {
+      m.get("file")->error(diags_, e.what());
+    }
+    return std::nullopt;
+  }
+
+  void readMeshBase(MapReader& m) {
+    const MeshPlacement place = meshPlacement(m);
+    const int64_t faces = m.integer("faces", 0, 0, 1'000'000);
+    std::optional<PolyMesh> mesh = readMeshFile(m, place);
+    if (!mesh) return;
+    if (faces > 0 && mesh->faceCount() > size_t(faces)) mesh = organisms::simplifyToFaceCount(triangulate(*mesh), size_t(faces));
+    spec_.base = controlOf(*mesh);
+  }
+
+  /// The surface (final stage's mesh) of the species file at key `key`, or nullopt after
+  /// an error. Species bases nest at most kMaxSpeciesNesting deep.
+  std::optional<Mesh> speciesSurface(MapReader& m, const char* key) {
+    auto file = m.path(key, policy_);
+    if (!file) {
+      if (!m.has(key)) m.node().error(diags_, std::string("missing required key '") + key + "' (a species file)");
+      return std::nullopt;
+    }
+    if (gSpeciesNesting >= kMaxSpeciesNesting) {
+      m.get(key)->error(diags_, "species bases nest more than " + std::to_string(kMaxSpeciesNesting) +
+                                    " deep (does a species name itself?)");
+      return std::nullopt;
+    }
+    std::optional<Mesh> out;
+    ++gSpeciesNesting;
+    try {
+      const Species base = loadSpecies(*file, policy_);
+      SpeciesModel model(base);
+      if (!model.hasSurfaceSettings())
+        throw UsageError("species " + file->string() + " has no surface (a tree needs a tree: section)");
+      ModelFigures figures;
+      out = model.buildMesh(model.finalStage(), 0.0f, false, &figures);
+    } catch (const InputError& e) {
+      diags_.append(e.diagnostics());
+    } catch (const std::exception& e) {
+      m.get(key)->error(diags_, e.what());
+    }
+    --gSpeciesNesting;
+    return out;
+  }
+
+  /// Another species' surface reduced to about `faces` faces.
+  void readSpeciesBase(MapReader& m) {
+    const int64_t faces = m.integer("faces", 1000, 4, 1'000'000);
+    const MeshPlacement place = meshPlacement(m);
+    std::optional<Mesh> surface = speciesSurface(m, "file");
+    if (!surface) return;
+    PolyMesh control = organisms::simplifyToFaceCount(*surface, size_t(faces));
+    place.apply(control.positions, control.bounds());
+    spec_.base = controlOf(control);
+  }
+
+  /// `capture: {file | species, max_distance, smoothing, center, size, rotate}`: analysis of a captured mesh
+  /// onto the base (§2.2); its details become the `captured` procedure.
+  void readCapture(const YNode& node) {
+    MapReader m(node, diags_, "capture");
+    const MeshPlacement place = meshPlacement(m);
+    organisms::AnalysisOptions o;
+    o.maxDistance = float(m.number("max_distance", o.maxDistance, 1e-9));
+    o.smoothing = int(m.integer("smoothing", o.smoothing, 0, 100));
+    std::optional<Mesh> captured;
+    if (m.has("species") == m.has("file")) {
+      m.node().error(diags_, "capture takes one of 'file' (a mesh file) and 'species' (a species file)");
+    } else if (m.has("species")) {
+      captured = speciesSurface(m, "species");
+      if (captured) place.apply(captured->positions, captured->bounds());
+    } else if (std::optional<PolyMesh> mesh = readMeshFile(m, place)) {
+      captured = triangulate(*mesh);
+    }
+    m.finish();
+    if (!captured || spec_.base.faceSizes.empty()) return;
+    render::Scene scene;
+    scene.addMesh(*captured, scene.addMaterial({}));
+    scene.commit();
+    const organisms::SurfaceProbe probe = [&scene](const Vec3& from, const Vec3& d, float maxDistance) -> std::optional<float> {
+      const auto ahead = scene.intersect(from, d, 0.0f, maxDistance);
+      const auto behind = scene.intersect(from, -d, 0.0f, maxDistance);
+      if (ahead && (!behind || ahead->t <= behind->t)) return ahead->t;
+      if (behind) return -behind->t;
+      return std::nullopt;
+    };
+    const Subdivision sub(spec_.base, spec_.levels);
+    organisms::AnalysisResult a = organisms::analyze(sub, spec_.base.positions, probe, o);
+    spec_.captureMisses = a.misses;
+    spec_.base.positions = std::move(a.control);
+    spec_.captured = makeStoredDetail(std::move(a.details));
   }
 
   void readRevolution(MapReader& m) {
@@ -160,6 +332,10 @@ class OrganismReader {
       o.levels = levelRange(m, {1, 1});
       o.placement = placement(m, 0.3f);
       p = makeSpur(o);
+    } else if (kind == "captured") {
+      if (!spec_.captured && !captureGiven_)
+        key.error(diags_, "'captured' detail needs a 'capture:' section in the organism");
+      p = spec_.captured;
     } else if (kind == "mushroom") {
       MushroomOptions o;
       o.height = float(m.number("height", o.height, 1e-6, 1e6));
@@ -367,6 +543,8 @@ class OrganismReader {
 
   DiagnosticList& diags_;
   OrganismSpec& spec_;
+  const PathPolicy& policy_;
+  bool captureGiven_ = false;  // a failed capture: 'captured' entries add no second error
 };
 
 /// The planet shader's colour of scalar h and alpha a.
@@ -530,7 +708,7 @@ Mesh buildOrganismMesh(const OrganismSpec& spec, double time, const Vec3& baseCo
   return std::move(s.mesh);
 }
 
-std::shared_ptr<const KindSpec> readOrganismSpec(MapReader& top, Species&, DiagnosticList& diags) {
+std::shared_ptr<const KindSpec> readOrganismSpec(MapReader& top, Species& species, DiagnosticList& diags) {
   std::optional<YNode> section = top.section("organism");
   if (!section) {
     if (!top.has("organism")) top.node().error(diags, "missing required key 'organism' in species file");
@@ -539,7 +717,7 @@ std::shared_ptr<const KindSpec> readOrganismSpec(MapReader& top, Species&, Diagn
   auto spec = std::make_shared<OrganismSpec>();
   spec->loc = section->loc();
   const size_t before = diags.items().size();
-  OrganismReader(diags, *spec).read(*section);
+  OrganismReader(diags, *spec, species.policy).read(*section);
   for (size_t i = before; i < diags.items().size(); ++i)
     if (diags.items()[i].severity == Severity::Error) return nullptr;
   if (spec->base.faceSizes.empty()) return nullptr;

@@ -5,7 +5,9 @@
 /// ```
 ///   kind: organism
 ///   organism:
-///     base: {cube_sphere: {radius: 1, quads: 2}}   # or torus, cylinder, plane, revolution
+///     base: {cube_sphere: {radius: 1, quads: 2}}   # or torus, cylinder, plane, revolution,
+///                                                   # mesh: {file, faces}, species: {file, faces}
+///     capture: {file: meshes/head.off}              # optional: analysed into `captured` detail
 ///     levels: 6                                     # Catmull-Clark levels (1..8)
 ///     detail:                                       # shape A: procedures, summed
 ///       - rock: {amplitude: 0.1, frequency: 2, levels: [1, 6], seed: 1}
@@ -59,6 +61,8 @@ class OrganismSpec : public KindSpec {
   std::optional<Vec3> blendColor;
   std::vector<organisms::Modification> modifications;
   std::optional<PlanetShader> planet;
+  std::shared_ptr<const organisms::DetailProcedure> captured;  ///< `capture:` analysed, or null
+  size_t captureMisses = 0;  ///< finest vertices whose rays missed the captured mesh
   int frames = 1;        ///< animation stages over time 0..1 (1 = a still organism)
   bool animated = false; ///< some procedure, the alpha or the shader depends on time
   SourceLoc loc;
