@@ -1,12 +1,17 @@
 #include <catch2/catch.hpp>
 
 #include <cstring>
+#include <fstream>
 
 #include "core/mesh.h"
+#include "core/mesh_io.h"
 #include "core/parallel.h"
 #include "model/model.h"
 #include "model/organism_kind.h"
 #include "model/species.h"
+#include "organisms/base_mesh.h"
+#include "organisms/multires.h"
+#include "tests/scratch_dir.h"
 
 using namespace sprig;
 
@@ -122,4 +127,33 @@ organism:
     INFO("vertex at x = " << m.positions[v].x);
     REQUIRE(m.colors[v] == (m.positions[v].x > 0 ? Vec3(1, 0, 0) : Vec3(0, 0, 1)));
   }
+}
+
+TEST_CASE("Organism bases from mesh files, and captured surfaces", "[model][organism]") {
+  test::TempDir dir("organism_mesh_base");
+  // A closed quad cube as OFF, and a finer sphere of radius 1.05 as OBJ (Sprig's writer).
+  std::ofstream(dir.path / "cube.off") << "OFF\n8 6 0\n-1 -1 -1\n1 -1 -1\n1 1 -1\n-1 1 -1\n-1 -1 1\n1 -1 1\n1 1 1\n-1 1 1\n"
+                                          "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 2 3 7 6\n4 1 2 6 5\n4 0 4 7 3\n";
+  {
+    const organisms::ControlMesh ball = organisms::cubeSphere(1.05f, 8);
+    const organisms::Subdivision sub(ball, 1);
+    writeObj(organisms::limitMesh(sub, organisms::referenceLevels(sub, ball.positions).back()), dir.path / "ball.obj");
+  }
+  const PathPolicy policy{dir.path, false};
+  const std::string head = "kind: organism\norganism:\n  base: {mesh: {file: cube.off}}\n  levels: 4\n";
+  const Species plain = parseSpecies(head, (dir.path / "a.yaml").string(), policy);
+  CHECK(specOf(plain).base.faceCount() == 6);
+  const Mesh cube = buildOrganismMesh(specOf(plain), 1.0, Vec3(0.5f));
+  CHECK(analyzeTopology(cube).closed());
+  // Captured onto the cube: the subdivided cube becomes the sphere of radius 1.05.
+  const Species cap = parseSpecies(head + "  capture: {file: ball.obj, max_distance: 0.8}\n  detail: [{captured: {}}]\n",
+                                   (dir.path / "b.yaml").string(), policy);
+  CHECK(specOf(cap).captureMisses == 0);
+  const Mesh ball = buildOrganismMesh(specOf(cap), 1.0, Vec3(0.5f));
+  double worst = 0;
+  for (const Vec3& p : ball.positions) worst = std::max(worst, std::abs(double(glm::length(p)) - 1.05));
+  INFO("worst radius error " << worst);
+  CHECK(worst < 0.04);  // the limit surface lies inside the reproduced control points on the sphere
+  CHECK(errorOf("kind: organism\norganism:\n  base: {plane: {}}\n  detail: [{captured: {}}]\n")
+            .find("'captured' detail needs a 'capture:' section") != std::string::npos);
 }
