@@ -575,23 +575,10 @@ class OrganismModel final : public KindModel {
   }
   std::vector<Stage> stripStages(int count) const override {
     if (!spec_.animated) return {finalStage()};
-    std::vector<Stage> out;
-    for (int i = 0; i < count; ++i) {
-      Stage s;
-      s.time = count > 1 ? double(i) / double(count - 1) : 1.0;
-      out.push_back(s);
-    }
-    return out;
+    return evenTimes(count);
   }
   std::vector<Stage> animationFrames(int framesPerStage, int, int) const override {
-    const int n = std::max(1, spec_.frames * std::max(1, framesPerStage));
-    std::vector<Stage> out;
-    for (int i = 0; i < n; ++i) {
-      Stage s;
-      s.time = n > 1 ? double(i) / double(n - 1) : 1.0;
-      out.push_back(s);
-    }
-    return out;
+    return evenTimes(std::max(1, spec_.frames * std::max(1, framesPerStage)));
   }
   std::string stageName(const Stage& stage) const override {
     if (!spec_.animated) return {};
@@ -640,6 +627,13 @@ class OrganismModel final : public KindModel {
 
  private:
   static double timeOf(const Stage& s) { return s.time < 0 ? 1.0 : s.time; }
+
+  /// n stages at evenly spaced times from 0 to 1 (one stage: time 1).
+  static std::vector<Stage> evenTimes(int n) {
+    std::vector<Stage> out(size_t(std::max(1, n)));
+    for (size_t i = 0; i < out.size(); ++i) out[i].time = out.size() > 1 ? double(i) / double(out.size() - 1) : 1.0;
+    return out;
+  }
 
   /// The surface at time; the last one is kept (framing and the render of the final stage
   /// use the same synthesis).

@@ -24,18 +24,6 @@ Vec3 anyPerpendicular(const Vec3& n) {
   return glm::normalize(glm::cross(n, a));
 }
 
-/// Index of the position nearest p (first on ties).
-uint32_t nearestVertex(std::span<const Vec3> positions, const Vec3& p) {
-  uint32_t best = 0;
-  float bestD = std::numeric_limits<float>::infinity();
-  for (size_t i = 0; i < positions.size(); ++i) {
-    Vec3 d = positions[i] - p;
-    float dd = glm::dot(d, d);
-    if (dd < bestD) bestD = dd, best = uint32_t(i);
-  }
-  return best;
-}
-
 /// Edge hops from source to every vertex, up to maxHops (-1 beyond).
 std::vector<int> hopDistances(const VertexNeighbours& nb, uint32_t source, int maxHops) {
   std::vector<int> hops(nb.offsets.size() - 1, -1);
@@ -61,7 +49,7 @@ void applyModifications(const LevelView& view, const std::vector<Modification>& 
     const size_t l = size_t(view.level);
     if (l >= m.gains.size() || m.gains[l] == 1.0f || m.radius <= 0) continue;
     if (!nb) nb = vertexNeighbours(*view.topology);
-    const uint32_t centre = nearestVertex(view.reference, m.center);
+    const uint32_t centre = nearestPosition(view.reference, m.center);
     const int maxHops = int(std::ceil(m.radius / std::max(view.sampleSize, 1e-30f)));
     const std::vector<int> hops = hopDistances(*nb, centre, maxHops);
     for (size_t v = 0; v < hops.size(); ++v) {
@@ -197,6 +185,17 @@ Mesh controlMeshOf(const LevelTopology& topo, std::span<const Vec3> positions) {
   for (size_t v = 0; v < positions.size(); ++v) mesh.normals[v] = frames[v].n;
   triangulateFaces(topo, positions, mesh);
   return mesh;
+}
+
+uint32_t nearestPosition(std::span<const Vec3> positions, const Vec3& p) {
+  uint32_t best = 0;
+  float bestD = std::numeric_limits<float>::infinity();
+  for (size_t i = 0; i < positions.size(); ++i) {
+    const Vec3 d = positions[i] - p;
+    const float dd = glm::dot(d, d);
+    if (dd < bestD) bestD = dd, best = uint32_t(i);
+  }
+  return best;
 }
 
 float meanEdgeLength(const LevelTopology& topo, std::span<const Vec3> p) {

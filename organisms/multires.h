@@ -181,6 +181,9 @@ Mesh limitMesh(const Subdivision& subdivision, std::span<const Vec3> finest);
 /// from the faces), for tests and level figures.
 Mesh controlMeshOf(const LevelTopology& topo, std::span<const Vec3> positions);
 
+/// Index of the position nearest p (the first on ties). O(n).
+uint32_t nearestPosition(std::span<const Vec3> positions, const Vec3& p);
+
 /// Mean edge length of a level's mesh with the given positions.
 float meanEdgeLength(const LevelTopology& topo, std::span<const Vec3> positions);
 

@@ -44,21 +44,10 @@ Vec3 closestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& 
   return bary = {1 - v - w, v, w}, a + ab * v + ac * w;
 }
 
-uint32_t nearestIndex(std::span<const Vec3> positions, const Vec3& p) {
-  uint32_t best = 0;
-  float bestD = std::numeric_limits<float>::infinity();
-  for (size_t i = 0; i < positions.size(); ++i) {
-    const Vec3 d = positions[i] - p;
-    const float dd = glm::dot(d, d);
-    if (dd < bestD) bestD = dd, best = uint32_t(i);
-  }
-  return best;
-}
-
 /// Projects seed.point onto the faces around its nearest vertex (fan-triangulated).
 void projectSurfaceSeed(Seed& s, const LevelView& view) {
   const LevelTopology& topo = *view.topology;
-  s.vertex = nearestIndex(view.smooth, s.point);
+  s.vertex = nearestPosition(view.smooth, s.point);
   float best = std::numeric_limits<float>::infinity();
   Vec3 bestPoint = view.smooth[s.vertex];
   for (uint32_t i = topo.vertexFaceOffsets[s.vertex]; i < topo.vertexFaceOffsets[s.vertex + 1]; ++i) {
@@ -202,7 +191,7 @@ std::vector<Seed> placeSeeds(const Placement& placement, const LevelView& view) 
           projectSurfaceSeed(s, view);
           seeds.push_back(s);
         } else {
-          seeds.push_back(vertexSeed(nearestIndex(view.smooth, p), view));
+          seeds.push_back(vertexSeed(nearestPosition(view.smooth, p), view));
         }
       }
       break;
