@@ -5,6 +5,8 @@
 #include <deque>
 #include <limits>
 
+#include <tbb/parallel_invoke.h>
+
 #include "core/parallel.h"
 
 namespace sprig::organisms {
@@ -269,14 +271,13 @@ SynthesisResult synthesize(const Subdivision& sub, std::span<const Vec3> control
       smoothHeight = height;
     } else {
       smooth.resize(n);
-      sub.interpolate(l, current, smooth);
       refineRef.resize(n);
-      sub.interpolate(l, reference, refineRef);
+      if (scalars) smoothHeight.resize(n);
+      // The three refinements are independent (each is OpenSubdiv's serial loop).
+      tbb::parallel_invoke([&] { sub.interpolate(l, current, smooth); },
+                           [&] { sub.interpolate(l, reference, refineRef); },
+                           [&] { if (scalars) sub.interpolate(l, height, smoothHeight); });
       reference.swap(refineRef);
-      if (scalars) {
-        smoothHeight.resize(n);
-        sub.interpolate(l, height, smoothHeight);
-      }
     }
     frames.resize(n);
     computeFrames(topo, smooth, frames);
