@@ -78,9 +78,7 @@ class OrganismReader {
     if (auto b = m.get("base")) readBase(*b);
     else m.node().error(diags_, "missing required key 'base' in organism (e.g. base: {cube_sphere: {radius: 1}})");
     if (!spec_.base.faceSizes.empty()) {
-      size_t finest = 0;
-      for (uint32_t s : spec_.base.faceSizes) finest += s;  // faces of level 1
-      finest <<= 2 * (spec_.levels - 1);
+      const size_t finest = finestFaceCount(spec_.base, spec_.levels);
       if (finest > kMaxFinestFaces)
         (m.get("levels") ? *m.get("levels") : m.node())
             .error(diags_, "'levels' " + std::to_string(spec_.levels) + " makes " + std::to_string(finest) +
@@ -639,7 +637,8 @@ class OrganismModel final : public KindModel {
   /// use the same synthesis).
   const OrganismSurface& surface(double time) {
     if (!cached_ || cachedTime_ != time) {
-      cached_ = buildOrganismSurface(spec_, time);
+      if (!subdivision_) subdivision_.emplace(spec_.base, spec_.levels);  // the topology never changes
+      cached_ = buildOrganismSurface(spec_, *subdivision_, time);
       cachedTime_ = time;
     }
     return *cached_;
@@ -654,13 +653,19 @@ class OrganismModel final : public KindModel {
   const OrganismSpec& spec_;
   std::optional<Box3> frame_;
   std::optional<OrganismSurface> cached_;
+  std::optional<Subdivision> subdivision_;
   double cachedTime_ = 0;
 };
 
 }  // namespace
 
-OrganismSurface buildOrganismSurface(const OrganismSpec& spec, double time) {
-  const Subdivision sub(spec.base, spec.levels);
+size_t finestFaceCount(const ControlMesh& base, int levels) {
+  size_t faces = 0;
+  for (uint32_t n : base.faceSizes) faces += n;  // level 1: one quad per corner
+  return faces << (2 * (levels - 1));
+}
+
+OrganismSurface buildOrganismSurface(const OrganismSpec& spec, const Subdivision& sub, double time) {
   SynthesisInput in;
   in.shapeA = spec.detail;
   in.shapeB = spec.blendDetail;
@@ -697,7 +702,7 @@ std::vector<Vec3> organismColors(const OrganismSpec& spec, const OrganismSurface
 }
 
 Mesh buildOrganismMesh(const OrganismSpec& spec, double time, const Vec3& baseColor) {
-  OrganismSurface s = buildOrganismSurface(spec, time);
+  OrganismSurface s = buildOrganismSurface(spec, Subdivision(spec.base, spec.levels), time);
   s.mesh.colors = organismColors(spec, s, baseColor);
   return std::move(s.mesh);
 }
@@ -719,9 +724,7 @@ std::shared_ptr<const KindSpec> readOrganismSpec(MapReader& top, Species& specie
 }
 
 std::string OrganismSpec::checkSummary(const Species& species) const {
-  size_t faces = 0;
-  for (uint32_t s : base.faceSizes) faces += s;
-  faces <<= 2 * (levels - 1);
+  const size_t faces = finestFaceCount(base, levels);
   return " '" + species.name + "', " + std::to_string(base.faceCount()) + " control faces, " + std::to_string(levels) +
          " levels (" + std::to_string(faces) + " faces)";
 }

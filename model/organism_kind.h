@@ -81,8 +81,12 @@ struct OrganismSurface {
   std::vector<float> alpha, scalar;
 };
 
-/// Synthesizes the organism at time t (0..1); the planet shader's relief is applied.
-OrganismSurface buildOrganismSurface(const OrganismSpec& spec, double time);
+/// Synthesizes the organism at time t (0..1) on subdivision (the refinement of spec.base to
+/// spec.levels; kept by callers that synthesize many times); the planet shader's relief is applied.
+OrganismSurface buildOrganismSurface(const OrganismSpec& spec, const organisms::Subdivision& subdivision, double time);
+
+/// Faces of the finest level of spec's base refined to its levels.
+size_t finestFaceCount(const organisms::ControlMesh& base, int levels);
 
 /// Per-vertex colours of a surface: baseColor, blended toward the blend colour by alpha, or
 /// the planet shader's colours.
