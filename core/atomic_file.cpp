@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "core/diagnostics.h"
 #include "core/progress.h"
 
 namespace sprig {
@@ -99,6 +100,21 @@ std::string readFile(const fs::path& path) {
   std::ostringstream ss;
   ss << in.rdbuf();
   return ss.str();
+}
+
+std::string readInputFile(const fs::path& path, const std::string& displayPath, uint64_t maxBytes,
+                          const std::string& what, const std::string& limitName) {
+  std::error_code ec;
+  const uint64_t size = fs::file_size(path, ec);
+  if (ec) throw InputError(SourceLoc{displayPath}, "cannot read this " + what + " file: " + ec.message());
+  if (size > maxBytes)
+    throw InputError(SourceLoc{displayPath}, "the file has " + std::to_string(size) + " bytes, more than the limit of " +
+                                                 std::to_string(maxBytes) + " bytes (" + limitName + ")");
+  std::string bytes(size, '\0');
+  std::ifstream f(path, std::ios::binary);
+  if (!f || !f.read(bytes.data(), std::streamsize(size)))
+    throw InputError(SourceLoc{displayPath}, "cannot read this " + what + " file");
+  return bytes;
 }
 
 int removeStaleTemporaries(const fs::path& folder) {

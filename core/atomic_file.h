@@ -8,6 +8,7 @@
 /// (removeStaleTemporaries). SIGINT and SIGTERM remove the live temporaries before
 /// the process ends (installSignalCleanup).
 
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <string_view>
@@ -42,6 +43,12 @@ void writeFileAtomic(const std::filesystem::path& path, std::string_view bytes);
 
 /// Reads a whole file. Throws std::runtime_error when it cannot be read.
 std::string readFile(const std::filesystem::path& path);
+
+/// Reads a whole input file of at most maxBytes bytes. Throws InputError at displayPath
+/// ("cannot read this <what> file: ...", or the size against the limit named by limitName)
+/// before allocating.
+std::string readInputFile(const std::filesystem::path& path, const std::string& displayPath, uint64_t maxBytes,
+                          const std::string& what, const std::string& limitName);
 
 /// Removes SIGINT/SIGTERM-interrupted temporaries (`.sprig-tmp-*`) in folder (not recursive).
 /// Returns how many were removed.

@@ -1,5 +1,7 @@
 #include "core/polymesh.h"
 
+#include "core/atomic_file.h"
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -898,16 +900,7 @@ PolyMesh parsePolyMesh(std::string_view bytes, MeshFileFormat format, std::strin
 PolyMesh readPolyMesh(const fs::path& path, std::string displayPath, const PolyMeshLimits& limits) {
   MeshFileFormat format = meshFileFormatFor(path);
   if (displayPath.empty()) displayPath = path.string();
-  std::error_code ec;
-  uint64_t size = fs::file_size(path, ec);
-  if (ec) throw InputError(SourceLoc{displayPath}, std::string("cannot read this ") + formatName(format) + " file: " + ec.message());
-  if (size > limits.maxFileBytes)
-    throw InputError(SourceLoc{displayPath}, "the file has " + std::to_string(size) + " bytes, more than the limit of " +
-                                                 std::to_string(limits.maxFileBytes) + " bytes (PolyMeshLimits::maxFileBytes)");
-  std::string bytes(size, '\0');
-  std::ifstream f(path, std::ios::binary);
-  if (!f || !f.read(bytes.data(), std::streamsize(size)))
-    throw InputError(SourceLoc{displayPath}, std::string("cannot read this ") + formatName(format) + " file");
+  std::string bytes = readInputFile(path, displayPath, limits.maxFileBytes, formatName(format), "PolyMeshLimits::maxFileBytes");
   return parsePolyMesh(bytes, format, std::move(displayPath), limits);
 }
 

@@ -6,11 +6,14 @@
 #include <cstdio>
 #include <map>
 
+#include "core/inr_volume.h"
+#include "core/paths.h"
 #include "core/polymesh.h"
 #include "core/timer.h"
 #include "model/model.h"
 #include "organisms/analysis.h"
 #include "organisms/base_mesh.h"
+#include "organisms/iso_surface.h"
 #include "organisms/simplify.h"
 #include "render/scene.h"
 #include "organisms/detail.h"
@@ -150,13 +153,28 @@ class OrganismReader {
 
   /// A polygon mesh file, checked (every error at its face's file:line:col), placed.
   std::optional<PolyMesh> readMeshFile(MapReader& m, const MeshPlacement& place) {
+    m.allow({"iso"});  // read below, once the file is known to be a volume
     auto file = m.path("file", policy_);
     if (!file) {
       if (!m.has("file")) m.node().error(diags_, "missing required key 'file' in " + std::string("mesh"));
       return std::nullopt;
     }
+    const bool isVolume = lowerExtension(*file) == ".inr";
+    std::optional<double> iso;
+    if (isVolume) {
+      if (!m.has("iso")) m.get("file")->error(diags_, "a volume file (.inr) needs 'iso', the value of its surface");
+      else iso = m.number("iso", 0.0, -1e30, 1e30);
+    } else if (m.has("iso")) {
+      m.get("iso")->error(diags_, "'iso' is for volume files (.inr); this file is a mesh");
+    }
     try {
-      PolyMesh mesh = readPolyMesh(*file);
+      PolyMesh mesh;
+      if (isVolume) {
+        if (!iso) return std::nullopt;
+        mesh = organisms::isoSurface(readInrVolume(*file), *iso);
+      } else {
+        mesh = readPolyMesh(*file);
+      }
       const size_t before = diags_.items().size();
       checkPolyMesh(mesh, diags_);
       if (diags_.items().size() != before) return std::nullopt;
@@ -165,7 +183,7 @@ class OrganismReader {
     } catch (const InputError& e) {
       diags_.append(e.diagnostics());
     } catch (const std::invalid_argument& e) {
-      m.get("file")->error(diags_, e.what());
+      m.get(isVolume && m.has("iso") ? "iso" : "file")->error(diags_, e.what());
     }
     return std::nullopt;
   }
@@ -177,6 +195,7 @@ class OrganismReader {
     if (!mesh) return;
     if (faces > 0 && mesh->faceCount() > size_t(faces)) mesh = organisms::simplifyToFaceCount(triangulate(*mesh), size_t(faces));
     spec_.base = controlOf(*mesh);
+    baseColors_ = mesh->colors;
   }
 
   /// The surface (final stage's mesh) of the species file at key `key`, or nullopt after
@@ -219,6 +238,7 @@ class OrganismReader {
     PolyMesh control = organisms::simplifyToFaceCount(*surface, size_t(faces));
     place.apply(control.positions, control.bounds());
     spec_.base = controlOf(control);
+    baseColors_ = control.colors;
   }
 
   /// `capture: {file | species, max_distance, smoothing, center, size, rotate}`: analysis of a captured mesh
@@ -445,7 +465,7 @@ class OrganismReader {
   }
 
   void readAlpha(const YNode& node) {
-    std::optional<std::pair<YNode, YNode>> one = single(node, "alpha", {"plane", "noise"});
+    std::optional<std::pair<YNode, YNode>> one = single(node, "alpha", {"plane", "noise", "painted"});
     if (!one) return;
     const auto& [key, value] = *one;
     MapReader m(value, diags_, key.scalar());
@@ -459,6 +479,23 @@ class OrganismReader {
       plane->sharp = m.choice("transition", "sharp", {"sharp", "soft"}) == "sharp";
       spec_.animated |= plane->speed != 0;
       spec_.alpha = plane;
+    } else if (key.scalar() == "painted") {
+      // The base's vertex paint: one channel (or the luminance) of its linear colours.
+      const std::string channel = m.choice("channel", "luminance", {"red", "green", "blue", "luminance"});
+      auto painted = std::make_shared<PaintedAlpha>();
+      painted->width = float(m.number("width", 1.0, 1e-3, 1e3));
+      painted->sharp = m.choice("transition", "sharp", {"sharp", "soft"}) == "sharp";
+      if (baseColors_.empty() && !spec_.base.faceSizes.empty()) {
+        key.error(diags_, "a painted alpha needs a base mesh with vertex colours (a mesh or species base whose "
+                          "vertices carry colours); this base has none");
+      } else {
+        const Vec3 weights = channel == "red"     ? Vec3(1, 0, 0)
+                             : channel == "green" ? Vec3(0, 1, 0)
+                             : channel == "blue"  ? Vec3(0, 0, 1)
+                                                  : Vec3(0.2126f, 0.7152f, 0.0722f);  // Rec. 709
+        for (const Vec3& col : baseColors_) painted->control.push_back(std::clamp(glm::dot(weights, col), 0.0f, 1.0f));
+      }
+      spec_.alpha = painted;
     } else {
       // A procedural alpha: smoothstep of noise of the reference position, the transition
       // narrowing per level like a sharp plane.
@@ -542,6 +579,7 @@ class OrganismReader {
   DiagnosticList& diags_;
   OrganismSpec& spec_;
   const PathPolicy& policy_;
+  std::vector<Vec3> baseColors_;  // a mesh or species base's vertex colours (painted alpha)
   bool captureGiven_ = false;  // a failed capture: 'captured' entries add no second error
 };
 

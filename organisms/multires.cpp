@@ -233,6 +233,17 @@ void FunctionAlpha::evaluate(const LevelView& view, std::span<float> alpha) cons
   }, kGrain);
 }
 
+void PaintedAlpha::evaluate(const LevelView& view, std::span<float> alpha) const {
+  std::vector<float> m(control), finer;
+  for (int l = 1; l <= view.level; ++l) {
+    finer.resize(view.subdivision->vertexCount(l));
+    view.subdivision->interpolate(l, m, finer);
+    m.swap(finer);
+  }
+  const float gain = (sharp ? float(1u << unsigned(std::max(0, view.level - 1))) : 1.0f) / width;
+  parallelFor(0, alpha.size(), [&](size_t v) { alpha[v] = smoothstep01(0.5f + (m[v] - 0.5f) * gain); }, kGrain);
+}
+
 std::vector<std::vector<Vec3>> referenceLevels(const Subdivision& sub, std::span<const Vec3> control) {
   std::vector<std::vector<Vec3>> levels(size_t(sub.levels()) + 1);
   levels[0].assign(control.begin(), control.end());

@@ -128,6 +128,18 @@ struct FunctionAlpha final : AlphaField {
   void evaluate(const LevelView& view, std::span<float> alpha) const override;
 };
 
+/// Alpha from a painted map: a value m in [0, 1] per control vertex (the base mesh's vertex
+/// paint), carried to level l by the same Catmull-Clark refinement as the surface. The
+/// painted edge is where m crosses 1/2; alpha_l = smoothstep(1/2 + (m_l - 1/2) 2^(l-1) / width)
+/// ("sharp": the transition narrows by half per level, as Burt's masks do, §6) or
+/// smoothstep(1/2 + (m_l - 1/2) / width) at every level ("soft").
+struct PaintedAlpha final : AlphaField {
+  std::vector<float> control;  ///< m per control vertex
+  float width = 1;
+  bool sharp = true;
+  void evaluate(const LevelView& view, std::span<float> alpha) const override;
+};
+
 /// Local detail modification (§5.2): the detail of level l within `radius` (topological
 /// distance: edge hops at that level times its sample size) of the surface vertex nearest
 /// `center` is multiplied by 1 + (gain_l - 1) k(d / radius), k(x) = 1 - 3x^2 + 2x^3.

@@ -285,6 +285,46 @@ TEST_CASE("Blend: alpha 0 and 1 give each shape, widths follow c/2^(l-1)", "[org
   }
 }
 
+TEST_CASE("Painted alpha: the paint refined with the surface, sharpened per level", "[organisms]") {
+  // Paint m = 1/2 + x/4 on a plane: Catmull-Clark reproduces linear functions, so at every
+  // level m_l = 1/2 + x/4 exactly and alpha_l = smoothstep(1/2 + (x/4) 2^(l-1) / width).
+  const ControlMesh base = plane(2.0f, 8);
+  const Subdivision sub(base, 4);
+  const auto levels = referenceLevels(sub, base.positions);
+  for (bool sharp : {true, false}) {
+    auto painted = std::make_shared<PaintedAlpha>();
+    for (const Vec3& p : base.positions) painted->control.push_back(0.5f + p.x / 4);
+    painted->sharp = sharp;
+    painted->width = 0.5f;
+    for (int l = 0; l <= 4; ++l) {
+      LevelView view;
+      view.level = l;
+      view.subdivision = &sub;
+      view.reference = levels[size_t(l)];
+      std::vector<float> alpha(levels[size_t(l)].size());
+      painted->evaluate(view, alpha);
+      const float gain = (sharp ? float(1 << std::max(0, l - 1)) : 1.0f) / 0.5f;
+      float worst = 0;
+      for (size_t v = 0; v < alpha.size(); ++v) {
+        const float x = std::clamp(0.5f + levels[size_t(l)][v].x / 4 * gain, 0.0f, 1.0f);
+        worst = std::max(worst, std::fabs(alpha[v] - x * x * (3 - 2 * x)));
+      }
+      INFO("level " << l << (sharp ? " sharp" : " soft"));
+      CHECK(worst < 1e-5f);
+    }
+  }
+  // Paint 1 everywhere is shape B exactly.
+  RockOptions ro;
+  const DetailSet A = {makeRock(ro)};
+  ro.seed = 9;
+  const DetailSet B = {makeRock(ro)};
+  auto full = std::make_shared<PaintedAlpha>();
+  full->control.assign(base.positions.size(), 1.0f);
+  const SynthesisResult blended = synthesize(sub, base.positions, SynthesisInput{A, B, full, {}});
+  const SynthesisResult onlyB = run(sub, base, B);
+  CHECK(std::memcmp(blended.positions.data(), onlyB.positions.data(), onlyB.positions.size() * sizeof(Vec3)) == 0);
+}
+
 TEST_CASE("Local modification scales details near a point only", "[organisms]") {
   const ControlMesh ball = cubeSphere(1.0f, 2);
   const Subdivision sub(ball, 4);
