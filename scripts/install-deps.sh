@@ -9,6 +9,7 @@ packages=(
   libosd-dev libyaml-cpp-dev catch2 libcli11-dev libtinygltf-dev libopenvdb-dev libboost-iostreams-dev zlib1g-dev
   libbenchmark-dev parallel
   libmeshoptimizer-dev libcgal-demo
+  nodejs curl ca-certificates
 )
 
 missing=()
@@ -18,10 +19,7 @@ for p in "${packages[@]}"; do
   fi
 done
 
-if [ ${#missing[@]} -eq 0 ]; then
-  exit 0
-fi
-
+if [ ${#missing[@]} -gt 0 ]; then
 echo "sprig: installing missing packages: ${missing[*]}"
 sudo=""
 if [ "$(id -u)" -ne 0 ]; then
@@ -30,3 +28,22 @@ fi
 export DEBIAN_FRONTEND=noninteractive
 $sudo apt-get update -q
 $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
+
+# The Khronos glTF validator (npm package gltf-validator, Apache-2.0), for the tests that
+# read Sprig's .glb files back: one pinned tarball, checked by its SHA-256, unpacked under
+# tools/ (not committed). Node.js runs it (scripts/gltf-validate.js).
+validator_version=2.0.0-dev.3.10
+validator_sha256=4e03dbdc3bc0d1342afd5d2d7ae341a7e3474502ccb872b02dbbaddaee0fdec6
+validator_dir="$(dirname "$0")/../tools/node_modules/gltf-validator"
+if [ ! -f "$validator_dir/package.json" ] || ! grep -q "\"version\": \"$validator_version\"" "$validator_dir/package.json"; then
+  echo "sprig: fetching the glTF validator $validator_version"
+  tmp="$(mktemp -d)"
+  trap 'rm -rf "$tmp"' EXIT
+  curl -sSfL --retry 3 -o "$tmp/v.tgz" "https://registry.npmjs.org/gltf-validator/-/gltf-validator-$validator_version.tgz"
+  echo "$validator_sha256  $tmp/v.tgz" | sha256sum -c --quiet -
+  tar xzf "$tmp/v.tgz" -C "$tmp"
+  rm -rf "$validator_dir"
+  mkdir -p "$(dirname "$validator_dir")"
+  mv "$tmp/package" "$validator_dir"
+fi
