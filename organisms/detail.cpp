@@ -243,7 +243,13 @@ class Mushroom final : public DetailProcedure {
             if (rho >= o.footprint) return;
             const Vec2 c = mushroomProfile(o, rho);
             const Vec3 radial = rho > 1e-12f ? (xy.x * fs.t + xy.y * fs.b) / rho : Vec3(0.0f);
-            const Vec3 target = view.reference[v] + w * ((c.x - rho) * radial + c.y * fs.n);
+            // On a curved base the profile's heights are over the base, not over the seed's
+            // tangent plane: a point moved from rho to c.x keeps the base's height there,
+            // h (c.x / rho)^2 for the height h of the base at rho over the tangent plane (a
+            // second-order fit; 0 on a plane), so the foot stays on the base.
+            const float h = glm::dot(q, fs.n);
+            const float lift = rho > 1e-12f ? h * (c.x * c.x / (rho * rho) - 1.0f) : 0.0f;
+            const Vec3 target = view.reference[v] + w * ((c.x - rho) * radial + (c.y + lift) * fs.n);
             out.offset[v] += view.frames[v].toLocal(target - view.smooth[v]);
           });
         }
@@ -299,8 +305,16 @@ Vec2 mushroomProfile(const MushroomOptions& o, float rho) {
     const float s = (u - b) / (c - b);
     return {o.stalkRadius, (H - o.capUnder) * (1.0f - s)};
   }
+  // The foot spreads from the stalk to the footprint's edge, easing into the ground: its
+  // radius g(s) = k s + (1 - k) s^2 reaches the edge with slope 1 in rho (k = 2 - m, m the
+  // slope g must end with), so the displacement rho -> c.x - rho ends with value and slope 0
+  // there. Subdivision then barely moves the ground outside the footprint, which the
+  // feature does not touch; with a kink there it pulled that ground inward past the foot's
+  // outer vertices and folded the mesh (found by the self-intersection test).
   const float s = (u - c) / (1.0f - c);
-  return {o.stalkRadius + (o.footprint - o.stalkRadius) * s, 0.0f};
+  const float m = (1.0f - c) * o.footprint / (o.footprint - o.stalkRadius);
+  const float k = std::clamp(2.0f - m, 0.0f, 2.0f);
+  return {o.stalkRadius + (o.footprint - o.stalkRadius) * (k * s + (1.0f - k) * s * s), 0.0f};
 }
 
 std::shared_ptr<const DetailProcedure> makeRock(const RockOptions& o) { return std::make_shared<Rock>(o); }
