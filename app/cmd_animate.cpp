@@ -81,6 +81,9 @@ int runAnimate(const AnimateArgs& a, const GlobalOptions& g) {
     }
   }
   Species species = loadSpecies(a.file, g.pathPolicy());
+  if (species.kind != "tree" && !a.stages.empty())
+    throw UsageError("--stages selects derivation steps of a tree; a " + species.kind +
+                     " species animates its whole growth (use --frames-per-stage and --fps)");
   const SpeciesRender& look = species.render;
   const int lookWidth = look.image.width, lookHeight = look.image.height;
   opt.width = a.width > 0 ? a.width : lookWidth;
@@ -106,7 +109,9 @@ int runAnimate(const AnimateArgs& a, const GlobalOptions& g) {
   }
   AnimateResult r = animateSpecies(species, a.out, opt);
   if (!g.quiet)
-    std::cerr << a.out << ": " << r.frames << " frames, stages " << r.firstStage << ".." << r.lastStage << ", "
+    std::cerr << a.out << ": " << r.frames << " frames, "
+              << (species.kind == "tree" ? "stages " + std::to_string(r.firstStage) + ".." + std::to_string(r.lastStage) + ", "
+                                         : std::string())
               << opt.width << "x" << opt.height << ", " << r.seconds << " s\n";
   return kExitOk;
 }
