@@ -7,14 +7,11 @@
 #include <stdexcept>
 
 #include "core/parallel.h"
+#include "core/timer.h"
 
 namespace sprig::solids {
 
 namespace {
-
-double secondsSince(std::chrono::steady_clock::time_point t0) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
 
 using Tet = std::array<uint32_t, 4>;
 constexpr int kTetEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
@@ -78,7 +75,10 @@ struct Work {
 /// match). Returns the number of edges split.
 size_t cutAt(Work& w, size_t v, double b) {
   const std::vector<float>& f = w.fields[v];
-  auto phi = [&](uint32_t x) { return double(f[x]) - b; };
+  // Fields are stored as floats: compare with the float boundary, so that values set (or
+  // snapped) onto it read exactly zero.
+  const double bf = double(float(b));
+  auto phi = [&](uint32_t x) { return double(f[x]) - bf; };
   // 1. Crossing edges of active tetrahedra, sorted and unique.
   std::vector<uint64_t> keys = chunked<uint64_t>(w.tets.size(), [&](size_t lo, size_t hi, std::vector<uint64_t>& out) {
     for (size_t t = lo; t < hi; ++t) {
