@@ -399,12 +399,14 @@ class SolidModel final : public KindModel {
     return box.empty() ? Box3{Vec3(-1.0f), Vec3(1.0f)} : box;
   }
 
-  BuiltStage build(const Stage&, GeometryMode mode, const SpeciesRender&) override {
+  BuiltStage build(const Stage&, GeometryMode mode, const SpeciesRender& look) override {
     if (mode == GeometryMode::Skeleton) throw UsageError("solid species have no skeleton: use --mode exact or mesh");
     BuiltStage out;
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<uint16_t> mats;
-    std::vector<Mesh> parts = visibleMeshes(tets(), &mats);
+    std::vector<Mesh> parts =
+        look.section ? visibleMeshes(clipByPlane(tets(), DVec3(Vec3(*look.section)), double(look.section->w)), &mats)
+                     : visibleMeshes(tets(), &mats);
     for (size_t i = 0; i < parts.size(); ++i) {
       const Material& m = spec_.solid.materials.materials[mats[i]];
       render::MeshPart part;

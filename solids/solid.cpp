@@ -62,6 +62,7 @@ struct Work {
   std::vector<std::vector<float>> fields;  ///< [volume][vertex]
   std::vector<Tet> tets;
   std::vector<uint8_t> active;
+  std::vector<int> tag;  ///< carried to the pieces of a split (a material when clipping)
 
   double centroidValue(size_t volume, const Tet& t) const {
     const std::vector<float>& f = fields[volume];
@@ -117,6 +118,7 @@ size_t cutAt(Work& w, size_t v, double b) {
   struct Piece {
     Tet t;
     uint8_t active;
+    int tag;
   };
   std::vector<Piece> pieces = chunked<Piece>(w.tets.size(), [&](size_t lo, size_t hi, std::vector<Piece>& out) {
     std::vector<Tet> stack;
@@ -134,7 +136,7 @@ size_t cutAt(Work& w, size_t v, double b) {
           if (id >= 0 && k < best) best = k, be = e, m = id;
         }
         if (be < 0) {
-          out.push_back({q, w.active[t]});
+          out.push_back({q, w.active[t], w.tag[t]});
           continue;
         }
         Tet c1 = q, c2 = q;  // same orientation: a vertex moves along its edge
@@ -147,8 +149,31 @@ size_t cutAt(Work& w, size_t v, double b) {
   });
   w.tets.resize(pieces.size());
   w.active.resize(pieces.size());
-  for (size_t i = 0; i < pieces.size(); ++i) w.tets[i] = pieces[i].t, w.active[i] = pieces[i].active;
+  w.tag.resize(pieces.size());
+  for (size_t i = 0; i < pieces.size(); ++i) w.tets[i] = pieces[i].t, w.active[i] = pieces[i].active, w.tag[i] = pieces[i].tag;
   return keys.size();
+}
+
+/// The tetrahedra of w with a material >= 0, their vertices renumbered in id order.
+TetMesh compact(const Work& w, const std::vector<int>& material) {
+  TetMesh mesh;
+  std::vector<uint32_t> remap(w.positions.size(), 0);
+  for (size_t t = 0; t < w.tets.size(); ++t)
+    if (material[t] >= 0)
+      for (uint32_t x : w.tets[t]) remap[x] = 1;
+  uint32_t next = 0;
+  for (size_t x = 0; x < remap.size(); ++x)
+    if (remap[x]) {
+      remap[x] = next++;
+      mesh.positions.push_back(w.positions[x]);
+    }
+  for (size_t t = 0; t < w.tets.size(); ++t) {
+    if (material[t] < 0) continue;
+    const Tet& q = w.tets[t];
+    mesh.tets.push_back({remap[q[0]], remap[q[1]], remap[q[2]], remap[q[3]]});
+    mesh.materials.push_back(uint16_t(material[t]));
+  }
+  return mesh;
 }
 
 }  // namespace
@@ -267,6 +292,7 @@ TetMesh meshSolid(const Solid& solid, const Grid& grid, const MeshOptions& optio
   st.cellTets = w.tets.size();
   st.cubes = st.cellTets / 5;
   w.active.assign(w.tets.size(), 1);
+  w.tag.assign(w.tets.size(), 0);
 
   // 3. Cut at every boundary of every volume, in precedence order; a volume cuts only where
   // no earlier volume claims the space (but splits claimed tetrahedra along shared edges).
@@ -295,27 +321,27 @@ TetMesh meshSolid(const Solid& solid, const Grid& grid, const MeshOptions& optio
   }, 4096);
 
   // 5. Keep tetrahedra with a material; renumber the vertices they use in id order.
-  TetMesh mesh;
-  std::vector<uint32_t> remap(w.positions.size(), 0);
-  for (size_t t = 0; t < w.tets.size(); ++t)
-    if (material[t] >= 0)
-      for (uint32_t x : w.tets[t]) remap[x] = 1;
-  uint32_t next = 0;
-  for (size_t x = 0; x < remap.size(); ++x)
-    if (remap[x]) {
-      remap[x] = next++;
-      mesh.positions.push_back(w.positions[x]);
-    }
-  for (size_t t = 0; t < w.tets.size(); ++t) {
-    if (material[t] < 0) continue;
-    const Tet& q = w.tets[t];
-    mesh.tets.push_back({remap[q[0]], remap[q[1]], remap[q[2]], remap[q[3]]});
-    mesh.materials.push_back(uint16_t(material[t]));
-  }
+  TetMesh mesh = compact(w, material);
   st.tets = mesh.tets.size();
   st.meshSeconds = secondsSince(t0);
   if (stats) *stats = st;
   return mesh;
+}
+
+TetMesh clipByPlane(const TetMesh& mesh, const DVec3& normal, double offset) {
+  const DVec3 n = glm::normalize(normal);
+  Work w;
+  w.positions = mesh.positions;
+  w.tets = mesh.tets;
+  w.active.assign(w.tets.size(), 1);
+  w.fields.emplace_back(w.positions.size());
+  parallelFor(0, w.positions.size(), [&](size_t v) { w.fields[0][v] = float(glm::dot(n, w.positions[v]) - offset); }, 4096);
+  w.tag.assign(mesh.materials.begin(), mesh.materials.end());
+  cutAt(w, 0, 0.0);
+  std::vector<int> material(w.tets.size(), kUnclaimed);
+  for (size_t t = 0; t < w.tets.size(); ++t)
+    if (w.centroidValue(0, w.tets[t]) <= 0) material[t] = w.tag[t];
+  return compact(w, material);
 }
 
 namespace {

@@ -103,6 +103,10 @@ struct MeshOptions {
 /// thread count. Cost O(nodes · volumes + tets · boundaries).
 TetMesh meshSolid(const Solid& solid, const Grid& grid, const MeshOptions& options = {}, MeshStats* stats = nullptr);
 
+/// The part of mesh on the side n·x <= offset of a plane (a cut-away, Fig. 3e-f): tetrahedra
+/// crossing the plane are split exactly there, by the same edge splits as meshSolid.
+TetMesh clipByPlane(const TetMesh& mesh, const DVec3& normal, double offset);
+
 /// The lattice nodes of grid, x fastest.
 std::vector<Vec3> gridNodes(const Grid& grid);
 
