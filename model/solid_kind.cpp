@@ -471,30 +471,46 @@ class SolidModel final : public KindModel {
 }  // namespace
 
 std::vector<Mesh> visibleMeshes(const TetMesh& mesh, std::vector<uint16_t>* partMaterials) {
+  // Normals are smoothed over the faces around a vertex whose normals lie within 60° of
+  // each other; sharper edges (a cut-away's rim, a box's edges) stay creased.
+  constexpr float kCreaseCos = 0.5f;
   const std::vector<InterfaceTriangle> tris = visibleInterface(mesh);
-  std::map<uint16_t, Mesh> parts;
-  std::map<uint16_t, std::map<uint32_t, uint32_t>> local;
-  for (const InterfaceTriangle& t : tris) {
-    Mesh& m = parts[t.material];
-    auto& ids = local[t.material];
-    glm::uvec3 tri;
-    for (int k = 0; k < 3; ++k) {
-      auto [it, fresh] = ids.emplace(t.v[size_t(k)], uint32_t(m.positions.size()));
-      if (fresh) m.positions.push_back(Vec3(mesh.positions[t.v[size_t(k)]]));
-      tri[k] = it->second;
-    }
-    m.triangles.push_back(tri);
-  }
+  std::map<uint16_t, std::vector<size_t>> byMaterial;
+  for (size_t i = 0; i < tris.size(); ++i) byMaterial[tris[i].material].push_back(i);
   std::vector<Mesh> out;
   if (partMaterials) partMaterials->clear();
-  for (auto& [mat, m] : parts) {
-    // Smooth normals: area-weighted face normals summed at each vertex.
-    m.normals.assign(m.positions.size(), Vec3(0.0f));
-    for (const glm::uvec3& t : m.triangles) {
-      const Vec3 n = glm::cross(m.positions[t[1]] - m.positions[t[0]], m.positions[t[2]] - m.positions[t[0]]);
-      for (int k = 0; k < 3; ++k) m.normals[t[k]] += n;
+  for (const auto& [mat, list] : byMaterial) {
+    // Face normals (area-weighted) and the faces around each vertex.
+    std::vector<Vec3> faceNormal(list.size());
+    std::map<uint32_t, std::vector<uint32_t>> around;
+    for (size_t f = 0; f < list.size(); ++f) {
+      const auto& v = tris[list[f]].v;
+      const Vec3 a(mesh.positions[v[0]]), b(mesh.positions[v[1]]), c(mesh.positions[v[2]]);
+      faceNormal[f] = glm::cross(b - a, c - a);
+      for (uint32_t x : v) around[x].push_back(uint32_t(f));
+    }
+    // One output vertex per (vertex, group of faces with similar normals).
+    Mesh m;
+    std::vector<std::array<uint32_t, 3>> corner(list.size());
+    for (const auto& [x, faces] : around) {
+      std::vector<std::pair<Vec3, uint32_t>> groups;  // direction, output vertex
+      for (uint32_t f : faces) {
+        const Vec3 n = glm::normalize(faceNormal[f]);
+        size_t g = 0;
+        while (g < groups.size() && glm::dot(glm::normalize(groups[g].first), n) < kCreaseCos) ++g;
+        if (g == groups.size()) {
+          groups.push_back({Vec3(0.0f), uint32_t(m.positions.size())});
+          m.positions.push_back(Vec3(mesh.positions[x]));
+          m.normals.push_back(Vec3(0.0f));
+        }
+        groups[g].first += n;
+        m.normals[groups[g].second] += faceNormal[f];
+        const auto& v = tris[list[f]].v;
+        corner[f][size_t(std::find(v.begin(), v.end(), x) - v.begin())] = groups[g].second;
+      }
     }
     for (Vec3& n : m.normals) n = glm::length(n) > 0 ? glm::normalize(n) : Vec3(0, 1, 0);
+    for (const auto& c : corner) m.triangles.push_back({c[0], c[1], c[2]});
     if (partMaterials) partMaterials->push_back(mat);
     out.push_back(std::move(m));
   }
