@@ -34,7 +34,7 @@ const std::vector<Material>& builtinMaterials() {
       make("white_chocolate", {0.93f, 0.87f, 0.74f}, 0.45f, 0.06f, 1100, 3e8, 0.35, 1.5e6),
       make("nut", {0.72f, 0.50f, 0.30f}, 0.6f, 0.03f, 1000, 5e7, 0.3, 5e6),
       make("pink_frosting", {0.95f, 0.60f, 0.70f}, 0.5f, 0.05f, 900, 1e6, 0.45, 5e4),
-      make("foil", {0.86f, 0.86f, 0.90f}, 0.15f, 0.5f, 2700, 6.9e10, 0.33, 9e7),
+      make("foil", {0.70f, 0.71f, 0.75f}, 0.2f, 0.6f, 2700, 6.9e10, 0.33, 9e7),
       make("bronze", {0.55f, 0.37f, 0.17f}, 0.5f, 0.15f, 8800, 1.1e11, 0.34, 3.5e8),
       make("shiny_bronze", {0.80f, 0.55f, 0.25f}, 0.12f, 0.6f, 8800, 1.1e11, 0.34, 3.5e8),
       make("fired_clay", {0.70f, 0.38f, 0.24f}, 0.8f, 0.02f, 1900, 1.5e10, 0.2, 5e6),
