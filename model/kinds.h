@@ -108,6 +108,24 @@ class KindModel {
   virtual std::string writeVolumeMesh(const Stage& stage, const std::filesystem::path& path, bool progress);
 };
 
+/// A species with one stage that does not grow (blobs, solids): every stage is that one, and
+/// the gallery turns the camera around it.
+class StillKindModel : public KindModel {
+ public:
+  bool hasSurface() const override { return true; }
+  Stage finalStage() const override { return {}; }
+  Stage stageFromIndex(int) const override { return {}; }
+  std::vector<Stage> stripStages(int) const override { return {Stage{}}; }
+  std::vector<Stage> animationFrames(int, int, int) const override { return {Stage{}}; }
+  std::string stageName(const Stage&) const override { return {}; }
+  int stageNumber(const Stage& stage) const override { return stage.step; }
+  GalleryMotion galleryMotion(bool) override {
+    GalleryMotion m;
+    m.turntable = true;
+    return m;
+  }
+};
+
 /// A kind's keys, read and typed (one subclass per kind).
 class KindSpec {
  public:

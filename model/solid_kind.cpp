@@ -381,17 +381,9 @@ class SolidReader {
 };
 
 /// A solid: its tetrahedral mesh, built once.
-class SolidModel final : public KindModel {
+class SolidModel final : public StillKindModel {
  public:
   explicit SolidModel(const SolidSpec& spec) : spec_(spec) {}
-
-  bool hasSurface() const override { return true; }
-  Stage finalStage() const override { return {}; }
-  Stage stageFromIndex(int) const override { return {}; }
-  std::vector<Stage> stripStages(int) const override { return {Stage{}}; }
-  std::vector<Stage> animationFrames(int, int, int) const override { return {Stage{}}; }
-  std::string stageName(const Stage&) const override { return {}; }
-  int stageNumber(const Stage& stage) const override { return stage.step; }
 
   Box3 frameBox() override {
     Box3 box;
@@ -432,12 +424,6 @@ class SolidModel final : public KindModel {
     figures.primitives = tets().tets.size();
     figures.buildSeconds = buildSeconds_;
     return all;
-  }
-
-  GalleryMotion galleryMotion(bool) override {
-    GalleryMotion m;
-    m.turntable = true;
-    return m;
   }
 
   std::vector<std::string> volumeMeshExtensions() const override { return {".msh", ".vtu", ".mesh"}; }
