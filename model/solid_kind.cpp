@@ -396,9 +396,13 @@ class SolidModel final : public StillKindModel {
     BuiltStage out;
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<uint16_t> mats;
-    std::vector<Mesh> parts =
-        look.section ? visibleMeshes(clipByPlane(tets(), DVec3(Vec3(*look.section)), double(look.section->w)), &mats)
-                     : visibleMeshes(tets(), &mats);
+    std::vector<Mesh> parts;
+    if (look.section) {
+      parts = visibleMeshes(clipByPlane(tets(), DVec3(Vec3(*look.section)), double(look.section->w)), &mats);
+    } else {
+      parts = visible().first;
+      mats = visible().second;
+    }
     for (size_t i = 0; i < parts.size(); ++i) {
       const Material& m = spec_.solid.materials.materials[mats[i]];
       render::MeshPart part;
@@ -413,12 +417,12 @@ class SolidModel final : public StillKindModel {
   }
 
   Mesh buildMesh(const Stage&, float, bool, ModelFigures& figures) override {
-    std::vector<uint16_t> mats;
     Mesh all;
-    std::vector<Mesh> parts = visibleMeshes(tets(), &mats);
+    const auto& [parts, mats] = visible();
     for (size_t i = 0; i < parts.size(); ++i) {
-      parts[i].colors.assign(parts[i].vertexCount(), spec_.solid.materials.materials[mats[i]].color);
-      all.append(parts[i]);
+      Mesh part = parts[i];
+      part.colors.assign(part.vertexCount(), spec_.solid.materials.materials[mats[i]].color);
+      all.append(part);
     }
     figures.triangles = all.triangleCount();
     figures.primitives = tets().tets.size();
@@ -448,8 +452,18 @@ class SolidModel final : public StillKindModel {
     return *mesh_;
   }
 
+  /// The whole solid's render meshes and their materials (kept: turntable frames reuse them).
+  const std::pair<std::vector<Mesh>, std::vector<uint16_t>>& visible() {
+    if (!visible_) {
+      visible_.emplace();
+      visible_->first = visibleMeshes(tets(), &visible_->second);
+    }
+    return *visible_;
+  }
+
   const SolidSpec& spec_;
   std::optional<TetMesh> mesh_;
+  std::optional<std::pair<std::vector<Mesh>, std::vector<uint16_t>>> visible_;
   MeshStats stats_;
   double buildSeconds_ = 0;
 };
