@@ -435,10 +435,14 @@ class SolidModel final : public StillKindModel {
   std::string writeVolumeMesh(const Stage&, const std::filesystem::path& path, bool) override {
     const TetMesh& m = tets();
     writeTetMesh(m, spec_.solid.materials.materials, path);
+    const QualityStats q = measureQuality(m);
     char buf[512];
-    std::snprintf(buf, sizeof buf, "%s: %zu tetrahedra, %zu vertices (grid %dx%dx%d of cell %g; fields %.2f s, mesh %.2f s)",
+    std::snprintf(buf, sizeof buf,
+                  "%s: %zu tetrahedra, %zu vertices (grid %dx%dx%d of cell %g; fields %.2f s, mesh %.2f s); "
+                  "quality min %.2f mean %.2f, smallest solid angle %.2g sr",
                   path.string().c_str(), m.tets.size(), m.positions.size(), spec_.grid.cells[0], spec_.grid.cells[1],
-                  spec_.grid.cells[2], spec_.grid.cell, stats_.fieldSeconds, stats_.meshSeconds);
+                  spec_.grid.cells[2], spec_.grid.cell, stats_.fieldSeconds, stats_.meshSeconds, q.minQuality,
+                  q.meanQuality, q.minSolidAngle);
     return buf;
   }
 

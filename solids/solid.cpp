@@ -233,6 +233,42 @@ double TetMesh::volume(size_t t) const {
   return det(positions[q[0]], positions[q[1]], positions[q[2]], positions[q[3]]) / 6.0;
 }
 
+double minSolidAngle(const DVec3& a, const DVec3& b, const DVec3& c, const DVec3& d) {
+  const DVec3 p[4] = {a, b, c, d};
+  double best = 4 * M_PI;
+  for (int i = 0; i < 4; ++i) {
+    const DVec3 x = p[(i + 1) % 4] - p[i], y = p[(i + 2) % 4] - p[i], z = p[(i + 3) % 4] - p[i];
+    const double lx = glm::length(x), ly = glm::length(y), lz = glm::length(z);
+    const double num = std::abs(glm::dot(x, glm::cross(y, z)));
+    const double den = lx * ly * lz + glm::dot(x, y) * lz + glm::dot(x, z) * ly + glm::dot(y, z) * lx;
+    best = std::min(best, 2 * std::atan2(num, den));
+  }
+  return best;
+}
+
+QualityStats measureQuality(const TetMesh& mesh, size_t targetCount) {
+  QualityStats q;
+  if (mesh.tets.empty()) return q;
+  constexpr double kAlpha = 0.7;
+  double total = 0;
+  for (size_t t = 0; t < mesh.tets.size(); ++t) total += mesh.volume(t);
+  const double ideal = total / double(targetCount > 0 ? targetCount : mesh.tets.size());
+  std::vector<double> quality(mesh.tets.size()), angle(mesh.tets.size());
+  parallelFor(0, mesh.tets.size(), [&](size_t t) {
+    const auto& v = mesh.tets[t];
+    angle[t] = minSolidAngle(mesh.positions[v[0]], mesh.positions[v[1]], mesh.positions[v[2]], mesh.positions[v[3]]);
+    const double a = 10 * std::min(1.0, std::sqrt(2 * angle[t]));
+    const double b = 10 * std::min(1.0, std::sqrt(std::max(0.0, mesh.volume(t)) / ideal));
+    quality[t] = kAlpha * a + (1 - kAlpha) * b;
+  }, 4096);
+  q.minQuality = *std::min_element(quality.begin(), quality.end());
+  q.minSolidAngle = *std::min_element(angle.begin(), angle.end());
+  double sum = 0;
+  for (double x : quality) sum += x;  // in order: the same sum at any thread count
+  q.meanQuality = sum / double(quality.size());
+  return q;
+}
+
 std::vector<Vec3> gridNodes(const Grid& g) {
   const size_t nx = size_t(g.cells[0]) + 1, ny = size_t(g.cells[1]) + 1;
   std::vector<Vec3> nodes(g.nodeCount());

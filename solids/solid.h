@@ -107,6 +107,21 @@ TetMesh meshSolid(const Solid& solid, const Grid& grid, const MeshOptions& optio
 /// crossing the plane are split exactly there, by the same edge splits as meshSolid.
 TetMesh clipByPlane(const TetMesh& mesh, const DVec3& normal, double offset);
 
+/// The paper's tetrahedron quality (§4.4, α = 0.7), 0..10:
+/// Quality(t) = α·A(t) + (1 − α)·V(t), A(t) = 10·min(1, sqrt(2·min solid angle(t))),
+/// V(t) = 10·min(1, sqrt(volume(t) / ideal volume)), ideal = total volume / target count.
+struct QualityStats {
+  double minQuality = 0, meanQuality = 0;
+  double minSolidAngle = 0;  ///< steradians (a regular tetrahedron: 0.551)
+};
+
+/// Quality of every tetrahedron of mesh against targetCount tetrahedra (0 = the mesh's own count).
+QualityStats measureQuality(const TetMesh& mesh, size_t targetCount = 0);
+
+/// The smallest of the four solid angles of tetrahedron (a, b, c, d), steradians
+/// (Van Oosterom and Strackee 1983).
+double minSolidAngle(const DVec3& a, const DVec3& b, const DVec3& c, const DVec3& d);
+
 /// The lattice nodes of grid, x fastest.
 std::vector<Vec3> gridNodes(const Grid& grid);
 

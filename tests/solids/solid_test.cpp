@@ -346,3 +346,21 @@ TEST_CASE("writeTetMesh: Gmsh reads the .msh back with its materials", "[solids]
     CHECK(medit.substr(medit.size() - 4) == "End\n");
   }
 }
+
+TEST_CASE("measureQuality: the paper's metric", "[solids]") {
+  // A regular tetrahedron: the largest smallest solid angle, 0.551 sr, so A = 10.
+  const DVec3 a(1, 1, 1), b(1, -1, -1), c(-1, 1, -1), d(-1, -1, 1);
+  CHECK(minSolidAngle(a, b, c, d) == Approx(0.5513).epsilon(1e-3));
+  TetMesh one;
+  one.positions = {a, b, d, c};
+  one.tets = {{0, 1, 2, 3}};
+  one.materials = {0};
+  REQUIRE(one.volume(0) > 0);
+  CHECK(measureQuality(one).minQuality == Approx(10));
+  // A sliver scores low.
+  TetMesh flat = one;
+  flat.positions[3] = DVec3(0, 0, 0.05);
+  flat.positions[2] = DVec3(-1, -1, 0.0);
+  const QualityStats q = measureQuality(flat, 1);
+  CHECK(q.minQuality < 7);
+}
