@@ -70,32 +70,29 @@ struct Work {
   }
 };
 
-/// Cuts every tetrahedron of w at the zero set of fields[v] - b (§4.3): the edges of active
-/// tetrahedra whose ends lie strictly on both sides are split at the crossing, in order of
-/// their vertex ids, in every tetrahedron that has them (earlier volumes' too, so faces
-/// match). Returns the number of edges split.
-size_t cutAt(Work& w, size_t v, double b) {
-  const std::vector<float>& f = w.fields[v];
-  // Fields are stored as floats: compare with the float boundary, so that values set (or
-  // snapped) onto it read exactly zero.
-  const double bf = double(float(b));
-  auto phi = [&](uint32_t x) { return double(f[x]) - bf; };
-  // 1. Crossing edges of active tetrahedra, sorted and unique.
+/// The edges (sorted, unique keys) of tetrahedra t with take(t) for which crosses(a, c).
+template <class Take, class Crosses>
+std::vector<uint64_t> edgesWhere(const Work& w, Take take, Crosses crosses) {
   std::vector<uint64_t> keys = chunked<uint64_t>(w.tets.size(), [&](size_t lo, size_t hi, std::vector<uint64_t>& out) {
     for (size_t t = lo; t < hi; ++t) {
-      if (!w.active[t]) continue;
+      if (!take(t)) continue;
       const Tet& q = w.tets[t];
-      for (const auto& e : kTetEdges) {
-        const double pa = phi(q[e[0]]), pb = phi(q[e[1]]);
-        if ((pa < 0 && pb > 0) || (pa > 0 && pb < 0)) out.push_back(edgeKey(q[e[0]], q[e[1]]));
-      }
+      for (const auto& e : kTetEdges)
+        if (crosses(q[e[0]], q[e[1]])) out.push_back(edgeKey(q[e[0]], q[e[1]]));
     }
   });
   std::sort(keys.begin(), keys.end());
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
-  if (keys.empty()) return 0;
-  // 2. One new vertex per edge at the crossing of the (linear) field; every field is
-  // interpolated the same way, and this one is set exactly onto the boundary.
+  return keys;
+}
+
+/// Splits, in every tetrahedron of w that has them, the edges keys (sorted, unique) at the
+/// parameter s(a, c) in (0, 1) from a; every field is interpolated linearly there and then
+/// fix(new vertex) may set values exactly.
+template <class Param, class Fix>
+void splitEdges(Work& w, const std::vector<uint64_t>& keys, Param param, Fix fix) {
+  if (keys.empty()) return;
+  // 1. One new vertex per edge, in key order.
   const uint32_t first = uint32_t(w.positions.size());
   if (size_t(first) + keys.size() >= std::numeric_limits<uint32_t>::max())
     throw std::length_error("the tetrahedral mesh has more than 4 billion vertices");
@@ -103,10 +100,10 @@ size_t cutAt(Work& w, size_t v, double b) {
   for (auto& g : w.fields) g.resize(first + keys.size());
   parallelFor(0, keys.size(), [&](size_t i) {
     const uint32_t a = uint32_t(keys[i] >> 32), c = uint32_t(keys[i]);
-    const double pa = phi(a), pc = phi(c), s = pa / (pa - pc);
+    const double s = param(a, c);
     w.positions[first + i] = w.positions[a] + (w.positions[c] - w.positions[a]) * s;
     for (auto& g : w.fields) g[first + i] = float(double(g[a]) + (double(g[c]) - double(g[a])) * s);
-    w.fields[v][first + i] = float(b);
+    fix(uint32_t(first + i));
   }, 1024);
   auto lookup = [&](uint32_t a, uint32_t c) -> int64_t {
     const uint64_t k = edgeKey(a, c);
@@ -151,6 +148,25 @@ size_t cutAt(Work& w, size_t v, double b) {
   w.active.resize(pieces.size());
   w.tag.resize(pieces.size());
   for (size_t i = 0; i < pieces.size(); ++i) w.tets[i] = pieces[i].t, w.active[i] = pieces[i].active, w.tag[i] = pieces[i].tag;
+}
+
+/// Cuts every tetrahedron of w at the zero set of fields[v] - b (§4.3): the edges of active
+/// tetrahedra whose ends lie strictly on both sides are split at the crossing, in order of
+/// their vertex ids, in every tetrahedron that has them (earlier volumes' too, so faces
+/// match). Returns the number of edges split.
+size_t cutAt(Work& w, size_t v, double b) {
+  const std::vector<float>& f = w.fields[v];
+  // Fields are stored as floats: compare with the float boundary, so that values set (or
+  // snapped) onto it read exactly zero.
+  const double bf = double(float(b));
+  auto phi = [&](uint32_t x) { return double(f[x]) - bf; };
+  const std::vector<uint64_t> keys = edgesWhere(w, [&](size_t t) { return w.active[t] != 0; }, [&](uint32_t a, uint32_t c) {
+    const double pa = phi(a), pc = phi(c);
+    return (pa < 0 && pc > 0) || (pa > 0 && pc < 0);
+  });
+  // At the crossing of the (linear) field, set exactly onto the boundary.
+  splitEdges(w, keys, [&](uint32_t a, uint32_t c) { return phi(a) / (phi(a) - phi(c)); },
+             [&](uint32_t x) { w.fields[v][x] = float(b); });
   return keys.size();
 }
 
@@ -340,23 +356,62 @@ TetMesh meshSolid(const Solid& solid, const Grid& grid, const MeshOptions& optio
     for (double b : solid.volumes[v].boundaries) st.splits += cutAt(w, v, b);
   }
 
-  // 4. Materials: the first volume claiming each tetrahedron's centroid (fields are linear in it).
+  // 4. The region material of each tetrahedron: the first volume claiming its centroid
+  // (the fields are linear in it).
+  auto regionOf = [&](size_t t) {
+    for (size_t v = 0; v < nv; ++v) {
+      const int m = solid.volumes[v].regionAt(w.centroidValue(v, w.tets[t]));
+      if (m != kUnclaimed) return m;
+    }
+    return kUnclaimed;
+  };
+  // 5. Tetrahedra of procedural layers are subdivided to follow the procedure (§4.3, last
+  // paragraph): an edge whose ends choose different materials is split where the choice
+  // changes (bisection to 1/1024 of the edge), in every tetrahedron that has it.
+  for (size_t p = 0; p < solid.materials.procedural.size(); ++p) {
+    const ProceduralMaterial& proc = solid.materials.procedural[p];
+    const int code = kProcedural0 - int(p);
+    std::vector<uint8_t> in(w.tets.size());
+    parallelFor(0, w.tets.size(), [&](size_t t) { in[t] = regionOf(t) == code; }, 4096);
+    // Where along edge (a, c) the choice changes (bisection to 1/1024 of the edge).
+    auto crossing = [&](uint32_t a, uint32_t c) {
+      const DVec3 pa = w.positions[a], pc = w.positions[c];
+      const int ma = proc.at(pa);
+      double lo = 0, hi = 1;
+      for (int k = 0; k < 10; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        (proc.at(pa + (pc - pa) * mid) == ma ? lo : hi) = mid;
+      }
+      return 0.5 * (lo + hi);
+    };
+    for (int round = 0; round < options.proceduralRounds; ++round) {
+      // Crossings nearer an end than the snap fraction are left to the centroid choice (no slivers).
+      const double near = options.snapFraction;
+      const std::vector<uint64_t> keys = edgesWhere(w, [&](size_t t) { return in[t] != 0; }, [&](uint32_t a, uint32_t c) {
+        if (proc.at(w.positions[a]) == proc.at(w.positions[c])) return false;
+        const double x = crossing(std::min(a, c), std::max(a, c));
+        return x > near && x < 1 - near;
+      });
+      if (keys.empty()) break;
+      st.splits += keys.size();
+      for (size_t t = 0; t < in.size(); ++t) w.tag[t] = in[t];
+      splitEdges(w, keys, crossing, [](uint32_t) {});
+      in.assign(w.tag.begin(), w.tag.end());  // pieces keep their parent's flag
+    }
+  }
+  // 6. Materials; procedural ones chosen at the centroid.
   std::vector<int> material(w.tets.size(), kUnclaimed);
   parallelFor(0, w.tets.size(), [&](size_t t) {
-    const Tet& q = w.tets[t];
-    for (size_t v = 0; v < nv; ++v) {
-      int m = solid.volumes[v].regionAt(w.centroidValue(v, q));
-      if (m == kUnclaimed) continue;
-      if (m <= kProcedural0) {
-        const DVec3 c = (w.positions[q[0]] + w.positions[q[1]] + w.positions[q[2]] + w.positions[q[3]]) * 0.25;
-        m = solid.materials.procedural[size_t(kProcedural0 - m)].at(c);
-      }
-      material[t] = m;
-      break;
+    int m = regionOf(t);
+    if (m <= kProcedural0) {
+      const Tet& q = w.tets[t];
+      const DVec3 c = (w.positions[q[0]] + w.positions[q[1]] + w.positions[q[2]] + w.positions[q[3]]) * 0.25;
+      m = solid.materials.procedural[size_t(kProcedural0 - m)].at(c);
     }
+    material[t] = m;
   }, 4096);
 
-  // 5. Keep tetrahedra with a material; renumber the vertices they use in id order.
+  // 7. Keep tetrahedra with a material; renumber the vertices they use in id order.
   TetMesh mesh = compact(w, material);
   st.tets = mesh.tets.size();
   st.meshSeconds = secondsSince(t0);

@@ -13,8 +13,8 @@
 /// meshSolid (§4.3) samples every volume's field on the grid's nodes, splits each cubic
 /// cell into five tetrahedra with alternating orientation, then cuts the tetrahedra at
 /// every layer boundary (the zero set of d_v - b_k, linear in each tetrahedron) by
-/// splitting crossing edges, and gives each tetrahedron the material of the first volume
-/// that claims it.
+/// splitting crossing edges, subdivides tetrahedra of procedural layers where the procedure's
+/// choice changes, and gives each tetrahedron the material of the first volume that claims it.
 
 #include <array>
 #include <cstdint>
@@ -97,6 +97,9 @@ struct MeshOptions {
   /// Node values this close to a boundary (as a fraction of the cell) snap onto it, so no
   /// split lands nearer than this to a grid node (no needle tetrahedra of near-zero volume).
   double snapFraction = 0.05;
+  /// Rounds of splitting tetrahedra of procedural layers where the chosen material changes
+  /// along an edge (0 = each tetrahedron takes the choice at its centroid).
+  int proceduralRounds = 2;
 };
 
 /// The tetrahedral mesh of solid on grid (§4.3). Deterministic: the same bytes at any

@@ -15,6 +15,7 @@
 #include "core/parallel.h"
 #include "solids/distance_field.h"
 #include "solids/solid.h"
+#include "lsystem/expression.h"
 #include "solids/tet_io.h"
 #include "tests/scratch_dir.h"
 
@@ -363,4 +364,37 @@ TEST_CASE("measureQuality: the paper's metric", "[solids]") {
   flat.positions[2] = DVec3(-1, -1, 0.0);
   const QualityStats q = measureQuality(flat, 1);
   CHECK(q.minQuality < 7);
+}
+
+TEST_CASE("meshSolid: tetrahedra of a procedural layer follow the procedure", "[solids]") {
+  // A sphere whose outer layer is striped by x > 0.1: after subdivision every tetrahedron of
+  // the layer lies on one side of the plane (within the 5% snap of an edge).
+  Solid s;
+  ProceduralMaterial stripes;
+  stripes.name = "stripes";
+  stripes.select = lsystem::Expression::compile("x > 0.1", {"x", "y", "z"}, SourceLoc{"t", 1, 1});
+  stripes.choices = {*s.materials.concrete("chocolate"), *s.materials.concrete("white_chocolate")};
+  s.materials.procedural.push_back(stripes);
+  Layer core, coat;
+  core.fill = true;
+  core.material = *s.materials.concrete("nut");
+  coat.interior = false;
+  coat.thickness = 0.15;
+  coat.material = kProcedural0;
+  s.volumes.push_back(makeVolume(sphereField(DVec3(0.0), 0.5), {core, coat}));
+  const double cell = 0.05;
+  const TetMesh m = meshSolid(s, gridAround(0.75, cell));
+  size_t straddling = 0;
+  for (size_t t = 0; t < m.tets.size(); ++t) {
+    REQUIRE(m.volume(t) > 0);
+    if (m.materials[t] == uint16_t(core.material)) continue;
+    double lo = 1e9, hi = -1e9;
+    for (uint32_t v : m.tets[t]) lo = std::min(lo, m.positions[v].x), hi = std::max(hi, m.positions[v].x);
+    const bool white = m.materials[t] == uint16_t(stripes.choices[1]);
+    // A tetrahedron on the wrong side by more than the snap distance of its edges.
+    if ((white && lo < 0.1 - 0.05 * cell * 1.8) || (!white && hi > 0.1 + 0.05 * cell * 1.8)) ++straddling;
+  }
+  CHECK(straddling == 0);
+  CHECK(faceUses(m)[2] == 0);
+  CHECK(analyzeTopology(meshOf(m, visibleInterface(m))).closed());
 }
