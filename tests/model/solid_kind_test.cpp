@@ -6,20 +6,14 @@
 #include "model/solid_kind.h"
 #include "model/species.h"
 #include "solids/solid.h"
+#include "tests/model/species_error.h"
 #include "tests/scratch_dir.h"
 
 using namespace sprig;
 
 namespace {
 
-std::string errorOf(const std::string& text) {
-  try {
-    parseSpecies(text, "solid.yaml");
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return {};
-}
+std::string errorOf(const std::string& text) { return test::speciesError(text, "solid.yaml"); }
 
 const char* kStriped = R"(kind: solid
 materials:
