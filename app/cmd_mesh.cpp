@@ -10,6 +10,7 @@
 #include "app/cmd_common.h"
 #include "model/model.h"
 #include "core/mesh_io.h"
+#include "core/paths.h"
 
 namespace sprig {
 
@@ -24,11 +25,19 @@ struct MeshArgs {
 };
 
 int runMesh(const MeshArgs& a, const GlobalOptions& g) {
-  requireExtension("-o", a.out, {".ply", ".obj", ".glb"});
+  requireExtension("-o", a.out, {".ply", ".obj", ".glb", ".msh", ".vtu", ".mesh"});
   auto start = std::chrono::steady_clock::now();
   Species species = loadSpecies(a.file, g.pathPolicy());
   SpeciesModel model(species, a.growth.overrides());
   const Stage stage = a.stage.resolve(model);
+  // Volume meshes (tetrahedra with materials) of kinds that have them, by extension.
+  const std::string ext = lowerExtension(a.out);
+  if (ext == ".msh" || ext == ".vtu" || ext == ".mesh") {
+    const std::string line = model.writeVolumeMesh(stage, a.out, !g.quiet);
+    double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    note(g, std::cout, "%s (total %.2f s)", line.c_str(), total);
+    return kExitOk;
+  }
   ModelFigures fig;
   Mesh mesh = model.buildMesh(stage, static_cast<float>(a.cell), !g.quiet, &fig);
 
@@ -45,8 +54,8 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
 
 void addMeshCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run) {
   auto [sub, args] = subcommand<MeshArgs>(app, global, run, "mesh",
-                                          "Polygonize a species' surface into a closed triangle mesh (.ply, .obj, .glb)", runMesh);
-  addInputOutput(*sub, "SPECIES", args->file, args->out, "output mesh (.ply, .obj + .mtl, .glb)");
+                                          "Polygonize a species' surface into a closed triangle mesh (.ply, .obj, .glb), or write a solid's tetrahedra (.msh, .vtu, .mesh)", runMesh);
+  addInputOutput(*sub, "SPECIES", args->file, args->out, "output mesh (.ply, .obj + .mtl, .glb; solids also .msh, .vtu, .mesh)");
   sub->add_option("--cell", args->cell, "cell edge length in model units (default: automatic, from the smallest feature)")
       ->check(CLI::PositiveNumber);
   addStageFlags(*sub, args->stage);

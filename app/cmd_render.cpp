@@ -1,8 +1,9 @@
 /// `sprig render SPECIES -o OUT.{png,exr,jpg} [--width W --height H --spp N --mode exact|mesh|skeleton
-///  --stage K --fraction F --age DEG --view AZ,EL[,FOV] --camera X,Y,Z[,TX,TY,TZ]]`
+///  --stage K --fraction F --age DEG --view AZ,EL[,FOV] --camera X,Y,Z[,TX,TY,TZ] --section NX,NY,NZ,D]`
 
 #include <cstdio>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "app/cmd_common.h"
@@ -24,21 +25,28 @@ struct RenderArgs {
   StageFlags stage;
   std::string view;
   std::string camera;
+  std::string section;
   GrowthFlags growth;
 };
 
-/// Parses `X,Y,Z` (eye) or `X,Y,Z,TX,TY,TZ` (eye and target) into look.camera.
-void parseCamera(const std::string& text, SpeciesRender& look) {
+/// Comma-separated finite numbers of magnitude at most 1e6; nullopt when one is not.
+std::optional<std::vector<double>> parseNumberList(const std::string& text) {
   std::vector<double> v;
   std::stringstream ss(text);
   std::string part;
-  bool ok = true;
   while (std::getline(ss, part, ',')) {
     auto n = parseFiniteNumber(part);
-    if (!n || std::abs(*n) > 1e6) ok = false;
-    else v.push_back(*n);
+    if (!n || std::abs(*n) > 1e6) return std::nullopt;
+    v.push_back(*n);
   }
-  if (!ok || (v.size() != 3 && v.size() != 6))
+  return v;
+}
+
+/// Parses `X,Y,Z` (eye) or `X,Y,Z,TX,TY,TZ` (eye and target) into look.camera.
+void parseCamera(const std::string& text, SpeciesRender& look) {
+  const std::optional<std::vector<double>> list = parseNumberList(text);
+  const std::vector<double> v = list.value_or(std::vector<double>{});
+  if (!list || (v.size() != 3 && v.size() != 6))
     throw UsageError("--camera " + text + ": expected X,Y,Z or X,Y,Z,TX,TY,TZ (eye, then target)");
   CameraSpec c;
   c.position = Vec3(float(v[0]), float(v[1]), float(v[2]));
@@ -58,6 +66,13 @@ int runRender(const RenderArgs& a, const GlobalOptions& g) {
   if (!a.camera.empty()) parseCamera(a.camera, look);
 
   SpeciesModel model(species, a.growth.overrides());
+  if (!a.section.empty()) {
+    const std::optional<std::vector<double>> v = parseNumberList(a.section);
+    if (!v || v->size() != 4 || glm::length(DVec3((*v)[0], (*v)[1], (*v)[2])) == 0)
+      throw UsageError("--section " + a.section + ": expected NX,NY,NZ,D (the plane n·x = d; n not zero)");
+    if (model.volumeMeshExtensions().empty()) throw UsageError("--section applies to solid species only");
+    look.section = Vec4(float((*v)[0]), float((*v)[1]), float((*v)[2]), float((*v)[3]));
+  }
   RenderJob job;
   job.width = a.width;
   job.height = a.height;
@@ -97,6 +112,8 @@ void addRenderCommand(CLI::App& app, const GlobalOptions& global, CommandRun& ru
   addStageFlags(*sub, args->stage);
   sub->add_option("--view", args->view, "camera direction AZIMUTH,ELEVATION[,FOV] in degrees (automatic framing)");
   sub->add_option("--camera", args->camera, "explicit eye X,Y,Z or eye and target X,Y,Z,TX,TY,TZ");
+  sub->add_option("--section", args->section,
+                  "solids: cut away the side n·x > d of the plane NX,NY,NZ,D, showing the layers on the cut");
   addGrowthFlags(*sub, args->growth);
 }
 

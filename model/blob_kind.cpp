@@ -741,18 +741,10 @@ render::TextureTable textureTable(const std::shared_ptr<const textures::TextureR
 }
 
 /// A BlobTree written in the species file: one stage.
-class BlobModel final : public KindModel {
+class BlobModel final : public StillKindModel {
  public:
   explicit BlobModel(const BlobSpecies& blob)
       : blob_(blob), compiled_(std::make_shared<const blobtree::CompiledBlob>(blobtree::compile(blob.tree, blob.root))) {}
-
-  bool hasSurface() const override { return true; }
-  Stage finalStage() const override { return {}; }
-  Stage stageFromIndex(int) const override { return {}; }
-  std::vector<Stage> stripStages(int) const override { return {Stage{}}; }
-  std::vector<Stage> animationFrames(int, int, int) const override { return {Stage{}}; }
-  std::string stageName(const Stage&) const override { return {}; }
-  int stageNumber(const Stage& stage) const override { return stage.step; }
 
   Box3 frameBox() override {
     if (frame_) return *frame_;
@@ -789,12 +781,6 @@ class BlobModel final : public KindModel {
     po.cellSize = cellSize > 0 ? cellSize : blob_.cellSize;
     po.progress = progress;
     return blobtree::polygonize(*compiled_, po);
-  }
-
-  GalleryMotion galleryMotion(bool) override {
-    GalleryMotion m;
-    m.turntable = true;  // a blob does not grow: the camera turns around it
-    return m;
   }
 
  private:

@@ -5,6 +5,7 @@
 #include "model/blob_kind.h"
 #include "model/organism_kind.h"
 #include "model/shell_kind.h"
+#include "model/solid_kind.h"
 #include "model/tree_kind.h"
 
 namespace sprig {
@@ -15,6 +16,7 @@ const std::vector<KindEntry>& speciesKinds() {
       {"shell", readShellSpec},
       {"blob", readBlobSpec},
       {"organism", readOrganismSpec},
+      {"solid", readSolidSpec},
   };
   return kinds;
 }
@@ -32,5 +34,9 @@ const char* geometryModeName(GeometryMode mode) {
 }
 
 Stage KindModel::stageAtAge(double) const { throw UsageError("--age applies to shell species only"); }
+
+std::string KindModel::writeVolumeMesh(const Stage&, const std::filesystem::path& path, bool) {
+  throw UsageError("'" + path.extension().string() + "' is a tetrahedral mesh format: only solid species have one");
+}
 
 }  // namespace sprig

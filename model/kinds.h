@@ -9,6 +9,7 @@
 /// model/model.h), never a test of the kind. Adding a kind is a file pair and one line in
 /// the registry (model/kinds.cpp); README.md "Adding a species kind" is the recipe.
 
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -99,6 +100,30 @@ class KindModel {
   virtual Mesh buildMesh(const Stage& stage, float cellSize, bool progress, ModelFigures& figures) = 0;
   /// How the gallery animates it.
   virtual GalleryMotion galleryMotion(bool final) = 0;
+  /// Extensions of the volume (tetrahedral) meshes the kind writes (".msh", ...); empty
+  /// (the default) for kinds that have only a surface.
+  virtual std::vector<std::string> volumeMeshExtensions() const { return {}; }
+  /// Writes the stage's volume mesh to path (its extension one of volumeMeshExtensions())
+  /// atomically and returns the line `sprig mesh` prints. The default throws UsageError.
+  virtual std::string writeVolumeMesh(const Stage& stage, const std::filesystem::path& path, bool progress);
+};
+
+/// A species with one stage that does not grow (blobs, solids): every stage is that one, and
+/// the gallery turns the camera around it.
+class StillKindModel : public KindModel {
+ public:
+  bool hasSurface() const override { return true; }
+  Stage finalStage() const override { return {}; }
+  Stage stageFromIndex(int) const override { return {}; }
+  std::vector<Stage> stripStages(int) const override { return {Stage{}}; }
+  std::vector<Stage> animationFrames(int, int, int) const override { return {Stage{}}; }
+  std::string stageName(const Stage&) const override { return {}; }
+  int stageNumber(const Stage& stage) const override { return stage.step; }
+  GalleryMotion galleryMotion(bool) override {
+    GalleryMotion m;
+    m.turntable = true;
+    return m;
+  }
 };
 
 /// A kind's keys, read and typed (one subclass per kind).

@@ -76,6 +76,12 @@ class SpeciesModel {
   /// The box the camera frames for every stage: the final stage's bounds (trees: the union
   /// over their steps).
   Box3 frameBox() { return kind_->frameBox(); }
+  /// Extensions of the volume meshes the species writes (solids: .msh, .vtu, .mesh).
+  std::vector<std::string> volumeMeshExtensions() const { return kind_->volumeMeshExtensions(); }
+  /// Writes the stage's volume mesh (KindModel::writeVolumeMesh); returns the summary line.
+  std::string writeVolumeMesh(const Stage& stage, const std::filesystem::path& path, bool progress) {
+    return kind_->writeVolumeMesh(stage, path, progress);
+  }
   /// How the gallery animates the species.
   GalleryMotion galleryMotion(bool final) { return kind_->galleryMotion(final); }
 

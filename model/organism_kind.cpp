@@ -554,26 +554,9 @@ class OrganismReader {
     spec_.planet = s;
   }
 
-  /// A map with exactly one key among names: that pair, else an error.
   std::optional<std::pair<YNode, YNode>> single(const YNode& node, const std::string& what,
                                                 const std::vector<std::string>& names) {
-    if (!node.isMap() || node.pairs().size() != 1) {
-      node.error(diags_, what + " must be a map with one key, one of: " + join(names));
-      return std::nullopt;
-    }
-    auto pair = node.pairs()[0];
-    const std::string k = pair.first.scalar();
-    if (std::find(names.begin(), names.end(), k) == names.end()) {
-      pair.first.error(diags_, "unknown " + what + " " + sprig::quoted(k) + didYouMean(k, names) + " (one of: " + join(names) + ")");
-      return std::nullopt;
-    }
-    return pair;
-  }
-
-  static std::string join(const std::vector<std::string>& names) {
-    std::string s;
-    for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
-    return s;
+    return singleKey(node, diags_, what, names);
   }
 
   DiagnosticList& diags_;

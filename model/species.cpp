@@ -75,7 +75,7 @@ void readRender(MapReader& m, SpeciesRender& r, DiagnosticList& diags) {
 }
 
 /// Kinds Sprig names but does not build yet.
-const std::vector<std::string> kReservedKinds = {"solid"};
+const std::vector<std::string> kReservedKinds = {};
 
 Species readSpecies(std::shared_ptr<const YamlFile> yaml, const PathPolicy& policy, DiagnosticList& diags) {
   Species s;

@@ -54,6 +54,9 @@ struct SpeciesRender {
   SkeletonStyle style;                 ///< skeleton previews
   std::optional<CameraSpec> camera;    ///< `camera: {position, target, distance}`
   render::Material surface{Vec3(0.72f, 0.60f, 0.48f), 0.45f, 0.05f};  ///< `color`, `roughness`, `specular`: blob surfaces
+  /// Solids: a cut-away by the plane n·x = d (xyz = n, w = d); the side n·x > d is removed
+  /// (`sprig render --section`).
+  std::optional<Vec4> section;
 
   /// Renderer settings for an image of width x height.
   render::RenderSettings settings(int imageWidth, int imageHeight) const;

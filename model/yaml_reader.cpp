@@ -1,5 +1,6 @@
 #include "model/yaml_reader.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -522,6 +523,23 @@ void MapReader::finish() {
     if (known_.count(name)) continue;
     e.key.error(*diags_, "unknown key '" + name + "' in " + context_ + didYouMean(name, candidates));
   }
+}
+
+std::optional<std::pair<YNode, YNode>> singleKey(const YNode& node, DiagnosticList& diags, const std::string& what,
+                                                 const std::vector<std::string>& names) {
+  std::string list;
+  for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+  if (!node.isMap() || node.pairs().size() != 1) {
+    node.error(diags, what + " must be a map with one key, one of: " + list);
+    return std::nullopt;
+  }
+  auto pair = node.pairs()[0];
+  const std::string k = pair.first.scalar();
+  if (std::find(names.begin(), names.end(), k) == names.end()) {
+    pair.first.error(diags, "unknown " + what + " " + sprig::quoted(k) + didYouMean(k, names) + " (one of: " + list + ")");
+    return std::nullopt;
+  }
+  return pair;
 }
 
 }  // namespace sprig

@@ -248,4 +248,10 @@ class MapReader {
   std::set<std::string, std::less<>> known_;
 };
 
+/// A map with exactly one key among names (`{sphere: {...}}`): that key and its value.
+/// Otherwise adds "WHAT must be a map with one key, one of: A, B" or "unknown WHAT 'K' (did
+/// you mean ...)" at the node and returns nullopt.
+std::optional<std::pair<YNode, YNode>> singleKey(const YNode& node, DiagnosticList& diags, const std::string& what,
+                                                 const std::vector<std::string>& names);
+
 }  // namespace sprig

@@ -10,6 +10,7 @@ packages=(
   libbenchmark-dev parallel
   libmeshoptimizer-dev libcgal-demo
   nodejs curl ca-certificates
+  gmsh
 )
 
 missing=()

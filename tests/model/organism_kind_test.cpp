@@ -12,21 +12,14 @@
 #include "organisms/base_mesh.h"
 #include "organisms/multires.h"
 #include "tests/model/self_intersection.h"
+#include "tests/model/species_error.h"
 #include "tests/scratch_dir.h"
 
 using namespace sprig;
 
 namespace {
 
-/// The error text parseSpecies throws for text (empty when it loads).
-std::string errorOf(const std::string& text) {
-  try {
-    parseSpecies(text, "org.yaml");
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return {};
-}
+std::string errorOf(const std::string& text) { return test::speciesError(text, "org.yaml"); }
 
 const OrganismSpec& specOf(const Species& s) { return dynamic_cast<const OrganismSpec&>(*s.spec); }
 

@@ -1,0 +1,550 @@
+#include "model/solid_kind.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <map>
+
+#include "core/polymesh.h"
+#include "core/timer.h"
+#include "solids/tet_io.h"
+
+namespace sprig {
+
+namespace {
+
+using namespace solids;
+
+/// Grid nodes a solid may have: 16.8 million (256³). Meshing keeps about 100 bytes per node
+/// and volume plus 40 bytes per tetrahedron.
+constexpr size_t kMaxGridNodes = size_t(1) << 24;
+/// The default cell: the largest side over this, or half the thinnest layer when smaller...
+constexpr double kDefaultCellsAcross = 64;
+/// ...but never finer than the largest side over this.
+constexpr double kFinestCellsAcross = 200;
+
+const std::vector<std::string> kVolumeForms = {"volume", "precedence"};
+const std::vector<std::string> kFields = {"surface_mesh", "sphere",    "box",         "cylinder",
+                                          "ground_plane", "union",     "intersection", "subtraction",
+                                          "transform",    "from_volume_surface", "extrude_2d", "species"};
+const std::vector<std::string> kNotBuilt = {"from_volume_surface", "extrude_2d", "species"};
+const std::vector<std::string> kLayers = {"interior_layer", "exterior_layer"};
+
+std::string notBuilt(const std::string& what) {
+  return sprig::quoted(what) + " is not supported by this version of Sprig (docs/SOLIDS.md, \"Not built yet\")";
+}
+
+/// Reads the solid section; every error goes to diags.
+class SolidReader {
+ public:
+  SolidReader(DiagnosticList& diags, SolidSpec& spec, const PathPolicy& policy) : diags_(diags), spec_(spec), policy_(policy) {}
+
+  void readMaterials(const YNode& section) {
+    MapReader m(section, diags_, "materials");
+    const auto pairs = section.pairs();
+    // Concrete materials first, so procedural ones may choose among any of them.
+    for (int pass = 0; pass < 2; ++pass)
+      for (const auto& [key, value] : pairs) {
+        const std::string name = key.scalar();
+        const bool procedural = value.isMap() && value.node()["select"].IsDefined();
+        if (procedural != (pass == 1)) continue;
+        m.get(name);
+        if (name == "nothing" || findBuiltinMaterial(name)) {
+          key.error(diags_, sprig::quoted(name) + " is a built-in material: name yours differently (or start from it with 'base: " + name + "')");
+          continue;
+        }
+        if (procedural) readProcedural(name, value);
+        else readConcrete(name, value);
+      }
+    m.finish();
+  }
+
+  void readSolid(const YNode& section) {
+    MapReader m(section, diags_, "solid");
+    std::optional<YNode> grid = m.section("grid");
+    bool any = false;
+    for (const std::string& form : kVolumeForms)
+      if (auto v = m.get(form)) {
+        if (any) v->error(diags_, "a solid is one 'volume' or one 'precedence' list, not both");
+        any = true;
+        readVolumeForm(form, *v);
+      }
+    if (!any) section.error(diags_, "missing required key 'volume' or 'precedence' in solid");
+    m.finish();
+    if (!diags_.hasErrors() && !spec_.solid.volumes.empty()) resolveGrid(grid, section);
+  }
+
+ private:
+  // ---- materials ----
+  void readConcrete(const std::string& name, const YNode& value) {
+    MapReader m(value, diags_, "material " + sprig::quoted(name));
+    Material mat;
+    if (auto b = m.get("base")) {
+      const std::string base = b->scalar();
+      if (const Material* bm = findBuiltinMaterial(base)) mat = *bm;
+      else b->error(diags_, "unknown built-in material " + sprig::quoted(base) + didYouMean(base, builtinNames()));
+    }
+    mat.name = name;
+    mat.color = m.color("color", mat.color);
+    mat.roughness = float(m.number("roughness", mat.roughness, 0.0, 1.0));
+    mat.specular = float(m.number("specular", mat.specular, 0.0, 1.0));
+    mat.density = m.number("density", mat.density, 1e-9, 1e6);
+    mat.youngsModulus = m.number("youngs_modulus", mat.youngsModulus, 1e-9, 1e15);
+    mat.poissonRatio = m.number("poisson_ratio", mat.poissonRatio, 0.0, 0.4999);
+    mat.strength = m.number("strength", mat.strength, 1e-9, 1e15);
+    m.finish();
+    spec_.solid.materials.materials.push_back(mat);
+    names_[name] = int(spec_.solid.materials.materials.size() - 1);
+  }
+
+  void readProcedural(const std::string& name, const YNode& value) {
+    MapReader m(value, diags_, "material " + sprig::quoted(name));
+    ProceduralMaterial p;
+    p.name = name;
+    std::optional<YNode> sel = m.get("select");
+    std::vector<YNode> choices = m.sequence("choices");
+    m.finish();
+    if (choices.empty()) {
+      value.error(diags_, "missing required key 'choices' in material " + sprig::quoted(name) + " (the materials 'select' indexes)");
+      return;
+    }
+    for (const YNode& c : choices) {
+      const int id = materialId(c, false);
+      if (id >= 0) p.choices.push_back(id);
+      else if (id == kNothing || id <= kProcedural0) c.error(diags_, "a choice of a procedural material must be a concrete material");
+    }
+    if (auto text = sel->asString(diags_, "'select'")) {
+      try {
+        const SourceLoc at = sel->loc();
+        p.select = lsystem::Expression::compile(*text, {"x", "y", "z"}, at, sel->file().sourceLine(at.line));
+      } catch (const InputError& e) {
+        diags_.append(e.diagnostics());
+        return;
+      }
+    }
+    if (p.choices.size() != choices.size()) return;
+    spec_.solid.materials.procedural.push_back(std::move(p));
+    names_[name] = kProcedural0 - int(spec_.solid.materials.procedural.size() - 1);
+  }
+
+  static std::vector<std::string> builtinNames() {
+    std::vector<std::string> n;
+    for (const Material& m : builtinMaterials()) n.push_back(m.name);
+    return n;
+  }
+
+  /// The id of the material named at node; kUnclaimed after an error.
+  int materialId(const YNode& node, bool allowNothing = true) {
+    std::optional<std::string> name = node.asString(diags_, "'material'");
+    if (!name) return kUnclaimed;
+    if (*name == "nothing" && allowNothing) return kNothing;
+    if (auto it = names_.find(*name); it != names_.end()) return it->second;
+    if (auto id = spec_.solid.materials.concrete(*name)) return *id;
+    std::vector<std::string> all = builtinNames();
+    for (const auto& [n, id] : names_) all.push_back(n);
+    all.push_back("nothing");
+    node.error(diags_, "unknown material " + sprig::quoted(*name) + didYouMean(*name, all) +
+                           " (built-in: chocolate, white_chocolate, nut, pink_frosting, foil, bronze, shiny_bronze, "
+                           "fired_clay, stone, dirt, brick, wood; or define it under 'materials')");
+    return kUnclaimed;
+  }
+
+  // ---- volumes ----
+  void readVolumeForm(const std::string& form, const YNode& value) {
+    if (form == "volume") {
+      readVolume(value);
+      return;
+    }
+    if (!value.isSequence()) {
+      value.error(diags_, "'precedence' must be a sequence of volumes ({volume: ...} or {precedence: [...]}), first claims first");
+      return;
+    }
+    for (const YNode& item : value.items())
+      if (auto one = singleKey(item, diags_, "precedence entry", kVolumeForms)) readVolumeForm(one->first.scalar(), one->second);
+  }
+
+  void readVolume(const YNode& value) {
+    MapReader m(value, diags_, "volume");
+    if (auto v = m.get("velocity")) v->error(diags_, notBuilt("velocity"));
+    FieldPtr field;
+    if (auto f = m.get("distance_field")) field = readField(*f);
+    else value.error(diags_, "missing required key 'distance_field' in volume");
+    std::vector<Layer> layers;
+    const std::vector<YNode> items = m.sequence("layers");
+    if (items.empty() && !m.has("layers")) value.error(diags_, "missing required key 'layers' in volume");
+    for (const YNode& item : items)
+      if (auto l = readLayer(item)) layers.push_back(*l);
+    m.finish();
+    if (!field || layers.size() != items.size() || layers.empty()) return;
+    try {
+      spec_.solid.volumes.push_back(makeVolume(field, layers));
+      maxExterior_ = std::max(maxExterior_, spec_.solid.volumes.back().boundaries.back());
+      for (const Layer& l : layers)
+        if (!l.fill) thinnest_ = std::min(thinnest_, l.thickness);
+    } catch (const std::invalid_argument& e) {
+      value.error(diags_, e.what());
+    }
+  }
+
+  std::optional<Layer> readLayer(const YNode& item) {
+    auto one = singleKey(item, diags_, "layer", kLayers);
+    if (!one) return std::nullopt;
+    Layer l;
+    l.interior = one->first.scalar() == "interior_layer";
+    MapReader m(one->second, diags_, one->first.scalar());
+    const size_t errors = errorCount();
+    if (auto v = m.get("velocity")) v->error(diags_, notBuilt("velocity"));
+    if (auto mat = m.get("material")) l.material = materialId(*mat);
+    else one->second.error(diags_, "missing required key 'material' in " + one->first.scalar() + " (a material name or nothing)");
+    if (auto t = m.get("thickness")) {
+      if (t->isPlainScalar() && t->scalar() == "fill") {
+        l.fill = true;
+        if (!l.interior) t->error(diags_, "'thickness: fill' is for interior layers (an exterior layer needs a number)");
+      } else if (auto v = t->asNumber(diags_, "'thickness'")) {
+        if (*v <= 0) t->error(diags_, "'thickness' must be positive (world units, or fill), got " + t->scalar());
+        l.thickness = *v;
+      }
+    }
+    m.finish();
+    return errorCount() == errors ? std::optional<Layer>(l) : std::nullopt;
+  }
+
+  // ---- distance fields ----
+  FieldPtr readField(const YNode& node) {
+    auto one = singleKey(node, diags_, "distance field", kFields);
+    if (!one) return nullptr;
+    const std::string kind = one->first.scalar();
+    if (std::find(kNotBuilt.begin(), kNotBuilt.end(), kind) != kNotBuilt.end()) {
+      one->first.error(diags_, notBuilt(kind));
+      return nullptr;
+    }
+    const YNode& value = one->second;
+    if (kind == "union" || kind == "intersection" || kind == "subtraction") {
+      if (!value.isSequence() || value.items().empty()) {
+        value.error(diags_, sprig::quoted(kind) + " must be a sequence of distance fields");
+        return nullptr;
+      }
+      std::vector<FieldPtr> parts;
+      for (const YNode& item : value.items()) parts.push_back(readField(item));
+      if (std::find(parts.begin(), parts.end(), nullptr) != parts.end()) return nullptr;
+      if (kind == "union") return unionField(parts);
+      if (kind == "intersection") return intersectionField(parts);
+      if (parts.size() != 2) {
+        value.error(diags_, "'subtraction' takes two distance fields [a, b] (a minus b), got " + std::to_string(parts.size()));
+        return nullptr;
+      }
+      return subtractionField(parts[0], parts[1]);
+    }
+    MapReader m(value, diags_, kind);
+    FieldPtr out;
+    if (kind == "surface_mesh") {
+      if (auto v = m.get("velocity")) v->error(diags_, notBuilt("velocity"));
+      out = readMesh(m);
+    } else if (kind == "sphere") {
+      out = sphereField(DVec3(m.vec3("center", Vec3(0.0f))), m.number("radius", 1.0, 1e-6, 1e6));
+    } else if (kind == "box") {
+      out = boxField(DVec3(m.vec3("center", Vec3(0.0f))), DVec3(m.vec3("size", Vec3(1.0f), 1e-6, 1e6)));
+    } else if (kind == "cylinder") {
+      const Vec3 c = m.vec3("center", Vec3(0.0f));
+      const double r = m.number("radius", 0.5, 1e-6, 1e6), h = m.number("height", 1.0, 1e-6, 1e6);
+      out = cylinderField(DVec3(c), r, h, DVec3(axisOf(m, "axis")));
+    } else if (kind == "ground_plane") {
+      out = groundPlaneField(DVec3(axisOf(m, "normal")), m.number("height", 0.0));
+    } else if (kind == "transform") {
+      FieldPtr child;
+      if (auto f = m.get("distance_field")) child = readField(*f);
+      else value.error(diags_, "missing required key 'distance_field' in transform");
+      const double scale = m.number("scale", 1.0, 1e-6, 1e6);
+      Vec3 axis(0, 1, 0);
+      double angle = 0;
+      if (auto r = m.section("rotate")) {
+        MapReader rm(*r, diags_, "rotate");
+        axis = axisOf(rm, "axis");
+        angle = rm.number("angle_deg", 0.0, -360.0, 360.0);
+        rm.finish();
+      }
+      const Vec3 t = m.vec3("translate", Vec3(0.0f));
+      if (child) out = transformField(child, scale, DVec3(axis), angle, DVec3(t));
+    }
+    m.finish();
+    return out;
+  }
+
+  /// A unit direction at key (default +y); zero is an error.
+  Vec3 axisOf(MapReader& m, const char* key) {
+    const Vec3 a = m.vec3(key, Vec3(0, 1, 0));
+    if (glm::length(a) == 0) {
+      m.get(key)->error(diags_, sprig::quoted(key) + " must not be zero");
+      return Vec3(0, 1, 0);
+    }
+    return glm::normalize(a);
+  }
+
+  /// A closed mesh file as a field; the first open edge is an error at its face.
+  FieldPtr readMesh(MapReader& m) {
+    auto file = m.path("file", policy_);
+    if (!file) {
+      if (!m.has("file")) m.node().error(diags_, "missing required key 'file' in surface_mesh (an OBJ, PLY or OFF file)");
+      return nullptr;
+    }
+    try {
+      PolyMesh mesh = readPolyMesh(*file);
+      const size_t before = errorCount();
+      checkPolyMesh(mesh, diags_);
+      if (errorCount() != before) return nullptr;
+      if (auto open = firstOpenEdge(mesh)) {
+        const std::string what = "mesh " + sprig::quoted(file->string()) + " is not closed: the edge from vertex " +
+                                 std::to_string(open->a + 1) + " to vertex " + std::to_string(open->b + 1) +
+                                 " has only this face (a distance field needs a closed mesh)";
+        if (open->face < mesh.faceLocs.size() && mesh.faceLocs[open->face].line > 0) {
+          const SourceLoc& at = mesh.faceLocs[open->face];
+          diags_.error(at, what);
+        } else {
+          m.get("file")->error(diags_, what);
+        }
+        return nullptr;
+      }
+      return meshField(mesh);
+    } catch (const InputError& e) {
+      diags_.append(e.diagnostics());
+    } catch (const std::invalid_argument& e) {
+      m.get("file")->error(diags_, e.what());
+    }
+    return nullptr;
+  }
+
+  // ---- grid ----
+  void resolveGrid(const std::optional<YNode>& gridNode, const YNode& section) {
+    std::optional<DBox3> box;
+    double cell = 0;
+    if (gridNode) {
+      MapReader gm(*gridNode, diags_, "grid");
+      cell = gm.number("cell", 0.0, 1e-6, 1e6);
+      if (auto b = gm.section("bounds")) {
+        MapReader bm(*b, diags_, "bounds");
+        const Vec3 lo = bm.vec3("min", Vec3(-1.0f)), hi = bm.vec3("max", Vec3(1.0f));
+        bm.finish();
+        if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z)) b->error(diags_, "'bounds' needs min < max on every axis");
+        box = DBox3{DVec3(lo), DVec3(hi)};
+      }
+      gm.finish();
+    }
+    if (!box) {
+      DBox3 all;
+      for (const Volume& v : spec_.solid.volumes) {
+        std::optional<DBox3> b = v.field->bounds();
+        if (!b) {
+          (gridNode ? *gridNode : section)
+              .error(diags_, "a volume has no bounds (a ground plane): give 'grid: {bounds: {min: [x, y, z], max: [x, y, z]}}'");
+          return;
+        }
+        all.extend(b->expanded(std::max(0.0, v.boundaries.back())));
+      }
+      box = all;
+    }
+    const DVec3 size = box->size();
+    const double largest = std::max(size.x, std::max(size.y, size.z));
+    if (cell <= 0) cell = std::max(std::min(largest / kDefaultCellsAcross, thinnest_ / 2), largest / kFinestCellsAcross);
+    // One cell of margin around the box so the outermost interface closes inside the grid.
+    const DBox3 padded = box->expanded(gridNode && gridNode->node()["bounds"].IsDefined() ? 0.0 : cell);
+    Grid g;
+    g.origin = padded.lo;
+    g.cell = cell;
+    size_t nodes = 1;
+    for (int a = 0; a < 3; ++a) {
+      const double n = std::ceil((padded.hi[a] - padded.lo[a]) / cell - 1e-9);
+      g.cells[a] = int(std::clamp(n, 1.0, 1e9));
+      nodes *= size_t(g.cells[a]) + 1;
+    }
+    if (nodes > kMaxGridNodes) {
+      char buf[256];
+      std::snprintf(buf, sizeof buf, "'grid' of cell %g makes %d x %d x %d cells (%zu nodes), more than the limit %zu; use a larger 'cell'",
+                    cell, g.cells[0], g.cells[1], g.cells[2], nodes, kMaxGridNodes);
+      (gridNode ? *gridNode : section).error(diags_, buf);
+      return;
+    }
+    spec_.grid = g;
+  }
+
+  size_t errorCount() const {
+    return size_t(std::count_if(diags_.items().begin(), diags_.items().end(),
+                                [](const Diagnostic& d) { return d.severity == Severity::Error; }));
+  }
+
+  DiagnosticList& diags_;
+  SolidSpec& spec_;
+  const PathPolicy& policy_;
+  std::map<std::string, int> names_;  ///< file materials: concrete ids and procedural codes
+  double maxExterior_ = 0;
+  double thinnest_ = 1e30;
+};
+
+/// A solid: its tetrahedral mesh, built once.
+class SolidModel final : public StillKindModel {
+ public:
+  explicit SolidModel(const SolidSpec& spec) : spec_(spec) {}
+
+  Box3 frameBox() override {
+    Box3 box;
+    for (const DVec3& p : tets().positions) box.extend(Vec3(p));
+    return box.empty() ? Box3{Vec3(-1.0f), Vec3(1.0f)} : box;
+  }
+
+  BuiltStage build(const Stage&, GeometryMode mode, const SpeciesRender& look) override {
+    if (mode == GeometryMode::Skeleton) throw UsageError("solid species have no skeleton: use --mode exact or mesh");
+    BuiltStage out;
+    const auto t0 = std::chrono::steady_clock::now();
+    std::vector<uint16_t> mats;
+    std::vector<Mesh> parts;
+    if (look.section) {
+      parts = visibleMeshes(clipByPlane(tets(), DVec3(Vec3(*look.section)), double(look.section->w)), &mats);
+    } else {
+      parts = visible().first;
+      mats = visible().second;
+    }
+    for (size_t i = 0; i < parts.size(); ++i) {
+      const Material& m = spec_.solid.materials.materials[mats[i]];
+      render::MeshPart part;
+      out.figures.triangles += parts[i].triangleCount();
+      part.mesh = std::move(parts[i]);
+      part.material = render::Material{m.color, m.roughness, m.specular};
+      out.geometry.parts.push_back(std::move(part));
+    }
+    out.figures.primitives = tets().tets.size();
+    out.figures.buildSeconds = secondsSince(t0) + buildSeconds_;
+    return out;
+  }
+
+  Mesh buildMesh(const Stage&, float, bool, ModelFigures& figures) override {
+    Mesh all;
+    const auto& [parts, mats] = visible();
+    for (size_t i = 0; i < parts.size(); ++i) {
+      Mesh part = parts[i];
+      part.colors.assign(part.vertexCount(), spec_.solid.materials.materials[mats[i]].color);
+      all.append(part);
+    }
+    figures.triangles = all.triangleCount();
+    figures.primitives = tets().tets.size();
+    figures.buildSeconds = buildSeconds_;
+    return all;
+  }
+
+  std::vector<std::string> volumeMeshExtensions() const override { return {".msh", ".vtu", ".mesh"}; }
+
+  std::string writeVolumeMesh(const Stage&, const std::filesystem::path& path, bool) override {
+    const TetMesh& m = tets();
+    writeTetMesh(m, spec_.solid.materials.materials, path);
+    const QualityStats q = measureQuality(m);
+    char buf[512];
+    std::snprintf(buf, sizeof buf,
+                  "%s: %zu tetrahedra, %zu vertices (grid %dx%dx%d of cell %g; fields %.2f s, mesh %.2f s); "
+                  "quality min %.2f mean %.2f, smallest solid angle %.2g sr",
+                  path.string().c_str(), m.tets.size(), m.positions.size(), spec_.grid.cells[0], spec_.grid.cells[1],
+                  spec_.grid.cells[2], spec_.grid.cell, stats_.fieldSeconds, stats_.meshSeconds, q.minQuality,
+                  q.meanQuality, q.minSolidAngle);
+    return buf;
+  }
+
+ private:
+  const TetMesh& tets() {
+    if (!mesh_) {
+      const auto t0 = std::chrono::steady_clock::now();
+      mesh_ = meshSolid(spec_.solid, spec_.grid, {}, &stats_);
+      buildSeconds_ = secondsSince(t0);
+    }
+    return *mesh_;
+  }
+
+  /// The whole solid's render meshes and their materials (kept: turntable frames reuse them).
+  const std::pair<std::vector<Mesh>, std::vector<uint16_t>>& visible() {
+    if (!visible_) {
+      visible_.emplace();
+      visible_->first = visibleMeshes(tets(), &visible_->second);
+    }
+    return *visible_;
+  }
+
+  const SolidSpec& spec_;
+  std::optional<TetMesh> mesh_;
+  std::optional<std::pair<std::vector<Mesh>, std::vector<uint16_t>>> visible_;
+  MeshStats stats_;
+  double buildSeconds_ = 0;
+};
+
+}  // namespace
+
+std::vector<Mesh> visibleMeshes(const TetMesh& mesh, std::vector<uint16_t>* partMaterials) {
+  // Normals are smoothed over the faces around a vertex whose normals lie within 60° of
+  // each other; sharper edges (a cut-away's rim, a box's edges) stay creased.
+  constexpr float kCreaseCos = 0.5f;
+  const std::vector<InterfaceTriangle> tris = visibleInterface(mesh);
+  std::map<uint16_t, std::vector<size_t>> byMaterial;
+  for (size_t i = 0; i < tris.size(); ++i) byMaterial[tris[i].material].push_back(i);
+  std::vector<Mesh> out;
+  if (partMaterials) partMaterials->clear();
+  for (const auto& [mat, list] : byMaterial) {
+    // Face normals (area-weighted) and the faces around each vertex.
+    std::vector<Vec3> faceNormal(list.size());
+    std::map<uint32_t, std::vector<uint32_t>> around;
+    for (size_t f = 0; f < list.size(); ++f) {
+      const auto& v = tris[list[f]].v;
+      const Vec3 a(mesh.positions[v[0]]), b(mesh.positions[v[1]]), c(mesh.positions[v[2]]);
+      faceNormal[f] = glm::cross(b - a, c - a);
+      for (uint32_t x : v) around[x].push_back(uint32_t(f));
+    }
+    // One output vertex per (vertex, group of faces with similar normals).
+    Mesh m;
+    std::vector<std::array<uint32_t, 3>> corner(list.size());
+    for (const auto& [x, faces] : around) {
+      std::vector<std::pair<Vec3, uint32_t>> groups;  // direction, output vertex
+      for (uint32_t f : faces) {
+        const Vec3 n = glm::normalize(faceNormal[f]);
+        size_t g = 0;
+        while (g < groups.size() && glm::dot(glm::normalize(groups[g].first), n) < kCreaseCos) ++g;
+        if (g == groups.size()) {
+          groups.push_back({Vec3(0.0f), uint32_t(m.positions.size())});
+          m.positions.push_back(Vec3(mesh.positions[x]));
+          m.normals.push_back(Vec3(0.0f));
+        }
+        groups[g].first += n;
+        m.normals[groups[g].second] += faceNormal[f];
+        const auto& v = tris[list[f]].v;
+        corner[f][size_t(std::find(v.begin(), v.end(), x) - v.begin())] = groups[g].second;
+      }
+    }
+    for (Vec3& n : m.normals) n = glm::length(n) > 0 ? glm::normalize(n) : Vec3(0, 1, 0);
+    for (const auto& c : corner) m.triangles.push_back({c[0], c[1], c[2]});
+    if (partMaterials) partMaterials->push_back(mat);
+    out.push_back(std::move(m));
+  }
+  return out;
+}
+
+std::shared_ptr<const KindSpec> readSolidSpec(MapReader& top, Species& species, DiagnosticList& diags) {
+  auto spec = std::make_shared<SolidSpec>();
+  SolidReader reader(diags, *spec, species.policy);
+  if (auto m = top.section("materials")) reader.readMaterials(*m);
+  std::optional<YNode> section = top.section("solid");
+  if (!section) {
+    if (!top.has("solid")) top.node().error(diags, "missing required key 'solid' in species file");
+    return nullptr;
+  }
+  spec->loc = section->loc();
+  reader.readSolid(*section);
+  if (diags.hasErrors()) return nullptr;
+  return spec;
+}
+
+std::string SolidSpec::checkSummary(const Species& species) const {
+  char buf[256];
+  std::snprintf(buf, sizeof buf, " '%s', %zu volume%s, grid %dx%dx%d of cell %g", species.name.c_str(), solid.volumes.size(),
+                solid.volumes.size() == 1 ? "" : "s", grid.cells[0], grid.cells[1], grid.cells[2], grid.cell);
+  return buf;
+}
+
+std::unique_ptr<KindModel> SolidSpec::makeModel(const Species&, const ModelOptions&) const {
+  return std::make_unique<SolidModel>(*this);
+}
+
+}  // namespace sprig

@@ -1,0 +1,55 @@
+#pragma once
+/// `kind: solid` species: layered solid models as tetrahedral meshes with materials
+/// (Cutler, Dorsey, McMillan, Müller, Jagnow, "A procedural approach to authoring solid
+/// models", §2 and §4; solids/solid.h). The paper's script becomes YAML with the names of
+/// its appendix:
+///
+/// ```
+///   kind: solid
+///   materials:                                   # named materials (built-ins need none)
+///     striped_chocolate: {select: "y > 0.2", choices: [white_chocolate, chocolate]}
+///   solid:
+///     grid: {cell: 0.03}                         # optional: default from bounds and the thinnest layer
+///     precedence:                                # or one `volume:`
+///       - volume:
+///           distance_field: {surface_mesh: {file: meshes_solid/almond.obj}}
+///           layers:
+///             - interior_layer: {material: nut, thickness: fill}
+///       - volume:
+///           distance_field: {union: [{sphere: {radius: 1}}, {box: {size: [1, 1, 3]}}]}
+///           layers:
+///             - interior_layer: {material: chocolate, thickness: fill}
+///             - exterior_layer: {material: white_chocolate, thickness: 0.1}
+/// ```
+/// docs/SOLIDS.md lists every key, default and unit, and what is not built yet (interface
+/// velocity, from_volume_surface, 2-D extrusion, Sprig species as fields): those keys are
+/// errors at their file:line:col, never ignored.
+
+#include <memory>
+#include <string>
+
+#include "model/kinds.h"
+#include "model/yaml_reader.h"
+#include "solids/solid.h"
+
+namespace sprig {
+
+/// The keys of a solid species, read and checked; the grid is resolved at read time.
+class SolidSpec : public KindSpec {
+ public:
+  solids::Solid solid;
+  solids::Grid grid;
+  SourceLoc loc;
+
+  std::string checkSummary(const Species& species) const override;
+  std::unique_ptr<KindModel> makeModel(const Species& species, const ModelOptions& options) const override;
+};
+
+/// Reads the `solid:` section and the top-level `materials:` of a species file, adding every error to diags.
+std::shared_ptr<const KindSpec> readSolidSpec(MapReader& top, Species& species, DiagnosticList& diags);
+
+/// The visible interface of mesh as a render mesh: one part per material with its colour,
+/// smooth normals within each part.
+std::vector<Mesh> visibleMeshes(const solids::TetMesh& mesh, std::vector<uint16_t>* partMaterials = nullptr);
+
+}  // namespace sprig

@@ -1,0 +1,497 @@
+#include "solids/solid.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "core/parallel.h"
+#include "core/timer.h"
+
+namespace sprig::solids {
+
+namespace {
+
+using Tet = std::array<uint32_t, 4>;
+constexpr int kTetEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+/// Tetrahedra are processed in chunks of this many: chunk outputs are joined in chunk
+/// order, so results never depend on the thread count.
+constexpr size_t kChunk = 4096;
+
+uint64_t edgeKey(uint32_t a, uint32_t b) { return a < b ? (uint64_t(a) << 32) | b : (uint64_t(b) << 32) | a; }
+
+double det(const DVec3& a, const DVec3& b, const DVec3& c, const DVec3& d) {
+  return glm::dot(b - a, glm::cross(c - a, d - a));
+}
+
+/// The five tetrahedra of a cube (corner c = dx + 2·dy + 4·dz) for both parities, positively
+/// oriented: four corners cut off and the central tetrahedron, whose orientation
+/// alternates so that face diagonals match between neighbouring cubes (§4.3).
+std::array<std::array<Tet, 5>, 2> cubePatterns() {
+  const std::array<std::array<Tet, 5>, 2> raw = {{
+      {{{0, 1, 2, 4}, {3, 1, 2, 7}, {5, 1, 4, 7}, {6, 2, 4, 7}, {1, 2, 4, 7}}},
+      {{{1, 0, 3, 5}, {2, 0, 3, 6}, {4, 0, 5, 6}, {7, 3, 5, 6}, {0, 3, 5, 6}}},
+  }};
+  std::array<std::array<Tet, 5>, 2> out = raw;
+  auto corner = [](uint32_t c) { return DVec3(c & 1, (c >> 1) & 1, (c >> 2) & 1); };
+  for (auto& pattern : out)
+    for (Tet& t : pattern)
+      if (det(corner(t[0]), corner(t[1]), corner(t[2]), corner(t[3])) < 0) std::swap(t[2], t[3]);
+  return out;
+}
+
+/// Runs f(begin, end, out) over fixed chunks of [0, n) in parallel and joins the outputs in order.
+template <class T, class F>
+std::vector<T> chunked(size_t n, F&& f) {
+  const size_t chunks = (n + kChunk - 1) / kChunk;
+  std::vector<std::vector<T>> parts(chunks);
+  parallelFor(0, chunks, [&](size_t c) { f(c * kChunk, std::min(n, (c + 1) * kChunk), parts[c]); });
+  std::vector<T> out;
+  size_t total = 0;
+  for (auto& p : parts) total += p.size();
+  out.reserve(total);
+  for (auto& p : parts) out.insert(out.end(), p.begin(), p.end());
+  return out;
+}
+
+/// The mesh while it is cut: vertices with every volume's distance, tetrahedra with a flag
+/// "no earlier volume claims it".
+struct Work {
+  std::vector<DVec3> positions;
+  std::vector<std::vector<float>> fields;  ///< [volume][vertex]
+  std::vector<Tet> tets;
+  std::vector<uint8_t> active;
+  std::vector<int> tag;  ///< carried to the pieces of a split (a material when clipping)
+
+  double centroidValue(size_t volume, const Tet& t) const {
+    const std::vector<float>& f = fields[volume];
+    return (double(f[t[0]]) + f[t[1]] + f[t[2]] + f[t[3]]) * 0.25;
+  }
+};
+
+/// The edges (sorted, unique keys) of tetrahedra t with take(t) for which crosses(a, c).
+template <class Take, class Crosses>
+std::vector<uint64_t> edgesWhere(const Work& w, Take take, Crosses crosses) {
+  std::vector<uint64_t> keys = chunked<uint64_t>(w.tets.size(), [&](size_t lo, size_t hi, std::vector<uint64_t>& out) {
+    for (size_t t = lo; t < hi; ++t) {
+      if (!take(t)) continue;
+      const Tet& q = w.tets[t];
+      for (const auto& e : kTetEdges)
+        if (crosses(q[e[0]], q[e[1]])) out.push_back(edgeKey(q[e[0]], q[e[1]]));
+    }
+  });
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  return keys;
+}
+
+/// Splits, in every tetrahedron of w that has them, the edges keys (sorted, unique) at the
+/// parameter s(a, c) in (0, 1) from a; every field is interpolated linearly there and then
+/// fix(new vertex) may set values exactly.
+template <class Param, class Fix>
+void splitEdges(Work& w, const std::vector<uint64_t>& keys, Param param, Fix fix) {
+  if (keys.empty()) return;
+  // 1. One new vertex per edge, in key order.
+  const uint32_t first = uint32_t(w.positions.size());
+  if (size_t(first) + keys.size() >= std::numeric_limits<uint32_t>::max())
+    throw std::length_error("the tetrahedral mesh has more than 4 billion vertices");
+  w.positions.resize(first + keys.size());
+  for (auto& g : w.fields) g.resize(first + keys.size());
+  parallelFor(0, keys.size(), [&](size_t i) {
+    const uint32_t a = uint32_t(keys[i] >> 32), c = uint32_t(keys[i]);
+    const double s = param(a, c);
+    w.positions[first + i] = w.positions[a] + (w.positions[c] - w.positions[a]) * s;
+    for (auto& g : w.fields) g[first + i] = float(double(g[a]) + (double(g[c]) - double(g[a])) * s);
+    fix(uint32_t(first + i));
+  }, 1024);
+  auto lookup = [&](uint32_t a, uint32_t c) -> int64_t {
+    const uint64_t k = edgeKey(a, c);
+    auto it = std::lower_bound(keys.begin(), keys.end(), k);
+    return it != keys.end() && *it == k ? int64_t(first + (it - keys.begin())) : -1;
+  };
+  // 3. Split each tetrahedron on its listed edges, smallest key first (the consistent
+  // order: two tetrahedra sharing a face split its edges in the same order).
+  struct Piece {
+    Tet t;
+    uint8_t active;
+    int tag;
+  };
+  std::vector<Piece> pieces = chunked<Piece>(w.tets.size(), [&](size_t lo, size_t hi, std::vector<Piece>& out) {
+    std::vector<Tet> stack;
+    for (size_t t = lo; t < hi; ++t) {
+      stack.assign(1, w.tets[t]);
+      while (!stack.empty()) {
+        const Tet q = stack.back();
+        stack.pop_back();
+        uint64_t best = std::numeric_limits<uint64_t>::max();
+        int be = -1;
+        int64_t m = -1;
+        for (int e = 0; e < 6; ++e) {
+          const int64_t id = lookup(q[kTetEdges[e][0]], q[kTetEdges[e][1]]);
+          const uint64_t k = edgeKey(q[kTetEdges[e][0]], q[kTetEdges[e][1]]);
+          if (id >= 0 && k < best) best = k, be = e, m = id;
+        }
+        if (be < 0) {
+          out.push_back({q, w.active[t], w.tag[t]});
+          continue;
+        }
+        Tet c1 = q, c2 = q;  // same orientation: a vertex moves along its edge
+        c1[kTetEdges[be][1]] = uint32_t(m);
+        c2[kTetEdges[be][0]] = uint32_t(m);
+        stack.push_back(c2);  // c1 is handled first
+        stack.push_back(c1);
+      }
+    }
+  });
+  w.tets.resize(pieces.size());
+  w.active.resize(pieces.size());
+  w.tag.resize(pieces.size());
+  for (size_t i = 0; i < pieces.size(); ++i) w.tets[i] = pieces[i].t, w.active[i] = pieces[i].active, w.tag[i] = pieces[i].tag;
+}
+
+/// Cuts every tetrahedron of w at the zero set of fields[v] - b (§4.3): the edges of active
+/// tetrahedra whose ends lie strictly on both sides are split at the crossing, in order of
+/// their vertex ids, in every tetrahedron that has them (earlier volumes' too, so faces
+/// match). Returns the number of edges split.
+size_t cutAt(Work& w, size_t v, double b) {
+  const std::vector<float>& f = w.fields[v];
+  // Fields are stored as floats: compare with the float boundary, so that values set (or
+  // snapped) onto it read exactly zero.
+  const double bf = double(float(b));
+  auto phi = [&](uint32_t x) { return double(f[x]) - bf; };
+  const std::vector<uint64_t> keys = edgesWhere(w, [&](size_t t) { return w.active[t] != 0; }, [&](uint32_t a, uint32_t c) {
+    const double pa = phi(a), pc = phi(c);
+    return (pa < 0 && pc > 0) || (pa > 0 && pc < 0);
+  });
+  // At the crossing of the (linear) field, set exactly onto the boundary.
+  splitEdges(w, keys, [&](uint32_t a, uint32_t c) { return phi(a) / (phi(a) - phi(c)); },
+             [&](uint32_t x) { w.fields[v][x] = float(b); });
+  return keys.size();
+}
+
+/// The tetrahedra of w with a material >= 0, their vertices renumbered in id order.
+TetMesh compact(const Work& w, const std::vector<int>& material) {
+  TetMesh mesh;
+  std::vector<uint32_t> remap(w.positions.size(), 0);
+  for (size_t t = 0; t < w.tets.size(); ++t)
+    if (material[t] >= 0)
+      for (uint32_t x : w.tets[t]) remap[x] = 1;
+  uint32_t next = 0;
+  for (size_t x = 0; x < remap.size(); ++x)
+    if (remap[x]) {
+      remap[x] = next++;
+      mesh.positions.push_back(w.positions[x]);
+    }
+  for (size_t t = 0; t < w.tets.size(); ++t) {
+    if (material[t] < 0) continue;
+    const Tet& q = w.tets[t];
+    mesh.tets.push_back({remap[q[0]], remap[q[1]], remap[q[2]], remap[q[3]]});
+    mesh.materials.push_back(uint16_t(material[t]));
+  }
+  return mesh;
+}
+
+}  // namespace
+
+int Volume::regionAt(double d) const {
+  return regions[size_t(std::upper_bound(boundaries.begin(), boundaries.end(), d) - boundaries.begin())];
+}
+
+std::pair<double, double> Volume::claimed() const {
+  constexpr double inf = std::numeric_limits<double>::infinity();
+  const double lo = regions.front() != kUnclaimed ? -inf : boundaries.front();
+  const double hi = regions.back() != kUnclaimed ? inf : boundaries.back();
+  return {lo, hi};
+}
+
+Volume makeVolume(FieldPtr field, const std::vector<Layer>& layers) {
+  std::vector<Layer> in, out;
+  for (const Layer& l : layers) (l.interior ? in : out).push_back(l);
+  for (size_t i = 0; i < in.size(); ++i)
+    if (in[i].fill && i + 1 != in.size()) throw std::invalid_argument("only the innermost interior layer may fill");
+  for (const Layer& l : out)
+    if (l.fill) throw std::invalid_argument("an exterior layer cannot fill");
+  Volume v;
+  v.field = std::move(field);
+  const bool fill = !in.empty() && in.back().fill;
+  v.regions.push_back(fill ? in.back().material : kUnclaimed);
+  // Interior layers from the innermost finite one outward: layer i spans [-(s_i + t_i), -s_i].
+  std::vector<double> start(in.size(), 0.0);
+  for (size_t i = 1; i < in.size(); ++i) start[i] = start[i - 1] + in[i - 1].thickness;
+  for (size_t i = in.size(); i-- > 0;) {
+    if (in[i].fill) continue;
+    v.boundaries.push_back(-(start[i] + in[i].thickness));
+    v.regions.push_back(in[i].material);
+  }
+  v.boundaries.push_back(0.0);
+  double s = 0;
+  for (const Layer& l : out) {
+    v.regions.push_back(l.material);
+    s += l.thickness;
+    v.boundaries.push_back(s);
+  }
+  v.regions.push_back(kUnclaimed);
+  // Merge neighbouring regions of one material (no boundary to cut there).
+  for (size_t i = 0; i < v.boundaries.size();) {
+    if (v.regions[i] == v.regions[i + 1]) {
+      v.boundaries.erase(v.boundaries.begin() + long(i));
+      v.regions.erase(v.regions.begin() + long(i) + 1);
+    } else {
+      ++i;
+    }
+  }
+  return v;
+}
+
+double TetMesh::volume(size_t t) const {
+  const auto& q = tets[t];
+  return det(positions[q[0]], positions[q[1]], positions[q[2]], positions[q[3]]) / 6.0;
+}
+
+double minSolidAngle(const DVec3& a, const DVec3& b, const DVec3& c, const DVec3& d) {
+  const DVec3 p[4] = {a, b, c, d};
+  double best = 4 * M_PI;
+  for (int i = 0; i < 4; ++i) {
+    const DVec3 x = p[(i + 1) % 4] - p[i], y = p[(i + 2) % 4] - p[i], z = p[(i + 3) % 4] - p[i];
+    const double lx = glm::length(x), ly = glm::length(y), lz = glm::length(z);
+    const double num = std::abs(glm::dot(x, glm::cross(y, z)));
+    const double den = lx * ly * lz + glm::dot(x, y) * lz + glm::dot(x, z) * ly + glm::dot(y, z) * lx;
+    best = std::min(best, 2 * std::atan2(num, den));
+  }
+  return best;
+}
+
+QualityStats measureQuality(const TetMesh& mesh, size_t targetCount) {
+  QualityStats q;
+  if (mesh.tets.empty()) return q;
+  constexpr double kAlpha = 0.7;
+  double total = 0;
+  for (size_t t = 0; t < mesh.tets.size(); ++t) total += mesh.volume(t);
+  const double ideal = total / double(targetCount > 0 ? targetCount : mesh.tets.size());
+  std::vector<double> quality(mesh.tets.size()), angle(mesh.tets.size());
+  parallelFor(0, mesh.tets.size(), [&](size_t t) {
+    const auto& v = mesh.tets[t];
+    angle[t] = minSolidAngle(mesh.positions[v[0]], mesh.positions[v[1]], mesh.positions[v[2]], mesh.positions[v[3]]);
+    const double a = 10 * std::min(1.0, std::sqrt(2 * angle[t]));
+    const double b = 10 * std::min(1.0, std::sqrt(std::max(0.0, mesh.volume(t)) / ideal));
+    quality[t] = kAlpha * a + (1 - kAlpha) * b;
+  }, 4096);
+  q.minQuality = *std::min_element(quality.begin(), quality.end());
+  q.minSolidAngle = *std::min_element(angle.begin(), angle.end());
+  double sum = 0;
+  for (double x : quality) sum += x;  // in order: the same sum at any thread count
+  q.meanQuality = sum / double(quality.size());
+  return q;
+}
+
+std::vector<Vec3> gridNodes(const Grid& g) {
+  const size_t nx = size_t(g.cells[0]) + 1, ny = size_t(g.cells[1]) + 1;
+  std::vector<Vec3> nodes(g.nodeCount());
+  parallelFor(0, nodes.size(), [&](size_t n) {
+    nodes[n] = Vec3(g.origin + g.cell * DVec3(double(n % nx), double((n / nx) % ny), double(n / (nx * ny))));
+  }, 4096);
+  return nodes;
+}
+
+TetMesh meshSolid(const Solid& solid, const Grid& grid, const MeshOptions& options, MeshStats* stats) {
+  MeshStats st;
+  auto t0 = std::chrono::steady_clock::now();
+  const size_t nv = solid.volumes.size();
+  // 1. Every volume's distance at the grid's nodes, within a band wider than its boundaries.
+  Work w;
+  const std::vector<Vec3> nodes = gridNodes(grid);
+  w.positions.resize(nodes.size());
+  const size_t nx = size_t(grid.cells[0]) + 1, ny = size_t(grid.cells[1]) + 1;
+  parallelFor(0, nodes.size(), [&](size_t n) {
+    w.positions[n] = grid.origin + grid.cell * DVec3(double(n % nx), double((n / nx) % ny), double(n / (nx * ny)));
+  }, 4096);
+  for (const Volume& v : solid.volumes) {
+    double band = 0;
+    for (double b : v.boundaries) band = std::max(band, std::abs(b));
+    w.fields.push_back(v.field->sample(nodes, grid.cell, band + 2 * grid.cell));
+    // Snap nodes very near a boundary onto it.
+    std::vector<float>& f = w.fields.back();
+    const double snap = options.snapFraction * grid.cell;
+    parallelFor(0, f.size(), [&](size_t n) {
+      for (double b : v.boundaries)
+        if (std::abs(double(f[n]) - b) < snap) f[n] = float(b);
+    }, 4096);
+  }
+  st.fieldSeconds = secondsSince(t0);
+  t0 = std::chrono::steady_clock::now();
+
+  // 2. Five tetrahedra per cube that some volume may claim.
+  const auto patterns = cubePatterns();
+  const size_t cx = size_t(grid.cells[0]), cy = size_t(grid.cells[1]), cz = size_t(grid.cells[2]);
+  std::vector<std::pair<double, double>> claims;
+  for (const Volume& v : solid.volumes) claims.push_back(v.claimed());
+  w.tets = chunked<Tet>(cx * cy * cz, [&](size_t lo, size_t hi, std::vector<Tet>& out) {
+    for (size_t c = lo; c < hi; ++c) {
+      const size_t i = c % cx, j = (c / cx) % cy, k = c / (cx * cy);
+      uint32_t corner[8];
+      for (int q = 0; q < 8; ++q) corner[q] = uint32_t((i + (q & 1)) + nx * ((j + ((q >> 1) & 1)) + ny * (k + ((q >> 2) & 1))));
+      bool keep = false;
+      for (size_t v = 0; v < nv && !keep; ++v) {
+        float mn = std::numeric_limits<float>::max(), mx = std::numeric_limits<float>::lowest();
+        for (uint32_t n : corner) mn = std::min(mn, w.fields[v][n]), mx = std::max(mx, w.fields[v][n]);
+        keep = mx >= claims[v].first && mn <= claims[v].second;
+      }
+      if (!keep) continue;
+      for (const Tet& t : patterns[(i + j + k) & 1]) out.push_back({corner[t[0]], corner[t[1]], corner[t[2]], corner[t[3]]});
+    }
+  });
+  st.cellTets = w.tets.size();
+  st.cubes = st.cellTets / 5;
+  w.active.assign(w.tets.size(), 1);
+  w.tag.assign(w.tets.size(), 0);
+
+  // 3. Cut at every boundary of every volume, in precedence order; a volume cuts only where
+  // no earlier volume claims the space (but splits claimed tetrahedra along shared edges).
+  for (size_t v = 0; v < nv; ++v) {
+    if (v > 0)
+      parallelFor(0, w.tets.size(), [&](size_t t) {
+        if (w.active[t] && solid.volumes[v - 1].regionAt(w.centroidValue(v - 1, w.tets[t])) != kUnclaimed) w.active[t] = 0;
+      }, 4096);
+    for (double b : solid.volumes[v].boundaries) st.splits += cutAt(w, v, b);
+  }
+
+  // 4. The region material of each tetrahedron: the first volume claiming its centroid
+  // (the fields are linear in it).
+  auto regionOf = [&](size_t t) {
+    for (size_t v = 0; v < nv; ++v) {
+      const int m = solid.volumes[v].regionAt(w.centroidValue(v, w.tets[t]));
+      if (m != kUnclaimed) return m;
+    }
+    return kUnclaimed;
+  };
+  // 5. Tetrahedra of procedural layers are subdivided to follow the procedure (§4.3, last
+  // paragraph): an edge whose ends choose different materials is split where the choice
+  // changes (bisection to 1/1024 of the edge), in every tetrahedron that has it.
+  for (size_t p = 0; p < solid.materials.procedural.size(); ++p) {
+    const ProceduralMaterial& proc = solid.materials.procedural[p];
+    const int code = kProcedural0 - int(p);
+    std::vector<uint8_t> in(w.tets.size());
+    parallelFor(0, w.tets.size(), [&](size_t t) { in[t] = regionOf(t) == code; }, 4096);
+    // Where along edge (a, c) the choice changes (bisection to 1/1024 of the edge).
+    auto crossing = [&](uint32_t a, uint32_t c) {
+      const DVec3 pa = w.positions[a], pc = w.positions[c];
+      const int ma = proc.at(pa);
+      double lo = 0, hi = 1;
+      for (int k = 0; k < 10; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        (proc.at(pa + (pc - pa) * mid) == ma ? lo : hi) = mid;
+      }
+      return 0.5 * (lo + hi);
+    };
+    for (int round = 0; round < options.proceduralRounds; ++round) {
+      // Crossings nearer an end than the snap fraction are left to the centroid choice (no slivers).
+      const double near = options.snapFraction;
+      const std::vector<uint64_t> keys = edgesWhere(w, [&](size_t t) { return in[t] != 0; }, [&](uint32_t a, uint32_t c) {
+        if (proc.at(w.positions[a]) == proc.at(w.positions[c])) return false;
+        const double x = crossing(std::min(a, c), std::max(a, c));
+        return x > near && x < 1 - near;
+      });
+      if (keys.empty()) break;
+      st.splits += keys.size();
+      for (size_t t = 0; t < in.size(); ++t) w.tag[t] = in[t];
+      splitEdges(w, keys, crossing, [](uint32_t) {});
+      in.assign(w.tag.begin(), w.tag.end());  // pieces keep their parent's flag
+    }
+  }
+  // 6. Materials; procedural ones chosen at the centroid.
+  std::vector<int> material(w.tets.size(), kUnclaimed);
+  parallelFor(0, w.tets.size(), [&](size_t t) {
+    int m = regionOf(t);
+    if (m <= kProcedural0) {
+      const Tet& q = w.tets[t];
+      const DVec3 c = (w.positions[q[0]] + w.positions[q[1]] + w.positions[q[2]] + w.positions[q[3]]) * 0.25;
+      m = solid.materials.procedural[size_t(kProcedural0 - m)].at(c);
+    }
+    material[t] = m;
+  }, 4096);
+
+  // 7. Keep tetrahedra with a material; renumber the vertices they use in id order.
+  TetMesh mesh = compact(w, material);
+  st.tets = mesh.tets.size();
+  st.meshSeconds = secondsSince(t0);
+  if (stats) *stats = st;
+  return mesh;
+}
+
+TetMesh clipByPlane(const TetMesh& mesh, const DVec3& normal, double offset) {
+  const DVec3 n = glm::normalize(normal);
+  Work w;
+  w.positions = mesh.positions;
+  w.tets = mesh.tets;
+  w.active.assign(w.tets.size(), 1);
+  w.fields.emplace_back(w.positions.size());
+  parallelFor(0, w.positions.size(), [&](size_t v) { w.fields[0][v] = float(glm::dot(n, w.positions[v]) - offset); }, 4096);
+  w.tag.assign(mesh.materials.begin(), mesh.materials.end());
+  cutAt(w, 0, 0.0);
+  std::vector<int> material(w.tets.size(), kUnclaimed);
+  for (size_t t = 0; t < w.tets.size(); ++t)
+    if (w.centroidValue(0, w.tets[t]) <= 0) material[t] = w.tag[t];
+  return compact(w, material);
+}
+
+namespace {
+
+struct FaceRef {
+  std::array<uint32_t, 3> key;  ///< sorted vertex ids
+  uint32_t tet;
+  uint8_t face;
+  bool operator<(const FaceRef& o) const { return key != o.key ? key < o.key : tet < o.tet; }
+};
+
+/// Every tetrahedron face, sorted so shared faces are neighbours.
+std::vector<FaceRef> sortedFaces(const TetMesh& mesh) {
+  std::vector<FaceRef> faces(mesh.tets.size() * 4);
+  parallelFor(0, mesh.tets.size(), [&](size_t t) {
+    for (uint8_t f = 0; f < 4; ++f) {
+      std::array<uint32_t, 3> k = {mesh.tets[t][kTetFaces[f][0]], mesh.tets[t][kTetFaces[f][1]], mesh.tets[t][kTetFaces[f][2]]};
+      std::sort(k.begin(), k.end());
+      faces[t * 4 + f] = {k, uint32_t(t), f};
+    }
+  }, 4096);
+  std::sort(faces.begin(), faces.end());
+  return faces;
+}
+
+InterfaceTriangle triangleOf(const TetMesh& mesh, const FaceRef& f) {
+  const auto& q = mesh.tets[f.tet];
+  return {{q[kTetFaces[f.face][0]], q[kTetFaces[f.face][1]], q[kTetFaces[f.face][2]]}, mesh.materials[f.tet]};
+}
+
+}  // namespace
+
+std::vector<InterfaceTriangle> visibleInterface(const TetMesh& mesh, size_t* badFaces) {
+  const std::vector<FaceRef> faces = sortedFaces(mesh);
+  std::vector<InterfaceTriangle> out;
+  size_t bad = 0;
+  for (size_t i = 0; i < faces.size();) {
+    size_t j = i + 1;
+    while (j < faces.size() && faces[j].key == faces[i].key) ++j;
+    if (j - i == 1) out.push_back(triangleOf(mesh, faces[i]));
+    if (j - i > 2) ++bad;
+    i = j;
+  }
+  if (badFaces) *badFaces = bad;
+  return out;
+}
+
+std::vector<InterfaceTriangle> materialInterfaces(const TetMesh& mesh) {
+  const std::vector<FaceRef> faces = sortedFaces(mesh);
+  std::vector<InterfaceTriangle> out;
+  for (size_t i = 0; i + 1 < faces.size(); ++i) {
+    if (faces[i + 1].key != faces[i].key) continue;
+    if (mesh.materials[faces[i].tet] != mesh.materials[faces[i + 1].tet]) {
+      out.push_back(triangleOf(mesh, faces[i]));
+      out.push_back(triangleOf(mesh, faces[i + 1]));
+    }
+    ++i;
+  }
+  return out;
+}
+
+}  // namespace sprig::solids

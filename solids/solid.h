@@ -1,0 +1,151 @@
+#pragma once
+/// Layered solid models (Cutler, Dorsey, McMillan, Müller, Jagnow, "A procedural approach to
+/// authoring solid models", §2 and §4) and their tetrahedral meshes.
+///
+/// A Solid is a list of volumes in precedence order (§2.3): the first volume claims its
+/// space, the next fills what is left. A volume is a signed distance field and layers:
+/// interior layers stack inward from the zero set (the last may `fill` the interior),
+/// exterior layers outward; each is a range of distance with a material (§2.1). Ranges
+/// between adjacent layers are kept as boundaries b_0 < b_1 < ...: region r lies between
+/// b_{r-1} and b_r and has one material id, kUnclaimed (no layer: later volumes may fill
+/// it) or kNothing (a `material: nothing` layer: air that claims its space).
+///
+/// meshSolid (§4.3) samples every volume's field on the grid's nodes, splits each cubic
+/// cell into five tetrahedra with alternating orientation, then cuts the tetrahedra at
+/// every layer boundary (the zero set of d_v - b_k, linear in each tetrahedron) by
+/// splitting crossing edges, subdivides tetrahedra of procedural layers where the procedure's
+/// choice changes, and gives each tetrahedron the material of the first volume that claims it.
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "solids/distance_field.h"
+#include "solids/material.h"
+
+namespace sprig::solids {
+
+/// Material ids of a region besides concrete (>= 0) and procedural (<= kProcedural0) ones.
+constexpr int kUnclaimed = -1;
+constexpr int kNothing = -2;
+/// Procedural material p of the MaterialTable has id kProcedural0 - p.
+constexpr int kProcedural0 = -3;
+
+/// One layered volume: its field and its regions.
+struct Volume {
+  FieldPtr field;
+  std::vector<double> boundaries;  ///< ascending distances between regions
+  std::vector<int> regions;        ///< boundaries.size() + 1 material ids, from inside out
+
+  /// The material id of the region holding distance d (at a boundary: the outer region).
+  int regionAt(double d) const;
+  /// Lowest and highest distance claimed (kUnclaimed elsewhere); lo may be -inf.
+  std::pair<double, double> claimed() const;
+};
+
+/// A layer as written: a thickness (or fill) and a material id.
+struct Layer {
+  bool interior = true;
+  bool fill = false;        ///< interior only: to the end of the inside
+  double thickness = 1.0;   ///< world units, > 0
+  int material = kNothing;
+};
+
+/// The regions of a volume with these layers (interior layers inward from 0 in order,
+/// exterior outward). Adjacent regions of one material merge. Throws std::invalid_argument
+/// for a fill layer that is not the last interior layer or is exterior.
+Volume makeVolume(FieldPtr field, const std::vector<Layer>& layers);
+
+/// The lattice the fields are sampled on: node (i, j, k) is at origin + cell·(i, j, k).
+struct Grid {
+  DVec3 origin{0.0};
+  double cell = 0.1;  ///< world units
+  std::array<int, 3> cells{1, 1, 1};
+  size_t nodeCount() const { return size_t(cells[0] + 1) * size_t(cells[1] + 1) * size_t(cells[2] + 1); }
+};
+
+/// A solid: volumes in precedence order and their materials.
+struct Solid {
+  std::vector<Volume> volumes;
+  MaterialTable materials;
+};
+
+/// A tetrahedral mesh with a concrete material per tetrahedron. Every tetrahedron is
+/// positively oriented (det(v1-v0, v2-v0, v3-v0) > 0); faces between two tetrahedra match.
+struct TetMesh {
+  std::vector<DVec3> positions;
+  std::vector<std::array<uint32_t, 4>> tets;
+  std::vector<uint16_t> materials;  ///< per tetrahedron, ids into the solid's MaterialTable
+
+  /// Signed volume of tetrahedron t (world units³).
+  double volume(size_t t) const;
+};
+
+/// Counts of one meshing.
+struct MeshStats {
+  size_t cubes = 0;        ///< cubic cells kept (some volume may claim them)
+  size_t cellTets = 0;     ///< tetrahedral cells before splitting (5 per cube)
+  size_t splits = 0;       ///< edges split at interface crossings
+  size_t tets = 0;         ///< tetrahedra with a material in the result
+  double fieldSeconds = 0; ///< sampling the distance fields
+  double meshSeconds = 0;  ///< cells, splits, materials
+};
+
+/// Options of meshSolid.
+struct MeshOptions {
+  /// Node values this close to a boundary (as a fraction of the cell) snap onto it, so no
+  /// split lands nearer than this to a grid node (no needle tetrahedra of near-zero volume).
+  double snapFraction = 0.05;
+  /// Rounds of splitting tetrahedra of procedural layers where the chosen material changes
+  /// along an edge (0 = each tetrahedron takes the choice at its centroid).
+  int proceduralRounds = 2;
+};
+
+/// The tetrahedral mesh of solid on grid (§4.3). Deterministic: the same bytes at any
+/// thread count. Cost O(nodes · volumes + tets · boundaries).
+TetMesh meshSolid(const Solid& solid, const Grid& grid, const MeshOptions& options = {}, MeshStats* stats = nullptr);
+
+/// The part of mesh on the side n·x <= offset of a plane (a cut-away, Fig. 3e-f): tetrahedra
+/// crossing the plane are split exactly there, by the same edge splits as meshSolid.
+TetMesh clipByPlane(const TetMesh& mesh, const DVec3& normal, double offset);
+
+/// The paper's tetrahedron quality (§4.4, α = 0.7), 0..10:
+/// Quality(t) = α·A(t) + (1 − α)·V(t), A(t) = 10·min(1, sqrt(2·min solid angle(t))),
+/// V(t) = 10·min(1, sqrt(volume(t) / ideal volume)), ideal = total volume / target count.
+struct QualityStats {
+  double minQuality = 0, meanQuality = 0;
+  double minSolidAngle = 0;  ///< steradians (a regular tetrahedron: 0.551)
+};
+
+/// Quality of every tetrahedron of mesh against targetCount tetrahedra (0 = the mesh's own count).
+QualityStats measureQuality(const TetMesh& mesh, size_t targetCount = 0);
+
+/// The smallest of the four solid angles of tetrahedron (a, b, c, d), steradians
+/// (Van Oosterom and Strackee 1983).
+double minSolidAngle(const DVec3& a, const DVec3& b, const DVec3& c, const DVec3& d);
+
+/// The lattice nodes of grid, x fastest.
+std::vector<Vec3> gridNodes(const Grid& grid);
+
+/// A triangle of a tetrahedral mesh's boundary: three vertices (outward, counter-clockwise)
+/// and the material of the tetrahedron it bounds.
+struct InterfaceTriangle {
+  std::array<uint32_t, 3> v;
+  uint16_t material;
+};
+
+/// The visible interface (§4.1): faces of tetrahedra with no tetrahedron on their other
+/// side (material against nothing), oriented outward. A closed surface; sorted by vertex
+/// ids. Also reports faces shared by more than two tetrahedra (a broken mesh) in badFaces.
+std::vector<InterfaceTriangle> visibleInterface(const TetMesh& mesh, size_t* badFaces = nullptr);
+
+/// The interfaces between different materials: for each pair of tetrahedra of materials
+/// A != B sharing a face, the face oriented out of A (and once more out of B), so the
+/// triangles of one material together with its visible faces bound it closed.
+std::vector<InterfaceTriangle> materialInterfaces(const TetMesh& mesh);
+
+/// Tetrahedron faces in local vertex order, oriented outward for a positive tetrahedron.
+constexpr std::array<std::array<int, 3>, 4> kTetFaces = {{{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}}};
+
+}  // namespace sprig::solids

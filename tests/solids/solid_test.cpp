@@ -1,0 +1,400 @@
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <set>
+
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "core/atomic_file.h"
+#include "core/mesh.h"
+#include "core/parallel.h"
+#include "solids/distance_field.h"
+#include "solids/solid.h"
+#include "lsystem/expression.h"
+#include "solids/tet_io.h"
+#include "tests/scratch_dir.h"
+
+using namespace sprig;
+using namespace sprig::solids;
+
+namespace {
+
+/// A solid of one sphere: layers given as (interior?, thickness or 0 = fill, material name).
+struct LayerText {
+  bool interior;
+  double thickness;  // 0 = fill
+  const char* material;
+};
+
+Solid sphereSolid(double radius, const std::vector<LayerText>& layers, DVec3 center = DVec3(0.0)) {
+  Solid s;
+  std::vector<Layer> ls;
+  for (const LayerText& t : layers) {
+    Layer l;
+    l.interior = t.interior;
+    l.fill = t.thickness == 0;
+    l.thickness = t.thickness == 0 ? 1.0 : t.thickness;
+    l.material = std::string(t.material) == "nothing" ? kNothing : *s.materials.concrete(t.material);
+    ls.push_back(l);
+  }
+  s.volumes.push_back(makeVolume(sphereField(center, radius), ls));
+  return s;
+}
+
+Grid gridAround(double halfSize, double cell) {
+  Grid g;
+  g.cell = cell;
+  const int n = int(std::ceil(2 * halfSize / cell));
+  g.cells = {n, n, n};
+  g.origin = DVec3(-halfSize);
+  return g;
+}
+
+std::map<uint16_t, double> volumeByMaterial(const TetMesh& m) {
+  std::map<uint16_t, double> v;
+  for (size_t t = 0; t < m.tets.size(); ++t) v[m.materials[t]] += m.volume(t);
+  return v;
+}
+
+/// Number of faces used by exactly one, two, and more than two tetrahedra.
+std::array<size_t, 3> faceUses(const TetMesh& m) {
+  std::map<std::array<uint32_t, 3>, int> uses;
+  for (const auto& q : m.tets)
+    for (const auto& f : kTetFaces) {
+      std::array<uint32_t, 3> k = {q[size_t(f[0])], q[size_t(f[1])], q[size_t(f[2])]};
+      std::sort(k.begin(), k.end());
+      ++uses[k];
+    }
+  std::array<size_t, 3> out{0, 0, 0};
+  for (const auto& [k, n] : uses) ++out[size_t(std::min(n, 3) - 1)];
+  return out;
+}
+
+Mesh meshOf(const TetMesh& m, const std::vector<InterfaceTriangle>& tris) {
+  Mesh out;
+  for (const DVec3& p : m.positions) out.positions.push_back(Vec3(p));
+  for (const auto& t : tris) out.triangles.push_back({t.v[0], t.v[1], t.v[2]});
+  return out;
+}
+
+double ballVolume(double r) { return 4.0 / 3.0 * M_PI * r * r * r; }
+
+}  // namespace
+
+TEST_CASE("meshSolid: a layered sphere", "[solids]") {
+  // Pink frosting 0.15 inward from r = 0.6, chocolate filling the rest, white chocolate 0.1 outward.
+  const double cell = 0.05;
+  Solid s = sphereSolid(0.6, {{true, 0.15, "pink_frosting"}, {true, 0, "chocolate"}, {false, 0.1, "white_chocolate"}});
+  MeshStats st;
+  const TetMesh m = meshSolid(s, gridAround(0.8, cell), {}, &st);
+  INFO("tets " << m.tets.size() << ", splits " << st.splits);
+  REQUIRE(m.tets.size() > 1000);
+
+  SECTION("tetrahedron volumes sum to the volumes the layers enclose") {
+    // The mesh interpolates the exact distance linearly in each tetrahedron (diameter at
+    // most cell·√3); |p| has Hessian norm 1/r, so an interface moves inward by at most
+    // 3·cell²/(8·r), and snapping moves it by at most 0.05·cell.
+    const auto vol = volumeByMaterial(m);
+    double inside = 0;
+    for (const auto& [name, r] : std::vector<std::pair<const char*, double>>{{"chocolate", 0.45}, {"pink_frosting", 0.6}, {"white_chocolate", 0.7}}) {
+      inside += vol.at(uint16_t(*s.materials.concrete(name)));
+      const double delta = 3 * cell * cell / (8 * r) + 0.05 * cell;
+      INFO(name << ": volume inside r = " << r << " is " << inside << ", exact " << ballVolume(r) << ", bound ±" << delta << " in r");
+      CHECK(inside >= ballVolume(r - delta));
+      CHECK(inside <= ballVolume(r + delta));
+    }
+  }
+  SECTION("measured layer thicknesses equal the specified ones within one cell") {
+    // Radii of the vertices on each interface: the visible one (0.7), white | frosting (0.6),
+    // frosting | chocolate (0.45).
+    std::map<std::pair<int, int>, std::pair<double, double>> radii;  // material pair -> min, max radius
+    auto note = [&](int a, int b, uint32_t v) {
+      const double r = glm::length(m.positions[v]);
+      auto [it, fresh] = radii.emplace(std::make_pair(std::min(a, b), std::max(a, b)), std::make_pair(r, r));
+      it->second.first = std::min(it->second.first, r);
+      it->second.second = std::max(it->second.second, r);
+    };
+    for (const auto& t : visibleInterface(m))
+      for (uint32_t v : t.v) note(t.material, -1, v);
+    const auto inner = materialInterfaces(m);
+    std::map<std::array<uint32_t, 3>, int> firstSide;
+    for (const auto& t : inner) {
+      std::array<uint32_t, 3> k = t.v;
+      std::sort(k.begin(), k.end());
+      auto [it, fresh] = firstSide.emplace(k, t.material);
+      if (!fresh)
+        for (uint32_t v : t.v) note(it->second, t.material, v);
+    }
+    const int choc = *s.materials.concrete("chocolate"), pink = *s.materials.concrete("pink_frosting"),
+              white = *s.materials.concrete("white_chocolate");
+    const auto outer = radii.at({-1, white}), mid = radii.at({std::min(pink, white), std::max(pink, white)}),
+               core = radii.at({std::min(choc, pink), std::max(choc, pink)});
+    INFO("radii: outer " << outer.first << ".." << outer.second << ", mid " << mid.first << ".." << mid.second << ", core "
+                         << core.first << ".." << core.second);
+    CHECK(outer.first > 0.7 - cell);
+    CHECK(outer.second < 0.7 + cell);
+    CHECK(mid.first > 0.6 - cell);
+    CHECK(mid.second < 0.6 + cell);
+    CHECK(core.first > 0.45 - cell);
+    CHECK(core.second < 0.45 + cell);
+    // Thickness = difference of mean radii, within one cell of 0.1 and 0.15.
+    CHECK(std::abs((outer.first + outer.second) / 2 - (mid.first + mid.second) / 2 - 0.1) < cell);
+    CHECK(std::abs((mid.first + mid.second) / 2 - (core.first + core.second) / 2 - 0.15) < cell);
+  }
+  SECTION("no tetrahedron is inverted or flat") {
+    double minVolume = 1e30;
+    for (size_t t = 0; t < m.tets.size(); ++t) minVolume = std::min(minVolume, m.volume(t));
+    INFO("smallest volume " << minVolume);
+    CHECK(minVolume > 0);
+  }
+  SECTION("every face is shared by one or two tetrahedra, and the boundary is closed") {
+    const auto uses = faceUses(m);
+    CHECK(uses[2] == 0);
+    size_t bad = 99;
+    const auto vis = visibleInterface(m, &bad);
+    CHECK(bad == 0);
+    CHECK(vis.size() == uses[0]);
+    const MeshTopology top = analyzeTopology(meshOf(m, vis));
+    CHECK(top.closed());
+    CHECK(top.manifold());
+  }
+}
+
+
+TEST_CASE("meshSolid: precedence", "[solids]") {
+  // Sphere A (nut, r 0.5 at -0.2 x) claims first; sphere B (chocolate, r 0.6 at +0.3 x) fills what is left.
+  const double cell = 0.05, ra = 0.5, rb = 0.6, d = 0.5;
+  Solid s;
+  Layer nut, choc;
+  nut.fill = choc.fill = true;
+  nut.material = *s.materials.concrete("nut");
+  choc.material = *s.materials.concrete("chocolate");
+  s.volumes.push_back(makeVolume(sphereField(DVec3(-0.2, 0, 0), ra), {nut}));
+  s.volumes.push_back(makeVolume(sphereField(DVec3(0.3, 0, 0), rb), {choc}));
+  Grid g;
+  g.cell = cell;
+  g.origin = DVec3(-0.8, -0.7, -0.7);
+  g.cells = {34, 28, 28};
+  const TetMesh m = meshSolid(s, g);
+  const auto vol = volumeByMaterial(m);
+  // Exact: A, and B minus the lens A ∩ B.
+  const double lens = M_PI * std::pow(ra + rb - d, 2) * (d * d + 2 * d * rb - 3 * rb * rb + 2 * d * ra + 6 * rb * ra - 3 * ra * ra) / (12 * d);
+  const double exactA = ballVolume(ra), exactB = ballVolume(rb) - lens;
+  const double tolerance = 4 * M_PI * 0.6 * 0.6 * (3 * cell * cell / (8 * ra) + 0.05 * cell);  // area · interface shift
+  INFO("nut " << vol.at(uint16_t(nut.material)) << " (exact " << exactA << "), chocolate " << vol.at(uint16_t(choc.material))
+              << " (exact " << exactB << "), tolerance " << tolerance);
+  CHECK(std::abs(vol.at(uint16_t(nut.material)) - exactA) < tolerance);
+  CHECK(std::abs(vol.at(uint16_t(choc.material)) - exactB) < tolerance);
+  // No overlap and no gap: the total is the union's volume, faces match, the outside is closed.
+  CHECK(std::abs(vol.at(uint16_t(nut.material)) + vol.at(uint16_t(choc.material)) - (exactA + exactB)) < 2 * tolerance);
+  const auto uses = faceUses(m);
+  CHECK(uses[2] == 0);
+  const MeshTopology top = analyzeTopology(meshOf(m, visibleInterface(m)));
+  CHECK(top.closed());
+  CHECK(top.manifold());
+  for (size_t t = 0; t < m.tets.size(); ++t) REQUIRE(m.volume(t) > 0);
+}
+
+namespace {
+
+/// A closed octahedron of radius r as a polygon mesh (counter-clockwise seen from outside).
+PolyMesh octahedron(float r) {
+  PolyMesh p;
+  p.positions = {{r, 0, 0}, {-r, 0, 0}, {0, r, 0}, {0, -r, 0}, {0, 0, r}, {0, 0, -r}};
+  const uint32_t f[8][3] = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  for (const auto& t : f) {
+    p.faceSizes.push_back(3);
+    p.faceVertices.insert(p.faceVertices.end(), t, t + 3);
+  }
+  return p;
+}
+
+Solid octahedronSolid() {
+  Solid s;
+  Layer core, coat;
+  core.fill = true;
+  core.material = *s.materials.concrete("stone");
+  coat.interior = false;
+  coat.thickness = 0.1;
+  coat.material = *s.materials.concrete("dirt");
+  s.volumes.push_back(makeVolume(meshField(octahedron(0.6f)), {core, coat}));
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("distance fields", "[solids]") {
+  SECTION("primitives are Euclidean distances") {
+    const std::vector<Vec3> pts = {{0, 0, 0}, {2, 0, 0}, {2, 2, 0}, {0, 0.25f, 0}};
+    const auto box = boxField(DVec3(0.0), DVec3(2, 1, 1))->sample(pts, 0.1, 1);
+    CHECK(box[0] == Approx(-0.5));
+    CHECK(box[1] == Approx(1.0));
+    CHECK(box[2] == Approx(std::sqrt(1.0 + 1.5 * 1.5)));
+    const auto cyl = cylinderField(DVec3(0.0), 0.5, 1.0, DVec3(0, 1, 0))->sample(pts, 0.1, 1);
+    CHECK(cyl[0] == Approx(-0.5));
+    CHECK(cyl[1] == Approx(1.5));
+    CHECK(cyl[3] == Approx(-0.25));
+    const auto plane = groundPlaneField(DVec3(0, 1, 0), 0.25)->sample(pts, 0.1, 1);
+    CHECK(plane[2] == Approx(1.75));
+    CHECK(plane[3] == Approx(0.0).margin(1e-7));
+    const auto sub = subtractionField(boxField(DVec3(0.0), DVec3(2, 1, 1)), sphereField(DVec3(0.0), 0.2))->sample(pts, 0.1, 1);
+    CHECK(sub[0] == Approx(0.2));
+    const auto scaled = transformField(sphereField(DVec3(0.0), 1), 2.0, DVec3(0, 0, 1), 90, DVec3(0, 0, 0))->sample(pts, 0.1, 1);
+    CHECK(scaled[1] == Approx(0.0).margin(1e-6));
+  }
+  SECTION("a closed mesh: negative inside, the distance to its faces near them") {
+    const std::vector<Vec3> pts = {{0, 0, 0}, {0.5f, 0, 0}, {0.8f, 0, 0}, {3, 3, 3}};
+    const auto d = meshField(octahedron(0.6f))->sample(pts, 0.02, 0.2);
+    CHECK(d[0] < 0);  // deep inside: clamped to -band
+    CHECK(d[1] == Approx(-0.1 / std::sqrt(3.0)).margin(0.01));
+    CHECK(d[2] == Approx(0.2).margin(0.01));  // nearest: the vertex (0.6, 0, 0)
+    CHECK(d[3] > 0);
+  }
+  SECTION("the first open edge of a mesh") {
+    PolyMesh p = octahedron(1);
+    CHECK_FALSE(firstOpenEdge(p));
+    p.faceSizes.pop_back();
+    p.faceVertices.resize(p.faceVertices.size() - 3);
+    const auto open = firstOpenEdge(p);
+    REQUIRE(open);
+    CHECK(open->face == 3);  // {3, 0, 4}: its edge 3-0 lost the face {0, 3, 5}
+    CHECK(((open->a == 3 && open->b == 0)));
+  }
+}
+
+TEST_CASE("meshSolid: the same bytes at 1 and 2 threads", "[solids]") {
+  Solid s = octahedronSolid();
+  const Grid g = gridAround(0.8, 0.04);
+  std::string one, two;
+  {
+    ThreadLimit limit(1);
+    one = formatTetMesh(meshSolid(s, g), s.materials.materials, TetFormat::Msh);
+  }
+  {
+    ThreadLimit limit(2);
+    two = formatTetMesh(meshSolid(s, g), s.materials.materials, TetFormat::Msh);
+  }
+  CHECK(one.size() > 10000);
+  CHECK(one == two);
+}
+
+namespace {
+
+/// Runs a shell command, returning its exit code and output.
+std::pair<int, std::string> run(const std::string& command) {
+  std::string out;
+  FILE* p = ::popen((command + " 2>&1").c_str(), "r");
+  REQUIRE(p);
+  char buf[4096];
+  while (size_t n = std::fread(buf, 1, sizeof buf, p)) out.append(buf, n);
+  const int status = ::pclose(p);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+}  // namespace
+
+TEST_CASE("writeTetMesh: Gmsh reads the .msh back with its materials", "[solids]") {
+  // gmsh is installed by scripts/install-deps.sh (the test set-up).
+  Solid s = octahedronSolid();
+  const TetMesh m = meshSolid(s, gridAround(0.8, 0.05));
+  sprig::test::TempDir dir("solids-gmsh");
+  const auto msh = dir.path / "octa.msh";
+  writeTetMesh(m, s.materials.materials, msh);
+  SECTION("gmsh -check finds no error and counts our elements") {
+    const auto [code, out] = run("gmsh -check '" + msh.string() + "'");
+    INFO(out.substr(0, 3000));
+    CHECK(code == 0);
+    CHECK(out.find("Error") == std::string::npos);
+    CHECK(out.find(std::to_string(m.tets.size()) + " elements") != std::string::npos);
+  }
+  SECTION("re-exported as MSH 2.2 it keeps one physical group per material") {
+    const auto again = dir.path / "again.msh";
+    const auto [code, out] = run("gmsh '" + msh.string() + "' -0 -format msh22 -o '" + again.string() + "'");
+    INFO(out.substr(0, 3000));
+    REQUIRE(code == 0);
+    const std::string text = readFile(again);
+    CHECK(text.find("$PhysicalNames\n2\n3 1 \"stone\"\n3 2 \"dirt\"\n") != std::string::npos);
+    // Elements (only those of physical groups are saved): tetrahedra (type 4) per physical tag.
+    std::istringstream in(text.substr(text.find("$Elements")));
+    std::string tag;
+    size_t n = 0;
+    in >> tag >> n;
+    std::map<int, size_t> perPhysical;
+    for (size_t i = 0; i < n; ++i) {
+      int id, type, ntags, physical, entity;
+      in >> id >> type >> ntags >> physical >> entity;
+      for (int k = 2; k < ntags; ++k) in >> entity;
+      const int nodes = type == 4 ? 4 : type == 2 ? 3 : type == 1 ? 2 : 1;
+      for (int k = 0; k < nodes; ++k) in >> entity;
+      if (type == 4) ++perPhysical[physical];
+    }
+    size_t stone = 0;
+    for (uint16_t k : m.materials) stone += k == 0;
+    CHECK(perPhysical[1] == stone);
+    CHECK(perPhysical[2] == m.tets.size() - stone);
+  }
+  SECTION("VTU and Medit hold the same counts") {
+    const std::string vtu = formatTetMesh(m, s.materials.materials, TetFormat::Vtu);
+    CHECK(vtu.find("NumberOfPoints=\"" + std::to_string(m.positions.size()) + "\" NumberOfCells=\"" +
+                   std::to_string(m.tets.size()) + "\"") != std::string::npos);
+    const std::string medit = formatTetMesh(m, s.materials.materials, TetFormat::Medit);
+    CHECK(medit.find("Tetrahedra\n" + std::to_string(m.tets.size()) + "\n") != std::string::npos);
+    CHECK(medit.substr(medit.size() - 4) == "End\n");
+  }
+}
+
+TEST_CASE("measureQuality: the paper's metric", "[solids]") {
+  // A regular tetrahedron: the largest smallest solid angle, 0.551 sr, so A = 10.
+  const DVec3 a(1, 1, 1), b(1, -1, -1), c(-1, 1, -1), d(-1, -1, 1);
+  CHECK(minSolidAngle(a, b, c, d) == Approx(0.5513).epsilon(1e-3));
+  TetMesh one;
+  one.positions = {a, b, d, c};
+  one.tets = {{0, 1, 2, 3}};
+  one.materials = {0};
+  REQUIRE(one.volume(0) > 0);
+  CHECK(measureQuality(one).minQuality == Approx(10));
+  // A sliver scores low.
+  TetMesh flat = one;
+  flat.positions[3] = DVec3(0, 0, 0.05);
+  flat.positions[2] = DVec3(-1, -1, 0.0);
+  const QualityStats q = measureQuality(flat, 1);
+  CHECK(q.minQuality < 7);
+}
+
+TEST_CASE("meshSolid: tetrahedra of a procedural layer follow the procedure", "[solids]") {
+  // A sphere whose outer layer is striped by x > 0.1: after subdivision every tetrahedron of
+  // the layer lies on one side of the plane (within the 5% snap of an edge).
+  Solid s;
+  ProceduralMaterial stripes;
+  stripes.name = "stripes";
+  stripes.select = lsystem::Expression::compile("x > 0.1", {"x", "y", "z"}, SourceLoc{"t", 1, 1});
+  stripes.choices = {*s.materials.concrete("chocolate"), *s.materials.concrete("white_chocolate")};
+  s.materials.procedural.push_back(stripes);
+  Layer core, coat;
+  core.fill = true;
+  core.material = *s.materials.concrete("nut");
+  coat.interior = false;
+  coat.thickness = 0.15;
+  coat.material = kProcedural0;
+  s.volumes.push_back(makeVolume(sphereField(DVec3(0.0), 0.5), {core, coat}));
+  const double cell = 0.05;
+  const TetMesh m = meshSolid(s, gridAround(0.75, cell));
+  size_t straddling = 0;
+  for (size_t t = 0; t < m.tets.size(); ++t) {
+    REQUIRE(m.volume(t) > 0);
+    if (m.materials[t] == uint16_t(core.material)) continue;
+    double lo = 1e9, hi = -1e9;
+    for (uint32_t v : m.tets[t]) lo = std::min(lo, m.positions[v].x), hi = std::max(hi, m.positions[v].x);
+    const bool white = m.materials[t] == uint16_t(stripes.choices[1]);
+    // A tetrahedron on the wrong side by more than the snap distance of its edges.
+    if ((white && lo < 0.1 - 0.05 * cell * 1.8) || (!white && hi > 0.1 + 0.05 * cell * 1.8)) ++straddling;
+  }
+  CHECK(straddling == 0);
+  CHECK(faceUses(m)[2] == 0);
+  CHECK(analyzeTopology(meshOf(m, visibleInterface(m))).closed());
+}
