@@ -9,12 +9,16 @@
 #include <unordered_map>
 
 #include "core/rng.h"
+#include "core/text.h"
 #include "lsystem/detail/expression_parser.h"
 #include "lsystem/detail/scanner.h"
 
 namespace sprig::lsystem::detail {
 
 namespace {
+
+/// Most `[` nested in one axiom or successor as written (docs/ROBUSTNESS.md).
+constexpr size_t kMaxBracketDepth = 1024;
 
 /// Stream id for random draws in axiom parameters.
 constexpr uint64_t kAxiomStream = 0xfffffffffffffff1ull;
@@ -64,12 +68,17 @@ class GrammarParser {
 
   /// Parses and compiles a grammar file's text.
   std::shared_ptr<Program> run(std::string_view text) {
+    requireText(text, prog_.fileName, "a grammar file");
     scanner_.load(text);
     firstPass();
     secondPass();
     // Only on an otherwise clean file: a successor that failed to parse wrote nothing, and
     // its modules' parameter counts would be missed.
-    if (!diags().hasErrors()) checkArities();
+    if (!diags().hasErrors()) {
+      checkArities();
+      checkWrittenArities();
+      for (const RuleSet* rs : {&prog_.productions, &prog_.decomposition, &prog_.interpretation}) checkWeights(*rs);
+    }
     finish();
     diags().throwIfErrors();
     return std::make_shared<Program>(std::move(prog_));
@@ -78,6 +87,7 @@ class GrammarParser {
   /// Tokenizes every line of text as a constant module string over symbols (for
   /// parseModuleString); new symbols are interned into symbols.
   ModuleString constantString(std::string_view text, SymbolTable& symbols) {
+    requireText(text, prog_.fileName, "a module string");
     scanner_.load(text);
     prog_.symbols = symbols;
     scanner_.clearMultiNames();
@@ -429,6 +439,11 @@ class GrammarParser {
     for (const RawModule& m : mods) {
       if (m.name == "[") {
         open.push_back(m.col);
+        if (open.size() == kMaxBracketDepth + 1) {
+          error(line, m.col, std::string("branches in ") + where + " are nested more than " + std::to_string(kMaxBracketDepth) +
+                                 " levels deep (the limit)");
+          ok = false;
+        }
       } else if (m.name == "]") {
         if (open.empty()) {
           error(line, m.col, std::string("unmatched ']' in ") + where);
@@ -472,6 +487,55 @@ class GrammarParser {
                 " parameter" + (u.arity == 1 ? "" : "s") + ", but '" + u.name + "' is only written with " + list +
                 (one ? " parameter" : " parameters") + " (as at line " + std::to_string(first.first) + ":" +
                 std::to_string(first.second + 1) + "), so this production never applies");
+    }
+  }
+
+  /// A user module (not a turtle command, whose parameters are optional) written in the
+  /// axiom or a successor with a parameter count none of its productions takes, while
+  /// productions for other counts exist: cpfg and lpfg match a module only with the same
+  /// count, so the module would silently never be rewritten. Reported at the written
+  /// module, naming the production. Symbols already reported by checkArities (a
+  /// production whose count is never written) are left to that message.
+  void checkWrittenArities() {
+    std::map<std::string, std::map<int, const ArityUse*>> predecessors;
+    for (const ArityUse& u : arityUses_)
+      if (!u.context) predecessors[u.name].emplace(u.arity, &u);
+    for (const auto& [name, counts] : predecessors) {
+      auto w = written_.find(name);
+      if (w == written_.end() || isTurtleSymbol(name)) continue;
+      bool reported = std::any_of(counts.begin(), counts.end(), [&](const auto& c) { return !w->second.count(c.first); });
+      if (reported) continue;
+      const ArityUse& prod = *counts.begin()->second;
+      for (const auto& [count, where] : w->second) {
+        if (counts.count(count)) continue;
+        auto plural = [](int n) { return std::to_string(n) + (n == 1 ? " parameter" : " parameters"); };
+        error(where.first, where.second,
+              "module '" + name + "' is written here with " + plural(count) + ", but its production '" + prod.text +
+                  "' (line " + std::to_string(prod.line) + ":" + std::to_string(prod.col + 1) + ") takes " + plural(prod.arity) +
+                  ": a production matches a module only with its own parameter count, so this module is never rewritten");
+      }
+    }
+  }
+
+  /// True for the built-in turtle symbols and named surfaces (`~l`), whose parameters are optional.
+  static bool isTurtleSymbol(const std::string& name) {
+    if (name.size() > 1 && name[0] == '~') return true;
+    return std::any_of(std::begin(kTurtleSymbols), std::end(kTurtleSymbols), [&](const char* t) { return name == t; });
+  }
+
+  /// A predecessor whose stochastic productions all have weight 0 could never be rewritten
+  /// by them (the derivation would silently keep the module): an error at the first.
+  void checkWeights(const RuleSet& rs) {
+    std::map<SymbolId, std::vector<const Production*>> bySymbol;
+    for (const Production& p : rs.productions)
+      if (p.stochastic) bySymbol[p.predecessor].push_back(&p);
+    for (const auto& [sym, ps] : bySymbol) {
+      if (std::any_of(ps.begin(), ps.end(), [](const Production* p) { return p->weight > 0; })) continue;
+      std::string lines;
+      for (size_t k = 0; k < ps.size(); ++k) lines += (k ? ", " : "") + std::to_string(ps[k]->loc.line);
+      error(ps[0]->loc.line, ps[0]->loc.col - 1,
+            "every stochastic production of '" + prog_.symbols.name(sym) + "' has weight 0 (line" +
+                (ps.size() > 1 ? "s " : " ") + lines + "): at least one weight must be positive");
     }
   }
 
