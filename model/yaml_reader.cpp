@@ -172,7 +172,9 @@ class Walker {
     } else if (n.IsMap()) {
       std::map<std::string, int, std::less<>> firstLine;
       for (auto it = n.begin(); it != n.end(); ++it) {
-        const YAML::Node& key = it->first;
+        // A copy, not a reference: yaml-cpp's iterator returns a temporary from operator->,
+        // so a reference to its `first` dangles at the end of this statement.
+        const YAML::Node key = it->first;
         if (!key.IsScalar()) {
           report(key.Mark(), "map keys must be plain text, got " + std::string(kindName(key)));
         } else {
