@@ -1,6 +1,7 @@
 #include "lsystem/detail/grammar_parser.h"
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
@@ -281,11 +282,15 @@ class GrammarParser {
       }
     } else if (h.key == "axiom") {
       once(h.key, line, b);
-      std::vector<RawModule> mods;
+      // Streamed module by module, never stored: an axiom may hold millions of modules.
+      // finish() tokenizes the line again to append them, once the seed is known.
+      BracketState brackets;
       if (value.b == value.e) error(line, value.b, "the axiom is empty");
-      else if (scanner_.tokenizeModules(line, value.b, value.e, mods) && checkBrackets(line, mods, "the axiom")) {
-        noteWritten(line, mods);
-        axiomModules_ = std::move(mods);
+      else if (scanner_.tokenizeModules(line, value.b, value.e, [&](const RawModule& m) {
+                 bracketModule(line, m, brackets, "the axiom");
+                 noteWritten(line, m);
+               }) && bracketEnd(line, brackets, "the axiom")) {
+        axiomSpan_ = value;
         axiomLine_ = line;
         prog_.axiomLoc = SourceLoc{prog_.fileName, line, b + 1};
         prog_.axiomLine = scanner_.rawLine(line);
@@ -432,37 +437,62 @@ class GrammarParser {
     rs.productions.push_back(std::move(p));
   }
 
-  /// Reports brackets that do not pair up in mods (an axiom or a successor, named by where).
-  bool checkBrackets(int line, const std::vector<RawModule>& mods, const char* where) {
-    std::vector<int> open;
+  /// Open brackets of a module string being checked (bracketModule, bracketEnd).
+  struct BracketState {
+    std::vector<int> open;  ///< columns of the `[` not yet closed
     bool ok = true;
-    for (const RawModule& m : mods) {
-      if (m.name == "[") {
-        open.push_back(m.col);
-        if (open.size() == kMaxBracketDepth + 1) {
-          error(line, m.col, std::string("branches in ") + where + " are nested more than " + std::to_string(kMaxBracketDepth) +
-                                 " levels deep (the limit)");
-          ok = false;
-        }
-      } else if (m.name == "]") {
-        if (open.empty()) {
-          error(line, m.col, std::string("unmatched ']' in ") + where);
-          ok = false;
-        } else {
-          open.pop_back();
-        }
+  };
+
+  /// Reports m when it is a `]` closing nothing or a `[` beyond kMaxBracketDepth (in an
+  /// axiom or successor, named by where).
+  void bracketModule(int line, const RawModule& m, BracketState& st, const char* where) {
+    if (m.name == "[") {
+      st.open.push_back(m.col);
+      if (st.open.size() == kMaxBracketDepth + 1) {
+        error(line, m.col, std::string("branches in ") + where + " are nested more than " + std::to_string(kMaxBracketDepth) +
+                               " levels deep (the limit)");
+        st.ok = false;
+      }
+    } else if (m.name == "]") {
+      if (st.open.empty()) {
+        error(line, m.col, std::string("unmatched ']' in ") + where);
+        st.ok = false;
+      } else {
+        st.open.pop_back();
       }
     }
-    for (int col : open) {
+  }
+
+  /// Reports every `[` left open; true when the whole string was balanced.
+  bool bracketEnd(int line, BracketState& st, const char* where) {
+    for (int col : st.open) {
       error(line, col, std::string("unclosed '[' in ") + where + " (no matching ']')");
-      ok = false;
+      st.ok = false;
     }
-    return ok;
+    return st.ok;
+  }
+
+  /// Reports brackets that do not pair up in mods (an axiom or a successor, named by where).
+  bool checkBrackets(int line, const std::vector<RawModule>& mods, const char* where) {
+    BracketState st;
+    for (const RawModule& m : mods) bracketModule(line, m, st, where);
+    return bracketEnd(line, st, where);
   }
 
   /// Records the parameter count of every module written in an axiom or successor.
   void noteWritten(int line, const std::vector<RawModule>& mods) {
-    for (const RawModule& m : mods) written_[m.name].emplace(static_cast<int>(m.args.size()), std::pair{line, m.col});
+    for (const RawModule& m : mods) noteWritten(line, m);
+  }
+
+  /// Records m's parameter count, with its first place. One-character names with fewer
+  /// than 8 parameters are remembered in a bit table, so a long axiom costs no map lookup
+  /// per module.
+  void noteWritten(int line, const RawModule& m) {
+    const size_t n = m.args.size();
+    uint8_t* seen = m.name.size() == 1 && n < 8 ? &writtenSingle_[static_cast<unsigned char>(m.name[0])] : nullptr;
+    if (seen && (*seen >> n & 1)) return;
+    written_[m.name].emplace(static_cast<int>(n), std::pair{line, m.col});
+    if (seen) *seen |= uint8_t(1u << n);
   }
 
   /// A predecessor or context module whose parameter count no written module of its symbol
@@ -590,17 +620,20 @@ class GrammarParser {
 
   /// Appends modules whose parameters are constant expressions (random draws use rng).
   void appendConstant(const std::vector<RawModule>& mods, ModuleString& out, Rng* rng) {
-    for (const RawModule& m : mods) {
-      SymbolId id = prog_.symbols.intern(m.name);
-      std::vector<double> params;
-      bool ok = true;
-      for (const Span& a : m.args) {
-        std::optional<double> v = expr_.evaluate(scanner_.trim(a), rng);
-        if (v) params.push_back(*v);
-        else ok = false;
-      }
-      if (ok) out.push(id, params);
+    for (const RawModule& m : mods) appendConstant(m, out, rng);
+  }
+
+  /// Appends m, its parameters evaluated (nothing when one fails, after its diagnostic).
+  void appendConstant(const RawModule& m, ModuleString& out, Rng* rng) {
+    SymbolId id = prog_.symbols.intern(m.name);
+    params_.clear();
+    bool ok = true;
+    for (const Span& a : m.args) {
+      std::optional<double> v = expr_.evaluate(scanner_.trim(a), rng);
+      if (v) params_.push_back(*v);
+      else ok = false;
     }
+    if (ok) out.push(id, params_);
   }
 
   // ---- end of file -------------------------------------------------------------------
@@ -619,7 +652,8 @@ class GrammarParser {
       diags().error(SourceLoc{prog_.fileName, 0, 0}, "missing 'axiom:'");
     } else if (axiomLine_) {
       Rng rng(deriveSeed(prog_.seed, {kAxiomStream}));
-      appendConstant(axiomModules_, prog_.axiom, &rng);
+      scanner_.tokenizeModules(axiomLine_, axiomSpan_.b, axiomSpan_.e,
+                               [&](const RawModule& m) { appendConstant(m, prog_.axiom, &rng); });
     }
     // Ignore / consider table over every symbol, including ones interned late.
     prog_.ignored.assign(prog_.symbols.size(), 0);
@@ -649,8 +683,10 @@ class GrammarParser {
   std::unordered_map<std::string, double> defines_;
   ExpressionParser expr_{scanner_, defines_, prog_.code};
   std::map<std::string, int> seen_;
-  std::vector<RawModule> axiomModules_;
+  Span axiomSpan_;  ///< the axiom's text (tokenized again by finish())
   int axiomLine_ = 0;
+  std::vector<double> params_;  ///< scratch parameters of appendConstant
+  std::array<uint8_t, 256> writtenSingle_{};  ///< per byte: bit n set when written with n parameters
   std::vector<SymbolId> ignoreList_, considerList_;
   /// A predecessor or context module with its parameter count, checked by checkArities().
   struct ArityUse {
