@@ -1,12 +1,23 @@
 # Sprig's two commands. Each installs what is missing, configures, builds, then runs.
 #   make test     build and run the whole test suite (ctest)
 #   make gallery  render every shipped species into gallery/out/
+#   make sanitize build with clang, AddressSanitizer and UBSan in build-asan/, run ctest there
+#   make fuzz     build the libFuzzer targets (build-asan/fuzz/) and run each FUZZ_SECONDS
 BUILD   ?= build
 JOBS    ?= $(shell nproc)
 SPRIG   := $(BUILD)/sprig
 QUALITY ?= draft
+ASAN_BUILD   ?= build-asan
+FUZZ_SECONDS ?= 60
+CCACHE := $(if $(shell command -v ccache),-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+# -O1 -g1: sanitizer reports with line numbers, at about half the compile time of -O2 -g.
+ASAN_CONFIG := CC=clang CXX=clang++ cmake -S . -B $(ASAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release \
+  -DCMAKE_CXX_FLAGS_RELEASE="-O1 -g1" -DSPRIG_SANITIZE=ON -DSPRIG_FUZZ=ON $(CCACHE)
+export ASAN_OPTIONS  ?= detect_leaks=1:abort_on_error=1:detect_stack_use_after_return=0
+export UBSAN_OPTIONS ?= print_stacktrace=1:halt_on_error=1
+export LSAN_OPTIONS  ?= suppressions=$(CURDIR)/fuzz/lsan.supp:print_suppressions=0
 
-.PHONY: all deps configure build test gallery bench clean
+.PHONY: all deps configure build test gallery bench clean sanitize fuzz
 
 all: build
 
@@ -29,5 +40,15 @@ gallery: build
 bench: build
 	@for b in $(BUILD)/bench/*; do echo "== $$b"; $$b || exit 1; done
 
+sanitize: deps
+	@$(ASAN_CONFIG) >/dev/null
+	@cmake --build $(ASAN_BUILD) -j $(JOBS)
+	@cd $(ASAN_BUILD) && ctest --output-on-failure -j $(JOBS)
+
+fuzz: deps
+	@$(ASAN_CONFIG) >/dev/null
+	@cmake --build $(ASAN_BUILD) -j $(JOBS) --target $(addprefix fuzz_,grammar expression derive species_tree species_shell species_blob species_organism polymesh image)
+	@bash fuzz/run.sh $(ASAN_BUILD) $(FUZZ_SECONDS)
+
 clean:
-	@rm -rf $(BUILD)
+	@rm -rf $(BUILD) $(ASAN_BUILD)

@@ -40,6 +40,7 @@ int runPreview(const PreviewArgs& a, const GlobalOptions& g) {
   if (a.width > 0 && a.height <= 0) height = std::max(16, lookHeight * a.width / lookWidth);
   if (a.height > 0 && a.width <= 0) width = std::max(16, lookWidth * a.height / lookHeight);
 
+  checkCameraRays(width, height, look.image.spp);  // before anything is derived or built
   // The skeleton as derived at the step shown, framed like the final step.
   GrowthEngine engine(species, GrowthOptions{extra, -1, {}});
   const int last = engine.lastStep();

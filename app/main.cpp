@@ -41,8 +41,13 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    int rc = app.exit(e);
-    return rc == 0 ? kExitOk : kExitUsage;
+    // --help and --version are "errors" to CLI11 that exit 0: let it print them.
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::string command = "sprig";
+    for (const CLI::App* sub : app.get_subcommands()) command += " " + sub->get_name();
+    std::cerr << "sprig: error: " << e.what() << "\n"
+              << "Run '" << command << " --help' for the options.\n";
+    return kExitUsage;
   }
 
   try {

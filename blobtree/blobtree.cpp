@@ -4,6 +4,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
+#include "core/diagnostics.h"
+
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -84,6 +86,9 @@ Node unaryNode(NodeKind kind, NodeId child) { return operatorNode(kind, std::spa
 }  // namespace
 
 NodeId BlobTree::add(Node n) {
+  if (nodes_.size() >= kMaxBlobNodes)
+    throw InputError(SourceLoc{}, "the BlobTree has more than " + std::to_string(kMaxBlobNodes) +
+                                      " nodes (the limit, kMaxBlobNodes in blobtree/blobtree.h): use fewer derivation steps (steps:, --steps) or a smaller model");
   auto childBox = [&](size_t i) { return nodes_[n.children[i]].bounds; };
   auto childLip = [&](size_t i) { return nodes_[n.children[i]].lipschitz; };
   for (NodeId c : n.children) check(c);

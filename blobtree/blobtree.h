@@ -158,6 +158,10 @@ struct Node {
   float lipschitz = 0.0f;  ///< global Lipschitz bound of the field
 };
 
+/// Most nodes (primitives and operators) one BlobTree may hold: 4,194,304, about 1 GB of
+/// nodes and compiled tape. BlobTree::add throws InputError beyond it, before allocating.
+inline constexpr size_t kMaxBlobNodes = size_t(1) << 22;
+
 /// Builder of BlobTree nodes. All radii are 0.5-iso radii in world units; the support
 /// radius R is derived from the kernel (Wyvill R = r/0.4542, soft objects R = 2r).
 /// Primitives' fields are weight·g(dist²/R²) (weight defaults to 1).

@@ -14,6 +14,7 @@
 
 #include "blobtree/cell_size.h"
 #include "blobtree/detail/marching_tets.h"
+#include "core/diagnostics.h"
 #include "core/parallel.h"
 #include "core/progress.h"
 
@@ -546,6 +547,16 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
     return s;
   };
 
+  // The grid is checked before any cell is found: a tiny cell over a large model would
+  // otherwise allocate without bound while the sparse cells are collected.
+  {
+    Vec3 size = blob.bounds().size();
+    double cells = std::max({double(size.x), double(size.y), double(size.z)}) / double(requested);
+    if (!(cells < double(kAxisLimit - 2)))
+      throw InputError(SourceLoc{}, "a polygonization cell of " + std::to_string(requested) + " gives a grid of " +
+                                        std::to_string(int64_t(std::min(cells, 1e18))) + " cells on an axis, more than the limit of " +
+                                        std::to_string(kAxisLimit - 2) + " (2^20): use a larger cell (sprig mesh --cell, a blob's cell_size)");
+  }
   // 1. Cells that may hold the surface.
   Grid g(keptCells(blob, requested));
   res.cellSeconds = lap();

@@ -18,6 +18,30 @@ const char* severityName(Severity s) {
   return "error";
 }
 
+/// The range [begin, end) of at most width characters of a line of size n around caret.
+std::pair<size_t, size_t> windowAround(size_t n, size_t caret, size_t width) {
+  if (n <= width) return {0, n};
+  size_t begin = caret > width / 2 ? caret - width / 2 : 0;
+  size_t end = std::min(n, begin + width);
+  return {end - width, end};
+}
+
+/// A diagnostic whose source line, when far longer than the window, is stored cut to a few
+/// windows around the caret (a 400,000-character line is never copied per diagnostic).
+Diagnostic makeDiagnostic(Severity severity, SourceLoc loc, std::string message, std::string sourceLine) {
+  Diagnostic d{severity, std::move(loc), std::move(message), {}};
+  constexpr size_t kKeep = 4 * kDiagnosticWindow;
+  if (sourceLine.size() > kKeep && d.loc.col > 0) {
+    auto [begin, end] = windowAround(sourceLine.size(), static_cast<size_t>(d.loc.col - 1), kKeep);
+    d.sourceLine = sourceLine.substr(begin, end - begin);
+    d.lineOffset = begin;
+    d.lineCut = end < sourceLine.size();
+  } else {
+    d.sourceLine = std::move(sourceLine);
+  }
+  return d;
+}
+
 std::string formatAll(const std::vector<Diagnostic>& ds) {
   std::string out;
   for (size_t i = 0; i < ds.size(); ++i) {
@@ -43,12 +67,20 @@ std::string Diagnostic::format() const {
   out += ": ";
   out += message;
   if (!sourceLine.empty() && loc.col > 0) {
+    // A long line is shown as a window of at most kDiagnosticWindow columns around the
+    // caret, with "..." where it was cut, as compilers do.
+    size_t col0 = static_cast<size_t>(loc.col - 1);
+    size_t caret = std::min(col0 >= lineOffset ? col0 - lineOffset : 0, sourceLine.size());
+    auto [begin, end] = windowAround(sourceLine.size(), caret, kDiagnosticWindow);
+    const char* left = begin + lineOffset > 0 ? "..." : "";
     out += "\n  ";
-    out += sourceLine;
+    out += left;
+    out.append(sourceLine, begin, end - begin);
+    if (end < sourceLine.size() || lineCut) out += "...";
     out += "\n  ";
+    out.append(std::string_view(left).size(), ' ');
     // Keep tabs so the caret lines up under tab-indented text.
-    for (int i = 0; i + 1 < loc.col && i < static_cast<int>(sourceLine.size()); ++i)
-      out += sourceLine[i] == '\t' ? '\t' : ' ';
+    for (size_t i = begin; i < caret && i < end; ++i) out += sourceLine[i] == '\t' ? '\t' : ' ';
     out += '^';
   }
   return out;
@@ -58,14 +90,14 @@ InputError::InputError(std::vector<Diagnostic> diagnostics)
     : std::runtime_error(formatAll(diagnostics)), diagnostics_(std::move(diagnostics)) {}
 
 InputError::InputError(SourceLoc loc, std::string message, std::string sourceLine)
-    : InputError(std::vector<Diagnostic>{Diagnostic{Severity::Error, std::move(loc), std::move(message), std::move(sourceLine)}}) {}
+    : InputError(std::vector<Diagnostic>{makeDiagnostic(Severity::Error, std::move(loc), std::move(message), std::move(sourceLine))}) {}
 
 void DiagnosticList::error(SourceLoc loc, std::string message, std::string sourceLine) {
-  items_.push_back({Severity::Error, std::move(loc), std::move(message), std::move(sourceLine)});
+  items_.push_back(makeDiagnostic(Severity::Error, std::move(loc), std::move(message), std::move(sourceLine)));
 }
 
 void DiagnosticList::warning(SourceLoc loc, std::string message, std::string sourceLine) {
-  items_.push_back({Severity::Warning, std::move(loc), std::move(message), std::move(sourceLine)});
+  items_.push_back(makeDiagnostic(Severity::Warning, std::move(loc), std::move(message), std::move(sourceLine)));
 }
 
 bool DiagnosticList::hasErrors() const {

@@ -20,6 +20,10 @@ struct SourceLoc {
   int col = 0;
 };
 
+/// Most columns of a source line a diagnostic quotes: a longer line is shown as a window
+/// of this many columns around the caret, cut ends marked "...".
+inline constexpr size_t kDiagnosticWindow = 120;
+
 /// How serious a diagnostic is; only errors make DiagnosticList::throwIfErrors throw.
 enum class Severity { Error, Warning, Note };
 
@@ -29,8 +33,13 @@ struct Diagnostic {
   SourceLoc loc;
   std::string message;
   std::string sourceLine;  ///< the text of loc.line, without its newline; may be empty
+  /// Column (0-based) of the line at which sourceLine starts: lines far longer than the
+  /// window are stored already cut (DiagnosticList keeps at most a few windows of them).
+  size_t lineOffset = 0;
+  bool lineCut = false;  ///< sourceLine ends before the line does
 
-  /// `path:line:col: error: message`, plus the source line and a caret when known.
+  /// `path:line:col: error: message`, plus the source line (at most kDiagnosticWindow
+  /// columns of it around the caret) and a caret when known.
   std::string format() const;
 };
 

@@ -179,6 +179,12 @@ Image readImage(const fs::path& path) {
   const ImageInfo info = infoOf(in->spec());
   const int w = info.width, h = info.height, nc = info.channels;
   if (w <= 0 || h <= 0 || nc <= 0) throw ImageReadError(path, "empty image");
+  // Checked before the pixels are allocated: a 40-byte header may claim 65535 x 65535.
+  if (uint64_t(w) * uint64_t(h) > kMaxImagePixels)
+    throw ImageReadError(path, "the image is " + std::to_string(w) + " x " + std::to_string(h) + ", more than the limit of " +
+                                   std::to_string(kMaxImagePixels) + " pixels (8192 x 8192)");
+  if (nc > kMaxImageChannels)
+    throw ImageReadError(path, "the image has " + std::to_string(nc) + " channels, more than " + std::to_string(kMaxImageChannels));
   const size_t n = static_cast<size_t>(w) * h;
   std::vector<float> values(n * nc);
   bool ok = false;

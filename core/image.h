@@ -101,13 +101,19 @@ struct ImageInfo {
 /// is not an image OpenImageIO can open.
 ImageInfo readImageInfo(const std::filesystem::path& path);
 
+/// Most pixels an image file may hold to be read (readImage): 2^26, 8192 x 8192.
+inline constexpr uint64_t kMaxImagePixels = uint64_t(1) << 26;
+/// Most channels an image file may hold to be read.
+inline constexpr int kMaxImageChannels = 16;
+
 /// Reads an image file into linear RGBA. sRGB files (ImageInfo::srgb) are read as 8-bit
 /// values, color decoded with srgbToLinear(float) of value / 255 and alpha taken as
 /// value / 255; other files are read as floats and taken as linear. A gray file gives gray
 /// RGB; alpha is 1 where the file has none. Alpha follows OpenImageIO's default: color
 /// comes back multiplied by alpha (its PNG writer divides color by alpha), so an image whose
 /// color is already premultiplied, as the renderer's is, survives a PNG round trip.
-/// Throws ImageReadError when the file cannot be read.
+/// Throws ImageReadError when the file cannot be read or exceeds kMaxImagePixels or
+/// kMaxImageChannels (checked from the header, before the pixels are allocated).
 Image readImage(const std::filesystem::path& path);
 
 }  // namespace sprig

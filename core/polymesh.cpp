@@ -14,6 +14,7 @@
 
 #include "core/paths.h"
 #include "core/srgb.h"
+#include "core/text.h"
 
 namespace sprig {
 
@@ -90,8 +91,6 @@ const char* formatName(MeshFileFormat f) {
   return "mesh";
 }
 
-bool isControl(unsigned char c) { return (c < 0x20 && c != '\t' && c != '\n' && c != '\r') || c == 0x7f; }
-
 // Line and column (1-based) of byte offset pos in text.
 Where whereOffset(std::string_view text, size_t pos) {
   Where w;
@@ -103,16 +102,9 @@ Where whereOffset(std::string_view text, size_t pos) {
   return w;
 }
 
-// Fails with one error when text [begin, end) holds a control byte (binary data).
+// Fails with one error when text [0, end) is not UTF-8 text (binary data): core/text.h.
 void requireText(std::string_view text, size_t end, const char* what, Errors& e) {
-  for (size_t i = 0; i < end; ++i) {
-    auto c = static_cast<unsigned char>(text[i]);
-    if (!isControl(c)) continue;
-    char hex[8];
-    std::snprintf(hex, sizeof hex, "0x%02x", c);
-    e.fatal(whereOffset(text, i), std::string("byte ") + hex + (c == 0 ? " (NUL)" : "") + " is not text: " + what +
-                                      " must be text (is this a binary file?)");
-  }
+  if (auto fault = findNonText(text.substr(0, end))) e.fatal(Where{fault->line, fault->col, {}}, nonTextMessage(*fault, what));
 }
 
 // Lines of a text, numbered from 1, without their line endings.

@@ -77,9 +77,11 @@ class Writer {
   void copyRun(const SymbolId* s, const uint32_t* o, const double* pars, size_t m, const int32_t* births) {
     uint32_t pb = o[0], pe = o[m];
     reserve(m, pe - pb);
+    if (m == 0) return;
     std::memcpy(sym_ + n_, s, m * sizeof(SymbolId));
     if (births_) std::memcpy(birth_ + n_, births, m * sizeof(int32_t));
-    std::memcpy(par_ + np_, pars + pb, (pe - pb) * sizeof(double));
+    // pars may be null (a string without parameters): memcpy's pointers must not be.
+    if (pe > pb) std::memcpy(par_ + np_, pars + pb, (pe - pb) * sizeof(double));
     const uint32_t delta = static_cast<uint32_t>(np_) - pb;  // modular: offsets stay below 2^32
     for (size_t k = 1; k <= m; ++k) off_[n_ + k] = o[k] + delta;
     n_ += m;

@@ -9,6 +9,7 @@
 /// birthSteps is optional: empty unless the derivation was asked to track the step that
 /// created each module (DeriveOptions::trackBirthSteps); then it has size() entries.
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -33,6 +34,13 @@ class SymbolTable {
  private:
   std::vector<std::string> names_;
   std::unordered_map<std::string, SymbolId> ids_;
+  /// Ids of one-character names by their byte (-1: not interned), so the common symbol is
+  /// found without hashing a string (an 8-million-module axiom interns every module).
+  std::array<int32_t, 256> single_ = [] {
+    std::array<int32_t, 256> a{};
+    a.fill(-1);
+    return a;
+  }();
 };
 
 struct ModuleString {

@@ -62,6 +62,14 @@ render::Camera modelCamera(const SpeciesRender& look, const Box3& box, int width
   return cam;
 }
 
+void checkCameraRays(int width, int height, int samples) {
+  const uint64_t rays = uint64_t(std::max(width, 0)) * uint64_t(std::max(height, 0)) * uint64_t(std::max(samples, 0));
+  if (rays <= kMaxCameraRays) return;
+  throw UsageError("the image takes " + std::to_string(width) + " x " + std::to_string(height) + " x " +
+                   std::to_string(samples) + " samples = " + std::to_string(rays) + " camera rays, more than the limit of " +
+                   std::to_string(kMaxCameraRays) + " (2^34): lower --width, --height or --samples (render: width, height, samples in the species file)");
+}
+
 Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job, ModelFigures* figures,
                           render::RenderStats* stats) {
   const int lookWidth = look.image.width, lookHeight = look.image.height;
@@ -69,6 +77,7 @@ Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJo
   int height = job.height > 0 ? job.height : lookHeight;
   if (job.width > 0 && job.height <= 0) height = std::max(16, lookHeight * job.width / lookWidth);
   if (job.height > 0 && job.width <= 0) width = std::max(16, lookWidth * job.height / lookHeight);
+  checkCameraRays(width, height, job.samples > 0 ? job.samples : look.image.spp);
   const Box3 frame = job.frame ? *job.frame : model.frameBox();
   render::Scene scene;
   ModelFigures fig = model.addToScene(scene, job.stage, job.mode, look);

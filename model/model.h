@@ -19,6 +19,7 @@
 /// give the same geometry, and so the same image bytes, at any thread count.
 
 #include <memory>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -113,8 +114,17 @@ struct RenderJob {
   std::string progressLabel = "render";
 };
 
+/// Most camera rays (width x height x samples per pixel) one image may take: 2^34, about
+/// 17 billion (8192 x 8192 at 256 samples), hours of rendering. Raise it here.
+inline constexpr uint64_t kMaxCameraRays = uint64_t(1) << 34;
+
+/// Throws UsageError naming the flags and keys to lower when width x height x samples
+/// exceeds kMaxCameraRays. Called before anything is built or allocated.
+void checkCameraRays(int width, int height, int samples);
+
 /// Renders one stage of model with look (camera framed on model.frameBox(), or the species'
-/// explicit camera). Fills figures and stats when given.
+/// explicit camera). Fills figures and stats when given. Throws UsageError (checkCameraRays)
+/// for an image over kMaxCameraRays rays.
 Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job,
                           ModelFigures* figures = nullptr, render::RenderStats* stats = nullptr);
 

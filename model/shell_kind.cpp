@@ -73,7 +73,8 @@ void readGenerating(MapReader& top, ShellParams& p, DiagnosticList& diags) {
       item.error(diags, "a generating primitive must be a map with one key: point or cone");
       continue;
     }
-    const auto& [keyNode, value] = item.pairs().front();
+    const auto pairs = item.pairs();  // a copy: a reference into the temporary would dangle
+    const auto& [keyNode, value] = pairs.front();
     const std::string kind = keyNode.scalar();
     GeneratingPrimitive prim;
     MapReader r(value, diags, kind);

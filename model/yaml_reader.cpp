@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/srgb.h"
+#include "core/text.h"
 
 namespace sprig {
 
@@ -16,6 +17,79 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr int kMaxDepth = 256;
+
+/// Where (1-based line, 0-based column) the nesting of a YAML text first exceeds limit,
+/// or line 0 when it never does. yaml-cpp 0.7 parses nesting by recursion and overflows
+/// the stack on deep input (a few 10,000 levels), so the text is scanned before it is
+/// handed over. Depth counts block levels (distinct indentations), compact sequence
+/// entries (`- - x`) and open flow brackets (`[`, `{`) outside quotes and comments;
+/// block scalar bodies (`|`, `>`) are skipped. An over-estimate is harmless at 256.
+std::pair<int, int> yamlTooDeep(std::string_view text, size_t limit) {
+  std::vector<size_t> indents;
+  size_t flow = 0;
+  char quote = 0;              // the open quote of a scalar running over lines
+  size_t blockScalarIndent = std::string_view::npos;  // skip deeper lines after `|` or `>`
+  int lineNo = 0;
+  size_t pos = 0;
+  while (pos <= text.size()) {
+    size_t nl = text.find('\n', pos);
+    std::string_view line = text.substr(pos, nl == std::string_view::npos ? std::string_view::npos : nl - pos);
+    pos = nl == std::string_view::npos ? text.size() + 1 : nl + 1;
+    ++lineNo;
+    size_t indent = 0;
+    while (indent < line.size() && line[indent] == ' ') ++indent;
+    bool blank = indent == line.size() || line[indent] == '#' || line[indent] == '\r';
+    if (blockScalarIndent != std::string_view::npos) {
+      if (blank || indent > blockScalarIndent) continue;
+      blockScalarIndent = std::string_view::npos;
+    }
+    size_t depth = 0;
+    size_t i = indent;
+    if (!quote && flow == 0) {
+      if (blank) continue;
+      while (!indents.empty() && indents.back() > indent) indents.pop_back();
+      if (indents.empty() || indents.back() < indent) indents.push_back(indent);
+      // Compact nested sequences: each `- ` opens one more level on this line.
+      while (i + 1 < line.size() && line[i] == '-' && (line[i + 1] == ' ' || line[i + 1] == '\t')) {
+        ++depth;
+        i += 2;
+        while (i < line.size() && line[i] == ' ') ++i;
+        if (indents.size() + depth > limit) return {lineNo, static_cast<int>(i)};
+      }
+    }
+    depth += indents.size();
+    char prev = ' ';
+    size_t end = line.size();  // end of the line before any comment
+    for (; i < line.size(); prev = line[i], ++i) {
+      char c = line[i];
+      if (quote) {
+        if (quote == '"' && c == '\\') ++i;
+        else if (c == quote) quote = 0;
+        continue;
+      }
+      bool atToken = prev == ' ' || prev == '\t' || prev == '[' || prev == '{' || prev == ',' || prev == ':' || i == indent;
+      if ((c == '"' || c == '\'') && atToken) {
+        quote = c;
+      } else if (c == '#' && (prev == ' ' || prev == '\t')) {
+        end = i;
+        break;
+      } else if (c == '[' || c == '{') {
+        if (depth + ++flow > limit) return {lineNo, static_cast<int>(i)};
+      } else if ((c == ']' || c == '}') && flow > 0) {
+        --flow;
+      }
+    }
+    if (depth + flow > limit) return {lineNo, static_cast<int>(indent)};
+    // A block scalar header (`key: |`, `- >-`, `|2`) ends the line: skip its body.
+    std::string_view head = line.substr(0, end);
+    while (!head.empty() && (head.back() == ' ' || head.back() == '\t' || head.back() == '\r')) head.remove_suffix(1);
+    size_t k = head.find_last_of("|>");
+    if (!quote && flow == 0 && k != std::string_view::npos && (k == 0 || head[k - 1] == ' ') &&
+        head.find_first_not_of("+-0123456789", k + 1) == std::string_view::npos)
+      blockScalarIndent = indent;
+  }
+  return {0, 0};
+}
 
 /// Shortest text of a double that reads back exactly ("0.5", "1000", "1e+20").
 std::string formatNumber(double v) {
@@ -90,7 +164,7 @@ class Walker {
       return false;
     }
     if (depth > kMaxDepth) {
-      file_.error(diags_, n.Mark(), "YAML document nests deeper than " + std::to_string(kMaxDepth) + " levels");
+      file_.error(diags_, n.Mark(), "YAML document nests deeper than " + std::to_string(kMaxDepth) + " levels (the limit)");
       return false;
     }
     if (n.IsSequence()) {
@@ -99,7 +173,9 @@ class Walker {
     } else if (n.IsMap()) {
       std::map<std::string, int, std::less<>> firstLine;
       for (auto it = n.begin(); it != n.end(); ++it) {
-        const YAML::Node& key = it->first;
+        // A copy, not a reference: yaml-cpp's iterator returns a temporary from operator->,
+        // so a reference to its `first` dangles at the end of this statement.
+        const YAML::Node key = it->first;
         if (!key.IsScalar()) {
           report(key.Mark(), "map keys must be plain text, got " + std::string(kindName(key)));
         } else {
@@ -168,6 +244,12 @@ std::shared_ptr<const YamlFile> YamlFile::parseAt(std::string text, std::string 
   file->displayPath_ = std::move(displayPath);
   file->text_ = std::move(text);
   file->self_ = file;
+  if (!checkText(file->text_, file->displayPath_, "a YAML file", diags)) return nullptr;
+  if (auto [line, col] = yamlTooDeep(file->text_, kMaxDepth); line > 0) {
+    diags.error(SourceLoc{file->displayPath_, line, col + 1},
+                "YAML document nests deeper than " + std::to_string(kMaxDepth) + " levels (the limit)", file->sourceLine(line));
+    return nullptr;
+  }
   try {
     file->root_ = YAML::Load(file->text_);
   } catch (const YAML::Exception& e) {

@@ -11,6 +11,7 @@ packages=(
   libmeshoptimizer-dev libcgal-demo
   nodejs curl ca-certificates
   gmsh
+  clang-14 libclang-rt-14-dev ccache
 )
 
 missing=()

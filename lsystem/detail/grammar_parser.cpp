@@ -1,6 +1,7 @@
 #include "lsystem/detail/grammar_parser.h"
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
@@ -9,12 +10,16 @@
 #include <unordered_map>
 
 #include "core/rng.h"
+#include "core/text.h"
 #include "lsystem/detail/expression_parser.h"
 #include "lsystem/detail/scanner.h"
 
 namespace sprig::lsystem::detail {
 
 namespace {
+
+/// Most `[` nested in one axiom or successor as written (docs/ROBUSTNESS.md).
+constexpr size_t kMaxBracketDepth = 1024;
 
 /// Stream id for random draws in axiom parameters.
 constexpr uint64_t kAxiomStream = 0xfffffffffffffff1ull;
@@ -64,12 +69,17 @@ class GrammarParser {
 
   /// Parses and compiles a grammar file's text.
   std::shared_ptr<Program> run(std::string_view text) {
+    requireText(text, prog_.fileName, "a grammar file");
     scanner_.load(text);
     firstPass();
     secondPass();
     // Only on an otherwise clean file: a successor that failed to parse wrote nothing, and
     // its modules' parameter counts would be missed.
-    if (!diags().hasErrors()) checkArities();
+    if (!diags().hasErrors()) {
+      checkArities();
+      checkWrittenArities();
+      for (const RuleSet* rs : {&prog_.productions, &prog_.decomposition, &prog_.interpretation}) checkWeights(*rs);
+    }
     finish();
     diags().throwIfErrors();
     return std::make_shared<Program>(std::move(prog_));
@@ -78,6 +88,7 @@ class GrammarParser {
   /// Tokenizes every line of text as a constant module string over symbols (for
   /// parseModuleString); new symbols are interned into symbols.
   ModuleString constantString(std::string_view text, SymbolTable& symbols) {
+    requireText(text, prog_.fileName, "a module string");
     scanner_.load(text);
     prog_.symbols = symbols;
     scanner_.clearMultiNames();
@@ -271,11 +282,15 @@ class GrammarParser {
       }
     } else if (h.key == "axiom") {
       once(h.key, line, b);
-      std::vector<RawModule> mods;
+      // Streamed module by module, never stored: an axiom may hold millions of modules.
+      // finish() tokenizes the line again to append them, once the seed is known.
+      BracketState brackets;
       if (value.b == value.e) error(line, value.b, "the axiom is empty");
-      else if (scanner_.tokenizeModules(line, value.b, value.e, mods) && checkBrackets(line, mods, "the axiom")) {
-        noteWritten(line, mods);
-        axiomModules_ = std::move(mods);
+      else if (scanner_.tokenizeModules(line, value.b, value.e, [&](const RawModule& m) {
+                 bracketModule(line, m, brackets, "the axiom");
+                 noteWritten(line, m);
+               }) && bracketEnd(line, brackets, "the axiom")) {
+        axiomSpan_ = value;
         axiomLine_ = line;
         prog_.axiomLoc = SourceLoc{prog_.fileName, line, b + 1};
         prog_.axiomLine = scanner_.rawLine(line);
@@ -422,32 +437,62 @@ class GrammarParser {
     rs.productions.push_back(std::move(p));
   }
 
-  /// Reports brackets that do not pair up in mods (an axiom or a successor, named by where).
-  bool checkBrackets(int line, const std::vector<RawModule>& mods, const char* where) {
-    std::vector<int> open;
+  /// Open brackets of a module string being checked (bracketModule, bracketEnd).
+  struct BracketState {
+    std::vector<int> open;  ///< columns of the `[` not yet closed
     bool ok = true;
-    for (const RawModule& m : mods) {
-      if (m.name == "[") {
-        open.push_back(m.col);
-      } else if (m.name == "]") {
-        if (open.empty()) {
-          error(line, m.col, std::string("unmatched ']' in ") + where);
-          ok = false;
-        } else {
-          open.pop_back();
-        }
+  };
+
+  /// Reports m when it is a `]` closing nothing or a `[` beyond kMaxBracketDepth (in an
+  /// axiom or successor, named by where).
+  void bracketModule(int line, const RawModule& m, BracketState& st, const char* where) {
+    if (m.name == "[") {
+      st.open.push_back(m.col);
+      if (st.open.size() == kMaxBracketDepth + 1) {
+        error(line, m.col, std::string("branches in ") + where + " are nested more than " + std::to_string(kMaxBracketDepth) +
+                               " levels deep (the limit)");
+        st.ok = false;
+      }
+    } else if (m.name == "]") {
+      if (st.open.empty()) {
+        error(line, m.col, std::string("unmatched ']' in ") + where);
+        st.ok = false;
+      } else {
+        st.open.pop_back();
       }
     }
-    for (int col : open) {
+  }
+
+  /// Reports every `[` left open; true when the whole string was balanced.
+  bool bracketEnd(int line, BracketState& st, const char* where) {
+    for (int col : st.open) {
       error(line, col, std::string("unclosed '[' in ") + where + " (no matching ']')");
-      ok = false;
+      st.ok = false;
     }
-    return ok;
+    return st.ok;
+  }
+
+  /// Reports brackets that do not pair up in mods (an axiom or a successor, named by where).
+  bool checkBrackets(int line, const std::vector<RawModule>& mods, const char* where) {
+    BracketState st;
+    for (const RawModule& m : mods) bracketModule(line, m, st, where);
+    return bracketEnd(line, st, where);
   }
 
   /// Records the parameter count of every module written in an axiom or successor.
   void noteWritten(int line, const std::vector<RawModule>& mods) {
-    for (const RawModule& m : mods) written_[m.name].emplace(static_cast<int>(m.args.size()), std::pair{line, m.col});
+    for (const RawModule& m : mods) noteWritten(line, m);
+  }
+
+  /// Records m's parameter count, with its first place. One-character names with fewer
+  /// than 8 parameters are remembered in a bit table, so a long axiom costs no map lookup
+  /// per module.
+  void noteWritten(int line, const RawModule& m) {
+    const size_t n = m.args.size();
+    uint8_t* seen = m.name.size() == 1 && n < 8 ? &writtenSingle_[static_cast<unsigned char>(m.name[0])] : nullptr;
+    if (seen && (*seen >> n & 1)) return;
+    written_[m.name].emplace(static_cast<int>(n), std::pair{line, m.col});
+    if (seen) *seen |= uint8_t(1u << n);
   }
 
   /// A predecessor or context module whose parameter count no written module of its symbol
@@ -472,6 +517,55 @@ class GrammarParser {
                 " parameter" + (u.arity == 1 ? "" : "s") + ", but '" + u.name + "' is only written with " + list +
                 (one ? " parameter" : " parameters") + " (as at line " + std::to_string(first.first) + ":" +
                 std::to_string(first.second + 1) + "), so this production never applies");
+    }
+  }
+
+  /// A user module (not a turtle command, whose parameters are optional) written in the
+  /// axiom or a successor with a parameter count none of its productions takes, while
+  /// productions for other counts exist: cpfg and lpfg match a module only with the same
+  /// count, so the module would silently never be rewritten. Reported at the written
+  /// module, naming the production. Symbols already reported by checkArities (a
+  /// production whose count is never written) are left to that message.
+  void checkWrittenArities() {
+    std::map<std::string, std::map<int, const ArityUse*>> predecessors;
+    for (const ArityUse& u : arityUses_)
+      if (!u.context) predecessors[u.name].emplace(u.arity, &u);
+    for (const auto& [name, counts] : predecessors) {
+      auto w = written_.find(name);
+      if (w == written_.end() || isTurtleSymbol(name)) continue;
+      bool reported = std::any_of(counts.begin(), counts.end(), [&](const auto& c) { return !w->second.count(c.first); });
+      if (reported) continue;
+      const ArityUse& prod = *counts.begin()->second;
+      for (const auto& [count, where] : w->second) {
+        if (counts.count(count)) continue;
+        auto plural = [](int n) { return std::to_string(n) + (n == 1 ? " parameter" : " parameters"); };
+        error(where.first, where.second,
+              "module '" + name + "' is written here with " + plural(count) + ", but its production '" + prod.text +
+                  "' (line " + std::to_string(prod.line) + ":" + std::to_string(prod.col + 1) + ") takes " + plural(prod.arity) +
+                  ": a production matches a module only with its own parameter count, so this module is never rewritten");
+      }
+    }
+  }
+
+  /// True for the built-in turtle symbols and named surfaces (`~l`), whose parameters are optional.
+  static bool isTurtleSymbol(const std::string& name) {
+    if (name.size() > 1 && name[0] == '~') return true;
+    return std::any_of(std::begin(kTurtleSymbols), std::end(kTurtleSymbols), [&](const char* t) { return name == t; });
+  }
+
+  /// A predecessor whose stochastic productions all have weight 0 could never be rewritten
+  /// by them (the derivation would silently keep the module): an error at the first.
+  void checkWeights(const RuleSet& rs) {
+    std::map<SymbolId, std::vector<const Production*>> bySymbol;
+    for (const Production& p : rs.productions)
+      if (p.stochastic) bySymbol[p.predecessor].push_back(&p);
+    for (const auto& [sym, ps] : bySymbol) {
+      if (std::any_of(ps.begin(), ps.end(), [](const Production* p) { return p->weight > 0; })) continue;
+      std::string lines;
+      for (size_t k = 0; k < ps.size(); ++k) lines += (k ? ", " : "") + std::to_string(ps[k]->loc.line);
+      error(ps[0]->loc.line, ps[0]->loc.col - 1,
+            "every stochastic production of '" + prog_.symbols.name(sym) + "' has weight 0 (line" +
+                (ps.size() > 1 ? "s " : " ") + lines + "): at least one weight must be positive");
     }
   }
 
@@ -526,17 +620,20 @@ class GrammarParser {
 
   /// Appends modules whose parameters are constant expressions (random draws use rng).
   void appendConstant(const std::vector<RawModule>& mods, ModuleString& out, Rng* rng) {
-    for (const RawModule& m : mods) {
-      SymbolId id = prog_.symbols.intern(m.name);
-      std::vector<double> params;
-      bool ok = true;
-      for (const Span& a : m.args) {
-        std::optional<double> v = expr_.evaluate(scanner_.trim(a), rng);
-        if (v) params.push_back(*v);
-        else ok = false;
-      }
-      if (ok) out.push(id, params);
+    for (const RawModule& m : mods) appendConstant(m, out, rng);
+  }
+
+  /// Appends m, its parameters evaluated (nothing when one fails, after its diagnostic).
+  void appendConstant(const RawModule& m, ModuleString& out, Rng* rng) {
+    SymbolId id = prog_.symbols.intern(m.name);
+    params_.clear();
+    bool ok = true;
+    for (const Span& a : m.args) {
+      std::optional<double> v = expr_.evaluate(scanner_.trim(a), rng);
+      if (v) params_.push_back(*v);
+      else ok = false;
     }
+    if (ok) out.push(id, params_);
   }
 
   // ---- end of file -------------------------------------------------------------------
@@ -555,7 +652,8 @@ class GrammarParser {
       diags().error(SourceLoc{prog_.fileName, 0, 0}, "missing 'axiom:'");
     } else if (axiomLine_) {
       Rng rng(deriveSeed(prog_.seed, {kAxiomStream}));
-      appendConstant(axiomModules_, prog_.axiom, &rng);
+      scanner_.tokenizeModules(axiomLine_, axiomSpan_.b, axiomSpan_.e,
+                               [&](const RawModule& m) { appendConstant(m, prog_.axiom, &rng); });
     }
     // Ignore / consider table over every symbol, including ones interned late.
     prog_.ignored.assign(prog_.symbols.size(), 0);
@@ -585,8 +683,10 @@ class GrammarParser {
   std::unordered_map<std::string, double> defines_;
   ExpressionParser expr_{scanner_, defines_, prog_.code};
   std::map<std::string, int> seen_;
-  std::vector<RawModule> axiomModules_;
+  Span axiomSpan_;  ///< the axiom's text (tokenized again by finish())
   int axiomLine_ = 0;
+  std::vector<double> params_;  ///< scratch parameters of appendConstant
+  std::array<uint8_t, 256> writtenSingle_{};  ///< per byte: bit n set when written with n parameters
   std::vector<SymbolId> ignoreList_, considerList_;
   /// A predecessor or context module with its parameter count, checked by checkArities().
   struct ArityUse {

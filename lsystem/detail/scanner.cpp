@@ -90,7 +90,12 @@ void Scanner::addMultiName(std::string_view name) {
 }
 
 bool Scanner::tokenizeModules(int line, int b, int e, std::vector<RawModule>& out) {
+  return tokenizeModules(line, b, e, [&out](const RawModule& m) { out.push_back(m); });
+}
+
+bool Scanner::tokenizeModules(int line, int b, int e, const std::function<void(const RawModule&)>& each) {
   const std::string& s = clean_[line - 1];
+  RawModule m;
   int i = b;
   bool ok = true;
   while (i < e) {
@@ -100,19 +105,20 @@ bool Scanner::tokenizeModules(int line, int b, int e, std::vector<RawModule>& ou
       error(line, i, c == ')' ? "unmatched ')'" : std::string("unexpected '") + c + "' (parameters must follow a module name)");
       return false;
     }
-    RawModule m;
     m.col = i;
+    m.args.clear();
+    m.hasParens = false;
     size_t best = 0;
     for (const std::string& name : multiNames_)
-      if (name.size() > best && static_cast<int>(name.size()) <= e - i && s.compare(i, name.size(), name) == 0) best = name.size();
+      if (name[0] == c && name.size() > best && static_cast<int>(name.size()) <= e - i && s.compare(i, name.size(), name) == 0) best = name.size();
     if (best) {
-      m.name = s.substr(i, best);
+      m.name.assign(s, i, best);
       i += static_cast<int>(best);
     } else if (c == '~' && i + 1 < e && std::isalpha(static_cast<unsigned char>(s[i + 1]))) {
-      m.name = s.substr(i, 2);
+      m.name.assign(s, i, 2);
       i += 2;
     } else {
-      m.name = std::string(1, c);
+      m.name.assign(1, c);
       ++i;
     }
     int j = i;
@@ -145,7 +151,7 @@ bool Scanner::tokenizeModules(int line, int b, int e, std::vector<RawModule>& ou
           }
       i = k + 1;
     }
-    out.push_back(std::move(m));
+    each(m);
   }
   return ok;
 }

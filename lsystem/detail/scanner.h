@@ -5,6 +5,7 @@
 /// Private to lsystem/; used by the expression parser and the grammar parser.
 
 #include <cctype>
+#include <functional>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -94,6 +95,9 @@ class Scanner {
   /// false on an error that stops the line (a stray `(`, `)` or `,`, a missing `)`) or
   /// after reporting empty parameters.
   bool tokenizeModules(int line, int b, int e, std::vector<RawModule>& out);
+  /// As above, handing each module to each instead of storing it (one RawModule is
+  /// reused: no allocation per module). Used for the axiom, which may hold millions.
+  bool tokenizeModules(int line, int b, int e, const std::function<void(const RawModule&)>& each);
   /// The module m of line `line` as written (its name and parameter list).
   std::string moduleText(int line, const RawModule& m) const;
 

@@ -6,7 +6,9 @@
 #   - nothing was written: the case's output folder $OUT is empty afterwards and no
 #     temporary (.sprig-tmp-*) file is left beside the inputs.
 # A case is a block of lines `name:`, `args:` (split on spaces; $OUT is a fresh empty
-# folder), `exit:` and one or more `expect:` lines; blocks are separated by blank lines.
+# folder), `exit:`, one or more `expect:` lines and optionally `maxlines: N` (stderr holds
+# at most N lines and N*200 bytes: a long line or a binary file is never echoed whole);
+# blocks are separated by blank lines.
 set -u
 SPRIG=${1:?usage: run.sh PATH/TO/sprig}
 HERE=$(cd "$(dirname "$0")" && pwd)
@@ -16,7 +18,7 @@ trap 'rm -rf "$WORK"' EXIT
 
 pass=0
 fail=0
-name="" args="" code="" expects=()
+name="" args="" code="" expects=() maxlines=""
 
 run_case() {
   [ -z "$name" ] && return
@@ -33,6 +35,13 @@ run_case() {
     e=${e//\$OUT/$out}
     if ! grep -qxF -- "$e" "$stderr_file"; then ok=0; why="$why${why:+; }missing line: $e"; fi
   done
+  if [ -n "$maxlines" ]; then
+    local lines bytes
+    lines=$(wc -l <"$stderr_file") bytes=$(wc -c <"$stderr_file")
+    if [ "$lines" -gt "$maxlines" ] || [ "$bytes" -gt $((maxlines * 200)) ]; then
+      ok=0; why="$why${why:+; }stderr has $lines lines, $bytes bytes (at most $maxlines lines)"
+    fi
+  fi
   if [ -n "$(find "$out" -mindepth 1 -print -quit)" ]; then
     ok=0; why="$why${why:+; }left files: $(find "$out" -mindepth 1 | tr '\n' ' ')"
   fi
@@ -47,7 +56,7 @@ run_case() {
     echo "  command: sprig --quiet $expanded"
     sed 's/^/  stderr: /' "$stderr_file"
   fi
-  name="" args="" code="" expects=()
+  name="" args="" code="" expects=() maxlines=""
 }
 
 while IFS= read -r line || [ -n "$line" ]; do
@@ -58,6 +67,7 @@ while IFS= read -r line || [ -n "$line" ]; do
     args:\ *) args=${line#args: } ;;
     exit:\ *) code=${line#exit: } ;;
     expect:\ *) expects+=("${line#expect: }") ;;
+    maxlines:\ *) maxlines=${line#maxlines: } ;;
     *) echo "cases.txt: cannot read line: $line"; exit 2 ;;
   esac
 done <"$CASES"

@@ -6,6 +6,7 @@
 
 #include "core/atomic_file.h"
 #include "core/diagnostics.h"
+#include "core/text.h"
 #include "core/mesh.h"
 #include "core/parallel.h"
 #include "core/rng.h"
@@ -169,4 +170,35 @@ TEST_CASE("analyzeTopology", "[core]") {
   m.triangles.push_back({1, 3, 2});  // flipped
   t = analyzeTopology(m);
   CHECK(t.inconsistentEdges == 3);
+}
+
+TEST_CASE("Diagnostic::format shows a window of a long line around the caret", "[core]") {
+  std::string line(400000, 'x');
+  Diagnostic d{Severity::Error, SourceLoc{"g.lsys", 2, 200000}, "too deep", line};
+  std::string out = d.format();
+  CHECK(out.size() < 2 * kDiagnosticWindow + 100);
+  CHECK(out.find("\n  ...xxx") != std::string::npos);
+  CHECK(out.find("xxx...\n") != std::string::npos);
+  // Stored cut: a list of errors on a long line does not copy the line each time.
+  DiagnosticList list;
+  list.error(SourceLoc{"g.lsys", 2, 200000}, "too deep", line);
+  CHECK(list.items()[0].sourceLine.size() <= 4 * kDiagnosticWindow);
+  CHECK(list.items()[0].format() == out);
+  Diagnostic shortLine{Severity::Error, SourceLoc{"g.lsys", 1, 3}, "m", "abcdef"};
+  CHECK(shortLine.format() == "g.lsys:1:3: error: m\n  abcdef\n    ^");
+}
+
+TEST_CASE("findNonText", "[core]") {
+  CHECK(!findNonText("plain\ttext\r\n caf\xc3\xa9 \xe2\x82\xac \xf0\x9f\x8c\xb1"));
+  auto nul = findNonText(std::string("ab\ncd\0", 6));
+  REQUIRE(nul);
+  CHECK(nul->offset == 5);
+  CHECK(nul->line == 2);
+  CHECK(nul->col == 3);
+  CHECK(nul->what == "byte 0x00 (NUL)");
+  CHECK(findNonText("a\xff")->offset == 1);
+  CHECK(findNonText("\xc0\xaf"));       // overlong
+  CHECK(findNonText("\xed\xa0\x80"));   // surrogate
+  CHECK(findNonText("\xe2\x82"));        // truncated
+  CHECK(findNonText("\x1b[31m"));         // escape sequence
 }

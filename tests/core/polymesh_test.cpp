@@ -211,7 +211,7 @@ f -4 -2 -1   # a comment after a face
     text += '\0';
     text += "\x01\x02garbage\n";
     Strings errors = errorsOf(text, MeshFileFormat::Obj);
-    CHECK(errors == Strings{"m:2:5: error: byte 0x00 (NUL) is not text: an OBJ file must be text (is this a binary file?)"});
+    CHECK(errors == Strings{"m:2:5: error: byte 0x00 (NUL) at byte offset 12 is not text: an OBJ file must be UTF-8 text (is this a binary file?)"});
     try {
       parsePolyMesh(text, MeshFileFormat::Obj, "m");
     } catch (const InputError& e) {

@@ -165,7 +165,7 @@ B(x) : x>=1 -> B(x-1)
 TEST_CASE("Deriver::derive first match wins, unmatched modules are copied", "[lsystem]") {
   CHECK(deriveText("axiom: A(1)B\nA(x) : x>0 --> X\nA(x) --> Y\n", 1) == "XB");
   CHECK(deriveText("axiom: A(0)B\nA(x) : x>0 --> X\nA(x) --> Y\n", 1) == "YB");
-  CHECK(deriveText("axiom: A(1,2)A(3)\nA(x) --> X\n", 1) == "A(1,2)X");  // parameter count differs: no match
+  CHECK(deriveText("axiom: A(1,2)A(3)\nA(x) --> X\nA(x,y) : x > 5 --> Y\n", 1) == "A(1,2)X");  // parameter count differs: no match
   CHECK(deriveText("axiom: AB\nA --> *\n", 1) == "B");               // `*` successor: erase
   CHECK(deriveText("axiom: A(3)\nA(x) : * --> A(x+1)\n", 4) == "A(7)");
 }

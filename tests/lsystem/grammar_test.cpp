@@ -228,6 +228,29 @@ TEST_CASE("parseGrammar parameter counts that never match", "[lsystem]") {
   }
 }
 
+TEST_CASE("parseGrammar a user module written with a count no production takes", "[lsystem]") {
+  CHECK(errorsOf("axiom: A(1,2)\nA(x) --> A(x+1)\n") ==
+        "g.lsys:1:8: error: module 'A' is written here with 2 parameters, but its production 'A(x)' (line 2:1) takes 1 "
+        "parameter: a production matches a module only with its own parameter count, so this module is never rewritten");
+  // Turtle commands take optional parameters: F and F(2) together are fine.
+  CHECK(errorsOf("axiom: A\nA --> F F(2) +(30) + A\nF --> F F\n").empty());
+}
+
+TEST_CASE("parseGrammar stochastic productions whose weights are all zero", "[lsystem]") {
+  CHECK(errorsOf("axiom: A\nA --> F : 0\nA --> G : 0\n") ==
+        "g.lsys:2:1: error: every stochastic production of 'A' has weight 0 (lines 2, 3): at least one weight must be positive");
+  CHECK(errorsOf("axiom: A\nA --> F : 0\nA --> G : 0.5\n").empty());
+}
+
+TEST_CASE("parseGrammar text that is not UTF-8 is one error naming the byte", "[lsystem]") {
+  std::string text = "axiom: F\nF --> F";
+  text += '\0';
+  text += "\xff\x01 F\n";
+  CHECK(errorsOf(text) == "g.lsys:2:8: error: byte 0x00 (NUL) at byte offset 16 is not text: a grammar file must be UTF-8 "
+                          "text (is this a binary file?)");
+  CHECK(errorsOf("axiom: F\nF --> F // caf\xc3\xa9\n").empty());  // UTF-8 in a comment is text
+}
+
 TEST_CASE("parseGrammar deep nesting is an error, not a crash", "[lsystem]") {
   std::string text = "axiom: F\nA(x) --> B(" + std::string(50, '(') + "x" + std::string(50, ')') + ")\n";
   CHECK(errorsOf(text) == "g.lsys:2:60: error: expression is nested too deeply (more than 48 levels)");

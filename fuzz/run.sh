@@ -1,0 +1,94 @@
+#!/usr/bin/env bash
+# Runs every fuzz target of fuzz/ for SECONDS each (make fuzz FUZZ_SECONDS=N):
+#   fuzz/run.sh BUILD_DIR SECONDS [TARGET...]
+# Corpora live in BUILD_DIR/fuzz-corpus/<target>/, seeded on first use from the shipped
+# grammars/, species/, base meshes and textures; the inputs in fuzz/regressions/<target>/
+# are read too. Any crash, leak, timeout or out-of-memory input libFuzzer finds is copied
+# into fuzz/regressions/<target>/ (which ctest replays, fuzz_regressions_<target>) and the
+# script fails. One summary line per target: executions, exec/s, coverage (cov, ft), corpus.
+# Run from the repository root.
+set -u
+BUILD=${1:?usage: fuzz/run.sh BUILD_DIR SECONDS [TARGET...]}
+SECS=${2:?usage: fuzz/run.sh BUILD_DIR SECONDS [TARGET...]}
+shift 2
+TARGETS=("$@")
+[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(grammar expression derive species_tree species_shell species_blob species_organism polymesh image)
+ROOT=$(pwd)
+status=0
+
+# seed TARGET FOLDER: the first corpus of a target from the repository's own files.
+seed() {
+  local t=$1 dir=$2 f i=0
+  case $t in
+    grammar | derive)
+      cp grammars/*.lsys "$dir"/ ;;
+    expression)
+      for e in 't' 'x*0.9' 'sin(t)*x' 'max(0, 1 - t^2)' 'sqrt(x) + pow(t, 2) / 3' 'atan2(x, t) > 45 && t < 1' \
+               'floor(x) == ceil(x) || !t' '-(-(-x))' 'min(t, max(x, 1e-3))' 'exp(log(t + 1))'; do
+        printf '%s' "$e" >"$dir/e$((i++))"
+      done ;;
+    species_*)
+      local kind=${t#species_}
+      for f in species/*.yaml tests/gallery/species/*.yaml; do
+        [ -f "$f" ] || continue
+        grep -qx "kind: $kind" "$f" || continue
+        grep -vx "kind: $kind" "$f" >"$dir/$(basename "$f")"
+      done ;;
+    polymesh)
+      for f in species/meshes/*.off tests/bad_inputs/inputs/*.obj; do
+        [ -f "$f" ] && [ "$(stat -c %s "$f")" -le 65536 ] || continue
+        case $f in *.obj) p='\x00' ;; *.ply) p='\x01' ;; *) p='\x02' ;; esac
+        { printf "$p"; cat "$f"; } >"$dir/$(basename "$f")"
+      done
+      printf '\x01ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' >"$dir/tri.ply"
+      printf '\x00v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 3 4\nf 1 4 2\nf 2 4 3\n' >"$dir/tet.obj" ;;
+    image)
+      for f in textures/maps/*.png; do
+        [ "$(stat -c %s "$f")" -le 65536 ] || continue
+        { printf '\x00'; cat "$f"; } >"$dir/$(basename "$f")"
+      done
+      printf '\x05P3\n2 2\n255\n255 0 0 0 255 0 0 0 255 255 255 255\n' >"$dir/tiny.ppm" ;;
+  esac
+}
+
+dict_of() {
+  case $1 in
+    grammar | derive) echo fuzz/dict/grammar.dict ;;
+    expression) echo fuzz/dict/expression.dict ;;
+    species_*) echo fuzz/dict/yaml.dict ;;
+    polymesh) echo fuzz/dict/mesh.dict ;;
+    *) echo "" ;;
+  esac
+}
+
+for t in "${TARGETS[@]}"; do
+  exe="$BUILD/fuzz/fuzz_$t"
+  [ -x "$exe" ] || { echo "fuzz: $exe is not built"; status=1; continue; }
+  corpus="$BUILD/fuzz-corpus/$t"
+  art="$BUILD/fuzz-artifacts/$t"
+  mkdir -p "$corpus" "$art" "fuzz/regressions/$t"
+  [ -n "$(ls -A "$corpus")" ] || seed "$t" "$corpus"
+  dict=$(dict_of "$t")
+  log="$BUILD/fuzz-$t.log"
+  # One process, SECS of wall time; memory capped so an input that allocates without bound
+  # is reported as oom-* rather than taking the machine.
+  "$exe" -max_total_time="$SECS" -rss_limit_mb=2048 -malloc_limit_mb=1024 -timeout=10 -print_final_stats=1 \
+    -artifact_prefix="$art/" ${dict:+-dict=$dict} "$corpus" "fuzz/regressions/$t" >"$log" 2>&1
+  rc=$?
+  last=$(grep -E '^#[0-9]+' "$log" | tail -1)
+  execs=$(grep -oE 'stat::number_of_executed_units: *[0-9]+' "$log" | tail -1 | grep -oE '[0-9]+$')
+  rate=$(grep -oE 'stat::average_exec_per_sec: *[0-9]+' "$log" | tail -1 | grep -oE '[0-9]+$')
+  cov=$(echo "$last" | grep -oE 'cov: [0-9]+' | grep -oE '[0-9]+')
+  ft=$(echo "$last" | grep -oE 'ft: [0-9]+' | grep -oE '[0-9]+')
+  found=$(find "$art" -maxdepth 1 -type f \( -name 'crash-*' -o -name 'leak-*' -o -name 'timeout-*' -o -name 'oom-*' \) | wc -l)
+  printf 'fuzz %-17s %4ss  execs %-9s exec/s %-6s cov %-6s ft %-6s corpus %-5s found %s\n' \
+    "$t" "$SECS" "${execs:-?}" "${rate:-?}" "${cov:-?}" "${ft:-?}" "$(ls "$corpus" | wc -l)" "$found"
+  if [ "$found" -gt 0 ] || [ $rc -ne 0 ]; then
+    status=1
+    cp "$art"/crash-* "$art"/leak-* "$art"/timeout-* "$art"/oom-* "fuzz/regressions/$t/" 2>/dev/null
+    echo "  fuzz_$t failed (exit $rc): inputs copied to fuzz/regressions/$t/; log $log"
+    grep -m3 -E 'ERROR|SUMMARY|runtime error' "$log" | sed 's/^/  /'
+  fi
+done
+cd "$ROOT"
+exit $status
