@@ -12,7 +12,7 @@ BUILD=${1:?usage: fuzz/run.sh BUILD_DIR SECONDS [TARGET...]}
 SECS=${2:?usage: fuzz/run.sh BUILD_DIR SECONDS [TARGET...]}
 shift 2
 TARGETS=("$@")
-[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(grammar expression derive species_tree species_shell species_blob species_organism polymesh image)
+[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(grammar expression derive species_tree species_shell species_blob species_organism polymesh image volume)
 ROOT=$(pwd)
 status=0
 
@@ -48,6 +48,12 @@ seed() {
         { printf '\x00'; cat "$f"; } >"$dir/$(basename "$f")"
       done
       printf '\x05P3\n2 2\n255\n255 0 0 0 255 0 0 0 255 255 255 255\n' >"$dir/tiny.ppm" ;;
+    volume)
+      # A 4^3 float volume with one dense voxel, and an 8-bit big-endian one; header padded to 256.
+      inr() { local h="#INRIMAGE-4#{"$'\n'"$1"; while [ $(( (${#h} + 4) % 256 )) -ne 0 ]; do h+=$'\n'; done; printf '%s##}\n' "$h"; }
+      { inr $'XDIM=4\nYDIM=4\nZDIM=4\nTYPE=float\nPIXSIZE=32 bits\nCPU=decm\n'; head -c 84 /dev/zero; printf '\x00\x00\x80\x3f'; head -c 168 /dev/zero; } >"$dir/one.inr"
+      { inr $'XDIM=3\nYDIM=3\nZDIM=3\nTYPE=unsigned fixed\nPIXSIZE=8 bits\nCPU=sun\nVX=0.5\n'; printf '\x00%.0s' $(seq 13); printf '\xff'; printf '\x00%.0s' $(seq 13); } >"$dir/byte.inr"
+      cp tests/bad_inputs/inputs/damaged.inr "$dir/" ;;
   esac
 }
 
