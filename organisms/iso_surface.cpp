@@ -22,7 +22,9 @@ PolyMesh isoSurface(const ScalarVolume& volume, double iso) {
   m.preScale(openvdb::Vec3d(volume.voxel[0], volume.voxel[1], volume.voxel[2]));
   m.postTranslate(openvdb::Vec3d(volume.origin[0], volume.origin[1], volume.origin[2]));
   grid->setTransform(openvdb::math::Transform::createLinearTransform(m));
-  auto acc = grid->getAccessor();
+  // An accessor the tree does not register (IsSafe = false): the grid is filled here and
+  // nobody else holds it, so registration would only cost.
+  openvdb::tree::ValueAccessor<openvdb::FloatTree, false> acc(grid->tree());
   for (int k = 0; k < volume.dims[2]; ++k)
     for (int j = 0; j < volume.dims[1]; ++j)
       for (int i = 0; i < volume.dims[0]; ++i) acc.setValue(openvdb::Coord(i, j, k), float(iso - volume.at(i, j, k)));
