@@ -11,7 +11,7 @@ ASAN_BUILD   ?= build-asan
 FUZZ_SECONDS ?= 60
 CCACHE := $(if $(shell command -v ccache),-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
 # -O1 -g1: sanitizer reports with line numbers, at about half the compile time of -O2 -g.
-ASAN_CONFIG := CC=clang CXX=clang++ cmake -S . -B $(ASAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release \
+ASAN_CONFIG := CC=clang-14 CXX=clang++-14 cmake -S . -B $(ASAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_CXX_FLAGS_RELEASE="-O1 -g1" -DSPRIG_SANITIZE=ON -DSPRIG_FUZZ=ON $(CCACHE)
 export ASAN_OPTIONS  ?= detect_leaks=1:abort_on_error=1:detect_stack_use_after_return=0
 export UBSAN_OPTIONS ?= print_stacktrace=1:halt_on_error=1
