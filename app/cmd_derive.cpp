@@ -23,12 +23,14 @@ struct DeriveArgs {
   std::string skeletonOut;
 };
 
-/// What `sprig derive` reports: the final string and its skeleton.
+/// What `sprig derive` reports: the final string, its skeleton's summary and (for
+/// --skeleton only: 112 bytes per internode) the skeleton itself.
 struct Derived {
   int steps = 0;
   uint64_t seed = 0;
   const lsystem::ModuleString& modules;
   const lsystem::SymbolTable& symbols;
+  lsystem::SkeletonSummary summary;
   lsystem::Skeleton skeleton;
   lsystem::TurtleState end;
 };
@@ -45,10 +47,10 @@ std::string reportJson(const Derived& t) {
     o << (first ? "" : ", ") << json::string(t.symbols.name(static_cast<lsystem::SymbolId>(s))) << ": " << counts[s];
     first = false;
   }
-  DBox3 b = t.skeleton.bounds();
+  DBox3 b = t.summary.bounds;
   if (b.empty()) b = DBox3{DVec3(0), DVec3(0)};
-  o << "}, \"internodes\": " << t.skeleton.internodes.size()
-    << ", \"total_length\": " << json::number(t.skeleton.totalLength()) << ", \"bounds\": {\"min\": " << json::vec3(b.lo)
+  o << "}, \"internodes\": " << t.summary.internodes
+    << ", \"total_length\": " << json::number(t.summary.totalLength) << ", \"bounds\": {\"min\": " << json::vec3(b.lo)
     << ", \"max\": " << json::vec3(b.hi) << "}, \"end\": " << json::vec3(t.end.frame.position) << "}";
   return o.str();
 }
@@ -93,13 +95,18 @@ int runDerive(const DeriveArgs& a, const GlobalOptions& g) {
   GrowthEngine engine(species, GrowthOptions{extra, -1, "derive " + species.name});
   const int last = engine.lastStep();
   const lsystem::ModuleString& modules = engine.modulesAt(last);
-  Derived t{last, engine.seed(), modules, engine.symbols(), {}, {}};
-  t.skeleton = engine.skeletonAt(last, &t.end);
+  Derived t{last, engine.seed(), modules, engine.symbols(), {}, {}, {}};
+  if (a.skeletonOut.empty()) {
+    t.summary = engine.summaryAt(last, &t.end);
+  } else {
+    t.skeleton = engine.skeletonAt(last, &t.end);
+    t.summary = {t.skeleton.internodes.size(), t.skeleton.totalLength(), t.skeleton.bounds(), {}};
+  }
   if (a.print) std::cout << lsystem::formatModuleString(t.modules, t.symbols) << "\n";
   if (a.json) std::cout << reportJson(t) << "\n";
   if (!a.print && !a.json)
     std::cout << species.name << ": " << t.steps << " steps, " << t.modules.size() << " modules, "
-              << t.skeleton.internodes.size() << " internodes, total length " << json::number(t.skeleton.totalLength())
+              << t.summary.internodes << " internodes, total length " << json::number(t.summary.totalLength)
               << "\n";
   if (!a.skeletonOut.empty()) writeFileAtomic(a.skeletonOut, skeletonJson(t));
   return kExitOk;

@@ -6,6 +6,7 @@
 # are read too. Any crash, leak, timeout or out-of-memory input libFuzzer finds is copied
 # into fuzz/regressions/<target>/ (which ctest replays, fuzz_regressions_<target>) and the
 # script fails. One summary line per target: executions, exec/s, coverage (cov, ft), corpus.
+# FUZZ_JOBS (default: the number of cores) targets run at once.
 # Run from the repository root.
 set -u
 BUILD=${1:?usage: fuzz/run.sh BUILD_DIR SECONDS [TARGET...]}
@@ -67,15 +68,16 @@ dict_of() {
   esac
 }
 
-for t in "${TARGETS[@]}"; do
-  exe="$BUILD/fuzz/fuzz_$t"
-  [ -x "$exe" ] || { echo "fuzz: $exe is not built"; status=1; continue; }
-  corpus="$BUILD/fuzz-corpus/$t"
-  art="$BUILD/fuzz-artifacts/$t"
+# run_one TARGET: one libFuzzer run; its summary line (and, on failure, the report) goes to
+# BUILD/fuzz-TARGET.summary, and the file BUILD/fuzz-TARGET.failed marks a failure.
+run_one() {
+  local t=$1 exe="$BUILD/fuzz/fuzz_$1" corpus="$BUILD/fuzz-corpus/$1" art="$BUILD/fuzz-artifacts/$1"
+  local sum="$BUILD/fuzz-$1.summary" log="$BUILD/fuzz-$1.log" dict rc last execs rate cov ft found
+  rm -f "$BUILD/fuzz-$t.failed"
+  [ -x "$exe" ] || { echo "fuzz: $exe is not built" >"$sum"; touch "$BUILD/fuzz-$t.failed"; return; }
   mkdir -p "$corpus" "$art" "fuzz/regressions/$t"
   [ -n "$(ls -A "$corpus")" ] || seed "$t" "$corpus"
   dict=$(dict_of "$t")
-  log="$BUILD/fuzz-$t.log"
   # One process, SECS of wall time; memory capped so an input that allocates without bound
   # is reported as oom-* rather than taking the machine.
   "$exe" -max_total_time="$SECS" -rss_limit_mb=2048 -malloc_limit_mb=1024 -timeout=10 -print_final_stats=1 \
@@ -88,13 +90,28 @@ for t in "${TARGETS[@]}"; do
   ft=$(echo "$last" | grep -oE 'ft: [0-9]+' | grep -oE '[0-9]+')
   found=$(find "$art" -maxdepth 1 -type f \( -name 'crash-*' -o -name 'leak-*' -o -name 'timeout-*' -o -name 'oom-*' \) | wc -l)
   printf 'fuzz %-17s %4ss  execs %-9s exec/s %-6s cov %-6s ft %-6s corpus %-5s found %s\n' \
-    "$t" "$SECS" "${execs:-?}" "${rate:-?}" "${cov:-?}" "${ft:-?}" "$(ls "$corpus" | wc -l)" "$found"
+    "$t" "$SECS" "${execs:-?}" "${rate:-?}" "${cov:-?}" "${ft:-?}" "$(ls "$corpus" | wc -l)" "$found" >"$sum"
   if [ "$found" -gt 0 ] || [ $rc -ne 0 ]; then
-    status=1
+    touch "$BUILD/fuzz-$t.failed"
     cp "$art"/crash-* "$art"/leak-* "$art"/timeout-* "$art"/oom-* "fuzz/regressions/$t/" 2>/dev/null
-    echo "  fuzz_$t failed (exit $rc): inputs copied to fuzz/regressions/$t/; log $log"
-    grep -m3 -E 'ERROR|SUMMARY|runtime error' "$log" | sed 's/^/  /'
+    { echo "  fuzz_$t failed (exit $rc): inputs copied to fuzz/regressions/$t/; log $log"
+      grep -m3 -E 'ERROR|SUMMARY|runtime error' "$log" | sed 's/^/  /'; } >>"$sum"
   fi
+}
+
+# FUZZ_JOBS targets at a time (default: one per core), each a single-core libFuzzer process
+# for SECS of wall time; summaries are printed in the targets' order.
+JOBS=${FUZZ_JOBS:-$(nproc)}
+running=0
+for t in "${TARGETS[@]}"; do
+  if [ "$running" -ge "$JOBS" ]; then wait -n; running=$((running - 1)); fi
+  run_one "$t" &
+  running=$((running + 1))
+done
+wait
+for t in "${TARGETS[@]}"; do
+  cat "$BUILD/fuzz-$t.summary"
+  [ -e "$BUILD/fuzz-$t.failed" ] && status=1
 done
 cd "$ROOT"
 exit $status

@@ -57,4 +57,12 @@ struct Skeleton {
   std::vector<std::vector<int32_t>> children() const;
 };
 
+/// A skeleton's internodes reduced to what a report needs (Turtle::summarize), and its organs.
+struct SkeletonSummary {
+  size_t internodes = 0;
+  double totalLength = 0;  ///< as Skeleton::totalLength
+  DBox3 bounds;            ///< as Skeleton::bounds: internodes with radii, and organs
+  std::vector<Organ> organs;
+};
+
 }  // namespace sprig::lsystem

@@ -168,14 +168,23 @@ struct WalkBuffers {
  *
  * Handlers change st_.frame in place: copying the frame out to a local and back (around
  * `$`, say) made ABOP 2.6 a third slower in bench_turtle.
+ *
+ * kSummary: the same walk, but internodes are folded into a SkeletonSummary (count, length,
+ * bounds) instead of stored (Turtle::summarize). The one later change to a stored internode,
+ * taper setting a parent's tip radius to its continuation's base radius, is applied to the
+ * bounds when the continuation is drawn: the parent's start, base radius and order travel
+ * with the state (last_, saved beside the state stack). Skeleton::bounds uses
+ * max(base, tip) at both ends, and the parent's end is the continuation's start.
  */
+template <bool kSummary>
 class TurtleWalk {
  public:
   using Command = Turtle::Command;
 
   TurtleWalk(const SymbolTable& symbols, const TurtleSettings& settings, const std::vector<Command>& commands,
-             const ModuleString& ms, Skeleton& sk, std::span<const int32_t> moduleSteps)
-      : symbols_(symbols), settings_(settings), sk_(sk), n_(ms.size()), sym_(ms.symbols.data()),
+             const ModuleString& ms, Skeleton& sk, std::span<const int32_t> moduleSteps,
+             SkeletonSummary* summary = nullptr)
+      : symbols_(symbols), settings_(settings), sk_(sk), sum_(summary), n_(ms.size()), sym_(ms.symbols.data()),
         off_(ms.offsets.data()), prm_(ms.params.data()), cmd_(commands.data()), ncmd_(commands.size()),
         steps_(moduleSteps), haveSteps_(moduleSteps.size() >= n_),
         radiusScale_(0.5 * settings.widthScale),
@@ -306,12 +315,36 @@ class TurtleWalk {
     in.up = st_.frame.up;
     // Taper: the continuation of an axis (the child drawn at the parent's own order; a
     // parent has at most one, since `[` raises the order) ends the parent's radius.
-    if (taper_ && in.parent >= 0 && sk_.internodes[in.parent].order == in.order)
-      sk_.internodes[in.parent].tipRadius = in.baseRadius;
-    st_.internode = static_cast<int32_t>(sk_.internodes.size());
-    sk_.internodes.push_back(in);
+    if constexpr (kSummary) {
+      summarize(in);
+    } else {
+      if (taper_ && in.parent >= 0 && sk_.internodes[in.parent].order == in.order)
+        sk_.internodes[in.parent].tipRadius = in.baseRadius;
+      st_.internode = static_cast<int32_t>(sk_.internodes.size());
+      sk_.internodes.push_back(in);
+    }
     // A growing internode bends in proportion to its growth, so frames change smoothly.
     if (st_.elasticity != 0) applyTropism(st_.frame, tropism_, st_.elasticity * g);
+  }
+
+  /// kSummary: folds the internode just computed into the summary, as Skeleton::bounds and
+  /// totalLength would see it after the walk (see the class comment).
+  void summarize(const Internode& in) {
+    SkeletonSummary& s = *sum_;
+    const double r = std::max(in.baseRadius, in.tipRadius);
+    s.bounds.extend(in.start - r);
+    s.bounds.extend(in.start + r);
+    s.bounds.extend(in.end - r);
+    s.bounds.extend(in.end + r);
+    if (taper_ && in.parent >= 0 && last_.order == in.order && in.baseRadius > last_.radius) {
+      s.bounds.extend(last_.start - in.baseRadius);
+      s.bounds.extend(last_.start + in.baseRadius);
+      s.bounds.extend(in.start - in.baseRadius);
+      s.bounds.extend(in.start + in.baseRadius);
+    }
+    s.totalLength += in.length();
+    st_.internode = static_cast<int32_t>(s.internodes++);
+    last_ = {in.start, r, in.order};
   }
 
   /// `f` and `g`: moves without drawing (`f` adds a polygon point when withVertex).
@@ -343,6 +376,7 @@ class TurtleWalk {
   /// `[`: saves the state; the branch is one order higher.
   void push() {
     buf_.stack.push_back(st_);
+    if constexpr (kSummary) lastStack_.push_back(last_);
     ++st_.order;
   }
 
@@ -351,6 +385,10 @@ class TurtleWalk {
     if (!buf_.stack.empty()) {
       st_ = buf_.stack.back();
       buf_.stack.pop_back();
+      if constexpr (kSummary) {
+        last_ = lastStack_.back();
+        lastStack_.pop_back();
+      }
     }
   }
 
@@ -436,7 +474,8 @@ class TurtleWalk {
   /// `%`: the branch ends here: marks its last internode as cut and skips to the matching
   /// `]`. Returns the index before that `]` (or the last index), for the loop's ++i.
   size_t cut(size_t i) {
-    if (st_.internode >= 0) sk_.internodes[st_.internode].cut = true;
+    if constexpr (!kSummary)
+      if (st_.internode >= 0) sk_.internodes[st_.internode].cut = true;
     int depth = 0;
     size_t j = i + 1;
     for (; j < n_; ++j) {
@@ -451,9 +490,19 @@ class TurtleWalk {
     return j - 1;
   }
 
+  /// kSummary: what the current state's last internode contributes to a continuation.
+  struct LastDrawn {
+    DVec3 start{0};
+    double radius = 0;  ///< max(base, tip) as drawn
+    int order = 0;
+  };
+
   const SymbolTable& symbols_;
   const TurtleSettings& settings_;
   Skeleton& sk_;
+  SkeletonSummary* sum_;
+  LastDrawn last_;
+  std::vector<LastDrawn> lastStack_;
   WalkBuffers buf_;
   const size_t n_;
   const SymbolId* sym_;
@@ -486,10 +535,33 @@ void Turtle::run(const ModuleString& ms, Skeleton& sk, std::span<const int32_t> 
   sk.internodes.clear();
   sk.organs.clear();
   if (moduleSteps.empty() && ms.hasBirthSteps()) moduleSteps = ms.birthSteps;
-  TurtleWalk walk(symbols_, settings_, commands_, ms, sk, moduleSteps);
+  TurtleWalk<false> walk(symbols_, settings_, commands_, ms, sk, moduleSteps);
   walk.reserveInternodes();
   end_ = walk.walk();
   if (settings_.radii == RadiusModel::Pipe) walk.pipeRadii();
+}
+
+SkeletonSummary Turtle::summarize(const ModuleString& ms, std::span<const int32_t> moduleSteps) {
+  if (moduleSteps.empty() && ms.hasBirthSteps()) moduleSteps = ms.birthSteps;
+  Skeleton sk;
+  SkeletonSummary sum;
+  if (settings_.radii == RadiusModel::Pipe || settings_.growthStep >= 0) {
+    // Pipe radii are set after the whole walk, growth radii per internode: draw it all.
+    run(ms, sk, moduleSteps);
+    sum.internodes = sk.internodes.size();
+    sum.totalLength = sk.totalLength();
+    sum.bounds = sk.bounds();
+  } else {
+    TurtleWalk<true> walk(symbols_, settings_, commands_, ms, sk, moduleSteps, &sum);
+    end_ = walk.walk();
+    const DBox3 organs = sk.bounds();  // sk holds the organs only
+    if (!organs.empty()) {
+      sum.bounds.extend(organs.lo);
+      sum.bounds.extend(organs.hi);
+    }
+  }
+  sum.organs = std::move(sk.organs);
+  return sum;
 }
 
 Skeleton interpret(const ModuleString& modules, const SymbolTable& symbols, const TurtleSettings& settings,

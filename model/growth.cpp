@@ -127,6 +127,16 @@ lsystem::Skeleton GrowthEngine::skeletonAt(int step, lsystem::TurtleState* end) 
   return draw(interpretedAt(step), turtle_, end);
 }
 
+lsystem::SkeletonSummary GrowthEngine::summaryAt(int step, lsystem::TurtleState* end) {
+  if (step < 0 || step > lastStep_)
+    throw std::invalid_argument("step " + std::to_string(step) + " is outside 0.." + std::to_string(lastStep_));
+  const lsystem::ModuleString& interpreted = interpretedAt(step);
+  lsystem::Turtle turtle(deriver_->symbols(), turtle_);
+  lsystem::SkeletonSummary sum = turtle.summarize(interpreted, interpreted.birthSteps);
+  if (end) *end = turtle.endState();
+  return sum;
+}
+
 lsystem::Skeleton GrowthEngine::skeletonAt(int step, double fraction) {
   lsystem::TurtleSettings ts = turtle_;
   ts.growthStep = step;

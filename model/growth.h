@@ -67,6 +67,9 @@ class GrowthEngine {
   /// The string after `step` steps drawn as it is; end, when given, receives the turtle's
   /// state after the last module.
   lsystem::Skeleton skeletonAt(int step, lsystem::TurtleState* end = nullptr);
+  /// skeletonAt(step)'s internode count, total length and bounds, and its organs, without
+  /// storing its internodes (Turtle::summarize).
+  lsystem::SkeletonSummary summaryAt(int step, lsystem::TurtleState* end = nullptr);
   /// The growth frame (step, fraction): modules created in step drawn grown by fraction.
   lsystem::Skeleton skeletonAt(int step, double fraction);
 

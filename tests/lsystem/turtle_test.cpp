@@ -500,3 +500,50 @@ TEST_CASE("Turtle::random strings keep the invariants", "[lsystem]") {
     REQUIRE(glm::length(glm::cross(f.heading, f.left) - f.up) < 1e-9);
   }
 }
+
+TEST_CASE("Turtle::summarize equals the drawn skeleton's count, length and bounds", "[lsystem]") {
+  // Random strings with width changes (so taper raises a parent's tip radius, or does not),
+  // polygons, spheres and cuts; summarize must give the exact numbers of run().
+  const uint64_t seed = 20261202;
+  Rng rng(seed);
+  const char* alphabet[] = {"F", "F(0.5)", "f", "G", "+", "-(33)", "&", "^(12)", "/(77)", "!(0.3)", "!(2.5)", "!",
+                            "@Ts(0.2)", "@O(0.7)", "{", ".", "}", "%", "[", "]"};
+  const size_t letters = sizeof(alphabet) / sizeof(alphabet[0]);
+  size_t raised = 0;  // continuations wider than their parent: the deferred case
+  for (int trial = 0; trial < 300; ++trial) {
+    std::string text;
+    int depth = 0;
+    for (int i = 0; i < 200; ++i) {
+      std::string cmd = alphabet[rng.below(letters)];
+      if (cmd == "]" && depth == 0) continue;
+      depth += cmd == "[" ? 1 : cmd == "]" ? -1 : 0;
+      text += cmd;
+    }
+    text.append(static_cast<size_t>(depth), ']');
+    TurtleSettings s;
+    s.angleDeg = 25;
+    s.elasticity = 0.05;
+    s.taper = trial % 3 != 0;
+    SymbolTable table;
+    ModuleString ms = modules(table, text);
+    Turtle turtle(table, s);
+    const Skeleton sk = turtle.run(ms);
+    const TurtleState end = turtle.endState();
+    const SkeletonSummary sum = turtle.summarize(ms);
+    INFO("seed " << seed << " trial " << trial << ": " << text);
+    REQUIRE(sum.internodes == sk.internodes.size());
+    REQUIRE(sum.totalLength == sk.totalLength());  // same sum in the same order: exact
+    const DBox3 b = sk.bounds();
+    REQUIRE(sum.bounds.empty() == b.empty());
+    if (!b.empty()) {
+      REQUIRE(sum.bounds.lo == b.lo);
+      REQUIRE(sum.bounds.hi == b.hi);
+    }
+    REQUIRE(sum.organs.size() == sk.organs.size());
+    for (size_t k = 0; k < sk.organs.size(); ++k) REQUIRE(sum.organs[k].internode == sk.organs[k].internode);
+    REQUIRE(turtle.endState().frame.position == end.frame.position);
+    for (const Internode& in : sk.internodes)
+      raised += in.tipRadius > in.baseRadius;
+  }
+  CHECK(raised > 10);  // the deferred taper case was exercised
+}
