@@ -46,7 +46,8 @@ int runPreview(const PreviewArgs& a, const GlobalOptions& g) {
   const int last = engine.lastStep();
   const int step = a.stage >= 0 ? std::min(a.stage, last) : last;
   const lsystem::Skeleton shown = engine.skeletonAt(step);
-  const DBox3 frame = framingBox(step == last ? shown : engine.skeletonAt(last));
+  // Not `framingBox(step == last ? shown : ...)`: that conditional copies `shown`.
+  const DBox3 frame = step == last ? framingBox(shown) : framingBox(engine.skeletonAt(last));
   render::Scene scene;
   scene.add(skeletonPreview(shown, look.style));
   scene.commit();

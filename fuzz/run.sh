@@ -15,6 +15,10 @@ shift 2
 TARGETS=("$@")
 [ ${#TARGETS[@]} -eq 0 ] && TARGETS=(grammar expression derive species_tree species_shell species_blob species_organism polymesh image volume)
 ROOT=$(pwd)
+# The sanitizer settings of the Makefile, also when this script is run by hand.
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:detect_stack_use_after_return=0}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+export LSAN_OPTIONS=${LSAN_OPTIONS:-suppressions=$ROOT/fuzz/lsan.supp:print_suppressions=0}
 status=0
 
 # seed TARGET FOLDER: the first corpus of a target from the repository's own files.
@@ -80,17 +84,21 @@ run_one() {
   dict=$(dict_of "$t")
   # One process, SECS of wall time; memory capped so an input that allocates without bound
   # is reported as oom-* rather than taking the machine.
-  "$exe" -max_total_time="$SECS" -rss_limit_mb=2048 -malloc_limit_mb=1024 -timeout=10 -print_final_stats=1 \
-    -artifact_prefix="$art/" ${dict:+-dict=$dict} "$corpus" "fuzz/regressions/$t" >"$log" 2>&1
+  # The run's CPU seconds (user + system) are reported too: on a busy machine they are less
+  # than its wall time.
+  local TIMEFORMAT='%U %S' cpu
+  { time "$exe" -max_total_time="$SECS" -rss_limit_mb=2048 -malloc_limit_mb=1024 -timeout=10 -print_final_stats=1 \
+      -artifact_prefix="$art/" ${dict:+-dict=$dict} "$corpus" "fuzz/regressions/$t" >"$log" 2>&1; } 2>"$BUILD/fuzz-$t.cpu"
   rc=$?
+  cpu=$(awk '{printf "%.0f", $1 + $2}' "$BUILD/fuzz-$t.cpu")
   last=$(grep -E '^#[0-9]+' "$log" | tail -1)
   execs=$(grep -oE 'stat::number_of_executed_units: *[0-9]+' "$log" | tail -1 | grep -oE '[0-9]+$')
   rate=$(grep -oE 'stat::average_exec_per_sec: *[0-9]+' "$log" | tail -1 | grep -oE '[0-9]+$')
   cov=$(echo "$last" | grep -oE 'cov: [0-9]+' | grep -oE '[0-9]+')
   ft=$(echo "$last" | grep -oE 'ft: [0-9]+' | grep -oE '[0-9]+')
   found=$(find "$art" -maxdepth 1 -type f \( -name 'crash-*' -o -name 'leak-*' -o -name 'timeout-*' -o -name 'oom-*' \) | wc -l)
-  printf 'fuzz %-17s %4ss  execs %-9s exec/s %-6s cov %-6s ft %-6s corpus %-5s found %s\n' \
-    "$t" "$SECS" "${execs:-?}" "${rate:-?}" "${cov:-?}" "${ft:-?}" "$(ls "$corpus" | wc -l)" "$found" >"$sum"
+  printf 'fuzz %-17s %4ss (cpu %4ss)  execs %-9s exec/s %-6s cov %-6s ft %-6s corpus %-5s found %s\n' \
+    "$t" "$SECS" "${cpu:-?}" "${execs:-?}" "${rate:-?}" "${cov:-?}" "${ft:-?}" "$(ls "$corpus" | wc -l)" "$found" >"$sum"
   if [ "$found" -gt 0 ] || [ $rc -ne 0 ]; then
     touch "$BUILD/fuzz-$t.failed"
     cp "$art"/crash-* "$art"/leak-* "$art"/timeout-* "$art"/oom-* "fuzz/regressions/$t/" 2>/dev/null

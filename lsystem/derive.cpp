@@ -587,7 +587,10 @@ struct Deriver::Impl {
     const detail::SymbolRules* rules = rs.rules.data();
     // The buffers are allocated once from the size pass, and a limit overrun is caught
     // before allocating.
-    if (rs.anyContext) computeBrackets(in);
+    // Dispatch tables walk to neighbours over brackets too: a symbol with several
+    // context-free productions (the first always wins) has one (fuzz regression
+    // derive/crash-0836...).
+    if (rs.anyContext || !rs.dispatches.empty()) computeBrackets(in);
     choices.clear();
     auto [reserveModules, reserveParams] = decompose ? std::pair<size_t, size_t>{0, 0} : sizePass(rs, step);
     Writer w(next, births, opt.maxModules, limitAt, step, reserveModules, reserveParams);

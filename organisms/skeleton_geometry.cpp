@@ -9,14 +9,35 @@ namespace {
 
 Vec3 toVec3(const DVec3& v) { return Vec3(static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)); }
 
+/// True when the round segment a-c with radii ra, rc is the union of the segments a-b and
+/// b-c (radii ra, rb, rc): b lies on a-c (the directions agree to 1e-9) and rb is the linear
+/// interpolation of ra and rc at b (to 1e-9 of the larger radius). Then the joint at b is
+/// dropped without changing the shape: a straight run of equal internodes (`F F F ...`) is
+/// few segments. Merged segments stay at most kMaxMergedAspect times as long as their
+/// radius: Embree's float intersection of a round segment loses hits along one that is
+/// hundreds of radii long (an 8-million-F axiom drawn as one segment showed gaps).
+constexpr double kMaxMergedAspect = 16.0;
+
+bool mergeable(const DVec3& a, double ra, const DVec3& b, double rb, const DVec3& c, double rc) {
+  const DVec3 d1 = b - a, d2 = c - b;
+  const double l1 = glm::length(d1), l2 = glm::length(d2);
+  if (!(l1 > 0) || !(l2 > 0) || glm::dot(d1, d2) <= 0) return false;
+  if (l1 + l2 > kMaxMergedAspect * std::max(ra, rc)) return false;
+  if (glm::length(glm::cross(d1, d2)) > 1e-9 * l1 * l2) return false;
+  const double t = l1 / (l1 + l2);
+  return std::abs(rb - (ra + t * (rc - ra))) <= 1e-9 * std::max(ra, rc);
+}
+
 /// Internodes as curve chains: each internode is chained with the first child that starts
 /// where it ends (a continuation of the same order first, then any child), so joints are
-/// shared vertices of one curve rather than two overlapping caps.
+/// shared vertices of one curve rather than two overlapping caps. Collinear joints whose
+/// radius is the interpolation of its neighbours' are merged (see mergeable).
 CurveSet internodeCurves(const lsystem::Skeleton& skeleton, double radiusScale, double minRadius) {
   CurveSet out;
   const auto& nodes = skeleton.internodes;
   if (nodes.empty()) return out;
-  auto radius = [&](double r) { return static_cast<float>(std::max(r * radiusScale, minRadius)); };
+  auto radiusD = [&](double r) { return std::max(r * radiusScale, minRadius); };
+  auto radius = [&](double r) { return static_cast<float>(radiusD(r)); };
   std::vector<int32_t> next(nodes.size(), -1);
   std::vector<char> continues(nodes.size(), 0);
   for (int pass = 0; pass < 2; ++pass) {
@@ -34,10 +55,26 @@ CurveSet internodeCurves(const lsystem::Skeleton& skeleton, double radiusScale, 
   for (size_t i = 0; i < nodes.size(); ++i) {
     if (continues[i]) continue;
     out.vertices.emplace_back(toVec3(nodes[i].start), radius(nodes[i].baseRadius));
+    // The current segment's start and end in double precision, for mergeable().
+    DVec3 runStart = nodes[i].start, runEnd{0};
+    double runStartRadius = radiusD(nodes[i].baseRadius), runEndRadius = 0;
     bool firstInChain = true;
     for (int32_t k = static_cast<int32_t>(i); k >= 0; k = next[k]) {
       const auto& n = nodes[k];
       double tip = next[k] >= 0 ? 0.5 * (n.tipRadius + nodes[next[k]].baseRadius) : n.tipRadius;
+      if (!firstInChain && mergeable(runStart, runStartRadius, runEnd, runEndRadius, n.end, radiusD(tip))) {
+        out.vertices.back() = Vec4(toVec3(n.end), radius(tip));
+        runEnd = n.end;
+        runEndRadius = radiusD(tip);
+        if (next[k] < 0) out.flags.back() &= static_cast<uint8_t>(~CurveSet::kJoinedAfter);
+        continue;
+      }
+      if (!firstInChain) {
+        runStart = runEnd;
+        runStartRadius = runEndRadius;
+      }
+      runEnd = n.end;
+      runEndRadius = radiusD(tip);
       out.segments.push_back(static_cast<uint32_t>(out.vertices.size() - 1));
       out.vertices.emplace_back(toVec3(n.end), radius(tip));
       uint8_t f = 0;
