@@ -458,6 +458,21 @@ TEST_CASE("Turtle::shipped grammars", "[lsystem]") {
   }
 }
 
+/// `draws` picks from alphabet (no unmatched `]`), then the open brackets are closed.
+template <size_t N>
+std::string randomBalanced(Rng& rng, const char* const (&alphabet)[N], int draws) {
+  std::string text;
+  int depth = 0;
+  for (int i = 0; i < draws; ++i) {
+    std::string cmd = alphabet[rng.below(N)];
+    if (cmd == "]" && depth == 0) continue;
+    depth += cmd == "[" ? 1 : cmd == "]" ? -1 : 0;
+    text += cmd;
+  }
+  text.append(static_cast<size_t>(depth), ']');
+  return text;
+}
+
 TEST_CASE("Turtle::random strings keep the invariants", "[lsystem]") {
   // Seeded property test: random command strings with balanced brackets.
   const uint64_t seed = 20261122;
@@ -465,15 +480,7 @@ TEST_CASE("Turtle::random strings keep the invariants", "[lsystem]") {
   const char* alphabet[] = {"F", "F(0.5)", "f", "G", "g(2)", "+", "-(33)", "&", "^(12)", "\\", "/(77)", "|",
                             "$", "!(0.3)", "'", "@Ts(0.2)", "A", "[", "]"};
   for (int trial = 0; trial < 200; ++trial) {
-    std::string text;
-    int depth = 0;
-    for (int i = 0; i < 300; ++i) {
-      std::string cmd = alphabet[rng.below(19)];
-      if (cmd == "]" && depth == 0) continue;
-      depth += cmd == "[" ? 1 : cmd == "]" ? -1 : 0;
-      text += cmd;
-    }
-    text.append(static_cast<size_t>(depth), ']');
+    const std::string text = randomBalanced(rng, alphabet, 300);
     TurtleSettings s;
     s.angleDeg = 25;
     s.elasticity = 0.05;
@@ -508,18 +515,9 @@ TEST_CASE("Turtle::summarize equals the drawn skeleton's count, length and bound
   Rng rng(seed);
   const char* alphabet[] = {"F", "F(0.5)", "f", "G", "+", "-(33)", "&", "^(12)", "/(77)", "!(0.3)", "!(2.5)", "!",
                             "@Ts(0.2)", "@O(0.7)", "{", ".", "}", "%", "[", "]"};
-  const size_t letters = sizeof(alphabet) / sizeof(alphabet[0]);
   size_t raised = 0;  // continuations wider than their parent: the deferred case
   for (int trial = 0; trial < 300; ++trial) {
-    std::string text;
-    int depth = 0;
-    for (int i = 0; i < 200; ++i) {
-      std::string cmd = alphabet[rng.below(letters)];
-      if (cmd == "]" && depth == 0) continue;
-      depth += cmd == "[" ? 1 : cmd == "]" ? -1 : 0;
-      text += cmd;
-    }
-    text.append(static_cast<size_t>(depth), ']');
+    const std::string text = randomBalanced(rng, alphabet, 200);
     TurtleSettings s;
     s.angleDeg = 25;
     s.elasticity = 0.05;
