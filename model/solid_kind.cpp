@@ -8,6 +8,8 @@
 
 #include "core/polymesh.h"
 #include "core/timer.h"
+#include "model/solid_velocity.h"
+#include "solids/front_field.h"
 #include "solids/tet_io.h"
 
 namespace sprig {
@@ -28,7 +30,7 @@ const std::vector<std::string> kVolumeForms = {"volume", "precedence"};
 const std::vector<std::string> kFields = {"surface_mesh", "sphere",    "box",         "cylinder",
                                           "ground_plane", "union",     "intersection", "subtraction",
                                           "transform",    "from_volume_surface", "extrude_2d", "species"};
-const std::vector<std::string> kNotBuilt = {"from_volume_surface", "extrude_2d", "species"};
+const std::vector<std::string> kNotBuilt = {"extrude_2d", "species"};
 const std::vector<std::string> kLayers = {"interior_layer", "exterior_layer"};
 
 std::string notBuilt(const std::string& what) {
@@ -166,35 +168,91 @@ class SolidReader {
 
   void readVolume(const YNode& value) {
     MapReader m(value, diags_, "volume");
-    if (auto v = m.get("velocity")) v->error(diags_, notBuilt("velocity"));
     FieldPtr field;
     if (auto f = m.get("distance_field")) field = readField(*f);
     else value.error(diags_, "missing required key 'distance_field' in volume");
+    std::optional<VelocityWrap> velocity;
+    std::optional<YNode> velocityNode = m.get("velocity");
+    if (velocityNode) velocity = readVelocity(*velocityNode, diags_, nullptr, false);
     std::vector<Layer> layers;
+    std::vector<std::optional<YNode>> layerVelocity;
     const std::vector<YNode> items = m.sequence("layers");
     if (items.empty() && !m.has("layers")) value.error(diags_, "missing required key 'layers' in volume");
-    for (const YNode& item : items)
-      if (auto l = readLayer(item)) layers.push_back(*l);
+    for (const YNode& item : items) {
+      std::optional<YNode> lv;
+      if (auto l = readLayer(item, &lv)) {
+        layers.push_back(*l);
+        layerVelocity.push_back(lv);
+      }
+    }
     m.finish();
-    if (!field || layers.size() != items.size() || layers.empty()) return;
+    if (!field || layers.size() != items.size() || layers.empty() || (velocityNode && !velocity)) return;
+    // Per-layer velocity (§2.4, LUMPY_CANDY) is sugar for nested volumes: the first exterior
+    // layer's velocity is the field's; each later exterior layer with a velocity starts a
+    // volume of its own whose field is the outermost interface of the volumes before it.
+    std::vector<size_t> starts{0};
+    bool firstExterior = true;
+    for (size_t i = 0; i < layers.size(); ++i) {
+      if (!layerVelocity[i]) {
+        if (!layers[i].interior) firstExterior = false;
+        continue;
+      }
+      if (layers[i].interior) {
+        layerVelocity[i]->error(diags_, "a per-layer 'velocity' is for exterior layers (they nest outward, as in the paper's "
+                                        "LUMPY_CANDY); give the volume a 'velocity' for its interior layers");
+        return;
+      }
+      if (firstExterior) {
+        if (velocityNode) {
+          layerVelocity[i]->error(diags_, "the volume has a 'velocity' already: the first exterior layer's velocity is the volume's");
+          return;
+        }
+        velocity = readVelocity(*layerVelocity[i], diags_, nullptr, false);
+        if (!velocity) return;
+      } else {
+        starts.push_back(i);
+      }
+      firstExterior = false;
+    }
+    if (velocity) field = (*velocity)(field);
+    if (!field) return;
+    std::vector<Volume> nest;
+    for (size_t r = 0; r < starts.size(); ++r) {
+      const size_t end = r + 1 < starts.size() ? starts[r + 1] : layers.size();
+      const std::vector<Layer> run(layers.begin() + long(starts[r]), layers.begin() + long(end));
+      if (r > 0) {
+        std::optional<VelocityWrap> v = readVelocity(*layerVelocity[starts[r]], diags_, nullptr, true);
+        if (!v) return;
+        field = (*v)(volumeSurfaceField(nest));
+        if (!field) return;
+      }
+      if (!addVolume(value, field, run)) return;
+      nest.push_back(spec_.solid.volumes.back());
+    }
+  }
+
+  /// Appends a volume of field with layers; false after an error at node.
+  bool addVolume(const YNode& node, const FieldPtr& field, const std::vector<Layer>& layers) {
     try {
       spec_.solid.volumes.push_back(makeVolume(field, layers));
       maxExterior_ = std::max(maxExterior_, spec_.solid.volumes.back().boundaries.back());
       for (const Layer& l : layers)
-        if (!l.fill) thinnest_ = std::min(thinnest_, l.thickness);
+        if (!l.fill) thinnest_ = std::min(thinnest_, l.thickness * std::min(1.0, field->reach()));
+      return true;
     } catch (const std::invalid_argument& e) {
-      value.error(diags_, e.what());
+      node.error(diags_, e.what());
+      return false;
     }
   }
 
-  std::optional<Layer> readLayer(const YNode& item) {
+  std::optional<Layer> readLayer(const YNode& item, std::optional<YNode>* velocity) {
     auto one = singleKey(item, diags_, "layer", kLayers);
     if (!one) return std::nullopt;
     Layer l;
     l.interior = one->first.scalar() == "interior_layer";
     MapReader m(one->second, diags_, one->first.scalar());
     const size_t errors = errorCount();
-    if (auto v = m.get("velocity")) v->error(diags_, notBuilt("velocity"));
+    *velocity = m.get("velocity");
     if (auto mat = m.get("material")) l.material = materialId(*mat);
     else one->second.error(diags_, "missing required key 'material' in " + one->first.scalar() + " (a material name or nothing)");
     if (auto t = m.get("thickness")) {
@@ -220,6 +278,7 @@ class SolidReader {
       return nullptr;
     }
     const YNode& value = one->second;
+    if (kind == "from_volume_surface") return readVolumeSurface(value);
     if (kind == "union" || kind == "intersection" || kind == "subtraction") {
       if (!value.isSequence() || value.items().empty()) {
         value.error(diags_, sprig::quoted(kind) + " must be a sequence of distance fields");
@@ -239,8 +298,12 @@ class SolidReader {
     MapReader m(value, diags_, kind);
     FieldPtr out;
     if (kind == "surface_mesh") {
-      if (auto v = m.get("velocity")) v->error(diags_, notBuilt("velocity"));
-      out = readMesh(m);
+      PolyMesh mesh;
+      out = readMesh(m, &mesh);
+      if (auto v = m.get("velocity")) {
+        std::optional<VelocityWrap> w = readVelocity(*v, diags_, &mesh, false);
+        out = w && out ? (*w)(out) : nullptr;
+      }
     } else if (kind == "sphere") {
       out = sphereField(DVec3(m.vec3("center", Vec3(0.0f))), m.number("radius", 1.0, 1e-6, 1e6));
     } else if (kind == "box") {
@@ -282,7 +345,30 @@ class SolidReader {
   }
 
   /// A closed mesh file as a field; the first open edge is an error at its face.
-  FieldPtr readMesh(MapReader& m) {
+  /// The outermost interface of a volume or a precedence list (§2.3, Fig. 2c). The inner
+  /// volumes are part of the solid, in precedence before the volume that uses the field.
+  FieldPtr readVolumeSurface(const YNode& value) {
+    MapReader m(value, diags_, "from_volume_surface");
+    const size_t first = spec_.solid.volumes.size();
+    bool any = false;
+    for (const std::string& form : kVolumeForms)
+      if (auto v = m.get(form)) {
+        if (any) v->error(diags_, "from_volume_surface takes one 'volume' or one 'precedence' list, not both");
+        any = true;
+        readVolumeForm(form, *v);
+      }
+    if (!any) value.error(diags_, "missing required key 'volume' or 'precedence' in from_volume_surface");
+    std::optional<VelocityWrap> velocity;
+    std::optional<YNode> vn = m.get("velocity");
+    if (vn) velocity = readVelocity(*vn, diags_, nullptr, true);
+    m.finish();
+    if (!any || spec_.solid.volumes.size() == first || (vn && !velocity)) return nullptr;
+    std::vector<Volume> inner(spec_.solid.volumes.begin() + long(first), spec_.solid.volumes.end());
+    FieldPtr surface = volumeSurfaceField(std::move(inner));
+    return velocity ? (*velocity)(surface) : redistanced(surface);
+  }
+
+  FieldPtr readMesh(MapReader& m, PolyMesh* keep = nullptr) {
     auto file = m.path("file", policy_);
     if (!file) {
       if (!m.has("file")) m.node().error(diags_, "missing required key 'file' in surface_mesh (an OBJ, PLY or OFF file)");
@@ -305,7 +391,9 @@ class SolidReader {
         }
         return nullptr;
       }
-      return meshField(mesh);
+      FieldPtr field = meshField(mesh);
+      if (keep) *keep = std::move(mesh);
+      return field;
     } catch (const InputError& e) {
       diags_.append(e.diagnostics());
     } catch (const std::invalid_argument& e) {
@@ -339,7 +427,7 @@ class SolidReader {
               .error(diags_, "a volume has no bounds (a ground plane): give 'grid: {bounds: {min: [x, y, z], max: [x, y, z]}}'");
           return;
         }
-        all.extend(b->expanded(std::max(0.0, v.boundaries.back())));
+        all.extend(b->expanded(std::max(0.0, v.boundaries.back()) * v.field->reach()));
       }
       box = all;
     }

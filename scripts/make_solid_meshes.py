@@ -7,8 +7,9 @@ import math, os
 def spow(v, e):
     return math.copysign(abs(v) ** e, v)
 
-def write_uv(path, point, lat=24, lon=48, comment=""):
-    """A closed latitude-longitude mesh: poles, lat-1 rings of lon vertices, CCW outward."""
+def write_uv(path, point, lat=24, lon=48, comment="", paint=None):
+    """A closed latitude-longitude mesh: poles, lat-1 rings of lon vertices, CCW outward.
+    paint(x, y, z) -> grey level in [0, 1] writes it as each vertex's sRGB colour."""
     verts = [point(0.0, 0.0)]
     for i in range(1, lat):
         th = math.pi * i / lat
@@ -28,7 +29,11 @@ def write_uv(path, point, lat=24, lon=48, comment=""):
     with open(path, "w") as f:
         f.write("# %s\n# written by scripts/make_solid_meshes.py\n" % comment)
         for v in verts:
-            f.write("v %.6f %.6f %.6f\n" % v)
+            if paint:
+                g = paint(*v)
+                f.write("v %.6f %.6f %.6f %.4f %.4f %.4f\n" % (v + (g, g, g)))
+            else:
+                f.write("v %.6f %.6f %.6f\n" % v)
         for fc in faces:
             f.write("f " + " ".join(str(k) for k in fc) + "\n")
 
@@ -44,9 +49,18 @@ def almond(th, ph):
     taper = 1.0 - 0.45 * max(0.0, c) ** 2
     return (x, 0.2 * taper * s * math.cos(ph), 0.34 * taper * s * math.sin(ph))
 
+def ring_paint(x, y, z):
+    # Fig. 3a's painted velocity: a white ring of radius 0.45 on the top of the candy, black elsewhere.
+    if y < 0.1:
+        return 0.0
+    r = math.hypot(x, z)
+    return max(0.0, 1.0 - abs(r - 0.45) / 0.12)
+
 if __name__ == "__main__":
     out = "species/meshes_solid"
     os.makedirs(out, exist_ok=True)
     write_uv(os.path.join(out, "candy.obj"), candy, 32, 64, "candy: superellipsoid 2 x 0.84 x 1.4, closed")
     # The almond's poles lie on its long (x) axis.
     write_uv(os.path.join(out, "almond.obj"), lambda th, ph: almond(th, ph), 32, 48, "almond: tapered ellipsoid 1.2 x 0.4 x 0.68, closed")
+    write_uv(os.path.join(out, "candy_painted.obj"), candy, 64, 128, "candy painted with a ring on top (vertex colours), closed",
+             ring_paint)

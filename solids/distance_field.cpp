@@ -111,6 +111,11 @@ class MinMaxField final : public DistanceField {
     }
     return box;
   }
+  double reach() const override {
+    double r = 0;
+    for (const FieldPtr& c : children_) r = std::max(r, c->reach());
+    return r;
+  }
 
  private:
   std::vector<FieldPtr> children_;
@@ -127,6 +132,7 @@ class SubtractionField final : public DistanceField {
     return out;
   }
   std::optional<DBox3> bounds() const override { return a_->bounds(); }
+  double reach() const override { return std::max(a_->reach(), b_->reach()); }
 
  private:
   FieldPtr a_, b_;
@@ -161,6 +167,7 @@ class TransformField final : public DistanceField {
     }
     return out;
   }
+  double reach() const override { return child_->reach(); }
 
  private:
   DVec3 toChild(const DVec3& p) const { return rotate(p - t_, u_, -angle_) / s_; }

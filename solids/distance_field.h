@@ -31,6 +31,10 @@ class DistanceField {
   virtual std::vector<float> sample(const std::vector<Vec3>& points, double cellWorld, double bandWorld) const = 0;
   /// Box holding the field's interior (d <= 0), or nullopt when unbounded (a ground plane).
   virtual std::optional<DBox3> bounds() const = 0;
+  /// World units per unit of value, at most: 1 for a distance, the largest speed for a
+  /// front's arrival time (solids/front_field.h). A layer boundary b lies within
+  /// b·reach() of the zero set (the default grid's margin).
+  virtual double reach() const { return 1.0; }
 };
 
 using FieldPtr = std::shared_ptr<const DistanceField>;

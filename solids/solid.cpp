@@ -285,6 +285,77 @@ QualityStats measureQuality(const TetMesh& mesh, size_t targetCount) {
   return q;
 }
 
+namespace {
+
+/// Ranges (a, b] of distance with region ids that pass keep, adjacent ones merged.
+std::vector<std::pair<double, double>> rangesOf(const Volume& v, bool (*keep)(int)) {
+  std::vector<std::pair<double, double>> out;
+  const double inf = std::numeric_limits<double>::infinity();
+  for (size_t r = 0; r < v.regions.size(); ++r) {
+    if (!keep(v.regions[r])) continue;
+    const double a = r == 0 ? -inf : v.boundaries[r - 1], b = r < v.boundaries.size() ? v.boundaries[r] : inf;
+    if (!out.empty() && out.back().second == a) out.back().second = b;
+    else out.emplace_back(a, b);
+  }
+  return out;
+}
+
+/// Negative inside the ranges: min over ranges of max(a - d, d - b).
+float inRanges(const std::vector<std::pair<double, double>>& ranges, float d) {
+  float f = std::numeric_limits<float>::infinity();
+  for (const auto& [a, b] : ranges) f = std::min(f, float(std::max(a - d, d - b)));
+  return f;
+}
+
+bool isMaterial(int id) { return id != kUnclaimed && id != kNothing; }
+bool isNothing(int id) { return id == kNothing; }
+
+class VolumeSurfaceField final : public DistanceField {
+ public:
+  explicit VolumeSurfaceField(std::vector<Volume> volumes) : volumes_(std::move(volumes)) {
+    if (volumes_.empty()) throw std::invalid_argument("from_volume_surface needs a volume");
+    for (const Volume& v : volumes_) {
+      material_.push_back(rangesOf(v, isMaterial));
+      nothing_.push_back(rangesOf(v, isNothing));
+    }
+  }
+  std::vector<float> sample(const std::vector<Vec3>& points, double cell, double band) const override {
+    std::vector<float> out(points.size(), std::numeric_limits<float>::infinity());
+    std::vector<float> carved(points.size(), -std::numeric_limits<float>::infinity());  // max of -nothing so far
+    for (size_t v = 0; v < volumes_.size(); ++v) {
+      const double outer = volumes_[v].boundaries.empty() ? 0.0 : std::abs(volumes_[v].boundaries.back());
+      const std::vector<float> d = volumes_[v].field->sample(points, cell, band + outer);
+      for (size_t i = 0; i < points.size(); ++i) {
+        if (!material_[v].empty()) out[i] = std::min(out[i], std::max(inRanges(material_[v], d[i]), carved[i]));
+        if (!nothing_[v].empty()) carved[i] = std::max(carved[i], -inRanges(nothing_[v], d[i]));
+      }
+    }
+    for (float& f : out) f = std::clamp(f, float(-band), float(band));
+    return out;
+  }
+  std::optional<DBox3> bounds() const override {
+    std::optional<DBox3> box;
+    for (size_t v = 0; v < volumes_.size(); ++v) {
+      if (material_[v].empty()) continue;
+      std::optional<DBox3> b = volumes_[v].field->bounds();
+      if (!b) return std::nullopt;
+      const double outer = material_[v].back().second;
+      if (!std::isfinite(outer)) return std::nullopt;
+      const DBox3 e = b->expanded(std::max(0.0, outer) * volumes_[v].field->reach());
+      if (box) box->extend(e); else box = e;
+    }
+    return box;
+  }
+
+ private:
+  std::vector<Volume> volumes_;
+  std::vector<std::vector<std::pair<double, double>>> material_, nothing_;
+};
+
+}  // namespace
+
+FieldPtr volumeSurfaceField(std::vector<Volume> volumes) { return std::make_shared<VolumeSurfaceField>(std::move(volumes)); }
+
 std::vector<Vec3> gridNodes(const Grid& g) {
   const size_t nx = size_t(g.cells[0]) + 1, ny = size_t(g.cells[1]) + 1;
   std::vector<Vec3> nodes(g.nodeCount());

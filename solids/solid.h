@@ -44,6 +44,14 @@ struct Volume {
   std::pair<double, double> claimed() const;
 };
 
+/// The outermost interface of volumes in precedence order (§2.3, Fig. 2c: the paper's
+/// `from_volume_surface`): a field negative in the space their materials fill and zero on
+/// its boundary. Each volume's material is a union of ranges (a, b] of its distance; a
+/// `nothing` range of an earlier volume is carved out of later ones, as meshSolid does.
+/// The value is a combination by min and max, a distance only near the zero set: wrap it
+/// in a front (solids/front_field.h) to measure distance from the interface again.
+FieldPtr volumeSurfaceField(std::vector<Volume> volumes);
+
 /// A layer as written: a thickness (or fill) and a material id.
 struct Layer {
   bool interior = true;
