@@ -40,7 +40,7 @@ bool mentions(const std::string& text, const char* name) {
   return std::regex_search(text, std::regex(std::string("\\b") + name + "\\b"));
 }
 
-/// The colour luminance of the vertex nearest each point (a bucket grid over the vertices).
+/// The painted value near each point: vertex colour luminance smoothed over nearby vertices (a bucket grid).
 class NearestVertex {
  public:
   NearestVertex(const PolyMesh& mesh, double low, double high) : low_(low), high_(high) {
@@ -62,6 +62,23 @@ class NearestVertex {
     const DVec3 q(p);
     int c[3];
     for (int a = 0; a < 3; ++a) c[a] = std::clamp(int(std::floor((q[a] - box_.lo[a]) / cell_)), 0, dims_[a] - 1);
+    // The paint is smoothed over a radius of two buckets (weights (1 - (d/R)²)², Wendland-like),
+    // so the layer does not show the mesh's Voronoi cells; far from every vertex, the nearest.
+    const double radius = 2 * cell_;
+    double wsum = 0, vsum = 0;
+    for (int k = c[2] - 2; k <= c[2] + 2; ++k)
+      for (int j = c[1] - 2; j <= c[1] + 2; ++j)
+        for (int i = c[0] - 2; i <= c[0] + 2; ++i) {
+          if (i < 0 || j < 0 || k < 0 || i >= dims_[0] || j >= dims_[1] || k >= dims_[2]) continue;
+          for (uint32_t v : buckets_[i + size_t(dims_[0]) * (j + size_t(dims_[1]) * k)]) {
+            const double e = glm::length(DVec3(positions_[v]) - q) / radius;
+            if (e >= 1) continue;
+            const double w = (1 - e * e) * (1 - e * e);
+            wsum += w;
+            vsum += w * values_[v];
+          }
+        }
+    if (wsum > 1e-6) return float(low_ + (high_ - low_) * (vsum / wsum));
     double best = 1e300;
     uint32_t who = 0;
     // Rings of buckets outward until the ring is farther than the nearest vertex found.

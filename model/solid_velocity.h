@@ -13,8 +13,9 @@
 /// never compiled code. `max` bounds the speed (the default grid's margin and the front's
 /// band); by default it is measured on a 32³ lattice over the field's box, and a value
 /// that is not positive and finite there is an error at the expression. A painted speed is
-/// low + (high − low)·luminance of the colour of the mesh vertex nearest each point of the
-/// surface, carried outward along the front.
+/// low + (high − low)·luminance of the mesh's vertex colours, averaged over the vertices
+/// within about 1/24 of the mesh's size of each point of the surface (the nearest vertex
+/// where none is that near), carried outward along the normals.
 
 #include <functional>
 #include <optional>

@@ -131,8 +131,13 @@ class FrontField final : public DistanceField {
 
 }  // namespace
 
-std::vector<float> marchFront(const std::vector<float>& d, std::vector<float>& speed, const std::array<int, 3>& dims,
-                              double h, double limit, bool painted) {
+namespace {
+
+/// One fast march. extend = false: arrival times at the given speeds. extend = true: unit
+/// speed (distance), and the speeds of the nodes next to the zero set are carried to every
+/// node reached, along the distance's characteristics (the surface normals).
+std::vector<float> march(const std::vector<float>& d, std::vector<float>& speed, const std::array<int, 3>& dims, double h,
+                         double limit, bool extend) {
   const size_t n = d.size();
   const int64_t stride[3] = {1, dims[0], int64_t(dims[0]) * dims[1]};
   std::vector<float> t(n, kInf);
@@ -141,8 +146,6 @@ std::vector<float> marchFront(const std::vector<float>& d, std::vector<float>& s
   auto coord = [&](size_t idx, int a) {
     return a == 0 ? int(idx % dims[0]) : a == 1 ? int((idx / dims[0]) % dims[1]) : int(idx / (size_t(dims[0]) * dims[1]));
   };
-  for (float& s : speed) s = std::isfinite(s) ? std::max(s, kMinSpeed) : 1.0f;
-
   // Nodes next to the zero set: the distance to the crossings on their edges, combined over
   // the axes as 1/D^2 = sum 1/D_a^2 (the usual first-order initialization).
   for (size_t i = 0; i < n; ++i) {
@@ -163,7 +166,7 @@ std::vector<float> marchFront(const std::vector<float>& d, std::vector<float>& s
     }
     if (front || inv > 0) {
       const double dist = front ? 0.0 : 1 / std::sqrt(inv);
-      t[i] = float(dist / speed[i]);
+      t[i] = float(extend ? dist : dist / speed[i]);
       state[i] = Known;
     }
   }
@@ -185,26 +188,18 @@ std::vector<float> marchFront(const std::vector<float>& d, std::vector<float>& s
         }
       }
     }
-    double v = speed[i];
     int used = 0;
-    double ti = 0;
-    if (painted) {
-      // Extension: the speed is constant along characteristics, ∇v·∇T = 0, discretely the
-      // average of the upwind neighbours' speeds weighted by (T - T_a) (Adalsteinsson and
-      // Sethian 1999); two passes, the first with equal weights.
+    const double ti = solveEikonal(a, extend ? h : h / speed[i], used);
+    double v = speed[i];
+    if (extend) {
+      // Extension: the speed is constant along the characteristics, ∇v·∇T = 0, discretely
+      // the average of the upwind neighbours' speeds weighted by (T - T_a) (Adalsteinsson
+      // and Sethian 1999).
       double num = 0, den = 0;
       for (int ax = 0; ax < 3; ++ax)
-        if (a[ax] < kInf) num += sp[ax], den += 1;
-      v = num / den;
-      for (int pass = 0; pass < 2; ++pass) {
-        ti = solveEikonal(a, h / v, used);
-        num = den = 0;
-        for (int ax = 0; ax < 3; ++ax)
-          if (a[ax] < ti) num += (ti - a[ax]) * sp[ax], den += ti - a[ax];
-        if (den > 0) v = std::max(num / den, double(kMinSpeed));
-      }
+        if (a[ax] < ti) num += (ti - a[ax]) * sp[ax], den += ti - a[ax];
+      if (den > 0) v = std::max(num / den, double(kMinSpeed));
     }
-    ti = solveEikonal(a, h / v, used);
     if (ti < t[i]) {
       t[i] = float(ti);
       speed[i] = float(v);
@@ -234,6 +229,19 @@ std::vector<float> marchFront(const std::vector<float>& d, std::vector<float>& s
     t[i] = d[i] < 0 ? -mag : mag;
   }
   return t;
+}
+
+}  // namespace
+
+std::vector<float> marchFront(const std::vector<float>& d, std::vector<float>& speed, const std::array<int, 3>& dims,
+                              double h, double limit, bool painted) {
+  for (float& s : speed) s = std::isfinite(s) ? std::max(s, kMinSpeed) : 1.0f;
+  if (painted) {
+    // The painted speeds first travel along the normals (a unit-speed march as far as the
+    // fastest front gets), then the front runs at them.
+    march(d, speed, dims, h, limit * std::max(1.0f, *std::max_element(speed.begin(), speed.end())), true);
+  }
+  return march(d, speed, dims, h, limit, false);
 }
 
 FieldPtr constantSpeedField(FieldPtr child, double speed) { return std::make_shared<ConstantSpeedField>(std::move(child), speed); }

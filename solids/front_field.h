@@ -15,10 +15,12 @@
 /// same at any thread count). Nodes next to the zero set start at d/|∇d|/v.
 ///
 /// Speeds come from a procedure of the point (SpeedFn, evaluated at every lattice node) or
-/// are painted on the surface (evaluated only at the nodes next to the zero set and carried
-/// outward and inward along the front's characteristics: Adalsteinsson and Sethian, "The
-/// fast construction of extension velocities in level set methods", JCP 148, 1999), so a
-/// painted value sets the thickness of the layers above that part of the surface.
+/// are painted on the surface: evaluated only at the nodes next to the zero set, carried
+/// along the surface normals by a unit-speed march that extends them (Adalsteinsson and
+/// Sethian, "The fast construction of extension velocities in level set methods", JCP 148,
+/// 1999), and then the front runs at them, so a painted value sets the thickness of the
+/// layers above that part of the surface. Where a fast region borders a slow one the
+/// fast front spills sideways into the slow side, as the eikonal equation says it must.
 
 #include <functional>
 #include <vector>
@@ -43,7 +45,8 @@ FieldPtr frontField(FieldPtr child, SpeedFn speed, double maxSpeed, bool painted
 
 /// Arrival times on a lattice (x fastest): d are the starting field's values at the nodes,
 /// speed the speeds (all nodes; painted: valid only at nodes next to the zero set, the rest
-/// is overwritten by the extension), h the lattice step. Values beyond limit (in T) are
+/// is overwritten by the extension; speeds below kMinSpeed are raised to it, non-finite
+/// ones taken as 1), h the lattice step. Values beyond limit (in T) are
 /// left at ±limit. Exposed for tests.
 std::vector<float> marchFront(const std::vector<float>& d, std::vector<float>& speed, const std::array<int, 3>& dims,
                               double h, double limit, bool painted);
