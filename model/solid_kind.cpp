@@ -75,6 +75,8 @@ class SolidReader {
     if (!any) section.error(diags_, "missing required key 'volume' or 'precedence' in solid");
     m.finish();
     if (!diags_.hasErrors() && !spec_.solid.volumes.empty()) resolveGrid(grid, section);
+    // Wrappers reach two cells inward, closing the gap to the volumes they wrap.
+    for (size_t v : wrappers_) closeInward(spec_.solid.volumes[v], 2 * spec_.grid.cell);
   }
 
  private:
@@ -169,8 +171,13 @@ class SolidReader {
   void readVolume(const YNode& value) {
     MapReader m(value, diags_, "volume");
     FieldPtr field;
-    if (auto f = m.get("distance_field")) field = readField(*f);
-    else value.error(diags_, "missing required key 'distance_field' in volume");
+    bool wraps = false;  // the field is the outermost interface of earlier volumes
+    if (auto f = m.get("distance_field")) {
+      field = readField(*f);
+      wraps = f->isMap() && f->node().size() == 1 && f->node()["from_volume_surface"].IsDefined();
+    } else {
+      value.error(diags_, "missing required key 'distance_field' in volume");
+    }
     std::optional<VelocityWrap> velocity;
     std::optional<YNode> velocityNode = m.get("velocity");
     if (velocityNode) velocity = readVelocity(*velocityNode, diags_, nullptr, false);
@@ -227,6 +234,7 @@ class SolidReader {
         if (!field) return;
       }
       if (!addVolume(value, field, run)) return;
+      if (wraps || r > 0) wrappers_.push_back(spec_.solid.volumes.size() - 1);
       nest.push_back(spec_.solid.volumes.back());
     }
   }
@@ -464,6 +472,7 @@ class SolidReader {
   SolidSpec& spec_;
   const PathPolicy& policy_;
   std::map<std::string, int> names_;  ///< file materials: concrete ids and procedural codes
+  std::vector<size_t> wrappers_;  ///< volumes whose field is from_volume_surface
   double maxExterior_ = 0;
   double thinnest_ = 1e30;
 };

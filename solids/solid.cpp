@@ -244,6 +244,16 @@ Volume makeVolume(FieldPtr field, const std::vector<Layer>& layers) {
   return v;
 }
 
+void closeInward(Volume& v, double margin) {
+  const auto zero = std::find(v.boundaries.begin(), v.boundaries.end(), 0.0);
+  if (zero == v.boundaries.end() || !(margin > 0)) return;
+  const size_t z = size_t(zero - v.boundaries.begin());
+  const int below = v.regions[z], above = v.regions[z + 1];
+  if (below != kUnclaimed || above == kUnclaimed || above == kNothing) return;
+  const double floor = z > 0 ? v.boundaries[z - 1] : -std::numeric_limits<double>::infinity();
+  v.boundaries[z] = std::max(-margin, floor / 2);
+}
+
 double TetMesh::volume(size_t t) const {
   const auto& q = tets[t];
   return det(positions[q[0]], positions[q[1]], positions[q[2]], positions[q[3]]) / 6.0;

@@ -52,6 +52,13 @@ struct Volume {
 /// in a front (solids/front_field.h) to measure distance from the interface again.
 FieldPtr volumeSurfaceField(std::vector<Volume> volumes);
 
+/// For a volume wrapped around earlier ones (from_volume_surface): when the region just
+/// inside its zero set is unclaimed, the material just outside reaches `margin` inward, so
+/// the wrapper meets the earlier volumes without a gap (its zero set is their boundary only
+/// to within the front's discretization). Earlier volumes keep precedence: the margin only
+/// fills what they leave. A margin deeper than the unclaimed region is cut to half of it.
+void closeInward(Volume& v, double margin);
+
 /// A layer as written: a thickness (or fill) and a material id.
 struct Layer {
   bool interior = true;
