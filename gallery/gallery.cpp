@@ -130,8 +130,10 @@ GalleryItem renderGalleryItem(const fs::path& speciesFile, const fs::path& outDi
     item.triangles = fig.triangles;
     item.deriveSeconds = fig.buildSeconds;
 
-    // The growth strip: every stage framed like the final one.
-    const std::vector<Stage> stages = model.stripStages(5);
+    // The growth strip: every stage framed like the final one. A solid does not grow: its
+    // strip is the whole solid and its cut-away by the plane z = 0 (Fig. 3e, 3f).
+    const bool solid = !model.volumeMeshExtensions().empty();
+    const std::vector<Stage> stages = solid ? std::vector<Stage>{job.stage, job.stage} : model.stripStages(5);
     for (const Stage& st : stages)
       item.stages.push_back(model.stageNumber(st));
     const int stripHeight = std::max(16, height * 2 / 3);
@@ -146,7 +148,9 @@ GalleryItem renderGalleryItem(const fs::path& speciesFile, const fs::path& outDi
       cellJob.stage = stages[i];
       if (draft && exact) cellJob.samples = 1;
       cellJob.progressLabel = "stages " + stem + " " + std::to_string(i + 1) + "/" + std::to_string(stages.size());
-      Image cell = renderModel(model, stripLook, cellJob);
+      SpeciesRender cellLook = stripLook;
+      if (solid && i == 1) cellLook.section = look.section.value_or(Vec4(0, 0, 1, 0));
+      Image cell = renderModel(model, cellLook, cellJob);
       for (int y = 0; y < stripHeight; ++y)
         for (int x = 0; x < cellWidth; ++x) strip.set(static_cast<int>(i) * cellWidth + x, y, cell.at(x, y));
     }
