@@ -13,7 +13,7 @@ BUILD=${1:?usage: fuzz/run.sh BUILD_DIR SECONDS [TARGET...]}
 SECS=${2:?usage: fuzz/run.sh BUILD_DIR SECONDS [TARGET...]}
 shift 2
 TARGETS=("$@")
-[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(grammar expression derive species_tree species_shell species_blob species_organism polymesh image volume)
+[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(grammar expression derive species_tree species_shell species_blob species_organism species_solid polymesh image volume)
 ROOT=$(pwd)
 # The sanitizer settings of the Makefile, also when this script is run by hand.
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:detect_stack_use_after_return=0}

@@ -1,5 +1,5 @@
 /// Fuzz target: the species reader of one kind (SPRIG_FUZZ_KIND: tree, shell, blob,
-/// organism); the input is the file without its `kind:` line, which the target prepends.
+/// organism, solid); the input is the file without its `kind:` line, which the target prepends.
 ///
 /// File access is sandboxed: the species is read as /sprig-fuzz-sandbox/s.yaml with the
 /// library root /sprig-fuzz-sandbox, a folder that does not exist, so every referenced file
