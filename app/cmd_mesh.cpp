@@ -22,6 +22,7 @@ struct MeshArgs {
   double cell = 0.0;
   StageFlags stage;
   GrowthFlags growth;
+  bool interfaces = false;
 };
 
 int runMesh(const MeshArgs& a, const GlobalOptions& g) {
@@ -32,6 +33,19 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
   const Stage stage = a.stage.resolve(model);
   // Volume meshes (tetrahedra with materials) of kinds that have them, by extension.
   const std::string ext = lowerExtension(a.out);
+  if (a.interfaces) {
+    if (ext == ".msh" || ext == ".vtu" || ext == ".mesh")
+      throw UsageError("--interfaces writes triangle meshes: give -o a .ply, .obj or .glb name");
+    const std::filesystem::path out(a.out);
+    for (auto& [name, mesh] : model.interfaceMeshes(stage)) {
+      const std::filesystem::path path = out.parent_path() / (out.stem().string() + "_" + name + out.extension().string());
+      MeshWriteOptions wopt;
+      wopt.materialName = name;
+      writeMesh(mesh, path, wopt);
+      note(g, std::cout, "%s: %zu triangles, %zu vertices", path.string().c_str(), mesh.triangleCount(), mesh.vertexCount());
+    }
+    return kExitOk;
+  }
   if (ext == ".msh" || ext == ".vtu" || ext == ".mesh") {
     const std::string line = model.writeVolumeMesh(stage, a.out, !g.quiet);
     double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -58,6 +72,9 @@ void addMeshCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run)
   addInputOutput(*sub, "SPECIES", args->file, args->out, "output mesh (.ply, .obj + .mtl, .glb; solids also .msh, .vtu, .mesh)");
   sub->add_option("--cell", args->cell, "cell edge length in model units (default: automatic, from the smallest feature)")
       ->check(CLI::PositiveNumber);
+  sub->add_flag("--interfaces", args->interfaces,
+                 "solids: write each interface between two materials, and each material's outer surface, as OUT_<A>_<B>.EXT "
+                 "(triangles oriented out of A; B = outside for the visible interface)");
   addStageFlags(*sub, args->stage);
   addGrowthFlags(*sub, args->growth);
 }

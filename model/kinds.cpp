@@ -39,4 +39,8 @@ std::string KindModel::writeVolumeMesh(const Stage&, const std::filesystem::path
   throw UsageError("'" + path.extension().string() + "' is a tetrahedral mesh format: only solid species have one");
 }
 
+std::vector<std::pair<std::string, Mesh>> KindModel::interfaceMeshes(const Stage&) {
+  throw UsageError("--interfaces applies to solid species only (their material interfaces)");
+}
+
 }  // namespace sprig

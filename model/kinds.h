@@ -106,6 +106,9 @@ class KindModel {
   /// Writes the stage's volume mesh to path (its extension one of volumeMeshExtensions())
   /// atomically and returns the line `sprig mesh` prints. The default throws UsageError.
   virtual std::string writeVolumeMesh(const Stage& stage, const std::filesystem::path& path, bool progress);
+  /// The stage's interfaces between materials as meshes, each with its name ("nut_chocolate",
+  /// "foil_outside"). The default throws UsageError (only solids have materials).
+  virtual std::vector<std::pair<std::string, Mesh>> interfaceMeshes(const Stage& stage);
 };
 
 /// A species with one stage that does not grow (blobs, solids): every stage is that one, and

@@ -83,6 +83,8 @@ class SpeciesModel {
   std::string writeVolumeMesh(const Stage& stage, const std::filesystem::path& path, bool progress) {
     return kind_->writeVolumeMesh(stage, path, progress);
   }
+  /// The interfaces between materials as named meshes (KindModel::interfaceMeshes).
+  std::vector<std::pair<std::string, Mesh>> interfaceMeshes(const Stage& stage) { return kind_->interfaceMeshes(stage); }
   /// How the gallery animates the species.
   GalleryMotion galleryMotion(bool final) { return kind_->galleryMotion(final); }
 

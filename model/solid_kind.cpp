@@ -529,6 +529,38 @@ class SolidModel final : public StillKindModel {
 
   std::vector<std::string> volumeMeshExtensions() const override { return {".msh", ".vtu", ".mesh"}; }
 
+  std::vector<std::pair<std::string, Mesh>> interfaceMeshes(const Stage&) override {
+    const TetMesh& m = tets();
+    const auto& mats = spec_.solid.materials.materials;
+    // (A, B) with A < B, or (A, outside): triangles oriented out of A.
+    std::map<std::pair<int, int>, std::vector<std::array<uint32_t, 3>>> groups;
+    const std::vector<InterfaceTriangle> inner = materialInterfaces(m);
+    for (size_t k = 0; k + 1 < inner.size(); k += 2) {
+      const InterfaceTriangle& a = inner[k].material < inner[k + 1].material ? inner[k] : inner[k + 1];
+      const InterfaceTriangle& b = &a == &inner[k] ? inner[k + 1] : inner[k];
+      groups[{a.material, b.material}].push_back(a.v);
+    }
+    for (const InterfaceTriangle& t : visibleInterface(m)) groups[{t.material, -1}].push_back(t.v);
+    std::vector<std::pair<std::string, Mesh>> out;
+    for (const auto& [pair, tris] : groups) {
+      Mesh mesh;
+      std::map<uint32_t, uint32_t> index;
+      for (const auto& t : tris) {
+        glm::uvec3 tri;
+        for (int c = 0; c < 3; ++c) {
+          auto [it, fresh] = index.emplace(t[size_t(c)], uint32_t(mesh.positions.size()));
+          if (fresh) mesh.positions.push_back(Vec3(m.positions[t[size_t(c)]]));
+          tri[c] = it->second;
+        }
+        mesh.triangles.push_back(tri);
+      }
+      mesh.colors.assign(mesh.positions.size(), mats[size_t(pair.first)].color);
+      out.emplace_back(mats[size_t(pair.first)].name + "_" + (pair.second < 0 ? "outside" : mats[size_t(pair.second)].name),
+                       std::move(mesh));
+    }
+    return out;
+  }
+
   std::string writeVolumeMesh(const Stage&, const std::filesystem::path& path, bool) override {
     const TetMesh& m = tets();
     writeTetMesh(m, spec_.solid.materials.materials, path);

@@ -156,8 +156,9 @@ struct InterfaceTriangle {
 std::vector<InterfaceTriangle> visibleInterface(const TetMesh& mesh, size_t* badFaces = nullptr);
 
 /// The interfaces between different materials: for each pair of tetrahedra of materials
-/// A != B sharing a face, the face oriented out of A (and once more out of B), so the
-/// triangles of one material together with its visible faces bound it closed.
+/// A != B sharing a face, the face oriented out of A and then once more out of B (entries
+/// 2k and 2k + 1 are one face), so the triangles of one material together with its visible
+/// faces bound it closed.
 std::vector<InterfaceTriangle> materialInterfaces(const TetMesh& mesh);
 
 /// Tetrahedron faces in local vertex order, oriented outward for a positive tetrahedron.
