@@ -420,6 +420,15 @@ class SolidReader {
     if (!(o.heightHi > o.heightLo)) m.get("height")->error(diags_, "'height' must be [lo, hi] with lo < hi");
     if (!file || !(o.size.x > 0 && o.size.y > 0) || !(o.heightHi > o.heightLo)) return nullptr;
     try {
+      // The transform keeps about 80 bytes per pixel of the padded image (4 times the image).
+      constexpr uint64_t kMaxMaskPixels = uint64_t(2048) * 2048;
+      const ImageInfo info = readImageInfo(*file);
+      if (uint64_t(info.width) * uint64_t(info.height) > kMaxMaskPixels) {
+        m.get("file")->error(diags_, "image " + sprig::quoted(file->string()) + " is " + std::to_string(info.width) + " x " +
+                                         std::to_string(info.height) + " pixels, more than extrude_2d takes (" +
+                                         std::to_string(kMaxMaskPixels) + ", 2048 x 2048)");
+        return nullptr;
+      }
       const Image image = readImage(*file);
       Mask2d mask;
       mask.width = image.width;

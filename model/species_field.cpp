@@ -63,7 +63,7 @@ solids::FieldPtr readSpeciesField(MapReader& m, const PathPolicy& policy) {
   if (m.has("seed")) seed = m.integer("seed", 0, 0);
   auto file = m.path("file", policy);
   if (!file) {
-    if (!m.has("file")) m.node().error(diags, "missing required key 'file' in species (a blob, shell or tree species file)");
+    if (!m.has("file")) m.node().error(diags, "missing required key 'file' in species (a blob, shell, tree or organism species file)");
     return nullptr;
   }
   const YNode at = *m.get("file");
