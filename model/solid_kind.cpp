@@ -402,8 +402,8 @@ class SolidReader {
   }
 
   /// `extrude_2d: {file, size, center, axis, height, threshold}` (the paper's 2D_EXTRUDE):
-  /// pixels of the image darker than threshold (luminance of the sRGB-encoded values, 0
-  /// black to 1 white) form the region; solids/extrude_field.h places and extrudes it.
+  /// pixels of the image darker than threshold (the sRGB encoding of the linear Rec. 709
+  /// luminance: 0 black, 1 white) form the region; solids/extrude_field.h places and extrudes it.
   FieldPtr readExtrude(MapReader& m) {
     auto file = m.path("file", policy_);
     if (!file && !m.has("file"))
