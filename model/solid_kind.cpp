@@ -6,10 +6,14 @@
 #include <cstdio>
 #include <map>
 
+#include "core/image.h"
 #include "core/polymesh.h"
+#include "core/srgb.h"
 #include "core/timer.h"
 #include "model/solid_velocity.h"
 #include "solids/front_field.h"
+#include "model/species_field.h"
+#include "solids/extrude_field.h"
 #include "solids/tet_io.h"
 
 namespace sprig {
@@ -30,12 +34,8 @@ const std::vector<std::string> kVolumeForms = {"volume", "precedence"};
 const std::vector<std::string> kFields = {"surface_mesh", "sphere",    "box",         "cylinder",
                                           "ground_plane", "union",     "intersection", "subtraction",
                                           "transform",    "from_volume_surface", "extrude_2d", "species"};
-const std::vector<std::string> kNotBuilt = {"extrude_2d", "species"};
 const std::vector<std::string> kLayers = {"interior_layer", "exterior_layer"};
 
-std::string notBuilt(const std::string& what) {
-  return sprig::quoted(what) + " is not supported by this version of Sprig (docs/SOLIDS.md, \"Not built yet\")";
-}
 
 /// Reads the solid section; every error goes to diags.
 class SolidReader {
@@ -281,10 +281,6 @@ class SolidReader {
     auto one = singleKey(node, diags_, "distance field", kFields);
     if (!one) return nullptr;
     const std::string kind = one->first.scalar();
-    if (std::find(kNotBuilt.begin(), kNotBuilt.end(), kind) != kNotBuilt.end()) {
-      one->first.error(diags_, notBuilt(kind));
-      return nullptr;
-    }
     const YNode& value = one->second;
     if (kind == "from_volume_surface") return readVolumeSurface(value);
     if (kind == "union" || kind == "intersection" || kind == "subtraction") {
@@ -337,6 +333,10 @@ class SolidReader {
       }
       const Vec3 t = m.vec3("translate", Vec3(0.0f));
       if (child) out = transformField(child, scale, DVec3(axis), angle, DVec3(t));
+    } else if (kind == "extrude_2d") {
+      out = readExtrude(m);
+    } else if (kind == "species") {
+      out = readSpeciesField(m, policy_);
     }
     m.finish();
     return out;
@@ -475,6 +475,68 @@ class SolidReader {
   std::vector<size_t> wrappers_;  ///< volumes whose field is from_volume_surface
   double maxExterior_ = 0;
   double thinnest_ = 1e30;
+
+  // ---- extrude_2d ----
+  /// `[a, b]` of finite numbers at key (def when absent; after an error too).
+  glm::dvec2 pairOf(MapReader& m, const char* key, glm::dvec2 def) {
+    std::optional<YNode> v = m.get(key);
+    if (!v) return def;
+    const std::vector<YNode> items = v->items();
+    if (!v->isSequence() || items.size() != 2) {
+      v->error(diags_, sprig::quoted(key) + " must be [a, b]");
+      return def;
+    }
+    auto a = items[0].asNumber(diags_, sprig::quoted(key)), b = items[1].asNumber(diags_, sprig::quoted(key));
+    return a && b ? glm::dvec2(*a, *b) : def;
+  }
+
+  /// `extrude_2d: {file, size, center, axis, height, threshold}` (the paper's 2D_EXTRUDE):
+  /// pixels of the image darker than threshold (the sRGB encoding of the linear Rec. 709
+  /// luminance: 0 black, 1 white) form the region; solids/extrude_field.h places and extrudes it.
+  FieldPtr readExtrude(MapReader& m) {
+    auto file = m.path("file", policy_);
+    if (!file && !m.has("file"))
+      m.node().error(diags_, "missing required key 'file' in extrude_2d (a PNG or PPM image; dark pixels are inside)");
+    ExtrudeOptions o;
+    o.size = pairOf(m, "size", glm::dvec2(1.0));
+    o.center = pairOf(m, "center", glm::dvec2(0.0));
+    o.axis = DVec3(axisOf(m, "axis"));
+    const glm::dvec2 h = pairOf(m, "height", glm::dvec2(0.0, 1.0));
+    o.heightLo = h.x;
+    o.heightHi = h.y;
+    const double threshold = m.number("threshold", 0.5, 0.0, 1.0);
+    if (!(o.size.x > 0 && o.size.y > 0)) m.get("size")->error(diags_, "'size' must be positive, world units [along columns, along rows]");
+    if (!(o.heightHi > o.heightLo)) m.get("height")->error(diags_, "'height' must be [lo, hi] with lo < hi");
+    if (!file || !(o.size.x > 0 && o.size.y > 0) || !(o.heightHi > o.heightLo)) return nullptr;
+    try {
+      // The transform keeps about 80 bytes per pixel of the padded image (4 times the image).
+      constexpr uint64_t kMaxMaskPixels = uint64_t(2048) * 2048;
+      const ImageInfo info = readImageInfo(*file);
+      if (uint64_t(info.width) * uint64_t(info.height) > kMaxMaskPixels) {
+        m.get("file")->error(diags_, "image " + sprig::quoted(file->string()) + " is " + std::to_string(info.width) + " x " +
+                                         std::to_string(info.height) + " pixels, more than extrude_2d takes (" +
+                                         std::to_string(kMaxMaskPixels) + ", 2048 x 2048)");
+        return nullptr;
+      }
+      const Image image = readImage(*file);
+      Mask2d mask;
+      mask.width = image.width;
+      mask.height = image.height;
+      mask.inside.resize(size_t(image.width) * image.height);
+      for (int y = 0; y < image.height; ++y)
+        for (int x = 0; x < image.width; ++x) {
+          const Vec4 c = image.at(x, y);
+          const float lum = linearToSrgb(0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b);
+          mask.inside[size_t(y) * image.width + x] = lum < threshold ? 1 : 0;
+        }
+      return extrudeField(mask, o);
+    } catch (const ImageReadError& e) {
+      m.get("file")->error(diags_, e.what());
+    } catch (const std::invalid_argument& e) {
+      m.get("file")->error(diags_, e.what());
+    }
+    return nullptr;
+  }
 };
 
 /// A solid: its tetrahedral mesh, built once.

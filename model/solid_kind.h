@@ -22,8 +22,8 @@
 ///             - exterior_layer: {material: white_chocolate, thickness: 0.1}
 /// ```
 /// docs/SOLIDS.md lists every key, default and unit, and what is not built yet (interface
-/// velocity, from_volume_surface, 2-D extrusion, Sprig species as fields): those keys are
-/// errors at their file:line:col, never ignored.
+/// velocity, from_volume_surface): those keys are errors at their file:line:col, never
+/// ignored. `extrude_2d` and `species` fields: solids/extrude_field.h, model/species_field.h.
 
 #include <memory>
 #include <string>

@@ -77,8 +77,6 @@ TEST_CASE("kind: solid reports every mistake at its file:line:col", "[model][sol
   CHECK(errorOf(head + "      - exterior_layer: {material: chocolate, thickness: -1}\n")
             .find("'thickness' must be positive") != std::string::npos);
   CHECK(errorOf(head + "      - middle_layer: {material: chocolate}\n").find("unknown layer 'middle_layer'") != std::string::npos);
-  CHECK(errorOf("kind: solid\nsolid:\n  volume:\n    distance_field: {extrude_2d: {}}\n    layers: []\n")
-            .find("solid.yaml:4:22: error: 'extrude_2d' is not supported by this version of Sprig") != std::string::npos);
   CHECK(errorOf(head + "      - interior_layer: {material: chocolate, thickness: fill}\n"
                        "      - exterior_layer: {material: foil, thickness: 0.1, velocity: {painted: {}}}\n")
             .find("solid.yaml:7:78: error: a painted velocity belongs on a surface_mesh") != std::string::npos);

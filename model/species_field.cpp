@@ -1,0 +1,132 @@
+#include "model/species_field.h"
+
+#include <cstdio>
+#include <cstring>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "core/mesh.h"
+#include "core/polymesh.h"
+#include "model/model.h"
+#include "model/species.h"
+
+namespace sprig {
+
+namespace {
+
+/// The species files being read on this thread, outermost first: a file that appears here
+/// again is a cycle.
+thread_local std::vector<std::filesystem::path> gOpenFiles;
+
+std::filesystem::path identity(const std::filesystem::path& p) {
+  std::error_code ec;
+  std::filesystem::path c = std::filesystem::weakly_canonical(p, ec);
+  return ec ? p.lexically_normal() : c;
+}
+
+/// Pushes a file on gOpenFiles for a scope.
+struct OpenFile {
+  explicit OpenFile(std::filesystem::path p) { gOpenFiles.push_back(std::move(p)); }
+  ~OpenFile() { gOpenFiles.pop_back(); }
+  OpenFile(const OpenFile&) = delete;
+  OpenFile& operator=(const OpenFile&) = delete;
+};
+
+/// mesh with vertices at the same position made one, as a polygon mesh (the polygonizer's
+/// and the kinds' meshes may repeat a vertex per face; a distance field needs the topology).
+PolyMesh welded(const Mesh& mesh) {
+  PolyMesh out;
+  std::map<std::array<uint32_t, 3>, uint32_t> index;
+  std::vector<uint32_t> remap(mesh.positions.size());
+  for (size_t i = 0; i < mesh.positions.size(); ++i) {
+    std::array<uint32_t, 3> key;
+    std::memcpy(key.data(), &mesh.positions[i], sizeof key);
+    auto [it, fresh] = index.try_emplace(key, uint32_t(out.positions.size()));
+    if (fresh) out.positions.push_back(mesh.positions[i]);
+    remap[i] = it->second;
+  }
+  for (const glm::uvec3& t : mesh.triangles) {
+    const uint32_t a = remap[t.x], b = remap[t.y], c = remap[t.z];
+    if (a == b || b == c || a == c) continue;  // collapsed by welding
+    out.faceSizes.push_back(3);
+    out.faceVertices.insert(out.faceVertices.end(), {a, b, c});
+  }
+  return out;
+}
+
+}  // namespace
+
+solids::FieldPtr readSpeciesField(MapReader& m, const PathPolicy& policy) {
+  DiagnosticList& diags = m.diagnostics();
+  std::optional<int64_t> seed;
+  if (m.has("seed")) seed = m.integer("seed", 0, 0);
+  auto file = m.path("file", policy);
+  if (!file) {
+    if (!m.has("file")) m.node().error(diags, "missing required key 'file' in species (a blob, shell, tree or organism species file)");
+    return nullptr;
+  }
+  const YNode at = *m.get("file");
+  const std::string name = sprig::quoted(file->string());
+
+  // A cycle: the referred file is the referring one or one still being read around it.
+  const std::filesystem::path self = identity(at.file().path());
+  const std::filesystem::path target = identity(*file);
+  std::vector<std::filesystem::path> chain = gOpenFiles;
+  if (chain.empty() || chain.back() != self) chain.push_back(self);
+  for (size_t i = 0; i < chain.size(); ++i)
+    if (chain[i] == target) {
+      std::string text;
+      for (size_t k = i; k < chain.size(); ++k) text += chain[k].filename().string() + " -> ";
+      text += target.filename().string();
+      at.error(diags, "species files refer to each other in a cycle: " + text + " (a species field cannot contain itself)");
+      return nullptr;
+    }
+
+  const bool outer = gOpenFiles.empty();
+  std::optional<OpenFile> selfOpen;
+  if (outer || gOpenFiles.back() != self) selfOpen.emplace(self);
+  OpenFile targetOpen(target);
+  try {
+    const Species species = loadSpecies(*file, policy);
+    if (species.kind == "solid") {
+      at.error(diags, name + " is a solid species, and a solid species is not a distance field (name a blob, shell, tree or organism species)");
+      return nullptr;
+    }
+    if (seed && species.kind != "tree") {
+      m.get("seed")->error(diags, "'seed' replaces a tree's derivation seed; " + name + " is a " + species.kind +
+                                      " species (its seeds are in its own file)");
+      return nullptr;
+    }
+    ModelOptions options;
+    if (seed) options.extra.seed = uint64_t(*seed);
+    SpeciesModel model(species, options);
+    if (!model.hasSurfaceSettings()) {
+      at.error(diags, "species " + name + " has no surface (a tree needs a tree: section)");
+      return nullptr;
+    }
+    const Mesh surface = model.buildMesh(model.finalStage(), 0.0f, false);
+    const PolyMesh mesh = welded(surface);
+    if (mesh.faceSizes.empty()) {
+      at.error(diags, "the surface of species " + name + " is empty");
+      return nullptr;
+    }
+    if (auto open = solids::firstOpenEdge(mesh)) {
+      const Vec3 p = mesh.positions[open->a], q = mesh.positions[open->b];
+      char where[160];
+      std::snprintf(where, sizeof where, " (from %.4g, %.4g, %.4g to %.4g, %.4g, %.4g)", p.x, p.y, p.z, q.x, q.y, q.z);
+      at.error(diags, "the surface of species " + name + " is not closed: the edge from vertex " + std::to_string(open->a + 1) +
+                          " to vertex " + std::to_string(open->b + 1) + where +
+                          " has only one face (a distance field needs a closed mesh)");
+      return nullptr;
+    }
+    return solids::meshField(mesh);
+  } catch (const InputError& e) {
+    diags.append(e.diagnostics());
+  } catch (const std::exception& e) {
+    at.error(diags, e.what());
+  }
+  return nullptr;
+}
+
+}  // namespace sprig
