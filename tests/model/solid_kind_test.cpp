@@ -156,9 +156,11 @@ solid:
   }
   SECTION("the shipped Fig. 2c and Fig. 3 species read") {
     for (const char* f : {"fig_solid_02c_almond_wrapped", "fig_solid_03a_painted_velocity", "fig_solid_03b_turbulent_velocity",
-                          "fig_solid_03c_diagonal_velocity", "fig_solid_03d_lumpy_candy"}) {
+                          "fig_solid_03c_diagonal_velocity", "fig_solid_03d_lumpy_candy", "solid_urban_tree"}) {
       INFO(f);
-      const Species s = loadSpecies(std::string(SPRIG_SOURCE_DIR) + "/species/" + f + ".yaml");
+      PathPolicy policy;
+      policy.root = SPRIG_SOURCE_DIR;
+      const Species s = loadSpecies(std::string(SPRIG_SOURCE_DIR) + "/species/" + f + ".yaml", policy);
       CHECK(dynamic_cast<const SolidSpec&>(*s.spec).solid.volumes.size() >= 1);
     }
   }
