@@ -156,7 +156,7 @@ solid:
   }
   SECTION("the shipped Fig. 2c and Fig. 3 species read") {
     for (const char* f : {"fig_solid_02c_almond_wrapped", "fig_solid_03a_painted_velocity", "fig_solid_03b_turbulent_velocity",
-                          "fig_solid_03c_diagonal_velocity", "fig_solid_03d_lumpy_candy", "solid_urban_tree"}) {
+                          "fig_solid_03c_diagonal_velocity", "fig_solid_03d_lumpy_candy", "solid_urban_tree", "solid_murex_layers"}) {
       INFO(f);
       PathPolicy policy;
       policy.root = SPRIG_SOURCE_DIR;
