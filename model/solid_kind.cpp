@@ -65,14 +65,7 @@ class SolidReader {
   void readSolid(const YNode& section) {
     MapReader m(section, diags_, "solid");
     std::optional<YNode> grid = m.section("grid");
-    bool any = false;
-    for (const std::string& form : kVolumeForms)
-      if (auto v = m.get(form)) {
-        if (any) v->error(diags_, "a solid is one 'volume' or one 'precedence' list, not both");
-        any = true;
-        readVolumeForm(form, *v);
-      }
-    if (!any) section.error(diags_, "missing required key 'volume' or 'precedence' in solid");
+    readVolumes(m, section, "solid");
     m.finish();
     if (!diags_.hasErrors() && !spec_.solid.volumes.empty()) resolveGrid(grid, section);
     // Wrappers reach two cells inward, closing the gap to the volumes they wrap.
@@ -155,6 +148,19 @@ class SolidReader {
   }
 
   // ---- volumes ----
+  /// The one `volume` or `precedence` of map m (in `what`); false after an error.
+  bool readVolumes(MapReader& m, const YNode& node, const std::string& what) {
+    bool any = false;
+    for (const std::string& form : kVolumeForms)
+      if (auto v = m.get(form)) {
+        if (any) v->error(diags_, "a " + what + " takes one 'volume' or one 'precedence' list, not both");
+        any = true;
+        readVolumeForm(form, *v);
+      }
+    if (!any) node.error(diags_, "missing required key 'volume' or 'precedence' in " + what);
+    return any;
+  }
+
   void readVolumeForm(const std::string& form, const YNode& value) {
     if (form == "volume") {
       readVolume(value);
@@ -352,20 +358,12 @@ class SolidReader {
     return glm::normalize(a);
   }
 
-  /// A closed mesh file as a field; the first open edge is an error at its face.
   /// The outermost interface of a volume or a precedence list (§2.3, Fig. 2c). The inner
   /// volumes are part of the solid, in precedence before the volume that uses the field.
   FieldPtr readVolumeSurface(const YNode& value) {
     MapReader m(value, diags_, "from_volume_surface");
     const size_t first = spec_.solid.volumes.size();
-    bool any = false;
-    for (const std::string& form : kVolumeForms)
-      if (auto v = m.get(form)) {
-        if (any) v->error(diags_, "from_volume_surface takes one 'volume' or one 'precedence' list, not both");
-        any = true;
-        readVolumeForm(form, *v);
-      }
-    if (!any) value.error(diags_, "missing required key 'volume' or 'precedence' in from_volume_surface");
+    const bool any = readVolumes(m, value, "from_volume_surface");
     std::optional<VelocityWrap> velocity;
     std::optional<YNode> vn = m.get("velocity");
     if (vn) velocity = readVelocity(*vn, diags_, nullptr, true);
@@ -376,6 +374,7 @@ class SolidReader {
     return velocity ? (*velocity)(surface) : redistanced(surface);
   }
 
+  /// A closed mesh file as a field; the first open edge is an error at its face.
   FieldPtr readMesh(MapReader& m, PolyMesh* keep = nullptr) {
     auto file = m.path("file", policy_);
     if (!file) {

@@ -8,6 +8,7 @@
 #include "solids/distance_field.h"
 #include "solids/front_field.h"
 #include "solids/solid.h"
+#include "tests/solids/grid_fixture.h"
 
 using namespace sprig;
 using namespace sprig::solids;
@@ -41,14 +42,7 @@ Solid coated(FieldPtr field, double thickness) {
   return s;
 }
 
-Grid box(double half, double cell) {
-  Grid g;
-  g.cell = cell;
-  const int n = int(std::ceil(2 * half / cell));
-  g.cells = {n, n, n};
-  g.origin = DVec3(-half);
-  return g;
-}
+using test::gridAround;
 
 /// Smallest and largest |p| of the visible interface's vertices where pick(p).
 std::pair<double, double> outerRadii(const TetMesh& m, bool (*pick)(const DVec3&)) {
@@ -122,10 +116,10 @@ TEST_CASE("marchFront: arrival times of closed form", "[solids][front]") {
 
 TEST_CASE("interface velocity: velocity 2 gives layers twice as thick", "[solids][front]") {
   const double cell = 0.04, thickness = 0.2;
-  const TetMesh one = meshSolid(coated(sphereField(DVec3(0.0), 1.0), thickness), box(1.6, cell));
+  const TetMesh one = meshSolid(coated(sphereField(DVec3(0.0), 1.0), thickness), gridAround(1.6, cell));
   // The front path (a procedure of the point), not the exact division by a constant.
   const TetMesh two = meshSolid(coated(frontField(sphereField(DVec3(0.0), 1.0), constantSpeed(2.0f), 2.0, false), thickness),
-                                box(1.6, cell));
+                                gridAround(1.6, cell));
   auto all = [](const DVec3&) { return true; };
   const auto [lo1, hi1] = outerRadii(one, all);
   const auto [lo2, hi2] = outerRadii(two, all);
@@ -142,7 +136,7 @@ TEST_CASE("interface velocity: velocity 2 gives layers twice as thick", "[solids
     SpeedFn halves = [](const std::vector<Vec3>& pts, std::vector<float>& out) {
       for (size_t i = 0; i < pts.size(); ++i) out[i] = pts[i].x > 0 ? 2.0f : 1.0f;
     };
-    const TetMesh m = meshSolid(coated(frontField(sphereField(DVec3(0.0), 1.0), halves, 2.0, false), thickness), box(1.6, cell));
+    const TetMesh m = meshSolid(coated(frontField(sphereField(DVec3(0.0), 1.0), halves, 2.0, false), thickness), gridAround(1.6, cell));
     const auto [loF, hiF] = outerRadii(m, [](const DVec3& p) { return p.x > 0.9; });
     const auto [loS, hiS] = outerRadii(m, [](const DVec3& p) { return p.x < -0.9; });
     INFO("fast side " << loF << ".." << hiF << ", slow side " << loS << ".." << hiS);
@@ -150,7 +144,7 @@ TEST_CASE("interface velocity: velocity 2 gives layers twice as thick", "[solids
     CHECK(hiS == Approx(1 + thickness).margin(cell));
   }
   SECTION("constant speed: an exact division") {
-    const TetMesh c = meshSolid(coated(constantSpeedField(sphereField(DVec3(0.0), 1.0), 2.0), thickness), box(1.6, cell));
+    const TetMesh c = meshSolid(coated(constantSpeedField(sphereField(DVec3(0.0), 1.0), 2.0), thickness), gridAround(1.6, cell));
     const auto [lo, hi] = outerRadii(c, all);
     CHECK(lo > 1 + 2 * thickness - cell);
     CHECK(hi < 1 + 2 * thickness + cell);

@@ -18,6 +18,7 @@
 #include "lsystem/expression.h"
 #include "solids/tet_io.h"
 #include "tests/scratch_dir.h"
+#include "tests/solids/grid_fixture.h"
 
 using namespace sprig;
 using namespace sprig::solids;
@@ -46,14 +47,7 @@ Solid sphereSolid(double radius, const std::vector<LayerText>& layers, DVec3 cen
   return s;
 }
 
-Grid gridAround(double halfSize, double cell) {
-  Grid g;
-  g.cell = cell;
-  const int n = int(std::ceil(2 * halfSize / cell));
-  g.cells = {n, n, n};
-  g.origin = DVec3(-halfSize);
-  return g;
-}
+using test::gridAround;
 
 std::map<uint16_t, double> volumeByMaterial(const TetMesh& m) {
   std::map<uint16_t, double> v;
