@@ -90,7 +90,19 @@ Stage StageFlags::resolve(const SpeciesModel& model) const {
 
 void addInputOutput(CLI::App& sub, const char* name, std::string& file, std::string& out, const char* outputHelp) {
   sub.add_option(name, file, "species file (.yaml) or grammar (.lsys)")->required();
-  sub.add_option("-o,--output", out, outputHelp)->required();
+  // The folder the output goes into must exist before any work starts (a folder output,
+  // `frames/`, may itself be new: its parent must exist).
+  const CLI::Validator folderExists(
+      [](std::string& value) -> std::string {
+        std::string trimmed = value;
+        while (trimmed.size() > 1 && trimmed.back() == '/') trimmed.pop_back();
+        const std::filesystem::path parent = std::filesystem::path(trimmed).parent_path();
+        std::error_code ec;
+        if (parent.empty() || std::filesystem::is_directory(parent, ec)) return {};
+        return "folder '" + parent.string() + "' does not exist";
+      },
+      "", "output folder exists");
+  sub.add_option("-o,--output", out, outputHelp)->required()->check(folderExists);
 }
 
 void note(const GlobalOptions& g, std::ostream& os, const char* format, ...) {
