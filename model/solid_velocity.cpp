@@ -124,7 +124,12 @@ std::optional<VelocityWrap> readExpression(const YNode& exprNode, const std::str
     speed->expr = lsystem::Expression::compile(text, {"x", "y", "z", "noise", "turbulence"}, at,
                                                exprNode.file().sourceLine(at.line));
   } catch (const InputError& e) {
-    diags.append(e.diagnostics());
+    std::vector<Diagnostic> ds = e.diagnostics();
+    for (Diagnostic& d : ds)
+      if (d.message == "unknown function 'noise'" || d.message == "unknown function 'turbulence'")
+        d.message += ": here 'noise' and 'turbulence' are variables, the values at the point (their frequency is "
+                     "'noise: {scale}')";
+    diags.append(ds);
     return std::nullopt;
   }
   speed->usesNoise = mentions(text, "noise");
