@@ -65,6 +65,7 @@ class SolidReader {
   void readSolid(const YNode& section) {
     MapReader m(section, diags_, "solid");
     std::optional<YNode> grid = m.section("grid");
+    spec_.smoothRounds = int(m.integer("smooth", 0, 0, 10));
     readVolumes(m, section, "solid");
     m.finish();
     if (!diags_.hasErrors() && !spec_.solid.volumes.empty()) resolveGrid(grid, section);
@@ -633,7 +634,14 @@ class SolidModel final : public StillKindModel {
                   path.string().c_str(), m.tets.size(), m.positions.size(), spec_.grid.cells[0], spec_.grid.cells[1],
                   spec_.grid.cells[2], spec_.grid.cell, stats_.fieldSeconds, stats_.meshSeconds, q.minQuality,
                   q.meanQuality, q.minSolidAngle);
-    return buf;
+    std::string line = buf;
+    if (smooth_) {
+      std::snprintf(buf, sizeof buf, "; smoothing %.2f s, %zu moves, quality min %.2f -> %.2f, mean %.2f -> %.2f", smoothSeconds_,
+                    smooth_->moved, smooth_->before.minQuality, smooth_->after.minQuality, smooth_->before.meanQuality,
+                    smooth_->after.meanQuality);
+      line += buf;
+    }
+    return line;
   }
 
  private:
@@ -641,6 +649,11 @@ class SolidModel final : public StillKindModel {
     if (!mesh_) {
       const auto t0 = std::chrono::steady_clock::now();
       mesh_ = meshSolid(spec_.solid, spec_.grid, {}, &stats_);
+      if (spec_.smoothRounds > 0) {
+        const auto s0 = std::chrono::steady_clock::now();
+        smooth_ = smoothInterior(*mesh_, spec_.smoothRounds);
+        smoothSeconds_ = secondsSince(s0);
+      }
       buildSeconds_ = secondsSince(t0);
     }
     return *mesh_;
@@ -657,6 +670,8 @@ class SolidModel final : public StillKindModel {
 
   const SolidSpec& spec_;
   std::optional<TetMesh> mesh_;
+  std::optional<SmoothStats> smooth_;
+  double smoothSeconds_ = 0;
   std::optional<std::pair<std::vector<Mesh>, std::vector<uint16_t>>> visible_;
   MeshStats stats_;
   double buildSeconds_ = 0;

@@ -39,6 +39,7 @@ class SolidSpec : public KindSpec {
  public:
   solids::Solid solid;
   solids::Grid grid;
+  int smoothRounds = 0;  ///< `solid.smooth`: rounds of solids::smoothInterior after meshing
   SourceLoc loc;
 
   std::string checkSummary(const Species& species) const override;

@@ -136,6 +136,20 @@ struct QualityStats {
 /// Quality of every tetrahedron of mesh against targetCount tetrahedra (0 = the mesh's own count).
 QualityStats measureQuality(const TetMesh& mesh, size_t targetCount = 0);
 
+/// Quality before and after smoothInterior, and the vertex moves it made.
+struct SmoothStats {
+  QualityStats before, after;
+  size_t moved = 0;
+};
+
+/// Quality improvement by smoothing (the third of §4.4's operations; flips and half-edge
+/// collapses are not built): each vertex on no interface (neither the visible interface
+/// nor a face between two materials) moves toward the centroid of its neighbours, by the
+/// largest of the steps 1, 1/2, 1/4, 1/8 that raises the worst quality of the tetrahedra
+/// around it, for up to `rounds` sweeps. Interfaces do not move; no tetrahedron inverts;
+/// the minimum quality never falls. Sequential and deterministic. Cost O(rounds · tets).
+SmoothStats smoothInterior(TetMesh& mesh, int rounds = 3);
+
 /// The smallest of the four solid angles of tetrahedron (a, b, c, d), steradians
 /// (Van Oosterom and Strackee 1983).
 double minSolidAngle(const DVec3& a, const DVec3& b, const DVec3& c, const DVec3& d);

@@ -43,6 +43,7 @@ TEST_CASE("kind: solid reads the paper's language", "[model][solid]") {
   const auto& spec = dynamic_cast<const SolidSpec&>(*s.spec);
   REQUIRE(spec.solid.volumes.size() == 2);
   CHECK(spec.grid.cell == 0.1);
+  CHECK(spec.smoothRounds == 0);
   // Box: striped inside, nothing 0..0.1 (claims, no tetrahedra), foil 0.1..0.2.
   CHECK(spec.solid.volumes[1].boundaries == std::vector<double>{0.0, 0.1, 0.2});
   CHECK(spec.solid.volumes[1].regions[1] == solids::kNothing);
@@ -164,4 +165,25 @@ solid:
       CHECK(dynamic_cast<const SolidSpec&>(*s.spec).solid.volumes.size() >= 1);
     }
   }
+}
+
+TEST_CASE("kind: solid smooth: N improves the mesh after meshing and reports it", "[model][solid]") {
+  const Species s = parseSpecies(R"(kind: solid
+solid:
+  grid: {cell: 0.1}
+  smooth: 2
+  volume:
+    distance_field: {sphere: {radius: 0.6}}
+    layers:
+      - interior_layer: {material: chocolate, thickness: fill}
+      - exterior_layer: {material: foil, thickness: 0.1}
+)", "solid.yaml");
+  CHECK(dynamic_cast<const SolidSpec&>(*s.spec).smoothRounds == 2);
+  SpeciesModel model(s);
+  sprig::test::TempDir dir("solid-smooth");
+  const std::string line = model.writeVolumeMesh(model.finalStage(), dir.path / "s.msh", false);
+  INFO(line);
+  CHECK(line.find("; smoothing ") != std::string::npos);
+  CHECK(errorOf("kind: solid\nsolid:\n  smooth: 11\n  volume: {distance_field: {sphere: {}}, layers: [{interior_layer: {material: nut, thickness: fill}}]}\n")
+            .find("solid.yaml:3:11: error: 'smooth' is 11, out of range [0, 10]") != std::string::npos);
 }

@@ -392,3 +392,25 @@ TEST_CASE("meshSolid: tetrahedra of a procedural layer follow the procedure", "[
   CHECK(faceUses(m)[2] == 0);
   CHECK(analyzeTopology(meshOf(m, visibleInterface(m))).closed());
 }
+
+TEST_CASE("smoothInterior: raises the worst quality, keeps every interface and each material's volume", "[solids]") {
+  Solid s = sphereSolid(0.6, {{true, 0.15, "pink_frosting"}, {true, 0, "chocolate"}, {false, 0.1, "white_chocolate"}});
+  TetMesh m = meshSolid(s, gridAround(0.8, 0.05));
+  const TetMesh original = m;
+  const auto volumes = volumeByMaterial(m);
+  const SmoothStats st = smoothInterior(m);
+  INFO("quality min " << st.before.minQuality << " -> " << st.after.minQuality << ", mean " << st.before.meanQuality << " -> "
+                      << st.after.meanQuality << ", " << st.moved << " moves");
+  CHECK(st.moved > 0);
+  CHECK(st.after.minQuality > st.before.minQuality);
+  CHECK(st.after.meanQuality > st.before.meanQuality);
+  for (size_t t = 0; t < m.tets.size(); ++t) REQUIRE(m.volume(t) > 0);
+  // The interfaces are where they were: the same triangles on the same positions.
+  const auto before = visibleInterface(original), after = visibleInterface(m);
+  REQUIRE(before.size() == after.size());
+  for (size_t i = 0; i < before.size(); ++i)
+    for (int c = 0; c < 3; ++c) REQUIRE(m.positions[after[i].v[c]] == original.positions[before[i].v[c]]);
+  for (const auto& t : materialInterfaces(original))
+    for (uint32_t v : t.v) REQUIRE(m.positions[v] == original.positions[v]);
+  for (const auto& [mat, vol] : volumeByMaterial(m)) CHECK(vol == Approx(volumes.at(mat)).epsilon(1e-9));
+}
