@@ -116,8 +116,8 @@ class NearestVertex {
   std::vector<std::vector<uint32_t>> buckets_;
 };
 
-std::optional<VelocityWrap> readExpression(const YNode& exprNode, const std::string& text, MapReader* m, DiagnosticList& diags,
-                                           bool redistance) {
+/// An expression speed: always a front (the speed varies), whatever the child is.
+std::optional<VelocityWrap> readExpression(const YNode& exprNode, const std::string& text, MapReader* m, DiagnosticList& diags) {
   auto speed = std::make_shared<ExpressionSpeed>();
   try {
     const SourceLoc at = exprNode.loc();
@@ -148,7 +148,7 @@ std::optional<VelocityWrap> readExpression(const YNode& exprNode, const std::str
   }
   speed->noise = std::make_shared<textures::PerlinNoise>(seed);
   const YNode where = exprNode;
-  return VelocityWrap([speed, max, where, &diags, redistance](FieldPtr child) -> FieldPtr {
+  return VelocityWrap([speed, max, where, &diags](FieldPtr child) -> FieldPtr {
     if (!child) return nullptr;
     double top = max.value_or(0.0);
     if (!max) {
@@ -180,18 +180,13 @@ std::optional<VelocityWrap> readExpression(const YNode& exprNode, const std::str
     auto fn = [speed](const std::vector<Vec3>& pts, std::vector<float>& out) {
       parallelFor(0, pts.size(), [&](size_t i) { out[i] = float(speed->at(DVec3(pts[i]))); }, 4096);
     };
-    (void)redistance;
     return solids::frontField(child, fn, top, false);
   });
 }
 
 }  // namespace
 
-FieldPtr redistanced(FieldPtr child) {
-  return solids::frontField(
-      std::move(child), [](const std::vector<Vec3>&, std::vector<float>& out) { std::fill(out.begin(), out.end(), 1.0f); }, 1.0,
-      false);
-}
+FieldPtr redistanced(FieldPtr child) { return solids::frontField(std::move(child), solids::uniformSpeed(1.0f), 1.0, false); }
 
 std::optional<VelocityWrap> readVelocity(const YNode& node, DiagnosticList& diags, const PolyMesh* mesh, bool redistance) {
   if (node.isScalar() && node.isPlainScalar()) {
@@ -207,13 +202,11 @@ std::optional<VelocityWrap> readVelocity(const YNode& node, DiagnosticList& diag
       return VelocityWrap([v, redistance](FieldPtr child) -> FieldPtr {
         if (!child) return nullptr;
         if (!redistance) return solids::constantSpeedField(child, v);
-        return solids::frontField(
-            child, [v](const std::vector<Vec3>&, std::vector<float>& out) { std::fill(out.begin(), out.end(), float(v)); }, v,
-            false);
+        return solids::frontField(child, solids::uniformSpeed(float(v)), v, false);
       });
     }
   }
-  if (node.isScalar()) return readExpression(node, node.scalar(), nullptr, diags, redistance);
+  if (node.isScalar()) return readExpression(node, node.scalar(), nullptr, diags);
   if (!node.isMap()) {
     node.error(diags, "'velocity' must be a number, an expression, {expression: ...} or {painted: {low, high}}");
     return std::nullopt;
@@ -221,7 +214,7 @@ std::optional<VelocityWrap> readVelocity(const YNode& node, DiagnosticList& diag
   MapReader m(node, diags, "velocity");
   std::optional<VelocityWrap> out;
   if (auto e = m.get("expression")) {
-    if (auto text = e->asString(diags, "'expression'")) out = readExpression(*e, *text, &m, diags, redistance);
+    if (auto text = e->asString(diags, "'expression'")) out = readExpression(*e, *text, &m, diags);
   } else if (auto p = m.section("painted")) {
     MapReader pm(*p, diags, "painted");
     const double low = pm.number("low", 1.0, double(solids::kMinSpeed), 1e6);

@@ -36,6 +36,22 @@ double solveEikonal(std::array<double, 3> a, double r, int& used) {
   return t;
 }
 
+/// The lattice nodes next to the zero set of d: zero there, or a neighbour along an axis on
+/// the other side. The front starts at them, and painted speeds are asked only there.
+std::vector<size_t> zeroSetNodes(const std::vector<float>& d, const std::array<int, 3>& dims) {
+  const int64_t stride[3] = {1, dims[0], int64_t(dims[0]) * dims[1]};
+  std::vector<size_t> out;
+  for (size_t i = 0; i < d.size(); ++i) {
+    const int c[3] = {int(i % dims[0]), int((i / dims[0]) % dims[1]), int(i / (size_t(dims[0]) * dims[1]))};
+    bool edge = d[i] == 0;
+    for (int a = 0; a < 3 && !edge; ++a)
+      for (int s = -1; s <= 1 && !edge; s += 2)
+        if (c[a] + s >= 0 && c[a] + s < dims[a]) edge = (d[i + s * stride[a]] < 0) != (d[i] < 0);
+    if (edge) out.push_back(i);
+  }
+  return out;
+}
+
 /// Field values divided by a constant speed.
 class ConstantSpeedField final : public DistanceField {
  public:
@@ -82,16 +98,7 @@ class FrontField final : public DistanceField {
     std::vector<float> speed(n, 1.0f);
     if (painted_) {
       // Only the nodes next to the zero set need the painted value; the march extends it.
-      std::vector<size_t> front;
-      const int64_t stride[3] = {1, dims[0], int64_t(dims[0]) * dims[1]};
-      for (size_t i = 0; i < n; ++i) {
-        const int c[3] = {int(i % dims[0]), int((i / dims[0]) % dims[1]), int(i / (size_t(dims[0]) * dims[1]))};
-        bool edge = d[i] == 0;
-        for (int a = 0; a < 3 && !edge; ++a)
-          for (int s = -1; s <= 1 && !edge; s += 2)
-            if (c[a] + s >= 0 && c[a] + s < dims[a]) edge = (d[i + s * stride[a]] < 0) != (d[i] < 0);
-        if (edge) front.push_back(i);
-      }
+      const std::vector<size_t> front = zeroSetNodes(d, dims);
       std::vector<Vec3> at(front.size());
       for (size_t k = 0; k < front.size(); ++k) at[k] = nodes[front[k]];
       std::vector<float> v(front.size(), 1.0f);
@@ -148,7 +155,7 @@ std::vector<float> march(const std::vector<float>& d, std::vector<float>& speed,
   };
   // Nodes next to the zero set: the distance to the crossings on their edges, combined over
   // the axes as 1/D^2 = sum 1/D_a^2 (the usual first-order initialization).
-  for (size_t i = 0; i < n; ++i) {
+  for (size_t i : zeroSetNodes(d, dims)) {
     const bool in = d[i] < 0;
     double inv = 0;
     bool front = d[i] == 0;
@@ -164,11 +171,9 @@ std::vector<float> march(const std::vector<float>& d, std::vector<float>& speed,
       if (best == 0) front = true;
       else if (best < kInf) inv += 1 / (best * best);
     }
-    if (front || inv > 0) {
-      const double dist = front ? 0.0 : 1 / std::sqrt(inv);
-      t[i] = float(extend ? dist : dist / speed[i]);
-      state[i] = Known;
-    }
+    const double dist = front ? 0.0 : 1 / std::sqrt(inv);
+    t[i] = float(extend ? dist : dist / speed[i]);
+    state[i] = Known;
   }
 
   using Entry = std::pair<float, size_t>;
@@ -242,6 +247,10 @@ std::vector<float> marchFront(const std::vector<float>& d, std::vector<float>& s
     march(d, speed, dims, h, limit * std::max(1.0f, *std::max_element(speed.begin(), speed.end())), true);
   }
   return march(d, speed, dims, h, limit, false);
+}
+
+SpeedFn uniformSpeed(float v) {
+  return [v](const std::vector<Vec3>&, std::vector<float>& out) { std::fill(out.begin(), out.end(), v); };
 }
 
 FieldPtr constantSpeedField(FieldPtr child, double speed) { return std::make_shared<ConstantSpeedField>(std::move(child), speed); }

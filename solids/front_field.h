@@ -32,6 +32,9 @@ namespace sprig::solids {
 /// Speeds at points (one per point, written into out). Must be thread-safe.
 using SpeedFn = std::function<void(const std::vector<Vec3>& points, std::vector<float>& out)>;
 
+/// The same speed v everywhere.
+SpeedFn uniformSpeed(float v);
+
 /// Speeds below this are raised to it (a front that stops would never fill the layers).
 constexpr float kMinSpeed = 0.01f;
 
