@@ -626,7 +626,7 @@ class SolidModel final : public StillKindModel {
   std::string writeVolumeMesh(const Stage&, const std::filesystem::path& path, bool) override {
     const TetMesh& m = tets();
     writeTetMesh(m, spec_.solid.materials.materials, path);
-    const QualityStats q = measureQuality(m);
+    const QualityStats q = smooth_ ? smooth_->after : measureQuality(m);  // smoothing measured it already
     char buf[512];
     std::snprintf(buf, sizeof buf,
                   "%s: %zu tetrahedra, %zu vertices (grid %dx%dx%d of cell %g; fields %.2f s, mesh %.2f s); "

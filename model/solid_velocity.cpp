@@ -1,6 +1,7 @@
 #include "model/solid_velocity.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -60,8 +61,7 @@ class NearestVertex {
 
   float operator()(const Vec3& p) const {
     const DVec3 q(p);
-    int c[3];
-    for (int a = 0; a < 3; ++a) c[a] = std::clamp(int(std::floor((q[a] - box_.lo[a]) / cell_)), 0, dims_[a] - 1);
+    const std::array<int, 3> c = cellOf(q);
     // The paint is smoothed over a radius of two buckets (weights (1 - (d/R)²)², Wendland-like),
     // so the layer does not show the mesh's Voronoi cells; far from every vertex, the nearest.
     const double radius = 2 * cell_;
@@ -101,9 +101,13 @@ class NearestVertex {
   }
 
  private:
+  std::array<int, 3> cellOf(const DVec3& p) const {
+    std::array<int, 3> c{};
+    for (int a = 0; a < 3; ++a) c[size_t(a)] = std::clamp(int(std::floor((p[a] - box_.lo[a]) / cell_)), 0, dims_[a] - 1);
+    return c;
+  }
   size_t bucketOf(const DVec3& p) const {
-    int c[3];
-    for (int a = 0; a < 3; ++a) c[a] = std::clamp(int(std::floor((p[a] - box_.lo[a]) / cell_)), 0, dims_[a] - 1);
+    const std::array<int, 3> c = cellOf(p);
     return c[0] + size_t(dims_[0]) * (c[1] + size_t(dims_[1]) * c[2]);
   }
 
