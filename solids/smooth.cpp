@@ -7,25 +7,6 @@
 
 namespace sprig::solids {
 
-namespace {
-
-constexpr double kAlpha = 0.7;  // the paper's weight of the angle term (§4.4)
-
-double signedVolume(const DVec3& a, const DVec3& b, const DVec3& c, const DVec3& d) {
-  return glm::dot(glm::cross(b - a, c - a), d - a) / 6.0;
-}
-
-/// The paper's quality of one tetrahedron against the ideal volume (as measureQuality).
-double quality(const DVec3& a, const DVec3& b, const DVec3& c, const DVec3& d, double ideal) {
-  const double v = signedVolume(a, b, c, d);
-  if (!(v > 0)) return -1;
-  const double angle = 10 * std::min(1.0, std::sqrt(2 * minSolidAngle(a, b, c, d)));
-  const double size = 10 * std::min(1.0, std::sqrt(v / ideal));
-  return kAlpha * angle + (1 - kAlpha) * size;
-}
-
-}  // namespace
-
 SmoothStats smoothInterior(TetMesh& mesh, int rounds) {
   SmoothStats st;
   st.before = measureQuality(mesh);
@@ -53,7 +34,7 @@ SmoothStats smoothInterior(TetMesh& mesh, int rounds) {
     double w = 1e9;
     for (uint32_t k = start[v]; k < start[v + 1]; ++k) {
       const auto& q = mesh.tets[around[k]];
-      w = std::min(w, quality(mesh.positions[q[0]], mesh.positions[q[1]], mesh.positions[q[2]], mesh.positions[q[3]], ideal));
+      w = std::min(w, tetQuality(mesh.positions[q[0]], mesh.positions[q[1]], mesh.positions[q[2]], mesh.positions[q[3]], ideal));
     }
     return w;
   };

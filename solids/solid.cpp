@@ -7,6 +7,8 @@
 #include <stdexcept>
 
 #include "core/parallel.h"
+#include "solids/chunked.h"
+#include "solids/octree.h"
 #include "core/timer.h"
 
 namespace sprig::solids {
@@ -15,44 +17,10 @@ namespace {
 
 using Tet = std::array<uint32_t, 4>;
 constexpr int kTetEdges[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
-/// Tetrahedra are processed in chunks of this many: chunk outputs are joined in chunk
-/// order, so results never depend on the thread count.
-constexpr size_t kChunk = 4096;
-
 uint64_t edgeKey(uint32_t a, uint32_t b) { return a < b ? (uint64_t(a) << 32) | b : (uint64_t(b) << 32) | a; }
 
 double det(const DVec3& a, const DVec3& b, const DVec3& c, const DVec3& d) {
   return glm::dot(b - a, glm::cross(c - a, d - a));
-}
-
-/// The five tetrahedra of a cube (corner c = dx + 2·dy + 4·dz) for both parities, positively
-/// oriented: four corners cut off and the central tetrahedron, whose orientation
-/// alternates so that face diagonals match between neighbouring cubes (§4.3).
-std::array<std::array<Tet, 5>, 2> cubePatterns() {
-  const std::array<std::array<Tet, 5>, 2> raw = {{
-      {{{0, 1, 2, 4}, {3, 1, 2, 7}, {5, 1, 4, 7}, {6, 2, 4, 7}, {1, 2, 4, 7}}},
-      {{{1, 0, 3, 5}, {2, 0, 3, 6}, {4, 0, 5, 6}, {7, 3, 5, 6}, {0, 3, 5, 6}}},
-  }};
-  std::array<std::array<Tet, 5>, 2> out = raw;
-  auto corner = [](uint32_t c) { return DVec3(c & 1, (c >> 1) & 1, (c >> 2) & 1); };
-  for (auto& pattern : out)
-    for (Tet& t : pattern)
-      if (det(corner(t[0]), corner(t[1]), corner(t[2]), corner(t[3])) < 0) std::swap(t[2], t[3]);
-  return out;
-}
-
-/// Runs f(begin, end, out) over fixed chunks of [0, n) in parallel and joins the outputs in order.
-template <class T, class F>
-std::vector<T> chunked(size_t n, F&& f) {
-  const size_t chunks = (n + kChunk - 1) / kChunk;
-  std::vector<std::vector<T>> parts(chunks);
-  parallelFor(0, chunks, [&](size_t c) { f(c * kChunk, std::min(n, (c + 1) * kChunk), parts[c]); });
-  std::vector<T> out;
-  size_t total = 0;
-  for (auto& p : parts) total += p.size();
-  out.reserve(total);
-  for (auto& p : parts) out.insert(out.end(), p.begin(), p.end());
-  return out;
 }
 
 /// The mesh while it is cut: vertices with every volume's distance, tetrahedra with a flag
@@ -259,33 +227,55 @@ double TetMesh::volume(size_t t) const {
   return det(positions[q[0]], positions[q[1]], positions[q[2]], positions[q[3]]) / 6.0;
 }
 
-double minSolidAngle(const DVec3& a, const DVec3& b, const DVec3& c, const DVec3& d) {
+namespace {
+
+/// The smallest solid angle of (a, b, c, d) is 2·atan2(num, den) (Van Oosterom and
+/// Strackee 1983): at a corner with edges x, y, z, the numerator |x·(y×z)| is the same at
+/// every corner (six times the volume) and den = |x||y||z| + (x·y)|z| + (x·z)|y| + (y·z)|x|,
+/// so the smallest angle is the one of the largest den.
+std::pair<double, double> smallestAngleTangent(const DVec3& a, const DVec3& b, const DVec3& c, const DVec3& d) {
   const DVec3 p[4] = {a, b, c, d};
-  double best = 4 * M_PI;
+  const double num = std::abs(glm::dot(b - a, glm::cross(c - a, d - a)));
+  double den = -1e300;
   for (int i = 0; i < 4; ++i) {
     const DVec3 x = p[(i + 1) % 4] - p[i], y = p[(i + 2) % 4] - p[i], z = p[(i + 3) % 4] - p[i];
     const double lx = glm::length(x), ly = glm::length(y), lz = glm::length(z);
-    const double num = std::abs(glm::dot(x, glm::cross(y, z)));
-    const double den = lx * ly * lz + glm::dot(x, y) * lz + glm::dot(x, z) * ly + glm::dot(y, z) * lx;
-    best = std::min(best, 2 * std::atan2(num, den));
+    den = std::max(den, lx * ly * lz + glm::dot(x, y) * lz + glm::dot(x, z) * ly + glm::dot(y, z) * lx);
   }
-  return best;
+  return {num, den};
+}
+
+}  // namespace
+
+double minSolidAngle(const DVec3& a, const DVec3& b, const DVec3& c, const DVec3& d) {
+  const auto [num, den] = smallestAngleTangent(a, b, c, d);
+  return 2 * std::atan2(num, den);
+}
+
+double tetQuality(const DVec3& a, const DVec3& b, const DVec3& c, const DVec3& d, double idealVolume) {
+  constexpr double kAlpha = 0.7;  // the paper's weight of the angle term (§4.4)
+  const double v = det(a, b, c, d) / 6;
+  if (!(v > 0)) return -1;
+  // A(t) is 10 for every angle of 0.5 sr or more: no arctangent for those.
+  const auto [num, den] = smallestAngleTangent(a, b, c, d);
+  static const double kTanQuarter = std::tan(0.25);
+  const double angle = den <= 0 || num >= kTanQuarter * den ? 10.0 : 10 * std::sqrt(4 * std::atan2(num, den));
+  const double size = 10 * std::min(1.0, std::sqrt(v / idealVolume));
+  return kAlpha * angle + (1 - kAlpha) * size;
 }
 
 QualityStats measureQuality(const TetMesh& mesh, size_t targetCount) {
   QualityStats q;
   if (mesh.tets.empty()) return q;
-  constexpr double kAlpha = 0.7;
   double total = 0;
   for (size_t t = 0; t < mesh.tets.size(); ++t) total += mesh.volume(t);
   const double ideal = total / double(targetCount > 0 ? targetCount : mesh.tets.size());
   std::vector<double> quality(mesh.tets.size()), angle(mesh.tets.size());
   parallelFor(0, mesh.tets.size(), [&](size_t t) {
     const auto& v = mesh.tets[t];
-    angle[t] = minSolidAngle(mesh.positions[v[0]], mesh.positions[v[1]], mesh.positions[v[2]], mesh.positions[v[3]]);
-    const double a = 10 * std::min(1.0, std::sqrt(2 * angle[t]));
-    const double b = 10 * std::min(1.0, std::sqrt(std::max(0.0, mesh.volume(t)) / ideal));
-    quality[t] = kAlpha * a + (1 - kAlpha) * b;
+    const DVec3 &a = mesh.positions[v[0]], &b = mesh.positions[v[1]], &c = mesh.positions[v[2]], &d = mesh.positions[v[3]];
+    angle[t] = minSolidAngle(a, b, c, d);
+    quality[t] = tetQuality(a, b, c, d, ideal);
   }, 4096);
   q.minQuality = *std::min_element(quality.begin(), quality.end());
   q.minSolidAngle = *std::min_element(angle.begin(), angle.end());
@@ -402,28 +392,57 @@ TetMesh meshSolid(const Solid& solid, const Grid& grid, const MeshOptions& optio
   st.fieldSeconds = secondsSince(t0);
   t0 = std::chrono::steady_clock::now();
 
-  // 2. Five tetrahedra per cube that some volume may claim.
-  const auto patterns = cubePatterns();
-  const size_t cx = size_t(grid.cells[0]), cy = size_t(grid.cells[1]), cz = size_t(grid.cells[2]);
+  // 2. Five tetrahedra per cube that some volume may claim, on the coarsened octree
+  // (§4.4): a node's class packs its region index in every volume; nodes on a boundary or
+  // in a procedural layer never merge.
   std::vector<std::pair<double, double>> claims;
   for (const Volume& v : solid.volumes) claims.push_back(v.claimed());
-  w.tets = chunked<Tet>(cx * cy * cz, [&](size_t lo, size_t hi, std::vector<Tet>& out) {
-    for (size_t c = lo; c < hi; ++c) {
-      const size_t i = c % cx, j = (c / cx) % cy, k = c / (cx * cy);
-      uint32_t corner[8];
-      for (int q = 0; q < 8; ++q) corner[q] = uint32_t((i + (q & 1)) + nx * ((j + ((q >> 1) & 1)) + ny * (k + ((q >> 2) & 1))));
-      bool keep = false;
-      for (size_t v = 0; v < nv && !keep; ++v) {
-        float mn = std::numeric_limits<float>::max(), mx = std::numeric_limits<float>::lowest();
-        for (uint32_t n : corner) mn = std::min(mn, w.fields[v][n]), mx = std::max(mx, w.fields[v][n]);
-        keep = mx >= claims[v].first && mn <= claims[v].second;
+  std::vector<uint64_t> nodeClass;
+  int levels = options.coarsenLevels;
+  std::vector<int> bits;
+  int totalBits = 0;
+  for (const Volume& v : solid.volumes) {
+    int b = 1;
+    while ((size_t(1) << b) < v.regions.size()) ++b;
+    bits.push_back(b);
+    totalBits += b;
+  }
+  if (totalBits > 63) levels = 0;
+  if (levels > 0) {
+    nodeClass.resize(nodes.size());
+    parallelFor(0, nodes.size(), [&](size_t n) {
+      uint64_t k = 0;
+      int shift = 0;
+      bool claimed = false;
+      for (size_t v = 0; v < nv; ++v) {
+        const Volume& vol = solid.volumes[v];
+        const double d = w.fields[v][n];
+        const size_t r = size_t(std::upper_bound(vol.boundaries.begin(), vol.boundaries.end(), d) - vol.boundaries.begin());
+        const bool onBoundary = std::any_of(vol.boundaries.begin(), vol.boundaries.end(), [&](double b) { return double(float(b)) == d; });
+        if (onBoundary || (!claimed && vol.regions[r] <= kProcedural0)) {
+          nodeClass[n] = kMixedClass;
+          return;
+        }
+        claimed = claimed || vol.regions[r] != kUnclaimed;
+        k |= uint64_t(r) << shift;
+        shift += bits[v];
       }
-      if (!keep) continue;
-      for (const Tet& t : patterns[(i + j + k) & 1]) out.push_back({corner[t[0]], corner[t[1]], corner[t[2]], corner[t[3]]});
+      nodeClass[n] = k;
+    }, 4096);
+  }
+  CellStats cells;
+  w.tets = cellTetrahedra(grid, levels, nodeClass, [&](const uint32_t* corner) {
+    for (size_t v = 0; v < nv; ++v) {
+      float mn = std::numeric_limits<float>::max(), mx = std::numeric_limits<float>::lowest();
+      for (int q = 0; q < 8; ++q) mn = std::min(mn, w.fields[v][corner[q]]), mx = std::max(mx, w.fields[v][corner[q]]);
+      if (mx >= claims[v].first && mn <= claims[v].second) return true;
     }
-  });
+    return false;
+  }, &cells);
   st.cellTets = w.tets.size();
-  st.cubes = st.cellTets / 5;
+  st.cubes = cells.leaves;
+  st.coarseCubes = cells.coarseLeaves;
+  st.transitionCubes = cells.transition;
   w.active.assign(w.tets.size(), 1);
   w.tag.assign(w.tets.size(), 0);
 

@@ -99,8 +99,10 @@ struct TetMesh {
 
 /// Counts of one meshing.
 struct MeshStats {
-  size_t cubes = 0;        ///< cubic cells kept (some volume may claim them)
-  size_t cellTets = 0;     ///< tetrahedral cells before splitting (5 per cube)
+  size_t cubes = 0;        ///< octree leaves kept (some volume may claim them)
+  size_t coarseCubes = 0;  ///< of them, leaves of more than one cell (coarsening)
+  size_t transitionCubes = 0;  ///< of them, leaves meshed as a fan from their centre (next to finer leaves)
+  size_t cellTets = 0;     ///< tetrahedral cells before splitting (5 per plain cube)
   size_t splits = 0;       ///< edges split at interface crossings
   size_t tets = 0;         ///< tetrahedra with a material in the result
   double fieldSeconds = 0; ///< sampling the distance fields
@@ -115,6 +117,10 @@ struct MeshOptions {
   /// Rounds of splitting tetrahedra of procedural layers where the chosen material changes
   /// along an edge (0 = each tetrahedron takes the choice at its centroid).
   int proceduralRounds = 2;
+  /// Octree levels of coarsening (§4.4, Fig. 4; solids/octree.h): cubes of up to 2^levels
+  /// cells where no interface crosses, neighbours at most one level apart (0 = uniform).
+  /// Volumes whose region indices need more than 63 bits together are not coarsened.
+  int coarsenLevels = 0;
 };
 
 /// The tetrahedral mesh of solid on grid (§4.3). Deterministic: the same bytes at any
@@ -135,6 +141,10 @@ struct QualityStats {
 
 /// Quality of every tetrahedron of mesh against targetCount tetrahedra (0 = the mesh's own count).
 QualityStats measureQuality(const TetMesh& mesh, size_t targetCount = 0);
+
+/// The paper's quality (above) of tetrahedron (a, b, c, d) against an ideal volume; -1 when
+/// it is not positively oriented.
+double tetQuality(const DVec3& a, const DVec3& b, const DVec3& c, const DVec3& d, double idealVolume);
 
 /// Quality before and after smoothInterior, and the vertex moves it made.
 struct SmoothStats {

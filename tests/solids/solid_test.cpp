@@ -14,6 +14,7 @@
 #include "core/mesh.h"
 #include "core/parallel.h"
 #include "solids/distance_field.h"
+#include "solids/octree.h"
 #include "solids/solid.h"
 #include "lsystem/expression.h"
 #include "solids/tet_io.h"
@@ -275,6 +276,18 @@ TEST_CASE("meshSolid: the same bytes at 1 and 2 threads", "[solids]") {
   }
   CHECK(one.size() > 10000);
   CHECK(one == two);
+  MeshOptions coarse;
+  coarse.coarsenLevels = 3;
+  {
+    ThreadLimit limit(1);
+    one = formatTetMesh(meshSolid(s, g, coarse), s.materials.materials, TetFormat::Msh);
+  }
+  {
+    ThreadLimit limit(2);
+    two = formatTetMesh(meshSolid(s, g, coarse), s.materials.materials, TetFormat::Msh);
+  }
+  CHECK(one.size() > 10000);
+  CHECK(one == two);
 }
 
 namespace {
@@ -413,4 +426,108 @@ TEST_CASE("smoothInterior: raises the worst quality, keeps every interface and e
   for (const auto& t : materialInterfaces(original))
     for (uint32_t v : t.v) REQUIRE(m.positions[v] == original.positions[v]);
   for (const auto& [mat, vol] : volumeByMaterial(m)) CHECK(vol == Approx(volumes.at(mat)).epsilon(1e-9));
+}
+
+namespace {
+
+/// The tetrahedra of cellTetrahedra as a mesh on the unit lattice.
+TetMesh latticeMesh(const Grid& g, const std::vector<std::array<uint32_t, 4>>& tets) {
+  TetMesh m;
+  for (const Vec3& p : gridNodes(g)) m.positions.push_back(DVec3(p));
+  m.tets = tets;
+  m.materials.assign(tets.size(), 0);
+  return m;
+}
+
+double triangleArea(const TetMesh& m, const InterfaceTriangle& t) {
+  return 0.5 * glm::length(glm::cross(m.positions[t.v[1]] - m.positions[t.v[0]], m.positions[t.v[2]] - m.positions[t.v[0]]));
+}
+
+}  // namespace
+
+TEST_CASE("cellTetrahedra: a balanced octree meshes its leaves conforming", "[solids]") {
+  Grid g;
+  g.origin = DVec3(0.0);
+  g.cell = 1;
+  g.cells = {4, 4, 4};
+  std::vector<uint64_t> cls(g.nodeCount(), 0);
+  auto all = [](const uint32_t*) { return true; };
+  CellStats st;
+  SECTION("one class: a single leaf of five tetrahedra, or eight at one level less") {
+    CHECK(cellTetrahedra(g, 2, cls, all, &st).size() == 5);
+    CHECK(st.leaves == 1);
+    CHECK(cellTetrahedra(g, 1, cls, all, &st).size() == 40);
+    CHECK(st.leaves == 8);
+    CHECK(st.transition == 0);
+    CHECK(cellTetrahedra(g, 0, cls, all, &st).size() == 320);
+  }
+  SECTION("a mixed node keeps its cell fine; the leaves around it make the transition") {
+    cls[0] = kMixedClass;  // node (0, 0, 0): cell (0, 0, 0) cannot merge, nor its 2x2x2 block
+    const auto tets = cellTetrahedra(g, 2, cls, all, &st);
+    // 8 cells of 5; the block across a corner is plain (5); the three across a face split it
+    // (8 triangles) and meet the edges' midpoints on four faces (5 each): 30 each; the three
+    // across an edge have its midpoint on two faces: 5 + 5 + 4·2 = 18 each.
+    CHECK(st.leaves == 15);
+    CHECK(st.coarseLeaves == 7);
+    CHECK(st.transition == 6);
+    CHECK(tets.size() == 40 + 5 + 3 * 30 + 3 * 18);
+    const TetMesh m = latticeMesh(g, tets);
+    double volume = 0, minVolume = 1e9;
+    for (size_t t = 0; t < m.tets.size(); ++t) volume += m.volume(t), minVolume = std::min(minVolume, m.volume(t));
+    CHECK(volume == Approx(64).epsilon(1e-12));
+    CHECK(minVolume > 0);
+    // Faces match: none is used by three tetrahedra and the unmatched ones are exactly the
+    // box's six sides (a T-junction would leave unmatched faces inside).
+    CHECK(faceUses(m)[2] == 0);
+    double area = 0;
+    for (const auto& t : visibleInterface(m)) area += triangleArea(m, t);
+    CHECK(area == Approx(96).epsilon(1e-12));
+    // The transition tetrahedra keep a bounded solid angle (a regular one has 0.551 sr).
+    CHECK(measureQuality(m).minSolidAngle > 0.05);
+  }
+}
+
+TEST_CASE("meshSolid: octree coarsening keeps the interfaces with fewer tetrahedra in the core", "[solids]") {
+  // Fig. 4: the same distance field meshed on the uniform grid and on the coarsened octree.
+  // A thin shell over a thick core: the core is where the octree coarsens.
+  Solid s = sphereSolid(0.6, {{true, 0.05, "pink_frosting"}, {true, 0, "chocolate"}, {false, 0.05, "white_chocolate"}});
+  const Grid g = gridAround(0.7, 0.025);
+  MeshStats su, sc;
+  const TetMesh uniform = meshSolid(s, g, {}, &su);
+  MeshOptions opt;
+  opt.coarsenLevels = 3;
+  const TetMesh coarse = meshSolid(s, g, opt, &sc);
+  INFO("uniform " << uniform.tets.size() << " tetrahedra, coarsened " << coarse.tets.size() << " (" << sc.coarseCubes
+                  << " coarse leaves, " << sc.transitionCubes << " transition)");
+  CHECK(sc.coarseCubes > 0);
+  CHECK(coarse.tets.size() < uniform.tets.size());
+  // The core (radius 22 cells), where no interface crosses, needs far fewer tetrahedra
+  // (measured 56%: the 2:1 transition shells take most of so small a radius); the cut
+  // tetrahedra at the interfaces are the same in both.
+  const uint16_t core = uint16_t(*s.materials.concrete("chocolate"));
+  auto count = [&](const TetMesh& m, bool inCore) {
+    return size_t(std::count_if(m.materials.begin(), m.materials.end(), [&](uint16_t k) { return (k == core) == inCore; }));
+  };
+  INFO("core: uniform " << count(uniform, true) << ", coarsened " << count(coarse, true));
+  CHECK(count(coarse, true) * 5 < count(uniform, true) * 3);
+  // Interface tetrahedra are the same: each material's volume and the visible interface agree.
+  const auto vu = volumeByMaterial(uniform), vc = volumeByMaterial(coarse);
+  REQUIRE(vu.size() == vc.size());
+  for (const auto& [mat, vol] : vu) CHECK(vc.at(mat) == Approx(vol).epsilon(1e-9));
+  double au = 0, ac = 0;
+  for (const auto& t : visibleInterface(uniform)) au += triangleArea(uniform, t);
+  size_t bad = 99;
+  const auto vis = visibleInterface(coarse, &bad);
+  for (const auto& t : vis) ac += triangleArea(coarse, t);
+  CHECK(ac == Approx(au).epsilon(1e-9));
+  CHECK(bad == 0);
+  CHECK(faceUses(coarse)[2] == 0);
+  const MeshTopology top = analyzeTopology(meshOf(coarse, vis));
+  CHECK(top.closed());
+  CHECK(top.manifold());
+  double minVolume = 1e9;
+  for (size_t t = 0; t < coarse.tets.size(); ++t) minVolume = std::min(minVolume, coarse.volume(t));
+  CHECK(minVolume > 0);
+  // The same interface quality: the worst solid angle is an interface tetrahedron's in both.
+  CHECK(measureQuality(coarse).minSolidAngle == Approx(measureQuality(uniform).minSolidAngle).epsilon(1e-9));
 }
