@@ -66,9 +66,20 @@ class SolidReader {
     MapReader m(section, diags_, "solid");
     std::optional<YNode> grid = m.section("grid");
     spec_.smoothRounds = int(m.integer("smooth", 0, 0, 10));
+    spec_.coarsenLevels = int(m.integer("coarsen", 0, 0, 6));
+    double toleranceCells = 0;
+    if (std::optional<YNode> improve = m.section("improve")) {
+      MapReader r(*improve, diags_, "improve");
+      solids::ImproveOptions& o = spec_.improve.emplace();
+      o.qualityBelow = double(r.integer("quality_below", 10, 1, 10));
+      toleranceCells = r.number("tolerance", 0, 0, 0.5);
+      o.targetCount = size_t(r.integer("target_tetrahedra", 0, 0, 1000000000));
+      r.finish();
+    }
     readVolumes(m, section, "solid");
     m.finish();
     if (!diags_.hasErrors() && !spec_.solid.volumes.empty()) resolveGrid(grid, section);
+    if (spec_.improve) spec_.improve->interfaceTolerance = toleranceCells * spec_.grid.cell;
     // Wrappers reach two cells inward, closing the gap to the volumes they wrap.
     for (size_t v : wrappers_) closeInward(spec_.solid.volumes[v], 2 * spec_.grid.cell);
   }
@@ -626,7 +637,8 @@ class SolidModel final : public StillKindModel {
   std::string writeVolumeMesh(const Stage&, const std::filesystem::path& path, bool) override {
     const TetMesh& m = tets();
     writeTetMesh(m, spec_.solid.materials.materials, path);
-    const QualityStats q = smooth_ ? smooth_->after : measureQuality(m);  // smoothing measured it already
+    // Smoothing or improvement measured it already.
+    const QualityStats q = improved_ ? improved_->after : smooth_ ? smooth_->after : measureQuality(m);
     char buf[512];
     std::snprintf(buf, sizeof buf,
                   "%s: %zu tetrahedra, %zu vertices (grid %dx%dx%d of cell %g; fields %.2f s, mesh %.2f s); "
@@ -635,10 +647,24 @@ class SolidModel final : public StillKindModel {
                   spec_.grid.cells[2], spec_.grid.cell, stats_.fieldSeconds, stats_.meshSeconds, q.minQuality,
                   q.meanQuality, q.minSolidAngle);
     std::string line = buf;
+    if (spec_.coarsenLevels > 0) {
+      std::snprintf(buf, sizeof buf, "; octree %zu leaves, %zu coarse, %zu transition", stats_.cubes, stats_.coarseCubes,
+                    stats_.transitionCubes);
+      line += buf;
+    }
     if (smooth_) {
       std::snprintf(buf, sizeof buf, "; smoothing %.2f s, %zu moves, quality min %.2f -> %.2f, mean %.2f -> %.2f", smoothSeconds_,
                     smooth_->moved, smooth_->before.minQuality, smooth_->after.minQuality, smooth_->before.meanQuality,
                     smooth_->after.meanQuality);
+      line += buf;
+    }
+    if (improved_) {
+      const ImproveStats& i = *improved_;
+      std::snprintf(buf, sizeof buf,
+                    "; improvement %.2f s: %zu -> %zu tetrahedra (%zu 2-3 and %zu 3-2 flips, %zu collapses, %zu moves), "
+                    "quality min %.2f -> %.2f, mean %.2f -> %.2f",
+                    improveSeconds_, i.tetsBefore, i.tetsAfter, i.flips23, i.flips32, i.collapses, i.moves, i.before.minQuality,
+                    i.after.minQuality, i.before.meanQuality, i.after.meanQuality);
       line += buf;
     }
     return line;
@@ -648,11 +674,18 @@ class SolidModel final : public StillKindModel {
   const TetMesh& tets() {
     if (!mesh_) {
       const auto t0 = std::chrono::steady_clock::now();
-      mesh_ = meshSolid(spec_.solid, spec_.grid, {}, &stats_);
+      solids::MeshOptions options;
+      options.coarsenLevels = spec_.coarsenLevels;
+      mesh_ = meshSolid(spec_.solid, spec_.grid, options, &stats_);
       if (spec_.smoothRounds > 0) {
         const auto s0 = std::chrono::steady_clock::now();
         smooth_ = smoothInterior(*mesh_, spec_.smoothRounds);
         smoothSeconds_ = secondsSince(s0);
+      }
+      if (spec_.improve) {
+        const auto s0 = std::chrono::steady_clock::now();
+        improved_ = improveQuality(*mesh_, *spec_.improve);
+        improveSeconds_ = secondsSince(s0);
       }
       buildSeconds_ = secondsSince(t0);
     }
@@ -672,6 +705,8 @@ class SolidModel final : public StillKindModel {
   std::optional<TetMesh> mesh_;
   std::optional<SmoothStats> smooth_;
   double smoothSeconds_ = 0;
+  std::optional<ImproveStats> improved_;
+  double improveSeconds_ = 0;
   std::optional<std::pair<std::vector<Mesh>, std::vector<uint16_t>>> visible_;
   MeshStats stats_;
   double buildSeconds_ = 0;

@@ -30,6 +30,7 @@
 
 #include "model/kinds.h"
 #include "model/yaml_reader.h"
+#include "solids/improve.h"
 #include "solids/solid.h"
 
 namespace sprig {
@@ -40,6 +41,10 @@ class SolidSpec : public KindSpec {
   solids::Solid solid;
   solids::Grid grid;
   int smoothRounds = 0;  ///< `solid.smooth`: rounds of solids::smoothInterior after meshing
+  int coarsenLevels = 0; ///< `solid.coarsen`: octree levels merged where no interface crosses (solids/octree.h)
+  /// `solid.improve`: flips, collapses and smoothing after meshing (solids/improve.h); the
+  /// tolerance is in world units (the file gives it in cells).
+  std::optional<solids::ImproveOptions> improve;
   SourceLoc loc;
 
   std::string checkSummary(const Species& species) const override;
