@@ -323,7 +323,7 @@ class SolidReader {
       PolyMesh mesh;
       out = readMesh(m, &mesh);
       if (auto v = m.get("velocity")) {
-        std::optional<VelocityWrap> w = readVelocity(*v, diags_, &mesh, false);
+        std::optional<VelocityWrap> w = readVelocity(*v, diags_, &mesh, false, &policy_);
         out = w && out ? (*w)(out) : nullptr;
       }
     } else if (kind == "sphere") {

@@ -6,9 +6,12 @@
 #include <cstdio>
 #include <memory>
 #include <regex>
+#include <tuple>
 
+#include "core/image.h"
 #include "core/parallel.h"
 #include "lsystem/expression.h"
+#include "solids/extrude_field.h"
 #include "solids/front_field.h"
 #include "textures/noise.h"
 
@@ -40,6 +43,40 @@ struct ExpressionSpeed {
 bool mentions(const std::string& text, const char* name) {
   return std::regex_search(text, std::regex(std::string("\\b") + name + "\\b"));
 }
+
+/// The painted value at a point from an image map laid over the plane perpendicular to an
+/// axis (extrude_2d's placement): linear Rec. 709 luminance, bilinear, clamped at the edges.
+class ProjectedImage {
+ public:
+  ProjectedImage(const Image& image, const DVec3& axis, glm::dvec2 size, glm::dvec2 center, double low, double high)
+      : w_(image.width), h_(image.height), low_(low), high_(high), size_(size) {
+    std::tie(u_, v_) = solids::imagePlaneAxes(axis);
+    corner_ = center - size / 2.0;
+    for (int y = 0; y < h_; ++y)
+      for (int x = 0; x < w_; ++x) {
+        const Vec4 c = image.at(x, y);
+        lum_.push_back(0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b);
+      }
+  }
+
+  float operator()(const Vec3& p) const {
+    const DVec3 q(p);
+    const double fx = std::clamp((glm::dot(q, u_) - corner_.x) / size_.x * w_ - 0.5, 0.0, double(w_ - 1));
+    const double fy = std::clamp((glm::dot(q, v_) - corner_.y) / size_.y * h_ - 0.5, 0.0, double(h_ - 1));
+    const int x0 = int(fx), y0 = int(fy), x1 = std::min(x0 + 1, w_ - 1), y1 = std::min(y0 + 1, h_ - 1);
+    const double tx = fx - x0, ty = fy - y0;
+    auto at = [&](int x, int y) { return double(lum_[size_t(y) * size_t(w_) + size_t(x)]); };
+    const double value = (1 - ty) * ((1 - tx) * at(x0, y0) + tx * at(x1, y0)) + ty * ((1 - tx) * at(x0, y1) + tx * at(x1, y1));
+    return float(low_ + (high_ - low_) * value);
+  }
+
+ private:
+  int w_, h_;
+  double low_, high_;
+  glm::dvec2 size_, corner_;
+  DVec3 u_, v_;
+  std::vector<float> lum_;
+};
 
 /// The painted value near each point: vertex colour luminance smoothed over nearby vertices (a bucket grid).
 class NearestVertex {
@@ -188,11 +225,67 @@ std::optional<VelocityWrap> readExpression(const YNode& exprNode, const std::str
   });
 }
 
+/// `[u, v]` of two finite numbers at key, or def.
+std::optional<glm::dvec2> pairAt(MapReader& m, const char* key, glm::dvec2 def, DiagnosticList& diags) {
+  auto n = m.get(key);
+  if (!n) return def;
+  const std::vector<YNode> items = n->isSequence() ? n->items() : std::vector<YNode>{};
+  if (items.size() != 2) {
+    n->error(diags, sprig::quoted(key) + " must be [u, v]");
+    return std::nullopt;
+  }
+  auto a = items[0].asNumber(diags, sprig::quoted(key)), b = items[1].asNumber(diags, sprig::quoted(key));
+  if (!a || !b) return std::nullopt;
+  return glm::dvec2(*a, *b);
+}
+
+/// `image: {file, axis, size, center}` of a painted velocity: the paint from an image map.
+std::function<float(const Vec3&)> readImagePaint(const YNode& node, DiagnosticList& diags, const PolyMesh& mesh, double low,
+                                                 double high, const PathPolicy* policy) {
+  MapReader m(node, diags, "image");
+  std::optional<std::filesystem::path> file;
+  if (policy) file = m.path("file", *policy);
+  else m.get("file");
+  if (!m.has("file")) node.error(diags, "missing required key 'file' in image (a PNG or EXR map; its luminance is the paint)");
+  Vec3 axisIn = m.vec3("axis", Vec3(0, 1, 0));
+  if (glm::length(axisIn) == 0) {
+    m.get("axis")->error(diags, "'axis' must not be zero");
+    axisIn = Vec3(0, 1, 0);
+  }
+  const DVec3 axis = glm::normalize(DVec3(axisIn));
+  const auto [u, v] = solids::imagePlaneAxes(axis);
+  glm::dvec2 lo(1e300), hi(-1e300);
+  for (const Vec3& p : mesh.positions) {
+    const glm::dvec2 q(glm::dot(DVec3(p), u), glm::dot(DVec3(p), v));
+    lo = glm::min(lo, q), hi = glm::max(hi, q);
+  }
+  const std::optional<glm::dvec2> size = pairAt(m, "size", glm::max(hi - lo, glm::dvec2(1e-6)), diags);
+  const std::optional<glm::dvec2> center = pairAt(m, "center", (lo + hi) / 2.0, diags);
+  m.finish();
+  if (size && !(size->x > 0 && size->y > 0)) {
+    m.get("size")->error(diags, "'size' must be positive, world units [along columns, along rows]");
+    return {};
+  }
+  if (!policy && m.has("file")) {
+    node.error(diags, "an image map is not available here");
+    return {};
+  }
+  if (!file || !size || !center) return {};
+  try {
+    auto paint = std::make_shared<ProjectedImage>(readImage(*file), axis, *size, *center, low, high);
+    return [paint](const Vec3& q) { return (*paint)(q); };
+  } catch (const ImageReadError& e) {
+    m.get("file")->error(diags, e.what());
+  }
+  return {};
+}
+
 }  // namespace
 
 FieldPtr redistanced(FieldPtr child) { return solids::frontField(std::move(child), solids::uniformSpeed(1.0f), 1.0, false); }
 
-std::optional<VelocityWrap> readVelocity(const YNode& node, DiagnosticList& diags, const PolyMesh* mesh, bool redistance) {
+std::optional<VelocityWrap> readVelocity(const YNode& node, DiagnosticList& diags, const PolyMesh* mesh, bool redistance,
+                                         const PathPolicy* policy) {
   if (node.isScalar() && node.isPlainScalar()) {
     // A number, or an unquoted expression.
     const std::string text = node.scalar();
@@ -223,18 +316,24 @@ std::optional<VelocityWrap> readVelocity(const YNode& node, DiagnosticList& diag
     MapReader pm(*p, diags, "painted");
     const double low = pm.number("low", 1.0, double(solids::kMinSpeed), 1e6);
     const double high = pm.number("high", 2.0, double(solids::kMinSpeed), 1e6);
+    std::optional<YNode> imageNode = pm.section("image");
     pm.finish();
+    std::function<float(const Vec3&)> paint;
     if (!mesh) {
-      p->error(diags, "a painted velocity belongs on a surface_mesh (its vertex colours are the paint)");
+      p->error(diags, "a painted velocity belongs on a surface_mesh (its vertex colours or an image map are the paint)");
+    } else if (imageNode) {
+      paint = readImagePaint(*imageNode, diags, *mesh, low, high, policy);
     } else if (mesh->colors.size() != mesh->positions.size()) {
-      p->error(diags, "a painted velocity needs a mesh with vertex colours (OBJ 'v x y z r g b', PLY red/green/blue)");
+      p->error(diags, "a painted velocity needs a mesh with vertex colours (OBJ 'v x y z r g b', PLY red/green/blue) or an 'image' map");
     } else {
-      auto paint = std::make_shared<NearestVertex>(*mesh, low, high);
+      paint = [near = std::make_shared<NearestVertex>(*mesh, low, high)](const Vec3& q) { return (*near)(q); };
+    }
+    if (paint) {
       const double top = std::max(low, high);
       out = VelocityWrap([paint, top](FieldPtr child) -> FieldPtr {
         if (!child) return nullptr;
         auto fn = [paint](const std::vector<Vec3>& pts, std::vector<float>& v) {
-          parallelFor(0, pts.size(), [&](size_t i) { v[i] = (*paint)(pts[i]); }, 256);
+          parallelFor(0, pts.size(), [&](size_t i) { v[i] = paint(pts[i]); }, 256);
         };
         return solids::frontField(child, fn, top, true);
       });

@@ -6,6 +6,7 @@
 ///   velocity: "1 + 2*turbulence"                     # a procedure of the point (x, y, z, noise, turbulence)
 ///   velocity: {expression: "1 + 0.5*sin(900*(x+y))", noise: {scale: 0.2, octaves: 4, seed: 1}, max: 1.5}
 ///   velocity: {painted: {low: 1, high: 3}}           # surface_mesh only: the mesh's vertex colours
+///   velocity: {painted: {low: 1, high: 3, image: {file: ring.png, axis: [0, 1, 0]}}}  # or an image map
 ///
 /// In an expression `noise` is Perlin noise in [-1, 1] at the point divided by the noise
 /// scale and `turbulence` the turbulence (sum of |noise| over the octaves) in [0, 1] there
@@ -15,7 +16,12 @@
 /// that is not positive and finite there is an error at the expression. A painted speed is
 /// low + (high − low)·luminance of the mesh's vertex colours, averaged over the vertices
 /// within about 1/24 of the mesh's size of each point of the surface (the nearest vertex
-/// where none is that near), carried outward along the normals.
+/// where none is that near), carried outward along the normals. With `image`, the paint is
+/// the luminance of an image map laid on the plane perpendicular to `axis` as extrude_2d
+/// lays its image (solids/extrude_field.h: columns along u, rows along v, the top row at
+/// the −v edge), `size` [u, v] and `center` [u, v] defaulting to the mesh's extent on that
+/// plane; read bilinearly, clamped at the image's edges, and projected along the axis
+/// onto the surface (a decal, as a painter's top view).
 
 #include <functional>
 #include <optional>
@@ -31,10 +37,12 @@ namespace sprig {
 using VelocityWrap = std::function<solids::FieldPtr(solids::FieldPtr)>;
 
 /// Reads the `velocity` value at node. mesh: the surface mesh (painted velocity needs its
-/// colours), or nullptr where painting is not possible. redistance: the child is not a
-/// distance (from_volume_surface), so even a constant speed runs the front. Returns
-/// nullopt with errors added to diags.
-std::optional<VelocityWrap> readVelocity(const YNode& node, DiagnosticList& diags, const PolyMesh* mesh, bool redistance);
+/// colours or its extent), or nullptr where painting is not possible. redistance: the child
+/// is not a distance (from_volume_surface), so even a constant speed runs the front.
+/// policy: where an image map may come from (nullptr: none may). Returns nullopt with
+/// errors added to diags.
+std::optional<VelocityWrap> readVelocity(const YNode& node, DiagnosticList& diags, const PolyMesh* mesh, bool redistance,
+                                         const PathPolicy* policy = nullptr);
 
 /// The identity velocity of from_volume_surface: a unit-speed front that measures
 /// distance from the zero set again.

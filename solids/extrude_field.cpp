@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <tuple>
 
 #include "core/parallel.h"
 
@@ -93,8 +94,7 @@ class ExtrudeField final : public DistanceField {
     if (!(o.size.x > 0 && o.size.y > 0)) throw std::invalid_argument("'size' must be positive");
     if (!(o.heightHi > o.heightLo)) throw std::invalid_argument("'height' needs lo < hi");
     axis_ = glm::normalize(o.axis);
-    u_ = fromYTo(axis_, DVec3(1, 0, 0));
-    v_ = fromYTo(axis_, DVec3(0, 0, 1));
+    std::tie(u_, v_) = imagePlaneAxes(axis_);
     pu_ = o.size.x / mask.width;
     pv_ = o.size.y / mask.height;
     pad_ = (std::max(mask.width, mask.height) + 1) / 2;
@@ -156,6 +156,8 @@ class ExtrudeField final : public DistanceField {
 };
 
 }  // namespace
+
+std::pair<DVec3, DVec3> imagePlaneAxes(const DVec3& axis) { return {fromYTo(axis, DVec3(1, 0, 0)), fromYTo(axis, DVec3(0, 0, 1))}; }
 
 std::vector<float> signedDistance2d(const Mask2d& mask, double pixelU, double pixelV, int pad) {
   const int w = mask.width + 2 * pad, h = mask.height + 2 * pad;

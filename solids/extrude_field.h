@@ -17,6 +17,7 @@
 /// the slab distance dh = |h - mid| - half combine as a box's do:
 /// d = length(max((d2, dh), 0)) + min(max(d2, dh), 0), exact outside the slab's corner too.
 
+#include <utility>
 #include <vector>
 
 #include "core/types.h"
@@ -44,6 +45,10 @@ struct ExtrudeOptions {
   /// The slab lo <= dot(p, axis) <= hi, world units.
   double heightLo = 0.0, heightHi = 1.0;
 };
+
+/// The image plane's column (u) and row (v) directions for a unit extrusion axis: the x and
+/// z axes turned by the smallest rotation taking +y to axis (ExtrudeOptions::axis).
+std::pair<DVec3, DVec3> imagePlaneAxes(const DVec3& axis);
 
 /// 2-D signed distances of mask, in pixels of unit spacing scaled by (pixelU, pixelV)
 /// world units: negative inside. Returned row-major like the mask, over the mask padded

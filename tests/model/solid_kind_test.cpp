@@ -1,6 +1,7 @@
 #include <catch2/catch.hpp>
 
 #include "core/atomic_file.h"
+#include "core/image.h"
 #include "core/mesh.h"
 #include "model/model.h"
 #include "model/solid_kind.h"
@@ -9,6 +10,7 @@
 #include "tests/model/species_error.h"
 #include "tests/scratch_dir.h"
 
+#include <fstream>
 #include <set>
 
 using namespace sprig;
@@ -186,4 +188,99 @@ solid:
   CHECK(line.find("; smoothing ") != std::string::npos);
   CHECK(errorOf("kind: solid\nsolid:\n  smooth: 11\n  volume: {distance_field: {sphere: {}}, layers: [{interior_layer: {material: nut, thickness: fill}}]}\n")
             .find("solid.yaml:3:11: error: 'smooth' is 11, out of range [0, 10]") != std::string::npos);
+}
+
+TEST_CASE("kind: solid improve and coarsen: read, applied after meshing, reported", "[model][solid]") {
+  const Species s = parseSpecies(R"(kind: solid
+solid:
+  grid: {cell: 0.1}
+  coarsen: 2
+  improve: {quality_below: 4, tolerance: 0.2, target_tetrahedra: 5000}
+  volume:
+    distance_field: {sphere: {radius: 0.6}}
+    layers:
+      - interior_layer: {material: chocolate, thickness: fill}
+      - exterior_layer: {material: foil, thickness: 0.1}
+)", "solid.yaml");
+  const auto& spec = dynamic_cast<const SolidSpec&>(*s.spec);
+  REQUIRE(spec.improve);
+  CHECK(spec.improve->qualityBelow == 4);
+  CHECK(spec.improve->interfaceTolerance == Approx(0.02));  // 0.2 cells of 0.1
+  CHECK(spec.improve->targetCount == 5000);
+  CHECK(spec.coarsenLevels == 2);
+  SpeciesModel model(s);
+  sprig::test::TempDir dir("solid-improve");
+  const std::string line = model.writeVolumeMesh(model.finalStage(), dir.path / "s.msh", false);
+  INFO(line);
+  CHECK(line.find("; octree ") != std::string::npos);
+  CHECK(line.find("; improvement ") != std::string::npos);
+  const std::string head = "kind: solid\nsolid:\n";
+  const std::string volume = "  volume: {distance_field: {sphere: {}}, layers: [{interior_layer: {material: nut, thickness: fill}}]}\n";
+  CHECK(errorOf(head + "  improve: {tolerance: 0.6}\n" + volume).find("solid.yaml:3:24: error: 'tolerance' is 0.6, out of range [0, 0.5]") !=
+        std::string::npos);
+  CHECK(errorOf(head + "  improve: {qualty_below: 3}\n" + volume)
+            .find("solid.yaml:3:13: error: unknown key 'qualty_below' in improve (did you mean 'quality_below'?)") != std::string::npos);
+  CHECK(errorOf(head + "  coarsen: 7\n" + volume).find("solid.yaml:3:12: error: 'coarsen' is 7, out of range [0, 6]") != std::string::npos);
+}
+
+TEST_CASE("kind: solid paints velocity from an image map", "[model][solid]") {
+  // A unit box whose top carries a two-pixel image: white over x < 0, black over x > 0.
+  // Speed 3 under white and 1 under black: the frosting is 0.3 thick on the left, 0.1 on
+  // the right.
+  sprig::test::TempDir dir("solid-image-paint");
+  {
+    std::ofstream obj(dir.path / "box.obj");
+    for (int c = 0; c < 8; ++c) obj << "v " << ((c & 1) - 0.5) << " " << (((c >> 1) & 1) - 0.5) << " " << (((c >> 2) & 1) - 0.5) << "\n";
+    // Outward, counter-clockwise (corner c = x + 2y + 4z, 1-based in OBJ).
+    for (const char* f : {"1 3 4", "1 4 2", "5 6 8", "5 8 7", "1 2 6", "1 6 5", "3 7 8", "3 8 4", "1 5 7", "1 7 3", "2 4 8", "2 8 6"})
+      obj << "f " << f << "\n";
+  }
+  Image paint(2, 1);
+  paint.set(0, 0, Vec4(1, 1, 1, 1));
+  paint.set(1, 0, Vec4(0, 0, 0, 1));
+  writeImage(paint, dir.path / "paint.png");
+  const std::string text = R"(kind: solid
+solid:
+  grid: {cell: 0.025}
+  volume:
+    distance_field:
+      surface_mesh:
+        file: box.obj
+        velocity: {painted: {low: 1, high: 3, image: {file: paint.png, axis: [0, 1, 0]}}}
+    layers:
+      - interior_layer: {material: chocolate, thickness: fill}
+      - exterior_layer: {material: pink_frosting, thickness: 0.1}
+)";
+  {
+    std::ofstream(dir.path / "s.yaml") << text;
+  }
+  PathPolicy policy;
+  policy.root = dir.path;
+  const Species s = loadSpecies(dir.path / "s.yaml", policy);
+  const auto& spec = dynamic_cast<const SolidSpec&>(*s.spec);
+  const solids::TetMesh m = solids::meshSolid(spec.solid, spec.grid);
+  double left = -1, right = -1;
+  for (const auto& t : solids::visibleInterface(m))
+    for (uint32_t v : t.v) {
+      const DVec3 p = m.positions[v];
+      if (std::abs(p.z) > 0.3) continue;
+      if (p.x > -0.45 && p.x < -0.35) left = std::max(left, p.y);
+      if (p.x > 0.35 && p.x < 0.45) right = std::max(right, p.y);
+    }
+  INFO("top of the frosting over the white half " << left << ", over the black half " << right);
+  CHECK(left == Approx(0.5 + 0.3).margin(0.025));
+  CHECK(right == Approx(0.5 + 0.1).margin(0.025));
+  // A missing map and a painted image off a mesh are errors at their keys.
+  std::string missing = text;
+  missing.replace(missing.find("paint.png"), 9, "none.png");
+  {
+    std::ofstream(dir.path / "m.yaml") << missing;
+  }
+  try {
+    loadSpecies(dir.path / "m.yaml", policy);
+    FAIL("a missing image map was accepted");
+  } catch (const InputError& e) {
+    CHECK(std::string(e.what()).find("m.yaml:8:61: error:") != std::string::npos);
+    CHECK(std::string(e.what()).find("none.png") != std::string::npos);
+  }
 }
