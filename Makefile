@@ -10,6 +10,10 @@ QUALITY ?= draft
 ASAN_BUILD   ?= build-asan
 FUZZ_SECONDS ?= 60
 CCACHE := $(if $(shell command -v ccache),-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+# ccache hashes paths relative to the checkout and not the build folder, so every clone
+# (CI's, a worktree, the fresh-machine test's) shares one cache.
+export CCACHE_BASEDIR   ?= $(CURDIR)
+export CCACHE_NOHASHDIR ?= 1
 # -O1 -g1: sanitizer reports with line numbers, at about half the compile time of -O2 -g.
 ASAN_CONFIG := CC=clang-14 CXX=clang++-14 cmake -S . -B $(ASAN_BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_CXX_FLAGS_RELEASE="-O1 -g1" -DSPRIG_SANITIZE=ON -DSPRIG_FUZZ=ON $(CCACHE)

@@ -6,10 +6,16 @@
 # (and `make gallery` with --gallery). Every step prints its time. Mounts and the folder are
 # removed on exit, also when interrupted.
 #
-#   scripts/fresh-machine-test.sh [--gallery] [--keep] [--cache DIR] [--mirror URL]
+#   scripts/fresh-machine-test.sh [--gallery] [--keep] [--cache DIR] [--mirror URL] [--no-ccache]
 #
 #   --gallery     also run `make gallery` after `make test`
 #   --keep        leave the root file system in place (its path is printed)
+#   --no-ccache   compile everything anew; by default the host's compiler cache (ccache's
+#                 cache_dir, when ccache is installed) is mounted into the new system, so
+#                 objects the host already compiled from the same sources with the same
+#                 Debian compiler are reused. Every package is still installed from scratch
+#                 and every header is still read from the new system, so a missing package
+#                 still fails the build.
 #   --cache DIR   where downloaded .deb files are kept between runs on this machine
 #                 (default /var/cache/sprig-fresh-machine). Only downloads are cached,
 #                 never an installed system: every run installs everything from scratch.
@@ -23,13 +29,15 @@ gallery=0
 keep=0
 cache=/var/cache/sprig-fresh-machine
 mirror=http://deb.debian.org/debian
+use_ccache=1
 while [ $# -gt 0 ]; do
   case "$1" in
     --gallery) gallery=1 ;;
     --keep) keep=1 ;;
     --cache) cache="$2"; shift ;;
     --mirror) mirror="$2"; shift ;;
-    -h|--help) sed -n '2,18p' "$0"; exit 0 ;;
+    --no-ccache) use_ccache=0 ;;
+    -h|--help) sed -n '2,24p' "$0"; exit 0 ;;
     *) echo "fresh-machine-test: error: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
   shift
@@ -109,11 +117,19 @@ mount_into sys -t sysfs sysfs
 mount_into dev --bind /dev
 mount_into dev/pts --bind /dev/pts
 mount_into var/cache/apt/archives --bind "$cache/apt"
+if [ "$use_ccache" -eq 1 ] && command -v ccache >/dev/null 2>&1; then
+  ccache_dir="$(ccache --get-config cache_dir 2>/dev/null || true)"
+  if [ -n "$ccache_dir" ]; then
+    mkdir -p "$ccache_dir"
+    mount_into root/.cache/ccache --bind "$ccache_dir"
+    echo "== fresh-machine: sharing the host's compiler cache $ccache_dir (--no-ccache to compile anew)"
+  fi
+fi
 # apt downloads as its own user: give it the cache (the uid the new system assigned).
 chown -R "$(awk -F: '$1 == "_apt" {print $3}' "$root/etc/passwd")" "$cache/apt"
 
 in_root() {
-  chroot "$root" /usr/bin/env -i HOME=/root TERM=dumb LANG=C.UTF-8 \
+  chroot "$root" /usr/bin/env -i HOME=/root TERM=dumb LANG=C.UTF-8 CCACHE_MAXSIZE=20G \
     PATH=/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin DEBIAN_FRONTEND=noninteractive \
     /bin/bash -c "$1"
 }
