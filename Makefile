@@ -30,7 +30,7 @@ deps:
 	@bash scripts/extract-meshes.sh species/meshes
 
 configure: deps
-	@cmake -S . -B $(BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release >/dev/null
+	@cmake -S . -B $(BUILD) -G Ninja -DCMAKE_BUILD_TYPE=Release $(CCACHE) >/dev/null
 
 build: configure
 	@cmake --build $(BUILD) -j $(JOBS)
