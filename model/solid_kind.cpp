@@ -67,6 +67,7 @@ class SolidReader {
     std::optional<YNode> grid = m.section("grid");
     spec_.smoothRounds = int(m.integer("smooth", 0, 0, 10));
     spec_.coarsenLevels = int(m.integer("coarsen", 0, 0, 6));
+    spec_.coarsenTolerance = m.number("coarsen_tolerance", 0, 0, 0.5);
     double toleranceCells = 0;
     if (std::optional<YNode> improve = m.section("improve")) {
       MapReader r(*improve, diags_, "improve");
@@ -676,6 +677,7 @@ class SolidModel final : public StillKindModel {
       const auto t0 = std::chrono::steady_clock::now();
       solids::MeshOptions options;
       options.coarsenLevels = spec_.coarsenLevels;
+      options.coarsenTolerance = spec_.coarsenTolerance;
       mesh_ = meshSolid(spec_.solid, spec_.grid, options, &stats_);
       if (spec_.smoothRounds > 0) {
         const auto s0 = std::chrono::steady_clock::now();

@@ -42,6 +42,7 @@ class SolidSpec : public KindSpec {
   solids::Grid grid;
   int smoothRounds = 0;  ///< `solid.smooth`: rounds of solids::smoothInterior after meshing
   int coarsenLevels = 0; ///< `solid.coarsen`: octree levels merged where no interface crosses (solids/octree.h)
+  double coarsenTolerance = 0;  ///< `solid.coarsen_tolerance`, cells: merge across interfaces where fields are affine to it
   /// `solid.improve`: flips, collapses and smoothing after meshing (solids/improve.h); the
   /// tolerance is in world units (the file gives it in cells).
   std::optional<solids::ImproveOptions> improve;

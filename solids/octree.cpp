@@ -53,7 +53,7 @@ I3 add(I3 a, const I3& b, int s = 1) {
 }
 
 /// The leaf level of every cell after bottom-up merging (see the header).
-std::vector<uint8_t> coarsen(const Lattice& L, int levels, const std::vector<uint64_t>& nodeClass) {
+std::vector<uint8_t> coarsen(const Lattice& L, int levels, const std::vector<uint64_t>& nodeClass, const MergeTest& interpolated) {
   std::vector<uint8_t> level(L.cells(), 0);
   // A cell's class: its corners' common class, or mixed. Read at a leaf's first cell.
   std::vector<uint64_t> cls(L.cells());
@@ -77,12 +77,15 @@ std::vector<uint8_t> coarsen(const Lattice& L, int levels, const std::vector<uin
     std::vector<uint8_t> merge(candidates, 0);
     parallelFor(0, candidates, [&](size_t c) {
       const I3 base = {int(c % size_t(g[0])) * s, int((c / size_t(g[0])) % size_t(g[1])) * s, int(c / (size_t(g[0]) * size_t(g[1]))) * s};
+      // A leaf's class is read at its first cell: the common class of its nodes, or mixed.
       const uint64_t k = cls[L.cell(base)];
-      if (k == kMixedClass) return;
+      bool uniform = k != kMixedClass;
       for (int q = 0; q < 8; ++q) {
         const size_t child = L.cell(add(base, I3{(q & 1) * h, ((q >> 1) & 1) * h, ((q >> 2) & 1) * h}));
-        if (level[child] != l - 1 || cls[child] != k) return;
+        if (level[child] != l - 1) return;
+        uniform = uniform && cls[child] == k;
       }
+      if (!uniform && !(interpolated && interpolated(base, s))) return;
       // Every cell touching the block is in a leaf of level l - 1 or more.
       auto fine = [&](int x, int y, int z) {
         const I3 q = {x, y, z};
@@ -97,13 +100,14 @@ std::vector<uint8_t> coarsen(const Lattice& L, int levels, const std::vector<uin
             return;
           }
         }
-      merge[c] = 1;
+      merge[c] = uniform ? 1 : 2;
     }, 64);
     bool any = false;
     for (size_t c = 0; c < candidates; ++c) {
       if (!merge[c]) continue;
       any = true;
       const I3 base = {int(c % size_t(g[0])) * s, int((c / size_t(g[0])) % size_t(g[1])) * s, int(c / (size_t(g[0]) * size_t(g[1]))) * s};
+      if (merge[c] == 2) cls[L.cell(base)] = kMixedClass;
       for (int z = 0; z < s; ++z)
         for (int y = 0; y < s; ++y)
           std::fill_n(level.begin() + long(L.cell(add(base, I3{0, y, z}))), s, uint8_t(l));
@@ -145,9 +149,10 @@ void squareTriangles(const Lattice& L, const std::vector<uint8_t>& isCorner, I3 
 }  // namespace
 
 std::vector<Tet> cellTetrahedra(const Grid& grid, int levels, const std::vector<uint64_t>& nodeClass,
-                                const std::function<bool(const uint32_t*)>& keep, CellStats* stats) {
+                                const std::function<bool(const uint32_t*)>& keep, CellStats* stats,
+                                const MergeTest& interpolated) {
   const Lattice L(grid);
-  const std::vector<uint8_t> level = levels > 0 ? coarsen(L, std::min(levels, 7), nodeClass) : std::vector<uint8_t>(L.cells(), 0);
+  const std::vector<uint8_t> level = levels > 0 ? coarsen(L, std::min(levels, 7), nodeClass, interpolated) : std::vector<uint8_t>(L.cells(), 0);
   auto isLeaf = [&](size_t c, const I3& p) {
     const int s = 1 << level[c];
     return p[0] % s == 0 && p[1] % s == 0 && p[2] % s == 0;

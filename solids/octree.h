@@ -38,12 +38,18 @@ struct CellStats {
   size_t transition = 0;    ///< kept leaves meshed as a fan from their centre
 };
 
+/// Whether the block of size × size × size cells at cell `base` may merge although its
+/// nodes' classes differ (the fields are "accurately represented by interpolation" there).
+using MergeTest = std::function<bool(const std::array<int, 3>& base, int size)>;
+
 /// The tetrahedra (positively oriented, node ids) of the cubes of grid kept by keep(8 corner
 /// node ids, corner c = dx + 2·dy + 4·dz), merged up to `levels` octree levels where
-/// nodeClass (per node) allows; levels = 0 gives the uniform five tetrahedra per cell.
-/// Deterministic at any thread count; in the order of the leaves' first cells.
+/// nodeClass (per node) allows, or where interpolated (when given) accepts a block whose
+/// children are leaves of one level; levels = 0 gives the uniform five tetrahedra per cell.
+/// Deterministic at any thread count (interpolated is called concurrently); in the order
+/// of the leaves' first cells.
 std::vector<std::array<uint32_t, 4>> cellTetrahedra(const Grid& grid, int levels, const std::vector<uint64_t>& nodeClass,
                                                     const std::function<bool(const uint32_t*)>& keep,
-                                                    CellStats* stats = nullptr);
+                                                    CellStats* stats = nullptr, const MergeTest& interpolated = {});
 
 }  // namespace sprig::solids

@@ -408,8 +408,10 @@ TetMesh meshSolid(const Solid& solid, const Grid& grid, const MeshOptions& optio
     totalBits += b;
   }
   if (totalBits > 63) levels = 0;
+  std::vector<uint8_t> procedural;  // per node: in a procedural layer (never merged)
   if (levels > 0) {
     nodeClass.resize(nodes.size());
+    procedural.assign(nodes.size(), 0);
     parallelFor(0, nodes.size(), [&](size_t n) {
       uint64_t k = 0;
       int shift = 0;
@@ -419,7 +421,8 @@ TetMesh meshSolid(const Solid& solid, const Grid& grid, const MeshOptions& optio
         const double d = w.fields[v][n];
         const size_t r = size_t(std::upper_bound(vol.boundaries.begin(), vol.boundaries.end(), d) - vol.boundaries.begin());
         const bool onBoundary = std::any_of(vol.boundaries.begin(), vol.boundaries.end(), [&](double b) { return double(float(b)) == d; });
-        if (onBoundary || (!claimed && vol.regions[r] <= kProcedural0)) {
+        if (!claimed && vol.regions[r] <= kProcedural0) procedural[n] = 1;
+        if (onBoundary || procedural[n]) {
           nodeClass[n] = kMixedClass;
           return;
         }
@@ -430,6 +433,48 @@ TetMesh meshSolid(const Solid& solid, const Grid& grid, const MeshOptions& optio
       nodeClass[n] = k;
     }, 4096);
   }
+  // Blocks an interface crosses merge where every volume's field is affine on them to
+  // within the tolerance (§4.4: "accurately represented by interpolation"): the coarse
+  // tetrahedra's linear interpolation then puts each interface within that distance of
+  // where the fine cells put it. Volumes whose nodes in the block lie in one region (no
+  // boundary near) do not count; blocks with a node of a procedural layer never merge.
+  MergeTest interpolated;
+  if (levels > 0 && options.coarsenTolerance > 0) {
+    const double eps = options.coarsenTolerance * grid.cell;
+    interpolated = [&, eps](const std::array<int, 3>& base, int s) {
+      auto node = [&](int i, int j, int k) { return size_t(base[0] + i) + nx * (size_t(base[1] + j) + ny * size_t(base[2] + k)); };
+      for (int k = 0; k <= s; ++k)
+        for (int j = 0; j <= s; ++j)
+          for (int i = 0; i <= s; ++i)
+            if (procedural[node(i, j, k)]) return false;
+      for (size_t v = 0; v < nv; ++v) {
+        const Volume& vol = solid.volumes[v];
+        const std::vector<float>& f = w.fields[v];
+        auto region = [&](float d) { return std::upper_bound(vol.boundaries.begin(), vol.boundaries.end(), double(d)) - vol.boundaries.begin(); };
+        const auto r0 = region(f[node(0, 0, 0)]);
+        bool crossed = false;
+        for (int k = 0; k <= s && !crossed; ++k)
+          for (int j = 0; j <= s && !crossed; ++j)
+            for (int i = 0; i <= s && !crossed; ++i) crossed = region(f[node(i, j, k)]) != r0;
+        if (!crossed) continue;
+        // The affine function of the eight corners (least squares): mean and slopes per cell.
+        double c[8], mean = 0;
+        for (int q = 0; q < 8; ++q) mean += c[q] = f[node((q & 1) * s, ((q >> 1) & 1) * s, ((q >> 2) & 1) * s)];
+        mean /= 8;
+        double g[3] = {0, 0, 0};
+        for (int q = 0; q < 8; ++q)
+          for (int a = 0; a < 3; ++a) g[a] += ((q >> a) & 1 ? c[q] : -c[q]) / (4.0 * s);
+        const double half = s / 2.0;
+        for (int k = 0; k <= s; ++k)
+          for (int j = 0; j <= s; ++j)
+            for (int i = 0; i <= s; ++i) {
+              const double fit = mean + g[0] * (i - half) + g[1] * (j - half) + g[2] * (k - half);
+              if (std::abs(double(f[node(i, j, k)]) - fit) > eps) return false;
+            }
+      }
+      return true;
+    };
+  }
   CellStats cells;
   w.tets = cellTetrahedra(grid, levels, nodeClass, [&](const uint32_t* corner) {
     for (size_t v = 0; v < nv; ++v) {
@@ -438,7 +483,7 @@ TetMesh meshSolid(const Solid& solid, const Grid& grid, const MeshOptions& optio
       if (mx >= claims[v].first && mn <= claims[v].second) return true;
     }
     return false;
-  }, &cells);
+  }, &cells, interpolated);
   st.cellTets = w.tets.size();
   st.cubes = cells.leaves;
   st.coarseCubes = cells.coarseLeaves;

@@ -121,6 +121,10 @@ struct MeshOptions {
   /// cells where no interface crosses, neighbours at most one level apart (0 = uniform).
   /// Volumes whose region indices need more than 63 bits together are not coarsened.
   int coarsenLevels = 0;
+  /// Fraction of the cell by which coarsening may move an interface: blocks an interface
+  /// crosses merge where every field is affine to within it (0 = only blocks no interface
+  /// crosses, the interfaces exactly the uniform grid's).
+  double coarsenTolerance = 0;
 };
 
 /// The tetrahedral mesh of solid on grid (§4.3). Deterministic: the same bytes at any

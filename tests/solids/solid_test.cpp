@@ -531,3 +531,49 @@ TEST_CASE("meshSolid: octree coarsening keeps the interfaces with fewer tetrahed
   // The same interface quality: the worst solid angle is an interface tetrahedron's in both.
   CHECK(measureQuality(coarse).minSolidAngle == Approx(measureQuality(uniform).minSolidAngle).epsilon(1e-9));
 }
+
+TEST_CASE("meshSolid: coarsening across interfaces where the fields are affine to a tolerance", "[solids]") {
+  // §4.4: cells "accurately represented by interpolation" merge although an interface
+  // crosses them. On a sphere of radius 0.6 (20 cells) a distance field departs from its
+  // affine fit over a block of s cells by about s²/(8·20) cells: blocks of 2 and 4 pass a
+  // tolerance of 0.1 cells, so less than half the tetrahedra remain (Fig. 4).
+  Solid s = sphereSolid(0.6, {{true, 0.1, "pink_frosting"}, {true, 0, "chocolate"}, {false, 0.06, "white_chocolate"}});
+  const double cell = 0.03;
+  const Grid g = gridAround(0.72, cell);
+  MeshStats su, sc;
+  const TetMesh uniform = meshSolid(s, g, {}, &su);
+  MeshOptions opt;
+  opt.coarsenLevels = 3;
+  opt.coarsenTolerance = 0.1;
+  const TetMesh coarse = meshSolid(s, g, opt, &sc);
+  INFO("uniform " << uniform.tets.size() << " tetrahedra, coarsened " << coarse.tets.size() << " (" << sc.coarseCubes
+                  << " coarse leaves of " << sc.cubes << ")");
+  CHECK(coarse.tets.size() * 2 < uniform.tets.size());
+  // Valid: positive, conforming, a closed manifold visible interface.
+  for (size_t t = 0; t < coarse.tets.size(); ++t) REQUIRE(coarse.volume(t) > 0);
+  CHECK(faceUses(coarse)[2] == 0);
+  size_t bad = 99;
+  const auto vis = visibleInterface(coarse, &bad);
+  CHECK(bad == 0);
+  const MeshTopology top = analyzeTopology(meshOf(coarse, vis));
+  CHECK(top.closed());
+  CHECK(top.manifold());
+  // Each interface moved by at most the tolerance: every material's volume is within the
+  // tolerance times its surfaces' area of the uniform mesh's.
+  const auto vu = volumeByMaterial(uniform), vc = volumeByMaterial(coarse);
+  REQUIRE(vu.size() == vc.size());
+  const double eps = opt.coarsenTolerance * cell;
+  const double rIn = 0.5, rOut = 0.6, rWhite = 0.66;
+  const std::map<std::string, double> area = {{"pink_frosting", 4 * M_PI * (rIn * rIn + rOut * rOut)},
+                                              {"chocolate", 4 * M_PI * rIn * rIn},
+                                              {"white_chocolate", 4 * M_PI * (rOut * rOut + rWhite * rWhite)}};
+  for (const auto& [name, a] : area) {
+    const uint16_t id = uint16_t(*s.materials.concrete(name));
+    INFO(name);
+    CHECK(std::abs(vc.at(id) - vu.at(id)) <= eps * a);
+  }
+  // With no tolerance the same grid keeps every interface tetrahedron of the uniform mesh.
+  opt.coarsenTolerance = 0;
+  const TetMesh exact = meshSolid(s, g, opt);
+  for (const auto& [mat, vol] : volumeByMaterial(exact)) CHECK(vol == Approx(vu.at(mat)).epsilon(1e-9));
+}
