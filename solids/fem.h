@@ -39,9 +39,10 @@ enum class Preconditioner {
 
 /// Options of solveElastic.
 struct FemOptions {
-  /// IncompleteCholesky took fewer iterations and less time on every mesh measured
-  /// (docs/PERFORMANCE.md, bench_fem).
-  Preconditioner preconditioner = Preconditioner::IncompleteCholesky;
+  /// Jacobi: IncompleteCholesky takes fewer iterations (2.2× fewer on bench_fem's slab of
+  /// 300,000 tetrahedra, 7% fewer on the cantilever test) but each costs more, and it was
+  /// slower in both (1.22× and about 2×; docs/PERFORMANCE.md).
+  Preconditioner preconditioner = Preconditioner::Jacobi;
   /// Stop when ‖b − K·u‖ / ‖b‖ falls below this (Eigen's ConjugateGradient criterion).
   double tolerance = 1e-8;
   /// Iteration cap; 0 = twice the number of free degrees of freedom (Eigen's default).
