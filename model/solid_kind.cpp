@@ -66,6 +66,7 @@ class SolidReader {
     MapReader m(section, diags_, "solid");
     std::optional<YNode> grid = m.section("grid");
     spec_.smoothRounds = int(m.integer("smooth", 0, 0, 10));
+    if (auto ops = m.get("operations")) spec_.operations = readSolidOperations(*ops, spec_.solid.materials, diags_);
     readVolumes(m, section, "solid");
     m.finish();
     if (!diags_.hasErrors() && !spec_.solid.volumes.empty()) resolveGrid(grid, section);
@@ -653,6 +654,12 @@ class SolidModel final : public StillKindModel {
         const auto s0 = std::chrono::steady_clock::now();
         smooth_ = smoothInterior(*mesh_, spec_.smoothRounds);
         smoothSeconds_ = secondsSince(s0);
+      }
+      try {
+        applySolidOperations(*mesh_, spec_.solid.materials.materials, spec_.operations);
+      } catch (...) {
+        mesh_.reset();
+        throw;
       }
       buildSeconds_ = secondsSince(t0);
     }

@@ -29,6 +29,7 @@
 #include <string>
 
 #include "model/kinds.h"
+#include "model/solid_operations.h"
 #include "model/yaml_reader.h"
 #include "solids/solid.h"
 
@@ -40,6 +41,7 @@ class SolidSpec : public KindSpec {
   solids::Solid solid;
   solids::Grid grid;
   int smoothRounds = 0;  ///< `solid.smooth`: rounds of solids::smoothInterior after meshing
+  std::vector<SolidOperation> operations;  ///< `solid.operations`, applied in order after smoothing
   SourceLoc loc;
 
   std::string checkSummary(const Species& species) const override;
