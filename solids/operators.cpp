@@ -18,7 +18,10 @@ std::vector<uint8_t> usedVertices(const TetMesh& mesh) {
   return used;
 }
 
-/// The used vertices lowest along up (within 1e-9 of the mesh's extent along it).
+/// The used vertices within kGroundBand of the mesh's extent along up of its lowest point
+/// (where a model resting on the ground touches it: a plane base, or a cap of a round one).
+constexpr double kGroundBand = 0.02;
+
 std::vector<uint8_t> lowestVertices(const TetMesh& mesh, const DVec3& up) {
   const std::vector<uint8_t> used = usedVertices(mesh);
   double lo = INFINITY, hi = -INFINITY;
@@ -29,7 +32,7 @@ std::vector<uint8_t> lowestVertices(const TetMesh& mesh, const DVec3& up) {
       hi = std::max(hi, h);
     }
   std::vector<uint8_t> out(used.size(), 0);
-  const double tol = 1e-9 * std::max(hi - lo, 1e-300);
+  const double tol = kGroundBand * (hi - lo);
   for (size_t v = 0; v < used.size(); ++v)
     if (used[v] && glm::dot(mesh.positions[v], up) <= lo + tol) out[v] = 1;
   return out;

@@ -38,7 +38,8 @@ struct HammerOptions {
   std::vector<uint16_t> affects;
   /// Per vertex, 1 = held in place (empty = none given). Vertices of tetrahedra of materials
   /// not in `affects` are always held: other materials are not modified (§3.1). When that
-  /// leaves nothing held, the lowest vertices along `up` are (the model rests on the ground).
+  /// leaves nothing held, the ground is: the vertices within 2% of the model's height (along
+  /// `up`) of its lowest point (a plane base, or a cap of a round model).
   std::vector<uint8_t> anchored;
   DVec3 up{0, 1, 0};            ///< Sprig's up axis
   FractureCriterion criterion = FractureCriterion::MaxPrincipal;
@@ -57,8 +58,8 @@ struct HammerStats {
   std::vector<FemStats> fem;  ///< one per solve
 };
 
-/// The vertices hammer holds for these options (1 = held): options.anchored, the vertices
-/// of unaffected tetrahedra, or else the lowest vertices along options.up.
+/// The vertices hammer holds for these options (1 = held): options.anchored and the
+/// vertices of unaffected tetrahedra, or else the ground (see HammerOptions::anchored).
 std::vector<uint8_t> hammerAnchors(const TetMesh& mesh, const HammerOptions& options);
 
 /// The blow's force at each vertex, N: the Gaussian weights of the vertices used by some
@@ -83,7 +84,8 @@ struct DisplaceOptions {
   /// Material ids whose vertices move by `offset` (the paper's growing tree); required.
   std::vector<uint16_t> moving;
   DVec3 offset{0, 0.1, 0};      ///< displacement of the moving vertices, m
-  /// Per vertex, 1 = held at zero displacement (empty = the lowest vertices along `up`).
+  /// Per vertex, 1 = held at zero displacement (empty = the ground: vertices within 2% of
+  /// the model's height along `up` of its lowest point).
   /// A vertex both moving and held moves.
   std::vector<uint8_t> anchored;
   DVec3 up{0, 1, 0};            ///< Sprig's up axis

@@ -159,6 +159,59 @@ TEST_CASE("hammer: a blow on a clay mold", "[solids][operators]") {
   }
 }
 
+TEST_CASE("hammer: every material affected, a round stone rests on the ground", "[solids][operators]") {
+  // A stone ball of radius 0.5, nothing named: the held vertices are the cap within 2% of
+  // its height of the bottom (y < -0.48), enough to hold it; a blow on top breaks stone near
+  // it and nothing falls before the blow.
+  Solid s;
+  Layer l;
+  l.fill = true;
+  l.material = *s.materials.concrete("stone");
+  s.volumes.push_back(makeVolume(sphereField(DVec3(0.0), 0.5), {l}));
+  TetMesh m = meshSolid(s, test::gridAround(0.6, 0.06));
+  HammerOptions opt;
+  opt.position = DVec3(0, 0.5, 0);
+  opt.orientation = DVec3(0, -1, 0);
+  opt.size = 0.1;
+  opt.magnitude = 6e6;
+  const std::vector<uint8_t> held = hammerAnchors(m, opt);
+  double lowest = INFINITY;
+  for (const DVec3& p : m.positions) lowest = std::min(lowest, p.y);
+  size_t count = 0;
+  for (size_t v = 0; v < held.size(); ++v)
+    if (held[v]) {
+      ++count;
+      CHECK(m.positions[v].y <= lowest + 0.02 * 1.0 + 1e-9);
+    }
+  CHECK(count >= 3);
+  const TetMesh whole = m;
+  const HammerStats st = hammer(m, s.materials.materials, opt);
+  // Where the removed tetrahedra were: near the blow (within 3·size), near the ground
+  // (within 0.2 of the bottom, where the reaction concentrates on the small cap), along the
+  // loaded axis between them (a ball squeezed between two points splits along that
+  // diameter, as in the Brazilian test), or elsewhere.
+  std::set<Key> kept(m.tets.begin(), m.tets.end());
+  size_t near = 0, ground = 0, axis = 0, far = 0;
+  for (const Key& q : whole.tets)
+    if (!kept.count(q)) {
+      DVec3 c(0.0);
+      for (uint32_t v : q) c += 0.25 * whole.positions[v];
+      ++(glm::length(c - opt.position) < 3 * opt.size ? near
+         : c.y < lowest + 0.2                        ? ground
+         : std::hypot(c.x, c.z) < 0.15               ? axis
+                                                     : far);
+    }
+  INFO("held " << count << ", broken " << st.broken << ", fallen " << st.fallen << " of " << whole.tets.size()
+                << "; removed near the blow " << near << ", near the ground " << ground << ", along the axis " << axis
+                << ", elsewhere " << far);
+  CHECK(st.broken > 0);
+  CHECK(near > 0);
+  CHECK(near + ground + axis + far == st.broken + st.fallen);
+  CHECK(far == 0);
+  CHECK(minVolume(m) > 0);
+  CHECK(overusedFaces(m) == 0);
+}
+
 TEST_CASE("hammer: a snapped stick falls away", "[solids][operators]") {
   // A stick of fired clay, 1 m × 0.1 m × 0.1 m along x, standing out of a stone base (the
   // first cell column, held). A sideways blow at its end puts its root in tension; with
