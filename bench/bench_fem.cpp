@@ -7,7 +7,9 @@
 /// Prints the mesh, then for each preconditioner (Jacobi, Sprig's default, and
 /// IncompleteCholesky, the alternative) assembly, preconditioner and CG seconds, iterations and residual;
 /// Sprig's parallel assembly against a plain sequential triplet assembly (Eigen's
-/// setFromTriplets, all degrees of freedom); the process peak memory; and the ratios.
+/// setFromTriplets, all degrees of freedom); the Jacobi solve again on one thread (the
+/// parallel product's gain; its displacements must be the same bytes); the process peak
+/// memory; and the ratios.
 
 #include "bench/bench_clock.h"
 #include "core/parallel.h"
@@ -113,6 +115,22 @@ int main(int argc, char** argv) {
   }
   const FemStats& jac = results[0].stats;
   const FemStats& ic = results[1].stats;
+  // The Jacobi solve again on one thread: the parallel product's gain, and the same bytes.
+  FemResult single;
+  const int threads = threadCount();
+  {
+    ThreadLimit limit(1);
+    const auto t0 = Clock::now();
+    single = solveElastic(mesh, solid.materials.materials, pb);
+    std::printf("Jacobi, 1 thread: assembly %.2f s, CG %.2f s (%d iterations); total %.2f s wall; displacements %s "
+                "those at %d threads\n",
+                single.stats.assemblySeconds, single.stats.solveSeconds, single.stats.iterations, seconds(t0),
+                std::memcmp(single.displacement.data(), results[0].displacement.data(),
+                            single.displacement.size() * sizeof(DVec3)) == 0
+                    ? "are the same bytes as"
+                    : "DIFFER from",
+                threads);
+  }
   double diff = 0, size = 0;
   for (size_t v = 0; v < mesh.positions.size(); ++v) {
     diff = std::max(diff, glm::length(results[0].displacement[v] - results[1].displacement[v]));
@@ -126,9 +144,10 @@ int main(int argc, char** argv) {
   std::printf("sequential triplet assembly (all %zu dofs, %zu non-zeros, sum %.3e): %.2f s; peak memory %.0f MB\n",
               3 * mesh.positions.size(), nnz, sum, seq, peakMB());
   std::printf("ratios: IncompleteCholesky / Jacobi solve time (preconditioner + CG) = %.2f, iterations %.2f; "
-              "sequential triplet / Sprig assembly time = %.2f\n",
+              "sequential triplet / Sprig assembly time = %.2f; Jacobi CG 1 thread / %d threads = %.2f\n",
               (ic.preconditionerSeconds + ic.solveSeconds) / (jac.preconditionerSeconds + jac.solveSeconds),
-              double(ic.iterations) / double(jac.iterations), seq / jac.assemblySeconds);
+              double(ic.iterations) / double(jac.iterations), seq / jac.assemblySeconds, threadCount(),
+              single.stats.solveSeconds / jac.solveSeconds);
   std::printf("peak memory: after meshing %.0f MB, after the Jacobi solve %.0f MB, after the IncompleteCholesky solve %.0f MB\n",
               meshPeak, peaks[0], peaks[1]);
   return 0;

@@ -12,6 +12,101 @@
 #include <string>
 
 #include "core/parallel.h"
+#include "core/progress.h"
+
+namespace sprig::solids::detail {
+class ParallelProduct;
+}
+
+namespace Eigen::internal {
+/// ParallelProduct stands in for the sparse matrix in ConjugateGradient (Eigen's
+/// "matrix-free solver" interface), so it shares a sparse matrix's traits.
+template <>
+struct traits<sprig::solids::detail::ParallelProduct> : public traits<SparseMatrix<double>> {};
+}  // namespace Eigen::internal
+
+namespace sprig::solids::detail {
+
+/// The symmetric stiffness matrix K seen by conjugate gradients: K·x computed in parallel,
+/// one output entry per column (K = Kᵀ, so entry j is column j · x), each summed in the
+/// column's order by one thread, so the product is the same bytes at any thread count.
+/// Each product advances the progress bar (and notices a cancellation request).
+class ParallelProduct : public Eigen::EigenBase<ParallelProduct> {
+ public:
+  using Scalar = double;
+  using RealScalar = double;
+  using StorageIndex = int;
+  enum { ColsAtCompileTime = Eigen::Dynamic, MaxColsAtCompileTime = Eigen::Dynamic, IsRowMajor = false };
+
+  ParallelProduct(const Eigen::SparseMatrix<double>& k, Progress& progress) : k_(k), progress_(progress) {}
+  Eigen::Index rows() const { return k_.rows(); }
+  Eigen::Index cols() const { return k_.cols(); }
+
+  template <class Rhs>
+  Eigen::Product<ParallelProduct, Rhs, Eigen::AliasFreeProduct> operator*(const Eigen::MatrixBase<Rhs>& x) const {
+    return Eigen::Product<ParallelProduct, Rhs, Eigen::AliasFreeProduct>(*this, x.derived());
+  }
+
+  /// dst += alpha·K·x.
+  template <class Dest, class Rhs>
+  void addProduct(Dest& dst, const Rhs& x, double alpha) const {
+    const int* outer = k_.outerIndexPtr();
+    const int* inner = k_.innerIndexPtr();
+    const double* value = k_.valuePtr();
+    parallelForRange(0, size_t(k_.cols()), [&](size_t lo, size_t hi) {
+      for (size_t j = lo; j < hi; ++j) {
+        double sum = 0;
+        for (int e = outer[j]; e < outer[j + 1]; ++e) sum += value[e] * x.coeff(inner[e]);
+        dst.coeffRef(Eigen::Index(j)) += alpha * sum;
+      }
+    }, 2048);
+    progress_.advance();
+  }
+
+  /// The inverse diagonal (for the Jacobi preconditioner).
+  Eigen::VectorXd inverseDiagonal() const {
+    Eigen::VectorXd d = k_.diagonal();
+    for (Eigen::Index i = 0; i < d.size(); ++i) d[i] = d[i] != 0 ? 1 / d[i] : 1;
+    return d;
+  }
+
+ private:
+  const Eigen::SparseMatrix<double>& k_;
+  Progress& progress_;
+};
+
+/// Jacobi preconditioning for ParallelProduct (Eigen's DiagonalPreconditioner needs the
+/// sparse matrix's iterators): z = D⁻¹·r.
+class JacobiPreconditioner {
+ public:
+  JacobiPreconditioner() = default;
+  JacobiPreconditioner& analyzePattern(const ParallelProduct&) { return *this; }
+  JacobiPreconditioner& factorize(const ParallelProduct& k) {
+    inv_ = k.inverseDiagonal();
+    return *this;
+  }
+  JacobiPreconditioner& compute(const ParallelProduct& k) { return factorize(k); }
+  template <class Rhs>
+  Eigen::VectorXd solve(const Eigen::MatrixBase<Rhs>& r) const { return inv_.cwiseProduct(r); }
+  Eigen::ComputationInfo info() const { return Eigen::Success; }
+
+ private:
+  Eigen::VectorXd inv_;
+};
+
+}  // namespace sprig::solids::detail
+
+namespace Eigen::internal {
+template <class Rhs>
+struct generic_product_impl<sprig::solids::detail::ParallelProduct, Rhs, SparseShape, DenseShape, GemvProduct>
+    : generic_product_impl_base<sprig::solids::detail::ParallelProduct, Rhs,
+                                generic_product_impl<sprig::solids::detail::ParallelProduct, Rhs>> {
+  template <class Dest>
+  static void scaleAndAddTo(Dest& dst, const sprig::solids::detail::ParallelProduct& lhs, const Rhs& rhs, const double& alpha) {
+    lhs.addProduct(dst, rhs, alpha);
+  }
+};
+}  // namespace Eigen::internal
 
 namespace sprig::solids {
 
@@ -118,9 +213,11 @@ DVec3 principal(const std::array<double, 6>& s) {
   return DVec3(ev[0], ev[1], ev[2]);
 }
 
-template <class Pre>
-void runCg(const SpMat& K, const Eigen::VectorXd& b, Eigen::VectorXd& x, const FemOptions& options, FemStats& st) {
-  Eigen::ConjugateGradient<SpMat, Eigen::Lower | Eigen::Upper, Pre> cg;
+/// Conjugate gradients on K (a SpMat, or detail::ParallelProduct wrapping one) with
+/// preconditioner Pre; fills x (the initial guess on entry) and the solve's statistics.
+template <class Pre, class Mat>
+void runCg(const Mat& K, const Eigen::VectorXd& b, Eigen::VectorXd& x, const FemOptions& options, FemStats& st) {
+  Eigen::ConjugateGradient<Mat, Eigen::Lower | Eigen::Upper, Pre> cg;
   cg.setTolerance(options.tolerance);
   if (options.maxIterations > 0) cg.setMaxIterations(options.maxIterations);
   auto t0 = Clock::now();
@@ -132,7 +229,9 @@ void runCg(const SpMat& K, const Eigen::VectorXd& b, Eigen::VectorXd& x, const F
   st.solveSeconds = since(t0);
   st.iterations = int(cg.iterations());
   const double bn = b.norm();
-  st.residual = bn > 0 ? (b - K * x).norm() / bn : 0.0;
+  Eigen::VectorXd r = b;
+  r.noalias() -= K * x;
+  st.residual = bn > 0 ? r.norm() / bn : 0.0;
   st.converged = cg.info() == Eigen::Success;
 }
 
@@ -347,10 +446,15 @@ FemResult solveElastic(const TetMesh& mesh, const std::vector<Material>& materia
       for (int i = 0; i < 3; ++i)
         if (int d = dof[3 * v + size_t(i)]; d >= 0) x[d] = problem.initialGuess[v][i];
   if (nFree > 0) {
-    if (options.preconditioner == Preconditioner::Jacobi)
-      runCg<Eigen::DiagonalPreconditioner<double>>(K, rhs, x, options, st);
-    else
+    Progress progress("FEM solve (CG iterations)", 0);
+    if (options.preconditioner == Preconditioner::Jacobi) {
+      // The products run in parallel; CG's dot products and updates stay sequential.
+      const detail::ParallelProduct product(K, progress);
+      runCg<detail::JacobiPreconditioner>(product, rhs, x, options, st);
+    } else {
       runCg<Eigen::IncompleteCholesky<double>>(K, rhs, x, options, st);
+    }
+    progress.finish();
     if (!x.allFinite()) throw std::runtime_error("fem: the solve produced non-finite displacements");
     if (!st.converged && options.requireConvergence)
       throw std::runtime_error("fem: conjugate gradients did not converge in " + std::to_string(st.iterations) +

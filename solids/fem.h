@@ -19,8 +19,8 @@
 /// Fixed degrees of freedom are eliminated (their columns move to the right-hand side with
 /// their prescribed values), not penalized; the free system is solved by conjugate
 /// gradients. Assembly is parallel over vertices, each row summed over the vertex's
-/// tetrahedra in index order, so the matrix and every result are the same bytes at any
-/// thread count.
+/// tetrahedra in index order, and CG's products (with Jacobi) over columns, each summed by
+/// one thread, so the matrix and every result are the same bytes at any thread count.
 
 #include <array>
 #include <cstdint>
@@ -40,8 +40,9 @@ enum class Preconditioner {
 /// Options of solveElastic.
 struct FemOptions {
   /// Jacobi: IncompleteCholesky takes fewer iterations (2.2× fewer on bench_fem's slab of
-  /// 300,000 tetrahedra, 7% fewer on the cantilever test) but each costs more, and it was
-  /// slower in both (1.22× and about 2×; docs/PERFORMANCE.md).
+  /// 300,000 tetrahedra, 7% fewer on the cantilever test) but each costs more: it took
+  /// 1.1-1.2× the CPU time on the slab and 2-3× the time on the cantilever
+  /// (docs/PERFORMANCE.md). With Jacobi, CG's sparse products run in parallel.
   Preconditioner preconditioner = Preconditioner::Jacobi;
   /// Stop when ‖b − K·u‖ / ‖b‖ falls below this (Eigen's ConjugateGradient criterion).
   double tolerance = 1e-8;
@@ -98,7 +99,9 @@ struct FemResult {
 /// tetrahedron of non-positive volume, or a singular system: a face-connected part of the
 /// mesh whose fixed components do not hold all six rigid motions (nothing fixed, or only
 /// points on one line). Throws std::runtime_error when CG does not converge and
-/// options.requireConvergence. Cost: assembly O(tets); CG about O(dofs^1.3) on 3-D meshes.
+/// options.requireConvergence. With Jacobi, each CG iteration advances a progress bar and a
+/// cancellation request throws sprig::Cancelled (core/progress.h). Cost: assembly O(tets); CG
+/// about O(dofs^1.3) on 3-D meshes (300,000 tetrahedra: about 15 s of CPU).
 FemResult solveElastic(const TetMesh& mesh, const std::vector<Material>& materials, const FemProblem& problem,
                        const FemOptions& options = {});
 
