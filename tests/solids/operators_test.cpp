@@ -319,3 +319,28 @@ TEST_CASE("displace: bad input", "[solids][operators]") {
   CHECK_THROWS_WITH(displace(m, two, opt), Catch::Contains("would invert"));
   CHECK(m.positions == before.positions);
 }
+
+TEST_CASE("displace: the same bytes at 1 and 2 threads", "[solids][operators]") {
+  TetMesh m = test::tetBlock({12, 4, 12}, DVec3(0.0), DVec3(1.0, 0.4, 1.0));
+  const std::vector<Material> mats = {*findBuiltinMaterial("dirt"), *findBuiltinMaterial("wood")};
+  for (size_t t = 0; t < m.tets.size(); ++t) {
+    DVec3 c(0.0);
+    for (uint32_t v : m.tets[t]) c += 0.25 * m.positions[v];
+    m.materials[t] = glm::length(DVec3(c.x - 0.5, 0, c.z - 0.5)) < 0.15 ? 1 : 0;
+  }
+  DisplaceOptions opt;
+  opt.moving = {1};
+  opt.offset = DVec3(0.001, 0.004, 0);
+  opt.steps = 2;
+  TetMesh one = m, two = m;
+  {
+    ThreadLimit limit(1);
+    displace(one, mats, opt);
+  }
+  {
+    ThreadLimit limit(2);
+    displace(two, mats, opt);
+  }
+  CHECK(one.positions != m.positions);
+  CHECK(std::memcmp(one.positions.data(), two.positions.data(), one.positions.size() * sizeof(DVec3)) == 0);
+}
