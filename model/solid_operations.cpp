@@ -101,6 +101,8 @@ void applySolidOperations(solids::TetMesh& mesh, const std::vector<solids::Mater
       throw InputError(op.loc, message, op.sourceLine);
     }
   }
+  // Vertices the blows left unused would be written out as loose nodes.
+  if (!operations.empty()) solids::compactVertices(mesh);
 }
 
 }  // namespace sprig

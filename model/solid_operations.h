@@ -36,8 +36,9 @@ struct SolidOperation {
 /// are appended to it when first named); every error goes to diags.
 std::vector<SolidOperation> readSolidOperations(const YNode& list, solids::MaterialTable& materials, DiagnosticList& diags);
 
-/// Applies operations to mesh in order. An operation that fails (say, a part of the mesh
-/// nothing holds) throws InputError at its entry.
+/// Applies operations to mesh in order, then drops the vertices no tetrahedron uses any
+/// more. An operation that fails (say, a part of the mesh nothing holds) throws InputError
+/// at its entry.
 void applySolidOperations(solids::TetMesh& mesh, const std::vector<solids::Material>& materials,
                           const std::vector<SolidOperation>& operations);
 

@@ -162,6 +162,22 @@ HammerStats hammer(TetMesh& mesh, const std::vector<Material>& materials, const 
   return st;
 }
 
+size_t compactVertices(TetMesh& mesh) {
+  const std::vector<uint8_t> used = usedVertices(mesh);
+  std::vector<uint32_t> id(mesh.positions.size(), UINT32_MAX);
+  uint32_t next = 0;
+  for (size_t v = 0; v < used.size(); ++v)
+    if (used[v]) {
+      id[v] = next;
+      mesh.positions[next++] = mesh.positions[v];
+    }
+  const size_t gone = mesh.positions.size() - next;
+  mesh.positions.resize(next);
+  for (auto& q : mesh.tets)
+    for (uint32_t& v : q) v = id[v];
+  return gone;
+}
+
 DisplaceStats displace(TetMesh& mesh, const std::vector<Material>& materials, const DisplaceOptions& options) {
   if (options.moving.empty()) throw std::invalid_argument("displace: 'moving' names no material");
   checkIds(options.moving, materials.size(), "displace: 'moving'");

@@ -79,6 +79,11 @@ std::vector<DVec3> hammerForces(const TetMesh& mesh, const HammerOptions& option
 /// material) and what solveElastic throws. Cost: one FEM solve per round.
 HammerStats hammer(TetMesh& mesh, const std::vector<Material>& materials, const HammerOptions& options);
 
+/// Drops the vertices no tetrahedron uses (hammer leaves them so vertex ids stay stable
+/// between operations), keeping the others in order and renumbering the tetrahedra.
+/// Returns how many went. Cost O(vertices + tets).
+size_t compactVertices(TetMesh& mesh);
+
 /// Options of displace.
 struct DisplaceOptions {
   /// Material ids whose vertices move by `offset` (the paper's growing tree); required.

@@ -120,6 +120,15 @@ TEST_CASE("hammer: a blow on a clay mold", "[solids][operators]") {
     for (uint8_t a : anchors) fixed.push_back(a ? 7 : 0);
     const std::vector<bool> held = componentsHeld(m, component, count, fixed);
     CHECK(std::count(held.begin(), held.end(), false) == 0);
+    // Compacting drops exactly the vertices no tetrahedron uses; each tetrahedron keeps its corners.
+    std::set<uint32_t> usedIds;
+    for (const auto& q : m.tets) usedIds.insert(q.begin(), q.end());
+    const TetMesh loose = m;
+    CHECK(compactVertices(m) == loose.positions.size() - usedIds.size());
+    CHECK(m.positions.size() == usedIds.size());
+    REQUIRE(m.tets.size() == loose.tets.size());
+    for (size_t t = 0; t < m.tets.size(); ++t)
+      for (int c = 0; c < 4; ++c) CHECK(m.positions[m.tets[t][size_t(c)]] == loose.positions[loose.tets[t][size_t(c)]]);
   }
   SECTION("a blow on the bronze side only (clay not affected) changes nothing") {
     opt.affects = {mold.bronze};
