@@ -77,6 +77,7 @@ class SolidReader {
       o.targetCount = size_t(r.integer("target_tetrahedra", 0, 0, 1000000000));
       r.finish();
     }
+    if (auto ops = m.get("operations")) spec_.operations = readSolidOperations(*ops, spec_.solid.materials, diags_);
     readVolumes(m, section, "solid");
     m.finish();
     if (!diags_.hasErrors() && !spec_.solid.volumes.empty()) resolveGrid(grid, section);
@@ -638,8 +639,9 @@ class SolidModel final : public StillKindModel {
   std::string writeVolumeMesh(const Stage&, const std::filesystem::path& path, bool) override {
     const TetMesh& m = tets();
     writeTetMesh(m, spec_.solid.materials.materials, path);
-    // Smoothing or improvement measured it already.
-    const QualityStats q = improved_ ? improved_->after : smooth_ ? smooth_->after : measureQuality(m);
+    // Smoothing or improvement measured it already, unless operations changed the mesh since.
+    const bool measured = spec_.operations.empty();
+    const QualityStats q = measured && improved_ ? improved_->after : measured && smooth_ ? smooth_->after : measureQuality(m);
     char buf[512];
     std::snprintf(buf, sizeof buf,
                   "%s: %zu tetrahedra, %zu vertices (grid %dx%dx%d of cell %g; fields %.2f s, mesh %.2f s); "
@@ -688,6 +690,12 @@ class SolidModel final : public StillKindModel {
         const auto s0 = std::chrono::steady_clock::now();
         improved_ = improveQuality(*mesh_, *spec_.improve);
         improveSeconds_ = secondsSince(s0);
+      }
+      try {
+        applySolidOperations(*mesh_, spec_.solid.materials.materials, spec_.operations);
+      } catch (...) {
+        mesh_.reset();
+        throw;
       }
       buildSeconds_ = secondsSince(t0);
     }

@@ -29,6 +29,7 @@
 #include <string>
 
 #include "model/kinds.h"
+#include "model/solid_operations.h"
 #include "model/yaml_reader.h"
 #include "solids/improve.h"
 #include "solids/solid.h"
@@ -46,6 +47,7 @@ class SolidSpec : public KindSpec {
   /// `solid.improve`: flips, collapses and smoothing after meshing (solids/improve.h); the
   /// tolerance is in world units (the file gives it in cells).
   std::optional<solids::ImproveOptions> improve;
+  std::vector<SolidOperation> operations;  ///< `solid.operations`, applied in order after smoothing
   SourceLoc loc;
 
   std::string checkSummary(const Species& species) const override;

@@ -9,6 +9,7 @@ packages=(
   libosd-dev libyaml-cpp-dev catch2 libcli11-dev libtinygltf-dev libopenvdb-dev libboost-iostreams-dev zlib1g-dev
   libbenchmark-dev parallel
   libmeshoptimizer-dev libcgal-demo
+  libeigen3-dev
   nodejs curl ca-certificates
   gmsh
   clang-14 libclang-rt-14-dev ccache

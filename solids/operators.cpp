@@ -1,0 +1,234 @@
+#include "solids/operators.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace sprig::solids {
+
+namespace {
+
+bool finite(const DVec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+
+std::vector<uint8_t> usedVertices(const TetMesh& mesh) {
+  std::vector<uint8_t> used(mesh.positions.size(), 0);
+  for (const auto& q : mesh.tets)
+    for (uint32_t v : q) used[v] = 1;
+  return used;
+}
+
+/// The used vertices within kGroundBand of the mesh's extent along up of its lowest point
+/// (where a model resting on the ground touches it: a plane base, or a cap of a round one).
+constexpr double kGroundBand = 0.02;
+
+std::vector<uint8_t> lowestVertices(const TetMesh& mesh, const DVec3& up) {
+  const std::vector<uint8_t> used = usedVertices(mesh);
+  double lo = INFINITY, hi = -INFINITY;
+  for (size_t v = 0; v < used.size(); ++v)
+    if (used[v]) {
+      const double h = glm::dot(mesh.positions[v], up);
+      lo = std::min(lo, h);
+      hi = std::max(hi, h);
+    }
+  std::vector<uint8_t> out(used.size(), 0);
+  const double tol = kGroundBand * (hi - lo);
+  for (size_t v = 0; v < used.size(); ++v)
+    if (used[v] && glm::dot(mesh.positions[v], up) <= lo + tol) out[v] = 1;
+  return out;
+}
+
+DVec3 unitUp(const DVec3& up) {
+  if (!finite(up) || glm::length(up) == 0) throw std::invalid_argument("'up' must be a finite, non-zero vector");
+  return glm::normalize(up);
+}
+
+std::vector<uint8_t> asFixed(const std::vector<uint8_t>& flags) {
+  std::vector<uint8_t> out(flags.size());
+  for (size_t v = 0; v < flags.size(); ++v) out[v] = flags[v] ? 7 : 0;
+  return out;
+}
+
+void checkIds(const std::vector<uint16_t>& ids, size_t count, const char* what) {
+  for (uint16_t id : ids)
+    if (id >= count)
+      throw std::invalid_argument(std::string(what) + " names material id " + std::to_string(id) + ", but there are " +
+                                  std::to_string(count) + " materials");
+}
+
+/// Keeps the tetrahedra with keep[t], in order; returns how many went.
+size_t removeTets(TetMesh& mesh, const std::vector<uint8_t>& keep) {
+  size_t out = 0;
+  for (size_t t = 0; t < mesh.tets.size(); ++t)
+    if (keep[t]) {
+      mesh.tets[out] = mesh.tets[t];
+      mesh.materials[out] = mesh.materials[t];
+      ++out;
+    }
+  const size_t gone = mesh.tets.size() - out;
+  mesh.tets.resize(out);
+  mesh.materials.resize(out);
+  return gone;
+}
+
+/// Removes every face-connected piece that `fixed` does not hold; returns how many tetrahedra went.
+size_t dropLoose(TetMesh& mesh, const std::vector<uint8_t>& fixed) {
+  const auto [component, count] = faceComponents(mesh);
+  const std::vector<bool> held = componentsHeld(mesh, component, count, fixed);
+  std::vector<uint8_t> keep(mesh.tets.size());
+  for (size_t t = 0; t < keep.size(); ++t) keep[t] = held[component[t]] ? 1 : 0;
+  return removeTets(mesh, keep);
+}
+
+}  // namespace
+
+std::vector<uint8_t> hammerAnchors(const TetMesh& mesh, const HammerOptions& options) {
+  const size_t nv = mesh.positions.size();
+  if (!options.anchored.empty() && options.anchored.size() != nv)
+    throw std::invalid_argument("hammer: 'anchored' has " + std::to_string(options.anchored.size()) +
+                                " entries; the mesh has " + std::to_string(nv) + " vertices");
+  std::vector<uint8_t> held(nv, 0);
+  for (size_t v = 0; v < options.anchored.size(); ++v) held[v] = options.anchored[v] ? 1 : 0;
+  if (!options.affects.empty())
+    for (size_t t = 0; t < mesh.tets.size(); ++t)
+      if (std::find(options.affects.begin(), options.affects.end(), mesh.materials[t]) == options.affects.end())
+        for (uint32_t v : mesh.tets[t]) held[v] = 1;
+  if (std::find(held.begin(), held.end(), 1) == held.end()) held = lowestVertices(mesh, unitUp(options.up));
+  return held;
+}
+
+std::vector<DVec3> hammerForces(const TetMesh& mesh, const HammerOptions& options, const std::vector<uint8_t>& anchored) {
+  if (!finite(options.position)) throw std::invalid_argument("hammer: 'position' is not finite");
+  if (!finite(options.orientation) || glm::length(options.orientation) == 0)
+    throw std::invalid_argument("hammer: 'orientation' must be a finite, non-zero vector");
+  if (!std::isfinite(options.magnitude)) throw std::invalid_argument("hammer: 'magnitude' is not finite");
+  if (!(options.size > 0) || !std::isfinite(options.size)) throw std::invalid_argument("hammer: 'size' must be positive");
+  const std::vector<uint8_t> used = usedVertices(mesh);
+  std::vector<double> w(mesh.positions.size(), 0.0);
+  double sum = 0;
+  for (size_t v = 0; v < w.size(); ++v) {
+    if (!used[v] || (v < anchored.size() && anchored[v])) continue;
+    const double d = glm::length(mesh.positions[v] - options.position) / options.size;
+    if (d > 3) continue;
+    w[v] = std::exp(-d * d);
+    sum += w[v];
+  }
+  std::vector<DVec3> f(w.size(), DVec3(0.0));
+  if (sum == 0) return f;
+  const DVec3 total = options.magnitude * glm::normalize(options.orientation);
+  for (size_t v = 0; v < w.size(); ++v) f[v] = (w[v] / sum) * total;
+  return f;
+}
+
+HammerStats hammer(TetMesh& mesh, const std::vector<Material>& materials, const HammerOptions& options) {
+  checkIds(options.affects, materials.size(), "hammer: 'affects'");
+  if (options.rounds < 1) throw std::invalid_argument("hammer: 'rounds' must be at least 1");
+  const std::vector<uint8_t> anchors = hammerAnchors(mesh, options);
+  hammerForces(mesh, options, anchors);  // validates the blow before anything changes
+  std::vector<uint8_t> affected(materials.size(), options.affects.empty() ? 1 : 0);
+  for (uint16_t id : options.affects) affected[id] = 1;
+  const std::vector<uint8_t> fixed = asFixed(anchors);
+
+  HammerStats st;
+  st.fallen += dropLoose(mesh, fixed);
+  std::vector<DVec3> guess;
+  for (int round = 0; round < options.rounds; ++round) {
+    FemProblem pb;
+    pb.forces = hammerForces(mesh, options, anchors);
+    const size_t loaded = size_t(std::count_if(pb.forces.begin(), pb.forces.end(), [](const DVec3& f) { return f != DVec3(0.0); }));
+    if (round == 0) st.loaded = loaded;
+    if (loaded == 0 || mesh.tets.empty()) break;
+    pb.fixed = fixed;
+    pb.initialGuess = guess;
+    FemResult r = solveElastic(mesh, materials, pb, options.fem);
+    st.fem.push_back(r.stats);
+    ++st.solves;
+    std::vector<uint8_t> keep(mesh.tets.size(), 1);
+    size_t breaking = 0;
+    for (size_t t = 0; t < keep.size(); ++t) {
+      const uint16_t id = mesh.materials[t];
+      if (!affected[id]) continue;
+      const double s = options.criterion == FractureCriterion::MaxPrincipal ? r.tets[t].maxPrincipal : r.tets[t].vonMises;
+      if (s > materials[id].strength) {
+        keep[t] = 0;
+        ++breaking;
+      }
+    }
+    if (breaking == 0) break;
+    st.broken += removeTets(mesh, keep);
+    st.fallen += dropLoose(mesh, fixed);
+    guess = std::move(r.displacement);
+  }
+  return st;
+}
+
+size_t compactVertices(TetMesh& mesh) {
+  const std::vector<uint8_t> used = usedVertices(mesh);
+  std::vector<uint32_t> id(mesh.positions.size(), UINT32_MAX);
+  uint32_t next = 0;
+  for (size_t v = 0; v < used.size(); ++v)
+    if (used[v]) {
+      id[v] = next;
+      mesh.positions[next++] = mesh.positions[v];
+    }
+  const size_t gone = mesh.positions.size() - next;
+  mesh.positions.resize(next);
+  for (auto& q : mesh.tets)
+    for (uint32_t& v : q) v = id[v];
+  return gone;
+}
+
+DisplaceStats displace(TetMesh& mesh, const std::vector<Material>& materials, const DisplaceOptions& options) {
+  if (options.moving.empty()) throw std::invalid_argument("displace: 'moving' names no material");
+  checkIds(options.moving, materials.size(), "displace: 'moving'");
+  if (!finite(options.offset)) throw std::invalid_argument("displace: 'offset' is not finite");
+  if (options.steps < 1) throw std::invalid_argument("displace: 'steps' must be at least 1");
+  const size_t nv = mesh.positions.size();
+  if (!options.anchored.empty() && options.anchored.size() != nv)
+    throw std::invalid_argument("displace: 'anchored' has " + std::to_string(options.anchored.size()) +
+                                " entries; the mesh has " + std::to_string(nv) + " vertices");
+
+  std::vector<uint8_t> moving(nv, 0);
+  for (size_t t = 0; t < mesh.tets.size(); ++t)
+    if (std::find(options.moving.begin(), options.moving.end(), mesh.materials[t]) != options.moving.end())
+      for (uint32_t v : mesh.tets[t]) moving[v] = 1;
+  const std::vector<uint8_t> held = options.anchored.empty() ? lowestVertices(mesh, unitUp(options.up)) : options.anchored;
+
+  DisplaceStats st;
+  FemProblem pb;
+  pb.fixed.assign(nv, 0);
+  pb.prescribed.assign(nv, DVec3(0.0));
+  const DVec3 step = options.offset / double(options.steps);
+  for (size_t v = 0; v < nv; ++v) {
+    if (moving[v]) {
+      pb.fixed[v] = 7;
+      pb.prescribed[v] = step;
+      ++st.moved;
+    } else if (held[v]) {
+      pb.fixed[v] = 7;
+      ++st.anchored;
+    }
+  }
+
+  const std::vector<DVec3> original = mesh.positions;
+  std::vector<double> before(mesh.tets.size());
+  for (size_t t = 0; t < before.size(); ++t) before[t] = mesh.volume(t);
+  for (int s = 0; s < options.steps; ++s) {
+    const FemResult r = solveElastic(mesh, materials, pb, options.fem);
+    st.fem.push_back(r.stats);
+    for (size_t v = 0; v < nv; ++v) mesh.positions[v] += r.displacement[v];
+    size_t inverted = 0;
+    for (size_t t = 0; t < mesh.tets.size(); ++t)
+      if (!(mesh.volume(t) > 0)) ++inverted;
+    if (inverted) {
+      mesh.positions = original;
+      throw std::runtime_error("displace: step " + std::to_string(s + 1) + " would invert " + std::to_string(inverted) +
+                               " tetrahedra; use a smaller offset or more steps");
+    }
+  }
+  st.minVolumeRatio = INFINITY;
+  for (size_t t = 0; t < before.size(); ++t) st.minVolumeRatio = std::min(st.minVolumeRatio, mesh.volume(t) / before[t]);
+  return st;
+}
+
+}  // namespace sprig::solids

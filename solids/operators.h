@@ -1,0 +1,119 @@
+#pragma once
+/// Simulation as a modeling operator (Cutler et al., "A procedural approach to authoring
+/// solid models", §3 and §5): tools that change a layered solid's tetrahedral mesh through
+/// the linear-elastic model of solids/fem.h.
+///
+/// hammer (§3.1): a Gaussian sphere of force breaks the tetrahedra of the affected materials
+/// whose stress exceeds their strength; pieces that lose their hold fall away. displace
+/// (§5.2): the vertices of some materials move by a prescribed offset and the rest settle
+/// into static equilibrium. Both leave the mesh conforming and every tetrahedron positively
+/// oriented; both are deterministic at any thread count.
+
+#include <cstdint>
+#include <vector>
+
+#include "solids/fem.h"
+#include "solids/material.h"
+#include "solids/solid.h"
+
+namespace sprig::solids {
+
+/// What breaks a tetrahedron in hammer.
+enum class FractureCriterion {
+  MaxPrincipal,  ///< largest principal stress > strength (Rankine; brittle materials in tension)
+  VonMises       ///< von Mises stress > strength
+};
+
+/// Options of hammer. Lengths in metres, force in newtons (solids/fem.h).
+struct HammerOptions {
+  DVec3 position{0.0};          ///< centre of the blow (the paper's default (0, 0, 0))
+  DVec3 orientation{1, 0, 0};   ///< direction of the force, normalized here (the paper's default)
+  double magnitude = 1e5;       ///< total force of the blow, N
+  /// Radius of the Gaussian sphere, m (the paper's `size`, default 1): a vertex at distance d
+  /// from position takes weight exp(−(d/size)²), none beyond 3·size; the total force
+  /// magnitude·orientation is shared among the loaded vertices in proportion, so the blow is
+  /// the same at any mesh resolution.
+  double size = 1.0;
+  /// Material ids that may break (the paper's `affects`); empty = every material.
+  std::vector<uint16_t> affects;
+  /// Per vertex, 1 = held in place (empty = none given). Vertices of tetrahedra of materials
+  /// not in `affects` are always held: other materials are not modified (§3.1). When that
+  /// leaves nothing held, the ground is: the vertices within 2% of the model's height (along
+  /// `up`) of its lowest point (a plane base, or a cap of a round model).
+  std::vector<uint8_t> anchored;
+  DVec3 up{0, 1, 0};            ///< Sprig's up axis
+  FractureCriterion criterion = FractureCriterion::MaxPrincipal;
+  /// Solve-and-break rounds: after tetrahedra break, the same blow is solved again on what
+  /// is left, until nothing more breaks or this many solves ran.
+  int rounds = 1;
+  FemOptions fem;
+};
+
+/// What one blow did.
+struct HammerStats {
+  size_t loaded = 0;   ///< vertices the blow's force reached (first round)
+  size_t broken = 0;   ///< tetrahedra removed for exceeding their strength
+  size_t fallen = 0;   ///< tetrahedra removed because their piece lost its hold
+  int solves = 0;
+  std::vector<FemStats> fem;  ///< one per solve
+};
+
+/// The vertices hammer holds for these options (1 = held): options.anchored and the
+/// vertices of unaffected tetrahedra, or else the ground (see HammerOptions::anchored).
+std::vector<uint8_t> hammerAnchors(const TetMesh& mesh, const HammerOptions& options);
+
+/// The blow's force at each vertex, N: the Gaussian weights of the vertices used by some
+/// tetrahedron and not held, scaled so they sum to magnitude·orientation. All zero when no
+/// such vertex lies within 3·size. Throws std::invalid_argument for a non-finite position,
+/// orientation or magnitude, a zero orientation, or size <= 0.
+std::vector<DVec3> hammerForces(const TetMesh& mesh, const HammerOptions& options, const std::vector<uint8_t>& anchored);
+
+/// Strikes mesh (§3.1): solves the linear-elastic model under the blow (held vertices fixed),
+/// removes the tetrahedra of affected materials whose stress exceeds their material's
+/// strength, then every face-connected piece whose held vertices do not hold its rigid
+/// motions (solids/fem.h, componentsHeld): it falls away. Pieces already loose before the
+/// blow fall first. Repeats for options.rounds. Tetrahedra keep their order and vertices
+/// their ids and positions (vertices no tetrahedron uses any more stay in the list), so the
+/// tetrahedra of unaffected materials are the same bytes before and after. Throws
+/// std::invalid_argument for bad options (see hammerForces; an `affects` id with no
+/// material) and what solveElastic throws. Cost: one FEM solve per round.
+HammerStats hammer(TetMesh& mesh, const std::vector<Material>& materials, const HammerOptions& options);
+
+/// Drops the vertices no tetrahedron uses (hammer leaves them so vertex ids stay stable
+/// between operations), keeping the others in order and renumbering the tetrahedra.
+/// Returns how many went. Cost O(vertices + tets).
+size_t compactVertices(TetMesh& mesh);
+
+/// Options of displace.
+struct DisplaceOptions {
+  /// Material ids whose vertices move by `offset` (the paper's growing tree); required.
+  std::vector<uint16_t> moving;
+  DVec3 offset{0, 0.1, 0};      ///< displacement of the moving vertices, m
+  /// Per vertex, 1 = held at zero displacement (empty = the ground: vertices within 2% of
+  /// the model's height along `up` of its lowest point).
+  /// A vertex both moving and held moves.
+  std::vector<uint8_t> anchored;
+  DVec3 up{0, 1, 0};            ///< Sprig's up axis
+  /// The offset is applied in this many equal steps, each solved on the mesh the previous
+  /// one left (large motions then follow the geometry, and invert less).
+  int steps = 1;
+  FemOptions fem;
+};
+
+/// What displace did.
+struct DisplaceStats {
+  size_t moved = 0;       ///< vertices of the moving materials
+  size_t anchored = 0;    ///< vertices held at zero
+  double minVolumeRatio = 0;  ///< smallest volume after / volume before over all tetrahedra
+  std::vector<FemStats> fem;  ///< one per step
+};
+
+/// Moves the vertices of the `moving` materials by offset and every other vertex to the
+/// static equilibrium of the linear-elastic model (§5.2): stiff materials keep their shape,
+/// soft ones deform. Throws std::invalid_argument for an empty `moving`, an id with no
+/// material, a non-finite offset or steps < 1, std::runtime_error when a step would invert a
+/// tetrahedron (the mesh is then left as it was), and what solveElastic throws (a piece
+/// neither moving nor held makes the system singular).
+DisplaceStats displace(TetMesh& mesh, const std::vector<Material>& materials, const DisplaceOptions& options);
+
+}  // namespace sprig::solids
