@@ -740,6 +740,7 @@ int Deriver::steps() const { return impl_->steps; }
 uint64_t Deriver::seed() const { return impl_->seed; }
 const SymbolTable& Deriver::symbols() const { return impl_->prog->symbols; }
 uint64_t Deriver::modulesWritten() const { return impl_->written; }
+bool Deriver::hasInterpretation() const { return !impl_->prog->interpretation.empty(); }
 
 ModuleString Deriver::interpret(const ModuleString& s) const {
   const Program& prog = *impl_->prog;
