@@ -43,6 +43,7 @@ gallery: build
 
 bench: build
 	@for b in $(BUILD)/bench/*; do echo "== $$b"; $$b || exit 1; done
+	@echo "== bench/startup.sh"; bash bench/startup.sh $(SPRIG)
 
 sanitize: deps
 	@$(ASAN_CONFIG) >/dev/null

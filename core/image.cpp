@@ -1,11 +1,10 @@
 #include "core/image.h"
 
-#include <OpenImageIO/imageio.h>
-
 #include <algorithm>
 #include <cmath>
 
 #include "core/atomic_file.h"
+#include "core/detail/image_backend.h"
 #include "core/paths.h"
 #include "core/srgb.h"
 
@@ -57,21 +56,6 @@ ImageFormat imageFormatFor(const fs::path& path) {
                               "' (supported: .png, .jpg, .jpeg, .exr)");
 }
 
-namespace {
-
-/// Opens out on path with spec, writes pixels of type `type`, closes; false on any failure
-/// with the writer's first error in `error`.
-bool writeOne(OIIO::ImageOutput& out, const fs::path& path, const OIIO::ImageSpec& spec, OIIO::TypeDesc type,
-              const void* pixels, std::string& error) {
-  bool ok = out.open(path.string(), spec) && out.write_image(type, pixels);
-  error = out.geterror();
-  ok = out.close() && ok;
-  if (error.empty()) error = out.geterror();
-  return ok;
-}
-
-}  // namespace
-
 void writeImage(const Image& image, const fs::path& path, ImageEncoding encoding) {
   const ImageFormat format = imageFormatFor(path);
   if (image.width <= 0 || image.height <= 0 || image.pixels.size() != static_cast<size_t>(image.width) * image.height * 4)
@@ -80,13 +64,16 @@ void writeImage(const Image& image, const fs::path& path, ImageEncoding encoding
   if (!dir.empty() && !fs::is_directory(dir))
     throw std::runtime_error("cannot write image '" + path.string() + "': folder '" + dir.string() + "' does not exist");
 
+  using detail::PixelType;
   TempPath temp(path);
-  auto out = OIIO::ImageOutput::create(temp.path().string());
-  if (!out) throw std::runtime_error("cannot write image '" + path.string() + "': " + OIIO::geterror());
+  detail::ImageFileSpec spec;
+  spec.width = image.width;
+  spec.height = image.height;
   std::string error;
   bool ok = false;
+  const detail::ImageBackend& io = detail::imageBackend();
   if (encoding == ImageEncoding::TextureMap) {
-    // RGB floats (sRGB-encoded in double for 8-bit files); OIIO converts to the file type.
+    // RGB floats (sRGB-encoded in double for 8-bit files); the writer converts to the file type.
     const bool linear = format == ImageFormat::Exr;
     const size_t n = static_cast<size_t>(image.width) * image.height;
     std::vector<float> rgb(n * 3);
@@ -95,20 +82,22 @@ void writeImage(const Image& image, const fs::path& path, ImageEncoding encoding
         const float v = image.pixels[i * 4 + c];
         rgb[i * 3 + c] = linear ? v : static_cast<float>(linearToSrgb(static_cast<double>(v)));
       }
-    OIIO::ImageSpec spec(image.width, image.height, 3, linear ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::UINT8);
-    spec.attribute("oiio:ColorSpace", linear ? "Linear" : "sRGB");
-    ok = writeOne(*out, temp.path(), spec, OIIO::TypeDesc::FLOAT, rgb.data(), error);
+    spec.channels = 3;
+    spec.fileType = linear ? PixelType::Half : PixelType::UInt8;
+    spec.colorSpace = linear ? "Linear" : "sRGB";
+    ok = io.write(temp.path().string(), spec, PixelType::Float, rgb.data(), error);
   } else if (format == ImageFormat::Exr) {
-    OIIO::ImageSpec spec(image.width, image.height, 4, OIIO::TypeDesc::HALF);
-    spec.attribute("compression", "zip");
-    ok = writeOne(*out, temp.path(), spec, OIIO::TypeDesc::FLOAT, image.pixels.data(), error);
+    spec.channels = 4;
+    spec.fileType = PixelType::Half;
+    spec.compression = "zip";
+    ok = io.write(temp.path().string(), spec, PixelType::Float, image.pixels.data(), error);
   } else {
-    const int channels = format == ImageFormat::Jpeg ? 3 : 4;
-    const std::vector<uint8_t> bytes = toSrgb8(image, channels);
-    OIIO::ImageSpec spec(image.width, image.height, channels, OIIO::TypeDesc::UINT8);
-    spec.attribute("oiio:ColorSpace", "sRGB");
-    if (format == ImageFormat::Jpeg) spec.attribute("CompressionQuality", 92);
-    ok = writeOne(*out, temp.path(), spec, OIIO::TypeDesc::UINT8, bytes.data(), error);
+    spec.channels = format == ImageFormat::Jpeg ? 3 : 4;
+    spec.fileType = PixelType::UInt8;
+    spec.colorSpace = "sRGB";
+    if (format == ImageFormat::Jpeg) spec.quality = 92;
+    const std::vector<uint8_t> bytes = toSrgb8(image, spec.channels);
+    ok = io.write(temp.path().string(), spec, PixelType::UInt8, bytes.data(), error);
   }
   if (!ok) throw std::runtime_error("cannot write image '" + path.string() + "': " + error);
   temp.commit();
@@ -117,25 +106,10 @@ void writeImage(const Image& image, const fs::path& path, ImageEncoding encoding
 void writeAnimatedGif(const std::vector<Image>& frames, double fps, const fs::path& path) {
   if (frames.empty()) throw std::runtime_error(path.string() + ": no frames to write");
   TempPath tmp(path);
-  {
-    auto writer = OIIO::ImageOutput::create(tmp.path().string());
-    if (!writer) throw std::runtime_error(path.string() + ": cannot write GIF: " + OIIO::geterror());
-    OIIO::ImageSpec spec(frames.front().width, frames.front().height, 3, OIIO::TypeDesc::UINT8);
-    // GIF frame delays are centiseconds: FramesPerSecond as the rational 100 / delay.
-    const int delayCs = std::max(1, static_cast<int>(std::lround(100.0 / std::max(fps, 0.01))));
-    const int rate[2] = {100, delayCs};
-    spec.attribute("FramesPerSecond", OIIO::TypeRational, rate);
-    spec.attribute("oiio:LoopCount", 0);
-    for (size_t i = 0; i < frames.size(); ++i) {
-      const auto mode = i == 0 ? OIIO::ImageOutput::Create : OIIO::ImageOutput::AppendSubimage;
-      if (!writer->open(tmp.path().string(), spec, mode))
-        throw std::runtime_error(path.string() + ": cannot write GIF: " + writer->geterror());
-      const std::vector<uint8_t> bytes = toSrgb8(frames[i], 3);
-      if (!writer->write_image(OIIO::TypeDesc::UINT8, bytes.data()))
-        throw std::runtime_error(path.string() + ": cannot write GIF frame: " + writer->geterror());
-    }
-    if (!writer->close()) throw std::runtime_error(path.string() + ": cannot write GIF: " + writer->geterror());
-  }
+  // GIF frame delays are centiseconds: FramesPerSecond as the rational 100 / delay.
+  const int delayCs = std::max(1, static_cast<int>(std::lround(100.0 / std::max(fps, 0.01))));
+  detail::imageBackend().writeGif(tmp.path().string(), path.string(), frames.front().width, frames.front().height,
+                                  delayCs, frames.size(), [&](size_t i) { return toSrgb8(frames[i], 3); });
   tmp.commit();
 }
 
@@ -144,39 +118,31 @@ ImageReadError::ImageReadError(const fs::path& path, std::string reason)
 
 namespace {
 
-/// The opened file, or ImageReadError with OIIO's message.
-std::unique_ptr<OIIO::ImageInput> openInput(const fs::path& path) {
-  auto in = OIIO::ImageInput::open(path.string());
-  if (!in) {
-    const std::string err = OIIO::geterror();
-    throw ImageReadError(path, err.empty() ? "not an image OpenImageIO can read" : err);
-  }
+/// The opened file, or ImageReadError with the reader's message.
+std::unique_ptr<detail::ImageFileReader> openInput(const fs::path& path) {
+  std::string err;
+  std::unique_ptr<detail::ImageFileReader> in = detail::imageBackend().open(path.string(), err);
+  if (!in) throw ImageReadError(path, err.empty() ? "not an image OpenImageIO can read" : err);
   return in;
 }
 
-ImageInfo infoOf(const OIIO::ImageSpec& spec) {
+ImageInfo infoOf(const detail::ImageFileHeader& header) {
   ImageInfo info;
-  info.width = spec.width;
-  info.height = spec.height;
-  info.channels = spec.nchannels;
-  const std::string cs = asciiLower(spec.get_string_attribute("oiio:ColorSpace"));
-  const bool integer = spec.format.basetype == OIIO::TypeDesc::UINT8 || spec.format.basetype == OIIO::TypeDesc::UINT16;
-  info.srgb = cs == "srgb" || (cs.empty() && integer);
+  info.width = header.width;
+  info.height = header.height;
+  info.channels = header.channels;
+  const std::string cs = asciiLower(header.colorSpace);
+  info.srgb = cs == "srgb" || (cs.empty() && header.integer8or16);
   return info;
 }
 
 }  // namespace
 
-ImageInfo readImageInfo(const fs::path& path) {
-  auto in = openInput(path);
-  ImageInfo info = infoOf(in->spec());
-  in->close();
-  return info;
-}
+ImageInfo readImageInfo(const fs::path& path) { return infoOf(openInput(path)->header()); }
 
 Image readImage(const fs::path& path) {
   auto in = openInput(path);
-  const ImageInfo info = infoOf(in->spec());
+  const ImageInfo info = infoOf(in->header());
   const int w = info.width, h = info.height, nc = info.channels;
   if (w <= 0 || h <= 0 || nc <= 0) throw ImageReadError(path, "empty image");
   // Checked before the pixels are allocated: a 40-byte header may claim 65535 x 65535.
@@ -188,15 +154,14 @@ Image readImage(const fs::path& path) {
   const size_t n = static_cast<size_t>(w) * h;
   std::vector<float> values(n * nc);
   bool ok = false;
+  std::string err;
   if (info.srgb) {
     std::vector<uint8_t> bytes(n * nc);
-    ok = in->read_image(0, 0, 0, nc, OIIO::TypeDesc::UINT8, bytes.data());
+    ok = in->read(detail::PixelType::UInt8, bytes.data(), err);
     for (size_t i = 0; i < values.size(); ++i) values[i] = bytes[i] / 255.0f;
   } else {
-    ok = in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, values.data());
+    ok = in->read(detail::PixelType::Float, values.data(), err);
   }
-  const std::string err = in->geterror();
-  in->close();
   if (!ok) throw ImageReadError(path, err.empty() ? "cannot read its pixels" : err);
 
   const int colors = nc >= 3 ? 3 : 1;

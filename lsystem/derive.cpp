@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "core/rng.h"
+#include "lsystem/detail/huge_pages.h"
 #include "lsystem/detail/program.h"
 
 namespace sprig::lsystem {
@@ -40,10 +41,12 @@ class Writer {
       : s_(s), births_(births), maxModules_(maxModules), limitAt_(limitAt), step_(step) {
     // Only the reserved part is sized (and zero-filled where new): sizing to the whole
     // capacity would cost O(largest string) per step.
-    s_.symbols.resize(std::max(modules, size_t(16)));
-    s_.offsets.resize(s_.symbols.size() + 1);
-    s_.params.resize(std::max(params, size_t(16)));
-    if (births_) s_.birthSteps.resize(s_.symbols.size());
+    // The string is rewritten from scratch: growing buffers drop, not copy, the old
+    // contents, and large new ones get huge pages (fewer first-touch faults).
+    detail::resizeForOverwrite(s_.symbols, std::max(modules, size_t(16)));
+    detail::resizeForOverwrite(s_.offsets, s_.symbols.size() + 1);
+    detail::resizeForOverwrite(s_.params, std::max(params, size_t(16)));
+    if (births_) detail::resizeForOverwrite(s_.birthSteps, s_.symbols.size());
     else s_.birthSteps.clear();
     refresh();
     off_[0] = 0;
@@ -740,6 +743,7 @@ int Deriver::steps() const { return impl_->steps; }
 uint64_t Deriver::seed() const { return impl_->seed; }
 const SymbolTable& Deriver::symbols() const { return impl_->prog->symbols; }
 uint64_t Deriver::modulesWritten() const { return impl_->written; }
+bool Deriver::hasInterpretation() const { return !impl_->prog->interpretation.empty(); }
 
 ModuleString Deriver::interpret(const ModuleString& s) const {
   const Program& prog = *impl_->prog;

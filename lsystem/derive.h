@@ -68,6 +68,8 @@ class Deriver {
   uint64_t seed() const;
   /// The grammar's symbol table (ids in every string this Deriver produces).
   const SymbolTable& symbols() const;
+  /// True when the grammar has `interpretation:` rules (else interpret(s) is a copy of s).
+  bool hasInterpretation() const;
   /// Applies the `interpretation:` (homomorphism) rules to s, recursively up to the
   /// block's `maximum depth` (default 1), as the turtle reads it; the result keeps
   /// birth steps when s has them. Returns a copy of s when there are no such rules.

@@ -5,9 +5,7 @@
 #include <cmath>
 #include <string_view>
 
-#ifdef __linux__
-#include <sys/mman.h>
-#endif
+#include "lsystem/detail/huge_pages.h"
 
 namespace sprig::lsystem {
 
@@ -44,22 +42,6 @@ class SinCosCache {
   };
   Entry entries_[kSize];
 };
-
-/// Large fresh outputs are dominated by first-touch page faults (about half the time
-/// for a 2-million-internode skeleton); asking Linux for transparent huge pages on the
-/// buffer cuts the number of faults 512-fold. A hint only: failure changes nothing.
-void adviseHugePages(void* data, size_t bytes) {
-#ifdef __linux__
-  constexpr uintptr_t kHuge = uintptr_t(2) << 20;
-  if (bytes < 4 * kHuge) return;
-  uintptr_t begin = (reinterpret_cast<uintptr_t>(data) + kHuge - 1) & ~(kHuge - 1);
-  uintptr_t end = (reinterpret_cast<uintptr_t>(data) + bytes) & ~(kHuge - 1);
-  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_HUGEPAGE);
-#else
-  (void)data;
-  (void)bytes;
-#endif
-}
 
 void orthonormalize(TurtleFrame& f) {
   f.heading = glm::normalize(f.heading);
@@ -209,7 +191,7 @@ class TurtleWalk {
       draws += c == Command::Forward || c == Command::ForwardNoVertex;
     }
     sk_.internodes.reserve(draws);
-    adviseHugePages(sk_.internodes.data(), sk_.internodes.capacity() * sizeof(Internode));
+    detail::adviseHugePages(sk_.internodes.data(), sk_.internodes.capacity() * sizeof(Internode));
   }
 
   /// Interprets every module; returns the state after the last one.

@@ -47,8 +47,12 @@ void GrowthEngine::advanceTo(int step) {
     if (bar) bar->advance();
   }
   if (bar) bar->finish();
-  interpreted_ = deriver_->interpret(deriver_->current());
+  if (deriver_->hasInterpretation()) interpreted_ = deriver_->interpret(deriver_->current());
   interpretedStep_ = step;
+}
+
+const lsystem::ModuleString& GrowthEngine::interpreted() const {
+  return deriver_->hasInterpretation() ? interpreted_ : deriver_->current();
 }
 
 namespace {
@@ -72,10 +76,10 @@ void GrowthEngine::measure() {
     if (ProgressSettings::cancelRequested()) throw Cancelled();
     advanceTo(step);
     moduleCounts_.push_back(deriver_->current().size());
-    snapshotBytes += bytesOf(interpreted_);
+    snapshotBytes += bytesOf(interpreted());
     keep = keep && snapshotBytes <= kSnapshotBytes;
-    if (keep) snapshots_.push_back(interpreted_);
-    lsystem::Skeleton sk = draw(interpreted_, turtle_, nullptr);
+    if (keep) snapshots_.push_back(interpreted());
+    lsystem::Skeleton sk = draw(interpreted(), turtle_, nullptr);
     const DBox3 b = framingBox(sk);
     frameBox_ = step == 0 ? b : DBox3{glm::min(frameBox_.lo, b.lo), glm::max(frameBox_.hi, b.hi)};
     double oldLength = 0, newLength = 0;
@@ -105,7 +109,7 @@ const lsystem::ModuleString& GrowthEngine::modulesAt(int step) {
 const lsystem::ModuleString& GrowthEngine::interpretedAt(int step) {
   if (static_cast<size_t>(step) < snapshots_.size() && step >= 0) return snapshots_[static_cast<size_t>(step)];
   advanceTo(step);
-  return interpreted_;
+  return interpreted();
 }
 
 size_t GrowthEngine::moduleCount(int step) {

@@ -1,7 +1,7 @@
 #pragma once
 /// The iso-surface of a scalar volume (a CT scan) as a closed quad mesh, through OpenVDB's
-/// volumeToMesh (uniform, adaptivity 0: dual quads, one vertex per crossed cell). This file
-/// is the only one that includes OpenVDB in organisms/.
+/// volumeToMesh (uniform, adaptivity 0: dual quads, one vertex per crossed cell), reached
+/// through organisms/detail/volume_backend.h.
 
 #include "core/inr_volume.h"
 #include "core/polymesh.h"

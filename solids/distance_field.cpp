@@ -1,9 +1,5 @@
 #include "solids/distance_field.h"
 
-#include <openvdb/openvdb.h>
-#include <openvdb/tools/Interpolation.h>
-#include <openvdb/tools/MeshToVolume.h>
-
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -11,6 +7,7 @@
 #include <stdexcept>
 
 #include "core/parallel.h"
+#include "solids/detail/mesh_distance_backend.h"
 
 namespace sprig::solids {
 
@@ -41,8 +38,7 @@ FieldPtr analytic(F f, std::optional<DBox3> box) {
 /// A closed triangle mesh: OpenVDB's narrow-band signed distance, sampled trilinearly.
 class MeshField final : public DistanceField {
  public:
-  explicit MeshField(const PolyMesh& mesh) {
-    for (const Vec3& p : mesh.positions) points_.emplace_back(p.x, p.y, p.z);
+  explicit MeshField(const PolyMesh& mesh) : points_(mesh.positions) {
     size_t c = 0;
     for (uint32_t n : mesh.faceSizes) {  // fan triangulation
       for (uint32_t k = 1; k + 1 < n; ++k)
@@ -58,29 +54,18 @@ class MeshField final : public DistanceField {
   std::vector<float> sample(const std::vector<Vec3>& points, double cell, double band) const override {
     std::vector<float> out(points.size());
     if (points.empty()) return out;
-    {
-      static std::once_flag once;
-      std::call_once(once, [] { openvdb::initialize(); });
-    }
     // The grid's voxel centres fall on the lattice of points[0] (exact values at lattice nodes).
-    auto xform = openvdb::math::Transform::createLinearTransform(cell);
-    xform->postTranslate(openvdb::Vec3d(points[0].x, points[0].y, points[0].z));
     const float bandVoxels = float(band / cell) + 1.0f;
-    std::vector<openvdb::Vec4I> quads;
-    openvdb::FloatGrid::Ptr grid =
-        openvdb::tools::meshToSignedDistanceField<openvdb::FloatGrid>(*xform, points_, tris_, quads, bandVoxels, bandVoxels);
-    parallelForRange(0, points.size(), [&](size_t b, size_t e) {
-      openvdb::FloatGrid::ConstAccessor acc = grid->getConstAccessor();
-      openvdb::tools::GridSampler<openvdb::FloatGrid::ConstAccessor, openvdb::tools::BoxSampler> s(acc, grid->transform());
-      for (size_t i = b; i < e; ++i) out[i] = s.wsSample(openvdb::Vec3d(points[i].x, points[i].y, points[i].z));
-    }, 4096);
+    const std::unique_ptr<detail::DistanceGrid> grid =
+        detail::meshDistanceBackend().build(points_, tris_, cell, points[0], bandVoxels);
+    parallelForRange(0, points.size(), [&](size_t b, size_t e) { grid->sample(&points[b], e - b, &out[b]); }, 4096);
     return out;
   }
   std::optional<DBox3> bounds() const override { return box_; }
 
  private:
-  std::vector<openvdb::Vec3s> points_;
-  std::vector<openvdb::Vec3I> tris_;
+  std::vector<Vec3> points_;
+  std::vector<glm::uvec3> tris_;
   DBox3 box_;
 };
 

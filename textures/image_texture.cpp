@@ -1,35 +1,17 @@
 #include "textures/image_texture.h"
 
-#include <OpenImageIO/texture.h>
-
 #include <algorithm>
 #include <filesystem>
 
 #include "core/image.h"
 #include "core/srgb.h"
+#include "textures/detail/texture_backend.h"
 
 namespace sprig::textures {
 
-namespace {
-
-/// OIIO's shared texture system, configured once.
-OIIO::TextureSystem* textureSystem() {
-  static OIIO::TextureSystem* ts = [] {
-    OIIO::TextureSystem* t = OIIO::TextureSystem::create(true);
-    t->attribute("automip", 1);      // mip-map untiled files (PNG, JPEG) on first use
-    t->attribute("autotile", 64);
-    t->attribute("accept_untiled", 1);
-    return t;
-  }();
-  return ts;
-}
-
-}  // namespace
-
 struct ImageTexture::Impl {
   std::string path;
-  OIIO::ustring name;
-  OIIO::TextureSystem::TextureHandle* handle = nullptr;
+  detail::TextureHandle* handle = nullptr;
   int width = 0, height = 0, channels = 0;
   bool srgb = false;
 };
@@ -55,10 +37,9 @@ ImageTexture ImageTexture::open(const std::string& path, const SourceLoc& where)
   impl->srgb = info.srgb;
   if (impl->width <= 0 || impl->height <= 0 || impl->channels <= 0) return fail("empty image");
 
-  OIIO::TextureSystem* ts = textureSystem();
-  impl->name = OIIO::ustring(path);
-  impl->handle = ts->get_texture_handle(impl->name);
-  if (!impl->handle || !ts->good(impl->handle)) return fail(ts->geterror());
+  std::string error;
+  impl->handle = detail::textureBackend().handle(path, error);
+  if (!impl->handle) return fail(error);
   ImageTexture t;
   t.impl_ = std::move(impl);
   return t;
@@ -66,14 +47,9 @@ ImageTexture ImageTexture::open(const std::string& path, const SourceLoc& where)
 
 Vec3 ImageTexture::color(Vec2 uv, Vec2 duvdx, Vec2 duvdy) const {
   const Impl& m = *impl_;
-  OIIO::TextureOpt opt;
-  opt.swrap = OIIO::TextureOpt::WrapPeriodic;
-  opt.twrap = OIIO::TextureOpt::WrapPeriodic;
-  opt.interpmode = OIIO::TextureOpt::InterpBilinear;
-  opt.mipmode = OIIO::TextureOpt::MipModeTrilinear;
   float rgb[3] = {0, 0, 0};
   int n = std::min(3, m.channels);
-  textureSystem()->texture(m.handle, nullptr, opt, uv.x, uv.y, duvdx.x, duvdx.y, duvdy.x, duvdy.y, n, rgb);
+  detail::textureBackend().lookup(m.handle, n, uv.x, uv.y, duvdx.x, duvdx.y, duvdy.x, duvdy.y, rgb);
   if (n == 1) rgb[1] = rgb[2] = rgb[0];
   if (n == 2) rgb[2] = 0;
   Vec3 c(rgb[0], rgb[1], rgb[2]);

@@ -2,8 +2,9 @@
 /// Image textures through OpenImageIO's TextureSystem: mip-mapped, filtered lookups.
 ///
 /// This is texture filtering, not image file I/O: reading and writing image files is
-/// core/image.h's alone (the header probe in open() goes through readImageInfo there), and
-/// image_texture.cpp is textures' one OpenImageIO file, for the TextureSystem only.
+/// core/image.h's alone (the header probe in open() goes through readImageInfo there). The
+/// TextureSystem itself is reached through textures/detail/texture_backend.h, implemented in
+/// backends/oiio_texture.cpp.
 ///
 /// One process-wide TextureSystem (OIIO's shared instance, thread-safe) serves every
 /// ImageTexture; untiled images are mip-mapped on first use ("automip"). Coordinates are

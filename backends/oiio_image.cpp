@@ -1,0 +1,111 @@
+/// core/detail/image_backend.h through OpenImageIO: still images and animated GIFs.
+
+#include <OpenImageIO/imageio.h>
+
+#include <stdexcept>
+
+#include "backends/backends.h"
+
+namespace sprig::backends {
+
+namespace {
+
+using detail::ImageFileHeader;
+using detail::ImageFileReader;
+using detail::ImageFileSpec;
+using detail::PixelType;
+
+OIIO::TypeDesc typeOf(PixelType t) {
+  switch (t) {
+    case PixelType::UInt8: return OIIO::TypeDesc::UINT8;
+    case PixelType::Half: return OIIO::TypeDesc::HALF;
+    case PixelType::Float: return OIIO::TypeDesc::FLOAT;
+  }
+  return OIIO::TypeDesc::UNKNOWN;
+}
+
+/// Opens out on path with spec, writes pixels of type `type`, closes; false on any failure
+/// with the writer's first error in `error`.
+bool writeOne(OIIO::ImageOutput& out, const std::string& path, const OIIO::ImageSpec& spec, OIIO::TypeDesc type,
+              const void* pixels, std::string& error) {
+  bool ok = out.open(path, spec) && out.write_image(type, pixels);
+  error = out.geterror();
+  ok = out.close() && ok;
+  if (error.empty()) error = out.geterror();
+  return ok;
+}
+
+bool write(const std::string& path, const ImageFileSpec& s, PixelType dataType, const void* data, std::string& error) {
+  auto out = OIIO::ImageOutput::create(path);
+  if (!out) {
+    error = OIIO::geterror();
+    return false;
+  }
+  OIIO::ImageSpec spec(s.width, s.height, s.channels, typeOf(s.fileType));
+  if (!s.colorSpace.empty()) spec.attribute("oiio:ColorSpace", s.colorSpace);
+  if (!s.compression.empty()) spec.attribute("compression", s.compression);
+  if (s.quality > 0) spec.attribute("CompressionQuality", s.quality);
+  return writeOne(*out, path, spec, typeOf(dataType), data, error);
+}
+
+void writeGif(const std::string& path, const std::string& displayPath, int width, int height, int delayCs,
+              size_t frameCount, const std::function<std::vector<uint8_t>(size_t)>& frameBytes) {
+  auto writer = OIIO::ImageOutput::create(path);
+  if (!writer) throw std::runtime_error(displayPath + ": cannot write GIF: " + OIIO::geterror());
+  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
+  const int rate[2] = {100, delayCs};  // FramesPerSecond as the rational 100 / delay
+  spec.attribute("FramesPerSecond", OIIO::TypeRational, rate);
+  spec.attribute("oiio:LoopCount", 0);
+  for (size_t i = 0; i < frameCount; ++i) {
+    const auto mode = i == 0 ? OIIO::ImageOutput::Create : OIIO::ImageOutput::AppendSubimage;
+    if (!writer->open(path, spec, mode)) throw std::runtime_error(displayPath + ": cannot write GIF: " + writer->geterror());
+    const std::vector<uint8_t> bytes = frameBytes(i);
+    if (!writer->write_image(OIIO::TypeDesc::UINT8, bytes.data()))
+      throw std::runtime_error(displayPath + ": cannot write GIF frame: " + writer->geterror());
+  }
+  if (!writer->close()) throw std::runtime_error(displayPath + ": cannot write GIF: " + writer->geterror());
+}
+
+class OiioReader final : public ImageFileReader {
+ public:
+  explicit OiioReader(std::unique_ptr<OIIO::ImageInput> in) : in_(std::move(in)) {
+    const OIIO::ImageSpec& spec = in_->spec();
+    header_.width = spec.width;
+    header_.height = spec.height;
+    header_.channels = spec.nchannels;
+    header_.colorSpace = spec.get_string_attribute("oiio:ColorSpace");
+    header_.integer8or16 = spec.format.basetype == OIIO::TypeDesc::UINT8 || spec.format.basetype == OIIO::TypeDesc::UINT16;
+  }
+  ~OiioReader() override { in_->close(); }
+
+  const ImageFileHeader& header() const override { return header_; }
+
+  bool read(PixelType type, void* out, std::string& error) override {
+    const bool ok = in_->read_image(0, 0, 0, header_.channels, typeOf(type), out);
+    error = in_->geterror();
+    in_->close();
+    return ok;
+  }
+
+ private:
+  std::unique_ptr<OIIO::ImageInput> in_;
+  ImageFileHeader header_;
+};
+
+std::unique_ptr<ImageFileReader> open(const std::string& path, std::string& error) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) {
+    error = OIIO::geterror();
+    return nullptr;
+  }
+  return std::make_unique<OiioReader>(std::move(in));
+}
+
+}  // namespace
+
+const detail::ImageBackend& oiioImage() {
+  static const detail::ImageBackend table{&write, &writeGif, &open};
+  return table;
+}
+
+}  // namespace sprig::backends
