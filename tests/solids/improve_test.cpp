@@ -9,31 +9,15 @@
 #include "solids/solid.h"
 #include "solids/tet_io.h"
 #include "tests/solids/grid_fixture.h"
+#include "tests/solids/tet_checks.h"
 
 using namespace sprig;
 using namespace sprig::solids;
+using test::faceUses;
+using test::meshOf;
+using test::volumeByMaterial;
 
 namespace {
-
-/// Number of faces used by exactly one, two, and more than two tetrahedra.
-std::array<size_t, 3> faceUses(const TetMesh& m) {
-  std::map<std::array<uint32_t, 3>, int> uses;
-  for (const auto& q : m.tets)
-    for (const auto& f : kTetFaces) {
-      std::array<uint32_t, 3> k = {q[size_t(f[0])], q[size_t(f[1])], q[size_t(f[2])]};
-      std::sort(k.begin(), k.end());
-      ++uses[k];
-    }
-  std::array<size_t, 3> out{0, 0, 0};
-  for (const auto& [k, n] : uses) ++out[size_t(std::min(n, 3) - 1)];
-  return out;
-}
-
-std::map<uint16_t, double> volumeByMaterial(const TetMesh& m) {
-  std::map<uint16_t, double> v;
-  for (size_t t = 0; t < m.tets.size(); ++t) v[m.materials[t]] += m.volume(t);
-  return v;
-}
 
 /// Area of each interface (material pair; 0xFFFF is outside), from the interface triangles.
 std::map<std::pair<int, int>, double> interfaceAreas(const TetMesh& m) {
@@ -46,13 +30,6 @@ std::map<std::pair<int, int>, double> interfaceAreas(const TetMesh& m) {
   for (size_t i = 0; i + 1 < between.size(); i += 2)
     out[{std::min(between[i].material, between[i + 1].material), std::max(between[i].material, between[i + 1].material)}] +=
         area(between[i]);
-  return out;
-}
-
-Mesh meshOf(const TetMesh& m, const std::vector<InterfaceTriangle>& tris) {
-  Mesh out;
-  for (const DVec3& p : m.positions) out.positions.push_back(Vec3(p));
-  for (const auto& t : tris) out.triangles.push_back({t.v[0], t.v[1], t.v[2]});
   return out;
 }
 

@@ -13,6 +13,7 @@
 #include "solids/solid.h"
 #include "tests/solids/grid_fixture.h"
 #include "tests/solids/tet_block.h"
+#include "tests/solids/tet_checks.h"
 
 using namespace sprig;
 using namespace sprig::solids;
@@ -42,18 +43,6 @@ Mold clayMold(double shell, double cell) {
   m.clay = uint16_t(clay);
   m.bronze = uint16_t(bronze);
   return m;
-}
-
-/// Faces used by more than two tetrahedra.
-size_t overusedFaces(const TetMesh& m) {
-  std::map<std::array<uint32_t, 3>, int> uses;
-  for (const auto& q : m.tets)
-    for (const auto& f : kTetFaces) {
-      std::array<uint32_t, 3> k = {q[size_t(f[0])], q[size_t(f[1])], q[size_t(f[2])]};
-      std::sort(k.begin(), k.end());
-      ++uses[k];
-    }
-  return size_t(std::count_if(uses.begin(), uses.end(), [](const auto& u) { return u.second > 2; }));
 }
 
 double minVolume(const TetMesh& m) {
@@ -113,7 +102,7 @@ TEST_CASE("hammer: a blow on a clay mold", "[solids][operators]") {
     CHECK(tetsOf(m, mold.bronze) == tetsOf(before, mold.bronze));
     CHECK(std::memcmp(m.positions.data(), before.positions.data(), m.positions.size() * sizeof(DVec3)) == 0);
     // Conforming and uninverted; every remaining piece is held.
-    CHECK(overusedFaces(m) == 0);
+    CHECK(test::faceUses(m)[2] == 0);
     CHECK(minVolume(m) > 0);
     const auto [component, count] = faceComponents(m);
     std::vector<uint8_t> fixed;
@@ -218,7 +207,7 @@ TEST_CASE("hammer: every material affected, a round stone rests on the ground", 
   CHECK(near + ground + axis + far == st.broken + st.fallen);
   CHECK(far == 0);
   CHECK(minVolume(m) > 0);
-  CHECK(overusedFaces(m) == 0);
+  CHECK(test::faceUses(m)[2] == 0);
 }
 
 TEST_CASE("hammer: a snapped stick falls away", "[solids][operators]") {
@@ -247,7 +236,7 @@ TEST_CASE("hammer: a snapped stick falls away", "[solids][operators]") {
   // Nothing of the stick's far half is left; the stone base is exactly as it was.
   for (size_t t = 0; t < m.tets.size(); ++t) CHECK(m.positions[m.tets[t][0]].x < 0.5 + 1e-12);
   CHECK(tetsOf(m, 0) == tetsOf(before, 0));
-  CHECK(overusedFaces(m) == 0);
+  CHECK(test::faceUses(m)[2] == 0);
   CHECK(minVolume(m) > 0);
 }
 
