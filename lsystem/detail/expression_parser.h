@@ -62,8 +62,9 @@ class ExpressionParser {
 
   void lex(State& st);
   bool isPunct(const State& st, std::string_view p) const;
-  int node(State& st, Op op, int a = -1, int b = -1);
+  int node(State& st, Op op, int a = -1, int b = -1, int c = -1);
   [[noreturn]] void unexpected(State& st, const char* what);
+  int parseConditional(State& st);
   int parseBinary(State& st, int level);
   int parseUnary(State& st);
   int parsePrimary(State& st);

@@ -29,6 +29,51 @@ const char* const kHeaders[] = {"lsystem", "derivation length", "seed", "angle",
 
 enum class Block { Main, Decomposition, Interpretation };
 
+/// True when line s has cpfg's `endlsystem` (any capitalization, as cpfg's `Endlsystem`) at b.
+bool isEndLsystem(const std::string& s, int b) {
+  if (static_cast<int>(s.size()) < b + 10) return false;
+  for (int k = 0; k < 10; ++k)
+    if (std::tolower(static_cast<unsigned char>(s[b + k])) != "endlsystem"[k]) return false;
+  return true;
+}
+
+/// cpfg's block keywords written without a colon, alone on their line (`homomorphism`,
+/// `Decomposition`, `homomorphism no warnings`): the header they stand for, or nullopt.
+std::optional<Header> bareBlockKeyword(const std::string& s, int b) {
+  std::string words;
+  for (int i = b; i < static_cast<int>(s.size()); ++i) {
+    char c = static_cast<char>(std::tolower(static_cast<unsigned char>(s[i])));
+    if (isSpace(c)) {
+      if (!words.empty() && words.back() != ' ') words += ' ';
+    } else {
+      words += c;
+    }
+  }
+  while (!words.empty() && words.back() == ' ') words.pop_back();
+  for (const char* key : {"homomorphism", "decomposition"}) {
+    std::string k(key);
+    if (words == k || words == k + " no warnings" || words == k + " warnings")
+      return Header{k, b + static_cast<int>(k.size())};
+  }
+  return std::nullopt;
+}
+
+/// cpfg headers Sprig does not implement, with what they are.
+struct UnsupportedHeader {
+  const char* key;
+  const char* shown;
+  const char* what;
+};
+constexpr UnsupportedHeader kUnsupportedHeaders[] = {
+    {"start", "Start:", "block of C statements"},
+    {"end", "End:", "block of C statements"},
+    {"starteach", "StartEach:", "block of C statements"},
+    {"start each", "StartEach:", "block of C statements"},
+    {"endeach", "EndEach:", "block of C statements"},
+    {"end each", "EndEach:", "block of C statements"},
+    {"define", "define:", "array declarations"},
+};
+
 /// True when line s, whose first non-space character is at b, declares modules
 /// (`module Apex, Leaf`) rather than being a production of a module named `module`.
 bool isModuleDeclaration(const std::string& s, int b) {
@@ -59,6 +104,9 @@ class GrammarParser {
   GrammarParser(const std::string& fileName, const GrammarOverrides& overrides)
       : overrides_(overrides), scanner_(fileName) {
     prog_.fileName = fileName;
+    prog_.dialect = dialectOf(fileName);
+    scanner_.setDialect(prog_.dialect);
+    for (size_t k = 0; k < kCpfgMultiNameCount; ++k) scanner_.addMultiName(kCpfgMultiNames[k]);
     for (const char* s : kTurtleSymbols) prog_.symbols.intern(s);
     prog_.openBracket = static_cast<SymbolId>(prog_.symbols.find("["));
     prog_.closeBracket = static_cast<SymbolId>(prog_.symbols.find("]"));
@@ -95,6 +143,7 @@ class GrammarParser {
     for (size_t i = 0; i < symbols.size(); ++i)
       if (symbols.name(static_cast<SymbolId>(i)).size() > 1 && symbols.name(static_cast<SymbolId>(i))[0] != '~')
         scanner_.addMultiName(symbols.name(static_cast<SymbolId>(i)));
+    for (size_t k = 0; k < kCpfgMultiNameCount; ++k) scanner_.addMultiName(kCpfgMultiNames[k]);
     ModuleString out;
     for (int line = 1; line <= scanner_.lineCount(); ++line) {
       std::vector<RawModule> mods;
@@ -120,14 +169,20 @@ class GrammarParser {
       const std::string& s = scanner_.line(line);
       int b = Scanner::firstNonSpace(s);
       if (b >= static_cast<int>(s.size())) continue;
-      if (s.compare(b, 10, "endlsystem") == 0) break;
+      if (isEndLsystem(s, b)) break;
       if (s.compare(b, 7, "#define") == 0 && (b + 7 == static_cast<int>(s.size()) || isSpace(s[b + 7]))) {
         defineConstant(line, b, defineLines);
       } else if (s[b] == '#') {
         int i = b + 1;
+        while (i < static_cast<int>(s.size()) && isSpace(s[i])) ++i;
         while (i < static_cast<int>(s.size()) && isIdentChar(s[i])) ++i;
         std::string word = s.substr(b, i - b);
-        error(line, b, "unknown directive '" + word + "'" + didYouMean(word, {"#define"}));
+        word.erase(std::remove_if(word.begin(), word.end(), [](char c) { return isSpace(c); }), word.end());
+        static const char* const kCpp[] = {"#include", "#ifdef", "#ifndef", "#if", "#else", "#elif", "#endif", "#undef", "#line", "#pragma", "#error"};
+        if (std::find(std::begin(kCpp), std::end(kCpp), word) != std::end(kCpp))
+          error(line, b, "cpfg's C preprocessor directive '" + word + "' is not supported (only '#define NAME constant' is)");
+        else
+          error(line, b, "unknown directive '" + word + "'" + didYouMean(word, {"#define"}));
       } else if (isModuleDeclaration(s, b)) {
         declareModules(line, b + 6);
       }
@@ -155,6 +210,10 @@ class GrammarParser {
       return;
     }
     std::string name = s.substr(nb, i - nb);
+    if (i < static_cast<int>(s.size()) && s[i] == '(') {
+      error(line, nb, "cpfg's function-like macro '#define " + name + "(...)' (C preprocessor) is not supported");
+      return;
+    }
     if (defineLines.count(name)) {
       error(line, nb, "'" + name + "' is already defined at line " + std::to_string(defineLines[name]));
       return;
@@ -214,13 +273,18 @@ class GrammarParser {
       const std::string& s = scanner_.line(line);
       int b = Scanner::firstNonSpace(s);
       if (b >= static_cast<int>(s.size())) continue;
-      if (s.compare(b, 10, "endlsystem") == 0) {
+      if (isEndLsystem(s, b)) {
         Span rest = scanner_.trim(Span{line, b + 10, static_cast<int>(s.size())});
         if (rest.b != rest.e) error(line, rest.b, "unexpected text after 'endlsystem'");
         break;
       }
       if (s[b] == '#') continue;
       if (isModuleDeclaration(s, b)) continue;
+      if (auto bare = bareBlockKeyword(s, b)) {
+        handleHeader(line, b, *bare, block);
+        continue;
+      }
+      if (unsupportedHeader(line, b)) continue;
       auto header = Scanner::headerOf(s, b);
       bool known = header && std::find(std::begin(kHeaders), std::end(kHeaders), header->key) != std::end(kHeaders);
       if (known) {
@@ -241,6 +305,27 @@ class GrammarParser {
     }
   }
 
+  /// Reports cpfg's headers Sprig does not implement (`Start:`, `define:`, `ring lsystem`)
+  /// at column b of line; true when the line was one.
+  bool unsupportedHeader(int line, int b) {
+    const std::string& s = scanner_.line(line);
+    auto header = Scanner::headerOf(s, b);
+    if (header)
+      for (const UnsupportedHeader& u : kUnsupportedHeaders)
+        if (header->key == u.key) {
+          error(line, b, std::string("cpfg's '") + u.shown + "' (" + u.what + ") is not supported");
+          return true;
+        }
+    std::string words;
+    for (int i = b; i < static_cast<int>(s.size()) && words.size() < 12; ++i)
+      if (!isSpace(s[i])) words += static_cast<char>(std::tolower(static_cast<unsigned char>(s[i])));
+    if (words == "ringlsystem" && Scanner::findArrow(s).first < 0) {
+      error(line, b, "cpfg's 'ring lsystem' (ring L-system) is not supported");
+      return true;
+    }
+    return false;
+  }
+
   /// Records header key at line; a second one is an error.
   void once(const std::string& key, int line, int col) {
     auto [it, inserted] = seen_.emplace(key, line);
@@ -253,6 +338,11 @@ class GrammarParser {
     Span value = scanner_.trim(Span{line, h.valueBegin, static_cast<int>(s.size())});
     std::string_view v = scanner_.view(value);
     if (h.key == "lsystem") {
+      if (seen_.count("lsystem")) {
+        error(line, b, "several L-systems in one file (cpfg's sub-L-systems) are not supported (the first is at line " +
+                           std::to_string(seen_["lsystem"]) + ")");
+        return;
+      }
       once(h.key, line, b);
       prog_.name = std::string(v);
     } else if (h.key == "derivation length") {
@@ -368,7 +458,9 @@ class GrammarParser {
     }
     if (!scanner_.tokenizeModules(line, pred.b, pred.e, predMods)) return;
     if (predMods.size() != 1) {
-      error(line, predMods.size() > 1 ? predMods[1].col : pred.b, "a predecessor must be a single module");
+      error(line, predMods.size() > 1 ? predMods[1].col : pred.b,
+            predMods.size() > 1 ? "a predecessor must be a single module (cpfg's predecessors of several modules are not supported)"
+                                : "a predecessor must be a single module");
       return;
     }
     if (predMods[0].name == "[" || predMods[0].name == "]") {
@@ -397,6 +489,10 @@ class GrammarParser {
     expr_.clearRandom();
     // Condition.
     cond = scanner_.trim(cond);
+    if (int brace = scanner_.findTop(line, cond.b, cond.e, '{'); brace >= 0) {
+      error(line, brace, "cpfg's C statement blocks ('{ ... }' around a condition) are not supported");
+      return;
+    }
     if (colon >= 0 && cond.b == cond.e) error(line, colon, "missing condition after ':' (write '*' for none)");
     else if (cond.b != cond.e && !scanner_.isStar(cond)) {
       size_t before = prog_.code.size();
@@ -489,6 +585,7 @@ class GrammarParser {
   /// per module.
   void noteWritten(int line, const RawModule& m) {
     const size_t n = m.args.size();
+    if (n == 0 && m.name.size() == 1 && std::string_view("+-&^\\/").find(m.name[0]) != std::string_view::npos) prog_.bareTurn = true;
     uint8_t* seen = m.name.size() == 1 && n < 8 ? &writtenSingle_[static_cast<unsigned char>(m.name[0])] : nullptr;
     if (seen && (*seen >> n & 1)) return;
     written_[m.name].emplace(static_cast<int>(n), std::pair{line, m.col});

@@ -17,6 +17,7 @@
 #include "core/diagnostics.h"
 #include "core/rng.h"
 #include "core/types.h"
+#include "lsystem/detail/cpfg.h"
 #include "lsystem/module_string.h"
 
 namespace sprig::lsystem::detail {
@@ -28,7 +29,40 @@ enum class Op : uint8_t {
   Const, Var, Add, Sub, Mul, Div, Pow, Neg, Not, Lt, Le, Gt, Ge, Eq, Ne, And, Or,
   Sin, Cos, Tan, Asin, Acos, Atan, Atan2, Sqrt, Exp, Log, PowFn, Abs, Min, Max, Floor, Ceil, Sign,
   Ran, Nran,
+  Select,  ///< `c ? a : b` (three operands, both evaluated)
+  Round,   ///< cpfg's `trunc(x)`: floor(x + 0.5) (cpfg rounds, whatever the name says)
+  Rem,     ///< cpfg's `a % b`: the remainder of the operands truncated to integers
+  Bran,    ///< `bran(a, b)`: a beta(a, b) draw
+  Biran,   ///< `biran(n, p)`: a binomial(n, p) draw
 };
+
+/// A draw from the beta(a, b) distribution, by R.C.H. Cheng's rejection algorithm BA
+/// ("Generating beta variates with nonintegral shape parameters", CACM 21(4), 1978).
+/// NaN for non-positive shapes (the caller reports non-finite values).
+inline double betaDraw(Rng& rng, double a, double b) {
+  if (!(a > 0) || !(b > 0)) return std::nan("");
+  const double alpha = a + b;
+  const double beta = std::min(a, b) <= 1 ? std::min(a, b) : std::sqrt((alpha - 2) / (2 * a * b - alpha));
+  const double lambda = std::min(a, b) <= 1 ? std::min(a, b) : 1 / beta;
+  const double gamma = a + lambda;
+  for (int tries = 0; tries < 100000; ++tries) {
+    double u1 = rng.uniform(), u2 = rng.uniform();
+    if (u1 <= 0 || u1 >= 1 || u2 <= 0) continue;
+    const double v = std::log(u1 / (1 - u1)) / lambda;
+    const double w = a * std::exp(v);
+    if (alpha * std::log(alpha / (b + w)) + gamma * v - std::log(4.0) >= std::log(u1 * u1 * u2)) return w / (b + w);
+  }
+  return std::nan("");
+}
+
+/// A draw from the binomial(n, p) distribution: n trials, each a success with probability p.
+inline double binomialDraw(Rng& rng, double n, double p) {
+  const long trials = static_cast<long>(n);
+  if (!(trials >= 0) || trials > 100000000) return std::nan("");
+  long k = 0;
+  for (long t = 0; t < trials; ++t) k += rng.uniform() <= p;
+  return static_cast<double>(k);
+}
 
 /// One bytecode instruction: push a constant or variable, or pop operands and push a result.
 struct Instr {
@@ -87,6 +121,16 @@ inline double evalCode(const Instr* code, const Instr* end, const double* vars, 
       case Op::Sign: stack[sp - 1] = stack[sp - 1] > 0 ? 1.0 : (stack[sp - 1] < 0 ? -1.0 : 0.0); break;
       case Op::Ran: stack[sp - 1] = rng->uniform() * stack[sp - 1]; break;
       case Op::Nran: --sp; stack[sp - 1] = rng->normal(stack[sp - 1], stack[sp]); break;
+      case Op::Select: sp -= 2; stack[sp - 1] = stack[sp - 1] != 0.0 ? stack[sp] : stack[sp + 1]; break;
+      case Op::Round: stack[sp - 1] = std::floor(stack[sp - 1] + 0.5); break;
+      case Op::Rem: {
+        --sp;
+        const double a = std::trunc(stack[sp - 1]), b = std::trunc(stack[sp]);
+        stack[sp - 1] = b == 0.0 || !std::isfinite(a) ? std::nan("") : std::fmod(a, b);
+        break;
+      }
+      case Op::Bran: --sp; stack[sp - 1] = betaDraw(*rng, stack[sp - 1], stack[sp]); break;
+      case Op::Biran: --sp; stack[sp - 1] = binomialDraw(*rng, stack[sp - 1], stack[sp]); break;
     }
   }
   return stack[0];
@@ -236,6 +280,10 @@ struct Program {
   uint64_t seed = 0;
   bool hasAngle = false;
   double angleDeg = 0;
+  Dialect dialect = Dialect::Sprig;  ///< the notation the file is read in (by its extension)
+  /// True when the axiom or a successor turns without an angle (`+`, `&`, ...), so that
+  /// the default angle matters.
+  bool bareTurn = false;
   SymbolTable symbols;
   ModuleString axiom;
   std::vector<std::pair<std::string, double>> defines;
