@@ -276,6 +276,16 @@ class GrammarParser {
       if (isEndLsystem(s, b)) {
         Span rest = scanner_.trim(Span{line, b + 10, static_cast<int>(s.size())});
         if (rest.b != rest.e) error(line, rest.b, "unexpected text after 'endlsystem'");
+        // Notes may follow; another `lsystem:` is cpfg's sub-L-system.
+        for (int k = line + 1; k <= scanner_.lineCount(); ++k) {
+          const std::string& t = scanner_.line(k);
+          const int tb = Scanner::firstNonSpace(t);
+          if (tb >= static_cast<int>(t.size())) continue;
+          if (auto h = Scanner::headerOf(t, tb); h && h->key == "lsystem") {
+            error(k, tb, "several L-systems in one file (cpfg's sub-L-systems) are not supported");
+            break;
+          }
+        }
         break;
       }
       if (s[b] == '#') continue;
