@@ -135,6 +135,49 @@ TEST_CASE("cpfg objects", "[lsystem][cpfg]") {
     checkNear(o.skeleton.internodes[3].end, 3.0 * e1);  // `]` restored elasticity 0
   }
 
+  SECTION("@M moves, @R sets the heading (and cpfg's up), @v rolls L horizontal; a bare decomposition") {
+    Drawn o = drawObject("move_heading", false);
+    CHECK(o.string == "F@M(3,0,1)F@R(1,0,0)F@R(0,0,1,0,1,0)F&(45)@v F");  // a space keeps @v and F apart
+    REQUIRE(o.skeleton.internodes.size() == 5);
+    checkNear(o.skeleton.internodes[0].end, DVec3(0, 1, 0));
+    checkNear(o.skeleton.internodes[1].start, DVec3(3, 0, 1));  // @M: no segment drawn to it
+    CHECK(o.skeleton.internodes[1].parent == -1);
+    checkNear(o.skeleton.internodes[2].end, DVec3(4, 1, 1));    // @R(1,0,0): heading +X
+    checkNear(o.skeleton.internodes[3].end, DVec3(4, 1, 2));    // @R(0,0,1, 0,1,0): heading +Z
+    // &(45) after H = +Z, U = -(cpfg's up) = -Y: H = (0, s, c); @v: L = Y x H normalized = +X.
+    const double r2 = std::sqrt(0.5);
+    checkNear(o.skeleton.internodes[4].end, DVec3(4, 1 + r2, 2 + r2));
+    checkNear(o.end.frame.left, DVec3(1, 0, 0));
+    checkNear(o.end.frame.up, DVec3(0, r2, -r2));
+  }
+
+  SECTION("@Ti without a value adds the tropism's step S, @Td(n, d) subtracts d, @Ts of a missing tropism is ignored") {
+    // E 0.1 + S 0.2 = 0.3: the first F turns 0.3 rad down; 0.3 - 0.3 = 0: the others go straight.
+    Drawn o = drawObject("elasticity_steps", true);
+    REQUIRE(o.skeleton.internodes.size() == 3);
+    const DVec3 h(-std::cos(0.3), -std::sin(0.3), 0);
+    checkNear(o.skeleton.internodes[0].end, h);
+    checkNear(o.skeleton.internodes[1].end, 2.0 * h);
+    checkNear(o.skeleton.internodes[2].end, 3.0 * h);
+  }
+
+  SECTION("bran and biran draw from the seeded generator") {
+    Drawn a = drawObject("random", false), b = drawObject("random", false);
+    CHECK(a.string == b.string);
+    Grammar g = loadGrammar(cpfgAsset("random/plant.l"));
+    Deriver d(g);
+    const ModuleString& s = d.derive();
+    REQUIRE(s.size() == 1);
+    REQUIRE(s.paramCount(0) == 5);
+    const double* p = s.params.data() + s.offsets[0];
+    CHECK(p[0] == 10);  // every trial below p = 1
+    CHECK(p[1] == 0);
+    CHECK(p[2] == std::floor(p[2]));
+    CHECK((p[2] >= 0 && p[2] <= 20));
+    CHECK((p[3] > 0 && p[3] < 1));
+    CHECK((p[4] > 0 && p[4] < 1));
+  }
+
   SECTION("@O(d) and @o(d) spheres of diameter d, @c(d) a disc in the HL plane") {
     Drawn o = drawObject("spheres_discs", true);
     REQUIRE(o.skeleton.organs.size() == 3);
