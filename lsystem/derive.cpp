@@ -359,7 +359,26 @@ struct Deriver::Impl {
     return true;
   }
 
-  bool condition(const Production& p, const double* vars, int step) {
+  /// Runs the statement block r of p (its `before` or `after`) on vars.
+  void statements(const Production& p, const detail::CodeRange& r, double* vars, int step) {
+    const Instr* code = prog->code.data();
+    double v = detail::evalCode(code + r.begin, code + r.end, vars, p.usesRandom ? moduleRng() : nullptr);
+    if (std::isnan(v))
+      throw InputError(p.loc, "the statements of production '" + p.text + "' loop more than " +
+                                  std::to_string(detail::kMaxLoopJumps) + " times at step " + std::to_string(step),
+                       p.sourceLine);
+  }
+
+  /// p's statements after its condition, when p applies (its successor reads them).
+  void afterStatements(const Production& p, double* vars, int step) {
+    if (!p.after.empty()) statements(p, p.after, vars, step);
+  }
+
+  bool condition(const Production& p, double* vars, int step) {
+    if (p.hasStatements()) {
+      for (uint16_t k = 0; k < p.localCount; ++k) vars[p.localFirst + k] = 0.0;
+      if (!p.before.empty()) statements(p, p.before, vars, step);
+    }
     if (p.condition.empty()) return true;
     const Instr* code = prog->code.data();
     double v = detail::evalCode(code + p.condition.begin, code + p.condition.end, vars, p.usesRandom ? moduleRng() : nullptr);
@@ -374,7 +393,10 @@ struct Deriver::Impl {
     for (size_t k = 0; k < cand.size(); ++k) {
       const Production& p = rs.productions[cand[k]];
       if (!matches(p, s, i, vars) || !condition(p, vars, step)) continue;
-      if (!p.stochastic) return &p;
+      if (!p.stochastic) {
+        afterStatements(p, vars, step);
+        return &p;
+      }
       // Stochastic: choose among every matching weighted production from here on,
       // with probability proportional to its weight.
       std::vector<uint32_t>& ids = stochasticIds;
@@ -400,6 +422,11 @@ struct Deriver::Impl {
       }
       const Production& chosen = rs.productions[ids[pick]];
       matches(chosen, s, i, vars);  // rebind its parameters
+      if (chosen.hasStatements()) {
+        // Other candidates' statements used the same registers: run its own again.
+        condition(chosen, vars, step);
+        afterStatements(chosen, vars, step);
+      }
       return &chosen;
     }
     return nullptr;
@@ -478,6 +505,7 @@ struct Deriver::Impl {
         if (!condition(p, vars, step)) continue;
         // Stochastic decomposition rules: weighted choice among the matching ones.
         const Production* chosen = &p;
+        if (!p.stochastic) afterStatements(p, vars, step);
         if (p.stochastic) {
           ModuleString& one = oneScratch;
           one.clear();

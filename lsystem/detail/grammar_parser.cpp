@@ -497,13 +497,10 @@ class GrammarParser {
     }
     if (diags().items().size() != diagsBefore) return;
     expr_.clearRandom();
-    // Condition.
+    // Condition, with cpfg's statements around it: `{ before } cond { after }`.
     cond = scanner_.trim(cond);
-    if (int brace = scanner_.findTop(line, cond.b, cond.e, '{'); brace >= 0) {
-      error(line, brace, "cpfg's C statement blocks ('{ ... }' around a condition) are not supported");
-      return;
-    }
-    if (colon >= 0 && cond.b == cond.e) error(line, colon, "missing condition after ':' (write '*' for none)");
+    if (scanner_.findTop(line, cond.b, cond.e, '{') >= 0 && !productionStatements(line, cond, varNames, p)) return;
+    if (colon >= 0 && cond.b == cond.e && !p.hasStatements()) error(line, colon, "missing condition after ':' (write '*' for none)");
     else if (cond.b != cond.e && !scanner_.isStar(cond)) {
       size_t before = prog_.code.size();
       if (expr_.compile(cond, varNames, "condition")) {
@@ -541,6 +538,216 @@ class GrammarParser {
     p.usesRandom = expr_.usesRandom();
     RuleSet& rs = block == Block::Main ? prog_.productions : block == Block::Decomposition ? prog_.decomposition : prog_.interpretation;
     rs.productions.push_back(std::move(p));
+  }
+
+  // ---- cpfg's statements ---------------------------------------------------------------
+
+  /// Index of the `close` matching the `open` at i of line (nesting counted), or -1.
+  int matching(int line, int i, int e, char open, char close) {
+    const std::string& s = scanner_.line(line);
+    int depth = 0;
+    for (int k = i; k < e; ++k) {
+      if (s[k] == open) ++depth;
+      else if (s[k] == close && --depth == 0) return k;
+    }
+    return -1;
+  }
+
+  /// Splits `{ before } cond { after }` (sp, the text between the production's `:` and
+  /// its arrow) and compiles the blocks into p; cond is narrowed to the condition. Locals
+  /// get registers after the formal parameters in varNames. False after an error.
+  bool productionStatements(int line, Span& cond, std::vector<std::string>& varNames, Production& p) {
+    const std::string& s = scanner_.line(line);
+    const size_t formalsCount = varNames.size();
+    int i = cond.b;
+    if (s[i] == '{') {
+      int close = matching(line, i, cond.e, '{', '}');
+      if (close < 0) {
+        error(line, i, "unclosed '{' of a statement block");
+        return false;
+      }
+      if (!statementBlock(line, i + 1, close, varNames, p.before)) return false;
+      i = close + 1;
+    }
+    int brace = scanner_.findTop(line, i, cond.e, '{');
+    Span c = scanner_.trim(Span{line, i, brace >= 0 ? brace : cond.e});
+    if (brace >= 0) {
+      int close = matching(line, brace, cond.e, '{', '}');
+      if (close < 0) {
+        error(line, brace, "unclosed '{' of a statement block");
+        return false;
+      }
+      if (!statementBlock(line, brace + 1, close, varNames, p.after)) return false;
+      Span rest = scanner_.trim(Span{line, close + 1, cond.e});
+      if (rest.b != rest.e) {
+        error(line, rest.b, "unexpected text after the statements (expected the arrow '-->')");
+        return false;
+      }
+    }
+    if (c.b == c.e) c = Span{line, c.b, c.b};
+    cond = c;
+    p.localFirst = static_cast<uint16_t>(formalsCount);
+    p.localCount = static_cast<uint16_t>(varNames.size() - formalsCount);
+    return true;
+  }
+
+  /// Compiles the statements of line[b, e) (inside one `{ }`) into a block of its own code.
+  bool statementBlock(int line, int b, int e, std::vector<std::string>& varNames, CodeRange& out) {
+    const uint32_t begin = static_cast<uint32_t>(prog_.code.size());
+    if (!statementList(line, b, e, varNames, begin)) {
+      prog_.code.resize(begin);
+      return false;
+    }
+    if (prog_.code.size() == begin) return true;  // `{ }`
+    out = CodeRange{begin, static_cast<uint32_t>(prog_.code.size())};
+    return true;
+  }
+
+  /// Appends a jump (op Jz or Jmp) to target (counted from base); returns its index.
+  size_t jump(Op op, uint32_t base, double target) {
+    Instr in;
+    in.op = op;
+    in.c = target - base;
+    prog_.code.push_back(in);
+    return prog_.code.size() - 1;
+  }
+  void patch(size_t at, uint32_t base) { prog_.code[at].c = static_cast<double>(prog_.code.size() - base); }
+
+  /// The word (identifier) at i of line, or empty.
+  std::string wordAt(int line, int i, int e) const {
+    const std::string& s = scanner_.line(line);
+    int j = i;
+    if (j < e && isIdentStart(s[j]))
+      while (j < e && isIdentChar(s[j])) ++j;
+    return s.substr(i, j - i);
+  }
+
+  /// `( expr )` at i: compiles expr; returns the index after `)`, or -1 after an error.
+  int parenthesized(int line, int i, int e, const std::vector<std::string>& varNames, const char* what) {
+    const std::string& s = scanner_.line(line);
+    while (i < e && isSpace(s[i])) ++i;
+    if (i >= e || s[i] != '(') {
+      error(line, i, std::string("expected '(' after '") + what + "'");
+      return -1;
+    }
+    int close = matching(line, i, e, '(', ')');
+    if (close < 0) {
+      error(line, i, "missing ')'");
+      return -1;
+    }
+    Span c = scanner_.trim(Span{line, i + 1, close});
+    if (c.b == c.e) {
+      error(line, i, std::string("missing condition of '") + what + "'");
+      return -1;
+    }
+    if (!expr_.compile(c, varNames, "condition")) return -1;
+    return close + 1;
+  }
+
+  /// `{ statements }` at i: compiles them; returns the index after `}`, or -1.
+  int braced(int line, int i, int e, std::vector<std::string>& varNames, uint32_t base, const char* after) {
+    const std::string& s = scanner_.line(line);
+    while (i < e && isSpace(s[i])) ++i;
+    if (i >= e || s[i] != '{') {
+      error(line, i, std::string("expected '{' after '") + after + "' (cpfg requires braces)");
+      return -1;
+    }
+    int close = matching(line, i, e, '{', '}');
+    if (close < 0) {
+      error(line, i, "unclosed '{'");
+      return -1;
+    }
+    if (!statementList(line, i + 1, close, varNames, base)) return -1;
+    return close + 1;
+  }
+
+  /// Statements `x = expr;`, `if (c) {...} [else {...}]`, `while (c) {...}`,
+  /// `do {...} while (c);` of line[b, e) (cpfg reference manual, 3.2), appended to the code.
+  bool statementList(int line, int b, int e, std::vector<std::string>& varNames, uint32_t base) {
+    const std::string& s = scanner_.line(line);
+    int i = b;
+    for (;;) {
+      while (i < e && (isSpace(s[i]) || s[i] == ';')) ++i;
+      if (i >= e) return true;
+      const std::string word = wordAt(line, i, e);
+      if (word.empty()) {
+        error(line, i, std::string("expected a statement (an assignment, 'if', 'while' or 'do'), got '") + s[i] + "'");
+        return false;
+      }
+      const int at = i;
+      i += static_cast<int>(word.size());
+      if (word == "if") {
+        if ((i = parenthesized(line, i, e, varNames, "if")) < 0) return false;
+        size_t jz = jump(Op::Jz, base, 0);
+        if ((i = braced(line, i, e, varNames, base, "if (...)")) < 0) return false;
+        int k = i;
+        while (k < e && isSpace(s[k])) ++k;
+        if (wordAt(line, k, e) == "else") {
+          size_t jmp = jump(Op::Jmp, base, 0);
+          patch(jz, base);
+          if ((i = braced(line, k + 4, e, varNames, base, "else")) < 0) return false;
+          patch(jmp, base);
+        } else {
+          patch(jz, base);
+        }
+      } else if (word == "while") {
+        const double top = static_cast<double>(prog_.code.size());
+        if ((i = parenthesized(line, i, e, varNames, "while")) < 0) return false;
+        size_t jz = jump(Op::Jz, base, 0);
+        if ((i = braced(line, i, e, varNames, base, "while (...)")) < 0) return false;
+        jump(Op::Jmp, base, top);
+        patch(jz, base);
+      } else if (word == "do") {
+        const double top = static_cast<double>(prog_.code.size());
+        if ((i = braced(line, i, e, varNames, base, "do")) < 0) return false;
+        while (i < e && isSpace(s[i])) ++i;
+        if (wordAt(line, i, e) != "while") {
+          error(line, i, "expected 'while (...)' after 'do { ... }'");
+          return false;
+        }
+        if ((i = parenthesized(line, i + 5, e, varNames, "while")) < 0) return false;
+        Instr notOp;
+        notOp.op = Op::Not;
+        prog_.code.push_back(notOp);
+        jump(Op::Jz, base, top);
+      } else {
+        // Assignment `name = expression;`.
+        while (i < e && isSpace(s[i])) ++i;
+        if (i >= e || s[i] != '=' || (i + 1 < e && s[i + 1] == '=')) {
+          error(line, i, "expected '=' after '" + word + "' (statements are assignments, 'if', 'while' and 'do')");
+          return false;
+        }
+        int end = scanner_.findTop(line, i + 1, e, ';');
+        if (end < 0) {
+          error(line, at, "missing ';' after the assignment to '" + word + "' (cpfg requires one after every statement)");
+          return false;
+        }
+        Span value = scanner_.trim(Span{line, i + 1, end});
+        if (value.b == value.e) {
+          error(line, i, "missing value after '" + word + " ='");
+          return false;
+        }
+        if (defines_.count(word)) {
+          error(line, at, "cannot assign to '" + word + "': it is a #define");
+          return false;
+        }
+        if (!expr_.compile(value, varNames, "value")) return false;
+        auto it = std::find(varNames.begin(), varNames.end(), word);
+        if (it == varNames.end()) {
+          if (varNames.size() >= static_cast<size_t>(kMaxVars)) {
+            error(line, at, "too many parameters and local variables in one production (at most " + std::to_string(kMaxVars) + ")");
+            return false;
+          }
+          varNames.push_back(word);
+          it = varNames.end() - 1;
+        }
+        Instr store;
+        store.op = Op::Store;
+        store.var = static_cast<uint16_t>(it - varNames.begin());
+        prog_.code.push_back(store);
+        i = end + 1;
+      }
+    }
   }
 
   /// Open brackets of a module string being checked (bracketModule, bracketEnd).

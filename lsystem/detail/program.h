@@ -34,7 +34,15 @@ enum class Op : uint8_t {
   Rem,     ///< cpfg's `a % b`: the remainder of the operands truncated to integers
   Bran,    ///< `bran(a, b)`: a beta(a, b) draw
   Biran,   ///< `biran(n, p)`: a binomial(n, p) draw
+  // Statements (cpfg's `{ x = ...; if (...) {...} }` blocks); never inside an expression.
+  Store,   ///< pops a value into register var
+  Jz,      ///< pops a value; when it is 0, jumps to instruction c of the block
+  Jmp,     ///< jumps to instruction c of the block
 };
+
+/// Most backward jumps one statement block may take (a `while` that never ends): past it
+/// evalCode stops and returns NaN, which the deriver reports.
+inline constexpr long kMaxLoopJumps = 10'000'000;
 
 /// A draw from the beta(a, b) distribution, by R.C.H. Cheng's rejection algorithm BA
 /// ("Generating beta variates with nonintegral shape parameters", CACM 21(4), 1978).
@@ -78,11 +86,14 @@ struct CodeRange {
   bool empty() const { return begin == end; }
 };
 
-/// Evaluates one expression. rng is used only by Ran/Nran (never null when the
-/// expression draws: the compiler marks such productions usesRandom).
+/// Evaluates one expression, or runs one statement block (Store, Jz, Jmp write into vars,
+/// which must then be writable; jump targets count from code; a block returns 0, or NaN
+/// after kMaxLoopJumps backward jumps). rng is used only by the random draws (never null
+/// when the code draws: the compiler marks such productions usesRandom).
 inline double evalCode(const Instr* code, const Instr* end, const double* vars, Rng* rng) {
   double stack[kMaxStack];
   int sp = 0;
+  long backJumps = 0;
   constexpr double kDeg = kPi / 180.0;
   for (const Instr* in = code; in != end; ++in) {
     switch (in->op) {
@@ -131,9 +142,19 @@ inline double evalCode(const Instr* code, const Instr* end, const double* vars, 
       }
       case Op::Bran: --sp; stack[sp - 1] = betaDraw(*rng, stack[sp - 1], stack[sp]); break;
       case Op::Biran: --sp; stack[sp - 1] = binomialDraw(*rng, stack[sp - 1], stack[sp]); break;
+      case Op::Store: const_cast<double*>(vars)[in->var] = stack[--sp]; break;
+      case Op::Jz:
+        if (stack[--sp] != 0.0) break;
+        [[fallthrough]];
+      case Op::Jmp: {
+        const Instr* to = code + static_cast<ptrdiff_t>(in->c);
+        if (to <= in && ++backJumps > kMaxLoopJumps) return std::nan("");
+        in = to - 1;  // the loop's ++in lands on the target
+        break;
+      }
     }
   }
-  return stack[0];
+  return sp > 0 ? stack[sp - 1] : 0.0;
 }
 
 /// How one successor parameter is computed.
@@ -174,6 +195,11 @@ struct Production {
   std::vector<PatternItem> left;   ///< in textual order
   std::vector<PatternItem> right;  ///< in textual order
   CodeRange condition;             ///< empty: always true
+  CodeRange before;                ///< cpfg's statements before the condition (`{ ... } cond`)
+  CodeRange after;                 ///< cpfg's statements after it (`cond { ... }`), run when the production applies
+  uint16_t localFirst = 0;         ///< registers of the statements' local variables (zeroed before `before`)
+  uint16_t localCount = 0;
+  bool hasStatements() const { return !before.empty() || !after.empty(); }
   std::vector<SuccModule> successor;
   std::vector<Arg> args;
   bool stochastic = false;
@@ -229,7 +255,7 @@ struct RuleSet {
       }
       if (bySymbol[s].size() == 1) {
         const Production& p = productions[bySymbol[s][0]];
-        if (!p.hasContext() && p.condition.empty() && !p.stochastic) r.simple = &p;
+        if (!p.hasContext() && p.condition.empty() && !p.stochastic && !p.hasStatements()) r.simple = &p;
       }
       if (!r.simple && r.count) buildDispatch(s, r);
     }
@@ -240,7 +266,7 @@ struct RuleSet {
     std::vector<SymbolId> used;
     for (uint32_t idx : bySymbol[s]) {
       const Production& p = productions[idx];
-      if (!p.simpleCtx || !p.condition.empty() || p.stochastic || p.predParams) return;
+      if (!p.simpleCtx || !p.condition.empty() || p.stochastic || p.predParams || p.hasStatements()) return;
       for (const auto* side : {&p.left, &p.right})
         for (const PatternItem& it : *side) {
           if (it.paramCount) return;

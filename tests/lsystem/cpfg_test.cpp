@@ -249,8 +249,7 @@ TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg
     CHECK(errorOf("axiom: F_(2)\n") == "t.l:1:9: cpfg's '_' (old-style elasticity change) is not supported");
   }
   SECTION("statements, blocks, preprocessor, several L-systems") {
-    CHECK(errorOf("axiom: A(1)\nA(y) : { x = y / 2; } x < 10 --> B(x)\n") ==
-          "t.l:2:8: cpfg's C statement blocks ('{ ... }' around a condition) are not supported");
+    CHECK(errorOf("axiom: A(1)\nA(y) : { x = y / 2; x < 10 --> B(x)\n") == "t.l:2:8: unclosed '{' of a statement block");
     CHECK(errorOf("Start: { i = 0; }\naxiom: A\n") == "t.l:1:1: cpfg's 'Start:' (block of C statements) is not supported");
     CHECK(errorOf("define: { array a[2]; }\naxiom: A\n") == "t.l:1:1: cpfg's 'define:' (array declarations) is not supported");
     CHECK(errorOf("#include \"x.h\"\naxiom: A\n") ==
@@ -289,5 +288,61 @@ TEST_CASE("cpfg notation in Sprig's .lsys files", "[lsystem][cpfg]") {
     CHECK(!parseGrammar("axiom: F+(30)F\n", "t.lsys").usesDefaultAngle());
     Grammar g = parseGrammar("axiom: A(-2^2, 2^3^2)\n", "t.lsys");
     CHECK(formatModuleString(g.axiom(), g.symbols()) == "A(-4,512)");
+  }
+}
+
+namespace {
+
+/// The string after `steps` steps of text (a grammar named file).
+std::string derived(const std::string& text, int steps, const std::string& file = "t.l") {
+  Grammar g = parseGrammar(text, file);
+  DeriveOptions opt;
+  opt.steps = steps;
+  Deriver d(g, opt);
+  return formatModuleString(d.derive(), d.symbols());
+}
+
+}  // namespace
+
+TEST_CASE("cpfg statements in productions", "[lsystem][cpfg]") {
+  SECTION("assignments before the condition: locals the condition and the successor read") {
+    const std::string g = "axiom: A(4)A(8)\nA(y) : { x = y / 2; s = x * x; } s < 10 --> B(x)\n";
+    CHECK(derived(g, 1) == "B(2)A(8)");  // 4: x 2, s 4; 8: s 16, no match
+  }
+  SECTION("if and else after the condition; a formal parameter may be assigned") {
+    const std::string g = "axiom: A(20)A(3)\nA(y) : * { if (y > 10) { y = 10; } else { y = y + 1; } } --> B(y)\n";
+    CHECK(derived(g, 1) == "B(10)B(4)");
+  }
+  SECTION("while and do ... while") {
+    CHECK(derived("axiom: A(4)\nA(n) : { k = 0; s = 0; while (k < n) { k = k + 1; s = s + k; } } * --> S(s)\n", 1) == "S(10)");
+    CHECK(derived("axiom: A(5)A(0)\nA(n) : { k = 0; do { k = k + 2; } while (k < n); } * --> D(k)\n", 1) == "D(6)D(2)");
+  }
+  SECTION("locals start at 0 in every application") {
+    CHECK(derived("axiom: A(1)\nA(n) : { if (n > 5) { t = 7; } } * --> A(n + 5)T(t)\n", 2) == "A(11)T(7)T(0)");
+  }
+  SECTION("a block over several lines (cpfg notation)") {
+    CHECK(derived("axiom: A(2)\nA(y) : {\n\tx = y * 3;\n} x > 5 --> B(x)\n", 1) == "B(6)");
+  }
+  SECTION("stochastic productions run their own statements") {
+    const std::string g = "seed: 3\naxiom: A(1)A(1)A(1)A(1)\nA(y) : { x = 10; } * --> X(x) : 1\nA(y) : { z = 20; } * --> Z(z) : 1\n";
+    const std::string out = derived(g, 1);
+    for (size_t k = 0; k < out.size(); ++k)
+      if (out[k] == 'X') CHECK(out.compare(k, 5, "X(10)") == 0);
+      else if (out[k] == 'Z') CHECK(out.compare(k, 5, "Z(20)") == 0);
+  }
+  SECTION("errors") {
+    CHECK(errorOf("axiom: A(1)\nA(y) : { x = y } * --> B(x)\n") ==
+          "t.l:2:10: missing ';' after the assignment to 'x' (cpfg requires one after every statement)");
+    CHECK(errorOf("axiom: A(1)\nA(y) : { if (y > 1) x = 2; } * --> B(y)\n") ==
+          "t.l:2:21: expected '{' after 'if (...)' (cpfg requires braces)");
+    CHECK(errorOf("axiom: A(1)\nA(y) : { x += 1; } * --> B(y)\n") ==
+          "t.l:2:12: expected '=' after 'x' (statements are assignments, 'if', 'while' and 'do')");
+    CHECK(errorOf("#define K 2\naxiom: A(1)\nA(y) : { K = 1; } * --> B(y)\n") == "t.l:3:10: cannot assign to 'K': it is a #define");
+    try {
+      derived("axiom: A(1)\nA(y) : { while (1) { y = y; } } * --> B(y)\n", 1);
+      FAIL("no error");
+    } catch (const InputError& e) {
+      CHECK(e.diagnostics().front().message == "the statements of production 'A(y)' loop more than 10000000 times at step 1");
+    }
   }
 }
