@@ -147,6 +147,9 @@ class Writer {
 
 }  // namespace
 
+/// Stream id of the random draws of cpfg's Start/StartEach/EndEach/End blocks (with the step).
+constexpr uint64_t kBlockStream = 0xfffffffffffe0000ull;
+
 struct Deriver::Impl {
   Grammar grammar;  // keeps the program alive
   const Program* prog = nullptr;
@@ -175,6 +178,27 @@ struct Deriver::Impl {
   Rng rng;
   bool rngReady = false;
   uint64_t rngStream = 0, rngItem = 0;
+
+  /// cpfg's global variables (Program::globals), kMaxVars registers.
+  std::vector<double> globals;
+
+  /// Runs one of cpfg's Start/StartEach/EndEach/End blocks on the globals; its random draws
+  /// come from a stream of their own for each step.
+  void runBlock(const detail::CodeRange& r, int step) {
+    if (r.empty()) return;
+    Rng blockRng(deriveSeed(seed, {kBlockStream, static_cast<uint64_t>(step)}));
+    const Instr* code = prog->code.data();
+    if (std::isnan(detail::evalCode(code + r.begin, code + r.end, globals.data(), &blockRng)))
+      throw InputError(SourceLoc{prog->fileName, 0, 0}, "a Start/StartEach/EndEach/End block loops more than " +
+                                                            std::to_string(detail::kMaxLoopJumps) + " times at step " +
+                                                            std::to_string(step));
+  }
+
+  /// Copies the globals into the top registers of a production's vars.
+  void loadGlobals(double* vars) const {
+    const size_t g = prog->globals.size();
+    for (size_t k = 0; k < g; ++k) vars[detail::kMaxVars - 1 - k] = globals[k];
+  }
 
   Rng* moduleRng() {
     if (!rngReady) {
@@ -498,6 +522,7 @@ struct Deriver::Impl {
     const RuleSet& rs = prog->decomposition;
     if (depth < rs.maxDepth && !rs.bySymbol[sym].empty()) {
       double vars[detail::kMaxVars];
+      loadGlobals(vars);
       for (uint32_t idx : rs.bySymbol[sym]) {
         const Production& p = rs.productions[idx];
         if (count != p.predParams) continue;
@@ -623,6 +648,7 @@ struct Deriver::Impl {
     auto [reserveModules, reserveParams] = decompose ? std::pair<size_t, size_t>{0, 0} : sizePass(rs, step);
     Writer w(next, births, opt.maxModules, limitAt, step, reserveModules, reserveParams);
     double vars[detail::kMaxVars];
+    loadGlobals(vars);
     rngStream = stream;
     size_t nextChoice = 0;
     for (size_t i = 0; i < n; ++i) {
@@ -714,6 +740,8 @@ struct Deriver::Impl {
   }
 
   void start() {
+    globals.assign(detail::kMaxVars, 0.0);
+    runBlock(prog->startBlock, 0);
     cur = prog->axiom;
     if (cur.size() > opt.maxModules) Writer::overLimit(opt.maxModules, limitAt, 0);
     if (opt.trackBirthSteps) cur.birthSteps.assign(cur.size(), 0);
@@ -751,7 +779,10 @@ void Deriver::restart() {
 const ModuleString& Deriver::step() {
   Impl& m = *impl_;
   int step = m.done + 1;
+  m.runBlock(m.prog->startEachBlock, step);
   m.rewrite(m.prog->productions, step, static_cast<uint64_t>(step), true);
+  m.runBlock(m.prog->endEachBlock, step);
+  if (step == m.steps) m.runBlock(m.prog->endBlock, step);
   m.done = step;
   if (m.opt.onStep) m.opt.onStep(step, m.cur.size());
   return m.cur;
@@ -780,6 +811,7 @@ ModuleString Deriver::interpret(const ModuleString& s) const {
   tmp.limitAt = impl_->limitAt;
   tmp.opt.trackBirthSteps = s.hasBirthSteps();
   tmp.cur = s;
+  tmp.globals = impl_->globals;
   // Interpretation recursion: depth 1 is one rewrite; deeper levels rewrite what the
   // previous level produced (modules no rule matches stay as they are).
   const RuleSet& rs = prog.interpretation;

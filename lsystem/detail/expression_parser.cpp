@@ -319,6 +319,14 @@ int ExpressionParser::parseName(State& st, const Token& id) {
       return n;
     }
   }
+  if (globals_) {
+    auto g = std::find(globals_->begin(), globals_->end(), name);
+    if (g != globals_->end()) {
+      int n = node(st, Op::Var);
+      st.nodes[n].var = static_cast<uint16_t>(kMaxVars - 1 - (g - globals_->begin()));
+      return n;
+    }
+  }
   auto d = defines_.find(name);
   if (d != defines_.end()) {
     int n = node(st, Op::Const);

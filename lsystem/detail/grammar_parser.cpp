@@ -65,14 +65,11 @@ struct UnsupportedHeader {
   const char* what;
 };
 constexpr UnsupportedHeader kUnsupportedHeaders[] = {
-    {"start", "Start:", "block of C statements"},
-    {"end", "End:", "block of C statements"},
-    {"starteach", "StartEach:", "block of C statements"},
-    {"start each", "StartEach:", "block of C statements"},
-    {"endeach", "EndEach:", "block of C statements"},
-    {"end each", "EndEach:", "block of C statements"},
     {"define", "define:", "array declarations"},
 };
+
+/// cpfg's blocks of statements over global variables, by header key.
+const char* const kBlockHeaders[] = {"start", "end", "starteach", "start each", "endeach", "end each"};
 
 /// True when line s, whose first non-space character is at b, declares modules
 /// (`module Apex, Leaf`) rather than being a production of a module named `module`.
@@ -107,6 +104,7 @@ class GrammarParser {
     prog_.dialect = dialectOf(fileName);
     scanner_.setDialect(prog_.dialect);
     for (size_t k = 0; k < kCpfgMultiNameCount; ++k) scanner_.addMultiName(kCpfgMultiNames[k]);
+    expr_.setGlobals(&prog_.globals);
     for (const char* s : kTurtleSymbols) prog_.symbols.intern(s);
     prog_.openBracket = static_cast<SymbolId>(prog_.symbols.find("["));
     prog_.closeBracket = static_cast<SymbolId>(prog_.symbols.find("]"));
@@ -296,6 +294,10 @@ class GrammarParser {
       }
       if (unsupportedHeader(line, b)) continue;
       auto header = Scanner::headerOf(s, b);
+      if (header && std::find(std::begin(kBlockHeaders), std::end(kBlockHeaders), header->key) != std::end(kBlockHeaders)) {
+        globalBlock(line, b, *header);
+        continue;
+      }
       bool known = header && std::find(std::begin(kHeaders), std::end(kHeaders), header->key) != std::end(kHeaders);
       if (known) {
         handleHeader(line, b, *header, block);
@@ -313,6 +315,39 @@ class GrammarParser {
         error(line, b, "expected a production ('pred --> successor') or a header such as 'axiom:'");
       }
     }
+  }
+
+  /// cpfg's `Start: { statements };` (and `End:`, `StartEach:`, `EndEach:`) at column b of
+  /// line: compiled over the global variables, which it may add to.
+  void globalBlock(int line, int b, const Header& h) {
+    const std::string& s = scanner_.line(line);
+    std::string key = h.key;
+    key.erase(std::remove(key.begin(), key.end(), ' '), key.end());
+    once(key, line, b);
+    Span v = scanner_.trim(Span{line, h.valueBegin, static_cast<int>(s.size())});
+    if (v.b == v.e || s[v.b] != '{') {
+      error(line, v.b, "expected '{ statements }' after '" + s.substr(b, h.valueBegin - b) + "'");
+      return;
+    }
+    int close = matching(line, v.b, v.e, '{', '}');
+    if (close < 0) {
+      error(line, v.b, "unclosed '{' of a statement block");
+      return;
+    }
+    Span rest = scanner_.trim(Span{line, close + 1, v.e});
+    if (rest.b != rest.e && !(rest.e == rest.b + 1 && s[rest.b] == ';')) {
+      error(line, rest.b, "unexpected text after the block");
+      return;
+    }
+    CodeRange& out = key == "start" ? prog_.startBlock : key == "end" ? prog_.endBlock
+                     : key == "starteach" ? prog_.startEachBlock : prog_.endEachBlock;
+    std::vector<std::string> names = prog_.globals;
+    expr_.setGlobals(nullptr);  // a block's own registers are the globals
+    inGlobalBlock_ = true;
+    const bool ok = statementBlock(line, v.b + 1, close, names, out);
+    inGlobalBlock_ = false;
+    expr_.setGlobals(&prog_.globals);
+    if (ok) prog_.globals = names;
   }
 
   /// Reports cpfg's headers Sprig does not implement (`Start:`, `define:`, `ring lsystem`)
@@ -731,10 +766,17 @@ class GrammarParser {
           error(line, at, "cannot assign to '" + word + "': it is a #define");
           return false;
         }
+        auto known = std::find(varNames.begin(), varNames.end(), word);
+        if (!inGlobalBlock_ && known == varNames.end() &&
+            std::find(prog_.globals.begin(), prog_.globals.end(), word) != prog_.globals.end()) {
+          error(line, at, "cannot assign the global variable '" + word +
+                              "' in a production (Sprig assigns globals only in 'Start:', 'StartEach:', 'EndEach:' and 'End:' blocks)");
+          return false;
+        }
         if (!expr_.compile(value, varNames, "value")) return false;
         auto it = std::find(varNames.begin(), varNames.end(), word);
         if (it == varNames.end()) {
-          if (varNames.size() >= static_cast<size_t>(kMaxVars)) {
+          if (varNames.size() >= static_cast<size_t>(kMaxVars) - (inGlobalBlock_ ? 0 : prog_.globals.size())) {
             error(line, at, "too many parameters and local variables in one production (at most " + std::to_string(kMaxVars) + ")");
             return false;
           }
@@ -1002,6 +1044,7 @@ class GrammarParser {
   std::vector<double> params_;  ///< scratch parameters of appendConstant
   std::array<uint8_t, 256> writtenSingle_{};  ///< per byte: bit n set when written with n parameters
   std::vector<SymbolId> ignoreList_, considerList_;
+  bool inGlobalBlock_ = false;  ///< compiling a Start/End block: its variables are the globals
   /// A predecessor or context module with its parameter count, checked by checkArities().
   struct ArityUse {
     std::string name;

@@ -310,6 +310,12 @@ struct Program {
   /// True when the axiom or a successor turns without an angle (`+`, `&`, ...), so that
   /// the default angle matters.
   bool bareTurn = false;
+  /// cpfg's global variables, in order of first assignment in the blocks below: global k
+  /// is register k while a block runs, and register kMaxVars - 1 - k of every production.
+  std::vector<std::string> globals;
+  /// cpfg's blocks: `Start:` (before the derivation), `StartEach:` and `EndEach:` (around
+  /// every step), `End:` (after the last step).
+  CodeRange startBlock, startEachBlock, endEachBlock, endBlock;
   SymbolTable symbols;
   ModuleString axiom;
   std::vector<std::pair<std::string, double>> defines;

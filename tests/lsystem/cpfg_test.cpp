@@ -250,7 +250,6 @@ TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg
   }
   SECTION("statements, blocks, preprocessor, several L-systems") {
     CHECK(errorOf("axiom: A(1)\nA(y) : { x = y / 2; x < 10 --> B(x)\n") == "t.l:2:8: unclosed '{' of a statement block");
-    CHECK(errorOf("Start: { i = 0; }\naxiom: A\n") == "t.l:1:1: cpfg's 'Start:' (block of C statements) is not supported");
     CHECK(errorOf("define: { array a[2]; }\naxiom: A\n") == "t.l:1:1: cpfg's 'define:' (array declarations) is not supported");
     CHECK(errorOf("#include \"x.h\"\naxiom: A\n") ==
           "t.l:1:1: cpfg's C preprocessor directive '#include' is not supported (only '#define NAME constant' is)");
@@ -344,5 +343,25 @@ TEST_CASE("cpfg statements in productions", "[lsystem][cpfg]") {
     } catch (const InputError& e) {
       CHECK(e.diagnostics().front().message == "the statements of production 'A(y)' loop more than 10000000 times at step 1");
     }
+  }
+}
+
+TEST_CASE("cpfg Start, StartEach, EndEach and End blocks over global variables", "[lsystem][cpfg]") {
+  SECTION("a counter the conditions read") {
+    // i is 0 at step 1, 1 at step 2, ...: A grows F while i < 3.
+    const std::string g =
+        "derivation length: 5\nStart: { i = 0; }\nEndEach: { i = i + 1; }\naxiom: A\nA : i < 3 --> FA\nA : i >= 3 --> B\n";
+    CHECK(derived(g, 5) == "FFFB");
+  }
+  SECTION("StartEach runs before each step; locals and globals side by side") {
+    const std::string g = "Start: { n = 10; }\nStartEach: { n = n * 2; }\naxiom: A(0)\nA(x) : { y = x + n; } * --> A(y)\n";
+    CHECK(derived(g, 2) == "A(60)");  // step 1: n 20, y 20; step 2: n 40, y 60
+  }
+  SECTION("errors") {
+    CHECK(errorOf("Start: { g = 1; }\naxiom: A\nA : * { g = 2; } --> B\n") ==
+          "t.l:3:9: cannot assign the global variable 'g' in a production (Sprig assigns globals only in 'Start:', "
+          "'StartEach:', 'EndEach:' and 'End:' blocks)");
+    CHECK(errorOf("Start: i = 0;\naxiom: A\n") == "t.l:1:8: expected '{ statements }' after 'Start:'");
+    CHECK(errorOf("Start: { i = 0; }\nStart: { j = 0; }\naxiom: A\n") == "t.l:2:1: duplicate 'start:' (first at line 1)");
   }
 }
