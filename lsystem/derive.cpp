@@ -147,6 +147,10 @@ class Writer {
 
 }  // namespace
 
+/// Decomposition recurses once per level: deeper than this (a `maximum depth` above it that
+/// the rules reach) is an error rather than a stack overflow.
+constexpr int kMaxDecompositionNesting = 256;
+
 /// Stream id of the random draws of cpfg's Start/StartEach/EndEach/End blocks (with the step).
 constexpr uint64_t kBlockStream = 0xfffffffffffe0000ull;
 
@@ -528,6 +532,11 @@ struct Deriver::Impl {
         if (count != p.predParams) continue;
         for (uint32_t k = 0; k < count; ++k) vars[p.predFirstVar + k] = params[k];
         if (!condition(p, vars, step)) continue;
+        if (depth >= kMaxDecompositionNesting)
+          throw InputError(p.loc, "decomposition nested deeper than " + std::to_string(kMaxDecompositionNesting) +
+                                      " levels at step " + std::to_string(step) + " (maximum depth " +
+                                      std::to_string(rs.maxDepth) + "): not supported",
+                           p.sourceLine);
         // Stochastic decomposition rules: weighted choice among the matching ones.
         const Production* chosen = &p;
         if (!p.stochastic) afterStatements(p, vars, step);

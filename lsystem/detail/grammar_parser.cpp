@@ -435,11 +435,23 @@ class GrammarParser {
       if (block != Block::Main) error(line, b, "'" + h.key + ":' belongs before the decomposition and interpretation blocks");
       std::vector<RawModule> mods;
       if (scanner_.tokenizeModules(line, value.b, value.e, mods)) {
+        bool open = false, close = false;
         for (const RawModule& m : mods) {
-          if (m.hasParens) error(line, m.col, "'" + h.key + ":' lists symbols without parameters");
-          else if (m.name == "[" || m.name == "]") error(line, m.col, "brackets cannot be ignored or considered: context matching always follows them");
-          else (h.key == "ignore" ? ignoreList_ : considerList_).push_back(prog_.symbols.intern(m.name));
+          if (m.hasParens) {
+            error(line, m.col, "'" + h.key + ":' lists symbols without parameters");
+          } else if (m.name == "[" || m.name == "]") {
+            // Sprig's context matching always follows brackets, which is what cpfg does when
+            // `consider:` lists them; ignoring them is not supported.
+            if (h.key == "ignore") error(line, m.col, "brackets cannot be ignored: context matching always follows them");
+            (m.name == "[" ? open : close) = true;
+          } else {
+            (h.key == "ignore" ? ignoreList_ : considerList_).push_back(prog_.symbols.intern(m.name));
+          }
         }
+        if (h.key == "consider" && prog_.dialect == Dialect::Cpfg && !(open && close))
+          error(line, value.b,
+                "cpfg's 'consider:' without '[' and ']' ignores brackets in context matching, which Sprig does not "
+                "support (it always follows them): list them, as in 'consider: " + std::string(scanner_.view(value)) + "[]'");
       }
       if (seen_.count("ignore") && seen_.count("consider") && h.key == (seen_["ignore"] < seen_["consider"] ? "consider" : "ignore"))
         error(line, b, "use either 'ignore:' or 'consider:', not both");
@@ -459,8 +471,8 @@ class GrammarParser {
       }
       once(block == Block::Decomposition ? "decomposition maximum depth" : "interpretation maximum depth", line, b);
       if (auto d = expr_.constant(value, "maximum depth")) {
-        if (*d < 1 || *d != std::floor(*d) || *d > 256)
-          error(line, value.b, "maximum depth must be a whole number from 1 to 256, got " + formatNumber(*d));
+        if (*d < 1 || *d != std::floor(*d) || *d > 1e6)
+          error(line, value.b, "maximum depth must be a whole number from 1 to 1000000, got " + formatNumber(*d));
         else
           (block == Block::Decomposition ? prog_.decomposition : prog_.interpretation).maxDepth = static_cast<int>(*d);
       }
@@ -941,8 +953,9 @@ class GrammarParser {
         error(a.line, a.b, "parameter '" + name + "' is already used in this production");
       } else if (defines_.count(name)) {
         error(a.line, a.b, "parameter '" + name + "' has the name of a #define");
-      } else if (varNames.size() >= static_cast<size_t>(detail::kMaxVars)) {
-        error(a.line, a.b, "too many parameters in one production (at most " + std::to_string(detail::kMaxVars) + ")");
+      } else if (varNames.size() + prog_.globals.size() >= static_cast<size_t>(detail::kMaxVars)) {
+        error(a.line, a.b, "too many parameters in one production (at most " + std::to_string(detail::kMaxVars) +
+                               " with the global variables)");
       }
       varNames.push_back(name);
     }

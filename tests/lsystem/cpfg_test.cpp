@@ -346,6 +346,27 @@ TEST_CASE("cpfg statements in productions", "[lsystem][cpfg]") {
   }
 }
 
+TEST_CASE("cpfg consider: with brackets; maximum depth beyond 256", "[lsystem][cpfg]") {
+  SECTION("consider: listing [ and ] follows brackets, as Sprig always does") {
+    const std::string g = "consider: BA[]\naxiom: A[C]B\nA > B --> X\n";
+    CHECK(derived(g, 1) == "X[C]B");
+    CHECK(errorOf("consider: BA\naxiom: A\n") ==
+          "t.l:1:11: cpfg's 'consider:' without '[' and ']' ignores brackets in context matching, which Sprig does not "
+          "support (it always follows them): list them, as in 'consider: BA[]'");
+    CHECK(errorOf("consider: BA\naxiom: A\n", "t.lsys") == "no error");  // Sprig's notation: brackets always followed
+  }
+  SECTION("maximum depth 1000 is read; decomposition nested deeper than 256 levels is an error") {
+    CHECK(derived("axiom: A\nA --> B\ndecomposition\nmaximum depth: 1000\nB --> CD\n", 1) == "CD");
+    try {
+      derived("derivation length: 1\naxiom: A\ndecomposition\nmaximum depth: 1000\nA --> FA\n", 1);
+      FAIL("no error");
+    } catch (const InputError& e) {
+      CHECK(e.diagnostics().front().message ==
+            "decomposition nested deeper than 256 levels at step 0 (maximum depth 1000): not supported");
+    }
+  }
+}
+
 TEST_CASE("cpfg Start, StartEach, EndEach and End blocks over global variables", "[lsystem][cpfg]") {
   SECTION("a counter the conditions read") {
     // i is 0 at step 1, 1 at step 2, ...: A grows F while i < 3.
