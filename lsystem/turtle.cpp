@@ -124,6 +124,7 @@ Turtle::Turtle(const SymbolTable& symbols, TurtleSettings settings) : symbols_(s
         case '!': c = Command::Width; break;
         case '\'': c = settings_.cpfg ? Command::None : Command::Color; break;
         case '#': c = Command::WidthUp; break;
+        case '_': c = settings_.cpfg ? Command::OldElasticity : Command::None; break;
         case ';': c = Command::ColorUp; break;
         case ',': c = Command::ColorDown; break;
         case '{': c = Command::PolygonBegin; break;
@@ -295,6 +296,9 @@ class TurtleWalk {
         case Command::ScaleSet: if (hasParam(i)) st_.scale = param(i); break;
         case Command::ScaleUp: scaleStep(i, false); break;
         case Command::ScaleDown: scaleStep(i, true); break;
+        case Command::OldElasticity:
+          st_.elasticity = hasParam(i) ? param(i) : st_.elasticity + settings_.elasticityIncrement;
+          break;
       }
     }
     return st_;
@@ -353,6 +357,7 @@ class TurtleWalk {
     DVec3 start = st_.frame.position;
     st_.frame.position += st_.frame.heading * length(i);
     if (settings_.cpfg) {
+      cpfgOldBend();
       st_.prevHeading = st_.frame.heading;
       st_.prevUp = st_.frame.up;
     }
@@ -413,6 +418,7 @@ class TurtleWalk {
   void move(size_t i, bool withVertex) {
     if (settings_.cpfg) cpfgTropisms();
     st_.frame.position += st_.frame.heading * length(i);
+    if (settings_.cpfg) cpfgOldBend();
     if (!buf_.polygons.empty() && withVertex) addPolygonPoint(st_.frame.position);
     st_.internode = -1;  // the next segment starts a new, disconnected axis
   }
@@ -565,6 +571,24 @@ class TurtleWalk {
                                axis * (glm::dot(axis, h) * (1 - std::cos(angle))));
     twistFree();
   }
+  /// cpfg's old tropism (interpret.c, `bend`), after every `F f G g`: with s1 = e T.U' and
+  /// s2 = e T.L (U' = -U, cpfg's up; T of unit length), H turns toward U' by asin s1, then
+  /// toward L by asin s2. cpfg computes NaN when e |T.U'| or e |T.L| exceeds 1; Sprig clamps.
+  void cpfgOldBend() {
+    const double e = st_.elasticity;
+    if (e == 0) return;
+    TurtleFrame& f = st_.frame;
+    const DVec3 t = oldTropism_;
+    double s1 = std::clamp(e * glm::dot(t, -f.up), -1.0, 1.0), c1 = std::sqrt(1 - s1 * s1);
+    DVec3 h = c1 * f.heading + s1 * (-f.up);
+    f.up = -(c1 * (-f.up) - s1 * f.heading);
+    f.heading = h;
+    double s2 = std::clamp(e * glm::dot(t, f.left), -1.0, 1.0), c2 = std::sqrt(1 - s2 * s2);
+    h = c2 * f.heading + s2 * f.left;
+    f.left = c2 * f.left - s2 * f.heading;
+    f.heading = h;
+  }
+
   /// `@Ti(n, de)` (sign +1) and `@Td(n, de)` (sign -1): steps the elasticity of tropism n
   /// by de, or by its step S: without de (cpfg's index rule: trunc(n - 1); out of range: ignored).
   void tropismStep(size_t i, int sign) {
@@ -729,6 +753,7 @@ class TurtleWalk {
   const double maxRadiusPerLength_;
   const bool taper_;
   const DVec3 tropism_;
+  const DVec3 oldTropism_ = glm::length(settings_.tropism) > 0 ? glm::normalize(settings_.tropism) : DVec3(0);
   const double defS_, defC_;
   const bool growing_;
   const double partial_;

@@ -72,6 +72,10 @@ struct TurtleSettings {
   double initialScale = 1.0;      ///< cpfg: `initial scale:` (view file), the turtle scale at the start
   double scaleMultiplier = 1.0;   ///< cpfg: `scale multiplier:` (view file), of `@Di` and `@Dd`
   std::vector<CpfgTropism> tropisms;  ///< cpfg: the view file's `tropism:` lines (at most kMaxTropisms)
+  /// cpfg's old tropism (view file `tropism direction:`, `initial elasticity:`, `elasticity
+  /// increment:`, module `_`): with `cpfg`, `tropism` (made unit length) and `elasticity`
+  /// are its direction and initial elasticity, bent by cpfg's old rule after every move.
+  double elasticityIncrement = 0.0;
   DVec3 origin{0};                ///< start position
   /// Growth animation (docs/GRAMMAR.md, "Growth over time"): modules whose birth step is
   /// growthStep are drawn partly grown, scaled by growthScale(); modules born later are
@@ -138,7 +142,7 @@ class Turtle {
     None, Forward, Move, ForwardNoVertex, MoveNoVertex, TurnLeft, TurnRight, PitchDown, PitchUp,
     RollLeft, RollRight, TurnAround, RollToVertical, Push, Pop, Width, Color, PolygonBegin, Vertex,
     PolygonEnd, Surface, SurfaceNamed, Cut, Tropism, Sphere, WidthUp, ColorUp, ColorDown, Circle, Disc,
-    TropismUp, TropismDown, TwistAdjust, TwistForce, MoveTo, SetHeading, ScaleSet, ScaleUp, ScaleDown
+    TropismUp, TropismDown, TwistAdjust, TwistForce, MoveTo, SetHeading, ScaleSet, ScaleUp, ScaleDown, OldElasticity
   };
   /// The command bound to symbol id `s` (None for ids outside the table).
   Command commandOf(SymbolId s) const { return s < commands_.size() ? commands_[s] : Command::None; }

@@ -221,10 +221,15 @@ class ViewParser {
     } else if (is("tropism")) {
       readTropism(line, vcol, value);
     } else if (is("initial elasticity")) {
-      if (auto v = values(line, vcol, key, value, 1, 1); v && (*v)[0] != 0)
-        error(line, kcol, "cpfg's old tropism 'initial elasticity:' is not supported (write 'tropism: T: x y z E: e')");
-    } else if (is("tropism direction") || is("elasticity increment")) {
-      warn(line, kcol, "'" + key + ":' ignored: cpfg's old tropisms bend only with 'initial elasticity:' or '_', which are errors");
+      if (auto v = values(line, vcol, key, value, 1, 1)) view_.oldElasticity = (*v)[0];
+    } else if (is("elasticity increment")) {
+      if (auto v = values(line, vcol, key, value, 1, 1)) view_.oldElasticityIncrement = (*v)[0];
+    } else if (is("tropism direction")) {
+      if (auto v = values(line, vcol, key, value, 3, 3)) {
+        const DVec3 d((*v)[0], (*v)[1], (*v)[2]);
+        if (glm::length(d) == 0) error(line, vcol, "'tropism direction:' must not be the zero vector");
+        else view_.oldTropismDirection = glm::normalize(d);
+      }
     } else {
       for (const UnsupportedKey& u : kUnsupportedKeys)
         if (key == u.key) {
@@ -344,7 +349,10 @@ TurtleSettings cpfgTurtleSettings(const ViewFile* view, TurtleSettings t) {
   t.initialScale = v.initialScale.value_or(1.0);
   t.scaleMultiplier = v.scaleMultiplier.value_or(1.0);
   t.tropisms = v.tropisms;
-  t.elasticity = 0;  // only the view file's tropisms bend, by cpfg's rule
+  // cpfg's old tropism (its defaults: direction +Y, elasticity 0, increment 0).
+  t.tropism = v.oldTropismDirection.value_or(DVec3(0, 1, 0));
+  t.elasticity = v.oldElasticity.value_or(0.0);
+  t.elasticityIncrement = v.oldElasticityIncrement.value_or(0.0);
   if (v.lineStyle.value_or(CpfgLineStyle::Pixel) != CpfgLineStyle::Pixel) {
     t.widthScale = 1.0;
     t.maxWidthToLength = 0.0;

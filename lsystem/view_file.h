@@ -33,6 +33,9 @@ struct ViewFile {
   std::optional<double> initialScale;   ///< `initial scale: x`
   std::optional<double> scaleMultiplier;  ///< `scale multiplier: x`
   std::vector<CpfgTropism> tropisms;    ///< `tropism: T: x y z ...`, in file order
+  std::optional<DVec3> oldTropismDirection;    ///< `tropism direction: x,y,z` (cpfg's old tropism)
+  std::optional<double> oldElasticity;         ///< `initial elasticity: e`
+  std::optional<double> oldElasticityIncrement;  ///< `elasticity increment: d` (the step of `_`)
   /// Warnings about keys read but not used (viewer settings), each at its line.
   std::vector<Diagnostic> warnings;
 };

@@ -73,7 +73,6 @@ std::optional<std::string> cpfgUnsupported(std::string_view name, size_t args, b
   if (dialect == Dialect::Cpfg) {
     if (name == "$") return notSupported("$", "end of a sub-L-system call; ABOP's roll to vertical is '@v' in cpfg");
     if (name == "~" || (name.size() > 1 && name[0] == '~')) return notSupported("~", "surface from a view file's surface file");
-    if (name == "_") return notSupported("_", "old-style elasticity change");
   }
   return std::nullopt;
 }

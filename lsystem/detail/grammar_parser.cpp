@@ -660,6 +660,13 @@ class GrammarParser {
   }
   void patch(size_t at, uint32_t base) { prog_.code[at].c = static_cast<double>(prog_.code.size() - base); }
 
+  /// The first column from i of line[.., e) that is not white space (e when none).
+  int nextNonSpace(int line, int i, int e) const {
+    const std::string& s = scanner_.line(line);
+    while (i < e && isSpace(s[i])) ++i;
+    return i;
+  }
+
   /// The word (identifier) at i of line, or empty.
   std::string wordAt(int line, int i, int e) const {
     const std::string& s = scanner_.line(line);
@@ -757,6 +764,16 @@ class GrammarParser {
         notOp.op = Op::Not;
         prog_.code.push_back(notOp);
         jump(Op::Jz, base, top);
+      } else if (const int k = nextNonSpace(line, i, e); k < e && s[k] == '(') {
+        // A call alone, `f(...);` (cpfg's printf, srand, ...): its value is dropped.
+        int end = scanner_.findTop(line, at, e, ';');
+        if (end < 0) {
+          error(line, at, "missing ';' after the call of '" + word + "' (cpfg requires one after every statement)");
+          return false;
+        }
+        if (!expr_.compile(scanner_.trim(Span{line, at, end}), varNames, "statement")) return false;
+        jump(Op::Jz, base, static_cast<double>(prog_.code.size() + 1));  // pops the value, jumps to the next instruction
+        i = end + 1;
       } else {
         // Assignment `name = expression;`.
         while (i < e && isSpace(s[i])) ++i;

@@ -161,6 +161,15 @@ TEST_CASE("cpfg objects", "[lsystem][cpfg]") {
     checkNear(o.skeleton.internodes[2].end, 3.0 * h);
   }
 
+  SECTION("cpfg's old tropism: '_', tropism direction, elasticity increment; the bend follows the move") {
+    // After +(90): H = -X, L = -Y, cpfg's up = -Z. `_`: e = 0 + 0.5. F moves to (-1,0,0), then
+    // bends: e T.up = 0, e T.L = 0.5: H = cos(30) H + 0.5 L. `_(0)` stops it.
+    Drawn o = drawObject("old_tropism", true);
+    REQUIRE(o.skeleton.internodes.size() == 2);
+    checkNear(o.skeleton.internodes[0].end, DVec3(-1, 0, 0));
+    checkNear(o.skeleton.internodes[1].end, DVec3(-1 - std::sqrt(0.75), -0.5, 0));
+  }
+
   SECTION("bran and biran draw from the seeded generator") {
     Drawn a = drawObject("random", false), b = drawObject("random", false);
     CHECK(a.string == b.string);
@@ -226,8 +235,7 @@ TEST_CASE("cpfg view file", "[lsystem][cpfg]") {
     CHECK(viewErrorOf("angle increment: 30\nangel factor: 8\n") ==
           "t.v:2:1: unknown view file command 'angel factor:' (did you mean 'angle factor'?)");
     CHECK(viewErrorOf("line: l leaf.s 1\n") == "t.v:1:1: cpfg's view file command 'line:' (F drawn as a surface) is not supported");
-    CHECK(viewErrorOf("initial elasticity: 0.2\n") ==
-          "t.v:1:1: cpfg's old tropism 'initial elasticity:' is not supported (write 'tropism: T: x y z E: e')");
+    CHECK(viewErrorOf("tropism direction: 0,0,0\n") == "t.v:1:20: 'tropism direction:' must not be the zero vector");
     CHECK(viewErrorOf("angle increment: thirty\n") == "t.v:1:18: 'angle increment:' expects 1 number, got 'thirty'");
     CHECK(viewErrorOf("tropism: E: 0.2\n") == "t.v:1:10: a tropism needs a non-zero vector 'T: x y z'");
     CHECK(viewErrorOf("#include \"x.v\"\n") == "t.v:1:1: C preprocessor directive '#include' in a view file is not supported");
@@ -246,7 +254,6 @@ TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg
     CHECK(errorOf("axiom: A\nA --> ?(2,1)B$\n") == "t.l:2:7: cpfg's '?(n, scale)' (sub-L-system call) is not supported");
     CHECK(errorOf("axiom: F@Tx(1)\n") == "t.l:1:9: cpfg's '@Tx' (texture) is not supported");
     CHECK(errorOf("axiom: F@Q\n") == "t.l:1:9: unknown cpfg command '@Q'");
-    CHECK(errorOf("axiom: F_(2)\n") == "t.l:1:9: cpfg's '_' (old-style elasticity change) is not supported");
   }
   SECTION("statements, blocks, preprocessor, several L-systems") {
     CHECK(errorOf("axiom: A(1)\nA(y) : { x = y / 2; x < 10 --> B(x)\n") == "t.l:2:8: unclosed '{' of a statement block");
@@ -337,6 +344,9 @@ TEST_CASE("cpfg statements in productions", "[lsystem][cpfg]") {
     CHECK(errorOf("axiom: A(1)\nA(y) : { x += 1; } * --> B(y)\n") ==
           "t.l:2:12: expected '=' after 'x' (statements are assignments, 'if', 'while' and 'do')");
     CHECK(errorOf("#define K 2\naxiom: A(1)\nA(y) : { K = 1; } * --> B(y)\n") == "t.l:3:10: cannot assign to 'K': it is a #define");
+    CHECK(errorOf("Start: { srand(3); }\naxiom: A\n") ==
+          "t.l:1:10: cpfg's function 'srand' (reseeds cpfg's one global generator; Sprig draws per module from 'seed:') is not supported");
+    CHECK(derived("axiom: A(2)\nA(y) : { x = 1; fabs(y); x = x + 1; } * --> B(x)\n", 1) == "B(2)");  // a call alone: value dropped
     try {
       derived("axiom: A(1)\nA(y) : { while (1) { y = y; } } * --> B(y)\n", 1);
       FAIL("no error");
