@@ -480,11 +480,11 @@ class TurtleWalk {
     if (settings_.cpfg) st_.width = std::max(st_.width, kMinCpfgWidth);
   }
   /// `'`: sets the color index, or increments it.
-  void color(size_t i) { st_.color = hasParam(i) ? static_cast<int>(param(i)) : st_.color + 1; }
+  void color(size_t i) { st_.color = hasParam(i) ? colorIndex(param(i)) : st_.color + 1; }
   /// `;` (sign +1) and `,` (sign -1): sets the color index, or steps it by the color
   /// increment; cpfg keeps the index in 0..255 by wrapping.
   void colorStep(size_t i, int sign) {
-    st_.color = hasParam(i) ? static_cast<int>(param(i)) : st_.color + sign * settings_.colorIncrement;
+    st_.color = hasParam(i) ? colorIndex(param(i)) : st_.color + sign * settings_.colorIncrement;
     if (settings_.cpfg) {
       if (sign > 0 && st_.color > 255) st_.color -= 256;
       if (sign < 0 && st_.color < 0) st_.color += 256;
@@ -594,7 +594,7 @@ class TurtleWalk {
   void tropismStep(size_t i, int sign) {
     const uint32_t n = paramCount(i);
     if (n == 0) return;
-    const int k = static_cast<int>(static_cast<short>(paramAt(i, 0) - 1));
+    const int k = tropismIndex(paramAt(i, 0));
     if (settings_.cpfg) {
       if (k < 0 || k >= static_cast<int>(std::min(settings_.tropisms.size(), size_t(kMaxTropisms)))) return;
       st_.elasticities[k] += sign * (n >= 2 ? paramAt(i, 1) : settings_.tropisms[k].step);
@@ -606,6 +606,15 @@ class TurtleWalk {
   void vertex() {
     if (!buf_.polygons.empty()) addPolygonPoint(st_.frame.position);
   }
+  /// cpfg's index of tropism number n: n - 1 truncated toward 0 (`(short)(n - 1)`), -1
+  /// when out of any tropism's range.
+  static int tropismIndex(double n) {
+    const double k = std::trunc(n - 1);
+    return k >= 0 && k < kMaxTropisms ? static_cast<int>(k) : -1;
+  }
+  /// A color index from a parameter (clamped into int's range).
+  static int colorIndex(double c) { return static_cast<int>(std::clamp(c, -1e9, 1e9)); }
+
   /// `@Ts(n, e)`: sets the elasticity of tropism n to e (cpfg's index rule: trunc(n - 1);
   /// an index out of range is ignored, as cpfg does). In cpfg's notation `@Ts(n)` sets it
   /// to 0, as cpfg does; in Sprig's, `@Ts(e)` sets the one (species) tropism's elasticity to e.
@@ -616,7 +625,7 @@ class TurtleWalk {
       st_.elasticity = param(i);
       return;
     }
-    const int k = static_cast<int>(static_cast<short>(paramAt(i, 0) - 1));
+    const int k = tropismIndex(paramAt(i, 0));
     const double e = n >= 2 ? paramAt(i, 1) : 0.0;
     if (settings_.cpfg) {
       if (k >= 0 && k < static_cast<int>(std::min(settings_.tropisms.size(), size_t(kMaxTropisms)))) st_.elasticities[k] = e;

@@ -95,14 +95,10 @@ class ViewParser {
     int openLine = 0;
     const std::string clean = blankComments(text, openLine);
     if (openLine) diags_.error(SourceLoc{view_.file, openLine, 1}, "unterminated comment '/*'", lineOf(text, openLine));
-    std::istringstream in(clean);
-    std::string lineText;
-    int line = 0;
-    while (std::getline(in, lineText)) {
-      ++line;
-      if (!lineText.empty() && lineText.back() == '\r') lineText.pop_back();
-      raw_ = lineOf(text, line);
-      readLine(line, lineText);
+    const std::vector<std::string> raws = lines(text), cleans = lines(clean);
+    for (size_t k = 0; k < cleans.size(); ++k) {
+      raw_ = k < raws.size() ? raws[k] : std::string();
+      readLine(static_cast<int>(k) + 1, cleans[k]);
     }
     diags_.throwIfErrors();
     if (!viewerKeys_.empty()) {
@@ -114,6 +110,17 @@ class ViewParser {
   }
 
  private:
+  /// text cut at its newlines, without a trailing `\r`.
+  static std::vector<std::string> lines(const std::string& text) {
+    std::vector<std::string> out;
+    std::istringstream in(text);
+    for (std::string l; std::getline(in, l);) {
+      if (!l.empty() && l.back() == '\r') l.pop_back();
+      out.push_back(std::move(l));
+    }
+    return out;
+  }
+
   static std::string lineOf(const std::string& text, int line) {
     std::istringstream in(text);
     std::string l;
@@ -145,6 +152,8 @@ class ViewParser {
     }
     return v;
   }
+
+  static std::string formatLimit(double v) { return std::to_string(static_cast<long>(v)); }
 
   static std::string trimmed(const std::string& s) {
     size_t b = s.find_first_not_of(" \t");
@@ -189,7 +198,13 @@ class ViewParser {
         else view_.angleDeg = is("angle factor") ? 360.0 / (*v)[0] : (*v)[0];
       }
     } else if (is("initial color") || is("color increment")) {
-      if (auto v = values(line, vcol, key, value, 1, 2)) (is("initial color") ? view_.initialColor : view_.colorIncrement) = static_cast<int>((*v)[0]);
+      if (auto v = values(line, vcol, key, value, 1, 2)) {
+        const double limit = is("initial color") ? 65535 : 255;
+        if (std::fabs((*v)[0]) > limit)
+          error(line, vcol, "'" + key + ":' must be from " + formatLimit(-limit) + " to " + formatLimit(limit));
+        else
+          (is("initial color") ? view_.initialColor : view_.colorIncrement) = static_cast<int>((*v)[0]);
+      }
     } else if (is("initial line width")) {
       // cpfg: a number, then an optional style word (`p`ixels, `s`haded cylinders); a number
       // alone means polygons in world units.

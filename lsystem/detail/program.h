@@ -65,8 +65,8 @@ inline double betaDraw(Rng& rng, double a, double b) {
 
 /// A draw from the binomial(n, p) distribution: n trials, each a success with probability p.
 inline double binomialDraw(Rng& rng, double n, double p) {
+  if (!(n >= 0) || n > 1e7) return std::nan("");  // beyond 10^7 trials: a non-finite value
   const long trials = static_cast<long>(n);
-  if (!(trials >= 0) || trials > 100000000) return std::nan("");
   long k = 0;
   for (long t = 0; t < trials; ++t) k += rng.uniform() <= p;
   return static_cast<double>(k);
