@@ -5,6 +5,8 @@
 #include <cmath>
 #include <string_view>
 
+#include <glm/gtc/quaternion.hpp>
+
 #ifdef __linux__
 #include <sys/mman.h>
 #endif
@@ -545,10 +547,14 @@ class TurtleWalk {
     const size_t n = std::min(settings_.tropisms.size(), size_t(kMaxTropisms));
     if (n == 0) return;
     TurtleFrame& f = st_.frame;
-    DVec3 d(0);
+    DVec3 d(0), twist(0);
     for (size_t k = 0; k < n; ++k) {
       const CpfgTropism& t = settings_.tropisms[k];
       const double e = st_.elasticities[k];
+      if (t.torque) {
+        twist += e * t.direction;
+        continue;
+      }
       const double a = radians(t.angleDeg);
       d += std::cos(a) * e * t.direction;
       if (std::sin(a) != 0) {
@@ -563,13 +569,40 @@ class TurtleWalk {
     }
     DVec3 axis = glm::cross(f.heading, d);
     double len = glm::length(axis);
-    if (len < 1e-6) return;
-    const double angle = std::min(len, 1.0);
-    axis /= len;
-    const DVec3 h = f.heading;
-    f.heading = glm::normalize(h * std::cos(angle) + glm::cross(axis, h) * std::sin(angle) +
-                               axis * (glm::dot(axis, h) * (1 - std::cos(angle))));
-    twistFree();
+    if (len >= 1e-6) {
+      const double angle = std::min(len, 1.0);
+      axis /= len;
+      const DVec3 h = f.heading;
+      f.heading = glm::normalize(h * std::cos(angle) + glm::cross(axis, h) * std::sin(angle) +
+                                 axis * (glm::dot(axis, h) * (1 - std::cos(angle))));
+      twistFree();
+    }
+    if (twist != DVec3(0)) cpfgTorque(twist);
+  }
+
+  /// cpfg's torque (movements.c): the sum of the torques' e T, projected perpendicular to H,
+  /// turns cpfg's up vector (-U) by min(|U' x D|, 1) radians, by cpfg's own quaternion
+  /// rule, reproduced as written; H stays. The frame becomes the twist-free reference.
+  void cpfgTorque(const DVec3& twist) {
+    TurtleFrame& f = st_.frame;
+    const double length = glm::length(twist);
+    const DVec3 v = glm::cross(f.heading, twist / length);
+    if (glm::dot(v, v) > 1e-8) {
+      const DVec3 des = glm::cross(v, f.heading) * length;
+      const DVec3 uc = -f.up;
+      const DVec3 w = glm::cross(uc, des);
+      const double wl = glm::length(w);
+      if (wl >= 1e-7) {
+        const double lc = std::min(wl, 1.0);
+        const double half = 0.5 * lc;
+        const glm::dquat q(std::cos(half), std::sin(half) * (w / lc));  // (w, x, y, z)
+        const glm::dquat r = glm::inverse(q) * glm::dquat(0, uc) * q;
+        f.up = -DVec3(r.x, r.y, r.z);
+        f.left = glm::cross(f.up, f.heading);
+      }
+      st_.prevHeading = f.heading;
+      st_.prevUp = f.up;
+    }
   }
   /// cpfg's old tropism (interpret.c, `bend`), after every `F f G g`: with s1 = e T.U' and
   /// s2 = e T.L (U' = -U, cpfg's up; T of unit length), H turns toward U' by asin s1, then

@@ -40,6 +40,7 @@ struct CpfgTropism {
   double angleDeg = 0;        ///< A: the angle to T that segments try to reach (0: toward T)
   double elasticity = 0;      ///< E: initial elasticity
   double step = 0;            ///< S: elasticity step of `@Ti` and `@Td` without a value
+  bool torque = false;        ///< a `torque:` line: turns U about H toward T instead of bending H
 };
 
 /// Turtle options; defaults are documented per field.

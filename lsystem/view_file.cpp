@@ -39,12 +39,11 @@ struct UnsupportedKey {
 constexpr UnsupportedKey kUnsupportedKeys[] = {
     {"line", "F drawn as a surface"},
     {"background scene", "geometry from background files"},
-    {"torque", "twist movement"},
 };
 
 const char* const kReadKeys[] = {
     "angle factor",  "angle increment",   "initial color", "color increment", "initial line width",
-    "line width increment", "line style", "initial scale", "scale multiplier", "tropism",
+    "line width increment", "line style", "initial scale", "scale multiplier", "tropism", "torque",
     "tropism direction", "initial elasticity", "elasticity increment",
 };
 
@@ -233,8 +232,8 @@ class ViewParser {
       if (auto v = values(line, vcol, key, value, 1, 1)) view_.initialScale = (*v)[0];
     } else if (is("scale multiplier")) {
       if (auto v = values(line, vcol, key, value, 1, 1)) view_.scaleMultiplier = (*v)[0];
-    } else if (is("tropism")) {
-      readTropism(line, vcol, value);
+    } else if (is("tropism") || is("torque")) {
+      readTropism(line, vcol, value, is("torque"));
     } else if (is("initial elasticity")) {
       if (auto v = values(line, vcol, key, value, 1, 1)) view_.oldElasticity = (*v)[0];
     } else if (is("elasticity increment")) {
@@ -273,8 +272,9 @@ class ViewParser {
   }
 
   /// `tropism: T: x y z A: angle I: intensity E: elasticity S: step` (movements.c).
-  void readTropism(int line, size_t vcol, const std::string& value) {
+  void readTropism(int line, size_t vcol, const std::string& value, bool torque) {
     CpfgTropism t;
+    t.torque = torque;
     std::string all;
     for (char c : value) all += (c == ',' || c == ':' || c == '\t') ? ' ' : c;
     std::istringstream in(all);
@@ -304,7 +304,7 @@ class ViewParser {
         dir = DVec3(v[0], v[1], v[2]);
         haveT = true;
       } else if (sub == "A") {
-        t.angleDeg = v[0];
+        if (!torque) t.angleDeg = v[0];  // cpfg ignores A: in a torque
       } else if (sub == "I") {
         intensity = v[0];
       } else if (sub == "E") {
@@ -322,7 +322,7 @@ class ViewParser {
       return;
     }
     if (view_.tropisms.size() >= size_t(kMaxTropisms)) {
-      error(line, vcol, "more than " + std::to_string(kMaxTropisms) + " tropisms (cpfg's limit)");
+      error(line, vcol, "more than " + std::to_string(kMaxTropisms) + " tropisms and torques (cpfg's limit)");
       return;
     }
     t.direction = glm::normalize(dir) * std::clamp(intensity, -1.0, 1.0);

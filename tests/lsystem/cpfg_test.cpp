@@ -170,6 +170,18 @@ TEST_CASE("cpfg objects", "[lsystem][cpfg]") {
     checkNear(o.skeleton.internodes[1].end, DVec3(-1 - std::sqrt(0.75), -0.5, 0));
   }
 
+  SECTION("torque: U turns about H by cpfg's quaternion rule, H stays") {
+    // D = 0.5 X projected perpendicular to H = +Y: (0.5, 0, 0). cpfg's up (0,0,-1) turns by
+    // |up x D| = 0.5 rad about +Y (cpfg's q^-1 v q with the axis up x D = -Y): Sprig's
+    // U = -(cpfg's up) = (sin 0.5, 0, cos 0.5).
+    Drawn o = drawObject("torque", true);
+    REQUIRE(o.skeleton.internodes.size() == 1);
+    checkNear(o.end.frame.position, DVec3(0, 1, 0));
+    checkNear(o.end.frame.heading, DVec3(0, 1, 0));
+    checkNear(o.end.frame.up, DVec3(std::sin(0.5), 0, std::cos(0.5)));
+    checkNear(o.end.frame.left, DVec3(-std::cos(0.5), 0, std::sin(0.5)));
+  }
+
   SECTION("bran and biran draw from the seeded generator") {
     Drawn a = drawObject("random", false), b = drawObject("random", false);
     CHECK(a.string == b.string);
@@ -235,6 +247,8 @@ TEST_CASE("cpfg view file", "[lsystem][cpfg]") {
     CHECK(viewErrorOf("angle increment: 30\nangel factor: 8\n") ==
           "t.v:2:1: unknown view file command 'angel factor:' (did you mean 'angle factor'?)");
     CHECK(viewErrorOf("line: l leaf.s 1\n") == "t.v:1:1: cpfg's view file command 'line:' (F drawn as a surface) is not supported");
+    CHECK(viewErrorOf("background scene: a.dat\n") ==
+          "t.v:1:1: cpfg's view file command 'background scene:' (geometry from background files) is not supported");
     CHECK(viewErrorOf("tropism direction: 0,0,0\n") == "t.v:1:20: 'tropism direction:' must not be the zero vector");
     CHECK(viewErrorOf("angle increment: thirty\n") == "t.v:1:18: 'angle increment:' expects 1 number, got 'thirty'");
     CHECK(viewErrorOf("tropism: E: 0.2\n") == "t.v:1:10: a tropism needs a non-zero vector 'T: x y z'");

@@ -1,1 +1,1 @@
-torque: T: 0 1 0 E: 0.1
+background scene: ground.dat
