@@ -222,6 +222,13 @@ class GrammarParser {
       error(line, i, "expected a value after '#define " + name + "'");
       return;
     }
+    // cpp's textual macros: a module string (`#define LEAF [+F]~l`) is not an expression.
+    const std::string_view text = scanner_.view(value);
+    if (text.find_first_of("[]$@{}~") != std::string_view::npos || (text.find('?') != std::string_view::npos && text.find(':') == std::string_view::npos)) {
+      error(line, value.b, "cpfg's #define of a module string ('" + std::string(text) +
+                               "', a C preprocessor macro) is not supported: only constants are");
+      return;
+    }
     double v = 0;
     std::optional<double> compiled = expr_.constant(value, "#define " + name);
     auto ov = std::find_if(overrides_.defines.rbegin(), overrides_.defines.rend(), [&](const DefineOverride& o) { return o.name == name; });

@@ -276,6 +276,11 @@ TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg
           "t.l:1:1: cpfg's C preprocessor directive '#include' is not supported (only '#define NAME constant' is)");
     CHECK(errorOf("#define G(x) F(x)\naxiom: A\n") ==
           "t.l:1:9: cpfg's function-like macro '#define G(...)' (C preprocessor) is not supported");
+    CHECK(errorOf("#define LEAF ?(4,1)leaf(2)$\naxiom: A\n") ==
+          "t.l:1:14: cpfg's #define of a module string ('?(4,1)leaf(2)$', a C preprocessor macro) is not supported: only constants are");
+    CHECK(errorOf("#define B [+F]\naxiom: A\n") ==
+          "t.l:1:11: cpfg's #define of a module string ('[+F]', a C preprocessor macro) is not supported: only constants are");
+    CHECK(errorOf("#define K (1 > 0 ? 2 : 3)\naxiom: A\n") == "no error");
     CHECK(errorOf("lsystem: 1\naxiom: A\nendlsystem\n", "t.l") == "no error");
     CHECK(errorOf("lsystem: 1\naxiom: A\nlsystem: 2\naxiom: B\n") ==
           "t.l:3:1: several L-systems in one file (cpfg's sub-L-systems) are not supported (the first is at line 1)");
