@@ -81,6 +81,7 @@ int runAnimate(const AnimateArgs& a, const GlobalOptions& g) {
     }
   }
   Species species = loadSpecies(a.file, g.pathPolicy());
+  printNotes(g, species);
   if (species.kind != "tree" && !a.stages.empty())
     throw UsageError("--stages selects derivation steps of a tree; a " + species.kind +
                      " species animates its whole growth (use --frames-per-stage and --fps)");

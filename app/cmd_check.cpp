@@ -19,6 +19,7 @@ std::string checkOne(const std::string& file, const GlobalOptions& g, std::strin
   try {
     // Loading reads every section of the species (and its grammar) and reports every error.
     Species s = loadSpecies(file, g.pathPolicy());
+    printNotes(g, s);
     summary = s.kind + (s.bareGrammar ? " grammar" : " species") + s.spec->checkSummary(s);
     return {};
   } catch (const InputError& e) {
@@ -47,7 +48,7 @@ int runCheck(const CheckArgs& a, const GlobalOptions& g) {
 void addCheckCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run) {
   auto [sub, args] = subcommand<CheckArgs>(app, global, run, "check",
                                           "Validate species files and grammars, printing every diagnostic", runCheck);
-  sub->add_option("FILE", args->files, "species files (.yaml) or grammars (.lsys)")->required();
+  sub->add_option("FILE", args->files, "species files (.yaml), grammars (.lsys, cpfg's .l) or vlab object folders")->required();
 }
 
 }  // namespace sprig

@@ -2,6 +2,7 @@
 
 #include "app/cmd_common.h"
 
+#include <iostream>
 #include <sstream>
 
 #include <algorithm>
@@ -89,7 +90,7 @@ Stage StageFlags::resolve(const SpeciesModel& model) const {
 }
 
 void addInputOutput(CLI::App& sub, const char* name, std::string& file, std::string& out, const char* outputHelp) {
-  sub.add_option(name, file, "species file (.yaml) or grammar (.lsys)")->required();
+  sub.add_option(name, file, "species file (.yaml), grammar (.lsys, cpfg's .l) or vlab object folder")->required();
   // The folder the output goes into must exist before any work starts (a folder output,
   // `frames/`, may itself be new: its parent must exist).
   const CLI::Validator folderExists(
@@ -103,6 +104,11 @@ void addInputOutput(CLI::App& sub, const char* name, std::string& file, std::str
       },
       "", "output folder exists");
   sub.add_option("-o,--output", out, outputHelp)->required()->check(folderExists);
+}
+
+void printNotes(const GlobalOptions& g, const Species& species) {
+  if (g.quiet) return;
+  for (const Diagnostic& d : species.notes) std::cerr << d.format() << "\n";
 }
 
 void note(const GlobalOptions& g, std::ostream& os, const char* format, ...) {

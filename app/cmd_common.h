@@ -46,6 +46,10 @@ void addStageFlags(CLI::App& sub, StageFlags& flags);
 /// Prints one printf-formatted line (a command's summary) to os unless g.quiet.
 [[gnu::format(printf, 3, 4)]] void note(const GlobalOptions& g, std::ostream& os, const char* format, ...);
 
+/// Prints the notes and warnings of reading species (cpfg defaults used, view file keys
+/// ignored) to stderr, unless g.quiet.
+void printNotes(const GlobalOptions& g, const Species& species);
+
 /// Parses `--view AZ,EL` or `AZ,EL,FOV` (degrees) into view. Throws UsageError.
 void parseView(const std::string& text, render::ViewSpec& view);
 

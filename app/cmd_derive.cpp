@@ -92,6 +92,7 @@ int runDerive(const DeriveArgs& a, const GlobalOptions& g) {
   if (!a.skeletonOut.empty()) requireExtension("--skeleton", a.skeletonOut, {".json"});
   lsystem::GrammarOverrides extra = a.growth.overrides();
   Species species = loadSpecies(a.file, g.pathPolicy());
+  printNotes(g, species);
   GrowthEngine engine(species, GrowthOptions{extra, -1, "derive " + species.name});
   const int last = engine.lastStep();
   const lsystem::ModuleString& modules = engine.modulesAt(last);
@@ -117,7 +118,7 @@ int runDerive(const DeriveArgs& a, const GlobalOptions& g) {
 void addDeriveCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run) {
   auto [sub, args] = subcommand<DeriveArgs>(app, global, run, "derive",
                                           "Derive a grammar or tree species and report the result", runDerive);
-  sub->add_option("FILE", args->file, "species file (.yaml) or grammar (.lsys)")->required();
+  sub->add_option("FILE", args->file, "species file (.yaml), grammar (.lsys, cpfg's .l) or vlab object folder")->required();
   addGrowthFlags(*sub, args->growth);
   sub->add_flag("--print", args->print, "print the final module string in grammar notation");
   sub->add_flag("--json", args->json, "print a JSON report (steps, modules, symbols, internodes, ...)");

@@ -29,6 +29,7 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
   requireExtension("-o", a.out, {".ply", ".obj", ".glb", ".msh", ".vtu", ".mesh"});
   auto start = std::chrono::steady_clock::now();
   Species species = loadSpecies(a.file, g.pathPolicy());
+  printNotes(g, species);
   SpeciesModel model(species, a.growth.overrides());
   const Stage stage = a.stage.resolve(model);
   // Volume meshes (tetrahedra with materials) of kinds that have them, by extension.

@@ -30,6 +30,7 @@ int runPreview(const PreviewArgs& a, const GlobalOptions& g) {
   requireExtension("-o", a.out, {".png", ".jpg", ".jpeg", ".exr"});
   lsystem::GrammarOverrides extra = a.growth.overrides();
   Species species = loadSpecies(a.file, g.pathPolicy());
+  printNotes(g, species);
   SpeciesRender look = species.render;
   if (!a.view.empty()) parseView(a.view, look.view);
   if (a.samples > 0) look.image.spp = a.samples;

@@ -61,6 +61,7 @@ int runRender(const RenderArgs& a, const GlobalOptions& g) {
                       : a.mode == "skeleton" ? GeometryMode::Skeleton
                                              : GeometryMode::Exact;
   Species species = loadSpecies(a.file, g.pathPolicy());
+  printNotes(g, species);
   SpeciesRender look = species.render;
   if (!a.view.empty()) parseView(a.view, look.view);
   if (!a.camera.empty()) parseCamera(a.camera, look);

@@ -13,7 +13,7 @@ BUILD=${1:?usage: fuzz/run.sh BUILD_DIR SECONDS [TARGET...]}
 SECS=${2:?usage: fuzz/run.sh BUILD_DIR SECONDS [TARGET...]}
 shift 2
 TARGETS=("$@")
-[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(grammar expression derive species_tree species_shell species_blob species_organism species_solid polymesh image volume)
+[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(grammar view expression derive species_tree species_shell species_blob species_organism species_solid polymesh image volume)
 ROOT=$(pwd)
 # The sanitizer settings of the Makefile, also when this script is run by hand.
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:detect_stack_use_after_return=0}
@@ -26,7 +26,10 @@ seed() {
   local t=$1 dir=$2 f i=0
   case $t in
     grammar | derive)
-      cp grammars/*.lsys "$dir"/ ;;
+      cp grammars/*.lsys "$dir"/
+      for f in tests/assets/cpfg/*/*.l; do cp "$f" "$dir/$(basename "$(dirname "$f")").l"; done ;;
+    view)
+      for f in tests/assets/cpfg/*/*.v; do cp "$f" "$dir/$(basename "$(dirname "$f")").v"; done ;;
     expression)
       for e in 't' 'x*0.9' 'sin(t)*x' 'max(0, 1 - t^2)' 'sqrt(x) + pow(t, 2) / 3' 'atan2(x, t) > 45 && t < 1' \
                'floor(x) == ceil(x) || !t' '-(-(-x))' 'min(t, max(x, 1e-3))' 'exp(log(t + 1))'; do
@@ -65,6 +68,7 @@ seed() {
 dict_of() {
   case $1 in
     grammar | derive) echo fuzz/dict/grammar.dict ;;
+    view) echo fuzz/dict/view.dict ;;
     expression) echo fuzz/dict/expression.dict ;;
     species_*) echo fuzz/dict/yaml.dict ;;
     polymesh) echo fuzz/dict/mesh.dict ;;

@@ -150,6 +150,13 @@ class Writer {
 
 }  // namespace
 
+/// Decomposition recurses once per level: deeper than this (a `maximum depth` above it that
+/// the rules reach) is an error rather than a stack overflow.
+constexpr int kMaxDecompositionNesting = 256;
+
+/// Stream id of the random draws of cpfg's Start/StartEach/EndEach/End blocks (with the step).
+constexpr uint64_t kBlockStream = 0xfffffffffffe0000ull;
+
 struct Deriver::Impl {
   Grammar grammar;  // keeps the program alive
   const Program* prog = nullptr;
@@ -178,6 +185,27 @@ struct Deriver::Impl {
   Rng rng;
   bool rngReady = false;
   uint64_t rngStream = 0, rngItem = 0;
+
+  /// cpfg's global variables (Program::globals), kMaxVars registers.
+  std::vector<double> globals;
+
+  /// Runs one of cpfg's Start/StartEach/EndEach/End blocks on the globals; its random draws
+  /// come from a stream of their own for each step.
+  void runBlock(const detail::CodeRange& r, int step) {
+    if (r.empty()) return;
+    Rng blockRng(deriveSeed(seed, {kBlockStream, static_cast<uint64_t>(step)}));
+    const Instr* code = prog->code.data();
+    if (std::isnan(detail::evalCode(code + r.begin, code + r.end, globals.data(), &blockRng)))
+      throw InputError(SourceLoc{prog->fileName, 0, 0}, "a Start/StartEach/EndEach/End block loops more than " +
+                                                            std::to_string(detail::kMaxLoopJumps) + " times at step " +
+                                                            std::to_string(step));
+  }
+
+  /// Copies the globals into the top registers of a production's vars.
+  void loadGlobals(double* vars) const {
+    const size_t g = prog->globals.size();
+    for (size_t k = 0; k < g; ++k) vars[detail::kMaxVars - 1 - k] = globals[k];
+  }
 
   Rng* moduleRng() {
     if (!rngReady) {
@@ -362,7 +390,26 @@ struct Deriver::Impl {
     return true;
   }
 
-  bool condition(const Production& p, const double* vars, int step) {
+  /// Runs the statement block r of p (its `before` or `after`) on vars.
+  void statements(const Production& p, const detail::CodeRange& r, double* vars, int step) {
+    const Instr* code = prog->code.data();
+    double v = detail::evalCode(code + r.begin, code + r.end, vars, p.usesRandom ? moduleRng() : nullptr);
+    if (std::isnan(v))
+      throw InputError(p.loc, "the statements of production '" + p.text + "' loop more than " +
+                                  std::to_string(detail::kMaxLoopJumps) + " times at step " + std::to_string(step),
+                       p.sourceLine);
+  }
+
+  /// p's statements after its condition, when p applies (its successor reads them).
+  void afterStatements(const Production& p, double* vars, int step) {
+    if (!p.after.empty()) statements(p, p.after, vars, step);
+  }
+
+  bool condition(const Production& p, double* vars, int step) {
+    if (p.hasStatements()) {
+      for (uint16_t k = 0; k < p.localCount; ++k) vars[p.localFirst + k] = 0.0;
+      if (!p.before.empty()) statements(p, p.before, vars, step);
+    }
     if (p.condition.empty()) return true;
     const Instr* code = prog->code.data();
     double v = detail::evalCode(code + p.condition.begin, code + p.condition.end, vars, p.usesRandom ? moduleRng() : nullptr);
@@ -377,7 +424,10 @@ struct Deriver::Impl {
     for (size_t k = 0; k < cand.size(); ++k) {
       const Production& p = rs.productions[cand[k]];
       if (!matches(p, s, i, vars) || !condition(p, vars, step)) continue;
-      if (!p.stochastic) return &p;
+      if (!p.stochastic) {
+        afterStatements(p, vars, step);
+        return &p;
+      }
       // Stochastic: choose among every matching weighted production from here on,
       // with probability proportional to its weight.
       std::vector<uint32_t>& ids = stochasticIds;
@@ -403,6 +453,11 @@ struct Deriver::Impl {
       }
       const Production& chosen = rs.productions[ids[pick]];
       matches(chosen, s, i, vars);  // rebind its parameters
+      if (chosen.hasStatements()) {
+        // Other candidates' statements used the same registers: run its own again.
+        condition(chosen, vars, step);
+        afterStatements(chosen, vars, step);
+      }
       return &chosen;
     }
     return nullptr;
@@ -474,13 +529,20 @@ struct Deriver::Impl {
     const RuleSet& rs = prog->decomposition;
     if (depth < rs.maxDepth && !rs.bySymbol[sym].empty()) {
       double vars[detail::kMaxVars];
+      loadGlobals(vars);
       for (uint32_t idx : rs.bySymbol[sym]) {
         const Production& p = rs.productions[idx];
         if (count != p.predParams) continue;
         for (uint32_t k = 0; k < count; ++k) vars[p.predFirstVar + k] = params[k];
         if (!condition(p, vars, step)) continue;
+        if (depth >= kMaxDecompositionNesting)
+          throw InputError(p.loc, "decomposition nested deeper than " + std::to_string(kMaxDecompositionNesting) +
+                                      " levels at step " + std::to_string(step) + " (maximum depth " +
+                                      std::to_string(rs.maxDepth) + "): not supported",
+                           p.sourceLine);
         // Stochastic decomposition rules: weighted choice among the matching ones.
         const Production* chosen = &p;
+        if (!p.stochastic) afterStatements(p, vars, step);
         if (p.stochastic) {
           ModuleString& one = oneScratch;
           one.clear();
@@ -598,6 +660,7 @@ struct Deriver::Impl {
     auto [reserveModules, reserveParams] = decompose ? std::pair<size_t, size_t>{0, 0} : sizePass(rs, step);
     Writer w(next, births, opt.maxModules, limitAt, step, reserveModules, reserveParams);
     double vars[detail::kMaxVars];
+    loadGlobals(vars);
     rngStream = stream;
     size_t nextChoice = 0;
     for (size_t i = 0; i < n; ++i) {
@@ -689,6 +752,8 @@ struct Deriver::Impl {
   }
 
   void start() {
+    globals.assign(detail::kMaxVars, 0.0);
+    runBlock(prog->startBlock, 0);
     cur = prog->axiom;
     if (cur.size() > opt.maxModules) Writer::overLimit(opt.maxModules, limitAt, 0);
     if (opt.trackBirthSteps) cur.birthSteps.assign(cur.size(), 0);
@@ -726,7 +791,10 @@ void Deriver::restart() {
 const ModuleString& Deriver::step() {
   Impl& m = *impl_;
   int step = m.done + 1;
+  m.runBlock(m.prog->startEachBlock, step);
   m.rewrite(m.prog->productions, step, static_cast<uint64_t>(step), true);
+  m.runBlock(m.prog->endEachBlock, step);
+  if (step == m.steps) m.runBlock(m.prog->endBlock, step);
   m.done = step;
   if (m.opt.onStep) m.opt.onStep(step, m.cur.size());
   return m.cur;
@@ -756,6 +824,7 @@ ModuleString Deriver::interpret(const ModuleString& s) const {
   tmp.limitAt = impl_->limitAt;
   tmp.opt.trackBirthSteps = s.hasBirthSteps();
   tmp.cur = s;
+  tmp.globals = impl_->globals;
   // Interpretation recursion: depth 1 is one rewrite; deeper levels rewrite what the
   // previous level produced (modules no rule matches stay as they are).
   const RuleSet& rs = prog.interpretation;

@@ -29,6 +29,8 @@ std::vector<std::string> Grammar::defineNames() const {
 }
 size_t Grammar::productionCount() const { return program_->productions.productions.size(); }
 bool Grammar::hasInterpretation() const { return !program_->interpretation.empty(); }
+bool Grammar::cpfgNotation() const { return program_->dialect == detail::Dialect::Cpfg; }
+bool Grammar::usesDefaultAngle() const { return program_->bareTurn; }
 
 Grammar parseGrammar(std::string_view text, const std::string& fileName, const GrammarOverrides& overrides) {
   Grammar g;

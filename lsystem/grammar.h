@@ -33,6 +33,7 @@ struct Program;
 inline constexpr const char* kTurtleSymbols[] = {
     "F", "f", "G", "g", "+", "-", "&", "^", "\\", "/", "|", "$", "[", "]",
     "!", "'", "{", ".", "}", "~", "%", "@Ts", "@v", "@O", "@Tf", "@o", "@c",
+    "#", ";", ",", "@Ti", "@Td", "@Tp", "@M", "@R", "@D", "@Di", "@Dd", "@!",
 };
 
 /// One `#define` constant replaced from outside the grammar (`-D NAME=VALUE`, a species file).
@@ -77,6 +78,13 @@ class Grammar {
   size_t productionCount() const;
   /// True when the grammar has `interpretation:` (homomorphism) rules.
   bool hasInterpretation() const;
+  /// True when the grammar is in cpfg's own notation (a `.l` file: docs/GRAMMAR.md, "cpfg
+  /// compatibility"); false for Sprig's `.lsys` notation. The turtle must then be run with
+  /// TurtleSettings::cpfg set.
+  bool cpfgNotation() const;
+  /// True when the axiom or a successor turns without an angle (`+`, `-`, `&`, `^`, `\`,
+  /// `/` without a parameter), so that the default turn angle is used.
+  bool usesDefaultAngle() const;
 
   /// The compiled program (internal; used by Deriver).
   const detail::Program& program() const { return *program_; }

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <string_view>
 
+#include <glm/gtc/quaternion.hpp>
+
 #include "lsystem/detail/huge_pages.h"
 
 namespace sprig::lsystem {
@@ -104,7 +106,11 @@ Turtle::Turtle(const SymbolTable& symbols, TurtleSettings settings) : symbols_(s
         case '[': c = Command::Push; break;
         case ']': c = Command::Pop; break;
         case '!': c = Command::Width; break;
-        case '\'': c = Command::Color; break;
+        case '\'': c = settings_.cpfg ? Command::None : Command::Color; break;
+        case '#': c = Command::WidthUp; break;
+        case '_': c = settings_.cpfg ? Command::OldElasticity : Command::None; break;
+        case ';': c = Command::ColorUp; break;
+        case ',': c = Command::ColorDown; break;
         case '{': c = Command::PolygonBegin; break;
         case '.': c = Command::Vertex; break;
         case '}': c = Command::PolygonEnd; break;
@@ -118,6 +124,28 @@ Turtle::Turtle(const SymbolTable& symbols, TurtleSettings settings) : symbols_(s
       c = Command::RollToVertical;
     } else if (n == "@O") {
       c = Command::Sphere;
+    } else if (n == "@o") {
+      c = Command::Circle;
+    } else if (n == "@c") {
+      c = Command::Disc;
+    } else if (n == "@Ti") {
+      c = Command::TropismUp;
+    } else if (n == "@Td") {
+      c = Command::TropismDown;
+    } else if (n == "@Tp") {
+      c = Command::TwistAdjust;
+    } else if (n == "@Tf") {
+      c = Command::TwistForce;
+    } else if (n == "@M") {
+      c = Command::MoveTo;
+    } else if (n == "@R") {
+      c = Command::SetHeading;
+    } else if (n == "@D") {
+      c = Command::ScaleSet;
+    } else if (n == "@Di") {
+      c = Command::ScaleUp;
+    } else if (n == "@Dd") {
+      c = Command::ScaleDown;
     } else if (n.size() > 1 && n[0] == '~') {
       c = Command::SurfaceNamed;
     }
@@ -126,6 +154,11 @@ Turtle::Turtle(const SymbolTable& symbols, TurtleSettings settings) : symbols_(s
 }
 
 namespace {
+
+/// cpfg's least line width (interpret.c's MinWidth).
+constexpr double kMinCpfgWidth = 1e-7;
+/// Vertices of the polygon that draws a `@c` disc.
+constexpr int kDiscSides = 32;
 
 /// An open `{` polygon.
 struct OpenPolygon {
@@ -180,6 +213,12 @@ class TurtleWalk {
     st_.frame.position = settings.origin;
     st_.width = settings.initialWidth;
     st_.elasticity = settings.elasticity;
+    st_.color = settings.initialColor;
+    st_.scale = settings.cpfg ? settings.initialScale : 1.0;
+    st_.prevHeading = st_.frame.heading;
+    st_.prevUp = st_.frame.up;
+    for (size_t k = 0; k < settings.tropisms.size() && k < size_t(kMaxTropisms); ++k)
+      st_.elasticities[k] = settings.tropisms[k].elasticity;
     buf_.stack.reserve(64);
   }
 
@@ -224,6 +263,26 @@ class TurtleWalk {
         case Command::Sphere: sphere(i); break;
         case Command::Tropism: tropismChange(i); break;
         case Command::Cut: i = cut(i); break;
+        case Command::WidthUp: widthUp(i); break;
+        case Command::ColorUp: colorStep(i, +1); break;
+        case Command::ColorDown: colorStep(i, -1); break;
+        case Command::Circle: sphere(i); break;
+        case Command::Disc: disc(i); break;
+        case Command::TropismUp: tropismStep(i, +1); break;
+        case Command::TropismDown: tropismStep(i, -1); break;
+        case Command::TwistAdjust: twistFree(); break;
+        case Command::TwistForce:
+          st_.prevHeading = st_.frame.heading;
+          st_.prevUp = st_.frame.up;
+          break;
+        case Command::MoveTo: moveTo(i); break;
+        case Command::SetHeading: setHeading(i); break;
+        case Command::ScaleSet: if (hasParam(i)) st_.scale = param(i); break;
+        case Command::ScaleUp: scaleStep(i, false); break;
+        case Command::ScaleDown: scaleStep(i, true); break;
+        case Command::OldElasticity:
+          st_.elasticity = hasParam(i) ? param(i) : st_.elasticity + settings_.elasticityIncrement;
+          break;
       }
     }
     return st_;
@@ -267,15 +326,25 @@ class TurtleWalk {
   }
   /// Length of the move of module i (its parameter, or the step length), scaled by growth.
   double length(size_t i) const {
-    const double l = hasParam(i) ? param(i) : settings_.stepLength;
+    const double l = (hasParam(i) ? param(i) : settings_.stepLength) * st_.scale;
     return growing_ ? l * growth(i) : l;
   }
+  /// Number of parameters of module i.
+  uint32_t paramCount(size_t i) const { return off_[i + 1] - off_[i]; }
+  /// Parameter k of module i (which must have it).
+  double paramAt(size_t i, uint32_t k) const { return prm_[off_[i] + k]; }
 
   /// `F` and `G`: draws an internode (or, inside a polygon, adds an outline point when
   /// withVertex). Growing modules draw shorter and thinner; unborn ones draw nothing.
   void forward(size_t i, bool withVertex) {
+    if (settings_.cpfg) cpfgTropisms();
     DVec3 start = st_.frame.position;
     st_.frame.position += st_.frame.heading * length(i);
+    if (settings_.cpfg) {
+      cpfgOldBend();
+      st_.prevHeading = st_.frame.heading;
+      st_.prevUp = st_.frame.up;
+    }
     if (!buf_.polygons.empty()) {
       if (withVertex) addPolygonPoint(st_.frame.position);
       st_.internode = -1;  // outlines are not drawn; the next segment starts a new axis
@@ -306,7 +375,7 @@ class TurtleWalk {
       sk_.internodes.push_back(in);
     }
     // A growing internode bends in proportion to its growth, so frames change smoothly.
-    if (st_.elasticity != 0) applyTropism(st_.frame, tropism_, st_.elasticity * g);
+    if (!settings_.cpfg && st_.elasticity != 0) applyTropism(st_.frame, tropism_, st_.elasticity * g);
   }
 
   /// kSummary: folds the internode just computed into the summary, as Skeleton::bounds and
@@ -331,7 +400,9 @@ class TurtleWalk {
 
   /// `f` and `g`: moves without drawing (`f` adds a polygon point when withVertex).
   void move(size_t i, bool withVertex) {
+    if (settings_.cpfg) cpfgTropisms();
     st_.frame.position += st_.frame.heading * length(i);
+    if (settings_.cpfg) cpfgOldBend();
     if (!buf_.polygons.empty() && withVertex) addPolygonPoint(st_.frame.position);
     st_.internode = -1;  // the next segment starts a new, disconnected axis
   }
@@ -377,17 +448,205 @@ class TurtleWalk {
   /// Adds p to the innermost open polygon.
   void addPolygonPoint(DVec3 p) { buf_.polygons.back().points.push_back(p); }
 
-  /// `!`: sets the width, or multiplies it by the width factor.
-  void width(size_t i) { st_.width = hasParam(i) ? param(i) : st_.width * settings_.widthFactor; }
+  /// `!`: sets the width, or thins it: Sprig's notation multiplies it by the width
+  /// factor, cpfg's subtracts the width increment (times the turtle scale; at least 1e-7).
+  void width(size_t i) {
+    if (!settings_.cpfg) {
+      st_.width = hasParam(i) ? param(i) : st_.width * settings_.widthFactor;
+      return;
+    }
+    st_.width = hasParam(i) ? param(i) * st_.scale : st_.width - settings_.widthIncrement * st_.scale;
+    st_.width = std::max(st_.width, kMinCpfgWidth);
+  }
+  /// `#`: sets the width, or adds the width increment (times the turtle scale in cpfg's notation).
+  void widthUp(size_t i) {
+    st_.width = hasParam(i) ? param(i) * st_.scale : st_.width + settings_.widthIncrement * st_.scale;
+    if (settings_.cpfg) st_.width = std::max(st_.width, kMinCpfgWidth);
+  }
   /// `'`: sets the color index, or increments it.
-  void color(size_t i) { st_.color = hasParam(i) ? static_cast<int>(param(i)) : st_.color + 1; }
+  void color(size_t i) { st_.color = hasParam(i) ? colorIndex(param(i)) : st_.color + 1; }
+  /// `;` (sign +1) and `,` (sign -1): sets the color index, or steps it by the color
+  /// increment; cpfg keeps the index in 0..255 by wrapping.
+  void colorStep(size_t i, int sign) {
+    st_.color = hasParam(i) ? colorIndex(param(i)) : st_.color + sign * settings_.colorIncrement;
+    if (settings_.cpfg) {
+      if (sign > 0 && st_.color > 255) st_.color -= 256;
+      if (sign < 0 && st_.color < 0) st_.color += 256;
+    }
+  }
+  /// `@Di` (divide false) and `@Dd` (divide true): multiplies or divides the turtle scale
+  /// by the parameter (ignored when 0, as cpfg does), or by the scale multiplier.
+  void scaleStep(size_t i, bool divide) {
+    double f = hasParam(i) ? param(i) : settings_.scaleMultiplier;
+    if (f == 0) return;
+    st_.scale = divide ? st_.scale / f : st_.scale * f;
+  }
+  /// `@M(x,y,z)`: moves to (x, y, z) (z = 0 with two parameters) without drawing.
+  void moveTo(size_t i) {
+    const uint32_t n = paramCount(i);
+    if (n < 2) return;
+    st_.frame.position = DVec3(paramAt(i, 0), paramAt(i, 1), n >= 3 ? paramAt(i, 2) : 0.0);
+    st_.internode = -1;
+  }
+  /// `@R(hx,hy,hz)` and `@R(hx,hy,hz,ux,uy,uz)`: sets the heading (and cpfg's up vector,
+  /// which is Sprig's -U); without a valid up the frame turns without twist (`@Tp`).
+  void setHeading(size_t i) {
+    const uint32_t n = paramCount(i);
+    if (n < 2) return;
+    DVec3 h(paramAt(i, 0), paramAt(i, 1), n >= 3 ? paramAt(i, 2) : 0.0);
+    h = glm::dot(h, h) == 0 ? DVec3(0, 1, 0) : glm::normalize(h);
+    st_.frame.heading = h;
+    if (n >= 6) {
+      const DVec3 upCpfg(paramAt(i, 3), paramAt(i, 4), paramAt(i, 5));
+      if (glm::dot(upCpfg, upCpfg) != 0 && glm::dot(upCpfg, h) == 0) {
+        st_.frame.up = -glm::normalize(upCpfg);
+        st_.frame.left = glm::cross(st_.frame.up, h);
+        return;
+      }
+    }
+    twistFree();
+  }
+  /// cpfg's twist-free frame (`@Tp`, and after every tropism bend): U is the U of the last
+  /// `F` turned by the rotation that takes that `F`'s heading to the current one; L = U x H.
+  void twistFree() {
+    TurtleFrame& f = st_.frame;
+    DVec3 axis = glm::cross(f.heading, st_.prevHeading);
+    double len = glm::length(axis);
+    if (len > 1e-6) {
+      // The rotation by phi about prevH x H takes prevH to H (phi in [0, pi]).
+      double phi = std::asin(std::min(len, 1.0));
+      if (glm::dot(f.heading, st_.prevHeading) < 0) phi = kPi - phi;
+      const DVec3 a = -axis / len;  // prevH x H, normalized
+      const DVec3 u = st_.prevUp;
+      f.up = u * std::cos(phi) + glm::cross(a, u) * std::sin(phi) + a * (glm::dot(a, u) * (1 - std::cos(phi)));
+    }
+    f.left = glm::cross(f.up, f.heading);
+  }
+  /// cpfg's tropisms (movements.c), before every `F f G g`: the heading turns toward the
+  /// sum D of the tropisms (each T times its elasticity, tilted by its angle A) by the
+  /// angle min(|H x D|, 1) radians, about H x D; then the frame is made twist-free.
+  void cpfgTropisms() {
+    const size_t n = std::min(settings_.tropisms.size(), size_t(kMaxTropisms));
+    if (n == 0) return;
+    TurtleFrame& f = st_.frame;
+    DVec3 d(0), twist(0);
+    for (size_t k = 0; k < n; ++k) {
+      const CpfgTropism& t = settings_.tropisms[k];
+      const double e = st_.elasticities[k];
+      if (t.torque) {
+        twist += e * t.direction;
+        continue;
+      }
+      const double a = radians(t.angleDeg);
+      d += std::cos(a) * e * t.direction;
+      if (std::sin(a) != 0) {
+        DVec3 v = glm::cross(f.heading, t.direction);
+        double len = glm::length(v);
+        if (len < 1e-7) {
+          v = f.left;
+          len = 1;
+        }
+        d += (e * std::sin(a) / len) * glm::cross(t.direction, v);
+      }
+    }
+    DVec3 axis = glm::cross(f.heading, d);
+    double len = glm::length(axis);
+    if (len >= 1e-6) {
+      const double angle = std::min(len, 1.0);
+      axis /= len;
+      const DVec3 h = f.heading;
+      f.heading = glm::normalize(h * std::cos(angle) + glm::cross(axis, h) * std::sin(angle) +
+                                 axis * (glm::dot(axis, h) * (1 - std::cos(angle))));
+      twistFree();
+    }
+    if (twist != DVec3(0)) cpfgTorque(twist);
+  }
+
+  /// cpfg's torque (movements.c): the sum of the torques' e T, projected perpendicular to H,
+  /// turns cpfg's up vector (-U) by min(|U' x D|, 1) radians, by cpfg's own quaternion
+  /// rule, reproduced as written; H stays. The frame becomes the twist-free reference.
+  void cpfgTorque(const DVec3& twist) {
+    TurtleFrame& f = st_.frame;
+    const double length = glm::length(twist);
+    const DVec3 v = glm::cross(f.heading, twist / length);
+    if (glm::dot(v, v) > 1e-8) {
+      const DVec3 des = glm::cross(v, f.heading) * length;
+      const DVec3 uc = -f.up;
+      const DVec3 w = glm::cross(uc, des);
+      const double wl = glm::length(w);
+      if (wl >= 1e-7) {
+        const double lc = std::min(wl, 1.0);
+        const double half = 0.5 * lc;
+        const glm::dquat q(std::cos(half), std::sin(half) * (w / lc));  // (w, x, y, z)
+        const glm::dquat r = glm::inverse(q) * glm::dquat(0, uc) * q;
+        f.up = -DVec3(r.x, r.y, r.z);
+        f.left = glm::cross(f.up, f.heading);
+      }
+      st_.prevHeading = f.heading;
+      st_.prevUp = f.up;
+    }
+  }
+  /// cpfg's old tropism (interpret.c, `bend`), after every `F f G g`: with s1 = e T.U' and
+  /// s2 = e T.L (U' = -U, cpfg's up; T of unit length), H turns toward U' by asin s1, then
+  /// toward L by asin s2. cpfg computes NaN when e |T.U'| or e |T.L| exceeds 1; Sprig clamps.
+  void cpfgOldBend() {
+    const double e = st_.elasticity;
+    if (e == 0) return;
+    TurtleFrame& f = st_.frame;
+    const DVec3 t = oldTropism_;
+    double s1 = std::clamp(e * glm::dot(t, -f.up), -1.0, 1.0), c1 = std::sqrt(1 - s1 * s1);
+    DVec3 h = c1 * f.heading + s1 * (-f.up);
+    f.up = -(c1 * (-f.up) - s1 * f.heading);
+    f.heading = h;
+    double s2 = std::clamp(e * glm::dot(t, f.left), -1.0, 1.0), c2 = std::sqrt(1 - s2 * s2);
+    h = c2 * f.heading + s2 * f.left;
+    f.left = c2 * f.left - s2 * f.heading;
+    f.heading = h;
+  }
+
+  /// `@Ti(n, de)` (sign +1) and `@Td(n, de)` (sign -1): steps the elasticity of tropism n
+  /// by de, or by its step S: without de (cpfg's index rule: trunc(n - 1); out of range: ignored).
+  void tropismStep(size_t i, int sign) {
+    const uint32_t n = paramCount(i);
+    if (n == 0) return;
+    const int k = tropismIndex(paramAt(i, 0));
+    if (settings_.cpfg) {
+      if (k < 0 || k >= static_cast<int>(std::min(settings_.tropisms.size(), size_t(kMaxTropisms)))) return;
+      st_.elasticities[k] += sign * (n >= 2 ? paramAt(i, 1) : settings_.tropisms[k].step);
+    } else if (k == 0 && n >= 2) {
+      st_.elasticity += sign * paramAt(i, 1);
+    }
+  }
   /// `.`: adds the position to the innermost open polygon.
   void vertex() {
     if (!buf_.polygons.empty()) addPolygonPoint(st_.frame.position);
   }
-  /// `@Ts(e)`: sets the tropism susceptibility.
+  /// cpfg's index of tropism number n: n - 1 truncated toward 0 (`(short)(n - 1)`), -1
+  /// when out of any tropism's range.
+  static int tropismIndex(double n) {
+    const double k = std::trunc(n - 1);
+    return k >= 0 && k < kMaxTropisms ? static_cast<int>(k) : -1;
+  }
+  /// A color index from a parameter (clamped into int's range).
+  static int colorIndex(double c) { return static_cast<int>(std::clamp(c, -1e9, 1e9)); }
+
+  /// `@Ts(n, e)`: sets the elasticity of tropism n to e (cpfg's index rule: trunc(n - 1);
+  /// an index out of range is ignored, as cpfg does). In cpfg's notation `@Ts(n)` sets it
+  /// to 0, as cpfg does; in Sprig's, `@Ts(e)` sets the one (species) tropism's elasticity to e.
   void tropismChange(size_t i) {
-    if (hasParam(i)) st_.elasticity = param(i);
+    const uint32_t n = paramCount(i);
+    if (n == 0) return;
+    if (!settings_.cpfg && n == 1) {
+      st_.elasticity = param(i);
+      return;
+    }
+    const int k = tropismIndex(paramAt(i, 0));
+    const double e = n >= 2 ? paramAt(i, 1) : 0.0;
+    if (settings_.cpfg) {
+      if (k >= 0 && k < static_cast<int>(std::min(settings_.tropisms.size(), size_t(kMaxTropisms)))) st_.elasticities[k] = e;
+    } else if (k == 0) {
+      st_.elasticity = e;
+    }
   }
 
   /// An organ of kind at the turtle, attached to the current internode, for module i.
@@ -444,12 +703,32 @@ class TurtleWalk {
     addSurface(i, symbols_.name(sym_[i]).substr(1), hasParam(i) ? param(i) : settings_.surfaceScale);
   }
 
-  /// `@O(r)`: a sphere of radius r (default: half the line width).
+  /// `@O(r)`: a sphere of radius r (default: half the line width). In cpfg's notation
+  /// `@O(d)` and `@o(d)` take a diameter (times the turtle scale; default the line width);
+  /// cpfg draws `@o` as a disc facing the viewer, whose outline a sphere has from every side.
   void sphere(size_t i) {
-    const double radius = (hasParam(i) ? param(i) : st_.width * radiusScale_) * growth(i);
+    double radius = hasParam(i) ? param(i) : st_.width * radiusScale_;
+    if (settings_.cpfg && hasParam(i)) radius = 0.5 * param(i) * st_.scale;
+    radius *= growth(i);
     if (radius <= 0 && growing_) return;
     Organ o = organHere(Organ::Kind::Sphere, i);
     o.radius = radius;
+    sk_.organs.push_back(std::move(o));
+  }
+
+  /// `@c(d)`: a disc of diameter d (times the turtle scale; default the line width) in the
+  /// turtle's HL plane, centered at the turtle: a polygon organ of kDiscSides vertices.
+  void disc(size_t i) {
+    double radius = hasParam(i) ? 0.5 * param(i) * (settings_.cpfg ? st_.scale : 1.0) : st_.width * radiusScale_;
+    radius *= growth(i);
+    if (radius <= 0) return;
+    Organ o = organHere(Organ::Kind::Polygon, i);
+    o.points.reserve(kDiscSides);
+    for (int k = 0; k < kDiscSides; ++k) {
+      const double t = 2 * kPi * k / kDiscSides;
+      o.points.push_back(st_.frame.position + radius * (std::cos(t) * st_.frame.heading + std::sin(t) * st_.frame.left));
+    }
+    o.position = o.points.front();
     sk_.organs.push_back(std::move(o));
   }
 
@@ -498,6 +777,7 @@ class TurtleWalk {
   const double maxRadiusPerLength_;
   const bool taper_;
   const DVec3 tropism_;
+  const DVec3 oldTropism_ = glm::length(settings_.tropism) > 0 ? glm::normalize(settings_.tropism) : DVec3(0);
   const double defS_, defC_;
   const bool growing_;
   const double partial_;

@@ -13,6 +13,7 @@
 /// command table built once from the SymbolTable; branch state lives on an explicit
 /// stack, so there is no allocation per module beyond the output vectors.
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -27,6 +28,19 @@ namespace sprig::lsystem {
 enum class RadiusModel {
   Width,  ///< from the turtle's line width (`!`): radius = 0.5 * width * widthScale
   Pipe,   ///< pipe model: parent radius^e = sum of child radii^e, tips get tipRadius
+};
+
+/// Most tropisms a cpfg view file may define (cpfg's MAXMOVEMENTS).
+inline constexpr int kMaxTropisms = 10;
+
+/// One tropism of a cpfg view file (`tropism: T: x y z A: angle I: intensity E: e S: step`),
+/// applied by cpfg's own rule (docs/TURTLE.md, "cpfg tropisms").
+struct CpfgTropism {
+  DVec3 direction{0, -1, 0};  ///< T: made unit length, times the intensity clamped to [-1, 1]
+  double angleDeg = 0;        ///< A: the angle to T that segments try to reach (0: toward T)
+  double elasticity = 0;      ///< E: initial elasticity
+  double step = 0;            ///< S: elasticity step of `@Ti` and `@Td` without a value
+  bool torque = false;        ///< a `torque:` line: turns U about H toward T instead of bending H
 };
 
 /// Turtle options; defaults are documented per field.
@@ -48,6 +62,21 @@ struct TurtleSettings {
   /// shipped species files do. Local to each internode, so every growth stage agrees.
   double maxWidthToLength = 0.0;
   double surfaceScale = 1.0;      ///< scale of a `~` surface without a parameter
+  /// cpfg's own command meanings (a `.l` grammar, Grammar::cpfgNotation): `!` and `#`
+  /// step the width by widthIncrement, `;` and `,` step the color by colorIncrement,
+  /// `@O(d)` and `@o(d)` take a diameter, `'` is no command, lengths and sizes are scaled by
+  /// the turtle scale (`@D`), and only the `tropisms` bend (cpfg's rule, before each move).
+  bool cpfg = false;
+  double widthIncrement = 0.0;    ///< cpfg: `line width increment:` (view file)
+  int colorIncrement = 1;         ///< `color increment:` (view file)
+  int initialColor = 0;           ///< `initial color:` (view file; cpfg's default is 128)
+  double initialScale = 1.0;      ///< cpfg: `initial scale:` (view file), the turtle scale at the start
+  double scaleMultiplier = 1.0;   ///< cpfg: `scale multiplier:` (view file), of `@Di` and `@Dd`
+  std::vector<CpfgTropism> tropisms;  ///< cpfg: the view file's `tropism:` lines (at most kMaxTropisms)
+  /// cpfg's old tropism (view file `tropism direction:`, `initial elasticity:`, `elasticity
+  /// increment:`, module `_`): with `cpfg`, `tropism` (made unit length) and `elasticity`
+  /// are its direction and initial elasticity, bent by cpfg's old rule after every move.
+  double elasticityIncrement = 0.0;
   DVec3 origin{0};                ///< start position
   /// Growth animation (docs/GRAMMAR.md, "Growth over time"): modules whose birth step is
   /// growthStep are drawn partly grown, scaled by growthScale(); modules born later are
@@ -76,6 +105,10 @@ struct TurtleState {
   int color = 0;              ///< color index (`'`)
   int order = 0;              ///< branch order: +1 per `[` entered
   int32_t internode = -1;     ///< last internode drawn on this branch (parent of the next), -1 for none
+  double scale = 1.0;         ///< cpfg: the turtle scale (`@D`), multiplies lengths and sizes
+  DVec3 prevHeading{0, 1, 0}; ///< cpfg: H at the last `F`/`G` (or `@Tf`), for twist-free frames
+  DVec3 prevUp{0, 0, 1};      ///< cpfg: U at the last `F`/`G` (or `@Tf`)
+  std::array<double, kMaxTropisms> elasticities{};  ///< cpfg: the current elasticity of each tropism
 };
 
 /// Interprets module strings of one grammar. Construction builds the symbol -> command
@@ -109,7 +142,8 @@ class Turtle {
   enum class Command : uint8_t {
     None, Forward, Move, ForwardNoVertex, MoveNoVertex, TurnLeft, TurnRight, PitchDown, PitchUp,
     RollLeft, RollRight, TurnAround, RollToVertical, Push, Pop, Width, Color, PolygonBegin, Vertex,
-    PolygonEnd, Surface, SurfaceNamed, Cut, Tropism, Sphere
+    PolygonEnd, Surface, SurfaceNamed, Cut, Tropism, Sphere, WidthUp, ColorUp, ColorDown, Circle, Disc,
+    TropismUp, TropismDown, TwistAdjust, TwistForce, MoveTo, SetHeading, ScaleSet, ScaleUp, ScaleDown, OldElasticity
   };
   /// The command bound to symbol id `s` (None for ids outside the table).
   Command commandOf(SymbolId s) const { return s < commands_.size() ? commands_[s] : Command::None; }

@@ -138,11 +138,13 @@ render::RenderSettings SpeciesRender::settings(int imageWidth, int imageHeight) 
 
 Species loadSpecies(const fs::path& path, const PathPolicy& policy) {
   const std::string ext = lowerExtension(path);
-  if (ext == ".lsys") return speciesFromGrammarFile(path);  // model/tree_kind.h
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) return speciesFromCpfgObject(path);  // model/tree_kind.h
+  if (ext == ".lsys" || ext == ".l") return speciesFromGrammarFile(path);
   if (ext != ".yaml" && ext != ".yml")
     throw InputError(SourceLoc{path.string(), 0, 0},
                      "unknown input extension '" + path.extension().string() +
-                         "' (expected a species file .yaml/.yml or a grammar .lsys)");
+                         "' (expected a species file .yaml/.yml, a grammar .lsys or .l, or a vlab object folder)");
   DiagnosticList diags;
   auto yaml = YamlFile::load(path, diags);
   if (!yaml) diags.throwIfErrors();

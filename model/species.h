@@ -68,7 +68,10 @@ struct Species {
   std::string name;         ///< `name` (default: the file's stem)
   std::string description;  ///< `description`
   std::filesystem::path file;  ///< the species (or grammar) file as given
-  bool bareGrammar = false;    ///< true when file is a `.lsys` grammar, not a species file
+  bool bareGrammar = false;    ///< true when file is a grammar (`.lsys`, `.l`, a vlab object folder), not a species file
+  /// Notes and warnings from reading it (cpfg defaults used, view file keys ignored), for
+  /// the commands to print.
+  std::vector<Diagnostic> notes;
   std::vector<int> stages;     ///< `stages`: steps of a tree's growth strip (empty = automatic)
   SpeciesRender render;        ///< `render:`
   std::shared_ptr<const KindSpec> spec;  ///< the kind's own keys, typed (model/kinds.h)
@@ -82,7 +85,8 @@ struct Species {
   SourceLoc loc() const;
 };
 
-/// Reads a species file or a bare grammar (chosen by extension: .yaml/.yml or .lsys).
+/// Reads a species file or a bare grammar (chosen by extension: .yaml/.yml, .lsys, cpfg's
+/// .l, or a vlab object folder).
 /// Referenced files must satisfy policy. Throws InputError with every diagnostic.
 Species loadSpecies(const std::filesystem::path& path, const PathPolicy& policy = {});
 

@@ -5,9 +5,11 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <sstream>
 
 #include "blobtree/polygonize.h"
 #include "core/atomic_file.h"
+#include "core/paths.h"
 #include "core/progress.h"
 #include "model/growth.h"
 #include "organisms/skeleton_geometry.h"
@@ -359,7 +361,10 @@ std::shared_ptr<const KindSpec> readTreeSpec(MapReader& top, Species& species, D
   return spec;
 }
 
-Species speciesFromGrammarFile(const fs::path& path) {
+namespace {
+
+/// A bare grammar (viewFile: its cpfg view file, empty for none).
+Species grammarSpecies(const fs::path& path, const fs::path& viewFile) {
   Species s;
   s.kind = "tree";
   s.bareGrammar = true;
@@ -374,11 +379,103 @@ Species speciesFromGrammarFile(const fs::path& path) {
   spec->grammarFile = path.string();
   // ABOP widths are pixel widths: keep a bare grammar's internodes slender (lsystem/turtle.h).
   spec->turtle.maxWidthToLength = 0.12;
+  if (!viewFile.empty()) {
+    spec->view = lsystem::loadViewFile(viewFile.string());
+    for (const Diagnostic& w : spec->view->warnings) s.notes.push_back(w);
+  }
   s.spec = spec;
   DiagnosticList diags;
   checkGrammar(s, *spec, diags);
   diags.throwIfErrors();
+  const lsystem::Grammar& g = *spec->grammar;
+  auto note = [&](const std::string& msg) {
+    Diagnostic d;
+    d.severity = Severity::Note;
+    d.loc = SourceLoc{path.string(), 0, 0};
+    d.message = msg;
+    s.notes.push_back(std::move(d));
+  };
+  if (g.cpfgNotation()) {
+    const lsystem::ViewFile* v = spec->view ? &*spec->view : nullptr;
+    if (!v)
+      note("no view file '" + fs::path(path).replace_extension(".v").filename().string() +
+           "' beside it: using cpfg's defaults: " + lsystem::cpfgDefaultsUsed(nullptr));
+    else if (!v->angleDeg && g.usesDefaultAngle())
+      note("the view file '" + viewFile.string() + "' sets no angle: turns without an angle use cpfg's default angle increment, 45 degrees");
+  } else if (!g.angleDeg() && g.usesDefaultAngle()) {
+    note("no 'angle:' header: turns without an angle use cpfg's default angle increment, 45 degrees");
+  }
   return s;
+}
+
+/// Whether text holds an `axiom:` (cpfg capitalizes it at will): a grammar, not a panel file.
+bool hasAxiom(const fs::path& p) {
+  try {
+    std::string t = readFile(p);
+    std::transform(t.begin(), t.end(), t.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    return t.find("axiom:") != std::string::npos;
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+}  // namespace
+
+Species speciesFromGrammarFile(const fs::path& path) {
+  fs::path view;
+  if (lowerExtension(path) == ".l") {
+    fs::path v = fs::path(path).replace_extension(".v");
+    std::error_code ec;
+    if (fs::is_regular_file(v, ec)) view = v;
+  }
+  return grammarSpecies(path, view);
+}
+
+Species speciesFromCpfgObject(const fs::path& folder) {
+  std::error_code ec;
+  fs::path grammar, view;
+  // The `specifications` file's cpfg command line names the grammar and the view file.
+  try {
+    std::istringstream spec(readFile(folder / "specifications"));
+    for (std::string line; std::getline(spec, line);) {
+      std::istringstream words(line);
+      std::vector<std::string> w;
+      for (std::string x; words >> x;) w.push_back(x);
+      if (w.empty() || w[0] != "cpfg") continue;
+      for (const std::string& x : w) {
+        const std::string e = lowerExtension(x);
+        if (e == ".l" && grammar.empty()) grammar = folder / x;
+        if (e == ".v" && view.empty()) view = folder / x;
+      }
+      break;
+    }
+  } catch (const std::exception&) {
+  }
+  if (grammar.empty()) {
+    std::vector<fs::path> grammars, views;
+    for (const auto& e : fs::directory_iterator(folder, ec)) {
+      if (!e.is_regular_file()) continue;
+      const std::string x = lowerExtension(e.path());
+      if (x == ".l" && hasAxiom(e.path())) grammars.push_back(e.path());
+      if (x == ".v") views.push_back(e.path());
+    }
+    std::sort(grammars.begin(), grammars.end());
+    if (grammars.size() != 1) {
+      std::string list;
+      for (const fs::path& p : grammars) list += (list.empty() ? "" : ", ") + p.filename().string();
+      throw InputError(SourceLoc{folder.string(), 0, 0},
+                       grammars.empty() ? "no cpfg grammar (a .l file with an 'axiom:') in this folder"
+                                        : "several cpfg grammars in this folder (" + list +
+                                              ") and no 'specifications' naming one: give the .l file");
+    }
+    grammar = grammars[0];
+    fs::path same = fs::path(grammar).replace_extension(".v");
+    if (fs::is_regular_file(same, ec)) view = same;
+    else if (views.size() == 1) view = views[0];
+  }
+  if (!fs::is_regular_file(grammar, ec)) throw InputError(SourceLoc{grammar.string(), 0, 0}, "cannot open file");
+  if (!view.empty() && !fs::is_regular_file(view, ec)) throw InputError(SourceLoc{view.string(), 0, 0}, "cannot open the view file");
+  return grammarSpecies(grammar, view);
 }
 
 const TreeSpec& treeSpec(const Species& species) {
@@ -415,7 +512,14 @@ lsystem::Grammar speciesGrammar(const Species& species, const lsystem::GrammarOv
 lsystem::TurtleSettings speciesTurtle(const Species& species, const lsystem::Grammar& grammar) {
   const TreeSpec& tree = treeSpec(species);
   lsystem::TurtleSettings t = tree.turtle;
-  if (!tree.angleSet) t.angleDeg = grammar.angleDeg().value_or(90.0);
+  if (grammar.cpfgNotation()) {
+    t = lsystem::cpfgTurtleSettings(tree.view ? &*tree.view : nullptr, t);
+    if (tree.angleSet) t.angleDeg = tree.turtle.angleDeg;
+    else if (grammar.angleDeg()) t.angleDeg = *grammar.angleDeg();
+    return t;
+  }
+  // cpfg's default angle increment (its view file's, interpret.c): 45 degrees.
+  if (!tree.angleSet) t.angleDeg = grammar.angleDeg().value_or(lsystem::kCpfgDefaultAngleDeg);
   return t;
 }
 

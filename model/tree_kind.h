@@ -13,6 +13,7 @@
 #include "core/mesh.h"
 #include "lsystem/grammar.h"
 #include "lsystem/turtle.h"
+#include "lsystem/view_file.h"
 #include "model/kinds.h"
 #include "organisms/tree_builder.h"
 #include "organisms/tree_options.h"
@@ -31,6 +32,9 @@ class TreeSpec : public KindSpec {
   lsystem::TurtleSettings turtle;       ///< `turtle:` (angle filled from the grammar when unset)
   bool angleSet = false;                ///< `turtle.angle` given in the species file
   std::optional<organisms::TreeOptions> surface;  ///< `tree:` (BlobTree tree builder options)
+  /// A cpfg grammar (`.l`): its view file when it has one (speciesTurtle applies it, or
+  /// cpfg's defaults without one).
+  std::optional<lsystem::ViewFile> view;
   /// The grammar parsed at load with the species' own overrides (shares its compiled form:
   /// copies are free); speciesGrammar returns it when no command-line override is given.
   std::optional<lsystem::Grammar> grammar;
@@ -44,8 +48,15 @@ class TreeSpec : public KindSpec {
 std::shared_ptr<const KindSpec> readTreeSpec(MapReader& top, Species& species, DiagnosticList& diags);
 
 /// A bare grammar as a tree species with default settings. Throws InputError when the file
-/// cannot be read or the grammar has errors.
+/// cannot be read or the grammar has errors. A cpfg grammar (`NAME.l`) is read with the view
+/// file `NAME.v` beside it when there is one (lsystem/view_file.h); Species::notes then says
+/// which of cpfg's defaults were used.
 Species speciesFromGrammarFile(const std::filesystem::path& path);
+
+/// A vlab object folder: the cpfg grammar and view file its `specifications` name on its
+/// `cpfg` line, else its only `.l` file with an `axiom:` and the `.v` of the same name (or
+/// its only `.v`). Throws InputError when the folder holds no such grammar or several.
+Species speciesFromCpfgObject(const std::filesystem::path& folder);
 
 /// The tree keys of species. Throws InputError when the species is not a tree.
 const TreeSpec& treeSpec(const Species& species);

@@ -22,7 +22,26 @@ constexpr FunctionInfo kFunctions[] = {
     {"acos", Op::Acos, 1},   {"atan", Op::Atan, 1},   {"atan2", Op::Atan2, 2}, {"sqrt", Op::Sqrt, 1},
     {"exp", Op::Exp, 1},     {"log", Op::Log, 1},     {"pow", Op::PowFn, 2},   {"abs", Op::Abs, 1},
     {"min", Op::Min, 2},     {"max", Op::Max, 2},     {"floor", Op::Floor, 1}, {"ceil", Op::Ceil, 1},
-    {"sign", Op::Sign, 1},   {"ran", Op::Ran, 1},     {"nran", Op::Nran, 2},
+    {"sign", Op::Sign, 1},   {"ran", Op::Ran, 1},     {"nran", Op::Nran, 2},   {"fabs", Op::Abs, 1},
+    {"trunc", Op::Round, 1}, {"bran", Op::Bran, 2},   {"biran", Op::Biran, 2},
+};
+
+/// cpfg functions Sprig does not implement, with why.
+struct UnsupportedFunction {
+  const char* name;
+  const char* what;
+};
+constexpr UnsupportedFunction kUnsupportedFunctions[] = {
+    {"srand", "reseeds cpfg's one global generator; Sprig draws per module from 'seed:'"},
+    {"printf", "output"}, {"fprintf", "file output"}, {"fopen", "file input and output"},
+    {"fclose", "file input and output"}, {"fflush", "file input and output"}, {"fscanf", "file input"},
+    {"stop", "stops the simulation"}, {"func", "function from a view file's function file"},
+    {"curveX", "contour from a view file's contour file"}, {"curveY", "contour from a view file's contour file"},
+    {"curveZ", "contour from a view file's contour file"}, {"curveGAL", "contour from a view file's contour file"},
+    {"play", "sound"}, {"inblob", "environment field"}, {"vvXmin", "view volume"}, {"vvXmax", "view volume"},
+    {"vvYmin", "view volume"}, {"vvYmax", "view volume"}, {"vvZmin", "view volume"}, {"vvZmax", "view volume"},
+    {"vvScale", "view volume"}, {"Display", "display"}, {"SetDerivationLength", "changes the derivation length"},
+    {"GetDerivationLength", "derivation length"},
 };
 
 /// Nesting of unary operators and parentheses beyond which an expression is rejected.
@@ -33,8 +52,9 @@ int arityOf(Op op) {
     case Op::Const: case Op::Var: return 0;
     case Op::Neg: case Op::Not: case Op::Sin: case Op::Cos: case Op::Tan: case Op::Asin: case Op::Acos:
     case Op::Atan: case Op::Sqrt: case Op::Exp: case Op::Log: case Op::Abs: case Op::Floor: case Op::Ceil:
-    case Op::Sign: case Op::Ran:
+    case Op::Sign: case Op::Ran: case Op::Round:
       return 1;
+    case Op::Select: return 3;
     default: return 2;
   }
 }
@@ -47,7 +67,7 @@ struct ExpressionParser::Node {
   Op op = Op::Const;
   double value = 0;
   uint16_t var = 0;
-  int kids[2] = {-1, -1};
+  int kids[3] = {-1, -1, -1};
 };
 
 struct ExpressionParser::Token {
@@ -109,12 +129,12 @@ void ExpressionParser::lex(State& st) {
     t.text = std::string_view(s).substr(i, j - i);
     st.pos = j;
   } else {
-    static const char* two[] = {"<=", ">=", "==", "!=", "&&", "||"};
+    static const char* two[] = {"<=", ">=", "==", "!=", "&&", "||", "<>"};
     int len = 0;
     for (const char* op : two)
       if (i + 1 < st.span.e && s.compare(i, 2, op) == 0) len = 2;
     if (!len) {
-      if (std::string_view("+-*/^<>!(),").find(c) == std::string_view::npos) {
+      if (std::string_view("+-*/^<>!(),?:%").find(c) == std::string_view::npos) {
         scanner_.error(st.span.line, i, std::string("unexpected character '") + c + "' in expression");
         throw ExprFail{};
       }
@@ -131,11 +151,12 @@ bool ExpressionParser::isPunct(const State& st, std::string_view p) const {
   return st.tok.kind == Token::Punct && st.tok.text == p;
 }
 
-int ExpressionParser::node(State& st, Op op, int a, int b) {
+int ExpressionParser::node(State& st, Op op, int a, int b, int c) {
   Node n;
   n.op = op;
   n.kids[0] = a;
   n.kids[1] = b;
+  n.kids[2] = c;
   st.nodes.push_back(n);
   return static_cast<int>(st.nodes.size()) - 1;
 }
@@ -148,16 +169,42 @@ void ExpressionParser::unexpected(State& st, const char* what) {
 
 // ---- grammar of expressions --------------------------------------------------------------
 
+/// C's conditional `c ? a : b`, the lowest precedence (right-associative, as in C and cpfg).
+int ExpressionParser::parseConditional(State& st) {
+  int cond = parseBinary(st, 0);
+  if (!isPunct(st, "?")) return cond;
+  if (++st.depth > kMaxNesting) {
+    scanner_.error(st.span.line, st.tok.col, "expression is nested too deeply (more than " + std::to_string(kMaxNesting) + " levels)");
+    throw ExprFail{};
+  }
+  struct Leave {
+    int& d;
+    ~Leave() { --d; }
+  } leave{st.depth};
+  lex(st);
+  int a = parseConditional(st);
+  if (!isPunct(st, ":")) unexpected(st, "':' of 'c ? a : b'");
+  lex(st);
+  int b = parseConditional(st);
+  return node(st, Op::Select, cond, a, b);
+}
+
 int ExpressionParser::parseBinary(State& st, int level) {
+  // cpfg's grammar (lsys_input.y) puts `^` below the unary operators, left-associative:
+  // in cpfg's notation `-2^2` is 4 and `2^3^2` is 64. Sprig's notation reads `^` as C's
+  // pow above them, right-associative (`-2^2` is -4, `2^3^2` is 512).
   static const std::vector<std::vector<std::pair<const char*, Op>>> levels = {
       {{"||", Op::Or}},
       {{"&&", Op::And}},
-      {{"==", Op::Eq}, {"!=", Op::Ne}},
+      {{"==", Op::Eq}, {"!=", Op::Ne}, {"<>", Op::Ne}},
       {{"<", Op::Lt}, {"<=", Op::Le}, {">", Op::Gt}, {">=", Op::Ge}},
       {{"+", Op::Add}, {"-", Op::Sub}},
-      {{"*", Op::Mul}, {"/", Op::Div}},
+      {{"*", Op::Mul}, {"/", Op::Div}, {"%", Op::Rem}},
+      {{"^", Op::Pow}},
   };
-  if (level == static_cast<int>(levels.size())) return parseUnary(st);
+  const bool cpfg = scanner_.dialect() == Dialect::Cpfg;
+  const int last = static_cast<int>(levels.size()) - (cpfg ? 0 : 1);
+  if (level == last) return parseUnary(st);
   int lhs = parseBinary(st, level + 1);
   for (;;) {
     const std::pair<const char*, Op>* hit = nullptr;
@@ -192,7 +239,7 @@ int ExpressionParser::parseUnary(State& st) {
     return node(st, Op::Not, parseUnary(st));
   }
   int base = parsePrimary(st);
-  if (isPunct(st, "^")) {
+  if (scanner_.dialect() == Dialect::Sprig && isPunct(st, "^")) {
     lex(st);
     return node(st, Op::Pow, base, parseUnary(st));
   }
@@ -208,7 +255,7 @@ int ExpressionParser::parsePrimary(State& st) {
   }
   if (isPunct(st, "(")) {
     lex(st);
-    int inner = parseBinary(st, 0);
+    int inner = parseConditional(st);
     if (!isPunct(st, ")")) unexpected(st, "')'");
     lex(st);
     return inner;
@@ -228,6 +275,11 @@ int ExpressionParser::parseCall(State& st, const Token& id) {
   for (const FunctionInfo& f : kFunctions)
     if (name == f.name) fn = &f;
   if (!fn) {
+    for (const UnsupportedFunction& u : kUnsupportedFunctions)
+      if (name == u.name) {
+        scanner_.error(st.span.line, id.col, "cpfg's function '" + name + "' (" + u.what + ") is not supported");
+        throw ExprFail{};
+      }
     std::vector<std::string> names;
     for (const FunctionInfo& f : kFunctions) names.emplace_back(f.name);
     scanner_.error(st.span.line, id.col, "unknown function '" + name + "'" + didYouMean(name, names));
@@ -237,7 +289,7 @@ int ExpressionParser::parseCall(State& st, const Token& id) {
   std::vector<int> args;
   if (!isPunct(st, ")")) {
     for (;;) {
-      args.push_back(parseBinary(st, 0));
+      args.push_back(parseConditional(st));
       if (isPunct(st, ",")) {
         lex(st);
         continue;
@@ -252,7 +304,7 @@ int ExpressionParser::parseCall(State& st, const Token& id) {
                                              (fn->arity == 1 ? "" : "s") + ", got " + std::to_string(args.size()));
     throw ExprFail{};
   }
-  if (fn->op == Op::Ran || fn->op == Op::Nran) usesRandom_ = true;
+  if (fn->op == Op::Ran || fn->op == Op::Nran || fn->op == Op::Bran || fn->op == Op::Biran) usesRandom_ = true;
   return node(st, fn->op, args[0], args.size() > 1 ? args[1] : -1);
 }
 
@@ -264,6 +316,14 @@ int ExpressionParser::parseName(State& st, const Token& id) {
     if (it != st.vars->end()) {
       int n = node(st, Op::Var);
       st.nodes[n].var = static_cast<uint16_t>(it - st.vars->begin());
+      return n;
+    }
+  }
+  if (globals_) {
+    auto g = std::find(globals_->begin(), globals_->end(), name);
+    if (g != globals_->end()) {
+      int n = node(st, Op::Var);
+      st.nodes[n].var = static_cast<uint16_t>(kMaxVars - 1 - (g - globals_->begin()));
       return n;
     }
   }
@@ -301,7 +361,7 @@ bool ExpressionParser::emit(const State& st, int n, int& depth, int& maxDepth) {
   in.op = nd.op;
   code_.push_back(in);
   depth -= arity - 1;
-  if (allConst && nd.op != Op::Ran && nd.op != Op::Nran) {
+  if (allConst && nd.op != Op::Ran && nd.op != Op::Nran && nd.op != Op::Bran && nd.op != Op::Biran) {
     size_t first = code_.size() - 1 - arity;
     double v = evalCode(code_.data() + first, code_.data() + code_.size(), nullptr, nullptr);
     code_.resize(first);
@@ -321,7 +381,7 @@ bool ExpressionParser::compile(Span sp, const std::vector<std::string>& vars, co
   size_t before = code_.size();
   try {
     lex(st);
-    int root = parseBinary(st, 0);
+    int root = parseConditional(st);
     if (st.tok.kind != Token::End) unexpected(st, "an operator");
     int depth = 0, maxDepth = 0;
     emit(st, root, depth, maxDepth);

@@ -51,6 +51,10 @@ class ExpressionParser {
   /// The code vector is left unchanged; usesRandom() is not affected.
   std::optional<double> evaluate(Span sp, Rng* rng);
 
+  /// cpfg's global variables (assigned in `Start:` ... blocks): a name not among an
+  /// expression's variables that is global k reads register kMaxVars - 1 - k. Null: none.
+  void setGlobals(const std::vector<std::string>* globals) { globals_ = globals; }
+
   /// Whether an expression compiled since clearRandom() draws random numbers.
   bool usesRandom() const { return usesRandom_; }
   void clearRandom() { usesRandom_ = false; }
@@ -62,8 +66,9 @@ class ExpressionParser {
 
   void lex(State& st);
   bool isPunct(const State& st, std::string_view p) const;
-  int node(State& st, Op op, int a = -1, int b = -1);
+  int node(State& st, Op op, int a = -1, int b = -1, int c = -1);
   [[noreturn]] void unexpected(State& st, const char* what);
+  int parseConditional(State& st);
   int parseBinary(State& st, int level);
   int parseUnary(State& st);
   int parsePrimary(State& st);
@@ -75,6 +80,7 @@ class ExpressionParser {
   const std::unordered_map<std::string, double>& defines_;
   std::vector<Instr>& code_;
   bool usesRandom_ = false;
+  const std::vector<std::string>* globals_ = nullptr;
 };
 
 }  // namespace sprig::lsystem::detail

@@ -29,6 +29,48 @@ const char* const kHeaders[] = {"lsystem", "derivation length", "seed", "angle",
 
 enum class Block { Main, Decomposition, Interpretation };
 
+/// True when line s has cpfg's `endlsystem` (any capitalization, as cpfg's `Endlsystem`) at b.
+bool isEndLsystem(const std::string& s, int b) {
+  if (static_cast<int>(s.size()) < b + 10) return false;
+  for (int k = 0; k < 10; ++k)
+    if (std::tolower(static_cast<unsigned char>(s[b + k])) != "endlsystem"[k]) return false;
+  return true;
+}
+
+/// cpfg's block keywords written without a colon, alone on their line (`homomorphism`,
+/// `Decomposition`, `homomorphism no warnings`): the header they stand for, or nullopt.
+std::optional<Header> bareBlockKeyword(const std::string& s, int b) {
+  std::string words;
+  for (int i = b; i < static_cast<int>(s.size()); ++i) {
+    char c = static_cast<char>(std::tolower(static_cast<unsigned char>(s[i])));
+    if (isSpace(c)) {
+      if (!words.empty() && words.back() != ' ') words += ' ';
+    } else {
+      words += c;
+    }
+  }
+  while (!words.empty() && words.back() == ' ') words.pop_back();
+  for (const char* key : {"homomorphism", "decomposition"}) {
+    std::string k(key);
+    if (words == k || words == k + " no warnings" || words == k + " warnings")
+      return Header{k, b + static_cast<int>(k.size())};
+  }
+  return std::nullopt;
+}
+
+/// cpfg headers Sprig does not implement, with what they are.
+struct UnsupportedHeader {
+  const char* key;
+  const char* shown;
+  const char* what;
+};
+constexpr UnsupportedHeader kUnsupportedHeaders[] = {
+    {"define", "define:", "array declarations"},
+};
+
+/// cpfg's blocks of statements over global variables, by header key.
+const char* const kBlockHeaders[] = {"start", "end", "starteach", "start each", "endeach", "end each"};
+
 /// True when line s, whose first non-space character is at b, declares modules
 /// (`module Apex, Leaf`) rather than being a production of a module named `module`.
 bool isModuleDeclaration(const std::string& s, int b) {
@@ -59,6 +101,10 @@ class GrammarParser {
   GrammarParser(const std::string& fileName, const GrammarOverrides& overrides)
       : overrides_(overrides), scanner_(fileName) {
     prog_.fileName = fileName;
+    prog_.dialect = dialectOf(fileName);
+    scanner_.setDialect(prog_.dialect);
+    for (size_t k = 0; k < kCpfgMultiNameCount; ++k) scanner_.addMultiName(kCpfgMultiNames[k]);
+    expr_.setGlobals(&prog_.globals);
     for (const char* s : kTurtleSymbols) prog_.symbols.intern(s);
     prog_.openBracket = static_cast<SymbolId>(prog_.symbols.find("["));
     prog_.closeBracket = static_cast<SymbolId>(prog_.symbols.find("]"));
@@ -95,6 +141,7 @@ class GrammarParser {
     for (size_t i = 0; i < symbols.size(); ++i)
       if (symbols.name(static_cast<SymbolId>(i)).size() > 1 && symbols.name(static_cast<SymbolId>(i))[0] != '~')
         scanner_.addMultiName(symbols.name(static_cast<SymbolId>(i)));
+    for (size_t k = 0; k < kCpfgMultiNameCount; ++k) scanner_.addMultiName(kCpfgMultiNames[k]);
     ModuleString out;
     for (int line = 1; line <= scanner_.lineCount(); ++line) {
       std::vector<RawModule> mods;
@@ -120,14 +167,20 @@ class GrammarParser {
       const std::string& s = scanner_.line(line);
       int b = Scanner::firstNonSpace(s);
       if (b >= static_cast<int>(s.size())) continue;
-      if (s.compare(b, 10, "endlsystem") == 0) break;
+      if (isEndLsystem(s, b)) break;
       if (s.compare(b, 7, "#define") == 0 && (b + 7 == static_cast<int>(s.size()) || isSpace(s[b + 7]))) {
         defineConstant(line, b, defineLines);
       } else if (s[b] == '#') {
         int i = b + 1;
+        while (i < static_cast<int>(s.size()) && isSpace(s[i])) ++i;
         while (i < static_cast<int>(s.size()) && isIdentChar(s[i])) ++i;
         std::string word = s.substr(b, i - b);
-        error(line, b, "unknown directive '" + word + "'" + didYouMean(word, {"#define"}));
+        word.erase(std::remove_if(word.begin(), word.end(), [](char c) { return isSpace(c); }), word.end());
+        static const char* const kCpp[] = {"#include", "#ifdef", "#ifndef", "#if", "#else", "#elif", "#endif", "#undef", "#line", "#pragma", "#error"};
+        if (std::find(std::begin(kCpp), std::end(kCpp), word) != std::end(kCpp))
+          error(line, b, "cpfg's C preprocessor directive '" + word + "' is not supported (only '#define NAME constant' is)");
+        else
+          error(line, b, "unknown directive '" + word + "'" + didYouMean(word, {"#define"}));
       } else if (isModuleDeclaration(s, b)) {
         declareModules(line, b + 6);
       }
@@ -155,6 +208,10 @@ class GrammarParser {
       return;
     }
     std::string name = s.substr(nb, i - nb);
+    if (i < static_cast<int>(s.size()) && s[i] == '(') {
+      error(line, nb, "cpfg's function-like macro '#define " + name + "(...)' (C preprocessor) is not supported");
+      return;
+    }
     if (defineLines.count(name)) {
       error(line, nb, "'" + name + "' is already defined at line " + std::to_string(defineLines[name]));
       return;
@@ -163,6 +220,13 @@ class GrammarParser {
     Span value = scanner_.trim(Span{line, i, static_cast<int>(s.size())});
     if (value.b == value.e) {
       error(line, i, "expected a value after '#define " + name + "'");
+      return;
+    }
+    // cpp's textual macros: a module string (`#define LEAF [+F]~l`) is not an expression.
+    const std::string_view text = scanner_.view(value);
+    if (text.find_first_of("[]$@{}~") != std::string_view::npos || (text.find('?') != std::string_view::npos && text.find(':') == std::string_view::npos)) {
+      error(line, value.b, "cpfg's #define of a module string ('" + std::string(text) +
+                               "', a C preprocessor macro) is not supported: only constants are");
       return;
     }
     double v = 0;
@@ -214,14 +278,33 @@ class GrammarParser {
       const std::string& s = scanner_.line(line);
       int b = Scanner::firstNonSpace(s);
       if (b >= static_cast<int>(s.size())) continue;
-      if (s.compare(b, 10, "endlsystem") == 0) {
+      if (isEndLsystem(s, b)) {
         Span rest = scanner_.trim(Span{line, b + 10, static_cast<int>(s.size())});
         if (rest.b != rest.e) error(line, rest.b, "unexpected text after 'endlsystem'");
+        // Notes may follow; another `lsystem:` is cpfg's sub-L-system.
+        for (int k = line + 1; k <= scanner_.lineCount(); ++k) {
+          const std::string& t = scanner_.line(k);
+          const int tb = Scanner::firstNonSpace(t);
+          if (tb >= static_cast<int>(t.size())) continue;
+          if (auto h = Scanner::headerOf(t, tb); h && h->key == "lsystem") {
+            error(k, tb, "several L-systems in one file (cpfg's sub-L-systems) are not supported");
+            break;
+          }
+        }
         break;
       }
       if (s[b] == '#') continue;
       if (isModuleDeclaration(s, b)) continue;
+      if (auto bare = bareBlockKeyword(s, b)) {
+        handleHeader(line, b, *bare, block);
+        continue;
+      }
+      if (unsupportedHeader(line, b)) continue;
       auto header = Scanner::headerOf(s, b);
+      if (header && std::find(std::begin(kBlockHeaders), std::end(kBlockHeaders), header->key) != std::end(kBlockHeaders)) {
+        globalBlock(line, b, *header);
+        continue;
+      }
       bool known = header && std::find(std::begin(kHeaders), std::end(kHeaders), header->key) != std::end(kHeaders);
       if (known) {
         handleHeader(line, b, *header, block);
@@ -241,6 +324,60 @@ class GrammarParser {
     }
   }
 
+  /// cpfg's `Start: { statements };` (and `End:`, `StartEach:`, `EndEach:`) at column b of
+  /// line: compiled over the global variables, which it may add to.
+  void globalBlock(int line, int b, const Header& h) {
+    const std::string& s = scanner_.line(line);
+    std::string key = h.key;
+    key.erase(std::remove(key.begin(), key.end(), ' '), key.end());
+    once(key, line, b);
+    Span v = scanner_.trim(Span{line, h.valueBegin, static_cast<int>(s.size())});
+    if (v.b == v.e || s[v.b] != '{') {
+      error(line, v.b, "expected '{ statements }' after '" + s.substr(b, h.valueBegin - b) + "'");
+      return;
+    }
+    int close = matching(line, v.b, v.e, '{', '}');
+    if (close < 0) {
+      error(line, v.b, "unclosed '{' of a statement block");
+      return;
+    }
+    Span rest = scanner_.trim(Span{line, close + 1, v.e});
+    if (rest.b != rest.e && !(rest.e == rest.b + 1 && s[rest.b] == ';')) {
+      error(line, rest.b, "unexpected text after the block");
+      return;
+    }
+    CodeRange& out = key == "start" ? prog_.startBlock : key == "end" ? prog_.endBlock
+                     : key == "starteach" ? prog_.startEachBlock : prog_.endEachBlock;
+    std::vector<std::string> names = prog_.globals;
+    expr_.setGlobals(nullptr);  // a block's own registers are the globals
+    inGlobalBlock_ = true;
+    const bool ok = statementBlock(line, v.b + 1, close, names, out);
+    inGlobalBlock_ = false;
+    expr_.setGlobals(&prog_.globals);
+    if (ok) prog_.globals = names;
+  }
+
+  /// Reports cpfg's headers Sprig does not implement (`Start:`, `define:`, `ring lsystem`)
+  /// at column b of line; true when the line was one.
+  bool unsupportedHeader(int line, int b) {
+    const std::string& s = scanner_.line(line);
+    auto header = Scanner::headerOf(s, b);
+    if (header)
+      for (const UnsupportedHeader& u : kUnsupportedHeaders)
+        if (header->key == u.key) {
+          error(line, b, std::string("cpfg's '") + u.shown + "' (" + u.what + ") is not supported");
+          return true;
+        }
+    std::string words;
+    for (int i = b; i < static_cast<int>(s.size()) && words.size() < 12; ++i)
+      if (!isSpace(s[i])) words += static_cast<char>(std::tolower(static_cast<unsigned char>(s[i])));
+    if (words == "ringlsystem" && Scanner::findArrow(s).first < 0) {
+      error(line, b, "cpfg's 'ring lsystem' (ring L-system) is not supported");
+      return true;
+    }
+    return false;
+  }
+
   /// Records header key at line; a second one is an error.
   void once(const std::string& key, int line, int col) {
     auto [it, inserted] = seen_.emplace(key, line);
@@ -253,6 +390,11 @@ class GrammarParser {
     Span value = scanner_.trim(Span{line, h.valueBegin, static_cast<int>(s.size())});
     std::string_view v = scanner_.view(value);
     if (h.key == "lsystem") {
+      if (seen_.count("lsystem")) {
+        error(line, b, "several L-systems in one file (cpfg's sub-L-systems) are not supported (the first is at line " +
+                           std::to_string(seen_["lsystem"]) + ")");
+        return;
+      }
       once(h.key, line, b);
       prog_.name = std::string(v);
     } else if (h.key == "derivation length") {
@@ -300,11 +442,23 @@ class GrammarParser {
       if (block != Block::Main) error(line, b, "'" + h.key + ":' belongs before the decomposition and interpretation blocks");
       std::vector<RawModule> mods;
       if (scanner_.tokenizeModules(line, value.b, value.e, mods)) {
+        bool open = false, close = false;
         for (const RawModule& m : mods) {
-          if (m.hasParens) error(line, m.col, "'" + h.key + ":' lists symbols without parameters");
-          else if (m.name == "[" || m.name == "]") error(line, m.col, "brackets cannot be ignored or considered: context matching always follows them");
-          else (h.key == "ignore" ? ignoreList_ : considerList_).push_back(prog_.symbols.intern(m.name));
+          if (m.hasParens) {
+            error(line, m.col, "'" + h.key + ":' lists symbols without parameters");
+          } else if (m.name == "[" || m.name == "]") {
+            // Sprig's context matching always follows brackets, which is what cpfg does when
+            // `consider:` lists them; ignoring them is not supported.
+            if (h.key == "ignore") error(line, m.col, "brackets cannot be ignored: context matching always follows them");
+            (m.name == "[" ? open : close) = true;
+          } else {
+            (h.key == "ignore" ? ignoreList_ : considerList_).push_back(prog_.symbols.intern(m.name));
+          }
         }
+        if (h.key == "consider" && prog_.dialect == Dialect::Cpfg && !(open && close))
+          error(line, value.b,
+                "cpfg's 'consider:' without '[' and ']' ignores brackets in context matching, which Sprig does not "
+                "support (it always follows them): list them, as in 'consider: " + std::string(scanner_.view(value)) + "[]'");
       }
       if (seen_.count("ignore") && seen_.count("consider") && h.key == (seen_["ignore"] < seen_["consider"] ? "consider" : "ignore"))
         error(line, b, "use either 'ignore:' or 'consider:', not both");
@@ -324,8 +478,8 @@ class GrammarParser {
       }
       once(block == Block::Decomposition ? "decomposition maximum depth" : "interpretation maximum depth", line, b);
       if (auto d = expr_.constant(value, "maximum depth")) {
-        if (*d < 1 || *d != std::floor(*d) || *d > 256)
-          error(line, value.b, "maximum depth must be a whole number from 1 to 256, got " + formatNumber(*d));
+        if (*d < 1 || *d != std::floor(*d) || *d > 1e6)
+          error(line, value.b, "maximum depth must be a whole number from 1 to 1000000, got " + formatNumber(*d));
         else
           (block == Block::Decomposition ? prog_.decomposition : prog_.interpretation).maxDepth = static_cast<int>(*d);
       }
@@ -368,7 +522,9 @@ class GrammarParser {
     }
     if (!scanner_.tokenizeModules(line, pred.b, pred.e, predMods)) return;
     if (predMods.size() != 1) {
-      error(line, predMods.size() > 1 ? predMods[1].col : pred.b, "a predecessor must be a single module");
+      error(line, predMods.size() > 1 ? predMods[1].col : pred.b,
+            predMods.size() > 1 ? "a predecessor must be a single module (cpfg's predecessors of several modules are not supported)"
+                                : "a predecessor must be a single module");
       return;
     }
     if (predMods[0].name == "[" || predMods[0].name == "]") {
@@ -395,9 +551,10 @@ class GrammarParser {
     }
     if (diags().items().size() != diagsBefore) return;
     expr_.clearRandom();
-    // Condition.
+    // Condition, with cpfg's statements around it: `{ before } cond { after }`.
     cond = scanner_.trim(cond);
-    if (colon >= 0 && cond.b == cond.e) error(line, colon, "missing condition after ':' (write '*' for none)");
+    if (scanner_.findTop(line, cond.b, cond.e, '{') >= 0 && !productionStatements(line, cond, varNames, p)) return;
+    if (colon >= 0 && cond.b == cond.e && !p.hasStatements()) error(line, colon, "missing condition after ':' (write '*' for none)");
     else if (cond.b != cond.e && !scanner_.isStar(cond)) {
       size_t before = prog_.code.size();
       if (expr_.compile(cond, varNames, "condition")) {
@@ -435,6 +592,240 @@ class GrammarParser {
     p.usesRandom = expr_.usesRandom();
     RuleSet& rs = block == Block::Main ? prog_.productions : block == Block::Decomposition ? prog_.decomposition : prog_.interpretation;
     rs.productions.push_back(std::move(p));
+  }
+
+  // ---- cpfg's statements ---------------------------------------------------------------
+
+  /// Index of the `close` matching the `open` at i of line (nesting counted), or -1.
+  int matching(int line, int i, int e, char open, char close) {
+    const std::string& s = scanner_.line(line);
+    int depth = 0;
+    for (int k = i; k < e; ++k) {
+      if (s[k] == open) ++depth;
+      else if (s[k] == close && --depth == 0) return k;
+    }
+    return -1;
+  }
+
+  /// Splits `{ before } cond { after }` (sp, the text between the production's `:` and
+  /// its arrow) and compiles the blocks into p; cond is narrowed to the condition. Locals
+  /// get registers after the formal parameters in varNames. False after an error.
+  bool productionStatements(int line, Span& cond, std::vector<std::string>& varNames, Production& p) {
+    const std::string& s = scanner_.line(line);
+    const size_t formalsCount = varNames.size();
+    int i = cond.b;
+    if (s[i] == '{') {
+      int close = matching(line, i, cond.e, '{', '}');
+      if (close < 0) {
+        error(line, i, "unclosed '{' of a statement block");
+        return false;
+      }
+      if (!statementBlock(line, i + 1, close, varNames, p.before)) return false;
+      i = close + 1;
+    }
+    int brace = scanner_.findTop(line, i, cond.e, '{');
+    Span c = scanner_.trim(Span{line, i, brace >= 0 ? brace : cond.e});
+    if (brace >= 0) {
+      int close = matching(line, brace, cond.e, '{', '}');
+      if (close < 0) {
+        error(line, brace, "unclosed '{' of a statement block");
+        return false;
+      }
+      if (!statementBlock(line, brace + 1, close, varNames, p.after)) return false;
+      Span rest = scanner_.trim(Span{line, close + 1, cond.e});
+      if (rest.b != rest.e) {
+        error(line, rest.b, "unexpected text after the statements (expected the arrow '-->')");
+        return false;
+      }
+    }
+    if (c.b == c.e) c = Span{line, c.b, c.b};
+    cond = c;
+    p.localFirst = static_cast<uint16_t>(formalsCount);
+    p.localCount = static_cast<uint16_t>(varNames.size() - formalsCount);
+    return true;
+  }
+
+  /// Compiles the statements of line[b, e) (inside one `{ }`) into a block of its own code.
+  bool statementBlock(int line, int b, int e, std::vector<std::string>& varNames, CodeRange& out) {
+    const uint32_t begin = static_cast<uint32_t>(prog_.code.size());
+    if (!statementList(line, b, e, varNames, begin)) {
+      prog_.code.resize(begin);
+      return false;
+    }
+    if (prog_.code.size() == begin) return true;  // `{ }`
+    out = CodeRange{begin, static_cast<uint32_t>(prog_.code.size())};
+    return true;
+  }
+
+  /// Appends a jump (op Jz or Jmp) to target (counted from base); returns its index.
+  size_t jump(Op op, uint32_t base, double target) {
+    Instr in;
+    in.op = op;
+    in.c = target - base;
+    prog_.code.push_back(in);
+    return prog_.code.size() - 1;
+  }
+  void patch(size_t at, uint32_t base) { prog_.code[at].c = static_cast<double>(prog_.code.size() - base); }
+
+  /// The first column from i of line[.., e) that is not white space (e when none).
+  int nextNonSpace(int line, int i, int e) const {
+    const std::string& s = scanner_.line(line);
+    while (i < e && isSpace(s[i])) ++i;
+    return i;
+  }
+
+  /// The word (identifier) at i of line, or empty.
+  std::string wordAt(int line, int i, int e) const {
+    const std::string& s = scanner_.line(line);
+    int j = i;
+    if (j < e && isIdentStart(s[j]))
+      while (j < e && isIdentChar(s[j])) ++j;
+    return s.substr(i, j - i);
+  }
+
+  /// `( expr )` at i: compiles expr; returns the index after `)`, or -1 after an error.
+  int parenthesized(int line, int i, int e, const std::vector<std::string>& varNames, const char* what) {
+    const std::string& s = scanner_.line(line);
+    while (i < e && isSpace(s[i])) ++i;
+    if (i >= e || s[i] != '(') {
+      error(line, i, std::string("expected '(' after '") + what + "'");
+      return -1;
+    }
+    int close = matching(line, i, e, '(', ')');
+    if (close < 0) {
+      error(line, i, "missing ')'");
+      return -1;
+    }
+    Span c = scanner_.trim(Span{line, i + 1, close});
+    if (c.b == c.e) {
+      error(line, i, std::string("missing condition of '") + what + "'");
+      return -1;
+    }
+    if (!expr_.compile(c, varNames, "condition")) return -1;
+    return close + 1;
+  }
+
+  /// `{ statements }` at i: compiles them; returns the index after `}`, or -1.
+  int braced(int line, int i, int e, std::vector<std::string>& varNames, uint32_t base, const char* after) {
+    const std::string& s = scanner_.line(line);
+    while (i < e && isSpace(s[i])) ++i;
+    if (i >= e || s[i] != '{') {
+      error(line, i, std::string("expected '{' after '") + after + "' (cpfg requires braces)");
+      return -1;
+    }
+    int close = matching(line, i, e, '{', '}');
+    if (close < 0) {
+      error(line, i, "unclosed '{'");
+      return -1;
+    }
+    if (!statementList(line, i + 1, close, varNames, base)) return -1;
+    return close + 1;
+  }
+
+  /// Statements `x = expr;`, `if (c) {...} [else {...}]`, `while (c) {...}`,
+  /// `do {...} while (c);` of line[b, e) (cpfg reference manual, 3.2), appended to the code.
+  bool statementList(int line, int b, int e, std::vector<std::string>& varNames, uint32_t base) {
+    const std::string& s = scanner_.line(line);
+    int i = b;
+    for (;;) {
+      while (i < e && (isSpace(s[i]) || s[i] == ';')) ++i;
+      if (i >= e) return true;
+      const std::string word = wordAt(line, i, e);
+      if (word.empty()) {
+        error(line, i, std::string("expected a statement (an assignment, 'if', 'while' or 'do'), got '") + s[i] + "'");
+        return false;
+      }
+      const int at = i;
+      i += static_cast<int>(word.size());
+      if (word == "if") {
+        if ((i = parenthesized(line, i, e, varNames, "if")) < 0) return false;
+        size_t jz = jump(Op::Jz, base, 0);
+        if ((i = braced(line, i, e, varNames, base, "if (...)")) < 0) return false;
+        int k = i;
+        while (k < e && isSpace(s[k])) ++k;
+        if (wordAt(line, k, e) == "else") {
+          size_t jmp = jump(Op::Jmp, base, 0);
+          patch(jz, base);
+          if ((i = braced(line, k + 4, e, varNames, base, "else")) < 0) return false;
+          patch(jmp, base);
+        } else {
+          patch(jz, base);
+        }
+      } else if (word == "while") {
+        const double top = static_cast<double>(prog_.code.size());
+        if ((i = parenthesized(line, i, e, varNames, "while")) < 0) return false;
+        size_t jz = jump(Op::Jz, base, 0);
+        if ((i = braced(line, i, e, varNames, base, "while (...)")) < 0) return false;
+        jump(Op::Jmp, base, top);
+        patch(jz, base);
+      } else if (word == "do") {
+        const double top = static_cast<double>(prog_.code.size());
+        if ((i = braced(line, i, e, varNames, base, "do")) < 0) return false;
+        while (i < e && isSpace(s[i])) ++i;
+        if (wordAt(line, i, e) != "while") {
+          error(line, i, "expected 'while (...)' after 'do { ... }'");
+          return false;
+        }
+        if ((i = parenthesized(line, i + 5, e, varNames, "while")) < 0) return false;
+        Instr notOp;
+        notOp.op = Op::Not;
+        prog_.code.push_back(notOp);
+        jump(Op::Jz, base, top);
+      } else if (const int k = nextNonSpace(line, i, e); k < e && s[k] == '(') {
+        // A call alone, `f(...);` (cpfg's printf, srand, ...): its value is dropped.
+        int end = scanner_.findTop(line, at, e, ';');
+        if (end < 0) {
+          error(line, at, "missing ';' after the call of '" + word + "' (cpfg requires one after every statement)");
+          return false;
+        }
+        if (!expr_.compile(scanner_.trim(Span{line, at, end}), varNames, "statement")) return false;
+        jump(Op::Jz, base, static_cast<double>(prog_.code.size() + 1));  // pops the value, jumps to the next instruction
+        i = end + 1;
+      } else {
+        // Assignment `name = expression;`.
+        while (i < e && isSpace(s[i])) ++i;
+        if (i >= e || s[i] != '=' || (i + 1 < e && s[i + 1] == '=')) {
+          error(line, i, "expected '=' after '" + word + "' (statements are assignments, 'if', 'while' and 'do')");
+          return false;
+        }
+        int end = scanner_.findTop(line, i + 1, e, ';');
+        if (end < 0) {
+          error(line, at, "missing ';' after the assignment to '" + word + "' (cpfg requires one after every statement)");
+          return false;
+        }
+        Span value = scanner_.trim(Span{line, i + 1, end});
+        if (value.b == value.e) {
+          error(line, i, "missing value after '" + word + " ='");
+          return false;
+        }
+        if (defines_.count(word)) {
+          error(line, at, "cannot assign to '" + word + "': it is a #define");
+          return false;
+        }
+        auto known = std::find(varNames.begin(), varNames.end(), word);
+        if (!inGlobalBlock_ && known == varNames.end() &&
+            std::find(prog_.globals.begin(), prog_.globals.end(), word) != prog_.globals.end()) {
+          error(line, at, "cannot assign the global variable '" + word +
+                              "' in a production (Sprig assigns globals only in 'Start:', 'StartEach:', 'EndEach:' and 'End:' blocks)");
+          return false;
+        }
+        if (!expr_.compile(value, varNames, "value")) return false;
+        auto it = std::find(varNames.begin(), varNames.end(), word);
+        if (it == varNames.end()) {
+          if (varNames.size() >= static_cast<size_t>(kMaxVars) - (inGlobalBlock_ ? 0 : prog_.globals.size())) {
+            error(line, at, "too many parameters and local variables in one production (at most " + std::to_string(kMaxVars) + ")");
+            return false;
+          }
+          varNames.push_back(word);
+          it = varNames.end() - 1;
+        }
+        Instr store;
+        store.op = Op::Store;
+        store.var = static_cast<uint16_t>(it - varNames.begin());
+        prog_.code.push_back(store);
+        i = end + 1;
+      }
+    }
   }
 
   /// Open brackets of a module string being checked (bracketModule, bracketEnd).
@@ -489,6 +880,7 @@ class GrammarParser {
   /// per module.
   void noteWritten(int line, const RawModule& m) {
     const size_t n = m.args.size();
+    if (n == 0 && m.name.size() == 1 && std::string_view("+-&^\\/").find(m.name[0]) != std::string_view::npos) prog_.bareTurn = true;
     uint8_t* seen = m.name.size() == 1 && n < 8 ? &writtenSingle_[static_cast<unsigned char>(m.name[0])] : nullptr;
     if (seen && (*seen >> n & 1)) return;
     written_[m.name].emplace(static_cast<int>(n), std::pair{line, m.col});
@@ -585,8 +977,9 @@ class GrammarParser {
         error(a.line, a.b, "parameter '" + name + "' is already used in this production");
       } else if (defines_.count(name)) {
         error(a.line, a.b, "parameter '" + name + "' has the name of a #define");
-      } else if (varNames.size() >= static_cast<size_t>(detail::kMaxVars)) {
-        error(a.line, a.b, "too many parameters in one production (at most " + std::to_string(detail::kMaxVars) + ")");
+      } else if (varNames.size() + prog_.globals.size() >= static_cast<size_t>(detail::kMaxVars)) {
+        error(a.line, a.b, "too many parameters in one production (at most " + std::to_string(detail::kMaxVars) +
+                               " with the global variables)");
       }
       varNames.push_back(name);
     }
@@ -688,6 +1081,7 @@ class GrammarParser {
   std::vector<double> params_;  ///< scratch parameters of appendConstant
   std::array<uint8_t, 256> writtenSingle_{};  ///< per byte: bit n set when written with n parameters
   std::vector<SymbolId> ignoreList_, considerList_;
+  bool inGlobalBlock_ = false;  ///< compiling a Start/End block: its variables are the globals
   /// A predecessor or context module with its parameter count, checked by checkArities().
   struct ArityUse {
     std::string name;

@@ -17,6 +17,7 @@
 #include "core/diagnostics.h"
 #include "core/rng.h"
 #include "core/types.h"
+#include "lsystem/detail/cpfg.h"
 #include "lsystem/module_string.h"
 
 namespace sprig::lsystem::detail {
@@ -28,7 +29,48 @@ enum class Op : uint8_t {
   Const, Var, Add, Sub, Mul, Div, Pow, Neg, Not, Lt, Le, Gt, Ge, Eq, Ne, And, Or,
   Sin, Cos, Tan, Asin, Acos, Atan, Atan2, Sqrt, Exp, Log, PowFn, Abs, Min, Max, Floor, Ceil, Sign,
   Ran, Nran,
+  Select,  ///< `c ? a : b` (three operands, both evaluated)
+  Round,   ///< cpfg's `trunc(x)`: floor(x + 0.5) (cpfg rounds, whatever the name says)
+  Rem,     ///< cpfg's `a % b`: the remainder of the operands truncated to integers
+  Bran,    ///< `bran(a, b)`: a beta(a, b) draw
+  Biran,   ///< `biran(n, p)`: a binomial(n, p) draw
+  // Statements (cpfg's `{ x = ...; if (...) {...} }` blocks); never inside an expression.
+  Store,   ///< pops a value into register var
+  Jz,      ///< pops a value; when it is 0, jumps to instruction c of the block
+  Jmp,     ///< jumps to instruction c of the block
 };
+
+/// Most backward jumps one statement block may take (a `while` that never ends): past it
+/// evalCode stops and returns NaN, which the deriver reports.
+inline constexpr long kMaxLoopJumps = 10'000'000;
+
+/// A draw from the beta(a, b) distribution, by R.C.H. Cheng's rejection algorithm BA
+/// ("Generating beta variates with nonintegral shape parameters", CACM 21(4), 1978).
+/// NaN for non-positive shapes (the caller reports non-finite values).
+inline double betaDraw(Rng& rng, double a, double b) {
+  if (!(a > 0) || !(b > 0)) return std::nan("");
+  const double alpha = a + b;
+  const double beta = std::min(a, b) <= 1 ? std::min(a, b) : std::sqrt((alpha - 2) / (2 * a * b - alpha));
+  const double lambda = std::min(a, b) <= 1 ? std::min(a, b) : 1 / beta;
+  const double gamma = a + lambda;
+  for (int tries = 0; tries < 100000; ++tries) {
+    double u1 = rng.uniform(), u2 = rng.uniform();
+    if (u1 <= 0 || u1 >= 1 || u2 <= 0) continue;
+    const double v = std::log(u1 / (1 - u1)) / lambda;
+    const double w = a * std::exp(v);
+    if (alpha * std::log(alpha / (b + w)) + gamma * v - std::log(4.0) >= std::log(u1 * u1 * u2)) return w / (b + w);
+  }
+  return std::nan("");
+}
+
+/// A draw from the binomial(n, p) distribution: n trials, each a success with probability p.
+inline double binomialDraw(Rng& rng, double n, double p) {
+  if (!(n >= 0) || n > 1e7) return std::nan("");  // beyond 10^7 trials: a non-finite value
+  const long trials = static_cast<long>(n);
+  long k = 0;
+  for (long t = 0; t < trials; ++t) k += rng.uniform() <= p;
+  return static_cast<double>(k);
+}
 
 /// One bytecode instruction: push a constant or variable, or pop operands and push a result.
 struct Instr {
@@ -44,11 +86,14 @@ struct CodeRange {
   bool empty() const { return begin == end; }
 };
 
-/// Evaluates one expression. rng is used only by Ran/Nran (never null when the
-/// expression draws: the compiler marks such productions usesRandom).
+/// Evaluates one expression, or runs one statement block (Store, Jz, Jmp write into vars,
+/// which must then be writable; jump targets count from code; a block returns 0, or NaN
+/// after kMaxLoopJumps backward jumps). rng is used only by the random draws (never null
+/// when the code draws: the compiler marks such productions usesRandom).
 inline double evalCode(const Instr* code, const Instr* end, const double* vars, Rng* rng) {
   double stack[kMaxStack];
   int sp = 0;
+  long backJumps = 0;
   constexpr double kDeg = kPi / 180.0;
   for (const Instr* in = code; in != end; ++in) {
     switch (in->op) {
@@ -87,9 +132,29 @@ inline double evalCode(const Instr* code, const Instr* end, const double* vars, 
       case Op::Sign: stack[sp - 1] = stack[sp - 1] > 0 ? 1.0 : (stack[sp - 1] < 0 ? -1.0 : 0.0); break;
       case Op::Ran: stack[sp - 1] = rng->uniform() * stack[sp - 1]; break;
       case Op::Nran: --sp; stack[sp - 1] = rng->normal(stack[sp - 1], stack[sp]); break;
+      case Op::Select: sp -= 2; stack[sp - 1] = stack[sp - 1] != 0.0 ? stack[sp] : stack[sp + 1]; break;
+      case Op::Round: stack[sp - 1] = std::floor(stack[sp - 1] + 0.5); break;
+      case Op::Rem: {
+        --sp;
+        const double a = std::trunc(stack[sp - 1]), b = std::trunc(stack[sp]);
+        stack[sp - 1] = b == 0.0 || !std::isfinite(a) ? std::nan("") : std::fmod(a, b);
+        break;
+      }
+      case Op::Bran: --sp; stack[sp - 1] = betaDraw(*rng, stack[sp - 1], stack[sp]); break;
+      case Op::Biran: --sp; stack[sp - 1] = binomialDraw(*rng, stack[sp - 1], stack[sp]); break;
+      case Op::Store: const_cast<double*>(vars)[in->var] = stack[--sp]; break;
+      case Op::Jz:
+        if (stack[--sp] != 0.0) break;
+        [[fallthrough]];
+      case Op::Jmp: {
+        const Instr* to = code + static_cast<ptrdiff_t>(in->c);
+        if (to <= in && ++backJumps > kMaxLoopJumps) return std::nan("");
+        in = to - 1;  // the loop's ++in lands on the target
+        break;
+      }
     }
   }
-  return stack[0];
+  return sp > 0 ? stack[sp - 1] : 0.0;
 }
 
 /// How one successor parameter is computed.
@@ -130,6 +195,11 @@ struct Production {
   std::vector<PatternItem> left;   ///< in textual order
   std::vector<PatternItem> right;  ///< in textual order
   CodeRange condition;             ///< empty: always true
+  CodeRange before;                ///< cpfg's statements before the condition (`{ ... } cond`)
+  CodeRange after;                 ///< cpfg's statements after it (`cond { ... }`), run when the production applies
+  uint16_t localFirst = 0;         ///< registers of the statements' local variables (zeroed before `before`)
+  uint16_t localCount = 0;
+  bool hasStatements() const { return !before.empty() || !after.empty(); }
   std::vector<SuccModule> successor;
   std::vector<Arg> args;
   bool stochastic = false;
@@ -185,7 +255,7 @@ struct RuleSet {
       }
       if (bySymbol[s].size() == 1) {
         const Production& p = productions[bySymbol[s][0]];
-        if (!p.hasContext() && p.condition.empty() && !p.stochastic) r.simple = &p;
+        if (!p.hasContext() && p.condition.empty() && !p.stochastic && !p.hasStatements()) r.simple = &p;
       }
       if (!r.simple && r.count) buildDispatch(s, r);
     }
@@ -196,7 +266,7 @@ struct RuleSet {
     std::vector<SymbolId> used;
     for (uint32_t idx : bySymbol[s]) {
       const Production& p = productions[idx];
-      if (!p.simpleCtx || !p.condition.empty() || p.stochastic || p.predParams) return;
+      if (!p.simpleCtx || !p.condition.empty() || p.stochastic || p.predParams || p.hasStatements()) return;
       for (const auto* side : {&p.left, &p.right})
         for (const PatternItem& it : *side) {
           if (it.paramCount) return;
@@ -236,6 +306,16 @@ struct Program {
   uint64_t seed = 0;
   bool hasAngle = false;
   double angleDeg = 0;
+  Dialect dialect = Dialect::Sprig;  ///< the notation the file is read in (by its extension)
+  /// True when the axiom or a successor turns without an angle (`+`, `&`, ...), so that
+  /// the default angle matters.
+  bool bareTurn = false;
+  /// cpfg's global variables, in order of first assignment in the blocks below: global k
+  /// is register k while a block runs, and register kMaxVars - 1 - k of every production.
+  std::vector<std::string> globals;
+  /// cpfg's blocks: `Start:` (before the derivation), `StartEach:` and `EndEach:` (around
+  /// every step), `End:` (after the last step).
+  CodeRange startBlock, startEachBlock, endEachBlock, endBlock;
   SymbolTable symbols;
   ModuleString axiom;
   std::vector<std::pair<std::string, double>> defines;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <tuple>
 
 namespace sprig::lsystem::detail {
 
@@ -71,9 +72,44 @@ void Scanner::load(std::string_view text) {
   }
   clean_ = splitAtNewlines(clean);
   raw_ = splitAtNewlines(std::string(text));
+  pieces_.assign(clean_.size(), {});
+  if (dialect_ != Dialect::Cpfg) return;
+  // cpfg's lexer reads a newline followed by a tab as white space: the line goes on. A
+  // line that opens a `{` statement block after a `:` (and has no arrow yet) also goes on
+  // until its braces close, so that the block is reported once, at its `{`.
+  int open = 0;  // logical line being continued (0-based), -1 for none
+  open = -1;
+  for (size_t k = 0; k < clean_.size(); ++k) {
+    const std::string& t = clean_[k];
+    bool continues = open >= 0 && (!t.empty() && t[0] == '\t');
+    if (open >= 0 && !continues) {
+      const std::string& o = clean_[open];
+      int depth = 0;
+      for (char c : o) depth += c == '{' ? 1 : c == '}' ? -1 : 0;
+      continues = depth > 0 && o.find(':') != std::string::npos && findArrow(o).first < 0 && !t.empty();
+    }
+    if (continues) {
+      std::string& o = clean_[open];
+      pieces_[open].push_back({static_cast<int>(o.size()) + 1, static_cast<int>(k) + 1, 0});
+      o += ' ';
+      o += t;
+      clean_[k].clear();
+    } else {
+      open = static_cast<int>(k);
+    }
+  }
+}
+
+std::pair<int, int> Scanner::physical(int line, int col0) const {
+  if (line < 1 || line > static_cast<int>(pieces_.size())) return {line, col0};
+  std::pair<int, int> at{line, col0};
+  for (const Piece& p : pieces_[line - 1])
+    if (col0 >= p.offset) at = {p.line, p.col + col0 - p.offset};
+  return at;
 }
 
 void Scanner::error(int line, int col0, std::string msg) {
+  std::tie(line, col0) = physical(line, col0);
   diags_.error(SourceLoc{fileName_, line, col0 + 1}, std::move(msg),
                line >= 1 && line <= static_cast<int>(raw_.size()) ? raw_[line - 1] : "");
 }
@@ -101,7 +137,7 @@ bool Scanner::tokenizeModules(int line, int b, int e, const std::function<void(c
   while (i < e) {
     if (isSpace(s[i])) { ++i; continue; }
     char c = s[i];
-    if (c == '(' || c == ')' || c == ',') {
+    if (c == '(' || c == ')') {
       error(line, i, c == ')' ? "unmatched ')'" : std::string("unexpected '") + c + "' (parameters must follow a module name)");
       return false;
     }
@@ -150,6 +186,11 @@ bool Scanner::tokenizeModules(int line, int b, int e, const std::function<void(c
             ok = false;
           }
       i = k + 1;
+    }
+    const size_t nameEnd = static_cast<size_t>(m.col) + m.name.size();
+    if (auto why = cpfgUnsupported(m.name, m.args.size(), m.hasParens, nameEnd < s.size() ? s[nameEnd] : '\0', dialect_)) {
+      error(line, m.col, *why);
+      return false;
     }
     each(m);
   }

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "core/diagnostics.h"
+#include "lsystem/detail/cpfg.h"
 
 namespace sprig::lsystem::detail {
 
@@ -77,8 +78,11 @@ class Scanner {
   /// The diagnostics reported so far.
   DiagnosticList& diagnostics() { return diags_; }
   const DiagnosticList& diagnostics() const { return diags_; }
-  /// Reports an error at line (1-based), col0 (0-based), quoting the raw line.
+  /// Reports an error at line (1-based), col0 (0-based), quoting the raw line. A column in
+  /// a continued line's continuation is reported at its own line.
   void error(int line, int col0, std::string msg);
+  /// The physical (line, 0-based column) of column col0 of logical line `line`.
+  std::pair<int, int> physical(int line, int col0) const;
 
   /// sp without leading and trailing white space.
   Span trim(Span sp) const;
@@ -91,6 +95,10 @@ class Scanner {
   void addMultiName(std::string_view name);
   /// Forgets every multi-character module name.
   void clearMultiNames() { multiNames_.clear(); }
+  /// The notation modules are read in: the tokenizer reports cpfg commands Sprig does not
+  /// implement in it (lsystem/detail/cpfg.h) as errors at their position.
+  void setDialect(Dialect d) { dialect_ = d; }
+  Dialect dialect() const { return dialect_; }
   /// Splits line(line)[b, e) into modules, appending them to out. Reports errors; returns
   /// false on an error that stops the line (a stray `(`, `)` or `,`, a missing `)`) or
   /// after reporting empty parameters.
@@ -116,8 +124,17 @@ class Scanner {
  private:
   std::string fileName_;
   std::vector<std::string> raw_, clean_;
+  /// A piece of a logical line that came from another line of the file (cpfg dialect:
+  /// a line starting with a tab continues the one before it): from column `offset` of the
+  /// logical line on, the text is line `line`'s from column `col` (all 0-based but line).
+  struct Piece {
+    int offset, line, col;
+  };
+  /// Per logical line with continuations: its pieces after the first (empty for most).
+  std::vector<std::vector<Piece>> pieces_;
   std::vector<std::string> multiNames_;
   std::pair<int, int> pendingComment_{0, 0};
+  Dialect dialect_ = Dialect::Sprig;
   DiagnosticList diags_;
 };
 

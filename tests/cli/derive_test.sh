@@ -7,7 +7,10 @@
 #   3. determinism: the same stochastic grammar and seed give the same bytes (stdout of
 #      --print and --json, the --skeleton file) in two runs and at --threads 1, 2 and 0,
 #      and a different seed gives different bytes;
-#   4. a species file and its bare grammar agree on the derivation.
+#   4. a species file and its bare grammar agree on the derivation;
+#   5. cpfg: a vlab object folder is read through its `specifications` (tree.l with view.v's
+#      angle factor 12, i.e. 30 degrees: 3 internodes, the top at 1 + cos 30), and a bare
+#      `.l` without a view file draws with cpfg's 45 degrees and says so in a note.
 # Usage: tests/cli/derive_test.sh path/to/sprig   (run from the repository root)
 set -euo pipefail
 SPRIG=$(realpath "$1")
@@ -68,5 +71,15 @@ cmp -s "$WORK/a.out" "$WORK/s42.out" || fail "--seed 42 differs from the grammar
 # species/abop_1_24a.yaml names the same grammar at the same n.
 js=$(sprig derive species/abop_1_24a.yaml --json | grep -o '^{"steps": [0-9]*, "modules": [0-9]*')
 [ "$js" = '{"steps": 5, "modules": 7811' ] || fail "species/abop_1_24a.yaml: $js"
+
+# --- 5. cpfg objects ------------------------------------------------------------------------
+jo=$(sprig derive tests/assets/cpfg/object_folder --json)
+echo "$jo" | grep -q '^{"steps": 2, "modules": 25, ' || fail "vlab folder: $jo"
+echo "$jo" | grep -q '"internodes": 3, "total_length": 3, ' || fail "vlab folder internodes: $jo"
+echo "$jo" | grep -q '"max": \[0.55[0-9]*, 1.926025403784438[0-9]*, 0.06\]' || fail "vlab folder: not 30 degrees: $jo"
+"$SPRIG" derive tests/assets/cpfg/no_view/plant.l --json >"$WORK/nv.out" 2>"$WORK/nv.err" || fail "no_view/plant.l failed"
+grep -q '"end": \[-0.7071067811865475, 1.7071067811865475, 0\]}$' "$WORK/nv.out" || fail "no view file: not 45 degrees: $(cat "$WORK/nv.out")"
+grep -qF "tests/assets/cpfg/no_view/plant.l: note: no view file 'plant.v' beside it: using cpfg's defaults: angle increment 45," "$WORK/nv.err" ||
+  fail "no note about cpfg's defaults: $(cat "$WORK/nv.err")"
 
 echo "cli_derive: all checks passed"

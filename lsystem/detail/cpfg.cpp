@@ -1,0 +1,80 @@
+#include "lsystem/detail/cpfg.h"
+
+#include <algorithm>
+#include <iterator>
+
+namespace sprig::lsystem::detail {
+
+namespace {
+
+/// A cpfg command Sprig reads as one module but does not implement, with what it does.
+struct Unsupported {
+  const char* name;
+  const char* what;
+};
+
+constexpr Unsupported kUnsupported[] = {
+    {"@Gs", "generalized cylinder"},
+    {"@Gc", "generalized cylinder"},
+    {"@Ge", "generalized cylinder"},
+    {"@Gt", "generalized cylinder tangents"},
+    {"@Gr", "generalized cylinder radius tangents"},
+    {"@#", "contour of generalized cylinders"},
+    {"@Tx", "texture"},
+    {"@bo", "circle boundary"},
+    {"@bc", "circle boundary"},
+    {"@PS", "L-system defined surface patch"},
+    {"@PC", "L-system defined surface patch"},
+    {"@PD", "L-system defined surface patch"},
+    {"@L", "label"},
+    {"@S", "system call"},
+    {"@I", "rayshade object"},
+    {"@J", "rayshade grid"},
+    {"@mo", "rayshade object"},
+    {"@mc", "conditional cut"},
+    {"@;", "back-side color"},
+    {"@,", "back-side color"},
+    {"?P", "query module"},
+    {"?H", "query module"},
+    {"?L", "query module"},
+    {"?U", "query module"},
+    {"?E", "communication with an environment program"},
+};
+
+}  // namespace
+
+const char* const kCpfgMultiNames[] = {
+    "@Gs", "@Gc", "@Ge", "@Gt", "@Gr", "@Ts", "@Ti", "@Td", "@Tp", "@Tf", "@Tx", "@bo", "@bc", "@PS",
+    "@PC", "@PD", "@Di", "@Dd", "@mo", "@mc", "@O",  "@o",  "@c",  "@v",  "@R",  "@M",  "@L",  "@S",
+    "@I",  "@J",  "@D",  "@#",  "@!",  "@;",  "@,",  "?P",  "?H",  "?L",  "?U",  "?E",
+};
+const size_t kCpfgMultiNameCount = std::size(kCpfgMultiNames);
+
+Dialect dialectOf(std::string_view fileName) {
+  return fileName.size() > 2 && fileName.substr(fileName.size() - 2) == ".l" ? Dialect::Cpfg : Dialect::Sprig;
+}
+
+std::optional<std::string> cpfgUnsupported(std::string_view name, size_t args, bool hasParens, char next,
+                                           Dialect dialect) {
+  auto notSupported = [&](std::string_view shown, const char* what) {
+    return "cpfg's '" + std::string(shown) + "' (" + what + ") is not supported";
+  };
+  for (const Unsupported& u : kUnsupported)
+    if (name == u.name) return notSupported(name, u.what);
+  if (name == "@") {
+    std::string shown = "@";
+    if (next && next != '(' && next != ' ' && next != '\t') shown += next;
+    return "unknown cpfg command '" + shown + "'";
+  }
+  if (name == "?") return notSupported(hasParens ? "?(n, scale)" : "?", "sub-L-system call");
+  if ((name == "{" || name == "}" || name == ".") && hasParens && args > 0)
+    return notSupported(std::string(name) + "(type)", "generalized cylinder");
+  if (name == "%" && hasParens && args > 0) return notSupported("%(n)", "substring move");
+  if (dialect == Dialect::Cpfg) {
+    if (name == "$") return notSupported("$", "end of a sub-L-system call; ABOP's roll to vertical is '@v' in cpfg");
+    if (name == "~" || (name.size() > 1 && name[0] == '~')) return notSupported("~", "surface from a view file's surface file");
+  }
+  return std::nullopt;
+}
+
+}  // namespace sprig::lsystem::detail

@@ -1,0 +1,393 @@
+#include "lsystem/view_file.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <iterator>
+#include <sstream>
+
+#include "core/atomic_file.h"
+#include "core/text.h"
+
+namespace sprig::lsystem {
+
+namespace {
+
+/// Keys that only change how cpfg's window shows the model: read and ignored, with a warning.
+const char* const kViewerKeys[] = {
+    "viewpoint",          "view reference point", "twist",          "projection",
+    "front distance",     "back distance",        "scale factor",   "z buffer",
+    "cue range",          "shade mode",           "light direction", "diffuse reflection",
+    "surface ambient",    "surface diffuse",      "box",            "background color",
+    "ambient light",      "font",                 "winfont",        "polygonization level",
+    "light",              "render mode",          "tapered lines",  "contour sides",
+    "viewing angle",      "twist of cylinders",   "interpretation step", "environment display",
+    "antialiasing",       "min zoom",             "max zoom",       "generate on view change",
+    "concave polygons",   "shadow map",           "PS linecap",     "rayshade objects",
+    "rayshade scale",     "texture",              "interpretation past %",
+};
+
+/// Keys naming files whose uses (`~`, `func`, `curveX`, `@#`, `inblob`) are errors in the
+/// grammar: not read, with a warning.
+const char* const kFileKeys[] = {"surface", "tsurface", "contour", "function", "function set", "curve", "blob"};
+
+/// Keys that would change the geometry and that Sprig does not implement, with what they do.
+struct UnsupportedKey {
+  const char* key;
+  const char* what;
+};
+constexpr UnsupportedKey kUnsupportedKeys[] = {
+    {"line", "F drawn as a surface"},
+    {"background scene", "geometry from background files"},
+};
+
+const char* const kReadKeys[] = {
+    "angle factor",  "angle increment",   "initial color", "color increment", "initial line width",
+    "line width increment", "line style", "initial scale", "scale multiplier", "tropism", "torque",
+    "tropism direction", "initial elasticity", "elasticity increment",
+};
+
+/// The view file's text with `/* */` comments blanked (newlines kept, so positions hold).
+std::string blankComments(std::string s, int& openLine) {
+  openLine = 0;
+  int line = 1;
+  for (size_t i = 0; i < s.size(); ++i) {
+    if (s[i] == '\n') ++line;
+    if (s[i] == '/' && i + 1 < s.size() && s[i + 1] == '*') {
+      const int start = line;
+      size_t j = i + 2;
+      while (j + 1 < s.size() && !(s[j] == '*' && s[j + 1] == '/')) ++j;
+      const bool closed = j + 1 < s.size();
+      const size_t end = closed ? j + 2 : s.size();
+      for (size_t k = i; k < end; ++k)
+        if (s[k] != '\n') s[k] = ' ';
+        else ++line;
+      if (!closed) openLine = start;
+      i = end - 1;
+      if (i < s.size() && s[i] == '\n') --line;  // counted by the loop
+    }
+  }
+  return s;
+}
+
+/// The numbers of text, separated by spaces, tabs or commas; nullopt when a word is no number.
+std::optional<std::vector<double>> numbers(const std::string& text) {
+  std::vector<double> out;
+  std::string word;
+  std::istringstream in(text);
+  std::string all;
+  for (char c : text) all += c == ',' ? ' ' : c;
+  std::istringstream words(all);
+  while (words >> word) {
+    auto v = parseFiniteNumber(word);
+    if (!v) return std::nullopt;
+    out.push_back(*v);
+  }
+  return out;
+}
+
+class ViewParser {
+ public:
+  explicit ViewParser(const std::string& fileName) { view_.file = fileName; }
+
+  ViewFile run(const std::string& text) {
+    int openLine = 0;
+    const std::string clean = blankComments(text, openLine);
+    if (openLine) diags_.error(SourceLoc{view_.file, openLine, 1}, "unterminated comment '/*'", lineOf(text, openLine));
+    const std::vector<std::string> raws = lines(text), cleans = lines(clean);
+    for (size_t k = 0; k < cleans.size(); ++k) {
+      raw_ = k < raws.size() ? raws[k] : std::string();
+      readLine(static_cast<int>(k) + 1, cleans[k]);
+    }
+    diags_.throwIfErrors();
+    if (!viewerKeys_.empty()) {
+      raw_ = viewerRaw_;
+      warn(viewerLine_, 0, "ignored, as they set how cpfg's window shows the model, not its geometry: " + viewerKeys_);
+    }
+    view_.warnings = warnings_;
+    return view_;
+  }
+
+ private:
+  /// text cut at its newlines, without a trailing `\r`.
+  static std::vector<std::string> lines(const std::string& text) {
+    std::vector<std::string> out;
+    std::istringstream in(text);
+    for (std::string l; std::getline(in, l);) {
+      if (!l.empty() && l.back() == '\r') l.pop_back();
+      out.push_back(std::move(l));
+    }
+    return out;
+  }
+
+  static std::string lineOf(const std::string& text, int line) {
+    std::istringstream in(text);
+    std::string l;
+    for (int k = 0; k < line && std::getline(in, l); ++k) {}
+    if (!l.empty() && l.back() == '\r') l.pop_back();
+    return l;
+  }
+
+  void error(int line, size_t col0, const std::string& msg) {
+    diags_.error(SourceLoc{view_.file, line, static_cast<int>(col0) + 1}, msg, raw_);
+  }
+  void warn(int line, size_t col0, const std::string& msg) {
+    Diagnostic d;
+    d.severity = Severity::Warning;
+    d.loc = SourceLoc{view_.file, line, static_cast<int>(col0) + 1};
+    d.message = msg;
+    d.sourceLine = raw_;
+    warnings_.push_back(std::move(d));
+  }
+
+  /// The numbers of value (at column col0 of line), exactly `min..max` of them, else an error.
+  std::optional<std::vector<double>> values(int line, size_t col0, const std::string& key, const std::string& value,
+                                            size_t min, size_t max) {
+    auto v = numbers(value);
+    if (!v || v->size() < min || v->size() > max) {
+      std::string want = min == max ? std::to_string(min) : std::to_string(min) + " to " + std::to_string(max);
+      error(line, col0, "'" + key + ":' expects " + want + (max == 1 ? " number" : " numbers") + ", got '" + trimmed(value) + "'");
+      return std::nullopt;
+    }
+    return v;
+  }
+
+  static std::string formatLimit(double v) { return std::to_string(static_cast<long>(v)); }
+
+  static std::string trimmed(const std::string& s) {
+    size_t b = s.find_first_not_of(" \t");
+    if (b == std::string::npos) return {};
+    size_t e = s.find_last_not_of(" \t");
+    return s.substr(b, e + 1 - b);
+  }
+
+  void readLine(int line, const std::string& s) {
+    const size_t b = s.find_first_not_of(" \t");
+    if (b == std::string::npos) return;
+    if (s[b] == '#') {
+      size_t e = b + 1;
+      while (e < s.size() && std::isalpha(static_cast<unsigned char>(s[e]))) ++e;
+      error(line, b, "C preprocessor directive '" + s.substr(b, e - b) + "' in a view file is not supported");
+      return;
+    }
+    const size_t colon = s.find(':', b);
+    if (colon == std::string::npos) {
+      error(line, b, "expected a view file command such as 'angle increment: 30'");
+      return;
+    }
+    std::string key;
+    for (size_t i = b; i < colon; ++i) {
+      const char c = s[i] == '\t' ? ' ' : s[i];
+      if (c == ' ' && (key.empty() || key.back() == ' ')) continue;
+      key += c;
+    }
+    while (!key.empty() && key.back() == ' ') key.pop_back();
+    const std::string value = s.substr(colon + 1);
+    const size_t vcol = colon + 1 + std::min(value.size(), value.find_first_not_of(" \t") == std::string::npos
+                                                                  ? value.size()
+                                                                  : value.find_first_not_of(" \t"));
+    readKey(line, b, vcol, key, value);
+  }
+
+  void readKey(int line, size_t kcol, size_t vcol, const std::string& key, const std::string& value) {
+    auto is = [&](const char* k) { return key == k; };
+    if (is("angle increment") || is("angle factor")) {
+      if (auto v = values(line, vcol, key, value, 1, 1)) {
+        if (is("angle factor") && (*v)[0] == 0) error(line, vcol, "'angle factor:' must not be 0 (the angle is 360 / factor)");
+        else view_.angleDeg = is("angle factor") ? 360.0 / (*v)[0] : (*v)[0];
+      }
+    } else if (is("initial color") || is("color increment")) {
+      if (auto v = values(line, vcol, key, value, 1, 2)) {
+        const double limit = is("initial color") ? 65535 : 255;
+        if (std::fabs((*v)[0]) > limit)
+          error(line, vcol, "'" + key + ":' must be from " + formatLimit(-limit) + " to " + formatLimit(limit));
+        else
+          (is("initial color") ? view_.initialColor : view_.colorIncrement) = static_cast<int>((*v)[0]);
+      }
+    } else if (is("initial line width")) {
+      // cpfg: a number, then an optional style word (`p`ixels, `s`haded cylinders); a number
+      // alone means polygons in world units.
+      std::istringstream in(value);
+      std::string number, style;
+      in >> number >> style;
+      auto w = parseFiniteNumber(number);
+      if (!w) {
+        error(line, vcol, "'initial line width:' expects a number, got '" + trimmed(value) + "'");
+        return;
+      }
+      view_.lineWidth = *w;
+      view_.lineStyle = style.empty() ? CpfgLineStyle::Polygon
+                        : style[0] == 'p' ? CpfgLineStyle::Pixel
+                        : style[0] == 's' ? CpfgLineStyle::Cylinder
+                                          : CpfgLineStyle::Polygon;
+    } else if (is("line width increment")) {
+      if (auto v = values(line, vcol, key, value, 1, 1)) view_.widthIncrement = (*v)[0];
+    } else if (is("line style")) {
+      const std::string v = trimmed(value);
+      if (v == "pixel") view_.lineStyle = CpfgLineStyle::Pixel;
+      else if (v == "polygon") view_.lineStyle = CpfgLineStyle::Polygon;
+      else if (v == "cylinder") view_.lineStyle = CpfgLineStyle::Cylinder;
+      else error(line, vcol, "'line style:' is pixel, polygon or cylinder, got '" + v + "'");
+    } else if (is("initial scale")) {
+      if (auto v = values(line, vcol, key, value, 1, 1)) view_.initialScale = (*v)[0];
+    } else if (is("scale multiplier")) {
+      if (auto v = values(line, vcol, key, value, 1, 1)) view_.scaleMultiplier = (*v)[0];
+    } else if (is("tropism") || is("torque")) {
+      readTropism(line, vcol, value, is("torque"));
+    } else if (is("initial elasticity")) {
+      if (auto v = values(line, vcol, key, value, 1, 1)) view_.oldElasticity = (*v)[0];
+    } else if (is("elasticity increment")) {
+      if (auto v = values(line, vcol, key, value, 1, 1)) view_.oldElasticityIncrement = (*v)[0];
+    } else if (is("tropism direction")) {
+      if (auto v = values(line, vcol, key, value, 3, 3)) {
+        const DVec3 d((*v)[0], (*v)[1], (*v)[2]);
+        if (glm::length(d) == 0) error(line, vcol, "'tropism direction:' must not be the zero vector");
+        else view_.oldTropismDirection = glm::normalize(d);
+      }
+    } else {
+      for (const UnsupportedKey& u : kUnsupportedKeys)
+        if (key == u.key) {
+          error(line, kcol, std::string("cpfg's view file command '") + u.key + ":' (" + u.what + ") is not supported");
+          return;
+        }
+      for (const char* k : kFileKeys)
+        if (key == k) {
+          warn(line, kcol, "'" + key + ":' ignored: the grammar's uses of it are errors (not supported)");
+          return;
+        }
+      for (const char* k : kViewerKeys)
+        if (key == k) {
+          if (viewerKeys_.empty()) {
+            viewerLine_ = line;
+            viewerRaw_ = raw_;
+          }
+          viewerKeys_ += (viewerKeys_.empty() ? "'" : ", '") + key + ":'";
+          return;
+        }
+      std::vector<std::string> all(std::begin(kReadKeys), std::end(kReadKeys));
+      for (const char* k : kViewerKeys) all.emplace_back(k);
+      for (const char* k : kFileKeys) all.emplace_back(k);
+      error(line, kcol, "unknown view file command '" + key + ":'" + didYouMean(key, all));
+    }
+  }
+
+  /// `tropism: T: x y z A: angle I: intensity E: elasticity S: step` (movements.c).
+  void readTropism(int line, size_t vcol, const std::string& value, bool torque) {
+    CpfgTropism t;
+    t.torque = torque;
+    std::string all;
+    for (char c : value) all += (c == ',' || c == ':' || c == '\t') ? ' ' : c;
+    std::istringstream in(all);
+    std::vector<std::string> words;
+    for (std::string w; in >> w;) words.push_back(w);
+    bool haveT = false;
+    double intensity = 1;
+    DVec3 dir(0);
+    for (size_t k = 0; k < words.size();) {
+      const std::string sub = words[k++];
+      const size_t count = sub == "T" ? 3 : 1;
+      if (sub != "T" && sub != "A" && sub != "I" && sub != "E" && sub != "S") {
+        error(line, vcol, "unknown tropism subcommand '" + sub + "' (T: A: I: E: S:)");
+        return;
+      }
+      double v[3] = {0, 0, 0};
+      for (size_t j = 0; j < count; ++j) {
+        auto n = k < words.size() ? parseFiniteNumber(words[k]) : std::nullopt;
+        if (!n) {
+          error(line, vcol, "tropism subcommand '" + sub + ":' expects " + std::to_string(count) + (count == 1 ? " number" : " numbers"));
+          return;
+        }
+        v[j] = *n;
+        ++k;
+      }
+      if (sub == "T") {
+        dir = DVec3(v[0], v[1], v[2]);
+        haveT = true;
+      } else if (sub == "A") {
+        if (!torque) t.angleDeg = v[0];  // cpfg ignores A: in a torque
+      } else if (sub == "I") {
+        intensity = v[0];
+      } else if (sub == "E") {
+        t.elasticity = v[0];
+      } else {
+        t.step = v[0];
+      }
+    }
+    if (!haveT || glm::length(dir) == 0) {
+      error(line, vcol, "a tropism needs a non-zero vector 'T: x y z'");
+      return;
+    }
+    if (intensity == 0) {
+      error(line, vcol, "a tropism's intensity 'I:' must not be 0");
+      return;
+    }
+    if (view_.tropisms.size() >= size_t(kMaxTropisms)) {
+      error(line, vcol, "more than " + std::to_string(kMaxTropisms) + " tropisms and torques (cpfg's limit)");
+      return;
+    }
+    t.direction = glm::normalize(dir) * std::clamp(intensity, -1.0, 1.0);
+    view_.tropisms.push_back(t);
+  }
+
+  ViewFile view_;
+  DiagnosticList diags_;
+  std::vector<Diagnostic> warnings_;
+  std::string raw_;
+  std::string viewerKeys_;  ///< the viewer keys read, for one warning
+  int viewerLine_ = 0;      ///< the line of the first
+  std::string viewerRaw_;
+};
+
+}  // namespace
+
+ViewFile parseViewFile(const std::string& text, const std::string& fileName) { return ViewParser(fileName).run(text); }
+
+ViewFile loadViewFile(const std::string& path) {
+  std::string text;
+  try {
+    text = readFile(path);
+  } catch (const std::exception&) {
+    throw InputError(SourceLoc{path, 0, 0}, "cannot read the view file");
+  }
+  return parseViewFile(text, path);
+}
+
+TurtleSettings cpfgTurtleSettings(const ViewFile* view, TurtleSettings t) {
+  const ViewFile none;
+  const ViewFile& v = view ? *view : none;
+  t.cpfg = true;
+  t.angleDeg = v.angleDeg.value_or(kCpfgDefaultAngleDeg);
+  t.initialWidth = v.lineWidth.value_or(kCpfgDefaultLineWidth);
+  t.widthIncrement = v.widthIncrement.value_or(0.0);
+  t.initialColor = v.initialColor.value_or(kCpfgDefaultColor);
+  t.colorIncrement = v.colorIncrement.value_or(1);
+  t.initialScale = v.initialScale.value_or(1.0);
+  t.scaleMultiplier = v.scaleMultiplier.value_or(1.0);
+  t.tropisms = v.tropisms;
+  // cpfg's old tropism (its defaults: direction +Y, elasticity 0, increment 0).
+  t.tropism = v.oldTropismDirection.value_or(DVec3(0, 1, 0));
+  t.elasticity = v.oldElasticity.value_or(0.0);
+  t.elasticityIncrement = v.oldElasticityIncrement.value_or(0.0);
+  if (v.lineStyle.value_or(CpfgLineStyle::Pixel) != CpfgLineStyle::Pixel) {
+    t.widthScale = 1.0;
+    t.maxWidthToLength = 0.0;
+  }
+  return t;
+}
+
+std::string cpfgDefaultsUsed(const ViewFile* view) {
+  const ViewFile none;
+  const ViewFile& v = view ? *view : none;
+  std::string out;
+  auto add = [&](const std::string& s) { out += (out.empty() ? "" : ", ") + s; };
+  if (!v.angleDeg) add("angle increment 45");
+  if (!v.lineWidth) add("initial line width 1 (pixels)");
+  if (!v.widthIncrement) add("line width increment 0");
+  if (!v.initialColor) add("initial color 128");
+  if (!v.colorIncrement) add("color increment 1");
+  if (!v.initialScale) add("initial scale 1");
+  if (v.tropisms.empty()) add("no tropism");
+  return out;
+}
+
+}  // namespace sprig::lsystem

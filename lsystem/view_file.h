@@ -1,0 +1,66 @@
+#pragma once
+/// cpfg's view file (`NAME.v` beside a `NAME.l` grammar; CPFG reference manual, section
+/// 8.1): the turtle's settings it holds (angle, line width, color, scale, tropisms) read
+/// into TurtleSettings. Keys that only change how cpfg's window shows the model (viewpoint,
+/// lights, render mode, ...) are warnings; keys that would change the geometry and that
+/// Sprig does not implement are errors naming them (docs/GRAMMAR.md, "The view file").
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "core/diagnostics.h"
+#include "lsystem/turtle.h"
+
+namespace sprig::lsystem {
+
+/// How cpfg draws `F` (`line style:`, or the style word of `initial line width:`).
+enum class CpfgLineStyle {
+  Pixel,     ///< widths are screen pixels (cpfg's default)
+  Polygon,   ///< widths are world units
+  Cylinder,  ///< widths are world units
+};
+
+/// What a view file sets. Unset fields keep cpfg's defaults (kCpfgDefaults...).
+struct ViewFile {
+  std::string file;                     ///< the path it was read from
+  std::optional<double> angleDeg;       ///< `angle increment: x` or `angle factor: n` (360/n)
+  std::optional<double> lineWidth;      ///< `initial line width: x [style]`
+  std::optional<CpfgLineStyle> lineStyle;  ///< `line style:` or the style word of `initial line width:`
+  std::optional<double> widthIncrement;    ///< `line width increment: x`
+  std::optional<int> initialColor;      ///< `initial color: i [i2]` (the front index)
+  std::optional<int> colorIncrement;    ///< `color increment: i [i2]`
+  std::optional<double> initialScale;   ///< `initial scale: x`
+  std::optional<double> scaleMultiplier;  ///< `scale multiplier: x`
+  std::vector<CpfgTropism> tropisms;    ///< `tropism: T: x y z ...`, in file order
+  std::optional<DVec3> oldTropismDirection;    ///< `tropism direction: x,y,z` (cpfg's old tropism)
+  std::optional<double> oldElasticity;         ///< `initial elasticity: e`
+  std::optional<double> oldElasticityIncrement;  ///< `elasticity increment: d` (the step of `_`)
+  /// Warnings about keys read but not used (viewer settings), each at its line.
+  std::vector<Diagnostic> warnings;
+};
+
+/// cpfg's defaults when the view file is absent or silent (interpret.c, InitializeParameters).
+inline constexpr double kCpfgDefaultAngleDeg = 45.0;
+inline constexpr double kCpfgDefaultLineWidth = 1.0;
+inline constexpr int kCpfgDefaultColor = 128;
+
+/// Parses view file text (named fileName in diagnostics). Throws InputError with every
+/// error (an unknown key with "did you mean", a malformed value, a key that changes the
+/// geometry and that Sprig does not implement).
+ViewFile parseViewFile(const std::string& text, const std::string& fileName);
+
+/// Reads and parses path; an unreadable file is an InputError at path.
+ViewFile loadViewFile(const std::string& path);
+
+/// The turtle settings of a cpfg grammar with view (or without one: nullptr), on top of
+/// base: cpfg's command meanings, the angle, width, color, scale and tropisms, each from the
+/// view file or cpfg's default. Pixel widths (cpfg's default style) are not world units, so
+/// they keep base's widthScale and width cap; world-unit styles set widthScale 1 and no cap.
+TurtleSettings cpfgTurtleSettings(const ViewFile* view, TurtleSettings base);
+
+/// The names and values of cpfg's defaults that a grammar read without (or with a silent)
+/// view file used, for a note: "angle increment 45, initial line width 1 (pixels), ...".
+std::string cpfgDefaultsUsed(const ViewFile* view);
+
+}  // namespace sprig::lsystem

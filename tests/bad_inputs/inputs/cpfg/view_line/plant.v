@@ -1,0 +1,1 @@
+line: l leaf.s 1

@@ -1,0 +1,417 @@
+// cpfg compatibility: the objects under tests/assets/cpfg/, each with the counts and
+// positions cpfg's semantics give (derived by hand in the comments), and the constructs
+// Sprig does not implement, each an error naming it at its position.
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <string>
+
+#include "lsystem/derive.h"
+#include "lsystem/grammar.h"
+#include "lsystem/turtle.h"
+#include "lsystem/view_file.h"
+
+using namespace sprig;
+using namespace sprig::lsystem;
+
+namespace {
+
+std::string cpfgAsset(const std::string& name) { return std::string(SPRIG_SOURCE_DIR) + "/tests/assets/cpfg/" + name; }
+
+/// A cpfg object of tests/assets/cpfg (its `plant.l`, and `plant.v` when withView) derived
+/// its own number of steps and drawn by the turtle with the view file's settings.
+struct Drawn {
+  std::string string;  ///< the derived string, in grammar notation
+  Skeleton skeleton;
+  TurtleState end;
+};
+
+Drawn drawObject(const std::string& folder, bool withView) {
+  Grammar g = loadGrammar(cpfgAsset(folder + "/plant.l"));
+  REQUIRE(g.cpfgNotation());
+  ViewFile view;
+  if (withView) view = loadViewFile(cpfgAsset(folder + "/plant.v"));
+  Deriver d(g);
+  const ModuleString& s = d.derive();
+  Drawn out;
+  out.string = formatModuleString(s, d.symbols());
+  Turtle t(d.symbols(), cpfgTurtleSettings(withView ? &view : nullptr, TurtleSettings{}));
+  out.skeleton = t.run(d.interpret(s));
+  out.end = t.endState();
+  return out;
+}
+
+void checkNear(const DVec3& a, const DVec3& b) {
+  INFO("got (" << a.x << ", " << a.y << ", " << a.z << "), expected (" << b.x << ", " << b.y << ", " << b.z << ")");
+  CHECK(glm::length(a - b) < 1e-9);
+}
+
+/// The first error message of parsing text as a cpfg grammar `t.l` (or `t.lsys`).
+std::string errorOf(const std::string& text, const std::string& file = "t.l") {
+  try {
+    parseGrammar(text, file);
+  } catch (const InputError& e) {
+    const Diagnostic& d = e.diagnostics().front();
+    return d.loc.file + ":" + std::to_string(d.loc.line) + ":" + std::to_string(d.loc.col) + ": " + d.message;
+  }
+  return "no error";
+}
+
+std::string viewErrorOf(const std::string& text) {
+  try {
+    parseViewFile(text, "t.v");
+  } catch (const InputError& e) {
+    const Diagnostic& d = e.diagnostics().front();
+    return d.loc.file + ":" + std::to_string(d.loc.line) + ":" + std::to_string(d.loc.col) + ": " + d.message;
+  }
+  return "no error";
+}
+
+}  // namespace
+
+TEST_CASE("cpfg objects", "[lsystem][cpfg]") {
+  const double s30 = 0.5, c30 = std::sqrt(3.0) / 2, r2 = std::sqrt(0.5);
+
+  SECTION("angle increment from the view file; Lsystem:, Axiom:, a bare homomorphism, Endlsystem") {
+    // A --> I+I, I --> F in the homomorphism: F+F turned by 30 degrees.
+    Drawn o = drawObject("angle_increment", true);
+    CHECK(o.string == "I+I");
+    REQUIRE(o.skeleton.internodes.size() == 2);
+    checkNear(o.skeleton.internodes[1].end, DVec3(-s30, 1 + c30, 0));
+  }
+
+  SECTION("angle factor 8 is 45 degrees; 'initial line width: 0.2 shaded' is a world width") {
+    Drawn o = drawObject("angle_factor", true);
+    REQUIRE(o.skeleton.internodes.size() == 2);
+    checkNear(o.skeleton.internodes[1].end, DVec3(r2, 1 + r2, 0));  // `-` turns right
+    CHECK(o.skeleton.internodes[0].baseRadius == Approx(0.1));
+  }
+
+  SECTION("without a view file, cpfg's default angle increment of 45 degrees") {
+    Drawn o = drawObject("no_view", false);
+    REQUIRE(o.skeleton.internodes.size() == 2);
+    checkNear(o.skeleton.internodes[1].end, DVec3(-r2, 1 + r2, 0));
+    CHECK(cpfgDefaultsUsed(nullptr).find("angle increment 45") == 0);
+  }
+
+  SECTION("a production continued on lines that start with a tab") {
+    Drawn o = drawObject("continuation", false);
+    CHECK(o.string == "F[+(90)F]F");
+    REQUIRE(o.skeleton.internodes.size() == 3);
+    checkNear(o.skeleton.internodes[1].end, DVec3(-1, 1, 0));
+    checkNear(o.skeleton.internodes[2].end, DVec3(0, 2, 0));
+  }
+
+  SECTION("expressions: c ? a : b, fabs, trunc rounds, %, <>, ^ below unary minus and left-associative") {
+    Drawn o = drawObject("expressions", false);
+    CHECK(o.string == "B(10,20)C(2,3,-2,1)D(4,64,0)");
+  }
+
+  SECTION("widths, colors and the turtle scale: ! # ; , @D") {
+    // View: width 4 in world units, increment 1, color 5, increment 2.
+    Drawn o = drawObject("width_color", true);
+    REQUIRE(o.skeleton.internodes.size() == 6);
+    const double radii[] = {2, 1.5, 2, 5, 5, 3};  // 4, 4-1, 3+1, 10, @D(2): 10, !(3) = 3*2
+    for (int k = 0; k < 6; ++k) CHECK(o.skeleton.internodes[k].baseRadius == Approx(radii[k]));
+    checkNear(o.end.frame.position, DVec3(0, 8, 0));  // four unit steps, then two of length 2
+    REQUIRE(o.skeleton.organs.size() == 2);
+    CHECK(o.skeleton.organs[0].color == 7);  // 5 + 2
+    CHECK(o.skeleton.organs[1].color == 3);  // 7 - 2 - 2
+    CHECK(o.skeleton.organs[0].radius == Approx(5));  // @O without a size: the line width is its diameter
+  }
+
+  SECTION("tropism from the view file, bent before each move; @Ts(n, e) sets tropism n's elasticity") {
+    // T = (0,-1,0) (unit length), e = 0.2. After +(90) H = (-1,0,0): the first F turns H by
+    // min(|H x 0.2T|, 1) = 0.2 rad toward T. @Ts(1,0) stops the bending; the branch sets 0.2
+    // again: H x 0.2T has length 0.2 cos(0.2), so it turns by that much more.
+    Drawn o = drawObject("tropism", true);
+    REQUIRE(o.skeleton.internodes.size() == 4);
+    const DVec3 e1(-std::cos(0.2), -std::sin(0.2), 0);
+    checkNear(o.skeleton.internodes[0].end, e1);
+    checkNear(o.skeleton.internodes[1].end, 2.0 * e1);
+    const double a = 0.2 + 0.2 * std::cos(0.2);
+    checkNear(o.skeleton.internodes[2].end, 2.0 * e1 + DVec3(-std::cos(a), -std::sin(a), 0));
+    checkNear(o.skeleton.internodes[3].end, 3.0 * e1);  // `]` restored elasticity 0
+  }
+
+  SECTION("@M moves, @R sets the heading (and cpfg's up), @v rolls L horizontal; a bare decomposition") {
+    Drawn o = drawObject("move_heading", false);
+    CHECK(o.string == "F@M(3,0,1)F@R(1,0,0)F@R(0,0,1,0,1,0)F&(45)@v F");  // a space keeps @v and F apart
+    REQUIRE(o.skeleton.internodes.size() == 5);
+    checkNear(o.skeleton.internodes[0].end, DVec3(0, 1, 0));
+    checkNear(o.skeleton.internodes[1].start, DVec3(3, 0, 1));  // @M: no segment drawn to it
+    CHECK(o.skeleton.internodes[1].parent == -1);
+    checkNear(o.skeleton.internodes[2].end, DVec3(4, 1, 1));    // @R(1,0,0): heading +X
+    checkNear(o.skeleton.internodes[3].end, DVec3(4, 1, 2));    // @R(0,0,1, 0,1,0): heading +Z
+    // &(45) after H = +Z, U = -(cpfg's up) = -Y: H = (0, s, c); @v: L = Y x H normalized = +X.
+    const double r2 = std::sqrt(0.5);
+    checkNear(o.skeleton.internodes[4].end, DVec3(4, 1 + r2, 2 + r2));
+    checkNear(o.end.frame.left, DVec3(1, 0, 0));
+    checkNear(o.end.frame.up, DVec3(0, r2, -r2));
+  }
+
+  SECTION("@Ti without a value adds the tropism's step S, @Td(n, d) subtracts d, @Ts of a missing tropism is ignored") {
+    // E 0.1 + S 0.2 = 0.3: the first F turns 0.3 rad down; 0.3 - 0.3 = 0: the others go straight.
+    Drawn o = drawObject("elasticity_steps", true);
+    REQUIRE(o.skeleton.internodes.size() == 3);
+    const DVec3 h(-std::cos(0.3), -std::sin(0.3), 0);
+    checkNear(o.skeleton.internodes[0].end, h);
+    checkNear(o.skeleton.internodes[1].end, 2.0 * h);
+    checkNear(o.skeleton.internodes[2].end, 3.0 * h);
+  }
+
+  SECTION("cpfg's old tropism: '_', tropism direction, elasticity increment; the bend follows the move") {
+    // After +(90): H = -X, L = -Y, cpfg's up = -Z. `_`: e = 0 + 0.5. F moves to (-1,0,0), then
+    // bends: e T.up = 0, e T.L = 0.5: H = cos(30) H + 0.5 L. `_(0)` stops it.
+    Drawn o = drawObject("old_tropism", true);
+    REQUIRE(o.skeleton.internodes.size() == 2);
+    checkNear(o.skeleton.internodes[0].end, DVec3(-1, 0, 0));
+    checkNear(o.skeleton.internodes[1].end, DVec3(-1 - std::sqrt(0.75), -0.5, 0));
+  }
+
+  SECTION("torque: U turns about H by cpfg's quaternion rule, H stays") {
+    // D = 0.5 X projected perpendicular to H = +Y: (0.5, 0, 0). cpfg's up (0,0,-1) turns by
+    // |up x D| = 0.5 rad about +Y (cpfg's q^-1 v q with the axis up x D = -Y): Sprig's
+    // U = -(cpfg's up) = (sin 0.5, 0, cos 0.5).
+    Drawn o = drawObject("torque", true);
+    REQUIRE(o.skeleton.internodes.size() == 1);
+    checkNear(o.end.frame.position, DVec3(0, 1, 0));
+    checkNear(o.end.frame.heading, DVec3(0, 1, 0));
+    checkNear(o.end.frame.up, DVec3(std::sin(0.5), 0, std::cos(0.5)));
+    checkNear(o.end.frame.left, DVec3(-std::cos(0.5), 0, std::sin(0.5)));
+  }
+
+  SECTION("bran and biran draw from the seeded generator") {
+    Drawn a = drawObject("random", false), b = drawObject("random", false);
+    CHECK(a.string == b.string);
+    Grammar g = loadGrammar(cpfgAsset("random/plant.l"));
+    Deriver d(g);
+    const ModuleString& s = d.derive();
+    REQUIRE(s.size() == 1);
+    REQUIRE(s.paramCount(0) == 5);
+    const double* p = s.params.data() + s.offsets[0];
+    CHECK(p[0] == 10);  // every trial below p = 1
+    CHECK(p[1] == 0);
+    CHECK(p[2] == std::floor(p[2]));
+    CHECK((p[2] >= 0 && p[2] <= 20));
+    CHECK((p[3] > 0 && p[3] < 1));
+    CHECK((p[4] > 0 && p[4] < 1));
+  }
+
+  SECTION("@O(d) and @o(d) spheres of diameter d, @c(d) a disc in the HL plane") {
+    Drawn o = drawObject("spheres_discs", true);
+    REQUIRE(o.skeleton.organs.size() == 3);
+    CHECK(o.skeleton.organs[0].kind == Organ::Kind::Sphere);
+    CHECK(o.skeleton.organs[0].radius == Approx(1));
+    CHECK(o.skeleton.organs[1].kind == Organ::Kind::Sphere);
+    CHECK(o.skeleton.organs[1].radius == Approx(2));
+    checkNear(o.skeleton.organs[1].position, DVec3(0, 1, 0));
+    const Organ& disc = o.skeleton.organs[2];
+    CHECK(disc.kind == Organ::Kind::Polygon);
+    REQUIRE(disc.points.size() == 32);
+    checkNear(disc.points[0], DVec3(0, 3, 0));   // center (0,2,0) + H
+    checkNear(disc.points[8], DVec3(-1, 2, 0));  // center + L
+  }
+}
+
+TEST_CASE("cpfg view file", "[lsystem][cpfg]") {
+  SECTION("turtle keys") {
+    ViewFile v = parseViewFile("angle factor: 12\ninitial line width: 3 pixels\nline width increment: 0.5\n"
+                               "initial color: 2 4\ncolor increment: 3\ninitial scale: 2\nscale multiplier: 1.5\n"
+                               "tropism: T: 0 0 3 A: 90 I: 0.5 E: 0.1 S: 0.05\n",
+                               "t.v");
+    CHECK(*v.angleDeg == Approx(30));
+    CHECK(*v.lineWidth == 3);
+    CHECK(*v.lineStyle == CpfgLineStyle::Pixel);
+    CHECK(*v.widthIncrement == 0.5);
+    CHECK(*v.initialColor == 2);
+    CHECK(*v.colorIncrement == 3);
+    CHECK(*v.initialScale == 2);
+    CHECK(*v.scaleMultiplier == 1.5);
+    REQUIRE(v.tropisms.size() == 1);
+    CHECK(v.tropisms[0].direction.z == Approx(0.5));  // unit length times the intensity
+    CHECK(v.tropisms[0].angleDeg == 90);
+    CHECK(v.tropisms[0].elasticity == 0.1);
+    CHECK(v.tropisms[0].step == 0.05);
+    CHECK(v.warnings.empty());
+  }
+  SECTION("viewer keys are warnings") {
+    ViewFile v = parseViewFile("/* view */\nviewpoint: 0,0,1\nrender mode: shaded\nz buffer: on\n", "t.v");
+    REQUIRE(v.warnings.size() == 1);
+    CHECK(v.warnings[0].loc.line == 2);
+    CHECK(v.warnings[0].message == "ignored, as they set how cpfg's window shows the model, not its geometry: "
+                                   "'viewpoint:', 'render mode:', 'z buffer:'");
+  }
+  SECTION("errors") {
+    CHECK(viewErrorOf("angle increment: 30\nangel factor: 8\n") ==
+          "t.v:2:1: unknown view file command 'angel factor:' (did you mean 'angle factor'?)");
+    CHECK(viewErrorOf("line: l leaf.s 1\n") == "t.v:1:1: cpfg's view file command 'line:' (F drawn as a surface) is not supported");
+    CHECK(viewErrorOf("background scene: a.dat\n") ==
+          "t.v:1:1: cpfg's view file command 'background scene:' (geometry from background files) is not supported");
+    CHECK(viewErrorOf("tropism direction: 0,0,0\n") == "t.v:1:20: 'tropism direction:' must not be the zero vector");
+    CHECK(viewErrorOf("angle increment: thirty\n") == "t.v:1:18: 'angle increment:' expects 1 number, got 'thirty'");
+    CHECK(viewErrorOf("tropism: E: 0.2\n") == "t.v:1:10: a tropism needs a non-zero vector 'T: x y z'");
+    CHECK(viewErrorOf("#include \"x.v\"\n") == "t.v:1:1: C preprocessor directive '#include' in a view file is not supported");
+  }
+}
+
+TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg]") {
+  SECTION("commands") {
+    CHECK(errorOf("axiom: A\nA --> F@Gc(10)F\n") == "t.l:2:8: cpfg's '@Gc' (generalized cylinder) is not supported");
+    CHECK(errorOf("axiom: F@Gs\n", "t.lsys") == "t.lsys:1:9: cpfg's '@Gs' (generalized cylinder) is not supported");
+    CHECK(errorOf("axiom: F{(1)F}(1)\n") == "t.l:1:9: cpfg's '{(type)' (generalized cylinder) is not supported");
+    CHECK(errorOf("axiom: A\nA --> F$A\n") ==
+          "t.l:2:8: cpfg's '$' (end of a sub-L-system call; ABOP's roll to vertical is '@v' in cpfg) is not supported");
+    CHECK(errorOf("axiom: F~l\n") == "t.l:1:9: cpfg's '~' (surface from a view file's surface file) is not supported");
+    CHECK(errorOf("axiom: ?P(0,0)A\n") == "t.l:1:8: cpfg's '?P' (query module) is not supported");
+    CHECK(errorOf("axiom: A\nA --> ?(2,1)B$\n") == "t.l:2:7: cpfg's '?(n, scale)' (sub-L-system call) is not supported");
+    CHECK(errorOf("axiom: F@Tx(1)\n") == "t.l:1:9: cpfg's '@Tx' (texture) is not supported");
+    CHECK(errorOf("axiom: F@Q\n") == "t.l:1:9: unknown cpfg command '@Q'");
+  }
+  SECTION("statements, blocks, preprocessor, several L-systems") {
+    CHECK(errorOf("axiom: A(1)\nA(y) : { x = y / 2; x < 10 --> B(x)\n") == "t.l:2:8: unclosed '{' of a statement block");
+    CHECK(errorOf("define: { array a[2]; }\naxiom: A\n") == "t.l:1:1: cpfg's 'define:' (array declarations) is not supported");
+    CHECK(errorOf("#include \"x.h\"\naxiom: A\n") ==
+          "t.l:1:1: cpfg's C preprocessor directive '#include' is not supported (only '#define NAME constant' is)");
+    CHECK(errorOf("#define G(x) F(x)\naxiom: A\n") ==
+          "t.l:1:9: cpfg's function-like macro '#define G(...)' (C preprocessor) is not supported");
+    CHECK(errorOf("#define LEAF ?(4,1)leaf(2)$\naxiom: A\n") ==
+          "t.l:1:14: cpfg's #define of a module string ('?(4,1)leaf(2)$', a C preprocessor macro) is not supported: only constants are");
+    CHECK(errorOf("#define B [+F]\naxiom: A\n") ==
+          "t.l:1:11: cpfg's #define of a module string ('[+F]', a C preprocessor macro) is not supported: only constants are");
+    CHECK(errorOf("#define K (1 > 0 ? 2 : 3)\naxiom: A\n") == "no error");
+    CHECK(errorOf("lsystem: 1\naxiom: A\nendlsystem\n", "t.l") == "no error");
+    CHECK(errorOf("lsystem: 1\naxiom: A\nlsystem: 2\naxiom: B\n") ==
+          "t.l:3:1: several L-systems in one file (cpfg's sub-L-systems) are not supported (the first is at line 1)");
+    CHECK(errorOf("ring lsystem\naxiom: A\n") == "t.l:1:1: cpfg's 'ring lsystem' (ring L-system) is not supported");
+    CHECK(errorOf("axiom: A(1)\nA(x) --> A(srand(2))\n") ==
+          "t.l:2:12: cpfg's function 'srand' (reseeds cpfg's one global generator; Sprig draws per module from 'seed:') is not supported");
+    CHECK(errorOf("axiom: A(1)\nA(x) --> A(func(1, x))\n") ==
+          "t.l:2:12: cpfg's function 'func' (function from a view file's function file) is not supported");
+  }
+  SECTION("an error in a continued line is reported at its own line") {
+    CHECK(errorOf("axiom: A\nA --> F\n\tF@Gc(2)\n") == "t.l:3:3: cpfg's '@Gc' (generalized cylinder) is not supported");
+  }
+}
+
+TEST_CASE("cpfg notation in Sprig's .lsys files", "[lsystem][cpfg]") {
+  SECTION("@Ts(n, e) sets the elasticity of tropism n (Sprig's one tropism is number 1)") {
+    Grammar g = parseGrammar("axiom: @Ts(1, 0.5)F@Ts(2, 0.9)F\n", "t.lsys");
+    TurtleSettings s;
+    Turtle t(g.symbols(), s);
+    t.run(g.axiom());
+    CHECK(t.endState().elasticity == 0.5);  // tropism 2 does not exist: ignored, as cpfg does
+  }
+  SECTION("`,` and `;` are modules; bare keywords; Endlsystem") {
+    Grammar g = parseGrammar("axiom: F;F,F\nhomomorphism\nF --> G\nEndlsystem\n", "t.lsys");
+    CHECK(g.axiom().size() == 5);
+    CHECK(g.hasInterpretation());
+  }
+  SECTION("a bare turn is noted; ^ keeps Sprig's precedence") {
+    CHECK(parseGrammar("axiom: F+F\n", "t.lsys").usesDefaultAngle());
+    CHECK(!parseGrammar("axiom: F+(30)F\n", "t.lsys").usesDefaultAngle());
+    Grammar g = parseGrammar("axiom: A(-2^2, 2^3^2)\n", "t.lsys");
+    CHECK(formatModuleString(g.axiom(), g.symbols()) == "A(-4,512)");
+  }
+}
+
+namespace {
+
+/// The string after `steps` steps of text (a grammar named file).
+std::string derived(const std::string& text, int steps, const std::string& file = "t.l") {
+  Grammar g = parseGrammar(text, file);
+  DeriveOptions opt;
+  opt.steps = steps;
+  Deriver d(g, opt);
+  return formatModuleString(d.derive(), d.symbols());
+}
+
+}  // namespace
+
+TEST_CASE("cpfg statements in productions", "[lsystem][cpfg]") {
+  SECTION("assignments before the condition: locals the condition and the successor read") {
+    const std::string g = "axiom: A(4)A(8)\nA(y) : { x = y / 2; s = x * x; } s < 10 --> B(x)\n";
+    CHECK(derived(g, 1) == "B(2)A(8)");  // 4: x 2, s 4; 8: s 16, no match
+  }
+  SECTION("if and else after the condition; a formal parameter may be assigned") {
+    const std::string g = "axiom: A(20)A(3)\nA(y) : * { if (y > 10) { y = 10; } else { y = y + 1; } } --> B(y)\n";
+    CHECK(derived(g, 1) == "B(10)B(4)");
+  }
+  SECTION("while and do ... while") {
+    CHECK(derived("axiom: A(4)\nA(n) : { k = 0; s = 0; while (k < n) { k = k + 1; s = s + k; } } * --> S(s)\n", 1) == "S(10)");
+    CHECK(derived("axiom: A(5)A(0)\nA(n) : { k = 0; do { k = k + 2; } while (k < n); } * --> D(k)\n", 1) == "D(6)D(2)");
+  }
+  SECTION("locals start at 0 in every application") {
+    CHECK(derived("axiom: A(1)\nA(n) : { if (n > 5) { t = 7; } } * --> A(n + 5)T(t)\n", 2) == "A(11)T(7)T(0)");
+  }
+  SECTION("a block over several lines (cpfg notation)") {
+    CHECK(derived("axiom: A(2)\nA(y) : {\n\tx = y * 3;\n} x > 5 --> B(x)\n", 1) == "B(6)");
+  }
+  SECTION("stochastic productions run their own statements") {
+    const std::string g = "seed: 3\naxiom: A(1)A(1)A(1)A(1)\nA(y) : { x = 10; } * --> X(x) : 1\nA(y) : { z = 20; } * --> Z(z) : 1\n";
+    const std::string out = derived(g, 1);
+    for (size_t k = 0; k < out.size(); ++k)
+      if (out[k] == 'X') CHECK(out.compare(k, 5, "X(10)") == 0);
+      else if (out[k] == 'Z') CHECK(out.compare(k, 5, "Z(20)") == 0);
+  }
+  SECTION("errors") {
+    CHECK(errorOf("axiom: A(1)\nA(y) : { x = y } * --> B(x)\n") ==
+          "t.l:2:10: missing ';' after the assignment to 'x' (cpfg requires one after every statement)");
+    CHECK(errorOf("axiom: A(1)\nA(y) : { if (y > 1) x = 2; } * --> B(y)\n") ==
+          "t.l:2:21: expected '{' after 'if (...)' (cpfg requires braces)");
+    CHECK(errorOf("axiom: A(1)\nA(y) : { x += 1; } * --> B(y)\n") ==
+          "t.l:2:12: expected '=' after 'x' (statements are assignments, 'if', 'while' and 'do')");
+    CHECK(errorOf("#define K 2\naxiom: A(1)\nA(y) : { K = 1; } * --> B(y)\n") == "t.l:3:10: cannot assign to 'K': it is a #define");
+    CHECK(errorOf("Start: { srand(3); }\naxiom: A\n") ==
+          "t.l:1:10: cpfg's function 'srand' (reseeds cpfg's one global generator; Sprig draws per module from 'seed:') is not supported");
+    CHECK(derived("axiom: A(2)\nA(y) : { x = 1; fabs(y); x = x + 1; } * --> B(x)\n", 1) == "B(2)");  // a call alone: value dropped
+    try {
+      derived("axiom: A(1)\nA(y) : { while (1) { y = y; } } * --> B(y)\n", 1);
+      FAIL("no error");
+    } catch (const InputError& e) {
+      CHECK(e.diagnostics().front().message == "the statements of production 'A(y)' loop more than 10000000 times at step 1");
+    }
+  }
+}
+
+TEST_CASE("cpfg consider: with brackets; maximum depth beyond 256", "[lsystem][cpfg]") {
+  SECTION("consider: listing [ and ] follows brackets, as Sprig always does") {
+    const std::string g = "consider: BA[]\naxiom: A[C]B\nA > B --> X\n";
+    CHECK(derived(g, 1) == "X[C]B");
+    CHECK(errorOf("consider: BA\naxiom: A\n") ==
+          "t.l:1:11: cpfg's 'consider:' without '[' and ']' ignores brackets in context matching, which Sprig does not "
+          "support (it always follows them): list them, as in 'consider: BA[]'");
+    CHECK(errorOf("consider: BA\naxiom: A\n", "t.lsys") == "no error");  // Sprig's notation: brackets always followed
+  }
+  SECTION("maximum depth 1000 is read; decomposition nested deeper than 256 levels is an error") {
+    CHECK(derived("axiom: A\nA --> B\ndecomposition\nmaximum depth: 1000\nB --> CD\n", 1) == "CD");
+    try {
+      derived("derivation length: 1\naxiom: A\ndecomposition\nmaximum depth: 1000\nA --> FA\n", 1);
+      FAIL("no error");
+    } catch (const InputError& e) {
+      CHECK(e.diagnostics().front().message ==
+            "decomposition nested deeper than 256 levels at step 0 (maximum depth 1000): not supported");
+    }
+  }
+}
+
+TEST_CASE("cpfg Start, StartEach, EndEach and End blocks over global variables", "[lsystem][cpfg]") {
+  SECTION("a counter the conditions read") {
+    // i is 0 at step 1, 1 at step 2, ...: A grows F while i < 3.
+    const std::string g =
+        "derivation length: 5\nStart: { i = 0; }\nEndEach: { i = i + 1; }\naxiom: A\nA : i < 3 --> FA\nA : i >= 3 --> B\n";
+    CHECK(derived(g, 5) == "FFFB");
+  }
+  SECTION("StartEach runs before each step; locals and globals side by side") {
+    const std::string g = "Start: { n = 10; }\nStartEach: { n = n * 2; }\naxiom: A(0)\nA(x) : { y = x + n; } * --> A(y)\n";
+    CHECK(derived(g, 2) == "A(60)");  // step 1: n 20, y 20; step 2: n 40, y 60
+  }
+  SECTION("errors") {
+    CHECK(errorOf("Start: { g = 1; }\naxiom: A\nA : * { g = 2; } --> B\n") ==
+          "t.l:3:9: cannot assign the global variable 'g' in a production (Sprig assigns globals only in 'Start:', "
+          "'StartEach:', 'EndEach:' and 'End:' blocks)");
+    CHECK(errorOf("Start: i = 0;\naxiom: A\n") == "t.l:1:8: expected '{ statements }' after 'Start:'");
+    CHECK(errorOf("Start: { i = 0; }\nStart: { j = 0; }\naxiom: A\n") == "t.l:2:1: duplicate 'start:' (first at line 1)");
+  }
+}
