@@ -175,8 +175,9 @@ class Improver {
       if (contains(m_.tets[t], u)) interfaceFaces(t, {u, v}, [&](const auto& f, Pair p) { faces.push_back({f, p}); });
     sortUnique(faces);
     std::vector<std::pair<Pair, int>> out;
-    for (const auto& [f, p] : faces) {
-      auto it = std::find_if(out.begin(), out.end(), [&](const auto& e) { return e.first == p; });
+    for (const auto& face : faces) {
+      const Pair p = face.second;
+      auto it = std::find_if(out.begin(), out.end(), [p](const auto& e) { return e.first == p; });
       if (it == out.end()) out.push_back({p, 1});
       else ++it->second;
     }
