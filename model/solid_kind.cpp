@@ -664,9 +664,9 @@ class SolidModel final : public StillKindModel {
     if (improved_) {
       const ImproveStats& i = *improved_;
       std::snprintf(buf, sizeof buf,
-                    "; improvement %.2f s: %zu -> %zu tetrahedra (%zu 2-3 and %zu 3-2 flips, %zu collapses, %zu moves), "
+                    "; improvement %.2f s: %zu -> %zu tetrahedra (%zu 2-3, %zu 3-2 and %zu 2-2 flips, %zu collapses, %zu moves), "
                     "quality min %.2f -> %.2f, mean %.2f -> %.2f",
-                    improveSeconds_, i.tetsBefore, i.tetsAfter, i.flips23, i.flips32, i.collapses, i.moves, i.before.minQuality,
+                    improveSeconds_, i.tetsBefore, i.tetsAfter, i.flips23, i.flips32, i.flips22, i.collapses, i.moves, i.before.minQuality,
                     i.after.minQuality, i.before.meanQuality, i.after.meanQuality);
       line += buf;
     }

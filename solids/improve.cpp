@@ -208,7 +208,7 @@ class Improver {
         if (flip23(t, i)) return true;
       for (int i = 0; i < 4; ++i)
         for (int j = i + 1; j < 4; ++j)
-          if (flip32(q[size_t(i)], q[size_t(j)])) return true;
+          if (flip32(q[size_t(i)], q[size_t(j)]) || flip22(q[size_t(i)], q[size_t(j)])) return true;
     }
     if (o_.smoothing)
       for (uint32_t v : q)
@@ -318,6 +318,61 @@ class Improver {
     add(x, material);
     add(y, material);
     ++stats_->flips32;
+    return true;
+  }
+
+  /// 2→2: the two tetrahedra around an edge (a, b) of the visible interface whose two
+  /// faces there are flat (within the tolerance) swap that edge for the other diagonal
+  /// (c, d) of the quadrilateral a-c-b-d; the visible interface keeps its shape.
+  bool flip22(uint32_t a, uint32_t b) {
+    uint32_t ring[2];
+    size_t n = 0;
+    for (uint32_t t : star_[a])
+      if (contains(m_.tets[t], b)) {
+        if (n == 2) return false;
+        ring[n++] = t;
+      }
+    if (n != 2 || m_.materials[ring[0]] != m_.materials[ring[1]]) return false;
+    // ring[0] = (a, b, c, x) and ring[1] = (a, b, d, x): they share the face (a, b, x).
+    uint32_t other[2][2];
+    for (int k = 0; k < 2; ++k) {
+      int m = 0;
+      for (uint32_t w : m_.tets[ring[k]])
+        if (w != a && w != b) other[k][m++] = w;
+    }
+    uint32_t x = 0, c = 0, d = 0;
+    bool shared = false;
+    for (int i = 0; i < 2 && !shared; ++i)
+      for (int j = 0; j < 2 && !shared; ++j)
+        if (other[0][i] == other[1][j]) x = other[0][i], c = other[0][1 - i], d = other[1][1 - j], shared = true;
+    if (!shared || c == d) return false;
+    // Both faces at the edge are visible and lie in one plane.
+    if (across(ring[0], a, b, c) >= 0 || across(ring[1], a, b, d) >= 0) return false;
+    const DVec3 &pa = m_.positions[a], &pb = m_.positions[b], &pc = m_.positions[c], &pd = m_.positions[d];
+    const DVec3 normal = glm::cross(pb - pa, pc - pa);
+    const double len = glm::length(normal);
+    if (!(len > 0) || std::abs(glm::dot(pd - pa, normal)) / len > tolerance_) return false;
+    Tally before;
+    before.add(quality(ring[0]));
+    before.add(quality(ring[1]));
+    const double old = volume(m_.tets[ring[0]]) + volume(m_.tets[ring[1]]);
+    Tet y = {c, d, x, a}, z = {c, d, x, b};
+    if (volume(y) < 0) std::swap(y[0], y[1]);
+    if (volume(z) < 0) std::swap(z[0], z[1]);
+    const double vy = volume(y), vz = volume(z);
+    if (!(vy > 0) || !(vz > 0) || std::abs(vy + vz - old) > 1e-9 * old) return false;
+    Tally after;
+    after.add(quality(y));
+    after.add(quality(z));
+    if (!after.improvesOn(before)) return false;
+    for (uint32_t t : star_[c])
+      if (contains(m_.tets[t], d)) return false;  // the edge c-d exists already
+    const uint16_t material = m_.materials[ring[0]];
+    kill(ring[0]);
+    kill(ring[1]);
+    add(y, material);
+    add(z, material);
+    ++stats_->flips22;
     return true;
   }
 

@@ -3,12 +3,15 @@
 /// (Cutler et al. 2002, §4.4; after Freitag and Ollivier-Gooch 1997).
 ///
 /// The paper's loop: for q = 1 … 10, every tetrahedron of quality at most q is offered the
-/// actions in turn (2→3 and 3→2 flips, half-edge collapses, moving a vertex toward the
+/// actions in turn (2→3, 3→2 and 2→2 flips, half-edge collapses, moving a vertex toward the
 /// centroid of its neighbours), and an action is taken only when the smallest quality of
 /// the tetrahedra it touches rises and no interface moves further than the tolerance.
 ///
 /// Interfaces (the visible interface and the faces between two materials) are kept:
-/// - flips only replace faces and edges inside one material, so every interface face stays;
+/// - 2→3 and 3→2 flips only replace faces and edges inside one material, so every interface
+///   face stays; a 2→2 flip swaps the diagonal of two visible faces that lie in one plane
+///   (within the tolerance), so the visible interface keeps its shape (the 4→4 flip that
+///   would do the same on a face between two materials is not built);
 /// - a vertex inside one material collapses into any neighbour;
 /// - a vertex on one interface sheet collapses only along an edge of that sheet, a vertex on a
 ///   curve where interfaces meet only along that curve, a vertex where curves meet never;
@@ -30,7 +33,7 @@ struct ImproveOptions {
   double qualityBelow = 10;
   /// World units an interface may move at a collapse (0: only where it is flat).
   double interfaceTolerance = 0;
-  bool flips = true;      ///< 2→3 and 3→2 flips
+  bool flips = true;      ///< 2→3, 3→2 and 2→2 flips
   bool collapses = true;  ///< half-edge collapses
   bool smoothing = true;  ///< moving free vertices toward their neighbours' centroid
   /// Ideal volume = total volume / targetCount (0 = the mesh's count before improvement).
@@ -41,7 +44,7 @@ struct ImproveOptions {
 struct ImproveStats {
   QualityStats before, after;  ///< against the same ideal volume
   size_t tetsBefore = 0, tetsAfter = 0;
-  size_t flips23 = 0, flips32 = 0, collapses = 0, moves = 0;
+  size_t flips23 = 0, flips32 = 0, flips22 = 0, collapses = 0, moves = 0;
 };
 
 /// Improves the tetrahedra of mesh in place (see the header comment), removing unused

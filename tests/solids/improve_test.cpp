@@ -116,6 +116,40 @@ TEST_CASE("improveQuality: a 2-3 flip of two tetrahedra over a wide face", "[sol
   checkValid(m);
 }
 
+TEST_CASE("improveQuality: a 2-2 flip of two tetrahedra under a flat visible quadrilateral", "[solids]") {
+  // The long diagonal a-b of the flat rhombus a-c-b-d (z = 0) under the apex x: two flat
+  // tetrahedra of quality 6.18. The short diagonal c-d gives two of 7.49 (computed
+  // independently of Sprig); the visible faces stay in the plane.
+  TetMesh m;
+  m.positions = {{-1, 0, 0}, {1, 0, 0}, {0, -0.3, 0}, {0, 0.3, 0}, {0, 0, 0.8}};
+  m.tets = {{0, 1, 2, 4}, {0, 1, 3, 4}};
+  for (auto& t : m.tets)
+    if (m.volume(size_t(&t - m.tets.data())) < 0) std::swap(t[2], t[3]);
+  m.materials = {0, 0};
+  ImproveOptions opt;
+  opt.collapses = false;
+  opt.smoothing = false;
+  const ImproveStats st = improveQuality(m, opt);
+  CHECK(st.flips22 == 1);
+  CHECK(st.flips23 + st.flips32 == 0);
+  REQUIRE(m.tets.size() == 2);
+  CHECK(st.before.minQuality == Approx(6.175).margin(1e-3));
+  CHECK(st.after.minQuality == Approx(7.490).margin(1e-3));
+  for (const auto& t : m.tets) CHECK((std::count(t.begin(), t.end(), 2u) == 1 && std::count(t.begin(), t.end(), 3u) == 1));
+  CHECK(m.volume(0) + m.volume(1) == Approx(0.16).epsilon(1e-12));
+  // The visible faces in z = 0 now split the rhombus along c-d; their area is unchanged.
+  double flat = 0;
+  for (const auto& t : visibleInterface(m)) {
+    bool inPlane = true;
+    for (uint32_t v : t.v) inPlane = inPlane && m.positions[v].z == 0;
+    if (!inPlane) continue;
+    flat += 0.5 * glm::length(glm::cross(m.positions[t.v[1]] - m.positions[t.v[0]], m.positions[t.v[2]] - m.positions[t.v[0]]));
+    CHECK((std::count(t.v.begin(), t.v.end(), 2u) == 1 && std::count(t.v.begin(), t.v.end(), 3u) == 1));
+  }
+  CHECK(flat == Approx(0.6).epsilon(1e-12));
+  checkValid(m);
+}
+
 TEST_CASE("improveQuality: flips, collapses and smoothing keep every interface and raise the quality", "[solids]") {
   TetMesh m = meshSolid(layeredSphere(), test::gridAround(0.8, 0.08));
   const auto volumes = volumeByMaterial(m);
