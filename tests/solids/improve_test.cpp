@@ -13,6 +13,7 @@
 
 using namespace sprig;
 using namespace sprig::solids;
+using test::checkValid;
 using test::faceUses;
 using test::meshOf;
 using test::volumeByMaterial;
@@ -47,19 +48,6 @@ Solid layeredSphere() {
   s.volumes.push_back(makeVolume(sphereField(DVec3(0.0), 0.6),
                                  {layer(true, 0.15, "pink_frosting"), layer(true, 0, "chocolate"), layer(false, 0.1, "white_chocolate")}));
   return s;
-}
-
-/// Checks what every improvement keeps: positive tetrahedra, matching faces, a closed
-/// manifold visible interface.
-void checkValid(const TetMesh& m) {
-  for (size_t t = 0; t < m.tets.size(); ++t) REQUIRE(m.volume(t) > 0);
-  CHECK(faceUses(m)[2] == 0);
-  size_t bad = 99;
-  const auto visible = visibleInterface(m, &bad);
-  CHECK(bad == 0);
-  const MeshTopology top = analyzeTopology(meshOf(m, visible));
-  CHECK(top.closed());
-  CHECK(top.manifold());
 }
 
 }  // namespace

@@ -526,15 +526,7 @@ TEST_CASE("meshSolid: coarsening across interfaces where the fields are affine t
   INFO("uniform " << uniform.tets.size() << " tetrahedra, coarsened " << coarse.tets.size() << " (" << sc.coarseCubes
                   << " coarse leaves of " << sc.cubes << ")");
   CHECK(coarse.tets.size() * 2 < uniform.tets.size());
-  // Valid: positive, conforming, a closed manifold visible interface.
-  for (size_t t = 0; t < coarse.tets.size(); ++t) REQUIRE(coarse.volume(t) > 0);
-  CHECK(faceUses(coarse)[2] == 0);
-  size_t bad = 99;
-  const auto vis = visibleInterface(coarse, &bad);
-  CHECK(bad == 0);
-  const MeshTopology top = analyzeTopology(meshOf(coarse, vis));
-  CHECK(top.closed());
-  CHECK(top.manifold());
+  test::checkValid(coarse);
   // Each interface moved by at most the tolerance: every material's volume is within the
   // tolerance times its surfaces' area of the uniform mesh's.
   const auto vu = volumeByMaterial(uniform), vc = volumeByMaterial(coarse);

@@ -6,6 +6,8 @@
 #include <map>
 #include <vector>
 
+#include <catch2/catch.hpp>
+
 #include "core/mesh.h"
 #include "solids/solid.h"
 
@@ -38,6 +40,19 @@ inline Mesh meshOf(const solids::TetMesh& m, const std::vector<solids::Interface
   for (const DVec3& p : m.positions) out.positions.push_back(Vec3(p));
   for (const auto& t : tris) out.triangles.push_back({t.v[0], t.v[1], t.v[2]});
   return out;
+}
+
+/// Checks what every mesher and improvement keeps: positive tetrahedra, faces used by at
+/// most two tetrahedra, a closed manifold visible interface.
+inline void checkValid(const solids::TetMesh& m) {
+  for (size_t t = 0; t < m.tets.size(); ++t) REQUIRE(m.volume(t) > 0);
+  CHECK(faceUses(m)[2] == 0);
+  size_t bad = 99;
+  const auto visible = solids::visibleInterface(m, &bad);
+  CHECK(bad == 0);
+  const MeshTopology top = analyzeTopology(meshOf(m, visible));
+  CHECK(top.closed());
+  CHECK(top.manifold());
 }
 
 }  // namespace sprig::test
