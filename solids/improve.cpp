@@ -275,17 +275,23 @@ class Improver {
     return true;
   }
 
+  /// The live tetrahedra around edge (a, b), at most n of them, into ring: their count, or
+  /// n + 1 when there are more.
+  size_t edgeRing(uint32_t a, uint32_t b, uint32_t* ring, size_t n) const {
+    size_t k = 0;
+    for (uint32_t t : star_[a])
+      if (contains(m_.tets[t], b)) {
+        if (k == n) return n + 1;
+        ring[k++] = t;
+      }
+    return k;
+  }
+
   /// 3→2: the three tetrahedra around an inner edge (a, b) of one material become two
   /// sharing the triangle of their other corners.
   bool flip32(uint32_t a, uint32_t b) {
     uint32_t ring[3];
-    size_t n = 0;
-    for (uint32_t t : star_[a])
-      if (contains(m_.tets[t], b)) {
-        if (n == 3) return false;
-        ring[n++] = t;
-      }
-    if (n != 3) return false;
+    if (edgeRing(a, b, ring, 3) != 3) return false;
     const uint16_t material = m_.materials[ring[0]];
     std::array<uint32_t, 6> others;
     Tally before;
@@ -326,13 +332,7 @@ class Improver {
   /// (c, d) of the quadrilateral a-c-b-d; the visible interface keeps its shape.
   bool flip22(uint32_t a, uint32_t b) {
     uint32_t ring[2];
-    size_t n = 0;
-    for (uint32_t t : star_[a])
-      if (contains(m_.tets[t], b)) {
-        if (n == 2) return false;
-        ring[n++] = t;
-      }
-    if (n != 2 || m_.materials[ring[0]] != m_.materials[ring[1]]) return false;
+    if (edgeRing(a, b, ring, 2) != 2 || m_.materials[ring[0]] != m_.materials[ring[1]]) return false;
     // ring[0] = (a, b, c, x) and ring[1] = (a, b, d, x): they share the face (a, b, x).
     uint32_t other[2][2];
     for (int k = 0; k < 2; ++k) {
