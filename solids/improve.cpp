@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <vector>
 
 namespace sprig::solids {
@@ -233,6 +234,29 @@ class Improver {
     }
   };
 
+  /// A flip: replaces `dead` (tetrahedra of one material) by `made` (oriented) when every
+  /// made tetrahedron is positive, they fill the volume of dead, they improve on it
+  /// (Tally::improvesOn) and fresh() holds (the new edge or face is not in the mesh yet;
+  /// asked last, the dearest test). Counts the flip in counter.
+  bool replace(std::initializer_list<uint32_t> dead, std::initializer_list<Tet> made, const std::function<bool()>& fresh,
+               size_t& counter) {
+    Tally before, after;
+    double old = 0, sum = 0;
+    for (uint32_t t : dead) before.add(quality(t)), old += volume(m_.tets[t]);
+    for (const Tet& x : made) {
+      const double v = volume(x);
+      if (!(v > 0)) return false;
+      sum += v;
+      after.add(quality(x));
+    }
+    if (std::abs(sum - old) > 1e-9 * old || !after.improvesOn(before) || !fresh()) return false;
+    const uint16_t material = m_.materials[*dead.begin()];
+    for (uint32_t t : dead) kill(t);
+    for (const Tet& x : made) add(x, material);
+    ++counter;
+    return true;
+  }
+
   /// 2→3: t and its neighbour across the face opposite corner i become three tetrahedra
   /// around the edge joining the two apexes.
   bool flip23(uint32_t t, int i) {
@@ -247,32 +271,15 @@ class Improver {
     uint32_t e = 0;
     for (uint32_t w : r)
       if (w != f[0] && w != f[1] && w != f[2]) e = w;
-    Tally before, after;
-    before.add(quality(t));
-    before.add(quality(uint32_t(s)));
     // t with each corner of the shared face replaced by e keeps t's orientation.
-    std::array<Tet, 3> made;
-    double sum = 0;
-    for (int k = 0, n = 0; k < 4; ++k) {
-      if (k == i) continue;
-      Tet x = q;
-      x[size_t(k)] = e;
-      const double v = volume(x);
-      if (!(v > 0)) return false;
-      sum += v;
-      after.add(quality(x));
-      made[size_t(n++)] = x;
-    }
-    const double old = volume(q) + volume(r);
-    if (std::abs(sum - old) > 1e-9 * old || !after.improvesOn(before)) return false;
-    for (uint32_t w : star_[d])
-      if (contains(m_.tets[w], e)) return false;  // the edge d-e exists already
-    const uint16_t material = m_.materials[t];
-    kill(t);
-    kill(uint32_t(s));
-    for (const Tet& x : made) add(x, material);
-    ++stats_->flips23;
-    return true;
+    Tet made[3];
+    for (int k = 0, n = 0; k < 4; ++k)
+      if (k != i) made[n] = q, made[n++][size_t(k)] = e;
+    return replace({t, uint32_t(s)}, {made[0], made[1], made[2]}, [&] {
+      for (uint32_t w : star_[d])
+        if (contains(m_.tets[w], e)) return false;  // the edge d-e exists already
+      return true;
+    }, stats_->flips23);
   }
 
   /// The live tetrahedra around edge (a, b), at most n of them, into ring: their count, or
@@ -294,13 +301,9 @@ class Improver {
     if (edgeRing(a, b, ring, 3) != 3) return false;
     const uint16_t material = m_.materials[ring[0]];
     std::array<uint32_t, 6> others;
-    Tally before;
-    double old = 0;
     size_t k = 0;
     for (uint32_t t : ring) {
       if (m_.materials[t] != material) return false;
-      before.add(quality(t));
-      old += volume(m_.tets[t]);
       for (uint32_t w : m_.tets[t])
         if (w != a && w != b) others[k++] = w;
     }
@@ -313,18 +316,8 @@ class Improver {
     Tet x = {c, d, e, a}, y = {c, d, e, b};
     if (volume(x) < 0) std::swap(x[1], x[2]);
     if (volume(y) < 0) std::swap(y[1], y[2]);
-    const double vx = volume(x), vy = volume(y);
-    if (!(vx > 0) || !(vy > 0) || std::abs(vx + vy - old) > 1e-9 * old) return false;
-    Tally after;
-    after.add(quality(x));
-    after.add(quality(y));
-    if (!after.improvesOn(before)) return false;
-    if (across(UINT32_MAX, c, d, e) >= 0) return false;  // the triangle exists already
-    for (uint32_t t : ring) kill(t);
-    add(x, material);
-    add(y, material);
-    ++stats_->flips32;
-    return true;
+    // The triangle c-d-e must not exist already.
+    return replace({ring[0], ring[1], ring[2]}, {x, y}, [&] { return across(UINT32_MAX, c, d, e) < 0; }, stats_->flips32);
   }
 
   /// 2→2: the two tetrahedra around an edge (a, b) of the visible interface whose two
@@ -352,28 +345,14 @@ class Improver {
     const DVec3 normal = glm::cross(pb - pa, pc - pa);
     const double len = glm::length(normal);
     if (!(len > 0) || std::abs(glm::dot(pd - pa, normal)) / len > tolerance_) return false;
-    Tally before;
-    before.add(quality(ring[0]));
-    before.add(quality(ring[1]));
-    const double old = volume(m_.tets[ring[0]]) + volume(m_.tets[ring[1]]);
     Tet y = {c, d, x, a}, z = {c, d, x, b};
     if (volume(y) < 0) std::swap(y[0], y[1]);
     if (volume(z) < 0) std::swap(z[0], z[1]);
-    const double vy = volume(y), vz = volume(z);
-    if (!(vy > 0) || !(vz > 0) || std::abs(vy + vz - old) > 1e-9 * old) return false;
-    Tally after;
-    after.add(quality(y));
-    after.add(quality(z));
-    if (!after.improvesOn(before)) return false;
-    for (uint32_t t : star_[c])
-      if (contains(m_.tets[t], d)) return false;  // the edge c-d exists already
-    const uint16_t material = m_.materials[ring[0]];
-    kill(ring[0]);
-    kill(ring[1]);
-    add(y, material);
-    add(z, material);
-    ++stats_->flips22;
-    return true;
+    return replace({ring[0], ring[1]}, {y, z}, [&] {
+      for (uint32_t t : star_[c])
+        if (contains(m_.tets[t], d)) return false;  // the edge c-d exists already
+      return true;
+    }, stats_->flips22);
   }
 
   /// Whether removing v into u keeps the interfaces v lies on (see the header).
