@@ -133,8 +133,11 @@ float evalLocalL(const Tape& T, uint32_t ni, const Box3& box) {
     case NodeKind::Union:
     case NodeKind::Intersect:
     case NodeKind::Difference: {
+      // A child whose support misses the box contributes 0, so only those reaching it are
+      // visited: a tree's root unites one group per junction, and walking all of them per
+      // cell made the bound cost grow with the whole tree.
       float m = 0.0f;
-      for (uint32_t k = 0; k < n.count; ++k) m = std::max(m, evalL(T, T.kids[n.first + k], box));
+      childrenIn(T, n, box, [&](uint32_t c) { m = std::max(m, evalL(T, c, box)); });
       return m;
     }
     case NodeKind::Negative: return n.weight * evalL(T, T.kids[n.first], box);
