@@ -78,27 +78,40 @@ int main(int argc, char** argv) {
   std::printf("== %d cones, bounds (%.1f %.1f %.1f) .. (%.1f %.1f %.1f), smallest radius %.3f, compile %.1f ms, %d threads\n",
               cones, b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z, rMin, compileS * 1e3, threadCount());
 
-  // 1. Target: cells half the smallest radius (the automatic default).
-  {
+  // 1. Target: cells half the smallest radius (the automatic default), by marching
+  // tetrahedra (the reference) and by dual marching cubes, in this order.
+  double tetSeconds = 0;
+  size_t tetTriangles = 0;
+  for (auto mesher : {PolygonizeOptions::Mesher::MarchingTetrahedra, PolygonizeOptions::Mesher::DualMarchingCubes}) {
+    const bool dual = mesher == PolygonizeOptions::Mesher::DualMarchingCubes;
     PolygonizeOptions opt;
+    opt.mesher = mesher;
     opt.cellSize = cellOverride > 0.0f ? cellOverride : 0.5f * rMin;
     auto t0 = Clock::now();
     double c0 = processCpuSeconds();
     PolygonizeResult r = polygonizeDetailed(blob, opt);
     double s = seconds(t0), cpu = processCpuSeconds() - c0;
     MeshTopology topo = analyzeTopology(r.mesh);
-    std::printf("sparse, cell %.4f (requested %.4f): %.2f s wall, %.2f s CPU, %zu triangles (%.2f M triangles/s wall, "
+    std::printf("sparse %s, cell %.4f (requested %.4f): %.2f s wall, %.2f s CPU, %zu triangles (%.2f M triangles/s wall, "
                 "%.2f M per CPU second), %zu vertices\n",
-                r.cellSize, opt.cellSize, s, cpu, r.mesh.triangleCount(), r.mesh.triangleCount() / s * 1e-6,
-                r.mesh.triangleCount() / cpu * 1e-6, r.mesh.vertexCount());
+                dual ? "dual marching cubes" : "marching tetrahedra", r.cellSize, opt.cellSize, s, cpu,
+                r.mesh.triangleCount(), r.mesh.triangleCount() / s * 1e-6, r.mesh.triangleCount() / cpu * 1e-6,
+                r.mesh.vertexCount());
     std::printf("  %zu surface cells, %zu with a sign change, %zu grid samples, %zu field evaluations (%.1f M/s); "
                 "closed %s, manifold %s\n",
                 r.surfaceCells, r.activeCells, r.gridSamples, r.fieldEvaluations, r.fieldEvaluations / s * 1e-6,
                 topo.closed() ? "yes" : "NO", topo.manifold() ? "yes" : "NO");
     std::printf("  phases (wall): surface cells %.2f s, grid samples %.2f s, triangulation %.2f s, vertices %.2f s\n",
                 r.cellSeconds, r.sampleSeconds, r.triangulateSeconds, r.vertexSeconds);
+    if (dual) {
+      std::printf("  dual / tetrahedra: %.2fx the time, %.2fx the triangles\n", s / tetSeconds,
+                  double(r.mesh.triangleCount()) / double(tetTriangles));
+      continue;
+    }
+    tetSeconds = s;
+    tetTriangles = r.mesh.triangleCount();
     // The dense baseline at the same cell, from every 16th slab (extrapolated).
-    if (!baseline) return 0;
+    if (!baseline) continue;
     size_t points = 0;
     double denseCpu = 0;
     double dense = denseSampling(blob, r.cellSize, points, denseCpu, quick ? 4 : 16);
@@ -106,6 +119,7 @@ int main(int argc, char** argv) {
                 "%.0f M points; dense / sparse = %.1fx wall, %.1fx CPU\n",
                 dense, denseCpu, points * 1e-6, dense / s, denseCpu / cpu);
   }
+  if (!baseline) return 0;
 
   // 2. Sparse vs dense at a coarser cell the dense grid can afford.
   {

@@ -13,6 +13,7 @@
 #include <string>
 
 #include "blobtree/cell_size.h"
+#include "blobtree/detail/dual_patches.h"
 #include "blobtree/detail/marching_tets.h"
 #include "core/diagnostics.h"
 #include "core/parallel.h"
@@ -355,16 +356,21 @@ struct Vertices {
   std::vector<EdgeRec> edges;        // per vertex
 };
 
+// The active cells by grid key.
+CellHash activeCellIndex(const Grid& g) {
+  CellHash index(g.active.size());
+  for (size_t a = 0; a < g.active.size(); ++a) {
+    glm::ivec3 q = g.cellCoords[g.active[a]];
+    index.insert(pointKey(q.x, q.y, q.z), uint32_t(a));
+  }
+  return index;
+}
+
 // Step 4a: every crossing edge P -> P + d (d a corner code) belongs to the cell with low
 // corner P; that cell has the crossing between its corners 0 and d, so it is active (kept
 // by the bounds or added by the closure). Vertices are numbered by owner cell, then by d.
-Vertices numberVertices(const Grid& g) {
+Vertices numberVertices(const Grid& g, const CellHash& activeIndex, uint8_t directions) {
   const size_t nActive = g.active.size();
-  CellHash activeIndex(nActive);
-  for (size_t a = 0; a < nActive; ++a) {
-    glm::ivec3 q = g.cellCoords[g.active[a]];
-    activeIndex.insert(pointKey(q.x, q.y, q.z), uint32_t(a));
-  }
   Vertices v;
   v.crossMask.resize(nActive);
   v.vertexBase.assign(nActive + 1, 0);
@@ -372,7 +378,7 @@ Vertices numberVertices(const Grid& g) {
   parallelFor(0, nActive, [&](size_t a) {
     uint8_t m = g.insideMask[g.active[a]], cross = 0;
     for (int d = 1; d < 8; ++d)
-      if (((m >> d) & 1) != (m & 1)) cross |= uint8_t(1u << d);
+      if (((directions >> d) & 1) && ((m >> d) & 1) != (m & 1)) cross |= uint8_t(1u << d);
     v.crossMask[a] = cross;
     v.vertexBase[a + 1] = uint32_t(std::popcount(unsigned(cross)));
     glm::ivec3 q = g.cellCoords[g.active[a]];
@@ -533,6 +539,158 @@ void fixFlatNormals(Mesh& mesh, const std::vector<uint8_t>& flatGradient) {
     }
 }
 
+
+// Dual marching cubes (blobtree/detail/dual_patches.h): a vertex per surface patch of each
+// active cell, a quad (two triangles) per crossing axis edge of the grid. Steps 4-5 of the
+// file comment for PolygonizeOptions::Mesher::DualMarchingCubes.
+void dualMesh(const CompiledBlob& blob, const PolygonizeOptions& options, const Grid& g, PolygonizeResult& res) {
+  const size_t nActive = g.active.size();
+  CellHash activeIndex = activeCellIndex(g);
+  // Crossing axis edges (directions 1, 2, 4), each owned by the cell at its low end.
+  Vertices v = numberVertices(g, activeIndex, uint8_t((1u << 1) | (1u << 2) | (1u << 4)));
+  auto edgePoint = [&](size_t a, int e) {
+    uint32_t owner = v.owners[a * 8 + size_t(detail::lowCorner(e))];
+    unsigned d = 1u << detail::edgeAxis(e);
+    if (owner == kNoCell || !((v.crossMask[owner] >> d) & 1)) throw std::logic_error("polygonize: crossing edge without an owner cell");
+    return v.vertexBase[owner] + uint32_t(std::popcount(unsigned(v.crossMask[owner]) & ((1u << d) - 1u)));
+  };
+
+  // The crossing points on the edges, by the same root search as the tetrahedra's vertices.
+  PolygonizeOptions edgeOptions = options;
+  edgeOptions.normals = edgeOptions.attributes = edgeOptions.progress = false;
+  // The patch's Newton steps land the vertex on the surface; its starting mean needs only
+  // rough crossings.
+  edgeOptions.refineSteps = std::min(options.refineSteps, 3);
+  PolygonizeResult crossings;
+  std::vector<uint8_t> unusedFlat;
+  std::vector<uint8_t> evals = placeVertices(blob, edgeOptions, g, v.edges, crossings, unusedFlat);
+  const std::vector<Vec3>& cross = crossings.mesh.positions;
+
+  // The patches of every active cell, numbered by cell.
+  std::vector<detail::CellPatches> patches(nActive);
+  std::vector<uint32_t> patchBase(nActive + 1, 0);
+  parallelFor(0, nActive, [&](size_t a) {
+    auto valuesOf = [&](size_t cell, float* f) {
+      for (int c = 0; c < 8; ++c) f[c] = g.values[g.cornerPoint[cell * 8 + size_t(c)]] - kIso;
+    };
+    float f[8], fn[8];
+    valuesOf(g.active[a], f);
+    // Ambiguous faces whose diagonal corners both cells join are decided for manifoldness.
+    int8_t forced[6];
+    const glm::ivec3 q = g.cellCoords[g.active[a]];
+    for (int face = 0; face < 6; ++face) {
+      forced[face] = -1;
+      const int axis = face / 2, side = face % 2;
+      glm::ivec3 n = q;
+      n[axis] += side ? 1 : -1;
+      uint32_t j = n[axis] < 0 ? kNoCell : activeIndex.find(pointKey(n.x, n.y, n.z));
+      if (j == kNoCell) continue;
+      valuesOf(g.active[j], fn);
+      forced[face] = detail::forcedFaceDecision(f, fn, axis, side);
+    }
+    patches[a] = detail::cellPatches(f, forced);
+    patchBase[a + 1] = uint32_t(patches[a].count);
+  }, 2048);
+  for (size_t a = 0; a < nActive; ++a) patchBase[a + 1] += patchBase[a];
+  const size_t nVerts = patchBase[nActive];
+
+  // Each patch's vertex: the mean of its crossing points, then Newton steps along the
+  // gradient toward F = 0.5, kept inside the cell (so the quads keep their layout).
+  Mesh& mesh = res.mesh;
+  mesh.positions.resize(nVerts);
+  if (options.normals) mesh.normals.resize(nVerts);
+  if (options.attributes) {
+    mesh.uvs.resize(nVerts);
+    res.attributes.resize(nVerts);
+  }
+  std::vector<uint8_t> flatGradient(nVerts, 0);
+  std::unique_ptr<Progress> bar;
+  if (options.progress) bar = std::make_unique<Progress>("polygonize", nActive);
+  constexpr int kNewtonSteps = 2;
+  std::atomic<size_t> sampleCount{0};
+  constexpr size_t kCellBlock = 256;
+  parallelFor(0, (nActive + kCellBlock - 1) / kCellBlock, [&](size_t blk) {
+    size_t begin = blk * kCellBlock, end = std::min(nActive, begin + kCellBlock), samples = 0;
+    for (size_t a = begin; a < end; ++a) {
+      const detail::CellPatches& cp = patches[a];
+      std::array<Vec3, 4> sum{};
+      std::array<int, 4> n{};
+      for (int e = 0; e < 12; ++e)
+        if (cp.patch[e] >= 0) {
+          sum[size_t(cp.patch[e])] += cross[edgePoint(a, e)];
+          ++n[size_t(cp.patch[e])];
+        }
+      const Vec3 lo = gridPosition(g.cs, g.cellCoords[g.active[a]]), hi = lo + Vec3(g.cs.cellSize);
+      for (int k = 0; k < cp.count; ++k) {
+        Vec3 p = sum[size_t(k)] / float(n[size_t(k)]);
+        Sample smp = blob.sample(p);
+        ++samples;
+        for (int step = 0; step < kNewtonSteps && options.refineSteps > 0; ++step) {
+          float r = smp.value - kIso, gg = glm::dot(smp.gradient, smp.gradient);
+          if (std::fabs(r) < options.fieldTolerance || !(gg > 1e-30f) || !std::isfinite(gg)) break;
+          Vec3 q = glm::clamp(p - (r / gg) * smp.gradient, lo, hi);
+          if (q == p) break;
+          p = q;
+          smp = blob.sample(p);
+          ++samples;
+        }
+        size_t vi = patchBase[a] + size_t(k);
+        mesh.positions[vi] = p;
+        if (options.normals) {
+          float len = glm::length(smp.gradient);
+          if (len > 1e-20f && std::isfinite(len)) mesh.normals[vi] = -smp.gradient / len;
+          else flatGradient[vi] = 1;
+        }
+        if (options.attributes) {
+          mesh.uvs[vi] = smp.attributes.uv;
+          res.attributes[vi] = smp.attributes;
+        }
+      }
+    }
+    sampleCount += samples;
+    if (bar) bar->advance(end - begin);
+  });
+  if (bar) bar->finish();
+
+  // A quad per crossing edge, joining its patch in the four cells around it, ordered
+  // counter-clockwise seen from the outside; split along its shorter diagonal.
+  mesh.triangles.resize(2 * v.edges.size());
+  parallelFor(0, nActive, [&](size_t a) {
+    const glm::ivec3 q = g.cellCoords[g.active[a]];
+    const bool lowInside = g.insideMask[g.active[a]] & 1;
+    for (int axis = 0; axis < 3; ++axis) {
+      const unsigned d = 1u << axis;
+      if (!((v.crossMask[a] >> d) & 1)) continue;
+      const int b = (axis + 1) % 3, c = (axis + 2) % 3;
+      static constexpr int kAround[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};  // counter-clockwise about +axis
+      uint32_t quad[4];
+      for (int k = 0; k < 4; ++k) {
+        glm::ivec3 cell = q;
+        cell[b] -= kAround[k][0];
+        cell[c] -= kAround[k][1];
+        uint32_t j = cell.x < 0 || cell.y < 0 || cell.z < 0 ? kNoCell : activeIndex.find(pointKey(cell.x, cell.y, cell.z));
+        int e = 4 * axis + kAround[k][0] + 2 * kAround[k][1];
+        if (j == kNoCell || patches[j].patch[size_t(e)] < 0) throw std::logic_error("polygonize: crossing edge without its four cells");
+        quad[k] = patchBase[j] + uint32_t(patches[j].patch[size_t(e)]);
+      }
+      if (!lowInside) std::swap(quad[1], quad[3]);  // the outside is toward −axis
+      const size_t t = 2 * size_t(edgePoint(a, 4 * axis));
+      const std::vector<Vec3>& P = mesh.positions;
+      if (glm::length(P[quad[0]] - P[quad[2]]) <= glm::length(P[quad[1]] - P[quad[3]])) {
+        mesh.triangles[t] = {quad[0], quad[1], quad[2]};
+        mesh.triangles[t + 1] = {quad[0], quad[2], quad[3]};
+      } else {
+        mesh.triangles[t] = {quad[0], quad[1], quad[3]};
+        mesh.triangles[t + 1] = {quad[1], quad[2], quad[3]};
+      }
+    }
+  }, 2048);
+  if (options.normals) fixFlatNormals(mesh, flatGradient);
+  size_t total = g.pointKeys.size() + sampleCount.load();
+  for (uint8_t k : evals) total += k;
+  res.fieldEvaluations = total;
+}
+
 }  // namespace
 
 PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOptions& options) {
@@ -579,8 +737,14 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
   res.extraCells = g.extraCells;
   if (g.active.empty()) return res;
 
+  if (options.mesher == PolygonizeOptions::Mesher::DualMarchingCubes) {
+    dualMesh(blob, options, g, res);
+    res.vertexSeconds = lap();
+    return res;
+  }
+
   // 4. Vertex numbering and marching tetrahedra.
-  Vertices v = numberVertices(g);
+  Vertices v = numberVertices(g, activeCellIndex(g), 0xfe);
   res.mesh.triangles = triangulate(g, v);
   std::vector<uint32_t>().swap(v.owners);
   res.triangulateSeconds = lap();

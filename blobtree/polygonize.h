@@ -42,6 +42,14 @@ namespace sprig::blobtree {
 
 /// Options of polygonize(); defaults give a mesh within 1% of a sphere's volume.
 struct PolygonizeOptions {
+  /// How active cells become triangles. MarchingTetrahedra: six Kuhn tetrahedra per cell,
+  /// a vertex on every crossing grid edge (including the cells' diagonals), exact on the
+  /// surface; the reference. DualMarchingCubes (Nielson 2004; blobtree/detail/dual_patches.h):
+  /// a vertex per surface patch of each cell (the mean of its edge crossings, moved onto
+  /// F = 0.5 by Newton steps kept inside the cell), a quad per crossing axis edge; about a
+  /// third of the triangles, closed and 2-manifold by construction.
+  enum class Mesher { MarchingTetrahedra, DualMarchingCubes };
+  Mesher mesher = Mesher::MarchingTetrahedra;
   /// Requested cell edge length in world units; 0 = automatic: the smaller of
   /// featureFraction · smallestFeature() (so the thinnest twig gets several cells across)
   /// and the model's bounds diagonal / sizeDivisions, but never finer than the diagonal /
