@@ -486,6 +486,14 @@ class GrammarParser {
     }
   }
 
+  static bool isQuery(std::string_view name) { return name == "?P" || name == "?H" || name == "?L" || name == "?U"; }
+  /// cpfg fills a query module of an interpretation rule in the interpreted copy of the
+  /// string, where no production reads it; Sprig refuses it rather than ignore it.
+  static std::string queryInInterpretation(std::string_view name) {
+    return "cpfg's query module '" + std::string(name) +
+           "' in an interpretation rule is not supported (its values would be lost with the interpreted string)";
+  }
+
   /// The production of line (from column b, its arrow at `arrow`), compiled into block's RuleSet.
   void parseProduction(int line, int b, int arrow, int arrowLen, Block block) {
     const std::string& s = scanner_.line(line);
@@ -521,14 +529,22 @@ class GrammarParser {
       return;
     }
     if (!scanner_.tokenizeModules(line, pred.b, pred.e, predMods)) return;
-    if (predMods.size() != 1) {
-      error(line, predMods.size() > 1 ? predMods[1].col : pred.b,
-            predMods.size() > 1 ? "a predecessor must be a single module (cpfg's predecessors of several modules are not supported)"
-                                : "a predecessor must be a single module");
+    if (predMods.empty()) {
+      error(line, pred.b, "a predecessor must be a single module");
       return;
     }
-    if (predMods[0].name == "[" || predMods[0].name == "]") {
-      error(line, predMods[0].col, "a bracket cannot be a predecessor");
+    if (predMods.size() > 1 && block != Block::Main) {
+      error(line, predMods[1].col, std::string("a predecessor of several modules is not allowed in ") + blockName(block) +
+                                       " rules (only in productions)");
+      return;
+    }
+    for (const RawModule& m : predMods)
+      if (m.name == "[" || m.name == "]") {
+        error(line, m.col, "a bracket cannot be a predecessor");
+        return;
+      }
+    if (block == Block::Interpretation && isQuery(predMods[0].name)) {
+      error(line, predMods[0].col, queryInInterpretation(predMods[0].name));
       return;
     }
     // Contexts (textual order: left, predecessor, right).
@@ -545,6 +561,14 @@ class GrammarParser {
     p.predFirstVar = static_cast<uint16_t>(varNames.size());
     p.predParams = static_cast<uint16_t>(formals(predMods[0], varNames));
     arityUses_.push_back({predMods[0].name, p.predParams, line, predMods[0].col, scanner_.moduleText(line, predMods[0]), false});
+    for (size_t k = 1; k < predMods.size(); ++k) {
+      PatternItem it;
+      it.symbol = prog_.symbols.intern(predMods[k].name);
+      it.firstVar = static_cast<uint16_t>(varNames.size());
+      it.paramCount = static_cast<uint16_t>(formals(predMods[k], varNames));
+      arityUses_.push_back({predMods[k].name, it.paramCount, line, predMods[k].col, scanner_.moduleText(line, predMods[k]), false});
+      p.predRest.push_back(it);
+    }
     if (rc.b != rc.e && !scanner_.isStar(rc)) {
       if (block != Block::Main) error(line, rc.b, std::string("context is not allowed in ") + blockName(block) + " rules");
       else p.right = pattern(rc, varNames, false);
@@ -570,6 +594,7 @@ class GrammarParser {
       if (scanner_.tokenizeModules(line, succ.b, succ.e, mods) && checkBrackets(line, mods, "the successor")) {
         noteWritten(line, mods);
         for (const RawModule& m : mods) {
+          if (block == Block::Interpretation && isQuery(m.name)) error(line, m.col, queryInInterpretation(m.name));
           SuccModule sm;
           sm.symbol = prog_.symbols.intern(m.name);
           sm.firstArg = static_cast<uint32_t>(p.args.size());
@@ -1057,6 +1082,7 @@ class GrammarParser {
     for (SymbolId id : ignoreList_) prog_.ignored[id] = 1;
     prog_.ignored[prog_.openBracket] = prog_.ignored[prog_.closeBracket] = 0;
     for (SymbolId id : prog_.axiom.symbols) prog_.usesCut |= id == prog_.cut;
+    for (const char* q : {"?P", "?H", "?L", "?U"}) prog_.usesQuery |= prog_.symbols.find(q) >= 0;
     for (const RuleSet* rs : {&prog_.productions, &prog_.decomposition})
       for (const Production& p : rs->productions)
         for (const SuccModule& m : p.successor) prog_.usesCut |= m.symbol == prog_.cut;

@@ -192,6 +192,9 @@ struct Production {
   SymbolId predecessor = 0;
   uint16_t predParams = 0;
   uint16_t predFirstVar = 0;
+  /// cpfg's predecessors of several modules: the modules after the first, matched at the
+  /// positions right after it (no skipping); the production replaces them all.
+  std::vector<PatternItem> predRest;
   std::vector<PatternItem> left;   ///< in textual order
   std::vector<PatternItem> right;  ///< in textual order
   CodeRange condition;             ///< empty: always true
@@ -206,12 +209,14 @@ struct Production {
   double weight = 1;
   bool usesRandom = false;  ///< condition or successor calls ran/nran
   bool simpleCtx = false;   ///< simpleContext(), cached by RuleSet::finalize()
-  bool hasContext() const { return !left.empty() || !right.empty(); }
+  /// True when matching looks at other modules than the predecessor's first (contexts, or
+  /// a predecessor of several modules).
+  bool hasContext() const { return !left.empty() || !right.empty() || !predRest.empty(); }
   /// Contexts of at most one symbol on each side (no brackets): matched against the
   /// cached neighbours directly.
   bool simpleContext() const {
     auto plain = [](const std::vector<PatternItem>& v) { return v.size() <= 1 && (v.empty() || (!v[0].openBracket && !v[0].closeBracket)); };
-    return plain(left) && plain(right);
+    return plain(left) && plain(right) && predRest.empty();
   }
 };
 
@@ -327,6 +332,10 @@ struct Program {
   SymbolId openBracket = 0, closeBracket = 0, cut = 0;
   /// True when some successor or the axiom contains the cut symbol `%`.
   bool usesCut = false;
+  /// True when the axiom or a production writes one of cpfg's query modules (`?P ?H ?L ?U`):
+  /// the Deriver then interprets the string before every step and writes the turtle's
+  /// state into their parameters.
+  bool usesQuery = false;
   /// The `derivation length:` header (line 0 when the file has none), with its line's text;
   /// module-limit errors point here when the grammar's own length is used.
   SourceLoc lengthLoc;

@@ -264,7 +264,10 @@ TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg
     CHECK(errorOf("axiom: A\nA --> F$A\n") ==
           "t.l:2:8: cpfg's '$' (end of a sub-L-system call; ABOP's roll to vertical is '@v' in cpfg) is not supported");
     CHECK(errorOf("axiom: F~l\n") == "t.l:1:9: cpfg's '~' (surface from a view file's surface file) is not supported");
-    CHECK(errorOf("axiom: ?P(0,0)A\n") == "t.l:1:8: cpfg's '?P' (query module) is not supported");
+    CHECK(errorOf("axiom: ?P(0,0)A\n") == "no error");
+    CHECK(errorOf("axiom: A\nhomomorphism\nA --> F?U(0,0,0)\n") ==
+          "t.l:3:8: cpfg's query module '?U' in an interpretation rule is not supported (its values would be lost with "
+          "the interpreted string)");
     CHECK(errorOf("axiom: A\nA --> ?(2,1)B$\n") == "t.l:2:7: cpfg's '?(n, scale)' (sub-L-system call) is not supported");
     CHECK(errorOf("axiom: F@Tx(1)\n") == "t.l:1:9: cpfg's '@Tx' (texture) is not supported");
     CHECK(errorOf("axiom: F@Q\n") == "t.l:1:9: unknown cpfg command '@Q'");
@@ -413,5 +416,68 @@ TEST_CASE("cpfg Start, StartEach, EndEach and End blocks over global variables",
           "'StartEach:', 'EndEach:' and 'End:' blocks)");
     CHECK(errorOf("Start: i = 0;\naxiom: A\n") == "t.l:1:8: expected '{ statements }' after 'Start:'");
     CHECK(errorOf("Start: { i = 0; }\nStart: { j = 0; }\naxiom: A\n") == "t.l:2:1: duplicate 'start:' (first at line 1)");
+  }
+}
+
+TEST_CASE("cpfg query modules", "[lsystem][cpfg]") {
+  // tests/assets/cpfg/query: values from its reference.py (cpfg's own turtle, independent of
+  // Sprig's): with the view file's 30 degrees, three F on each axis, and
+  const double c30 = std::sqrt(3.0) / 2;
+  const Grammar g = loadGrammar(cpfgAsset("query/plant.l"));
+  SECTION("the view file's turtle: apex at (-1.5, 2.598), branch tip 3 below it") {
+    const ViewFile view = loadViewFile(cpfgAsset("query/plant.v"));
+    DeriveOptions opt;
+    opt.queryTurtle = cpfgTurtleSettings(&view, TurtleSettings{});
+    Deriver d(g, opt);
+    const ModuleString& s = d.derive();
+    CHECK(countSymbol(s, d.symbols(), "F") == 6);
+    std::vector<double> want = {-1.5, 3 * c30, -1.5, 3 * c30, -3, 0, 0, -1, -c30, -0.5, 0, 0.5, -c30, 0};
+    std::vector<double> got;
+    for (size_t i = 0; i < s.size(); ++i)
+      if (d.symbols().name(s.symbols[i])[0] == '?')
+        for (double v : s.paramsOf(i)) got.push_back(v);
+    REQUIRE(got.size() == want.size());
+    for (size_t k = 0; k < want.size(); ++k) CHECK(got[k] == Approx(want[k]).margin(1e-12));
+    // The drawn main axis ends where ?P says.
+    Turtle t(d.symbols(), cpfgTurtleSettings(&view, TurtleSettings{}));
+    Skeleton sk = t.run(s);
+    REQUIRE(sk.internodes.size() == 6);
+    checkNear(sk.internodes[2].end, DVec3(-1.5, 3 * c30, 0));
+    checkNear(sk.internodes[5].end, DVec3(-1.5, 3 * c30, -3));
+  }
+  SECTION("without a view file: cpfg's 45 degrees grow the main axis once more") {
+    Deriver d(g);
+    const ModuleString& s = d.derive();
+    CHECK(countSymbol(s, d.symbols(), "F") == 7);
+    const double r2 = std::sqrt(0.5);
+    CHECK(formatModuleString(s, d.symbols()).substr(0, 12) == "+F(1)F(1)F(1");
+    size_t q = 0;
+    while (d.symbols().name(s.symbols[q]) != "?P") ++q;
+    CHECK(s.paramsOf(q)[0] == Approx(-4 * r2));
+    CHECK(s.paramsOf(q)[1] == Approx(4 * r2));
+  }
+  SECTION("the axiom's queries are filled before the first step, and through the homomorphism") {
+    Grammar h = parseGrammar("derivation length: 0\naxiom: A?P(0,0)B?P(0,0)?P\nhomomorphism\nA --> F(2)\nB --> f(1)\n", "t.l");
+    Deriver d(h);
+    CHECK(formatModuleString(d.current(), d.symbols()) == "A?P(0,2)B?P(0,3)?P");
+  }
+}
+
+TEST_CASE("cpfg predecessors of several modules", "[lsystem][cpfg]") {
+  SECTION("tests/assets/cpfg/multi_predecessor, derived by hand in its comment") {
+    Grammar g = loadGrammar(cpfgAsset("multi_predecessor/plant.l"));
+    Deriver d(g);
+    CHECK(formatModuleString(d.derive(), d.symbols()) == "D(3)CZCE(5)[B(6)]CG");
+  }
+  SECTION("left context before the first module; the replaced modules are not rewritten again") {
+    // X < A B: only the first A B follows X; B --> Q rewrites the B not consumed.
+    Grammar g = parseGrammar("derivation length: 2\naxiom: XABAB\nX < A B --> Y\nB --> Q\nY --> YY\n", "t.l");
+    Deriver d(g);
+    CHECK(formatModuleString(d.step(), d.symbols()) == "XYAQ");
+    CHECK(formatModuleString(d.step(), d.symbols()) == "XYYAQ");
+  }
+  SECTION("stochastic choice among predecessors of different lengths counts each once") {
+    Grammar g = parseGrammar("derivation length: 1\nseed: 3\naxiom: AB\nA B --> X : 1\nA --> Y : 0\n", "t.l");
+    CHECK(formatModuleString(derive(g), g.symbols()) == "X");
   }
 }
