@@ -1,6 +1,7 @@
 #include "lsystem/detail/grammar_parser.h"
 
 #include <algorithm>
+#include <tuple>
 #include <array>
 #include <charconv>
 #include <cmath>
@@ -176,11 +177,13 @@ class GrammarParser {
         while (i < static_cast<int>(s.size()) && isIdentChar(s[i])) ++i;
         std::string word = s.substr(b, i - b);
         word.erase(std::remove_if(word.begin(), word.end(), [](char c) { return isSpace(c); }), word.end());
-        static const char* const kCpp[] = {"#include", "#ifdef", "#ifndef", "#if", "#else", "#elif", "#endif", "#undef", "#line", "#pragma", "#error"};
+        static const char* const kCpp[] = {"#if", "#elif", "#line", "#pragma", "#error", "#warning"};
         if (std::find(std::begin(kCpp), std::end(kCpp), word) != std::end(kCpp))
-          error(line, b, "cpfg's C preprocessor directive '" + word + "' is not supported (only '#define NAME constant' is)");
+          error(line, b, "cpfg's C preprocessor directive '" + word + "' is not supported (Sprig's preprocessor reads "
+                         "#define, #undef, #include, #ifdef, #ifndef, #else and #endif)");
         else
-          error(line, b, "unknown directive '" + word + "'" + didYouMean(word, {"#define"}));
+          error(line, b, "unknown directive '" + word + "'" +
+                             didYouMean(word, {"#define", "#undef", "#include", "#ifdef", "#ifndef", "#else", "#endif"}));
       } else if (isModuleDeclaration(s, b)) {
         declareModules(line, b + 6);
       }
@@ -404,8 +407,7 @@ class GrammarParser {
           error(line, value.b, "derivation length must be a whole number from 0 to 1000000, got " + formatNumber(*d));
         } else {
           prog_.derivationLength = static_cast<int>(*d);
-          prog_.lengthLoc = SourceLoc{prog_.fileName, line, b + 1};
-          prog_.lengthLine = scanner_.rawLine(line);
+          std::tie(prog_.lengthLoc, prog_.lengthLine) = scanner_.locate(line, b);
         }
       }
     } else if (h.key == "seed") {
@@ -434,8 +436,7 @@ class GrammarParser {
                }) && bracketEnd(line, brackets, "the axiom")) {
         axiomSpan_ = value;
         axiomLine_ = line;
-        prog_.axiomLoc = SourceLoc{prog_.fileName, line, b + 1};
-        prog_.axiomLine = scanner_.rawLine(line);
+        std::tie(prog_.axiomLoc, prog_.axiomLine) = scanner_.locate(line, b);
       }
     } else if (h.key == "ignore" || h.key == "consider") {
       once(h.key, line, b);
@@ -554,9 +555,8 @@ class GrammarParser {
       if (block != Block::Main) error(line, lc.b, std::string("context is not allowed in ") + blockName(block) + " rules");
       else p.left = pattern(lc, varNames, true);
     }
-    p.loc = SourceLoc{prog_.fileName, line, predMods[0].col + 1};
+    std::tie(p.loc, p.sourceLine) = scanner_.locate(line, predMods[0].col);
     p.text = std::string(scanner_.view(pred));
-    p.sourceLine = scanner_.rawLine(line);
     p.predecessor = prog_.symbols.intern(predMods[0].name);
     p.predFirstVar = static_cast<uint16_t>(varNames.size());
     p.predParams = static_cast<uint16_t>(formals(predMods[0], varNames));

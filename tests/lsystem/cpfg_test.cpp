@@ -7,6 +7,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/atomic_file.h"
 #include "lsystem/derive.h"
 #include "lsystem/grammar.h"
 #include "lsystem/turtle.h"
@@ -275,14 +276,9 @@ TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg
   SECTION("statements, blocks, preprocessor, several L-systems") {
     CHECK(errorOf("axiom: A(1)\nA(y) : { x = y / 2; x < 10 --> B(x)\n") == "t.l:2:8: unclosed '{' of a statement block");
     CHECK(errorOf("define: { array a[2]; }\naxiom: A\n") == "t.l:1:1: cpfg's 'define:' (array declarations) is not supported");
-    CHECK(errorOf("#include \"x.h\"\naxiom: A\n") ==
-          "t.l:1:1: cpfg's C preprocessor directive '#include' is not supported (only '#define NAME constant' is)");
-    CHECK(errorOf("#define G(x) F(x)\naxiom: A\n") ==
-          "t.l:1:9: cpfg's function-like macro '#define G(...)' (C preprocessor) is not supported");
-    CHECK(errorOf("#define LEAF ?(4,1)leaf(2)$\naxiom: A\n") ==
-          "t.l:1:14: cpfg's #define of a module string ('?(4,1)leaf(2)$', a C preprocessor macro) is not supported: only constants are");
-    CHECK(errorOf("#define B [+F]\naxiom: A\n") ==
-          "t.l:1:11: cpfg's #define of a module string ('[+F]', a C preprocessor macro) is not supported: only constants are");
+    CHECK(errorOf("#if 1\naxiom: A\n#endif\n") ==
+          "t.l:1:1: cpfg's C preprocessor directive '#if' is not supported (Sprig's preprocessor reads #define, "
+          "#undef, #include, #ifdef, #ifndef, #else and #endif)");
     CHECK(errorOf("#define K (1 > 0 ? 2 : 3)\naxiom: A\n") == "no error");
     CHECK(errorOf("lsystem: 1\naxiom: A\nendlsystem\n", "t.l") == "no error");
     CHECK(errorOf("lsystem: 1\naxiom: A\nlsystem: 2\naxiom: B\n") ==
@@ -479,5 +475,44 @@ TEST_CASE("cpfg predecessors of several modules", "[lsystem][cpfg]") {
   SECTION("stochastic choice among predecessors of different lengths counts each once") {
     Grammar g = parseGrammar("derivation length: 1\nseed: 3\naxiom: AB\nA B --> X : 1\nA --> Y : 0\n", "t.l");
     CHECK(formatModuleString(derive(g), g.symbols()) == "X");
+  }
+}
+
+TEST_CASE("cpfg's C preprocessor", "[lsystem][cpfg]") {
+  SECTION("tests/assets/cpfg/preprocessor: macros, #ifdef, #include (derived by hand in its comment)") {
+    Grammar g = loadGrammar(cpfgAsset("preprocessor/plant.l"));
+    Deriver d(g);
+    CHECK(formatModuleString(d.derive(), d.symbols()) == "F(1)[+(30)F(0.5)@o(0.2)]F(1)[+(30)F(0.5)@o(0.2)]A");
+    CHECK(g.define("LATERAL").value() == 0.5);  // a number stays a constant -D may override
+  }
+  SECTION("an error in an included file is at its own file:line:col") {
+    const std::string file = cpfgAsset("preprocessor_errors/plant.l");
+    CHECK(errorOf(readFile(file), file) == cpfgAsset("preprocessor_errors/rules.h") +
+                                                    ":2:8: cpfg's '@Gc' (generalized cylinder) is not supported");
+  }
+  SECTION("an error inside a macro's expansion is at the macro's use") {
+    CHECK(errorOf("#define LEAF [@Gc(1)]\naxiom: F LEAF\n") == "t.l:2:10: cpfg's '@Gc' (generalized cylinder) is not supported");
+    CHECK(errorOf("#define B(x) F(x)\naxiom: A B(1, 2) C\n") ==
+          "t.l:2:10: macro 'B' takes 1 argument(s) (defined at t.l:1), or its expansion nests deeper than 64 levels");
+    // Columns after an expansion are the file's own.
+    CHECK(errorOf("#define S F(1)F(1)\naxiom: S@Gc(1)\n") == "t.l:2:9: cpfg's '@Gc' (generalized cylinder) is not supported");
+  }
+  SECTION("cpp's identifiers: a macro named B is not expanded inside AB; a number body stays a value") {
+    Grammar g = parseGrammar("#define B [+F]\n#define N (2 + 1)\naxiom: AB B F(N)\n", "t.l");
+    CHECK(formatModuleString(g.axiom(), g.symbols()) == "AB[+F]F(3)");
+  }
+  SECTION("cpp's textual substitution: an unparenthesized body binds as written") {
+    // #define K 1+2: 2*K is 2*1+2 = 4 in cpfg (cpp), not 6.
+    Grammar g = parseGrammar("#define K 1+2\naxiom: A(2*K)\n", "t.l");
+    CHECK(formatModuleString(g.axiom(), g.symbols()) == "A(4)");
+  }
+  SECTION("errors") {
+    CHECK(errorOf("#include \"../query/plant.v\"\naxiom: A\n", cpfgAsset("preprocessor/t.l")).find(
+              ":1:10: '#include \"../query/plant.v\"' is outside the object's folder") != std::string::npos);
+    CHECK(errorOf("#include \"missing.h\"\naxiom: A\n") == "t.l:1:10: cannot read the included file 'missing.h'");
+    CHECK(errorOf("#ifdef X\naxiom: A\n") == "t.l:1:1: '#if' block without '#endif'");
+    CHECK(errorOf("axiom: A\n#endif\n") == "t.l:2:1: '#endif' without '#ifdef' or '#ifndef'");
+    CHECK(errorOf("#define B F\n#define B G\naxiom: A\n") == "t.l:2:9: 'B' is already defined at t.l:1");
+    CHECK(errorOf("#define B F\n#undef B\n#define B G\naxiom: B\n") == "no error");
   }
 }
