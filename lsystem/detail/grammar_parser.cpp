@@ -216,7 +216,7 @@ class GrammarParser {
       return;
     }
     if (defineLines.count(name)) {
-      error(line, nb, "'" + name + "' is already defined at line " + std::to_string(defineLines[name]));
+      error(line, nb, "'" + name + "' is already defined at " + scanner_.lineRef(defineLines[name]));
       return;
     }
     defineLines[name] = line;
@@ -384,7 +384,7 @@ class GrammarParser {
   /// Records header key at line; a second one is an error.
   void once(const std::string& key, int line, int col) {
     auto [it, inserted] = seen_.emplace(key, line);
-    if (!inserted) error(line, col, "duplicate '" + key + ":' (first at line " + std::to_string(it->second) + ")");
+    if (!inserted) error(line, col, "duplicate '" + key + ":' (first at " + scanner_.lineRef(it->second) + ")");
   }
 
   /// A known header h at column b of line (`decomposition:` and `interpretation:` switch block).
@@ -932,8 +932,8 @@ class GrammarParser {
       error(u.line, u.col,
             std::string(u.context ? "context '" : "predecessor '") + u.text + "' has " + std::to_string(u.arity) +
                 " parameter" + (u.arity == 1 ? "" : "s") + ", but '" + u.name + "' is only written with " + list +
-                (one ? " parameter" : " parameters") + " (as at line " + std::to_string(first.first) + ":" +
-                std::to_string(first.second + 1) + "), so this production never applies");
+                (one ? " parameter" : " parameters") + " (as at " + scanner_.lineRef(first.first, first.second) +
+                "), so this production never applies");
     }
   }
 

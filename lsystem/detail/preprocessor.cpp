@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -386,6 +387,7 @@ void Scanner::preprocess(int file, const std::vector<std::string>& raw, const st
         }
         std::string text;
         try {
+          if (!fs::is_regular_file(path)) throw std::runtime_error("not a file");
           text = readFile(path);
         } catch (const std::exception&) {
           err(k, ni, "cannot read the included file '" + (from / target).string() + "'");

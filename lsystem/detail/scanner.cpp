@@ -136,6 +136,14 @@ std::pair<SourceLoc, std::string> Scanner::locate(int line, int col0) const {
   return {SourceLoc{files_[o.file], o.line, col + 1}, raw_[line - 1]};
 }
 
+std::string Scanner::lineRef(int line, int col0) const {
+  auto [loc, text] = locate(line, std::max(col0, 0));
+  const bool own = line >= 1 && line <= static_cast<int>(origin_.size()) && origin_[line - 1].file == 0;
+  std::string out = own ? "line " + std::to_string(loc.line) : loc.file + ":" + std::to_string(loc.line);
+  if (col0 >= 0) out += ":" + std::to_string(loc.col);
+  return out;
+}
+
 void Scanner::error(int line, int col0, std::string msg) {
   auto [loc, text] = locate(line, col0);
   diags_.error(loc, std::move(msg), std::move(text));

@@ -81,6 +81,9 @@ class Scanner {
   /// Where column col0 of logical line `line` was written: its file (the grammar's, or a
   /// file it includes), 1-based line and column, and that line's text as written.
   std::pair<SourceLoc, std::string> locate(int line, int col0) const;
+  /// "line N" (or "line N:C" with a column) for a logical line of the grammar file itself,
+  /// "FILE:N" ("FILE:N:C") for one of an included file: how messages name another place.
+  std::string lineRef(int line, int col0 = -1) const;
   /// (line, 0-based column) of a block comment that is never closed; line 0 when none.
   std::pair<int, int> unterminatedComment() const { return pendingComment_; }
 
