@@ -267,7 +267,7 @@ struct Deriver::Impl {
     if (r.empty()) return;
     Rng blockRng(deriveSeed(seed, {kBlockStream, static_cast<uint64_t>(step)}));
     const Instr* code = prog->code.data();
-    if (std::isnan(detail::evalCode(code + r.begin, code + r.end, globals.data(), &blockRng)))
+    if (std::isnan(detail::evalCode(code + r.begin, code + r.end, globals.data(), &blockRng, &prog->strings)))
       throw InputError(SourceLoc{prog->fileName, 0, 0}, "a Start/StartEach/EndEach/End block loops more than " +
                                                             std::to_string(detail::kMaxLoopJumps) + " times at step " +
                                                             std::to_string(step));
@@ -484,7 +484,7 @@ struct Deriver::Impl {
   /// Runs the statement block r of p (its `before` or `after`) on vars.
   void statements(const Production& p, const detail::CodeRange& r, double* vars, int step) {
     const Instr* code = prog->code.data();
-    double v = detail::evalCode(code + r.begin, code + r.end, vars, p.usesRandom ? moduleRng() : nullptr);
+    double v = detail::evalCode(code + r.begin, code + r.end, vars, p.usesRandom ? moduleRng() : nullptr, &prog->strings);
     if (std::isnan(v))
       throw InputError(p.loc, "the statements of production '" + p.text + "' loop more than " +
                                   std::to_string(detail::kMaxLoopJumps) + " times at step " + std::to_string(step),

@@ -749,6 +749,96 @@ class GrammarParser {
 
   /// Statements `x = expr;`, `if (c) {...} [else {...}]`, `while (c) {...}`,
   /// `do {...} while (c);` of line[b, e) (cpfg reference manual, 3.2), appended to the code.
+  /// cpfg's `printf("format", values...);` at column at of line (its `(` at open): compiles
+  /// the values and an Op::Printf; returns the column after its `;`, or -1 after an error.
+  int printfStatement(int line, int at, int open, int e, std::vector<std::string>& varNames) {
+    const std::string& s = scanner_.line(line);
+    int q = nextNonSpace(line, open + 1, e);
+    if (q >= e || s[q] != '"') {
+      error(line, q, "printf's first argument must be a format in double quotes");
+      return -1;
+    }
+    std::string format;
+    int j = q + 1;
+    for (; j < e && s[j] != '"'; ++j) {
+      if (s[j] == '\\' && j + 1 < e) {
+        const char c = s[++j];
+        format += c == 'n' ? '\n' : c == 't' ? '\t' : c;
+      } else {
+        format += s[j];
+      }
+    }
+    if (j >= e) {
+      error(line, q, "unterminated format string of printf");
+      return -1;
+    }
+    // Conversions: numbers only (cpfg's values are numbers), one per value.
+    int conversions = 0;
+    for (size_t f = 0; f < format.size(); ++f) {
+      if (format[f] != '%') continue;
+      if (f + 1 < format.size() && format[f + 1] == '%') {
+        ++f;
+        continue;
+      }
+      size_t g = f + 1;
+      while (g < format.size() && std::string_view("-+ #0123456789.hlL").find(format[g]) != std::string_view::npos) ++g;
+      if (g >= format.size() || std::string_view("diouxXcfFeEgGaA").find(format[g]) == std::string_view::npos) {
+        error(line, q, "printf's conversion '" + format.substr(f, g + 1 - f) +
+                           "' is not supported (only numbers: %d %i %o %u %x %c %f %e %g %a)");
+        return -1;
+      }
+      ++conversions;
+      f = g;
+    }
+    // The values: top-level commas up to the call's `)`.
+    int close = -1, depth = 0;
+    for (int k = j + 1; k < e; ++k) {
+      if (s[k] == '(') ++depth;
+      if (s[k] == ')' && depth-- == 0) {
+        close = k;
+        break;
+      }
+    }
+    if (close < 0) {
+      error(line, open, "missing ')' after the arguments of printf");
+      return -1;
+    }
+    int values = 0;
+    int k = nextNonSpace(line, j + 1, close);
+    if (k < close && s[k] != ',') {
+      error(line, k, "expected ',' or ')' after printf's format");
+      return -1;
+    }
+    while (k < close) {
+      int next = scanner_.findTop(line, k + 1, close, ',');
+      if (next < 0) next = close;
+      if (!expr_.compile(scanner_.trim(Span{line, k + 1, next}), varNames, "printf value")) return -1;
+      ++values;
+      k = next;
+    }
+    if (values != conversions) {
+      error(line, at, "printf's format has " + std::to_string(conversions) + " conversion(s) for " +
+                          std::to_string(values) + " value(s)");
+      return -1;
+    }
+    if (values > 8) {
+      error(line, at, "printf with more than 8 values is not supported");
+      return -1;
+    }
+    int semi = nextNonSpace(line, close + 1, e);
+    if (semi >= e || s[semi] != ';') {
+      error(line, at, "missing ';' after the call of 'printf' (cpfg requires one after every statement)");
+      return -1;
+    }
+    Instr pr;
+    pr.op = Op::Printf;
+    pr.var = static_cast<uint16_t>(prog_.strings.size());
+    pr.c = values;
+    prog_.strings.push_back(format);
+    prog_.code.push_back(pr);
+    return semi + 1;
+  }
+
   bool statementList(int line, int b, int e, std::vector<std::string>& varNames, uint32_t base) {
     const std::string& s = scanner_.line(line);
     int i = b;
@@ -796,8 +886,10 @@ class GrammarParser {
         notOp.op = Op::Not;
         prog_.code.push_back(notOp);
         jump(Op::Jz, base, top);
-      } else if (const int k = nextNonSpace(line, i, e); k < e && s[k] == '(') {
-        // A call alone, `f(...);` (cpfg's printf, srand, ...): its value is dropped.
+      } else if (const int k = nextNonSpace(line, i, e); k < e && s[k] == '(' && word == "printf") {
+        if ((i = printfStatement(line, at, k, e, varNames)) < 0) return false;
+      } else if (k < e && s[k] == '(') {
+        // A call alone, `f(...);` (cpfg's srand, ...): its value is dropped.
         int end = scanner_.findTop(line, at, e, ';');
         if (end < 0) {
           error(line, at, "missing ';' after the call of '" + word + "' (cpfg requires one after every statement)");

@@ -11,7 +11,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/diagnostics.h"
@@ -38,6 +40,7 @@ enum class Op : uint8_t {
   Store,   ///< pops a value into register var
   Jz,      ///< pops a value; when it is 0, jumps to instruction c of the block
   Jmp,     ///< jumps to instruction c of the block
+  Printf,  ///< cpfg's `printf(format, ...)`: pops c values, prints them to stderr with Program::strings[var]
 };
 
 /// Most backward jumps one statement block may take (a `while` that never ends): past it
@@ -90,7 +93,12 @@ struct CodeRange {
 /// which must then be writable; jump targets count from code; a block returns 0, or NaN
 /// after kMaxLoopJumps backward jumps). rng is used only by the random draws (never null
 /// when the code draws: the compiler marks such productions usesRandom).
-inline double evalCode(const Instr* code, const Instr* end, const double* vars, Rng* rng) {
+/// cpfg's printf to stderr: format (checked by the parser: only numeric conversions, one
+/// per value) with the n values args.
+void printFormatted(const std::string& format, const double* args, int n);
+
+inline double evalCode(const Instr* code, const Instr* end, const double* vars, Rng* rng,
+                       const std::vector<std::string>* strings = nullptr) {
   double stack[kMaxStack];
   int sp = 0;
   long backJumps = 0;
@@ -150,6 +158,12 @@ inline double evalCode(const Instr* code, const Instr* end, const double* vars, 
         const Instr* to = code + static_cast<ptrdiff_t>(in->c);
         if (to <= in && ++backJumps > kMaxLoopJumps) return std::nan("");
         in = to - 1;  // the loop's ++in lands on the target
+        break;
+      }
+      case Op::Printf: {
+        const int n = static_cast<int>(in->c);
+        if (strings && in->var < strings->size()) printFormatted((*strings)[in->var], stack + sp - n, n);
+        sp -= n;
         break;
       }
     }
@@ -325,6 +339,7 @@ struct Program {
   ModuleString axiom;
   std::vector<std::pair<std::string, double>> defines;
   std::vector<Instr> code;
+  std::vector<std::string> strings;  ///< printf formats (Instr::var of Op::Printf)
   RuleSet productions;
   RuleSet decomposition;
   RuleSet interpretation;

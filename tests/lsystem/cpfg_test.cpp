@@ -289,6 +289,17 @@ TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg
     CHECK(errorOf("axiom: A(1)\nA(x) --> A(func(1, x))\n") ==
           "t.l:2:12: cpfg's function 'func' (function from a view file's function file) is not supported");
   }
+  SECTION("printf: a statement with numeric conversions") {
+    CHECK(errorOf("axiom: A(1)\nA(x) : { printf(\"%s\", x); } 1 --> A(x)\n") ==
+          "t.l:2:17: printf's conversion '%s' is not supported (only numbers: %d %i %o %u %x %c %f %e %g %a)");
+    CHECK(errorOf("axiom: A(1)\nA(x) : { printf(\"%g %g\", x); } 1 --> A(x)\n") ==
+          "t.l:2:10: printf's format has 2 conversion(s) for 1 value(s)");
+    CHECK(errorOf("axiom: A(1)\nA(x) --> A(printf(\"%g\", x))\n") ==
+          "t.l:2:12: cpfg's function 'printf' (output; it is a statement of its own) is not supported");
+    CHECK(errorOf("axiom: A(1)\nA(x) : { printf(x); } 1 --> A(x)\n") ==
+          "t.l:2:17: printf's first argument must be a format in double quotes");
+    CHECK(errorOf("Start: { printf(\"%5.2f%%\\n\", 2); }\naxiom: A\n") == "no error");
+  }
   SECTION("an error in a continued line is reported at its own line") {
     CHECK(errorOf("axiom: A\nA --> F\n\tF@Gc(2)\n") == "t.l:3:3: cpfg's '@Gc' (generalized cylinder) is not supported");
   }
