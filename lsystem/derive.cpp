@@ -10,6 +10,7 @@
 #include "core/rng.h"
 #include "lsystem/detail/huge_pages.h"
 #include "lsystem/detail/program.h"
+#include "lsystem/view_file.h"
 
 namespace sprig::lsystem {
 
@@ -186,6 +187,77 @@ struct Deriver::Impl {
   bool rngReady = false;
   uint64_t rngStream = 0, rngItem = 0;
 
+  /// The turtle that fills query modules (made on first use).
+  std::unique_ptr<Turtle> queryTurtle;
+
+  /// cpfg's query modules: interprets cur (through the interpretation rules, which hold
+  /// no query module) and writes the turtle's frame at each query module it reaches into
+  /// that module's parameters. Query modules pass through the interpretation rules
+  /// unchanged and in order, so the k-th one of the interpreted string is the k-th of cur.
+  void fillQueries() {
+    if (!prog->usesQuery) return;
+    if (!queryTurtle) {
+      TurtleSettings t;
+      if (opt.queryTurtle) {
+        t = *opt.queryTurtle;
+      } else {
+        if (prog->dialect == detail::Dialect::Cpfg) t = cpfgTurtleSettings(nullptr, t);
+        t.angleDeg = prog->hasAngle ? prog->angleDeg : kCpfgDefaultAngleDeg;
+      }
+      t.growthStep = -1;
+      queryTurtle = std::make_unique<Turtle>(prog->symbols, t);
+    }
+    std::vector<Turtle::QueryHit> hits;
+    if (prog->interpretation.empty()) {
+      hits = queryTurtle->query(cur);
+    } else {
+      ModuleString shown = interpreted(cur, done);
+      hits = queryTurtle->query(shown);
+      // Index of the k-th query module of shown -> k-th of cur.
+      std::vector<size_t> curQueries, shownOrdinal(shown.size(), 0);
+      for (size_t i = 0; i < cur.size(); ++i)
+        if (queryTurtle->commandOf(cur.symbols[i]) == Turtle::Command::Query) curQueries.push_back(i);
+      size_t k = 0;
+      for (size_t i = 0; i < shown.size(); ++i)
+        if (queryTurtle->commandOf(shown.symbols[i]) == Turtle::Command::Query) shownOrdinal[i] = k++;
+      for (Turtle::QueryHit& h : hits) h.index = curQueries[shownOrdinal[h.index]];
+    }
+    for (const Turtle::QueryHit& h : hits) {
+      const std::string& name = prog->symbols.name(cur.symbols[h.index]);
+      DVec3 v = name == "?P" ? h.frame.position : name == "?H" ? h.frame.heading : name == "?L" ? h.frame.left : -h.frame.up;
+      const uint32_t count = std::min<uint32_t>(cur.paramCount(h.index), 3);
+      double* p = cur.params.data() + cur.offsets[h.index];
+      for (uint32_t c = 0; c < count; ++c) p[c] = v[static_cast<int>(c)];
+    }
+  }
+
+  /// s rewritten by the interpretation rules (recursively up to their maximum depth), as
+  /// the turtle reads it; random draws from the interpretation stream of step `step`.
+  ModuleString interpreted(const ModuleString& s, int step) const {
+    Impl tmp;
+    tmp.prog = prog;
+    tmp.seed = seed;
+    tmp.opt.maxModules = opt.maxModules;
+    tmp.limitAt = limitAt;
+    tmp.opt.trackBirthSteps = s.hasBirthSteps();
+    tmp.cur = s;
+    tmp.globals = globals;
+    // Interpretation recursion: depth 1 is one rewrite; deeper levels rewrite what the
+    // previous level produced (modules no rule matches stay as they are).
+    const RuleSet& rs = prog->interpretation;
+    for (int depth = 0; depth < rs.maxDepth; ++depth) {
+      bool any = false;
+      for (SymbolId id : tmp.cur.symbols)
+        if (!rs.bySymbol[id].empty()) {
+          any = true;
+          break;
+        }
+      if (!any) break;
+      tmp.rewrite(rs, step, kInterpretStream - static_cast<uint64_t>(depth), false);
+    }
+    return std::move(tmp.cur);
+  }
+
   /// cpfg's global variables (Program::globals), kMaxVars registers.
   std::vector<double> globals;
 
@@ -195,7 +267,7 @@ struct Deriver::Impl {
     if (r.empty()) return;
     Rng blockRng(deriveSeed(seed, {kBlockStream, static_cast<uint64_t>(step)}));
     const Instr* code = prog->code.data();
-    if (std::isnan(detail::evalCode(code + r.begin, code + r.end, globals.data(), &blockRng)))
+    if (std::isnan(detail::evalCode(code + r.begin, code + r.end, globals.data(), &blockRng, &prog->strings)))
       throw InputError(SourceLoc{prog->fileName, 0, 0}, "a Start/StartEach/EndEach/End block loops more than " +
                                                             std::to_string(detail::kMaxLoopJumps) + " times at step " +
                                                             std::to_string(step));
@@ -364,6 +436,25 @@ struct Deriver::Impl {
   bool matches(const Production& p, const ModuleString& s, size_t i, double* vars) {
     if (s.paramCount(i) != p.predParams) return false;
     bind(s, i, p.predFirstVar, p.predParams, vars);
+    if (!p.predRest.empty()) {
+      // cpfg's predecessor of several modules: the next modules as they stand (PredDiff).
+      size_t j = i + 1;
+      for (const PatternItem& it : p.predRest) {
+        if (j >= s.size() || s.symbols[j] != it.symbol || s.paramCount(j) != it.paramCount) return false;
+        bind(s, j, it.firstVar, it.paramCount, vars);
+        ++j;
+      }
+      if (!p.left.empty() && !matchLeft(s, i, p.left, vars)) return false;
+      if (!p.right.empty()) {
+        // The right context starts after the predecessor's last module; the cached right
+        // neighbour (of module i) does not apply there.
+        rightCached = false;
+        bool ok = matchRight(s, j - 1, p.right, vars);
+        rightCached = false;
+        if (!ok) return false;
+      }
+      return true;
+    }
     if (p.simpleCtx) {
       if (!p.left.empty()) {
         const PatternItem& it = p.left[0];
@@ -393,7 +484,7 @@ struct Deriver::Impl {
   /// Runs the statement block r of p (its `before` or `after`) on vars.
   void statements(const Production& p, const detail::CodeRange& r, double* vars, int step) {
     const Instr* code = prog->code.data();
-    double v = detail::evalCode(code + r.begin, code + r.end, vars, p.usesRandom ? moduleRng() : nullptr);
+    double v = detail::evalCode(code + r.begin, code + r.end, vars, p.usesRandom ? moduleRng() : nullptr, &prog->strings);
     if (std::isnan(v))
       throw InputError(p.loc, "the statements of production '" + p.text + "' loop more than " +
                                   std::to_string(detail::kMaxLoopJumps) + " times at step " + std::to_string(step),
@@ -710,6 +801,7 @@ struct Deriver::Impl {
         continue;
       }
       emit(w, *p, vars, productionStep ? step : birth, step, 0);
+      i += p->predRest.size();  // a predecessor of several modules replaces them all
     }
     w.finish();
     written += w.modules();
@@ -766,6 +858,7 @@ struct Deriver::Impl {
       applyCuts(cur);
     }
     written = 0;
+    fillQueries();
   }
 };
 
@@ -796,6 +889,7 @@ const ModuleString& Deriver::step() {
   m.runBlock(m.prog->endEachBlock, step);
   if (step == m.steps) m.runBlock(m.prog->endBlock, step);
   m.done = step;
+  m.fillQueries();
   if (m.opt.onStep) m.opt.onStep(step, m.cur.size());
   return m.cur;
 }
@@ -814,31 +908,9 @@ uint64_t Deriver::modulesWritten() const { return impl_->written; }
 bool Deriver::hasInterpretation() const { return !impl_->prog->interpretation.empty(); }
 
 ModuleString Deriver::interpret(const ModuleString& s) const {
-  const Program& prog = *impl_->prog;
-  if (prog.interpretation.empty()) return s;
+  if (impl_->prog->interpretation.empty()) return s;
   // A private Impl shares the program and seed so interpret() stays const on this Deriver.
-  Impl tmp;
-  tmp.prog = impl_->prog;
-  tmp.seed = impl_->seed;
-  tmp.opt.maxModules = impl_->opt.maxModules;
-  tmp.limitAt = impl_->limitAt;
-  tmp.opt.trackBirthSteps = s.hasBirthSteps();
-  tmp.cur = s;
-  tmp.globals = impl_->globals;
-  // Interpretation recursion: depth 1 is one rewrite; deeper levels rewrite what the
-  // previous level produced (modules no rule matches stay as they are).
-  const RuleSet& rs = prog.interpretation;
-  for (int depth = 0; depth < rs.maxDepth; ++depth) {
-    bool any = false;
-    for (SymbolId id : tmp.cur.symbols)
-      if (!rs.bySymbol[id].empty()) {
-        any = true;
-        break;
-      }
-    if (!any) break;
-    tmp.rewrite(rs, impl_->done, kInterpretStream - static_cast<uint64_t>(depth), false);
-  }
-  return std::move(tmp.cur);
+  return impl_->interpreted(s, impl_->done);
 }
 
 ModuleString derive(const Grammar& grammar, const DeriveOptions& options) {

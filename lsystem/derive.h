@@ -18,6 +18,7 @@
 
 #include "lsystem/grammar.h"
 #include "lsystem/module_string.h"
+#include "lsystem/turtle.h"
 
 namespace sprig::lsystem {
 
@@ -32,6 +33,13 @@ struct DeriveOptions {
   /// Record in ModuleString::birthSteps the step that created each module (0 = axiom).
   /// Off by default: it then costs nothing.
   bool trackBirthSteps = false;
+  /// The turtle that fills cpfg's query modules (`?P ?H ?L ?U`, docs/GRAMMAR.md): when the
+  /// grammar has any, the axiom and the string after every step are interpreted (with the
+  /// `interpretation:` rules) by a turtle with these settings and each query module reached
+  /// gets the turtle's position, heading, left or up vector (cpfg's up: -U of Sprig's
+  /// frame) in its first 2 or 3 parameters. Unset: the grammar's own (cpfg's defaults for a
+  /// `.l`, its `angle:` or 45 degrees).
+  std::optional<TurtleSettings> queryTurtle;
   /// Called after every completed step with (step, module count); may be empty.
   std::function<void(int step, size_t modules)> onStep;
 };

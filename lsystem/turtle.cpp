@@ -146,6 +146,8 @@ Turtle::Turtle(const SymbolTable& symbols, TurtleSettings settings) : symbols_(s
       c = Command::ScaleUp;
     } else if (n == "@Dd") {
       c = Command::ScaleDown;
+    } else if (n == "?P" || n == "?H" || n == "?L" || n == "?U") {
+      c = Command::Query;
     } else if (n.size() > 1 && n[0] == '~') {
       c = Command::SurfaceNamed;
     }
@@ -233,6 +235,9 @@ class TurtleWalk {
     detail::adviseHugePages(sk_.internodes.data(), sk_.internodes.capacity() * sizeof(Internode));
   }
 
+  /// Where walk() records the frame at each query module (none when null).
+  void recordQueries(std::vector<Turtle::QueryHit>* out) { queries_ = out; }
+
   /// Interprets every module; returns the state after the last one.
   const TurtleState& walk() {
     for (size_t i = 0; i < n_; ++i) {
@@ -282,6 +287,9 @@ class TurtleWalk {
         case Command::ScaleDown: scaleStep(i, true); break;
         case Command::OldElasticity:
           st_.elasticity = hasParam(i) ? param(i) : st_.elasticity + settings_.elasticityIncrement;
+          break;
+        case Command::Query:
+          if (queries_) queries_->push_back({i, st_.frame});
           break;
       }
     }
@@ -783,6 +791,7 @@ class TurtleWalk {
   const double partial_;
   SinCosCache trig_;
   TurtleState st_;
+  std::vector<Turtle::QueryHit>* queries_ = nullptr;
 };
 
 }  // namespace
@@ -824,6 +833,16 @@ SkeletonSummary Turtle::summarize(const ModuleString& ms, std::span<const int32_
   }
   sum.organs = std::move(sk.organs);
   return sum;
+}
+
+std::vector<Turtle::QueryHit> Turtle::query(const ModuleString& ms) {
+  std::vector<QueryHit> hits;
+  Skeleton sk;
+  SkeletonSummary sum;
+  TurtleWalk<true> walk(symbols_, settings_, commands_, ms, sk, {}, &sum);
+  walk.recordQueries(&hits);
+  end_ = walk.walk();
+  return hits;
 }
 
 Skeleton interpret(const ModuleString& modules, const SymbolTable& symbols, const TurtleSettings& settings,

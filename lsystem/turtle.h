@@ -133,6 +133,16 @@ class Turtle {
   /// Memory O(organs + bracket depth) instead of 112 bytes per internode.
   SkeletonSummary summarize(const ModuleString& modules, std::span<const int32_t> moduleSteps = {});
 
+  /// One of cpfg's query modules (`?P ?H ?L ?U`) reached by the turtle: its index in the
+  /// string and the turtle's frame there.
+  struct QueryHit {
+    size_t index;
+    TurtleFrame frame;
+  };
+  /// The frame at every query module of `modules` the turtle reaches (a `%` skips the rest
+  /// of its branch), in string order; the same walk as summarize(), nothing drawn.
+  std::vector<QueryHit> query(const ModuleString& modules);
+
   /// The turtle's state after the last module of the last run() or summarize().
   const TurtleState& endState() const { return end_; }
 
@@ -143,7 +153,8 @@ class Turtle {
     None, Forward, Move, ForwardNoVertex, MoveNoVertex, TurnLeft, TurnRight, PitchDown, PitchUp,
     RollLeft, RollRight, TurnAround, RollToVertical, Push, Pop, Width, Color, PolygonBegin, Vertex,
     PolygonEnd, Surface, SurfaceNamed, Cut, Tropism, Sphere, WidthUp, ColorUp, ColorDown, Circle, Disc,
-    TropismUp, TropismDown, TwistAdjust, TwistForce, MoveTo, SetHeading, ScaleSet, ScaleUp, ScaleDown, OldElasticity
+    TropismUp, TropismDown, TwistAdjust, TwistForce, MoveTo, SetHeading, ScaleSet, ScaleUp, ScaleDown, OldElasticity,
+    Query
   };
   /// The command bound to symbol id `s` (None for ids outside the table).
   Command commandOf(SymbolId s) const { return s < commands_.size() ? commands_[s] : Command::None; }

@@ -19,11 +19,12 @@ GrowthEngine::GrowthEngine(const Species& species, const GrowthOptions& options)
     : progressLabel_(options.progressLabel) {
   const TreeSpec& tree = treeSpec(species);
   grammar_ = std::make_unique<lsystem::Grammar>(speciesGrammar(species, options.extra));
+  turtle_ = speciesTurtle(species, *grammar_);
   lsystem::DeriveOptions dopt;
   dopt.maxModules = tree.maxModules;
   dopt.trackBirthSteps = true;
+  dopt.queryTurtle = turtle_;  // cpfg's query modules see the turtle that draws the tree
   deriver_ = std::make_unique<lsystem::Deriver>(*grammar_, dopt);
-  turtle_ = speciesTurtle(species, *grammar_);
   lastStep_ = options.lastStep < 0 ? deriver_->steps() : std::min(options.lastStep, deriver_->steps());
 }
 

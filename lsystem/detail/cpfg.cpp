@@ -34,10 +34,6 @@ constexpr Unsupported kUnsupported[] = {
     {"@mc", "conditional cut"},
     {"@;", "back-side color"},
     {"@,", "back-side color"},
-    {"?P", "query module"},
-    {"?H", "query module"},
-    {"?L", "query module"},
-    {"?U", "query module"},
     {"?E", "communication with an environment program"},
 };
 

@@ -33,7 +33,7 @@ struct UnsupportedFunction {
 };
 constexpr UnsupportedFunction kUnsupportedFunctions[] = {
     {"srand", "reseeds cpfg's one global generator; Sprig draws per module from 'seed:'"},
-    {"printf", "output"}, {"fprintf", "file output"}, {"fopen", "file input and output"},
+    {"printf", "output; it is a statement of its own"}, {"fprintf", "file output"}, {"fopen", "file input and output"},
     {"fclose", "file input and output"}, {"fflush", "file input and output"}, {"fscanf", "file input"},
     {"stop", "stops the simulation"}, {"func", "function from a view file's function file"},
     {"curveX", "contour from a view file's contour file"}, {"curveY", "contour from a view file's contour file"},

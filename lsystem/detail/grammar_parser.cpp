@@ -1,6 +1,7 @@
 #include "lsystem/detail/grammar_parser.h"
 
 #include <algorithm>
+#include <tuple>
 #include <array>
 #include <charconv>
 #include <cmath>
@@ -176,11 +177,13 @@ class GrammarParser {
         while (i < static_cast<int>(s.size()) && isIdentChar(s[i])) ++i;
         std::string word = s.substr(b, i - b);
         word.erase(std::remove_if(word.begin(), word.end(), [](char c) { return isSpace(c); }), word.end());
-        static const char* const kCpp[] = {"#include", "#ifdef", "#ifndef", "#if", "#else", "#elif", "#endif", "#undef", "#line", "#pragma", "#error"};
+        static const char* const kCpp[] = {"#if", "#elif", "#line", "#pragma", "#error", "#warning"};
         if (std::find(std::begin(kCpp), std::end(kCpp), word) != std::end(kCpp))
-          error(line, b, "cpfg's C preprocessor directive '" + word + "' is not supported (only '#define NAME constant' is)");
+          error(line, b, "cpfg's C preprocessor directive '" + word + "' is not supported (Sprig's preprocessor reads "
+                         "#define, #undef, #include, #ifdef, #ifndef, #else and #endif)");
         else
-          error(line, b, "unknown directive '" + word + "'" + didYouMean(word, {"#define"}));
+          error(line, b, "unknown directive '" + word + "'" +
+                             didYouMean(word, {"#define", "#undef", "#include", "#ifdef", "#ifndef", "#else", "#endif"}));
       } else if (isModuleDeclaration(s, b)) {
         declareModules(line, b + 6);
       }
@@ -213,7 +216,7 @@ class GrammarParser {
       return;
     }
     if (defineLines.count(name)) {
-      error(line, nb, "'" + name + "' is already defined at line " + std::to_string(defineLines[name]));
+      error(line, nb, "'" + name + "' is already defined at " + scanner_.lineRef(defineLines[name]));
       return;
     }
     defineLines[name] = line;
@@ -381,7 +384,7 @@ class GrammarParser {
   /// Records header key at line; a second one is an error.
   void once(const std::string& key, int line, int col) {
     auto [it, inserted] = seen_.emplace(key, line);
-    if (!inserted) error(line, col, "duplicate '" + key + ":' (first at line " + std::to_string(it->second) + ")");
+    if (!inserted) error(line, col, "duplicate '" + key + ":' (first at " + scanner_.lineRef(it->second) + ")");
   }
 
   /// A known header h at column b of line (`decomposition:` and `interpretation:` switch block).
@@ -404,8 +407,7 @@ class GrammarParser {
           error(line, value.b, "derivation length must be a whole number from 0 to 1000000, got " + formatNumber(*d));
         } else {
           prog_.derivationLength = static_cast<int>(*d);
-          prog_.lengthLoc = SourceLoc{prog_.fileName, line, b + 1};
-          prog_.lengthLine = scanner_.rawLine(line);
+          std::tie(prog_.lengthLoc, prog_.lengthLine) = scanner_.locate(line, b);
         }
       }
     } else if (h.key == "seed") {
@@ -434,8 +436,7 @@ class GrammarParser {
                }) && bracketEnd(line, brackets, "the axiom")) {
         axiomSpan_ = value;
         axiomLine_ = line;
-        prog_.axiomLoc = SourceLoc{prog_.fileName, line, b + 1};
-        prog_.axiomLine = scanner_.rawLine(line);
+        std::tie(prog_.axiomLoc, prog_.axiomLine) = scanner_.locate(line, b);
       }
     } else if (h.key == "ignore" || h.key == "consider") {
       once(h.key, line, b);
@@ -486,6 +487,14 @@ class GrammarParser {
     }
   }
 
+  static bool isQuery(std::string_view name) { return name == "?P" || name == "?H" || name == "?L" || name == "?U"; }
+  /// cpfg fills a query module of an interpretation rule in the interpreted copy of the
+  /// string, where no production reads it; Sprig refuses it rather than ignore it.
+  static std::string queryInInterpretation(std::string_view name) {
+    return "cpfg's query module '" + std::string(name) +
+           "' in an interpretation rule is not supported (its values would be lost with the interpreted string)";
+  }
+
   /// The production of line (from column b, its arrow at `arrow`), compiled into block's RuleSet.
   void parseProduction(int line, int b, int arrow, int arrowLen, Block block) {
     const std::string& s = scanner_.line(line);
@@ -521,14 +530,22 @@ class GrammarParser {
       return;
     }
     if (!scanner_.tokenizeModules(line, pred.b, pred.e, predMods)) return;
-    if (predMods.size() != 1) {
-      error(line, predMods.size() > 1 ? predMods[1].col : pred.b,
-            predMods.size() > 1 ? "a predecessor must be a single module (cpfg's predecessors of several modules are not supported)"
-                                : "a predecessor must be a single module");
+    if (predMods.empty()) {
+      error(line, pred.b, "a predecessor must be a single module");
       return;
     }
-    if (predMods[0].name == "[" || predMods[0].name == "]") {
-      error(line, predMods[0].col, "a bracket cannot be a predecessor");
+    if (predMods.size() > 1 && block != Block::Main) {
+      error(line, predMods[1].col, std::string("a predecessor of several modules is not allowed in ") + blockName(block) +
+                                       " rules (only in productions)");
+      return;
+    }
+    for (const RawModule& m : predMods)
+      if (m.name == "[" || m.name == "]") {
+        error(line, m.col, "a bracket cannot be a predecessor");
+        return;
+      }
+    if (block == Block::Interpretation && isQuery(predMods[0].name)) {
+      error(line, predMods[0].col, queryInInterpretation(predMods[0].name));
       return;
     }
     // Contexts (textual order: left, predecessor, right).
@@ -538,13 +555,20 @@ class GrammarParser {
       if (block != Block::Main) error(line, lc.b, std::string("context is not allowed in ") + blockName(block) + " rules");
       else p.left = pattern(lc, varNames, true);
     }
-    p.loc = SourceLoc{prog_.fileName, line, predMods[0].col + 1};
+    std::tie(p.loc, p.sourceLine) = scanner_.locate(line, predMods[0].col);
     p.text = std::string(scanner_.view(pred));
-    p.sourceLine = scanner_.rawLine(line);
     p.predecessor = prog_.symbols.intern(predMods[0].name);
     p.predFirstVar = static_cast<uint16_t>(varNames.size());
     p.predParams = static_cast<uint16_t>(formals(predMods[0], varNames));
     arityUses_.push_back({predMods[0].name, p.predParams, line, predMods[0].col, scanner_.moduleText(line, predMods[0]), false});
+    for (size_t k = 1; k < predMods.size(); ++k) {
+      PatternItem it;
+      it.symbol = prog_.symbols.intern(predMods[k].name);
+      it.firstVar = static_cast<uint16_t>(varNames.size());
+      it.paramCount = static_cast<uint16_t>(formals(predMods[k], varNames));
+      arityUses_.push_back({predMods[k].name, it.paramCount, line, predMods[k].col, scanner_.moduleText(line, predMods[k]), false});
+      p.predRest.push_back(it);
+    }
     if (rc.b != rc.e && !scanner_.isStar(rc)) {
       if (block != Block::Main) error(line, rc.b, std::string("context is not allowed in ") + blockName(block) + " rules");
       else p.right = pattern(rc, varNames, false);
@@ -570,6 +594,7 @@ class GrammarParser {
       if (scanner_.tokenizeModules(line, succ.b, succ.e, mods) && checkBrackets(line, mods, "the successor")) {
         noteWritten(line, mods);
         for (const RawModule& m : mods) {
+          if (block == Block::Interpretation && isQuery(m.name)) error(line, m.col, queryInInterpretation(m.name));
           SuccModule sm;
           sm.symbol = prog_.symbols.intern(m.name);
           sm.firstArg = static_cast<uint32_t>(p.args.size());
@@ -724,6 +749,96 @@ class GrammarParser {
 
   /// Statements `x = expr;`, `if (c) {...} [else {...}]`, `while (c) {...}`,
   /// `do {...} while (c);` of line[b, e) (cpfg reference manual, 3.2), appended to the code.
+  /// cpfg's `printf("format", values...);` at column at of line (its `(` at open): compiles
+  /// the values and an Op::Printf; returns the column after its `;`, or -1 after an error.
+  int printfStatement(int line, int at, int open, int e, std::vector<std::string>& varNames) {
+    const std::string& s = scanner_.line(line);
+    int q = nextNonSpace(line, open + 1, e);
+    if (q >= e || s[q] != '"') {
+      error(line, q, "printf's first argument must be a format in double quotes");
+      return -1;
+    }
+    std::string format;
+    int j = q + 1;
+    for (; j < e && s[j] != '"'; ++j) {
+      if (s[j] == '\\' && j + 1 < e) {
+        const char c = s[++j];
+        format += c == 'n' ? '\n' : c == 't' ? '\t' : c;
+      } else {
+        format += s[j];
+      }
+    }
+    if (j >= e) {
+      error(line, q, "unterminated format string of printf");
+      return -1;
+    }
+    // Conversions: numbers only (cpfg's values are numbers), one per value.
+    int conversions = 0;
+    for (size_t f = 0; f < format.size(); ++f) {
+      if (format[f] != '%') continue;
+      if (f + 1 < format.size() && format[f + 1] == '%') {
+        ++f;
+        continue;
+      }
+      size_t g = f + 1;
+      while (g < format.size() && std::string_view("-+ #0123456789.hlL").find(format[g]) != std::string_view::npos) ++g;
+      if (g >= format.size() || std::string_view("diouxXcfFeEgGaA").find(format[g]) == std::string_view::npos) {
+        error(line, q, "printf's conversion '" + format.substr(f, g + 1 - f) +
+                           "' is not supported (only numbers: %d %i %o %u %x %c %f %e %g %a)");
+        return -1;
+      }
+      ++conversions;
+      f = g;
+    }
+    // The values: top-level commas up to the call's `)`.
+    int close = -1, depth = 0;
+    for (int k = j + 1; k < e; ++k) {
+      if (s[k] == '(') ++depth;
+      if (s[k] == ')' && depth-- == 0) {
+        close = k;
+        break;
+      }
+    }
+    if (close < 0) {
+      error(line, open, "missing ')' after the arguments of printf");
+      return -1;
+    }
+    int values = 0;
+    int k = nextNonSpace(line, j + 1, close);
+    if (k < close && s[k] != ',') {
+      error(line, k, "expected ',' or ')' after printf's format");
+      return -1;
+    }
+    while (k < close) {
+      int next = scanner_.findTop(line, k + 1, close, ',');
+      if (next < 0) next = close;
+      if (!expr_.compile(scanner_.trim(Span{line, k + 1, next}), varNames, "printf value")) return -1;
+      ++values;
+      k = next;
+    }
+    if (values != conversions) {
+      error(line, at, "printf's format has " + std::to_string(conversions) + " conversion(s) for " +
+                          std::to_string(values) + " value(s)");
+      return -1;
+    }
+    if (values > 8) {
+      error(line, at, "printf with more than 8 values is not supported");
+      return -1;
+    }
+    int semi = nextNonSpace(line, close + 1, e);
+    if (semi >= e || s[semi] != ';') {
+      error(line, at, "missing ';' after the call of 'printf' (cpfg requires one after every statement)");
+      return -1;
+    }
+    Instr pr;
+    pr.op = Op::Printf;
+    pr.var = static_cast<uint16_t>(prog_.strings.size());
+    pr.c = values;
+    prog_.strings.push_back(format);
+    prog_.code.push_back(pr);
+    return semi + 1;
+  }
+
   bool statementList(int line, int b, int e, std::vector<std::string>& varNames, uint32_t base) {
     const std::string& s = scanner_.line(line);
     int i = b;
@@ -771,8 +886,10 @@ class GrammarParser {
         notOp.op = Op::Not;
         prog_.code.push_back(notOp);
         jump(Op::Jz, base, top);
-      } else if (const int k = nextNonSpace(line, i, e); k < e && s[k] == '(') {
-        // A call alone, `f(...);` (cpfg's printf, srand, ...): its value is dropped.
+      } else if (const int k = nextNonSpace(line, i, e); k < e && s[k] == '(' && word == "printf") {
+        if ((i = printfStatement(line, at, k, e, varNames)) < 0) return false;
+      } else if (k < e && s[k] == '(') {
+        // A call alone, `f(...);` (cpfg's srand, ...): its value is dropped.
         int end = scanner_.findTop(line, at, e, ';');
         if (end < 0) {
           error(line, at, "missing ';' after the call of '" + word + "' (cpfg requires one after every statement)");
@@ -907,8 +1024,8 @@ class GrammarParser {
       error(u.line, u.col,
             std::string(u.context ? "context '" : "predecessor '") + u.text + "' has " + std::to_string(u.arity) +
                 " parameter" + (u.arity == 1 ? "" : "s") + ", but '" + u.name + "' is only written with " + list +
-                (one ? " parameter" : " parameters") + " (as at line " + std::to_string(first.first) + ":" +
-                std::to_string(first.second + 1) + "), so this production never applies");
+                (one ? " parameter" : " parameters") + " (as at " + scanner_.lineRef(first.first, first.second) +
+                "), so this production never applies");
     }
   }
 
@@ -1057,6 +1174,7 @@ class GrammarParser {
     for (SymbolId id : ignoreList_) prog_.ignored[id] = 1;
     prog_.ignored[prog_.openBracket] = prog_.ignored[prog_.closeBracket] = 0;
     for (SymbolId id : prog_.axiom.symbols) prog_.usesCut |= id == prog_.cut;
+    for (const char* q : {"?P", "?H", "?L", "?U"}) prog_.usesQuery |= prog_.symbols.find(q) >= 0;
     for (const RuleSet* rs : {&prog_.productions, &prog_.decomposition})
       for (const Production& p : rs->productions)
         for (const SuccModule& m : p.successor) prog_.usesCut |= m.symbol == prog_.cut;

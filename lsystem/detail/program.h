@@ -11,7 +11,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "core/diagnostics.h"
@@ -38,6 +40,7 @@ enum class Op : uint8_t {
   Store,   ///< pops a value into register var
   Jz,      ///< pops a value; when it is 0, jumps to instruction c of the block
   Jmp,     ///< jumps to instruction c of the block
+  Printf,  ///< cpfg's `printf(format, ...)`: pops c values, prints them to stderr with Program::strings[var]
 };
 
 /// Most backward jumps one statement block may take (a `while` that never ends): past it
@@ -90,7 +93,12 @@ struct CodeRange {
 /// which must then be writable; jump targets count from code; a block returns 0, or NaN
 /// after kMaxLoopJumps backward jumps). rng is used only by the random draws (never null
 /// when the code draws: the compiler marks such productions usesRandom).
-inline double evalCode(const Instr* code, const Instr* end, const double* vars, Rng* rng) {
+/// cpfg's printf to stderr: format (checked by the parser: only numeric conversions, one
+/// per value) with the n values args.
+void printFormatted(const std::string& format, const double* args, int n);
+
+inline double evalCode(const Instr* code, const Instr* end, const double* vars, Rng* rng,
+                       const std::vector<std::string>* strings = nullptr) {
   double stack[kMaxStack];
   int sp = 0;
   long backJumps = 0;
@@ -152,6 +160,12 @@ inline double evalCode(const Instr* code, const Instr* end, const double* vars, 
         in = to - 1;  // the loop's ++in lands on the target
         break;
       }
+      case Op::Printf: {
+        const int n = static_cast<int>(in->c);
+        if (strings && in->var < strings->size()) printFormatted((*strings)[in->var], stack + sp - n, n);
+        sp -= n;
+        break;
+      }
     }
   }
   return sp > 0 ? stack[sp - 1] : 0.0;
@@ -192,6 +206,9 @@ struct Production {
   SymbolId predecessor = 0;
   uint16_t predParams = 0;
   uint16_t predFirstVar = 0;
+  /// cpfg's predecessors of several modules: the modules after the first, matched at the
+  /// positions right after it (no skipping); the production replaces them all.
+  std::vector<PatternItem> predRest;
   std::vector<PatternItem> left;   ///< in textual order
   std::vector<PatternItem> right;  ///< in textual order
   CodeRange condition;             ///< empty: always true
@@ -206,12 +223,14 @@ struct Production {
   double weight = 1;
   bool usesRandom = false;  ///< condition or successor calls ran/nran
   bool simpleCtx = false;   ///< simpleContext(), cached by RuleSet::finalize()
-  bool hasContext() const { return !left.empty() || !right.empty(); }
+  /// True when matching looks at other modules than the predecessor's first (contexts, or
+  /// a predecessor of several modules).
+  bool hasContext() const { return !left.empty() || !right.empty() || !predRest.empty(); }
   /// Contexts of at most one symbol on each side (no brackets): matched against the
   /// cached neighbours directly.
   bool simpleContext() const {
     auto plain = [](const std::vector<PatternItem>& v) { return v.size() <= 1 && (v.empty() || (!v[0].openBracket && !v[0].closeBracket)); };
-    return plain(left) && plain(right);
+    return plain(left) && plain(right) && predRest.empty();
   }
 };
 
@@ -320,6 +339,7 @@ struct Program {
   ModuleString axiom;
   std::vector<std::pair<std::string, double>> defines;
   std::vector<Instr> code;
+  std::vector<std::string> strings;  ///< printf formats (Instr::var of Op::Printf)
   RuleSet productions;
   RuleSet decomposition;
   RuleSet interpretation;
@@ -327,6 +347,10 @@ struct Program {
   SymbolId openBracket = 0, closeBracket = 0, cut = 0;
   /// True when some successor or the axiom contains the cut symbol `%`.
   bool usesCut = false;
+  /// True when the axiom or a production writes one of cpfg's query modules (`?P ?H ?L ?U`):
+  /// the Deriver then interprets the string before every step and writes the turtle's
+  /// state into their parameters.
+  bool usesQuery = false;
   /// The `derivation length:` header (line 0 when the file has none), with its line's text;
   /// module-limit errors point here when the grammar's own length is used.
   SourceLoc lengthLoc;

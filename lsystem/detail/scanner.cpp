@@ -6,8 +6,6 @@
 
 namespace sprig::lsystem::detail {
 
-namespace {
-
 /// s cut at every `\n`, each line without a trailing `\r`.
 std::vector<std::string> splitAtNewlines(const std::string& s) {
   std::vector<std::string> lines;
@@ -23,15 +21,9 @@ std::vector<std::string> splitAtNewlines(const std::string& s) {
   return lines;
 }
 
-}  // namespace
-
-std::string formatNumber(double v) {
-  char buf[64];
-  auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
-}
-
-void Scanner::load(std::string_view text) {
+/// text with `//` and block comments replaced by spaces (newlines kept, so columns stay);
+/// pending gets the (line, 0-based column) of a block comment never closed.
+std::string blankComments(std::string_view text, std::pair<int, int>& pending) {
   std::string clean(text);
   size_t i = 0;
   int line = 1;
@@ -65,13 +57,38 @@ void Scanner::load(std::string_view text) {
         }
         ++i;
       }
-      if (!closed) pendingComment_ = {startLine, startCol};
+      if (!closed) pending = {startLine, startCol};
     } else {
       ++i;
     }
   }
-  clean_ = splitAtNewlines(clean);
-  raw_ = splitAtNewlines(std::string(text));
+  return clean;
+}
+
+std::string formatNumber(double v) {
+  char buf[64];
+  auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+
+void Scanner::load(std::string_view text) {
+  std::pair<int, int> pending{0, 0};
+  const std::string clean = blankComments(text, pending);
+  files_.assign(1, fileName_);
+  raw_.clear();
+  clean_.clear();
+  origin_.clear();
+  colMap_.clear();
+  macros_.clear();
+  constants_.clear();
+  conditionals_.clear();
+  preprocess(0, splitAtNewlines(std::string(text)), splitAtNewlines(clean), 0);
+  for (const Conditional& c : conditionals_)
+    diags_.error(SourceLoc{files_[c.file], c.line, c.col + 1}, "'#if' block without '#endif'");
+  pendingComment_ = {0, 0};
+  if (pending.first)
+    for (size_t k = 0; k < origin_.size(); ++k)
+      if (origin_[k].file == 0 && origin_[k].line == pending.first) pendingComment_ = {static_cast<int>(k) + 1, pending.second};
   pieces_.assign(clean_.size(), {});
   if (dialect_ != Dialect::Cpfg) return;
   // cpfg's lexer reads a newline followed by a tab as white space: the line goes on. A
@@ -108,10 +125,28 @@ std::pair<int, int> Scanner::physical(int line, int col0) const {
   return at;
 }
 
-void Scanner::error(int line, int col0, std::string msg) {
+std::pair<SourceLoc, std::string> Scanner::locate(int line, int col0) const {
   std::tie(line, col0) = physical(line, col0);
-  diags_.error(SourceLoc{fileName_, line, col0 + 1}, std::move(msg),
-               line >= 1 && line <= static_cast<int>(raw_.size()) ? raw_[line - 1] : "");
+  if (line < 1 || line > static_cast<int>(raw_.size())) return {SourceLoc{fileName_, line, col0 + 1}, ""};
+  const Origin& o = origin_[line - 1];
+  const std::vector<int>& m = colMap_[line - 1];
+  int col = col0;
+  if (!m.empty())
+    col = col0 < static_cast<int>(m.size()) ? m[col0] : static_cast<int>(raw_[line - 1].size()) + col0 - static_cast<int>(m.size());
+  return {SourceLoc{files_[o.file], o.line, col + 1}, raw_[line - 1]};
+}
+
+std::string Scanner::lineRef(int line, int col0) const {
+  auto [loc, text] = locate(line, std::max(col0, 0));
+  const bool own = line >= 1 && line <= static_cast<int>(origin_.size()) && origin_[line - 1].file == 0;
+  std::string out = own ? "line " + std::to_string(loc.line) : loc.file + ":" + std::to_string(loc.line);
+  if (col0 >= 0) out += ":" + std::to_string(loc.col);
+  return out;
+}
+
+void Scanner::error(int line, int col0, std::string msg) {
+  auto [loc, text] = locate(line, col0);
+  diags_.error(loc, std::move(msg), std::move(text));
 }
 
 Span Scanner::trim(Span sp) const {

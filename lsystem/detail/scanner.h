@@ -21,6 +21,12 @@ inline bool isSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == 
 inline bool isIdentStart(char c) { return std::isalpha(static_cast<unsigned char>(c)) || c == '_'; }
 inline bool isIdentChar(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
 
+/// s cut at every `\n`, each line without a trailing `\r`.
+std::vector<std::string> splitAtNewlines(const std::string& s);
+/// text with `//` and block comments replaced by spaces (newlines kept, so columns stay);
+/// pending gets the (line, 0-based column) of a block comment never closed ({0, 0}: none).
+std::string blankComments(std::string_view text, std::pair<int, int>& pending);
+
 /// v in its shortest round-trip form (`0.5`, `1e+300`, `inf`), as diagnostics print numbers.
 std::string formatNumber(double v);
 
@@ -72,6 +78,12 @@ class Scanner {
   /// Line `line` (1-based) as written.
   const std::string& rawLine(int line) const { return raw_[line - 1]; }
   const std::string& fileName() const { return fileName_; }
+  /// Where column col0 of logical line `line` was written: its file (the grammar's, or a
+  /// file it includes), 1-based line and column, and that line's text as written.
+  std::pair<SourceLoc, std::string> locate(int line, int col0) const;
+  /// "line N" (or "line N:C" with a column) for a logical line of the grammar file itself,
+  /// "FILE:N" ("FILE:N:C") for one of an included file: how messages name another place.
+  std::string lineRef(int line, int col0 = -1) const;
   /// (line, 0-based column) of a block comment that is never closed; line 0 when none.
   std::pair<int, int> unterminatedComment() const { return pendingComment_; }
 
@@ -122,8 +134,40 @@ class Scanner {
   int findTopLast(int line, int b, int e, char c) const;
 
  private:
+  /// cpfg's C preprocessor (docs/GRAMMAR.md, "The C preprocessor"), run on the lines of
+  /// one file (raw and with comments blanked) before continuations are joined: appends the
+  /// resulting lines, their origins and column maps to raw_, clean_, origin_, colMap_.
+  void preprocess(int file, const std::vector<std::string>& raw, const std::vector<std::string>& clean, int depth);
+  struct Macro;
+  /// line with the macros expanded; map gets the original column of each column.
+  std::string expand(const std::string& line, std::vector<int>& map, int file, int lineNo, const std::string& rawLine);
+  std::string expandText(const std::string& text, std::vector<std::string>& disabled, int depth, bool& failed);
+
   std::string fileName_;
   std::vector<std::string> raw_, clean_;
+  /// Per physical line: the file (index into files_) and 1-based line it was written at,
+  /// and the original column of each column when macros changed it (empty: the same).
+  struct Origin {
+    int file, line;
+  };
+  std::vector<std::string> files_;
+  std::vector<Origin> origin_;
+  std::vector<std::vector<int>> colMap_;
+  /// The preprocessor's state: textual and function-like macros, constant `#define`s (left
+  /// to the grammar parser), and open `#ifdef` blocks.
+  struct Macro {
+    std::vector<std::string> params;
+    bool functionLike = false;
+    std::string body;
+    int file = 0, line = 0;
+  };
+  std::vector<std::pair<std::string, Macro>> macros_;
+  std::vector<std::pair<std::string, int>> constants_;
+  struct Conditional {
+    bool active, parentActive, elseSeen;
+    int file, line, col;
+  };
+  std::vector<Conditional> conditionals_;
   /// A piece of a logical line that came from another line of the file (cpfg dialect:
   /// a line starting with a tab continues the one before it): from column `offset` of the
   /// logical line on, the text is line `line`'s from column `col` (all 0-based but line).

@@ -10,7 +10,8 @@
 #   4. a species file and its bare grammar agree on the derivation;
 #   5. cpfg: a vlab object folder is read through its `specifications` (tree.l with view.v's
 #      angle factor 12, i.e. 30 degrees: 3 internodes, the top at 1 + cos 30), and a bare
-#      `.l` without a view file draws with cpfg's 45 degrees and says so in a note.
+#      `.l` without a view file draws with cpfg's 45 degrees and says so in a note; cpfg's
+#      printf writes to stderr.
 # Usage: tests/cli/derive_test.sh path/to/sprig   (run from the repository root)
 set -euo pipefail
 SPRIG=$(realpath "$1")
@@ -81,5 +82,10 @@ echo "$jo" | grep -q '"max": \[0.55[0-9]*, 1.926025403784438[0-9]*, 0.06\]' || f
 grep -q '"end": \[-0.7071067811865475, 1.7071067811865475, 0\]}$' "$WORK/nv.out" || fail "no view file: not 45 degrees: $(cat "$WORK/nv.out")"
 grep -qF "tests/assets/cpfg/no_view/plant.l: note: no view file 'plant.v' beside it: using cpfg's defaults: angle increment 45," "$WORK/nv.err" ||
   fail "no note about cpfg's defaults: $(cat "$WORK/nv.err")"
+
+# printf in statement blocks writes to stderr (tests/assets/cpfg/printf/plant.l's comment).
+"$SPRIG" --quiet derive tests/assets/cpfg/printf/plant.l --print >"$WORK/pf.out" 2>"$WORK/pf.err" || fail "printf/plant.l failed"
+[ "$(cat "$WORK/pf.out")" = "A(3.5)" ] || fail "printf object string: $(cat "$WORK/pf.out")"
+[ "$(cat "$WORK/pf.err")" = "$(printf 'A 1.5 -> 3 (50%%)\nA 2.5 -> 5 (50%%)\ndone after 2 steps')" ] || fail "printf output: $(cat "$WORK/pf.err")"
 
 echo "cli_derive: all checks passed"

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/atomic_file.h"
 #include "lsystem/derive.h"
 #include "lsystem/grammar.h"
 #include "lsystem/turtle.h"
@@ -264,7 +265,10 @@ TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg
     CHECK(errorOf("axiom: A\nA --> F$A\n") ==
           "t.l:2:8: cpfg's '$' (end of a sub-L-system call; ABOP's roll to vertical is '@v' in cpfg) is not supported");
     CHECK(errorOf("axiom: F~l\n") == "t.l:1:9: cpfg's '~' (surface from a view file's surface file) is not supported");
-    CHECK(errorOf("axiom: ?P(0,0)A\n") == "t.l:1:8: cpfg's '?P' (query module) is not supported");
+    CHECK(errorOf("axiom: ?P(0,0)A\n") == "no error");
+    CHECK(errorOf("axiom: A\nhomomorphism\nA --> F?U(0,0,0)\n") ==
+          "t.l:3:8: cpfg's query module '?U' in an interpretation rule is not supported (its values would be lost with "
+          "the interpreted string)");
     CHECK(errorOf("axiom: A\nA --> ?(2,1)B$\n") == "t.l:2:7: cpfg's '?(n, scale)' (sub-L-system call) is not supported");
     CHECK(errorOf("axiom: F@Tx(1)\n") == "t.l:1:9: cpfg's '@Tx' (texture) is not supported");
     CHECK(errorOf("axiom: F@Q\n") == "t.l:1:9: unknown cpfg command '@Q'");
@@ -272,14 +276,9 @@ TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg
   SECTION("statements, blocks, preprocessor, several L-systems") {
     CHECK(errorOf("axiom: A(1)\nA(y) : { x = y / 2; x < 10 --> B(x)\n") == "t.l:2:8: unclosed '{' of a statement block");
     CHECK(errorOf("define: { array a[2]; }\naxiom: A\n") == "t.l:1:1: cpfg's 'define:' (array declarations) is not supported");
-    CHECK(errorOf("#include \"x.h\"\naxiom: A\n") ==
-          "t.l:1:1: cpfg's C preprocessor directive '#include' is not supported (only '#define NAME constant' is)");
-    CHECK(errorOf("#define G(x) F(x)\naxiom: A\n") ==
-          "t.l:1:9: cpfg's function-like macro '#define G(...)' (C preprocessor) is not supported");
-    CHECK(errorOf("#define LEAF ?(4,1)leaf(2)$\naxiom: A\n") ==
-          "t.l:1:14: cpfg's #define of a module string ('?(4,1)leaf(2)$', a C preprocessor macro) is not supported: only constants are");
-    CHECK(errorOf("#define B [+F]\naxiom: A\n") ==
-          "t.l:1:11: cpfg's #define of a module string ('[+F]', a C preprocessor macro) is not supported: only constants are");
+    CHECK(errorOf("#if 1\naxiom: A\n#endif\n") ==
+          "t.l:1:1: cpfg's C preprocessor directive '#if' is not supported (Sprig's preprocessor reads #define, "
+          "#undef, #include, #ifdef, #ifndef, #else and #endif)");
     CHECK(errorOf("#define K (1 > 0 ? 2 : 3)\naxiom: A\n") == "no error");
     CHECK(errorOf("lsystem: 1\naxiom: A\nendlsystem\n", "t.l") == "no error");
     CHECK(errorOf("lsystem: 1\naxiom: A\nlsystem: 2\naxiom: B\n") ==
@@ -289,6 +288,17 @@ TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg
           "t.l:2:12: cpfg's function 'srand' (reseeds cpfg's one global generator; Sprig draws per module from 'seed:') is not supported");
     CHECK(errorOf("axiom: A(1)\nA(x) --> A(func(1, x))\n") ==
           "t.l:2:12: cpfg's function 'func' (function from a view file's function file) is not supported");
+  }
+  SECTION("printf: a statement with numeric conversions") {
+    CHECK(errorOf("axiom: A(1)\nA(x) : { printf(\"%s\", x); } 1 --> A(x)\n") ==
+          "t.l:2:17: printf's conversion '%s' is not supported (only numbers: %d %i %o %u %x %c %f %e %g %a)");
+    CHECK(errorOf("axiom: A(1)\nA(x) : { printf(\"%g %g\", x); } 1 --> A(x)\n") ==
+          "t.l:2:10: printf's format has 2 conversion(s) for 1 value(s)");
+    CHECK(errorOf("axiom: A(1)\nA(x) --> A(printf(\"%g\", x))\n") ==
+          "t.l:2:12: cpfg's function 'printf' (output; it is a statement of its own) is not supported");
+    CHECK(errorOf("axiom: A(1)\nA(x) : { printf(x); } 1 --> A(x)\n") ==
+          "t.l:2:17: printf's first argument must be a format in double quotes");
+    CHECK(errorOf("Start: { printf(\"%5.2f%%\\n\", 2); }\naxiom: A\n") == "no error");
   }
   SECTION("an error in a continued line is reported at its own line") {
     CHECK(errorOf("axiom: A\nA --> F\n\tF@Gc(2)\n") == "t.l:3:3: cpfg's '@Gc' (generalized cylinder) is not supported");
@@ -413,5 +423,107 @@ TEST_CASE("cpfg Start, StartEach, EndEach and End blocks over global variables",
           "'StartEach:', 'EndEach:' and 'End:' blocks)");
     CHECK(errorOf("Start: i = 0;\naxiom: A\n") == "t.l:1:8: expected '{ statements }' after 'Start:'");
     CHECK(errorOf("Start: { i = 0; }\nStart: { j = 0; }\naxiom: A\n") == "t.l:2:1: duplicate 'start:' (first at line 1)");
+  }
+}
+
+TEST_CASE("cpfg query modules", "[lsystem][cpfg]") {
+  // tests/assets/cpfg/query: values from its reference.py (cpfg's own turtle, independent of
+  // Sprig's): with the view file's 30 degrees, three F on each axis, and
+  const double c30 = std::sqrt(3.0) / 2;
+  const Grammar g = loadGrammar(cpfgAsset("query/plant.l"));
+  SECTION("the view file's turtle: apex at (-1.5, 2.598), branch tip 3 below it") {
+    const ViewFile view = loadViewFile(cpfgAsset("query/plant.v"));
+    DeriveOptions opt;
+    opt.queryTurtle = cpfgTurtleSettings(&view, TurtleSettings{});
+    Deriver d(g, opt);
+    const ModuleString& s = d.derive();
+    CHECK(countSymbol(s, d.symbols(), "F") == 6);
+    std::vector<double> want = {-1.5, 3 * c30, -1.5, 3 * c30, -3, 0, 0, -1, -c30, -0.5, 0, 0.5, -c30, 0};
+    std::vector<double> got;
+    for (size_t i = 0; i < s.size(); ++i)
+      if (d.symbols().name(s.symbols[i])[0] == '?')
+        for (double v : s.paramsOf(i)) got.push_back(v);
+    REQUIRE(got.size() == want.size());
+    for (size_t k = 0; k < want.size(); ++k) CHECK(got[k] == Approx(want[k]).margin(1e-12));
+    // The drawn main axis ends where ?P says.
+    Turtle t(d.symbols(), cpfgTurtleSettings(&view, TurtleSettings{}));
+    Skeleton sk = t.run(s);
+    REQUIRE(sk.internodes.size() == 6);
+    checkNear(sk.internodes[2].end, DVec3(-1.5, 3 * c30, 0));
+    checkNear(sk.internodes[5].end, DVec3(-1.5, 3 * c30, -3));
+  }
+  SECTION("without a view file: cpfg's 45 degrees grow the main axis once more") {
+    Deriver d(g);
+    const ModuleString& s = d.derive();
+    CHECK(countSymbol(s, d.symbols(), "F") == 7);
+    const double r2 = std::sqrt(0.5);
+    CHECK(formatModuleString(s, d.symbols()).substr(0, 12) == "+F(1)F(1)F(1");
+    size_t q = 0;
+    while (d.symbols().name(s.symbols[q]) != "?P") ++q;
+    CHECK(s.paramsOf(q)[0] == Approx(-4 * r2));
+    CHECK(s.paramsOf(q)[1] == Approx(4 * r2));
+  }
+  SECTION("the axiom's queries are filled before the first step, and through the homomorphism") {
+    Grammar h = parseGrammar("derivation length: 0\naxiom: A?P(0,0)B?P(0,0)?P\nhomomorphism\nA --> F(2)\nB --> f(1)\n", "t.l");
+    Deriver d(h);
+    CHECK(formatModuleString(d.current(), d.symbols()) == "A?P(0,2)B?P(0,3)?P");
+  }
+}
+
+TEST_CASE("cpfg predecessors of several modules", "[lsystem][cpfg]") {
+  SECTION("tests/assets/cpfg/multi_predecessor, derived by hand in its comment") {
+    Grammar g = loadGrammar(cpfgAsset("multi_predecessor/plant.l"));
+    Deriver d(g);
+    CHECK(formatModuleString(d.derive(), d.symbols()) == "D(3)CZCE(5)[B(6)]CG");
+  }
+  SECTION("left context before the first module; the replaced modules are not rewritten again") {
+    // X < A B: only the first A B follows X; B --> Q rewrites the B not consumed.
+    Grammar g = parseGrammar("derivation length: 2\naxiom: XABAB\nX < A B --> Y\nB --> Q\nY --> YY\n", "t.l");
+    Deriver d(g);
+    CHECK(formatModuleString(d.step(), d.symbols()) == "XYAQ");
+    CHECK(formatModuleString(d.step(), d.symbols()) == "XYYAQ");
+  }
+  SECTION("stochastic choice among predecessors of different lengths counts each once") {
+    Grammar g = parseGrammar("derivation length: 1\nseed: 3\naxiom: AB\nA B --> X : 1\nA --> Y : 0\n", "t.l");
+    CHECK(formatModuleString(derive(g), g.symbols()) == "X");
+  }
+}
+
+TEST_CASE("cpfg's C preprocessor", "[lsystem][cpfg]") {
+  SECTION("tests/assets/cpfg/preprocessor: macros, #ifdef, #include (derived by hand in its comment)") {
+    Grammar g = loadGrammar(cpfgAsset("preprocessor/plant.l"));
+    Deriver d(g);
+    CHECK(formatModuleString(d.derive(), d.symbols()) == "F(1)[+(30)F(0.5)@o(0.2)]F(1)[+(30)F(0.5)@o(0.2)]A");
+    CHECK(g.define("LATERAL").value() == 0.5);  // a number stays a constant -D may override
+  }
+  SECTION("an error in an included file is at its own file:line:col") {
+    const std::string file = cpfgAsset("preprocessor_errors/plant.l");
+    CHECK(errorOf(readFile(file), file) == cpfgAsset("preprocessor_errors/rules.h") +
+                                                    ":2:8: cpfg's '@Gc' (generalized cylinder) is not supported");
+  }
+  SECTION("an error inside a macro's expansion is at the macro's use") {
+    CHECK(errorOf("#define LEAF [@Gc(1)]\naxiom: F LEAF\n") == "t.l:2:10: cpfg's '@Gc' (generalized cylinder) is not supported");
+    CHECK(errorOf("#define B(x) F(x)\naxiom: A B(1, 2) C\n") ==
+          "t.l:2:10: macro 'B' takes 1 argument(s) (defined at t.l:1), or its expansion nests deeper than 64 levels");
+    // Columns after an expansion are the file's own.
+    CHECK(errorOf("#define S F(1)F(1)\naxiom: S@Gc(1)\n") == "t.l:2:9: cpfg's '@Gc' (generalized cylinder) is not supported");
+  }
+  SECTION("cpp's identifiers: a macro named B is not expanded inside AB; a number body stays a value") {
+    Grammar g = parseGrammar("#define B [+F]\n#define N (2 + 1)\naxiom: AB B F(N)\n", "t.l");
+    CHECK(formatModuleString(g.axiom(), g.symbols()) == "AB[+F]F(3)");
+  }
+  SECTION("cpp's textual substitution: an unparenthesized body binds as written") {
+    // #define K 1+2: 2*K is 2*1+2 = 4 in cpfg (cpp), not 6.
+    Grammar g = parseGrammar("#define K 1+2\naxiom: A(2*K)\n", "t.l");
+    CHECK(formatModuleString(g.axiom(), g.symbols()) == "A(4)");
+  }
+  SECTION("errors") {
+    CHECK(errorOf("#include \"../query/plant.v\"\naxiom: A\n", cpfgAsset("preprocessor/t.l")).find(
+              ":1:10: '#include \"../query/plant.v\"' is outside the object's folder") != std::string::npos);
+    CHECK(errorOf("#include \"missing.h\"\naxiom: A\n") == "t.l:1:10: cannot read the included file 'missing.h'");
+    CHECK(errorOf("#ifdef X\naxiom: A\n") == "t.l:1:1: '#if' block without '#endif'");
+    CHECK(errorOf("axiom: A\n#endif\n") == "t.l:2:1: '#endif' without '#ifdef' or '#ifndef'");
+    CHECK(errorOf("#define B F\n#define B G\naxiom: A\n") == "t.l:2:9: 'B' is already defined at t.l:1");
+    CHECK(errorOf("#define B F\n#undef B\n#define B G\naxiom: B\n") == "no error");
   }
 }

@@ -1,0 +1,2 @@
+/* included by plant.l */
+#define LEAF @o(0.2)

@@ -1,0 +1,2 @@
+/* productions of plant.l */
+A --> F@Gc(2)
