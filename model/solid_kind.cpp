@@ -570,7 +570,8 @@ class SolidModel final : public StillKindModel {
     std::vector<uint16_t> mats;
     std::vector<Mesh> parts;
     if (look.section) {
-      parts = visibleMeshes(clipByPlane(tets(), DVec3(Vec3(*look.section)), double(look.section->w)), &mats);
+      parts = visibleMeshes(clipByPlane(tets(), DVec3(Vec3(*look.section)), double(look.section->w)), &mats,
+                            &spec_.solid.materials.materials);
     } else {
       parts = visible().first;
       mats = visible().second;
@@ -593,7 +594,7 @@ class SolidModel final : public StillKindModel {
     const auto& [parts, mats] = visible();
     for (size_t i = 0; i < parts.size(); ++i) {
       Mesh part = parts[i];
-      part.colors.assign(part.vertexCount(), spec_.solid.materials.materials[mats[i]].color);
+      if (part.colors.size() != part.vertexCount()) part.colors.assign(part.vertexCount(), spec_.solid.materials.materials[mats[i]].color);
       all.append(part);
     }
     figures.triangles = all.triangleCount();
@@ -630,6 +631,9 @@ class SolidModel final : public StillKindModel {
         mesh.triangles.push_back(tri);
       }
       mesh.colors.assign(mesh.positions.size(), mats[size_t(pair.first)].color);
+      if (pair.second < 0 && m.tints.size() == m.positions.size())  // the visible faces carry the tools' tints
+        for (const auto& [x, i] : index)
+          mesh.colors[i] = glm::mix(mats[size_t(pair.first)].color, Vec3(m.tints[x]), std::clamp(m.tints[x].w, 0.0f, 1.0f));
       out.emplace_back(mats[size_t(pair.first)].name + "_" + (pair.second < 0 ? "outside" : mats[size_t(pair.second)].name),
                        std::move(mesh));
     }
@@ -706,7 +710,7 @@ class SolidModel final : public StillKindModel {
   const std::pair<std::vector<Mesh>, std::vector<uint16_t>>& visible() {
     if (!visible_) {
       visible_.emplace();
-      visible_->first = visibleMeshes(tets(), &visible_->second);
+      visible_->first = visibleMeshes(tets(), &visible_->second, &spec_.solid.materials.materials);
     }
     return *visible_;
   }
@@ -724,7 +728,9 @@ class SolidModel final : public StillKindModel {
 
 }  // namespace
 
-std::vector<Mesh> visibleMeshes(const TetMesh& mesh, std::vector<uint16_t>* partMaterials) {
+std::vector<Mesh> visibleMeshes(const TetMesh& mesh, std::vector<uint16_t>* partMaterials,
+                                const std::vector<solids::Material>* materials) {
+  const bool tinted = materials && !mesh.tints.empty() && mesh.tints.size() == mesh.positions.size();
   // Normals are smoothed over the faces around a vertex whose normals lie within 60° of
   // each other; sharper edges (a cut-away's rim, a box's edges) stay creased.
   constexpr float kCreaseCos = 0.5f;
@@ -756,6 +762,10 @@ std::vector<Mesh> visibleMeshes(const TetMesh& mesh, std::vector<uint16_t>* part
           groups.push_back({Vec3(0.0f), uint32_t(m.positions.size())});
           m.positions.push_back(Vec3(mesh.positions[x]));
           m.normals.push_back(Vec3(0.0f));
+          if (tinted) {
+            const Vec4& t = mesh.tints[x];
+            m.colors.push_back(glm::mix((*materials)[mat].color, Vec3(t), std::clamp(t.w, 0.0f, 1.0f)));
+          }
         }
         groups[g].first += n;
         m.normals[groups[g].second] += faceNormal[f];
