@@ -82,6 +82,44 @@ size_t dropLoose(TetMesh& mesh, const std::vector<uint8_t>& fixed) {
   return removeTets(mesh, keep);
 }
 
+/// Removes, round by round, the affected tetrahedra around edges of the visible interface
+/// that more than two visible triangles share (two pieces touching along an edge only,
+/// left by removals), until none is left or only unaffected tetrahedra meet there.
+size_t mendEdges(TetMesh& mesh, const std::vector<uint8_t>& affected) {
+  size_t gone = 0;
+  for (int round = 0; round < 64; ++round) {
+    std::vector<uint64_t> edges;
+    for (const InterfaceTriangle& t : visibleInterface(mesh))
+      for (int e = 0; e < 3; ++e) {
+        const uint32_t a = t.v[size_t(e)], b = t.v[size_t((e + 1) % 3)];
+        edges.push_back(a < b ? (uint64_t(a) << 32) | b : (uint64_t(b) << 32) | a);
+      }
+    std::sort(edges.begin(), edges.end());
+    std::vector<uint64_t> bad;
+    for (size_t i = 0; i < edges.size();) {
+      size_t j = i + 1;
+      while (j < edges.size() && edges[j] == edges[i]) ++j;
+      if (j - i > 2) bad.push_back(edges[i]);
+      i = j;
+    }
+    if (bad.empty()) break;
+    std::vector<uint8_t> keep(mesh.tets.size(), 1);
+    for (size_t t = 0; t < mesh.tets.size(); ++t) {
+      if (!affected[mesh.materials[t]]) continue;
+      const auto& q = mesh.tets[t];
+      for (int a = 0; a < 4; ++a)
+        for (int b = a + 1; b < 4; ++b) {
+          const uint32_t x = q[size_t(a)], y = q[size_t(b)];
+          if (std::binary_search(bad.begin(), bad.end(), x < y ? (uint64_t(x) << 32) | y : (uint64_t(y) << 32) | x)) keep[t] = 0;
+        }
+    }
+    const size_t r = removeTets(mesh, keep);
+    if (r == 0) break;
+    gone += r;
+  }
+  return gone;
+}
+
 }  // namespace
 
 std::vector<uint8_t> hammerAnchors(const TetMesh& mesh, const HammerOptions& options) {
@@ -268,13 +306,18 @@ size_t subtractRegion(TetMesh& mesh, size_t materialCount, const std::vector<uin
     for (uint32_t v : mesh.tets[t])
       if (value[v] < -eps) keep[t] = 0;
   }
-  const size_t removed = removeTets(mesh, keep);
+  size_t removed = removeTets(mesh, keep);
+  removed += mendEdges(mesh, affected);
   std::vector<uint8_t> held(mesh.positions.size(), 0);
   for (size_t t = 0; t < mesh.tets.size(); ++t)
     if (!affected[mesh.materials[t]])
       for (uint32_t v : mesh.tets[t]) held[v] = 1;
   if (std::find(held.begin(), held.end(), 1) == held.end() && !mesh.tets.empty()) held = lowestVertices(mesh, unitUp(up));
-  const size_t loose = dropLoose(mesh, asFixed(held));
+  size_t loose = dropLoose(mesh, asFixed(held));
+  if (loose) {
+    removed += mendEdges(mesh, affected);
+    loose += dropLoose(mesh, asFixed(held));
+  }
   if (fallen) *fallen = loose;
   return removed;
 }

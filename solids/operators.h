@@ -127,8 +127,10 @@ PolishStats polish(TetMesh& mesh, const std::vector<Material>& materials, const 
 
 /// CSG subtraction of the region field < 0 from the tetrahedra of the affected materials
 /// (polish's first half, and erode's): cutByField on the affected tetrahedra, removal of
-/// every affected piece with a vertex where field < −eps, then of affected pieces left
-/// loose (held: the vertices of unaffected tetrahedra, or else the ground along up).
+/// every affected piece with a vertex where field < −eps, then of the affected tetrahedra
+/// around visible edges that more than two visible faces share (pieces left touching along
+/// an edge only: the visible interface stays a manifold where the affected material meets
+/// itself), then of affected pieces left loose (held: the vertices of unaffected tetrahedra, or else the ground along up).
 /// Returns the tetrahedra removed inside; *split and *fallen (when given) get the edges
 /// split and the loose tetrahedra removed.
 size_t subtractRegion(TetMesh& mesh, size_t materialCount, const std::vector<uint16_t>& affects,

@@ -119,7 +119,7 @@ struct Surface {
     }
     if (tris.empty()) return;
     meanEdge = edges / (3.0 * double(tris.size()));
-    const double step = stepHint > 0 ? stepHint : 0.5 * meanEdge;
+    const double step = stepHint;
     triGrid.build(boxes, lo, hi, std::max(2 * step, meanEdge));
     for (auto& c : cols) c.first.z = c.second.z = 0;  // one layer
     colLo = flo;
@@ -314,9 +314,9 @@ ParticleStats runParticles(TetMesh& mesh, const std::vector<Material>& materials
   ParticleStats st;
   st.passes.assign(mesh.positions.size(), 0);
   const DVec3 up = glm::normalize(o.up);
-  const Surface s(mesh, up, affected, o.step, o.radius);
+  const Surface s(mesh, up, affected, o.step > 0 ? o.step : 0.5 * o.radius, o.radius);
   if (s.tris.empty() || o.particles == 0) return st;
-  const double step = o.step > 0 ? o.step : 0.5 * s.meanEdge;
+  const double step = o.step > 0 ? o.step : 0.5 * o.radius;
   if (o.life * o.speed / step > 1e6) throw std::invalid_argument(tool + ": life * speed / step is more than a million steps per particle");
   const double cosTop = std::cos(o.topAngleDeg * kPi / 180);
   std::vector<DVec3> craters;

@@ -52,7 +52,7 @@ struct ParticleOptions {
   int particles = 10000;          ///< the paper's num_particles
   double life = 1.0;              ///< seconds (the paper's particle_life)
   double speed = 1.0;             ///< m/s along the surface
-  double step = 0;                ///< m; 0 = half the mean edge of the visible faces
+  double step = 0;                ///< m; 0 = half the radius
   double fallingAngleDeg = 60;    ///< CLINGING's falling angle, degrees from straight down
   double radius = 0.1;            ///< m: action radius (wash, lichen) or eroded sphere (erode)
   double strength = 0.2;          ///< blend weight per step at the particle (wash, lichen)

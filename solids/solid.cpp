@@ -592,7 +592,7 @@ TetMesh clipByPlane(const TetMesh& mesh, const DVec3& normal, double offset) {
 }
 
 size_t cutByField(TetMesh& mesh, const std::vector<uint8_t>& splittable, const std::function<double(const DVec3&)>& field,
-                  std::vector<uint32_t>* parent) {
+                  std::vector<uint32_t>* parent, double snap) {
   if (splittable.size() != mesh.tets.size()) throw std::invalid_argument("cutByField: one flag per tetrahedron expected");
   const size_t nv = mesh.positions.size();
   std::vector<double> value(nv);
@@ -616,13 +616,13 @@ size_t cutByField(TetMesh& mesh, const std::vector<uint8_t>& splittable, const s
       w.fields.emplace_back(nv);
       for (size_t v = 0; v < nv; ++v) w.fields.back()[v] = mesh.tints[v][c];
     }
-  const std::vector<uint64_t> keys = edgesWhere(w, [&](size_t t) { return splittable[t] != 0; }, [&](uint32_t a, uint32_t c) {
+  const std::vector<uint64_t> candidates = edgesWhere(w, [&](size_t t) { return splittable[t] != 0; }, [&](uint32_t a, uint32_t c) {
     const double pa = value[a], pc = value[c];
     if (!((pa < 0 && pc > 0) || (pa > 0 && pc < 0))) return false;
     return !std::binary_search(frozen.begin(), frozen.end(), edgeKey(a, c));
   });
   // Bisection of the field along the edge, from the end with the smaller id.
-  splitEdges(w, keys, [&](uint32_t a, uint32_t c) {
+  auto crossing = [&](uint32_t a, uint32_t c) {
     const DVec3 pa = mesh.positions[a], pc = mesh.positions[c];
     const bool negA = value[a] < 0;
     double lo = 0, hi = 1;
@@ -631,6 +631,16 @@ size_t cutByField(TetMesh& mesh, const std::vector<uint8_t>& splittable, const s
       ((field(pa + (pc - pa) * mid) < 0) == negA ? lo : hi) = mid;
     }
     return 0.5 * (lo + hi);
+  };
+  std::vector<uint64_t> kept;
+  std::vector<double> at;
+  for (uint64_t k : candidates) {
+    const double x = crossing(uint32_t(k >> 32), uint32_t(k));
+    if (x > snap && x < 1 - snap) kept.push_back(k), at.push_back(x);
+  }
+  const std::vector<uint64_t>& keys = kept;
+  splitEdges(w, keys, [&](uint32_t a, uint32_t c) {
+    return at[size_t(std::lower_bound(keys.begin(), keys.end(), edgeKey(a, c)) - keys.begin())];
   }, [](uint32_t) {});
   mesh.positions = std::move(w.positions);
   if (tinted) {

@@ -150,9 +150,10 @@ TetMesh clipByPlane(const TetMesh& mesh, const DVec3& normal, double offset);
 /// same conforming splits as meshSolid). Tetrahedra without splits and every vertex keep
 /// their order, ids and bytes; new vertices are appended (tints interpolated) and pieces
 /// take their parent's place and material. parent, when given, receives each output
-/// tetrahedron's input index. Returns the number of edges split.
+/// tetrahedron's input index. Crossings nearer an end than `snap` of the edge are not split
+/// (no slivers; that end lies within snap of the zero set). Returns the number of edges split.
 size_t cutByField(TetMesh& mesh, const std::vector<uint8_t>& splittable, const std::function<double(const DVec3&)>& field,
-                  std::vector<uint32_t>* parent = nullptr);
+                  std::vector<uint32_t>* parent = nullptr, double snap = 0.05);
 
 /// The paper's tetrahedron quality (§4.4, α = 0.7), 0..10:
 /// Quality(t) = α·A(t) + (1 − α)·V(t), A(t) = 10·min(1, sqrt(2·min solid angle(t))),

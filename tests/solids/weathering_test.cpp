@@ -79,7 +79,7 @@ TEST_CASE("cutByField: a block cut at a sphere", "[solids][weathering]") {
   TetMesh m = test::tetBlock({6, 6, 6}, DVec3(-0.6), DVec3(1.2));
   const double before = [&] { double v = 0; for (size_t t = 0; t < m.tets.size(); ++t) v += m.volume(t); return v; }();
   auto sphere = [](const DVec3& p) { return glm::length(p - DVec3(0.1, 0.05, 0)) - 0.45; };
-  const size_t n = cutByField(m, std::vector<uint8_t>(m.tets.size(), 1), sphere);
+  const size_t n = cutByField(m, std::vector<uint8_t>(m.tets.size(), 1), sphere, nullptr, 0.0);
   CHECK(n > 0);
   test::checkValid(m);
   double after = 0;
