@@ -68,7 +68,7 @@ solids::DisplaceOptions readDisplace(MapReader& m, const YNode& node, solids::Ma
 /// The id of the one concrete material named under key, or -1 (absent: def, which may be empty).
 int oneMaterial(MapReader& m, const std::string& key, const std::string& def, solids::MaterialTable& materials,
                 DiagnosticList& diags) {
-  std::optional<YNode> node = m.keyNode(key);
+  std::optional<YNode> node = m.get(key);
   std::string name = def;
   if (node) {
     std::optional<std::string> s = node->asString(diags, "'" + key + "'");
