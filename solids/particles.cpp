@@ -120,7 +120,7 @@ struct Surface {
     if (tris.empty()) return;
     meanEdge = edges / (3.0 * double(tris.size()));
     const double step = stepHint;
-    triGrid.build(boxes, lo, hi, std::max(2 * step, meanEdge));
+    triGrid.build(boxes, lo, hi, std::max(step, meanEdge));
     for (auto& c : cols) c.first.z = c.second.z = 0;  // one layer
     colLo = flo;
     columns.build(cols, DVec3(flo.x, flo.y, 0), DVec3(fhi.x, fhi.y, 0), std::max(meanEdge, 1e-9));
@@ -261,6 +261,7 @@ const char* toolName(ParticleTool t) { return t == ParticleTool::Wash ? "wash" :
 ParticleOptions particleDefaults(ParticleTool tool) {
   ParticleOptions o;
   o.tool = tool;
+  o.strength = 0.01;
   if (tool == ParticleTool::Erode) {
     o.particles = 2000;
     o.radius = 0.03;
