@@ -567,7 +567,8 @@ class SolidModel final : public StillKindModel {
   std::vector<Stage> animationFrames(int, int first, int last) const override {
     if (operationCount() == 0) return {Stage{}};
     std::vector<Stage> out;
-    for (int k = std::clamp(first, 0, operationCount()); k <= std::clamp(last, 0, operationCount()); ++k) out.push_back(stageAt(k));
+    const int end = last < 0 ? operationCount() : std::min(last, operationCount());
+    for (int k = std::clamp(first, 0, operationCount()); k <= end; ++k) out.push_back(stageAt(k));
     return out;
   }
   std::string stageName(const Stage& stage) const override {
