@@ -131,9 +131,12 @@ GalleryItem renderGalleryItem(const fs::path& speciesFile, const fs::path& outDi
     item.deriveSeconds = fig.buildSeconds;
 
     // The growth strip: every stage framed like the final one. A solid does not grow: its
-    // strip is the whole solid and its cut-away by the plane z = 0 (Fig. 3e, 3f).
+    // strip is the whole solid and its cut-away by the plane z = 0 (Fig. 3e, 3f); a solid
+    // with operations shows its sequence instead, one cell per operation (Fig. 6-8).
     const bool solid = !model.volumeMeshExtensions().empty();
-    const std::vector<Stage> stages = solid ? std::vector<Stage>{job.stage, job.stage} : model.stripStages(5);
+    const std::vector<Stage> sequence = solid ? model.stripStages(0) : std::vector<Stage>{};
+    const bool cutAway = solid && sequence.size() <= 1;
+    const std::vector<Stage> stages = cutAway ? std::vector<Stage>{job.stage, job.stage} : solid ? sequence : model.stripStages(5);
     for (const Stage& st : stages)
       item.stages.push_back(model.stageNumber(st));
     const int stripHeight = std::max(16, height * 2 / 3);
@@ -149,7 +152,7 @@ GalleryItem renderGalleryItem(const fs::path& speciesFile, const fs::path& outDi
       if (draft && exact) cellJob.samples = 1;
       cellJob.progressLabel = "stages " + stem + " " + std::to_string(i + 1) + "/" + std::to_string(stages.size());
       SpeciesRender cellLook = stripLook;
-      if (solid && i == 1) cellLook.section = look.section.value_or(Vec4(0, 0, 1, 0));
+      if (cutAway && i == 1) cellLook.section = look.section.value_or(Vec4(0, 0, 1, 0));
       Image cell = renderModel(model, cellLook, cellJob);
       for (int y = 0; y < stripHeight; ++y)
         for (int x = 0; x < cellWidth; ++x) strip.set(static_cast<int>(i) * cellWidth + x, y, cell.at(x, y));

@@ -557,23 +557,54 @@ class SolidModel final : public StillKindModel {
  public:
   explicit SolidModel(const SolidSpec& spec) : spec_(spec) {}
 
+  // Stages of a solid with operations (`sprig animate`, the gallery's strip): stage k is the
+  // solid after its first k operations, 0 the solid as meshed; the final stage all of them.
+  // Without operations a solid has the one still stage.
+  int operationCount() const { return int(spec_.operations.size()); }
+  Stage finalStage() const override { return operationCount() == 0 ? Stage{} : stageAt(operationCount()); }
+  Stage stageFromIndex(int k) const override { return operationCount() == 0 ? Stage{} : stageAt(std::clamp(k, 0, operationCount())); }
+  std::vector<Stage> stripStages(int) const override { return animationFrames(1, 0, operationCount()); }
+  std::vector<Stage> animationFrames(int, int first, int last) const override {
+    if (operationCount() == 0) return {Stage{}};
+    std::vector<Stage> out;
+    const int end = last < 0 ? operationCount() : std::min(last, operationCount());
+    for (int k = std::clamp(first, 0, operationCount()); k <= end; ++k) out.push_back(stageAt(k));
+    return out;
+  }
+  std::string stageName(const Stage& stage) const override {
+    if (operationCount() == 0) return {};
+    const int k = stepOf(stage);
+    if (k == 0) return "before the operations";
+    return "after operation " + std::to_string(k) + " of " + std::to_string(operationCount()) + " (" +
+           spec_.operations[size_t(k - 1)].tool + ")";
+  }
+  GalleryMotion galleryMotion(bool final) override {
+    if (operationCount() == 0) return StillKindModel::galleryMotion(final);
+    GalleryMotion m;
+    m.framesPerStage = 1;
+    return m;
+  }
+
   Box3 frameBox() override {
+    // The solid as meshed, so every stage of an operation sequence is framed alike.
     Box3 box;
-    for (const DVec3& p : tets().positions) box.extend(Vec3(p));
+    for (const DVec3& p : stageMesh(0).positions) box.extend(Vec3(p));
     return box.empty() ? Box3{Vec3(-1.0f), Vec3(1.0f)} : box;
   }
 
-  BuiltStage build(const Stage&, GeometryMode mode, const SpeciesRender& look) override {
+  BuiltStage build(const Stage& stage, GeometryMode mode, const SpeciesRender& look) override {
+    const int k = stepOf(stage);
     if (mode == GeometryMode::Skeleton) throw UsageError("solid species have no skeleton: use --mode exact or mesh");
     BuiltStage out;
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<uint16_t> mats;
     std::vector<Mesh> parts;
     if (look.section) {
-      parts = visibleMeshes(clipByPlane(tets(), DVec3(Vec3(*look.section)), double(look.section->w)), &mats);
+      parts = visibleMeshes(clipByPlane(stageMesh(k), DVec3(Vec3(*look.section)), double(look.section->w)), &mats,
+                            &spec_.solid.materials.materials);
     } else {
-      parts = visible().first;
-      mats = visible().second;
+      parts = visible(k).first;
+      mats = visible(k).second;
     }
     for (size_t i = 0; i < parts.size(); ++i) {
       const Material& m = spec_.solid.materials.materials[mats[i]];
@@ -583,29 +614,30 @@ class SolidModel final : public StillKindModel {
       part.material = render::Material{m.color, m.roughness, m.specular};
       out.geometry.parts.push_back(std::move(part));
     }
-    out.figures.primitives = tets().tets.size();
+    out.figures.primitives = stageMesh(k).tets.size();
     out.figures.buildSeconds = secondsSince(t0) + buildSeconds_;
     return out;
   }
 
-  Mesh buildMesh(const Stage&, float, bool, ModelFigures& figures) override {
+  Mesh buildMesh(const Stage& stage, float, bool, ModelFigures& figures) override {
     Mesh all;
-    const auto& [parts, mats] = visible();
+    const int k = stepOf(stage);
+    const auto& [parts, mats] = visible(k);
     for (size_t i = 0; i < parts.size(); ++i) {
       Mesh part = parts[i];
-      part.colors.assign(part.vertexCount(), spec_.solid.materials.materials[mats[i]].color);
+      if (part.colors.size() != part.vertexCount()) part.colors.assign(part.vertexCount(), spec_.solid.materials.materials[mats[i]].color);
       all.append(part);
     }
     figures.triangles = all.triangleCount();
-    figures.primitives = tets().tets.size();
+    figures.primitives = stageMesh(k).tets.size();
     figures.buildSeconds = buildSeconds_;
     return all;
   }
 
   std::vector<std::string> volumeMeshExtensions() const override { return {".msh", ".vtu", ".mesh"}; }
 
-  std::vector<std::pair<std::string, Mesh>> interfaceMeshes(const Stage&) override {
-    const TetMesh& m = tets();
+  std::vector<std::pair<std::string, Mesh>> interfaceMeshes(const Stage& stage) override {
+    const TetMesh& m = stageMesh(stepOf(stage));
     const auto& mats = spec_.solid.materials.materials;
     // (A, B) with A < B, or (A, outside): triangles oriented out of A.
     std::map<std::pair<int, int>, std::vector<std::array<uint32_t, 3>>> groups;
@@ -630,17 +662,20 @@ class SolidModel final : public StillKindModel {
         mesh.triangles.push_back(tri);
       }
       mesh.colors.assign(mesh.positions.size(), mats[size_t(pair.first)].color);
+      if (pair.second < 0 && m.tints.size() == m.positions.size())  // the visible faces carry the tools' tints
+        for (const auto& [x, i] : index)
+          mesh.colors[i] = glm::mix(mats[size_t(pair.first)].color, Vec3(m.tints[x]), std::clamp(m.tints[x].w, 0.0f, 1.0f));
       out.emplace_back(mats[size_t(pair.first)].name + "_" + (pair.second < 0 ? "outside" : mats[size_t(pair.second)].name),
                        std::move(mesh));
     }
     return out;
   }
 
-  std::string writeVolumeMesh(const Stage&, const std::filesystem::path& path, bool) override {
-    const TetMesh& m = tets();
+  std::string writeVolumeMesh(const Stage& stage, const std::filesystem::path& path, bool) override {
+    const TetMesh& m = stageMesh(stepOf(stage));
     writeTetMesh(m, spec_.solid.materials.materials, path);
     // Smoothing or improvement measured it already, unless operations changed the mesh since.
-    const bool measured = spec_.operations.empty();
+    const bool measured = stepOf(stage) == 0;
     const QualityStats q = measured && improved_ ? improved_->after : measured && smooth_ ? smooth_->after : measureQuality(m);
     char buf[512];
     std::snprintf(buf, sizeof buf,
@@ -674,7 +709,19 @@ class SolidModel final : public StillKindModel {
   }
 
  private:
-  const TetMesh& tets() {
+  static Stage stageAt(int k) {
+    Stage st;
+    st.step = k;
+    return st;
+  }
+  /// The operations a stage has applied (-1 and out of range: all).
+  int stepOf(const Stage& stage) const {
+    return stage.step < 0 || stage.step > operationCount() ? operationCount() : stage.step;
+  }
+
+  /// The mesh after the first k operations, unused vertices dropped (built once per k; the
+  /// operations run once, in order, whatever stages are asked for).
+  const TetMesh& stageMesh(int k) {
     if (!mesh_) {
       const auto t0 = std::chrono::steady_clock::now();
       solids::MeshOptions options;
@@ -691,24 +738,35 @@ class SolidModel final : public StillKindModel {
         improved_ = improveQuality(*mesh_, *spec_.improve);
         improveSeconds_ = secondsSince(s0);
       }
-      try {
-        applySolidOperations(*mesh_, spec_.solid.materials.materials, spec_.operations);
-      } catch (...) {
-        mesh_.reset();
-        throw;
-      }
+      working_ = *mesh_;
+      applied_ = 0;
+      stages_.clear();
+      stages_.emplace(0, *mesh_);
       buildSeconds_ = secondsSince(t0);
     }
-    return *mesh_;
+    auto it = stages_.find(k);
+    if (it != stages_.end()) return it->second;
+    const auto t0 = std::chrono::steady_clock::now();
+    while (applied_ < k) {
+      applySolidOperation(working_, spec_.solid.materials.materials, spec_.operations[size_t(applied_)]);
+      ++applied_;
+      TetMesh out = working_;
+      solids::compactVertices(out);
+      stages_.emplace(applied_, std::move(out));
+    }
+    buildSeconds_ += secondsSince(t0);
+    return stages_.at(k);
   }
 
-  /// The whole solid's render meshes and their materials (kept: turntable frames reuse them).
-  const std::pair<std::vector<Mesh>, std::vector<uint16_t>>& visible() {
-    if (!visible_) {
-      visible_.emplace();
-      visible_->first = visibleMeshes(tets(), &visible_->second);
+  /// A stage's render meshes and their materials (kept: turntable frames reuse them).
+  const std::pair<std::vector<Mesh>, std::vector<uint16_t>>& visible(int k) {
+    auto it = visible_.find(k);
+    if (it == visible_.end()) {
+      std::pair<std::vector<Mesh>, std::vector<uint16_t>> v;
+      v.first = visibleMeshes(stageMesh(k), &v.second, &spec_.solid.materials.materials);
+      it = visible_.emplace(k, std::move(v)).first;
     }
-    return *visible_;
+    return it->second;
   }
 
   const SolidSpec& spec_;
@@ -717,14 +775,19 @@ class SolidModel final : public StillKindModel {
   double smoothSeconds_ = 0;
   std::optional<ImproveStats> improved_;
   double improveSeconds_ = 0;
-  std::optional<std::pair<std::vector<Mesh>, std::vector<uint16_t>>> visible_;
+  TetMesh working_;   ///< the mesh after `applied_` operations, vertices not yet dropped
+  int applied_ = 0;
+  std::map<int, TetMesh> stages_;
+  std::map<int, std::pair<std::vector<Mesh>, std::vector<uint16_t>>> visible_;
   MeshStats stats_;
   double buildSeconds_ = 0;
 };
 
 }  // namespace
 
-std::vector<Mesh> visibleMeshes(const TetMesh& mesh, std::vector<uint16_t>* partMaterials) {
+std::vector<Mesh> visibleMeshes(const TetMesh& mesh, std::vector<uint16_t>* partMaterials,
+                                const std::vector<solids::Material>* materials) {
+  const bool tinted = materials && !mesh.tints.empty() && mesh.tints.size() == mesh.positions.size();
   // Normals are smoothed over the faces around a vertex whose normals lie within 60° of
   // each other; sharper edges (a cut-away's rim, a box's edges) stay creased.
   constexpr float kCreaseCos = 0.5f;
@@ -756,6 +819,10 @@ std::vector<Mesh> visibleMeshes(const TetMesh& mesh, std::vector<uint16_t>* part
           groups.push_back({Vec3(0.0f), uint32_t(m.positions.size())});
           m.positions.push_back(Vec3(mesh.positions[x]));
           m.normals.push_back(Vec3(0.0f));
+          if (tinted) {
+            const Vec4& t = mesh.tints[x];
+            m.colors.push_back(glm::mix((*materials)[mat].color, Vec3(t), std::clamp(t.w, 0.0f, 1.0f)));
+          }
         }
         groups[g].first += n;
         m.normals[groups[g].second] += faceNormal[f];

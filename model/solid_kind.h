@@ -58,7 +58,10 @@ class SolidSpec : public KindSpec {
 std::shared_ptr<const KindSpec> readSolidSpec(MapReader& top, Species& species, DiagnosticList& diags);
 
 /// The visible interface of mesh as a render mesh: one part per material with its colour,
-/// smooth normals within each part.
-std::vector<Mesh> visibleMeshes(const solids::TetMesh& mesh, std::vector<uint16_t>* partMaterials = nullptr);
+/// smooth normals within each part. When mesh has tints (the weathering tools and polish)
+/// and materials is given, every part gets vertex colours mix(material colour, tint rgb,
+/// tint amount); otherwise none (the part's material colour applies).
+std::vector<Mesh> visibleMeshes(const solids::TetMesh& mesh, std::vector<uint16_t>* partMaterials = nullptr,
+                                const std::vector<solids::Material>* materials = nullptr);
 
 }  // namespace sprig

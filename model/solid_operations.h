@@ -21,15 +21,18 @@
 #include "core/diagnostics.h"
 #include "model/yaml_reader.h"
 #include "solids/operators.h"
+#include "solids/particles.h"
 
 namespace sprig {
 
 /// One entry of `operations:`: the tool, its options, and where it was written.
 struct SolidOperation {
-  std::string tool;  ///< "hammer" or "displace"
+  std::string tool;  ///< "hammer", "displace", "polish", "dirt", "wash", "erode" or "lichen"
   SourceLoc loc;
   std::string sourceLine;
-  std::variant<solids::HammerOptions, solids::DisplaceOptions> options;
+  std::variant<solids::HammerOptions, solids::DisplaceOptions, solids::PolishOptions, solids::DirtOptions,
+               solids::ParticleOptions>
+      options;
 };
 
 /// Reads an `operations:` sequence. Material names resolve against materials (built-ins
@@ -41,5 +44,8 @@ std::vector<SolidOperation> readSolidOperations(const YNode& list, solids::Mater
 /// at its entry.
 void applySolidOperations(solids::TetMesh& mesh, const std::vector<solids::Material>& materials,
                           const std::vector<SolidOperation>& operations);
+
+/// Applies one operation (as applySolidOperations does, without dropping unused vertices).
+void applySolidOperation(solids::TetMesh& mesh, const std::vector<solids::Material>& materials, const SolidOperation& op);
 
 }  // namespace sprig

@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "core/parallel.h"
+
 namespace sprig::solids {
 
 namespace {
@@ -78,6 +80,44 @@ size_t dropLoose(TetMesh& mesh, const std::vector<uint8_t>& fixed) {
   std::vector<uint8_t> keep(mesh.tets.size());
   for (size_t t = 0; t < keep.size(); ++t) keep[t] = held[component[t]] ? 1 : 0;
   return removeTets(mesh, keep);
+}
+
+/// Removes, round by round, the affected tetrahedra around edges of the visible interface
+/// that more than two visible triangles share (two pieces touching along an edge only,
+/// left by removals), until none is left or only unaffected tetrahedra meet there.
+size_t mendEdges(TetMesh& mesh, const std::vector<uint8_t>& affected) {
+  size_t gone = 0;
+  for (int round = 0; round < 64; ++round) {
+    std::vector<uint64_t> edges;
+    for (const InterfaceTriangle& t : visibleInterface(mesh))
+      for (int e = 0; e < 3; ++e) {
+        const uint32_t a = t.v[size_t(e)], b = t.v[size_t((e + 1) % 3)];
+        edges.push_back(a < b ? (uint64_t(a) << 32) | b : (uint64_t(b) << 32) | a);
+      }
+    std::sort(edges.begin(), edges.end());
+    std::vector<uint64_t> bad;
+    for (size_t i = 0; i < edges.size();) {
+      size_t j = i + 1;
+      while (j < edges.size() && edges[j] == edges[i]) ++j;
+      if (j - i > 2) bad.push_back(edges[i]);
+      i = j;
+    }
+    if (bad.empty()) break;
+    std::vector<uint8_t> keep(mesh.tets.size(), 1);
+    for (size_t t = 0; t < mesh.tets.size(); ++t) {
+      if (!affected[mesh.materials[t]]) continue;
+      const auto& q = mesh.tets[t];
+      for (int a = 0; a < 4; ++a)
+        for (int b = a + 1; b < 4; ++b) {
+          const uint32_t x = q[size_t(a)], y = q[size_t(b)];
+          if (std::binary_search(bad.begin(), bad.end(), x < y ? (uint64_t(x) << 32) | y : (uint64_t(y) << 32) | x)) keep[t] = 0;
+        }
+    }
+    const size_t r = removeTets(mesh, keep);
+    if (r == 0) break;
+    gone += r;
+  }
+  return gone;
 }
 
 }  // namespace
@@ -169,10 +209,12 @@ size_t compactVertices(TetMesh& mesh) {
   for (size_t v = 0; v < used.size(); ++v)
     if (used[v]) {
       id[v] = next;
+      if (!mesh.tints.empty()) mesh.tints[next] = mesh.tints[v];
       mesh.positions[next++] = mesh.positions[v];
     }
   const size_t gone = mesh.positions.size() - next;
   mesh.positions.resize(next);
+  if (!mesh.tints.empty()) mesh.tints.resize(next);
   for (auto& q : mesh.tets)
     for (uint32_t& v : q) v = id[v];
   return gone;
@@ -228,6 +270,102 @@ DisplaceStats displace(TetMesh& mesh, const std::vector<Material>& materials, co
   }
   st.minVolumeRatio = INFINITY;
   for (size_t t = 0; t < before.size(); ++t) st.minVolumeRatio = std::min(st.minVolumeRatio, mesh.volume(t) / before[t]);
+  return st;
+}
+
+void blendTint(TetMesh& mesh, uint32_t v, const Vec3& c, double w) {
+  if (mesh.tints.empty()) mesh.tints.assign(mesh.positions.size(), Vec4(0.0f));
+  w = std::clamp(w, 0.0, 1.0);
+  Vec4& t = mesh.tints[v];
+  // F = mix(M, T, a) -> mix(F, c, w) = mix(M, T', a'), a' = a + w(1 - a), T' = (a(1 - w)T + w c) / a'.
+  const double a = t.w, a2 = a + w * (1 - a);
+  if (a2 <= 0) return;
+  const Vec3 rgb = Vec3((a * (1 - w) * DVec3(Vec3(t)) + w * DVec3(c)) / a2);
+  t = Vec4(rgb, float(a2));
+}
+
+void clearTint(TetMesh& mesh, uint32_t v, double w) {
+  if (mesh.tints.empty()) return;
+  mesh.tints[v].w = float(double(mesh.tints[v].w) * (1 - std::clamp(w, 0.0, 1.0)));
+}
+
+size_t subtractRegion(TetMesh& mesh, size_t materialCount, const std::vector<uint16_t>& affects,
+                      const std::function<double(const DVec3&)>& field, double eps, const DVec3& up, size_t* split,
+                      size_t* fallen) {
+  std::vector<uint8_t> affected(materialCount, affects.empty() ? 1 : 0);
+  for (uint16_t id : affects) affected[id] = 1;
+  std::vector<uint8_t> splittable(mesh.tets.size());
+  for (size_t t = 0; t < splittable.size(); ++t) splittable[t] = affected[mesh.materials[t]];
+  const size_t cut = cutByField(mesh, splittable, field);
+  if (split) *split = cut;
+  std::vector<double> value(mesh.positions.size());
+  parallelFor(0, value.size(), [&](size_t v) { value[v] = field(mesh.positions[v]); }, 1024);
+  std::vector<uint8_t> keep(mesh.tets.size(), 1);
+  for (size_t t = 0; t < keep.size(); ++t) {
+    if (!affected[mesh.materials[t]]) continue;
+    for (uint32_t v : mesh.tets[t])
+      if (value[v] < -eps) keep[t] = 0;
+  }
+  size_t removed = removeTets(mesh, keep);
+  removed += mendEdges(mesh, affected);
+  std::vector<uint8_t> held(mesh.positions.size(), 0);
+  for (size_t t = 0; t < mesh.tets.size(); ++t)
+    if (!affected[mesh.materials[t]])
+      for (uint32_t v : mesh.tets[t]) held[v] = 1;
+  if (std::find(held.begin(), held.end(), 1) == held.end() && !mesh.tets.empty()) held = lowestVertices(mesh, unitUp(up));
+  size_t loose = dropLoose(mesh, asFixed(held));
+  if (loose) {
+    removed += mendEdges(mesh, affected);
+    loose += dropLoose(mesh, asFixed(held));
+  }
+  if (fallen) *fallen = loose;
+  return removed;
+}
+
+PolishStats polish(TetMesh& mesh, const std::vector<Material>& materials, const PolishOptions& options) {
+  if (options.affects.empty()) throw std::invalid_argument("polish: 'affects' names no material");
+  checkIds(options.affects, materials.size(), "polish: 'affects'");
+  checkIds(options.shines, materials.size(), "polish: 'shines'");
+  if (options.shiny >= int(materials.size())) throw std::invalid_argument("polish: 'shiny' names no material");
+  if (!finite(options.position)) throw std::invalid_argument("polish: 'position' is not finite");
+  if (!(options.size > 0) || !std::isfinite(options.size)) throw std::invalid_argument("polish: 'size' must be positive");
+  std::vector<uint8_t> affected(materials.size(), 0);
+  for (uint16_t id : options.affects) affected[id] = 1;
+  unitUp(options.up);
+  PolishStats st;
+  const DVec3 c = options.position;
+  const double r = options.size;
+  auto sphere = [&](const DVec3& p) { return glm::length(p - c) - r; };
+
+  // 1. Subtraction: cut the affected tetrahedra at the sphere, remove the pieces inside.
+  st.removed = subtractRegion(mesh, materials.size(), options.affects, sphere, 1e-9 * r, options.up, &st.splitEdges, &st.fallen);
+
+  // 2. Blending toward the shiny material.
+  if (options.shiny >= 0) {
+    std::vector<uint8_t> shines(materials.size(), 0);
+    if (options.shines.empty())
+      for (size_t m = 0; m < shines.size(); ++m) shines[m] = !affected[m];
+    for (uint16_t id : options.shines) shines[id] = 1;
+    std::vector<double> weight(mesh.positions.size(), 0.0);
+    for (size_t t = 0; t < mesh.tets.size(); ++t) {
+      if (!shines[mesh.materials[t]]) continue;
+      const auto& q = mesh.tets[t];
+      const DVec3 centroid = (mesh.positions[q[0]] + mesh.positions[q[1]] + mesh.positions[q[2]] + mesh.positions[q[3]]) * 0.25;
+      const double w = 1 - glm::length(centroid - c) / r;
+      if (w <= 0) continue;
+      for (uint32_t v : q) weight[v] = std::max(weight[v], w);
+      if (w >= 0.5 && mesh.materials[t] != uint16_t(options.shiny)) {
+        mesh.materials[t] = uint16_t(options.shiny);
+        ++st.shined;
+      }
+    }
+    const Vec3 shinyColor = materials[size_t(options.shiny)].color;
+    for (size_t v = 0; v < weight.size(); ++v)
+      if (weight[v] > 0) {
+        blendTint(mesh, uint32_t(v), shinyColor, weight[v]);
+        ++st.tinted;
+      }
+  }
   return st;
 }
 

@@ -10,6 +10,7 @@
 /// oriented; both are deterministic at any thread count.
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 #include "solids/fem.h"
@@ -83,6 +84,67 @@ HammerStats hammer(TetMesh& mesh, const std::vector<Material>& materials, const 
 /// between operations), keeping the others in order and renumbering the tetrahedra.
 /// Returns how many went. Cost O(vertices + tets).
 size_t compactVertices(TetMesh& mesh);
+
+/// Options of polish (§5.1, the paper's POLISH): CSG subtraction of a sphere from the
+/// affected materials, then the material nearby blended toward a shiny one.
+struct PolishOptions {
+  DVec3 position{0.0};     ///< centre of the sphere, m (the paper's default)
+  double size = 1.0;       ///< radius of the sphere, m (the paper's default)
+  /// Material ids subtracted inside the sphere (the paper: FIRED_CLAY); required.
+  std::vector<uint16_t> affects;
+  /// The material blended in (the paper: SHINY_BRONZE); -1 = no blending.
+  int shiny = -1;
+  /// Material ids that blend toward `shiny` (empty = every material not in affects).
+  std::vector<uint16_t> shines;
+  DVec3 up{0, 1, 0};       ///< for the fallback support of what is left (see polish)
+};
+
+/// What polish did.
+struct PolishStats {
+  size_t splitEdges = 0;   ///< edges of affected tetrahedra split on the sphere
+  size_t removed = 0;      ///< tetrahedra (pieces) removed inside the sphere
+  size_t fallen = 0;       ///< tetrahedra of affected materials left loose and removed
+  size_t shined = 0;       ///< tetrahedra whose material became `shiny`
+  size_t tinted = 0;       ///< vertices whose tint moved toward `shiny`'s colour
+};
+
+/// Polishes mesh (§5.1). 1. Subtraction "by subdivision and tetrahedron removal": the
+/// tetrahedra of affected materials are cut at the sphere (solids::cutByField on
+/// |x − position| − size; edges that also belong to an unaffected tetrahedron are never
+/// split, so those are untouched), then every affected piece with a vertex strictly inside
+/// the sphere (by more than 1e-9·size) is removed: no tetrahedron of an affected material
+/// is left inside the sphere (a piece held to an unaffected tetrahedron by an edge that
+/// could not split goes whole, so slightly more than the sphere may go there). Affected
+/// pieces no longer held (as hammer decides: the vertices of unaffected tetrahedra hold, or
+/// else the ground) fall away. 2. Blending: each tetrahedron of a `shines` material whose
+/// centroid lies within size of position has weight w = 1 − d/size; where w ≥ 0.5 its
+/// material becomes `shiny` (so it renders with shiny's roughness and specular), and each
+/// of its vertices' tints moves toward shiny's colour by w (the largest w of its tetrahedra).
+/// Deterministic (sequential blending; the cut is the same bytes at any thread count).
+/// Throws std::invalid_argument for empty affects, ids with no material, a non-finite
+/// position or size <= 0.
+PolishStats polish(TetMesh& mesh, const std::vector<Material>& materials, const PolishOptions& options);
+
+/// CSG subtraction of the region field < 0 from the tetrahedra of the affected materials
+/// (polish's first half, and erode's): cutByField on the affected tetrahedra, removal of
+/// every affected piece with a vertex where field < −eps, then of the affected tetrahedra
+/// around visible edges that more than two visible faces share (pieces left touching along
+/// an edge only: the visible interface stays a manifold where the affected material meets
+/// itself), then of affected pieces left loose (held: the vertices of unaffected tetrahedra, or else the ground along up).
+/// Returns the tetrahedra removed inside; *split and *fallen (when given) get the edges
+/// split and the loose tetrahedra removed.
+size_t subtractRegion(TetMesh& mesh, size_t materialCount, const std::vector<uint16_t>& affects,
+                      const std::function<double(const DVec3&)>& field, double eps, const DVec3& up, size_t* split = nullptr,
+                      size_t* fallen = nullptr);
+
+/// Blends vertex v's tint toward colour c by weight w in [0, 1] (the face colour there moves
+/// from F to mix(F, c, w), whatever the material under it): mesh.tints is created (all
+/// zero) when empty.
+void blendTint(TetMesh& mesh, uint32_t v, const Vec3& c, double w);
+
+/// Moves vertex v's face colour back toward its material's own colour by w (the tint's
+/// amount is multiplied by 1 − w). No-op without tints.
+void clearTint(TetMesh& mesh, uint32_t v, double w);
 
 /// Options of displace.
 struct DisplaceOptions {

@@ -139,7 +139,8 @@ size_t cutAt(Work& w, size_t v, double b) {
 }
 
 /// The tetrahedra of w with a material >= 0, their vertices renumbered in id order.
-TetMesh compact(const Work& w, const std::vector<int>& material) {
+/// tintField: index of the first of four fields holding the tints (none when < 0).
+TetMesh compact(const Work& w, const std::vector<int>& material, int tintField = -1) {
   TetMesh mesh;
   std::vector<uint32_t> remap(w.positions.size(), 0);
   for (size_t t = 0; t < w.tets.size(); ++t)
@@ -150,6 +151,10 @@ TetMesh compact(const Work& w, const std::vector<int>& material) {
     if (remap[x]) {
       remap[x] = next++;
       mesh.positions.push_back(w.positions[x]);
+      if (tintField >= 0) {
+        const size_t f = size_t(tintField);
+        mesh.tints.push_back(Vec4(w.fields[f][x], w.fields[f + 1][x], w.fields[f + 2][x], w.fields[f + 3][x]));
+      }
     }
   for (size_t t = 0; t < w.tets.size(); ++t) {
     if (material[t] < 0) continue;
@@ -573,11 +578,85 @@ TetMesh clipByPlane(const TetMesh& mesh, const DVec3& normal, double offset) {
   w.fields.emplace_back(w.positions.size());
   parallelFor(0, w.positions.size(), [&](size_t v) { w.fields[0][v] = float(glm::dot(n, w.positions[v]) - offset); }, 4096);
   w.tag.assign(mesh.materials.begin(), mesh.materials.end());
+  const bool tinted = mesh.tints.size() == mesh.positions.size() && !mesh.tints.empty();
+  if (tinted)
+    for (int c = 0; c < 4; ++c) {
+      w.fields.emplace_back(mesh.positions.size());
+      for (size_t v = 0; v < mesh.positions.size(); ++v) w.fields.back()[v] = mesh.tints[v][c];
+    }
   cutAt(w, 0, 0.0);
   std::vector<int> material(w.tets.size(), kUnclaimed);
   for (size_t t = 0; t < w.tets.size(); ++t)
     if (w.centroidValue(0, w.tets[t]) <= 0) material[t] = w.tag[t];
-  return compact(w, material);
+  return compact(w, material, tinted ? 1 : -1);
+}
+
+size_t cutByField(TetMesh& mesh, const std::vector<uint8_t>& splittable, const std::function<double(const DVec3&)>& field,
+                  std::vector<uint32_t>* parent, double snap) {
+  if (splittable.size() != mesh.tets.size()) throw std::invalid_argument("cutByField: one flag per tetrahedron expected");
+  const size_t nv = mesh.positions.size();
+  std::vector<double> value(nv);
+  parallelFor(0, nv, [&](size_t v) { value[v] = field(mesh.positions[v]); }, 1024);
+  // Edges of tetrahedra that may not split.
+  std::vector<uint64_t> frozen;
+  for (size_t t = 0; t < mesh.tets.size(); ++t)
+    if (!splittable[t])
+      for (const auto& e : kTetEdges) frozen.push_back(edgeKey(mesh.tets[t][e[0]], mesh.tets[t][e[1]]));
+  std::sort(frozen.begin(), frozen.end());
+  frozen.erase(std::unique(frozen.begin(), frozen.end()), frozen.end());
+  Work w;
+  w.positions = mesh.positions;
+  w.tets = mesh.tets;
+  w.active.assign(w.tets.size(), 1);
+  w.tag.resize(w.tets.size());
+  for (size_t t = 0; t < w.tag.size(); ++t) w.tag[t] = int(t);
+  const bool tinted = mesh.tints.size() == nv && nv > 0;
+  if (tinted)
+    for (int c = 0; c < 4; ++c) {
+      w.fields.emplace_back(nv);
+      for (size_t v = 0; v < nv; ++v) w.fields.back()[v] = mesh.tints[v][c];
+    }
+  const std::vector<uint64_t> candidates = edgesWhere(w, [&](size_t t) { return splittable[t] != 0; }, [&](uint32_t a, uint32_t c) {
+    const double pa = value[a], pc = value[c];
+    if (!((pa < 0 && pc > 0) || (pa > 0 && pc < 0))) return false;
+    return !std::binary_search(frozen.begin(), frozen.end(), edgeKey(a, c));
+  });
+  // Bisection of the field along the edge, from the end with the smaller id.
+  auto crossing = [&](uint32_t a, uint32_t c) {
+    const DVec3 pa = mesh.positions[a], pc = mesh.positions[c];
+    const bool negA = value[a] < 0;
+    double lo = 0, hi = 1;
+    for (int k = 0; k < 42; ++k) {
+      const double mid = 0.5 * (lo + hi);
+      ((field(pa + (pc - pa) * mid) < 0) == negA ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+  };
+  std::vector<uint64_t> kept;
+  std::vector<double> at;
+  for (uint64_t k : candidates) {
+    const double x = crossing(uint32_t(k >> 32), uint32_t(k));
+    if (x > snap && x < 1 - snap) kept.push_back(k), at.push_back(x);
+  }
+  const std::vector<uint64_t>& keys = kept;
+  splitEdges(w, keys, [&](uint32_t a, uint32_t c) {
+    return at[size_t(std::lower_bound(keys.begin(), keys.end(), edgeKey(a, c)) - keys.begin())];
+  }, [](uint32_t) {});
+  mesh.positions = std::move(w.positions);
+  if (tinted) {
+    mesh.tints.resize(mesh.positions.size());
+    for (size_t v = nv; v < mesh.positions.size(); ++v)
+      mesh.tints[v] = Vec4(w.fields[0][v], w.fields[1][v], w.fields[2][v], w.fields[3][v]);
+  }
+  std::vector<uint16_t> materials(w.tets.size());
+  if (parent) parent->assign(w.tets.size(), 0);
+  for (size_t t = 0; t < w.tets.size(); ++t) {
+    materials[t] = mesh.materials[size_t(w.tag[t])];
+    if (parent) (*parent)[t] = uint32_t(w.tag[t]);
+  }
+  mesh.tets = std::move(w.tets);
+  mesh.materials = std::move(materials);
+  return keys.size();
 }
 
 namespace {

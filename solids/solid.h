@@ -18,6 +18,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -92,6 +93,11 @@ struct TetMesh {
   std::vector<DVec3> positions;
   std::vector<std::array<uint32_t, 4>> tets;
   std::vector<uint16_t> materials;  ///< per tetrahedron, ids into the solid's MaterialTable
+  /// Optional surface tint per vertex (the weathering tools' dirt and lichen, the polish's
+  /// shine; solids/particles.h): linear RGB and an amount a in [0, 1]; a face shows
+  /// mix(material colour, rgb, a) at the vertex. Empty = no tint anywhere; otherwise one per
+  /// position. Splits interpolate it linearly.
+  std::vector<Vec4> tints;
 
   /// Signed volume of tetrahedron t (world units³).
   double volume(size_t t) const;
@@ -134,6 +140,20 @@ TetMesh meshSolid(const Solid& solid, const Grid& grid, const MeshOptions& optio
 /// The part of mesh on the side n·x <= offset of a plane (a cut-away, Fig. 3e-f): tetrahedra
 /// crossing the plane are split exactly there, by the same edge splits as meshSolid.
 TetMesh clipByPlane(const TetMesh& mesh, const DVec3& normal, double offset);
+
+/// Cuts tetrahedra at the zero set of an exact field (CSG against an implicit solid,
+/// §5.1's "subdivision"): every edge of a tetrahedron with splittable[t] whose ends have
+/// field values of strictly opposite signs, and that is no edge of a tetrahedron without
+/// splittable[t], gets a vertex where the field along it crosses zero (bisection of the
+/// field itself to 1e-12 of the edge, so for a sphere the vertex lies on the sphere), and
+/// every tetrahedron having such edges is split there, smallest vertex-id pair first (the
+/// same conforming splits as meshSolid). Tetrahedra without splits and every vertex keep
+/// their order, ids and bytes; new vertices are appended (tints interpolated) and pieces
+/// take their parent's place and material. parent, when given, receives each output
+/// tetrahedron's input index. Crossings nearer an end than `snap` of the edge are not split
+/// (no slivers; that end lies within snap of the zero set). Returns the number of edges split.
+size_t cutByField(TetMesh& mesh, const std::vector<uint8_t>& splittable, const std::function<double(const DVec3&)>& field,
+                  std::vector<uint32_t>* parent = nullptr, double snap = 0.05);
 
 /// The paper's tetrahedron quality (§4.4, α = 0.7), 0..10:
 /// Quality(t) = α·A(t) + (1 − α)·V(t), A(t) = 10·min(1, sqrt(2·min solid angle(t))),

@@ -91,3 +91,52 @@ TEST_CASE("solid operations: a failing operation is an error at its entry", "[mo
     CHECK(std::string(e.what()).find("ops.yaml:10:7: error: displace:") != std::string::npos);
   }
 }
+
+TEST_CASE("solid operations: polish and the particle tools are read with their defaults", "[model][solid]") {
+  const Species s = parseSpecies(mold("    - polish: {position: [0.5, 0, 0], size: 0.2}\n"
+                                      "    - dirt: {}\n"
+                                      "    - wash: {particles: 50, seed: 4}\n"
+                                      "    - erode: {}\n"
+                                      "    - lichen: {color: [0.2, 0.3, 0.1]}\n"),
+                                 "ops.yaml");
+  const auto& spec = dynamic_cast<const SolidSpec&>(*s.spec);
+  REQUIRE(spec.operations.size() == 5);
+  const auto& p = std::get<solids::PolishOptions>(spec.operations[0].options);
+  REQUIRE(p.affects.size() == 1);
+  CHECK(spec.solid.materials.materials[p.affects[0]].name == "fired_clay");
+  REQUIRE(p.shiny >= 0);
+  CHECK(spec.solid.materials.materials[size_t(p.shiny)].name == "shiny_bronze");
+  CHECK(std::get<solids::DirtOptions>(spec.operations[1].options).color == Vec3(0.5f));
+  const auto& w = std::get<solids::ParticleOptions>(spec.operations[2].options);
+  CHECK(w.tool == solids::ParticleTool::Wash);
+  CHECK(w.particles == 50);
+  CHECK(w.seed == 4);
+  CHECK(w.radius == 0.1);
+  const auto& e = std::get<solids::ParticleOptions>(spec.operations[3].options);
+  CHECK(e.tool == solids::ParticleTool::Erode);
+  CHECK(e.particles == 2000);
+  const auto& l = std::get<solids::ParticleOptions>(spec.operations[4].options);
+  CHECK(l.particles == 40000);
+  CHECK(l.color == Vec3(0.2f, 0.3f, 0.1f));
+}
+
+TEST_CASE("solid operations: stages play the list one operation at a time", "[model][solid]") {
+  const Species s = parseSpecies(mold("    - polish: {position: [0.5, 0, 0], size: 0.2}\n"
+                                      "    - polish: {position: [-0.5, 0, 0], size: 0.2}\n"),
+                                 "ops.yaml");
+  SpeciesModel model(s);
+  CHECK(model.finalStage().step == 2);
+  const std::vector<Stage> frames = model.animationFrames(6, 0, 2);
+  REQUIRE(frames.size() == 3);
+  size_t tets[3];
+  for (int k = 0; k < 3; ++k) {
+    ModelFigures fig;
+    model.buildMesh(frames[size_t(k)], 0, false, &fig);
+    tets[k] = size_t(fig.primitives);
+  }
+  CHECK(tets[0] == tetCount(parseSpecies(mold(""), "ops.yaml")));
+  CHECK(tets[1] != tets[0]);
+  CHECK(tets[2] != tets[1]);
+  CHECK(tets[2] == tetCount(s));
+  CHECK(model.stageName(frames[1]) == "after operation 1 of 2 (polish)");
+}
