@@ -27,6 +27,7 @@ void readRender(MapReader& m, SpeciesRender& r, DiagnosticList& diags) {
   im.width = static_cast<int>(m.integer("width", im.width, 16, 8192));
   im.height = static_cast<int>(m.integer("height", im.height, 16, 8192));
   im.spp = static_cast<int>(m.integer("samples", im.spp, 1, 1024));
+  im.thinMinPixels = static_cast<float>(m.number("thin_min_pixels", im.thinMinPixels, 0.0, 8.0));
   if (auto v = m.section("view")) {
     MapReader view(*v, diags, "render.view");
     readView(view, r.view);
