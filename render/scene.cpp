@@ -371,7 +371,7 @@ std::optional<SurfaceHit> Scene::intersect(const Vec3& origin, const Vec3& direc
     return hit;
   }
   if (rec.kind == GeometryRecord::Kind::Curves && rec.curves && rec.curves->widened) {
-    // A widened curve: shade the true surface under the hit, with the segment's coverage.
+    // A widened curve: shaded with the normal of the true surface, with the segment's coverage.
     const detail::CurveData& cd = *rec.curves;
     const uint32_t i = cd.segments[prim];
     const Vec3 a(cd.real[i]), b(cd.real[i + 1]);
@@ -383,8 +383,9 @@ std::optional<SurfaceHit> Scene::intersect(const Vec3& origin, const Vec3& direc
     const float nl = glm::length(n);
     n = nl > 0 ? n / nl : -direction;
     hit.opacity = cd.opacity(prim, u);
-    const float r = (1.0f - u) * cd.real[i].w + u * cd.real[i + 1].w;
-    hit.position = c + r * n;
+    // The hit stays on the drawn tube, outside what it stands for (a twig's blended
+    // surface may be fatter than its cone near a junction, and a shading point inside it
+    // would be shadowed by it).
     hit.normal = hit.geometricNormal = n;
     // Continue behind the drawn tube: the exit of the ray from the cylinder of the
     // segment's largest drawn radius (what the tube stands for lies inside it).
