@@ -27,8 +27,22 @@ struct AnimateArgs {
   int width = 0;
   int height = 0;
   int samples = 0;
+  std::string wind;
+  double windSeconds = 4;
   GrowthFlags growth;
 };
+
+/// Parses `SPEED[,DIRECTION]`: m/s in [0, 60] and degrees (default 0).
+void parseWind(const std::string& text, double& speed, double& direction) {
+  const size_t comma = text.find(',');
+  auto s = parseFiniteNumber(text.substr(0, comma));
+  std::optional<double> d = 0.0;
+  if (comma != std::string::npos) d = parseFiniteNumber(text.substr(comma + 1));
+  if (!s || *s < 0 || *s > 60 || !d || *d < -360 || *d > 360)
+    throw UsageError("--wind " + text + ": expected SPEED[,DIRECTION] with 0 <= SPEED <= 60 (m/s) and -360 <= DIRECTION <= 360 (degrees)");
+  speed = *s;
+  direction = *d;
+}
 
 /// Parses `A..B` (either side may be empty: `..B`, `A..`) into first/last (-1 = default).
 void parseStages(const std::string& text, int& first, int& last) {
@@ -69,6 +83,11 @@ int runAnimate(const AnimateArgs& a, const GlobalOptions& g) {
   opt.holdSeconds = a.hold;
   opt.samples = a.samples;
   if (!a.stages.empty()) parseStages(a.stages, opt.firstStage, opt.lastStage);
+  if (!a.wind.empty()) {
+    parseWind(a.wind, opt.windSpeed, opt.windDirectionDeg);
+    if (!a.at.empty()) throw UsageError("--wind sways an animation over time; --at renders one still frame");
+  }
+  opt.windSeconds = a.windSeconds;
   std::optional<GrowthFrame> single;
   if (!a.at.empty()) {
     requireExtension("-o", a.out, {".png", ".jpg", ".jpeg", ".exr"});
@@ -82,6 +101,8 @@ int runAnimate(const AnimateArgs& a, const GlobalOptions& g) {
   }
   Species species = loadSpecies(a.file, g.pathPolicy());
   printNotes(g, species);
+  if (species.kind != "tree" && !a.wind.empty())
+    throw UsageError("--wind sways trees; a " + species.kind + " species has no wind");
   if (species.kind != "tree" && !a.stages.empty())
     throw UsageError("--stages selects derivation steps of a tree; a " + species.kind +
                      " species animates its whole growth (use --frames-per-stage and --fps)");
@@ -134,6 +155,12 @@ void addAnimateCommand(CLI::App& app, const GlobalOptions& global, CommandRun& r
   sub->add_option("--width", args->width, "frame width in pixels")->check(CLI::Range(16, 8192));
   sub->add_option("--height", args->height, "frame height in pixels")->check(CLI::Range(16, 8192));
   sub->add_option("--samples", args->samples, "camera samples per pixel")->check(CLI::Range(1, 1024));
+  sub->add_option("--wind", args->wind,
+                  "SPEED[,DIRECTION]: sway a tree in wind of SPEED m/s blowing toward azimuth DIRECTION degrees "
+                  "(default 0: toward +Z), alone or on top of growth");
+  sub->add_option("--wind-seconds", args->windSeconds,
+                  "with --wind: the animation lasts at least this long, holding the last stage (default 4)")
+      ->check(CLI::Range(0.0, 600.0));
   addGrowthFlags(*sub, args->growth);
 }
 

@@ -49,11 +49,12 @@ int runPreview(const PreviewArgs& a, const GlobalOptions& g) {
   const lsystem::Skeleton shown = engine.skeletonAt(step);
   // Not `framingBox(step == last ? shown : ...)`: that conditional copies `shown`.
   const DBox3 frame = step == last ? framingBox(shown) : framingBox(engine.skeletonAt(last));
-  render::Scene scene;
-  scene.add(skeletonPreview(shown, look.style));
-  scene.commit();
   const render::Camera camera = render::frameBounds(Box3{Vec3(frame.lo), Vec3(frame.hi)}, look.view,
                                                     static_cast<double>(width) / height);
+  render::Scene scene;
+  scene.setPixelFootprint(camera, width, height, look.image.thinMinPixels);
+  scene.add(skeletonPreview(shown, look.style));
+  scene.commit();
   render::RenderSettings rs = look.settings(width, height);
   rs.progressLabel = "render " + species.name;
   Image image = render::renderImage(scene, camera, rs);

@@ -70,6 +70,8 @@ int renderGalleryAnimation(SpeciesModel& model, const fs::path& out, const Speci
   opt.height = h;
   opt.samples = samples;
   opt.progressLabel = "animate " + name;
+  opt.windSpeed = look.windSpeed;  // trees only (the species reader refuses it elsewhere)
+  opt.windDirectionDeg = look.windDirectionDeg;
   return animateModel(model, look, out, opt).frames;
 }
 

@@ -105,6 +105,9 @@ AnimationFormat checkAnimation(const fs::path& out, const AnimateOptions& option
   }
   if (options.framesPerStage < 1) throw std::invalid_argument("--frames-per-stage must be at least 1");
   if (!(options.fps > 0)) throw std::invalid_argument("--fps must be positive");
+  if (!(options.windSpeed >= 0) || !std::isfinite(options.windSpeed) || !std::isfinite(options.windDirectionDeg) ||
+      !(options.windSeconds >= 0) || !std::isfinite(options.windSeconds))
+    throw std::invalid_argument("--wind: the speed and duration must be finite and not negative");
   return format;
 }
 
@@ -125,7 +128,16 @@ AnimateResult animateModel(SpeciesModel& model, const SpeciesRender& baseLook, c
   AnimateResult result;
   result.lastStage = std::max(0, model.finalStage().step);
   result.firstStage = std::clamp(options.firstStage, 0, result.lastStage);
-  const std::vector<Stage> frames = model.animationFrames(options.framesPerStage, result.firstStage, result.lastStage);
+  std::vector<Stage> frames = model.animationFrames(options.framesPerStage, result.firstStage, result.lastStage);
+  if (options.windSpeed > 0 && !frames.empty()) {
+    const auto windFrames = static_cast<size_t>(std::lround(std::max(0.0, options.windSeconds) * options.fps));
+    while (frames.size() < windFrames) frames.push_back(frames.back());
+    for (size_t i = 0; i < frames.size(); ++i) {
+      frames[i].windSpeed = options.windSpeed;
+      frames[i].windDirectionDeg = options.windDirectionDeg;
+      frames[i].windSeconds = static_cast<double>(i) / options.fps;
+    }
+  }
   result.frames = static_cast<int>(frames.size());
   const GeometryMode mode = options.mode ? *options.mode : model.defaultMode();
 

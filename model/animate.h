@@ -35,6 +35,12 @@ struct AnimateOptions {
   int height = 0;           ///< 0 = the species' render height
   int samples = 0;          ///< camera samples per pixel; 0 = the species' own
   lsystem::GrammarOverrides extra;  ///< -D, --steps, --seed on top of the species
+  /// Wind (trees only, organisms/wind.h): speed in m/s (0 = none) and the azimuth it blows
+  /// toward. Frame i sways at time i / fps; with wind the animation lasts at least
+  /// windSeconds, holding the last stage while the wind blows on.
+  double windSpeed = 0;
+  double windDirectionDeg = 0;
+  double windSeconds = 4;
   std::string progressLabel = "animate";  ///< empty = no progress bar
   /// How frames show the species; unset = SpeciesModel::defaultMode() (exact surfaces for
   /// trees with a `tree:` section, shells and blobs; skeleton previews for other trees).

@@ -39,6 +39,9 @@ struct Stage {
   double fraction = 1;  ///< tree: growth of the modules created in that step, 0..1
   double age = -1;      ///< shell: θ_end in degrees (-1 = the species' age)
   double time = -1;     ///< organism: animation time 0..1 (-1 = the final time, 1)
+  double windSpeed = 0;         ///< tree: wind speed, m/s (0 = still; organisms/wind.h)
+  double windDirectionDeg = 0;  ///< tree: azimuth the wind blows toward
+  double windSeconds = 0;       ///< tree: the moment of the wind's sway, seconds
 };
 
 /// Counts and times of one built stage (the gallery's figures).

@@ -79,7 +79,9 @@ Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJo
   if (job.height > 0 && job.width <= 0) width = std::max(16, lookWidth * job.height / lookHeight);
   checkCameraRays(width, height, job.samples > 0 ? job.samples : look.image.spp);
   const Box3 frame = job.frame ? *job.frame : model.frameBox();
+  const render::Camera camera = modelCamera(look, frame, width, height);
   render::Scene scene;
+  scene.setPixelFootprint(camera, width, height, look.image.thinMinPixels);
   ModelFigures fig = model.addToScene(scene, job.stage, job.mode, look);
   const auto t0 = std::chrono::steady_clock::now();
   scene.commit();
@@ -89,7 +91,7 @@ Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJo
   if (job.samples > 0) rs.spp = job.samples;
   rs.progress = job.progress;
   rs.progressLabel = job.progressLabel;
-  Image image = render::renderImage(scene, modelCamera(look, frame, width, height), rs, stats);
+  Image image = render::renderImage(scene, camera, rs, stats);
   if (figures) *figures = fig;
   return image;
 }

@@ -27,6 +27,13 @@ void readRender(MapReader& m, SpeciesRender& r, DiagnosticList& diags) {
   im.width = static_cast<int>(m.integer("width", im.width, 16, 8192));
   im.height = static_cast<int>(m.integer("height", im.height, 16, 8192));
   im.spp = static_cast<int>(m.integer("samples", im.spp, 1, 1024));
+  im.thinMinPixels = static_cast<float>(m.number("thin_min_pixels", im.thinMinPixels, 0.0, 8.0));
+  if (auto w = m.section("wind")) {
+    MapReader wind(*w, diags, "render.wind");
+    r.windSpeed = wind.number("speed", r.windSpeed, 0.0, 60.0);
+    r.windDirectionDeg = wind.number("direction", r.windDirectionDeg, -360.0, 360.0);
+    wind.finish();
+  }
   if (auto v = m.section("view")) {
     MapReader view(*v, diags, "render.view");
     readView(view, r.view);
@@ -117,6 +124,8 @@ Species readSpecies(std::shared_ptr<const YamlFile> yaml, const PathPolicy& poli
   if (auto r = top.section("render")) {
     MapReader render(*r, diags, "render");
     readRender(render, s.render, diags);
+    if (auto w = render.keyNode("wind"); w && s.kind != "tree")
+      w->error(diags, "'render.wind' sways trees; a " + s.kind + " species has no wind");
   }
   for (const YNode& st : top.sequence("stages"))
     if (auto v = st.asInteger(diags, "'stages' entry", 0, 100000)) s.stages.push_back(static_cast<int>(*v));

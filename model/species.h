@@ -57,6 +57,10 @@ struct SpeciesRender {
   /// Solids: a cut-away by the plane n·x = d (xyz = n, w = d); the side n·x > d is removed
   /// (`sprig render --section`).
   std::optional<Vec4> section;
+  /// Trees: `wind: {speed, direction}`, the wind the gallery's animation sways the tree in
+  /// (m/s, 0 = none; azimuth degrees it blows toward). `sprig animate` uses --wind instead.
+  double windSpeed = 0;
+  double windDirectionDeg = 0;
 
   /// Renderer settings for an image of width x height.
   render::RenderSettings settings(int imageWidth, int imageHeight) const;

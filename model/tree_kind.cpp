@@ -13,6 +13,7 @@
 #include "core/progress.h"
 #include "model/growth.h"
 #include "organisms/skeleton_geometry.h"
+#include "organisms/wind.h"
 #include "textures/procedural.h"
 
 namespace sprig {
@@ -189,9 +190,9 @@ render::Geometry surfaceGeometry(const TreeSurface& tree, const SpeciesRender& l
   }
   render::Geometry out;
   if (mesh)
-    out.parts.push_back(render::PolygonizedPart{mesh, look.style.wood, std::move(textures)});
+    out.parts.push_back(render::PolygonizedPart{mesh, look.style.wood, std::move(textures), tree.axes});
   else
-    out.parts.push_back(render::ImplicitPart{tree.compiled, look.style.wood, {}, std::move(textures)});
+    out.parts.push_back(render::ImplicitPart{tree.compiled, look.style.wood, {}, std::move(textures), tree.axes});
   if (tree.leaves.triangleCount() > 0) {
     Mesh leaves = tree.leaves;
     leaves.materials.clear();  // one leaf material; the vertex colors carry each leaf's tint
@@ -267,7 +268,7 @@ class TreeModel final : public KindModel {
     ModelFigures& fig = out.figures;
     const auto t0 = std::chrono::steady_clock::now();
     const int step = stage.step < 0 ? engine_.lastStep() : stage.step;
-    lsystem::Skeleton skeleton = engine_.skeletonAt(step, stage.fraction);
+    lsystem::Skeleton skeleton = windy(engine_.skeletonAt(step, stage.fraction), stage);
     fig.modules = engine_.moduleCount(step);
     fig.internodes = skeleton.internodes.size();
     if (mode == GeometryMode::Skeleton || skeleton.internodes.empty()) {
@@ -293,7 +294,7 @@ class TreeModel final : public KindModel {
 
   Mesh buildMesh(const Stage& stage, float cellSize, bool progress, ModelFigures& fig) override {
     const int step = stage.step < 0 ? engine_.lastStep() : stage.step;
-    lsystem::Skeleton skeleton = engine_.skeletonAt(step, stage.fraction);
+    lsystem::Skeleton skeleton = windy(engine_.skeletonAt(step, stage.fraction), stage);
     fig.modules = engine_.moduleCount(step);
     fig.internodes = skeleton.internodes.size();
     if (skeleton.internodes.empty())
@@ -318,6 +319,16 @@ class TreeModel final : public KindModel {
   }
 
  private:
+  /// The skeleton swayed by the stage's wind (unchanged without wind).
+  lsystem::Skeleton windy(lsystem::Skeleton skeleton, const Stage& stage) const {
+    if (!(stage.windSpeed > 0)) return skeleton;
+    organisms::WindOptions w;
+    w.speed = stage.windSpeed;
+    w.directionDeg = stage.windDirectionDeg;
+    w.seed = spec_.surface ? spec_.surface->seed : organisms::TreeOptions{}.seed;
+    return organisms::swayInWind(skeleton, w, stage.windSeconds);
+  }
+
   const Species& species_;
   const TreeSpec& spec_;
   mutable GrowthEngine engine_;
@@ -571,7 +582,12 @@ organisms::TreeOptions readTreeOptions(const YNode& section, DiagnosticList& dia
   }
   if (auto s = m.section("scars")) {
     MapReader p(*s, diags, "scars");
-    o.scars.stubLength = p.number("stub_length", o.scars.stubLength, 0.01, 100.0);
+    const std::string style = p.choice("style", "flush", {"flush", "knob"});
+    o.scars.style = style == "knob" ? organisms::ScarStyle::Knob : organisms::ScarStyle::Flush;
+    if (o.scars.style == organisms::ScarStyle::Knob || !p.has("stub_length"))
+      o.scars.stubLength = p.number("stub_length", o.scars.stubLength, 0.01, 100.0);
+    else
+      p.get("stub_length")->error(diags, "'scars.stub_length' applies to style knob only (a flush scar's stub reaches the bark)");
     o.scars.stubRadius = p.number("stub_radius", o.scars.stubRadius, 0.01, 10.0);
     o.scars.negativeRadius = p.number("negative_radius", o.scars.negativeRadius, 0.0, 10.0);
     o.scars.negativeWeight = p.number("negative_weight", o.scars.negativeWeight, 0.0, 10.0);
@@ -620,6 +636,7 @@ TreeSurface buildTreeSurface(const lsystem::Skeleton& skeleton, const organisms:
   m.options = options;
   m.blob = organisms::buildTreeBlob(skeleton, m.options);
   m.compiled = std::make_shared<const blobtree::CompiledBlob>(blobtree::compile(m.blob.tree, m.blob.root));
+  m.axes = organisms::treeAxes(m.blob);
   m.leaves = organisms::buildLeafMesh(skeleton, m.options);
   return m;
 }

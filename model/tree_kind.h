@@ -102,6 +102,7 @@ struct TreeSurface {
   organisms::TreeOptions options;
   organisms::TreeBlob blob;
   std::shared_ptr<const blobtree::CompiledBlob> compiled;
+  CurveSet axes;  ///< the internode cones' axes (drawn at a minimum pixel width where thin)
   Mesh leaves;
 };
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "core/diagnostics.h"
 #include "core/rng.h"
@@ -14,6 +15,27 @@ namespace {
 
 Vec3 f(const DVec3& v) { return Vec3(v); }
 
+/// The part's axis end, nudged off its start when the two coincide.
+DVec3 partEnd(const ConePart& p) {
+  return glm::length(p.end - p.start) < 1e-9 ? p.start + DVec3(0, 1e-6, 0) : p.end;
+}
+
+/// The bend of part p (§3.6), or nothing when it is straight. The tangent angle is capped so
+/// the cone's support stays inside the bend radius (ρ = L / (2 sin θ) for tangent angle θ).
+std::optional<bt::Bend> partBend(const ConePart& p, bt::Kernel kernel) {
+  if (!(p.bendAngle > 0)) return std::nullopt;
+  const float r0 = static_cast<float>(std::max(p.startRadius, 1e-6));
+  const float r1 = static_cast<float>(std::max(p.endRadius, 1e-6));
+  const DVec3 b = partEnd(p);
+  const double len = glm::length(b - p.start);
+  const double support = bt::supportRadius(kernel, std::max(r0, r1));
+  double theta = std::min(p.bendAngle, 0.45 * kPi);
+  const double maxSin = len / (2.0 * support * 1.25);
+  if (std::sin(theta) > maxSin) theta = maxSin < 1 ? std::asin(maxSin) : theta;
+  if (!(theta > 1e-4)) return std::nullopt;
+  return bt::Bend::fromAngle(f(p.start), f(b), f(p.bendToward), static_cast<float>(2.0 * theta));
+}
+
 // The cone of one part, bent when the plan says so.
 bt::NodeId partNode(bt::BlobTree& tree, const ConePart& p, const lsystem::Skeleton& sk, const TreeOptions& opt) {
   bt::TextureAttr tex;
@@ -25,22 +47,10 @@ bt::NodeId partNode(bt::BlobTree& tree, const ConePart& p, const lsystem::Skelet
   }
   const float r0 = static_cast<float>(std::max(p.startRadius, 1e-6));
   const float r1 = static_cast<float>(std::max(p.endRadius, 1e-6));
-  DVec3 b = p.end;
-  if (glm::length(b - p.start) < 1e-9) b = p.start + DVec3(0, 1e-6, 0);
+  const DVec3 b = partEnd(p);
   bt::NodeId id = tree.cone(f(p.start), f(b), r0, r1, tex);
 
-  if (p.bendAngle > 0) {
-    // Keep the support inside the bend radius (ρ = L / (2 sin θ) for tangent angle θ).
-    const double len = glm::length(b - p.start);
-    const double support = bt::supportRadius(tree.kernel(), std::max(r0, r1));
-    double theta = std::min(p.bendAngle, 0.45 * kPi);
-    const double maxSin = len / (2.0 * support * 1.25);
-    if (std::sin(theta) > maxSin) theta = maxSin < 1 ? std::asin(maxSin) : theta;
-    if (theta > 1e-4) {
-      const auto bend = bt::Bend::fromAngle(f(p.start), f(b), f(p.bendToward), static_cast<float>(2.0 * theta));
-      id = tree.bend(id, bend);
-    }
-  }
+  if (auto bend = partBend(p, tree.kernel())) id = tree.bend(id, *bend);
   if (p.kind == ConePart::Kind::Pruned) {
     const bt::NodeId saw = tree.halfspace(f(p.cutPoint), f(p.cutNormal));
     const bt::NodeId both[2] = {id, saw};
@@ -99,6 +109,30 @@ TreeBlob buildTreeBlob(const lsystem::Skeleton& skeleton, const TreeOptions& opt
   } else {
     negatives.insert(negatives.begin(), body);
     out.root = tree.blend(negatives);
+  }
+  return out;
+}
+
+CurveSet treeAxes(const TreeBlob& blob) {
+  CurveSet out;
+  constexpr int kArcSegments = 4;
+  for (const ConePart& p : blob.plan.parts) {
+    if (p.kind != ConePart::Kind::Internode) continue;
+    const DVec3 b = partEnd(p);
+    const auto bend = partBend(p, blob.tree.kernel());
+    const int n = bend ? kArcSegments : 1;
+    const uint32_t first = static_cast<uint32_t>(out.vertices.size());
+    for (int k = 0; k <= n; ++k) {
+      const double s = static_cast<double>(k) / n;
+      Vec3 x = f(p.start + s * (b - p.start));
+      if (bend) x = bend->worldFromLocal(x);
+      out.vertices.emplace_back(x, static_cast<float>((1.0 - s) * p.startRadius + s * p.endRadius));
+    }
+    for (int k = 0; k < n; ++k) {
+      out.segments.push_back(first + static_cast<uint32_t>(k));
+      out.flags.push_back(static_cast<uint8_t>((k > 0 ? CurveSet::kJoinedBefore : 0) |
+                                               (k + 1 < n ? CurveSet::kJoinedAfter : 0)));
+    }
   }
   return out;
 }

@@ -18,6 +18,7 @@
 
 #include "blobtree/blobtree.h"
 #include "core/mesh.h"
+#include "core/shapes.h"
 #include "lsystem/skeleton.h"
 #include "organisms/tree_options.h"
 #include "organisms/tree_plan.h"
@@ -36,6 +37,12 @@ struct TreeBlob {
 /// Builds the implicit tree of `skeleton`. Throws InputError when the skeleton has no
 /// internode. Cost: O(internodes) nodes; evaluation cost is the compiled tape's.
 TreeBlob buildTreeBlob(const lsystem::Skeleton& skeleton, const TreeOptions& options);
+
+/// The axes of the tree's internode cones as round curves with the cones' 0.5-iso radii
+/// (bent cones as arcs of four segments through the same bend): what the renderer draws at
+/// a minimum pixel width where the cones are thinner than a pixel. Pruned parts and stubs
+/// are left out. O(parts).
+CurveSet treeAxes(const TreeBlob& blob);
 
 /// Leaf geometry for the skeleton's organs: polygons `{ . }` are fan-triangulated, spheres
 /// become small UV spheres, named surfaces `~` become an ovate leaf blade in the turtle frame

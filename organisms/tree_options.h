@@ -39,11 +39,22 @@ struct PruneOptions {
 };
 
 /// Negative-field scars where a branch was lost (§3.5, Fig. 15).
+/// How a scar's stub sits on its parent (§3.5, Fig. 15).
+enum class ScarStyle {
+  /// The stub runs from the branching point straight out to the parent's bark (radially)
+  /// and the negative field is centred where it meets the bark: beyond the bark the two
+  /// fields nearly cancel, leaving a round, shallow scar flush with the bark.
+  Flush,
+  /// The stub of stubLength base radii along the branch, dented at its end: a raised knob.
+  Knob,
+};
+
 struct ScarOptions {
   BranchSelector select;         ///< branches replaced by a scar
-  double stubLength = 1.5;       ///< stub length in units of the branch's base radius
-  double stubRadius = 1.0;       ///< stub radius in units of the branch's base radius
-  double negativeRadius = 0.8;   ///< radius of the negative field in units of the branch's base radius
+  ScarStyle style = ScarStyle::Flush;
+  double stubLength = 1.5;       ///< Knob: stub length in units of the branch's base radius
+  double stubRadius = 0.8;       ///< stub radius in units of the branch's base radius (at most 0.9 of the parent's)
+  double negativeRadius = 0.9;   ///< radius of the negative field in units of the branch's base radius
   double negativeWeight = 1.0;   ///< weight of the negative field (field subtracted = w·f)
 };
 

@@ -142,7 +142,10 @@ TreePlan planTree(const lsystem::Skeleton& sk, const TreeOptions& opt) {
     if (j.branches.empty()) continue;
     const double rA = a.endRadius;
     double rMax = 0;
-    for (int32_t b : j.branches) rMax = std::max(rMax, plan.parts[b].startRadius);
+    // A flush scar's stub stands for no branch: A is shortened as for the others alone.
+    for (int32_t b : j.branches)
+      if (plan.parts[b].kind != ConePart::Kind::Stub || opt.scars.style != ScarStyle::Flush)
+        rMax = std::max(rMax, plan.parts[b].startRadius);
     j.pcm = opt.junctions == JunctionModel::Pcm && j.branches.size() > 1;
     if (opt.basalOffset) {
       j.deltaA = j.pcm ? deltaAMultiple(rA, rMax, opt.deltaAMulti) : deltaASingle(rMax, opt.deltaA);
@@ -169,6 +172,24 @@ TreePlan planTree(const lsystem::Skeleton& sk, const TreeOptions& opt) {
     auto radiusAt = [&](double t) { return len > 0 ? rb + (rt - rb) * (t / len) : rb; };
     const DVec3 origin = p.start;
 
+    if (p.kind == ConePart::Kind::Stub && opt.scars.style == ScarStyle::Flush && p.junctionAtStart >= 0) {
+      // Radially from the parent's axis at P out to its bark: the scar faces straight out
+      // of the bark and is round on it (points of the bark at one distance from a radial
+      // segment lie on a circle about where it meets the bark).
+      const Junction& j = plan.junctions[p.junctionAtStart];
+      const auto& basal = sk.internodes[plan.parts[j.basal].internode];
+      const DVec3 axis = safeDir(basal.start, basal.end);
+      const double rA = radius(basal.tipRadius);
+      DVec3 out = d - glm::dot(d, axis) * axis;
+      out = glm::length(out) > 1e-9 ? glm::normalize(out) : d;
+      p.start = j.point;
+      p.end = j.point + rA * out;
+      p.startRadius = p.endRadius = std::min(opt.scars.stubRadius * rb, 0.9 * rA);
+      p.negativeCenter = p.end;
+      p.negativeRadius = opt.scars.negativeRadius * rb;
+      p.negativeWeight = opt.scars.negativeWeight;
+      continue;
+    }
     if (p.kind == ConePart::Kind::Stub) {
       const double ls = opt.scars.stubLength * rb;
       p.end = origin + ls * d;

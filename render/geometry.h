@@ -73,18 +73,25 @@ struct MeshPart {
 };
 
 /// A compiled BlobTree ray cast exactly; hit colours blend the table's textures.
+/// thinAxes (optional): the axes of the blob's cones as round curves with their radii.
+/// When the scene has a pixel footprint (Scene::setPixelFootprint), the segments thinner
+/// than the minimum width there are drawn as widened, partly transparent curves (coverage
+/// kept, the hair approach) instead of the blob's own sub-pixel surface; otherwise unused.
 struct ImplicitPart {
   std::shared_ptr<const blobtree::CompiledBlob> blob;
   Material material;
   ImplicitOptions options;
   TextureTable textures;
+  CurveSet thinAxes;
 };
 
 /// A polygonized BlobTree: triangles, with vertex colours from its attributes and the table.
+/// thinAxes: as ImplicitPart's (sub-pixel twigs the polygonizer cannot resolve).
 struct PolygonizedPart {
   std::shared_ptr<const blobtree::PolygonizeResult> mesh;
   Material material;
   TextureTable textures;
+  CurveSet thinAxes;
 };
 
 /// One part of a Geometry.

@@ -93,12 +93,31 @@ class Integrator {
     Vec3 bg = background(fy);
     float bgAlpha = s_.background == Background::Transparent ? 0.0f : 1.0f;
 
-    std::optional<SurfaceHit> hit = scene_.intersect(ray.origin, ray.direction, 0.0f, kInf);
     float tGround = groundHit(ray.origin, ray.direction);
-    if (hit && hit->t <= tGround) {
+    // Widened thin curves (opacity < 1) are blended over what lies behind them, front to
+    // back, for at most kLayers of them.
+    constexpr int kLayers = 8;
+    Vec4 front(0);
+    float through = 1.0f;
+    float tnear = 0.0f;
+    for (int layer = 0;; ++layer) {
+      std::optional<SurfaceHit> hit = scene_.intersect(ray.origin, ray.direction, tnear, kInf);
+      if (!hit || hit->t > tGround) break;
       const Material& m = scene_.material(hit->material);
-      return Vec4(shade(*hit, m, ray.direction, st, rng, c), 1.0f);
+      const Vec4 lit(shade(*hit, m, ray.direction, st, rng, c), 1.0f);
+      if (hit->opacity >= 1.0f || layer + 1 == kLayers) return front + through * lit;
+      front += through * hit->opacity * lit;
+      through *= 1.0f - hit->opacity;
+      tnear = hit->behind;
     }
+    if (through < 1.0f) return front + through * behindSurfaces(ray, tGround, bg, bgAlpha, st, rng, c);
+    return behindSurfaces(ray, tGround, bg, bgAlpha, st, rng, c);
+  }
+
+ private:
+  /// The ground or the background seen along ray.
+  Vec4 behindSurfaces(const Ray& ray, float tGround, const Vec3& bg, float bgAlpha, const Strata& st, Rng& rng,
+                      Counters& c) const {
     if (tGround < kInf) {
       SurfaceHit g;
       g.t = tGround;
@@ -119,7 +138,6 @@ class Integrator {
     return Vec4(bg, bgAlpha);
   }
 
- private:
   Vec3 background(float fy) const {
     switch (s_.background) {
       case Background::Color: return s_.backgroundColor;

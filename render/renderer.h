@@ -69,6 +69,10 @@ struct RenderSettings {
   Vec3 groundColor{0.45f, 0.42f, 0.37f};  ///< linear albedo of the ground
   float groundFade = 6.0f;        ///< ground fades into the background beyond this many model radii
 
+  /// Minimum drawn width of thin curves and twigs, in pixels (Scene::setPixelFootprint;
+  /// the callers that build the scene pass it on). 0 = draw them as they are.
+  float thinMinPixels = 2.0f;
+
   float exposure = 0.0f;          ///< stops; linear values are multiplied by 2^exposure
   bool progress = true;           ///< show a progress bar over tiles (silent when not a terminal)
   std::string progressLabel = "render";  ///< text before the progress bar

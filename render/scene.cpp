@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <mutex>
 #include <stdexcept>
 #include <string>
@@ -26,6 +27,7 @@ uint32_t Scene::Impl::attach(RTCGeometry geometry, GeometryRecord record) {
   uint32_t id = static_cast<uint32_t>(records.size());
   rtcAttachGeometryByID(scene, geometry, id);
   rtcReleaseGeometry(geometry);
+  anyGeometry = true;
   records.push_back(std::move(record));
   if (!error.empty()) throw std::runtime_error(error);
   return id;
@@ -85,9 +87,95 @@ uint32_t Scene::addMaterial(const Material& m) {
 
 const Material& Scene::material(uint32_t id) const { return impl_->materials.at(id); }
 
+namespace {
+
+uint64_t mix64(uint64_t z) {
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
+}
+
+uint64_t floatBits(float f) {
+  uint32_t u;
+  std::memcpy(&u, &f, sizeof u);
+  return u;
+}
+
+/// Shadow and sky rays pass a widened curve with probability 1 - opacity: a hash of the
+/// ray and the segment, so the decision is the same at any thread count.
+void thinOcclusionFilter(const RTCFilterFunctionNArguments* args) {
+  const auto* data = static_cast<const detail::CurveData*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] == 0) continue;
+    const uint32_t prim = RTCHitN_primID(args->hit, args->N, i);
+    const float u = RTCHitN_u(args->hit, args->N, i);
+    const float opacity = data->opacity(prim, std::clamp(u, 0.0f, 1.0f));
+    if (opacity >= 1.0f) continue;
+    uint64_t h = 0x9e3779b97f4a7c15ull ^ prim;
+    for (float f : {RTCRayN_org_x(args->ray, args->N, i), RTCRayN_org_y(args->ray, args->N, i),
+                    RTCRayN_org_z(args->ray, args->N, i), RTCRayN_dir_x(args->ray, args->N, i),
+                    RTCRayN_dir_y(args->ray, args->N, i), RTCRayN_dir_z(args->ray, args->N, i)})
+      h = mix64(h ^ floatBits(f));
+    const float x = static_cast<float>(h >> 40) * (1.0f / 16777216.0f);
+    if (x >= opacity) args->valid[i] = 0;
+  }
+}
+
+}  // namespace
+
+void Scene::setPixelFootprint(const Camera& camera, int width, int height, float minPixels) {
+  if (impl_->anyGeometry) throw std::logic_error("Scene::setPixelFootprint after geometry was added");
+  if (minPixels <= 0.0f || width < 1 || height < 1) {
+    impl_->footprint.reset();
+    return;
+  }
+  PixelFootprint f;
+  f.eye = camera.position;
+  f.forward = glm::normalize(camera.target - camera.position);
+  f.pixelPerDepth = 2.0f * std::tan(0.5f * static_cast<float>(radians(camera.fovYDeg))) / static_cast<float>(height);
+  f.minPixels = minPixels;
+  impl_->footprint = f;
+}
+
+uint32_t Scene::Impl::addCurveGeometry(std::shared_ptr<detail::CurveData> data, uint32_t material) {
+  data->drawn = data->real;
+  if (footprint) {
+    for (Vec4& v : data->drawn) {
+      const float r = footprint->minRadius(Vec3(v));
+      if (v.w < r) {
+        v.w = r;
+        data->widened = true;
+      }
+    }
+  }
+  RTCGeometry g = rtcNewGeometry(device, RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE);
+  setBallVertices(g, data->drawn);
+  auto* s = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT,
+                                                           sizeof(uint32_t), data->segments.size()));
+  std::copy(data->segments.begin(), data->segments.end(), s);
+  stats.curveSegments += data->segments.size();
+  if (data->widened) {
+    rtcSetGeometryUserData(g, data.get());
+    rtcSetGeometryOccludedFilterFunction(g, thinOcclusionFilter);
+  }
+  GeometryRecord rec;
+  rec.kind = GeometryRecord::Kind::Curves;
+  rec.material = material;
+  rec.curves = std::move(data);
+  return attach(g, std::move(rec));
+}
+
 uint32_t Scene::addCurves(const CurveSet& curves, uint32_t material) {
   if (impl_->committed) throw std::logic_error("Scene::addCurves after commit");
   if (material >= impl_->materials.size()) throw std::invalid_argument("Scene::addCurves: unknown material id");
+  if (impl_->footprint) {
+    // Widened curves: separate segments (a joined flag would fold the drawn tube's end
+    // caps into its neighbours, which the opacity of each segment does not account for).
+    auto data = std::make_shared<detail::CurveData>();
+    data->real = curves.vertices;
+    data->segments = curves.segments;
+    return impl_->addCurveGeometry(std::move(data), material);
+  }
   RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_ROUND_LINEAR_CURVE);
   impl_->setBallVertices(g, curves.vertices);
   auto* s = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT,
@@ -106,6 +194,25 @@ uint32_t Scene::addCurves(const CurveSet& curves, uint32_t material) {
   rec.kind = GeometryRecord::Kind::Curves;
   rec.material = material;
   return impl_->attach(g, std::move(rec));
+}
+
+std::optional<uint32_t> Scene::addThinAxes(const CurveSet& axes, uint32_t material) {
+  if (impl_->committed) throw std::logic_error("Scene::addThinAxes after commit");
+  if (material >= impl_->materials.size()) throw std::invalid_argument("Scene::addThinAxes: unknown material id");
+  if (!impl_->footprint || axes.empty()) return std::nullopt;
+  auto data = std::make_shared<detail::CurveData>();
+  data->standIn = true;
+  for (uint32_t first : axes.segments) {
+    if (first + 1 >= axes.vertices.size()) throw std::invalid_argument("Scene::addThinAxes: segment index out of range");
+    const Vec4 &a = axes.vertices[first], &b = axes.vertices[first + 1];
+    const float need = 0.5f * (impl_->footprint->minRadius(Vec3(a)) + impl_->footprint->minRadius(Vec3(b)));
+    if (0.5f * (a.w + b.w) >= need) continue;
+    data->segments.push_back(static_cast<uint32_t>(data->real.size()));
+    data->real.push_back(a);
+    data->real.push_back(b);
+  }
+  if (data->segments.empty()) return std::nullopt;
+  return impl_->addCurveGeometry(std::move(data), material);
 }
 
 uint32_t Scene::addSpheres(const SphereSet& spheres, uint32_t material) {
@@ -146,14 +253,17 @@ std::vector<uint32_t> Scene::add(const Geometry& geometry) {
       ids.push_back(addMesh(m->mesh, addMaterial(material), m->triangleColors));
     } else if (const auto* im = std::get_if<ImplicitPart>(&part)) {
       const uint32_t base = impl_->addTextureTable(im->textures);
-      const uint32_t id = addImplicit(*im->blob, addMaterial(im->material), im->options);
+      const uint32_t material = addMaterial(im->material);
+      const uint32_t id = addImplicit(*im->blob, material, im->options);
       impl_->records[id].textureBase = base;
       impl_->records[id].textureCount = static_cast<uint32_t>(im->textures.size());
       ids.push_back(id);
+      addThinAxes(im->thinAxes, material);
     } else if (const auto* pm = std::get_if<PolygonizedPart>(&part)) {
       const uint32_t base = impl_->addTextureTable(pm->textures);
-      ids.push_back(addPolygonized(*pm->mesh, addMaterial(pm->material), base,
-                                   static_cast<uint32_t>(pm->textures.size())));
+      const uint32_t material = addMaterial(pm->material);
+      ids.push_back(addPolygonized(*pm->mesh, material, base, static_cast<uint32_t>(pm->textures.size())));
+      addThinAxes(pm->thinAxes, material);
     }
   }
   return ids;
@@ -258,6 +368,36 @@ std::optional<SurfaceHit> Scene::intersect(const Vec3& origin, const Vec3& direc
     hit.normal = hit.geometricNormal = ih.normal;
     hit.color = attributeColor(ih.attributes, ih.point, impl_->materials[hit.material], rec.textureBase,
                                rec.textureCount);
+    return hit;
+  }
+  if (rec.kind == GeometryRecord::Kind::Curves && rec.curves && rec.curves->widened) {
+    // A widened curve: shaded with the normal of the true surface, with the segment's coverage.
+    const detail::CurveData& cd = *rec.curves;
+    const uint32_t i = cd.segments[prim];
+    const Vec3 a(cd.real[i]), b(cd.real[i + 1]);
+    const Vec3 axis = b - a;
+    const float len2 = glm::dot(axis, axis);
+    const float u = len2 > 0 ? std::clamp(glm::dot(hit.position - a, axis) / len2, 0.0f, 1.0f) : 0.0f;
+    const Vec3 c = a + u * axis;
+    Vec3 n = hit.position - c;
+    const float nl = glm::length(n);
+    n = nl > 0 ? n / nl : -direction;
+    hit.opacity = cd.opacity(prim, u);
+    // The hit stays on the drawn tube, outside what it stands for (a twig's blended
+    // surface may be fatter than its cone near a junction, and a shading point inside it
+    // would be shadowed by it).
+    hit.normal = hit.geometricNormal = n;
+    // Continue behind the drawn tube: the exit of the ray from the cylinder of the
+    // segment's largest drawn radius (what the tube stands for lies inside it).
+    const float R = std::max(cd.drawn[i].w, cd.drawn[i + 1].w);
+    const Vec3 e = len2 > 0 ? axis / std::sqrt(len2) : Vec3(0, 1, 0);
+    const Vec3 w = origin - a;
+    const Vec3 dp = direction - glm::dot(direction, e) * e, wp = w - glm::dot(w, e) * e;
+    const float A = glm::dot(dp, dp), B = 2.0f * glm::dot(dp, wp), C = glm::dot(wp, wp) - R * R;
+    const float disc = B * B - 4.0f * A * C;
+    float exit = hit.t + std::sqrt(len2) + 2.0f * R;
+    if (A > 1e-12f * glm::dot(direction, direction) && disc >= 0.0f) exit = (-B + std::sqrt(disc)) / (2.0f * A);
+    hit.behind = std::max(exit, hit.t) + 0.05f * R + 1e-5f * hit.t;  // past Embree's exit hit
     return hit;
   }
   if (rec.kind == GeometryRecord::Kind::Triangles) {

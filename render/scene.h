@@ -6,6 +6,7 @@
 /// Embree itself stays behind this interface (only render/*.cpp include it). After commit() the scene is immutable and
 /// intersect()/occluded() may be called from any number of threads.
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -16,6 +17,7 @@
 #include "core/mesh.h"
 #include "core/shapes.h"
 #include "core/types.h"
+#include "render/camera.h"
 #include "render/geometry.h"
 #include "textures/registry.h"
 
@@ -34,6 +36,24 @@ struct SurfaceHit {
   Vec3 color{0.5f};               ///< linear albedo at the hit
   uint32_t material = 0;
   uint32_t geometry = 0;          ///< index of the geometry in the scene (order of add calls)
+  /// Coverage of a widened thin curve at the hit (true width / drawn width), 1 for
+  /// everything else. Below 1 the renderer blends this hit over what lies behind it,
+  /// traced again from `behind` (past the curve's drawn tube and what it stands for).
+  float opacity = 1.0f;
+  float behind = 0.0f;
+};
+
+/// How wide a pixel is along the camera's view: a segment thinner than `minPixels` pixels
+/// is drawn that wide with opacity true width / drawn width.
+struct PixelFootprint {
+  Vec3 eye{0};                 ///< camera position
+  Vec3 forward{0, 0, -1};      ///< unit view direction
+  float pixelPerDepth = 0.0f;  ///< world size of one pixel at unit depth along forward
+  float minPixels = 1.0f;      ///< minimum drawn diameter, pixels
+  /// The smallest drawn radius at world point p.
+  float minRadius(const Vec3& p) const {
+    return 0.5f * minPixels * pixelPerDepth * std::max(glm::dot(p - eye, forward), 0.0f);
+  }
 };
 
 /// Counts of what a scene holds.
@@ -61,8 +81,23 @@ class Scene {
   /// table (part texture ids index that table). Returns the geometry ids, one per part.
   std::vector<uint32_t> add(const Geometry& geometry);
 
+  /// Minimum drawn width of thin geometry (the hair approach): after this call, curve
+  /// segments narrower than minPixels pixels as seen by camera in a width x height image are
+  /// widened to minPixels with opacity true width / drawn width, so sub-pixel twigs keep
+  /// their coverage instead of breaking into dots; implicit and polygonized parts draw
+  /// their thinAxes that way. Call before adding geometry (throws std::logic_error after);
+  /// minPixels <= 0 turns it off. Scenes without a footprint draw curves as they are.
+  void setPixelFootprint(const Camera& camera, int width, int height, float minPixels = kThinMinPixels);
+  /// Default minimum width of thin geometry, pixels.
+  static constexpr float kThinMinPixels = 2.0f;
+
   /// Adds tapered round curves (Embree round linear curves) with one material.
   uint32_t addCurves(const CurveSet& curves, uint32_t material);
+  /// Adds the segments of axes that are thinner than the footprint's minimum width (mean
+  /// radius) as widened transparent curves standing for geometry already added (hits of
+  /// other geometry inside their tubes are skipped). Nothing without a footprint; returns
+  /// the geometry id, or nothing when no segment is thin.
+  std::optional<uint32_t> addThinAxes(const CurveSet& axes, uint32_t material);
 
   /// Adds spheres (Embree sphere points), each with its own colour. Returns the geometry id.
   uint32_t addSpheres(const SphereSet& spheres, uint32_t material);

@@ -3,7 +3,9 @@
 
 #include <embree3/rtcore.h>
 
+#include <algorithm>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,6 +17,24 @@ namespace sprig::render::detail {
 /// A compiled blob with its surface cells, the payload of one Embree user geometry.
 /// Defined in implicit.cpp only: other files hold it through a shared_ptr.
 struct ImplicitData;
+
+/// Curve vertices as drawn (widened to the pixel footprint) and as they are, for the
+/// opacity of a hit; the payload of a curve geometry's occlusion filter.
+struct CurveData {
+  std::vector<Vec4> drawn;      ///< xyz, radius as given to Embree
+  std::vector<Vec4> real;       ///< xyz, true radius
+  std::vector<uint32_t> segments;
+  bool widened = false;         ///< some radius was raised (opacity may be below 1)
+  bool standIn = false;         ///< thin axes standing for an implicit or mesh part
+  /// Opacity at parameter u of segment prim: true radius / drawn radius.
+  float opacity(uint32_t prim, float u) const {
+    if (!widened) return 1.0f;
+    const uint32_t i = segments[prim];
+    const float r = (1.0f - u) * real[i].w + u * real[i + 1].w;
+    const float d = (1.0f - u) * drawn[i].w + u * drawn[i + 1].w;
+    return d > 0.0f ? std::min(1.0f, r / d) : 1.0f;
+  }
+};
 
 /// What the renderer needs to know about one Embree geometry to shade its hits.
 struct GeometryRecord {
@@ -28,6 +48,7 @@ struct GeometryRecord {
   std::vector<Vec3> primitiveColors;         ///< optional per-primitive colors (any kind)
   std::vector<uint32_t> primitiveMaterials;  ///< optional per-primitive material ids
   std::shared_ptr<const ImplicitData> implicit;  ///< Implicit
+  std::shared_ptr<const CurveData> curves;       ///< Curves
   uint32_t textureBase = 0;                      ///< the part's texture table in Scene::Impl::textures
   uint32_t textureCount = Scene::kAllTextures;   ///< its size (kAllTextures: the scene's whole table)
 };
@@ -53,6 +74,8 @@ struct Scene::Impl {
   Box3 bounds;
   SceneStats stats;
   bool committed = false;
+  bool anyGeometry = false;               ///< something was added (the footprint is fixed then)
+  std::optional<PixelFootprint> footprint;  ///< minimum width of thin curves, when set
 
   /// Commits geometry, attaches it under the next id and records how to shade it.
   uint32_t attach(RTCGeometry geometry, detail::GeometryRecord record);
@@ -61,6 +84,8 @@ struct Scene::Impl {
   /// Fills geometry's vertex buffer with balls (xyz centre, w radius: curve vertices or
   /// spheres) and grows the scene bounds by each ball.
   void setBallVertices(RTCGeometry geometry, const std::vector<Vec4>& balls);
+  /// Adds curves (widened to the footprint when there is one) as Embree round linear curves.
+  uint32_t addCurveGeometry(std::shared_ptr<detail::CurveData> data, uint32_t material);
   /// Adds record's triangles as Embree triangle geometry.
   uint32_t addTriangles(detail::GeometryRecord record);
 };

@@ -13,6 +13,7 @@
 #include "model/growth.h"
 #include "model/tree_kind.h"
 #include "core/atomic_file.h"
+#include "core/parallel.h"
 #include "core/progress.h"
 #include "lsystem/turtle.h"
 #include "tests/scratch_dir.h"
@@ -211,5 +212,51 @@ TEST_CASE("animateSpecies", "[model]") {
     }
     CHECK_THROWS_AS(animationFormatFor(tmp.path / "x.avi"), std::invalid_argument);
     CHECK(animationFormatFor(tmp.path / "out") == AnimationFormat::Frames);
+  }
+}
+
+TEST_CASE("animateSpecies with wind", "[model][wind]") {
+  ProgressSettings::setQuiet(true);
+  TempDir tmp("animate-wind-test");
+  Species s = parseSpecies(kStochastic, "bush.yaml");
+  AnimateOptions opt;
+  opt.firstStage = 4;
+  opt.progressLabel.clear();
+  opt.fps = 4;
+  opt.windSeconds = 1;
+  const AnimateResult still = animateSpecies(s, tmp.path / "still", opt);
+  REQUIRE(still.frames == 1);
+  auto frame = [&](const char* folder, int i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "frame_%05d.png", i);
+    return readFile(tmp.path / folder / name);
+  };
+  SECTION("zero wind is the still tree, byte for byte") {
+    opt.windSpeed = 0;
+    CHECK(animateSpecies(s, tmp.path / "calm", opt).frames == 1);
+    CHECK(frame("calm", 0) == frame("still", 0));
+  }
+  SECTION("wind: windSeconds * fps frames, moving, the same bytes twice and at 1 and 2 threads") {
+    opt.windSpeed = 12;
+    opt.windDirectionDeg = 90;
+    REQUIRE(animateSpecies(s, tmp.path / "windy", opt).frames == 4);
+    {
+      ThreadLimit one(1);
+      animateSpecies(s, tmp.path / "windy1", opt);
+    }
+    {
+      ThreadLimit two(2);
+      animateSpecies(s, tmp.path / "windy2", opt);
+    }
+    for (int i = 0; i < 4; ++i) {
+      CHECK(frame("windy", i) == frame("windy1", i));
+      CHECK(frame("windy", i) == frame("windy2", i));
+    }
+    CHECK(frame("windy", 0) != frame("still", 0));
+    CHECK(frame("windy", 1) != frame("windy", 2));
+  }
+  SECTION("bad wind is refused") {
+    opt.windSpeed = -1;
+    CHECK_THROWS_AS(animateSpecies(s, tmp.path / "bad", opt), std::invalid_argument);
   }
 }

@@ -15,12 +15,13 @@ namespace sprig::test {
 inline Image growthFrameImage(GrowthEngine& engine, const SpeciesRender& look, const GrowthFrame& frame,
                                       int width, int height) {
   lsystem::Skeleton sk = engine.skeletonAt(frame.stage, frame.fraction);
-  render::Scene scene;
-  scene.add(skeletonPreview(sk, look.style));
-  scene.commit();
   const DBox3& fb = engine.frameBox();
   render::Camera camera =
       render::frameBounds(Box3{Vec3(fb.lo), Vec3(fb.hi)}, look.view, static_cast<double>(width) / height);
+  render::Scene scene;
+  scene.setPixelFootprint(camera, width, height, look.image.thinMinPixels);
+  scene.add(skeletonPreview(sk, look.style));
+  scene.commit();
   render::RenderSettings rs = look.settings(width, height);
   rs.progress = false;
   return render::renderImage(scene, camera, rs);

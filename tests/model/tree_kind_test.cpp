@@ -29,7 +29,7 @@ branch_offset: false
 tips: hemisphere
 seed: 9
 prune: {orders: [1, 2], below_height: 2.5, probability: 1, cut_fraction: 0.3}
-scars: {internodes: [4, 7], stub_length: 2, negative_radius: 0.6}
+scars: {internodes: [4, 7], style: knob, stub_length: 2, negative_radius: 0.6}
 bends: {angle: 15, order_scale: 0.8, randomness: 0.3, trunk: true}
 bark: {enabled: false, v_scale: 3}
 leaves: {scale: 1.5}
@@ -44,6 +44,7 @@ leaves: {scale: 1.5}
     CHECK(o.prune.select.probability == 1.0);
     CHECK(o.prune.cutFraction == 0.3);
     CHECK(o.scars.select.internodes == std::vector<int>{4, 7});
+    CHECK(o.scars.style == organisms::ScarStyle::Knob);
     CHECK(o.scars.stubLength == 2.0);
     CHECK(o.scars.negativeRadius == 0.6);
     CHECK(o.bends.angleDeg == 15.0);

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <vector>
 
 #include "organisms/tree_builder.h"
 #include "tests/organisms/internode.h"
@@ -226,14 +227,17 @@ TEST_CASE("buildTreeBlob::pruning leaves a planar face (§3.5, Fig. 14)", "[orga
   CHECK(field.value(Vec3(p + 1.5 * d)) == 0.0f);
 }
 
-TEST_CASE("buildTreeBlob::scars dent the stub (§3.5, Fig. 15)", "[organisms]") {
+TEST_CASE("buildTreeBlob::knob scars dent the stub (§3.5, Fig. 15)", "[organisms]") {
   Skeleton sk;
   sk.internodes.push_back(seg({0, 0, 0}, {0, 1, 0}, 0.1, 0.1, -1, 0));
   sk.internodes.push_back(seg({0, 1, 0}, {0, 2, 0}, 0.1, 0.1, 0, 0));
   sk.internodes.push_back(seg({0, 1, 0}, {1, 1, 0}, 0.06, 0.05, 0, 1));
   TreeOptions opt;
   opt.scars.select.internodes = {2};
+  opt.scars.style = ScarStyle::Knob;
   opt.scars.stubLength = 1.5;
+  opt.scars.stubRadius = 1.0;
+  opt.scars.negativeRadius = 0.8;
   const Field scar{buildTreeBlob(sk, opt)};
   opt.scars.negativeWeight = 0;
   const Field stub{buildTreeBlob(sk, opt)};
@@ -251,6 +255,81 @@ TEST_CASE("buildTreeBlob::scars dent the stub (§3.5, Fig. 15)", "[organisms]") 
   CHECK(surfaceDistance(bigger, {0, 1, 0}, {1, 0, 0}, 0.5) < reachScar);
   // the rest of the branch is gone
   CHECK(stub.value({0.8f, 1, 0}) == 0.0f);
+}
+
+namespace {
+
+/// The bark around a scar against the same trunk without the branch: surface distance from
+/// the trunk's axis on a grid of azimuths (±60° about the branch's side) and heights
+/// (±2.5 branch radii about the branching point).
+struct ScarShape {
+  double raise = 0, dip = 0;     ///< largest outward / inward deviation from the plain trunk
+  double height = 0, width = 0;  ///< extent of the dip (deeper than a quarter of the deepest) along the axis / around it
+};
+
+ScarShape scarShape(ScarStyle style) {
+  const double rT = 0.1, rB = 0.06;
+  Skeleton sk;
+  sk.internodes.push_back(seg({0, 0, 0}, {0, 1, 0}, rT, rT, -1, 0));
+  sk.internodes.push_back(seg({0, 1, 0}, {0, 2, 0}, rT, rT, 0, 0));
+  const Field plain{buildTreeBlob(sk, TreeOptions{})};
+  const DVec3 d(std::sin(radians(60)), std::cos(radians(60)), 0);
+  sk.internodes.push_back(seg({0, 1, 0}, DVec3(0, 1, 0) + d, rB, 0.05, 0, 1));
+  TreeOptions opt;
+  opt.scars.select.internodes = {2};
+  opt.scars.style = style;
+  if (style == ScarStyle::Knob) {  // the Fig. 15 settings before flush scars
+    opt.scars.stubLength = 1.6;
+    opt.scars.stubRadius = 1.2;
+    opt.scars.negativeRadius = 0.9;
+    opt.scars.negativeWeight = 1.15;
+  }
+  const Field scar{buildTreeBlob(sk, opt)};
+  constexpr int kN = 41;
+  std::vector<double> dev(kN * kN);
+  ScarShape s;
+  for (int i = 0; i < kN; ++i)
+    for (int k = 0; k < kN; ++k) {
+      const double phi = radians(-60.0 + 120.0 * i / (kN - 1));
+      const float y = static_cast<float>(1.0 + rB * (-2.5 + 5.0 * k / (kN - 1)));
+      const Vec3 dir(static_cast<float>(std::cos(phi)), 0, static_cast<float>(std::sin(phi)));
+      const double e = surfaceDistance(scar, {0, y, 0}, dir, 0.5) - surfaceDistance(plain, {0, y, 0}, dir, 0.5);
+      dev[i * kN + k] = e;
+      s.raise = std::max(s.raise, e);
+      s.dip = std::min(s.dip, e);
+    }
+  int i0 = kN, i1 = -1, k0 = kN, k1 = -1;
+  for (int i = 0; i < kN; ++i)
+    for (int k = 0; k < kN; ++k)
+      if (dev[i * kN + k] < 0.25 * s.dip) {
+        i0 = std::min(i0, i), i1 = std::max(i1, i);
+        k0 = std::min(k0, k), k1 = std::max(k1, k);
+      }
+  if (i1 >= i0) {
+    s.width = rT * radians(120.0 * (i1 - i0 + 1) / (kN - 1));
+    s.height = rB * 5.0 * (k1 - k0 + 1) / (kN - 1);
+  }
+  std::printf("scar (%s): raise %.4f dip %.4f, dip %.4f high x %.4f around\n",
+              style == ScarStyle::Flush ? "flush" : "knob", s.raise, s.dip, s.height, s.width);
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("buildTreeBlob::flush scars are round and stay on the bark's cylinder (§3.5, Fig. 15)", "[organisms]") {
+  const double rB = 0.06;
+  const ScarShape flush = scarShape(ScarStyle::Flush);
+  // Within a quarter of the lost branch's radius of the bark everywhere around the scar...
+  CHECK(flush.raise < 0.25 * rB);
+  CHECK(flush.dip > -0.25 * rB);
+  // ...yet a scar: a shallow round dish, as high as it is wide (within 30%).
+  CHECK(flush.dip < -0.05 * rB);
+  REQUIRE(flush.width > 0);
+  CHECK(flush.height / flush.width == Approx(1.0).margin(0.3));
+  // The knob scars (a stub out along the branch, dented at its end) stand far off the bark.
+  const ScarShape knob = scarShape(ScarStyle::Knob);
+  CHECK(knob.raise > 0.3 * rB);
+  CHECK(knob.raise > 10 * flush.raise);
 }
 
 TEST_CASE("buildTreeBlob::deterministic", "[organisms]") {

@@ -143,10 +143,13 @@ TEST_CASE("planTree::pruning and scars", "[organisms]") {
     opt.prune.select.belowHeight = 0.5;
     CHECK(planTree(sk, opt).parts[2].kind == ConePart::Kind::Internode);
   }
-  SECTION("scar: stub of stubLength base radii plus a negative field at its end") {
+  SECTION("knob scar: stub of stubLength base radii plus a negative field at its end") {
     Skeleton sk = fork(0.1, 0.08, 0.05);
     TreeOptions opt;
     opt.scars.select.internodes = {2};
+    opt.scars.style = ScarStyle::Knob;
+    opt.scars.stubRadius = 1.0;
+    opt.scars.negativeRadius = 0.8;
     TreePlan plan = planTree(sk, opt);
     REQUIRE(plan.parts.size() == 3);
     const ConePart& p = plan.parts[2];
@@ -154,6 +157,23 @@ TEST_CASE("planTree::pruning and scars", "[organisms]") {
     CHECK(p.length() == Approx(1.5 * 0.05));
     CHECK(p.startRadius == Approx(0.05));
     CHECK(p.negativeRadius == Approx(0.8 * 0.05));
+    CHECK(glm::length(p.negativeCenter - p.end) == Approx(0.0).margin(1e-12));
+  }
+  SECTION("flush scar: a radial stub from P to the parent's bark, the negative field where it meets it") {
+    Skeleton sk = fork(0.1, 0.08, 0.05);
+    TreeOptions opt;
+    opt.scars.select.internodes = {2};
+    TreePlan plan = planTree(sk, opt);
+    REQUIRE(plan.parts.size() == 3);
+    const ConePart& p = plan.parts[2];
+    const Junction& j = plan.junctions[p.junctionAtStart];
+    CHECK(p.kind == ConePart::Kind::Stub);
+    CHECK(glm::length(p.start - j.point) == Approx(0.0).margin(1e-12));
+    CHECK(p.length() == Approx(0.1));  // the basal internode's tip radius
+    const DVec3 axis = glm::normalize(sk.internodes[0].end - sk.internodes[0].start);
+    CHECK(glm::dot(p.end - p.start, axis) == Approx(0.0).margin(1e-12));  // radial
+    CHECK(p.startRadius == Approx(0.8 * 0.05));
+    CHECK(p.negativeRadius == Approx(0.9 * 0.05));
     CHECK(glm::length(p.negativeCenter - p.end) == Approx(0.0).margin(1e-12));
   }
 }

@@ -1,0 +1,117 @@
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdio>
+
+#include "organisms/wind.h"
+#include "tests/organisms/internode.h"
+
+using namespace sprig;
+using namespace sprig::organisms;
+using lsystem::Skeleton;
+using test::seg;
+
+namespace {
+
+/// A trunk of four internodes up +Y with a lateral of two internodes at each of its upper
+/// three joints, and a leaf polygon on each lateral's tip.
+Skeleton windTree() {
+  Skeleton sk;
+  for (int i = 0; i < 4; ++i) sk.internodes.push_back(seg({0, i, 0}, {0, i + 1, 0}, 0.2 - 0.04 * i, 0.16 - 0.04 * i, i - 1, 0));
+  for (int j = 1; j < 4; ++j) {
+    const DVec3 p(0, j, 0), d = glm::normalize(DVec3(std::cos(2.0 * j), 1.0, std::sin(2.0 * j)));
+    const int first = static_cast<int>(sk.internodes.size());
+    sk.internodes.push_back(seg(p, p + 0.5 * d, 0.05, 0.04, j - 1, 1));
+    sk.internodes.push_back(seg(p + 0.5 * d, p + d, 0.04, 0.03, first, 1));
+    lsystem::Organ leaf;
+    leaf.points = {p + d, p + d + DVec3(0.1, 0.05, 0), p + d + DVec3(0, 0.2, 0), p + d + DVec3(-0.1, 0.05, 0)};
+    leaf.internode = first + 1;
+    sk.organs.push_back(leaf);
+  }
+  return sk;
+}
+
+WindOptions wind(double speed) {
+  WindOptions w;
+  w.speed = speed;
+  w.directionDeg = 90;  // toward +X
+  w.seed = 3;
+  return w;
+}
+
+double displacement(const Skeleton& a, const Skeleton& b, size_t i) { return glm::length(a.internodes[i].end - b.internodes[i].end); }
+
+}  // namespace
+
+TEST_CASE("swayInWind: no wind is the still tree", "[organisms][wind]") {
+  const Skeleton sk = windTree();
+  const Skeleton still = swayInWind(sk, wind(0), 1.25);
+  REQUIRE(still.internodes.size() == sk.internodes.size());
+  for (size_t i = 0; i < sk.internodes.size(); ++i) {
+    CHECK(still.internodes[i].start == sk.internodes[i].start);
+    CHECK(still.internodes[i].end == sk.internodes[i].end);
+  }
+  CHECK(still.organs[0].points == sk.organs[0].points);
+}
+
+TEST_CASE("swayInWind: rigid, connected, deterministic", "[organisms][wind]") {
+  const Skeleton sk = windTree();
+  const Skeleton a = swayInWind(sk, wind(12), 0.7), b = swayInWind(sk, wind(12), 0.7);
+  for (size_t i = 0; i < sk.internodes.size(); ++i) {
+    CHECK(a.internodes[i].end == b.internodes[i].end);  // same bytes
+    CHECK(a.internodes[i].length() == Approx(sk.internodes[i].length()).epsilon(1e-12));
+    const int p = sk.internodes[i].parent;
+    if (p >= 0) CHECK(glm::length(a.internodes[i].start - a.internodes[p].end) < 1e-12);  // no tearing
+  }
+  CHECK(a.internodes[0].start == sk.internodes[0].start);  // the root stays put
+  // The leaf keeps its shape and hangs on its twig's tip.
+  const auto& l0 = sk.organs[0].points;
+  const auto& l1 = a.organs[0].points;
+  CHECK(glm::length(l1[2] - l1[0]) == Approx(glm::length(l0[2] - l0[0])).epsilon(1e-12));
+  CHECK(glm::length(l1[0] - a.internodes[5].end) < 1e-12);
+  // Another seed sways the branches differently.
+  WindOptions other = wind(12);
+  other.seed = 4;
+  CHECK(glm::length(swayInWind(sk, other, 0.7).internodes[5].end - a.internodes[5].end) > 1e-6);
+}
+
+TEST_CASE("swayInWind: displacement grows with speed and with height", "[organisms][wind]") {
+  const Skeleton sk = windTree();
+  // The trunk's joints: higher joints move further, and the lean is downwind (+X).
+  const Skeleton a = swayInWind(sk, wind(10), 0.0);
+  double prev = 0;
+  for (size_t i = 0; i < 4; ++i) {
+    const double d = displacement(a, sk, i);
+    CHECK(d > prev);
+    CHECK(a.internodes[i].end.x - sk.internodes[i].end.x > 0);
+    prev = d;
+  }
+  // Faster wind, further for every internode's tip, trunk and branches (at one moment).
+  for (double t : {0.0, 0.4, 1.3}) {
+    const Skeleton s5 = swayInWind(sk, wind(5), t), s10 = swayInWind(sk, wind(10), t), s20 = swayInWind(sk, wind(20), t);
+    for (size_t i : {size_t(3), size_t(9)}) {
+      CHECK(displacement(s5, sk, i) < displacement(s10, sk, i));
+      CHECK(displacement(s10, sk, i) < displacement(s20, sk, i));
+    }
+  }
+  std::printf("wind: trunk top moves %.4f at 5 m/s, %.4f at 10, %.4f at 20 (tree height 4)\n",
+              displacement(swayInWind(sk, wind(5), 0), sk, 3), displacement(swayInWind(sk, wind(10), 0), sk, 3),
+              displacement(swayInWind(sk, wind(20), 0), sk, 3));
+}
+
+TEST_CASE("swayInWind: no popping between frames", "[organisms][wind]") {
+  // At 12 frames per second every point moves by a small fraction of the tree's height per
+  // frame (the motions are sums of sines of at most a few hertz).
+  const Skeleton sk = windTree();
+  double worst = 0;
+  for (int f = 0; f < 48; ++f) {
+    const Skeleton a = swayInWind(sk, wind(15), f / 12.0), b = swayInWind(sk, wind(15), (f + 1) / 12.0);
+    for (size_t i = 0; i < sk.internodes.size(); ++i) worst = std::max(worst, displacement(a, b, i));
+    for (size_t o = 0; o < sk.organs.size(); ++o)
+      for (size_t k = 0; k < sk.organs[o].points.size(); ++k)
+        worst = std::max(worst, glm::length(a.organs[o].points[k] - b.organs[o].points[k]));
+  }
+  std::printf("wind 15 m/s: largest move of a point between frames at 12 fps %.4f (tree height 4)\n", worst);
+  CHECK(worst > 0.0);
+  CHECK(worst < 0.04 * 4.0);
+}
