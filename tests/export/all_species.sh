@@ -8,7 +8,9 @@ sprig="$1"
 out="${2:-$(mktemp -d)}"
 mkdir -p "$out"
 bad=0
-for f in species/*.yaml; do
+# Trees last: they are the biggest meshes (millions of triangles each).
+mapfile -t files < <(grep -L '^kind: tree' species/*.yaml; grep -l '^kind: tree' species/*.yaml)
+for f in "${files[@]}"; do
   s="$(basename "$f" .yaml)"
   if ! "$sprig" --quiet mesh "$f" -o "$out/$s.glb" >"$out/$s.log" 2>&1; then
     echo "$s: sprig mesh failed"; cat "$out/$s.log"; bad=1; continue
