@@ -95,7 +95,9 @@ TEST_CASE("SpeciesModel::exportParts of shipped species", "[model][slow]") {
   };
   for (const Case& c : cases) {
     INFO(c.species);
-    const Species species = loadSpecies(std::string(SPRIG_SOURCE_DIR) + "/species/" + c.species + ".yaml");
+    PathPolicy policy;
+    policy.root = SPRIG_SOURCE_DIR;
+    const Species species = loadSpecies(std::string(SPRIG_SOURCE_DIR) + "/species/" + c.species + ".yaml", policy);
     ModelOptions options;
     options.lastStep = c.lastStep;
     SpeciesModel model(species, options);
