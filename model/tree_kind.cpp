@@ -325,8 +325,8 @@ class TreeModel final : public KindModel {
     po.cellSize = cellSize;
     po.progress = progress;
     // The wood: coloured by its bark as the renderer colours it, then cleaned.
-    const render::Geometry look3 = surfaceGeometry(tree, look, nullptr);
-    const auto& implicit = std::get<render::ImplicitPart>(look3.parts.front());
+    const render::Geometry geometry = surfaceGeometry(tree, look, nullptr);
+    const auto& implicit = std::get<render::ImplicitPart>(geometry.parts.front());
     std::vector<ExportPart> parts(1);
     parts[0].name = "wood";
     parts[0].mesh = paintPolygonized(blobtree::polygonizeDetailed(*tree.compiled, po), implicit.textures,
