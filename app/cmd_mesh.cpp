@@ -23,6 +23,7 @@ struct MeshArgs {
   StageFlags stage;
   GrowthFlags growth;
   bool interfaces = false;
+  double minVolume = MeshCleanOptions{}.minVolumeFraction;
 };
 
 int runMesh(const MeshArgs& a, const GlobalOptions& g) {
@@ -54,14 +55,31 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
     return kExitOk;
   }
   ModelFigures fig;
-  Mesh mesh = model.buildMesh(stage, static_cast<float>(a.cell), !g.quiet, &fig);
-
-  MeshWriteOptions wopt;
-  wopt.materialName = species.name.empty() ? "sprig" : species.name;
-  writeMesh(mesh, a.out, wopt);
+  MeshCleanOptions clean;
+  clean.minVolumeFraction = a.minVolume;
+  const std::vector<ExportPart> parts = model.exportParts(stage, static_cast<float>(a.cell), !g.quiet, clean, &fig);
+  writeParts(parts, a.out);
   double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  size_t vertices = 0;
+  std::string names;
+  for (const ExportPart& p : parts) {
+    if (p.mesh.triangles.empty()) continue;
+    vertices += p.mesh.vertexCount();
+    names += (names.empty() ? "" : ", ") + p.name + " " + std::to_string(p.mesh.triangleCount());
+  }
   note(g, std::cout, "%s: %zu triangles, %zu vertices, %zu primitives, built in %.2f s (total %.2f s)", a.out.c_str(),
-       mesh.triangleCount(), mesh.vertexCount(), fig.primitives, fig.buildSeconds, total);
+       fig.triangles, vertices, fig.primitives, fig.buildSeconds, total);
+  note(g, std::cout, "parts: %s", names.c_str());
+  const MeshCleanReport& c = fig.clean;
+  if (c.componentsBefore > 0)
+    note(g, std::cout, "cleaned: %zu components -> %zu (%zu specks, %zu voids, %zu triangles removed); %zu faces against their normals -> %zu (%zu normals fixed)",
+         c.componentsBefore, c.componentsAfter, c.specks, c.voids, c.removedTriangles, c.facesAgainstBefore,
+         c.facesAgainstAfter, c.fixedNormals);
+  if (lowerExtension(a.out) == ".glb")
+    for (const ExportPart& p : parts)
+      if (size_t k = clampedColorChannels(p))
+        note(g, std::cout, "%s: %zu vertex colour channels are brighter than the part's base colour and are clamped to it in COLOR_0",
+             p.name.c_str(), k);
   return kExitOk;
 }
 
@@ -76,6 +94,11 @@ void addMeshCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run)
   sub->add_flag("--interfaces", args->interfaces,
                  "solids: write each interface between two materials, and each material's outer surface, as OUT_<A>_<B>.EXT "
                  "(triangles oriented out of A; B = outside for the visible interface)");
+  sub->add_option("--min-volume", args->minVolume,
+                  "remove connected components of a polygonized surface whose enclosed volume is below this fraction of the model's "
+                  "(specks outside, voids inside); 0 keeps them")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
   addStageFlags(*sub, args->stage);
   addGrowthFlags(*sub, args->growth);
 }

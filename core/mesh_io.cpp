@@ -113,13 +113,15 @@ void writeMesh(const Mesh& mesh, const fs::path& path, const MeshWriteOptions& o
   }
 }
 
-void writePly(const Mesh& mesh, const fs::path& path) {
+void writePly(const Mesh& mesh, const fs::path& path) { writePly(mesh, path, std::string()); }
+
+void writePly(const Mesh& mesh, const fs::path& path, const std::string& comments) {
   validate(mesh);
   size_t n = mesh.positions.size();
   bool hasN = !mesh.normals.empty(), hasUv = !mesh.uvs.empty(), hasC = !mesh.colors.empty();
   bool hasM = !mesh.materials.empty();
 
-  std::string out = "ply\nformat binary_little_endian 1.0\ncomment written by Sprig\n";
+  std::string out = "ply\nformat binary_little_endian 1.0\ncomment written by Sprig\n" + comments;
   out += "element vertex " + std::to_string(n) + "\n";
   out += "property float x\nproperty float y\nproperty float z\n";
   if (hasN) out += "property float nx\nproperty float ny\nproperty float nz\n";
@@ -303,6 +305,232 @@ void writeGlb(const Mesh& mesh, const fs::path& path, const MeshWriteOptions& op
   if (!writer.WriteGltfSceneToStream(&model, stream, false, true))
     throw std::runtime_error("cannot write '" + path.string() + "': glTF serialization failed");
   writeAtomic(path, stream.str());
+}
+
+}  // namespace sprig
+
+namespace sprig {
+
+namespace {
+
+// A name safe for OBJ/MTL statements (whitespace becomes '_').
+std::string objName(const std::string& name) {
+  std::string out = name.empty() ? std::string("part") : name;
+  for (char& c : out)
+    if (c == ' ' || c == '\t' || c == '\n' || c == '\r') c = '_';
+  return out;
+}
+
+// The colour glTF's COLOR_0 carries for colour c of a part with base colour b: c / b per
+// channel, clamped to [0,1]; a channel of b that is 0 gives 1 (the product is 0 anyway).
+Vec3 relativeColor(const Vec3& c, const Vec3& b, size_t* clamped = nullptr) {
+  Vec3 out;
+  for (int k = 0; k < 3; ++k) {
+    float r = b[k] > 0 ? c[k] / b[k] : 1.0f;
+    if (r > 1.0f + 1e-6f && clamped) ++*clamped;
+    out[k] = std::clamp(r, 0.0f, 1.0f);
+  }
+  return out;
+}
+
+// True when the part has vertex colours that differ from its base colour.
+bool hasOwnColors(const ExportPart& part) {
+  const Mesh& m = part.mesh;
+  if (m.colors.size() != m.positions.size() || m.colors.empty()) return false;
+  for (const Vec3& c : m.colors)
+    if (glm::any(glm::greaterThan(glm::abs(c - part.material.baseColor), Vec3(1e-6f)))) return true;
+  return false;
+}
+
+void checkParts(const std::vector<ExportPart>& parts) {
+  std::vector<std::string> names;
+  for (const ExportPart& p : parts) {
+    validate(p.mesh);
+    names.push_back(p.name);
+  }
+  std::sort(names.begin(), names.end());
+  auto dup = std::adjacent_find(names.begin(), names.end());
+  if (dup != names.end()) throw std::invalid_argument("two exported parts are named '" + *dup + "'");
+}
+
+void writePartsGlb(const std::vector<ExportPart>& parts, const fs::path& path) {
+  tinygltf::Model model;
+  model.asset.version = "2.0";
+  model.asset.generator = "Sprig";
+  tinygltf::Scene scene;
+  scene.name = "Sprig";
+  tinygltf::Buffer buffer;
+  std::vector<unsigned char>& data = buffer.data;
+  auto addAccessor = [&](const void* bytes, size_t byteLength, size_t count, int type, int componentType, int target) {
+    while (data.size() % 4) data.push_back(0);
+    tinygltf::BufferView view;
+    view.buffer = 0;
+    view.byteOffset = data.size();
+    view.byteLength = byteLength;
+    view.target = target;
+    auto* b = static_cast<const unsigned char*>(bytes);
+    data.insert(data.end(), b, b + byteLength);
+    model.bufferViews.push_back(view);
+    tinygltf::Accessor acc;
+    acc.bufferView = int(model.bufferViews.size() - 1);
+    acc.byteOffset = 0;
+    acc.componentType = componentType;
+    acc.count = count;
+    acc.type = type;
+    model.accessors.push_back(acc);
+    return int(model.accessors.size() - 1);
+  };
+  for (const ExportPart& part : parts) {
+    const Mesh& mesh = part.mesh;
+    if (mesh.triangles.empty()) continue;
+    tinygltf::Material mat;
+    mat.name = part.material.name;
+    const Vec3& c = part.material.baseColor;
+    mat.pbrMetallicRoughness.baseColorFactor = {c.x, c.y, c.z, 1.0};
+    mat.pbrMetallicRoughness.metallicFactor = 0.0;
+    mat.pbrMetallicRoughness.roughnessFactor = part.material.roughness;
+    mat.doubleSided = part.material.doubleSided;
+    model.materials.push_back(mat);
+
+    const size_t n = mesh.positions.size();
+    tinygltf::Primitive prim;
+    prim.mode = TINYGLTF_MODE_TRIANGLES;
+    prim.material = int(model.materials.size() - 1);
+    const int pos = addAccessor(mesh.positions.data(), n * sizeof(Vec3), n, TINYGLTF_TYPE_VEC3,
+                                TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+    const Box3 box = mesh.bounds();
+    model.accessors[size_t(pos)].minValues = {box.lo.x, box.lo.y, box.lo.z};
+    model.accessors[size_t(pos)].maxValues = {box.hi.x, box.hi.y, box.hi.z};
+    prim.attributes["POSITION"] = pos;
+    if (!mesh.normals.empty())
+      prim.attributes["NORMAL"] = addAccessor(mesh.normals.data(), n * sizeof(Vec3), n, TINYGLTF_TYPE_VEC3,
+                                              TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+    if (!mesh.uvs.empty()) {
+      std::vector<Vec2> flipped(n);
+      for (size_t i = 0; i < n; ++i) flipped[i] = {mesh.uvs[i].x, 1.0f - mesh.uvs[i].y};
+      prim.attributes["TEXCOORD_0"] = addAccessor(flipped.data(), n * sizeof(Vec2), n, TINYGLTF_TYPE_VEC2,
+                                                  TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+    }
+    if (hasOwnColors(part)) {
+      std::vector<Vec3> rel(n);
+      for (size_t i = 0; i < n; ++i) rel[i] = relativeColor(mesh.colors[i], c);
+      prim.attributes["COLOR_0"] = addAccessor(rel.data(), n * sizeof(Vec3), n, TINYGLTF_TYPE_VEC3,
+                                               TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+    }
+    prim.indices = addAccessor(mesh.triangles.data(), mesh.triangles.size() * sizeof(glm::uvec3),
+                               mesh.triangles.size() * 3, TINYGLTF_TYPE_SCALAR,
+                               TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+    tinygltf::Mesh gm;
+    gm.name = part.name;
+    gm.primitives.push_back(prim);
+    model.meshes.push_back(gm);
+    tinygltf::Node node;
+    node.name = part.name;
+    node.mesh = int(model.meshes.size() - 1);
+    model.nodes.push_back(node);
+    scene.nodes.push_back(int(model.nodes.size() - 1));
+  }
+  if (!data.empty()) model.buffers.push_back(std::move(buffer));
+  model.scenes.push_back(scene);
+  model.defaultScene = 0;
+  std::ostringstream stream;
+  tinygltf::TinyGLTF writer;
+  if (!writer.WriteGltfSceneToStream(&model, stream, false, true))
+    throw std::runtime_error("cannot write '" + path.string() + "': glTF serialization failed");
+  writeAtomic(path, stream.str());
+}
+
+void writePartsObj(const std::vector<ExportPart>& parts, const fs::path& path) {
+  fs::path mtlPath = path;
+  mtlPath.replace_extension(".mtl");
+  std::string mtl = "# written by Sprig\n";
+  std::string out = "# written by Sprig\nmtllib " + mtlPath.filename().string() + "\n";
+  uint64_t base = 0;
+  for (const ExportPart& part : parts) {
+    const Mesh& mesh = part.mesh;
+    if (mesh.triangles.empty()) continue;
+    const std::string matName = objName(part.material.name);
+    const Vec3& c = part.material.baseColor;
+    mtl += "newmtl " + matName + "\nKa 0 0 0\nKd ";
+    putFloat(mtl, c.x), mtl += ' ', putFloat(mtl, c.y), mtl += ' ', putFloat(mtl, c.z);
+    mtl += "\nKs 0.04 0.04 0.04\nNs 32\nd 1\nillum 2\n\n";
+    const bool hasN = !mesh.normals.empty(), hasUv = !mesh.uvs.empty(), hasC = !mesh.colors.empty();
+    out += "o " + objName(part.name) + "\n";
+    for (size_t i = 0; i < mesh.positions.size(); ++i) {
+      const Vec3& p = mesh.positions[i];
+      out += "v ";
+      putFloat(out, p.x), out += ' ', putFloat(out, p.y), out += ' ', putFloat(out, p.z);
+      if (hasC) {
+        out += ' ';
+        putFloat(out, linearToSrgb(mesh.colors[i].x)), out += ' ';
+        putFloat(out, linearToSrgb(mesh.colors[i].y)), out += ' ';
+        putFloat(out, linearToSrgb(mesh.colors[i].z));
+      }
+      out += '\n';
+    }
+    if (hasUv)
+      for (const auto& uv : mesh.uvs) out += "vt ", putFloat(out, uv.x), out += ' ', putFloat(out, uv.y), out += '\n';
+    if (hasN)
+      for (const auto& nm : mesh.normals) {
+        out += "vn ";
+        putFloat(out, nm.x), out += ' ', putFloat(out, nm.y), out += ' ', putFloat(out, nm.z);
+        out += '\n';
+      }
+    out += "usemtl " + matName + "\n";
+    for (const auto& t : mesh.triangles) {
+      out += 'f';
+      for (int k = 0; k < 3; ++k) {
+        const uint64_t idx = base + uint64_t(t[k]) + 1;
+        out += ' ';
+        putUint(out, idx);
+        if (hasUv || hasN) {
+          out += '/';
+          if (hasUv) putUint(out, idx);
+          if (hasN) out += '/', putUint(out, idx);
+        }
+      }
+      out += '\n';
+    }
+    base += mesh.positions.size();
+  }
+  writeAtomic(mtlPath, mtl);
+  writeAtomic(path, out);
+}
+
+void writePartsPly(const std::vector<ExportPart>& parts, const fs::path& path) {
+  Mesh all;
+  std::string comments;
+  uint32_t index = 0;
+  for (const ExportPart& part : parts) {
+    if (part.mesh.triangles.empty()) continue;
+    Mesh m = part.mesh;
+    if (m.colors.size() != m.positions.size()) m.colors.assign(m.positions.size(), part.material.baseColor);
+    m.uvs.clear();
+    m.materials.assign(m.triangles.size(), index);
+    comments += "comment part " + std::to_string(index) + " " + objName(part.name) + "\n";
+    all.append(m);
+    ++index;
+  }
+  writePly(all, path, comments);
+}
+
+}  // namespace
+
+size_t clampedColorChannels(const ExportPart& part) {
+  size_t clamped = 0;
+  if (hasOwnColors(part))
+    for (const Vec3& c : part.mesh.colors) relativeColor(c, part.material.baseColor, &clamped);
+  return clamped;
+}
+
+void writeParts(const std::vector<ExportPart>& parts, const fs::path& path) {
+  const MeshFormat format = meshFormatFor(path);
+  checkParts(parts);
+  switch (format) {
+    case MeshFormat::Ply: writePartsPly(parts, path); break;
+    case MeshFormat::Obj: writePartsObj(parts, path); break;
+    case MeshFormat::Glb: writePartsGlb(parts, path); break;
+  }
 }
 
 }  // namespace sprig

@@ -14,6 +14,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "core/mesh.h"
 #include "core/types.h"
@@ -48,11 +49,46 @@ void writeMesh(const Mesh& mesh, const std::filesystem::path& path, const MeshWr
 /// `vertex_indices` (uchar count, uint indices) per face, and `material` (uint) per face
 /// when the mesh has material ids. Throws as writeMesh.
 void writePly(const Mesh& mesh, const std::filesystem::path& path);
+/// writePly with extra header lines (each `comment ...\n`) after Sprig's own comment.
+void writePly(const Mesh& mesh, const std::filesystem::path& path, const std::string& comments);
 
 /// OBJ with `mtllib`, plus the MTL file beside it (same stem, `.mtl`); both are written
 /// atomically, the MTL first. Indices are 1-based; faces are `v/vt/vn` as available.
 /// Throws as writeMesh.
 void writeObj(const Mesh& mesh, const std::filesystem::path& path, const MeshWriteOptions& options = {});
+
+/// The material of an exported part.
+struct PartMaterial {
+  std::string name = "sprig";  ///< material name in glTF and MTL (letters, digits, '_' in OBJ)
+  Vec3 baseColor{0.8f};        ///< linear RGB in [0,1]: glTF baseColorFactor and MTL Kd, both as these linear numbers
+  float roughness = 0.6f;      ///< glTF roughnessFactor in [0,1]
+  bool doubleSided = false;    ///< glTF doubleSided (leaves: both faces are seen)
+};
+
+/// One named part of an exported model (wood, leaves, whorl, a solid's material, ...).
+/// Vertex colours, when the mesh has them, are the part's colours at its vertices; the
+/// writers keep them relative to the material's base colour (see writeParts).
+struct ExportPart {
+  std::string name;  ///< node name in glTF, object name in OBJ
+  Mesh mesh;
+  PartMaterial material;
+};
+
+/// Writes parts to path in the format its extension names, atomically, each part kept
+/// apart: glTF (.glb) one node, mesh and material per part, named after the part;
+/// COLOR_0, when the part's mesh has colours, is each colour divided by the material's
+/// base colour per channel (glTF multiplies them) and clamped to [0,1]. OBJ one object
+/// (`o`) and one material (`usemtl`) per part, its MTL with the base colours, vertex
+/// colours after the positions as in writeObj. PLY one mesh with a colour at every vertex
+/// (a part without vertex colours gets its base colour) and the part's index as each
+/// face's `material`; the header names the parts in comments (`comment part 0 wood`).
+/// Parts without triangles are skipped. Throws as writeMesh, and std::invalid_argument
+/// when two parts share a name.
+void writeParts(const std::vector<ExportPart>& parts, const std::filesystem::path& path);
+
+/// How many colour channels writeParts clamps in glTF's COLOR_0 (a vertex brighter than its
+/// part's base colour in a channel); 0 means the glTF shows every vertex colour exactly.
+size_t clampedColorChannels(const ExportPart& part);
 
 /// glTF 2.0 binary through TinyGLTF: one mesh, one primitive (triangles), POSITION
 /// (with min/max), NORMAL, TEXCOORD_0 (v flipped to glTF's top-left origin), COLOR_0,

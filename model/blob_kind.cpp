@@ -2,6 +2,7 @@
 #include "core/timer.h"
 
 #include "blobtree/polygonize.h"
+#include "model/mesh_parts.h"
 #include "render/scene.h"
 
 #include <algorithm>
@@ -781,6 +782,21 @@ class BlobModel final : public StillKindModel {
     po.cellSize = cellSize > 0 ? cellSize : blob_.cellSize;
     po.progress = progress;
     return blobtree::polygonize(*compiled_, po);
+  }
+
+  std::vector<ExportPart> exportParts(const Stage&, float cellSize, bool progress, const SpeciesRender& look,
+                                      const MeshCleanOptions& clean, ModelFigures& fig) override {
+    fig.primitives = compiled_->primitiveCount();
+    blobtree::PolygonizeOptions po;
+    po.cellSize = cellSize > 0 ? cellSize : blob_.cellSize;
+    po.progress = progress;
+    ExportPart part;
+    part.name = "blob";
+    part.mesh = paintPolygonized(blobtree::polygonizeDetailed(*compiled_, po), textureTable(blob_.textures), look.surface.baseColor);
+    fig.clean = cleanMesh(part.mesh, clean);
+    part.mesh.materials.clear();
+    part.material = {"blob", look.surface.baseColor, look.surface.roughness, false};
+    return {std::move(part)};
   }
 
  private:

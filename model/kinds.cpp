@@ -39,6 +39,17 @@ std::string KindModel::writeVolumeMesh(const Stage&, const std::filesystem::path
   throw UsageError("'" + path.extension().string() + "' is a tetrahedral mesh format: only solid species have one");
 }
 
+std::vector<ExportPart> KindModel::exportParts(const Stage& stage, float cellSize, bool progress, const SpeciesRender& look,
+                                              const MeshCleanOptions&, ModelFigures& figures) {
+  ExportPart part;
+  part.name = "surface";
+  part.mesh = buildMesh(stage, cellSize, progress, figures);
+  part.material.name = "surface";
+  part.material.baseColor = look.surface.baseColor;
+  part.material.roughness = look.surface.roughness;
+  return {std::move(part)};
+}
+
 std::vector<std::pair<std::string, Mesh>> KindModel::interfaceMeshes(const Stage&) {
   throw UsageError("--interfaces applies to solid species only (their material interfaces)");
 }

@@ -15,6 +15,8 @@
 #include <vector>
 
 #include "core/mesh.h"
+#include "core/mesh_clean.h"
+#include "core/mesh_io.h"
 #include "core/types.h"
 #include "lsystem/grammar.h"
 #include "model/species.h"
@@ -52,6 +54,8 @@ struct ModelFigures {
   size_t triangles = 0;   ///< triangles in the scene (leaves, meshes, polygon organs)
   size_t cells = 0;       ///< exact mode: surface cells (Embree user primitives)
   double buildSeconds = 0;  ///< derivation, turtle, BlobTree build, compile, polygonization
+  /// exportParts: what cleaning the polygonized wood or shell found (zero when nothing was cleaned).
+  MeshCleanReport clean;
 };
 
 /// A built stage: what to render, and its figures.
@@ -101,6 +105,13 @@ class KindModel {
   virtual BuiltStage build(const Stage& stage, GeometryMode mode, const SpeciesRender& look) = 0;
   /// The stage's surface as one closed triangle mesh; cellSize 0 = automatic.
   virtual Mesh buildMesh(const Stage& stage, float cellSize, bool progress, ModelFigures& figures) = 0;
+  /// The stage's surface as named parts with the species' colours, for `sprig mesh`
+  /// (core/mesh_io.h writeParts): trees wood, leaves, fruit; shells whorl, varices, spines,
+  /// bumps, inside; solids one part per material; others one part. Polygonized BlobTrees are
+  /// cleaned (core/mesh_clean.h) with clean, the report in figures.clean. The default is
+  /// buildMesh as one part "surface" in look.surface's colour.
+  virtual std::vector<ExportPart> exportParts(const Stage& stage, float cellSize, bool progress, const SpeciesRender& look,
+                                              const MeshCleanOptions& clean, ModelFigures& figures);
   /// How the gallery animates it.
   virtual GalleryMotion galleryMotion(bool final) = 0;
   /// Extensions of the volume (tetrahedral) meshes the kind writes (".msh", ...); empty

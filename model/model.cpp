@@ -41,6 +41,18 @@ Mesh SpeciesModel::buildMesh(const Stage& stage, float cellSize, bool progress, 
   return out;
 }
 
+std::vector<ExportPart> SpeciesModel::exportParts(const Stage& stage, float cellSize, bool progress,
+                                                 const MeshCleanOptions& clean, ModelFigures* figures) {
+  ModelFigures fig;
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<ExportPart> parts = kind_->exportParts(stage, cellSize, progress, species_.render, clean, fig);
+  fig.triangles = 0;
+  for (const ExportPart& p : parts) fig.triangles += p.mesh.triangleCount();
+  fig.buildSeconds = secondsSince(t0);
+  if (figures) *figures = fig;
+  return parts;
+}
+
 render::Camera modelCamera(const SpeciesRender& look, const Box3& box, int width, int height) {
   const double aspect = static_cast<double>(width) / height;
   if (!look.camera) return render::frameBounds(box, look.view, aspect);

@@ -99,6 +99,11 @@ class SpeciesModel {
   /// cellSize 0 = automatic. progress shows a bar on a terminal.
   Mesh buildMesh(const Stage& stage, float cellSize, bool progress, ModelFigures* figures = nullptr);
 
+  /// The stage's surface as named parts in the species' colours (KindModel::exportParts),
+  /// polygonized BlobTrees cleaned with clean. Fills figures (triangles: all parts', build time).
+  std::vector<ExportPart> exportParts(const Stage& stage, float cellSize, bool progress, const MeshCleanOptions& clean = {},
+                                      ModelFigures* figures = nullptr);
+
  private:
   Species species_;
   std::unique_ptr<KindModel> kind_;

@@ -637,6 +637,17 @@ class OrganismModel final : public KindModel {
     return m;
   }
 
+  std::vector<ExportPart> exportParts(const Stage& stage, float, bool, const SpeciesRender& look, const MeshCleanOptions&,
+                                      ModelFigures& figures) override {
+    ExportPart part;
+    part.name = "organism";
+    part.mesh = mesh(timeOf(stage), look.surface.baseColor);
+    part.material = {"organism", look.surface.baseColor, look.surface.roughness, false};
+    figures.triangles = part.mesh.triangleCount();
+    figures.primitives = spec_.base.faceCount();
+    return {std::move(part)};
+  }
+
   GalleryMotion galleryMotion(bool) override {
     GalleryMotion m;
     m.turntable = !spec_.animated;

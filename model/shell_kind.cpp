@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "blobtree/polygonize.h"
+#include "model/mesh_parts.h"
 
 namespace sprig {
 
@@ -456,6 +457,42 @@ class ShellModel final : public KindModel {
     po.cellSize = cellSize > 0 ? cellSize : shellMeshCell(*shell.blob);
     po.progress = progress;
     return blobtree::polygonize(*shell.blob, po);
+  }
+
+  std::vector<ExportPart> exportParts(const Stage& stage, float cellSize, bool progress, const SpeciesRender&,
+                                      const MeshCleanOptions& clean, ModelFigures& fig) override {
+    const ShellBuild shell = buildShell(spec_, stage.age < 0 ? std::nullopt : std::optional(stage.age));
+    fig.primitives = shell.blob->primitiveCount();
+    blobtree::PolygonizeOptions po;
+    po.cellSize = cellSize > 0 ? cellSize : shellMeshCell(*shell.blob);
+    po.progress = progress;
+    // Painted as the renderer paints it, cleaned as one surface, then split by the part
+    // whose texture weighs most on each triangle.
+    const render::Geometry geometry = shellGeometry(shell, nullptr);
+    const auto& implicit = std::get<render::ImplicitPart>(geometry.parts.front());
+    const organisms::ShellTextureOptions& colors = shell.painter->options();
+    Mesh surface = paintPolygonized(blobtree::polygonizeDetailed(*shell.blob, po), implicit.textures, colors.whorlColor);
+    fig.clean = cleanMesh(surface, clean);
+    using organisms::ShellPart;
+    std::vector<ExportPart> parts;
+    for (auto& [id, mesh] : splitByMaterial(surface)) {
+      const auto part = id == kNoPartTexture ? ShellPart::Whorl : ShellPart(id);
+      std::pair<const char*, Vec3> look = {"whorl", colors.whorlColor};
+      switch (part) {
+        case ShellPart::Whorl: break;
+        case ShellPart::VarixSpine: look = {"varices", colors.varixColor}; break;
+        case ShellPart::AxialSpine: look = {"spines", colors.axialColor}; break;
+        case ShellPart::Bump: look = {"bumps", colors.bumpColor}; break;
+        case ShellPart::Inside: look = {"inside", colors.insideColor}; break;
+      }
+      auto same = std::find_if(parts.begin(), parts.end(), [&](const ExportPart& p) { return p.name == look.first; });
+      if (same != parts.end()) {
+        same->mesh.append(mesh);  // no texture and the whorl's texture are both the whorl
+        continue;
+      }
+      parts.push_back(ExportPart{look.first, std::move(mesh), PartMaterial{look.first, look.second, implicit.material.roughness, false}});
+    }
+    return parts;
   }
 
   GalleryMotion galleryMotion(bool final) override {

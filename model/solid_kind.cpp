@@ -634,6 +634,25 @@ class SolidModel final : public StillKindModel {
     return all;
   }
 
+  std::vector<ExportPart> exportParts(const Stage&, float, bool, const SpeciesRender&, const MeshCleanOptions&,
+                                      ModelFigures& figures) override {
+    std::vector<ExportPart> out;
+    const auto& [parts, mats] = visible();
+    for (size_t i = 0; i < parts.size(); ++i) {
+      const Material& m = spec_.solid.materials.materials[mats[i]];
+      figures.triangles += parts[i].triangleCount();
+      auto same = std::find_if(out.begin(), out.end(), [&](const ExportPart& p) { return p.name == m.name; });
+      if (same != out.end()) {
+        same->mesh.append(parts[i]);
+        continue;
+      }
+      out.push_back(ExportPart{m.name, parts[i], PartMaterial{m.name, m.color, m.roughness, false}});
+    }
+    figures.primitives = tets().tets.size();
+    figures.buildSeconds = buildSeconds_;
+    return out;
+  }
+
   std::vector<std::string> volumeMeshExtensions() const override { return {".msh", ".vtu", ".mesh"}; }
 
   std::vector<std::pair<std::string, Mesh>> interfaceMeshes(const Stage& stage) override {

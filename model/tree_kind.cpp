@@ -12,6 +12,7 @@
 #include "core/paths.h"
 #include "core/progress.h"
 #include "model/growth.h"
+#include "model/mesh_parts.h"
 #include "organisms/skeleton_geometry.h"
 #include "organisms/wind.h"
 #include "textures/procedural.h"
@@ -308,6 +309,44 @@ class TreeModel final : public KindModel {
     Mesh out = blobtree::polygonize(*tree.compiled, po);
     if (tree.leaves.triangleCount() > 0) appendMesh(out, tree.leaves);
     return out;
+  }
+
+  std::vector<ExportPart> exportParts(const Stage& stage, float cellSize, bool progress, const SpeciesRender& look,
+                                      const MeshCleanOptions& clean, ModelFigures& fig) override {
+    const int step = stage.step < 0 ? engine_.lastStep() : stage.step;
+    lsystem::Skeleton skeleton = engine_.skeletonAt(step, stage.fraction);
+    fig.modules = engine_.moduleCount(step);
+    fig.internodes = skeleton.internodes.size();
+    if (skeleton.internodes.empty())
+      throw InputError(species_.loc(), "the species draws no internodes at " + stageName(stage) +
+                                           ": there is no surface to mesh");
+    TreeSurface tree = buildTreeSurface(skeleton, spec_.surface.value_or(organisms::TreeOptions{}));
+    fig.primitives = tree.compiled->primitiveCount();
+    blobtree::PolygonizeOptions po;
+    po.cellSize = cellSize;
+    po.progress = progress;
+    // The wood: coloured by its bark as the renderer colours it, then cleaned.
+    const render::Geometry geometry = surfaceGeometry(tree, look, nullptr);
+    const auto& implicit = std::get<render::ImplicitPart>(geometry.parts.front());
+    std::vector<ExportPart> parts(1);
+    parts[0].name = "wood";
+    parts[0].mesh = paintPolygonized(blobtree::polygonizeDetailed(*tree.compiled, po), implicit.textures,
+                                     look.style.wood.baseColor);
+    fig.clean = cleanMesh(parts[0].mesh, clean);
+    parts[0].mesh.materials.clear();
+    parts[0].material = {"wood", look.style.wood.baseColor, look.style.wood.roughness, false};
+    const organisms::TreeOptions& options = tree.options;
+    const std::pair<organisms::OrganSet, const char*> sets[] = {{organisms::OrganSet::Leaves, "leaves"},
+                                                                 {organisms::OrganSet::Fruit, "fruit"}};
+    for (const auto& [set, name] : sets) {
+      Mesh organs = organisms::buildOrganMesh(skeleton, options, set);
+      if (organs.triangleCount() == 0) continue;
+      organs.materials.clear();
+      const render::Material& m = set == organisms::OrganSet::Leaves ? look.style.leaf : look.style.fruit;
+      // Leaves are open polygons seen from both sides; fruit are closed spheres.
+      parts.push_back(ExportPart{name, std::move(organs), PartMaterial{name, m.baseColor, m.roughness, set == organisms::OrganSet::Leaves}});
+    }
+    return parts;
   }
 
   GalleryMotion galleryMotion(bool final) override {

@@ -1,5 +1,7 @@
 #include "organisms/tree_builder.h"
 
+#include <optional>
+
 #include <algorithm>
 #include <cmath>
 #include <optional>
@@ -245,13 +247,16 @@ void addSphere(LeafWriter& w, const lsystem::Organ& o, Vec3 color) {
 
 }  // namespace
 
-Mesh buildLeafMesh(const lsystem::Skeleton& skeleton, const TreeOptions& opt) {
+namespace {
+
+Mesh organMesh(const lsystem::Skeleton& skeleton, const TreeOptions& opt, std::optional<OrganSet> set) {
   Mesh mesh;
   if (!opt.leaves.enabled) return mesh;
   LeafWriter w{mesh, opt.leaves.material};
   constexpr uint64_t kSeedLeaf = 0x4c454146ull;
   for (size_t i = 0; i < skeleton.organs.size(); ++i) {
     const auto& o = skeleton.organs[i];
+    if (set && (*set == OrganSet::Fruit) != (o.kind == lsystem::Organ::Kind::Sphere)) continue;
     Rng rng(deriveSeed(opt.seed, {kSeedLeaf, static_cast<uint64_t>(i)}));
     const Vec3 color = leafColor(o.color, rng);
     switch (o.kind) {
@@ -261,6 +266,14 @@ Mesh buildLeafMesh(const lsystem::Skeleton& skeleton, const TreeOptions& opt) {
     }
   }
   return mesh;
+}
+
+}  // namespace
+
+Mesh buildLeafMesh(const lsystem::Skeleton& skeleton, const TreeOptions& opt) { return organMesh(skeleton, opt, std::nullopt); }
+
+Mesh buildOrganMesh(const lsystem::Skeleton& skeleton, const TreeOptions& opt, OrganSet set) {
+  return organMesh(skeleton, opt, set);
 }
 
 }  // namespace sprig::organisms

@@ -51,4 +51,14 @@ CurveSet treeAxes(const TreeBlob& blob);
 /// leaves are disabled or there are no organs. Deterministic.
 Mesh buildLeafMesh(const lsystem::Skeleton& skeleton, const TreeOptions& options);
 
+/// Which organs buildOrganMesh builds.
+enum class OrganSet {
+  Leaves,  ///< polygons and named surfaces
+  Fruit,   ///< spheres
+};
+
+/// buildLeafMesh restricted to one set of organs (each organ keeps the colour it has in
+/// buildLeafMesh), so an export can keep leaves and fruit apart.
+Mesh buildOrganMesh(const lsystem::Skeleton& skeleton, const TreeOptions& options, OrganSet set);
+
 }  // namespace sprig::organisms

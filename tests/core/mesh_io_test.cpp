@@ -246,3 +246,100 @@ TEST_CASE("writeMesh::failures", "[core]") {
     CHECK(dir.entries() == 1);
   }
 }
+
+namespace {
+
+// Two parts: a textured-looking "wood" cube with vertex colours at half its base colour or
+// brighter, and a "leaves" cube moved aside, double-sided, without vertex colours.
+std::vector<ExportPart> twoParts() {
+  ExportPart wood{"wood", test::cube(true), PartMaterial{"wood", Vec3(0.5f, 0.4f, 0.2f), 0.7f, false}};
+  wood.mesh.materials.clear();
+  for (size_t i = 0; i < wood.mesh.colors.size(); ++i)
+    wood.mesh.colors[i] = i == 7 ? Vec3(0.6f, 0.2f, 0.1f) : Vec3(0.25f, 0.2f, 0.1f);
+  ExportPart leaves{"leaves", test::cube(false), PartMaterial{"leaves", Vec3(0.1f, 0.4f, 0.05f), 0.5f, true}};
+  for (auto& p : leaves.mesh.positions) p += Vec3(2, 0, 0);
+  return {wood, leaves};
+}
+
+}  // namespace
+
+TEST_CASE("writeParts", "[core]") {
+  TempDir dir;
+  const std::vector<ExportPart> parts = twoParts();
+  SECTION("glb: one named node, mesh and material per part; COLOR_0 relative to the base colour") {
+    const fs::path file = dir.path / "parts.glb";
+    writeParts(parts, file);
+    tinygltf::Model model;
+    tinygltf::TinyGLTF loader;
+    std::string err, warn;
+    REQUIRE(loader.LoadBinaryFromFile(&model, &err, &warn, file.string()));
+    REQUIRE(model.nodes.size() == 2);
+    CHECK(model.nodes[0].name == "wood");
+    CHECK(model.nodes[1].name == "leaves");
+    REQUIRE(model.meshes.size() == 2);
+    REQUIRE(model.materials.size() == 2);
+    const auto& wood = model.materials[size_t(model.meshes[size_t(model.nodes[0].mesh)].primitives[0].material)];
+    const auto& leaves = model.materials[size_t(model.meshes[size_t(model.nodes[1].mesh)].primitives[0].material)];
+    CHECK(wood.name == "wood");
+    CHECK(wood.pbrMetallicRoughness.baseColorFactor == std::vector<double>{0.5f, 0.4f, 0.2f, 1.0});
+    CHECK_FALSE(wood.doubleSided);
+    CHECK(leaves.pbrMetallicRoughness.baseColorFactor == std::vector<double>{0.1f, 0.4f, 0.05f, 1.0});
+    CHECK(leaves.doubleSided);
+    const auto& wp = model.meshes[size_t(model.nodes[0].mesh)].primitives[0];
+    const auto& lp = model.meshes[size_t(model.nodes[1].mesh)].primitives[0];
+    CHECK(lp.attributes.count("COLOR_0") == 0);
+    REQUIRE(wp.attributes.count("COLOR_0") == 1);
+    const auto& acc = model.accessors[size_t(wp.attributes.at("COLOR_0"))];
+    const auto& view = model.bufferViews[size_t(acc.bufferView)];
+    std::vector<Vec3> rel(8);
+    std::memcpy(rel.data(), model.buffers[0].data.data() + view.byteOffset + acc.byteOffset, 8 * sizeof(Vec3));
+    CHECK(rel[0].x == Approx(0.5));  // 0.25 / 0.5
+    CHECK(rel[0].y == Approx(0.5));
+    CHECK(rel[0].z == Approx(0.5));
+    CHECK(rel[7].x == 1.0f);  // 0.6 / 0.5 clamped
+    CHECK(rel[7].y == Approx(0.5));
+    CHECK(clampedColorChannels(parts[0]) == 1);
+    CHECK(clampedColorChannels(parts[1]) == 0);
+    // The leaves' positions are the moved cube's.
+    const auto& pos = model.accessors[size_t(lp.attributes.at("POSITION"))];
+    CHECK(pos.minValues == std::vector<double>{2, 0, 0});
+  }
+  SECTION("obj: one object and material per part, indices continue across parts") {
+    const fs::path file = dir.path / "parts.obj";
+    writeParts(parts, file);
+    const std::string obj = readFile(file), mtl = readFile(dir.path / "parts.mtl");
+    CHECK(obj.find("mtllib parts.mtl\n") != std::string::npos);
+    CHECK(obj.find("o wood\n") < obj.find("usemtl wood\n"));
+    CHECK(obj.find("usemtl wood\n") < obj.find("o leaves\n"));
+    CHECK(obj.find("o leaves\n") < obj.find("usemtl leaves\n"));
+    // The leaves' first triangle (0 2 3 of the cube) follows the wood's 8 vertices.
+    CHECK(obj.find("usemtl leaves\nf 9 11 12\n") != std::string::npos);
+    CHECK(mtl.find("newmtl wood\nKa 0 0 0\nKd 0.5 0.4 0.2\n") != std::string::npos);
+    CHECK(mtl.find("newmtl leaves\nKa 0 0 0\nKd 0.1 0.4 0.05\n") != std::string::npos);
+  }
+  SECTION("ply: a colour at every vertex, the part index per face, the parts named in the header") {
+    const fs::path file = dir.path / "parts.ply";
+    writeParts(parts, file);
+    const std::string bytes = readFile(file);
+    CHECK(bytes.find("comment part 0 wood\ncomment part 1 leaves\n") != std::string::npos);
+    CHECK(bytes.find("element vertex 16\n") != std::string::npos);
+    CHECK(bytes.find("property uchar red\n") != std::string::npos);
+    CHECK(bytes.find("property uint material\n") != std::string::npos);
+    // Vertex 8 (the first of the leaves) carries the leaves' base colour, sRGB-encoded. The
+    // wood has normals and the leaves none, so the merged mesh keeps positions and colours
+    // only: 15 bytes a vertex.
+    const size_t body = bytes.find("end_header\n") + 11;
+    const size_t v8 = body + 8 * 15 + 12;
+    CHECK(uint8_t(bytes[v8]) == 89);       // linearToSrgb(0.1) * 255 = 89.04
+    CHECK(uint8_t(bytes[v8 + 1]) == 170);  // linearToSrgb(0.4) * 255 = 169.6
+    CHECK(uint8_t(bytes[v8 + 2]) == 63);   // linearToSrgb(0.05) * 255 = 63.2
+    // The last face's material is the leaves' index, 1.
+    CHECK(readRaw<uint32_t>(bytes, bytes.size() - 4) == 1);
+  }
+  SECTION("two parts of one name are refused, nothing written") {
+    std::vector<ExportPart> same = parts;
+    same[1].name = "wood";
+    CHECK_THROWS_AS(writeParts(same, dir.path / "same.glb"), std::invalid_argument);
+    CHECK(dir.entries() == 0);
+  }
+}

@@ -1,24 +1,39 @@
 #!/usr/bin/env bash
 # Every kind's .glb export read back by the Khronos glTF validator (scripts/gltf-validate.js):
-# no errors, no warnings. One species of each kind and of each organism base and colouring.
+# no errors, no warnings; and its parts and colours checked against the species file by
+# scripts/gltf-parts.py (node names, baseColorFactor, double-sided leaves). One species of
+# each kind, of each part type (wood + leaves, whorl + varices + spines + inside, solid
+# materials) and of each organism base and colouring.
 # Usage: gltf_validate.sh path/to/sprig   (run from the repository root)
 set -euo pipefail
 sprig="$1"
 out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
+# species  [parts it must have]  (flags after '|')
 species=(
-  abop_1_24a                 # tree, skeleton of an L-system
-  fig_tree_12_pcm_offset     # tree, BlobTree with PCM
-  shell_top                  # shell, painted pigment
-  blob_ricci_fig3            # blob
-  fig_org_05b_berry_level2   # organism on a primitive
-  fig_org_13a_mummified_skull_sharp  # organism on a CT volume, blend colour
-  fig_org_14c_planet_blend   # organism with the planet shader
-  org_painted_band           # organism on a painted mesh
+  "abop_1_24a wood | --steps 3"            # tree, skeleton of an L-system
+  "fig_tree_12_pcm_offset wood"            # tree, BlobTree with PCM
+  "tree_lime wood leaves | --steps 3 --cell 0.01"  # tree in leaf: wood and double-sided leaves apart
+  "shell_top whorl inside"                 # shell, painted pigment
+  "fig_shell_07b_varix_full whorl varices" # shell with varices and their spines
+  "fig_shell_09a_axial_straight whorl varices spines"  # shell with axial canal spines
+  "blob_ricci_fig3 blob"                   # blob
+  "fig_org_05b_berry_level2 organism"      # organism on a primitive
+  "fig_org_13a_mummified_skull_sharp organism"  # organism on a CT volume, blend colour
+  "fig_org_14c_planet_blend organism"      # organism with the planet shader
+  "org_painted_band organism"              # organism on a painted mesh
+  "fig_solid_01_striped_candy chocolate white_chocolate"  # solid: one part per material
 )
 files=()
-for s in "${species[@]}"; do
-  "$sprig" mesh "species/$s.yaml" -o "$out/$s.glb" >/dev/null
+for entry in "${species[@]}"; do
+  read -r s parts <<<"${entry%%|*}"
+  flags=""
+  [[ "$entry" == *"|"* ]] && flags="${entry#*|}"
+  # shellcheck disable=SC2086
+  "$sprig" mesh "species/$s.yaml" -o "$out/$s.glb" $flags >/dev/null
   files+=("$out/$s.glb")
+  expect=()
+  for p in $parts; do expect+=(--expect "$p"); done
+  python3 scripts/gltf-parts.py "species/$s.yaml" "$out/$s.glb" "${expect[@]}"
 done
 node scripts/gltf-validate.js "${files[@]}"

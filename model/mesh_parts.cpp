@@ -1,0 +1,72 @@
+#include "model/mesh_parts.h"
+
+#include <map>
+#include <stdexcept>
+
+namespace sprig {
+
+Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::TextureTable& textures, const Vec3& base) {
+  Mesh mesh = result.mesh;
+  const size_t n = mesh.positions.size();
+  if (result.attributes.size() != n) throw std::invalid_argument("paintPolygonized: the mesh has no attributes");
+  mesh.colors.assign(n, base);
+  for (size_t v = 0; v < n; ++v) {
+    const blobtree::Attributes& a = result.attributes[v];
+    if (a.textureCount == 0 || textures.empty()) continue;
+    Vec3 sum(0);
+    float wsum = 0;
+    for (int i = 0; i < a.textureCount && i < blobtree::Attributes::kMaxTextures; ++i) {
+      const float w = a.textureWeights[size_t(i)];
+      if (!(w > 0)) continue;
+      const uint16_t id = a.textureIds[size_t(i)];
+      sum += w * (id < textures.size() ? textures[id](a.uv, mesh.positions[v]) : base);
+      wsum += w;
+    }
+    if (wsum > 0) mesh.colors[v] = sum / wsum;
+  }
+  mesh.materials.assign(mesh.triangles.size(), kNoPartTexture);
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    std::map<uint32_t, float> weight;
+    for (int k = 0; k < 3; ++k) {
+      const blobtree::Attributes& a = result.attributes[mesh.triangles[t][k]];
+      for (int i = 0; i < a.textureCount && i < blobtree::Attributes::kMaxTextures; ++i)
+        weight[a.textureIds[size_t(i)]] += a.textureWeights[size_t(i)];
+    }
+    float best = 0;
+    for (const auto& [id, w] : weight)  // ties go to the smaller id (map order)
+      if (w > best) best = w, mesh.materials[t] = id;
+  }
+  return mesh;
+}
+
+std::vector<std::pair<uint32_t, Mesh>> splitByMaterial(const Mesh& mesh) {
+  if (mesh.materials.size() != mesh.triangles.size())
+    throw std::invalid_argument("splitByMaterial: the mesh has no per-triangle ids");
+  std::map<uint32_t, std::vector<size_t>> groups;
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) groups[mesh.materials[t]].push_back(t);
+  std::vector<std::pair<uint32_t, Mesh>> out;
+  const size_t n = mesh.positions.size();
+  for (const auto& [id, tris] : groups) {
+    std::vector<uint32_t> remap(n, UINT32_MAX);
+    for (size_t t : tris)
+      for (int k = 0; k < 3; ++k) remap[mesh.triangles[t][k]] = 0;
+    Mesh part;
+    uint32_t next = 0;
+    for (size_t v = 0; v < n; ++v) {
+      if (remap[v] == UINT32_MAX) continue;
+      remap[v] = next++;
+      part.positions.push_back(mesh.positions[v]);
+      if (mesh.normals.size() == n) part.normals.push_back(mesh.normals[v]);
+      if (mesh.uvs.size() == n) part.uvs.push_back(mesh.uvs[v]);
+      if (mesh.colors.size() == n) part.colors.push_back(mesh.colors[v]);
+    }
+    for (size_t t : tris) {
+      const glm::uvec3& tri = mesh.triangles[t];
+      part.triangles.push_back(glm::uvec3(remap[tri.x], remap[tri.y], remap[tri.z]));
+    }
+    out.emplace_back(id, std::move(part));
+  }
+  return out;
+}
+
+}  // namespace sprig

@@ -1,0 +1,31 @@
+#pragma once
+/// Helpers the kinds use to hand `sprig mesh` their parts (KindModel::exportParts):
+/// polygonized BlobTrees coloured as the renderer colours them, and meshes split by their
+/// per-triangle ids.
+
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include "blobtree/polygonize.h"
+#include "core/mesh.h"
+#include "render/geometry.h"
+
+namespace sprig {
+
+/// Texture id meaning "no texture contributes" in paintPolygonized's triangle ids.
+inline constexpr uint32_t kNoPartTexture = 0xffffffffu;
+
+/// The polygonized mesh of result with, per vertex, the colour the renderer gives it
+/// (Σ wᵢ·textureᵢ(uv, p) / Σ wᵢ over the vertex's textures; base where none contributes,
+/// as render::Scene::attributeColor), and per triangle (Mesh::materials) the texture id
+/// with the largest weight summed over its three vertices (kNoPartTexture when none).
+/// result must carry attributes (PolygonizeOptions::attributes). O(V·textures).
+Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::TextureTable& textures, const Vec3& base);
+
+/// The triangles of mesh grouped by their Mesh::materials id, in increasing id order;
+/// each group is its own mesh (only the vertices it uses, in their original order; every
+/// per-vertex array kept; materials cleared). mesh.materials must have one id per triangle.
+std::vector<std::pair<uint32_t, Mesh>> splitByMaterial(const Mesh& mesh);
+
+}  // namespace sprig

@@ -1,0 +1,137 @@
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cstring>
+#include <map>
+#include <string>
+#include <tuple>
+
+#include "core/mesh.h"
+#include "core/mesh_clean.h"
+#include "model/mesh_parts.h"
+#include "model/model.h"
+#include "model/species.h"
+#include "tests/core/cube_mesh.h"
+
+using namespace sprig;
+
+namespace {
+
+// The parts' triangles in one mesh, each part's boundary vertices merged with the other
+// parts' boundary vertices at identical positions (a shell's parts are cut from one surface
+// along shared vertices). Interior vertices stay apart, even where two coincide.
+Mesh weld(const std::vector<ExportPart>& parts, const std::vector<std::string>& names) {
+  Mesh out;
+  std::map<std::tuple<float, float, float>, uint32_t> index;
+  for (const ExportPart& p : parts) {
+    if (std::find(names.begin(), names.end(), p.name) == names.end()) continue;
+    std::map<std::pair<uint32_t, uint32_t>, int> edges;  // undirected edge -> use count
+    for (const auto& t : p.mesh.triangles)
+      for (int k = 0; k < 3; ++k) ++edges[std::minmax(t[k], t[(k + 1) % 3])];
+    std::vector<char> boundary(p.mesh.positions.size(), 0);
+    for (const auto& [e, n] : edges)
+      if (n == 1) boundary[e.first] = boundary[e.second] = 1;
+    std::vector<uint32_t> remap(p.mesh.positions.size());
+    for (size_t v = 0; v < p.mesh.positions.size(); ++v) {
+      const Vec3& q = p.mesh.positions[v];
+      if (!boundary[v]) {
+        remap[v] = uint32_t(out.positions.size());
+        out.positions.push_back(q);
+        continue;
+      }
+      auto [it, fresh] = index.emplace(std::make_tuple(q.x, q.y, q.z), uint32_t(out.positions.size()));
+      if (fresh) out.positions.push_back(q);
+      remap[v] = it->second;
+    }
+    for (const auto& t : p.mesh.triangles) out.triangles.push_back(glm::uvec3(remap[t.x], remap[t.y], remap[t.z]));
+  }
+  return out;
+}
+
+const ExportPart* find(const std::vector<ExportPart>& parts, const std::string& name) {
+  for (const ExportPart& p : parts)
+    if (p.name == name) return &p;
+  return nullptr;
+}
+
+}  // namespace
+
+TEST_CASE("splitByMaterial", "[model]") {
+  Mesh cube = test::cube(true);  // material t / 4: three groups of four triangles
+  const auto groups = splitByMaterial(cube);
+  REQUIRE(groups.size() == 3);
+  size_t triangles = 0;
+  for (const auto& [id, m] : groups) {
+    CHECK(m.triangleCount() == 4);
+    CHECK(m.materials.empty());
+    CHECK(m.normals.size() == m.vertexCount());
+    CHECK(m.colors.size() == m.vertexCount());
+    triangles += m.triangleCount();
+    // Every triangle is the cube's, at the same positions.
+    for (size_t t = 0; t < m.triangles.size(); ++t)
+      for (int k = 0; k < 3; ++k) CHECK(m.positions[m.triangles[t][k]] == cube.positions[cube.triangles[4 * id + t][k]]);
+  }
+  CHECK(triangles == 12);
+  // Faces {0,2,3,1} and {4,5,7,6} (ids 0) use all eight vertices; {0,1,5,4} and {2,6,7,3} too.
+  CHECK(groups[0].second.vertexCount() == 8);
+}
+
+// The shipped species' wood and shell surfaces mesh to one closed, consistently oriented
+// part in their colours; the turret's specks and voids (issue 18) are gone.
+TEST_CASE("SpeciesModel::exportParts of shipped species", "[model][slow]") {
+  struct Case {
+    const char* species;
+    int lastStep;
+    float cell;
+    std::vector<std::string> surface;  // the parts that make the closed surface
+    size_t components;                  // its parts: 1, or the number the species implies
+  };
+  const Case cases[] = {
+      {"fig_tree_12_pcm_offset", -1, 0.0f, {"wood"}, 1},
+      {"tree_lime", 3, 0.01f, {"wood"}, 1},
+      {"fig_shell_07b_varix_full", -1, 0.0f, {"whorl", "varices"}, 1},
+      {"shell_turret", -1, 0.0f, {"whorl", "inside"}, 1},
+      {"blob_ricci_fig3", -1, 0.0f, {"blob"}, 5},  // five blends side by side (Fig. 3)
+  };
+  for (const Case& c : cases) {
+    INFO(c.species);
+    PathPolicy policy;
+    policy.root = SPRIG_SOURCE_DIR;
+    const Species species = loadSpecies(std::string(SPRIG_SOURCE_DIR) + "/species/" + c.species + ".yaml", policy);
+    ModelOptions options;
+    options.lastStep = c.lastStep;
+    SpeciesModel model(species, options);
+    ModelFigures fig;
+    const std::vector<ExportPart> parts = model.exportParts(model.finalStage(), c.cell, false, {}, &fig);
+    for (const std::string& name : c.surface) REQUIRE(find(parts, name) != nullptr);
+    const Mesh surface = c.surface.size() == 1 ? find(parts, c.surface[0])->mesh : weld(parts, c.surface);
+    size_t components = 0;
+    triangleComponents(surface, &components);
+    CHECK(components == c.components);
+    const MeshTopology topo = analyzeTopology(surface);
+    INFO("boundary " << topo.boundaryEdges << ", non-manifold " << topo.nonManifoldEdges << ", inconsistent "
+                     << topo.inconsistentEdges);
+    CHECK(topo.closed());
+    CHECK(topo.manifold());
+    CHECK(signedVolume(surface) > 0);
+    CHECK(fig.clean.componentsAfter == c.components);
+    CHECK(fig.clean.facesAgainstAfter < fig.clean.facesAgainstBefore + 1);
+    if (std::string(c.species) == "shell_turret") {
+      CHECK(fig.clean.componentsBefore == 18);
+      CHECK(fig.clean.specks == 3);
+      CHECK(fig.clean.voids == 14);
+      CHECK(find(parts, "whorl")->material.baseColor == Vec3(0.62f, 0.45f, 0.30f));
+      CHECK(find(parts, "inside")->material.baseColor == Vec3(0.90f, 0.80f, 0.72f));
+    }
+    if (std::string(c.species) == "tree_lime") {
+      const ExportPart* leaves = find(parts, "leaves");
+      REQUIRE(leaves != nullptr);
+      CHECK(leaves->material.doubleSided);
+      CHECK(leaves->material.baseColor == Vec3(0.20f, 0.42f, 0.10f));
+      CHECK(find(parts, "wood")->material.baseColor == Vec3(0.36f, 0.30f, 0.26f));
+      CHECK_FALSE(find(parts, "wood")->material.doubleSided);
+      // The leaves are apart from the wood: the wood alone is the closed part above.
+      CHECK(leaves->mesh.triangleCount() > 0);
+    }
+  }
+}
