@@ -1,5 +1,6 @@
 /// `sprig schema [-o FILE]`: the JSON Schema of species files, for editors (model/schema.h).
 
+#include <filesystem>
 #include <iostream>
 
 #include "app/cmd_common.h"
@@ -20,6 +21,10 @@ int runSchema(const SchemaArgs& a, const GlobalOptions& g) {
     std::cout << json;
     return kExitOk;
   }
+  const std::filesystem::path parent = std::filesystem::path(a.out).parent_path();
+  std::error_code ec;
+  if (!parent.empty() && !std::filesystem::is_directory(parent, ec))
+    throw UsageError("--output: folder '" + parent.string() + "' does not exist");
   writeFileAtomic(a.out, json);
   if (!g.quiet) std::cout << "wrote " << a.out << " (" << json.size() << " bytes)\n";
   return kExitOk;

@@ -22,16 +22,15 @@ ajv() { local c=$1; shift; "$AJV" "$c" "$@" --spec=draft7 --strict=false $([ "$c
 ajv compile -s "$WORK/schema.json" > /dev/null || fail "the schema does not compile"
 
 # 2. Every shipped species.
-n=0
-for f in species/*.yaml; do
-  ajv validate -s "$WORK/schema.json" -d "$f" > "$WORK/out" 2>&1 || { cat "$WORK/out"; fail "$f is valid for sprig but not for the schema"; }
-  n=$((n + 1))
-done
+# One validator run for all of them (each start of Node.js costs about a second here).
+n=$(ls species/*.yaml | wc -l)
 [ "$n" -ge 50 ] || fail "only $n species files"
+ajv validate -s "$WORK/schema.json" -d "species/*.yaml" > "$WORK/out" 2>&1 || { grep -v " valid$" "$WORK/out"; fail "species valid for sprig but not for the schema"; }
+[ "$(grep -c ' valid$' "$WORK/out")" -eq "$n" ] || { cat "$WORK/out"; fail "ajv did not report all $n species valid"; }
 
 # 3. Rejected by both the reader and the schema.
 rejected=(unknown_key wrong_type wrong_section_type out_of_range bad_choice bad_color missing_kind unknown_kind
-          nan_value inf_value)
+          nan_value inf_value organism_bad_procedure three_sections)
 for c in "${rejected[@]}"; do
   f=tests/bad_inputs/inputs/$c.yaml
   if "$SPRIG" -q check "$f" > /dev/null 2>&1; then fail "sprig accepts $f"; fi
