@@ -4,6 +4,7 @@
 #include <sstream>
 
 #include "app/cmd_common.h"
+#include "app/watch.h"
 #include "model/growth.h"
 #include "model/species.h"
 #include "model/tree_kind.h"
@@ -24,10 +25,10 @@ struct PreviewArgs {
   int samples = 0;
   std::string view;
   GrowthFlags growth;
+  WatchFlags watch;
 };
 
-int runPreview(const PreviewArgs& a, const GlobalOptions& g) {
-  requireExtension("-o", a.out, {".png", ".jpg", ".jpeg", ".exr"});
+int previewOnce(const PreviewArgs& a, const GlobalOptions& g) {
   lsystem::GrammarOverrides extra = a.growth.overrides();
   Species species = loadSpecies(a.file, g.pathPolicy());
   printNotes(g, species);
@@ -63,6 +64,11 @@ int runPreview(const PreviewArgs& a, const GlobalOptions& g) {
   return kExitOk;
 }
 
+int runPreview(const PreviewArgs& a, const GlobalOptions& g) {
+  requireExtension("-o", a.out, {".png", ".jpg", ".jpeg", ".exr"});
+  return runWatched(a.watch, g, a.file, a.out, [&] { return previewOnce(a, g); });
+}
+
 }  // namespace
 
 void addPreviewCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run) {
@@ -76,6 +82,7 @@ void addPreviewCommand(CLI::App& app, const GlobalOptions& global, CommandRun& r
   sub->add_option("--samples", args->samples, "camera samples per pixel")->check(CLI::Range(1, 1024));
   sub->add_option("--view", args->view, "camera direction AZIMUTH,ELEVATION[,FOV] in degrees");
   addGrowthFlags(*sub, args->growth);
+  addWatchFlags(*sub, args->watch);
 }
 
 }  // namespace sprig

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "app/cmd_common.h"
+#include "app/watch.h"
 #include "model/model.h"
 #include "model/species.h"
 #include "core/image.h"
@@ -27,6 +28,7 @@ struct RenderArgs {
   std::string camera;
   std::string section;
   GrowthFlags growth;
+  WatchFlags watch;
 };
 
 /// Comma-separated finite numbers of magnitude at most 1e6; nullopt when one is not.
@@ -55,8 +57,7 @@ void parseCamera(const std::string& text, SpeciesRender& look) {
   look.camera = c;
 }
 
-int runRender(const RenderArgs& a, const GlobalOptions& g) {
-  requireExtension("-o", a.out, {".png", ".jpg", ".jpeg", ".exr"});
+int renderOnce(const RenderArgs& a, const GlobalOptions& g) {
   GeometryMode mode = a.mode == "mesh" ? GeometryMode::Mesh
                       : a.mode == "skeleton" ? GeometryMode::Skeleton
                                              : GeometryMode::Exact;
@@ -96,6 +97,11 @@ int runRender(const RenderArgs& a, const GlobalOptions& g) {
   return kExitOk;
 }
 
+int runRender(const RenderArgs& a, const GlobalOptions& g) {
+  requireExtension("-o", a.out, {".png", ".jpg", ".jpeg", ".exr"});
+  return runWatched(a.watch, g, a.file, a.out, [&] { return renderOnce(a, g); });
+}
+
 }  // namespace
 
 void addRenderCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run) {
@@ -116,6 +122,7 @@ void addRenderCommand(CLI::App& app, const GlobalOptions& global, CommandRun& ru
   sub->add_option("--section", args->section,
                   "solids: cut away the side n·x > d of the plane NX,NY,NZ,D, showing the layers on the cut");
   addGrowthFlags(*sub, args->growth);
+  addWatchFlags(*sub, args->watch);
 }
 
 }  // namespace sprig

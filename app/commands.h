@@ -52,6 +52,9 @@ void addGalleryCommand(CLI::App& app, const GlobalOptions& global, CommandRun& r
 /// `sprig animate SPECIES -o OUT` (app/cmd_animate.cpp).
 void addAnimateCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run);
 
+/// `sprig schema [-o FILE]` (app/cmd_schema.cpp).
+void addSchemaCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run);
+
 /// `sprig render SPECIES -o OUT` (app/cmd_render.cpp).
 void addRenderCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run);
 

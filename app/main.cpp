@@ -37,6 +37,7 @@ int main(int argc, char** argv) {
   addMeshCommand(app, global, run);
   addGalleryCommand(app, global, run);
   addAnimateCommand(app, global, run);
+  addSchemaCommand(app, global, run);
 
   try {
     app.parse(argc, argv);

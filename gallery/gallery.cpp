@@ -1,6 +1,7 @@
 #include "gallery/gallery.h"
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <iterator>
@@ -66,6 +67,7 @@ int renderGalleryAnimation(SpeciesModel& model, const fs::path& out, const Speci
   opt.framesPerStage = motion.framesPerStage;
   opt.fps = final ? 12 : 8;
   opt.holdSeconds = 1;
+  opt.holdFirst = true;  // the page's first glimpse (and the GIF's first frame) is the grown form
   opt.width = w;
   opt.height = h;
   opt.samples = samples;
@@ -174,48 +176,185 @@ GalleryItem renderGalleryItem(const fs::path& speciesFile, const fs::path& outDi
   return item;
 }
 
+namespace {
+
+/// A kind's heading in the index, in the order the index shows them.
+struct KindGroup {
+  const char* kind;
+  const char* heading;
+};
+constexpr KindGroup kKindGroups[] = {
+    {"tree", "Trees"}, {"shell", "Shells"}, {"organism", "Organisms"}, {"solid", "Solids"}, {"blob", "BlobTree models"}};
+
+/// The figure sets of the papers, recognized by the species file's name.
+struct FigureSet {
+  const char* prefix;
+  const char* title;
+};
+constexpr FigureSet kFigureSets[] = {
+    {"abop_", "ABOP (Prusinkiewicz, Lindenmayer)"},
+    {"fig_tree_", "BlobTree Trees (Galbraith et al.)"},
+    {"blob_", "BlobTree blends and offsets"},
+    {"fig_shell_", "Murex cabritii shell (Galbraith et al.)"},
+    {"fig_org_", "Shapes on subdivision surfaces (Velho et al.)"},
+    {"fig_solid_", "Layered solid models (Cutler et al.)"},
+};
+
+std::string stemOf(const GalleryItem& it) { return fs::path(it.source).stem().string(); }
+
+std::string lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+const char* pageStyle() {
+  return "body{font-family:system-ui,sans-serif;margin:0;background:#f4f3ef;color:#222}\n"
+         "header{position:sticky;top:0;z-index:1;background:#2f3a2c;color:#eee;padding:10px 24px;display:flex;"
+         "gap:16px;align-items:center;flex-wrap:wrap}\n"
+         "header h1{font-size:20px;margin:0;font-weight:600}header a{color:#cfe3c0}\n"
+         "#filter{font-size:16px;padding:6px 10px;border-radius:6px;border:0;min-width:260px}\n"
+         "nav a{margin-right:12px}\n.sets button{margin:2px;border:1px solid #888;background:#fff;border-radius:12px;"
+         "padding:2px 10px;cursor:pointer;font-size:13px}\n"
+         "main{padding:8px 24px 40px}\nsection h2{margin:24px 0 8px;font-weight:600}\n"
+         ".grid{display:grid;grid-template-columns:repeat(auto-fill,minmax(200px,1fr));gap:12px}\n"
+         ".card{background:#fff;border-radius:8px;overflow:hidden;box-shadow:0 1px 3px rgba(0,0,0,.15);"
+         "text-decoration:none;color:inherit;display:flex;flex-direction:column}\n"
+         ".card:hover{box-shadow:0 2px 8px rgba(0,0,0,.3)}\n.card img{width:100%;height:auto;display:block;"
+         "aspect-ratio:4/3;background:#e6e5e0}\n"
+         ".card .name{padding:6px 8px 0;font-weight:600;font-size:14px}\n.card .set{padding:0 8px 8px;color:#666;"
+         "font-size:12px}\n.card.failed{border:2px solid #a00}\n"
+         ".count{color:#cfe3c0;font-size:14px}\n"
+         ".page img{max-width:100%;border-radius:4px;display:block}\n.page figure{margin:16px 0}\n"
+         ".page figcaption{color:#555;font-size:14px;margin-top:4px}\n"
+         ".figs{color:#333;font-size:14px;border-collapse:collapse}\n.figs td{padding:2px 14px 2px 0}\n"
+         ".error{color:#a00;white-space:pre-wrap;font-family:monospace}\n";
+}
+
+}  // namespace
+
+std::string galleryFigureSet(const std::string& stem) {
+  for (const FigureSet& f : kFigureSets)
+    if (stem.rfind(f.prefix, 0) == 0) return f.title;
+  return {};
+}
+
+std::string galleryPageFile(const GalleryItem& item) { return "pages/" + stemOf(item) + ".html"; }
+
+std::string galleryThumbFile(const GalleryItem& item) {
+  return item.preview.empty() ? std::string() : "thumbs/" + stemOf(item) + ".png";
+}
+
 std::string galleryIndexHtml(const std::vector<GalleryItem>& items) {
   std::string o;
-  o += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>Sprig gallery</title>\n<style>\n"
-       "body{font-family:system-ui,sans-serif;margin:24px;background:#f4f3ef;color:#222}\n"
-       "h1{font-weight:600}\n.item{background:#fff;border-radius:8px;padding:16px;margin:0 0 20px;"
-       "box-shadow:0 1px 3px rgba(0,0,0,.15);display:flex;gap:20px;flex-wrap:wrap}\n"
-       ".item img{border-radius:4px;display:block}\n.preview img{height:300px}\n.strip img{height:200px}\n"
-       ".animation img{height:200px}\n"
-       ".meta{min-width:240px;max-width:420px}\n.meta h2{margin:0 0 6px}\n.figs{color:#555;font-size:14px}\n"
-       ".figs td{padding:1px 10px 1px 0}\n.error{color:#a00;white-space:pre-wrap;font-family:monospace}\n"
-       "</style>\n</head>\n<body>\n<h1>Sprig gallery</h1>\n<p>" +
-       std::to_string(items.size()) +
-       " species. Each shows the final stage, a strip of growth stages and its growth animation. "
-       "<a href=\"contact_sheet.png\">Contact sheet</a>.</p>\n";
-  for (const auto& it : items) {
-    o += "<div class=\"item\" id=\"" + html(fs::path(it.source).stem().string()) + "\">\n<div class=\"meta\">\n<h2>" +
-         html(it.name) + "</h2>\n<p>" + html(it.description) + "</p>\n";
-    if (!it.error.empty()) {
-      o += "<p class=\"error\">" + html(it.error) + "</p>\n</div>\n</div>\n";
-      continue;
-    }
-    std::string stages;
-    for (size_t i = 0; i < it.stages.size(); ++i) stages += (i ? ", " : "") + std::to_string(it.stages[i]);
-    o += "<table class=\"figs\">\n<tr><td>source</td><td>" + html(it.source) + "</td></tr>\n<tr><td>kind</td><td>" +
-         html(it.kind) + "</td></tr>\n<tr><td>render mode</td><td>" + html(it.mode) + "</td></tr>\n<tr><td>steps</td><td>" + std::to_string(it.steps) +
-         "</td></tr>\n<tr><td>modules</td><td>" + std::to_string(it.modules) + "</td></tr>\n<tr><td>internodes</td><td>" +
-         std::to_string(it.internodes) + "</td></tr>\n<tr><td>primitives</td><td>" + std::to_string(it.primitives) +
-         "</td></tr>\n<tr><td>triangles</td><td>" + std::to_string(it.triangles) +
-         "</td></tr>\n<tr><td>build</td><td class=\"time\">" + fixed(it.deriveSeconds, 3) +
-         " s</td></tr>\n<tr><td>render</td><td class=\"time\">" + fixed(it.renderSeconds, 2) +
-         " s</td></tr>\n<tr><td>stages</td><td>" +
-         stages + "</td></tr>\n</table>\n</div>\n";
-    o += "<div class=\"preview\"><a href=\"" + html(it.preview) + "\"><img src=\"" + html(it.preview) + "\" alt=\"" +
-         html(it.name) + "\"></a></div>\n";
-    o += "<div class=\"strip\"><a href=\"" + html(it.strip) + "\"><img src=\"" + html(it.strip) + "\" alt=\"" +
-         html(it.name) + " growth stages\"></a></div>\n";
-    if (!it.animation.empty())
-      o += "<div class=\"animation\"><a href=\"" + html(it.animation) + "\"><img src=\"" + html(it.animation) +
-           "\" alt=\"" + html(it.name) + " growing (" + std::to_string(it.frames) + " frames)\"></a></div>\n";
-    o += "</div>\n";
+  o += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+       "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n<title>Sprig gallery</title>\n"
+       "<link rel=\"icon\" href=\"data:,\">\n<style>\n";
+  o += pageStyle();
+  o += "</style>\n</head>\n<body>\n<header>\n<h1>Sprig gallery</h1>\n"
+       "<input type=\"search\" id=\"filter\" placeholder=\"Filter by name, kind, figure, file\" "
+       "aria-label=\"Filter species\" autofocus>\n<span class=\"count\" id=\"count\">" +
+       std::to_string(items.size()) + " species</span>\n<nav>";
+  // Groups in a fixed order, then any other kind.
+  std::vector<std::pair<std::string, std::string>> groups;
+  for (const KindGroup& g : kKindGroups) groups.emplace_back(g.kind, g.heading);
+  for (const auto& it : items)
+    if (std::none_of(groups.begin(), groups.end(), [&](const auto& g) { return g.first == it.kind; }))
+      groups.emplace_back(it.kind, it.kind.empty() ? "Failed" : it.kind);
+  for (const auto& [kind, heading] : groups) {
+    const auto n = std::count_if(items.begin(), items.end(), [&](const GalleryItem& it) { return it.kind == kind; });
+    if (n > 0) o += "<a href=\"#kind-" + html(kind) + "\">" + html(heading) + " (" + std::to_string(n) + ")</a>";
   }
-  o += "</body>\n</html>\n";
+  o += "<a href=\"contact_sheet.png\">contact sheet</a></nav>\n<div class=\"sets\">";
+  for (const FigureSet& f : kFigureSets) {
+    const bool used = std::any_of(items.begin(), items.end(),
+                                  [&](const GalleryItem& it) { return stemOf(it).rfind(f.prefix, 0) == 0; });
+    if (used) o += "<button type=\"button\" data-q=\"" + html(lower(f.title)) + "\">" + html(f.title) + "</button>";
+  }
+  o += "</div>\n</header>\n<main>\n";
+  for (const auto& [kind, heading] : groups) {
+    std::string cards;
+    for (const auto& it : items) {
+      if (it.kind != kind) continue;
+      const std::string stem = stemOf(it), set = galleryFigureSet(stem);
+      const std::string search = lower(it.name + " " + it.description + " " + it.kind + " " + set + " " + stem);
+      cards += "<a class=\"card" + std::string(it.error.empty() ? "" : " failed") + "\" href=\"" +
+               html(galleryPageFile(it)) + "\" data-search=\"" + html(search) + "\">";
+      if (!it.preview.empty())
+        cards += "<img src=\"" + html(galleryThumbFile(it)) + "\" width=\"320\" height=\"240\" alt=\"" + html(it.name) +
+                 "\">";
+      cards += "<span class=\"name\">" + html(it.name) + "</span><span class=\"set\">" +
+               html(set.empty() ? stem : set + " · " + stem) + "</span></a>\n";
+    }
+    if (cards.empty()) continue;
+    o += "<section id=\"kind-" + html(kind) + "\">\n<h2>" + html(heading) + "</h2>\n<div class=\"grid\">\n" + cards +
+         "</div>\n</section>\n";
+  }
+  o += "</main>\n<script>\n"
+       "const box = document.getElementById('filter'), count = document.getElementById('count');\n"
+       "function apply() {\n"
+       "  const words = box.value.toLowerCase().split(/\\s+/).filter(w => w);\n"
+       "  let shown = 0;\n"
+       "  for (const s of document.querySelectorAll('section')) {\n"
+       "    let n = 0;\n"
+       "    for (const c of s.querySelectorAll('.card')) {\n"
+       "      const ok = words.every(w => c.dataset.search.includes(w));\n"
+       "      c.hidden = !ok; if (ok) n++;\n"
+       "    }\n"
+       "    s.hidden = n === 0; shown += n;\n"
+       "  }\n"
+       "  count.textContent = shown + ' of " +
+       std::to_string(items.size()) +
+       " species';\n"
+       "  history.replaceState(null, '', words.length ? '#q=' + encodeURIComponent(box.value) : location.pathname);\n"
+       "}\n"
+       "box.addEventListener('input', apply);\n"
+       "for (const b of document.querySelectorAll('.sets button'))\n"
+       "  b.addEventListener('click', () => { box.value = b.dataset.q; apply(); });\n"
+       "if (location.hash.startsWith('#q=')) { box.value = decodeURIComponent(location.hash.slice(3)); apply(); }\n"
+       "</script>\n</body>\n</html>\n";
+  return o;
+}
+
+std::string gallerySpeciesPageHtml(const std::vector<GalleryItem>& items, size_t index) {
+  const GalleryItem& it = items.at(index);
+  const std::string stem = stemOf(it), set = galleryFigureSet(stem);
+  std::string o;
+  o += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+       "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n<title>" +
+       html(it.name) + " · Sprig gallery</title>\n<link rel=\"icon\" href=\"data:,\">\n<style>\n";
+  o += pageStyle();
+  o += "</style>\n</head>\n<body>\n<header>\n<h1>" + html(it.name) + "</h1>\n<nav><a href=\"../index.html\">all species</a>";
+  if (index > 0) o += "<a href=\"" + html(stemOf(items[index - 1])) + ".html\">&larr; " + html(items[index - 1].name) + "</a>";
+  if (index + 1 < items.size())
+    o += "<a href=\"" + html(stemOf(items[index + 1])) + ".html\">" + html(items[index + 1].name) + " &rarr;</a>";
+  o += "</nav>\n</header>\n<main class=\"page\">\n";
+  if (!it.description.empty()) o += "<p>" + html(it.description) + "</p>\n";
+  if (!it.error.empty()) {
+    o += "<p class=\"error\">" + html(it.error) + "</p>\n</main>\n</body>\n</html>\n";
+    return o;
+  }
+  std::string stages;
+  for (size_t i = 0; i < it.stages.size(); ++i) stages += (i ? ", " : "") + std::to_string(it.stages[i]);
+  const std::string stageWord = it.kind == "shell" ? "ages (degrees)" : it.kind == "tree" ? "steps" : "stages";
+  o += "<figure><a href=\"../" + html(it.preview) + "\"><img src=\"../" + html(it.preview) + "\" alt=\"" + html(it.name) +
+       ", final stage\"></a><figcaption>The final stage (" + html(it.mode) + " render).</figcaption></figure>\n";
+  if (!it.strip.empty())
+    o += "<figure><a href=\"../" + html(it.strip) + "\"><img src=\"../" + html(it.strip) + "\" alt=\"" + html(it.name) +
+         ", growth stages\"></a><figcaption>Growth strip: " + stageWord + " " + html(stages) + ".</figcaption></figure>\n";
+  if (!it.animation.empty())
+    o += "<figure><a href=\"../" + html(it.animation) + "\"><img src=\"../" + html(it.animation) + "\" alt=\"" +
+         html(it.name) + " growing\"></a><figcaption>Animation, " + std::to_string(it.frames) +
+         " frames; it opens on the grown form.</figcaption></figure>\n";
+  o += "<table class=\"figs\">\n<tr><td>source</td><td>" + html(it.source) + "</td></tr>\n<tr><td>kind</td><td>" +
+       html(it.kind) + "</td></tr>\n";
+  if (!set.empty()) o += "<tr><td>figure set</td><td>" + html(set) + "</td></tr>\n";
+  o += "<tr><td>render mode</td><td>" + html(it.mode) + "</td></tr>\n<tr><td>steps</td><td>" + std::to_string(it.steps) +
+       "</td></tr>\n<tr><td>modules</td><td>" + std::to_string(it.modules) + "</td></tr>\n<tr><td>internodes</td><td>" +
+       std::to_string(it.internodes) + "</td></tr>\n<tr><td>primitives</td><td>" + std::to_string(it.primitives) +
+       "</td></tr>\n<tr><td>triangles</td><td>" + std::to_string(it.triangles) +
+       "</td></tr>\n<tr><td>build</td><td class=\"time\">" + fixed(it.deriveSeconds, 3) +
+       " s</td></tr>\n<tr><td>render</td><td class=\"time\">" + fixed(it.renderSeconds, 2) +
+       " s</td></tr>\n<tr><td>" + stageWord + "</td><td>" + html(stages) + "</td></tr>\n</table>\n</main>\n</body>\n</html>\n";
   return o;
 }
 

@@ -43,7 +43,23 @@ struct GalleryItem {
 GalleryItem renderGalleryItem(const std::filesystem::path& speciesFile, const std::filesystem::path& outDir,
                               GalleryQuality quality, const PathPolicy& policy);
 
-/// The HTML of index.html for items (in order).
+/// The HTML of index.html for items (in order): a grid of thumbnails grouped by kind (trees,
+/// shells, organisms, solids, BlobTree models), a filter box (every word must occur in the
+/// name, description, kind, figure set or file name) and buttons for the papers' figure
+/// sets. Each card links to the species' page (gallerySpeciesPageHtml).
 std::string galleryIndexHtml(const std::vector<GalleryItem>& items);
+
+/// The HTML of the page of items[index] (`pages/STEM.html`): the final stage, the growth
+/// strip, the animation, the figures, and links to the index and its neighbours.
+std::string gallerySpeciesPageHtml(const std::vector<GalleryItem>& items, size_t index);
+
+/// The figure set of a species file's stem ("fig_shell_07a_varix_spines" -> "Murex cabritii
+/// shell (Galbraith et al.)"), from the prefixes the shipped files use; empty when none.
+std::string galleryFigureSet(const std::string& stem);
+
+/// `pages/STEM.html`, where a species' page is written.
+std::string galleryPageFile(const GalleryItem& item);
+/// `thumbs/STEM.png` (320 x 240, the final stage scaled to fit), empty when it has none.
+std::string galleryThumbFile(const GalleryItem& item);
 
 }  // namespace sprig

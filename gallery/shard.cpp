@@ -121,9 +121,33 @@ void writeContactSheet(const std::vector<GalleryItem>& items, const fs::path& ou
   writeImage(sheet, outDir / "contact_sheet.png");
 }
 
+/// The index's thumbnails: each final stage scaled to fit 320 x 240 (the page's card colour
+/// around it), so the index loads a few megabytes, not every full-size picture.
+void writeThumbnails(const std::vector<GalleryItem>& items, const fs::path& outDir) {
+  constexpr int kThumbW = 320, kThumbH = 240;
+  std::error_code ec;
+  fs::create_directories(outDir / "thumbs", ec);
+  for (const auto& it : items) {
+    if (it.preview.empty()) continue;
+    try {
+      Image img = readImage(outDir / it.preview);
+      for (size_t i = 3; i < img.pixels.size(); i += 4) img.pixels[i] = 1.0f;  // shown opaque
+      Image thumb(kThumbW, kThumbH, Vec4(0.79f, 0.78f, 0.75f, 1.0f));
+      pasteScaled(img, thumb, 0, 0, kThumbW, kThumbH);
+      writeImage(thumb, outDir / galleryThumbFile(it));
+    } catch (const ImageReadError&) {
+    }
+  }
+}
+
 void writeIndex(std::vector<GalleryItem> items, const fs::path& outDir) {
   std::sort(items.begin(), items.end(), [](const GalleryItem& a, const GalleryItem& b) { return a.source < b.source; });
   writeContactSheet(items, outDir);
+  writeThumbnails(items, outDir);
+  std::error_code ec;
+  fs::create_directories(outDir / "pages", ec);
+  for (size_t i = 0; i < items.size(); ++i)
+    writeFileAtomic(outDir / galleryPageFile(items[i]), gallerySpeciesPageHtml(items, i));
   writeFileAtomic(outDir / "index.html", galleryIndexHtml(items));
 }
 

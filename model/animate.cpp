@@ -185,7 +185,10 @@ AnimateResult animateModel(SpeciesModel& model, const SpeciesRender& baseLook, c
                           ? 0
                           : static_cast<size_t>(std::lround(std::max(0.0, options.holdSeconds) * options.fps));
   if (format == AnimationFormat::Gif) {
-    for (size_t i = 0; i < hold; ++i) gifFrames.push_back(gifFrames.back());
+    if (options.holdFirst && hold > 0)  // the grown form opens the loop: viewers show frame 0 before playing
+      gifFrames.insert(gifFrames.begin(), hold, gifFrames.back());
+    else
+      for (size_t i = 0; i < hold; ++i) gifFrames.push_back(gifFrames.back());
     writeAnimatedGif(gifFrames, options.fps, out);
   }
   if (format == AnimationFormat::Mp4)

@@ -31,6 +31,9 @@ struct AnimateOptions {
   int framesPerStage = 6;   ///< frames over which one step's new modules grow in
   double fps = 12;          ///< GIF and MP4 frame rate
   double holdSeconds = 0;   ///< GIF and MP4: show the last frame this much longer before looping
+  /// GIF: the hold comes first instead of last, so the file's first frame (what a page or
+  /// file browser shows before the animation plays) is the grown form, not the sprout.
+  bool holdFirst = false;
   int width = 0;            ///< 0 = the species' render width
   int height = 0;           ///< 0 = the species' render height
   int samples = 0;          ///< camera samples per pixel; 0 = the species' own

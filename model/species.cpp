@@ -171,6 +171,60 @@ Species parseSpecies(std::string text, const std::string& displayPath, const Pat
   return s;
 }
 
+namespace {
+
+void collectStrings(const YAML::Node& n, std::vector<std::string>& out, int depth) {
+  if (depth > 64 || out.size() > 10000) return;
+  if (n.IsScalar()) {
+    out.push_back(n.Scalar());
+  } else if (n.IsSequence()) {
+    for (const auto& c : n) collectStrings(c, out, depth + 1);
+  } else if (n.IsMap()) {
+    for (const auto& kv : n) collectStrings(kv.second, out, depth + 1);
+  }
+}
+
+void addInputFiles(const fs::path& path, std::vector<fs::path>& out, int depth) {
+  if (std::find(out.begin(), out.end(), path) != out.end()) return;
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) {
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(path, ec))
+      if (e.is_regular_file()) files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    out.insert(out.end(), files.begin(), files.end());
+    return;
+  }
+  out.push_back(path);
+  const std::string ext = lowerExtension(path);
+  if (ext == ".l") {
+    fs::path view = path;
+    view.replace_extension(".v");
+    out.push_back(view);  // watched even while missing: creating it changes the plant
+    return;
+  }
+  if ((ext != ".yaml" && ext != ".yml") || depth > 8) return;
+  std::vector<std::string> strings;
+  try {
+    collectStrings(YAML::LoadFile(path.string()), strings, 0);
+  } catch (const std::exception&) {
+    return;  // the reader reports it; the file itself is watched
+  }
+  for (const std::string& s : strings) {
+    if (s.empty() || s.size() > 1024 || s.find('\n') != std::string::npos) continue;
+    const fs::path p = (path.parent_path() / s).lexically_normal();
+    if (fs::is_regular_file(p, ec)) addInputFiles(p, out, depth + 1);
+  }
+}
+
+}  // namespace
+
+std::vector<fs::path> speciesInputFiles(const fs::path& path) {
+  std::vector<fs::path> out;
+  addInputFiles(path, out, 0);
+  return out;
+}
+
 std::vector<fs::path> listSpeciesFiles(const fs::path& folder) {
   std::vector<fs::path> out;
   std::error_code ec;

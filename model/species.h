@@ -97,6 +97,13 @@ Species loadSpecies(const std::filesystem::path& path, const PathPolicy& policy 
 /// Reads species text as if it were the file displayPath (tests). Throws as loadSpecies.
 Species parseSpecies(std::string text, const std::string& displayPath, const PathPolicy& policy = {});
 
+/// The files a species is read from, for watching them (`--watch`): the file itself (every
+/// file of a vlab object folder; a cpfg `.l` file's view file `NAME.v`), and for a species
+/// file every string value naming an existing file beside it (grammar, meshes, textures,
+/// images), followed into referenced species files. Never throws: an unreadable or
+/// malformed file is listed alone, so its repair is seen.
+std::vector<std::filesystem::path> speciesInputFiles(const std::filesystem::path& path);
+
 /// The species files of a folder (`*.yaml`, `*.yml`), sorted by name.
 std::vector<std::filesystem::path> listSpeciesFiles(const std::filesystem::path& folder);
 

@@ -9,6 +9,7 @@
 
 #include "core/srgb.h"
 #include "core/text.h"
+#include "model/detail/key_recorder.h"
 
 namespace sprig {
 
@@ -145,7 +146,7 @@ const char* kindName(const YAML::Node& n) {
 
 /// "got 'text'" for scalars, "got a map" otherwise.
 std::string gotText(const YNode& n) {
-  if (n.isScalar()) return "got '" + n.scalar() + "'";
+  if (n.isScalar()) return "got '" + n.node().Scalar() + "'";
   return std::string("got ") + kindName(n.node());
 }
 
@@ -277,7 +278,142 @@ void YamlFile::error(DiagnosticList& diags, const YAML::Mark& mark, std::string 
 
 // ---- YNode ------------------------------------------------------------------------
 
+// ---- Describe mode (`sprig schema`, model/detail/key_recorder.h) ------------------------
+
+namespace detail {
+
+namespace {
+thread_local KeyRecorder* tActiveRecorder = nullptr;
+}
+
+void KeySchema::range(double lo, double hi) {
+  if (std::isfinite(lo)) min = min ? std::min(*min, lo) : lo;
+  if (std::isfinite(hi)) max = max ? std::max(*max, hi) : hi;
+}
+
+KeyRecorder* KeyRecorder::active() { return tActiveRecorder; }
+
+KeyRecorder::KeyRecorder(KeySchema& root, int pass) : root_(&root), pass_(pass), previous_(tActiveRecorder) {
+  tActiveRecorder = this;
+}
+
+uint64_t KeyRecorder::nextRandom() {
+  uint64_t z = (static_cast<uint64_t>(pass_) << 32) + ++questions_ * 0x9e3779b97f4a7c15ull;
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
+}
+
+bool KeyRecorder::answerHas() {
+  if (pass_ < 2) return pass_ == 0;
+  return nextRandom() & 1;
+}
+
+KeyRecorder::~KeyRecorder() { tActiveRecorder = previous_; }
+
+KeySchema* KeyRecorder::schemaOf(const YAML::Node& node, bool asRoot) {
+  for (auto& [n, s] : bound_)
+    if (n.is(node)) return s;
+  if (asRoot && root_) {
+    KeySchema* r = root_;
+    root_ = nullptr;
+    bind(node, *r);
+    return r;
+  }
+  return nullptr;
+}
+
+void KeyRecorder::bind(const YAML::Node& node, KeySchema& schema) {
+  for (auto& [n, s] : bound_)
+    if (n.is(node)) {
+      s = &schema;
+      return;
+    }
+  bound_.emplace_back(node, &schema);
+}
+
+YAML::Node KeyRecorder::placeholder() {
+  const uint64_t r = pass_ < 2 ? 0 : nextRandom() % 4;
+  if (r == 2) placeholders_.emplace_back(std::string("0"));  // a number, an integer, a text, an expression
+  else if (r == 3) placeholders_.emplace_back(YAML::NodeType::Sequence);
+  else placeholders_.emplace_back(YAML::NodeType::Map);
+  return placeholders_.back();
+}
+
+bool KeyRecorder::isPlaceholder(const YAML::Node& node) const {
+  for (const auto& p : placeholders_)
+    if (p.is(node)) return true;
+  return false;
+}
+
+}  // namespace detail
+
+namespace {
+
+/// The schema node of n while describing, else null (the one test on every real read).
+detail::KeySchema* describing(const YAML::Node& n) {
+  detail::KeyRecorder* r = detail::KeyRecorder::active();
+  return r ? r->schemaOf(n) : nullptr;
+}
+
+/// Typed reads under way on this thread: scalar() records "string" only outside them (a
+/// reader that takes a node's text itself accepts a scalar there).
+thread_local int tTypedReads = 0;
+struct TypedRead {
+  TypedRead() { ++tTypedReads; }
+  ~TypedRead() { --tTypedReads; }
+  TypedRead(const TypedRead&) = delete;
+  TypedRead& operator=(const TypedRead&) = delete;
+};
+
+void noteType(const YAML::Node& n, const char* type, double lo = -HUGE_VAL, double hi = HUGE_VAL) {
+  if (detail::KeySchema* s = describing(n)) {
+    s->types.insert(type);
+    s->range(lo, hi);
+  }
+}
+
+std::string jsonNumber(double v) {
+  std::ostringstream o;
+  o.precision(9);
+  o << v;
+  return o.str();
+}
+
+std::string jsonVec3(const Vec3& v) {
+  return "[" + jsonNumber(v.x) + ", " + jsonNumber(v.y) + ", " + jsonNumber(v.z) + "]";
+}
+
+std::string jsonString(std::string_view text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') out += '\\', out += c;
+    else if (c == '\n') out += "\\n";
+    else if (static_cast<unsigned char>(c) < 0x20) out += ' ';
+    else out += c;
+  }
+  return out + "\"";
+}
+
+}  // namespace
+
+std::string YNode::scalar() const {
+  if (tTypedReads == 0 && node_.IsScalar())
+    if (detail::KeySchema* s = describing(node_)) s->types.insert("string");
+  return node_.IsScalar() ? node_.Scalar() : std::string();
+}
+
 std::vector<YNode> YNode::items() const {
+  if (detail::KeySchema* s = describing(node_)) {
+    s->types.insert("sequence");
+    std::vector<YNode> out;
+    if (!node_.IsSequence()) return out;
+    for (const auto& child : node_) {
+      detail::KeyRecorder::active()->bind(child, s->item());
+      out.emplace_back(file_, child);
+    }
+    return out;
+  }
   std::vector<YNode> out;
   if (!node_.IsSequence()) return out;
   for (const auto& child : node_) out.emplace_back(file_, child);
@@ -285,6 +421,9 @@ std::vector<YNode> YNode::items() const {
 }
 
 std::vector<std::pair<YNode, YNode>> YNode::pairs() const {
+  // A reader walking a map's pairs itself treats its keys as data (material names, defines).
+  if (tTypedReads == 0)
+    if (detail::KeySchema* s = describing(node_)) s->dataKeys = true;
   std::vector<std::pair<YNode, YNode>> out;
   if (!node_.IsMap()) return out;
   for (auto it = node_.begin(); it != node_.end(); ++it)
@@ -293,6 +432,8 @@ std::vector<std::pair<YNode, YNode>> YNode::pairs() const {
 }
 
 std::optional<double> YNode::asNumber(DiagnosticList& diags, std::string_view what, double min, double max) const {
+  TypedRead typedRead;
+  noteType(node_, "number", min, max);
   if (!isScalar()) {
     error(diags, std::string(what) + " must be a number, " + gotText(*this));
     return std::nullopt;
@@ -320,6 +461,9 @@ std::optional<double> YNode::asNumber(DiagnosticList& diags, std::string_view wh
 
 std::optional<int64_t> YNode::asInteger(DiagnosticList& diags, std::string_view what, int64_t min,
                                         int64_t max) const {
+  TypedRead typedRead;
+  noteType(node_, "integer", min == std::numeric_limits<int64_t>::min() ? -HUGE_VAL : double(min),
+           max == std::numeric_limits<int64_t>::max() ? HUGE_VAL : double(max));
   if (!isScalar()) {
     error(diags, std::string(what) + " must be an integer, " + gotText(*this));
     return std::nullopt;
@@ -358,6 +502,8 @@ std::optional<int64_t> YNode::asInteger(DiagnosticList& diags, std::string_view 
 }
 
 std::optional<bool> YNode::asBoolean(DiagnosticList& diags, std::string_view what) const {
+  TypedRead typedRead;
+  noteType(node_, "boolean");
   if (isPlainScalar()) {
     const std::string s = trim(scalar());
     static const char* yes[] = {"true", "True", "TRUE", "yes", "Yes", "YES", "on", "On", "ON"};
@@ -372,6 +518,8 @@ std::optional<bool> YNode::asBoolean(DiagnosticList& diags, std::string_view wha
 }
 
 std::optional<std::string> YNode::asString(DiagnosticList& diags, std::string_view what) const {
+  TypedRead typedRead;
+  noteType(node_, "string");
   if (!isScalar()) {
     error(diags, std::string(what) + " must be a string, " + gotText(*this));
     return std::nullopt;
@@ -380,6 +528,8 @@ std::optional<std::string> YNode::asString(DiagnosticList& diags, std::string_vi
 }
 
 std::optional<Vec3> YNode::asVec3(DiagnosticList& diags, std::string_view what, double min, double max) const {
+  TypedRead typedRead;
+  noteType(node_, "vec3", min, max);
   if (!isSequence() || node_.size() != 3) {
     std::string got = isSequence() ? "got " + std::to_string(node_.size()) + " elements" : gotText(*this);
     error(diags, std::string(what) + " must be [x, y, z], " + got);
@@ -400,6 +550,8 @@ std::optional<Vec3> YNode::asVec3(DiagnosticList& diags, std::string_view what, 
 }
 
 std::optional<Vec3> YNode::asColor(DiagnosticList& diags, std::string_view what) const {
+  TypedRead typedRead;
+  noteType(node_, "color");
   if (isScalar()) {
     const std::string s = trim(scalar());
     auto hex = [](char c) -> int {
@@ -471,6 +623,14 @@ std::optional<fs::path> resolveReference(const YNode& at, std::string_view ref, 
 
 MapReader::MapReader(YNode node, DiagnosticList& diags, std::string context)
     : node_(std::move(node)), diags_(&diags), context_(std::move(context)) {
+  TypedRead ownPairs;  // the pairs() below are the reader's index, not keys as data
+  if (detail::KeyRecorder* r = detail::KeyRecorder::active()) {
+    schema_ = r->schemaOf(node_.node(), true);
+    if (schema_) {
+      schema_->types.insert("map");
+      if (schema_->context.empty()) schema_->context = context_;
+    }
+  }
   if (node_.isMap()) {
     for (auto& [k, v] : node_.pairs()) {
       if (!k.isScalar()) continue;  // reported when the file was loaded
@@ -484,11 +644,22 @@ MapReader::MapReader(YNode node, DiagnosticList& diags, std::string context)
   }
 }
 
-bool MapReader::has(std::string_view key) const { return index_.find(key) != index_.end(); }
+bool MapReader::has(std::string_view key) const {
+  if (schema_) return detail::KeyRecorder::active()->answerHas();
+  return index_.find(key) != index_.end();
+}
 
 std::optional<YNode> MapReader::get(std::string_view key) {
   known_.emplace(key);
   auto it = index_.find(key);
+  if (schema_) {  // describing: an absent key reads as a placeholder, or stays absent
+    detail::KeyRecorder* r = detail::KeyRecorder::active();
+    detail::KeySchema& child = schema_->property(std::string(key));
+    if (it == index_.end() && !r->answerHas()) return std::nullopt;
+    YAML::Node n = it == index_.end() ? r->placeholder() : entries_[it->second].value.node();
+    r->bind(n, child);
+    return YNode(node_.fileHandle(), n);
+  }
   if (it == index_.end()) return std::nullopt;
   return entries_[it->second].value;
 }
@@ -500,7 +671,10 @@ std::optional<YNode> MapReader::keyNode(std::string_view key) const {
 }
 
 void MapReader::allow(std::initializer_list<std::string_view> keys) {
-  for (auto k : keys) known_.emplace(k);
+  for (auto k : keys) {
+    known_.emplace(k);
+    if (schema_) schema_->property(std::string(k));
+  }
 }
 
 std::string quoted(std::string_view key) {
@@ -513,24 +687,28 @@ std::string quoted(std::string_view key) {
 }
 
 double MapReader::number(std::string_view key, double def, double min, double max) {
+  if (schema_) schema_->property(std::string(key)).defaultJson = jsonNumber(def);
   auto v = get(key);
   if (!v) return def;
   return v->asNumber(*diags_, quoted(key), min, max).value_or(def);
 }
 
 int64_t MapReader::integer(std::string_view key, int64_t def, int64_t min, int64_t max) {
+  if (schema_) schema_->property(std::string(key)).defaultJson = std::to_string(def);
   auto v = get(key);
   if (!v) return def;
   return v->asInteger(*diags_, quoted(key), min, max).value_or(def);
 }
 
 std::string MapReader::string(std::string_view key, std::string def) {
+  if (schema_ && !def.empty()) schema_->property(std::string(key)).defaultJson = jsonString(def);
   auto v = get(key);
   if (!v) return def;
   return v->asString(*diags_, quoted(key)).value_or(def);
 }
 
 std::optional<std::string> MapReader::requiredString(std::string_view key) {
+  if (schema_) schema_->required.insert(std::string(key));
   auto v = get(key);
   if (!v) {
     node_.error(*diags_, "missing required key '" + std::string(key) + "' in " + context_);
@@ -540,24 +718,33 @@ std::optional<std::string> MapReader::requiredString(std::string_view key) {
 }
 
 bool MapReader::boolean(std::string_view key, bool def) {
+  if (schema_) schema_->property(std::string(key)).defaultJson = def ? "true" : "false";
   auto v = get(key);
   if (!v) return def;
   return v->asBoolean(*diags_, quoted(key)).value_or(def);
 }
 
 Vec3 MapReader::vec3(std::string_view key, Vec3 def, double min, double max) {
+  if (schema_) schema_->property(std::string(key)).defaultJson = jsonVec3(def);
   auto v = get(key);
   if (!v) return def;
   return v->asVec3(*diags_, quoted(key), min, max).value_or(def);
 }
 
 Vec3 MapReader::color(std::string_view key, Vec3 def) {
+  if (schema_) schema_->property(std::string(key)).defaultJson = jsonVec3(def);
   auto v = get(key);
   if (!v) return def;
   return v->asColor(*diags_, quoted(key)).value_or(def);
 }
 
 std::string MapReader::choice(std::string_view key, std::string def, const std::vector<std::string>& choices) {
+  if (schema_) {
+    detail::KeySchema& k = schema_->property(std::string(key));
+    for (const auto& c : choices)
+      if (std::find(k.choices.begin(), k.choices.end(), c) == k.choices.end()) k.choices.push_back(c);
+    if (!def.empty()) k.defaultJson = jsonString(def);
+  }
   auto v = get(key);
   if (!v) return def;
   auto s = v->asString(*diags_, quoted(key));
@@ -571,6 +758,7 @@ std::string MapReader::choice(std::string_view key, std::string def, const std::
 }
 
 std::optional<YNode> MapReader::section(std::string_view key) {
+  if (schema_) schema_->property(std::string(key)).types.insert("map");
   auto v = get(key);
   if (!v) return std::nullopt;
   if (!v->isMap()) {
@@ -583,6 +771,14 @@ std::optional<YNode> MapReader::section(std::string_view key) {
 std::vector<YNode> MapReader::sequence(std::string_view key) {
   auto v = get(key);
   if (!v) return {};
+  if (schema_ && detail::KeyRecorder::active()->isPlaceholder(v->node())) {  // describing: one placeholder element
+    detail::KeyRecorder* r = detail::KeyRecorder::active();
+    detail::KeySchema& s = schema_->property(std::string(key));
+    s.types.insert("sequence");
+    YAML::Node element = r->placeholder();
+    r->bind(element, s.item());
+    return {YNode(node_.fileHandle(), element)};
+  }
   if (!v->isSequence()) {
     v->error(*diags_, quoted(key) + " must be a sequence, " + gotText(*v));
     return {};
@@ -599,6 +795,7 @@ std::optional<fs::path> MapReader::path(std::string_view key, const PathPolicy& 
 }
 
 void MapReader::finish() {
+  if (schema_) schema_->closed = true;
   std::vector<std::string> candidates(known_.begin(), known_.end());
   for (const auto& e : entries_) {
     const std::string name = e.key.scalar();
@@ -609,6 +806,11 @@ void MapReader::finish() {
 
 std::optional<std::pair<YNode, YNode>> singleKey(const YNode& node, DiagnosticList& diags, const std::string& what,
                                                  const std::vector<std::string>& names) {
+  if (detail::KeySchema* s = describing(node.node())) {
+    s->types.insert("map");
+    for (const auto& n : names)
+      if (std::find(s->oneKey.begin(), s->oneKey.end(), n) == s->oneKey.end()) s->oneKey.push_back(n);
+  }
   std::string list;
   for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
   if (!node.isMap() || node.pairs().size() != 1) {

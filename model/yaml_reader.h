@@ -63,6 +63,9 @@
 namespace sprig {
 
 class YNode;
+namespace detail {
+struct KeySchema;
+}
 
 /// Options for loading a YAML file.
 struct YamlLoadOptions {
@@ -132,7 +135,7 @@ class YNode {
   /// True for a plain (unquoted) scalar; quoted scalars are always strings.
   bool isPlainScalar() const { return node_.IsScalar() && node_.Tag() != "!"; }
   /// The scalar text (empty for non-scalars).
-  std::string scalar() const { return node_.IsScalar() ? node_.Scalar() : std::string(); }
+  std::string scalar() const;
   /// Elements of a sequence (empty otherwise).
   std::vector<YNode> items() const;
   /// Key/value pairs of a map in file order, duplicates included (empty otherwise).
@@ -246,6 +249,7 @@ class MapReader {
   std::vector<Entry> entries_;          // first occurrence of each key, file order
   std::map<std::string, size_t, std::less<>> index_;
   std::set<std::string, std::less<>> known_;
+  detail::KeySchema* schema_ = nullptr;  // `sprig schema` only (model/detail/key_recorder.h)
 };
 
 /// A map with exactly one key among names (`{sphere: {...}}`): that key and its value.

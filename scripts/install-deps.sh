@@ -13,6 +13,7 @@ packages=(
   nodejs curl ca-certificates
   gmsh
   clang-14 libclang-rt-14-dev ccache
+  chromium  # tests: headless Chromium loads the gallery (tests/gallery/browser_test.sh)
 )
 
 missing=()
@@ -60,4 +61,19 @@ if [ ! -f "$validator_dir/package.json" ] || ! grep -q "\"version\": \"$validato
   rm -rf "$validator_dir"
   mkdir -p "$(dirname "$validator_dir")"
   mv "$tmp/package" "$validator_dir"
+fi
+
+# ajv-cli 5.0.0 (MIT), the independent JSON Schema validator that checks `sprig schema`
+# against every shipped species (tests/cli/schema_test.sh). npm ci installs exactly the
+# versions of scripts/ajv/package-lock.json, each checked by its integrity hash, under
+# tools/ajv (not committed).
+ajv_dir="$(dirname "$0")/../tools/ajv"
+if [ ! -x "$ajv_dir/node_modules/.bin/ajv" ] || ! cmp -s "$(dirname "$0")/ajv/package-lock.json" "$ajv_dir/package-lock.json"; then
+  echo "sprig: installing ajv-cli (scripts/ajv/package-lock.json)"
+  if ! command -v npm >/dev/null; then  # Debian's nodejs comes without npm; NodeSource's has it
+    $([ "$(id -u)" -ne 0 ] && echo sudo) apt-get install -y -q --no-install-recommends npm
+  fi
+  mkdir -p "$ajv_dir"
+  cp "$(dirname "$0")/ajv/package.json" "$(dirname "$0")/ajv/package-lock.json" "$ajv_dir/"
+  (cd "$ajv_dir" && npm ci --no-audit --no-fund --loglevel=error)
 fi

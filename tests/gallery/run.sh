@@ -20,13 +20,13 @@ cp "$SRC"/grammars/abop_1_24a.lsys "$SRC"/grammars/shrub.lsys "$SRC"/grammars/gr
 cd "$WORK/lib"
 gallery() { "$SPRIG" --root . --threads 2 gallery species/*.yaml "$@"; }
 
-# Compares two gallery folders: every file but the manifests, index.html without timings.
+# Compares two gallery folders: every file but the manifests, the HTML pages without timings.
 same_gallery() {
   local a=$1 b=$2
   diff <(cd "$a" && find . -type f ! -path './manifests/*' | sort) \
        <(cd "$b" && find . -type f ! -path './manifests/*' | sort) || fail "$a and $b hold different files"
   while read -r f; do
-    if [ "$f" = ./index.html ]; then
+    if [ "$f" = ./index.html ] || [ "${f#./pages/}" != "$f" ]; then
       cmp -s <(sed 's|<td class="time">[^<]*</td>|<td class="time"></td>|g' "$a/$f") \
              <(sed 's|<td class="time">[^<]*</td>|<td class="time"></td>|g' "$b/$f") || fail "$f differs"
     else
@@ -49,11 +49,11 @@ parallel --halt now,fail=1 "$SPRIG" --root . --threads 1 -q gallery species/*.ya
 same_gallery out1 out2
 
 # 2. A re-run renders nothing new (and rewrites no image).
-before=$(cd out1 && find . -type f ! -path './manifests/*' ! -name index.html ! -name contact_sheet.png \
+before=$(cd out1 && find . -type f ! -path './manifests/*' ! -path './thumbs/*' ! -path './pages/*' ! -name index.html ! -name contact_sheet.png \
          -printf '%p %T@\n' | sort)
 gallery -o out1 2> log2 || { cat log2; fail "re-run failed"; }
 grep -q "0 rendered, 3 up to date" log2 || { cat log2; fail "re-run rendered something"; }
-after=$(cd out1 && find . -type f ! -path './manifests/*' ! -name index.html ! -name contact_sheet.png \
+after=$(cd out1 && find . -type f ! -path './manifests/*' ! -path './thumbs/*' ! -path './pages/*' ! -name index.html ! -name contact_sheet.png \
         -printf '%p %T@\n' | sort)
 [ "$before" = "$after" ] || fail "re-run rewrote images"
 
@@ -90,7 +90,7 @@ for i in $(seq 1 20); do
     n=0
     while read -r f; do
       case "$(basename "$f")" in .sprig-tmp-*) continue ;; esac
-      case "$f" in ./manifests/*|./index.html|./contact_sheet.png) continue ;; esac
+      case "$f" in ./manifests/*|./thumbs/*|./pages/*|./index.html|./contact_sheet.png) continue ;; esac
       cmp -s "out3/$f" "out1/$f" || fail "killed run left a partial or wrong $f (try $i)"
       n=$((n + 1))
     done < <(cd out3 && find . -type f | sort)

@@ -1,0 +1,188 @@
+#include "model/schema.h"
+
+#include <cmath>
+#include <sstream>
+
+#include "model/detail/key_recorder.h"
+#include "model/kinds.h"
+#include "model/species.h"
+
+namespace sprig {
+
+namespace {
+
+using detail::KeySchema;
+
+/// Runs of each kind's reader (model/detail/key_recorder.h): enough that every branch on
+/// presence or shape is taken both ways (the schema stops changing well before this).
+constexpr int kPasses = 512;
+
+std::string jsonText(const std::string& text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') out += '\\', out += c;
+    else if (c == '\n') out += "\\n";
+    else if (static_cast<unsigned char>(c) < 0x20) out += ' ';
+    else out += c;
+  }
+  return out + "\"";
+}
+
+std::string number(double v) {
+  std::ostringstream o;
+  o.precision(9);
+  o << v;
+  return o.str();
+}
+
+std::string rangeText(const KeySchema& k) {
+  if (k.min && k.max) return " in [" + number(*k.min) + ", " + number(*k.max) + "]";
+  if (k.min) return " >= " + number(*k.min);
+  if (k.max) return " <= " + number(*k.max);
+  return "";
+}
+
+std::string rangeJson(const KeySchema& k) {
+  std::string out;
+  if (k.min) out += ", \"minimum\": " + number(*k.min);
+  if (k.max) out += ", \"maximum\": " + number(*k.max);
+  return out;
+}
+
+/// JSON of one position; `path` is where it sits ("render.view.azimuth") for descriptions.
+std::string emit(const KeySchema& k, const std::string& path, int depth);
+
+std::string mapJson(const KeySchema& k, const std::string& path, int depth) {
+  const std::string pad(2 * (depth + 1), ' ');
+  std::string out = "{\"type\": \"object\"";
+  if (!k.properties.empty()) {
+    out += ", \"properties\": {";
+    bool first = true;
+    for (const auto& [name, child] : k.properties) {
+      out += std::string(first ? "" : ",") + "\n" + pad + jsonText(name) + ": " +
+             emit(*child, path.empty() ? name : path + "." + name, depth + 1);
+      first = false;
+    }
+    out += "}";
+  }
+  if (!k.required.empty()) {
+    out += ", \"required\": [";
+    bool first = true;
+    for (const auto& r : k.required) out += std::string(first ? "" : ", ") + jsonText(r), first = false;
+    out += "]";
+  }
+  if (!k.oneKey.empty()) {
+    out += ", \"minProperties\": 1, \"maxProperties\": 1, \"propertyNames\": {\"enum\": [";
+    for (size_t i = 0; i < k.oneKey.size(); ++i) out += (i ? ", " : "") + jsonText(k.oneKey[i]);
+    out += "]}";
+  } else if (k.closed && !k.dataKeys) {
+    out += ", \"additionalProperties\": false";
+  }
+  return out + "}";
+}
+
+std::string emit(const KeySchema& k, const std::string& path, int depth) {
+  std::vector<std::string> alternatives;
+  std::string what;
+  if (!k.choices.empty()) {
+    std::string e = "{\"enum\": [";
+    for (size_t i = 0; i < k.choices.size(); ++i) e += (i ? ", " : "") + jsonText(k.choices[i]);
+    alternatives.push_back(e + "]}");
+    what = "one of the listed words";
+  } else {
+    for (const std::string& t : k.types) {
+      if (t == "number") {
+        alternatives.push_back("{\"type\": \"number\"" + rangeJson(k) + "}");
+        what += (what.empty() ? "" : " or ") + std::string("a number") + rangeText(k);
+      } else if (t == "integer") {
+        if (k.types.count("number")) continue;
+        alternatives.push_back("{\"type\": \"integer\"" + rangeJson(k) + "}");
+        what += (what.empty() ? "" : " or ") + std::string("an integer") + rangeText(k);
+      } else if (t == "boolean") {
+        // The reader also takes YAML 1.1's words, which YAML 1.2 tools read as strings.
+        alternatives.push_back("{\"type\": \"boolean\"}");
+        alternatives.push_back(
+            "{\"enum\": [\"yes\", \"Yes\", \"YES\", \"no\", \"No\", \"NO\", \"on\", \"On\", "
+            "\"ON\", \"off\", \"Off\", \"OFF\"]}");
+        what += (what.empty() ? "" : " or ") + std::string("true or false");
+      } else if (t == "string") {
+        // The reader takes any scalar as text (`name: 2.6`); a colour's hex string is above.
+        if (!k.types.count("color")) alternatives.push_back("{\"type\": [\"string\", \"number\", \"boolean\"]}");
+        if (!k.types.count("color")) what += (what.empty() ? "" : " or ") + std::string("text");
+      } else if (t == "vec3") {
+        if (k.types.count("color")) continue;
+        std::string r = rangeJson(k);
+        alternatives.push_back("{\"type\": \"array\", \"minItems\": 3, \"maxItems\": 3, \"items\": {\"type\": \"number\"" +
+                               r + "}}");
+        what += (what.empty() ? "" : " or ") + std::string("[x, y, z]") + rangeText(k);
+      } else if (t == "color") {
+        alternatives.push_back(
+            "{\"type\": \"array\", \"minItems\": 3, \"maxItems\": 3, \"items\": {\"type\": \"number\", \"minimum\": 0, "
+            "\"maximum\": 1}}");
+        alternatives.push_back("{\"type\": \"string\", \"pattern\": \"^\\\\s*#[0-9A-Fa-f]{6}\\\\s*$\"}");
+        what += (what.empty() ? "" : " or ") + std::string("a colour [r, g, b] (linear, 0..1) or \\\"#rrggbb\\\" (sRGB)");
+      } else if (t == "map") {
+        alternatives.push_back(mapJson(k, path, depth));
+        what += (what.empty() ? "" : " or ") +
+                std::string(k.oneKey.empty() ? "a map" : "a map with one key");
+      } else if (t == "sequence") {
+        std::string items = k.items ? ", \"items\": " + emit(*k.items, path + "[]", depth + 1) : "";
+        alternatives.push_back("{\"type\": \"array\"" + items + "}");
+        what += (what.empty() ? "" : " or ") + std::string("a list");
+      }
+    }
+  }
+  std::string desc = path;
+  if (!k.context.empty() && k.context != path) desc += " (" + k.context + ")";
+  desc += what.empty() ? "" : ": " + what;
+  if (!k.defaultJson.empty()) desc += "; default " + k.defaultJson;
+  std::string head = "{\"description\": " + jsonText(desc);
+  if (!k.defaultJson.empty()) head += ", \"default\": " + k.defaultJson;
+  // Several alternatives go under anyOf.
+  std::string joined;
+  for (size_t i = 0; i < alternatives.size(); ++i) joined += (i ? ", " : "") + alternatives[i];
+  if (alternatives.empty()) return head + "}";
+  if (alternatives.size() == 1) return head + ", " + alternatives[0].substr(1);
+  return head + ", \"anyOf\": [" + joined + "]}";
+}
+
+}  // namespace
+
+std::string speciesSchemaJson() {
+  std::string kinds, branches, defs;
+  bool first = true;
+  for (const KindEntry& kind : speciesKinds()) {
+    KeySchema root;
+    for (int pass = 0; pass < kPasses; ++pass) {
+      detail::KeyRecorder recorder(root, pass);
+      try {
+        parseSpecies(std::string("kind: ") + kind.name + "\n", "species.yaml");
+      } catch (const InputError&) {
+        // The empty document is not a valid species; only the keys asked for matter.
+      }
+    }
+    root.property("name").defaultJson.clear();  // the file's stem, not a constant
+    KeySchema& k = root.property("kind");
+    k.types.clear();
+    k.choices = {kind.name};
+    root.required.insert("kind");
+    const std::string name = kind.name;
+    kinds += std::string(first ? "" : ", ") + jsonText(name);
+    branches += std::string(first ? "" : ",\n    ") + "{\"if\": {\"required\": [\"kind\"], \"properties\": {\"kind\": {\"const\": " +
+                jsonText(name) + "}}}, \"then\": {\"$ref\": \"#/definitions/" + name + "\"}}";
+    defs += std::string(first ? "" : ",\n") + "    " + jsonText(name) + ": " + mapJson(root, "", 2);
+    first = false;
+  }
+  std::string out = "{\n";
+  out += "  \"$schema\": \"http://json-schema.org/draft-07/schema#\",\n";
+  out += "  \"title\": \"Sprig species file\",\n";
+  out += "  \"description\": \"A Sprig species file (species/*.yaml), generated by `sprig schema` from the readers' own keys, types, ranges and defaults.\",\n";
+  out += "  \"type\": \"object\",\n";
+  out += "  \"required\": [\"kind\"],\n";
+  out += "  \"properties\": {\"kind\": {\"description\": \"what the file describes\", \"enum\": [" + kinds + "]}},\n";
+  out += "  \"allOf\": [\n    " + branches + "\n  ],\n";
+  out += "  \"definitions\": {\n" + defs + "\n  }\n}\n";
+  return out;
+}
+
+}  // namespace sprig

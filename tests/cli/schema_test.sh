@@ -1,0 +1,78 @@
+#!/usr/bin/env bash
+# `sprig schema` checked by an independent validator, ajv-cli (registered with ctest as
+# `cli_schema`; scripts/install-deps.sh installs it into tools/ajv):
+#   1. the schema is valid draft-07 JSON Schema;
+#   2. every shipped species file (species/*.yaml, also accepted by `sprig check`) is valid;
+#   3. files the reader rejects for an unknown key, a wrong type, a value out of range, a
+#      wrong word or colour, a missing or unknown kind (tests/bad_inputs and a few edits of
+#      shipped species) are rejected by the schema too, and the same edits within range are
+#      accepted by both.
+# Usage: tests/cli/schema_test.sh path/to/sprig   (run from the repository root)
+set -euo pipefail
+SPRIG=$(realpath "$1")
+AJV=$(pwd)/tools/ajv/node_modules/.bin/ajv
+WORK=$(mktemp -d "${TMPDIR:-/tmp}/sprig-schema-test-XXXXXX")
+trap 'rm -rf "$WORK"' EXIT
+fail() { echo "FAIL: $*" >&2; exit 1; }
+[ -x "$AJV" ] || fail "ajv-cli is not installed: run scripts/install-deps.sh"
+ajv() { local c=$1; shift; "$AJV" "$c" "$@" --spec=draft7 --strict=false $([ "$c" = validate ] && echo --errors=line); }
+
+"$SPRIG" -q schema -o "$WORK/schema.json"
+"$SPRIG" schema | cmp -s - "$WORK/schema.json" || fail "schema on stdout differs from -o"
+ajv compile -s "$WORK/schema.json" > /dev/null || fail "the schema does not compile"
+
+# 2. Every shipped species.
+# One validator run for all of them (each start of Node.js costs about a second here).
+n=$(ls species/*.yaml | wc -l)
+[ "$n" -ge 50 ] || fail "only $n species files"
+ajv validate -s "$WORK/schema.json" -d "species/*.yaml" > "$WORK/out" 2>&1 || { grep -v " valid$" "$WORK/out"; fail "species valid for sprig but not for the schema"; }
+[ "$(grep -c ' valid$' "$WORK/out")" -eq "$n" ] || { cat "$WORK/out"; fail "ajv did not report all $n species valid"; }
+
+# 3. Rejected by both the reader and the schema.
+rejected=(unknown_key wrong_type wrong_section_type out_of_range bad_choice bad_color missing_kind unknown_kind
+          nan_value inf_value organism_bad_procedure three_sections)
+for c in "${rejected[@]}"; do
+  f=tests/bad_inputs/inputs/$c.yaml
+  if "$SPRIG" -q check "$f" > /dev/null 2>&1; then fail "sprig accepts $f"; fi
+  if ajv validate -s "$WORK/schema.json" -d "$f" > "$WORK/out" 2>&1; then fail "the schema accepts $f"; fi
+done
+# Edits, one key each, of a small tree species and of shipped species: TEXT appended, and
+# whether both must accept or both reject it.
+mkdir -p "$WORK/lib/species"
+cp -r grammars "$WORK/lib/"
+cp species/fig_shell_07a_varix_spines.yaml species/blob_ricci_fig3.yaml "$WORK/lib/species/"
+printf 'kind: tree\ngrammar: ../grammars/abop_1_24a.lsys\n' > "$WORK/lib/species/tree.yaml"
+edits=0
+both() {  # both SPECIES 'yaml text to append' valid|invalid
+  local src=$1 edit=$2 want=$3 f="$WORK/lib/species/case.yaml"
+  { cat "$WORK/lib/species/$src.yaml"; echo "$edit"; } > "$f"
+  local r=0 s=0
+  (cd "$WORK/lib" && "$SPRIG" -q --root . check species/case.yaml > /dev/null 2>&1) || r=1
+  ajv validate -s "$WORK/schema.json" -d "$f" > "$WORK/out" 2>&1 || s=1
+  if [ "$want" = valid ]; then
+    [ "$r" -eq 0 ] || fail "$src + '$edit': sprig rejects it"
+    [ "$s" -eq 0 ] || { cat "$WORK/out"; fail "$src + '$edit': the schema rejects it"; }
+  else
+    [ "$r" -eq 1 ] || fail "$src + '$edit': sprig accepts it"
+    [ "$s" -eq 1 ] || fail "$src + '$edit': the schema accepts it"
+  fi
+  edits=$((edits + 1))
+}
+both tree 'max_modules: 1000' valid
+both tree 'max_modules: 0' invalid
+both tree 'seeed: 3' invalid
+both tree 'turtle: {tropism: [0, -1, 0], elasticity: 0.2}' valid
+both tree 'turtle: {elasticity: 20}' invalid
+both tree 'turtle: {tropism: [0, -1]}' invalid
+both tree 'turtle: {radii: pipe, pipe_exponent: 2.5}' valid
+both tree 'turtle: {radii: pipe, pipe_exponent: 20}' invalid
+both tree 'render: {width: 10}' invalid
+both tree 'render: {sun: {elevation: 0.5}}' invalid
+both tree 'render: {wood: "#5b3f28", view: {fov: 40}, ground: false}' valid
+both tree 'render: {wood: "#5b3f2"}' invalid
+both tree 'render: {background: colour}' invalid
+both fig_shell_07a_varix_spines 'stages: [1, 2]' valid
+both fig_shell_07a_varix_spines 'stages: [1, -2]' invalid
+both blob_ricci_fig3 'kernel: soft' valid
+both blob_ricci_fig3 'kernel: smooth' invalid
+echo "schema: ok ($n shipped species valid, ${#rejected[@]} bad inputs and $edits edits agree with sprig)"
