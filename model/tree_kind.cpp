@@ -625,8 +625,8 @@ organisms::TreeOptions readTreeOptions(const YNode& section, DiagnosticList& dia
     o.scars.style = style == "knob" ? organisms::ScarStyle::Knob : organisms::ScarStyle::Flush;
     if (o.scars.style == organisms::ScarStyle::Knob || !p.has("stub_length"))
       o.scars.stubLength = p.number("stub_length", o.scars.stubLength, 0.01, 100.0);
-    else
-      p.get("stub_length")->error(diags, "'scars.stub_length' applies to style knob only (a flush scar's stub reaches the bark)");
+    else if (auto stub = p.get("stub_length"))  // (sprig schema's describe mode may answer has() and get() differently)
+      stub->error(diags, "'scars.stub_length' applies to style knob only (a flush scar's stub reaches the bark)");
     o.scars.stubRadius = p.number("stub_radius", o.scars.stubRadius, 0.01, 10.0);
     o.scars.negativeRadius = p.number("negative_radius", o.scars.negativeRadius, 0.0, 10.0);
     o.scars.negativeWeight = p.number("negative_weight", o.scars.negativeWeight, 0.0, 10.0);
