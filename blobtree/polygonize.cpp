@@ -431,6 +431,21 @@ std::vector<glm::uvec3> triangulate(const Grid& g, const Vertices& v) {
   return triangles;
 }
 
+// Vertex v's normal −∇F/|∇F| (or a mark in flatGradient where the gradient vanishes) and
+// attributes from the field's sample there, as options ask.
+void storeSample(const PolygonizeOptions& options, const Sample& smp, size_t v, PolygonizeResult& res,
+                 std::vector<uint8_t>& flatGradient) {
+  if (options.normals) {
+    float len = glm::length(smp.gradient);
+    if (len > 1e-20f && std::isfinite(len)) res.mesh.normals[v] = -smp.gradient / len;
+    else flatGradient[v] = 1;
+  }
+  if (options.attributes) {
+    res.mesh.uvs[v] = smp.attributes.uv;
+    res.attributes[v] = smp.attributes;
+  }
+}
+
 // Step 5a: every vertex moved onto F = 0.5 along its edge, with its normal and attributes.
 // Fixed blocks of vertices (consecutive edge keys: spatially coherent rows) iterate in
 // lockstep, each step one batched values() call over the block's unconverged vertices.
@@ -503,18 +518,7 @@ std::vector<uint8_t> placeVertices(const CompiledBlob& blob, const PolygonizeOpt
       size_t v = begin + k;
       Vec3 p = pIn[k] + float(t[k]) * (pOut[k] - pIn[k]);
       mesh.positions[v] = p;
-      if (options.normals || options.attributes) {
-        Sample smp = blob.sample(p);
-        if (options.normals) {
-          float len = glm::length(smp.gradient);
-          if (len > 1e-20f && std::isfinite(len)) mesh.normals[v] = -smp.gradient / len;
-          else flatGradient[v] = 1;
-        }
-        if (options.attributes) {
-          mesh.uvs[v] = smp.attributes.uv;
-          res.attributes[v] = smp.attributes;
-        }
-      }
+      if (options.normals || options.attributes) storeSample(options, blob.sample(p), v, res, flatGradient);
     }
     if (bar) bar->advance(n);
   });
@@ -636,15 +640,7 @@ void dualMesh(const CompiledBlob& blob, const PolygonizeOptions& options, const 
         }
         size_t vi = patchBase[a] + size_t(k);
         mesh.positions[vi] = p;
-        if (options.normals) {
-          float len = glm::length(smp.gradient);
-          if (len > 1e-20f && std::isfinite(len)) mesh.normals[vi] = -smp.gradient / len;
-          else flatGradient[vi] = 1;
-        }
-        if (options.attributes) {
-          mesh.uvs[vi] = smp.attributes.uv;
-          res.attributes[vi] = smp.attributes;
-        }
+        storeSample(options, smp, vi, res, flatGradient);
       }
     }
     sampleCount += samples;

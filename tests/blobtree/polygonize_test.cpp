@@ -9,28 +9,14 @@
 #include "blobtree/polygonize.h"
 #include "core/parallel.h"
 #include "core/rng.h"
+#include "tests/blobtree/mesh_checks.h"
 
 using namespace sprig;
 using namespace sprig::blobtree;
+using sprig::test::euler;
+using sprig::test::requireClosedManifold;
 
 namespace {
-
-// Euler characteristic V − E + F of a closed mesh (2 − 2·genus per component).
-long euler(const Mesh& m) {
-  std::set<std::pair<uint32_t, uint32_t>> edges;
-  for (const auto& t : m.triangles)
-    for (int k = 0; k < 3; ++k) edges.insert(std::minmax(t[k], t[(k + 1) % 3]));
-  return long(m.vertexCount()) - long(edges.size()) + long(m.triangleCount());
-}
-
-void requireClosedManifold(const Mesh& m) {
-  MeshTopology topo = analyzeTopology(m);
-  CHECK(m.triangleCount() > 0);
-  CHECK(topo.boundaryEdges == 0);
-  CHECK(topo.nonManifoldEdges == 0);
-  CHECK(topo.inconsistentEdges == 0);
-  CHECK(topo.degenerateTriangles == 0);
-}
 
 // Largest |F − 0.5| over the mesh vertices.
 float maxFieldError(const CompiledBlob& blob, const Mesh& m) {
