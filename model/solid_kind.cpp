@@ -634,10 +634,11 @@ class SolidModel final : public StillKindModel {
     return all;
   }
 
-  std::vector<ExportPart> exportParts(const Stage&, float, bool, const SpeciesRender&, const MeshCleanOptions&,
+  std::vector<ExportPart> exportParts(const Stage& stage, float, bool, const SpeciesRender&, const MeshCleanOptions&,
                                       ModelFigures& figures) override {
     std::vector<ExportPart> out;
-    const auto& [parts, mats] = visible();
+    const int k = stepOf(stage);
+    const auto& [parts, mats] = visible(k);
     for (size_t i = 0; i < parts.size(); ++i) {
       const Material& m = spec_.solid.materials.materials[mats[i]];
       figures.triangles += parts[i].triangleCount();
@@ -648,7 +649,7 @@ class SolidModel final : public StillKindModel {
       }
       out.push_back(ExportPart{m.name, parts[i], PartMaterial{m.name, m.color, m.roughness, false}});
     }
-    figures.primitives = tets().tets.size();
+    figures.primitives = stageMesh(k).tets.size();
     figures.buildSeconds = buildSeconds_;
     return out;
   }
