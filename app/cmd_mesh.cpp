@@ -24,6 +24,7 @@ struct MeshArgs {
   GrowthFlags growth;
   bool interfaces = false;
   double minVolume = MeshCleanOptions{}.minVolumeFraction;
+  std::string mesher;  ///< empty = the species' render.mesher
 };
 
 int runMesh(const MeshArgs& a, const GlobalOptions& g) {
@@ -31,6 +32,7 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
   auto start = std::chrono::steady_clock::now();
   Species species = loadSpecies(a.file, g.pathPolicy());
   printNotes(g, species);
+  if (!a.mesher.empty()) species.render.dualMesher = a.mesher == "dual";
   SpeciesModel model(species, a.growth.overrides());
   const Stage stage = a.stage.resolve(model);
   // Volume meshes (tetrahedra with materials) of kinds that have them, by extension.
@@ -94,6 +96,10 @@ void addMeshCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run)
   sub->add_flag("--interfaces", args->interfaces,
                  "solids: write each interface between two materials, and each material's outer surface, as OUT_<A>_<B>.EXT "
                  "(triangles oriented out of A; B = outside for the visible interface)");
+  sub->add_option("--mesher", args->mesher,
+                  "polygonized surfaces: tetrahedra (marching tetrahedra, the reference) or dual (dual marching cubes, "
+                  "about a third of the triangles); default: the species' render.mesher")
+      ->check(CLI::IsMember({"tetrahedra", "dual"}));
   sub->add_option("--min-volume", args->minVolume,
                   "remove connected components of a polygonized surface whose enclosed volume is below this fraction of the model's "
                   "(specks outside, voids inside); 0 keeps them")

@@ -23,6 +23,7 @@ struct RenderArgs {
   int height = 0;
   int spp = 0;
   std::string mode = "exact";
+  std::string mesher;  ///< empty = the species' render.mesher
   StageFlags stage;
   std::string view;
   std::string camera;
@@ -66,6 +67,7 @@ int renderOnce(const RenderArgs& a, const GlobalOptions& g) {
   SpeciesRender look = species.render;
   if (!a.view.empty()) parseView(a.view, look.view);
   if (!a.camera.empty()) parseCamera(a.camera, look);
+  if (!a.mesher.empty()) look.dualMesher = a.mesher == "dual";
 
   SpeciesModel model(species, a.growth.overrides());
   if (!a.section.empty()) {
@@ -116,6 +118,10 @@ void addRenderCommand(CLI::App& app, const GlobalOptions& global, CommandRun& ru
       ->check(CLI::Range(1, 4096));
   sub->add_option("--mode", args->mode, "exact (ray cast the implicit surface), mesh (polygonize first) or skeleton")
       ->check(CLI::IsMember({"exact", "mesh", "skeleton"}));
+  sub->add_option("--mesher", args->mesher,
+                  "--mode mesh: tetrahedra (marching tetrahedra) or dual (dual marching cubes); default: the species' "
+                  "render.mesher")
+      ->check(CLI::IsMember({"tetrahedra", "dual"}));
   addStageFlags(*sub, args->stage);
   sub->add_option("--view", args->view, "camera direction AZIMUTH,ELEVATION[,FOV] in degrees (automatic framing)");
   sub->add_option("--camera", args->camera, "explicit eye X,Y,Z or eye and target X,Y,Z,TX,TY,TZ");

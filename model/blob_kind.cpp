@@ -764,7 +764,7 @@ class BlobModel final : public StillKindModel {
     const auto t0 = std::chrono::steady_clock::now();
     out.figures.primitives = compiled_->primitiveCount();
     if (mode == GeometryMode::Mesh) {
-      blobtree::PolygonizeOptions po;
+      blobtree::PolygonizeOptions po = polygonizeOptions(look);
       po.cellSize = blob_.cellSize;
       auto mesh = std::make_shared<blobtree::PolygonizeResult>(blobtree::polygonizeDetailed(*compiled_, po));
       out.figures.triangles = mesh->mesh.triangleCount();
@@ -787,7 +787,7 @@ class BlobModel final : public StillKindModel {
   std::vector<ExportPart> exportParts(const Stage&, float cellSize, bool progress, const SpeciesRender& look,
                                       const MeshCleanOptions& clean, ModelFigures& fig) override {
     fig.primitives = compiled_->primitiveCount();
-    blobtree::PolygonizeOptions po;
+    blobtree::PolygonizeOptions po = polygonizeOptions(look);
     po.cellSize = cellSize > 0 ? cellSize : blob_.cellSize;
     po.progress = progress;
     ExportPart part;

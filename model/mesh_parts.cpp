@@ -5,6 +5,13 @@
 
 namespace sprig {
 
+blobtree::PolygonizeOptions polygonizeOptions(const SpeciesRender& look) {
+  blobtree::PolygonizeOptions po;
+  po.mesher = look.dualMesher ? blobtree::PolygonizeOptions::Mesher::DualMarchingCubes
+                              : blobtree::PolygonizeOptions::Mesher::MarchingTetrahedra;
+  return po;
+}
+
 Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::TextureTable& textures, const Vec3& base) {
   Mesh mesh = result.mesh;
   const size_t n = mesh.positions.size();

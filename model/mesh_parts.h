@@ -9,6 +9,7 @@
 
 #include "blobtree/polygonize.h"
 #include "core/mesh.h"
+#include "model/species.h"
 #include "render/geometry.h"
 
 namespace sprig {
@@ -21,6 +22,9 @@ inline constexpr uint32_t kNoPartTexture = 0xffffffffu;
 /// as render::Scene::attributeColor), and per triangle (Mesh::materials) the texture id
 /// with the largest weight summed over its three vertices (kNoPartTexture when none).
 /// result must carry attributes (PolygonizeOptions::attributes). O(V·textures).
+/// The polygonizer's options a species' look asks for (render.mesher).
+blobtree::PolygonizeOptions polygonizeOptions(const SpeciesRender& look);
+
 Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::TextureTable& textures, const Vec3& base);
 
 /// The triangles of mesh grouped by their Mesh::materials id, in increasing id order;

@@ -424,7 +424,7 @@ class ShellModel final : public KindModel {
     return box.empty() ? Box3{Vec3(-0.5f), Vec3(0.5f)} : box;
   }
 
-  BuiltStage build(const Stage& stage, GeometryMode mode, const SpeciesRender&) override {
+  BuiltStage build(const Stage& stage, GeometryMode mode, const SpeciesRender& look) override {
     if (mode == GeometryMode::Skeleton) throw UsageError("shells have no skeleton: use --mode exact or mesh");
     BuiltStage out;
     const auto t0 = std::chrono::steady_clock::now();
@@ -440,7 +440,7 @@ class ShellModel final : public KindModel {
     out.figures.primitives = shell->blob->primitiveCount();
     std::shared_ptr<const blobtree::PolygonizeResult> mesh;
     if (mode == GeometryMode::Mesh) {
-      blobtree::PolygonizeOptions po;
+      blobtree::PolygonizeOptions po = polygonizeOptions(look);
       po.cellSize = shellMeshCell(*shell->blob);
       mesh = std::make_shared<blobtree::PolygonizeResult>(blobtree::polygonizeDetailed(*shell->blob, po));
       out.figures.triangles = mesh->mesh.triangleCount();
@@ -459,11 +459,11 @@ class ShellModel final : public KindModel {
     return blobtree::polygonize(*shell.blob, po);
   }
 
-  std::vector<ExportPart> exportParts(const Stage& stage, float cellSize, bool progress, const SpeciesRender&,
+  std::vector<ExportPart> exportParts(const Stage& stage, float cellSize, bool progress, const SpeciesRender& look,
                                       const MeshCleanOptions& clean, ModelFigures& fig) override {
     const ShellBuild shell = buildShell(spec_, stage.age < 0 ? std::nullopt : std::optional(stage.age));
     fig.primitives = shell.blob->primitiveCount();
-    blobtree::PolygonizeOptions po;
+    blobtree::PolygonizeOptions po = polygonizeOptions(look);
     po.cellSize = cellSize > 0 ? cellSize : shellMeshCell(*shell.blob);
     po.progress = progress;
     // Painted as the renderer paints it, cleaned as one surface, then split by the part

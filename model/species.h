@@ -61,6 +61,10 @@ struct SpeciesRender {
   /// (m/s, 0 = none; azimuth degrees it blows toward). `sprig animate` uses --wind instead.
   double windSpeed = 0;
   double windDirectionDeg = 0;
+  /// `mesher: tetrahedra | dual`: how polygonized surfaces (mesh-mode renders, `sprig mesh`)
+  /// are meshed: marching tetrahedra (the reference; a vertex on every crossing grid edge) or
+  /// dual marching cubes (a third of the triangles); both closed and 2-manifold.
+  bool dualMesher = false;
 
   /// Renderer settings for an image of width x height.
   render::RenderSettings settings(int imageWidth, int imageHeight) const;

@@ -285,7 +285,7 @@ class TreeModel final : public KindModel {
     fig.triangles = tree.leaves.triangleCount();
     std::shared_ptr<const blobtree::PolygonizeResult> mesh;
     if (mode == GeometryMode::Mesh) {
-      mesh = std::make_shared<blobtree::PolygonizeResult>(blobtree::polygonizeDetailed(*tree.compiled, {}));
+      mesh = std::make_shared<blobtree::PolygonizeResult>(blobtree::polygonizeDetailed(*tree.compiled, polygonizeOptions(look)));
       fig.triangles += mesh->mesh.triangleCount();
     }
     fig.buildSeconds = secondsSince(t0);
@@ -322,7 +322,7 @@ class TreeModel final : public KindModel {
                                            ": there is no surface to mesh");
     TreeSurface tree = buildTreeSurface(skeleton, spec_.surface.value_or(organisms::TreeOptions{}));
     fig.primitives = tree.compiled->primitiveCount();
-    blobtree::PolygonizeOptions po;
+    blobtree::PolygonizeOptions po = polygonizeOptions(look);
     po.cellSize = cellSize;
     po.progress = progress;
     // The wood: coloured by its bark as the renderer colours it, then cleaned.

@@ -23,6 +23,8 @@ species=(
   "fig_org_14c_planet_blend organism"      # organism with the planet shader
   "org_painted_band organism"              # organism on a painted mesh
   "fig_solid_01_striped_candy chocolate white_chocolate"  # solid: one part per material
+  "fig_tree_12_pcm_offset wood | --mesher dual"  # dual marching cubes
+  "shell_top whorl inside | --mesher dual"
 )
 files=()
 for entry in "${species[@]}"; do
@@ -30,10 +32,11 @@ for entry in "${species[@]}"; do
   flags=""
   [[ "$entry" == *"|"* ]] && flags="${entry#*|}"
   # shellcheck disable=SC2086
-  "$sprig" mesh "species/$s.yaml" -o "$out/$s.glb" $flags >/dev/null
-  files+=("$out/$s.glb")
+  f="$out/$s.${#files[@]}.glb"
+  "$sprig" mesh "species/$s.yaml" -o "$f" $flags >/dev/null
+  files+=("$f")
   expect=()
   for p in $parts; do expect+=(--expect "$p"); done
-  python3 scripts/gltf-parts.py "species/$s.yaml" "$out/$s.glb" "${expect[@]}"
+  python3 scripts/gltf-parts.py "species/$s.yaml" "$f" "${expect[@]}"
 done
 node scripts/gltf-validate.js "${files[@]}"

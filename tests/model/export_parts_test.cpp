@@ -135,3 +135,32 @@ TEST_CASE("SpeciesModel::exportParts of shipped species", "[model][slow]") {
     }
   }
 }
+
+TEST_CASE("SpeciesModel::exportParts with render.mesher dual", "[model]") {
+  // The same closed, outward parts from dual marching cubes, with under half the triangles.
+  for (const auto& [name, components] : {std::pair<const char*, size_t>{"fig_tree_12_pcm_offset", 1}, {"blob_ricci_fig3", 5}}) {
+    INFO(name);
+    PathPolicy policy;
+    policy.root = SPRIG_SOURCE_DIR;
+    Species species = loadSpecies(std::string(SPRIG_SOURCE_DIR) + "/species/" + name + ".yaml", policy);
+    const std::string part = std::string(name) == "blob_ricci_fig3" ? "blob" : "wood";
+    size_t triangles[2] = {0, 0};
+    for (int dual = 0; dual < 2; ++dual) {
+      species.render.dualMesher = dual == 1;
+      SpeciesModel model(species, ModelOptions{});
+      const std::vector<ExportPart> parts = model.exportParts(model.finalStage(), 0.0f, false);
+      const ExportPart* p = find(parts, part);
+      REQUIRE(p != nullptr);
+      size_t n = 0;
+      triangleComponents(p->mesh, &n);
+      CHECK(n == components);
+      const MeshTopology topo = analyzeTopology(p->mesh);
+      CHECK(topo.closed());
+      CHECK(topo.manifold());
+      CHECK(topo.inconsistentEdges == 0);
+      CHECK(signedVolume(p->mesh) > 0);
+      triangles[dual] = p->mesh.triangleCount();
+    }
+    CHECK(triangles[1] < triangles[0] / 2);
+  }
+}
