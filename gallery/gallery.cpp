@@ -260,9 +260,10 @@ std::string galleryIndexHtml(const std::vector<GalleryItem>& items) {
   for (const auto& it : items)
     if (std::none_of(groups.begin(), groups.end(), [&](const auto& g) { return g.first == it.kind; }))
       groups.emplace_back(it.kind, it.kind.empty() ? "Failed" : it.kind);
-  for (const auto& [kind, heading] : groups) {
+  for (const auto& group : groups) {
+    const std::string& kind = group.first;  // (clang 14: lambdas cannot capture structured bindings)
     const auto n = std::count_if(items.begin(), items.end(), [&](const GalleryItem& it) { return it.kind == kind; });
-    if (n > 0) o += "<a href=\"#kind-" + html(kind) + "\">" + html(heading) + " (" + std::to_string(n) + ")</a>";
+    if (n > 0) o += "<a href=\"#kind-" + html(kind) + "\">" + html(group.second) + " (" + std::to_string(n) + ")</a>";
   }
   o += "<a href=\"contact_sheet.png\">contact sheet</a></nav>\n<div class=\"sets\">";
   for (const FigureSet& f : kFigureSets) {
