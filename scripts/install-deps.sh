@@ -11,6 +11,7 @@ packages=(
   libmeshoptimizer-dev libcgal-demo
   libeigen3-dev
   nodejs curl ca-certificates
+  python3-yaml  # tests: scripts/gltf-parts.py reads species files on its own
   gmsh
   clang-14 libclang-rt-14-dev ccache
   chromium  # tests: headless Chromium loads the gallery (tests/gallery/browser_test.sh)
