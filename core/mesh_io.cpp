@@ -64,6 +64,32 @@ void putUint(std::string& out, uint64_t v) {
   out.append(buf, res.ptr);
 }
 
+// The OBJ vertex lines of mesh: `v` (with sRGB colours when it has colours), then `vt` and
+// `vn` when it has uvs and normals.
+void appendObjVertices(std::string& out, const Mesh& mesh) {
+  const bool hasN = !mesh.normals.empty(), hasUv = !mesh.uvs.empty(), hasC = !mesh.colors.empty();
+  for (size_t i = 0; i < mesh.positions.size(); ++i) {
+    const Vec3& p = mesh.positions[i];
+    out += "v ";
+    putFloat(out, p.x), out += ' ', putFloat(out, p.y), out += ' ', putFloat(out, p.z);
+    if (hasC) {
+      out += ' ';
+      putFloat(out, linearToSrgb(mesh.colors[i].x)), out += ' ';
+      putFloat(out, linearToSrgb(mesh.colors[i].y)), out += ' ';
+      putFloat(out, linearToSrgb(mesh.colors[i].z));
+    }
+    out += '\n';
+  }
+  if (hasUv)
+    for (const auto& uv : mesh.uvs) out += "vt ", putFloat(out, uv.x), out += ' ', putFloat(out, uv.y), out += '\n';
+  if (hasN)
+    for (const auto& nm : mesh.normals) {
+      out += "vn ";
+      putFloat(out, nm.x), out += ' ', putFloat(out, nm.y), out += ' ', putFloat(out, nm.z);
+      out += '\n';
+    }
+}
+
 void writeAtomic(const fs::path& path, const std::string& bytes) {
   TempPath tmp(path);
   {
@@ -178,26 +204,7 @@ void writeObj(const Mesh& mesh, const fs::path& path, const MeshWriteOptions& op
 
   std::string out = "# written by Sprig\nmtllib " + mtlPath.filename().string() + "\n";
   out.reserve(mesh.positions.size() * (hasC ? 90 : 40) * (1 + hasN + hasUv) + mesh.triangles.size() * 40);
-  for (size_t i = 0; i < mesh.positions.size(); ++i) {
-    const Vec3& p = mesh.positions[i];
-    out += "v ";
-    putFloat(out, p.x), out += ' ', putFloat(out, p.y), out += ' ', putFloat(out, p.z);
-    if (hasC) {
-      out += ' ';
-      putFloat(out, linearToSrgb(mesh.colors[i].x)), out += ' ';
-      putFloat(out, linearToSrgb(mesh.colors[i].y)), out += ' ';
-      putFloat(out, linearToSrgb(mesh.colors[i].z));
-    }
-    out += '\n';
-  }
-  if (hasUv)
-    for (const auto& uv : mesh.uvs) out += "vt ", putFloat(out, uv.x), out += ' ', putFloat(out, uv.y), out += '\n';
-  if (hasN)
-    for (const auto& nm : mesh.normals) {
-      out += "vn ";
-      putFloat(out, nm.x), out += ' ', putFloat(out, nm.y), out += ' ', putFloat(out, nm.z);
-      out += '\n';
-    }
+  appendObjVertices(out, mesh);
   if (!hasM) out += "usemtl " + nameOf(0) + "\n";
   uint32_t current = ~0u;
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
@@ -454,28 +461,9 @@ void writePartsObj(const std::vector<ExportPart>& parts, const fs::path& path) {
     mtl += "newmtl " + matName + "\nKa 0 0 0\nKd ";
     putFloat(mtl, c.x), mtl += ' ', putFloat(mtl, c.y), mtl += ' ', putFloat(mtl, c.z);
     mtl += "\nKs 0.04 0.04 0.04\nNs 32\nd 1\nillum 2\n\n";
-    const bool hasN = !mesh.normals.empty(), hasUv = !mesh.uvs.empty(), hasC = !mesh.colors.empty();
+    const bool hasN = !mesh.normals.empty(), hasUv = !mesh.uvs.empty();
     out += "o " + objName(part.name) + "\n";
-    for (size_t i = 0; i < mesh.positions.size(); ++i) {
-      const Vec3& p = mesh.positions[i];
-      out += "v ";
-      putFloat(out, p.x), out += ' ', putFloat(out, p.y), out += ' ', putFloat(out, p.z);
-      if (hasC) {
-        out += ' ';
-        putFloat(out, linearToSrgb(mesh.colors[i].x)), out += ' ';
-        putFloat(out, linearToSrgb(mesh.colors[i].y)), out += ' ';
-        putFloat(out, linearToSrgb(mesh.colors[i].z));
-      }
-      out += '\n';
-    }
-    if (hasUv)
-      for (const auto& uv : mesh.uvs) out += "vt ", putFloat(out, uv.x), out += ' ', putFloat(out, uv.y), out += '\n';
-    if (hasN)
-      for (const auto& nm : mesh.normals) {
-        out += "vn ";
-        putFloat(out, nm.x), out += ' ', putFloat(out, nm.y), out += ' ', putFloat(out, nm.z);
-        out += '\n';
-      }
+    appendObjVertices(out, mesh);
     out += "usemtl " + matName + "\n";
     for (const auto& t : mesh.triangles) {
       out += 'f';
