@@ -8,6 +8,7 @@
 
 #include "model/species.h"
 #include "app/cmd_common.h"
+#include "model/mesh_parts.h"
 #include "model/model.h"
 #include "core/mesh_io.h"
 #include "core/paths.h"
@@ -25,20 +26,24 @@ struct MeshArgs {
   bool interfaces = false;
   double minVolume = MeshCleanOptions{}.minVolumeFraction;
   std::string mesher;  ///< empty = the species' render.mesher
+  double simplify = -1;  ///< < 0 = the species' render.simplify
 };
 
 int runMesh(const MeshArgs& a, const GlobalOptions& g) {
   requireExtension("-o", a.out, {".ply", ".obj", ".glb", ".msh", ".vtu", ".mesh"});
   auto start = std::chrono::steady_clock::now();
+  // Volume meshes (tetrahedra with materials) of kinds that have them, by extension.
+  const std::string ext = lowerExtension(a.out);
+  const bool volume = ext == ".msh" || ext == ".vtu" || ext == ".mesh";
+  if (a.simplify > 0 && (a.interfaces || volume))
+    throw UsageError("--simplify applies to the surface parts written as .ply, .obj or .glb, not to --interfaces or volume meshes");
   Species species = loadSpecies(a.file, g.pathPolicy());
   printNotes(g, species);
   if (!a.mesher.empty()) species.render.dualMesher = a.mesher == "dual";
   SpeciesModel model(species, a.growth.overrides());
   const Stage stage = a.stage.resolve(model);
-  // Volume meshes (tetrahedra with materials) of kinds that have them, by extension.
-  const std::string ext = lowerExtension(a.out);
   if (a.interfaces) {
-    if (ext == ".msh" || ext == ".vtu" || ext == ".mesh")
+    if (volume)
       throw UsageError("--interfaces writes triangle meshes: give -o a .ply, .obj or .glb name");
     const std::filesystem::path out(a.out);
     for (auto& [name, mesh] : model.interfaceMeshes(stage)) {
@@ -50,7 +55,7 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
     }
     return kExitOk;
   }
-  if (ext == ".msh" || ext == ".vtu" || ext == ".mesh") {
+  if (volume) {
     const std::string line = model.writeVolumeMesh(stage, a.out, !g.quiet);
     double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     note(g, std::cout, "%s (total %.2f s)", line.c_str(), total);
@@ -59,7 +64,21 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
   ModelFigures fig;
   MeshCleanOptions clean;
   clean.minVolumeFraction = a.minVolume;
-  const std::vector<ExportPart> parts = model.exportParts(stage, static_cast<float>(a.cell), !g.quiet, clean, &fig);
+  std::vector<ExportPart> parts = model.exportParts(stage, static_cast<float>(a.cell), !g.quiet, clean, &fig);
+  std::string simplified;
+  const double simplify = a.simplify >= 0 ? a.simplify : species.render.simplify;
+  if (simplify > 0) {
+    const std::vector<organisms::SimplifyReport> reports = simplifyParts(parts, simplify);
+    fig.triangles = 0;
+    for (size_t i = 0; i < parts.size(); ++i) {
+      fig.triangles += parts[i].mesh.triangleCount();
+      if (reports[i].inputTriangles == 0) continue;
+      char buf[160];
+      std::snprintf(buf, sizeof buf, "%s%s %zu -> %zu (error %.3g)", simplified.empty() ? "" : ", ", parts[i].name.c_str(),
+                    reports[i].inputTriangles, reports[i].faces, double(reports[i].absoluteError));
+      simplified += buf;
+    }
+  }
   writeParts(parts, a.out);
   double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   size_t vertices = 0;
@@ -72,6 +91,7 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
   note(g, std::cout, "%s: %zu triangles, %zu vertices, %zu primitives, built in %.2f s (total %.2f s)", a.out.c_str(),
        fig.triangles, vertices, fig.primitives, fig.buildSeconds, total);
   note(g, std::cout, "parts: %s", names.c_str());
+  if (!simplified.empty()) note(g, std::cout, "simplified to %g of the model's extent: %s", simplify, simplified.c_str());
   const MeshCleanReport& c = fig.clean;
   if (c.componentsBefore > 0)
     note(g, std::cout, "cleaned: %zu components -> %zu (%zu specks, %zu voids, %zu triangles removed); %zu faces against their normals -> %zu (%zu normals fixed)",
@@ -105,6 +125,11 @@ void addMeshCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run)
                   "(specks outside, voids inside); 0 keeps them")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 1.0));
+  sub->add_option("--simplify", args->simplify,
+                  "collapse edges of the polygonized parts while the geometric error stays below this fraction of the model's "
+                  "extent (meshoptimizer; e.g. 1e-3); closed parts stay closed and manifold; 0 keeps every triangle; "
+                  "default: the species' render.simplify (0)")
+      ->check(CLI::Range(0.0, 0.1));
   addStageFlags(*sub, args->stage);
   addGrowthFlags(*sub, args->growth);
 }

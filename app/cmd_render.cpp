@@ -24,6 +24,7 @@ struct RenderArgs {
   int spp = 0;
   std::string mode = "exact";
   std::string mesher;  ///< empty = the species' render.mesher
+  double simplify = -1;  ///< < 0 = the species' render.simplify
   StageFlags stage;
   std::string view;
   std::string camera;
@@ -68,6 +69,7 @@ int renderOnce(const RenderArgs& a, const GlobalOptions& g) {
   if (!a.view.empty()) parseView(a.view, look.view);
   if (!a.camera.empty()) parseCamera(a.camera, look);
   if (!a.mesher.empty()) look.dualMesher = a.mesher == "dual";
+  if (a.simplify >= 0) look.simplify = a.simplify;
 
   SpeciesModel model(species, a.growth.overrides());
   if (!a.section.empty()) {
@@ -122,6 +124,10 @@ void addRenderCommand(CLI::App& app, const GlobalOptions& global, CommandRun& ru
                   "--mode mesh: tetrahedra (marching tetrahedra) or dual (dual marching cubes); default: the species' "
                   "render.mesher")
       ->check(CLI::IsMember({"tetrahedra", "dual"}));
+  sub->add_option("--simplify", args->simplify,
+                  "--mode mesh: simplify the polygonized surface while the geometric error stays below this fraction of its "
+                  "extent (meshoptimizer); 0 keeps every triangle; default: the species' render.simplify (0)")
+      ->check(CLI::Range(0.0, 0.1));
   addStageFlags(*sub, args->stage);
   sub->add_option("--view", args->view, "camera direction AZIMUTH,ELEVATION[,FOV] in degrees (automatic framing)");
   sub->add_option("--camera", args->camera, "explicit eye X,Y,Z or eye and target X,Y,Z,TX,TY,TZ");

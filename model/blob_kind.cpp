@@ -766,7 +766,7 @@ class BlobModel final : public StillKindModel {
     if (mode == GeometryMode::Mesh) {
       blobtree::PolygonizeOptions po = polygonizeOptions(look);
       po.cellSize = blob_.cellSize;
-      auto mesh = std::make_shared<blobtree::PolygonizeResult>(blobtree::polygonizeDetailed(*compiled_, po));
+      auto mesh = std::make_shared<blobtree::PolygonizeResult>(polygonizeForLook(*compiled_, po, look));
       out.figures.triangles = mesh->mesh.triangleCount();
       out.geometry.parts.push_back(render::PolygonizedPart{std::move(mesh), look.surface, textureTable(blob_.textures)});
     } else {

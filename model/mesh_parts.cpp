@@ -1,5 +1,6 @@
 #include "model/mesh_parts.h"
 
+#include <algorithm>
 #include <map>
 #include <stdexcept>
 
@@ -74,6 +75,36 @@ std::vector<std::pair<uint32_t, Mesh>> splitByMaterial(const Mesh& mesh) {
     out.emplace_back(id, std::move(part));
   }
   return out;
+}
+
+blobtree::PolygonizeResult polygonizeForLook(const blobtree::CompiledBlob& blob, const blobtree::PolygonizeOptions& options,
+                                             const SpeciesRender& look) {
+  blobtree::PolygonizeResult r = blobtree::polygonizeDetailed(blob, options);
+  if (!(look.simplify > 0) || r.mesh.triangles.empty()) return r;
+  std::vector<uint32_t> source;
+  r.mesh = organisms::simplifyToError(r.mesh, float(look.simplify), nullptr, &source);
+  if (!r.attributes.empty()) {
+    std::vector<blobtree::Attributes> kept(source.size());
+    for (size_t v = 0; v < source.size(); ++v) kept[v] = r.attributes[source[v]];
+    r.attributes = std::move(kept);
+  }
+  return r;
+}
+
+std::vector<organisms::SimplifyReport> simplifyParts(std::vector<ExportPart>& parts, double relativeError) {
+  auto extent = [](const Box3& b) { return b.empty() ? 0.0f : std::max({b.size().x, b.size().y, b.size().z}); };
+  Box3 all;
+  for (const ExportPart& p : parts)
+    if (!p.mesh.triangles.empty()) all.extend(p.mesh.bounds());
+  const double absolute = relativeError * double(extent(all));
+  std::vector<organisms::SimplifyReport> reports(parts.size());
+  for (size_t i = 0; i < parts.size(); ++i) {
+    Mesh& m = parts[i].mesh;
+    const float own = extent(m.bounds());
+    if (m.triangles.empty() || !(own > 0)) continue;
+    m = organisms::simplifyToError(m, float(absolute / double(own)), &reports[i]);
+  }
+  return reports;
 }
 
 }  // namespace sprig

@@ -9,6 +9,8 @@
 
 #include "blobtree/polygonize.h"
 #include "core/mesh.h"
+#include "core/mesh_io.h"
+#include "organisms/simplify.h"
 #include "model/species.h"
 #include "render/geometry.h"
 
@@ -31,5 +33,18 @@ Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::Te
 /// each group is its own mesh (only the vertices it uses, in their original order; every
 /// per-vertex array kept; materials cleared). mesh.materials must have one id per triangle.
 std::vector<std::pair<uint32_t, Mesh>> splitByMaterial(const Mesh& mesh);
+
+/// polygonizeDetailed(blob, options), simplified to look.simplify of the surface's extent
+/// when that is above 0 (the per-vertex attributes follow the vertices that remain): the
+/// surface of a mesh-mode render.
+blobtree::PolygonizeResult polygonizeForLook(const blobtree::CompiledBlob& blob, const blobtree::PolygonizeOptions& options,
+                                             const SpeciesRender& look);
+
+/// Simplifies every part of a model to a geometric error (organisms::simplifyToError):
+/// relativeError is a fraction of the whole model's extent (the largest side of the
+/// bounding box of all parts), so every part gets the same error in model units.
+/// Normals, texture coordinates and colours stay at the vertices that remain; a closed,
+/// manifold part stays so. Returns one report per part, in order. O(T log T).
+std::vector<organisms::SimplifyReport> simplifyParts(std::vector<ExportPart>& parts, double relativeError);
 
 }  // namespace sprig

@@ -442,7 +442,7 @@ class ShellModel final : public KindModel {
     if (mode == GeometryMode::Mesh) {
       blobtree::PolygonizeOptions po = polygonizeOptions(look);
       po.cellSize = shellMeshCell(*shell->blob);
-      mesh = std::make_shared<blobtree::PolygonizeResult>(blobtree::polygonizeDetailed(*shell->blob, po));
+      mesh = std::make_shared<blobtree::PolygonizeResult>(polygonizeForLook(*shell->blob, po, look));
       out.figures.triangles = mesh->mesh.triangleCount();
     }
     out.figures.buildSeconds = secondsSince(t0);

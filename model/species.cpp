@@ -29,6 +29,7 @@ void readRender(MapReader& m, SpeciesRender& r, DiagnosticList& diags) {
   im.spp = static_cast<int>(m.integer("samples", im.spp, 1, 1024));
   im.thinMinPixels = static_cast<float>(m.number("thin_min_pixels", im.thinMinPixels, 0.0, 8.0));
   r.dualMesher = m.choice("mesher", r.dualMesher ? "dual" : "tetrahedra", {"tetrahedra", "dual"}) == "dual";
+  r.simplify = m.number("simplify", r.simplify, 0.0, 0.1);
   if (auto w = m.section("wind")) {
     MapReader wind(*w, diags, "render.wind");
     r.windSpeed = wind.number("speed", r.windSpeed, 0.0, 60.0);

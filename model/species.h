@@ -65,6 +65,10 @@ struct SpeciesRender {
   /// are meshed: marching tetrahedra (the reference; a vertex on every crossing grid edge) or
   /// dual marching cubes (a third of the triangles); both closed and 2-manifold.
   bool dualMesher = false;
+  /// `simplify`: polygonized surfaces (mesh-mode renders, `sprig mesh`) are simplified by
+  /// edge collapses while the geometric error stays below this fraction of the surface's
+  /// extent (organisms::simplifyToError, meshoptimizer); 0 (the default) keeps every triangle.
+  double simplify = 0;
 
   /// Renderer settings for an image of width x height.
   render::RenderSettings settings(int imageWidth, int imageHeight) const;

@@ -285,7 +285,7 @@ class TreeModel final : public KindModel {
     fig.triangles = tree.leaves.triangleCount();
     std::shared_ptr<const blobtree::PolygonizeResult> mesh;
     if (mode == GeometryMode::Mesh) {
-      mesh = std::make_shared<blobtree::PolygonizeResult>(blobtree::polygonizeDetailed(*tree.compiled, polygonizeOptions(look)));
+      mesh = std::make_shared<blobtree::PolygonizeResult>(polygonizeForLook(*tree.compiled, polygonizeOptions(look), look));
       fig.triangles += mesh->mesh.triangleCount();
     }
     fig.buildSeconds = secondsSince(t0);

@@ -120,6 +120,13 @@ SimplifiedMesh simplifyMesh(const Mesh& mesh, size_t targetFaces, float maxRelat
   poly.faceVertices.assign(simplified.begin(), simplified.end());
   poly.faceSizes.assign(count / 3, 3);
 
+  out.source.assign(used, 0);
+  std::vector<uint32_t> lowest(welded, UINT32_MAX);  // welded vertex -> lowest input vertex
+  for (size_t i = n; i-- > 0;)
+    if (remap[i] != ~0u) lowest[remap[i]] = uint32_t(i);
+  for (size_t w = 0; w < welded; ++w)
+    if (compact[w] != ~0u) out.source[compact[w]] = lowest[w];
+
   report.faces = count / 3;
   report.vertices = used;
   report.relativeError = error;
@@ -129,6 +136,26 @@ SimplifiedMesh simplifyMesh(const Mesh& mesh, size_t targetFaces, float maxRelat
 
 PolyMesh simplifyToFaceCount(const Mesh& mesh, size_t targetFaces, float maxRelativeError) {
   return simplifyMesh(mesh, targetFaces, maxRelativeError).mesh;
+}
+
+Mesh simplifyToError(const Mesh& mesh, float maxRelativeError, SimplifyReport* report, std::vector<uint32_t>* source) {
+  SimplifiedMesh s = simplifyMesh(mesh, 0, maxRelativeError);
+  if (report) *report = s.report;
+  Mesh out;
+  out.positions = std::move(s.mesh.positions);
+  out.triangles.resize(s.mesh.faceCount());
+  for (size_t f = 0; f < out.triangles.size(); ++f)
+    out.triangles[f] = glm::uvec3(s.mesh.faceVertices[3 * f], s.mesh.faceVertices[3 * f + 1], s.mesh.faceVertices[3 * f + 2]);
+  auto carry = [&](const auto& from, auto& to) {
+    if (from.size() != mesh.vertexCount()) return;
+    to.resize(s.source.size());
+    for (size_t v = 0; v < s.source.size(); ++v) to[v] = from[s.source[v]];
+  };
+  carry(mesh.normals, out.normals);
+  carry(mesh.uvs, out.uvs);
+  carry(mesh.colors, out.colors);
+  if (source) *source = std::move(s.source);
+  return out;
 }
 
 }  // namespace sprig::organisms

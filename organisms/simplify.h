@@ -38,6 +38,10 @@ struct SimplifyReport {
 struct SimplifiedMesh {
   PolyMesh mesh;  ///< triangles as faces; colors kept when the input has them; no faceLocs
   SimplifyReport report;
+  /// For each vertex of mesh, the input vertex it is (the lowest-numbered input vertex at
+  /// its position): edge collapses move no vertex, so every per-vertex value of the input
+  /// (a field normal, texture coordinates) stays valid at the vertex it came from.
+  std::vector<uint32_t> source;
 };
 
 /// Reduces mesh to about targetFaces triangles (fewer is never asked of meshoptimizer;
@@ -60,5 +64,14 @@ SimplifiedMesh simplifyMesh(const Mesh& mesh, size_t targetFaces, float maxRelat
 
 /// simplifyMesh(...).mesh.
 PolyMesh simplifyToFaceCount(const Mesh& mesh, size_t targetFaces, float maxRelativeError = 1e-1f);
+
+/// Collapses edges of mesh while meshoptimizer's error stays within maxRelativeError of
+/// the mesh's extent (simplifyMesh with no face target), and keeps the input's per-vertex
+/// arrays (normals, uvs, colours) at the vertices that remain (SimplifiedMesh::source);
+/// per-triangle materials are dropped. A closed manifold input stays closed and manifold.
+/// report, when given, receives simplifyMesh's report, and source the input vertex of each
+/// vertex of the result (for per-vertex data kept outside the mesh). Throws as simplifyMesh.
+Mesh simplifyToError(const Mesh& mesh, float maxRelativeError, SimplifyReport* report = nullptr,
+                     std::vector<uint32_t>* source = nullptr);
 
 }  // namespace sprig::organisms

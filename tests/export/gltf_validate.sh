@@ -25,6 +25,7 @@ species=(
   "fig_solid_01_striped_candy chocolate white_chocolate"  # solid: one part per material
   "fig_tree_12_pcm_offset wood | --mesher dual"  # dual marching cubes
   "shell_top whorl inside | --mesher dual"
+  "shell_top whorl inside | --mesher dual --simplify 1e-3"  # simplified parts keep their borders
 )
 files=()
 for entry in "${species[@]}"; do

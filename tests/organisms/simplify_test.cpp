@@ -101,6 +101,52 @@ TEST_CASE("simplifyMesh", "[organisms]") {
   }
 }
 
+TEST_CASE("simplifyToError keeps the input's per-vertex data", "[organisms]") {
+  const Vec3 center(1, 2, 3);
+  const float radius = 2.5f;
+  Mesh sphere = test::unwelded(test::icosphere(5, center, radius));
+  // Field normals, a uv and a colour that are functions of the vertex's position, so the
+  // kept vertex's values can be checked against its position.
+  sphere.normals.clear();
+  sphere.uvs.clear();
+  sphere.colors.clear();
+  for (const Vec3& p : sphere.positions) {
+    const Vec3 n = glm::normalize(p - center);
+    sphere.normals.push_back(n);
+    sphere.uvs.push_back(Vec2(p.x, p.z));
+    sphere.colors.push_back(0.5f * (n + 1.0f));
+  }
+  SimplifyReport report;
+  std::vector<uint32_t> source;
+  const float bound = 1e-3f;
+  Mesh s = simplifyToError(sphere, bound, &report, &source);
+  // The icosphere's level-5 facets deviate from the sphere by about R(1 - cos(edge/2)),
+  // 2.5e-4 of its diameter, so a bound of 1e-3 allows collapses but not down to a handful.
+  CHECK(s.triangleCount() < sphere.triangleCount() / 4);
+  CHECK(s.triangleCount() > 200);
+  CHECK(report.relativeError <= bound);
+  CHECK(report.faces == s.triangleCount());
+  MeshTopology t = analyzeTopology(s);
+  CHECK(t.closed());
+  CHECK(t.manifold());
+  CHECK(signedVolume(s) > 0);
+  REQUIRE(source.size() == s.vertexCount());
+  REQUIRE(s.normals.size() == s.vertexCount());
+  REQUIRE(s.uvs.size() == s.vertexCount());
+  REQUIRE(s.colors.size() == s.vertexCount());
+  for (size_t v = 0; v < s.vertexCount(); ++v) {
+    CHECK(s.positions[v] == sphere.positions[source[v]]);  // collapses move no vertex
+    CHECK(s.normals[v] == glm::normalize(s.positions[v] - center));
+    CHECK(s.uvs[v] == Vec2(s.positions[v].x, s.positions[v].z));
+  }
+  // Every triangle's centroid within the bound (of the 5-unit extent) plus the flat
+  // facets' own sag of the sphere.
+  for (const auto& tri : s.triangles) {
+    const Vec3 c = (s.positions[tri.x] + s.positions[tri.y] + s.positions[tri.z]) / 3.0f;
+    CHECK(radius - glm::length(c - center) <= 4 * bound * 2 * radius);
+  }
+}
+
 TEST_CASE("simplifyMesh where meshoptimizer pinches", "[organisms]") {
   test::TempDir dir("simplify-meshes");
   std::optional<std::filesystem::path> meshes = test::freeMeshes(dir.path);
