@@ -563,8 +563,12 @@ void dualMesh(const CompiledBlob& blob, const PolygonizeOptions& options, const 
   PolygonizeOptions edgeOptions = options;
   edgeOptions.normals = edgeOptions.attributes = edgeOptions.progress = false;
   // The patch's Newton steps land the vertex on the surface; its starting mean needs only
-  // rough crossings.
-  edgeOptions.refineSteps = std::min(options.refineSteps, 3);
+  // the crossings of the corner values' linear interpolation (as in Nielson's dual marching
+  // cubes), so no field is evaluated on the edges. Measured on the 2,000-cone scene: 11.9 M
+  // field evaluations instead of 18.3 M with three regula-falsi steps per edge, and the
+  // vertices that end more than 1e-3 off F = 0.5 (clamped in their cell at creases) 0.15 %
+  // instead of 0.09 % (tests/blobtree/dual_mesher_test.cpp bounds them).
+  edgeOptions.refineSteps = 0;
   PolygonizeResult crossings;
   std::vector<uint8_t> unusedFlat;
   std::vector<uint8_t> evals = placeVertices(blob, edgeOptions, g, v.edges, crossings, unusedFlat);
@@ -610,7 +614,7 @@ void dualMesh(const CompiledBlob& blob, const PolygonizeOptions& options, const 
   std::vector<uint8_t> flatGradient(nVerts, 0);
   std::unique_ptr<Progress> bar;
   if (options.progress) bar = std::make_unique<Progress>("polygonize", nActive);
-  constexpr int kNewtonSteps = 2;
+  constexpr int kNewtonSteps = 3;
   std::atomic<size_t> sampleCount{0};
   constexpr size_t kCellBlock = 256;
   parallelFor(0, (nActive + kCellBlock - 1) / kCellBlock, [&](size_t blk) {

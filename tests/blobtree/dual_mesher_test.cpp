@@ -187,4 +187,17 @@ TEST_CASE("dual mesher: a branching blend of cones, deterministic at any thread 
   CHECK(euler(one) == euler(tets));
   CHECK(signedVolume(one) == Approx(signedVolume(tets)).epsilon(0.01));
   CHECK(one.triangleCount() < tets.triangleCount() / 2);
+  // The patch vertices start from the mean of linearly interpolated edge crossings and are
+  // moved onto F = 0.5 by Newton steps kept inside their cell: nearly all land there.
+  std::vector<float> f(one.vertexCount());
+  blob.values(one.positions, f);
+  size_t off = 0;
+  float worst = 0;
+  for (float v : f) {
+    off += std::fabs(v - 0.5f) > 1e-3f;
+    worst = std::max(worst, std::fabs(v - 0.5f));
+  }
+  INFO("vertices off the surface by more than 1e-3 in F: " << off << " of " << f.size() << ", worst " << std::to_string(worst));
+  CHECK(off * 200 < f.size());
+  CHECK(worst < 0.05f);
 }
