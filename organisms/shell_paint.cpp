@@ -14,6 +14,8 @@ ShellPainter::ShellPainter(const ShellParams& params, const ShellModel& model, S
       fullEndDeg_(params.whorls * params.whorlDeg),
       varixSpacingDeg_(params.varices.spacingDeg),
       varices_(params.varices.enabled),
+      opening_(params.opening.enabled),
+      openingFromDeg_(model.endDeg - params.opening.depthDeg),
       spineLength_(params.varices.spineLength),
       axialLength_(params.axialSpines.length),
       shellFromWorld_(glm::inverse(model.worldFromShell)) {
@@ -65,6 +67,11 @@ Vec3 ShellPainter::whorlColor(Vec3 shellPoint) const {
     const double u = h.aroundDeg / 360.0;
     const float a = pigment_->sample(u, v);
     c = glm::mix(c, o.pigmentColor, o.pigmentStrength * a);
+  }
+  // The inside of the aperture: the cut surface of the opening, inside the whorl's wall.
+  if (opening_ && o.insideRadial > 0.0f && h.thetaDeg > openingFromDeg_) {
+    const double w = std::clamp((o.insideRadial + 0.04 - h.radial) / 0.08, 0.0, 1.0);
+    if (w > 0.0) return glm::mix(c, o.insideColor, static_cast<float>(w));
   }
   // Pale bands where varices were laid down.
   if (varices_ && varixSpacingDeg_ > 0.0) {
