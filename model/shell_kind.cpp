@@ -112,12 +112,11 @@ void readGenerating(MapReader& top, ShellParams& p, DiagnosticList& diags) {
 void readCanal(MapReader& top, ShellParams& p, DiagnosticList& diags) {
   auto sec = top.section("canal");
   if (!sec) return;
-  if (!p.canal) {
+  organisms::CanalOptions unused;  // the keys are still read (checked, and seen by `sprig schema`)
+  if (!p.canal)
     sec->error(diags, "'canal' shapes the siphonal canal of 'generating: murex', and this shell's generating surface has "
                       "none (use generating: murex, or a cone with 'canal: true' among its primitives)");
-    return;
-  }
-  organisms::CanalOptions& c = *p.canal;
+  organisms::CanalOptions& c = p.canal ? *p.canal : unused;
   MapReader r(*sec, diags, "canal");
   if (auto st = r.get("start")) {
     const std::vector<float> xy = floatList(*st, diags, "start", -100.0, 100.0);
@@ -133,6 +132,7 @@ void readCanal(MapReader& top, ShellParams& p, DiagnosticList& diags) {
   c.turnDeg = num(r, "turn", c.turnDeg, 1.0, 90.0);
   c.sweepDeg = r.number("sweep", c.sweepDeg, 1.0, 40 * 3600.0);
   r.finish();
+  if (!p.canal) return;
   if (!(c.start.x > c.tipX(p.spiral))) {
     char buf[160];
     std::snprintf(buf, sizeof buf, "the canal's start x (%.3g) must lie farther from the shell axis than its tip (x = %.3g here)",
