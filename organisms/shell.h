@@ -81,9 +81,9 @@ struct CanalOptions {
   Vec2 start{-0.45f, 0.7f};   ///< where the canal leaves the generating point (unit frame)
   float length = 8.0f;        ///< axial extent from `start` to the tip, unit frame
   float axisOffset = 0.1f;    ///< distance of the straight part from the shell axis, unit frame
-  float radiusStart = 0.3f;   ///< 0.5-iso radius at the start (before size calibration)
+  float radiusStart = 0.25f;  ///< 0.5-iso radius at the start (before size calibration)
   float radiusEnd = 0.2f;     ///< 0.5-iso radius at the tip
-  float turnDeg = 60.0f;      ///< the canal's direction at its start, from the axis direction (0, 90]
+  float turnDeg = 75.0f;      ///< the canal's direction at its start, from the axis direction (0, 90]
   double sweepDeg = 464.0;    ///< swept over the last sweepDeg before θ_end (1⅓ whorls)
 
   /// The tip's x in the unit frame for `spiral`.

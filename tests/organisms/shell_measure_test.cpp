@@ -13,6 +13,7 @@ using namespace sprig::organisms;
 TEST_CASE("CanalOptions::centre line is an arc that ends parallel to the axis", "[organisms]") {
   const HelicoSpiral s{1.3, 22.5, 0.2};
   CanalOptions c;
+  c.turnDeg = 60.0f;
   // Tip beside the axis: R/D = (λ+1)·sin β/(λ−1) = 2.3·0.382683/0.3.
   const double axisX = -2.3 * std::sin(22.5 * kPi / 180.0) / 0.3;
   CHECK(c.tipX(s) == Approx(axisX + 0.1).epsilon(1e-9));
