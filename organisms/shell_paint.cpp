@@ -76,7 +76,9 @@ Vec3 ShellPainter::whorlColor(Vec3 shellPoint) const {
   // Pale bands where varices were laid down.
   if (varices_ && varixSpacingDeg_ > 0.0) {
     const double dv = std::abs(std::remainder(h.thetaDeg - startDeg_, varixSpacingDeg_));
-    if (h.thetaDeg > startDeg_ + 0.5 * varixSpacingDeg_ && dv < 4.0)
+    // Only on the whorl proper: the canal's points lie far from every generating centre, and
+    // a band there (constant θ along the axis) would draw a pale line down the canal.
+    if (h.thetaDeg > startDeg_ + 0.5 * varixSpacingDeg_ && dv < 4.0 && h.radial < 1.25)
       c = glm::mix(c, o.varixColor, static_cast<float>(0.6 * (1.0 - dv / 4.0)));
   }
   return c;
