@@ -12,11 +12,12 @@
 //                    [--baseline 1] [--image OUT.png] [--age DEG]
 //   --cell-div N: surface cells of diagonal/N (0 = organisms::shellCellSize's choice)
 //   --baseline 0 skips the baseline render
-//   --canal ax,ay,bx,by,ra,rb,bend: another canal cone for the Murex (unit generating frame)
+//   --canal sx,sy,length,ra,rb,turn: another canal for the Murex (organisms::CanalOptions:
+//     start, length along the axis, radii, turn in degrees; unit generating frame)
 //   --tolerance T: relative root tolerance (default organisms::kShellTraceTolerance = 1e-4)
 //   --canal-deg DEG: sweep the canal over the last DEG degrees (the paper: 464)
 //   --without LIST leaves parts out of the Murex (cost breakdown): any of varices, bumps,
-//     axial, opening, tori, spinebend, canalbend, canal, axialbend,
+//     axial, opening, tori, spinebend, canal, axialbend,
 //     ricci (bumps summed instead of the n = 400 blend)
 
 #include <chrono>
@@ -49,7 +50,7 @@ struct Args {
   std::string image;
   double age = 0.0;
   std::string without;  ///< parts left out of the Murex, for a cost breakdown
-  std::string canal;    ///< canal cone override "ax,ay,bx,by,ra,rb,bend" (unit frame)
+  std::string canal;    ///< canal override "sx,sy,length,ra,rb,turn" (unit frame)
   double canalDeg = 0;  ///< canal sweep override (degrees before θ_end)
   float tolerance = 0;  ///< relative root tolerance (0 = organisms::kShellTraceTolerance)
 };
@@ -150,23 +151,22 @@ int main(int argc, char** argv) {
     if (has("opening")) murex.opening.enabled = false;
     if (has("spinebend")) murex.varices.bendDeg = 0.0f;
     if (has("tori")) murex.varices.tori = false;
-    if (has("canalbend")) murex.generating.primitives[1].bendDeg = 0.0f;
-    if (has("canal")) murex.generating = organisms::GeneratingSurface::point();
+    if (has("canal")) murex.canal.reset();
     if (has("axialbend")) murex.axialSpines.randomBends = false;
     if (has("ricci")) murex.bumps.blendN = 1.0f;
-    if (a.canalDeg > 0 && murex.generating.primitives.size() > 1) murex.generating.primitives[1].lastDeg = a.canalDeg;
-    if (!a.canal.empty()) {
-      organisms::GeneratingPrimitive& c = murex.generating.primitives[1];
-      float v[7] = {};
-      if (std::sscanf(a.canal.c_str(), "%f,%f,%f,%f,%f,%f,%f", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5], &v[6]) != 7) {
-        std::fprintf(stderr, "bench_shell: --canal needs ax,ay,bx,by,ra,rb,bend\n");
+    if (a.canalDeg > 0 && murex.canal) murex.canal->sweepDeg = a.canalDeg;
+    if (!a.canal.empty() && murex.canal) {
+      organisms::CanalOptions& c = *murex.canal;
+      float v[6] = {};
+      if (std::sscanf(a.canal.c_str(), "%f,%f,%f,%f,%f,%f", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5]) != 6) {
+        std::fprintf(stderr, "bench_shell: --canal needs sx,sy,length,ra,rb,turn\n");
         return 2;
       }
-      c.a = Vec3(v[0], v[1], 0.0f);
-      c.b = Vec3(v[2], v[3], 0.0f);
-      c.radiusA = v[4];
-      c.radiusB = v[5];
-      c.bendDeg = v[6];
+      c.start = Vec2(v[0], v[1]);
+      c.length = v[2];
+      c.radiusStart = v[3];
+      c.radiusEnd = v[4];
+      c.turnDeg = v[5];
     }
     const auto total = Clock::now();
     const Result m = run(murex, a, a.image, "murex");

@@ -59,16 +59,18 @@ void readGenerating(MapReader& top, ShellParams& p, DiagnosticList& diags) {
   if (g->isScalar()) {
     static const std::vector<std::string> kinds = {"point", "murex"};
     const std::string k = g->scalar();
-    if (k == "point")
-      p.generating = GeneratingSurface::point();
-    else if (k == "murex")
-      p.generating = GeneratingSurface::murex(1.333 * p.whorlDeg);
-    else
+    p.generating = GeneratingSurface::point();
+    p.canal.reset();
+    if (k == "murex") {
+      p.canal = organisms::CanalOptions{};
+      p.canal->sweepDeg = 1.333 * p.whorlDeg;
+    } else if (k != "point")
       g->error(diags, "unknown generating surface '" + k + "' (point, murex or a map of primitives)" + didYouMean(k, kinds));
     return;
   }
   MapReader gen(*g, diags, "generating");
   p.generating.primitives.clear();
+  p.canal.reset();
   for (const YNode& item : gen.sequence("primitives")) {
     if (!item.isMap() || item.pairs().size() != 1) {
       item.error(diags, "a generating primitive must be a map with one key: point or cone");
@@ -104,6 +106,44 @@ void readGenerating(MapReader& top, ShellParams& p, DiagnosticList& diags) {
   }
   if (p.generating.primitives.empty()) g->error(diags, "'generating' needs at least one primitive");
   gen.finish();
+}
+
+/// `canal:` shapes the canal of `generating: murex` (organisms::CanalOptions).
+void readCanal(MapReader& top, ShellParams& p, DiagnosticList& diags) {
+  auto sec = top.section("canal");
+  if (!sec) return;
+  organisms::CanalOptions unused;  // the keys are still read (checked, and seen by `sprig schema`)
+  if (!p.canal)
+    sec->error(diags, "'canal' shapes the siphonal canal of 'generating: murex', and this shell's generating surface has "
+                      "none (use generating: murex, or a cone with 'canal: true' among its primitives)");
+  organisms::CanalOptions& c = p.canal ? *p.canal : unused;
+  MapReader r(*sec, diags, "canal");
+  if (auto st = r.get("start")) {
+    const std::vector<float> xy = floatList(*st, diags, "start", -100.0, 100.0);
+    if (xy.size() == 2)
+      c.start = Vec2(xy[0], xy[1]);
+    else if (st->isSequence())
+      st->error(diags, "'start' must be [x, y] (the unit generating frame)");
+  }
+  c.length = num(r, "length", c.length, 0.01, 100.0);
+  c.axisOffset = num(r, "axis_offset", c.axisOffset, -10.0, 10.0);
+  c.radiusStart = num(r, "radius_start", c.radiusStart, 1e-3, 10.0);
+  c.radiusEnd = num(r, "radius_end", c.radiusEnd, 1e-3, 10.0);
+  c.turnDeg = num(r, "turn", c.turnDeg, 1.0, 90.0);
+  c.sweepDeg = r.number("sweep", c.sweepDeg, 1.0, 40 * 3600.0);
+  r.finish();
+  if (!p.canal) return;
+  if (!(c.start.x > c.tipX(p.spiral))) {
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "the canal's start x (%.3g) must lie farther from the shell axis than its tip (x = %.3g here)",
+                  static_cast<double>(c.start.x), c.tipX(p.spiral));
+    sec->error(diags, buf);
+  } else if (c.arcHeight(p.spiral) > c.length) {
+    char buf[200];
+    std::snprintf(buf, sizeof buf, "the canal's 'length' (%.3g) is shorter than its bend, which turns %.3g degrees over %.3g along the axis",
+                  static_cast<double>(c.length), static_cast<double>(c.turnDeg), c.arcHeight(p.spiral));
+    sec->error(diags, buf);
+  }
 }
 
 void readVarices(MapReader& top, ShellParams& p, DiagnosticList& diags) {
@@ -233,6 +273,7 @@ void readTextures(MapReader& top, organisms::ShellTextureOptions& t, DiagnosticL
     t.axialColor = r.color("axial", t.axialColor);
     t.bumpColor = r.color("bump", t.bumpColor);
     t.insideColor = r.color("inside", t.insideColor);
+    t.insideRadial = num(r, "inside_radial", t.insideRadial, 0.0, 1.0);
     r.finish();
   }
   bool on = t.pigment;
@@ -294,6 +335,7 @@ std::optional<ShellSpec> readShellSection(const YNode& section, DiagnosticList& 
   p.calibrateSize = top.boolean("calibrate", p.calibrateSize);
   p.apexUp = top.boolean("apex_up", p.apexUp);
   readGenerating(top, p, diags);
+  readCanal(top, p, diags);
   readVarices(top, p, diags);
   readBumps(top, p, diags);
   readAxial(top, p, diags);

@@ -37,7 +37,10 @@ glm::dmat4 rotateZDeg(double deg) { return glm::rotate(glm::dmat4(1.0), radians(
 
 class ShellBuilder {
  public:
-  ShellBuilder(const ShellParams& p, ShellModel& m) : p_(p), m_(m), t_(m.tree), s_(p.spiral) {}
+  ShellBuilder(const ShellParams& p, ShellModel& m) : p_(p), m_(m), t_(m.tree), s_(p.spiral), gen_(p.generating) {
+    if (p.canal)
+      for (const GeneratingPrimitive& g : p.canal->primitives(p.spiral)) gen_.primitives.push_back(g);
+  }
 
   void build();
 
@@ -65,6 +68,7 @@ class ShellBuilder {
   ShellModel& m_;
   BlobTree& t_;
   HelicoSpiral s_;
+  GeneratingSurface gen_;  // p.generating plus the canal
   double end_ = 0.0, step_ = 0.0;
   Calibration cal_;  // calibration of the main generating surface
 };
@@ -204,7 +208,7 @@ void ShellBuilder::placeGenerating(std::vector<NodeId>& out, double theta, const
   const float radiusScale = cal.k;
   const glm::dmat4 m = s_.shellFromGenerating(theta) * glm::translate(glm::dmat4(1.0), glm::dvec3(cal.shift, 0, 0));
   const double d = s_.curveSize(theta);
-  for (const GeneratingPrimitive& g : p_.generating.primitives) {
+  for (const GeneratingPrimitive& g : gen_.primitives) {
     if (g.lastDeg > 0.0 && theta < end_ - g.lastDeg - kEps) continue;
     if (g.canal && !withCanal) continue;
     if (g.kind == GeneratingPrimitive::Kind::Point) {
@@ -267,7 +271,7 @@ void ShellBuilder::varix(std::vector<NodeId>& parts, int number, double theta) {
 void ShellBuilder::axialRow(std::vector<NodeId>& out, int number, double theta, const std::vector<float>& sizes) {
   const AxialSpineOptions& a = p_.axialSpines;
   const GeneratingPrimitive* canal = nullptr;
-  for (const GeneratingPrimitive& g : p_.generating.primitives)
+  for (const GeneratingPrimitive& g : gen_.primitives)
     if (g.canal && g.kind == GeneratingPrimitive::Kind::Cone) canal = &g;
   if (!canal || sizes.empty()) return;
   const glm::dmat4 m = s_.shellFromGenerating(theta);
@@ -277,8 +281,13 @@ void ShellBuilder::axialRow(std::vector<NodeId>& out, int number, double theta, 
   for (size_t j = 0; j < sizes.size(); ++j) {
     const float tj = sizes.size() == 1 ? a.firstT
                                         : a.firstT + (a.lastT - a.firstT) * static_cast<float>(j) / (sizes.size() - 1);
-    const Vec3 onAxis = canal->a + tj * (canal->b - canal->a);
-    const Vec3 base = canal->bendDeg != 0.0f ? cb.worldFromLocal(onAxis) : onAxis;
+    Vec3 base;
+    if (p_.canal) {
+      base = p_.canal->pointAt(s_, tj);
+    } else {
+      const Vec3 onAxis = canal->a + tj * (canal->b - canal->a);
+      base = canal->bendDeg != 0.0f ? cb.worldFromLocal(onAxis) : onAxis;
+    }
     const float size = sizes[j];
     const Vec3 tip = base + dir * (a.length * size);
     std::vector<Bend> bends;
@@ -486,24 +495,63 @@ GeneratingSurface GeneratingSurface::point() {
   return g;
 }
 
-GeneratingSurface GeneratingSurface::murex(double canalDeg) {
-  GeneratingSurface g = point();
-  GeneratingPrimitive c;
-  c.kind = GeneratingPrimitive::Kind::Cone;
-  // The canal runs from below the aperture's centre down to the shell axis (R/D = 2.93 for
-  // the Murex, so x = −2.8 ends just beside the axis): the copies swept over the last
-  // 1⅓ whorls converge into one slender canal along the columella instead of hanging as a
-  // comb of separate fingers around the body whorl.
-  c.a = Vec3(-0.35f, 0.4f, 0.0f);
-  c.b = Vec3(-2.8f, 5.5f, 0.0f);
-  c.radiusA = 0.45f;
-  c.radiusB = 0.16f;
-  c.bendDeg = 15.0f;
-  c.bendDirection = Vec3(1.0f, 0.0f, 0.0f);
-  c.lastDeg = canalDeg;
-  c.canal = true;
-  g.primitives.push_back(c);
-  return g;
+double CanalOptions::tipX(const HelicoSpiral& spiral) const { return -1.0 / spiral.sizeRatio() + axisOffset; }
+
+double CanalOptions::arcHeight(const HelicoSpiral& spiral) const {
+  const double turn = radians(turnDeg);
+  return (start.x - tipX(spiral)) * std::sin(turn) / (1.0 - std::cos(turn));
+}
+
+double CanalOptions::centreLength(const HelicoSpiral& spiral) const {
+  const double turn = radians(turnDeg);
+  const double rho = (start.x - tipX(spiral)) / (1.0 - std::cos(turn));
+  return rho * turn + std::max(0.0, length - arcHeight(spiral));
+}
+
+Vec3 CanalOptions::pointAt(const HelicoSpiral& spiral, double t) const {
+  // Arc of radius ρ about the centre (start.x − ρ·cos(turn), start.y − ... ): parametrized by
+  // the angle ψ from the axis direction, turning from `turn` down to 0.
+  const double turn = radians(turnDeg);
+  const double rho = (start.x - tipX(spiral)) / (1.0 - std::cos(turn));
+  const double arc = rho * turn, total = centreLength(spiral);
+  const double s = std::clamp(t, 0.0, 1.0) * total;
+  if (s <= arc) {
+    const double psi = turn - s / rho;
+    // Direction at ψ: (−sin ψ, cos ψ); x falls by ρ(cos ψ − cos turn), y rises by ρ(sin turn − sin ψ).
+    return Vec3(static_cast<float>(start.x - rho * (std::cos(psi) - std::cos(turn))),
+                static_cast<float>(start.y + rho * (std::sin(turn) - std::sin(psi))), 0.0f);
+  }
+  return Vec3(static_cast<float>(tipX(spiral)), static_cast<float>(start.y + arcHeight(spiral) + (s - arc)), 0.0f);
+}
+
+std::vector<GeneratingPrimitive> CanalOptions::primitives(const HelicoSpiral& spiral) const {
+  const double turn = radians(turnDeg);
+  const double rho = (start.x - tipX(spiral)) / (1.0 - std::cos(turn));
+  const double arc = rho * turn, total = centreLength(spiral);
+  const float rMid = static_cast<float>(radiusStart + (radiusEnd - radiusStart) * arc / total);
+  std::vector<GeneratingPrimitive> out;
+  GeneratingPrimitive bent;
+  bent.kind = GeneratingPrimitive::Kind::Cone;
+  bent.a = Vec3(start.x, start.y, 0.0f);
+  bent.b = pointAt(spiral, arc / total);
+  bent.radiusA = radiusStart;
+  bent.radiusB = rMid;
+  bent.bendDeg = turnDeg;
+  // The arc bulges towards the apex and the axis side of its chord: it first heads inwards.
+  bent.bendDirection = Vec3(-1.0f, -1.0f, 0.0f);
+  bent.lastDeg = sweepDeg;
+  bent.canal = true;
+  out.push_back(bent);
+  if (total - arc > 1e-6) {
+    GeneratingPrimitive straight = bent;
+    straight.a = bent.b;
+    straight.b = pointAt(spiral, 1.0);
+    straight.radiusA = rMid;
+    straight.radiusB = radiusEnd;
+    straight.bendDeg = 0.0f;
+    out.push_back(straight);
+  }
+  return out;
 }
 
 std::vector<std::vector<VarixSpine>> murexTable1() {
@@ -538,7 +586,9 @@ ShellParams murexCabritii() {
   p.whorlDeg = 348.0;
   p.sectionDeg = 116.0;
   p.surfacesPerSection = 6;
-  p.generating = GeneratingSurface::murex(464.0);
+  p.generating = GeneratingSurface::point();
+  p.canal = CanalOptions{};
+  p.axialSpines.length = 1.8f;  // long slender canal spines (Fig. 13-14); Table 2 sizes are relative to it
   p.varices.enabled = true;
   p.varices.spinesByWhorl = murexTable1();
   p.bumps.enabled = true;
@@ -559,6 +609,18 @@ ShellModel buildShell(const ShellParams& p, const SourceLoc& loc) {
   if (p.whorls < 1 || !(p.whorlDeg > 0.0) || !(p.sectionDeg > 0.0) || p.surfacesPerSection < 1)
     fail("whorls, whorl angle, section angle and surfaces per section must be positive");
   if (p.generating.primitives.empty()) fail("the generating surface has no primitive");
+  if (p.canal) {
+    const CanalOptions& c = *p.canal;
+    if (!(c.length > 0.0f) || !(c.radiusStart > 0.0f) || !(c.radiusEnd > 0.0f) || !(c.sweepDeg > 0.0))
+      fail("canal length, radii and sweep must be > 0");
+    if (!(c.start.x > c.tipX(p.spiral)))
+      fail("the canal must start farther from the shell axis than its tip (start x " + std::to_string(c.start.x) +
+           ", tip x " + std::to_string(c.tipX(p.spiral)) + ")");
+    if (!(c.turnDeg > 0.0f && c.turnDeg <= 90.0f)) fail("canal turn must lie in (0, 90] degrees");
+    if (!(c.arcHeight(p.spiral) <= c.length))
+      fail("the canal is too short for its turn: the bend alone reaches " + std::to_string(c.arcHeight(p.spiral)) +
+           " along the axis, more than its length " + std::to_string(c.length));
+  }
   if (!(p.endDeg() >= p.startDeg)) fail("age (theta_end) must not be below the start angle");
   if (p.varices.enabled && !(p.varices.spacingDeg > 0.0)) fail("varix spacing must be > 0");
   if (p.axialSpines.enabled && (p.axialSpines.bendsMin < 0 || p.axialSpines.bendsMax < p.axialSpines.bendsMin))

@@ -66,9 +66,36 @@ struct GeneratingSurface {
 
   /// A unit point primitive: a circular aperture (Fig. 4-5).
   static GeneratingSurface point();
-  /// The Murex composite: a point plus a bent cone for the siphonal canal (Fig. 6), the
-  /// canal swept over the last `canalDeg` degrees.
-  static GeneratingSurface murex(double canalDeg = 464.0);
+};
+
+/// The siphonal canal of the Murex generating surface (Fig. 6): below the point, a cone
+/// bent on a circular arc that leaves the aperture's lower inner side heading `turnDeg`
+/// away from the axis direction and turns until it runs parallel to the shell axis,
+/// `axisOffset` beside it, continued by a straight cone down to the tip. Every swept copy
+/// ends along the axis, so the copies overlap into one long, slender, straight canal
+/// (Fig. 13-14) instead of fanning out into a funnel. Unit generating frame (x away from
+/// the axis, y along the axis away from the apex, 1 = D(θ)); the tip's x is
+/// −R/D + axisOffset, taken from the spiral (−2.93 + offset for the Murex), so the canal
+/// follows λ and β.
+struct CanalOptions {
+  Vec2 start{-0.45f, 0.7f};   ///< where the canal leaves the generating point (unit frame)
+  float length = 8.0f;        ///< axial extent from `start` to the tip, unit frame
+  float axisOffset = 0.1f;    ///< distance of the straight part from the shell axis, unit frame
+  float radiusStart = 0.25f;  ///< 0.5-iso radius at the start (before size calibration)
+  float radiusEnd = 0.2f;     ///< 0.5-iso radius at the tip
+  float turnDeg = 75.0f;      ///< the canal's direction at its start, from the axis direction (0, 90]
+  double sweepDeg = 464.0;    ///< swept over the last sweepDeg before θ_end (1⅓ whorls)
+
+  /// The tip's x in the unit frame for `spiral`.
+  double tipX(const HelicoSpiral& spiral) const;
+  /// Axial extent of the bent part: (start.x − tipX)·sin(turn)/(1 − cos(turn)).
+  double arcHeight(const HelicoSpiral& spiral) const;
+  /// Arc length of the centre line (bent part plus straight part).
+  double centreLength(const HelicoSpiral& spiral) const;
+  /// Point of the centre line at arc-length fraction t in [0, 1] (unit frame, z = 0).
+  Vec3 pointAt(const HelicoSpiral& spiral, double t) const;
+  /// The canal as generating primitives (canal = true): the bent cone and the straight one.
+  std::vector<GeneratingPrimitive> primitives(const HelicoSpiral& spiral) const;
 };
 
 /// One spine of a varix row: its angle in the generating plane and its relative size σ.
@@ -146,6 +173,9 @@ struct ShellParams {
   double startDeg = 0.0;        ///< angle of the first generating surface (apex)
   std::optional<double> ageDeg; ///< θ_end; default whorls·whorlDeg
   GeneratingSurface generating = GeneratingSurface::point();
+  /// The Murex canal (`generating: murex`), added to the generating surface by the builder
+  /// from the spiral's proportions; nullopt: none.
+  std::optional<CanalOptions> canal;
   bool controlledBlending = true;  ///< Eq. 10; false: every section blends with every other
   /// Shrink and shift generating primitives so the summed field of the row spaced Δθ apart
   /// along the curved spiral has a cross-section of mean radius D(θ) centred on the spiral

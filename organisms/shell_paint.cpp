@@ -14,6 +14,8 @@ ShellPainter::ShellPainter(const ShellParams& params, const ShellModel& model, S
       fullEndDeg_(params.whorls * params.whorlDeg),
       varixSpacingDeg_(params.varices.spacingDeg),
       varices_(params.varices.enabled),
+      opening_(params.opening.enabled),
+      openingFromDeg_(model.endDeg - params.opening.depthDeg),
       spineLength_(params.varices.spineLength),
       axialLength_(params.axialSpines.length),
       shellFromWorld_(glm::inverse(model.worldFromShell)) {
@@ -66,10 +68,17 @@ Vec3 ShellPainter::whorlColor(Vec3 shellPoint) const {
     const float a = pigment_->sample(u, v);
     c = glm::mix(c, o.pigmentColor, o.pigmentStrength * a);
   }
+  // The inside of the aperture: the cut surface of the opening, inside the whorl's wall.
+  if (opening_ && o.insideRadial > 0.0f && h.thetaDeg > openingFromDeg_) {
+    const double w = std::clamp((o.insideRadial + 0.04 - h.radial) / 0.08, 0.0, 1.0);
+    if (w > 0.0) return glm::mix(c, o.insideColor, static_cast<float>(w));
+  }
   // Pale bands where varices were laid down.
   if (varices_ && varixSpacingDeg_ > 0.0) {
     const double dv = std::abs(std::remainder(h.thetaDeg - startDeg_, varixSpacingDeg_));
-    if (h.thetaDeg > startDeg_ + 0.5 * varixSpacingDeg_ && dv < 4.0)
+    // Only on the whorl proper: the canal's points lie far from every generating centre, and
+    // a band there (constant θ along the axis) would draw a pale line down the canal.
+    if (h.thetaDeg > startDeg_ + 0.5 * varixSpacingDeg_ && dv < 4.0 && h.radial < 1.25)
       c = glm::mix(c, o.varixColor, static_cast<float>(0.6 * (1.0 - dv / 4.0)));
   }
   return c;

@@ -33,6 +33,11 @@ struct ShellTextureOptions {
   Vec3 axialColor{0.84f, 0.80f, 0.74f};    ///< axial canal spines
   Vec3 bumpColor{0.70f, 0.58f, 0.46f};     ///< bumps
   Vec3 insideColor{0.93f, 0.78f, 0.74f};   ///< aperture and inside wall
+  /// The whorl's inner surface (the hollow the opening cuts, Eq. 14) takes insideColor:
+  /// points nearer the generating centre than this fraction of D(θ), within the opening's
+  /// depth of the lip. The cut surface carries the whorl's texture id (a difference keeps
+  /// the shell's attributes), so the painter tells it by its place. 0 = off.
+  float insideRadial = 0.9f;
   bool pigment = false;                    ///< lay the reaction-diffusion pattern on the whorl
   Vec3 pigmentColor{0.30f, 0.15f, 0.08f};  ///< colour of high activator
   float pigmentStrength = 0.85f;
@@ -69,6 +74,8 @@ class ShellPainter {
   HelicoSpiral spiral_;
   double startDeg_ = 0.0, endDeg_ = 0.0, fullEndDeg_ = 0.0, varixSpacingDeg_ = 0.0;
   bool varices_ = false;
+  bool opening_ = false;
+  double openingFromDeg_ = 0.0;  // θ_end − depth
   float spineLength_ = 1.0f, axialLength_ = 1.0f;
   glm::dmat4 shellFromWorld_{1.0};
   std::shared_ptr<const textures::PigmentPattern> pigment_;
