@@ -102,7 +102,8 @@ Turtle::Turtle(const SymbolTable& symbols, TurtleSettings settings) : symbols_(s
         case '\\': c = Command::RollLeft; break;
         case '/': c = Command::RollRight; break;
         case '|': c = Command::TurnAround; break;
-        case '$': c = Command::RollToVertical; break;
+        case '$': c = settings_.cpfg ? Command::SubEnd : Command::RollToVertical; break;
+        case '?': c = settings_.cpfg ? Command::SubCall : Command::None; break;
         case '[': c = Command::Push; break;
         case ']': c = Command::Pop; break;
         case '!': c = Command::Width; break;
@@ -291,6 +292,8 @@ class TurtleWalk {
         case Command::Query:
           if (queries_) queries_->push_back({i, st_.frame});
           break;
+        case Command::SubCall: subCall(i); break;
+        case Command::SubEnd: subEnd(); break;
       }
     }
     return st_;
@@ -482,6 +485,30 @@ class TurtleWalk {
       if (sign < 0 && st_.color < 0) st_.color += 256;
     }
   }
+  /// cpfg's `?(n, s)` (interpret.c, UpdateCurrentLsystem): the sub-L-system scale becomes
+  /// the enclosing one times s (unchanged without s), and so do the turtle scale and the
+  /// line width (in proportion). The scales form a stack of their own, which `[` and `]`
+  /// do not save.
+  void subCall(size_t i) {
+    if (!hasParam(i)) return;
+    if (subScales_.empty()) subScales_.push_back(settings_.initialScale);
+    const double outer = subScales_.back();
+    const double inner = off_[i + 1] - off_[i] >= 2 ? outer * prm_[off_[i] + 1] : outer;
+    subScales_.push_back(inner);
+    st_.scale = inner;
+    st_.width = outer != 0 ? st_.width * inner / outer : st_.width;
+  }
+
+  /// cpfg's `$`: back to the enclosing sub-L-system's scale (an unmatched `$` does nothing,
+  /// as cpfg does after its warning).
+  void subEnd() {
+    if (subScales_.size() < 2) return;
+    const double inner = subScales_.back();
+    subScales_.pop_back();
+    st_.scale = subScales_.back();
+    st_.width = inner != 0 ? st_.width * st_.scale / inner : st_.width;
+  }
+
   /// `@Di` (divide false) and `@Dd` (divide true): multiplies or divides the turtle scale
   /// by the parameter (ignored when 0, as cpfg does), or by the scale multiplier.
   void scaleStep(size_t i, bool divide) {
@@ -791,6 +818,7 @@ class TurtleWalk {
   const double partial_;
   SinCosCache trig_;
   TurtleState st_;
+  std::vector<double> subScales_;  ///< cpfg's sub-L-system scales (`?(n, s)`), outermost first
   std::vector<Turtle::QueryHit>* queries_ = nullptr;
 };
 

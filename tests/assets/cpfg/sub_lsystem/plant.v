@@ -1,0 +1,2 @@
+angle increment: 90
+initial line width: 0.2 polygon
