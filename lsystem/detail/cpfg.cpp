@@ -14,10 +14,6 @@ struct Unsupported {
 };
 
 constexpr Unsupported kUnsupported[] = {
-    {"@Gs", "generalized cylinder"},
-    {"@Gc", "generalized cylinder"},
-    {"@Ge", "generalized cylinder"},
-    {"@Gt", "generalized cylinder tangents"},
     {"@Gr", "generalized cylinder radius tangents"},
     {"@#", "contour of generalized cylinders"},
     {"@Tx", "texture"},

@@ -259,8 +259,8 @@ TEST_CASE("cpfg view file", "[lsystem][cpfg]") {
 
 TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg]") {
   SECTION("commands") {
-    CHECK(errorOf("axiom: A\nA --> F@Gc(10)F\n") == "t.l:2:8: cpfg's '@Gc' (generalized cylinder) is not supported");
-    CHECK(errorOf("axiom: F@Gs\n", "t.lsys") == "t.lsys:1:9: cpfg's '@Gs' (generalized cylinder) is not supported");
+    CHECK(errorOf("axiom: A\nA --> F@#(10)F\n") == "t.l:2:8: cpfg's '@#' (contour of generalized cylinders) is not supported");
+    CHECK(errorOf("axiom: F@Gr(1)\n", "t.lsys") == "t.lsys:1:9: cpfg's '@Gr' (generalized cylinder radius tangents) is not supported");
     CHECK(errorOf("axiom: F{(1)F}(1)\n") == "t.l:1:9: cpfg's '{(type)' (generalized cylinder) is not supported");
     CHECK(errorOf("axiom: A\nA --> F$A\n") ==
           "t.l:2:8: cpfg's '$' ends a sub-L-system call '?(n, scale)', and this file makes none (ABOP's roll to vertical is '@v' in cpfg)");
@@ -302,7 +302,7 @@ TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg
     CHECK(errorOf("Start: { printf(\"%5.2f%%\\n\", 2); }\naxiom: A\n") == "no error");
   }
   SECTION("an error in a continued line is reported at its own line") {
-    CHECK(errorOf("axiom: A\nA --> F\n\tF@Gc(2)\n") == "t.l:3:3: cpfg's '@Gc' (generalized cylinder) is not supported");
+    CHECK(errorOf("axiom: A\nA --> F\n\tF@Gr(2)\n") == "t.l:3:3: cpfg's '@Gr' (generalized cylinder radius tangents) is not supported");
   }
 }
 
@@ -499,14 +499,14 @@ TEST_CASE("cpfg's C preprocessor", "[lsystem][cpfg]") {
   SECTION("an error in an included file is at its own file:line:col") {
     const std::string file = cpfgAsset("preprocessor_errors/plant.l");
     CHECK(errorOf(readFile(file), file) == cpfgAsset("preprocessor_errors/rules.h") +
-                                                    ":2:8: cpfg's '@Gc' (generalized cylinder) is not supported");
+                                                    ":2:8: cpfg's '@Gr' (generalized cylinder radius tangents) is not supported");
   }
   SECTION("an error inside a macro's expansion is at the macro's use") {
-    CHECK(errorOf("#define LEAF [@Gc(1)]\naxiom: F LEAF\n") == "t.l:2:10: cpfg's '@Gc' (generalized cylinder) is not supported");
+    CHECK(errorOf("#define LEAF [@Gr(1)]\naxiom: F LEAF\n") == "t.l:2:10: cpfg's '@Gr' (generalized cylinder radius tangents) is not supported");
     CHECK(errorOf("#define B(x) F(x)\naxiom: A B(1, 2) C\n") ==
           "t.l:2:10: macro 'B' takes 1 argument(s) (defined at t.l:1), or its expansion nests deeper than 64 levels");
     // Columns after an expansion are the file's own.
-    CHECK(errorOf("#define S F(1)F(1)\naxiom: S@Gc(1)\n") == "t.l:2:9: cpfg's '@Gc' (generalized cylinder) is not supported");
+    CHECK(errorOf("#define S F(1)F(1)\naxiom: S@Gr(1)\n") == "t.l:2:9: cpfg's '@Gr' (generalized cylinder radius tangents) is not supported");
   }
   SECTION("cpp's identifiers: a macro named B is not expanded inside AB; a number body stays a value") {
     Grammar g = parseGrammar("#define B [+F]\n#define N (2 + 1)\naxiom: AB B F(N)\n", "t.l");
@@ -689,5 +689,49 @@ TEST_CASE("cpfg function files and func(n, x)", "[lsystem][cpfg]") {
     CHECK(viewErrorOf("function: missing.func\n") == "t.v:1:11: cannot read the function file 'missing.func'");
     CHECK(viewErrorOf("function: ../x.func\n") ==
           "t.v:1:11: the function file '../x.func' is outside the object's folder (only files beside the view file, or in folders below it)");
+  }
+}
+
+TEST_CASE("cpfg generalized cylinders", "[lsystem][cpfg]") {
+  SECTION("tests/assets/cpfg/generalized_cylinder: pieces from its reference.py (Hermite basis)") {
+    Drawn o = drawObject("generalized_cylinder", true);
+    struct Piece {
+      DVec3 a, b;
+      double ra, rb;
+    };
+    const std::vector<Piece> want = {
+        {{0, 0, 0}, {0, 1, 0}, 0.1, 0.1},
+        {{0, 1, 0}, {0, 2, 0}, 0.1, 0.1},
+        {{0, 2, 0}, {-0.2, 2.3375, 0}, 0.1, 0.125},
+        {{-0.2, 2.3375, 0}, {-0.7, 2.3, 0}, 0.125, 0.15},
+        {{-0.7, 2.3, 0}, {-1.35, 2.1125, 0}, 0.15, 0.175},
+        {{-1.35, 2.1125, 0}, {-2, 2, 0}, 0.175, 0.2}};
+    REQUIRE(o.skeleton.internodes.size() == want.size());  // f draws nothing: only the tube
+    for (size_t k = 0; k < want.size(); ++k) {
+      INFO("piece " << k);
+      const Internode& in = o.skeleton.internodes[k];
+      checkNear(in.start, want[k].a);
+      checkNear(in.end, want[k].b);
+      CHECK(in.baseRadius == Approx(want[k].ra));
+      CHECK(in.tipRadius == Approx(want[k].rb));
+      CHECK(in.parent == static_cast<int32_t>(k) - 1);  // one chain
+    }
+  }
+  SECTION("@Gc without a parameter draws cpfg's 4 rings; [ ] saves the cylinder; @Gt sets the tangents") {
+    // The branch continues the cylinder from (0,1) and ends it; after ] the outer one goes
+    // on from (0,1) too: two segments of 4 rings and one of 1.
+    Grammar g = parseGrammar("axiom: @Gs f(1) @Gc [ + f(1) @Ge ] f(1) @Ge(1)\n", "t.l");
+    ViewFile view = parseViewFile("angle increment: 90\ninitial line width: 0.2 polygon\n", "t.v");
+    Skeleton sk = Turtle(g.symbols(), cpfgTurtleSettings(&view, {})).run(g.axiom());
+    REQUIRE(sk.internodes.size() == 9);
+    checkNear(sk.internodes[7].end, DVec3(-1, 1, 0));   // the branch's end
+    checkNear(sk.internodes[8].start, DVec3(0, 1, 0));  // the outer cylinder resumes at (0,1)
+    checkNear(sk.internodes[8].end, DVec3(0, 2, 0));
+    CHECK(sk.internodes[8].parent == 3);
+    // @Gt(0, 0): zero tangents make the segment straight: its mid ring on the chord.
+    Grammar s = parseGrammar("axiom: @Gt(0) @Gs f(1) + f(1) @Ge(2)\n", "t.l");
+    Skeleton straight = Turtle(s.symbols(), cpfgTurtleSettings(&view, {})).run(s.axiom());
+    REQUIRE(straight.internodes.size() == 2);
+    checkNear(straight.internodes[0].end, DVec3(-0.5, 0.5, 0));  // the chord (0,0)-(-1,1)
   }
 }

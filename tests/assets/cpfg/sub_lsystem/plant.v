@@ -1,2 +1,3 @@
 angle increment: 90
-initial line width: 0.2 polygon
+initial line width: 0.2
+line style: cylinder
