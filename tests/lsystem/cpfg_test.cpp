@@ -554,6 +554,14 @@ TEST_CASE("cpfg sub-L-systems", "[lsystem][cpfg]") {
     CHECK(o.skeleton.internodes[7].baseRadius == Approx(r0));  // `]` restored the main width
     CHECK(o.skeleton.internodes[8].baseRadius == Approx(0.5 * r0));
   }
+  SECTION("tests/assets/cpfg/sub_lsystem_include: the sub-L-system and its #define in an included file") {
+    Grammar g = loadGrammar(cpfgAsset("sub_lsystem_include/plant.l"));
+    Deriver d(g);
+    CHECK(formatModuleString(d.step(), d.symbols()) == "F(1)[?(2,0.5)L(1)$]A");
+    // Inside the call L is L-system 2's (x * RATE), never the main one's (x + 100).
+    CHECK(formatModuleString(d.step(), d.symbols()) == "F(1)[?(2,0.5)L(2)$]F(1)[?(2,0.5)L(1)$]A");
+    CHECK(g.define("RATE") == 2.0);
+  }
   SECTION("a call back into the main L-system by its number; a cut ends at the call's '$'") {
     Grammar g = parseGrammar("lsystem: 1\nderivation length: 2\naxiom: ?(2)AB$A\nA --> AX\nendlsystem\n"
                              "lsystem: 2\nA --> ?(1)A$%B\nB --> C\nendlsystem\n",
