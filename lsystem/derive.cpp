@@ -163,6 +163,7 @@ struct Deriver::Impl {
   const Program* prog = nullptr;
   DeriveOptions opt;
   int steps = 0;
+  int baseSteps = 0;  ///< steps before any `stop`: restart() begins with it again
   uint64_t seed = 0;
   int done = 0;
   uint64_t written = 0;
@@ -260,14 +261,29 @@ struct Deriver::Impl {
 
   /// cpfg's global variables (Program::globals), kMaxVars registers.
   std::vector<double> globals;
+  /// What cpfg's `stop` and `srand` asked for (the stop flag is cleared at each start).
+  detail::Effects effects;
+  /// The seed before any `srand` (options or grammar): restart() begins with it again.
+  uint64_t baseSeed = 0;
+  /// Steps completed at the last `srand`: step k draws from stream k - streamBase.
+  int streamBase = 0;
 
   /// Runs one of cpfg's Start/StartEach/EndEach/End blocks on the globals; its random draws
   /// come from a stream of their own for each step.
-  void runBlock(const detail::CodeRange& r, int step) {
+  /// stepsBefore: the steps completed when the block runs (for `srand`).
+  void runBlock(const detail::CodeRange& r, int step, int stepsBefore) {
     if (r.empty()) return;
     Rng blockRng(deriveSeed(seed, {kBlockStream, static_cast<uint64_t>(step)}));
     const Instr* code = prog->code.data();
-    if (std::isnan(detail::evalCode(code + r.begin, code + r.end, globals.data(), &blockRng, &prog->strings)))
+    const bool looped = std::isnan(
+        detail::evalCode(code + r.begin, code + r.end, globals.data(), &blockRng, &prog->strings, &effects, &prog->functions));
+    if (effects.reseed) {
+      // cpfg's srand(s): the next step draws as the first step of a derivation with seed s.
+      seed = static_cast<uint64_t>(static_cast<int64_t>(std::clamp(effects.seed, -9.2e18, 9.2e18)));
+      streamBase = stepsBefore;
+      effects.reseed = false;
+    }
+    if (looped)
       throw InputError(SourceLoc{prog->fileName, 0, 0}, "a Start/StartEach/EndEach/End block loops more than " +
                                                             std::to_string(detail::kMaxLoopJumps) + " times at step " +
                                                             std::to_string(step));
@@ -484,7 +500,8 @@ struct Deriver::Impl {
   /// Runs the statement block r of p (its `before` or `after`) on vars.
   void statements(const Production& p, const detail::CodeRange& r, double* vars, int step) {
     const Instr* code = prog->code.data();
-    double v = detail::evalCode(code + r.begin, code + r.end, vars, p.usesRandom ? moduleRng() : nullptr, &prog->strings);
+    double v = detail::evalCode(code + r.begin, code + r.end, vars, p.usesRandom ? moduleRng() : nullptr, &prog->strings, &effects,
+                                &prog->functions);
     if (std::isnan(v))
       throw InputError(p.loc, "the statements of production '" + p.text + "' loop more than " +
                                   std::to_string(detail::kMaxLoopJumps) + " times at step " + std::to_string(step),
@@ -503,7 +520,8 @@ struct Deriver::Impl {
     }
     if (p.condition.empty()) return true;
     const Instr* code = prog->code.data();
-    double v = detail::evalCode(code + p.condition.begin, code + p.condition.end, vars, p.usesRandom ? moduleRng() : nullptr);
+    double v = detail::evalCode(code + p.condition.begin, code + p.condition.end, vars, p.usesRandom ? moduleRng() : nullptr,
+                                nullptr, nullptr, &prog->functions);
     if (std::isnan(v))
       throw InputError(p.loc, "the condition of production '" + p.text + "' is not a number (nan) at step " + std::to_string(step), p.sourceLine);
     return v != 0.0;
@@ -574,7 +592,8 @@ struct Deriver::Impl {
       case ArgKind::VarDivConst: v = vars[a.var] / a.c; break;
       default: {
         const Instr* code = prog->code.data();
-        v = detail::evalCode(code + a.code.begin, code + a.code.end, vars, p.usesRandom ? moduleRng() : nullptr);
+        v = detail::evalCode(code + a.code.begin, code + a.code.end, vars, p.usesRandom ? moduleRng() : nullptr, nullptr, nullptr,
+                             &prog->functions);
       }
     }
     if (!std::isfinite(v)) [[unlikely]]
@@ -731,8 +750,71 @@ struct Deriver::Impl {
     return j - 1;
   }
 
+  /// The productions `?(id, ...)` calls at step (the main ones for the main L-system's
+  /// number); an unknown id is an InputError.
+  const RuleSet& subRules(double id, int step) const {
+    for (const detail::SubLsystem& sub : prog->subLsystems)
+      if (sub.id == id) return sub.productions;
+    if (prog->mainLsystemId && *prog->mainLsystemId == id) return prog->productions;
+    std::string known;
+    if (prog->mainLsystemId) known = numberText(*prog->mainLsystemId);
+    for (const detail::SubLsystem& sub : prog->subLsystems) known += (known.empty() ? "" : ", ") + numberText(sub.id);
+    throw InputError(prog->subLsystems.front().loc, "'?(" + numberText(id) + ", ...)' at step " + std::to_string(step) +
+                                                        " calls a sub-L-system the file does not define (its L-systems: " + known + ")",
+                     prog->subLsystems.front().sourceLine);
+  }
+
+  /// One derivation step of a grammar with cpfg's sub-L-systems (generate.c, CheckPred):
+  /// a stack of L-systems starts with the main one; each module is rewritten by the
+  /// productions on top, then the modules it matched switch L-systems: `?(n, s)` pushes
+  /// sub-L-system n, `$` pops (an unmatched `$` leaves the main one, as cpfg does after
+  /// its warning).
+  void rewriteWithSubLsystems(int step, uint64_t stream) {
+    const ModuleString& in = cur;
+    const size_t n = in.size();
+    const bool births = opt.trackBirthSteps;
+    computeBrackets(in);
+    Writer w(next, births, opt.maxModules, limitAt, step, std::min(opt.maxModules, 2 * n + 16), 2 * in.params.size() + 16);
+    double vars[detail::kMaxVars];
+    loadGlobals(vars);
+    rngStream = stream;
+    std::vector<const RuleSet*> stack{&prog->productions};
+    const SymbolId call = prog->subCall.value_or(static_cast<SymbolId>(-1));
+    for (size_t i = 0; i < n; ++i) {
+      const RuleSet& rs = *stack.back();
+      const SymbolId sym = in.symbols[i];
+      const int32_t birth = births ? in.birthSteps[i] : 0;
+      rngReady = false;
+      rngItem = i;
+      leftCached = rightCached = false;
+      const Production* p = rs.rules[sym].count == 0 ? nullptr : choose(rs, in, i, vars, step);
+      size_t last = i;
+      if (p) {
+        emit(w, *p, vars, step, step, 0);
+        last = i + p->predRest.size();
+      } else {
+        const uint32_t count = in.paramCount(i);
+        w.reserve(1, count);
+        w.copy(sym, in.params.data() + in.offsets[i], count, birth);
+      }
+      for (size_t k = i; k <= last; ++k) {
+        if (in.symbols[k] == call && in.paramCount(k) >= 1) stack.push_back(&subRules(in.params[in.offsets[k]], step));
+        else if (in.symbols[k] == prog->subEnd && stack.size() > 1) stack.pop_back();
+      }
+      i = last;
+    }
+    w.finish();
+    written += w.modules();
+    std::swap(cur, next);
+    if (prog->usesCut) applyCuts(cur);
+  }
+
   /// Rewrites cur into next with rules rs (one derivation step when rs is the main block).
   void rewrite(const RuleSet& rs, int step, uint64_t stream, bool productionStep) {
+    if (productionStep && !prog->subLsystems.empty() && &rs == &prog->productions) {
+      rewriteWithSubLsystems(step, stream);
+      return;
+    }
     const ModuleString& in = cur;
     const size_t n = in.size();
     const bool births = opt.trackBirthSteps;
@@ -819,12 +901,16 @@ struct Deriver::Impl {
     while (i < n) {
       if (s.symbols[i] == prog->cut) {
         any = true;
-        int depth = 0;
+        int depth = 0, subDepth = 0;
+        const bool subs = !prog->subLsystems.empty();
         ++i;
         for (; i < n; ++i) {
           SymbolId c = s.symbols[i];
           if (c == prog->openBracket) ++depth;
           else if (c == prog->closeBracket && depth-- == 0) break;
+          // cpfg's cut also ends at the `$` closing the sub-L-system it is in (SkipCutPart).
+          else if (subs && prog->subCall && c == *prog->subCall && s.paramCount(i) >= 1) ++subDepth;
+          else if (subs && c == prog->subEnd && subDepth-- == 0) break;
         }
         continue;
       }
@@ -845,7 +931,11 @@ struct Deriver::Impl {
 
   void start() {
     globals.assign(detail::kMaxVars, 0.0);
-    runBlock(prog->startBlock, 0);
+    effects = {};
+    seed = baseSeed;
+    streamBase = 0;
+    steps = baseSteps;
+    runBlock(prog->startBlock, 0, 0);
     cur = prog->axiom;
     if (cur.size() > opt.maxModules) Writer::overLimit(opt.maxModules, limitAt, 0);
     if (opt.trackBirthSteps) cur.birthSteps.assign(cur.size(), 0);
@@ -866,7 +956,8 @@ Deriver::Deriver(const Grammar& grammar, DeriveOptions options) : impl_(std::mak
   impl_->grammar = grammar;
   impl_->prog = &grammar.program();
   impl_->steps = options.steps.value_or(grammar.derivationLength());
-  impl_->seed = options.seed.value_or(grammar.seed());
+  impl_->seed = impl_->baseSeed = options.seed.value_or(grammar.seed());
+  impl_->baseSteps = impl_->steps;
   impl_->opt = std::move(options);
   impl_->locateLimit();
   impl_->start();
@@ -884,10 +975,12 @@ void Deriver::restart() {
 const ModuleString& Deriver::step() {
   Impl& m = *impl_;
   int step = m.done + 1;
-  m.runBlock(m.prog->startEachBlock, step);
-  m.rewrite(m.prog->productions, step, static_cast<uint64_t>(step), true);
-  m.runBlock(m.prog->endEachBlock, step);
-  if (step == m.steps) m.runBlock(m.prog->endBlock, step);
+  m.runBlock(m.prog->startEachBlock, step, step - 1);
+  m.rewrite(m.prog->productions, step, static_cast<uint64_t>(step - m.streamBase), true);
+  m.runBlock(m.prog->endEachBlock, step, step);
+  // cpfg's stop(x): the derivation ends after this step (control.c, GenerateNSteps).
+  if (m.effects.stop) m.steps = step;
+  if (step == m.steps) m.runBlock(m.prog->endBlock, step, step);
   m.done = step;
   m.fillQueries();
   if (m.opt.onStep) m.opt.onStep(step, m.cur.size());

@@ -70,9 +70,10 @@ class Deriver {
   const ModuleString& current() const;
   /// Steps performed so far.
   int stepsDone() const;
-  /// Target number of steps (options or grammar).
+  /// Target number of steps (options or grammar); after cpfg's `stop(x)` ran in a step
+  /// (a production's or a Start/StartEach/EndEach block's statements), that step.
   int steps() const;
-  /// The seed in use.
+  /// The seed in use (after cpfg's `srand(s)` in a Start/StartEach/EndEach/End block, s).
   uint64_t seed() const;
   /// The grammar's symbol table (ids in every string this Deriver produces).
   const SymbolTable& symbols() const;

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "core/diagnostics.h"
+#include "lsystem/cpfg_function.h"
 #include "lsystem/module_string.h"
 
 namespace sprig::lsystem {
@@ -49,6 +50,9 @@ struct GrammarOverrides {
   std::vector<DefineOverride> defines;
   std::optional<int> derivationLength;  ///< replaces `derivation length:`
   std::optional<uint64_t> seed;         ///< replaces `seed:`
+  /// cpfg's function files of the grammar's view file (ViewFile::functions), which
+  /// `func(n, x)` reads; without them `func` is an error.
+  std::vector<CpfgFunction> cpfgFunctions;
 };
 
 /// A parsed, compiled L-system.

@@ -102,7 +102,8 @@ Turtle::Turtle(const SymbolTable& symbols, TurtleSettings settings) : symbols_(s
         case '\\': c = Command::RollLeft; break;
         case '/': c = Command::RollRight; break;
         case '|': c = Command::TurnAround; break;
-        case '$': c = Command::RollToVertical; break;
+        case '$': c = settings_.cpfg ? Command::SubEnd : Command::RollToVertical; break;
+        case '?': c = settings_.cpfg ? Command::SubCall : Command::None; break;
         case '[': c = Command::Push; break;
         case ']': c = Command::Pop; break;
         case '!': c = Command::Width; break;
@@ -146,6 +147,14 @@ Turtle::Turtle(const SymbolTable& symbols, TurtleSettings settings) : symbols_(s
       c = Command::ScaleUp;
     } else if (n == "@Dd") {
       c = Command::ScaleDown;
+    } else if (n == "@Gs") {
+      c = Command::GcStart;
+    } else if (n == "@Gc") {
+      c = Command::GcPoint;
+    } else if (n == "@Ge") {
+      c = Command::GcEnd;
+    } else if (n == "@Gt") {
+      c = Command::GcTangents;
     } else if (n == "?P" || n == "?H" || n == "?L" || n == "?U") {
       c = Command::Query;
     } else if (n.size() > 1 && n[0] == '~') {
@@ -161,6 +170,10 @@ namespace {
 constexpr double kMinCpfgWidth = 1e-7;
 /// Vertices of the polygon that draws a `@c` disc.
 constexpr int kDiscSides = 32;
+/// cpfg's rings per generalized-cylinder segment without a parameter (general.h, DEFAULT_RINGS).
+constexpr int kDefaultGcRings = 4;
+/// Most rings per segment Sprig draws (a larger `@Gc(n)` draws this many).
+constexpr int kMaxGcRings = 1024;
 
 /// An open `{` polygon.
 struct OpenPolygon {
@@ -222,6 +235,9 @@ class TurtleWalk {
     for (size_t k = 0; k < settings.tropisms.size() && k < size_t(kMaxTropisms); ++k)
       st_.elasticities[k] = settings.tropisms[k].elasticity;
     buf_.stack.reserve(64);
+    for (size_t k = 0; k < ncmd_ && !usesGc_; ++k)
+      usesGc_ = cmd_[k] == Command::GcStart || cmd_[k] == Command::GcPoint || cmd_[k] == Command::GcEnd ||
+                cmd_[k] == Command::GcTangents;
   }
 
   /// Reserves the exact number of drawing modules: cheaper than growing the vector.
@@ -290,6 +306,20 @@ class TurtleWalk {
           break;
         case Command::Query:
           if (queries_) queries_->push_back({i, st_.frame});
+          break;
+        case Command::SubCall: subCall(i); break;
+        case Command::SubEnd: subEnd(); break;
+        case Command::GcStart:
+          gcRestart();
+          gcPoint(i, false);
+          break;
+        case Command::GcPoint: gcPoint(i, false); break;
+        case Command::GcEnd: gcPoint(i, true); break;
+        case Command::GcTangents:
+          if (hasParam(i)) {
+            gc_.tangentIn = param(i);
+            gc_.tangentOut = paramCount(i) > 1 ? paramAt(i, 1) : param(i);
+          }
           break;
       }
     }
@@ -437,6 +467,7 @@ class TurtleWalk {
   /// `[`: saves the state; the branch is one order higher.
   void push() {
     buf_.stack.push_back(st_);
+    if (usesGc_) gcStack_.push_back(gc_);
     if constexpr (kSummary) lastStack_.push_back(last_);
     ++st_.order;
   }
@@ -446,6 +477,10 @@ class TurtleWalk {
     if (!buf_.stack.empty()) {
       st_ = buf_.stack.back();
       buf_.stack.pop_back();
+      if (usesGc_ && !gcStack_.empty()) {
+        gc_ = gcStack_.back();
+        gcStack_.pop_back();
+      }
       if constexpr (kSummary) {
         last_ = lastStack_.back();
         lastStack_.pop_back();
@@ -482,6 +517,102 @@ class TurtleWalk {
       if (sign < 0 && st_.color < 0) st_.color += 256;
     }
   }
+  /// cpfg's generalized cylinder (`@Gs`, `@Gc(n)`, `@Ge(n)`; general.c, SetControlPoint and
+  /// interpolate_connection, Hermite base, circular contour): each control point after the
+  /// first joins the previous one by a Hermite cubic whose end tangents are the two
+  /// headings times the chord length times the tangent parameters (`@Gt`, default 1.2),
+  /// drawn as n internodes (n from the point's parameter, at least 1; 4 without one) at
+  /// t = k/n, their radii linear from half the previous point's width to half this one's.
+  /// Control points closer than 1e-5 draw nothing. The state is saved by `[` and restored
+  /// by `]`, as cpfg's spline stack is. end: `@Ge`, which ends the cylinder after its point.
+  void gcPoint(size_t i, bool end) {
+    const DVec3 p2 = st_.frame.position, h2 = st_.frame.heading;
+    const double w2 = st_.width;
+    if (!gc_.active) gcRestart();
+    if (gc_.hasPoint) {
+      const DVec3 p1 = gc_.position;
+      const double len = glm::length(p2 - p1);
+      const double g = growth(i);
+      if (len >= 1e-5 && g > 0) {
+        const DVec3 t1 = gc_.heading * (len * gc_.pointTangentOut), t2 = h2 * (len * gc_.tangentIn);
+        const DVec3 a2 = -3.0 * (p1 - p2) - 2.0 * t1 - t2, a3 = 2.0 * (p1 - p2) + t1 + t2;
+        int rings = hasParam(i) ? std::max(1, static_cast<int>(param(i))) : kDefaultGcRings;
+        rings = std::min(rings, kMaxGcRings);
+        DVec3 from = p1;
+        int32_t parent = gc_.lastInternode;
+        for (int k = 1; k <= rings; ++k) {
+          const double t = static_cast<double>(k) / rings;
+          const DVec3 to = k == rings ? p2 : p1 + t * (t1 + t * (a2 + t * a3));
+          Internode in;
+          in.start = from;
+          in.end = to;
+          in.baseRadius = radiusScale_ * (gc_.width + (w2 - gc_.width) * (k - 1) / rings);
+          in.tipRadius = radiusScale_ * (gc_.width + (w2 - gc_.width) * t);
+          if (maxRadiusPerLength_ > 0) {
+            in.baseRadius = std::min(in.baseRadius, maxRadiusPerLength_ * len);
+            in.tipRadius = std::min(in.tipRadius, maxRadiusPerLength_ * len);
+          }
+          in.parent = parent;
+          in.order = st_.order;
+          in.step = stepOf(i);
+          in.module = static_cast<uint32_t>(i);
+          in.up = st_.frame.up;
+          if (growing_) buf_.internodeGrowth.push_back(g);
+          if constexpr (kSummary) {
+            const int32_t keep = st_.internode;
+            summarize(in);
+            parent = st_.internode;
+            st_.internode = keep;
+          } else {
+            parent = static_cast<int32_t>(sk_.internodes.size());
+            sk_.internodes.push_back(in);
+          }
+          from = to;
+        }
+        gc_.lastInternode = parent;
+      }
+    } else {
+      gc_.lastInternode = st_.internode;
+    }
+    gc_.hasPoint = true;
+    gc_.position = p2;
+    gc_.heading = h2;
+    gc_.width = w2;
+    gc_.pointTangentOut = gc_.tangentOut;
+    if (end) gc_.active = gc_.hasPoint = false;
+  }
+
+  /// Starts a generalized cylinder with no control point yet (the tangent parameters stay).
+  void gcRestart() {
+    gc_.active = true;
+    gc_.hasPoint = false;
+    gc_.lastInternode = -1;
+  }
+
+  /// cpfg's `?(n, s)` (interpret.c, UpdateCurrentLsystem): the sub-L-system scale becomes
+  /// the enclosing one times s (unchanged without s), and so do the turtle scale and the
+  /// line width (in proportion). The scales form a stack of their own, which `[` and `]`
+  /// do not save.
+  void subCall(size_t i) {
+    if (!hasParam(i)) return;
+    if (subScales_.empty()) subScales_.push_back(settings_.initialScale);
+    const double outer = subScales_.back();
+    const double inner = off_[i + 1] - off_[i] >= 2 ? outer * prm_[off_[i] + 1] : outer;
+    subScales_.push_back(inner);
+    st_.scale = inner;
+    st_.width = outer != 0 ? st_.width * inner / outer : st_.width;
+  }
+
+  /// cpfg's `$`: back to the enclosing sub-L-system's scale (an unmatched `$` does nothing,
+  /// as cpfg does after its warning).
+  void subEnd() {
+    if (subScales_.size() < 2) return;
+    const double inner = subScales_.back();
+    subScales_.pop_back();
+    st_.scale = subScales_.back();
+    st_.width = inner != 0 ? st_.width * st_.scale / inner : st_.width;
+  }
+
   /// `@Di` (divide false) and `@Dd` (divide true): multiplies or divides the turtle scale
   /// by the parameter (ignored when 0, as cpfg does), or by the scale multiplier.
   void scaleStep(size_t i, bool divide) {
@@ -791,6 +922,20 @@ class TurtleWalk {
   const double partial_;
   SinCosCache trig_;
   TurtleState st_;
+  std::vector<double> subScales_;  ///< cpfg's sub-L-system scales (`?(n, s)`), outermost first
+  /// cpfg's generalized cylinder in progress (gcPoint) and the turtle's tangent parameters.
+  struct GcState {
+    bool active = false;      ///< between `@Gs` (or a first `@Gc`) and `@Ge`
+    bool hasPoint = false;    ///< the previous control point below is set
+    DVec3 position{0}, heading{0, 1, 0};
+    double width = 0;
+    double tangentIn = 1.2, tangentOut = 1.2;  ///< `@Gt(in, out)`: the turtle's (cpfg's defaults)
+    double pointTangentOut = 1.2;              ///< tangentOut at the previous control point
+    int32_t lastInternode = -1;                ///< the last piece drawn (parent of the next)
+  };
+  GcState gc_;
+  std::vector<GcState> gcStack_;  ///< saved by `[` when the string has generalized cylinders
+  bool usesGc_ = false;
   std::vector<Turtle::QueryHit>* queries_ = nullptr;
 };
 

@@ -1,6 +1,8 @@
 #include "lsystem/view_file.h"
 
 #include <algorithm>
+#include <charconv>
+#include <filesystem>
 #include <cctype>
 #include <cmath>
 #include <iterator>
@@ -29,7 +31,7 @@ const char* const kViewerKeys[] = {
 
 /// Keys naming files whose uses (`~`, `func`, `curveX`, `@#`, `inblob`) are errors in the
 /// grammar: not read, with a warning.
-const char* const kFileKeys[] = {"surface", "tsurface", "contour", "function", "function set", "curve", "blob"};
+const char* const kFileKeys[] = {"surface", "tsurface", "contour", "function set", "curve", "blob"};
 
 /// Keys that would change the geometry and that Sprig does not implement, with what they do.
 struct UnsupportedKey {
@@ -244,6 +246,8 @@ class ViewParser {
         if (glm::length(d) == 0) error(line, vcol, "'tropism direction:' must not be the zero vector");
         else view_.oldTropismDirection = glm::normalize(d);
       }
+    } else if (is("function")) {
+      readFunction(line, vcol, value);
     } else {
       for (const UnsupportedKey& u : kUnsupportedKeys)
         if (key == u.key) {
@@ -268,6 +272,51 @@ class ViewParser {
       for (const char* k : kViewerKeys) all.emplace_back(k);
       for (const char* k : kFileKeys) all.emplace_back(k);
       error(line, kcol, "unknown view file command '" + key + ":'" + didYouMean(key, all));
+    }
+  }
+
+  /// `function: NAME.func [samples]` (interpret.c, case 52): the function file beside the
+  /// view file (or in a folder below it), func(n, x)'s n-th in file order.
+  void readFunction(int line, size_t vcol, const std::string& value) {
+    std::istringstream in(value);
+    std::string name, extra;
+    int samples = -1;
+    in >> name;
+    if (name.empty()) {
+      error(line, vcol, "expected a function file after 'function:'");
+      return;
+    }
+    if (!(in >> extra).fail()) {
+      int v = 0;
+      auto r = std::from_chars(extra.data(), extra.data() + extra.size(), v);
+      if (r.ec != std::errc() || r.ptr != extra.data() + extra.size() || v < 0 || v > 1000000) {
+        error(line, vcol + value.find(extra), "the number of samples after the function file is a whole number from 0 to 1000000, got '" + extra + "'");
+        return;
+      }
+      samples = v;
+      if (!(in >> extra).fail()) {
+        error(line, vcol + value.rfind(extra), "unexpected '" + extra + "' after 'function: " + name + " " + std::to_string(samples) + "'");
+        return;
+      }
+    }
+    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path();
+    const std::filesystem::path file = (folder / name).lexically_normal();
+    const std::string rel = file.lexically_relative(folder.empty() ? "." : folder).generic_string();
+    if (std::filesystem::path(name).is_absolute() || rel.empty() || rel.rfind("..", 0) == 0) {
+      error(line, vcol, "the function file '" + name + "' is outside the object's folder (only files beside the view file, or in folders below it)");
+      return;
+    }
+    std::string text;
+    try {
+      text = readFile(file.string());
+    } catch (const std::exception&) {
+      error(line, vcol, "cannot read the function file '" + file.string() + "'");
+      return;
+    }
+    try {
+      view_.functions.push_back(CpfgFunction::parse(text, file.string(), samples));
+    } catch (const InputError& e) {
+      for (const Diagnostic& d : e.diagnostics()) diags_.add(d);
     }
   }
 

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/diagnostics.h"
+#include "lsystem/cpfg_function.h"
 #include "lsystem/turtle.h"
 
 namespace sprig::lsystem {
@@ -36,6 +37,9 @@ struct ViewFile {
   std::optional<DVec3> oldTropismDirection;    ///< `tropism direction: x,y,z` (cpfg's old tropism)
   std::optional<double> oldElasticity;         ///< `initial elasticity: e`
   std::optional<double> oldElasticityIncrement;  ///< `elasticity increment: d` (the step of `_`)
+  /// `function: NAME.func [samples]`: the function files, in file order (`func(1, x)` is
+  /// the first), read when the view file is.
+  std::vector<CpfgFunction> functions;
   /// Warnings about keys read but not used (viewer settings), each at its line.
   std::vector<Diagnostic> warnings;
 };

@@ -413,8 +413,28 @@ std::shared_ptr<const KindSpec> readTreeSpec(MapReader& top, Species& species, D
 
 namespace {
 
-/// A bare grammar (viewFile: its cpfg view file, empty for none).
-Species grammarSpecies(const fs::path& path, const fs::path& viewFile) {
+/// cpfg's colour map file (`-m NAME.map` on the object's cpfg command line; irisGL.c,
+/// load_in_colormaps): 256 entries of 3 bytes (red, green, blue), colour index i being
+/// entry i. Another size is an InputError at the file.
+std::vector<Vec3> readCpfgColormap(const fs::path& path) {
+  std::string bytes;
+  try {
+    bytes = readFile(path);
+  } catch (const std::exception&) {
+    throw InputError(SourceLoc{path.string(), 0, 0}, "cannot read the colour map");
+  }
+  if (bytes.size() != 768)
+    throw InputError(SourceLoc{path.string(), 0, 0}, "a cpfg colour map holds 256 entries of 3 bytes (768 bytes), this file has " +
+                                                          std::to_string(bytes.size()));
+  std::vector<Vec3> palette(256);
+  for (size_t i = 0; i < 256; ++i)
+    for (int c = 0; c < 3; ++c) palette[i][c] = static_cast<float>(static_cast<unsigned char>(bytes[3 * i + c])) / 255.0f;
+  return palette;
+}
+
+/// A bare grammar (viewFile: its cpfg view file, empty for none; colormap: its colour map,
+/// empty for none).
+Species grammarSpecies(const fs::path& path, const fs::path& viewFile, const fs::path& colormap = {}) {
   Species s;
   s.kind = "tree";
   s.bareGrammar = true;
@@ -433,6 +453,8 @@ Species grammarSpecies(const fs::path& path, const fs::path& viewFile) {
     spec->view = lsystem::loadViewFile(viewFile.string());
     for (const Diagnostic& w : spec->view->warnings) s.notes.push_back(w);
   }
+  // The colour map colours organs by their colour index (`;`, `,`, `initial color:`).
+  if (!colormap.empty()) s.render.style.palette = readCpfgColormap(colormap);
   s.spec = spec;
   DiagnosticList diags;
   checkGrammar(s, *spec, diags);
@@ -483,8 +505,9 @@ Species speciesFromGrammarFile(const fs::path& path) {
 
 Species speciesFromCpfgObject(const fs::path& folder) {
   std::error_code ec;
-  fs::path grammar, view;
-  // The `specifications` file's cpfg command line names the grammar and the view file.
+  fs::path grammar, view, colormap;
+  // The `specifications` file's cpfg command line names the grammar, the view file and the
+  // colour map (`-m NAME.map`).
   try {
     std::istringstream spec(readFile(folder / "specifications"));
     for (std::string line; std::getline(spec, line);) {
@@ -496,18 +519,20 @@ Species speciesFromCpfgObject(const fs::path& folder) {
         const std::string e = lowerExtension(x);
         if (e == ".l" && grammar.empty()) grammar = folder / x;
         if (e == ".v" && view.empty()) view = folder / x;
+        if (e == ".map" && colormap.empty()) colormap = folder / x;
       }
       break;
     }
   } catch (const std::exception&) {
   }
   if (grammar.empty()) {
-    std::vector<fs::path> grammars, views;
+    std::vector<fs::path> grammars, views, maps;
     for (const auto& e : fs::directory_iterator(folder, ec)) {
       if (!e.is_regular_file()) continue;
       const std::string x = lowerExtension(e.path());
       if (x == ".l" && hasAxiom(e.path())) grammars.push_back(e.path());
       if (x == ".v") views.push_back(e.path());
+      if (x == ".map") maps.push_back(e.path());
     }
     std::sort(grammars.begin(), grammars.end());
     if (grammars.size() != 1) {
@@ -522,10 +547,15 @@ Species speciesFromCpfgObject(const fs::path& folder) {
     fs::path same = fs::path(grammar).replace_extension(".v");
     if (fs::is_regular_file(same, ec)) view = same;
     else if (views.size() == 1) view = views[0];
+    fs::path sameMap = fs::path(grammar).replace_extension(".map");
+    if (fs::is_regular_file(sameMap, ec)) colormap = sameMap;
+    else if (maps.size() == 1) colormap = maps[0];
   }
   if (!fs::is_regular_file(grammar, ec)) throw InputError(SourceLoc{grammar.string(), 0, 0}, "cannot open file");
   if (!view.empty() && !fs::is_regular_file(view, ec)) throw InputError(SourceLoc{view.string(), 0, 0}, "cannot open the view file");
-  return grammarSpecies(grammar, view);
+  if (!colormap.empty() && !fs::is_regular_file(colormap, ec))
+    throw InputError(SourceLoc{colormap.string(), 0, 0}, "cannot open the colour map");
+  return grammarSpecies(grammar, view, colormap);
 }
 
 const TreeSpec& treeSpec(const Species& species) {
@@ -540,6 +570,7 @@ lsystem::Grammar speciesGrammar(const Species& species, const lsystem::GrammarOv
   const TreeSpec& tree = treeSpec(species);
   if (tree.grammar && extra.defines.empty() && !extra.derivationLength && !extra.seed) return *tree.grammar;
   lsystem::GrammarOverrides o = tree.overrides;
+  if (tree.view) o.cpfgFunctions = tree.view->functions;
   for (const auto& d : extra.defines) o.defines.push_back(d);
   if (extra.derivationLength) o.derivationLength = extra.derivationLength;
   if (extra.seed) o.seed = extra.seed;

@@ -14,10 +14,6 @@ struct Unsupported {
 };
 
 constexpr Unsupported kUnsupported[] = {
-    {"@Gs", "generalized cylinder"},
-    {"@Gc", "generalized cylinder"},
-    {"@Ge", "generalized cylinder"},
-    {"@Gt", "generalized cylinder tangents"},
     {"@Gr", "generalized cylinder radius tangents"},
     {"@#", "contour of generalized cylinders"},
     {"@Tx", "texture"},
@@ -62,12 +58,17 @@ std::optional<std::string> cpfgUnsupported(std::string_view name, size_t args, b
     if (next && next != '(' && next != ' ' && next != '\t') shown += next;
     return "unknown cpfg command '" + shown + "'";
   }
-  if (name == "?") return notSupported(hasParens ? "?(n, scale)" : "?", "sub-L-system call");
+  if (name == "?") {
+    if (!hasParens || args == 0) return notSupported("?", "a '?' without a query letter or a sub-L-system number");
+    if (args > 2) return std::string("cpfg's sub-L-system call '?(n, scale)' takes 1 or 2 parameters, got ") + std::to_string(args);
+    if (dialect != Dialect::Cpfg)
+      return std::string("cpfg's '?(n, scale)' (sub-L-system call) is supported only in cpfg's notation (a .l file), where '$' ends it");
+    return std::nullopt;
+  }
   if ((name == "{" || name == "}" || name == ".") && hasParens && args > 0)
     return notSupported(std::string(name) + "(type)", "generalized cylinder");
   if (name == "%" && hasParens && args > 0) return notSupported("%(n)", "substring move");
   if (dialect == Dialect::Cpfg) {
-    if (name == "$") return notSupported("$", "end of a sub-L-system call; ABOP's roll to vertical is '@v' in cpfg");
     if (name == "~" || (name.size() > 1 && name[0] == '~')) return notSupported("~", "surface from a view file's surface file");
   }
   return std::nullopt;

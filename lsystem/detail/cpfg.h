@@ -25,8 +25,8 @@ extern const char* const kCpfgMultiNames[];
 extern const size_t kCpfgMultiNameCount;
 
 /// Why a module written as `name` with `args` parameters (hasParens: written with `(...)`)
-/// cannot be read, as the message to report at its position (`cpfg's '@Gc' (generalized
-/// cylinder) is not supported`), or nullopt when Sprig implements it (or it is no cpfg
+/// cannot be read, as the message to report at its position (`cpfg's '@Gr' (generalized
+/// cylinder radius tangents) is not supported`), or nullopt when Sprig implements it (or it is no cpfg
 /// command at all). `next` is the character after the name, for `@` and `?` followed by
 /// an unknown letter.
 std::optional<std::string> cpfgUnsupported(std::string_view name, size_t args, bool hasParens, char next,

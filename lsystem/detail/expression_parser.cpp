@@ -32,10 +32,9 @@ struct UnsupportedFunction {
   const char* what;
 };
 constexpr UnsupportedFunction kUnsupportedFunctions[] = {
-    {"srand", "reseeds cpfg's one global generator; Sprig draws per module from 'seed:'"},
     {"printf", "output; it is a statement of its own"}, {"fprintf", "file output"}, {"fopen", "file input and output"},
     {"fclose", "file input and output"}, {"fflush", "file input and output"}, {"fscanf", "file input"},
-    {"stop", "stops the simulation"}, {"func", "function from a view file's function file"},
+
     {"curveX", "contour from a view file's contour file"}, {"curveY", "contour from a view file's contour file"},
     {"curveZ", "contour from a view file's contour file"}, {"curveGAL", "contour from a view file's contour file"},
     {"play", "sound"}, {"inblob", "environment field"}, {"vvXmin", "view volume"}, {"vvXmax", "view volume"},
@@ -52,7 +51,7 @@ int arityOf(Op op) {
     case Op::Const: case Op::Var: return 0;
     case Op::Neg: case Op::Not: case Op::Sin: case Op::Cos: case Op::Tan: case Op::Asin: case Op::Acos:
     case Op::Atan: case Op::Sqrt: case Op::Exp: case Op::Log: case Op::Abs: case Op::Floor: case Op::Ceil:
-    case Op::Sign: case Op::Ran: case Op::Round:
+    case Op::Sign: case Op::Ran: case Op::Round: case Op::Srand: case Op::Stop: case Op::Func:
       return 1;
     case Op::Select: return 3;
     default: return 2;
@@ -274,6 +273,20 @@ int ExpressionParser::parseCall(State& st, const Token& id) {
   const FunctionInfo* fn = nullptr;
   for (const FunctionInfo& f : kFunctions)
     if (name == f.name) fn = &f;
+  if (name == "srand" || name == "stop") {
+    const bool ok = name == "srand" ? allowSrand_ : allowStop_;
+    if (!ok) {
+      scanner_.error(st.span.line, id.col,
+                     name == "srand" ? std::string("cpfg's function 'srand' is supported only as a statement of a 'Start:', 'StartEach:', "
+                                                   "'EndEach:' or 'End:' block ('srand(s);'): Sprig draws each module's numbers "
+                                                   "from the seed, which srand replaces for the later draws")
+                                     : std::string(allowStopReason_));
+      throw ExprFail{};
+    }
+    static constexpr FunctionInfo kSrand{"srand", Op::Srand, 1}, kStop{"stop", Op::Stop, 1};
+    fn = name == "srand" ? &kSrand : &kStop;
+  }
+  if (name == "func") return parseFunc(st, id);
   if (!fn) {
     for (const UnsupportedFunction& u : kUnsupportedFunctions)
       if (name == u.name) {
@@ -306,6 +319,31 @@ int ExpressionParser::parseCall(State& st, const Token& id) {
   }
   if (fn->op == Op::Ran || fn->op == Op::Nran || fn->op == Op::Bran || fn->op == Op::Biran) usesRandom_ = true;
   return node(st, fn->op, args[0], args.size() > 1 ? args[1] : -1);
+}
+
+/// cpfg's `func(n, x)`: n a number (or `#define`) naming the n-th `function:` file of the
+/// view file; the current token is the `(`.
+int ExpressionParser::parseFunc(State& st, const Token& id) {
+  lex(st);
+  const int nArg = parseConditional(st);
+  if (!isPunct(st, ",")) unexpected(st, "',' (func takes 2 arguments: the function's number and x)");
+  lex(st);
+  const int xArg = parseConditional(st);
+  if (!isPunct(st, ")")) unexpected(st, "')' (func takes 2 arguments: the function's number and x)");
+  lex(st);
+  const Node n = st.nodes[nArg];
+  const size_t count = functions_ ? functions_->size() : 0;
+  if (n.op != Op::Const || n.value != std::floor(n.value) || n.value < 1 || n.value > static_cast<double>(count)) {
+    scanner_.error(st.span.line, id.col,
+                   count == 0 ? std::string("cpfg's func(n, x) reads the view file's function files, and it names none "
+                                            "('function: NAME.func')")
+                              : "func's first argument must be a number from 1 to " + std::to_string(count) +
+                                    " (the view file names " + std::to_string(count) + " function file(s))");
+    throw ExprFail{};
+  }
+  const int f = node(st, Op::Func, xArg);
+  st.nodes[f].var = static_cast<uint16_t>(n.value - 1);
+  return f;
 }
 
 /// A formal parameter or a `#define` (in that order of precedence).
@@ -359,9 +397,11 @@ bool ExpressionParser::emit(const State& st, int n, int& depth, int& maxDepth) {
   for (int k = 0; k < arity; ++k) allConst &= emit(st, nd.kids[k], depth, maxDepth);
   Instr in;
   in.op = nd.op;
+  if (nd.op == Op::Func) in.var = nd.var;
   code_.push_back(in);
   depth -= arity - 1;
-  if (allConst && nd.op != Op::Ran && nd.op != Op::Nran && nd.op != Op::Bran && nd.op != Op::Biran) {
+  if (allConst && nd.op != Op::Ran && nd.op != Op::Nran && nd.op != Op::Bran && nd.op != Op::Biran && nd.op != Op::Srand &&
+      nd.op != Op::Stop && nd.op != Op::Func) {
     size_t first = code_.size() - 1 - arity;
     double v = evalCode(code_.data() + first, code_.data() + code_.size(), nullptr, nullptr);
     code_.resize(first);
@@ -453,7 +493,7 @@ std::optional<double> ExpressionParser::evaluate(Span sp, Rng* rng) {
     if (usesRandom_ && !rng) {
       scanner_.error(sp.line, sp.b, "random functions are not allowed here");
     } else {
-      double v = evalCode(code_.data() + before, code_.data() + code_.size(), nullptr, rng);
+      double v = evalCode(code_.data() + before, code_.data() + code_.size(), nullptr, rng, nullptr, nullptr, functions_);
       if (std::isfinite(v)) value = v;
       else scanner_.error(sp.line, sp.b, "parameter is not finite (" + formatNumber(v) + ")");
     }

@@ -58,6 +58,15 @@ class ExpressionParser {
   /// Whether an expression compiled since clearRandom() draws random numbers.
   bool usesRandom() const { return usesRandom_; }
   void clearRandom() { usesRandom_ = false; }
+  /// The view file's function files `func(n, x)` may name (none when null).
+  void setFunctions(const std::vector<CpfgFunction>* functions) { functions_ = functions; }
+  /// Whether cpfg's `srand` and `stop` may be called (only as statements, see
+  /// grammar_parser.cpp); stopError is the message for a `stop` that may not.
+  void allowEffects(bool srand, bool stop, const char* stopError) {
+    allowSrand_ = srand;
+    allowStop_ = stop;
+    allowStopReason_ = stopError;
+  }
 
  private:
   struct Node;
@@ -73,6 +82,7 @@ class ExpressionParser {
   int parseUnary(State& st);
   int parsePrimary(State& st);
   int parseCall(State& st, const Token& id);
+  int parseFunc(State& st, const Token& id);
   int parseName(State& st, const Token& id);
   bool emit(const State& st, int n, int& depth, int& maxDepth);
 
@@ -80,6 +90,10 @@ class ExpressionParser {
   const std::unordered_map<std::string, double>& defines_;
   std::vector<Instr>& code_;
   bool usesRandom_ = false;
+  const std::vector<CpfgFunction>* functions_ = nullptr;
+  bool allowSrand_ = false;
+  bool allowStop_ = false;
+  const char* allowStopReason_ = "cpfg's function 'stop' is supported only as a statement ('stop(1);')";
   const std::vector<std::string>* globals_ = nullptr;
 };
 

@@ -106,6 +106,8 @@ class GrammarParser {
     scanner_.setDialect(prog_.dialect);
     for (size_t k = 0; k < kCpfgMultiNameCount; ++k) scanner_.addMultiName(kCpfgMultiNames[k]);
     expr_.setGlobals(&prog_.globals);
+    prog_.functions = overrides.cpfgFunctions;
+    expr_.setFunctions(&prog_.functions);
     for (const char* s : kTurtleSymbols) prog_.symbols.intern(s);
     prog_.openBracket = static_cast<SymbolId>(prog_.symbols.find("["));
     prog_.closeBracket = static_cast<SymbolId>(prog_.symbols.find("]"));
@@ -126,6 +128,9 @@ class GrammarParser {
       checkArities();
       checkWrittenArities();
       for (const RuleSet* rs : {&prog_.productions, &prog_.decomposition, &prog_.interpretation}) checkWeights(*rs);
+      for (const SubLsystem& sub : prog_.subLsystems) checkWeights(sub.productions);
+      checkSubLsystems();
+      checkSubLsystemCalls();
     }
     finish();
     diags().throwIfErrors();
@@ -164,11 +169,18 @@ class GrammarParser {
   void firstPass() {
     if (auto [line, col] = scanner_.unterminatedComment(); line) error(line, col, "unterminated comment '/*'");
     std::map<std::string, int> defineLines;
+    int gapUntil = 0;
     for (int line = 1; line <= scanner_.lineCount(); ++line) {
       const std::string& s = scanner_.line(line);
       int b = Scanner::firstNonSpace(s);
       if (b >= static_cast<int>(s.size())) continue;
-      if (isEndLsystem(s, b)) break;
+      if (isEndLsystem(s, b)) {
+        // cpfg: a later `lsystem:` starts a sub-L-system; only `#` lines count in between.
+        gapUntil = prog_.dialect == Dialect::Cpfg ? nextLsystemHeader(line) : 0;
+        if (!gapUntil) break;
+        continue;
+      }
+      if (line < gapUntil && s[b] != '#') continue;
       if (s.compare(b, 7, "#define") == 0 && (b + 7 == static_cast<int>(s.size()) || isSpace(s[b + 7]))) {
         defineConstant(line, b, defineLines);
       } else if (s[b] == '#') {
@@ -284,7 +296,17 @@ class GrammarParser {
       if (isEndLsystem(s, b)) {
         Span rest = scanner_.trim(Span{line, b + 10, static_cast<int>(s.size())});
         if (rest.b != rest.e) error(line, rest.b, "unexpected text after 'endlsystem'");
-        // Notes may follow; another `lsystem:` is cpfg's sub-L-system.
+        // In cpfg's notation a later `lsystem:` starts a sub-L-system (notes may stand
+        // between); in Sprig's, notes follow and another `lsystem:` is an error.
+        if (prog_.dialect == Dialect::Cpfg) {
+          if (const int next = nextLsystemHeader(line)) {
+            line = next - 1;
+            afterEnd_ = true;
+            block = Block::Main;
+            continue;
+          }
+          break;
+        }
         for (int k = line + 1; k <= scanner_.lineCount(); ++k) {
           const std::string& t = scanner_.line(k);
           const int tb = Scanner::firstNonSpace(t);
@@ -305,6 +327,11 @@ class GrammarParser {
       if (unsupportedHeader(line, b)) continue;
       auto header = Scanner::headerOf(s, b);
       if (header && std::find(std::begin(kBlockHeaders), std::end(kBlockHeaders), header->key) != std::end(kBlockHeaders)) {
+        if (!subs_.empty()) {
+          error(line, b, "'" + header->key + ":' in a sub-L-system ('lsystem: " + subs_.back().label +
+                             "') is not supported (Sprig reads a sub-L-system's productions only)");
+          continue;
+        }
         globalBlock(line, b, *header);
         continue;
       }
@@ -325,6 +352,40 @@ class GrammarParser {
         error(line, b, "expected a production ('pred --> successor') or a header such as 'axiom:'");
       }
     }
+  }
+
+  /// The line of the first `lsystem:` header after line, or 0.
+  int nextLsystemHeader(int line) const {
+    for (int k = line + 1; k <= scanner_.lineCount(); ++k) {
+      const std::string& t = scanner_.line(k);
+      const int tb = Scanner::firstNonSpace(t);
+      if (tb >= static_cast<int>(t.size())) continue;
+      if (auto h = Scanner::headerOf(t, tb); h && h->key == "lsystem") return k;
+    }
+    return 0;
+  }
+
+  /// cpfg's `lsystem: n` after an `endlsystem` (value at column b of line): starts the
+  /// sub-L-system n, whose productions `?(n, scale)` calls apply (docs/GRAMMAR.md).
+  void subLsystemHeader(int line, int b, Span value) {
+    afterEnd_ = false;
+    std::string_view v = scanner_.view(value);
+    prog_.subLsystems.emplace_back();
+    subs_.push_back({std::string(v), line, b});
+    SubLsystem& sub = prog_.subLsystems.back();
+    std::tie(sub.loc, sub.sourceLine) = scanner_.locate(line, b);
+    auto id = expr_.constant(value, "the number of a sub-L-system");
+    if (!id) return;
+    if (*id != std::floor(*id)) {
+      error(line, value.b, "a sub-L-system's number must be a whole number (cpfg calls it with '?(n, scale)'), got " + formatNumber(*id));
+      return;
+    }
+    sub.id = *id;
+    if (prog_.mainLsystemId && *prog_.mainLsystemId == *id)
+      error(line, b, "'lsystem: " + std::string(v) + "' has the number of the main L-system");
+    for (size_t k = 0; k + 1 < prog_.subLsystems.size(); ++k)
+      if (prog_.subLsystems[k].id == *id)
+        error(line, b, "'lsystem: " + std::string(v) + "' is defined twice (first at " + scanner_.lineRef(subs_[k].line) + ")");
   }
 
   /// cpfg's `Start: { statements };` (and `End:`, `StartEach:`, `EndEach:`) at column b of
@@ -392,6 +453,18 @@ class GrammarParser {
     const std::string& s = scanner_.line(line);
     Span value = scanner_.trim(Span{line, h.valueBegin, static_cast<int>(s.size())});
     std::string_view v = scanner_.view(value);
+    if (h.key == "lsystem" && afterEnd_) {
+      subLsystemHeader(line, b, value);
+      return;
+    }
+    if (!subs_.empty() && h.key != "derivation length" && h.key != "axiom") {
+      // cpfg reads a sub-L-system's productions; its own derivation length and axiom
+      // matter only when it is the main one (lsys_input.y), so Sprig skips them too.
+      error(line, b, "'" + h.key + ":' in a sub-L-system ('lsystem: " + subs_.back().label +
+                         "') is not supported (Sprig reads a sub-L-system's productions only)");
+      return;
+    }
+    if (!subs_.empty()) return;
     if (h.key == "lsystem") {
       if (seen_.count("lsystem")) {
         error(line, b, "several L-systems in one file (cpfg's sub-L-systems) are not supported (the first is at line " +
@@ -400,6 +473,11 @@ class GrammarParser {
       }
       once(h.key, line, b);
       prog_.name = std::string(v);
+      if (prog_.dialect == Dialect::Cpfg) {  // its number, for `?(n, s)` calls back into it
+        double id = 0;
+        auto r = std::from_chars(v.data(), v.data() + v.size(), id);
+        if (!v.empty() && r.ec == std::errc() && r.ptr == v.data() + v.size()) prog_.mainLsystemId = id;
+      }
     } else if (h.key == "derivation length") {
       once(h.key, line, b);
       if (auto d = expr_.constant(value, "derivation length")) {
@@ -498,6 +576,7 @@ class GrammarParser {
   /// The production of line (from column b, its arrow at `arrow`), compiled into block's RuleSet.
   void parseProduction(int line, int b, int arrow, int arrowLen, Block block) {
     const std::string& s = scanner_.line(line);
+    statementBlock_ = block;
     int n = static_cast<int>(s.size());
     Production p;
     size_t diagsBefore = diags().items().size();
@@ -615,7 +694,8 @@ class GrammarParser {
       }
     }
     p.usesRandom = expr_.usesRandom();
-    RuleSet& rs = block == Block::Main ? prog_.productions : block == Block::Decomposition ? prog_.decomposition : prog_.interpretation;
+    RuleSet& rs = !subs_.empty() ? prog_.subLsystems.back().productions
+                  : block == Block::Main ? prog_.productions : block == Block::Decomposition ? prog_.decomposition : prog_.interpretation;
     rs.productions.push_back(std::move(p));
   }
 
@@ -895,7 +975,15 @@ class GrammarParser {
           error(line, at, "missing ';' after the call of '" + word + "' (cpfg requires one after every statement)");
           return false;
         }
-        if (!expr_.compile(scanner_.trim(Span{line, at, end}), varNames, "statement")) return false;
+        // cpfg's srand and stop are statements of their own (Op::Srand, Op::Stop).
+        const bool effectCall = word == "srand" || word == "stop";
+        if (effectCall)
+          expr_.allowEffects(inGlobalBlock_, inGlobalBlock_ || statementBlock_ != Block::Interpretation,
+                             "cpfg's function 'stop' in an interpretation rule is not supported (the derivation has ended "
+                             "when the string is interpreted): call it in a production or a Start/EndEach block");
+        const bool compiled = expr_.compile(scanner_.trim(Span{line, at, end}), varNames, "statement");
+        if (effectCall) expr_.allowEffects(false, false, "cpfg's function 'stop' is supported only as a statement ('stop(1);')");
+        if (!compiled) return false;
         jump(Op::Jz, base, static_cast<double>(prog_.code.size() + 1));  // pops the value, jumps to the next instruction
         i = end + 1;
       } else {
@@ -1002,6 +1090,32 @@ class GrammarParser {
     if (seen && (*seen >> n & 1)) return;
     written_[m.name].emplace(static_cast<int>(n), std::pair{line, m.col});
     if (seen) *seen |= uint8_t(1u << n);
+    if (m.name == "?" && n >= 1) subCalls_.push_back({line, m.col, std::string(scanner_.view(scanner_.trim(m.args[0])))});
+  }
+
+  /// cpfg's `?(n, s)` calls and `$`: a call whose n is a number naming no L-system of the
+  /// file, and a `$` in a file without any call (ABOP's roll to vertical, which is `@v` in
+  /// cpfg), are errors at their positions.
+  void checkSubLsystemCalls() {
+    if (prog_.dialect != Dialect::Cpfg) return;
+    if (subCalls_.empty()) {
+      if (auto it = written_.find("$"); it != written_.end()) {
+        const auto [line, col] = it->second.begin()->second;
+        error(line, col, "cpfg's '$' ends a sub-L-system call '?(n, scale)', and this file makes none (ABOP's roll to "
+                         "vertical is '@v' in cpfg)");
+      }
+      return;
+    }
+    for (const SubCall& c : subCalls_) {
+      double id = 0;
+      auto r = std::from_chars(c.first.data(), c.first.data() + c.first.size(), id);
+      if (r.ec != std::errc() || r.ptr != c.first.data() + c.first.size()) continue;  // an expression: checked when derived
+      bool known = prog_.mainLsystemId && *prog_.mainLsystemId == id;
+      for (const SubLsystem& sub : prog_.subLsystems) known |= sub.id == id;
+      if (!known)
+        error(c.line, c.col, "'?(" + c.first + ", ...)' calls a sub-L-system the file does not define (no 'lsystem: " + c.first +
+                                 "' after an 'endlsystem')");
+    }
   }
 
   /// A predecessor or context module whose parameter count no written module of its symbol
@@ -1060,6 +1174,17 @@ class GrammarParser {
   static bool isTurtleSymbol(const std::string& name) {
     if (name.size() > 1 && name[0] == '~') return true;
     return std::any_of(std::begin(kTurtleSymbols), std::end(kTurtleSymbols), [&](const char* t) { return name == t; });
+  }
+
+  /// Sub-L-systems with rules that apply to the whole string (decomposition,
+  /// interpretation): cpfg applies each L-system's own inside its calls, which Sprig does not.
+  void checkSubLsystems() {
+    if (prog_.subLsystems.empty()) return;
+    for (const RuleSet* rs : {&prog_.decomposition, &prog_.interpretation})
+      if (!rs->empty())
+        error(subs_.front().line, subs_.front().col,
+              std::string("sub-L-systems together with ") + (rs == &prog_.decomposition ? "decomposition" : "interpretation") +
+                  " rules are not supported (cpfg applies each L-system's own rules inside its '?(n, scale) ... $' calls)");
   }
 
   /// A predecessor whose stochastic productions all have weight 0 could never be rewritten
@@ -1175,10 +1300,15 @@ class GrammarParser {
     prog_.ignored[prog_.openBracket] = prog_.ignored[prog_.closeBracket] = 0;
     for (SymbolId id : prog_.axiom.symbols) prog_.usesCut |= id == prog_.cut;
     for (const char* q : {"?P", "?H", "?L", "?U"}) prog_.usesQuery |= prog_.symbols.find(q) >= 0;
-    for (const RuleSet* rs : {&prog_.productions, &prog_.decomposition})
-      for (const Production& p : rs->productions)
-        for (const SuccModule& m : p.successor) prog_.usesCut |= m.symbol == prog_.cut;
-    for (RuleSet* rs : {&prog_.productions, &prog_.decomposition, &prog_.interpretation}) {
+    std::vector<RuleSet*> sets{&prog_.productions, &prog_.decomposition, &prog_.interpretation};
+    for (SubLsystem& sub : prog_.subLsystems) sets.push_back(&sub.productions);
+    for (const RuleSet* rs : sets)
+      if (rs != &prog_.interpretation)
+        for (const Production& p : rs->productions)
+          for (const SuccModule& m : p.successor) prog_.usesCut |= m.symbol == prog_.cut;
+    if (int q = prog_.symbols.find("?"); q >= 0) prog_.subCall = static_cast<SymbolId>(q);
+    prog_.subEnd = static_cast<SymbolId>(prog_.symbols.find("$"));
+    for (RuleSet* rs : sets) {
       rs->bySymbol.assign(prog_.symbols.size(), {});
       for (uint32_t i = 0; i < rs->productions.size(); ++i) {
         rs->bySymbol[rs->productions[i].predecessor].push_back(i);
@@ -1199,7 +1329,23 @@ class GrammarParser {
   std::vector<double> params_;  ///< scratch parameters of appendConstant
   std::array<uint8_t, 256> writtenSingle_{};  ///< per byte: bit n set when written with n parameters
   std::vector<SymbolId> ignoreList_, considerList_;
+  /// cpfg's sub-L-system calls `?(n, ...)` written in the axiom and successors: line,
+  /// column and the text of n.
+  struct SubCall {
+    int line = 0, col = 0;
+    std::string first;
+  };
+  std::vector<SubCall> subCalls_;
+  bool afterEnd_ = false;         ///< an `endlsystem` was read and no `lsystem:` since
+  /// The labels of the sub-L-systems read so far (the last is being read), with the
+  /// scanner line and column of their `lsystem:` headers.
+  struct SubHeader {
+    std::string label;
+    int line = 0, col = 0;
+  };
+  std::vector<SubHeader> subs_;
   bool inGlobalBlock_ = false;  ///< compiling a Start/End block: its variables are the globals
+  Block statementBlock_ = Block::Main;  ///< the block of the production whose statements are compiled
   /// A predecessor or context module with its parameter count, checked by checkArities().
   struct ArityUse {
     std::string name;

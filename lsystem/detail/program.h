@@ -12,6 +12,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -19,6 +20,7 @@
 #include "core/diagnostics.h"
 #include "core/rng.h"
 #include "core/types.h"
+#include "lsystem/cpfg_function.h"
 #include "lsystem/detail/cpfg.h"
 #include "lsystem/module_string.h"
 
@@ -41,6 +43,16 @@ enum class Op : uint8_t {
   Jz,      ///< pops a value; when it is 0, jumps to instruction c of the block
   Jmp,     ///< jumps to instruction c of the block
   Printf,  ///< cpfg's `printf(format, ...)`: pops c values, prints them to stderr with Program::strings[var]
+  Srand,   ///< cpfg's `srand(s)`: records s as the seed of later draws (Effects::reseed); value 0
+  Stop,    ///< cpfg's `stop(x)`: asks the derivation to end after the current step (Effects::stop); value 0
+  Func,    ///< cpfg's `func(n, x)`: function var (n - 1) of the view file's function files at x
+};
+
+/// What cpfg's `srand` and `stop` ask of the Deriver, recorded by evalCode.
+struct Effects {
+  bool stop = false;    ///< `stop(x)` ran: end the derivation after the current step
+  bool reseed = false;  ///< `srand(s)` ran: seed the later draws with seed
+  double seed = 0;
 };
 
 /// Most backward jumps one statement block may take (a `while` that never ends): past it
@@ -89,16 +101,19 @@ struct CodeRange {
   bool empty() const { return begin == end; }
 };
 
-/// Evaluates one expression, or runs one statement block (Store, Jz, Jmp write into vars,
-/// which must then be writable; jump targets count from code; a block returns 0, or NaN
-/// after kMaxLoopJumps backward jumps). rng is used only by the random draws (never null
-/// when the code draws: the compiler marks such productions usesRandom).
 /// cpfg's printf to stderr: format (checked by the parser: only numeric conversions, one
 /// per value) with the n values args.
 void printFormatted(const std::string& format, const double* args, int n);
 
+/// Evaluates one expression, or runs one statement block (Store, Jz, Jmp write into vars,
+/// which must then be writable; jump targets count from code; a block returns 0, or NaN
+/// after kMaxLoopJumps backward jumps). rng is used only by the random draws (never null
+/// when the code draws: the compiler marks such productions usesRandom). effects, when
+/// given, records what `srand` and `stop` ask for; functions are the view file's function
+/// files `func` reads (NaN without them).
 inline double evalCode(const Instr* code, const Instr* end, const double* vars, Rng* rng,
-                       const std::vector<std::string>* strings = nullptr) {
+                       const std::vector<std::string>* strings = nullptr, Effects* effects = nullptr,
+                       const std::vector<CpfgFunction>* functions = nullptr) {
   double stack[kMaxStack];
   int sp = 0;
   long backJumps = 0;
@@ -160,6 +175,20 @@ inline double evalCode(const Instr* code, const Instr* end, const double* vars, 
         in = to - 1;  // the loop's ++in lands on the target
         break;
       }
+      case Op::Srand:
+        if (effects) {
+          effects->reseed = true;
+          effects->seed = stack[sp - 1];
+        }
+        stack[sp - 1] = 0.0;
+        break;
+      case Op::Stop:
+        if (effects) effects->stop = true;
+        stack[sp - 1] = 0.0;
+        break;
+      case Op::Func:
+        stack[sp - 1] = functions && in->var < functions->size() ? (*functions)[in->var].value(stack[sp - 1]) : std::nan("");
+        break;
       case Op::Printf: {
         const int n = static_cast<int>(in->c);
         if (strings && in->var < strings->size()) printFormatted((*strings)[in->var], stack + sp - n, n);
@@ -317,6 +346,15 @@ struct RuleSet {
   bool empty() const { return productions.empty(); }
 };
 
+/// One of cpfg's sub-L-systems (`lsystem: n` after the main one's `endlsystem`): its
+/// productions rewrite the modules between a `?(n, scale)` and its `$`.
+struct SubLsystem {
+  double id = 0;           ///< n
+  SourceLoc loc;           ///< its `lsystem:` header
+  std::string sourceLine;
+  RuleSet productions;
+};
+
 /// A compiled grammar.
 struct Program {
   std::string fileName;
@@ -340,9 +378,18 @@ struct Program {
   std::vector<std::pair<std::string, double>> defines;
   std::vector<Instr> code;
   std::vector<std::string> strings;  ///< printf formats (Instr::var of Op::Printf)
+  std::vector<CpfgFunction> functions;  ///< the view file's function files (`func(n, x)`), n = 1, 2, ...
   RuleSet productions;
   RuleSet decomposition;
   RuleSet interpretation;
+  /// cpfg's sub-L-systems, in file order (empty for most grammars; only in cpfg's notation).
+  std::vector<SubLsystem> subLsystems;
+  /// The main L-system's number (its `lsystem:` label, when a number): `?(n, s)` with this
+  /// n calls the main productions again.
+  std::optional<double> mainLsystemId;
+  /// `?` (the sub-L-system call, when the file writes it) and `$` (its end).
+  std::optional<SymbolId> subCall;
+  SymbolId subEnd = 0;
   std::vector<uint8_t> ignored;  ///< per symbol: skipped by context matching
   SymbolId openBracket = 0, closeBracket = 0, cut = 0;
   /// True when some successor or the axiom contains the cut symbol `%`.

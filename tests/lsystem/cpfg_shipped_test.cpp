@@ -1,12 +1,15 @@
-// Every grammar shipped in grammars/ also runs as a cpfg `.l` file in a vlab object folder:
-// each is converted on the fly to cpfg's notation (the `angle:` header becomes the view
-// file's `angle increment`, ABOP's `$` becomes cpfg's `@v`, the color step `'` becomes `;`,
-// `@O`'s radius becomes cpfg's diameter), written with its view file into a folder, read
-// back as cpfg reads it, and must give the same module string (up to those renamings) and
-// the same skeleton as the native grammar.
+// Every grammar shipped in grammars/ also runs as a cpfg `.l` file in a vlab object folder,
+// grammars/vlab/NAME/ (NAME.l and, when the grammar has an angle, NAME.v). This test is the
+// folders' generator and their check: each grammar is converted to cpfg's notation (the
+// `angle:` header becomes the view file's `angle increment`, ABOP's `$` becomes cpfg's
+// `@v`, the color step `'` becomes `;`, `@O`'s radius becomes cpfg's diameter); the stored
+// folder must hold exactly that (run the test with SPRIG_UPDATE_VLAB=1 to write them
+// after changing a grammar), and, read back as cpfg reads it, must give the same module
+// string (up to those renamings) and the same skeleton as the native grammar.
 
 #include <catch2/catch.hpp>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -87,18 +90,28 @@ std::string cpfgName(const std::string& name) {
 
 TEST_CASE("every shipped grammar runs as a cpfg .l file in a vlab object folder", "[lsystem][cpfg]") {
   const std::filesystem::path grammars = std::filesystem::path(SPRIG_SOURCE_DIR) / "grammars";
-  test::TempDir tmp("cpfg-shipped");
-  size_t converted = 0;
+  const bool update = std::getenv("SPRIG_UPDATE_VLAB") != nullptr;
+  size_t converted = 0, stored = 0;
   for (const auto& entry : std::filesystem::directory_iterator(grammars)) {
     if (entry.path().extension() != ".lsys") continue;
     const std::string name = entry.path().stem().string();
     INFO(name);
     const CpfgObject obj = toCpfg(readFile(entry.path()));
-    const std::filesystem::path folder = tmp.path / name;
-    std::filesystem::create_directories(folder);
+    const std::filesystem::path folder = grammars / "vlab" / name;
     const std::string lPath = (folder / (name + ".l")).string();
-    { std::ofstream(lPath) << obj.grammar; }
-    if (!obj.view.empty()) std::ofstream(folder / (name + ".v")) << obj.view;
+    const std::filesystem::path vPath = folder / (name + ".v");
+    if (update) {
+      std::filesystem::create_directories(folder);
+      writeFileAtomic(lPath, obj.grammar);
+      if (!obj.view.empty()) writeFileAtomic(vPath.string(), obj.view);
+      else std::filesystem::remove(vPath);
+    }
+    // The stored object is the conversion of the shipped grammar, byte for byte.
+    REQUIRE(std::filesystem::exists(lPath));
+    CHECK(readFile(lPath) == obj.grammar);
+    CHECK(std::filesystem::exists(vPath) == !obj.view.empty());
+    if (!obj.view.empty() && std::filesystem::exists(vPath)) CHECK(readFile(vPath.string()) == obj.view);
+    ++stored;
     if (name == "tree_lime") {
       // Sprig's predefined leaf `~l`: cpfg's `~` reads a surface file of the view file,
       // which the object does not have (and Sprig does not read): an error, not a leaf.
@@ -150,4 +163,5 @@ TEST_CASE("every shipped grammar runs as a cpfg .l file in a vlab object folder"
     ++converted;
   }
   CHECK(converted == 15);  // the 16 shipped grammars but tree_lime
+  CHECK(stored == 16);
 }

@@ -259,17 +259,18 @@ TEST_CASE("cpfg view file", "[lsystem][cpfg]") {
 
 TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg]") {
   SECTION("commands") {
-    CHECK(errorOf("axiom: A\nA --> F@Gc(10)F\n") == "t.l:2:8: cpfg's '@Gc' (generalized cylinder) is not supported");
-    CHECK(errorOf("axiom: F@Gs\n", "t.lsys") == "t.lsys:1:9: cpfg's '@Gs' (generalized cylinder) is not supported");
+    CHECK(errorOf("axiom: A\nA --> F@#(10)F\n") == "t.l:2:8: cpfg's '@#' (contour of generalized cylinders) is not supported");
+    CHECK(errorOf("axiom: F@Gr(1)\n", "t.lsys") == "t.lsys:1:9: cpfg's '@Gr' (generalized cylinder radius tangents) is not supported");
     CHECK(errorOf("axiom: F{(1)F}(1)\n") == "t.l:1:9: cpfg's '{(type)' (generalized cylinder) is not supported");
     CHECK(errorOf("axiom: A\nA --> F$A\n") ==
-          "t.l:2:8: cpfg's '$' (end of a sub-L-system call; ABOP's roll to vertical is '@v' in cpfg) is not supported");
+          "t.l:2:8: cpfg's '$' ends a sub-L-system call '?(n, scale)', and this file makes none (ABOP's roll to vertical is '@v' in cpfg)");
     CHECK(errorOf("axiom: F~l\n") == "t.l:1:9: cpfg's '~' (surface from a view file's surface file) is not supported");
     CHECK(errorOf("axiom: ?P(0,0)A\n") == "no error");
     CHECK(errorOf("axiom: A\nhomomorphism\nA --> F?U(0,0,0)\n") ==
           "t.l:3:8: cpfg's query module '?U' in an interpretation rule is not supported (its values would be lost with "
           "the interpreted string)");
-    CHECK(errorOf("axiom: A\nA --> ?(2,1)B$\n") == "t.l:2:7: cpfg's '?(n, scale)' (sub-L-system call) is not supported");
+    CHECK(errorOf("axiom: A\nA --> ?(2,1)B$\n") ==
+          "t.l:2:7: '?(2, ...)' calls a sub-L-system the file does not define (no 'lsystem: 2' after an 'endlsystem')");
     CHECK(errorOf("axiom: F@Tx(1)\n") == "t.l:1:9: cpfg's '@Tx' (texture) is not supported");
     CHECK(errorOf("axiom: F@Q\n") == "t.l:1:9: unknown cpfg command '@Q'");
   }
@@ -284,10 +285,10 @@ TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg
     CHECK(errorOf("lsystem: 1\naxiom: A\nlsystem: 2\naxiom: B\n") ==
           "t.l:3:1: several L-systems in one file (cpfg's sub-L-systems) are not supported (the first is at line 1)");
     CHECK(errorOf("ring lsystem\naxiom: A\n") == "t.l:1:1: cpfg's 'ring lsystem' (ring L-system) is not supported");
-    CHECK(errorOf("axiom: A(1)\nA(x) --> A(srand(2))\n") ==
-          "t.l:2:12: cpfg's function 'srand' (reseeds cpfg's one global generator; Sprig draws per module from 'seed:') is not supported");
+    CHECK(errorOf("axiom: A(1)\nA(x) --> A(srand(2))\n").find(
+              "t.l:2:12: cpfg's function 'srand' is supported only as a statement of a 'Start:'") == 0);
     CHECK(errorOf("axiom: A(1)\nA(x) --> A(func(1, x))\n") ==
-          "t.l:2:12: cpfg's function 'func' (function from a view file's function file) is not supported");
+          "t.l:2:12: cpfg's func(n, x) reads the view file's function files, and it names none ('function: NAME.func')");
   }
   SECTION("printf: a statement with numeric conversions") {
     CHECK(errorOf("axiom: A(1)\nA(x) : { printf(\"%s\", x); } 1 --> A(x)\n") ==
@@ -301,7 +302,7 @@ TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg
     CHECK(errorOf("Start: { printf(\"%5.2f%%\\n\", 2); }\naxiom: A\n") == "no error");
   }
   SECTION("an error in a continued line is reported at its own line") {
-    CHECK(errorOf("axiom: A\nA --> F\n\tF@Gc(2)\n") == "t.l:3:3: cpfg's '@Gc' (generalized cylinder) is not supported");
+    CHECK(errorOf("axiom: A\nA --> F\n\tF@Gr(2)\n") == "t.l:3:3: cpfg's '@Gr' (generalized cylinder radius tangents) is not supported");
   }
 }
 
@@ -373,8 +374,7 @@ TEST_CASE("cpfg statements in productions", "[lsystem][cpfg]") {
     CHECK(errorOf("axiom: A(1)\nA(y) : { x += 1; } * --> B(y)\n") ==
           "t.l:2:12: expected '=' after 'x' (statements are assignments, 'if', 'while' and 'do')");
     CHECK(errorOf("#define K 2\naxiom: A(1)\nA(y) : { K = 1; } * --> B(y)\n") == "t.l:3:10: cannot assign to 'K': it is a #define");
-    CHECK(errorOf("Start: { srand(3); }\naxiom: A\n") ==
-          "t.l:1:10: cpfg's function 'srand' (reseeds cpfg's one global generator; Sprig draws per module from 'seed:') is not supported");
+    CHECK(errorOf("Start: { srand(3); }\naxiom: A\n") == "no error");
     CHECK(derived("axiom: A(2)\nA(y) : { x = 1; fabs(y); x = x + 1; } * --> B(x)\n", 1) == "B(2)");  // a call alone: value dropped
     try {
       derived("axiom: A(1)\nA(y) : { while (1) { y = y; } } * --> B(y)\n", 1);
@@ -499,14 +499,14 @@ TEST_CASE("cpfg's C preprocessor", "[lsystem][cpfg]") {
   SECTION("an error in an included file is at its own file:line:col") {
     const std::string file = cpfgAsset("preprocessor_errors/plant.l");
     CHECK(errorOf(readFile(file), file) == cpfgAsset("preprocessor_errors/rules.h") +
-                                                    ":2:8: cpfg's '@Gc' (generalized cylinder) is not supported");
+                                                    ":2:8: cpfg's '@Gr' (generalized cylinder radius tangents) is not supported");
   }
   SECTION("an error inside a macro's expansion is at the macro's use") {
-    CHECK(errorOf("#define LEAF [@Gc(1)]\naxiom: F LEAF\n") == "t.l:2:10: cpfg's '@Gc' (generalized cylinder) is not supported");
+    CHECK(errorOf("#define LEAF [@Gr(1)]\naxiom: F LEAF\n") == "t.l:2:10: cpfg's '@Gr' (generalized cylinder radius tangents) is not supported");
     CHECK(errorOf("#define B(x) F(x)\naxiom: A B(1, 2) C\n") ==
           "t.l:2:10: macro 'B' takes 1 argument(s) (defined at t.l:1), or its expansion nests deeper than 64 levels");
     // Columns after an expansion are the file's own.
-    CHECK(errorOf("#define S F(1)F(1)\naxiom: S@Gc(1)\n") == "t.l:2:9: cpfg's '@Gc' (generalized cylinder) is not supported");
+    CHECK(errorOf("#define S F(1)F(1)\naxiom: S@Gr(1)\n") == "t.l:2:9: cpfg's '@Gr' (generalized cylinder radius tangents) is not supported");
   }
   SECTION("cpp's identifiers: a macro named B is not expanded inside AB; a number body stays a value") {
     Grammar g = parseGrammar("#define B [+F]\n#define N (2 + 1)\naxiom: AB B F(N)\n", "t.l");
@@ -525,5 +525,221 @@ TEST_CASE("cpfg's C preprocessor", "[lsystem][cpfg]") {
     CHECK(errorOf("axiom: A\n#endif\n") == "t.l:2:1: '#endif' without '#ifdef' or '#ifndef'");
     CHECK(errorOf("#define B F\n#define B G\naxiom: A\n") == "t.l:2:9: 'B' is already defined at t.l:1");
     CHECK(errorOf("#define B F\n#undef B\n#define B G\naxiom: B\n") == "no error");
+  }
+}
+
+TEST_CASE("cpfg sub-L-systems", "[lsystem][cpfg]") {
+  SECTION("tests/assets/cpfg/sub_lsystem: each call derived by its own L-system (strings by hand in plant.l)") {
+    Drawn o = drawObject("sub_lsystem", true);
+    CHECK(o.string ==
+          "F(1)F(1)F(1)BF(1)[+?(2,0.5)F(2)?(3,2)F(4)D$F(2)?(3,2)D$BEE$]F(1)[+?(2,0.5)F(2)?(3,2)D$BE$]F(1)[+?(2,0.5)B$]A");
+    // The view file's 90 degrees; ?(2, 0.5) halves lengths and widths, ?(3, 2) inside it
+    // doubles them back: F(2) is 1 long, F(4) 4 long (0.5 * 2 * 4).
+    const std::vector<std::pair<DVec3, DVec3>> want = {
+        {{0, 0, 0}, {0, 1, 0}},   {{0, 1, 0}, {0, 2, 0}},   {{0, 2, 0}, {0, 3, 0}},   {{0, 3, 0}, {0, 4, 0}},
+        {{0, 4, 0}, {-1, 4, 0}},  {{-1, 4, 0}, {-5, 4, 0}}, {{-5, 4, 0}, {-6, 4, 0}}, {{0, 4, 0}, {0, 5, 0}},
+        {{0, 5, 0}, {-1, 5, 0}},  {{0, 5, 0}, {0, 6, 0}}};
+    REQUIRE(o.skeleton.internodes.size() == want.size());
+    for (size_t k = 0; k < want.size(); ++k) {
+      INFO("internode " << k);
+      checkNear(o.skeleton.internodes[k].start, want[k].first);
+      checkNear(o.skeleton.internodes[k].end, want[k].second);
+    }
+    // Widths: 0.2 on the main axis, 0.1 in L-system 2, 0.2 again in L-system 3 (x 0.5 x 2).
+    const double r0 = o.skeleton.internodes[0].baseRadius;
+    REQUIRE(r0 > 0);
+    CHECK(o.skeleton.internodes[4].baseRadius == Approx(0.5 * r0));
+    CHECK(o.skeleton.internodes[5].baseRadius == Approx(r0));
+    CHECK(o.skeleton.internodes[6].baseRadius == Approx(0.5 * r0));
+    CHECK(o.skeleton.internodes[7].baseRadius == Approx(r0));  // `]` restored the main width
+    CHECK(o.skeleton.internodes[8].baseRadius == Approx(0.5 * r0));
+  }
+  SECTION("tests/assets/cpfg/sub_lsystem_include: the sub-L-system and its #define in an included file") {
+    Grammar g = loadGrammar(cpfgAsset("sub_lsystem_include/plant.l"));
+    Deriver d(g);
+    CHECK(formatModuleString(d.step(), d.symbols()) == "F(1)[?(2,0.5)L(1)$]A");
+    // Inside the call L is L-system 2's (x * RATE), never the main one's (x + 100).
+    CHECK(formatModuleString(d.step(), d.symbols()) == "F(1)[?(2,0.5)L(2)$]F(1)[?(2,0.5)L(1)$]A");
+    CHECK(g.define("RATE") == 2.0);
+  }
+  SECTION("a call back into the main L-system by its number; a cut ends at the call's '$'") {
+    Grammar g = parseGrammar("lsystem: 1\nderivation length: 2\naxiom: ?(2)AB$A\nA --> AX\nendlsystem\n"
+                             "lsystem: 2\nA --> ?(1)A$%B\nB --> C\nendlsystem\n",
+                             "t.l");
+    Deriver d(g);
+    // Step 1: inside L-system 2, A --> ?(1)A$%B and B --> C; the cut removes %BC up to the
+    // call's $ (not to the end of the string); outside, A --> AX.
+    CHECK(formatModuleString(d.step(), d.symbols()) == "?(2)?(1)A$$AX");
+    // Step 2: the inner A is in L-system 1 again.
+    CHECK(formatModuleString(d.step(), d.symbols()) == "?(2)?(1)AX$$AXX");
+  }
+  SECTION("errors") {
+    CHECK(errorOf("axiom: ?(2)A$\nendlsystem\nlsystem: 2\nignore: F\nA --> B\n") ==
+          "t.l:4:1: 'ignore:' in a sub-L-system ('lsystem: 2') is not supported (Sprig reads a sub-L-system's productions only)");
+    CHECK(errorOf("axiom: A\nendlsystem\nlsystem: 2\nendlsystem\nlsystem: 2\n") ==
+          "t.l:5:1: 'lsystem: 2' is defined twice (first at line 3)");
+    CHECK(errorOf("axiom: A\nhomomorphism\nA --> F\nendlsystem\nlsystem: 2\nA --> B\n") ==
+          "t.l:5:1: sub-L-systems together with interpretation rules are not supported (cpfg applies each L-system's own "
+          "rules inside its '?(n, scale) ... $' calls)");
+    CHECK(errorOf("axiom: ?(2)A$\nendlsystem\nlsystem: 2\nA --> B\n", "t.lsys") ==
+          "t.lsys:1:8: cpfg's '?(n, scale)' (sub-L-system call) is supported only in cpfg's notation (a .l file), where '$' ends it");
+    CHECK(errorOf("axiom: ?(2,1,3)A$\n") == "t.l:1:8: cpfg's sub-L-system call '?(n, scale)' takes 1 or 2 parameters, got 3");
+    // A number computed at derivation time: the error comes then.
+    Grammar g = parseGrammar("#define N 5\naxiom: ?(N)A$\nA --> B\nendlsystem\nlsystem: 2\nA --> C\n", "t.l");
+    try {
+      Deriver d(g);
+      d.step();
+      FAIL("no error");
+    } catch (const InputError& e) {
+      CHECK(e.diagnostics().front().message ==
+            "'?(5, ...)' at step 1 calls a sub-L-system the file does not define (its L-systems: 2)");
+    }
+  }
+}
+
+TEST_CASE("cpfg srand and stop", "[lsystem][cpfg]") {
+  const std::string rules = "derivation length: 4\naxiom: A(0)\nA(x) --> A(ran(1))A(x) : 1\nA(x) --> B : 1\n";
+  SECTION("srand(s) in Start: seeds the draws as 'seed: s' does") {
+    Grammar reseeded = parseGrammar("Start: {srand(7);}\n" + rules, "t.l");
+    Grammar seeded = parseGrammar("seed: 7\n" + rules, "t.l");
+    Grammar unseeded = parseGrammar(rules, "t.l");
+    const std::string a = formatModuleString(derive(reseeded), reseeded.symbols());
+    CHECK(a == formatModuleString(derive(seeded), seeded.symbols()));
+    CHECK(a != formatModuleString(derive(unseeded), unseeded.symbols()));
+  }
+  SECTION("srand in StartEach: reseeds before every step, so every step draws alike") {
+    Grammar g = parseGrammar("derivation length: 3\nStartEach: {srand(3);}\naxiom: A(0)\nA(x) --> A(ran(1))\n", "t.l");
+    Deriver d(g);
+    const double first = d.step().params[0];
+    CHECK(d.step().params[0] == first);
+    CHECK(d.step().params[0] == first);
+    CHECK(d.seed() == 3);
+    d.restart();
+    CHECK(d.seed() == 0);
+  }
+  SECTION("stop(x) in a production ends the derivation after the current step") {
+    Grammar g = parseGrammar("derivation length: 10\naxiom: A(0)\nA(n) : {if (n == 2) {stop(1);}} * --> F A(n+1)\n", "t.l");
+    Deriver d(g);
+    // Step 3 rewrites A(2), which calls stop: A(3) after step 3, and no step 4.
+    CHECK(formatModuleString(d.derive(), d.symbols()) == "FFFA(3)");
+    CHECK(d.stepsDone() == 3);
+    CHECK(d.steps() == 3);
+    d.restart();
+    CHECK(d.steps() == 10);
+  }
+  SECTION("stop in EndEach: over a global; End: still runs after the last step") {
+    Grammar g = parseGrammar("derivation length: 10\nStart: {k = 0;}\nEndEach: {k = k + 1; if (k == 2) {stop(0);}}\n"
+                             "End: {printf(\"\");}\naxiom: A\nA --> FA\n",
+                             "t.l");
+    Deriver d(g);
+    CHECK(formatModuleString(d.derive(), d.symbols()) == "FFA");
+  }
+  SECTION("errors") {
+    CHECK(errorOf("axiom: A\nA : {srand(2);} * --> B\n") ==
+          "t.l:2:6: cpfg's function 'srand' is supported only as a statement of a 'Start:', 'StartEach:', 'EndEach:' or "
+          "'End:' block ('srand(s);'): Sprig draws each module's numbers from the seed, which srand replaces for the later draws");
+    CHECK(errorOf("axiom: A\nA : stop(1) --> B\n") == "t.l:2:5: cpfg's function 'stop' is supported only as a statement ('stop(1);')");
+    CHECK(errorOf("axiom: A\nhomomorphism\nA : {stop(1);} * --> F\n") ==
+          "t.l:3:6: cpfg's function 'stop' in an interpretation rule is not supported (the derivation has ended when the "
+          "string is interpreted): call it in a production or a Start/EndEach block");
+  }
+}
+
+TEST_CASE("cpfg function files and func(n, x)", "[lsystem][cpfg]") {
+  SECTION("tests/assets/cpfg/function: values from its reference.py (scipy's B-splines)") {
+    const ViewFile view = loadViewFile(cpfgAsset("function/plant.v"));
+    REQUIRE(view.functions.size() == 3);
+    CHECK(view.functions[0].samples() == 0);  // fver files keep their own samples
+    CHECK(view.functions[1].samples() == 5);  // the range: format takes the view file's
+    CHECK(view.functions[2].samples() == 0);
+    CHECK(view.functions[2].points().size() == 5);  // the multiplicity 2 doubles a point
+    GrammarOverrides o;
+    o.cpfgFunctions = view.functions;
+    const std::string file = cpfgAsset("function/plant.l");
+    Grammar g = parseGrammar(readFile(file), file, o);
+    const ModuleString s = derive(g);
+    REQUIRE(s.size() == 4);
+    const std::vector<double> want = {0.15625, 0.783014893532, 0.000002859160, 0.999997140840,
+                                      0.570114535667, 0.434987995268, 0.066938758886, 2.0};
+    std::vector<double> got;
+    for (size_t i = 0; i < s.size(); ++i)
+      for (double v : s.paramsOf(i)) got.push_back(v);
+    REQUIRE(got.size() == want.size());
+    for (size_t k = 0; k < want.size(); ++k) CHECK(got[k] == Approx(want[k]).margin(1e-9));
+  }
+  SECTION("a four-point function is a Bezier segment: its ends are the first and last points") {
+    CpfgFunction f = CpfgFunction::parse("range: 0 1\npoints: 4\n0 0.5\n0.3 2\n0.6 -1\n1 0.25\n", "f.func", -1);
+    CHECK(f.point(0).y == Approx(0.5));
+    CHECK(f.point(0.999999).y == Approx(0.25).margin(1e-5));
+    // Bezier: y(1/2) = (0.5 + 3 * 2 + 3 * (-1) + 0.25) / 8, at x(1/2) = (0 + 0.9 + 1.8 + 1) / 8.
+    CHECK(f.point(0.5).y == Approx(3.75 / 8));
+    CHECK(f.point(0.5).x == Approx(3.7 / 8).epsilon(1e-6));
+  }
+  SECTION("errors") {
+    auto errorIn = [](const std::string& text) {
+      try {
+        CpfgFunction::parse(text, "f.func", -1);
+      } catch (const InputError& e) {
+        const Diagnostic& d = e.diagnostics().front();
+        return d.loc.file + ":" + std::to_string(d.loc.line) + ":" + std::to_string(d.loc.col) + ": " + d.message;
+      }
+      return std::string("no error");
+    };
+    CHECK(errorIn("range: 0 1\npoints: 3\n0 0\n0.5 1\n1 0\n") ==
+          "f.func:2:1: a function needs at least 4 points ('points: n', n from 4 to 100000)");
+    CHECK(errorIn("range: 0 1\npoints: 4\n0 0\n0.5 x1\n0.7 1\n1 0\n") == "f.func:4:5: expected a number, got 'x1'");
+    CHECK(errorIn("fver 2 0\n") == "f.func:1:1: function file version 2.0 is not supported (cpfg reads 'fver 1 1' and the 'range:' format)");
+    CHECK(errorIn("range: 0 1\npoints: 4\n0.2 0\n0.5 1\n0.7 1\n1 0\n").find(
+              "f.func:2:1: the function's x does not increase from 0 to 1 along its curve") == 0);
+    CHECK(errorIn("range: 0 1\npoints: 5\n0 0\n0.5 1\n") == "f.func:4:1: the function file ends after 2 of its 5 points");
+    CHECK(errorOf("axiom: A(func(1, 0.5))\n") ==
+          "t.l:1:10: cpfg's func(n, x) reads the view file's function files, and it names none ('function: NAME.func')");
+    CHECK(viewErrorOf("function: missing.func\n") == "t.v:1:11: cannot read the function file 'missing.func'");
+    CHECK(viewErrorOf("function: ../x.func\n") ==
+          "t.v:1:11: the function file '../x.func' is outside the object's folder (only files beside the view file, or in folders below it)");
+  }
+}
+
+TEST_CASE("cpfg generalized cylinders", "[lsystem][cpfg]") {
+  SECTION("tests/assets/cpfg/generalized_cylinder: pieces from its reference.py (Hermite basis)") {
+    Drawn o = drawObject("generalized_cylinder", true);
+    struct Piece {
+      DVec3 a, b;
+      double ra, rb;
+    };
+    const std::vector<Piece> want = {
+        {{0, 0, 0}, {0, 1, 0}, 0.1, 0.1},
+        {{0, 1, 0}, {0, 2, 0}, 0.1, 0.1},
+        {{0, 2, 0}, {-0.2, 2.3375, 0}, 0.1, 0.125},
+        {{-0.2, 2.3375, 0}, {-0.7, 2.3, 0}, 0.125, 0.15},
+        {{-0.7, 2.3, 0}, {-1.35, 2.1125, 0}, 0.15, 0.175},
+        {{-1.35, 2.1125, 0}, {-2, 2, 0}, 0.175, 0.2}};
+    REQUIRE(o.skeleton.internodes.size() == want.size());  // f draws nothing: only the tube
+    for (size_t k = 0; k < want.size(); ++k) {
+      INFO("piece " << k);
+      const Internode& in = o.skeleton.internodes[k];
+      checkNear(in.start, want[k].a);
+      checkNear(in.end, want[k].b);
+      CHECK(in.baseRadius == Approx(want[k].ra));
+      CHECK(in.tipRadius == Approx(want[k].rb));
+      CHECK(in.parent == static_cast<int32_t>(k) - 1);  // one chain
+    }
+  }
+  SECTION("@Gc without a parameter draws cpfg's 4 rings; [ ] saves the cylinder; @Gt sets the tangents") {
+    // The branch continues the cylinder from (0,1) and ends it; after ] the outer one goes
+    // on from (0,1) too: two segments of 4 rings and one of 1.
+    Grammar g = parseGrammar("axiom: @Gs f(1) @Gc [ + f(1) @Ge ] f(1) @Ge(1)\n", "t.l");
+    ViewFile view = parseViewFile("angle increment: 90\ninitial line width: 0.2 polygon\n", "t.v");
+    Skeleton sk = Turtle(g.symbols(), cpfgTurtleSettings(&view, {})).run(g.axiom());
+    REQUIRE(sk.internodes.size() == 9);
+    checkNear(sk.internodes[7].end, DVec3(-1, 1, 0));   // the branch's end
+    checkNear(sk.internodes[8].start, DVec3(0, 1, 0));  // the outer cylinder resumes at (0,1)
+    checkNear(sk.internodes[8].end, DVec3(0, 2, 0));
+    CHECK(sk.internodes[8].parent == 3);
+    // @Gt(0, 0): zero tangents make the segment straight: its mid ring on the chord.
+    Grammar s = parseGrammar("axiom: @Gt(0) @Gs f(1) + f(1) @Ge(2)\n", "t.l");
+    Skeleton straight = Turtle(s.symbols(), cpfgTurtleSettings(&view, {})).run(s.axiom());
+    REQUIRE(straight.internodes.size() == 2);
+    checkNear(straight.internodes[0].end, DVec3(-0.5, 0.5, 0));  // the chord (0,0)-(-1,1)
   }
 }

@@ -116,3 +116,32 @@ TEST_CASE("tree species: same file and seed, same mesh bytes", "[model]") {
   CHECK(two == a);
   std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("cpfg colour map of a vlab object", "[model][cpfg]") {
+  SECTION("tests/assets/cpfg/colormap: the specifications' -m plant.map, entry i for colour index i") {
+    const Species s = loadSpecies(std::filesystem::path(SPRIG_SOURCE_DIR) / "tests/assets/cpfg/colormap");
+    REQUIRE(s.render.style.palette.size() == 256);
+    CHECK(s.render.style.palette[1] == Vec3(1.0f, 1.0f, 0.0f));
+    CHECK(s.render.style.palette[2] == Vec3(250 / 255.0f, 0.0f, 0.0f));
+    CHECK(s.render.style.palette[3] == Vec3(0.0f, 249 / 255.0f, 0.0f));
+    CHECK(s.render.style.palette[200] == Vec3(200 / 255.0f));
+    // The spheres carry colour indices 1, 2, 3 (`;(1)`, then `;` adds the increment 1).
+    GrowthEngine engine(s);
+    const lsystem::Skeleton sk = engine.skeletonAt(engine.lastStep());
+    REQUIRE(sk.organs.size() == 3);
+    for (int k = 0; k < 3; ++k) CHECK(sk.organs[static_cast<size_t>(k)].color == k + 1);
+  }
+  SECTION("a colour map of another size is an error at the file") {
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "sprig-cpfg-colormap-test";
+    std::filesystem::create_directories(dir);
+    writeFileAtomic(dir / "plant.l", "axiom: F\n");
+    writeFileAtomic(dir / "plant.map", std::string(10, '\0'));
+    try {
+      loadSpecies(dir);
+      FAIL("no error");
+    } catch (const InputError& e) {
+      CHECK(e.diagnostics().front().message == "a cpfg colour map holds 256 entries of 3 bytes (768 bytes), this file has 10");
+    }
+    std::filesystem::remove_all(dir);
+  }
+}

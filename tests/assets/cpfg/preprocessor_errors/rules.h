@@ -1,2 +1,2 @@
 /* productions of plant.l */
-A --> F@Gc(2)
+A --> F@Gr(2)
