@@ -171,6 +171,19 @@ Sample CompiledBlob::sample(Vec3 p) const {
       s.attributes.textureWeights[size_t(i)] = r.acc.w[size_t(order[size_t(i)])] / total;
     }
     s.attributes.textureCount = uint8_t(r.acc.count);
+    // Layers: by decreasing weight (ties keep their order: deterministic), normalized.
+    std::array<Attributes::Layer, Attributes::kMaxLayers> layers = r.acc.layers;
+    const int n = r.acc.layerCount;
+    std::stable_sort(layers.begin(), layers.begin() + n,
+                     [](const Attributes::Layer& a, const Attributes::Layer& b) { return a.weight > b.weight; });
+    float layerTotal = 0.0f;
+    for (int i = 0; i < n; ++i) layerTotal += layers[size_t(i)].weight;
+    for (int i = 0; i < n; ++i) {
+      s.attributes.layers[size_t(i)] = layers[size_t(i)];
+      s.attributes.layers[size_t(i)].weight /= layerTotal;
+    }
+    s.attributes.layerCount = uint8_t(n);
+    s.attributes.contact = r.acc.contact;
   }
   return s;
 }

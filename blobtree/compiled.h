@@ -52,6 +52,27 @@ struct Attributes {
   std::array<uint16_t, kMaxTextures> textureIds{};  ///< by decreasing weight
   std::array<float, kMaxTextures> textureWeights{}; ///< sum to 1 over textureCount
   uint8_t textureCount = 0;  ///< 0 when no primitive contributes
+
+  /// One contributing primitive: its texture, its own natural (u,v) after its uv transform,
+  /// and its share of the field weight.
+  struct Layer {
+    Vec2 uv{0.0f};
+    uint16_t textureId = 0;
+    float weight = 0.0f;
+  };
+  static constexpr int kMaxLayers = 4;
+  /// The heaviest contributing primitives (up to kMaxLayers, by decreasing weight; weights
+  /// sum to 1 over layerCount). Colouring each at its own uv and blending the colours
+  /// (tree paper §3.7: "each contributing primitive uses its native 2D coordinates")
+  /// avoids blending angles of different axes, which swirls, and blending u across its
+  /// wrap at 0/1, which leaves a seam.
+  std::array<Layer, kMaxLayers> layers{};
+  uint8_t layerCount = 0;
+  /// Closeness to a PCM contact in [0, 1]: over the PCM nodes reached, the largest
+  /// 1 − (c − f_j)/w of a child j that is not the node's strongest (1 on the seam where two
+  /// primitives press together, 0 beyond the propagation width w). Marks the branch bark
+  /// ridge, where real bark is compressed and darker (tree paper §5).
+  float contact = 0.0f;
 };
 
 /// Field value, analytic gradient and attributes at a point.

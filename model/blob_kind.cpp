@@ -567,6 +567,11 @@ std::optional<textures::Texture> readProcedural(const std::string& kind, const Y
     o.tileV = int(m.integer("tile_v", o.tileV, 0, 100000));
     o.ridgeColor = m.color("ridge_color", o.ridgeColor);
     o.furrowColor = m.color("furrow_color", o.furrowColor);
+    o.maturity = m.number("maturity", o.maturity, 0.0, 1.0);
+    o.lenticels = m.number("lenticels", o.lenticels, 0.0, 1.0);
+    o.lenticelFrequency = m.number("lenticel_frequency", o.lenticelFrequency, 0.0, 1e4);
+    o.youngColor = m.color("young_color", o.ridgeColor);
+    o.lenticelColor = m.color("lenticel_color", o.lenticelColor);
     o.seed = readSeed(m);
     out = textures::BarkTexture(o);
   } else if (kind == "stripes") {

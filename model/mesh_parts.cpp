@@ -14,6 +14,14 @@ blobtree::PolygonizeOptions polygonizeOptions(const SpeciesRender& look) {
 }
 
 Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::TextureTable& textures, const Vec3& base) {
+  render::Material material;
+  material.baseColor = base;
+  return paintPolygonized(result, textures, material);
+}
+
+Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::TextureTable& textures,
+                      const render::Material& material) {
+  const Vec3 base = material.baseColor;
   Mesh mesh = result.mesh;
   const size_t n = mesh.positions.size();
   if (result.attributes.size() != n) throw std::invalid_argument("paintPolygonized: the mesh has no attributes");
@@ -23,14 +31,25 @@ Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::Te
     if (a.textureCount == 0 || textures.empty()) continue;
     Vec3 sum(0);
     float wsum = 0;
-    for (int i = 0; i < a.textureCount && i < blobtree::Attributes::kMaxTextures; ++i) {
-      const float w = a.textureWeights[size_t(i)];
-      if (!(w > 0)) continue;
-      const uint16_t id = a.textureIds[size_t(i)];
-      sum += w * (id < textures.size() ? textures[id](a.uv, mesh.positions[v]) : base);
-      wsum += w;
+    if (material.textureLayers) {
+      for (int i = 0; i < a.layerCount && i < blobtree::Attributes::kMaxLayers; ++i) {
+        const blobtree::Attributes::Layer& l = a.layers[size_t(i)];
+        if (!(l.weight > 0)) continue;
+        sum += l.weight * (l.textureId < textures.size() ? textures[l.textureId](l.uv, mesh.positions[v]) : base);
+        wsum += l.weight;
+      }
+    } else {
+      for (int i = 0; i < a.textureCount && i < blobtree::Attributes::kMaxTextures; ++i) {
+        const float w = a.textureWeights[size_t(i)];
+        if (!(w > 0)) continue;
+        const uint16_t id = a.textureIds[size_t(i)];
+        sum += w * (id < textures.size() ? textures[id](a.uv, mesh.positions[v]) : base);
+        wsum += w;
+      }
     }
-    if (wsum > 0) mesh.colors[v] = sum / wsum;
+    if (wsum > 0)
+      mesh.colors[v] = sum / wsum * (1.0f - std::clamp(material.contactDarkening * a.contact * a.contact * a.contact,
+                                                        0.0f, 1.0f));
   }
   mesh.materials.assign(mesh.triangles.size(), kNoPartTexture);
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {

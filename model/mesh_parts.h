@@ -28,6 +28,10 @@ inline constexpr uint32_t kNoPartTexture = 0xffffffffu;
 blobtree::PolygonizeOptions polygonizeOptions(const SpeciesRender& look);
 
 Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::TextureTable& textures, const Vec3& base);
+/// paintPolygonized with a material: its base colour, and its textureLayers and
+/// contactDarkening applied as render::Scene::attributeColor applies them.
+Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::TextureTable& textures,
+                      const render::Material& material);
 
 /// The triangles of mesh grouped by their Mesh::materials id, in increasing id order;
 /// each group is its own mesh (only the vertices it uses, in their original order; every

@@ -182,18 +182,31 @@ render::Geometry surfaceGeometry(const TreeSurface& tree, const SpeciesRender& l
                                  const std::shared_ptr<const blobtree::PolygonizeResult>& mesh) {
   render::TextureTable textures;
   if (tree.options.bark.enabled) {
-    textures::BarkOptions bo;
-    bo.seed = tree.options.seed;
-    bo.ridgeColor = look.style.wood.baseColor;
-    bo.furrowColor = look.style.wood.baseColor * 0.3f;
-    auto bark = std::make_shared<textures::BarkTexture>(bo);
-    textures.push_back([bark](Vec2 uv, const Vec3&) { return bark->color(uv); });
+    const organisms::BarkOptions& b = tree.options.bark;
+    const Vec3 wood = look.style.wood.baseColor;
+    // Ids below bark.texture hold the wood color; then one texture per bark class.
+    for (int i = 0; i < b.texture; ++i) textures.push_back([wood](Vec2, const Vec3&) { return wood; });
+    for (const organisms::BarkClass& c : tree.blob.barkClasses) {
+      textures::BarkOptions bo = b.pattern;
+      bo.seed = tree.options.seed;
+      bo.ridgeColor = b.ridgeColor.value_or(wood);
+      bo.furrowColor = b.furrowColor.value_or(wood * 0.3f);
+      bo.youngColor = b.youngColor.value_or(bo.ridgeColor);
+      if (b.lenticelColor) bo.lenticelColor = *b.lenticelColor;
+      bo.furrows = c.furrows;
+      bo.maturity = c.maturity;
+      auto bark = std::make_shared<textures::BarkTexture>(bo);
+      textures.push_back([bark](Vec2 uv, const Vec3&) { return bark->color(uv); });
+    }
   }
+  render::Material wood = look.style.wood;
+  wood.textureLayers = true;  // every cone's bark in its own coordinates (furrows along each branch)
+  wood.contactDarkening = static_cast<float>(tree.options.bark.ridgeDarkening);
   render::Geometry out;
   if (mesh)
-    out.parts.push_back(render::PolygonizedPart{mesh, look.style.wood, std::move(textures), tree.axes});
+    out.parts.push_back(render::PolygonizedPart{mesh, wood, std::move(textures), tree.axes});
   else
-    out.parts.push_back(render::ImplicitPart{tree.compiled, look.style.wood, {}, std::move(textures), tree.axes});
+    out.parts.push_back(render::ImplicitPart{tree.compiled, wood, {}, std::move(textures), tree.axes});
   if (tree.leaves.triangleCount() > 0) {
     Mesh leaves = tree.leaves;
     leaves.materials.clear();  // one leaf material; the vertex colors carry each leaf's tint
@@ -331,7 +344,7 @@ class TreeModel final : public KindModel {
     std::vector<ExportPart> parts(1);
     parts[0].name = "wood";
     parts[0].mesh = paintPolygonized(blobtree::polygonizeDetailed(*tree.compiled, po), implicit.textures,
-                                     look.style.wood.baseColor);
+                                     implicit.material);
     fig.clean = cleanMesh(parts[0].mesh, clean);
     parts[0].mesh.materials.clear();
     parts[0].material = {"wood", look.style.wood.baseColor, look.style.wood.roughness, false};
@@ -676,9 +689,31 @@ organisms::TreeOptions readTreeOptions(const YNode& section, DiagnosticList& dia
   if (auto s = m.section("bark")) {
     MapReader p(*s, diags, "bark");
     o.bark.enabled = p.boolean("enabled", o.bark.enabled);
-    o.bark.texture = static_cast<int>(p.integer("texture", o.bark.texture, 0, 65535));
+    o.bark.texture = static_cast<int>(p.integer("texture", o.bark.texture, 0, 16383));
     o.bark.uScale = p.number("u_scale", o.bark.uScale, -kInf, kInf);
     o.bark.vScale = p.number("v_scale", o.bark.vScale, -kInf, kInf);
+    o.bark.ridgeWidth = p.number("ridge_width", o.bark.ridgeWidth, 0.0, 1e6);
+    o.bark.matureRadius = p.number("mature_radius", o.bark.matureRadius, 0.0, 1e6);
+    o.bark.ridgeDarkening = p.number("ridge_darkening", o.bark.ridgeDarkening, 0.0, 1.0);
+    textures::BarkOptions& b = o.bark.pattern;
+    b.furrows = static_cast<int>(p.integer("furrows", b.furrows, 1, 1000));
+    b.warp = p.number("warp", b.warp, 0.0, 100.0);
+    b.alongFrequency = p.number("along_frequency", b.alongFrequency, 0.0, 1e4);
+    b.sharpness = p.number("sharpness", b.sharpness, 1e-3, 100.0);
+    b.grain = p.number("grain", b.grain, 0.0, 10.0);
+    b.cracks = p.number("cracks", b.cracks, 0.0, 10.0);
+    b.maturity = p.number("maturity", b.maturity, 0.0, 1.0);
+    b.lenticels = p.number("lenticels", b.lenticels, 0.0, 1.0);
+    b.lenticelFrequency = p.number("lenticel_frequency", b.lenticelFrequency, 0.0, 1e4);
+    auto optColor = [&p, &diags](std::string_view key) -> std::optional<Vec3> {
+      auto n = p.get(key);
+      if (!n) return std::nullopt;
+      return n->asColor(diags, "'" + std::string(key) + "'");
+    };
+    o.bark.ridgeColor = optColor("ridge_color");
+    o.bark.furrowColor = optColor("furrow_color");
+    o.bark.youngColor = optColor("young_color");
+    o.bark.lenticelColor = optColor("lenticel_color");
     p.finish();
   }
   if (auto s = m.section("leaves")) {

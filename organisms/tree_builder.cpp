@@ -1,8 +1,8 @@
 #include "organisms/tree_builder.h"
 
-#include <optional>
-
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 #include <cmath>
 #include <optional>
 
@@ -38,14 +38,55 @@ std::optional<bt::Bend> partBend(const ConePart& p, bt::Kernel kernel) {
   return bt::Bend::fromAngle(f(p.start), f(b), f(p.bendToward), static_cast<float>(2.0 * theta));
 }
 
+/// The index of class c in classes, appended when new.
+size_t classIndex(std::vector<BarkClass>& classes, const BarkClass& c) {
+  for (size_t i = 0; i < classes.size(); ++i)
+    if (classes[i] == c) return i;
+  classes.push_back(c);
+  return classes.size() - 1;
+}
+
+/// The direction of u = 0 around each internode's axis: the root's turtle up vector,
+/// carried from parent to child by parallel transport (projected perpendicular to the
+/// child's axis), so the bark's furrows run on along a branch where the turtle rolls
+/// between internodes (`/` on the 137.5° spiral). Falls back to the internode's own up
+/// vector where the projection vanishes.
+std::vector<DVec3> barkReferences(const lsystem::Skeleton& sk) {
+  std::vector<DVec3> ref(sk.internodes.size());
+  auto perpendicular = [](DVec3 v, DVec3 axis) {
+    const double len = glm::length(axis);
+    if (len < 1e-12) return DVec3(0);
+    axis /= len;
+    v -= glm::dot(v, axis) * axis;
+    const double l = glm::length(v);
+    return l < 1e-6 ? DVec3(0) : v / l;
+  };
+  for (size_t i = 0; i < sk.internodes.size(); ++i) {
+    const lsystem::Internode& in = sk.internodes[i];
+    const DVec3 axis = in.end - in.start;
+    DVec3 r(0);
+    if (in.parent >= 0 && static_cast<size_t>(in.parent) < i) r = perpendicular(ref[size_t(in.parent)], axis);
+    if (glm::length(r) == 0) r = perpendicular(in.up, axis);
+    ref[i] = glm::length(r) == 0 ? in.up : r;
+  }
+  return ref;
+}
+
 // The cone of one part, bent when the plan says so.
-bt::NodeId partNode(bt::BlobTree& tree, const ConePart& p, const lsystem::Skeleton& sk, const TreeOptions& opt) {
+bt::NodeId partNode(bt::BlobTree& tree, const ConePart& p, const std::vector<DVec3>& barkRef, const TreeOptions& opt,
+                    std::vector<BarkClass>& barkClasses) {
   bt::TextureAttr tex;
   if (opt.bark.enabled) {
-    tex.textureId = static_cast<uint16_t>(opt.bark.texture);
+    const size_t cls = classIndex(barkClasses, barkClassFor(opt.bark, 0.5 * (p.startRadius + p.endRadius)));
+    // At most 4094 furrow counts x 9 ages = 36,846 classes after texture <= 16383 (the
+    // species reader's range): the ids stay below kNoTexture.
+    if (opt.bark.texture < 0 || opt.bark.texture + cls > 65534)
+      throw std::logic_error("buildTreeBlob: bark texture id " + std::to_string(opt.bark.texture + cls) +
+                             " out of range");
+    tex.textureId = static_cast<uint16_t>(opt.bark.texture + cls);
     tex.uvScale = Vec2(static_cast<float>(opt.bark.uScale), static_cast<float>(opt.bark.vScale));
     tex.vOffset = static_cast<float>(p.vStart);
-    tex.refDir = f(sk.internodes[p.internode].up);
+    tex.refDir = f(barkRef[size_t(p.internode)]);
   }
   const float r0 = static_cast<float>(std::max(p.startRadius, 1e-6));
   const float r1 = static_cast<float>(std::max(p.endRadius, 1e-6));
@@ -63,6 +104,16 @@ bt::NodeId partNode(bt::BlobTree& tree, const ConePart& p, const lsystem::Skelet
 
 }  // namespace
 
+BarkClass barkClassFor(const BarkOptions& bark, double r) {
+  BarkClass c{bark.pattern.furrows, bark.pattern.maturity};
+  if (bark.ridgeWidth > 0) {
+    const double n = std::round(2 * kPi * std::max(0.0, r) / bark.ridgeWidth);
+    c.furrows = static_cast<int>(std::clamp(n, 3.0, 4096.0));
+  }
+  if (bark.matureRadius > 0) c.maturity = std::min(1.0, std::round(8 * std::max(0.0, r) / bark.matureRadius) / 8);
+  return c;
+}
+
 TreeBlob buildTreeBlob(const lsystem::Skeleton& skeleton, const TreeOptions& opt) {
   if (skeleton.internodes.empty()) throw InputError(SourceLoc{}, "tree skeleton has no internode");
   TreeBlob out{bt::BlobTree(opt.softKernel ? bt::Kernel::SoftObject : bt::Kernel::Wyvill), 0,
@@ -71,7 +122,8 @@ TreeBlob buildTreeBlob(const lsystem::Skeleton& skeleton, const TreeOptions& opt
   const TreePlan& plan = out.plan;
 
   out.partNodes.reserve(plan.parts.size());
-  for (const ConePart& p : plan.parts) out.partNodes.push_back(partNode(tree, p, skeleton, opt));
+  const std::vector<DVec3> barkRef = barkReferences(skeleton);
+  for (const ConePart& p : plan.parts) out.partNodes.push_back(partNode(tree, p, barkRef, opt, out.barkClasses));
 
   std::vector<bt::NodeId> negatives;
   for (const ConePart& p : plan.parts)

@@ -32,7 +32,14 @@ struct TreeBlob {
   TreePlan plan;
   /// Node of each plan part (the cone after its bend / cut), for tests and tools.
   std::vector<blobtree::NodeId> partNodes;
+  /// The bark classes the cones use (texture id options.bark.texture + index), in order of
+  /// first use; one class {pattern.furrows, pattern.maturity} when neither ridgeWidth nor
+  /// matureRadius is set. Empty when bark is disabled.
+  std::vector<BarkClass> barkClasses;
 };
+
+/// The bark class of a cone of mean 0.5-iso radius r (BarkOptions).
+BarkClass barkClassFor(const BarkOptions& bark, double r);
 
 /// Builds the implicit tree of `skeleton`. Throws InputError when the skeleton has no
 /// internode. Cost: O(internodes) nodes; evaluation cost is the compiled tape's.

@@ -4,7 +4,11 @@
 /// (app/species_tree.h); every field here has a key of the same name in snake_case.
 
 #include <cstdint>
+#include <optional>
 #include <vector>
+
+#include "core/types.h"
+#include "textures/procedural.h"
 
 namespace sprig::organisms {
 
@@ -67,12 +71,36 @@ struct BendOptions {
   bool trunk = false;            ///< also bend order-0 internodes (in a seeded random plane)
 };
 
-/// Bark texture mapping (§3.7).
+/// Bark texture mapping (§3.7) and the bark pattern per girth.
+///
+/// Every cone is textured in its own coordinates (u around its axis, v along the skeleton
+/// from the root), so furrows run along each branch. A cone's bark class (furrow count and
+/// age) follows its mean 0.5-iso radius r: furrows = max(3, round(2π r / ridgeWidth)) when
+/// ridgeWidth > 0 (ridges keep their width as a branch thickens), and maturity =
+/// min(1, r / matureRadius) in steps of 1/8 when matureRadius > 0 (young twigs smooth with
+/// lenticels, the trunk furrowed). Each class is one texture (textureIds texture,
+/// texture + 1, …, in TreeBlob::barkClasses order).
 struct BarkOptions {
   bool enabled = true;
-  int texture = 0;               ///< texture id of every internode primitive (0: a fresh scene's first texture)
+  int texture = 0;               ///< texture id of the first bark class, 0..16383 (0: a fresh scene's first texture)
   double uScale = 1.0;           ///< texture u per full turn around the branch
   double vScale = 1.0;           ///< texture v per world unit along the axis (continuous from the root)
+  double ridgeWidth = 0.0;       ///< world width of a bark ridge (> 0); 0: pattern.furrows on every cone
+  double matureRadius = 0.0;     ///< branch radius with fully furrowed bark (> 0); 0: pattern.maturity everywhere
+  /// Bark multiplied by 1 − ridgeDarkening·contact³ (blobtree::Attributes::contact: 1 on
+  /// the PCM seam, 0 a propagation width away): the compressed bark of the branch bark ridge.
+  double ridgeDarkening = 0.0;
+  /// The pattern (furrows, warp, colors, lenticels, ...); furrows and maturity are replaced
+  /// per class as above. Colors left unset take the wood color (furrows 0.3 of it).
+  textures::BarkOptions pattern;
+  std::optional<Vec3> ridgeColor, furrowColor, youngColor, lenticelColor;
+};
+
+/// One bark class: the furrow count and age shared by the cones of similar girth.
+struct BarkClass {
+  int furrows = 9;
+  double maturity = 1.0;
+  bool operator==(const BarkClass&) const = default;
 };
 
 /// Leaf geometry from the grammar's organs.

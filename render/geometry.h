@@ -30,6 +30,14 @@ struct Material {
   float roughness = 0.6f;   ///< 0 = mirror-like highlight, 1 = no highlight
   float specular = 0.04f;   ///< highlight strength (reflectance at normal incidence)
   int texture = -1;         ///< texture id for textured models, -1 for none
+  /// Textured blobs: colour each contributing primitive's texture at its own natural uv
+  /// and blend the colours by field weight (blobtree::Attributes::layers; trees' bark, so
+  /// furrows follow each branch). false: each texture once at the field-blended uv.
+  bool textureLayers = false;
+  /// Textured blobs: the colour is multiplied by 1 − contactDarkening·contact³, where
+  /// contact (blobtree::Attributes::contact) is 1 on a PCM seam (the branch bark ridge);
+  /// the cube narrows the band to the part of the propagation region nearest the seam.
+  float contactDarkening = 0.0f;
 };
 
 /// A color texture: linear RGB at natural coordinates uv (and world position, for solid

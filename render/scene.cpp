@@ -315,14 +315,26 @@ Vec3 Scene::attributeColor(const blobtree::Attributes& a, const Vec3& p, const M
   if (a.textureCount == 0 || count == 0) return material.baseColor;
   Vec3 sum(0);
   float wsum = 0;
-  for (int i = 0; i < a.textureCount && i < blobtree::Attributes::kMaxTextures; ++i) {
-    float w = a.textureWeights[i];
-    if (!(w > 0)) continue;
-    uint16_t id = a.textureIds[i];
-    sum += w * (id < count ? impl_->textures[textureBase + id](a.uv, p) : material.baseColor);
-    wsum += w;
+  if (material.textureLayers) {
+    // Each contributing primitive's texture at its own uv; the colours blended by weight.
+    for (int i = 0; i < a.layerCount && i < blobtree::Attributes::kMaxLayers; ++i) {
+      const blobtree::Attributes::Layer& l = a.layers[size_t(i)];
+      if (!(l.weight > 0)) continue;
+      sum += l.weight * (l.textureId < count ? impl_->textures[textureBase + l.textureId](l.uv, p) : material.baseColor);
+      wsum += l.weight;
+    }
+  } else {
+    for (int i = 0; i < a.textureCount && i < blobtree::Attributes::kMaxTextures; ++i) {
+      float w = a.textureWeights[i];
+      if (!(w > 0)) continue;
+      uint16_t id = a.textureIds[i];
+      sum += w * (id < count ? impl_->textures[textureBase + id](a.uv, p) : material.baseColor);
+      wsum += w;
+    }
   }
-  return wsum > 0 ? sum / wsum : material.baseColor;
+  if (!(wsum > 0)) return material.baseColor;
+  const float c = a.contact * a.contact * a.contact;  // a narrow band along the seam
+  return sum / wsum * (1.0f - std::clamp(material.contactDarkening * c, 0.0f, 1.0f));
 }
 
 void Scene::commit() {

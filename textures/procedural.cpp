@@ -45,9 +45,13 @@ double BarkTexture::height(Vec2 uv) const {
   FractalOptions f;
   f.octaves = 4;
   double ridge = static_cast<double>(uv.x) * furrows + o.warp * noise_.fbm(p, f, glm::ivec3(0, 0, period(along, o.tileV)));
-  double h = 1 - std::abs(2 * fract(ridge) - 1);           // 1 on a ridge, 0 in a furrow
-  h = 1 - std::pow(1 - h, std::max(1e-3, o.sharpness));  // sharpness > 1 narrows the furrows
-  if (o.cracks > 0) {
+  const double m = std::clamp(o.maturity, 0.0, 1.0);
+  double h = 1 - std::abs(2 * fract(ridge) - 1);  // 1 on a ridge, 0 in a furrow
+  // sharpness > 1 narrows the furrows; young bark's are narrower still, and shallower.
+  h = 1 - std::pow(1 - h, std::max(1e-3, o.sharpness * (1 + 4 * (1 - m))));
+  h = 1 - (0.2 + 0.8 * m) * (1 - h);
+  const double cracks = o.cracks * m;
+  if (cracks > 0) {
     // Cross cracks split each ridge into plates. The plate coordinate q depends on the
     // ridge's index (random phase, wavy spacing); the index changes only in a furrow, where
     // h = 0, so h stays continuous. Taken modulo furrows, the index keeps u periodic.
@@ -59,9 +63,41 @@ double BarkTexture::height(Vec2 uv) const {
     double q = v * plates + phase +
                0.35 * noise_.periodic(DVec3(index * 7.31 + 0.5, v * wave, 3.7), glm::ivec3(0, period(wave, o.tileV), 0));
     double d = std::abs(q - std::round(q));  // distance to the nearest crack, in plate lengths
-    h *= 1 - o.cracks * (1 - smoothstep(0.01, 0.035, d));
+    h *= 1 - cracks * (1 - smoothstep(0.01, 0.035, d));
   }
   return h;
+}
+
+double BarkTexture::lenticelCover(Vec2 uv) const {
+  const BarkOptions& o = options_;
+  if (!(o.lenticels > 0)) return 0;
+  const int furrows = std::max(1, o.furrows);
+  const double x = static_cast<double>(uv.x) * furrows;
+  const double freq = tiled(o.lenticelFrequency, o.tileV);
+  const int rows = period(freq, o.tileV);  // > 0: rows repeat every tile
+  const double y = static_cast<double>(uv.y) * freq;
+  const double ci = std::floor(x), cj = std::floor(y);
+  const double fx = x - ci, fy = y - cj;
+  double cover = 0;
+  for (int dj = -1; dj <= 1; ++dj) {
+    for (int di = -1; di <= 1; ++di) {
+      // The cell index around is taken modulo furrows: the lenticels close at u = 1.
+      auto cellX = static_cast<int64_t>(std::fmod(ci + di, static_cast<double>(furrows)));
+      if (cellX < 0) cellX += furrows;
+      auto cellY = static_cast<int64_t>(cj) + dj;
+      if (rows > 0) cellY = ((cellY % rows) + rows) % rows;
+      Rng rng(deriveSeed(o.seed, {0x1e27u, static_cast<uint64_t>(cellX), static_cast<uint64_t>(cellY)}));
+      const bool present = rng.uniform() < o.lenticels;
+      const double cx = di + 0.5 + (rng.uniform() - 0.5) * 0.4;
+      const double cy = dj + 0.5 + (rng.uniform() - 0.5) * 0.4;
+      const double size = 0.75 + 0.5 * rng.uniform();
+      if (!present) continue;
+      // A diamond wider (across the branch) than long: |dx|/0.30 + |dy|/0.16 <= size.
+      const double d = (std::abs(fx - cx) / 0.30 + std::abs(fy - cy) / 0.16) / size;
+      cover = std::max(cover, smoothstep(1.0, 0.75, d));
+    }
+  }
+  return cover;
 }
 
 Vec3 BarkTexture::color(Vec2 uv) const {
@@ -76,7 +112,10 @@ Vec3 BarkTexture::color(Vec2 uv) const {
   FractalOptions f;
   f.octaves = 3;
   double grain = 1 + o.grain * noise_.fbm(p, f, glm::ivec3(0, 0, period(along, o.tileV)));
-  return mix(o.furrowColor, o.ridgeColor, h) * static_cast<float>(std::max(0.0, grain));
+  const double m = std::clamp(o.maturity, 0.0, 1.0);
+  Vec3 c = mix(o.furrowColor, mix(o.youngColor, o.ridgeColor, m), h) * static_cast<float>(std::max(0.0, grain));
+  if (m < 1 && o.lenticels > 0) c = mix(c, o.lenticelColor, (1 - m) * lenticelCover(uv));
+  return c;
 }
 
 Vec3 StripesTexture::color(Vec2 uv) const {

@@ -65,6 +65,15 @@ class NoiseTexture : public SeededTexture<NoiseColorOptions> {
 /// (R cos 2 pi u, R sin 2 pi u, alongFrequency * v) with R = furrows / (2 pi), so it is periodic in u,
 /// has about one feature per ridge width across and alongFrequency features per unit of v.
 /// Color: mix(furrowColor, ridgeColor, h), times 1 + grain * fbm (fine lengthwise grain).
+///
+/// Age (`maturity` m in [0, 1], 1 = the pattern above): young bark is smooth. The furrows'
+/// depth is 0.2 + 0.8 m and their profile exponent sharpness·(1 + 4 (1 − m)) (hairline
+/// cracks on young bark that widen and deepen as it ages); the cross cracks scale with m;
+/// the ridge color goes from youngColor (m = 0) to ridgeColor (m = 1). Lenticels (young
+/// bark's breathing pores, diamond-shaped on a poplar) sit one per cell of a jittered grid
+/// (one cell per ridge width around, lenticelFrequency rows per unit of v; the cell index
+/// around is taken modulo furrows, so they too close at u = 1), present in a fraction
+/// `lenticels` of the cells, darkening the bark by (1 − m).
 struct BarkOptions {
   int furrows = 9;                     ///< ridges around the branch, >= 1
   double warp = 0.6;                   ///< how far the furrows wander sideways (in ridge widths)
@@ -77,6 +86,11 @@ struct BarkOptions {
   int tileV = 0;
   Vec3 ridgeColor{0.20f, 0.14f, 0.09f};
   Vec3 furrowColor{0.035f, 0.025f, 0.018f};
+  double maturity = 1.0;               ///< bark age in [0, 1]: 0 young and smooth, 1 fully furrowed
+  double lenticels = 0.0;              ///< fraction of lenticel cells holding one, in [0, 1] (0 = none)
+  double lenticelFrequency = 4.0;      ///< lenticel rows per unit of v (whole rows per tile when tileV > 0)
+  Vec3 youngColor{0.20f, 0.14f, 0.09f};    ///< ridge color of young bark (maturity 0)
+  Vec3 lenticelColor{0.05f, 0.04f, 0.035f};
   uint64_t seed = 0;
 };
 /// Bark texture.
@@ -88,6 +102,8 @@ class BarkTexture : public SeededTexture<BarkOptions> {
   double height(Vec2 uv) const;
   /// Bark color at (u, v).
   Vec3 color(Vec2 uv) const;
+  /// Lenticel cover in [0, 1] at (u, v) before the maturity fade (0 when lenticels = 0).
+  double lenticelCover(Vec2 uv) const;
 };
 
 /// Shell stripes: bands at constant v (growth lines) or at constant u (spiral bands).

@@ -17,9 +17,11 @@ SV primitiveS(const Prim& P, Vec3 p) {
   SV r;
   r.v = primValue(P, p, &r.g);
   if (P.hasAttributes && r.v > 0.0f) {
-    r.acc.uvSum = r.v * primUv(P, p);
+    const Vec2 uv = primUv(P, p);
+    r.acc.uvSum = r.v * uv;
     r.acc.wSum = r.v;
     r.acc.addTexture(P.tex.textureId, r.v);
+    r.acc.addLayer(Attributes::Layer{uv, P.tex.textureId, r.v});
   }
   return r;
 }
@@ -86,19 +88,27 @@ SV differenceS(const Tape& T, const TNode& n, Vec3 p) {
 SV pcmS(const Tape& T, const TNode& n, Vec3 p) {
   SV r;
   float fmax = 0.0f, dsum = 0.0f, dmax = 0.0f, dpmax = 0.0f;
+  float close1 = 0.0f, close2 = 0.0f;  // the two largest closenesses to contact
   Vec3 gsum{0.0f}, gmax{0.0f};
+  const PcmDerived& pp = params(T, n).pcm;
   childrenAt(T, n, p, [&](uint32_t c) {
     SV s = evalS(T, c, p);
     float f = std::max(0.0f, s.v);
     if (s.v < 0.0f) s.g = Vec3(0.0f);
+    // Closeness is increasing in f, so the strongest child has the largest; the contact is
+    // the second largest (the strongest non-maximal child's).
+    const float close = f > 0.0f ? std::clamp(1.0f - (pp.c - f) / pp.w, 0.0f, 1.0f) : 0.0f;
+    if (close > close1) { close2 = close1; close1 = close; }
+    else if (close > close2) close2 = close;
     float dp;
-    float d = pcmD(params(T, n).pcm, f, &dp);
+    float d = pcmD(pp, f, &dp);
     dsum += d;
     gsum += dp * s.g;
     r.acc.merge(s.acc);
     if (f > fmax) { fmax = f; dmax = d; dpmax = dp; gmax = s.g; }
   });
   if (fmax <= 0.0f) return r;
+  r.acc.contact = std::max(r.acc.contact, close2);
   r.v = fmax + dsum - dmax;
   if (r.v <= 0.0f) { r.v = 0.0f; return r; }
   r.g = gmax + gsum - dpmax * gmax;

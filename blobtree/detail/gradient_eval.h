@@ -4,6 +4,7 @@
 
 #include "blobtree/detail/tape.h"
 
+#include <algorithm>
 #include <array>
 
 namespace sprig::blobtree::detail {
@@ -31,10 +32,28 @@ struct AttrAcc {
       if (w[size_t(i)] < w[size_t(k)]) k = i;
     if (w[size_t(k)] < weight) { ids[size_t(k)] = id; w[size_t(k)] = weight; }
   }
+  /// The heaviest primitives so far, each with its own uv (Attributes::layers).
+  std::array<Attributes::Layer, Attributes::kMaxLayers> layers{};
+  int layerCount = 0;
+  float contact = 0.0f;  ///< Attributes::contact
+
+  void addLayer(const Attributes::Layer& l) {
+    if (layerCount < Attributes::kMaxLayers) {
+      layers[size_t(layerCount++)] = l;
+      return;
+    }
+    // Replace the lightest when heavier.
+    int k = 0;
+    for (int i = 1; i < layerCount; ++i)
+      if (layers[size_t(i)].weight < layers[size_t(k)].weight) k = i;
+    if (layers[size_t(k)].weight < l.weight) layers[size_t(k)] = l;
+  }
   void merge(const AttrAcc& o) {
     uvSum += o.uvSum;
     wSum += o.wSum;
     for (int i = 0; i < o.count; ++i) addTexture(o.ids[size_t(i)], o.w[size_t(i)]);
+    for (int i = 0; i < o.layerCount; ++i) addLayer(o.layers[size_t(i)]);
+    contact = std::max(contact, o.contact);
   }
 };
 

@@ -156,6 +156,82 @@ TEST_CASE("BarkTexture", "[textures]") {
   }
 }
 
+TEST_CASE("BarkTexture maturity and lenticels", "[textures]") {
+  BarkOptions o;
+  o.seed = 11;
+  o.warp = 0;
+  o.furrows = 8;
+  SECTION("young bark keeps 80% of its height; mature bark reaches the furrow floor") {
+    // h = 1 − (0.2 + 0.8 m)(1 − h0) with h0 in [0, 1] and no cracks at m = 0.
+    o.maturity = 0;
+    BarkTexture young(o);
+    o.maturity = 1;
+    BarkTexture old(o);
+    double youngMin = 1, oldMin = 1;
+    for (int i = 0; i < 4000; ++i) {
+      const Vec2 uv(float(i) / 4000, 0.37f);
+      youngMin = std::min(youngMin, young.height(uv));
+      oldMin = std::min(oldMin, old.height(uv));
+    }
+    CHECK(youngMin >= 0.8 - 1e-9);
+    CHECK(youngMin < 0.81);
+    CHECK(oldMin < 0.01);
+  }
+  SECTION("furrows widen with age: the fraction of the circumference below half height grows") {
+    // Without warp and cracks the profile is 1 − (0.2 + 0.8 m)(1 − h0)^s with
+    // s = 1.8·(1 + 4(1 − m)); below 0.5 where (1 − h0) > (0.5 / (0.2 + 0.8 m))^(1/s):
+    // a fraction 1 − that of the circumference (h0 is linear in u inside each ridge).
+    o.cracks = 0;
+    double last = -1;
+    for (double m : {0.5, 0.75, 1.0}) {
+      o.maturity = m;
+      BarkTexture bark(o);
+      int below = 0;
+      const int n = 8000;
+      for (int i = 0; i < n; ++i) below += bark.height(Vec2((i + 0.5f) / n, 0.2f)) < 0.5;
+      const double s = 1.8 * (1 + 4 * (1 - m));
+      const double expected = 1 - std::pow(0.5 / (0.2 + 0.8 * m), 1 / s);
+      INFO("maturity " << m);
+      CHECK(double(below) / n == Approx(std::max(0.0, expected)).margin(0.002));
+      CHECK(double(below) / n > last);
+      last = double(below) / n;
+    }
+  }
+  SECTION("lenticels: none by default; diamonds covering the expected share; closed at u = 1") {
+    BarkTexture none(o);
+    CHECK(none.lenticelCover(Vec2(0.3f, 0.4f)) == 0);
+    o.lenticels = 1;
+    o.lenticelFrequency = 10;
+    BarkTexture bark(o);
+    // Every cell holds a diamond |dx|/0.30 + |dy|/0.16 <= size·t, size uniform in
+    // [0.75, 1.25]; cover > 0.5 for t < 0.875 (the smoothstep's midpoint): area
+    // 2·0.30·0.16·0.875²·E[size²] per cell, E[size²] = 1 + 0.25²/3.
+    const double expected = 2 * 0.30 * 0.16 * 0.875 * 0.875 * (1 + 0.0625 / 3);
+    int covered = 0;
+    const int nu = 400, nv = 400;
+    for (int i = 0; i < nu; ++i)
+      for (int j = 0; j < nv; ++j) covered += bark.lenticelCover(Vec2((i + 0.5f) / nu, (j + 0.5f) / nv * 4)) > 0.5;
+    CHECK(double(covered) / (nu * nv) == Approx(expected).epsilon(0.15));
+    Rng rng(3);
+    for (int i = 0; i < 500; ++i) {
+      const Vec2 uv(float(rng.uniform()), float(rng.uniform(-2, 2)));
+      REQUIRE(std::abs(bark.lenticelCover(uv) - bark.lenticelCover(uv + Vec2(1, 0))) < 1e-3);
+    }
+  }
+  SECTION("lenticels darken young bark only") {
+    o.lenticels = 1;
+    o.lenticelFrequency = 10;
+    o.maturity = 1;
+    BarkTexture old(o);
+    o.lenticels = 0;
+    BarkTexture plain(o);
+    for (int i = 0; i < 300; ++i) {
+      const Vec2 uv(i / 300.0f, i * 0.013f);
+      REQUIRE(maxDiff(old.color(uv), plain.color(uv)) < 1e-6);
+    }
+  }
+}
+
 TEST_CASE("StripesTexture and SpotsTexture", "[textures]") {
   SECTION("stripes without wobble: band centers and gaps, exactly periodic") {
     StripesOptions o;
