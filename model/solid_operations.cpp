@@ -119,6 +119,7 @@ solids::ParticleOptions readParticles(MapReader& m, solids::ParticleTool tool, s
   o.fallingAngleDeg = m.number("falling_angle", o.fallingAngleDeg, 0.0, 180.0);
   o.radius = m.number("radius", o.radius, 1e-9, 1e6);
   if (tool != solids::ParticleTool::Erode) o.strength = m.number("strength", o.strength, 0.0, 1.0);
+  if (tool == solids::ParticleTool::Wash) o.attraction = m.number("attraction", o.attraction, 0.0, 1e6);
   if (tool == solids::ParticleTool::Lichen) {
     o.color = m.color("color", o.color);
     o.topAngleDeg = m.number("top_angle", o.topAngleDeg, 0.0, 90.0);
