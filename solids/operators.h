@@ -171,7 +171,8 @@ struct DisplaceOptions {
   double stiffenBelow = 0.3;
   /// An increment that leaves a tetrahedron with no more than this fraction of the volume it
   /// had before the increment is undone and retried at half the size, at most `halvings`
-  /// times in a row (down to 1/1024 of a step by default); then displace throws. In (0, 1).
+  /// times in all (a halved size is kept: down to 1/1024 of a step by default); then
+  /// displace throws. In (0, 1).
   double minStepVolumeRatio = 0.5;
   /// How many times an increment may be halved before displace gives up (0: never; with
   /// stiffening 0 that is the plain sequence of `steps` linear solves).
