@@ -103,8 +103,8 @@ int runAnimate(const AnimateArgs& a, const GlobalOptions& g) {
   printNotes(g, species);
   if (species.kind != "tree" && !a.wind.empty())
     throw UsageError("--wind sways trees; a " + species.kind + " species has no wind");
-  if (species.kind != "tree" && !a.stages.empty())
-    throw UsageError("--stages selects derivation steps of a tree; a " + species.kind +
+  if (species.kind != "tree" && species.kind != "solid" && !a.stages.empty())
+    throw UsageError("--stages selects derivation steps of a tree or operation stages of a solid; a " + species.kind +
                      " species animates its whole growth (use --frames-per-stage and --fps)");
   const SpeciesRender& look = species.render;
   const int lookWidth = look.image.width, lookHeight = look.image.height;
@@ -132,8 +132,9 @@ int runAnimate(const AnimateArgs& a, const GlobalOptions& g) {
   AnimateResult r = animateSpecies(species, a.out, opt);
   if (!g.quiet)
     std::cerr << a.out << ": " << r.frames << " frames, "
-              << (species.kind == "tree" ? "stages " + std::to_string(r.firstStage) + ".." + std::to_string(r.lastStage) + ", "
-                                         : std::string())
+              << (species.kind == "tree" || (species.kind == "solid" && r.lastStage > 0)
+                      ? "stages " + std::to_string(r.firstStage) + ".." + std::to_string(r.lastStage) + ", "
+                      : std::string())
               << opt.width << "x" << opt.height << ", " << r.seconds << " s\n";
   return kExitOk;
 }
@@ -145,7 +146,8 @@ void addAnimateCommand(CLI::App& app, const GlobalOptions& global, CommandRun& r
                                           "Render a species growing, stage by stage, with smooth growth between steps", runAnimate);
   addInputOutput(*sub, "SPECIES", args->file, args->out,
                  "a folder (PNG frames), .gif or .mp4 (needs ffmpeg); .png with --at");
-  sub->add_option("--stages", args->stages, "derivation steps shown, A..B (default: 0 to the species' steps)");
+  sub->add_option("--stages", args->stages, "stages shown, A..B: a tree's derivation steps, a solid's operations "
+                  "(stage k = after k operations; default: 0 to the last)");
   sub->add_option("--frames-per-stage", args->framesPerStage, "frames over which one step's new organs grow in")
       ->check(CLI::Range(1, 1000));
   sub->add_option("--fps", args->fps, "frames per second of the GIF or MP4")->check(CLI::Range(0.1, 240.0));

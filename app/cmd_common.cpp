@@ -74,7 +74,7 @@ void addGrowthFlags(CLI::App& sub, GrowthFlags& flags) {
 }
 
 void addStageFlags(CLI::App& sub, StageFlags& flags) {
-  sub.add_option("--stage", flags.stage, "tree: derivation step; shell: number of whorls grown")
+  sub.add_option("--stage", flags.stage, "tree: derivation step; shell: number of whorls grown; solid: after the first k operations")
       ->check(CLI::Range(0, 100000));
   sub.add_option("--fraction", flags.fraction, "tree: growth of the stage's newest modules, 0..1 (default 1)")
       ->check(CLI::Range(0.0, 1.0));

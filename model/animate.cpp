@@ -127,6 +127,9 @@ AnimateResult animateModel(SpeciesModel& model, const SpeciesRender& baseLook, c
   const AnimationFormat format = checkAnimation(out, options, ffmpeg);
   AnimateResult result;
   result.lastStage = std::max(0, model.finalStage().step);
+  // A tree is derived only up to options.lastStage already; a solid's operation stages are
+  // all there, so --stages A..B cuts the sequence here.
+  if (options.lastStage >= 0) result.lastStage = std::min(result.lastStage, options.lastStage);
   result.firstStage = std::clamp(options.firstStage, 0, result.lastStage);
   std::vector<Stage> frames = model.animationFrames(options.framesPerStage, result.firstStage, result.lastStage);
   if (options.windSpeed > 0 && !frames.empty()) {

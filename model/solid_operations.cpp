@@ -62,6 +62,11 @@ solids::DisplaceOptions readDisplace(MapReader& m, const YNode& node, solids::Ma
   o.offset = dvec(m.vec3("offset", Vec3(o.offset)));
   o.up = dvec(m.vec3("up", Vec3(o.up)));
   o.steps = int(m.integer("steps", o.steps, 1, 1000));
+  o.stiffening = m.number("stiffening", o.stiffening, 0.0, 10.0);
+  o.maxStiffening = m.number("max_stiffening", o.maxStiffening, 1.0, 1e9);
+  o.stiffenBelow = m.number("stiffen_below", o.stiffenBelow, 0.0, 1.0);
+  o.minStepVolumeRatio = m.number("min_step_volume_ratio", o.minStepVolumeRatio, 0.01, 0.99);
+  o.halvings = int(m.integer("halvings", o.halvings, 0, 30));
   return o;
 }
 
@@ -114,6 +119,7 @@ solids::ParticleOptions readParticles(MapReader& m, solids::ParticleTool tool, s
   o.fallingAngleDeg = m.number("falling_angle", o.fallingAngleDeg, 0.0, 180.0);
   o.radius = m.number("radius", o.radius, 1e-9, 1e6);
   if (tool != solids::ParticleTool::Erode) o.strength = m.number("strength", o.strength, 0.0, 1.0);
+  if (tool == solids::ParticleTool::Wash) o.attraction = m.number("attraction", o.attraction, 0.0, 1e6);
   if (tool == solids::ParticleTool::Lichen) {
     o.color = m.color("color", o.color);
     o.topAngleDeg = m.number("top_angle", o.topAngleDeg, 0.0, 90.0);

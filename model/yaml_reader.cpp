@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 #include <regex>
+#include <set>
 #include <sstream>
 
 #include "core/srgb.h"
@@ -800,6 +801,15 @@ void MapReader::finish() {
   for (const auto& e : entries_) {
     const std::string name = e.key.scalar();
     if (known_.count(name)) continue;
+    if (name == "operations") {
+      // Simulation tools act on tetrahedral solids only; say so rather than "unknown key".
+      static const std::set<std::string> kinds = {"tree", "shell", "organism", "blob"};
+      const std::string where = kinds.count(context_)
+                                    ? std::string("this is ") + (context_ == "organism" ? "an " : "a ") + context_
+                                    : "not in " + context_;
+      e.key.error(*diags_, "'operations' belong to solid species, under 'solid:' (" + where + ")");
+      continue;
+    }
     e.key.error(*diags_, "unknown key '" + name + "' in " + context_ + didYouMean(name, candidates));
   }
 }

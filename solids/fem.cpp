@@ -127,7 +127,7 @@ struct Element {
 };
 
 /// g_a for a tetrahedron: rows of J⁻¹ with J = [x1−x0, x2−x0, x3−x0] (columns), g_0 = −Σ.
-Element element(const TetMesh& m, size_t t, const std::vector<Material>& materials) {
+Element element(const TetMesh& m, size_t t, const std::vector<Material>& materials, double scale = 1.0) {
   const auto& q = m.tets[t];
   const DVec3 x0 = m.positions[q[0]];
   const DMat3 J(m.positions[q[1]] - x0, m.positions[q[2]] - x0, m.positions[q[3]] - x0);  // columns
@@ -139,7 +139,7 @@ Element element(const TetMesh& m, size_t t, const std::vector<Material>& materia
   for (int r = 0; r < 3; ++r) e.g[size_t(r + 1)] = DVec3(inv[0][r], inv[1][r], inv[2][r]);
   e.g[0] = -(e.g[1] + e.g[2] + e.g[3]);
   const Material& mat = materials[m.materials[t]];
-  const double E = mat.youngsModulus, nu = mat.poissonRatio;
+  const double E = mat.youngsModulus * scale, nu = mat.poissonRatio;
   e.lambda = E * nu / ((1 + nu) * (1 - 2 * nu));
   e.mu = E / (2 * (1 + nu));
   return e;
@@ -155,7 +155,8 @@ void addBlock(const Element& e, int a, int b, double (&k)[3][3]) {
       k[i][j] += e.volume * (e.lambda * ga[i] * gb[j] + e.mu * ga[j] * gb[i] + (i == j ? e.mu * dot : 0.0));
 }
 
-std::vector<Element> elements(const TetMesh& mesh, const std::vector<Material>& materials) {
+std::vector<Element> elements(const TetMesh& mesh, const std::vector<Material>& materials,
+                              const std::vector<double>& scale) {
   for (size_t t = 0; t < mesh.tets.size(); ++t) {
     const uint16_t id = mesh.materials[t];
     if (id >= materials.size())
@@ -171,7 +172,7 @@ std::vector<Element> elements(const TetMesh& mesh, const std::vector<Material>& 
         !(mat.poissonRatio < 0.5))
       throw std::invalid_argument("fem: material '" + mat.name + "' needs Young's modulus > 0 and Poisson ratio in (-1, 0.5)");
   std::vector<Element> out(mesh.tets.size());
-  parallelFor(0, out.size(), [&](size_t t) { out[t] = element(mesh, t, materials); }, 1024);
+  parallelFor(0, out.size(), [&](size_t t) { out[t] = element(mesh, t, materials, scale.empty() ? 1.0 : scale[t]); }, 1024);
   for (size_t t = 0; t < out.size(); ++t)
     if (!(out[t].volume > 0))
       throw std::invalid_argument("fem: tetrahedron " + std::to_string(t) + " has non-positive or undefined volume " +
@@ -322,6 +323,12 @@ FemResult solveElastic(const TetMesh& mesh, const std::vector<Material>& materia
   checkSize(problem.fixed.size(), nv, "fixed");
   checkSize(problem.prescribed.size(), nv, "prescribed");
   checkSize(problem.initialGuess.size(), nv, "initialGuess");
+  if (!problem.stiffnessScale.empty() && problem.stiffnessScale.size() != mesh.tets.size())
+    throw std::invalid_argument("fem: 'stiffnessScale' has " + std::to_string(problem.stiffnessScale.size()) +
+                                " entries; the mesh has " + std::to_string(mesh.tets.size()) + " tetrahedra");
+  for (size_t t = 0; t < problem.stiffnessScale.size(); ++t)
+    if (!(problem.stiffnessScale[t] > 0) || !std::isfinite(problem.stiffnessScale[t]))
+      throw std::invalid_argument("fem: the stiffness scale of tetrahedron " + std::to_string(t) + " is not a finite positive number");
   if (mesh.materials.size() != mesh.tets.size())
     throw std::invalid_argument("fem: the mesh has " + std::to_string(mesh.tets.size()) + " tetrahedra but " +
                                 std::to_string(mesh.materials.size()) + " material ids");
@@ -340,7 +347,7 @@ FemResult solveElastic(const TetMesh& mesh, const std::vector<Material>& materia
   FemResult res;
   FemStats& st = res.stats;
   const auto t0 = Clock::now();
-  const std::vector<Element> el = elements(mesh, materials);
+  const std::vector<Element> el = elements(mesh, materials, problem.stiffnessScale);
   const VertexTets vt = vertexTets(mesh);
 
   // Step 1: which components are fixed (unused vertices: all), and whether that holds every

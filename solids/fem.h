@@ -64,6 +64,10 @@ struct FemProblem {
   std::vector<uint8_t> fixed;
   std::vector<DVec3> prescribed;  ///< displacement of the fixed components, m (empty = zero)
   std::vector<DVec3> initialGuess;  ///< warm start for the free components, m (empty = zero)
+  /// Per tetrahedron, a factor on its material's Young's modulus (empty = 1 everywhere): the
+  /// displace operator stiffens crushed soft tetrahedra with it so they do not invert. Finite
+  /// and > 0; stresses are reported with the scaled modulus.
+  std::vector<double> stiffnessScale;
 };
 
 /// Strain and stress of one tetrahedron (constant inside it). Voigt order xx, yy, zz, yz,

@@ -220,11 +220,34 @@ size_t compactVertices(TetMesh& mesh) {
   return gone;
 }
 
+/// 6√2·V / l³ with l the root mean square of the six edge lengths: 1 for a regular
+/// tetrahedron, toward 0 as it flattens.
+double meanRatio(const TetMesh& mesh, size_t t) {
+  const auto& q = mesh.tets[t];
+  double l2 = 0;
+  for (int a = 0; a < 4; ++a)
+    for (int b = a + 1; b < 4; ++b) {
+      const DVec3 e = mesh.positions[q[size_t(a)]] - mesh.positions[q[size_t(b)]];
+      l2 += glm::dot(e, e);
+    }
+  const double l = std::sqrt(l2 / 6);
+  return 6 * std::sqrt(2.0) * mesh.volume(t) / (l * l * l);
+}
+
 DisplaceStats displace(TetMesh& mesh, const std::vector<Material>& materials, const DisplaceOptions& options) {
   if (options.moving.empty()) throw std::invalid_argument("displace: 'moving' names no material");
   checkIds(options.moving, materials.size(), "displace: 'moving'");
   if (!finite(options.offset)) throw std::invalid_argument("displace: 'offset' is not finite");
   if (options.steps < 1) throw std::invalid_argument("displace: 'steps' must be at least 1");
+  if (!(options.stiffening >= 0) || !std::isfinite(options.stiffening))
+    throw std::invalid_argument("displace: 'stiffening' must be a finite number >= 0");
+  if (!(options.maxStiffening >= 1) || !std::isfinite(options.maxStiffening))
+    throw std::invalid_argument("displace: 'max_stiffening' must be a finite number >= 1");
+  if (!(options.stiffenBelow >= 0 && options.stiffenBelow <= 1))
+    throw std::invalid_argument("displace: 'stiffen_below' must be in [0, 1]");
+  if (!(options.minStepVolumeRatio > 0 && options.minStepVolumeRatio < 1))
+    throw std::invalid_argument("displace: 'min_step_volume_ratio' must be in (0, 1)");
+  if (options.halvings < 0 || options.halvings > 30) throw std::invalid_argument("displace: 'halvings' must be in [0, 30]");
   const size_t nv = mesh.positions.size();
   if (!options.anchored.empty() && options.anchored.size() != nv)
     throw std::invalid_argument("displace: 'anchored' has " + std::to_string(options.anchored.size()) +
@@ -240,11 +263,9 @@ DisplaceStats displace(TetMesh& mesh, const std::vector<Material>& materials, co
   FemProblem pb;
   pb.fixed.assign(nv, 0);
   pb.prescribed.assign(nv, DVec3(0.0));
-  const DVec3 step = options.offset / double(options.steps);
   for (size_t v = 0; v < nv; ++v) {
     if (moving[v]) {
       pb.fixed[v] = 7;
-      pb.prescribed[v] = step;
       ++st.moved;
     } else if (held[v]) {
       pb.fixed[v] = 7;
@@ -252,21 +273,70 @@ DisplaceStats displace(TetMesh& mesh, const std::vector<Material>& materials, co
     }
   }
 
+  // The offset is applied in increments, each solved on the geometry the last one left (an
+  // updated-Lagrangian sequence of linear solves). Two things keep soft tetrahedra from
+  // inverting under motions much larger than the cell:
+  //  - Jacobian stiffening (Stein, Tezduyar and Benney, "Mesh moving techniques for
+  //    fluid-structure interactions with large displacements", J. Appl. Mech. 70, 2003): a
+  //    tetrahedron crushed to a fraction r of its volume before the operation has its modulus
+  //    scaled by r^-stiffening, so the crushed dirt between a rising root and a brick pushes
+  //    the brick instead of folding; one whose shape (mean ratio q) is below stiffenBelow
+  //    by (stiffenBelow/q)^stiffening, so what an earlier operation crushed stays stiff;
+  //  - step control: an increment that leaves any tetrahedron with less than
+  //    `minStepVolumeRatio` of the volume it had before it is undone and retried at half the
+  //    size (down to 1/1024 of a step, then the error).
   const std::vector<DVec3> original = mesh.positions;
   std::vector<double> before(mesh.tets.size());
   for (size_t t = 0; t < before.size(); ++t) before[t] = mesh.volume(t);
-  for (int s = 0; s < options.steps; ++s) {
+  std::vector<double> cur = before, next(before.size());
+  pb.stiffnessScale.assign(mesh.tets.size(), 1.0);
+  double done = 0;  // fraction of the offset applied
+  double frac = 1.0 / double(options.steps);
+  const double minFrac = std::ldexp(frac, -options.halvings);
+  std::vector<DVec3> guess;
+  while (done < 1) {
+    frac = std::min(frac, 1 - done);
+    for (size_t v = 0; v < nv; ++v)
+      if (moving[v]) pb.prescribed[v] = frac * options.offset;
+    if (options.stiffening > 0)
+      for (size_t t = 0; t < cur.size(); ++t) {
+        const double worse = std::max({1.0, before[t] / cur[t], options.stiffenBelow / meanRatio(mesh, t)});
+        pb.stiffnessScale[t] = std::min(options.maxStiffening, std::pow(worse, options.stiffening));
+      }
+    pb.initialGuess = guess;
     const FemResult r = solveElastic(mesh, materials, pb, options.fem);
     st.fem.push_back(r.stats);
+    const std::vector<DVec3> start = mesh.positions;
     for (size_t v = 0; v < nv; ++v) mesh.positions[v] += r.displacement[v];
-    size_t inverted = 0;
-    for (size_t t = 0; t < mesh.tets.size(); ++t)
-      if (!(mesh.volume(t) > 0)) ++inverted;
-    if (inverted) {
-      mesh.positions = original;
-      throw std::runtime_error("displace: step " + std::to_string(s + 1) + " would invert " + std::to_string(inverted) +
-                               " tetrahedra; use a smaller offset or more steps");
+    size_t bad = 0;
+    for (size_t t = 0; t < mesh.tets.size(); ++t) {
+      next[t] = mesh.volume(t);
+      if (!(next[t] > options.minStepVolumeRatio * cur[t])) ++bad;
     }
+    if (bad) {
+      mesh.positions = start;
+      if (frac / 2 < minFrac * (1 - 1e-12)) {
+        mesh.positions = original;
+        throw std::runtime_error("displace: " + std::to_string(bad) + " tetrahedra would invert (or lose more than " +
+                                 std::to_string(int(std::lround(100 * (1 - options.minStepVolumeRatio)))) +
+                                 "% of their volume in one increment) after " + std::to_string(int(std::lround(100 * done))) +
+                                 "% of the offset, even at 1/" + std::to_string(1LL << options.halvings) +
+                                 " of a step; use a smaller offset");
+      }
+      frac /= 2;
+      ++st.retries;
+      for (DVec3& u : guess) u *= 0.5;
+      continue;
+    }
+    ++st.increments;
+    done += frac;
+    if (1 - done < 1e-12) done = 1;
+    cur.swap(next);
+    guess = r.displacement;  // the next increment is alike (the same size, or half): a warm start
+    for (size_t v = 0; v < nv; ++v)
+      if (pb.fixed[v]) guess[v] = DVec3(0.0);
+    // A halved size stays for the rest of the operation: the crushed tetrahedra that needed
+    // it are still there (trying the larger size again cost a wasted solve each time).
   }
   st.minVolumeRatio = INFINITY;
   for (size_t t = 0; t < before.size(); ++t) st.minVolumeRatio = std::min(st.minVolumeRatio, mesh.volume(t) / before[t]);

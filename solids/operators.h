@@ -156,10 +156,30 @@ struct DisplaceOptions {
   /// A vertex both moving and held moves.
   std::vector<uint8_t> anchored;
   DVec3 up{0, 1, 0};            ///< Sprig's up axis
-  /// The offset is applied in this many equal steps, each solved on the mesh the previous
-  /// one left (large motions then follow the geometry, and invert less).
+  /// The offset is applied in at least this many equal steps, each solved on the mesh the
+  /// previous one left (large motions then follow the geometry, and invert less). A step
+  /// that would crush a tetrahedron is halved (see minStepVolumeRatio).
   int steps = 1;
-  FemOptions fem;
+  /// Jacobian stiffening: a tetrahedron whose volume has fallen to a fraction r of its volume
+  /// before the operation solves with its modulus times min(maxStiffening, r^-stiffening),
+  /// so crushed soft material pushes what is beyond it rather than folding. 0 = off.
+  double stiffening = 2;
+  double maxStiffening = 1e3;  ///< cap of the stiffening factor (>= 1)
+  /// Also stiffened: a tetrahedron whose mean ratio q = 6√2·V / l_rms³ (1 regular, 0 flat)
+  /// is below this, by (stiffenBelow / q)^stiffening (so dirt crushed by an earlier
+  /// operation stays stiff). In [0, 1]; 0 = off.
+  double stiffenBelow = 0.3;
+  /// An increment that leaves a tetrahedron with no more than this fraction of the volume it
+  /// had before the increment is undone and retried at half the size, at most `halvings`
+  /// times in all (a halved size is kept: down to 1/1024 of a step by default); then
+  /// displace throws. In (0, 1).
+  double minStepVolumeRatio = 0.5;
+  /// How many times an increment may be halved before displace gives up (0: never; with
+  /// stiffening 0 that is the plain sequence of `steps` linear solves).
+  int halvings = 10;
+  /// The solver; its tolerance is 1e-6 here (not 1e-8): displacements to a millionth of the
+  /// right-hand side are far below a cell, and each solve takes about half the iterations.
+  FemOptions fem{Preconditioner::Jacobi, 1e-6, 0, true};
 };
 
 /// What displace did.
@@ -167,14 +187,17 @@ struct DisplaceStats {
   size_t moved = 0;       ///< vertices of the moving materials
   size_t anchored = 0;    ///< vertices held at zero
   double minVolumeRatio = 0;  ///< smallest volume after / volume before over all tetrahedra
-  std::vector<FemStats> fem;  ///< one per step
+  int increments = 0;         ///< increments applied (steps, more when some were halved)
+  int retries = 0;            ///< increments undone and halved
+  std::vector<FemStats> fem;  ///< one per solve (increments + retries)
 };
 
 /// Moves the vertices of the `moving` materials by offset and every other vertex to the
 /// static equilibrium of the linear-elastic model (§5.2): stiff materials keep their shape,
 /// soft ones deform. Throws std::invalid_argument for an empty `moving`, an id with no
-/// material, a non-finite offset or steps < 1, std::runtime_error when a step would invert a
-/// tetrahedron (the mesh is then left as it was), and what solveElastic throws (a piece
+/// material, a non-finite offset, steps < 1 or a stiffening option out of range,
+/// std::runtime_error when even a step halved `halvings` times would crush a tetrahedron (the mesh is then
+/// left as it was), and what solveElastic throws (a piece
 /// neither moving nor held makes the system singular).
 DisplaceStats displace(TetMesh& mesh, const std::vector<Material>& materials, const DisplaceOptions& options);
 

@@ -216,6 +216,7 @@ Path walk(const Surface& s, const ParticleOptions& o, double step, size_t index)
   const double cosFall = std::cos(o.fallingAngleDeg * kPi / 180);
   const double level = std::sin(kPi / 180);
   const size_t steps = size_t(std::floor(o.life * o.speed / step + 1e-9));
+  const double attract = o.tool == ParticleTool::Wash && !s.mesh.tints.empty() ? o.attraction : 0.0;
   for (size_t k = 0; k < steps; ++k) {
     const DVec3 n = s.normal[size_t(t)];
     if (glm::dot(n, g) > cosFall) {
@@ -232,7 +233,25 @@ Path walk(const Surface& s, const ParticleOptions& o, double step, size_t index)
     DVec3 dir = g - glm::dot(g, n) * n;
     const double len = glm::length(dir);
     if (len < level) break;  // level: at rest
-    const auto [t2, p2] = s.nearest(p + dir * (step / len));
+    dir /= len;
+    if (attract > 0) {
+      // Rivulets: steer sideways (never uphill) toward cleaner surface, down the gradient of
+      // the tint amount over the face. Tints change only between batches, so this reads a
+      // fixed state while paths run in parallel.
+      const auto& v = s.tris[size_t(t)].v;
+      const DVec3 q0 = s.mesh.positions[v[0]], q1 = s.mesh.positions[v[1]], q2 = s.mesh.positions[v[2]];
+      const double twiceArea = glm::length(glm::cross(q1 - q0, q2 - q0));
+      if (twiceArea > 0) {
+        const double a0 = s.mesh.tints[v[0]].a, a1 = s.mesh.tints[v[1]].a, a2 = s.mesh.tints[v[2]].a;
+        const DVec3 grad = (a0 * glm::cross(n, q2 - q1) + a1 * glm::cross(n, q0 - q2) + a2 * glm::cross(n, q1 - q0)) / twiceArea;
+        DVec3 side = -grad - glm::dot(-grad, dir) * dir - glm::dot(-grad, n) * n;
+        side *= attract * o.radius;
+        const double sl = glm::length(side);
+        if (sl > 1) side /= sl;  // at most 45 degrees off the fall line
+        dir = glm::normalize(dir + side);
+      }
+    }
+    const auto [t2, p2] = s.nearest(p + dir * step);
     if (t2 < 0) {
       path.lost = true;
       break;
@@ -305,6 +324,7 @@ ParticleStats runParticles(TetMesh& mesh, const std::vector<Material>& materials
   positive(o.speed, "speed");
   positive(o.radius, "radius");
   if (!(o.step >= 0) || !std::isfinite(o.step)) throw std::invalid_argument(tool + ": 'step' must not be negative");
+  if (!(o.attraction >= 0) || !std::isfinite(o.attraction)) throw std::invalid_argument(tool + ": 'attraction' must be finite and not negative");
   if (!(o.strength >= 0 && o.strength <= 1)) throw std::invalid_argument(tool + ": 'strength' must lie in [0, 1]");
   if (!(o.fallingAngleDeg >= 0 && o.fallingAngleDeg <= 180)) throw std::invalid_argument(tool + ": 'falling_angle' must lie in [0, 180]");
   if (!(o.topAngleDeg >= 0 && o.topAngleDeg <= 90)) throw std::invalid_argument(tool + ": 'top_angle' must lie in [0, 90]");

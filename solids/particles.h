@@ -56,6 +56,11 @@ struct ParticleOptions {
   double fallingAngleDeg = 60;    ///< CLINGING's falling angle, degrees from straight down
   double radius = 0.1;            ///< m: action radius (wash, lichen) or eroded sphere (erode)
   double strength = 0.01;         ///< blend weight per step at the particle (wash, lichen)
+  /// wash: rivulets. Each step turns sideways (never uphill, at most 45°) toward cleaner
+  /// surface by attraction·radius·|lateral gradient of the tint amount|; 0 = the paper's
+  /// CLINGING. Tints change between batches of 4,096 particles, so later particles follow
+  /// the tracks earlier ones washed.
+  double attraction = 0;
   Vec3 color{0.0f};               ///< lichen colour, linear RGB
   double topAngleDeg = 60;        ///< lichen: faces within this angle of straight up grow it
   std::vector<uint16_t> affects;  ///< material ids; empty = every material

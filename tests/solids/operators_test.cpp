@@ -298,6 +298,90 @@ TEST_CASE("displace: stiff bricks stay rectilinear, soft dirt deforms", "[solids
   CHECK(brick < 0.2 * dirt);  // measured: 0.107 (E differs 500-fold; bricks next to the tree must bend)
 }
 
+TEST_CASE("displace: a root rising far more than the gap lifts the bricks without inverting", "[solids][operators]") {
+  // A block 1.2 × 0.8 × 1.2 m of 0.1 m cells (y up): dirt, a brick slab on top (y > 0.7), and a
+  // buried root (0.5 < x, z < 0.7, 0.5 < y < 0.6) one cell below the bricks. The root rises
+  // 0.5 m: 5 times the dirt between it and the bricks, and 14 times the 0.036 m the paving
+  // species could take before (a linear solve per step folded the crushed dirt). With
+  // Jacobian stiffening and step control the crushed dirt pushes the bricks up instead;
+  // every increment keeps every tetrahedron positive.
+  TetMesh m = test::tetBlock({12, 8, 12}, DVec3(0.0), DVec3(1.2, 0.8, 1.2));
+  std::vector<Material> mats = {*findBuiltinMaterial("dirt"), *findBuiltinMaterial("brick"), *findBuiltinMaterial("wood")};
+  for (size_t t = 0; t < m.tets.size(); ++t) {
+    DVec3 c(0.0);
+    for (uint32_t v : m.tets[t]) c += 0.25 * m.positions[v];
+    m.materials[t] = (c.x > 0.5 && c.x < 0.7 && c.z > 0.5 && c.z < 0.7 && c.y > 0.5 && c.y < 0.6) ? 2 : c.y > 0.7 ? 1 : 0;
+  }
+  const TetMesh before = m;
+  DisplaceOptions opt;
+  opt.moving = {2};
+  opt.offset = DVec3(0, 0.5, 0);
+  opt.steps = 2;
+
+  SECTION("the old way, two plain linear steps, inverts and leaves the mesh as it was") {
+    // Each step (0.25 m) is more than twice the gap: the soft dirt takes the motion and folds.
+    opt.stiffening = 0;
+    opt.halvings = 0;
+    opt.minStepVolumeRatio = 1e-9;  // accept anything not inverted
+    TetMesh old = m;
+    CHECK_THROWS_WITH(displace(old, mats, opt), Catch::Contains("would invert"));
+    CHECK(old.positions == before.positions);
+  }
+  SECTION("stiffened increments") {
+    const DisplaceStats st = displace(m, mats, opt);
+    INFO(st.increments << " increments, " << st.retries << " retries, min volume ratio " << st.minVolumeRatio);
+    CHECK(st.increments >= 2);
+    CHECK(st.retries > 0);  // the first step needed halving
+    CHECK(int(st.fem.size()) == st.increments + st.retries);
+    // Same tetrahedra (the mesh stays conforming), all positive, a closed manifold surface.
+    CHECK(m.tets == before.tets);
+    CHECK(m.materials == before.materials);
+    CHECK(minVolume(m) > 0);
+    CHECK(st.minVolumeRatio > 0);
+    test::checkValid(m);
+    double rootTop = -INFINITY, brickAboveRootLow = INFINITY, brickFarRise = 0;
+    for (size_t v = 0; v < m.positions.size(); ++v) {
+      const DVec3 p0 = before.positions[v], p = m.positions[v];
+      bool root = false, brick = false;
+      for (size_t t = 0; t < m.tets.size(); ++t) {
+        if (std::find(m.tets[t].begin(), m.tets[t].end(), uint32_t(v)) == m.tets[t].end()) continue;
+        root |= m.materials[t] == 2;
+        brick |= m.materials[t] == 1;
+      }
+      if (root) {
+        CHECK(std::abs(p.y - p0.y - 0.5) < 1e-12);  // the root moved by exactly the offset
+        CHECK(p.x == p0.x);
+        CHECK(p.z == p0.z);
+        rootTop = std::max(rootTop, p.y);
+      }
+      if (p0.y == 0 && !root) CHECK(p == p0);  // the ground held
+      if (brick && std::abs(p0.y - 0.7) < 1e-9 && p0.x > 0.5 - 1e-9 && p0.x < 0.7 + 1e-9 && p0.z > 0.5 - 1e-9 && p0.z < 0.7 + 1e-9)
+        brickAboveRootLow = std::min(brickAboveRootLow, p.y);
+      if (brick && std::abs(p0.y - 0.8) < 1e-9 && (p0.x < 0.05 || p0.x > 1.15)) brickFarRise = std::max(brickFarRise, p.y - p0.y);
+    }
+    INFO("root top " << rootTop << ", lowest brick above it " << brickAboveRootLow << ", far brick rise " << brickFarRise);
+    // The root top is at 1.1, above the slab's old top (0.8): the bricks over it rode up
+    // above it, with crushed dirt between.
+    CHECK(rootTop == Approx(1.1).margin(1e-12));
+    CHECK(brickAboveRootLow > rootTop);
+    // The bricks stayed bricks: each brick tetrahedron keeps its volume within 5 % (measured:
+    // 0.969 to 1.037, the one-cell slab bends over the root; the dirt's went down to 0.28).
+    double brickLo = INFINITY, brickHi = 0;
+    for (size_t t = 0; t < m.tets.size(); ++t)
+      if (m.materials[t] == 1) {
+        const double r = m.volume(t) / before.volume(t);
+        brickLo = std::min(brickLo, r);
+        brickHi = std::max(brickHi, r);
+      }
+    INFO("brick volume ratios " << brickLo << " .. " << brickHi);
+    CHECK(brickLo > 0.95);
+    CHECK(brickHi < 1.05);
+    // The far edge of the slab rose too, but less than the part over the root.
+    CHECK(brickFarRise > 0);
+    CHECK(brickFarRise < brickAboveRootLow - 0.7);
+  }
+}
+
 TEST_CASE("displace: bad input", "[solids][operators]") {
   TetMesh m = test::tetBlock({2, 2, 2}, DVec3(0.0), DVec3(1.0));
   const std::vector<Material> mats = {*findBuiltinMaterial("dirt")};
@@ -308,14 +392,26 @@ TEST_CASE("displace: bad input", "[solids][operators]") {
   opt.moving = {0};
   opt.offset.x = NAN;
   CHECK_THROWS_WITH(displace(m, mats, opt), Catch::Contains("'offset' is not finite"));
-  // A large offset that inverts: an error, and the mesh as it was.
-  m.materials[0] = 0;
+  // An offset that must invert: the lower layer's vertices are all held (y = 0) or moving
+  // (y = 0.5, with the upper layer's material), and the upper layer moves down by more than
+  // the lower one is high. Stiffening cannot help; halving ends at 1/1024 of the step with
+  // an error, and the mesh is as it was.
   std::vector<Material> two = {*findBuiltinMaterial("dirt"), *findBuiltinMaterial("brick")};
-  for (size_t t = 1; t < m.tets.size(); ++t) m.materials[t] = 1;
+  for (size_t t = 0; t < m.tets.size(); ++t) {
+    DVec3 c(0.0);
+    for (uint32_t v : m.tets[t]) c += 0.25 * m.positions[v];
+    m.materials[t] = c.y > 0.5 ? 1 : 0;
+  }
   const TetMesh before = m;
-  opt.offset = DVec3(0, -5, 0);
-  CHECK_THROWS_WITH(displace(m, two, opt), Catch::Contains("would invert"));
+  opt.moving = {1};
+  opt.offset = DVec3(0, -0.6, 0);
+  CHECK_THROWS_WITH(displace(m, two, opt), Catch::Contains("would invert") && Catch::Contains("1/1024 of a step"));
   CHECK(m.positions == before.positions);
+  opt.halvings = 31;
+  CHECK_THROWS_WITH(displace(m, two, opt), Catch::Contains("'halvings' must be in [0, 30]"));
+  opt.halvings = 10;
+  opt.stiffening = NAN;
+  CHECK_THROWS_WITH(displace(m, two, opt), Catch::Contains("'stiffening' must be a finite number"));
 }
 
 TEST_CASE("displace: the same bytes at 1 and 2 threads", "[solids][operators]") {
