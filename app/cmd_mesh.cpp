@@ -79,7 +79,7 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
       simplified += buf;
     }
   }
-  writeParts(parts, a.out);
+  const std::vector<PartWriteReport> written = writeParts(parts, a.out);
   double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   size_t vertices = 0;
   std::string names;
@@ -97,6 +97,14 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
     note(g, std::cout, "cleaned: %zu components -> %zu (%zu specks, %zu voids, %zu triangles removed); %zu faces against their normals -> %zu (%zu normals fixed)",
          c.componentsBefore, c.componentsAfter, c.specks, c.voids, c.removedTriangles, c.facesAgainstBefore,
          c.facesAgainstAfter, c.fixedNormals);
+  for (const PartWriteReport& r : written) {
+    if (r.textureWidth > 0)
+      note(g, std::cout, "%s: texture %dx%d baked from the species' %s", r.name.c_str(), r.textureWidth, r.textureHeight,
+           r.name == "wood" ? "bark" : "shell texture");
+    if (r.creaseVertices > 0 || r.seamCorners > 0)
+      note(g, std::cout, "%s: %zu vertices split at creases (faces more than 90 degrees apart), %zu texture-seam uvs added",
+           r.name.c_str(), r.creaseVertices, r.seamCorners);
+  }
   if (lowerExtension(a.out) == ".glb")
     for (const ExportPart& p : parts)
       if (size_t k = clampedColorChannels(p))

@@ -13,6 +13,8 @@
 #include <stdexcept>
 
 #include "core/atomic_file.h"
+#include "core/image.h"
+#include "core/mesh_corners.h"
 #include "core/paths.h"
 #include "core/srgb.h"
 
@@ -349,18 +351,62 @@ bool hasOwnColors(const ExportPart& part) {
   return false;
 }
 
+// The corner normals and uvs a part is written with (glTF, OBJ), and what they did.
+struct PartCorners {
+  CornerTable<Vec3> normals;
+  CornerTable<Vec2> uvs;
+  PartWriteReport report;
+};
+
+PartCorners partCorners(const ExportPart& part) {
+  PartCorners c;
+  const Mesh& mesh = part.mesh;
+  const size_t n = mesh.positions.size();
+  c.report.name = part.name;
+  if (mesh.normals.size() == n) {
+    CreaseNormals cn = splitCreaseNormals(mesh);
+    c.report.creaseVertices = cn.splitVertices;
+    c.normals = std::move(cn.normals);
+  }
+  if (mesh.uvs.size() == n) {
+    const PartTexture* tex = part.material.texture.get();
+    c.uvs = cornerUvs(mesh, tex ? tex->seams : UvSeamOptions{});
+    c.report.seamCorners = c.uvs.values.size() - n;
+    if (tex) c.report.textureWidth = tex->image.width, c.report.textureHeight = tex->image.height;
+  }
+  return c;
+}
+
+// The PNG bytes of a texture image (8-bit sRGB RGB), through a temporary file beside
+// `near` (core/image.h owns image files; the temporary is removed when this returns).
+std::string pngBytes(const Image& image, const fs::path& near) {
+  fs::path dest = near;
+  dest.replace_extension(".png");
+  TempPath temp(dest);
+  writeImage(image, temp.path(), ImageEncoding::TextureMap);
+  return readFile(temp.path());
+}
+
 void checkParts(const std::vector<ExportPart>& parts) {
   std::vector<std::string> names;
   for (const ExportPart& p : parts) {
     validate(p.mesh);
     names.push_back(p.name);
+    if (const PartTexture* tex = p.material.texture.get()) {
+      if (p.mesh.uvs.size() != p.mesh.positions.size())
+        throw std::invalid_argument("exported part '" + p.name + "' has a texture but no texture coordinates");
+      const Image& im = tex->image;
+      if (im.width <= 0 || im.height <= 0 || im.pixels.size() != size_t(im.width) * size_t(im.height) * 4)
+        throw std::invalid_argument("exported part '" + p.name + "' has an empty or malformed texture image");
+    }
   }
   std::sort(names.begin(), names.end());
   auto dup = std::adjacent_find(names.begin(), names.end());
   if (dup != names.end()) throw std::invalid_argument("two exported parts are named '" + *dup + "'");
 }
 
-void writePartsGlb(const std::vector<ExportPart>& parts, const fs::path& path) {
+std::vector<PartWriteReport> writePartsGlb(const std::vector<ExportPart>& parts, const fs::path& path) {
+  std::vector<PartWriteReport> reports;
   tinygltf::Model model;
   model.asset.version = "2.0";
   model.asset.generator = "Sprig";
@@ -388,12 +434,48 @@ void writePartsGlb(const std::vector<ExportPart>& parts, const fs::path& path) {
     return int(model.accessors.size() - 1);
   };
   for (const ExportPart& part : parts) {
-    const Mesh& mesh = part.mesh;
-    if (mesh.triangles.empty()) continue;
+    if (part.mesh.triangles.empty()) continue;
+    PartCorners corners = partCorners(part);
+    reports.push_back(corners.report);
+    const Mesh mesh = unweld(part.mesh, corners.normals, corners.uvs);
     tinygltf::Material mat;
     mat.name = part.material.name;
     const Vec3& c = part.material.baseColor;
+    const PartTexture* tex = part.material.texture.get();
     mat.pbrMetallicRoughness.baseColorFactor = {c.x, c.y, c.z, 1.0};
+    if (tex) {
+      // The image holds absolute colours: factor 1, the species' colour kept in extras.
+      mat.pbrMetallicRoughness.baseColorFactor = {1.0, 1.0, 1.0, 1.0};
+      tinygltf::Value::Array rgb{tinygltf::Value(double(c.x)), tinygltf::Value(double(c.y)), tinygltf::Value(double(c.z))};
+      tinygltf::Value::Object extras;
+      extras["sprigBaseColor"] = tinygltf::Value(rgb);
+      mat.extras = tinygltf::Value(extras);
+      const std::string png = pngBytes(tex->image, path);
+      while (data.size() % 4) data.push_back(0);
+      tinygltf::BufferView view;
+      view.buffer = 0;
+      view.byteOffset = data.size();
+      view.byteLength = png.size();
+      data.insert(data.end(), png.begin(), png.end());
+      model.bufferViews.push_back(view);
+      tinygltf::Image image;
+      image.name = part.name;
+      image.mimeType = "image/png";
+      image.bufferView = int(model.bufferViews.size() - 1);
+      model.images.push_back(image);
+      tinygltf::Sampler sampler;
+      sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
+      sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
+      sampler.wrapS = tex->seams.repeatU ? TINYGLTF_TEXTURE_WRAP_REPEAT : TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+      sampler.wrapT = tex->seams.repeatV ? TINYGLTF_TEXTURE_WRAP_REPEAT : TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+      model.samplers.push_back(sampler);
+      tinygltf::Texture texture;
+      texture.name = part.name;
+      texture.sampler = int(model.samplers.size() - 1);
+      texture.source = int(model.images.size() - 1);
+      model.textures.push_back(texture);
+      mat.pbrMetallicRoughness.baseColorTexture.index = int(model.textures.size() - 1);
+    }
     mat.pbrMetallicRoughness.metallicFactor = 0.0;
     mat.pbrMetallicRoughness.roughnessFactor = part.material.roughness;
     mat.doubleSided = part.material.doubleSided;
@@ -418,7 +500,7 @@ void writePartsGlb(const std::vector<ExportPart>& parts, const fs::path& path) {
       prim.attributes["TEXCOORD_0"] = addAccessor(flipped.data(), n * sizeof(Vec2), n, TINYGLTF_TYPE_VEC2,
                                                   TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
     }
-    if (hasOwnColors(part)) {
+    if (!tex && hasOwnColors(part)) {
       std::vector<Vec3> rel(n);
       for (size_t i = 0; i < n; ++i) rel[i] = relativeColor(mesh.colors[i], c);
       prim.attributes["COLOR_0"] = addAccessor(rel.data(), n * sizeof(Vec3), n, TINYGLTF_TYPE_VEC3,
@@ -445,44 +527,77 @@ void writePartsGlb(const std::vector<ExportPart>& parts, const fs::path& path) {
   if (!writer.WriteGltfSceneToStream(&model, stream, false, true))
     throw std::runtime_error("cannot write '" + path.string() + "': glTF serialization failed");
   writeAtomic(path, stream.str());
+  return reports;
 }
 
-void writePartsObj(const std::vector<ExportPart>& parts, const fs::path& path) {
+std::vector<PartWriteReport> writePartsObj(const std::vector<ExportPart>& parts, const fs::path& path) {
+  std::vector<PartWriteReport> reports;
   fs::path mtlPath = path;
   mtlPath.replace_extension(".mtl");
   std::string mtl = "# written by Sprig\n";
   std::string out = "# written by Sprig\nmtllib " + mtlPath.filename().string() + "\n";
-  uint64_t base = 0;
+  std::vector<std::pair<fs::path, const Image*>> images;
+  uint64_t base = 0, uvBase = 0, nBase = 0;
   for (const ExportPart& part : parts) {
+    if (part.mesh.triangles.empty()) continue;
+    PartCorners corners = partCorners(part);
+    reports.push_back(corners.report);
+    // v lines from the welded positions; vt and vn from the corner tables.
+    Mesh lines;
+    lines.positions = part.mesh.positions;
+    lines.colors = part.mesh.colors;
+    lines.uvs = corners.uvs.values;
+    lines.normals = corners.normals.values;
     const Mesh& mesh = part.mesh;
-    if (mesh.triangles.empty()) continue;
     const std::string matName = objName(part.material.name);
-    const Vec3& c = part.material.baseColor;
+    const PartTexture* tex = part.material.texture.get();
+    const Vec3 c = tex ? Vec3(1.0f) : part.material.baseColor;
     mtl += "newmtl " + matName + "\nKa 0 0 0\nKd ";
     putFloat(mtl, c.x), mtl += ' ', putFloat(mtl, c.y), mtl += ' ', putFloat(mtl, c.z);
-    mtl += "\nKs 0.04 0.04 0.04\nNs 32\nd 1\nillum 2\n\n";
-    const bool hasN = !mesh.normals.empty(), hasUv = !mesh.uvs.empty();
+    mtl += "\nKs 0.04 0.04 0.04\nNs 32\nd 1\nillum 2\n";
+    if (tex) {
+      fs::path png = path;
+      png.replace_filename(path.stem().string() + "_" + objName(part.name) + ".png");
+      images.emplace_back(png, &tex->image);
+      mtl += "map_Kd " + png.filename().string() + "\n";
+    }
+    mtl += "\n";
+    const bool hasN = !lines.normals.empty(), hasUv = !lines.uvs.empty();
     out += "o " + objName(part.name) + "\n";
-    appendObjVertices(out, mesh);
+    appendObjVertices(out, lines);
     out += "usemtl " + matName + "\n";
-    for (const auto& t : mesh.triangles) {
+    for (size_t t = 0; t < mesh.triangles.size(); ++t) {
       out += 'f';
       for (int k = 0; k < 3; ++k) {
-        const uint64_t idx = base + uint64_t(t[k]) + 1;
         out += ' ';
-        putUint(out, idx);
+        putUint(out, base + uint64_t(mesh.triangles[t][k]) + 1);
         if (hasUv || hasN) {
           out += '/';
-          if (hasUv) putUint(out, idx);
-          if (hasN) out += '/', putUint(out, idx);
+          if (hasUv) putUint(out, uvBase + uint64_t(corners.uvs.index[t * 3 + size_t(k)]) + 1);
+          if (hasN) out += '/', putUint(out, nBase + uint64_t(corners.normals.index[t * 3 + size_t(k)]) + 1);
         }
       }
       out += '\n';
     }
     base += mesh.positions.size();
+    uvBase += lines.uvs.size();
+    nBase += lines.normals.size();
   }
-  writeAtomic(mtlPath, mtl);
-  writeAtomic(path, out);
+  // Images first, then the MTL naming them, then the OBJ; a failure removes the images.
+  std::vector<fs::path> written;
+  try {
+    for (const auto& [png, image] : images) {
+      writeImage(*image, png, ImageEncoding::TextureMap);
+      written.push_back(png);
+    }
+    writeAtomic(mtlPath, mtl);
+    writeAtomic(path, out);
+  } catch (...) {
+    std::error_code ec;
+    for (const fs::path& p : written) fs::remove(p, ec);
+    throw;
+  }
+  return reports;
 }
 
 void writePartsPly(const std::vector<ExportPart>& parts, const fs::path& path) {
@@ -506,19 +621,26 @@ void writePartsPly(const std::vector<ExportPart>& parts, const fs::path& path) {
 
 size_t clampedColorChannels(const ExportPart& part) {
   size_t clamped = 0;
-  if (hasOwnColors(part))
+  if (!part.material.texture && hasOwnColors(part))
     for (const Vec3& c : part.mesh.colors) relativeColor(c, part.material.baseColor, &clamped);
   return clamped;
 }
 
-void writeParts(const std::vector<ExportPart>& parts, const fs::path& path) {
+std::vector<PartWriteReport> writeParts(const std::vector<ExportPart>& parts, const fs::path& path) {
   const MeshFormat format = meshFormatFor(path);
   checkParts(parts);
   switch (format) {
-    case MeshFormat::Ply: writePartsPly(parts, path); break;
-    case MeshFormat::Obj: writePartsObj(parts, path); break;
-    case MeshFormat::Glb: writePartsGlb(parts, path); break;
+    case MeshFormat::Ply: {
+      writePartsPly(parts, path);
+      std::vector<PartWriteReport> reports;
+      for (const ExportPart& p : parts)
+        if (!p.mesh.triangles.empty()) reports.push_back(PartWriteReport{p.name, 0, 0, 0, 0});
+      return reports;
+    }
+    case MeshFormat::Obj: return writePartsObj(parts, path);
+    case MeshFormat::Glb: return writePartsGlb(parts, path);
   }
+  return {};
 }
 
 }  // namespace sprig

@@ -13,10 +13,13 @@
 /// after the position in OBJ (the common `v x y z r g b` extension).
 
 #include <filesystem>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "core/image.h"
 #include "core/mesh.h"
+#include "core/mesh_corners.h"
 #include "core/types.h"
 
 namespace sprig {
@@ -57,12 +60,26 @@ void writePly(const Mesh& mesh, const std::filesystem::path& path, const std::st
 /// Throws as writeMesh.
 void writeObj(const Mesh& mesh, const std::filesystem::path& path, const MeshWriteOptions& options = {});
 
+/// A part's texture baked into an image: the colour at texture coordinate (s, t) of the
+/// part's Mesh::uvs (origin at the image's bottom-left, as OBJ's vt) is the image's colour
+/// there, absolute (not relative to the base colour). The writers store it as an 8-bit sRGB
+/// PNG: embedded in glb, beside the OBJ.
+struct PartTexture {
+  Image image;            ///< linear RGB (alpha ignored), top row = t of 1
+  UvSeamOptions seams;    ///< which axes repeat (glTF sampler REPEAT, else CLAMP_TO_EDGE) and the seam rules
+};
+
 /// The material of an exported part.
 struct PartMaterial {
   std::string name = "sprig";  ///< material name in glTF and MTL (letters, digits, '_' in OBJ)
   Vec3 baseColor{0.8f};        ///< linear RGB in [0,1]: glTF baseColorFactor and MTL Kd, both as these linear numbers
   float roughness = 0.6f;      ///< glTF roughnessFactor in [0,1]
   bool doubleSided = false;    ///< glTF doubleSided (leaves: both faces are seen)
+  /// The part's colours as an image (the part's mesh must then have uvs), or null. A
+  /// textured material has baseColorFactor and Kd 1 (the image holds absolute colours; both
+  /// formats multiply the factor in), keeps baseColor in glTF's material extras as
+  /// `sprigBaseColor`, and has no COLOR_0 (it would multiply again).
+  std::shared_ptr<const PartTexture> texture;
 };
 
 /// One named part of an exported model (wood, leaves, whorl, a solid's material, ...).
@@ -84,10 +101,26 @@ struct ExportPart {
 /// face's `material`; the header names the parts in comments (`comment part 0 wood`).
 /// Parts without triangles are skipped. Throws as writeMesh, and std::invalid_argument
 /// when two parts share a name.
-void writeParts(const std::vector<ExportPart>& parts, const std::filesystem::path& path);
+///
+/// Normals: glTF and OBJ split them at creases (splitCreaseNormals: faces around a vertex
+/// more than 90° apart), glTF by duplicating the vertex, OBJ by its own `vn` index; PLY
+/// keeps one normal per vertex. Textures (PartMaterial::texture): glTF embeds the PNG as a
+/// bufferView image referenced by baseColorTexture (seams duplicated as for creases);
+/// OBJ writes `STEM_PART.png` beside the OBJ (each file atomically, the images first,
+/// then the MTL with `map_Kd`, then the OBJ; a failure removes the images it wrote) and
+/// per-corner `vt` indices; PLY keeps its per-vertex colours and names the images nowhere.
+/// Returns what was done per part.
+struct PartWriteReport {
+  std::string name;
+  size_t creaseVertices = 0;  ///< vertices given more than one normal (glTF, OBJ)
+  size_t seamCorners = 0;     ///< uv values added at texture seams (glTF, OBJ)
+  int textureWidth = 0, textureHeight = 0;  ///< the texture image's size, 0 without one
+};
+std::vector<PartWriteReport> writeParts(const std::vector<ExportPart>& parts, const std::filesystem::path& path);
 
 /// How many colour channels writeParts clamps in glTF's COLOR_0 (a vertex brighter than its
-/// part's base colour in a channel); 0 means the glTF shows every vertex colour exactly.
+/// part's base colour in a channel); 0 means the glTF shows every vertex colour exactly
+/// (always for a textured part, which has no COLOR_0).
 size_t clampedColorChannels(const ExportPart& part);
 
 /// glTF 2.0 binary through TinyGLTF: one mesh, one primitive (triangles), POSITION

@@ -2,6 +2,7 @@
 #include "core/timer.h"
 
 #include "blobtree/polygonize.h"
+#include "model/detail/key_recorder.h"
 #include "model/mesh_parts.h"
 #include "render/scene.h"
 
@@ -37,6 +38,12 @@ class NodeReader {
     if (depth_ >= kMaxDepth) {
       node.error(diags_, "blob nodes are nested more than " + std::to_string(kMaxDepth) + " deep");
       return std::nullopt;
+    }
+    if (auto described = describeOneKey(node, kKinds, "blob_node")) {  // `sprig schema`: one kind's keys
+      ++depth_;
+      std::optional<NodeId> id = dispatch(described->first.scalar(), described->first, described->second);
+      --depth_;
+      return id;
     }
     if (!node.isMap() || node.pairs().size() != 1 || !node.pairs()[0].first.isScalar()) {
       node.error(diags_, "a blob node must be a map with one key naming its kind, e.g. {point: {radius: 1}}");
@@ -390,7 +397,10 @@ class NodeReader {
       if (textureCount_ == 0) {
         idNode->error(diags_, "texture id " + idNode->scalar() +
                                   " names no texture: the species has no 'textures:' list");
-      } else if (auto id = idNode->asInteger(diags_, "'id'", 0, textureCount_ < 0 ? kNoTexture - 1 : textureCount_ - 1)) {
+      } else if (auto id = idNode->asInteger(diags_, "'id'", 0,
+                                             // `sprig schema`: the list's length is the file's, not a constant
+                                             textureCount_ < 0 || detail::KeyRecorder::active() ? kNoTexture - 1
+                                                                                                 : textureCount_ - 1)) {
         t.textureId = uint16_t(*id);
       }
     } else {

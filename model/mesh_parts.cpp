@@ -1,8 +1,11 @@
 #include "model/mesh_parts.h"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <stdexcept>
+
+#include "core/parallel.h"
 
 namespace sprig {
 
@@ -64,6 +67,39 @@ Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::Te
       if (w > best) best = w, mesh.materials[t] = id;
   }
   return mesh;
+}
+
+std::shared_ptr<PartTexture> bakeTexture(int width, int height, const std::function<Vec3(double s, double t)>& colorAt,
+                                         const UvSeamOptions& seams) {
+  auto tex = std::make_shared<PartTexture>();
+  tex->seams = seams;
+  tex->image = Image(width, height, Vec4(0, 0, 0, 1));
+  Image& im = tex->image;
+  parallelFor(0, size_t(height), [&](size_t y) {
+    const double t = 1.0 - (double(y) + 0.5) / height;  // top row = t near 1
+    for (int x = 0; x < width; ++x) {
+      const Vec3 c = colorAt((x + 0.5) / width, t);
+      im.set(x, int(y), Vec4(c, 1.0f));
+    }
+  });
+  return tex;
+}
+
+void textureBark(ExportPart& part, const std::function<Vec3(Vec2 uv)>& bark) {
+  Mesh& mesh = part.mesh;
+  if (mesh.uvs.size() != mesh.positions.size() || mesh.uvs.empty())
+    throw std::invalid_argument("textureBark: the wood mesh has no texture coordinates");
+  float lo = INFINITY, hi = -INFINITY;
+  for (const Vec2& uv : mesh.uvs)
+    if (std::isfinite(uv.y)) lo = std::min(lo, uv.y), hi = std::max(hi, uv.y);
+  if (!(hi >= lo)) lo = 0, hi = 1;
+  const float range = std::max(hi - lo, 1e-6f);
+  for (Vec2& uv : mesh.uvs) uv.y = std::isfinite(uv.y) ? (uv.y - lo) / range : 0.0f;
+  UvSeamOptions seams;
+  seams.repeatU = true;
+  part.material.texture = bakeTexture(kExportTextureShort, kExportTextureLong, [&](double s, double t) {
+    return bark(Vec2(float(s), float(lo + t * range)));
+  }, seams);
 }
 
 std::vector<std::pair<uint32_t, Mesh>> splitByMaterial(const Mesh& mesh) {

@@ -4,6 +4,8 @@
 /// per-triangle ids.
 
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <utility>
 #include <vector>
 
@@ -32,6 +34,26 @@ Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::Te
 /// contactDarkening applied as render::Scene::attributeColor applies them.
 Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::TextureTable& textures,
                       const render::Material& material);
+
+/// Size of the images exports bake textures into: kExportTextureLong texels along the
+/// texture's long axis (a tree's height, a shell's spiral), kExportTextureShort around a
+/// branch, kExportTextureAround around a shell's generating curve. Powers of two.
+inline constexpr int kExportTextureLong = 2048;
+inline constexpr int kExportTextureShort = 512;
+inline constexpr int kExportTextureAround = 1024;
+
+/// A width x height texture whose texel centred at texture coordinate (s, t) (t = 0 at the
+/// bottom row, as Mesh::uvs) has colour colorAt(s, t); texels are computed in parallel
+/// (colorAt must be thread-safe). O(width·height) calls.
+std::shared_ptr<PartTexture> bakeTexture(int width, int height, const std::function<Vec3(double s, double t)>& colorAt,
+                                         const UvSeamOptions& seams);
+
+/// Maps a bark texture onto a tree's wood: the mesh's uvs are the bark's (u, v) (u turns
+/// around the branch, v along it, as the polygonizer blends them); v is rescaled to
+/// t = (v − vMin)/(vMax − vMin) over the mesh's range and the image covers one period of u
+/// (repeating, the bark closes at u = 1) times that range, each texel bark((s, v(t))).
+/// Sets part.material.texture. Throws std::invalid_argument when the mesh has no uvs.
+void textureBark(ExportPart& part, const std::function<Vec3(Vec2 uv)>& bark);
 
 /// The triangles of mesh grouped by their Mesh::materials id, in increasing id order;
 /// each group is its own mesh (only the vertices it uses, in their original order; every

@@ -1,6 +1,8 @@
 #include "model/schema.h"
 
 #include <cmath>
+#include <map>
+#include <memory>
 #include <sstream>
 
 #include "model/detail/key_recorder.h"
@@ -14,8 +16,15 @@ namespace {
 using detail::KeySchema;
 
 /// Runs of each kind's reader (model/detail/key_recorder.h): enough that every branch on
-/// presence or shape is taken both ways (the schema stops changing well before this).
-constexpr int kPasses = 512;
+/// presence or shape is taken both ways, and that each alternative of the one-key maps
+/// (blob nodes, distance fields, layers, operations) is described a few levels deep.
+constexpr int kPasses = 4096;
+
+/// A map is closed (additionalProperties: false) in the schema only when its reader
+/// finished it in this many passes: one-key alternatives nest (blob nodes, distance fields,
+/// operations), and a position deep in them that few passes reached may not have had all of
+/// its keys asked for; it stays open rather than reject a key the reader takes.
+constexpr int kMinFinishes = 8;
 
 std::string jsonText(const std::string& text) {
   std::string out = "\"";
@@ -75,13 +84,15 @@ std::string mapJson(const KeySchema& k, const std::string& path, int depth) {
     out += ", \"minProperties\": 1, \"maxProperties\": 1, \"propertyNames\": {\"enum\": [";
     for (size_t i = 0; i < k.oneKey.size(); ++i) out += (i ? ", " : "") + jsonText(k.oneKey[i]);
     out += "]}";
-  } else if (k.closed && !k.dataKeys) {
+  } else if (k.closed && !k.dataKeys && k.finishes >= kMinFinishes) {
     out += ", \"additionalProperties\": false";
   }
   return out + "}";
 }
 
 std::string emit(const KeySchema& k, const std::string& path, int depth) {
+  if (!k.ref.empty())
+    return "{\"description\": " + jsonText(path + ": " + k.ref) + ", \"$ref\": \"#/definitions/part_" + k.ref + "\"}";
   std::vector<std::string> alternatives;
   std::string what;
   if (!k.choices.empty()) {
@@ -151,10 +162,12 @@ std::string emit(const KeySchema& k, const std::string& path, int depth) {
 std::string speciesSchemaJson() {
   std::string kinds, branches, defs;
   bool first = true;
+  std::map<std::string, std::unique_ptr<KeySchema>> shared;  // one-key maps: blob nodes, fields, operations
   for (const KindEntry& kind : speciesKinds()) {
     KeySchema root;
     for (int pass = 0; pass < kPasses; ++pass) {
       detail::KeyRecorder recorder(root, pass);
+      recorder.setDefinitions(&shared);
       try {
         parseSpecies(std::string("kind: ") + kind.name + "\n", "species.yaml");
       } catch (const InputError&) {
@@ -181,6 +194,8 @@ std::string speciesSchemaJson() {
   out += "  \"required\": [\"kind\"],\n";
   out += "  \"properties\": {\"kind\": {\"description\": \"what the file describes\", \"enum\": [" + kinds + "]}},\n";
   out += "  \"allOf\": [\n    " + branches + "\n  ],\n";
+  for (const auto& [name, def] : shared)
+    defs += ",\n    " + jsonText("part_" + name) + ": " + emit(*def, name, 2);
   out += "  \"definitions\": {\n" + defs + "\n  }\n}\n";
   return out;
 }

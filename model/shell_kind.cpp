@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "blobtree/polygonize.h"
+#include "core/parallel.h"
 #include "model/mesh_parts.h"
 
 namespace sprig {
@@ -403,6 +404,35 @@ namespace {
 float shellMeshCell(const blobtree::CompiledBlob& blob) { return glm::length(blob.bounds().size()) / 340.0f; }
 
 /// A shell grown to any age.
+/// Maps the main whorl's texture onto the whorl part as an image over the helico-spiral
+/// coordinates of each vertex (organisms/shell_paint.h): s = angle around the generating
+/// curve / 360° (repeating), t = θ rescaled over the part's range. A triangle spanning more
+/// than 90° of θ or around (between two whorls, or at the apex) takes one corner's
+/// coordinates. The texels are the painter's own whorl colour at their coordinates.
+void textureWhorl(ExportPart& part, const organisms::ShellPainter& painter) {
+  Mesh& mesh = part.mesh;
+  if (mesh.triangleCount() == 0) return;
+  std::vector<organisms::HelicoCoords> coords(mesh.positions.size());
+  parallelFor(0, coords.size(), [&](size_t v) { coords[v] = painter.helicoCoordsOfWorld(mesh.positions[v]); }, 256);
+  double lo = INFINITY, hi = -INFINITY;
+  for (const auto& h : coords) lo = std::min(lo, h.thetaDeg), hi = std::max(hi, h.thetaDeg);
+  const double range = std::max(hi - lo, 1e-6);
+  mesh.uvs.resize(mesh.positions.size());
+  for (size_t v = 0; v < coords.size(); ++v) {
+    const double s = coords[v].aroundDeg / 360.0;
+    mesh.uvs[v] = Vec2(float(s < 0 ? s + 1.0 : s), float((coords[v].thetaDeg - lo) / range));
+  }
+  UvSeamOptions seams;
+  seams.repeatU = true;
+  seams.maxSpan = Vec2(0.25f, float(90.0 / range));
+  part.material.texture = bakeTexture(kExportTextureAround, kExportTextureLong, [&](double s, double t) {
+    organisms::HelicoCoords h;
+    h.aroundDeg = s > 0.5 ? 360.0 * s - 360.0 : 360.0 * s;  // helicoCoords' range (−180°, 180°]
+    h.thetaDeg = lo + t * range;
+    return painter.whorlColorAt(h);
+  }, seams);
+}
+
 class ShellModel final : public KindModel {
  public:
   explicit ShellModel(const ShellSpec& spec) : spec_(spec) {}
@@ -532,8 +562,10 @@ class ShellModel final : public KindModel {
         same->mesh.append(mesh);  // no texture and the whorl's texture are both the whorl
         continue;
       }
-      parts.push_back(ExportPart{look.first, std::move(mesh), PartMaterial{look.first, look.second, implicit.material.roughness, false}});
+      parts.push_back(ExportPart{look.first, std::move(mesh), PartMaterial{look.first, look.second, implicit.material.roughness, false, nullptr}});
     }
+    for (ExportPart& p : parts)
+      if (p.name == "whorl") textureWhorl(p, *shell.painter);
     return parts;
   }
 

@@ -347,7 +347,13 @@ class TreeModel final : public KindModel {
                                      implicit.material);
     fig.clean = cleanMesh(parts[0].mesh, clean);
     parts[0].mesh.materials.clear();
-    parts[0].material = {"wood", look.style.wood.baseColor, look.style.wood.roughness, false};
+    parts[0].material = {"wood", look.style.wood.baseColor, look.style.wood.roughness, false, nullptr};
+    // The bark as an image over the wood's (u, v), the renderer's own bark function baked.
+    const uint16_t barkId = static_cast<uint16_t>(tree.options.bark.texture);
+    if (tree.options.bark.enabled && barkId < implicit.textures.size() && parts[0].mesh.triangleCount() > 0) {
+      const render::ColorTexture& bark = implicit.textures[barkId];
+      textureBark(parts[0], [&bark](Vec2 uv) { return bark(uv, Vec3(0.0f)); });
+    }
     const organisms::TreeOptions& options = tree.options;
     const std::pair<organisms::OrganSet, const char*> sets[] = {{organisms::OrganSet::Leaves, "leaves"},
                                                                  {organisms::OrganSet::Fruit, "fruit"}};
@@ -357,7 +363,7 @@ class TreeModel final : public KindModel {
       organs.materials.clear();
       const render::Material& m = set == organisms::OrganSet::Leaves ? look.style.leaf : look.style.fruit;
       // Leaves are open polygons seen from both sides; fruit are closed spheres.
-      parts.push_back(ExportPart{name, std::move(organs), PartMaterial{name, m.baseColor, m.roughness, set == organisms::OrganSet::Leaves}});
+      parts.push_back(ExportPart{name, std::move(organs), PartMaterial{name, m.baseColor, m.roughness, set == organisms::OrganSet::Leaves, nullptr}});
     }
     return parts;
   }

@@ -310,6 +310,28 @@ bool KeyRecorder::answerHas() {
   return nextRandom() & 1;
 }
 
+std::optional<size_t> KeyRecorder::chooseAlternative(size_t n) {
+  if (n == 0 || descents_ >= kMaxDescents) return std::nullopt;
+  ++descents_;
+  return static_cast<size_t>(nextRandom() % n);
+}
+
+std::optional<YAML::Node> KeyRecorder::answered(const KeySchema* at, bool& wasAbsent) const {
+  auto it = answers_.find(at);
+  wasAbsent = it != answers_.end() && !it->second;
+  if (it == answers_.end() || !it->second) return std::nullopt;
+  return it->second;
+}
+
+void KeyRecorder::remember(const KeySchema* at, std::optional<YAML::Node> answer) { answers_[at] = std::move(answer); }
+
+KeySchema* KeyRecorder::definition(const std::string& name) {
+  if (!definitions_) return nullptr;
+  auto& d = (*definitions_)[name];
+  if (!d) d = std::make_unique<KeySchema>();
+  return d.get();
+}
+
 KeyRecorder::~KeyRecorder() { tActiveRecorder = previous_; }
 
 KeySchema* KeyRecorder::schemaOf(const YAML::Node& node, bool asRoot) {
@@ -374,6 +396,16 @@ void noteType(const YAML::Node& n, const char* type, double lo = -HUGE_VAL, doub
   }
 }
 
+/// Describing, and n stands for an absent key: a typed read records its type and then
+/// succeeds with a neutral value, so the reader goes on to the keys after it (a blob node's
+/// `hi` after its `lo`) instead of stopping at its first error.
+bool describedPlaceholder(const YAML::Node& n) {
+  detail::KeyRecorder* r = detail::KeyRecorder::active();
+  return r && r->isPlaceholder(n) && r->schemaOf(n);
+}
+
+double neutral(double min, double max) { return std::max(min, std::min(1.0, max)); }
+
 std::string jsonNumber(double v) {
   std::ostringstream o;
   o.precision(9);
@@ -409,6 +441,13 @@ std::vector<YNode> YNode::items() const {
     s->types.insert("sequence");
     std::vector<YNode> out;
     if (!node_.IsSequence()) return out;
+    detail::KeyRecorder* r = detail::KeyRecorder::active();
+    if (r->isPlaceholder(node_) && node_.size() == 0) {  // describing: one placeholder element
+      YAML::Node element = r->placeholder();
+      r->bind(element, s->item());
+      out.emplace_back(file_, element);
+      return out;
+    }
     for (const auto& child : node_) {
       detail::KeyRecorder::active()->bind(child, s->item());
       out.emplace_back(file_, child);
@@ -435,6 +474,7 @@ std::vector<std::pair<YNode, YNode>> YNode::pairs() const {
 std::optional<double> YNode::asNumber(DiagnosticList& diags, std::string_view what, double min, double max) const {
   TypedRead typedRead;
   noteType(node_, "number", min, max);
+  if (describedPlaceholder(node_)) return neutral(min, max);
   if (!isScalar()) {
     error(diags, std::string(what) + " must be a number, " + gotText(*this));
     return std::nullopt;
@@ -465,6 +505,7 @@ std::optional<int64_t> YNode::asInteger(DiagnosticList& diags, std::string_view 
   TypedRead typedRead;
   noteType(node_, "integer", min == std::numeric_limits<int64_t>::min() ? -HUGE_VAL : double(min),
            max == std::numeric_limits<int64_t>::max() ? HUGE_VAL : double(max));
+  if (describedPlaceholder(node_)) return std::max(min, std::min<int64_t>(1, max));
   if (!isScalar()) {
     error(diags, std::string(what) + " must be an integer, " + gotText(*this));
     return std::nullopt;
@@ -505,6 +546,7 @@ std::optional<int64_t> YNode::asInteger(DiagnosticList& diags, std::string_view 
 std::optional<bool> YNode::asBoolean(DiagnosticList& diags, std::string_view what) const {
   TypedRead typedRead;
   noteType(node_, "boolean");
+  if (describedPlaceholder(node_)) return false;
   if (isPlainScalar()) {
     const std::string s = trim(scalar());
     static const char* yes[] = {"true", "True", "TRUE", "yes", "Yes", "YES", "on", "On", "ON"};
@@ -531,6 +573,7 @@ std::optional<std::string> YNode::asString(DiagnosticList& diags, std::string_vi
 std::optional<Vec3> YNode::asVec3(DiagnosticList& diags, std::string_view what, double min, double max) const {
   TypedRead typedRead;
   noteType(node_, "vec3", min, max);
+  if (describedPlaceholder(node_)) return Vec3(static_cast<float>(neutral(min, max)));
   if (!isSequence() || node_.size() != 3) {
     std::string got = isSequence() ? "got " + std::to_string(node_.size()) + " elements" : gotText(*this);
     error(diags, std::string(what) + " must be [x, y, z], " + got);
@@ -553,6 +596,7 @@ std::optional<Vec3> YNode::asVec3(DiagnosticList& diags, std::string_view what, 
 std::optional<Vec3> YNode::asColor(DiagnosticList& diags, std::string_view what) const {
   TypedRead typedRead;
   noteType(node_, "color");
+  if (describedPlaceholder(node_)) return Vec3(0.0f);
   if (isScalar()) {
     const std::string s = trim(scalar());
     auto hex = [](char c) -> int {
@@ -656,8 +700,20 @@ std::optional<YNode> MapReader::get(std::string_view key) {
   if (schema_) {  // describing: an absent key reads as a placeholder, or stays absent
     detail::KeyRecorder* r = detail::KeyRecorder::active();
     detail::KeySchema& child = schema_->property(std::string(key));
-    if (it == index_.end() && !r->answerHas()) return std::nullopt;
-    YAML::Node n = it == index_.end() ? r->placeholder() : entries_[it->second].value.node();
+    YAML::Node n;
+    if (it == index_.end()) {  // the same answer each time this pass asks (axisOf reads twice)
+      bool wasAbsent = false;
+      if (auto again = r->answered(&child, wasAbsent)) return YNode(node_.fileHandle(), *again);
+      if (wasAbsent) return std::nullopt;
+      if (!r->answerHas()) {
+        r->remember(&child, std::nullopt);
+        return std::nullopt;
+      }
+      n = r->placeholder();
+      r->remember(&child, n);
+    } else {
+      n = entries_[it->second].value.node();
+    }
     r->bind(n, child);
     return YNode(node_.fileHandle(), n);
   }
@@ -796,7 +852,7 @@ std::optional<fs::path> MapReader::path(std::string_view key, const PathPolicy& 
 }
 
 void MapReader::finish() {
-  if (schema_) schema_->closed = true;
+  if (schema_) schema_->closed = true, ++schema_->finishes;
   std::vector<std::string> candidates(known_.begin(), known_.end());
   for (const auto& e : entries_) {
     const std::string name = e.key.scalar();
@@ -814,13 +870,35 @@ void MapReader::finish() {
   }
 }
 
+std::optional<std::pair<YNode, YNode>> describeOneKey(const YNode& node, const std::vector<std::string>& names,
+                                                      const std::string& definition) {
+  detail::KeySchema* s = describing(node.node());
+  if (!s) return std::nullopt;
+  detail::KeyRecorder* rec = detail::KeyRecorder::active();
+  if (detail::KeySchema* shared = definition.empty() ? nullptr : rec->definition(definition)) {
+    // Every position holding one of these refers to one definition: nested ones included.
+    s->ref = definition;
+    s = shared;
+  }
+  s->types.insert("map");
+  for (const auto& n : names)
+    if (std::find(s->oneKey.begin(), s->oneKey.end(), n) == s->oneKey.end()) s->oneKey.push_back(n);
+  detail::KeyRecorder* r = detail::KeyRecorder::active();
+  if (!r->isPlaceholder(node.node())) return std::nullopt;  // a real map is read as it is
+  const std::optional<size_t> pick = r->chooseAlternative(names.size());
+  if (!pick) return std::nullopt;
+  // A key node naming the alternative, and a placeholder value bound to its property.
+  YAML::Node value = r->placeholder();
+  r->bind(value, s->property(names[*pick]));
+  YAML::Node key(names[*pick]);
+  return std::make_pair(YNode(node.fileHandle(), key), YNode(node.fileHandle(), value));
+}
+
 std::optional<std::pair<YNode, YNode>> singleKey(const YNode& node, DiagnosticList& diags, const std::string& what,
                                                  const std::vector<std::string>& names) {
-  if (detail::KeySchema* s = describing(node.node())) {
-    s->types.insert("map");
-    for (const auto& n : names)
-      if (std::find(s->oneKey.begin(), s->oneKey.end(), n) == s->oneKey.end()) s->oneKey.push_back(n);
-  }
+  std::string definition;
+  for (char c : what) definition += c == ' ' ? '_' : c;
+  if (auto described = describeOneKey(node, names, definition)) return described;
   std::string list;
   for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
   if (!node.isMap() || node.pairs().size() != 1) {

@@ -252,6 +252,17 @@ class MapReader {
   detail::KeySchema* schema_ = nullptr;  // `sprig schema` only (model/detail/key_recorder.h)
 };
 
+/// Describe mode (`sprig schema`) only: records that node is a map with one key among names
+/// and, when node is a placeholder, returns one of them (chosen per pass) with a
+/// placeholder value bound to that key's schema, so the reader goes on to describe that
+/// alternative's keys. Outside describe mode, or for a real node, nullopt. singleKey calls
+/// it; readers that check their one key themselves (blob nodes) call it first.
+/// With a definition name, every position described this way refers to one shared schema
+/// of that name (`$ref`), so nested and recurring ones (a blob node's children) are checked
+/// alike; singleKey uses its `what` ("distance field" -> distance_field).
+std::optional<std::pair<YNode, YNode>> describeOneKey(const YNode& node, const std::vector<std::string>& names,
+                                                      const std::string& definition = "");
+
 /// A map with exactly one key among names (`{sphere: {...}}`): that key and its value.
 /// Otherwise adds "WHAT must be a map with one key, one of: A, B" or "unknown WHAT 'K' (did
 /// you mean ...)" at the node and returns nullopt.

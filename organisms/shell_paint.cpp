@@ -47,8 +47,13 @@ HelicoCoords ShellPainter::helicoCoords(Vec3 q) const {
   return best;
 }
 
-Vec3 ShellPainter::whorlColor(Vec3 shellPoint) const {
-  const HelicoCoords h = helicoCoords(shellPoint);
+HelicoCoords ShellPainter::helicoCoordsOfWorld(Vec3 worldPoint) const {
+  return helicoCoords(Vec3(shellFromWorld_ * glm::dvec4(DVec3(worldPoint), 1.0)));
+}
+
+Vec3 ShellPainter::whorlColor(Vec3 shellPoint) const { return whorlColorAt(helicoCoords(shellPoint)); }
+
+Vec3 ShellPainter::whorlColorAt(const HelicoCoords& h) const {
   const ShellTextureOptions& o = options_;
   Vec3 c = o.whorlColor;
   // Spiral cords: bands that follow the spiral (constant angle around the curve).

@@ -65,6 +65,12 @@ class ShellPainter {
   Vec3 partColor(ShellPart part, Vec3 worldPoint, Vec2 uv) const;
   /// Helico-spiral coordinates of a shell-space point (see the file comment).
   HelicoCoords helicoCoords(Vec3 shellPoint) const;
+  /// Helico-spiral coordinates of a world point (helicoCoords of its shell-space point).
+  HelicoCoords helicoCoordsOfWorld(Vec3 worldPoint) const;
+  /// The main whorl's colour at helico-spiral coordinates (only thetaDeg and aroundDeg
+  /// matter): partColor(Whorl, p, uv) is whorlColorAt(helicoCoordsOfWorld(p)). Exports bake
+  /// it into an image over (aroundDeg, thetaDeg).
+  Vec3 whorlColorAt(const HelicoCoords& coords) const;
   const ShellTextureOptions& options() const { return options_; }
 
  private:

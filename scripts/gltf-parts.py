@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Checks that a .glb written by `sprig mesh` keeps the parts and colours its species says.
 
-Usage: gltf-parts.py SPECIES.yaml FILE.glb [--expect NAME ...]
+Usage: gltf-parts.py SPECIES.yaml FILE.glb [--expect NAME ...] [--textured NAME ...]
 
 Reads the species file itself (PyYAML) and works out, independently of Sprig's code, which
 parts the kind may export and each part's colour: trees wood/leaves/fruit from `render:`
@@ -11,7 +11,10 @@ parts the kind may export and each part's colour: trees wood/leaves/fruit from `
 Then reads the GLB's JSON chunk and asserts: every node has a name the kind allows and a mesh
 whose primitives use the material of the same name; each material's baseColorFactor equals
 the expected colour (to 1e-6), alpha 1; leaves are double-sided and nothing else is; each
---expect NAME is present. Prints one line per part; exits 1 on any mismatch.
+--expect NAME is present. A material with a baseColorTexture (a baked bark or shell texture)
+must instead have baseColorFactor 1, the expected colour in extras.sprigBaseColor, an
+embedded PNG (bufferView, image/png, PNG signature), TEXCOORD_0 and no COLOR_0; each
+--textured NAME must be such a part. Prints one line per part; exits 1 on any mismatch.
 """
 import json
 import os
@@ -81,11 +84,22 @@ def glb_json(path):
     return json.loads(data[20:20 + chunk_length])
 
 
+def glb_bin(path):
+    data = open(path, 'rb').read()
+    json_length = struct.unpack_from('<I', data, 12)[0]
+    offset = 20 + json_length
+    bin_length, bin_type = struct.unpack_from('<II', data, offset)
+    if bin_type != 0x004E4942:
+        raise SystemExit('gltf-parts: error: %s: the second chunk is not BIN' % path)
+    return data[offset + 8:offset + 8 + bin_length]
+
+
 def main(argv):
     if len(argv) < 3:
         raise SystemExit(__doc__)
     species_path, glb_path = argv[1], argv[2]
     expect = [argv[i + 1] for i in range(3, len(argv) - 1) if argv[i] == '--expect']
+    want_textured = [argv[i + 1] for i in range(3, len(argv) - 1) if argv[i] == '--textured']
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     species = yaml.safe_load(open(species_path))
     allowed, required = expected_parts(species, root)
@@ -93,6 +107,7 @@ def main(argv):
     materials = gltf.get('materials', [])
     bad = []
     seen = []
+    textured = []
     for node in gltf.get('nodes', []):
         name = node.get('name')
         seen.append(name)
@@ -106,17 +121,38 @@ def main(argv):
             want = allowed[name]
             if mat.get('name') != name:
                 bad.append('node %r uses material %r' % (name, mat.get('name')))
+            tex = mat['pbrMetallicRoughness'].get('baseColorTexture')
+            if tex is not None:
+                # A baked texture holds absolute colours: factor 1, the species' colour in extras.
+                textured.append(name)
+                if factor != [1, 1, 1, 1]:
+                    bad.append('%s: textured, but baseColorFactor is %s, not 1' % (name, factor))
+                factor = mat.get('extras', {}).get('sprigBaseColor', [-1, -1, -1]) + [1]
+                image = gltf['images'][gltf['textures'][tex['index']]['source']]
+                view = gltf['bufferViews'][image.get('bufferView', -1)] if 'bufferView' in image else None
+                if image.get('mimeType') != 'image/png' or view is None:
+                    bad.append('%s: the texture is not an embedded PNG' % name)
+                elif glb_bin(glb_path)[view.get('byteOffset', 0):][:8] != b'\x89PNG\r\n\x1a\n':
+                    bad.append('%s: the texture bytes are not a PNG' % name)
+                if 'TEXCOORD_0' not in prim['attributes']:
+                    bad.append('%s: textured without TEXCOORD_0' % name)
+                if 'COLOR_0' in prim['attributes']:
+                    bad.append('%s: textured and COLOR_0 (they multiply)' % name)
             if any(abs(a - b) > 1e-6 for a, b in zip(factor[:3], want)) or factor[3] != 1:
                 bad.append('%s: baseColorFactor %s, the species says %s' % (name, factor, want))
             if bool(mat.get('doubleSided', False)) != (name == 'leaves'):
                 bad.append('%s: doubleSided is %s' % (name, mat.get('doubleSided', False)))
-            print('%s: %s part %s baseColorFactor [%.4f, %.4f, %.4f]%s%s' % (
-                glb_path, species.get('kind'), name, factor[0], factor[1], factor[2],
+            print('%s: %s part %s %s [%.4f, %.4f, %.4f]%s%s' % (
+                glb_path, species.get('kind'), name, 'texture, sprigBaseColor' if tex is not None else 'baseColorFactor',
+                factor[0], factor[1], factor[2],
                 ' double-sided' if mat.get('doubleSided') else '',
                 ' COLOR_0' if 'COLOR_0' in prim['attributes'] else ''))
-    for name in required + expect:
+    for name in required + expect + want_textured:
         if name not in seen:
             bad.append('no part named %r' % name)
+    for name in want_textured:
+        if name in seen and name not in textured:
+            bad.append('part %r has no baseColorTexture' % name)
     if len(set(seen)) != len(seen):
         bad.append('repeated part names %s' % seen)
     for b in bad:

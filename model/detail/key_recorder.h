@@ -16,7 +16,8 @@
 /// schema is the same every time). The union of what the passes saw is the key table. With
 /// no recorder active (every real read) nothing here runs.
 ///
-/// Only model/yaml_reader.cpp (the recording hooks) and model/schema.cpp (the generator)
+/// Only model/yaml_reader.cpp (the recording hooks), model/schema.cpp (the generator) and
+/// model/blob_kind.cpp (a texture id's range is the file's list length, not a constant)
 /// include this header.
 
 #include <yaml-cpp/yaml.h>
@@ -42,8 +43,10 @@ struct KeySchema {
   std::string defaultJson;           ///< the default as JSON (empty: none / required)
   std::string context;               ///< the map's name in the reader's messages ("render.view")
   bool closed = false;               ///< a map whose finish() ran: other keys are errors
+  int finishes = 0;                  ///< passes whose reader finished this map (how well its keys are known)
   bool dataKeys = false;             ///< a map whose keys are names the file chooses (materials, defines)
   std::set<std::string> required;    ///< keys of this map that requiredString demands
+  std::string ref;  ///< the position holds a shared definition (KeyRecorder::definition) of this name
   std::map<std::string, std::unique_ptr<KeySchema>> properties;  ///< a map's keys
   std::unique_ptr<KeySchema> items;                              ///< a sequence's elements
 
@@ -82,6 +85,24 @@ class KeyRecorder {
   YAML::Node placeholder();
   /// What MapReader::has answers in this pass.
   bool answerHas();
+  /// Which of n alternatives (a one-key map's names) this pass descends into, or nullopt
+  /// when the pass has used its budget of descents (kMaxDescents: one-key maps nest, e.g.
+  /// a blob node's children, a distance field's union, so a pass stops somewhere).
+  std::optional<size_t> chooseAlternative(size_t n);
+  /// The answer this pass already gave for an absent key at position `at` (a placeholder,
+  /// or null for "absent"), so a reader asking twice gets the same answer; nullopt before
+  /// the first time.
+  std::optional<YAML::Node> answered(const KeySchema* at, bool& wasAbsent) const;
+  /// Remembers the answer for `at` (an invalid node = absent).
+  void remember(const KeySchema* at, std::optional<YAML::Node> answer);
+  /// Shared definitions (one-key maps that recur at many positions and nest: blob nodes,
+  /// distance fields, layers, operations), kept by the generator across passes and kinds;
+  /// null until setDefinitions.
+  void setDefinitions(std::map<std::string, std::unique_ptr<KeySchema>>* definitions) { definitions_ = definitions; }
+  /// The shared definition of this name (created on first use), or null without definitions.
+  KeySchema* definition(const std::string& name);
+  /// Most one-key descents in one pass.
+  static constexpr int kMaxDescents = 48;
   bool isPlaceholder(const YAML::Node& node) const;
 
  private:
@@ -90,6 +111,9 @@ class KeyRecorder {
   KeySchema* root_;
   int pass_;
   uint64_t questions_ = 0;
+  int descents_ = 0;
+  std::map<std::string, std::unique_ptr<KeySchema>>* definitions_ = nullptr;
+  std::map<const KeySchema*, std::optional<YAML::Node>> answers_;
   std::vector<std::pair<YAML::Node, KeySchema*>> bound_;
   std::vector<YAML::Node> placeholders_;
   KeyRecorder* previous_;

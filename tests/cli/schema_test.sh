@@ -6,7 +6,8 @@
 #   3. files the reader rejects for an unknown key, a wrong type, a value out of range, a
 #      wrong word or colour, a missing or unknown kind (tests/bad_inputs and a few edits of
 #      shipped species) are rejected by the schema too, and the same edits within range are
-#      accepted by both.
+#      accepted by both; so are unknown keys inside blob nodes (also nested in a blend),
+#      solids' distance fields (also in a union), layers and operations.
 # Usage: tests/cli/schema_test.sh path/to/sprig   (run from the repository root)
 set -euo pipefail
 SPRIG=$(realpath "$1")
@@ -75,4 +76,23 @@ both fig_shell_07a_varix_spines 'stages: [1, 2]' valid
 both fig_shell_07a_varix_spines 'stages: [1, -2]' invalid
 both blob_ricci_fig3 'kernel: soft' valid
 both blob_ricci_fig3 'kernel: smooth' invalid
+# Keys inside the parts the readers walk themselves (one-key maps): blob nodes, nested in
+# blends; solids' distance fields, nested in unions; operations.
+printf 'kind: blob\n' > "$WORK/lib/species/blobbase.yaml"
+printf 'kind: solid\n' > "$WORK/lib/species/solidbase.yaml"
+sphere='volume: {distance_field: {sphere: {radius: 1}}, layers: [{interior_layer: {material: wood, thickness: fill}}]}'
+both blobbase 'blob: {point: {radius: 1}}' valid
+both blobbase 'blob: {point: {radius: 1, colour: 2}}' invalid
+both blobbase 'blob: {blend: [{point: {radius: 1}}, {point: {radius: 1, center: [0, 0, 0]}}]}' valid
+both blobbase 'blob: {blend: [{point: {radius: 1}}, {point: {radius: 1, centre: [0, 0, 0]}}]}' invalid
+both blobbase 'blob: {cone: {a: [0, 0, 0], b: [0, 1, 0], radius: 0.2, offset_radius: -1}}' invalid
+both blobbase 'blob: {blob: {radius: 1}}' invalid
+both solidbase "solid: {$sphere}" valid
+both solidbase 'solid: {volume: {distance_field: {sphere: {radius: 1, radious: 2}}, layers: [{interior_layer: {material: wood, thickness: fill}}]}}' invalid
+both solidbase 'solid: {volume: {distance_field: {union: [{sphere: {radius: 1}}, {box: {size: [1, 1, 1]}}]}, layers: [{interior_layer: {material: wood, thickness: fill}}]}}' valid
+both solidbase 'solid: {volume: {distance_field: {union: [{sphere: {radius: 1}}, {box: {size: [1, 1, 1], sise: 2}}]}, layers: [{interior_layer: {material: wood, thickness: fill}}]}}' invalid
+both solidbase 'solid: {volume: {distance_field: {sphere: {radius: 1}}, layers: [{interior_layer: {material: wood, thickness: fill, colour: 1}}]}}' invalid
+both solidbase "solid: {$sphere, operations: [{hammer: {rounds: 2}}]}" valid
+both solidbase "solid: {$sphere, operations: [{hammer: {rounds: 2, strength: 1}}]}" invalid
+both solidbase "solid: {$sphere, operations: [{polish: {shiny: 0.5}}, {dirt: {amount: 0.5, colour: 1}}]}" invalid
 echo "schema: ok ($n shipped species valid, ${#rejected[@]} bad inputs and $edits edits agree with sprig)"

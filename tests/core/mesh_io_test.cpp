@@ -343,3 +343,72 @@ TEST_CASE("writeParts", "[core]") {
     CHECK(dir.entries() == 0);
   }
 }
+
+TEST_CASE("writeParts::texture", "[core]") {
+  TempDir dir;
+  // One quad and a 4 x 2 texture: red on the top row, blue below.
+  ExportPart quad;
+  quad.name = "bark";
+  quad.mesh.positions = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0)};
+  quad.mesh.uvs = {Vec2(0.2f, 0), Vec2(0.6f, 0), Vec2(0.6f, 1), Vec2(0.2f, 1)};  // u spans < 0.5: no seam
+  quad.mesh.colors.assign(4, Vec3(0.9f, 0.1f, 0.1f));  // brighter than the base colour: no COLOR_0, nothing clamped
+  quad.mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  auto tex = std::make_shared<PartTexture>();
+  tex->image = Image(4, 2, Vec4(0, 0, 1, 1));
+  for (int x = 0; x < 4; ++x) tex->image.set(x, 0, Vec4(1, 0, 0, 1));
+  tex->seams.repeatU = true;
+  quad.material = PartMaterial{"bark", Vec3(0.3f, 0.2f, 0.1f), 0.8f, false, tex};
+  CHECK(clampedColorChannels(quad) == 0);
+  SECTION("glb: an embedded PNG as baseColorTexture, factor 1, the base colour in extras, no COLOR_0") {
+    const fs::path file = dir.path / "t.glb";
+    const auto reports = writeParts({quad}, file);
+    REQUIRE(reports.size() == 1);
+    CHECK(reports[0].textureWidth == 4);
+    CHECK(reports[0].textureHeight == 2);
+    tinygltf::Model model;
+    tinygltf::TinyGLTF loader;
+    std::string err, warn;
+    REQUIRE(loader.LoadBinaryFromFile(&model, &err, &warn, file.string()));
+    REQUIRE(model.materials.size() == 1);
+    const auto& pbr = model.materials[0].pbrMetallicRoughness;
+    CHECK(pbr.baseColorFactor == std::vector<double>{1, 1, 1, 1});
+    REQUIRE(pbr.baseColorTexture.index == 0);
+    REQUIRE(model.textures.size() == 1);
+    REQUIRE(model.images.size() == 1);
+    const auto& image = model.images[size_t(model.textures[0].source)];
+    CHECK(image.mimeType == "image/png");
+    CHECK(image.bufferView >= 0);
+    // TinyGLTF decodes the PNG (stb_image): 4 x 2, 8-bit sRGB red over blue.
+    REQUIRE(image.width == 4);
+    REQUIRE(image.height == 2);
+    CHECK(int(image.image[0]) == 255);
+    CHECK(int(image.image[size_t(image.component) * 4 + 2]) == 255);
+    CHECK(int(image.image[size_t(image.component) * 4 + 0]) == 0);
+    const auto& sampler = model.samplers[size_t(model.textures[0].sampler)];
+    CHECK(sampler.wrapS == TINYGLTF_TEXTURE_WRAP_REPEAT);
+    CHECK(sampler.wrapT == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE);
+    const auto& extras = model.materials[0].extras.Get("sprigBaseColor");
+    REQUIRE(extras.IsArray());
+    CHECK(extras.Get(0).GetNumberAsDouble() == Approx(0.3));
+    const auto& prim = model.meshes[0].primitives[0];
+    CHECK(prim.attributes.count("COLOR_0") == 0);
+    CHECK(prim.attributes.count("TEXCOORD_0") == 1);
+    CHECK(dir.entries() == 1);  // the PNG went into the file, no temporary left beside it
+  }
+  SECTION("obj: the PNG beside it, map_Kd and Kd 1 in the MTL") {
+    const fs::path file = dir.path / "t.obj";
+    writeParts({quad}, file);
+    CHECK(fs::exists(dir.path / "t_bark.png"));
+    const std::string mtl = readFile(dir.path / "t.mtl");
+    CHECK(mtl.find("newmtl bark\nKa 0 0 0\nKd 1 1 1\n") != std::string::npos);
+    CHECK(mtl.find("map_Kd t_bark.png\n") != std::string::npos);
+    CHECK(readFile(file).find("f 1/1 2/2 3/3\n") != std::string::npos);
+    CHECK(dir.entries() == 3);
+  }
+  SECTION("a texture without uvs is refused, nothing written") {
+    ExportPart bad = quad;
+    bad.mesh.uvs.clear();
+    CHECK_THROWS_AS(writeParts({bad}, dir.path / "bad.obj"), std::invalid_argument);
+    CHECK(dir.entries() == 0);
+  }
+}

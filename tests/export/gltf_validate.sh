@@ -9,14 +9,14 @@ set -euo pipefail
 sprig="$1"
 out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
-# species  [parts it must have]  (flags after '|')
+# species  [parts it must have; *part: with a baked baseColorTexture]  (flags after '|')
 species=(
   "abop_1_24a wood | --steps 3"            # tree, skeleton of an L-system
-  "fig_tree_12_pcm_offset wood"            # tree, BlobTree with PCM
-  "tree_lime wood leaves | --steps 3 --cell 0.01"  # tree in leaf: wood and double-sided leaves apart
-  "shell_top whorl inside"                 # shell, painted pigment
-  "fig_shell_07b_varix_full whorl varices" # shell with varices and their spines
-  "fig_shell_09a_axial_straight whorl varices spines"  # shell with axial canal spines
+  "fig_tree_12_pcm_offset wood"             # tree, BlobTree with PCM, bark off: no image
+  "tree_lime *wood leaves | --steps 3 --cell 0.01"  # tree in leaf: wood and double-sided leaves apart
+  "shell_top *whorl inside"                 # shell, painted pigment
+  "fig_shell_07b_varix_full *whorl varices" # shell with varices and their spines
+  "fig_shell_09a_axial_straight *whorl varices spines"  # shell with axial canal spines
   "blob_ricci_fig3 blob"                   # blob
   "fig_org_05b_berry_level2 organism"      # organism on a primitive
   "fig_org_13a_mummified_skull_sharp organism"  # organism on a CT volume, blend colour
@@ -37,7 +37,9 @@ for entry in "${species[@]}"; do
   "$sprig" mesh "species/$s.yaml" -o "$f" $flags >/dev/null
   files+=("$f")
   expect=()
-  for p in $parts; do expect+=(--expect "$p"); done
+  for p in $parts; do
+    if [[ "$p" == \** ]]; then expect+=(--textured "${p#\*}"); else expect+=(--expect "$p"); fi
+  done
   python3 scripts/gltf-parts.py "species/$s.yaml" "$f" "${expect[@]}"
 done
 node scripts/gltf-validate.js "${files[@]}"

@@ -1,6 +1,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <map>
 #include <string>
@@ -46,6 +47,35 @@ Mesh weld(const std::vector<ExportPart>& parts, const std::vector<std::string>& 
     for (const auto& t : p.mesh.triangles) out.triangles.push_back(glm::uvec3(remap[t.x], remap[t.y], remap[t.z]));
   }
   return out;
+}
+
+// The bilinearly filtered colour of a baked texture at (s, t) (t = 0 at the bottom row),
+// repeating in s, clamped in t: what a viewer shows there.
+Vec3 sampleTexture(const PartTexture& tex, Vec2 st) {
+  const Image& im = tex.image;
+  const float x = st.x * float(im.width) - 0.5f, y = (1.0f - st.y) * float(im.height) - 0.5f;
+  const int x0 = int(std::floor(x)), y0 = int(std::floor(y));
+  const float fx = x - float(x0), fy = y - float(y0);
+  auto texel = [&](int xi, int yi) {
+    xi = ((xi % im.width) + im.width) % im.width;
+    yi = std::clamp(yi, 0, im.height - 1);
+    return Vec3(im.at(xi, yi));
+  };
+  return glm::mix(glm::mix(texel(x0, y0), texel(x0 + 1, y0), fx), glm::mix(texel(x0, y0 + 1), texel(x0 + 1, y0 + 1), fx), fy);
+}
+
+// Median over a part's vertices of |texture at the vertex's uv − the vertex colour| (the
+// colour the renderer gives the vertex), the largest channel; flipT reads the image upside down.
+float medianTextureError(const ExportPart& part, bool flipT) {
+  std::vector<float> err;
+  for (size_t v = 0; v < part.mesh.vertexCount(); ++v) {
+    Vec2 st = part.mesh.uvs[v];
+    if (flipT) st.y = 1.0f - st.y;
+    const Vec3 d = glm::abs(sampleTexture(*part.material.texture, st) - part.mesh.colors[v]);
+    err.push_back(std::max({d.x, d.y, d.z}));
+  }
+  std::nth_element(err.begin(), err.begin() + long(err.size() / 2), err.end());
+  return err[err.size() / 2];
 }
 
 const ExportPart* find(const std::vector<ExportPart>& parts, const std::string& name) {
@@ -116,6 +146,23 @@ TEST_CASE("SpeciesModel::exportParts of shipped species", "[model][slow]") {
     CHECK(signedVolume(surface) > 0);
     CHECK(fig.clean.componentsAfter == c.components);
     CHECK(fig.clean.facesAgainstAfter < fig.clean.facesAgainstBefore + 1);
+    // The bark and the main whorl are baked into images over the uvs the renderer's
+    // texture reads: the image at each vertex's uv is the vertex's colour (the median
+    // vertex within 3 of 255), while the same image read upside down is not.
+    // fig_tree_12 turns its bark off (bark: {enabled: false}): its wood has no image.
+    if (std::string(c.species) == "fig_tree_12_pcm_offset") CHECK(find(parts, "wood")->material.texture == nullptr);
+    const ExportPart* textured = std::string(c.species) == "tree_lime" ? find(parts, "wood") : find(parts, "whorl");
+    if (textured) {
+      REQUIRE(textured->material.texture != nullptr);
+      CHECK(textured->material.texture->seams.repeatU);
+      CHECK(textured->material.texture->image.height == kExportTextureLong);
+      const float right = medianTextureError(*textured, false), flipped = medianTextureError(*textured, true);
+      INFO("median texture error " << right << ", read upside down " << flipped);
+      CHECK(right < 3.0f / 255.0f);
+      // Where the upside-down image differs (not 07b's plain whorl, nor the turret's
+      // cords, which run along θ, and growth lines, periodic along it), the right one is far closer.
+      if (flipped > 0.02f) CHECK(flipped > 20.0f * right);
+    }
     if (std::string(c.species) == "shell_turret") {
       CHECK(fig.clean.componentsBefore == 18);
       CHECK(fig.clean.specks == 3);
