@@ -349,8 +349,12 @@ class TreeModel final : public KindModel {
     parts[0].mesh.materials.clear();
     parts[0].material = {"wood", look.style.wood.baseColor, look.style.wood.roughness, false, nullptr};
     // The bark as an image over the wood's (u, v), the renderer's own bark function baked.
+    // One image reproduces the render only where every cone wears the same bark: with bark
+    // per girth (several classes, each cone coloured in its own coordinates and the colours
+    // blended) or darkened PCM seams, the wood keeps the renderer's vertex colours.
     const uint16_t barkId = static_cast<uint16_t>(tree.options.bark.texture);
-    if (tree.options.bark.enabled && barkId < implicit.textures.size() && parts[0].mesh.triangleCount() > 0) {
+    const bool oneBark = tree.blob.barkClasses.size() == 1 && !(tree.options.bark.ridgeDarkening > 0);
+    if (tree.options.bark.enabled && oneBark && barkId < implicit.textures.size() && parts[0].mesh.triangleCount() > 0) {
       const render::ColorTexture& bark = implicit.textures[barkId];
       textureBark(parts[0], [&bark](Vec2 uv) { return bark(uv, Vec3(0.0f)); });
     }

@@ -13,7 +13,8 @@ trap 'rm -rf "$out"' EXIT
 species=(
   "abop_1_24a wood | --steps 3"            # tree, skeleton of an L-system
   "fig_tree_12_pcm_offset wood"             # tree, BlobTree with PCM, bark off: no image
-  "tree_lime *wood leaves | --steps 3 --cell 0.01"  # tree in leaf: wood and double-sided leaves apart
+  "tree_lime wood leaves | --steps 3 --cell 0.01"  # tree in leaf: wood and double-sided leaves apart (bark per girth: vertex colours)
+  "tree_scarred *wood | --steps 4"        # one bark for every cone: baked into an image
   "shell_top *whorl inside"                 # shell, painted pigment
   "fig_shell_07b_varix_full *whorl varices" # shell with varices and their spines
   "fig_shell_09a_axial_straight *whorl varices spines"  # shell with axial canal spines
