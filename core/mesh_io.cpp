@@ -122,6 +122,29 @@ Vec3 materialColor(const Vec3& base, uint32_t id) {
   return 0.5f * base + 0.5f * rgb;
 }
 
+/// Appends one attribute or index array to data (4-byte aligned) as its own buffer view
+/// and accessor of model; returns the accessor's index.
+int addGltfAccessor(tinygltf::Model& model, std::vector<unsigned char>& data, const void* bytes, size_t byteLength,
+                    size_t count, int type, int componentType, int target) {
+  while (data.size() % 4) data.push_back(0);
+  tinygltf::BufferView view;
+  view.buffer = 0;
+  view.byteOffset = data.size();
+  view.byteLength = byteLength;
+  view.target = target;
+  auto* b = static_cast<const unsigned char*>(bytes);
+  data.insert(data.end(), b, b + byteLength);
+  model.bufferViews.push_back(view);
+  tinygltf::Accessor acc;
+  acc.bufferView = int(model.bufferViews.size() - 1);
+  acc.byteOffset = 0;
+  acc.componentType = componentType;
+  acc.count = count;
+  acc.type = type;
+  model.accessors.push_back(acc);
+  return int(model.accessors.size() - 1);
+}
+
 }  // namespace
 
 MeshFormat meshFormatFor(const fs::path& path) {
@@ -249,26 +272,8 @@ void writeGlb(const Mesh& mesh, const fs::path& path, const MeshWriteOptions& op
   if (!mesh.triangles.empty()) {
     tinygltf::Buffer buffer;
     std::vector<unsigned char>& data = buffer.data;
-    // Appends one attribute or index array as its own buffer view and accessor.
-    auto addAccessor = [&](const void* bytes, size_t byteLength, size_t count, int type, int componentType,
-                           int target) {
-      while (data.size() % 4) data.push_back(0);
-      tinygltf::BufferView view;
-      view.buffer = 0;
-      view.byteOffset = data.size();
-      view.byteLength = byteLength;
-      view.target = target;
-      auto* b = static_cast<const unsigned char*>(bytes);
-      data.insert(data.end(), b, b + byteLength);
-      model.bufferViews.push_back(view);
-      tinygltf::Accessor acc;
-      acc.bufferView = int(model.bufferViews.size() - 1);
-      acc.byteOffset = 0;
-      acc.componentType = componentType;
-      acc.count = count;
-      acc.type = type;
-      model.accessors.push_back(acc);
-      return int(model.accessors.size() - 1);
+    auto addAccessor = [&](const void* bytes, size_t byteLength, size_t count, int type, int componentType, int target) {
+      return addGltfAccessor(model, data, bytes, byteLength, count, type, componentType, target);
     };
     size_t n = mesh.positions.size();
     tinygltf::Primitive prim;
@@ -415,23 +420,7 @@ std::vector<PartWriteReport> writePartsGlb(const std::vector<ExportPart>& parts,
   tinygltf::Buffer buffer;
   std::vector<unsigned char>& data = buffer.data;
   auto addAccessor = [&](const void* bytes, size_t byteLength, size_t count, int type, int componentType, int target) {
-    while (data.size() % 4) data.push_back(0);
-    tinygltf::BufferView view;
-    view.buffer = 0;
-    view.byteOffset = data.size();
-    view.byteLength = byteLength;
-    view.target = target;
-    auto* b = static_cast<const unsigned char*>(bytes);
-    data.insert(data.end(), b, b + byteLength);
-    model.bufferViews.push_back(view);
-    tinygltf::Accessor acc;
-    acc.bufferView = int(model.bufferViews.size() - 1);
-    acc.byteOffset = 0;
-    acc.componentType = componentType;
-    acc.count = count;
-    acc.type = type;
-    model.accessors.push_back(acc);
-    return int(model.accessors.size() - 1);
+    return addGltfAccessor(model, data, bytes, byteLength, count, type, componentType, target);
   };
   for (const ExportPart& part : parts) {
     if (part.mesh.triangles.empty()) continue;

@@ -306,9 +306,13 @@ class TreeModel final : public KindModel {
     return out;
   }
 
-  Mesh buildMesh(const Stage& stage, float cellSize, bool progress, ModelFigures& fig) override {
+  /// The stage's skeleton (swayed by the stage's wind when sway) and its BlobTree surface,
+  /// for `sprig mesh`; fills fig's modules, internodes and primitives. Throws InputError
+  /// when the stage draws no internode.
+  TreeSurface meshSurface(const Stage& stage, bool sway, ModelFigures& fig, lsystem::Skeleton& skeleton) const {
     const int step = stage.step < 0 ? engine_.lastStep() : stage.step;
-    lsystem::Skeleton skeleton = windy(engine_.skeletonAt(step, stage.fraction), stage);
+    skeleton = engine_.skeletonAt(step, stage.fraction);
+    if (sway) skeleton = windy(std::move(skeleton), stage);
     fig.modules = engine_.moduleCount(step);
     fig.internodes = skeleton.internodes.size();
     if (skeleton.internodes.empty())
@@ -316,6 +320,12 @@ class TreeModel final : public KindModel {
                                            ": there is no surface to mesh");
     TreeSurface tree = buildTreeSurface(skeleton, spec_.surface.value_or(organisms::TreeOptions{}));
     fig.primitives = tree.compiled->primitiveCount();
+    return tree;
+  }
+
+  Mesh buildMesh(const Stage& stage, float cellSize, bool progress, ModelFigures& fig) override {
+    lsystem::Skeleton skeleton;
+    TreeSurface tree = meshSurface(stage, true, fig, skeleton);
     blobtree::PolygonizeOptions po;
     po.cellSize = cellSize;
     po.progress = progress;
@@ -326,15 +336,8 @@ class TreeModel final : public KindModel {
 
   std::vector<ExportPart> exportParts(const Stage& stage, float cellSize, bool progress, const SpeciesRender& look,
                                       const MeshCleanOptions& clean, ModelFigures& fig) override {
-    const int step = stage.step < 0 ? engine_.lastStep() : stage.step;
-    lsystem::Skeleton skeleton = engine_.skeletonAt(step, stage.fraction);
-    fig.modules = engine_.moduleCount(step);
-    fig.internodes = skeleton.internodes.size();
-    if (skeleton.internodes.empty())
-      throw InputError(species_.loc(), "the species draws no internodes at " + stageName(stage) +
-                                           ": there is no surface to mesh");
-    TreeSurface tree = buildTreeSurface(skeleton, spec_.surface.value_or(organisms::TreeOptions{}));
-    fig.primitives = tree.compiled->primitiveCount();
+    lsystem::Skeleton skeleton;
+    TreeSurface tree = meshSurface(stage, false, fig, skeleton);
     blobtree::PolygonizeOptions po = polygonizeOptions(look);
     po.cellSize = cellSize;
     po.progress = progress;
