@@ -13,7 +13,7 @@ BUILD=${1:?usage: fuzz/run.sh BUILD_DIR SECONDS [TARGET...]}
 SECS=${2:?usage: fuzz/run.sh BUILD_DIR SECONDS [TARGET...]}
 shift 2
 TARGETS=("$@")
-[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(grammar view expression derive species_tree species_shell species_blob species_organism species_solid polymesh image volume)
+[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(grammar view function expression derive species_tree species_shell species_blob species_organism species_solid polymesh image volume)
 ROOT=$(pwd)
 # The sanitizer settings of the Makefile, also when this script is run by hand.
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:detect_stack_use_after_return=0}
@@ -30,6 +30,8 @@ seed() {
       for f in tests/assets/cpfg/*/*.l; do cp "$f" "$dir/$(basename "$(dirname "$f")").l"; done ;;
     view)
       for f in tests/assets/cpfg/*/*.v; do cp "$f" "$dir/$(basename "$(dirname "$f")").v"; done ;;
+    function)
+      cp tests/assets/cpfg/function/*.func "$dir"/ ;;
     expression)
       for e in 't' 'x*0.9' 'sin(t)*x' 'max(0, 1 - t^2)' 'sqrt(x) + pow(t, 2) / 3' 'atan2(x, t) > 45 && t < 1' \
                'floor(x) == ceil(x) || !t' '-(-(-x))' 'min(t, max(x, 1e-3))' 'exp(log(t + 1))'; do

@@ -1,5 +1,7 @@
 #include "lsystem/cpfg_function.h"
 
+#include <cstdio>
+
 #include <charconv>
 #include <cmath>
 #include <sstream>
@@ -132,8 +134,13 @@ CpfgFunction CpfgFunction::parse(const std::string& text, const std::string& fil
     const size_t l = ls.next;
     const std::vector<double> v = numbers(ls, l, ls.expect("fver"));
     if (v.size() != 2 || v[0] != 1 || v[1] != 1)
-      ls.fail(l, 0, "function file version " + (v.size() == 2 ? std::to_string(int(v[0])) + "." + std::to_string(int(v[1])) : std::string("?")) +
+    {
+      // %g, not a cast to int: the version may be any number (1e31 made the cast undefined).
+      char version[64] = "?";
+      if (v.size() == 2) std::snprintf(version, sizeof version, "%g.%g", v[0], v[1]);
+      ls.fail(l, 0, std::string("function file version ") + version +
                         " is not supported (cpfg reads 'fver 1 1' and the 'range:' format)");
+    }
     const size_t nc = ls.expect("name:");
     f.name_ = ls.text[ls.next - 1].substr(nc);
     f.name_.erase(0, f.name_.find_first_not_of(" \t"));
@@ -147,6 +154,10 @@ CpfgFunction CpfgFunction::parse(const std::string& text, const std::string& fil
       const size_t ml = ls.next;
       const std::vector<double> m = numbers(ls, ml, ls.expect("markers:"));
       if (m.size() != 1 || m[0] < 0 || m[0] != std::floor(m[0])) ls.fail(ml, 0, "'markers:' takes one whole number");
+      // Compared as doubles first: a count past the file's end (1e105 once) is an error,
+      // never a cast out of range.
+      if (m[0] > double(ls.text.size() - ls.next))
+        ls.fail(ml, 0, "'markers:' counts more lines than the file has after it");
       ls.next += static_cast<size_t>(m[0]);
     }
     ls.expect("flip:");
