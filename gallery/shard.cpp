@@ -200,9 +200,31 @@ std::vector<size_t> shardItems(const Shard& shard, size_t itemCount) {
   return out;
 }
 
+/// The running program's own bytes (and its backends library), hashed once: a rebuilt Sprig (a changed renderer, a
+/// fixed texture) makes every picture stale, though the version string did not change.
+/// Empty when the executable cannot be read; nothing is then up to date.
+const std::string& executableHash() {
+  static const std::string hash = [] {
+    try {
+      Hasher h;
+      const fs::path exe = fs::read_symlink("/proc/self/exe");
+      h.add(readFile(exe));
+      // The image and volume code loaded beside it (backends/), when present.
+      std::error_code ec;
+      const fs::path backends = exe.parent_path() / "libsprig_backends.so";
+      if (fs::is_regular_file(backends, ec)) h.add(readFile(backends));
+      return h.hex();
+    } catch (const std::exception&) {
+      return std::string();
+    }
+  }();
+  return hash;
+}
+
 std::string galleryInputHash(const fs::path& speciesFile, std::string_view options) {
   Hasher h;
   h.add("sprig " SPRIG_VERSION);
+  h.add(executableHash());
   h.add(options);
   std::string text;
   try {
@@ -287,7 +309,7 @@ GalleryRunResult renderGallery(std::vector<fs::path> files, const fs::path& outD
     const std::string hash = galleryInputHash(f, optionText);
     auto old = previous.find(f.string());
     ManifestEntry entry;
-    if (old != previous.end() && old->second.hash == hash && old->second.item.error.empty() &&
+    if (old != previous.end() && !executableHash().empty() && old->second.hash == hash && old->second.item.error.empty() &&
         outputsExist(outDir, old->second.outputs)) {
       entry = old->second;
       ++result.skipped;

@@ -3,7 +3,7 @@
 #   1. a 2-shard gallery built by GNU parallel and merged equals a 1-shard gallery
 #      (same files, same bytes; index.html compared without its timing cells);
 #   2. a re-run renders nothing new;
-#   3. a changed species file re-renders only that species;
+#   3. a changed species file re-renders only that species; a rebuilt sprig re-renders all;
 #   4. a run killed mid-render (SIGKILL) leaves no partial image and resumes;
 #   5. frames of `sprig animate` equal single renders (`--at STAGE:FRACTION`).
 # Usage: tests/gallery/run.sh path/to/sprig   (run from the repository root)
@@ -66,6 +66,11 @@ grep -q "^species/shrub.yaml: [0-9]* modules" log3 || { cat log3; fail "shrub wa
 echo "/* changed */" >> grammars/growth_timed.lsys
 gallery -o out1 2> log4 || { cat log4; fail "run after a grammar change failed"; }
 grep -q "1 rendered, 2 up to date" log4 || { cat log4; fail "a changed grammar should re-render its species alone"; }
+# A rebuilt Sprig (here: the same program with a byte appended, so a different executable)
+# re-renders everything, since its pictures may differ though no input changed.
+mkdir "$WORK/rebuilt" && cp "$SPRIG" "$(dirname "$SPRIG")"/libsprig_backends.so "$WORK/rebuilt/" && printf 'x' >> "$WORK/rebuilt/sprig"
+"$WORK/rebuilt/sprig" --root . --threads 2 gallery species/*.yaml -o out1 2> log5 || { cat log5; fail "run of a rebuilt sprig failed"; }
+grep -q "3 rendered, 0 up to date" log5 || { cat log5; fail "a rebuilt sprig should re-render every species"; }
 
 # 4. Killed mid-render: completed outputs are whole, the rest absent or temporaries; a re-run
 #    resumes. The kill is aimed, not timed: the run starts in the background and is killed
