@@ -52,6 +52,7 @@ solids::HammerOptions readHammer(MapReader& m, solids::MaterialTable& materials,
                     ? solids::FractureCriterion::VonMises
                     : solids::FractureCriterion::MaxPrincipal;
   o.rounds = int(m.integer("rounds", o.rounds, 1, 1000));
+  o.manifold = m.boolean("manifold", o.manifold);
   return o;
 }
 
@@ -119,7 +120,11 @@ solids::ParticleOptions readParticles(MapReader& m, solids::ParticleTool tool, s
   o.fallingAngleDeg = m.number("falling_angle", o.fallingAngleDeg, 0.0, 180.0);
   o.radius = m.number("radius", o.radius, 1e-9, 1e6);
   if (tool != solids::ParticleTool::Erode) o.strength = m.number("strength", o.strength, 0.0, 1.0);
-  if (tool == solids::ParticleTool::Wash) o.attraction = m.number("attraction", o.attraction, 0.0, 1e6);
+  if (tool == solids::ParticleTool::Wash) {
+    o.attraction = m.number("attraction", o.attraction, 0.0, 1e6);
+    o.meander = m.number("meander", o.meander, 0.0, 1e6);
+    o.meanderScale = m.number("meander_scale", o.meanderScale, 1e-6, 1e6);
+  }
   if (tool == solids::ParticleTool::Lichen) {
     o.color = m.color("color", o.color);
     o.topAngleDeg = m.number("top_angle", o.topAngleDeg, 0.0, 90.0);

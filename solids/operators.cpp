@@ -120,7 +120,128 @@ size_t mendEdges(TetMesh& mesh, const std::vector<uint8_t>& affected) {
   return gone;
 }
 
+/// Removes, round by round, affected tetrahedra where the visible interface is not a
+/// manifold (surfaceDefects), until it is or only unaffected tetrahedra meet there. At a bad
+/// vertex (or edge) the tetrahedra around it are split into groups joined through faces at
+/// it (the pieces that touch there); the affected tetrahedra of every group but the largest
+/// go (the largest by count, then by lowest index), or, when they hold none or there is one
+/// group only, the affected tetrahedra around it. Returns how many went.
+size_t mendSurface(TetMesh& mesh, const std::vector<uint8_t>& affected) {
+  size_t gone = 0;
+  for (int round = 0; round < 64; ++round) {
+    const SurfaceDefects bad = surfaceDefects(mesh);
+    if (bad.edges.empty() && bad.vertices.empty()) break;
+    // Tetrahedra by vertex (compressed rows).
+    std::vector<uint32_t> start(mesh.positions.size() + 1, 0), items(mesh.tets.size() * 4);
+    for (const auto& q : mesh.tets)
+      for (uint32_t v : q) ++start[v + 1];
+    for (size_t v = 0; v + 1 < start.size(); ++v) start[v + 1] += start[v];
+    {
+      std::vector<uint32_t> at(start.begin(), start.end() - 1);
+      for (size_t t = 0; t < mesh.tets.size(); ++t)
+        for (uint32_t v : mesh.tets[t]) items[at[v]++] = uint32_t(t);
+    }
+    std::vector<uint8_t> keep(mesh.tets.size(), 1);
+    auto common = [&](uint32_t s, uint32_t t) {
+      int n = 0;
+      for (uint32_t x : mesh.tets[s]) n += std::find(mesh.tets[t].begin(), mesh.tets[t].end(), x) != mesh.tets[t].end() ? 1 : 0;
+      return n;
+    };
+    // Separates the pieces meeting at the tetrahedra `star` (all around one vertex or edge).
+    auto separate = [&](const std::vector<uint32_t>& star) {
+      const size_t k = star.size();
+      std::vector<uint32_t> parent(k);
+      for (size_t a = 0; a < k; ++a) parent[a] = uint32_t(a);
+      auto find = [&](uint32_t a) {
+        while (parent[a] != a) a = parent[a] = parent[parent[a]];
+        return a;
+      };
+      for (size_t a = 0; a < k; ++a)
+        for (size_t b = a + 1; b < k; ++b)
+          if (common(star[a], star[b]) == 3) parent[find(uint32_t(a))] = find(uint32_t(b));
+      std::vector<size_t> size(k, 0);
+      for (size_t a = 0; a < k; ++a) ++size[find(uint32_t(a))];
+      uint32_t largest = find(0);
+      for (size_t a = 0; a < k; ++a)
+        if (size[find(uint32_t(a))] > size[largest]) largest = find(uint32_t(a));
+      bool removed = false;
+      for (size_t a = 0; a < k; ++a)
+        if (find(uint32_t(a)) != largest && affected[mesh.materials[star[a]]]) keep[star[a]] = 0, removed = true;
+      if (!removed)
+        for (uint32_t t : star)
+          if (affected[mesh.materials[t]]) keep[t] = 0;
+    };
+    std::vector<uint32_t> star;
+    for (uint32_t v : bad.vertices) {
+      star.assign(items.begin() + start[v], items.begin() + start[v + 1]);
+      separate(star);
+    }
+    for (uint64_t e : bad.edges) {
+      const uint32_t a = uint32_t(e >> 32), b = uint32_t(e & 0xffffffffu);
+      star.clear();
+      for (uint32_t i = start[a]; i < start[a + 1]; ++i) {
+        const auto& q = mesh.tets[items[i]];
+        if (std::find(q.begin(), q.end(), b) != q.end()) star.push_back(items[i]);
+      }
+      separate(star);
+    }
+    const size_t r = removeTets(mesh, keep);
+    if (r == 0) break;
+    gone += r;
+  }
+  return gone;
+}
+
 }  // namespace
+
+SurfaceDefects surfaceDefects(const TetMesh& mesh) {
+  SurfaceDefects out;
+  const std::vector<InterfaceTriangle> tris = visibleInterface(mesh);
+  std::vector<uint64_t> edges;
+  std::vector<std::pair<uint32_t, uint32_t>> corners;  // (vertex, triangle)
+  for (size_t t = 0; t < tris.size(); ++t)
+    for (int e = 0; e < 3; ++e) {
+      const uint32_t a = tris[t].v[size_t(e)], b = tris[t].v[size_t((e + 1) % 3)];
+      edges.push_back(a < b ? (uint64_t(a) << 32) | b : (uint64_t(b) << 32) | a);
+      corners.push_back({a, uint32_t(t)});
+    }
+  std::sort(edges.begin(), edges.end());
+  for (size_t i = 0; i < edges.size();) {
+    size_t j = i + 1;
+    while (j < edges.size() && edges[j] == edges[i]) ++j;
+    if (j - i > 2) out.edges.push_back(edges[i]);
+    i = j;
+  }
+  // Fans: the triangles at a vertex, joined when they share a second vertex (an edge at it).
+  std::sort(corners.begin(), corners.end());
+  std::vector<uint32_t> parent;
+  for (size_t i = 0; i < corners.size();) {
+    size_t j = i + 1;
+    while (j < corners.size() && corners[j].first == corners[i].first) ++j;
+    const uint32_t v = corners[i].first;
+    const size_t k = j - i;
+    parent.resize(k);
+    for (size_t a = 0; a < k; ++a) parent[a] = uint32_t(a);
+    auto find = [&](uint32_t a) {
+      while (parent[a] != a) a = parent[a] = parent[parent[a]];
+      return a;
+    };
+    for (size_t a = 0; a < k; ++a)
+      for (size_t b = a + 1; b < k; ++b) {
+        const auto& ta = tris[corners[i + a].second].v;
+        const auto& tb = tris[corners[i + b].second].v;
+        bool share = false;
+        for (uint32_t x : ta)
+          if (x != v && std::find(tb.begin(), tb.end(), x) != tb.end()) share = true;
+        if (share) parent[find(uint32_t(a))] = find(uint32_t(b));
+      }
+    size_t fans = 0;
+    for (size_t a = 0; a < k; ++a) fans += find(uint32_t(a)) == a ? 1 : 0;
+    if (fans > 1) out.vertices.push_back(v);
+    i = j;
+  }
+  return out;
+}
 
 std::vector<uint8_t> hammerAnchors(const TetMesh& mesh, const HammerOptions& options) {
   const size_t nv = mesh.positions.size();
@@ -197,6 +318,11 @@ HammerStats hammer(TetMesh& mesh, const std::vector<Material>& materials, const 
     if (breaking == 0) break;
     st.broken += removeTets(mesh, keep);
     st.fallen += dropLoose(mesh, fixed);
+    if (options.manifold) {
+      const size_t mended = mendSurface(mesh, affected);
+      st.mended += mended;
+      if (mended) st.fallen += dropLoose(mesh, fixed);
+    }
     guess = std::move(r.displacement);
   }
   return st;

@@ -47,6 +47,13 @@ struct HammerOptions {
   /// Solve-and-break rounds: after tetrahedra break, the same blow is solved again on what
   /// is left, until nothing more breaks or this many solves ran.
   int rounds = 1;
+  /// After each round that broke something, mend the visible interface: affected
+  /// tetrahedra around an edge that more than two visible triangles share, or around a
+  /// vertex whose visible triangles form more than one fan (pieces left touching along an
+  /// edge or at a vertex only), are removed until no such edge or vertex is left (or only
+  /// unaffected tetrahedra meet there); then pieces left loose fall. false: the broken
+  /// surface is left as the fracture made it.
+  bool manifold = true;
   FemOptions fem;
 };
 
@@ -55,9 +62,21 @@ struct HammerStats {
   size_t loaded = 0;   ///< vertices the blow's force reached (first round)
   size_t broken = 0;   ///< tetrahedra removed for exceeding their strength
   size_t fallen = 0;   ///< tetrahedra removed because their piece lost its hold
+  size_t mended = 0;   ///< tetrahedra removed where pieces touched along an edge or at a vertex only
   int solves = 0;
   std::vector<FemStats> fem;  ///< one per solve
 };
+
+/// Where the visible interface (solids/solid.h) is not a manifold: edges (keys
+/// (min << 32) | max of their vertex ids) that more than two visible triangles share, and
+/// vertices whose visible triangles form more than one fan (groups joined through the
+/// edges at the vertex), both ascending. A closed manifold surface has neither. Cost
+/// O(T log T) in the visible triangles.
+struct SurfaceDefects {
+  std::vector<uint64_t> edges;
+  std::vector<uint32_t> vertices;
+};
+SurfaceDefects surfaceDefects(const TetMesh& mesh);
 
 /// The vertices hammer holds for these options (1 = held): options.anchored and the
 /// vertices of unaffected tetrahedra, or else the ground (see HammerOptions::anchored).
@@ -73,7 +92,8 @@ std::vector<DVec3> hammerForces(const TetMesh& mesh, const HammerOptions& option
 /// removes the tetrahedra of affected materials whose stress exceeds their material's
 /// strength, then every face-connected piece whose held vertices do not hold its rigid
 /// motions (solids/fem.h, componentsHeld): it falls away. Pieces already loose before the
-/// blow fall first. Repeats for options.rounds. Tetrahedra keep their order and vertices
+/// blow fall first. Then, with options.manifold, the surface is mended (see
+/// HammerOptions::manifold). Repeats for options.rounds. Tetrahedra keep their order and vertices
 /// their ids and positions (vertices no tetrahedron uses any more stay in the list), so the
 /// tetrahedra of unaffected materials are the same bytes before and after. Throws
 /// std::invalid_argument for bad options (see hammerForces; an `affects` id with no

@@ -9,6 +9,7 @@
 #include "core/progress.h"
 #include "core/rng.h"
 #include "solids/operators.h"
+#include "textures/noise.h"
 
 namespace sprig::solids {
 
@@ -191,7 +192,16 @@ struct Path {
   bool lost = false;
 };
 
-Path walk(const Surface& s, const ParticleOptions& o, double step, size_t index) {
+/// A smooth seeded vector field of three Perlin noises (the meander of a wash), about
+/// [-1, 1] per component.
+struct VectorNoise {
+  textures::PerlinNoise x, y, z;
+  explicit VectorNoise(uint64_t seed)
+      : x(deriveSeed(seed, {0x4d45414e44ull, 0})), y(deriveSeed(seed, {0x4d45414e44ull, 1})), z(deriveSeed(seed, {0x4d45414e44ull, 2})) {}
+  DVec3 operator()(const DVec3& p) const { return DVec3(x(p), y(p), z(p)); }
+};
+
+Path walk(const Surface& s, const ParticleOptions& o, double step, size_t index, const VectorNoise& noise) {
   Path path;
   Rng rng(deriveSeed(o.seed, {0x5041525449434cull, uint64_t(index)}));
   const DVec3 flo = s.frame(s.lo), fhi = s.frame(s.hi);
@@ -217,6 +227,7 @@ Path walk(const Surface& s, const ParticleOptions& o, double step, size_t index)
   const double level = std::sin(kPi / 180);
   const size_t steps = size_t(std::floor(o.life * o.speed / step + 1e-9));
   const double attract = o.tool == ParticleTool::Wash && !s.mesh.tints.empty() ? o.attraction : 0.0;
+  const double meander = o.tool == ParticleTool::Wash ? o.meander : 0.0;
   for (size_t k = 0; k < steps; ++k) {
     const DVec3 n = s.normal[size_t(t)];
     if (glm::dot(n, g) > cosFall) {
@@ -234,6 +245,12 @@ Path walk(const Surface& s, const ParticleOptions& o, double step, size_t index)
     const double len = glm::length(dir);
     if (len < level) break;  // level: at rest
     dir /= len;
+    DVec3 side(0.0);
+    if (meander > 0) {
+      // Meanders: the smooth noise field's part across the fall line, the same for every drop here.
+      const DVec3 f = noise(p / o.meanderScale);
+      side += meander * (f - glm::dot(f, dir) * dir - glm::dot(f, n) * n);
+    }
     if (attract > 0) {
       // Rivulets: steer sideways (never uphill) toward cleaner surface, down the gradient of
       // the tint amount over the face. Tints change only between batches, so this reads a
@@ -244,12 +261,13 @@ Path walk(const Surface& s, const ParticleOptions& o, double step, size_t index)
       if (twiceArea > 0) {
         const double a0 = s.mesh.tints[v[0]].a, a1 = s.mesh.tints[v[1]].a, a2 = s.mesh.tints[v[2]].a;
         const DVec3 grad = (a0 * glm::cross(n, q2 - q1) + a1 * glm::cross(n, q0 - q2) + a2 * glm::cross(n, q1 - q0)) / twiceArea;
-        DVec3 side = -grad - glm::dot(-grad, dir) * dir - glm::dot(-grad, n) * n;
-        side *= attract * o.radius;
-        const double sl = glm::length(side);
-        if (sl > 1) side /= sl;  // at most 45 degrees off the fall line
-        dir = glm::normalize(dir + side);
+        side += attract * o.radius * (-grad - glm::dot(-grad, dir) * dir - glm::dot(-grad, n) * n);
       }
+    }
+    if (side != DVec3(0.0)) {
+      const double sl = glm::length(side);
+      if (sl > 1) side /= sl;  // at most 45 degrees off the fall line
+      dir = glm::normalize(dir + side);
     }
     const auto [t2, p2] = s.nearest(p + dir * step);
     if (t2 < 0) {
@@ -325,6 +343,8 @@ ParticleStats runParticles(TetMesh& mesh, const std::vector<Material>& materials
   positive(o.radius, "radius");
   if (!(o.step >= 0) || !std::isfinite(o.step)) throw std::invalid_argument(tool + ": 'step' must not be negative");
   if (!(o.attraction >= 0) || !std::isfinite(o.attraction)) throw std::invalid_argument(tool + ": 'attraction' must be finite and not negative");
+  if (!(o.meander >= 0) || !std::isfinite(o.meander)) throw std::invalid_argument(tool + ": 'meander' must be finite and not negative");
+  positive(o.meanderScale, "meander_scale");
   if (!(o.strength >= 0 && o.strength <= 1)) throw std::invalid_argument(tool + ": 'strength' must lie in [0, 1]");
   if (!(o.fallingAngleDeg >= 0 && o.fallingAngleDeg <= 180)) throw std::invalid_argument(tool + ": 'falling_angle' must lie in [0, 180]");
   if (!(o.topAngleDeg >= 0 && o.topAngleDeg <= 90)) throw std::invalid_argument(tool + ": 'top_angle' must lie in [0, 90]");
@@ -364,13 +384,14 @@ ParticleStats runParticles(TetMesh& mesh, const std::vector<Material>& materials
         }
   };
 
+  const VectorNoise noise(o.seed);
   Progress progress(tool + " particles", uint64_t(o.particles));
   constexpr size_t kBatch = 4096;
   std::vector<Path> paths;
   for (size_t first = 0; first < size_t(o.particles); first += kBatch) {
     const size_t count = std::min(kBatch, size_t(o.particles) - first);
     paths.assign(count, Path{});
-    parallelFor(0, count, [&](size_t i) { paths[i] = walk(s, o, step, first + i); }, 16);
+    parallelFor(0, count, [&](size_t i) { paths[i] = walk(s, o, step, first + i, noise); }, 16);
     for (const Path& path : paths) {
       if (path.stops.empty()) {
         ++st.lost;

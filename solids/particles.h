@@ -61,6 +61,13 @@ struct ParticleOptions {
   /// CLINGING. Tints change between batches of 4,096 particles, so later particles follow
   /// the tracks earlier ones washed.
   double attraction = 0;
+  /// wash: meandering. Each step also turns sideways (never uphill, at most 45° with
+  /// attraction together) by meander·(the part across the fall line of a seeded vector noise
+  /// of position at scale meanderScale): one smooth field for every drop, so drops that
+  /// pass one place turn alike and their tracks wander, merge and part irregularly, as rain
+  /// on a rough stone does (the statue's primitives are smooth); 0 = off.
+  double meander = 0;
+  double meanderScale = 0.1;      ///< m: the wavelength of the meander noise is about this
   Vec3 color{0.0f};               ///< lichen colour, linear RGB
   double topAngleDeg = 60;        ///< lichen: faces within this angle of straight up grow it
   std::vector<uint16_t> affects;  ///< material ids; empty = every material

@@ -265,6 +265,55 @@ TEST_CASE("wash attraction: later drops follow washed tracks, so the slope washe
   CHECK(!sameMesh(plain, streaky));
 }
 
+TEST_CASE("wash meander: streaks wander off the fall line", "[solids][weathering]") {
+  // The ramp's slope washed in streaks (attraction 4), with and without meander. Straight
+  // streaks run down the fall line (x), so the dirt left across the slope (per column of
+  // equal z) in the slope's upper part matches the lower part's; meandering ones drift
+  // sideways between the two, and the two profiles correlate less.
+  const std::vector<Material> mats = {*findBuiltinMaterial("stone")};
+  auto run = [&](double meander, int threads) {
+    ThreadLimit limit(threads);
+    TetMesh m = ramp(16);
+    dirt(m, mats, DirtOptions{});
+    ParticleOptions o = particleDefaults(ParticleTool::Wash);
+    o.particles = 16384;
+    o.radius = 0.06;
+    o.strength = 0.01;
+    o.attraction = 4;
+    o.meander = meander;
+    o.meanderScale = 0.15;
+    o.seed = 5;
+    runParticles(m, mats, o);
+    return m;
+  };
+  // Correlation of the column means of the dirt left for x in [1.25, 1.45] and in [1.65, 1.85].
+  auto upperLower = [](const TetMesh& m) {
+    std::map<long, std::array<double, 4>> col;  // z -> upper sum, count, lower sum, count
+    for (size_t v = 0; v < m.positions.size(); ++v) {
+      const DVec3 p = m.positions[v];
+      if (std::abs(p.y - topHeight(p.x)) > 1e-9 || p.z < 0.1 || p.z > 0.9) continue;
+      auto& c = col[std::lround(p.z * 16)];
+      if (p.x > 1.25 && p.x < 1.45) c[0] += m.tints[v].w, c[1] += 1;
+      if (p.x > 1.65 && p.x < 1.85) c[2] += m.tints[v].w, c[3] += 1;
+    }
+    std::vector<double> a, b;
+    for (const auto& [z, c] : col) a.push_back(c[0] / c[1]), b.push_back(c[2] / c[3]);
+    const double n = double(a.size());
+    double ma = 0, mb = 0;
+    for (size_t i = 0; i < a.size(); ++i) ma += a[i] / n, mb += b[i] / n;
+    double sab = 0, saa = 0, sbb = 0;
+    for (size_t i = 0; i < a.size(); ++i) sab += (a[i] - ma) * (b[i] - mb), saa += (a[i] - ma) * (a[i] - ma), sbb += (b[i] - mb) * (b[i] - mb);
+    return sab / std::sqrt(saa * sbb);
+  };
+  const TetMesh straight = run(0, 2), wandering = run(1, 2), wandering1 = run(1, 1);
+  const double a = upperLower(straight), b = upperLower(wandering);
+  INFO("correlation of the upper and lower profiles across the slope: straight " << a << ", meander 1: " << b);
+  CHECK(a > 0.8);
+  CHECK(b < a - 0.3);  // measured: 0.872 against 0.326
+  CHECK(sameMesh(wandering, wandering1));  // the same bytes at 1 and 2 threads
+  CHECK(!sameMesh(straight, wandering));
+}
+
 TEST_CASE("particle tools: the same bytes at 1 and 2 threads; unaffected materials unchanged", "[solids][weathering]") {
   Mold mold = clayMold(0.06);
   const auto& mats = mold.solid.materials.materials;
@@ -337,6 +386,12 @@ TEST_CASE("particle tools: bad options throw and change nothing", "[solids][weat
   o = particleDefaults(ParticleTool::Wash);
   o.attraction = -1;
   CHECK_THROWS_WITH(runParticles(m, mats, o), Catch::Contains("'attraction' must be finite and not negative"));
+  o.attraction = 0;
+  o.meander = NAN;
+  CHECK_THROWS_WITH(runParticles(m, mats, o), Catch::Contains("'meander' must be finite and not negative"));
+  o.meander = 1;
+  o.meanderScale = 0;
+  CHECK_THROWS_WITH(runParticles(m, mats, o), Catch::Contains("'meander_scale' must be positive and finite"));
   DirtOptions d;
   d.color = Vec3(NAN);
   CHECK_THROWS_AS(dirt(m, mats, d), std::invalid_argument);
