@@ -163,6 +163,44 @@ TEST_CASE("polish: no clay inside the sphere; bronze untouched; shine near the c
   }
 }
 
+TEST_CASE("polish replayed at a finer grid takes the same clay (section 3.3's replay)", "[solids][weathering]") {
+  // The operation list is in world units, so the same file at a finer `grid` replays the
+  // same cut on the finer mesh: the clay taken converges to the sphere's share of the clay
+  // shell (a 200³ midpoint rule), and the bronze is untouched at both grids.
+  PolishOptions o;
+  o.position = DVec3(0.55, 0, 0);
+  o.size = 0.15;
+  const int N = 200;
+  double expected = 0;
+  const double h = 2 * o.size / N;
+  for (int i = 0; i < N; ++i)
+    for (int j = 0; j < N; ++j)
+      for (int k = 0; k < N; ++k) {
+        const DVec3 p = o.position + DVec3(-o.size + (i + 0.5) * h, -o.size + (j + 0.5) * h, -o.size + (k + 0.5) * h);
+        const double r = glm::length(p);
+        if (glm::length(p - o.position) < o.size && r < 0.5 && r > 0.38) expected += h * h * h;
+      }
+  double error[2];
+  size_t tets[2];
+  const double cells[2] = {0.08, 0.04};
+  for (int g = 0; g < 2; ++g) {
+    Mold mold = clayMold(cells[g]);
+    const TetMesh before = mold.mesh;
+    o.affects = {mold.clay};
+    polish(mold.mesh, mold.solid.materials.materials, o);
+    test::checkValid(mold.mesh);
+    CHECK(sameBytes(cornersOf(before, mold.bronze), cornersOf(mold.mesh, mold.bronze)));
+    const double taken = test::volumeByMaterial(before)[mold.clay] - test::volumeByMaterial(mold.mesh)[mold.clay];
+    error[g] = std::fabs(taken / expected - 1);
+    tets[g] = mold.mesh.tets.size();
+    INFO("cell " << cells[g] << ": taken " << taken << ", expected " << expected);
+    CHECK(error[g] < 0.12);
+  }
+  INFO("relative errors " << error[0] << " (cell 0.08), " << error[1] << " (cell 0.04); tetrahedra " << tets[0] << ", " << tets[1]);
+  CHECK(tets[1] > 4 * tets[0]);
+  CHECK(error[1] < error[0]);
+}
+
 TEST_CASE("blendTint composes: blending toward c by w twice equals once by 1 - (1 - w)^2", "[solids][weathering]") {
   TetMesh m;
   m.positions = {DVec3(0.0)};
