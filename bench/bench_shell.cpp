@@ -16,6 +16,9 @@
 //     start, length along the axis, radii, turn in degrees; unit generating frame)
 //   --tolerance T: relative root tolerance (default organisms::kShellTraceTolerance = 1e-4)
 //   --canal-deg DEG: sweep the canal over the last DEG degrees (the paper: 464)
+//   --full-tape 1: also render the Murex with every cell tracing the whole tape
+//     (ImplicitOptions::prunedTapes = false), the baseline of the per-cell pruned tapes;
+//     --full-image OUT.png writes that image (compare it with --image's by idiff)
 //   --without LIST leaves parts out of the Murex (cost breakdown): any of varices, bumps,
 //     axial, opening, tori, spinebend, canal, axialbend,
 //     ricci (bumps summed instead of the n = 400 blend)
@@ -53,6 +56,8 @@ struct Args {
   std::string canal;    ///< canal override "sx,sy,length,ra,rb,turn" (unit frame)
   double canalDeg = 0;  ///< canal sweep override (degrees before θ_end)
   float tolerance = 0;  ///< relative root tolerance (0 = organisms::kShellTraceTolerance)
+  bool fullTape = false;  ///< also render the Murex without pruned tapes (baseline)
+  std::string fullImage;  ///< image of that render
 };
 
 struct Result {
@@ -61,7 +66,8 @@ struct Result {
   uint64_t rays = 0;
 };
 
-Result run(const organisms::ShellParams& params, const Args& a, const std::string& image, const char* label) {
+Result run(const organisms::ShellParams& params, const Args& a, const std::string& image, const char* label,
+           bool prunedTapes = true) {
   Result r;
   auto t = Clock::now();
   organisms::ShellModel model = organisms::buildShell(params);
@@ -81,10 +87,15 @@ Result run(const organisms::ShellParams& params, const Args& a, const std::strin
   render::ImplicitOptions opt;
   opt.cellSize = a.cellDiv > 0 ? glm::length(blob.bounds().size()) / a.cellDiv : organisms::shellCellSize(blob);
   opt.trace.relativeTolerance = a.tolerance > 0 ? a.tolerance : organisms::kShellTraceTolerance;
+  opt.prunedTapes = prunedTapes;
   scene.addImplicit(blob, material, opt);
   scene.commit();
   r.sceneS = since(t);
   r.cells = scene.stats().implicitCells;
+  if (scene.stats().implicitTapes > 0)
+    std::printf("%s: pruned tapes: %zu distinct for %zu cells, %.1f nodes per cell (whole tape %zu nodes)\n", label,
+                scene.stats().implicitTapes, r.cells, double(scene.stats().implicitTapeNodes) / double(r.cells),
+                blob.nodeCount());
 
   render::ViewSpec view;
   view.azimuthDeg = 25;
@@ -133,6 +144,8 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--image")) a.image = next("--image");
     else if (!std::strcmp(argv[i], "--age")) a.age = std::atof(next("--age"));
     else if (!std::strcmp(argv[i], "--without")) a.without = next("--without");
+    else if (!std::strcmp(argv[i], "--full-tape")) a.fullTape = std::atoi(next("--full-tape")) != 0;
+    else if (!std::strcmp(argv[i], "--full-image")) a.fullImage = next("--full-image");
     else if (!std::strcmp(argv[i], "--canal")) a.canal = next("--canal");
     else if (!std::strcmp(argv[i], "--canal-deg")) a.canalDeg = std::atof(next("--canal-deg"));
     else if (!std::strcmp(argv[i], "--tolerance")) a.tolerance = static_cast<float>(std::atof(next("--tolerance")));
@@ -171,6 +184,12 @@ int main(int argc, char** argv) {
     const auto total = Clock::now();
     const Result m = run(murex, a, a.image, "murex");
     std::printf("murex: build + compile + cells + render %.2f s\n", since(total));
+    if (a.fullTape) {
+      const Result f = run(murex, a, a.fullImage, "murex, full tape (baseline)", false);
+      std::printf("pruned tapes: render %.2f s vs full tape %.2f s (x%.2f), render CPU x%.2f; "
+                  "surface cells %.2f s vs %.2f s\n",
+                  m.renderS, f.renderS, f.renderS / m.renderS, f.renderCpuS / m.renderCpuS, m.sceneS, f.sceneS);
+    }
     if (a.baseline) {
       organisms::ShellParams smooth;
       smooth.spiral = murex.spiral;

@@ -10,7 +10,10 @@
 // against the reference per-cell tracer (ImplicitOptions::batched = false) on a 1/6-size
 // image at 1 spp.
 //
-// Usage: bench_tree [steps=11] [width=1536] [height=2048] [spp=9] [out.png] [cell=0] [bend=8]
+// Usage: bench_tree [steps=11] [width=1536] [height=2048] [spp=9] [out.png] [cell=0] [bend=8] [full=0]
+//   full: 1 also renders the exact image with every cell tracing the whole tape
+//   (ImplicitOptions::prunedTapes = false), the baseline of the per-cell pruned tapes, and
+//   writes it beside out.png as out.png.full.png
 //   cell: surface cell edge of the exact render in world units (0 = the renderer's
 //   automatic size); bend: the bend angle of order-1 laterals in degrees (0 = no bends);
 //   polygonization uses cells of 1/400 of the bounds diagonal
@@ -60,6 +63,7 @@ int main(int argc, char** argv) {
   const std::string out = argc > 5 && std::string(argv[5]) != "-" ? argv[5] : "";
   const float cell = argc > 6 ? float(std::atof(argv[6])) : 0.0f;
   const double bendDeg = argc > 7 ? std::atof(argv[7]) : 8.0;
+  const bool fullTape = argc > 8 && std::atoi(argv[8]) != 0;
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
   try {
     // Grow the skeleton.
@@ -147,6 +151,33 @@ int main(int argc, char** argv) {
       std::printf("  total exact (cells + render): %.2f s wall, %.2f s CPU (idle 2-core estimate %.1f s)\n",
                   sceneS + renderS, sceneCpu + renderCpu, 0.5 * (sceneCpu + renderCpu));
       if (!out.empty()) writeImage(image, out);
+      if (scene.stats().implicitTapes > 0)
+        std::printf("  pruned tapes: %zu distinct for %zu cells, %.1f nodes per cell (whole tape %zu nodes)\n",
+                    scene.stats().implicitTapes, scene.stats().implicitCells,
+                    double(scene.stats().implicitTapeNodes) / double(scene.stats().implicitCells), compiled.nodeCount());
+
+      if (fullTape) {
+        // Baseline: the same render with every cell tracing the whole tape.
+        render::Scene full;
+        full.addTexture([bark](Vec2 uv, const Vec3&) { return bark->color(uv); });
+        full.addMaterial(render::Material{Vec3(0.62f, 0.60f, 0.52f), 0.7f, 0.03f, 0});
+        render::ImplicitOptions fullOpt = io;
+        fullOpt.prunedTapes = false;
+        t = Clock::now();
+        c0 = cpuSeconds();
+        full.addImplicit(compiled, wood, fullOpt);
+        full.commit();
+        const double fullSceneS = since(t), fullSceneCpu = cpuSeconds() - c0;
+        render::RenderStats fullStats;
+        t = Clock::now();
+        c0 = cpuSeconds();
+        Image fullImage = render::renderImage(full, camera, rs, &fullStats);
+        const double fullS = since(t), fullCpu = cpuSeconds() - c0;
+        std::printf("  full-tape baseline: surface cells %.2f s (CPU %.2f s), render %.2f s (CPU %.2f s); "
+                    "pruned tapes: cells CPU x%.2f, render CPU x%.2f faster\n",
+                    fullSceneS, fullSceneCpu, fullS, fullCpu, fullSceneCpu / sceneCpu, fullCpu / renderCpu);
+        if (!out.empty()) writeImage(fullImage, out + ".full.png");
+      }
 
       // Baseline: the reference per-cell tracer vs the batched one, same scene, small image.
       render::Scene ref;

@@ -212,6 +212,7 @@ float CompiledBlob::lipschitz(const Box3& box) const { return tape_->empty ? 0.0
 float CompiledBlob::lipschitz() const { return tape_->empty ? 0.0f : tape_->nodes[tape_->root].lip; }
 
 size_t CompiledBlob::primitiveCount() const { return tape_->instBox.size(); }
+size_t CompiledBlob::nodeCount() const { return tape_->empty ? 0 : tape_->nodes.size(); }
 float CompiledBlob::smallestFeature() const { return tape_->minFeature; }
 
 }  // namespace sprig::blobtree

@@ -98,19 +98,11 @@ struct Cell {
   float lipschitz = 0.0f;     ///< local Lipschitz bound of F over box
   uint32_t firstPrimitive = 0;  ///< into CellSet::primitives
   uint32_t primitiveCount = 0;  ///< primitives whose support overlaps box
+  static constexpr uint32_t kNoTape = 0xffffffffu;
+  uint32_t tape = kNoTape;      ///< into CellSet::tapes (SurfaceCellOptions::prunedTapes)
 };
 
-/// The surface cells of a compiled blob on a regular grid (found sparsely).
-struct CellSet {
-  Vec3 origin{0.0f};     ///< grid origin (the root bounds' low corner)
-  float cellSize = 0.0f; ///< actual edge length (<= the requested size: root cube / 2^k)
-  std::vector<Cell> cells;           ///< in deterministic (Morton-like recursive) order
-  std::vector<uint32_t> primitives;  ///< primitive instance indices (a primitive under its chain of warps)
-  /// The primitive list of one cell.
-  std::span<const uint32_t> primitivesOf(const Cell& c) const {
-    return {primitives.data() + c.firstPrimitive, c.primitiveCount};
-  }
-};
+struct CellSet;
 
 /// Options of CompiledBlob::intersect and intersectCell (blobtree/tracer.h).
 struct TraceOptions {
@@ -132,6 +124,12 @@ struct SurfaceCellOptions {
   bool lipschitz = true;
   /// Fill Cell::firstPrimitive/primitiveCount and CellSet::primitives.
   bool primitiveLists = true;
+  /// Fill Cell::tape and CellSet::tapes: each cell's tape pruned to the nodes whose support
+  /// reaches it (libfive's approach; blobtree/detail/prune.h), identical tapes of different
+  /// cells stored once. Exact: at points in the cell the pruned tape gives the full tape's
+  /// value (bit for bit where the child order agrees, else to the rounding of the sums).
+  /// Costs about one more interval walk per cell.
+  bool prunedTapes = false;
 };
 
 namespace detail { struct Tape; }
@@ -188,8 +186,11 @@ class CompiledBlob {
   /// bounds() is unbounded.
   CellSet surfaceCells(float cellSize, const SurfaceCellOptions& options = {}) const;
 
-  /// Number of primitives (leaves) in the tape.
+  /// Number of primitives (leaves) in the tape (0 for a cell's pruned tape).
   size_t primitiveCount() const;
+  /// Number of nodes in the tape (operators and primitives; a cell's pruned tape counts
+  /// only its own).
+  size_t nodeCount() const;
   /// The smallest 0.5-iso radius of any point/segment/cone/torus primitive (0 if none):
   /// a natural scale for default cell sizes.
   float smallestFeature() const;
@@ -200,6 +201,26 @@ class CompiledBlob {
  private:
   friend CompiledBlob compile(const BlobTree& tree, NodeId root);
   std::shared_ptr<const detail::Tape> tape_;
+};
+
+/// The surface cells of a compiled blob on a regular grid (found sparsely).
+struct CellSet {
+  Vec3 origin{0.0f};     ///< grid origin (the root bounds' low corner)
+  float cellSize = 0.0f; ///< actual edge length (<= the requested size: root cube / 2^k)
+  std::vector<Cell> cells;           ///< in deterministic (Morton-like recursive) order
+  std::vector<uint32_t> primitives;  ///< primitive instance indices (a primitive under its chain of warps)
+  /// Pruned tapes (SurfaceCellOptions::prunedTapes), shared by the cells whose pruned form
+  /// is the same; each is a CompiledBlob of its own (all evaluators work on it) valid at
+  /// points of its cells only.
+  std::vector<CompiledBlob> tapes;
+  /// The primitive list of one cell.
+  std::span<const uint32_t> primitivesOf(const Cell& c) const {
+    return {primitives.data() + c.firstPrimitive, c.primitiveCount};
+  }
+  /// The cell's pruned tape, or fallback (the full blob) when the cell has none.
+  const CompiledBlob& tapeOf(const Cell& c, const CompiledBlob& fallback) const {
+    return c.tape < tapes.size() ? tapes[c.tape] : fallback;
+  }
 };
 
 /// Compiles the subtree at root. O(n log n) in the number of reachable nodes.

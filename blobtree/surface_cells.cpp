@@ -3,6 +3,7 @@
 
 #include "blobtree/compiled.h"
 #include "blobtree/detail/interval_eval.h"
+#include "blobtree/detail/prune.h"
 #include "blobtree/detail/tape.h"
 #include "blobtree/detail/traverse.h"
 #include "core/parallel.h"
@@ -10,6 +11,8 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string_view>
+#include <unordered_map>
 
 namespace sprig::blobtree {
 
@@ -54,6 +57,9 @@ CellSet CompiledBlob::surfaceCells(float cellSize, const SurfaceCellOptions& opt
   }
   std::vector<std::vector<Cell>> cellsOf(frontier.size());
   std::vector<std::vector<uint32_t>> primsOf(frontier.size());
+  // Pruned-tape keys, per frontier subtree: keysOf[k] concatenated, keyEnd[k][i] ends cell i's.
+  std::vector<std::vector<uint32_t>> keysOf(frontier.size());
+  std::vector<std::vector<uint32_t>> keyEnd(frontier.size());
   parallelFor(0, frontier.size(), [&](size_t k) {
     std::vector<Item> stack{frontier[k]};
     auto& cells = cellsOf[k];
@@ -74,16 +80,49 @@ CellSet CompiledBlob::surfaceCells(float cellSize, const SurfaceCellOptions& opt
       cell.box = b;
       cell.index = it.idx;
       cell.bounds = iv;
-      if (options.lipschitz) cell.lipschitz = evalL(T, T.root, b);
+      // With pruned tapes the bound is taken from the cell's own tape below (the same
+      // children reach the box; a walk of a few nodes instead of the whole tape).
+      if (options.lipschitz && !options.prunedTapes) cell.lipschitz = evalL(T, T.root, b);
       cell.firstPrimitive = uint32_t(prims.size());
       if (options.primitiveLists && T.instBvh >= 0)
         walkBvh(T, T.instBvh, [&](const Box3& bb) { return bb.overlaps(b); }, [&](uint32_t i) {
           if (T.instBox[i].overlaps(b)) prims.push_back(i);
         });
       cell.primitiveCount = uint32_t(prims.size()) - cell.firstPrimitive;
+      if (options.prunedTapes) {
+        // A margin of 1/64 cell keeps ray samples rounded just outside the box covered.
+        pruneKey(T, b.expanded(edge / 64.0f), keysOf[k]);
+        keyEnd[k].push_back(uint32_t(keysOf[k].size()));
+      }
       cells.push_back(cell);
     }
   }, 1);
+  if (options.prunedTapes) {
+    // Deduplicate keys in cell order (deterministic), then build each distinct tape once.
+    std::unordered_map<std::string_view, uint32_t> index;
+    std::vector<std::span<const uint32_t>> distinct;
+    for (size_t k = 0; k < frontier.size(); ++k) {
+      uint32_t start = 0;
+      for (size_t i = 0; i < cellsOf[k].size(); ++i) {
+        std::span<const uint32_t> key(keysOf[k].data() + start, keyEnd[k][i] - start);
+        start = keyEnd[k][i];
+        std::string_view bytes(reinterpret_cast<const char*>(key.data()), key.size_bytes());
+        auto [it, fresh] = index.try_emplace(bytes, uint32_t(distinct.size()));
+        if (fresh) distinct.push_back(key);
+        cellsOf[k][i].tape = it->second;
+      }
+    }
+    out.tapes.resize(distinct.size());
+    parallelFor(0, distinct.size(), [&](size_t i) {
+      CompiledBlob b;
+      b.tape_ = buildPruned(tape_, distinct[i]);
+      out.tapes[i] = std::move(b);
+    }, 64);
+    if (options.lipschitz)
+      parallelFor(0, frontier.size(), [&](size_t k) {
+        for (Cell& c : cellsOf[k]) c.lipschitz = out.tapes[c.tape].lipschitz(c.box);
+      }, 1);
+  }
   for (size_t k = 0; k < frontier.size(); ++k) {
     uint32_t base = uint32_t(out.primitives.size());
     for (Cell c : cellsOf[k]) {

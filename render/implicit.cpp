@@ -41,11 +41,13 @@ constexpr float kIso = 0.5f;
 std::optional<blobtree::Hit> traceCell(const ImplicitData& data, const blobtree::Cell& cell, const blobtree::Ray& ray,
                                        float tnear, float tfar, bool anyHit) {
   if (!data.batched) return data.blob.intersectCell(cell, ray, tnear, tfar, data.trace);
-  std::optional<float> t = blobtree::traceCell(data.blob, cell, ray, tnear, tfar, data.tolerance,
+  // The cell's pruned tape when it has one: exact at the cell's points, a shorter walk.
+  const blobtree::CompiledBlob& blob = data.cells.tapeOf(cell, data.blob);
+  std::optional<float> t = blobtree::traceCell(blob, cell, ray, tnear, tfar, data.tolerance,
                                                anyHit ? blobtree::Crossing::Any : blobtree::Crossing::FirstStraddle);
   if (!t) return std::nullopt;
   if (anyHit) return blobtree::Hit{.t = *t};
-  return blobtree::hitAt(data.blob, ray, *t);
+  return blobtree::hitAt(blob, ray, *t);
 }
 
 void cellBounds(const RTCBoundsFunctionArguments* args) {
@@ -131,7 +133,9 @@ uint32_t Scene::addImplicit(const blobtree::CompiledBlob& blob, uint32_t materia
   Box3 support = blob.bounds();
   if (!support.empty()) {
     float cellSize = options.cellSize > 0 ? options.cellSize : blobtree::autoCellSize(blob, kTracerCells);
-    data->cells = blob.surfaceCells(cellSize);
+    blobtree::SurfaceCellOptions cellOptions;
+    cellOptions.prunedTapes = options.batched && options.prunedTapes;
+    data->cells = blob.surfaceCells(cellSize, cellOptions);
   }
   RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_USER);
   rtcSetGeometryUserPrimitiveCount(g, static_cast<unsigned>(data->cells.cells.size()));
@@ -143,6 +147,9 @@ uint32_t Scene::addImplicit(const blobtree::CompiledBlob& blob, uint32_t materia
   for (const auto& c : data->cells.cells) cellBox.extend(c.box);
   if (!cellBox.empty()) impl_->bounds.extend(tightenBounds(blob, cellBox.intersected(support)));
   impl_->stats.implicitCells += data->cells.cells.size();
+  impl_->stats.implicitTapes += data->cells.tapes.size();
+  for (const auto& c : data->cells.cells)
+    impl_->stats.implicitTapeNodes += c.tape < data->cells.tapes.size() ? data->cells.tapes[c.tape].nodeCount() : 0;
   detail::GeometryRecord rec;
   rec.kind = detail::GeometryRecord::Kind::Implicit;
   rec.material = material;

@@ -108,7 +108,7 @@ void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* 
     return;
   }
   if (isPrimitive(n.kind)) {
-    primBatch<false>(T.prims[n.prim], pts, out);
+    primBatch<false>(T.prim(n.prim), pts, out);
     return;
   }
   alignas(32) float tmp[kBlock];
@@ -118,7 +118,7 @@ void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* 
       childrenIn(T, n, pbox, [&](uint32_t c) {
         const TNode& cn = T.nodes[c];
         if (isPrimitive(cn.kind)) {
-          primBatch<true>(T.prims[cn.prim], pts, out);
+          primBatch<true>(T.prim(cn.prim), pts, out);
         } else {
           evalB(T, c, pts, pbox, tmp);
           for (int i = 0; i < pts.n8; ++i) out[i] += tmp[i];

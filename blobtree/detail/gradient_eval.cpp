@@ -130,7 +130,7 @@ SV evalS(const Tape& T, uint32_t ni, Vec3 p) {
   const TNode& n = T.nodes[ni];
   SV r;
   if (!n.box.contains(p)) return r;
-  if (isPrimitive(n.kind)) return primitiveS(T.prims[n.prim], p);
+  if (isPrimitive(n.kind)) return primitiveS(T.prim(n.prim), p);
   switch (n.kind) {
     case NodeKind::Blend:
       childrenAt(T, n, p, [&](uint32_t c) {

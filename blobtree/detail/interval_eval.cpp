@@ -7,8 +7,6 @@
 
 namespace sprig::blobtree::detail {
 
-namespace {
-
 /// The child-space box covering the preimage of world box under warp node n.
 Box3 localBoxOf(const TNode& n, const Tape& T, const Box3& box) {
   const Box3& cb = T.nodes[T.kids[n.first]].box;
@@ -31,6 +29,8 @@ Box3 localBoxOf(const TNode& n, const Tape& T, const Box3& box) {
   }
 }
 
+namespace {
+
 float evalLocalL(const Tape& T, uint32_t ni, const Box3& box);
 
 }  // namespace
@@ -39,7 +39,7 @@ Interval evalI(const Tape& T, uint32_t ni, const Box3& box) {
   const TNode& n = T.nodes[ni];
   if (box.empty() || !box.overlaps(n.box)) return {0.0f, 0.0f};
   if (isPrimitive(n.kind)) {
-    Interval r = primInterval(T.prims[n.prim], box);
+    Interval r = primInterval(T.prim(n.prim), box);
     if (!n.box.contains(box.lo) || !n.box.contains(box.hi)) r.lo = std::min(r.lo, 0.0f);
     return r;
   }

@@ -10,5 +10,8 @@ namespace sprig::blobtree::detail {
 Interval evalI(const Tape& T, uint32_t ni, const Box3& box);
 /// Local Lipschitz bound of tape node ni over box, never above the node's global bound.
 float evalL(const Tape& T, uint32_t ni, const Box3& box);
+/// The child-space box covering the preimage of world box under warp node n (Transform,
+/// Bend, Twist, Taper; box itself for other kinds).
+Box3 localBoxOf(const TNode& n, const Tape& T, const Box3& box);
 
 }  // namespace sprig::blobtree::detail

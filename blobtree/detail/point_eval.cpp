@@ -10,7 +10,7 @@ namespace sprig::blobtree::detail {
 float evalV(const Tape& T, uint32_t ni, Vec3 p, bool cull) {
   const TNode& n = T.nodes[ni];
   if (cull && !n.box.contains(p)) return 0.0f;
-  if (isPrimitive(n.kind)) return primValue(T.prims[n.prim], p, nullptr);
+  if (isPrimitive(n.kind)) return primValue(T.prim(n.prim), p, nullptr);
   switch (n.kind) {
     case NodeKind::Blend: {
       float s = 0.0f;

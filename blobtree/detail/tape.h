@@ -6,6 +6,7 @@
 #include "blobtree/detail/field.h"
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace sprig::blobtree::detail {
@@ -35,7 +36,9 @@ struct TNode {
   float exponent = 1.0f; ///< Ricci
 };
 
-/// The flattened tape.
+/// The flattened tape. A pruned tape (blobtree/detail/prune.h) holds only its own nodes
+/// and child lists and reads primitives and operator parameters from its base, which it
+/// keeps alive; TNode::prim indexes the base's arrays.
 struct Tape {
   std::vector<TNode> nodes;
   std::vector<uint32_t> kids;
@@ -51,6 +54,12 @@ struct Tape {
   std::vector<uint32_t> instPrim;
   int32_t instBvh = -1;
   float minFeature = 0.0f;
+  std::shared_ptr<const Tape> base;  ///< set on pruned tapes: the owner of prims and params
+
+  /// Primitive i (this tape's or, for a pruned tape, its base's).
+  const Prim& prim(uint32_t i) const { return base ? base->prims[i] : prims[i]; }
+  /// Operator parameters i (this tape's or, for a pruned tape, its base's).
+  const TParams& param(uint32_t i) const { return base ? base->params[i] : params[i]; }
 };
 
 }  // namespace sprig::blobtree::detail

@@ -108,7 +108,7 @@ struct RicciAcc {
 };
 
 /// The heavy parameters of an operator node.
-inline const TParams& params(const Tape& T, const TNode& n) { return T.params[n.prim]; }
+inline const TParams& params(const Tape& T, const TNode& n) { return T.param(n.prim); }
 
 /// The child-space point of warp/transform node n at world point p; with jt, the transpose
 /// of d(local)/d(world) there.

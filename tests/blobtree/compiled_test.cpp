@@ -308,3 +308,97 @@ TEST_CASE("CompiledBlob::surfaceCells", "[blobtree]") {
   REQUIRE(again.cells.size() == coarse.cells.size());
   for (size_t i = 0; i < again.cells.size(); ++i) CHECK(again.cells[i].index == coarse.cells[i].index);
 }
+
+TEST_CASE("CellSet::tapes (pruned tapes per surface cell)", "[blobtree]") {
+  SurfaceCellOptions pruned;
+  pruned.prunedTapes = true;
+  SECTION("a pruned tape evaluates to the full tape's value at points of its cell") {
+    for (uint64_t seed : {5u, 17u, 29u}) {
+      SeededScene s(seed);
+      CellSet cells = s.blob.surfaceCells(0.06f, pruned);
+      REQUIRE(cells.cells.size() > 1000);
+      REQUIRE(!cells.tapes.empty());
+      CHECK(cells.tapes.size() < cells.cells.size() / 4);  // neighbours share tapes
+      Rng rng(seed + 1);
+      size_t exact = 0, compared = 0, prunedNodes = 0;
+      float worst = 0.0f;
+      for (size_t ci = 0; ci < cells.cells.size(); ci += 7) {
+        const Cell& c = cells.cells[ci];
+        REQUIRE(c.tape < cells.tapes.size());
+        const CompiledBlob& p = cells.tapeOf(c, s.blob);
+        prunedNodes += p.nodeCount();
+        Vec3 pts[8];
+        float full[8], mine[8];
+        for (Vec3& q : pts) q = randomIn(rng, c.box.lo, c.box.hi);
+        s.blob.values(pts, std::span<float>(full, 8));
+        p.values(pts, std::span<float>(mine, 8));
+        for (int i = 0; i < 8; ++i) {
+          INFO("seed " << seed << " cell " << ci << " point " << i);
+          // The same terms; only a grid node's child order may differ between the batch and
+          // the cell, which changes a sum by its rounding.
+          CHECK(mine[i] == Approx(full[i]).margin(1e-6));
+          worst = std::max(worst, std::abs(mine[i] - full[i]));
+          exact += mine[i] == full[i];
+          ++compared;
+          CHECK(p.value(pts[i]) == Approx(s.blob.value(pts[i])).margin(1e-6));
+        }
+        Vec3 q = randomIn(rng, c.box.lo, c.box.hi);
+        Sample a = s.blob.sample(q), b = p.sample(q);
+        CHECK(b.value == Approx(a.value).margin(1e-6));
+        CHECK(glm::length(b.gradient - a.gradient) <= 1e-4f * std::max(1.0f, glm::length(a.gradient)));
+        CHECK(b.attributes.textureCount == a.attributes.textureCount);
+        CHECK(p.valueBounds(c.box).lo <= a.value);
+        CHECK(p.valueBounds(c.box).hi >= a.value);
+      }
+      INFO("seed " << seed << ": " << exact << " of " << compared << " bit-identical, worst " << worst);
+      CHECK(exact * 10 >= compared * 9);
+      // The walk is shorter: on average a cell's tape is a small part of the whole.
+      size_t sampled = (cells.cells.size() + 6) / 7;
+      CHECK(double(prunedNodes) / double(sampled) < 0.25 * double(s.blob.nodeCount()));
+    }
+  }
+  SECTION("pruning removes the nodes that cannot reach a cell (counts)") {
+    // Three separate balls in a sum blend, minus a box cutter around the third:
+    // 6 nodes. Near the first ball only the ball is left (blend of one = the ball; the
+    // cutter cannot reach and the ball's field lies in [0, 1], so the difference goes too).
+    BlobTree t;
+    NodeId a = t.point(Vec3(0, 0, 0), 1.0f), b = t.point(Vec3(10, 0, 0), 1.0f), c = t.point(Vec3(20, 0, 0), 1.0f);
+    NodeId sum = t.blend(std::vector<NodeId>{a, b, c});
+    NodeId cut = t.box(Vec3(19.5f, -5, -5), Vec3(25, 5, 5), 0.01f);
+    CompiledBlob blob = compile(t, t.difference(sum, cut));
+    REQUIRE(blob.nodeCount() == 6);
+    CellSet cells = blob.surfaceCells(0.1f, pruned);
+    REQUIRE(!cells.cells.empty());
+    size_t nearA = 0, nearC = 0;
+    Rng rng(8);
+    for (const Cell& cell : cells.cells) {
+      const CompiledBlob& p = cells.tapeOf(cell, blob);
+      Vec3 m = cell.box.center();
+      if (m.x < 5.0f) {
+        ++nearA;
+        CHECK(p.nodeCount() == 1);
+      } else if (m.x > 15.0f && cell.box.hi.x < 19.49f) {
+        CHECK(p.nodeCount() == 1);  // the cutter (support from x = 19.495) cannot reach: ball c alone
+      } else if (m.x > 15.0f && cell.box.hi.x > 19.5f) {
+        ++nearC;
+        CHECK(p.nodeCount() == 3);  // difference(ball c, cutter)
+      }
+      Vec3 pts[8];
+      float full[8], mine[8];
+      for (Vec3& q : pts) q = randomIn(rng, cell.box.lo, cell.box.hi);
+      blob.values(pts, std::span<float>(full, 8));
+      p.values(pts, std::span<float>(mine, 8));
+      for (int i = 0; i < 8; ++i) CHECK(mine[i] == full[i]);  // no grid node: bit for bit
+    }
+    CHECK(nearA > 100);
+    CHECK(nearC > 20);
+    // Tapes are shared: all cells of ball a have the same one.
+    CHECK(cells.tapes.size() <= 8);
+  }
+  SECTION("off by default") {
+    SeededScene s(5);
+    CellSet cells = s.blob.surfaceCells(0.1f);
+    CHECK(cells.tapes.empty());
+    for (const Cell& c : cells.cells) CHECK(c.tape == Cell::kNoTape);
+  }
+}

@@ -315,3 +315,38 @@ TEST_CASE("buildShell::batched evaluation of the n = 400 bump blend", "[organism
   }
   CHECK(nearSurface > compared / 20);
 }
+
+TEST_CASE("buildShell::pruned tapes of the Murex", "[organisms]") {
+  // Every part (varices, bumps under the n = 400 blend, canal, axial spines, the CSG
+  // opening): each surface cell's pruned tape gives the whole tape's values there.
+  ShellParams p = murexCabritii();
+  p.ageDeg = 3 * 348.0;
+  ShellModel m = buildShell(p);
+  const CompiledBlob b = compile(m.tree, m.root);
+  blobtree::SurfaceCellOptions so;
+  so.prunedTapes = true;
+  const blobtree::CellSet cells = b.surfaceCells(glm::length(b.bounds().size()) / 60.0f, so);
+  REQUIRE(cells.cells.size() > 100);
+  REQUIRE(cells.tapes.size() < cells.cells.size());
+  Rng rng(12);
+  size_t nodes = 0, sampled = 0;
+  for (size_t ci = 0; ci < cells.cells.size(); ci += 3, ++sampled) {
+    const blobtree::Cell& c = cells.cells[ci];
+    const CompiledBlob& t = cells.tapeOf(c, b);
+    nodes += t.nodeCount();
+    Vec3 pts[8];
+    float full[8], mine[8];
+    for (Vec3& q : pts) q = c.box.lo + Vec3(float(rng.uniform()), float(rng.uniform()), float(rng.uniform())) * c.box.size();
+    b.values(pts, std::span<float>(full, 8));
+    t.values(pts, std::span<float>(mine, 8));
+    for (int i = 0; i < 8; ++i) {
+      INFO("cell " << ci << " point " << i);
+      CHECK(mine[i] == Approx(full[i]).margin(2e-6));
+    }
+    const blobtree::Sample sa = b.sample(pts[0]), sb = t.sample(pts[0]);
+    CHECK(sb.value == Approx(sa.value).margin(2e-6));
+    CHECK(glm::length(sb.gradient - sa.gradient) <= 1e-4f * std::max(1.0f, glm::length(sa.gradient)));
+  }
+  INFO(b.nodeCount() << " nodes in the tape, " << double(nodes) / double(sampled) << " per cell on average");
+  CHECK(double(nodes) / double(sampled) < 0.1 * double(b.nodeCount()));
+}

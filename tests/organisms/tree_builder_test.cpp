@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <vector>
 
+#include "blobtree/compiled.h"
+#include "core/rng.h"
 #include "organisms/tree_builder.h"
 #include "tests/organisms/internode.h"
 
@@ -389,4 +391,68 @@ TEST_CASE("buildLeafMesh", "[organisms]") {
     CHECK(m2.positions == m.positions);
     CHECK(m2.colors == m.colors);
   }
+}
+
+TEST_CASE("buildTreeBlob::pruned tapes of a PCM tree with bends", "[organisms]") {
+  // A binary tree of 63 internodes (PCM junctions, 8° bends, as the poplar): each surface
+  // cell's pruned tape gives the whole tape's value at the cell's points and is much shorter.
+  Skeleton sk;
+  struct Tip {
+    int index;
+    DVec3 dir;
+    double len, r;
+  };
+  sk.internodes.push_back(seg({0, 0, 0}, {0, 1, 0}, 0.08, 0.06, -1, 0));
+  std::vector<Tip> tips{{0, {0, 1, 0}, 1.0, 0.06}};
+  for (int depth = 0; depth < 5; ++depth) {
+    std::vector<Tip> next;
+    for (const Tip& t : tips) {
+      const DVec3 p = sk.internodes[size_t(t.index)].end;
+      for (int side : {-1, 1}) {
+        const double a = radians(35.0) * side;
+        const DVec3 axis = depth % 2 == 0 ? DVec3(0, 0, 1) : DVec3(1, 0, 0);
+        DVec3 d = t.dir * std::cos(a) + glm::cross(axis, t.dir) * std::sin(a) + axis * glm::dot(axis, t.dir) * (1 - std::cos(a));
+        d = glm::normalize(d);
+        const double len = t.len * 0.75, r = t.r * 0.75;
+        sk.internodes.push_back(seg(p, p + len * d, t.r, r, t.index, depth + 1));
+        next.push_back({int(sk.internodes.size() - 1), d, len, r});
+      }
+    }
+    tips = std::move(next);
+  }
+  REQUIRE(sk.internodes.size() == 63);
+  TreeOptions opt;
+  opt.junctions = JunctionModel::Pcm;
+  opt.bends.angleDeg = 8;
+  opt.bends.randomness = 0.5;
+  TreeBlob tb = buildTreeBlob(sk, opt);
+  const blobtree::CompiledBlob blob = blobtree::compile(tb.tree, tb.root);
+  blobtree::SurfaceCellOptions so;
+  so.prunedTapes = true;
+  const blobtree::CellSet cells = blob.surfaceCells(0.02f, so);
+  REQUIRE(cells.cells.size() > 2000);
+  Rng rng(4);
+  size_t nodes = 0, sampled = 0;
+  for (size_t ci = 0; ci < cells.cells.size(); ci += 5, ++sampled) {
+    const blobtree::Cell& c = cells.cells[ci];
+    const blobtree::CompiledBlob& p = cells.tapeOf(c, blob);
+    REQUIRE(&p != &blob);
+    nodes += p.nodeCount();
+    Vec3 pts[8];
+    float full[8], mine[8];
+    for (Vec3& q : pts) q = c.box.lo + Vec3(float(rng.uniform()), float(rng.uniform()), float(rng.uniform())) * c.box.size();
+    blob.values(pts, std::span<float>(full, 8));
+    p.values(pts, std::span<float>(mine, 8));
+    for (int i = 0; i < 8; ++i) {
+      INFO("cell " << ci << " point " << i);
+      CHECK(mine[i] == Approx(full[i]).margin(1e-6));
+    }
+    const blobtree::Sample a = blob.sample(pts[0]), b = p.sample(pts[0]);
+    CHECK(b.value == Approx(a.value).margin(1e-6));
+    CHECK(glm::length(b.gradient - a.gradient) <= 1e-4f * std::max(1.0f, glm::length(a.gradient)));
+    CHECK(b.attributes.contact == Approx(a.attributes.contact).margin(1e-5));
+  }
+  INFO(blob.nodeCount() << " nodes in the tape, " << double(nodes) / double(sampled) << " per cell on average");
+  CHECK(double(nodes) / double(sampled) < 0.1 * double(blob.nodeCount()));
+  CHECK(cells.tapes.size() < cells.cells.size() / 4);
 }

@@ -187,6 +187,32 @@ TEST_CASE("render::exact mode determinism", "[render]") {
   CHECK(renderImage(rebuilt, cam, rs).pixels == a.pixels);
 }
 
+TEST_CASE("Scene::addImplicit pruned tapes", "[render]") {
+  // Each cell traced with its pruned tape (the default) gives the image of the whole tape:
+  // the branch's blend has too few children for a point grid, so the pruned tapes sum the
+  // same terms in the same order and the pixels are the same bits.
+  Image images[2];
+  size_t tapes[2] = {};
+  for (int pruned = 0; pruned < 2; ++pruned) {
+    Scene scene;
+    ImplicitOptions opt;
+    opt.prunedTapes = pruned == 1;
+    scene.addImplicit(branchBlob(), scene.addMaterial(Material{}), opt);
+    scene.commit();
+    tapes[pruned] = scene.stats().implicitTapes;
+    if (pruned == 1) {
+      REQUIRE(tapes[1] > 0);
+      CHECK(tapes[1] < scene.stats().implicitCells / 4);
+      // The whole tape has 5 nodes; most cells see one or two cones.
+      CHECK(double(scene.stats().implicitTapeNodes) / double(scene.stats().implicitCells) < 2.5);
+    }
+    RenderSettings rs = quietSettings(96, 96);
+    images[pruned] = renderImage(scene, frameBounds(scene.bounds(), ViewSpec{}, 1.0), rs);
+  }
+  CHECK(tapes[0] == 0);
+  CHECK(images[0].pixels == images[1].pixels);
+}
+
 TEST_CASE("Scene::addImplicit batched tracing", "[render]") {
   // The Embree scene (the tracer over each surface cell) and CompiledBlob::intersect (the
   // same tracer over whole rays, empty space skipped by interval bounds, no cells) find the
