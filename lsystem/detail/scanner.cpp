@@ -223,6 +223,20 @@ bool Scanner::tokenizeModules(int line, int b, int e, const std::function<void(c
       i = k + 1;
     }
     const size_t nameEnd = static_cast<size_t>(m.col) + m.name.size();
+    if (dialect_ == Dialect::Cpfg && !m.name.empty() && m.name[0] == '~') {
+      // cpfg's `~X` draws the view file's surface X (the letter after `~`).
+      const char id = m.name.size() > 1 ? m.name[1] : nameEnd < s.size() ? s[nameEnd] : '\0';
+      if (id == '\0' || id == ' ' || id == '\t') {
+        error(line, m.col, "cpfg's '~' must be followed by a surface id (the letter of a view file's 'surface:' line)");
+        return false;
+      }
+      if (cpfgSurfaceIds_.find(id) == std::string::npos) {
+        error(line, m.col, std::string("cpfg's '~") + id + "' names no surface: " +
+                               (cpfgSurfaceIds_.empty() ? std::string("there is no view file with a 'surface:' line")
+                                                        : "the view file has no 'surface: " + std::string(1, id) + " ...' line (it defines '" + cpfgSurfaceIds_ + "')"));
+        return false;
+      }
+    }
     if (auto why = cpfgUnsupported(m.name, m.args.size(), m.hasParens, nameEnd < s.size() ? s[nameEnd] : '\0', dialect_)) {
       error(line, m.col, *why);
       return false;

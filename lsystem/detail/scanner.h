@@ -111,6 +111,8 @@ class Scanner {
   /// implement in it (lsystem/detail/cpfg.h) as errors at their position.
   void setDialect(Dialect d) { dialect_ = d; }
   Dialect dialect() const { return dialect_; }
+  /// cpfg: the ids of the view file's surfaces; `~X` with another X is an error.
+  void setCpfgSurfaceIds(std::string ids) { cpfgSurfaceIds_ = std::move(ids); }
   /// Splits line(line)[b, e) into modules, appending them to out. Reports errors; returns
   /// false on an error that stops the line (a stray `(`, `)` or `,`, a missing `)`) or
   /// after reporting empty parameters.
@@ -179,6 +181,7 @@ class Scanner {
   std::vector<std::string> multiNames_;
   std::pair<int, int> pendingComment_{0, 0};
   Dialect dialect_ = Dialect::Sprig;
+  std::string cpfgSurfaceIds_;
   DiagnosticList diags_;
 };
 
