@@ -156,6 +156,8 @@ Turtle::Turtle(const SymbolTable& symbols, TurtleSettings settings) : symbols_(s
       c = Command::GcEnd;
     } else if (n == "@Gt") {
       c = Command::GcTangents;
+    } else if (n == "@Gr") {
+      c = Command::GcRadiusTangents;
     } else if (n == "@#") {
       c = Command::Contour;
     } else if (n == "@!") {
@@ -242,7 +244,7 @@ class TurtleWalk {
     buf_.stack.reserve(64);
     for (size_t k = 0; k < ncmd_ && !usesGc_; ++k)
       usesGc_ = cmd_[k] == Command::GcStart || cmd_[k] == Command::GcPoint || cmd_[k] == Command::GcEnd ||
-                cmd_[k] == Command::GcTangents;
+                cmd_[k] == Command::GcTangents || cmd_[k] == Command::GcRadiusTangents;
   }
 
   /// Reserves the exact number of drawing modules: cheaper than growing the vector.
@@ -321,6 +323,7 @@ class TurtleWalk {
         case Command::GcPoint: gcPoint(i, false); break;
         case Command::GcEnd: gcPoint(i, true); break;
         case Command::Contour: contour(i); break;
+        case Command::GcRadiusTangents: gcRadiusTangents(i); break;
         case Command::ContourSides:
           // cpfg's `@!(n)`: points around a contour (at least 3; 8 without a parameter).
           st_.contourSides = hasParam(i) ? std::clamp(static_cast<int>(std::isfinite(param(i)) ? std::clamp(param(i), -1e6, 1e6) : 0.0),
@@ -554,20 +557,40 @@ class TurtleWalk {
         const DVec3 a2 = -3.0 * (p1 - p2) - 2.0 * t1 - t2, a3 = 2.0 * (p1 - p2) + t1 + t2;
         int rings = hasParam(i) ? std::max(1, static_cast<int>(param(i))) : kDefaultGcRings;
         rings = std::min(rings, kMaxGcRings);
+        // cpfg's radius Hermite (general.c, interpolate_connection): the pairs (t, radius)
+        // from (0, w1/2) to (1, w2/2) with the tangents of `@Gr` (the first point's second
+        // and this point's first; times |p2 - p1| after `@Gr(1)`); a zero tangent is
+        // (1, (w2 - w1)/2), so that without `@Gr` t = k/n and the radius is linear.
+        glm::dvec2 r0 = gc_.pointRadiusOut, r1 = gc_.radiusIn;
+        if (gc_.scaleRadiusTangents) {
+          r0.y *= len;
+          r1.y *= len;
+        }
+        const double half = 0.5 * (w2 - gc_.width);
+        if (r0 == glm::dvec2(0.0)) r0 = glm::dvec2(1, half);
+        if (r1 == glm::dvec2(0.0)) r1 = glm::dvec2(1, half);
+        const glm::dvec2 c0(0, 0.5 * gc_.width), c2(3 - 2 * r0.x - r1.x, 3 * half - 2 * r0.y - r1.y),
+            c3(-2 + r0.x + r1.x, -2 * half + r0.y + r1.y);
+        std::vector<glm::dvec2> ring(static_cast<size_t>(rings) + 1);  // (t, width) per ring
+        for (int k = 0; k <= rings; ++k) {
+          const double r = static_cast<double>(k) / rings;
+          const glm::dvec2 v = k == rings ? glm::dvec2(1, 0.5 * w2) : ((c3 * r + c2) * r + r0) * r + c0;
+          ring[static_cast<size_t>(k)] = glm::dvec2(v.x, 2 * v.y);
+        }
         if (gc_.contour != 0 || st_.contour != 0) {
-          gcContourMesh(i, p1, t1, a2, a3, len, rings, w2);
+          gcContourMesh(i, p1, t1, a2, a3, len, ring);
           rings = 0;  // drawn as a mesh
         }
         DVec3 from = p1;
         int32_t parent = gc_.lastInternode;
         for (int k = 1; k <= rings; ++k) {
-          const double t = static_cast<double>(k) / rings;
+          const double t = ring[static_cast<size_t>(k)].x;
           const DVec3 to = k == rings ? p2 : p1 + t * (t1 + t * (a2 + t * a3));
           Internode in;
           in.start = from;
           in.end = to;
-          in.baseRadius = radiusScale_ * (gc_.width + (w2 - gc_.width) * (k - 1) / rings);
-          in.tipRadius = radiusScale_ * (gc_.width + (w2 - gc_.width) * t);
+          in.baseRadius = radiusScale_ * ring[static_cast<size_t>(k) - 1].y;
+          in.tipRadius = radiusScale_ * ring[static_cast<size_t>(k)].y;
           if (maxRadiusPerLength_ > 0) {
             in.baseRadius = std::min(in.baseRadius, maxRadiusPerLength_ * len);
             in.tipRadius = std::min(in.tipRadius, maxRadiusPerLength_ * len);
@@ -602,7 +625,27 @@ class TurtleWalk {
     gc_.contour = st_.contour;
     gc_.sides = st_.contourSides > 0 ? st_.contourSides : settings_.contourSides;
     gc_.pointTangentOut = gc_.tangentOut;
+    gc_.pointRadiusOut = gc_.radiusOut;
     if (end) gc_.active = gc_.hasPoint = false;
+  }
+
+  /// cpfg's `@Gr` (blackbox.c): `@Gr(s)` makes later radius tangents scale with the
+  /// segment's length (s != 0) or not; `@Gr(a, l)` sets both radius tangents to
+  /// l (cos a, sin a) (a in degrees; in (t, radius) space), `@Gr(a, l, a2, l2)` the second
+  /// to l2 (cos a2, sin a2). Without parameters: nothing.
+  void gcRadiusTangents(size_t i) {
+    const uint32_t n = paramCount(i);
+    if (n == 1) {
+      gc_.scaleRadiusTangents = paramAt(i, 0) != 0;
+      return;
+    }
+    if (n < 2) return;
+    auto tangent = [&](uint32_t k) {
+      const double a = radians(paramAt(i, k)), l = paramAt(i, k + 1);
+      return glm::dvec2(std::cos(a) * l, std::sin(a) * l);
+    };
+    gc_.radiusIn = gc_.radiusOut = tangent(0);
+    if (n >= 4) gc_.radiusOut = tangent(2);
   }
 
   /// cpfg's `@#(id)`: the contour of the generalized cylinders from here on (0 or no
@@ -626,15 +669,16 @@ class TurtleWalk {
   }
 
   /// A generalized-cylinder segment with a contour (general.c, interpolate_connection and
-  /// make_contour): rings 0..rings along the Hermite curve p1 + t t1 + t^2 a2 + t^3 a3, each
-  /// the contours of the two control points blended by t, scaled by the radius (linear in
-  /// t from half the first point's width to half w2's), placed in the ring's frame: H the
+  /// make_contour): rings at the (t, width) pairs of ring along the Hermite curve
+  /// p1 + t t1 + t^2 a2 + t^3 a3, each the contours of the two control points blended by t,
+  /// scaled by the radius (half the width), placed in the ring's frame: H the
   /// curve's tangent (the first point's heading at t = 0), cpfg's up vector U' the first
   /// point's turned by the rotation taking its heading to H, L = H x U'; a contour point
   /// (x, y, z) goes to the ring's centre + r (x U' - y L) + r z H / |p2 - p1|. One Surface
   /// organ per segment, its triangles joining consecutive rings.
-  void gcContourMesh(size_t i, const DVec3& p1, const DVec3& t1, const DVec3& a2, const DVec3& a3, double len, int rings,
-                     double w2) {
+  void gcContourMesh(size_t i, const DVec3& p1, const DVec3& t1, const DVec3& a2, const DVec3& a3, double len,
+                     const std::vector<glm::dvec2>& ring) {
+    const int rings = static_cast<int>(ring.size()) - 1;
     const CpfgContour circle = CpfgContour::circle();
     const CpfgContour* c1 = gc_.contour ? findContour(gc_.contour) : &circle;
     const CpfgContour* c2 = st_.contour ? findContour(st_.contour) : &circle;
@@ -649,7 +693,7 @@ class TurtleWalk {
     const DVec3 h0 = gc_.heading, u0 = -gc_.up;  // cpfg's up vector at the first point
     const uint32_t per = static_cast<uint32_t>(sides) + 1;
     for (int k = 0; k <= rings; ++k) {
-      const double t = static_cast<double>(k) / rings;
+      const double t = ring[static_cast<size_t>(k)].x;
       const DVec3 pos = p1 + t * (t1 + t * (a2 + t * a3));
       DVec3 h = h0;
       if (k > 0) {
@@ -665,7 +709,7 @@ class TurtleWalk {
         u = u0 * cs + glm::cross(a, u0) * sn + a * glm::dot(a, u0) * (1 - cs);
       }
       const DVec3 l = glm::cross(h, u);
-      const double r = radiusScale_ * (gc_.width + (w2 - gc_.width) * t) * g;
+      const double r = radiusScale_ * ring[static_cast<size_t>(k)].y * g;
       for (uint32_t m = 0; m < per; ++m) {
         const DVec3 c = k1[m] * (1 - t) + k2[m] * t;
         o.points.push_back(pos + r * (c.x * u - c.y * l) + (r * c.z / len) * h);
@@ -1093,6 +1137,9 @@ class TurtleWalk {
     DVec3 position{0}, heading{0, 1, 0}, up{0, 0, 1};
     double width = 0;
     int contour = 0;  ///< the contour id at the previous control point
+    glm::dvec2 radiusIn{0.0}, radiusOut{0.0};  ///< `@Gr(a, l[, a2, l2])`: the turtle's radius tangents (cpfg's [0], [1])
+    glm::dvec2 pointRadiusOut{0.0};            ///< radiusOut at the previous control point
+    bool scaleRadiusTangents = false;          ///< `@Gr(s)`, s != 0: radius tangents times the segment's length
     int sides = CpfgContour::kDefaultSides;  ///< points around its contour
     double tangentIn = 1.2, tangentOut = 1.2;  ///< `@Gt(in, out)`: the turtle's (cpfg's defaults)
     double pointTangentOut = 1.2;              ///< tangentOut at the previous control point

@@ -165,7 +165,7 @@ class Turtle {
     RollLeft, RollRight, TurnAround, RollToVertical, Push, Pop, Width, Color, PolygonBegin, Vertex,
     PolygonEnd, Surface, SurfaceNamed, Cut, Tropism, Sphere, WidthUp, ColorUp, ColorDown, Circle, Disc,
     TropismUp, TropismDown, TwistAdjust, TwistForce, MoveTo, SetHeading, ScaleSet, ScaleUp, ScaleDown, OldElasticity,
-    Query, SubCall, SubEnd, GcStart, GcPoint, GcEnd, GcTangents, Contour, ContourSides
+    Query, SubCall, SubEnd, GcStart, GcPoint, GcEnd, GcTangents, Contour, ContourSides, GcRadiusTangents
   };
   /// The command bound to symbol id `s` (None for ids outside the table).
   Command commandOf(SymbolId s) const { return s < commands_.size() ? commands_[s] : Command::None; }

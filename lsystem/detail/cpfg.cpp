@@ -14,7 +14,6 @@ struct Unsupported {
 };
 
 constexpr Unsupported kUnsupported[] = {
-    {"@Gr", "generalized cylinder radius tangents"},
     {"@Tx", "texture"},
     {"@bo", "circle boundary"},
     {"@bc", "circle boundary"},

@@ -263,7 +263,7 @@ TEST_CASE("cpfg view file", "[lsystem][cpfg]") {
 
 TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg]") {
   SECTION("commands") {
-    CHECK(errorOf("axiom: F@Gr(1)\n", "t.lsys") == "t.lsys:1:9: cpfg's '@Gr' (generalized cylinder radius tangents) is not supported");
+    CHECK(errorOf("axiom: F@Tx(1)\n", "t.lsys") == "t.lsys:1:9: cpfg's '@Tx' (texture) is not supported");
     CHECK(errorOf("axiom: F{(1)F}(1)\n") == "t.l:1:9: cpfg's '{(type)' (generalized cylinder) is not supported");
     CHECK(errorOf("axiom: A\nA --> F$A\n") ==
           "t.l:2:8: cpfg's '$' ends a sub-L-system call '?(n, scale)', and this file makes none (ABOP's roll to vertical is '@v' in cpfg)");
@@ -305,7 +305,7 @@ TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg
     CHECK(errorOf("Start: { printf(\"%5.2f%%\\n\", 2); }\naxiom: A\n") == "no error");
   }
   SECTION("an error in a continued line is reported at its own line") {
-    CHECK(errorOf("axiom: A\nA --> F\n\tF@Gr(2)\n") == "t.l:3:3: cpfg's '@Gr' (generalized cylinder radius tangents) is not supported");
+    CHECK(errorOf("axiom: A\nA --> F\n\tF@Tx(2)\n") == "t.l:3:3: cpfg's '@Tx' (texture) is not supported");
   }
 }
 
@@ -502,14 +502,14 @@ TEST_CASE("cpfg's C preprocessor", "[lsystem][cpfg]") {
   SECTION("an error in an included file is at its own file:line:col") {
     const std::string file = cpfgAsset("preprocessor_errors/plant.l");
     CHECK(errorOf(readFile(file), file) == cpfgAsset("preprocessor_errors/rules.h") +
-                                                    ":2:8: cpfg's '@Gr' (generalized cylinder radius tangents) is not supported");
+                                                    ":2:8: cpfg's '@Tx' (texture) is not supported");
   }
   SECTION("an error inside a macro's expansion is at the macro's use") {
-    CHECK(errorOf("#define LEAF [@Gr(1)]\naxiom: F LEAF\n") == "t.l:2:10: cpfg's '@Gr' (generalized cylinder radius tangents) is not supported");
+    CHECK(errorOf("#define LEAF [@Tx(1)]\naxiom: F LEAF\n") == "t.l:2:10: cpfg's '@Tx' (texture) is not supported");
     CHECK(errorOf("#define B(x) F(x)\naxiom: A B(1, 2) C\n") ==
           "t.l:2:10: macro 'B' takes 1 argument(s) (defined at t.l:1), or its expansion nests deeper than 64 levels");
     // Columns after an expansion are the file's own.
-    CHECK(errorOf("#define S F(1)F(1)\naxiom: S@Gr(1)\n") == "t.l:2:9: cpfg's '@Gr' (generalized cylinder radius tangents) is not supported");
+    CHECK(errorOf("#define S F(1)F(1)\naxiom: S@Tx(1)\n") == "t.l:2:9: cpfg's '@Tx' (texture) is not supported");
   }
   SECTION("cpp's identifiers: a macro named B is not expanded inside AB; a number body stays a value") {
     Grammar g = parseGrammar("#define B [+F]\n#define N (2 + 1)\naxiom: AB B F(N)\n", "t.l");
@@ -1024,4 +1024,37 @@ TEST_CASE("cpfg contour files and generalized cylinders with @#(n)", "[lsystem][
     CHECK(viewErrorOf("contour: 0 a.con\n") == "t.v:1:10: contour id 0 is cpfg's circle; a contour file takes another id");
     CHECK(viewErrorOf("contour sides: 2\n") == "t.v:1:16: 'contour sides:' is a whole number from 3 to 1024");
   }
+}
+
+TEST_CASE("cpfg generalized cylinders: @Gr radius tangents", "[lsystem][cpfg]") {
+  // general.c, interpolate_connection: the rings are the Hermite cubic of the pairs
+  // (t, radius) from (0, r1) to (1, r2) with the radius tangents. @Gr(90, 1) makes both
+  // (0, 1): with r1 = r2 = 0.2, ring k of 4 (r = k/4) is at t = 3r^2 - 2r^3 with radius
+  // 0.2 + r - 3r^2 + 2r^3; @Gt(0) makes the curve p1 + (3t^2 - 2t^3)(p2 - p1).
+  ViewFile view = parseViewFile("initial line width: 0.4\nline style: cylinder\n", "t.v");
+  auto expect = [](const Skeleton& sk, double length) {
+    REQUIRE(sk.internodes.size() == 4);
+    auto at = [&](int k) {
+      const double r = k / 4.0, t = 3 * r * r - 2 * r * r * r;
+      return std::pair{DVec3(0, length * (3 * t * t - 2 * t * t * t), 0), 0.2 + r - 3 * r * r + 2 * r * r * r};
+    };
+    for (int k = 1; k <= 4; ++k) {
+      INFO("ring " << k);
+      checkNear(sk.internodes[static_cast<size_t>(k - 1)].start, at(k - 1).first);
+      checkNear(sk.internodes[static_cast<size_t>(k - 1)].end, at(k).first);
+      CHECK(sk.internodes[static_cast<size_t>(k - 1)].baseRadius == Approx(at(k - 1).second).margin(1e-12));
+      CHECK(sk.internodes[static_cast<size_t>(k - 1)].tipRadius == Approx(at(k).second).margin(1e-12));
+    }
+  };
+  Grammar g = parseGrammar("axiom: @Gt(0) @Gr(90, 1) @Gs f(1) @Ge(4)\n", "t.l");
+  expect(Turtle(g.symbols(), cpfgTurtleSettings(&view, {})).run(g.axiom()), 1.0);
+  // @Gr(1): tangents times the segment's length, so (0, 0.5) on a segment of 2 is (0, 1).
+  Grammar s = parseGrammar("axiom: @Gt(0) @Gr(1) @Gr(90, 0.5) @Gs f(2) @Ge(4)\n", "t.l");
+  expect(Turtle(s.symbols(), cpfgTurtleSettings(&view, {})).run(s.axiom()), 2.0);
+  // The middle ring of the first: r = 1/2 gives t = 1/2 and radius 0.2 (the curve's middle).
+  Grammar m = parseGrammar("axiom: @Gt(0) @Gr(90, 1) @Gs f(1) @Ge(2)\n", "t.l");
+  Skeleton mid = Turtle(m.symbols(), cpfgTurtleSettings(&view, {})).run(m.axiom());
+  REQUIRE(mid.internodes.size() == 2);
+  checkNear(mid.internodes[0].end, DVec3(0, 0.5, 0));
+  CHECK(mid.internodes[0].tipRadius == Approx(0.2));
 }
