@@ -406,7 +406,7 @@ class TurtleWalk {
     const double g = growth(i);
     if (g <= 0) return;  // not grown yet: nothing drawn, no bend; the axis carries on from its parent
     if (st_.contour != 0)
-      throw InputError(SourceLoc{}, "cpfg's contour '@#(" + std::to_string(st_.contour) +
+      throw InputError(SourceLoc{"sprig", 0, 0}, "cpfg's contour '@#(" + std::to_string(st_.contour) +
                                         ")' on an 'F' segment (a cylinder outside a generalized cylinder) is not supported: "
                                         "select it for '@Gs ... @Gc' cylinders drawn with 'f'");
     Internode in;
@@ -654,7 +654,7 @@ class TurtleWalk {
     const double v = hasParam(i) ? param(i) : 0.0;
     const int id = std::isfinite(v) ? static_cast<int>(std::clamp(v, -2e9, 2e9)) : -1;
     if (id != 0 && !findContour(id))
-      throw InputError(SourceLoc{}, "cpfg's '@#(" + (std::isfinite(v) ? std::to_string(id) : std::string("nan")) +
+      throw InputError(SourceLoc{"sprig", 0, 0}, "cpfg's '@#(" + (std::isfinite(v) ? std::to_string(id) : std::string("nan")) +
                                         ")' names no contour: " +
                                         (settings_.cpfgContours ? "the view file has no 'contour: " + std::to_string(id) + " ...' line"
                                                                 : std::string("the view file has no 'contour:' line")));
