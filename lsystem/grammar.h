@@ -60,6 +60,9 @@ struct GrammarOverrides {
   /// The ids of the view file's surfaces (ViewFile::surfaces), which `~X` may name; any
   /// other `~X` in a `.l` grammar is an error.
   std::string cpfgSurfaceIds;
+  /// cpfg: the names of a view file's `function set:` functions (ViewFile::functionNames),
+  /// which the preprocessor defines as 1, 2, ... in a `.l` grammar.
+  std::vector<std::string> cpfgFunctionNames;
 };
 
 /// A parsed, compiled L-system.

@@ -31,7 +31,7 @@ const char* const kViewerKeys[] = {
 
 /// Keys naming files whose uses (`~`, `func`, `curveX`, `@#`, `inblob`) are errors in the
 /// grammar: not read, with a warning.
-const char* const kFileKeys[] = {"tsurface", "function set", "blob"};
+const char* const kFileKeys[] = {"tsurface", "blob"};
 
 /// Most `surface:` lines of a view file (cpfg's SURFACES - 1).
 constexpr size_t kMaxSurfaces = 14;
@@ -49,15 +49,21 @@ constexpr UnsupportedKey kUnsupportedKeys[] = {
 const char* const kReadKeys[] = {
     "angle factor",  "angle increment",   "initial color", "color increment", "initial line width",
     "line width increment", "line style", "initial scale", "scale multiplier", "tropism", "torque",
-    "tropism direction", "initial elasticity", "elasticity increment", "function", "surface", "curve", "contour", "contour sides",
+    "tropism direction", "initial elasticity", "elasticity increment", "function", "function set", "surface", "curve", "contour", "contour sides",
 };
 
-/// The view file's text with `/* */` comments blanked (newlines kept, so positions hold).
+/// The view file's text with `/* */` and `//` comments blanked (newlines kept, so positions
+/// hold): cpfg runs its view file through the C preprocessor, which removes both.
 std::string blankComments(std::string s, int& openLine) {
   openLine = 0;
   int line = 1;
   for (size_t i = 0; i < s.size(); ++i) {
     if (s[i] == '\n') ++line;
+    if (s[i] == '/' && i + 1 < s.size() && s[i + 1] == '/') {
+      while (i < s.size() && s[i] != '\n') s[i++] = ' ';
+      if (i < s.size()) ++line;
+      continue;
+    }
     if (s[i] == '/' && i + 1 < s.size() && s[i + 1] == '*') {
       const int start = line;
       size_t j = i + 2;
@@ -251,6 +257,9 @@ class ViewParser {
       }
     } else if (is("function")) {
       readFunction(line, vcol, value);
+      view_.functionNames.clear();  // cpfg: the functions are no longer only the set's
+    } else if (is("function set")) {
+      readFunctionSet(line, vcol, value);
     } else if (is("surface")) {
       readSurface(line, vcol, value);
     } else if (is("curve")) {
@@ -334,6 +343,87 @@ class ViewParser {
     } catch (const InputError& e) {
       for (const Diagnostic& d : e.diagnostics()) diags_.add(d);
     }
+  }
+
+  /// `function set: NAME.fset` (interpret.c, case 55; splinearr.cpp): a function gallery,
+  /// `funcgalleryver 1 1`, `items: n`, then n functions in the `fver 1 1` format. It
+  /// replaces the functions read so far; cpfg's preprocessor then defines each function's
+  /// name (without its suffix) as its number.
+  void readFunctionSet(int line, size_t vcol, const std::string& value) {
+    const std::string name = trimmed(value);
+    if (name.empty() || name.find_first_of(" \t") != std::string::npos) {
+      error(line, vcol, "expected one function set file after 'function set:'");
+      return;
+    }
+    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path();
+    const std::filesystem::path file = (folder / name).lexically_normal();
+    const std::string rel = file.lexically_relative(folder.empty() ? "." : folder).generic_string();
+    if (std::filesystem::path(name).is_absolute() || rel.empty() || rel.rfind("..", 0) == 0) {
+      error(line, vcol, "the function set file '" + name + "' is outside the object's folder (only files beside the view file, or in folders below it)");
+      return;
+    }
+    std::string text;
+    try {
+      text = readFile(file.string());
+    } catch (const std::exception&) {
+      error(line, vcol, "cannot read the function set file '" + file.string() + "'");
+      return;
+    }
+    std::vector<std::string> lines;
+    {
+      std::istringstream in(text);
+      std::string l;
+      while (std::getline(in, l)) lines.push_back(l);
+    }
+    auto fail = [&](size_t l, const std::string& msg) {
+      diags_.error(SourceLoc{file.string(), static_cast<int>(l) + 1, 1}, msg, l < lines.size() ? lines[l] : std::string());
+    };
+    size_t l = 0;
+    while (l < lines.size() && trimmed(lines[l]).empty()) ++l;
+    if (l >= lines.size() || trimmed(lines[l]) != "funcgalleryver 1 1") {
+      fail(l, "expected 'funcgalleryver 1 1' (the function set version cpfg reads)");
+      return;
+    }
+    ++l;
+    int items = -1;
+    if (l < lines.size()) {
+      std::istringstream in(lines[l]);
+      std::string key;
+      if (!(in >> key >> items) || key != "items:" || items < 0 || items > 10000) items = -1;
+    }
+    if (items < 0) {
+      fail(l, "expected 'items: n' in a function set");
+      return;
+    }
+    // The functions: each from its `fver` line to the next one.
+    std::vector<size_t> starts;
+    for (size_t k = l + 1; k < lines.size(); ++k)
+      if (trimmed(lines[k]).rfind("fver", 0) == 0) starts.push_back(k);
+    if (static_cast<int>(starts.size()) != items) {
+      fail(l, "'items: " + std::to_string(items) + "' but the set holds " + std::to_string(starts.size()) + " function(s) ('fver' lines)");
+      return;
+    }
+    std::vector<CpfgFunction> set;
+    std::vector<std::string> names;
+    for (size_t k = 0; k < starts.size(); ++k) {
+      const size_t end = k + 1 < starts.size() ? starts[k + 1] : lines.size();
+      std::string chunk;
+      for (size_t j = starts[k]; j < end; ++j) chunk += lines[j] + "\n";
+      try {
+        set.push_back(CpfgFunction::parse(chunk, file.string(), -1));
+      } catch (const InputError& e) {
+        for (Diagnostic d : e.diagnostics()) {
+          if (d.loc.line > 0) d.loc.line += static_cast<int>(starts[k]);
+          diags_.add(d);
+        }
+        return;
+      }
+      std::string n = set.back().name();
+      if (size_t dot = n.rfind('.'); dot != std::string::npos) n.erase(dot);
+      names.push_back(n);
+    }
+    view_.functions = std::move(set);
+    view_.functionNames = std::move(names);
   }
 
   /// `contour: id NAME.con` (interpret.c, case 40; general.c): the contour file beside the

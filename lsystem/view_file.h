@@ -43,6 +43,9 @@ struct ViewFile {
   /// `function: NAME.func [samples]`: the function files, in file order (`func(1, x)` is
   /// the first), read when the view file is.
   std::vector<CpfgFunction> functions;
+  /// After a `function set: NAME.fset` line (not followed by `function:` lines): its
+  /// functions' names without their suffix, which cpfg's preprocessor defines as 1, 2, ...
+  std::vector<std::string> functionNames;
   /// `surface: X NAME.s [size [s t]] [texture]`: the surface files, read and tessellated when
   /// the view file is, which `~X` draws.
   std::vector<CpfgSurfaceEntry> surfaces;

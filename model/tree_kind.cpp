@@ -599,6 +599,7 @@ lsystem::Grammar speciesGrammar(const Species& species, const lsystem::GrammarOv
   if (tree.view) {
     o.cpfgFunctions = tree.view->functions;
     o.cpfgCurves = tree.view->curves;
+    o.cpfgFunctionNames = tree.view->functionNames;
     for (const auto& sf : tree.view->surfaces) o.cpfgSurfaceIds += sf.id;
   }
   for (const auto& d : extra.defines) o.defines.push_back(d);

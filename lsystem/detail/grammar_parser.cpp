@@ -109,6 +109,7 @@ class GrammarParser {
     prog_.cpfg.functions = overrides.cpfgFunctions;
     prog_.cpfg.curves = overrides.cpfgCurves;
     scanner_.setCpfgSurfaceIds(overrides.cpfgSurfaceIds);
+    if (prog_.dialect == Dialect::Cpfg) scanner_.setPredefined(overrides.cpfgFunctionNames);
     expr_.setTables(&prog_.cpfg);
     for (const char* s : kTurtleSymbols) prog_.symbols.intern(s);
     prog_.openBracket = static_cast<SymbolId>(prog_.symbols.find("["));

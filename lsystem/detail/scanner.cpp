@@ -82,6 +82,12 @@ void Scanner::load(std::string_view text) {
   macros_.clear();
   constants_.clear();
   conditionals_.clear();
+  // cpfg's function set names (`-DNAME=n` on its preprocessor's command line).
+  for (size_t k = 0; k < predefined_.size(); ++k) {
+    Macro m;
+    m.body = std::to_string(k + 1);
+    macros_.emplace_back(predefined_[k], m);
+  }
   preprocess(0, splitAtNewlines(std::string(text)), splitAtNewlines(clean), 0);
   for (const Conditional& c : conditionals_)
     diags_.error(SourceLoc{files_[c.file], c.line, c.col + 1}, "'#if' block without '#endif'");

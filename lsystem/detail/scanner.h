@@ -113,6 +113,9 @@ class Scanner {
   Dialect dialect() const { return dialect_; }
   /// cpfg: the ids of the view file's surfaces; `~X` with another X is an error.
   void setCpfgSurfaceIds(std::string ids) { cpfgSurfaceIds_ = std::move(ids); }
+  /// cpfg: names the preprocessor defines before the file, the k-th (0-based) as k + 1
+  /// (the functions of a view file's `function set:`).
+  void setPredefined(std::vector<std::string> names) { predefined_ = std::move(names); }
   /// Splits line(line)[b, e) into modules, appending them to out. Reports errors; returns
   /// false on an error that stops the line (a stray `(`, `)` or `,`, a missing `)`) or
   /// after reporting empty parameters.
@@ -182,6 +185,7 @@ class Scanner {
   std::pair<int, int> pendingComment_{0, 0};
   Dialect dialect_ = Dialect::Sprig;
   std::string cpfgSurfaceIds_;
+  std::vector<std::string> predefined_;
   DiagnosticList diags_;
 };
 

@@ -1058,3 +1058,37 @@ TEST_CASE("cpfg generalized cylinders: @Gr radius tangents", "[lsystem][cpfg]") 
   checkNear(mid.internodes[0].end, DVec3(0, 0.5, 0));
   CHECK(mid.internodes[0].tipRadius == Approx(0.2));
 }
+
+TEST_CASE("cpfg view files: // comments", "[lsystem][cpfg]") {
+  // cpfg runs the view file through the C preprocessor, which removes // and /* */ comments
+  // (vlab's TexturedSurfaces has '// light: ...' lines).
+  const ViewFile v = parseViewFile("angle increment: 30 // degrees\n// light: V: 5 3 1 D: 1.3 1.5 1.3\n/* a\n b */ initial scale: 2\n", "t.v");
+  REQUIRE(v.angleDeg);
+  CHECK(*v.angleDeg == 30);
+  REQUIRE(v.initialScale);
+  CHECK(*v.initialScale == 2);
+  CHECK(viewErrorOf("// fine\nangel increment: 3\n") == "t.v:2:1: unknown view file command 'angel increment:' (did you mean 'angle increment'?)");
+}
+
+TEST_CASE("cpfg function sets: function set: and the functions' names", "[lsystem][cpfg]") {
+  const ViewFile view = loadViewFile(cpfgAsset("function_set/plant.v"));
+  REQUIRE(view.functions.size() == 2);  // the set replaces the 'function:' line before it
+  CHECK(view.functionNames == std::vector<std::string>{"WIDTH", "ANGLE"});
+  GrammarOverrides o;
+  o.cpfgFunctions = view.functions;
+  o.cpfgFunctionNames = view.functionNames;
+  const std::string file = cpfgAsset("function_set/plant.l");
+  const ModuleString s = derive(parseGrammar(readFile(file), file, o));
+  REQUIRE(s.size() == 1);
+  const std::vector<double> want = {0.15625, 0.783014893532, 0.066938758886};  // tests/assets/cpfg/function/reference.py
+  REQUIRE(s.paramsOf(0).size() == 3);
+  for (size_t k = 0; k < 3; ++k) CHECK(s.paramsOf(0)[k] == Approx(want[k]).margin(1e-9));
+  // A 'function:' line after the set: the names are no longer defined (cpfg's
+  // SetFunctionsFromGallery(FALSE)).
+  std::string v2 = readFile(cpfgAsset("function_set/plant.v")) + "function: ignored.func\n";
+  const std::string dir = cpfgAsset("function_set/");
+  const ViewFile after = parseViewFile(v2, dir + "plant.v");
+  CHECK(after.functions.size() == 3);
+  CHECK(after.functionNames.empty());
+  CHECK(viewErrorOf("function set: a.fset b\n") == "t.v:1:15: expected one function set file after 'function set:'");
+}
