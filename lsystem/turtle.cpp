@@ -673,7 +673,9 @@ class TurtleWalk {
   /// p1 + t t1 + t^2 a2 + t^3 a3, each the contours of the two control points blended by t,
   /// scaled by the radius (half the width), placed in the ring's frame: H the
   /// curve's tangent (the first point's heading at t = 0), cpfg's up vector U' the first
-  /// point's turned by the rotation taking its heading to H, L = H x U'; a contour point
+  /// point's turned by the rotation taking its heading to H and then about H by t times the
+  /// twist angle (from that transported vector to the second point's own at t = 1; the last
+  /// ring is the second point's frame), L = H x U'; a contour point
   /// (x, y, z) goes to the ring's centre + r (x U' - y L) + r z H / |p2 - p1|. One Surface
   /// organ per segment, its triangles joining consecutive rings.
   void gcContourMesh(size_t i, const DVec3& p1, const DVec3& t1, const DVec3& a2, const DVec3& a3, double len,
@@ -691,24 +693,37 @@ class TurtleWalk {
     o.name = "@#";
     o.position = p1;
     const DVec3 h0 = gc_.heading, u0 = -gc_.up;  // cpfg's up vector at the first point
+    // The minimal rotation taking h0 to h, applied to u0 (Rodrigues).
+    auto transported = [&](const DVec3& h) {
+      const DVec3 axis = glm::cross(h0, h);
+      const double sn = glm::length(axis), cs = glm::dot(h0, h);
+      if (sn <= 1e-12) return u0;
+      const DVec3 a = axis / sn;
+      return u0 * cs + glm::cross(a, u0) * sn + a * glm::dot(a, u0) * (1 - cs);
+    };
+    auto turned = [](const DVec3& v, const DVec3& axis, double angle) {
+      return v * std::cos(angle) + glm::cross(axis, v) * std::sin(angle) + axis * glm::dot(axis, v) * (1 - std::cos(angle));
+    };
+    // cpfg's twist angle (get_twist_angle): from the transported up vector to the second
+    // point's own, about its heading; ring t turns by t times it, the last ring is the
+    // second point's frame.
+    const TurtleFrame& fe = st_.frame;
+    const DVec3 uEnd = -fe.up, u1 = transported(fe.heading);
+    const double twist = std::atan2(glm::dot(glm::cross(u1, uEnd), fe.heading), glm::dot(u1, uEnd));
     const uint32_t per = static_cast<uint32_t>(sides) + 1;
     for (int k = 0; k <= rings; ++k) {
       const double t = ring[static_cast<size_t>(k)].x;
-      const DVec3 pos = p1 + t * (t1 + t * (a2 + t * a3));
-      DVec3 h = h0;
-      if (k > 0) {
+      const DVec3 pos = k == rings ? fe.position : p1 + t * (t1 + t * (a2 + t * a3));
+      DVec3 h = h0, u = u0, l;
+      if (k == rings) {
+        h = fe.heading;
+        u = uEnd;
+      } else if (k > 0) {
         const DVec3 d = t1 + t * (2.0 * a2 + t * 3.0 * a3);
         if (glm::length(d) > 1e-12) h = glm::normalize(d);
+        u = turned(transported(h), h, twist * t);
       }
-      // The minimal rotation taking h0 to h, applied to u0 (Rodrigues).
-      DVec3 u = u0;
-      const DVec3 axis = glm::cross(h0, h);
-      const double sn = glm::length(axis), cs = glm::dot(h0, h);
-      if (sn > 1e-12) {
-        const DVec3 a = axis / sn;
-        u = u0 * cs + glm::cross(a, u0) * sn + a * glm::dot(a, u0) * (1 - cs);
-      }
-      const DVec3 l = glm::cross(h, u);
+      l = glm::cross(h, u);
       const double r = radiusScale_ * ring[static_cast<size_t>(k)].y * g;
       for (uint32_t m = 0; m < per; ++m) {
         const DVec3 c = k1[m] * (1 - t) + k2[m] * t;

@@ -1092,3 +1092,25 @@ TEST_CASE("cpfg function sets: function set: and the functions' names", "[lsyste
   CHECK(after.functionNames.empty());
   CHECK(viewErrorOf("function set: a.fset b\n") == "t.v:1:15: expected one function set file after 'function set:'");
 }
+
+TEST_CASE("cpfg generalized cylinders with @#(n): a roll between control points twists the rings", "[lsystem][cpfg]") {
+  // cpfg's twist angle: a straight segment whose second point is rolled by 90 degrees has
+  // its last ring in the rolled frame and its middle ring turned half way (45 degrees).
+  ViewFile view = loadViewFile(cpfgAsset("contour/plant.v"));
+  Grammar g = parseGrammar("axiom: @#(1) @Gs f(1) /(90) @Ge(2)\n", "t.l");
+  Skeleton sk = Turtle(g.symbols(), cpfgTurtleSettings(&view, {})).run(g.axiom());
+  REQUIRE(sk.organs.size() == 1);
+  const std::vector<DVec3>& p = sk.organs[0].points;
+  REQUIRE(p.size() == 3 * 7);
+  for (size_t m = 0; m < 6; ++m) {
+    const DVec3 a = p[m] - DVec3(0, 0, 0), b = p[7 + m] - DVec3(0, 0.5, 0), c = p[14 + m] - DVec3(0, 1, 0);
+    auto angle = [](const DVec3& x, const DVec3& y) { return std::acos(std::clamp(glm::dot(glm::normalize(x), glm::normalize(y)), -1.0, 1.0)); };
+    INFO("contour point " << m);
+    CHECK(std::fabs(a.y) < 1e-12);  // every ring perpendicular to the straight axis
+    CHECK(std::fabs(b.y) < 1e-12);
+    CHECK(std::fabs(c.y) < 1e-12);
+    CHECK(angle(a, c) == Approx(kPi / 2));
+    CHECK(angle(a, b) == Approx(kPi / 4));
+    CHECK(angle(b, c) == Approx(kPi / 4));
+  }
+}
