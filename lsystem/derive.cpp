@@ -276,7 +276,7 @@ struct Deriver::Impl {
     Rng blockRng(deriveSeed(seed, {kBlockStream, static_cast<uint64_t>(step)}));
     const Instr* code = prog->code.data();
     const bool looped = std::isnan(
-        detail::evalCode(code + r.begin, code + r.end, globals.data(), &blockRng, &prog->strings, &effects, &prog->functions));
+        detail::evalCode(code + r.begin, code + r.end, globals.data(), &blockRng, &prog->strings, &effects, &prog->cpfg));
     if (effects.reseed) {
       // cpfg's srand(s): the next step draws as the first step of a derivation with seed s.
       seed = static_cast<uint64_t>(static_cast<int64_t>(std::clamp(effects.seed, -9.2e18, 9.2e18)));
@@ -501,7 +501,7 @@ struct Deriver::Impl {
   void statements(const Production& p, const detail::CodeRange& r, double* vars, int step) {
     const Instr* code = prog->code.data();
     double v = detail::evalCode(code + r.begin, code + r.end, vars, p.usesRandom ? moduleRng() : nullptr, &prog->strings, &effects,
-                                &prog->functions);
+                                &prog->cpfg);
     if (std::isnan(v))
       throw InputError(p.loc, "the statements of production '" + p.text + "' loop more than " +
                                   std::to_string(detail::kMaxLoopJumps) + " times at step " + std::to_string(step),
@@ -521,7 +521,7 @@ struct Deriver::Impl {
     if (p.condition.empty()) return true;
     const Instr* code = prog->code.data();
     double v = detail::evalCode(code + p.condition.begin, code + p.condition.end, vars, p.usesRandom ? moduleRng() : nullptr,
-                                nullptr, nullptr, &prog->functions);
+                                nullptr, nullptr, &prog->cpfg);
     if (std::isnan(v))
       throw InputError(p.loc, "the condition of production '" + p.text + "' is not a number (nan) at step " + std::to_string(step), p.sourceLine);
     return v != 0.0;
@@ -593,7 +593,7 @@ struct Deriver::Impl {
       default: {
         const Instr* code = prog->code.data();
         v = detail::evalCode(code + a.code.begin, code + a.code.end, vars, p.usesRandom ? moduleRng() : nullptr, nullptr, nullptr,
-                             &prog->functions);
+                             &prog->cpfg);
       }
     }
     if (!std::isfinite(v)) [[unlikely]]

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "core/diagnostics.h"
+#include "lsystem/cpfg_curve.h"
 #include "lsystem/cpfg_function.h"
 #include "lsystem/module_string.h"
 
@@ -53,6 +54,15 @@ struct GrammarOverrides {
   /// cpfg's function files of the grammar's view file (ViewFile::functions), which
   /// `func(n, x)` reads; without them `func` is an error.
   std::vector<CpfgFunction> cpfgFunctions;
+  /// cpfg's curve files of the grammar's view file (ViewFile::curves), which `curveX(n, t)`,
+  /// `curveY`, `curveZ` and `curveGAL(n)` read; without them these are errors.
+  std::vector<CpfgCurve> cpfgCurves;
+  /// The ids of the view file's surfaces (ViewFile::surfaces), which `~X` may name; any
+  /// other `~X` in a `.l` grammar is an error.
+  std::string cpfgSurfaceIds;
+  /// cpfg: the names of a view file's `function set:` functions (ViewFile::functionNames),
+  /// which the preprocessor defines as 1, 2, ... in a `.l` grammar.
+  std::vector<std::string> cpfgFunctionNames;
 };
 
 /// A parsed, compiled L-system.

@@ -28,11 +28,15 @@ struct Internode {
   double length() const;
 };
 
-/// A non-internode part: leaf polygon, sphere, or a named predefined surface.
+/// A non-internode part: leaf polygon, sphere, or a named surface: a predefined one (drawn
+/// by the geometry builders from position, frame and radius), or, in cpfg's notation, a
+/// surface file's mesh already placed in world units (triangles not empty).
 struct Organ {
   enum class Kind { Polygon, Sphere, Surface };
   Kind kind = Kind::Polygon;
-  std::vector<DVec3> points;   ///< polygon vertices in order (Polygon)
+  std::vector<DVec3> points;   ///< polygon vertices in order (Polygon), or a surface file's mesh vertices (Surface)
+  std::vector<DVec3> normals;  ///< Surface from a cpfg surface file: unit normal per vertex of points
+  std::vector<uint32_t> triangles;  ///< Surface from a cpfg surface file: 3 indices into points per triangle
   DVec3 position{0};           ///< center (Sphere) or turtle position (Surface)
   DVec3 heading{0, 1, 0};      ///< turtle frame when created (Surface)
   DVec3 left{-1, 0, 0};

@@ -7,6 +7,7 @@
 
 #include <glm/gtc/quaternion.hpp>
 
+#include "core/diagnostics.h"
 #include "lsystem/detail/huge_pages.h"
 
 namespace sprig::lsystem {
@@ -155,6 +156,12 @@ Turtle::Turtle(const SymbolTable& symbols, TurtleSettings settings) : symbols_(s
       c = Command::GcEnd;
     } else if (n == "@Gt") {
       c = Command::GcTangents;
+    } else if (n == "@Gr") {
+      c = Command::GcRadiusTangents;
+    } else if (n == "@#") {
+      c = Command::Contour;
+    } else if (n == "@!") {
+      c = Command::ContourSides;
     } else if (n == "?P" || n == "?H" || n == "?L" || n == "?U") {
       c = Command::Query;
     } else if (n.size() > 1 && n[0] == '~') {
@@ -237,7 +244,7 @@ class TurtleWalk {
     buf_.stack.reserve(64);
     for (size_t k = 0; k < ncmd_ && !usesGc_; ++k)
       usesGc_ = cmd_[k] == Command::GcStart || cmd_[k] == Command::GcPoint || cmd_[k] == Command::GcEnd ||
-                cmd_[k] == Command::GcTangents;
+                cmd_[k] == Command::GcTangents || cmd_[k] == Command::GcRadiusTangents;
   }
 
   /// Reserves the exact number of drawing modules: cheaper than growing the vector.
@@ -315,6 +322,14 @@ class TurtleWalk {
           break;
         case Command::GcPoint: gcPoint(i, false); break;
         case Command::GcEnd: gcPoint(i, true); break;
+        case Command::Contour: contour(i); break;
+        case Command::GcRadiusTangents: gcRadiusTangents(i); break;
+        case Command::ContourSides:
+          // cpfg's `@!(n)`: points around a contour (at least 3; 8 without a parameter).
+          st_.contourSides = hasParam(i) ? std::clamp(static_cast<int>(std::isfinite(param(i)) ? std::clamp(param(i), -1e6, 1e6) : 0.0),
+                                                     CpfgContour::kMinSides, CpfgContour::kMaxSides)
+                                         : CpfgContour::kDefaultSides;
+          break;
         case Command::GcTangents:
           if (hasParam(i)) {
             gc_.tangentIn = param(i);
@@ -390,6 +405,10 @@ class TurtleWalk {
     }
     const double g = growth(i);
     if (g <= 0) return;  // not grown yet: nothing drawn, no bend; the axis carries on from its parent
+    if (st_.contour != 0)
+      throw InputError(SourceLoc{"sprig", 0, 0}, "cpfg's contour '@#(" + std::to_string(st_.contour) +
+                                        ")' on an 'F' segment (a cylinder outside a generalized cylinder) is not supported: "
+                                        "select it for '@Gs ... @Gc' cylinders drawn with 'f'");
     Internode in;
     in.start = start;
     in.end = st_.frame.position;
@@ -538,16 +557,40 @@ class TurtleWalk {
         const DVec3 a2 = -3.0 * (p1 - p2) - 2.0 * t1 - t2, a3 = 2.0 * (p1 - p2) + t1 + t2;
         int rings = hasParam(i) ? std::max(1, static_cast<int>(param(i))) : kDefaultGcRings;
         rings = std::min(rings, kMaxGcRings);
+        // cpfg's radius Hermite (general.c, interpolate_connection): the pairs (t, radius)
+        // from (0, w1/2) to (1, w2/2) with the tangents of `@Gr` (the first point's second
+        // and this point's first; times |p2 - p1| after `@Gr(1)`); a zero tangent is
+        // (1, (w2 - w1)/2), so that without `@Gr` t = k/n and the radius is linear.
+        glm::dvec2 r0 = gc_.pointRadiusOut, r1 = gc_.radiusIn;
+        if (gc_.scaleRadiusTangents) {
+          r0.y *= len;
+          r1.y *= len;
+        }
+        const double half = 0.5 * (w2 - gc_.width);
+        if (r0 == glm::dvec2(0.0)) r0 = glm::dvec2(1, half);
+        if (r1 == glm::dvec2(0.0)) r1 = glm::dvec2(1, half);
+        const glm::dvec2 c0(0, 0.5 * gc_.width), c2(3 - 2 * r0.x - r1.x, 3 * half - 2 * r0.y - r1.y),
+            c3(-2 + r0.x + r1.x, -2 * half + r0.y + r1.y);
+        std::vector<glm::dvec2> ring(static_cast<size_t>(rings) + 1);  // (t, width) per ring
+        for (int k = 0; k <= rings; ++k) {
+          const double r = static_cast<double>(k) / rings;
+          const glm::dvec2 v = k == rings ? glm::dvec2(1, 0.5 * w2) : ((c3 * r + c2) * r + r0) * r + c0;
+          ring[static_cast<size_t>(k)] = glm::dvec2(v.x, 2 * v.y);
+        }
+        if (gc_.contour != 0 || st_.contour != 0) {
+          gcContourMesh(i, p1, t1, a2, a3, len, ring);
+          rings = 0;  // drawn as a mesh
+        }
         DVec3 from = p1;
         int32_t parent = gc_.lastInternode;
         for (int k = 1; k <= rings; ++k) {
-          const double t = static_cast<double>(k) / rings;
+          const double t = ring[static_cast<size_t>(k)].x;
           const DVec3 to = k == rings ? p2 : p1 + t * (t1 + t * (a2 + t * a3));
           Internode in;
           in.start = from;
           in.end = to;
-          in.baseRadius = radiusScale_ * (gc_.width + (w2 - gc_.width) * (k - 1) / rings);
-          in.tipRadius = radiusScale_ * (gc_.width + (w2 - gc_.width) * t);
+          in.baseRadius = radiusScale_ * ring[static_cast<size_t>(k) - 1].y;
+          in.tipRadius = radiusScale_ * ring[static_cast<size_t>(k)].y;
           if (maxRadiusPerLength_ > 0) {
             in.baseRadius = std::min(in.baseRadius, maxRadiusPerLength_ * len);
             in.tipRadius = std::min(in.tipRadius, maxRadiusPerLength_ * len);
@@ -577,9 +620,133 @@ class TurtleWalk {
     gc_.hasPoint = true;
     gc_.position = p2;
     gc_.heading = h2;
+    gc_.up = st_.frame.up;
     gc_.width = w2;
+    gc_.contour = st_.contour;
+    gc_.sides = st_.contourSides > 0 ? st_.contourSides : settings_.contourSides;
     gc_.pointTangentOut = gc_.tangentOut;
+    gc_.pointRadiusOut = gc_.radiusOut;
     if (end) gc_.active = gc_.hasPoint = false;
+  }
+
+  /// cpfg's `@Gr` (blackbox.c): `@Gr(s)` makes later radius tangents scale with the
+  /// segment's length (s != 0) or not; `@Gr(a, l)` sets both radius tangents to
+  /// l (cos a, sin a) (a in degrees; in (t, radius) space), `@Gr(a, l, a2, l2)` the second
+  /// to l2 (cos a2, sin a2). Without parameters: nothing.
+  void gcRadiusTangents(size_t i) {
+    const uint32_t n = paramCount(i);
+    if (n == 1) {
+      gc_.scaleRadiusTangents = paramAt(i, 0) != 0;
+      return;
+    }
+    if (n < 2) return;
+    auto tangent = [&](uint32_t k) {
+      const double a = radians(paramAt(i, k)), l = paramAt(i, k + 1);
+      return glm::dvec2(std::cos(a) * l, std::sin(a) * l);
+    };
+    gc_.radiusIn = gc_.radiusOut = tangent(0);
+    if (n >= 4) gc_.radiusOut = tangent(2);
+  }
+
+  /// cpfg's `@#(id)`: the contour of the generalized cylinders from here on (0 or no
+  /// parameter: the circle). An id the view file does not define is an error.
+  void contour(size_t i) {
+    const double v = hasParam(i) ? param(i) : 0.0;
+    const int id = std::isfinite(v) ? static_cast<int>(std::clamp(v, -2e9, 2e9)) : -1;
+    if (id != 0 && !findContour(id))
+      throw InputError(SourceLoc{"sprig", 0, 0}, "cpfg's '@#(" + (std::isfinite(v) ? std::to_string(id) : std::string("nan")) +
+                                        ")' names no contour: " +
+                                        (settings_.cpfgContours ? "the view file has no 'contour: " + std::to_string(id) + " ...' line"
+                                                                : std::string("the view file has no 'contour:' line")));
+    st_.contour = id;
+  }
+
+  const CpfgContour* findContour(int id) const {
+    if (!settings_.cpfgContours) return nullptr;
+    for (const CpfgContourEntry& e : *settings_.cpfgContours)
+      if (e.id == id) return &e.contour;
+    return nullptr;
+  }
+
+  /// A generalized-cylinder segment with a contour (general.c, interpolate_connection and
+  /// make_contour): rings at the (t, width) pairs of ring along the Hermite curve
+  /// p1 + t t1 + t^2 a2 + t^3 a3, each the contours of the two control points blended by t,
+  /// scaled by the radius (half the width), placed in the ring's frame: H the
+  /// curve's tangent (the first point's heading at t = 0), cpfg's up vector U' the first
+  /// point's turned by the rotation taking its heading to H and then about H by t times the
+  /// twist angle (from that transported vector to the second point's own at t = 1; the last
+  /// ring is the second point's frame), L = H x U'; a contour point
+  /// (x, y, z) goes to the ring's centre + r (x U' - y L) + r z H / |p2 - p1|. One Surface
+  /// organ per segment, its triangles joining consecutive rings.
+  void gcContourMesh(size_t i, const DVec3& p1, const DVec3& t1, const DVec3& a2, const DVec3& a3, double len,
+                     const std::vector<glm::dvec2>& ring) {
+    const int rings = static_cast<int>(ring.size()) - 1;
+    const CpfgContour circle = CpfgContour::circle();
+    const CpfgContour* c1 = gc_.contour ? findContour(gc_.contour) : &circle;
+    const CpfgContour* c2 = st_.contour ? findContour(st_.contour) : &circle;
+    if (!c1) c1 = &circle;
+    if (!c2) c2 = &circle;
+    const int sides = gc_.sides;
+    const std::vector<DVec3> k1 = c1->sample(sides), k2 = c2->sample(sides);
+    const double g = growth(i);
+    Organ o = organHere(Organ::Kind::Surface, i);
+    o.name = "@#";
+    o.position = p1;
+    const DVec3 h0 = gc_.heading, u0 = -gc_.up;  // cpfg's up vector at the first point
+    // The minimal rotation taking h0 to h, applied to u0 (Rodrigues).
+    auto transported = [&](const DVec3& h) {
+      const DVec3 axis = glm::cross(h0, h);
+      const double sn = glm::length(axis), cs = glm::dot(h0, h);
+      if (sn <= 1e-12) return u0;
+      const DVec3 a = axis / sn;
+      return u0 * cs + glm::cross(a, u0) * sn + a * glm::dot(a, u0) * (1 - cs);
+    };
+    auto turned = [](const DVec3& v, const DVec3& axis, double angle) {
+      return v * std::cos(angle) + glm::cross(axis, v) * std::sin(angle) + axis * glm::dot(axis, v) * (1 - std::cos(angle));
+    };
+    // cpfg's twist angle (get_twist_angle): from the transported up vector to the second
+    // point's own, about its heading; ring t turns by t times it, the last ring is the
+    // second point's frame.
+    const TurtleFrame& fe = st_.frame;
+    const DVec3 uEnd = -fe.up, u1 = transported(fe.heading);
+    const double twist = std::atan2(glm::dot(glm::cross(u1, uEnd), fe.heading), glm::dot(u1, uEnd));
+    const uint32_t per = static_cast<uint32_t>(sides) + 1;
+    for (int k = 0; k <= rings; ++k) {
+      const double t = ring[static_cast<size_t>(k)].x;
+      const DVec3 pos = k == rings ? fe.position : p1 + t * (t1 + t * (a2 + t * a3));
+      DVec3 h = h0, u = u0, l;
+      if (k == rings) {
+        h = fe.heading;
+        u = uEnd;
+      } else if (k > 0) {
+        const DVec3 d = t1 + t * (2.0 * a2 + t * 3.0 * a3);
+        if (glm::length(d) > 1e-12) h = glm::normalize(d);
+        u = turned(transported(h), h, twist * t);
+      }
+      l = glm::cross(h, u);
+      const double r = radiusScale_ * ring[static_cast<size_t>(k)].y * g;
+      for (uint32_t m = 0; m < per; ++m) {
+        const DVec3 c = k1[m] * (1 - t) + k2[m] * t;
+        o.points.push_back(pos + r * (c.x * u - c.y * l) + (r * c.z / len) * h);
+      }
+    }
+    for (uint32_t k = 0; k < static_cast<uint32_t>(rings); ++k)
+      for (uint32_t m = 0; m < static_cast<uint32_t>(sides); ++m) {
+        const uint32_t a = k * per + m, b = a + 1, c = a + per, d = c + 1;
+        o.triangles.insert(o.triangles.end(), {a, c, b, b, c, d});
+      }
+    // Vertex normals: the area-weighted normals of the triangles around each vertex.
+    o.normals.assign(o.points.size(), DVec3(0.0));
+    for (size_t k = 0; k + 2 < o.triangles.size(); k += 3) {
+      const DVec3 n = glm::cross(o.points[o.triangles[k + 1]] - o.points[o.triangles[k]],
+                                 o.points[o.triangles[k + 2]] - o.points[o.triangles[k]]);
+      for (int v = 0; v < 3; ++v) o.normals[o.triangles[k + v]] += n;
+    }
+    for (DVec3& n : o.normals) {
+      const double l = glm::length(n);
+      n = l > 0 ? n / l : n;
+    }
+    sk_.organs.push_back(std::move(o));
   }
 
   /// Starts a generalized cylinder with no control point yet (the tangent parameters stay).
@@ -826,10 +993,61 @@ class TurtleWalk {
     sk_.organs.push_back(std::move(o));
   }
 
+  /// cpfg's `~X`, `~X(s)` or `~X(sx, sy, sz)` for module i (interpret.c's '~' case,
+  /// patches.c): the view file's surface X, scaled by s (default 1) times the turtle scale,
+  /// a Surface organ with its mesh placed at the turtle (CpfgSurface's comment has the map);
+  /// then the turtle moves to the surface's end point (scaled by s only, as in cpfg). An id
+  /// the view file does not define draws nothing (the grammar parser refuses it).
+  void cpfgSurface(size_t i, char id) {
+    if (!settings_.cpfgSurfaces) return;
+    const CpfgSurface* sf = nullptr;
+    for (const CpfgSurfaceEntry& e : *settings_.cpfgSurfaces)
+      if (e.id == id) sf = &e.surface;
+    if (!sf) return;
+    const uint32_t n = paramCount(i);
+    DVec3 sc(1.0);
+    if (n >= 3) sc = DVec3(paramAt(i, 0), paramAt(i, 1), paramAt(i, 2));
+    else if (n >= 1) sc = DVec3(paramAt(i, 0));
+    sc *= st_.scale * growth(i);
+    const TurtleFrame& f = st_.frame;
+    const DVec3 cpfgUp = -f.up;
+    if (sc.x != 0 && sc.y != 0 && sc.z != 0) {
+      Organ o = organHere(Organ::Kind::Surface, i);
+      o.radius = sc.y;
+      o.name = std::string(1, id);
+      const glm::dmat3 m(sc.x * f.left, sc.y * f.heading, sc.z * cpfgUp);  // columns
+      // Normals transform by the inverse transpose (cofactor form: no division by zero).
+      const glm::dmat3 nm(glm::cross(m[1], m[2]), glm::cross(m[2], m[0]), glm::cross(m[0], m[1]));
+      o.points.reserve(sf->vertices().size());
+      o.normals.reserve(sf->vertices().size());
+      for (size_t k = 0; k < sf->vertices().size(); ++k) {
+        o.points.push_back(f.position + m * sf->vertices()[k]);
+        const DVec3 nk = nm * sf->normals()[k];
+        const double len = glm::length(nk);
+        o.normals.push_back(len > 0 ? nk / len : nk);
+      }
+      o.triangles = sf->triangles();
+      // A mirroring scale (an odd number of negative factors) turns the winding over.
+      if (sc.x * sc.y * sc.z < 0)
+        for (size_t k = 0; k + 2 < o.triangles.size(); k += 3) std::swap(o.triangles[k + 1], o.triangles[k + 2]);
+      sk_.organs.push_back(std::move(o));
+    }
+    const double s = sc.x;
+    const DVec3 e = sf->endPoint();
+    st_.frame.position += s * (e.x * f.left + e.y * f.heading + e.z * cpfgUp);
+  }
+
   /// cpfg's `~l` or `~l(scale)` written as two modules: the module after `~` names the
   /// surface and is consumed. Returns the index of the last module read.
   size_t surface(size_t i) {
     if (i + 1 >= n_) return i;
+    if (settings_.cpfg) {
+      // cpfg: `~` reads the next module; its name's first letter is the surface id.
+      ++i;
+      const std::string& name = symbols_.name(sym_[i]);
+      cpfgSurface(i, name.empty() ? '\0' : name[0]);
+      return i;
+    }
     double radius = hasParam(i) ? param(i) : settings_.surfaceScale;
     ++i;
     if (off_[i] == off_[i - 1] && hasParam(i)) radius = param(i);
@@ -839,6 +1057,10 @@ class TurtleWalk {
 
   /// `~l` as one symbol (`~` and a letter).
   void surfaceNamed(size_t i) {
+    if (settings_.cpfg) {
+      cpfgSurface(i, symbols_.name(sym_[i])[1]);
+      return;
+    }
     addSurface(i, symbols_.name(sym_[i]).substr(1), hasParam(i) ? param(i) : settings_.surfaceScale);
   }
 
@@ -927,8 +1149,13 @@ class TurtleWalk {
   struct GcState {
     bool active = false;      ///< between `@Gs` (or a first `@Gc`) and `@Ge`
     bool hasPoint = false;    ///< the previous control point below is set
-    DVec3 position{0}, heading{0, 1, 0};
+    DVec3 position{0}, heading{0, 1, 0}, up{0, 0, 1};
     double width = 0;
+    int contour = 0;  ///< the contour id at the previous control point
+    glm::dvec2 radiusIn{0.0}, radiusOut{0.0};  ///< `@Gr(a, l[, a2, l2])`: the turtle's radius tangents (cpfg's [0], [1])
+    glm::dvec2 pointRadiusOut{0.0};            ///< radiusOut at the previous control point
+    bool scaleRadiusTangents = false;          ///< `@Gr(s)`, s != 0: radius tangents times the segment's length
+    int sides = CpfgContour::kDefaultSides;  ///< points around its contour
     double tangentIn = 1.2, tangentOut = 1.2;  ///< `@Gt(in, out)`: the turtle's (cpfg's defaults)
     double pointTangentOut = 1.2;              ///< tangentOut at the previous control point
     int32_t lastInternode = -1;                ///< the last piece drawn (parent of the next)

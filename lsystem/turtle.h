@@ -15,10 +15,13 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
 #include "core/types.h"
+#include "lsystem/cpfg_contour.h"
+#include "lsystem/cpfg_surface.h"
 #include "lsystem/module_string.h"
 #include "lsystem/skeleton.h"
 
@@ -73,6 +76,12 @@ struct TurtleSettings {
   double initialScale = 1.0;      ///< cpfg: `initial scale:` (view file), the turtle scale at the start
   double scaleMultiplier = 1.0;   ///< cpfg: `scale multiplier:` (view file), of `@Di` and `@Dd`
   std::vector<CpfgTropism> tropisms;  ///< cpfg: the view file's `tropism:` lines (at most kMaxTropisms)
+  /// cpfg: the view file's surfaces (`surface:` lines), which `~X` draws as meshes; null for none.
+  std::shared_ptr<const std::vector<CpfgSurfaceEntry>> cpfgSurfaces;
+  /// cpfg: the view file's contours (`contour:` lines), which `@#(id)` selects as the
+  /// cross-section of generalized cylinders; null for none.
+  std::shared_ptr<const std::vector<CpfgContourEntry>> cpfgContours;
+  int contourSides = CpfgContour::kDefaultSides;  ///< cpfg: `contour sides:` (view file), points around a contour
   /// cpfg's old tropism (view file `tropism direction:`, `initial elasticity:`, `elasticity
   /// increment:`, module `_`): with `cpfg`, `tropism` (made unit length) and `elasticity`
   /// are its direction and initial elasticity, bent by cpfg's old rule after every move.
@@ -109,6 +118,8 @@ struct TurtleState {
   DVec3 prevHeading{0, 1, 0}; ///< cpfg: H at the last `F`/`G` (or `@Tf`), for twist-free frames
   DVec3 prevUp{0, 0, 1};      ///< cpfg: U at the last `F`/`G` (or `@Tf`)
   std::array<double, kMaxTropisms> elasticities{};  ///< cpfg: the current elasticity of each tropism
+  int contour = 0;            ///< cpfg: the contour id `@#(id)` selected (0: the circle)
+  int contourSides = 0;       ///< cpfg: points around a contour, `@!(n)` (0: the view file's)
 };
 
 /// Interprets module strings of one grammar. Construction builds the symbol -> command
@@ -154,7 +165,7 @@ class Turtle {
     RollLeft, RollRight, TurnAround, RollToVertical, Push, Pop, Width, Color, PolygonBegin, Vertex,
     PolygonEnd, Surface, SurfaceNamed, Cut, Tropism, Sphere, WidthUp, ColorUp, ColorDown, Circle, Disc,
     TropismUp, TropismDown, TwistAdjust, TwistForce, MoveTo, SetHeading, ScaleSet, ScaleUp, ScaleDown, OldElasticity,
-    Query, SubCall, SubEnd, GcStart, GcPoint, GcEnd, GcTangents
+    Query, SubCall, SubEnd, GcStart, GcPoint, GcEnd, GcTangents, Contour, ContourSides, GcRadiusTangents
   };
   /// The command bound to symbol id `s` (None for ids outside the table).
   Command commandOf(SymbolId s) const { return s < commands_.size() ? commands_[s] : Command::None; }

@@ -22,7 +22,7 @@ const char* const kViewerKeys[] = {
     "cue range",          "shade mode",           "light direction", "diffuse reflection",
     "surface ambient",    "surface diffuse",      "box",            "background color",
     "ambient light",      "font",                 "winfont",        "polygonization level",
-    "light",              "render mode",          "tapered lines",  "contour sides",
+    "light",              "render mode",          "tapered lines",
     "viewing angle",      "twist of cylinders",   "interpretation step", "environment display",
     "antialiasing",       "min zoom",             "max zoom",       "generate on view change",
     "concave polygons",   "shadow map",           "PS linecap",     "rayshade objects",
@@ -31,7 +31,10 @@ const char* const kViewerKeys[] = {
 
 /// Keys naming files whose uses (`~`, `func`, `curveX`, `@#`, `inblob`) are errors in the
 /// grammar: not read, with a warning.
-const char* const kFileKeys[] = {"surface", "tsurface", "contour", "function set", "curve", "blob"};
+const char* const kFileKeys[] = {"tsurface", "blob"};
+
+/// Most `surface:` lines of a view file (cpfg's SURFACES - 1).
+constexpr size_t kMaxSurfaces = 14;
 
 /// Keys that would change the geometry and that Sprig does not implement, with what they do.
 struct UnsupportedKey {
@@ -46,15 +49,21 @@ constexpr UnsupportedKey kUnsupportedKeys[] = {
 const char* const kReadKeys[] = {
     "angle factor",  "angle increment",   "initial color", "color increment", "initial line width",
     "line width increment", "line style", "initial scale", "scale multiplier", "tropism", "torque",
-    "tropism direction", "initial elasticity", "elasticity increment",
+    "tropism direction", "initial elasticity", "elasticity increment", "function", "function set", "surface", "curve", "contour", "contour sides",
 };
 
-/// The view file's text with `/* */` comments blanked (newlines kept, so positions hold).
+/// The view file's text with `/* */` and `//` comments blanked (newlines kept, so positions
+/// hold): cpfg runs its view file through the C preprocessor, which removes both.
 std::string blankComments(std::string s, int& openLine) {
   openLine = 0;
   int line = 1;
   for (size_t i = 0; i < s.size(); ++i) {
     if (s[i] == '\n') ++line;
+    if (s[i] == '/' && i + 1 < s.size() && s[i + 1] == '/') {
+      while (i < s.size() && s[i] != '\n') s[i++] = ' ';
+      if (i < s.size()) ++line;
+      continue;
+    }
     if (s[i] == '/' && i + 1 < s.size() && s[i + 1] == '*') {
       const int start = line;
       size_t j = i + 2;
@@ -248,6 +257,22 @@ class ViewParser {
       }
     } else if (is("function")) {
       readFunction(line, vcol, value);
+      view_.functionNames.clear();  // cpfg: the functions are no longer only the set's
+    } else if (is("function set")) {
+      readFunctionSet(line, vcol, value);
+    } else if (is("surface")) {
+      readSurface(line, vcol, value);
+    } else if (is("curve")) {
+      readCurve(line, vcol, value);
+    } else if (is("contour")) {
+      readContour(line, vcol, value);
+    } else if (is("contour sides")) {
+      if (auto v = values(line, vcol, key, value, 1, 1)) {
+        if ((*v)[0] != std::floor((*v)[0]) || (*v)[0] < CpfgContour::kMinSides || (*v)[0] > CpfgContour::kMaxSides)
+          error(line, vcol, "'contour sides:' is a whole number from 3 to 1024");
+        else
+          view_.contourSides = static_cast<int>((*v)[0]);
+      }
     } else {
       for (const UnsupportedKey& u : kUnsupportedKeys)
         if (key == u.key) {
@@ -315,6 +340,278 @@ class ViewParser {
     }
     try {
       view_.functions.push_back(CpfgFunction::parse(text, file.string(), samples));
+    } catch (const InputError& e) {
+      for (const Diagnostic& d : e.diagnostics()) diags_.add(d);
+    }
+  }
+
+  /// `function set: NAME.fset` (interpret.c, case 55; splinearr.cpp): a function gallery,
+  /// `funcgalleryver 1 1`, `items: n`, then n functions in the `fver 1 1` format. It
+  /// replaces the functions read so far; cpfg's preprocessor then defines each function's
+  /// name (without its suffix) as its number.
+  void readFunctionSet(int line, size_t vcol, const std::string& value) {
+    const std::string name = trimmed(value);
+    if (name.empty() || name.find_first_of(" \t") != std::string::npos) {
+      error(line, vcol, "expected one function set file after 'function set:'");
+      return;
+    }
+    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path();
+    const std::filesystem::path file = (folder / name).lexically_normal();
+    const std::string rel = file.lexically_relative(folder.empty() ? "." : folder).generic_string();
+    if (std::filesystem::path(name).is_absolute() || rel.empty() || rel.rfind("..", 0) == 0) {
+      error(line, vcol, "the function set file '" + name + "' is outside the object's folder (only files beside the view file, or in folders below it)");
+      return;
+    }
+    std::string text;
+    try {
+      text = readFile(file.string());
+    } catch (const std::exception&) {
+      error(line, vcol, "cannot read the function set file '" + file.string() + "'");
+      return;
+    }
+    std::vector<std::string> lines;
+    {
+      std::istringstream in(text);
+      std::string l;
+      while (std::getline(in, l)) lines.push_back(l);
+    }
+    auto fail = [&](size_t l, const std::string& msg) {
+      diags_.error(SourceLoc{file.string(), static_cast<int>(l) + 1, 1}, msg, l < lines.size() ? lines[l] : std::string());
+    };
+    size_t l = 0;
+    while (l < lines.size() && trimmed(lines[l]).empty()) ++l;
+    if (l >= lines.size() || trimmed(lines[l]) != "funcgalleryver 1 1") {
+      fail(l, "expected 'funcgalleryver 1 1' (the function set version cpfg reads)");
+      return;
+    }
+    ++l;
+    int items = -1;
+    if (l < lines.size()) {
+      std::istringstream in(lines[l]);
+      std::string key;
+      if (!(in >> key >> items) || key != "items:" || items < 0 || items > 10000) items = -1;
+    }
+    if (items < 0) {
+      fail(l, "expected 'items: n' in a function set");
+      return;
+    }
+    // The functions: each from its `fver` line to the next one.
+    std::vector<size_t> starts;
+    for (size_t k = l + 1; k < lines.size(); ++k)
+      if (trimmed(lines[k]).rfind("fver", 0) == 0) starts.push_back(k);
+    if (static_cast<int>(starts.size()) != items) {
+      fail(l, "'items: " + std::to_string(items) + "' but the set holds " + std::to_string(starts.size()) + " function(s) ('fver' lines)");
+      return;
+    }
+    std::vector<CpfgFunction> set;
+    std::vector<std::string> names;
+    for (size_t k = 0; k < starts.size(); ++k) {
+      const size_t end = k + 1 < starts.size() ? starts[k + 1] : lines.size();
+      std::string chunk;
+      for (size_t j = starts[k]; j < end; ++j) chunk += lines[j] + "\n";
+      try {
+        set.push_back(CpfgFunction::parse(chunk, file.string(), -1));
+      } catch (const InputError& e) {
+        for (Diagnostic d : e.diagnostics()) {
+          if (d.loc.line > 0) d.loc.line += static_cast<int>(starts[k]);
+          diags_.add(d);
+        }
+        return;
+      }
+      std::string n = set.back().name();
+      if (size_t dot = n.rfind('.'); dot != std::string::npos) n.erase(dot);
+      names.push_back(n);
+    }
+    view_.functions = std::move(set);
+    view_.functionNames = std::move(names);
+  }
+
+  /// `contour: id NAME.con` (interpret.c, case 40; general.c): the contour file beside the
+  /// view file (or below it) that `@#(id)` selects. At most 31 (cpfg's MAXCONTOURS - 1).
+  void readContour(int line, size_t vcol, const std::string& value) {
+    std::istringstream in(value);
+    std::string idText, name, extra;
+    in >> idText >> name;
+    int id = 0;
+    auto r = std::from_chars(idText.data(), idText.data() + idText.size(), id);
+    if (idText.empty() || name.empty() || r.ec != std::errc() || r.ptr != idText.data() + idText.size()) {
+      error(line, vcol, "expected 'contour: id FILE.con' (id a whole number)");
+      return;
+    }
+    if (!(in >> extra).fail()) {
+      error(line, vcol + value.rfind(extra), "unexpected '" + extra + "' after 'contour: " + idText + " " + name + "'");
+      return;
+    }
+    if (id == 0) {
+      error(line, vcol, "contour id 0 is cpfg's circle; a contour file takes another id");
+      return;
+    }
+    for (const CpfgContourEntry& e : view_.contours)
+      if (e.id == id) {
+        error(line, vcol, "contour id " + idText + " is already used by an earlier 'contour:' line");
+        return;
+      }
+    if (view_.contours.size() >= 31) {
+      error(line, vcol, "a view file has at most 31 contours (cpfg's limit)");
+      return;
+    }
+    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path();
+    const std::filesystem::path file = (folder / name).lexically_normal();
+    const std::string rel = file.lexically_relative(folder.empty() ? "." : folder).generic_string();
+    const size_t ncol = vcol - std::min(vcol, value.find_first_not_of(" \t")) + value.find(name, value.find(idText) + idText.size());
+    if (std::filesystem::path(name).is_absolute() || rel.empty() || rel.rfind("..", 0) == 0) {
+      error(line, ncol, "the contour file '" + name + "' is outside the object's folder (only files beside the view file, or in folders below it)");
+      return;
+    }
+    std::string text;
+    try {
+      text = readFile(file.string());
+    } catch (const std::exception&) {
+      error(line, ncol, "cannot read the contour file '" + file.string() + "'");
+      return;
+    }
+    try {
+      view_.contours.push_back({id, CpfgContour::parse(text, file.string())});
+    } catch (const InputError& e) {
+      for (const Diagnostic& d : e.diagnostics()) diags_.add(d);
+    }
+  }
+
+  /// `curve: NAME [samples]` (interpret.c, case 53): the curve file beside the view file (or
+  /// below it), sampled at samples points (default 100) for arc length.
+  void readCurve(int line, size_t vcol, const std::string& value) {
+    std::istringstream in(value);
+    std::string name, extra;
+    int samples = CpfgCurve::kDefaultSamples;
+    in >> name;
+    if (name.empty()) {
+      error(line, vcol, "expected a curve file after 'curve:'");
+      return;
+    }
+    if (!(in >> extra).fail()) {
+      int v = 0;
+      auto r = std::from_chars(extra.data(), extra.data() + extra.size(), v);
+      if (r.ec != std::errc() || r.ptr != extra.data() + extra.size() || v < 2 || v > 1000000) {
+        error(line, vcol + value.find(extra), "the number of samples after the curve file is a whole number from 2 to 1000000, got '" + extra + "'");
+        return;
+      }
+      samples = v;
+      if (!(in >> extra).fail()) {
+        error(line, vcol + value.rfind(extra), "unexpected '" + extra + "' after 'curve: " + name + " " + std::to_string(samples) + "'");
+        return;
+      }
+    }
+    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path();
+    const std::filesystem::path file = (folder / name).lexically_normal();
+    const std::string rel = file.lexically_relative(folder.empty() ? "." : folder).generic_string();
+    if (std::filesystem::path(name).is_absolute() || rel.empty() || rel.rfind("..", 0) == 0) {
+      error(line, vcol, "the curve file '" + name + "' is outside the object's folder (only files beside the view file, or in folders below it)");
+      return;
+    }
+    std::string text;
+    try {
+      text = readFile(file.string());
+    } catch (const std::exception&) {
+      error(line, vcol, "cannot read the curve file '" + file.string() + "'");
+      return;
+    }
+    try {
+      view_.curves.push_back(CpfgCurve::parse(text, file.string(), samples));
+    } catch (const InputError& e) {
+      for (const Diagnostic& d : e.diagnostics()) diags_.add(d);
+    }
+  }
+
+  /// `surface: X NAME.s [size [s t] [texture]]` (interpret.c, case 21): the surface file
+  /// beside the view file (or below it) that `~X` draws, scaled so that its SIZE is size
+  /// (default 1; cpfg reads a size <= 0 as 1), tessellated s x t per patch (0 or absent: the
+  /// file's precision). A single number after the size is a texture index.
+  void readSurface(int line, size_t vcol, const std::string& value) {
+    std::vector<std::pair<std::string, size_t>> words;  // each word and its column
+    const size_t base = vcol - std::min(vcol, value.find_first_not_of(" \t"));  // the column of value[0]
+    for (size_t i = 0; i < value.size();) {
+      if (value[i] == ' ' || value[i] == '\t' || value[i] == '\r') {
+        ++i;
+        continue;
+      }
+      size_t j = i;
+      while (j < value.size() && value[j] != ' ' && value[j] != '\t' && value[j] != '\r') ++j;
+      words.emplace_back(value.substr(i, j - i), base + i);
+      i = j;
+    }
+    if (words.size() < 2) {
+      error(line, vcol, "expected 'surface: X FILE.s [size [s-precision t-precision] [texture]]'");
+      return;
+    }
+    const std::string& id = words[0].first;
+    if (id.size() != 1) {
+      error(line, words[0].second, "a surface's id is one character (the letter after '~'), got '" + id + "'");
+      return;
+    }
+    if (id == "~") {
+      error(line, words[0].second, "cpfg's segment surface 'surface: ~' (F drawn as a surface) is not supported");
+      return;
+    }
+    for (const CpfgSurfaceEntry& e : view_.surfaces)
+      if (e.id == id[0]) {
+        error(line, words[0].second, "surface id '" + id + "' is already used by an earlier 'surface:' line");
+        return;
+      }
+    if (view_.surfaces.size() >= kMaxSurfaces) {
+      error(line, vcol, "a view file has at most " + std::to_string(kMaxSurfaces) + " surfaces (cpfg's limit)");
+      return;
+    }
+    double size = 1.0;
+    std::vector<int> ints;
+    for (size_t k = 2; k < words.size(); ++k) {
+      const std::string& x = words[k].first;
+      if (k == 2) {
+        auto v = parseFiniteNumber(x);
+        if (!v) {
+          error(line, words[k].second, "expected the surface's size (a number), got '" + x + "'");
+          return;
+        }
+        size = *v > 0 ? *v : 1.0;
+        continue;
+      }
+      int v = 0;
+      auto r = std::from_chars(x.data(), x.data() + x.size(), v);
+      if (r.ec != std::errc() || r.ptr != x.data() + x.size() || ints.size() >= 3) {
+        error(line, words[k].second, ints.size() >= 3 ? "unexpected '" + x + "' after the surface's texture"
+                                                      : "expected a whole number (precision or texture), got '" + x + "'");
+        return;
+      }
+      ints.push_back(v);
+    }
+    int s = 0, t = 0;
+    if (ints.size() >= 2) {
+      s = ints[0];
+      t = ints[1];
+      for (int k = 0; k < 2; ++k)
+        if (ints[k] < 0 || ints[k] > CpfgSurface::kMaxPrecision) {
+          error(line, words[3 + k].second, "a surface's precision is 0 (the file's) or 1 to " + std::to_string(CpfgSurface::kMaxPrecision) + ", got " + std::to_string(ints[k]));
+          return;
+        }
+    }
+    if (ints.size() == 1 || ints.size() == 3)
+      warn(line, words.back().second, "the surface's texture index is ignored (Sprig draws surfaces untextured)");
+    const std::string& name = words[1].first;
+    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path();
+    const std::filesystem::path file = (folder / name).lexically_normal();
+    const std::string rel = file.lexically_relative(folder.empty() ? "." : folder).generic_string();
+    if (std::filesystem::path(name).is_absolute() || rel.empty() || rel.rfind("..", 0) == 0) {
+      error(line, words[1].second, "the surface file '" + name + "' is outside the object's folder (only files beside the view file, or in folders below it)");
+      return;
+    }
+    std::string text;
+    try {
+      text = readFile(file.string());
+    } catch (const std::exception&) {
+      error(line, words[1].second, "cannot read the surface file '" + file.string() + "'");
+      return;
+    }
+    try {
+      view_.surfaces.push_back({id[0], CpfgSurface::parse(text, file.string(), size, s, t)});
     } catch (const InputError& e) {
       for (const Diagnostic& d : e.diagnostics()) diags_.add(d);
     }
@@ -413,6 +710,9 @@ TurtleSettings cpfgTurtleSettings(const ViewFile* view, TurtleSettings t) {
   t.initialScale = v.initialScale.value_or(1.0);
   t.scaleMultiplier = v.scaleMultiplier.value_or(1.0);
   t.tropisms = v.tropisms;
+  t.cpfgSurfaces = v.surfaces.empty() ? nullptr : std::make_shared<const std::vector<CpfgSurfaceEntry>>(v.surfaces);
+  t.cpfgContours = v.contours.empty() ? nullptr : std::make_shared<const std::vector<CpfgContourEntry>>(v.contours);
+  t.contourSides = v.contourSides.value_or(CpfgContour::kDefaultSides);
   // cpfg's old tropism (its defaults: direction +Y, elasticity 0, increment 0).
   t.tropism = v.oldTropismDirection.value_or(DVec3(0, 1, 0));
   t.elasticity = v.oldElasticity.value_or(0.0);

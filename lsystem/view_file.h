@@ -10,7 +10,10 @@
 #include <vector>
 
 #include "core/diagnostics.h"
+#include "lsystem/cpfg_contour.h"
+#include "lsystem/cpfg_curve.h"
 #include "lsystem/cpfg_function.h"
+#include "lsystem/cpfg_surface.h"
 #include "lsystem/turtle.h"
 
 namespace sprig::lsystem {
@@ -40,6 +43,17 @@ struct ViewFile {
   /// `function: NAME.func [samples]`: the function files, in file order (`func(1, x)` is
   /// the first), read when the view file is.
   std::vector<CpfgFunction> functions;
+  /// After a `function set: NAME.fset` line (not followed by `function:` lines): its
+  /// functions' names without their suffix, which cpfg's preprocessor defines as 1, 2, ...
+  std::vector<std::string> functionNames;
+  /// `surface: X NAME.s [size [s t]] [texture]`: the surface files, read and tessellated when
+  /// the view file is, which `~X` draws.
+  std::vector<CpfgSurfaceEntry> surfaces;
+  /// `curve: NAME [samples]`: the curve files, in file order (`curveX(1, t)` reads the first).
+  std::vector<CpfgCurve> curves;
+  /// `contour: id NAME.con`: the contours `@#(id)` selects for generalized cylinders.
+  std::vector<CpfgContourEntry> contours;
+  std::optional<int> contourSides;  ///< `contour sides: n` (default CpfgContour::kDefaultSides)
   /// Warnings about keys read but not used (viewer settings), each at its line.
   std::vector<Diagnostic> warnings;
 };

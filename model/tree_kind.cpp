@@ -596,7 +596,12 @@ lsystem::Grammar speciesGrammar(const Species& species, const lsystem::GrammarOv
   const TreeSpec& tree = treeSpec(species);
   if (tree.grammar && extra.defines.empty() && !extra.derivationLength && !extra.seed) return *tree.grammar;
   lsystem::GrammarOverrides o = tree.overrides;
-  if (tree.view) o.cpfgFunctions = tree.view->functions;
+  if (tree.view) {
+    o.cpfgFunctions = tree.view->functions;
+    o.cpfgCurves = tree.view->curves;
+    o.cpfgFunctionNames = tree.view->functionNames;
+    for (const auto& sf : tree.view->surfaces) o.cpfgSurfaceIds += sf.id;
+  }
   for (const auto& d : extra.defines) o.defines.push_back(d);
   if (extra.derivationLength) o.derivationLength = extra.derivationLength;
   if (extra.seed) o.seed = extra.seed;

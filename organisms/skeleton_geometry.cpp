@@ -124,6 +124,18 @@ SkeletonGeometry buildSkeletonGeometry(const lsystem::Skeleton& skeleton, const 
       std::vector<Vec3> pts;
       for (const auto& p : organ.points) pts.push_back(toVec3(p));
       addFlatPolygon(g, pts, organColor(organ, o.leafColor));
+    } else if (organ.kind == lsystem::Organ::Kind::Surface && !organ.triangles.empty()) {
+      // A cpfg surface file's mesh, placed by the turtle.
+      const Vec3 color = organColor(organ, o.leafColor);
+      const uint32_t base = static_cast<uint32_t>(g.leaves.positions.size());
+      for (size_t k = 0; k < organ.points.size(); ++k) {
+        g.leaves.positions.push_back(toVec3(organ.points[k]));
+        g.leaves.normals.push_back(k < organ.normals.size() ? toVec3(organ.normals[k]) : toVec3(organ.up));
+      }
+      for (size_t k = 0; k + 2 < organ.triangles.size(); k += 3) {
+        g.leaves.triangles.emplace_back(base + organ.triangles[k], base + organ.triangles[k + 1], base + organ.triangles[k + 2]);
+        g.leafColors.push_back(color);
+      }
     } else if (organ.kind == lsystem::Organ::Kind::Surface) {
       // A named surface is drawn as a diamond leaf in the turtle's heading-left plane.
       double s = organ.radius > 0 ? organ.radius : surfaceScale;

@@ -27,7 +27,7 @@ struct SkeletonGeometryOptions {
 /// A skeleton as curves, a leaf mesh and spheres.
 struct SkeletonGeometry {
   CurveSet internodes;  ///< an internode that continues its parent's end shares the joint
-  Mesh leaves;          ///< polygons fan-triangulated (Newell normals), named surfaces as diamonds
+  Mesh leaves;          ///< polygons fan-triangulated (Newell normals), named surfaces as diamonds, cpfg surface meshes as placed
   std::vector<Vec3> leafColors;  ///< one per leaf triangle
   SphereSet fruit;               ///< sphere organs
 };

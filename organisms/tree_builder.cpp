@@ -248,6 +248,19 @@ void addBlade(LeafWriter& w, const lsystem::Organ& o, double scale, Vec3 color) 
   w.tri(M.back(), tip, L.back());
 }
 
+/// A cpfg surface file's mesh, placed by the turtle (world units; the leaf scale does not
+/// apply: the view file's size is the surface's size). uv: the vertex's x and y relative to
+/// the organ's frame, scaled into [0, 1] per organ.
+void addSurfaceMesh(LeafWriter& w, const lsystem::Organ& o, Vec3 color) {
+  const uint32_t base = static_cast<uint32_t>(w.mesh.positions.size());
+  for (size_t k = 0; k < o.points.size(); ++k) {
+    const DVec3 n = k < o.normals.size() && glm::length(o.normals[k]) > 0 ? o.normals[k] : o.up;
+    w.vertex(o.points[k], n, Vec2(0.5f, static_cast<float>(k) / static_cast<float>(std::max<size_t>(1, o.points.size() - 1))), color);
+  }
+  for (size_t k = 0; k + 2 < o.triangles.size(); k += 3)
+    w.tri(base + o.triangles[k], base + o.triangles[k + 1], base + o.triangles[k + 2]);
+}
+
 void addPolygon(LeafWriter& w, const lsystem::Organ& o, Vec3 color) {
   if (o.points.size() < 3) return;
   DVec3 n(0);  // Newell normal
@@ -314,7 +327,10 @@ Mesh organMesh(const lsystem::Skeleton& skeleton, const TreeOptions& opt, std::o
     switch (o.kind) {
       case lsystem::Organ::Kind::Polygon: addPolygon(w, o, color); break;
       case lsystem::Organ::Kind::Sphere: addSphere(w, o, color); break;
-      case lsystem::Organ::Kind::Surface: addBlade(w, o, opt.leaves.scale, color); break;
+      case lsystem::Organ::Kind::Surface:
+        if (o.triangles.empty()) addBlade(w, o, opt.leaves.scale, color);
+        else addSurfaceMesh(w, o, color);
+        break;
     }
   }
   return mesh;

@@ -14,8 +14,6 @@ struct Unsupported {
 };
 
 constexpr Unsupported kUnsupported[] = {
-    {"@Gr", "generalized cylinder radius tangents"},
-    {"@#", "contour of generalized cylinders"},
     {"@Tx", "texture"},
     {"@bo", "circle boundary"},
     {"@bc", "circle boundary"},
@@ -68,9 +66,6 @@ std::optional<std::string> cpfgUnsupported(std::string_view name, size_t args, b
   if ((name == "{" || name == "}" || name == ".") && hasParens && args > 0)
     return notSupported(std::string(name) + "(type)", "generalized cylinder");
   if (name == "%" && hasParens && args > 0) return notSupported("%(n)", "substring move");
-  if (dialect == Dialect::Cpfg) {
-    if (name == "~" || (name.size() > 1 && name[0] == '~')) return notSupported("~", "surface from a view file's surface file");
-  }
   return std::nullopt;
 }
 

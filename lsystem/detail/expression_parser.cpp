@@ -35,8 +35,6 @@ constexpr UnsupportedFunction kUnsupportedFunctions[] = {
     {"printf", "output; it is a statement of its own"}, {"fprintf", "file output"}, {"fopen", "file input and output"},
     {"fclose", "file input and output"}, {"fflush", "file input and output"}, {"fscanf", "file input"},
 
-    {"curveX", "contour from a view file's contour file"}, {"curveY", "contour from a view file's contour file"},
-    {"curveZ", "contour from a view file's contour file"}, {"curveGAL", "contour from a view file's contour file"},
     {"play", "sound"}, {"inblob", "environment field"}, {"vvXmin", "view volume"}, {"vvXmax", "view volume"},
     {"vvYmin", "view volume"}, {"vvYmax", "view volume"}, {"vvZmin", "view volume"}, {"vvZmax", "view volume"},
     {"vvScale", "view volume"}, {"Display", "display"}, {"SetDerivationLength", "changes the derivation length"},
@@ -51,8 +49,9 @@ int arityOf(Op op) {
     case Op::Const: case Op::Var: return 0;
     case Op::Neg: case Op::Not: case Op::Sin: case Op::Cos: case Op::Tan: case Op::Asin: case Op::Acos:
     case Op::Atan: case Op::Sqrt: case Op::Exp: case Op::Log: case Op::Abs: case Op::Floor: case Op::Ceil:
-    case Op::Sign: case Op::Ran: case Op::Round: case Op::Srand: case Op::Stop: case Op::Func:
+    case Op::Sign: case Op::Ran: case Op::Round: case Op::Srand: case Op::Stop: case Op::Func: case Op::Curve:
       return 1;
+    case Op::CurveLength: return 0;
     case Op::Select: return 3;
     default: return 2;
   }
@@ -287,6 +286,7 @@ int ExpressionParser::parseCall(State& st, const Token& id) {
     fn = name == "srand" ? &kSrand : &kStop;
   }
   if (name == "func") return parseFunc(st, id);
+  if (name == "curveX" || name == "curveY" || name == "curveZ" || name == "curveGAL") return parseCurve(st, id, name);
   if (!fn) {
     for (const UnsupportedFunction& u : kUnsupportedFunctions)
       if (name == u.name) {
@@ -332,7 +332,7 @@ int ExpressionParser::parseFunc(State& st, const Token& id) {
   if (!isPunct(st, ")")) unexpected(st, "')' (func takes 2 arguments: the function's number and x)");
   lex(st);
   const Node n = st.nodes[nArg];
-  const size_t count = functions_ ? functions_->size() : 0;
+  const size_t count = tables_ ? tables_->functions.size() : 0;
   if (n.op != Op::Const || n.value != std::floor(n.value) || n.value < 1 || n.value > static_cast<double>(count)) {
     scanner_.error(st.span.line, id.col,
                    count == 0 ? std::string("cpfg's func(n, x) reads the view file's function files, and it names none "
@@ -343,6 +343,36 @@ int ExpressionParser::parseFunc(State& st, const Token& id) {
   }
   const int f = node(st, Op::Func, xArg);
   st.nodes[f].var = static_cast<uint16_t>(n.value - 1);
+  return f;
+}
+
+/// cpfg's `curveX(n, t)`, `curveY(n, t)`, `curveZ(n, t)` and `curveGAL(n)`: n a number (or
+/// `#define`) naming the n-th `curve:` file of the view file; the current token is the `(`.
+int ExpressionParser::parseCurve(State& st, const Token& id, const std::string& name) {
+  const bool gal = name == "curveGAL";
+  const std::string usage = gal ? "curveGAL takes 1 argument: the curve's number" : name + " takes 2 arguments: the curve's number and t";
+  lex(st);
+  const int nArg = parseConditional(st);
+  int tArg = -1;
+  if (!gal) {
+    if (!isPunct(st, ",")) unexpected(st, ("',' (" + usage + ")").c_str());
+    lex(st);
+    tArg = parseConditional(st);
+  }
+  if (!isPunct(st, ")")) unexpected(st, ("')' (" + usage + ")").c_str());
+  lex(st);
+  const Node n = st.nodes[nArg];
+  const size_t count = tables_ ? tables_->curves.size() : 0;
+  if (n.op != Op::Const || n.value != std::floor(n.value) || n.value < 1 || n.value > static_cast<double>(count)) {
+    scanner_.error(st.span.line, id.col,
+                   count == 0 ? "cpfg's " + name + " reads the view file's curve files, and it names none ('curve: NAME.con')"
+                              : name + "'s first argument must be a number from 1 to " + std::to_string(count) +
+                                    " (the view file names " + std::to_string(count) + " curve file(s))");
+    throw ExprFail{};
+  }
+  const int f = gal ? node(st, Op::CurveLength) : node(st, Op::Curve, tArg);
+  st.nodes[f].var = static_cast<uint16_t>(n.value - 1);
+  st.nodes[f].value = gal ? 0 : name == "curveX" ? 0 : name == "curveY" ? 1 : 2;
   return f;
 }
 
@@ -397,11 +427,12 @@ bool ExpressionParser::emit(const State& st, int n, int& depth, int& maxDepth) {
   for (int k = 0; k < arity; ++k) allConst &= emit(st, nd.kids[k], depth, maxDepth);
   Instr in;
   in.op = nd.op;
-  if (nd.op == Op::Func) in.var = nd.var;
+  if (nd.op == Op::Func || nd.op == Op::Curve) in.var = nd.var;
+  if (nd.op == Op::Curve) in.c = nd.value;
   code_.push_back(in);
   depth -= arity - 1;
   if (allConst && nd.op != Op::Ran && nd.op != Op::Nran && nd.op != Op::Bran && nd.op != Op::Biran && nd.op != Op::Srand &&
-      nd.op != Op::Stop && nd.op != Op::Func) {
+      nd.op != Op::Stop && nd.op != Op::Func && nd.op != Op::Curve) {
     size_t first = code_.size() - 1 - arity;
     double v = evalCode(code_.data() + first, code_.data() + code_.size(), nullptr, nullptr);
     code_.resize(first);
@@ -493,7 +524,7 @@ std::optional<double> ExpressionParser::evaluate(Span sp, Rng* rng) {
     if (usesRandom_ && !rng) {
       scanner_.error(sp.line, sp.b, "random functions are not allowed here");
     } else {
-      double v = evalCode(code_.data() + before, code_.data() + code_.size(), nullptr, rng, nullptr, nullptr, functions_);
+      double v = evalCode(code_.data() + before, code_.data() + code_.size(), nullptr, rng, nullptr, nullptr, tables_);
       if (std::isfinite(v)) value = v;
       else scanner_.error(sp.line, sp.b, "parameter is not finite (" + formatNumber(v) + ")");
     }

@@ -59,7 +59,7 @@ class ExpressionParser {
   bool usesRandom() const { return usesRandom_; }
   void clearRandom() { usesRandom_ = false; }
   /// The view file's function files `func(n, x)` may name (none when null).
-  void setFunctions(const std::vector<CpfgFunction>* functions) { functions_ = functions; }
+  void setTables(const CpfgTables* tables) { tables_ = tables; }
   /// Whether cpfg's `srand` and `stop` may be called (only as statements, see
   /// grammar_parser.cpp); stopError is the message for a `stop` that may not.
   void allowEffects(bool srand, bool stop, const char* stopError) {
@@ -83,6 +83,7 @@ class ExpressionParser {
   int parsePrimary(State& st);
   int parseCall(State& st, const Token& id);
   int parseFunc(State& st, const Token& id);
+  int parseCurve(State& st, const Token& id, const std::string& name);
   int parseName(State& st, const Token& id);
   bool emit(const State& st, int n, int& depth, int& maxDepth);
 
@@ -90,7 +91,7 @@ class ExpressionParser {
   const std::unordered_map<std::string, double>& defines_;
   std::vector<Instr>& code_;
   bool usesRandom_ = false;
-  const std::vector<CpfgFunction>* functions_ = nullptr;
+  const CpfgTables* tables_ = nullptr;
   bool allowSrand_ = false;
   bool allowStop_ = false;
   const char* allowStopReason_ = "cpfg's function 'stop' is supported only as a statement ('stop(1);')";

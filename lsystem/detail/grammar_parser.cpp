@@ -106,8 +106,11 @@ class GrammarParser {
     scanner_.setDialect(prog_.dialect);
     for (size_t k = 0; k < kCpfgMultiNameCount; ++k) scanner_.addMultiName(kCpfgMultiNames[k]);
     expr_.setGlobals(&prog_.globals);
-    prog_.functions = overrides.cpfgFunctions;
-    expr_.setFunctions(&prog_.functions);
+    prog_.cpfg.functions = overrides.cpfgFunctions;
+    prog_.cpfg.curves = overrides.cpfgCurves;
+    scanner_.setCpfgSurfaceIds(overrides.cpfgSurfaceIds);
+    if (prog_.dialect == Dialect::Cpfg) scanner_.setPredefined(overrides.cpfgFunctionNames);
+    expr_.setTables(&prog_.cpfg);
     for (const char* s : kTurtleSymbols) prog_.symbols.intern(s);
     prog_.openBracket = static_cast<SymbolId>(prog_.symbols.find("["));
     prog_.closeBracket = static_cast<SymbolId>(prog_.symbols.find("]"));

@@ -20,6 +20,7 @@
 #include "core/diagnostics.h"
 #include "core/rng.h"
 #include "core/types.h"
+#include "lsystem/cpfg_curve.h"
 #include "lsystem/cpfg_function.h"
 #include "lsystem/detail/cpfg.h"
 #include "lsystem/module_string.h"
@@ -46,6 +47,14 @@ enum class Op : uint8_t {
   Srand,   ///< cpfg's `srand(s)`: records s as the seed of later draws (Effects::reseed); value 0
   Stop,    ///< cpfg's `stop(x)`: asks the derivation to end after the current step (Effects::stop); value 0
   Func,    ///< cpfg's `func(n, x)`: function var (n - 1) of the view file's function files at x
+  Curve,   ///< cpfg's `curveX/Y/Z(n, t)`: coordinate c (0, 1, 2) of curve var (n - 1) at arc length t
+  CurveLength,  ///< cpfg's `curveGAL(n)`: the length of curve var (n - 1); pops nothing
+};
+
+/// The view file's function and curve files, which `func` and `curveX...` read.
+struct CpfgTables {
+  std::vector<CpfgFunction> functions;  ///< `function:` lines (`func(n, x)`), n = 1, 2, ...
+  std::vector<CpfgCurve> curves;        ///< `curve:` lines (`curveX(n, t)`), n = 1, 2, ...
 };
 
 /// What cpfg's `srand` and `stop` ask of the Deriver, recorded by evalCode.
@@ -109,11 +118,11 @@ void printFormatted(const std::string& format, const double* args, int n);
 /// which must then be writable; jump targets count from code; a block returns 0, or NaN
 /// after kMaxLoopJumps backward jumps). rng is used only by the random draws (never null
 /// when the code draws: the compiler marks such productions usesRandom). effects, when
-/// given, records what `srand` and `stop` ask for; functions are the view file's function
-/// files `func` reads (NaN without them).
+/// given, records what `srand` and `stop` ask for; tables are the view file's function and
+/// curve files `func` and `curveX...` read (NaN without them).
 inline double evalCode(const Instr* code, const Instr* end, const double* vars, Rng* rng,
                        const std::vector<std::string>* strings = nullptr, Effects* effects = nullptr,
-                       const std::vector<CpfgFunction>* functions = nullptr) {
+                       const CpfgTables* tables = nullptr) {
   double stack[kMaxStack];
   int sp = 0;
   long backJumps = 0;
@@ -187,7 +196,15 @@ inline double evalCode(const Instr* code, const Instr* end, const double* vars, 
         stack[sp - 1] = 0.0;
         break;
       case Op::Func:
-        stack[sp - 1] = functions && in->var < functions->size() ? (*functions)[in->var].value(stack[sp - 1]) : std::nan("");
+        stack[sp - 1] = tables && in->var < tables->functions.size() ? tables->functions[in->var].value(stack[sp - 1]) : std::nan("");
+        break;
+      case Op::Curve:
+        stack[sp - 1] = tables && in->var < tables->curves.size()
+                            ? tables->curves[in->var].atLength(stack[sp - 1])[static_cast<int>(in->c) % 3]
+                            : std::nan("");
+        break;
+      case Op::CurveLength:
+        stack[sp++] = tables && in->var < tables->curves.size() ? tables->curves[in->var].length() : std::nan("");
         break;
       case Op::Printf: {
         const int n = static_cast<int>(in->c);
@@ -378,7 +395,7 @@ struct Program {
   std::vector<std::pair<std::string, double>> defines;
   std::vector<Instr> code;
   std::vector<std::string> strings;  ///< printf formats (Instr::var of Op::Printf)
-  std::vector<CpfgFunction> functions;  ///< the view file's function files (`func(n, x)`), n = 1, 2, ...
+  CpfgTables cpfg;  ///< the view file's function and curve files (`func(n, x)`, `curveX(n, t)`)
   RuleSet productions;
   RuleSet decomposition;
   RuleSet interpretation;

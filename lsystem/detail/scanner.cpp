@@ -82,6 +82,12 @@ void Scanner::load(std::string_view text) {
   macros_.clear();
   constants_.clear();
   conditionals_.clear();
+  // cpfg's function set names (`-DNAME=n` on its preprocessor's command line).
+  for (size_t k = 0; k < predefined_.size(); ++k) {
+    Macro m;
+    m.body = std::to_string(k + 1);
+    macros_.emplace_back(predefined_[k], m);
+  }
   preprocess(0, splitAtNewlines(std::string(text)), splitAtNewlines(clean), 0);
   for (const Conditional& c : conditionals_)
     diags_.error(SourceLoc{files_[c.file], c.line, c.col + 1}, "'#if' block without '#endif'");
@@ -223,6 +229,20 @@ bool Scanner::tokenizeModules(int line, int b, int e, const std::function<void(c
       i = k + 1;
     }
     const size_t nameEnd = static_cast<size_t>(m.col) + m.name.size();
+    if (dialect_ == Dialect::Cpfg && !m.name.empty() && m.name[0] == '~') {
+      // cpfg's `~X` draws the view file's surface X (the letter after `~`).
+      const char id = m.name.size() > 1 ? m.name[1] : nameEnd < s.size() ? s[nameEnd] : '\0';
+      if (id == '\0' || id == ' ' || id == '\t') {
+        error(line, m.col, "cpfg's '~' must be followed by a surface id (the letter of a view file's 'surface:' line)");
+        return false;
+      }
+      if (cpfgSurfaceIds_.find(id) == std::string::npos) {
+        error(line, m.col, std::string("cpfg's '~") + id + "' names no surface: " +
+                               (cpfgSurfaceIds_.empty() ? std::string("there is no view file with a 'surface:' line")
+                                                        : "the view file has no 'surface: " + std::string(1, id) + " ...' line (it defines '" + cpfgSurfaceIds_ + "')"));
+        return false;
+      }
+    }
     if (auto why = cpfgUnsupported(m.name, m.args.size(), m.hasParens, nameEnd < s.size() ? s[nameEnd] : '\0', dialect_)) {
       error(line, m.col, *why);
       return false;

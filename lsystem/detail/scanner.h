@@ -111,6 +111,11 @@ class Scanner {
   /// implement in it (lsystem/detail/cpfg.h) as errors at their position.
   void setDialect(Dialect d) { dialect_ = d; }
   Dialect dialect() const { return dialect_; }
+  /// cpfg: the ids of the view file's surfaces; `~X` with another X is an error.
+  void setCpfgSurfaceIds(std::string ids) { cpfgSurfaceIds_ = std::move(ids); }
+  /// cpfg: names the preprocessor defines before the file, the k-th (0-based) as k + 1
+  /// (the functions of a view file's `function set:`).
+  void setPredefined(std::vector<std::string> names) { predefined_ = std::move(names); }
   /// Splits line(line)[b, e) into modules, appending them to out. Reports errors; returns
   /// false on an error that stops the line (a stray `(`, `)` or `,`, a missing `)`) or
   /// after reporting empty parameters.
@@ -179,6 +184,8 @@ class Scanner {
   std::vector<std::string> multiNames_;
   std::pair<int, int> pendingComment_{0, 0};
   Dialect dialect_ = Dialect::Sprig;
+  std::string cpfgSurfaceIds_;
+  std::vector<std::string> predefined_;
   DiagnosticList diags_;
 };
 

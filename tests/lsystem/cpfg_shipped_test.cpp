@@ -5,7 +5,9 @@
 // `@v`, the color step `'` becomes `;`, `@O`'s radius becomes cpfg's diameter); the stored
 // folder must hold exactly that (run the test with SPRIG_UPDATE_VLAB=1 to write them
 // after changing a grammar), and, read back as cpfg reads it, must give the same module
-// string (up to those renamings) and the same skeleton as the native grammar.
+// string (up to those renamings) and the same skeleton as the native grammar. Sprig's
+// predefined leaf `~l` becomes cpfg's surface `l`: a `leaf.s` beside the grammar, which the
+// view file names.
 
 #include <catch2/catch.hpp>
 
@@ -31,7 +33,29 @@ namespace {
 struct CpfgObject {
   std::string grammar;  ///< NAME.l
   std::string view;     ///< NAME.v (empty: no view file)
+  std::string leaf;     ///< leaf.s (empty: none), the surface of Sprig's predefined leaf `~l`
 };
+
+/// Sprig's predefined leaf `~l` as a cpfg surface file: one Bezier patch, an ovate blade of
+/// length 1 along the heading and at most 0.38 wide on either side (as organisms/
+/// tree_builder.cpp's blade), facing the turtle's up (the file's UP is cpfg's, -U in Sprig).
+const char* const kLeafSurface =
+    "-0.55 0.55  0 1  0 0\n"
+    "PRECISION S: 6 T: 4\n"
+    "CONTACT POINT  X: 0 Y: 0 Z: 0\n"
+    "END POINT  X: 0 Y: 1 Z: 0\n"
+    "HEADING  X: 0 Y: 1 Z: 0\n"
+    "UP  X: 0 Y: 0 Z: -1\n"
+    "SIZE: 1\n"
+    "blade\n"
+    "TOP COLOR: 0 DIFFUSE: 0.00 BOTTOM COLOR: 0 DIFFUSE: 0.00\n"
+    "AL: ~ A: ~ AR: ~\n"
+    "L: ~ R: ~\n"
+    "BL: ~ B: ~ BR: ~\n"
+    "-0.03 0 0  -0.01 0 0  0.01 0 0  0.03 0 0\n"
+    "-0.55 0.3 0  -0.18 0.3 0  0.18 0.3 0  0.55 0.3 0\n"
+    "-0.45 0.75 0  -0.15 0.75 0  0.15 0.75 0  0.45 0.75 0\n"
+    "-0.01 1 0  -0.003 1 0  0.003 1 0  0.01 1 0\n";
 
 /// The argument of every `@O(...)` from column `from` on, wrapped as `2*(...)` (radius to diameter).
 std::string doubleSpheres(std::string s, size_t from) {
@@ -77,6 +101,11 @@ CpfgObject toCpfg(const std::string& lsys) {
     }
     out.grammar += line + "\n";
   }
+  // Sprig's predefined leaf `~l` is a surface file in cpfg, named by the view file.
+  if (lsys.find("~l") != std::string::npos) {
+    out.view += "surface: l leaf.s 1 6 4\n";
+    out.leaf = kLeafSurface;
+  }
   return out;
 }
 
@@ -105,26 +134,23 @@ TEST_CASE("every shipped grammar runs as a cpfg .l file in a vlab object folder"
       writeFileAtomic(lPath, obj.grammar);
       if (!obj.view.empty()) writeFileAtomic(vPath.string(), obj.view);
       else std::filesystem::remove(vPath);
+      if (!obj.leaf.empty()) writeFileAtomic((folder / "leaf.s").string(), obj.leaf);
+      else std::filesystem::remove(folder / "leaf.s");
     }
     // The stored object is the conversion of the shipped grammar, byte for byte.
     REQUIRE(std::filesystem::exists(lPath));
     CHECK(readFile(lPath) == obj.grammar);
     CHECK(std::filesystem::exists(vPath) == !obj.view.empty());
     if (!obj.view.empty() && std::filesystem::exists(vPath)) CHECK(readFile(vPath.string()) == obj.view);
+    CHECK(std::filesystem::exists(folder / "leaf.s") == !obj.leaf.empty());
+    if (!obj.leaf.empty() && std::filesystem::exists(folder / "leaf.s")) CHECK(readFile((folder / "leaf.s").string()) == obj.leaf);
     ++stored;
-    if (name == "tree_lime") {
-      // Sprig's predefined leaf `~l`: cpfg's `~` reads a surface file of the view file,
-      // which the object does not have (and Sprig does not read): an error, not a leaf.
-      try {
-        loadGrammar(lPath);
-        FAIL("tree_lime.l should not parse");
-      } catch (const InputError& e) {
-        CHECK(e.diagnostics().front().message == "cpfg's '~' (surface from a view file's surface file) is not supported");
-      }
-      continue;
-    }
+    ViewFile view;
+    if (!obj.view.empty()) view = loadViewFile((folder / (name + ".v")).string());
+    GrammarOverrides overrides;
+    for (const CpfgSurfaceEntry& sf : view.surfaces) overrides.cpfgSurfaceIds += sf.id;
     const Grammar native = loadGrammar(entry.path().string());
-    const Grammar cpfg = loadGrammar(lPath);
+    const Grammar cpfg = loadGrammar(lPath, overrides);
     REQUIRE(cpfg.cpfgNotation());
     Deriver dn(native), dc(cpfg);
     const ModuleString& sn = dn.derive();
@@ -145,8 +171,6 @@ TEST_CASE("every shipped grammar runs as a cpfg .l file in a vlab object folder"
     TurtleSettings tn;
     tn.angleDeg = native.angleDeg().value_or(kCpfgDefaultAngleDeg);
     tn.tropism = DVec3(0);
-    ViewFile view;
-    if (!obj.view.empty()) view = loadViewFile((folder / (name + ".v")).string());
     const Skeleton kn = Turtle(dn.symbols(), tn).run(dn.interpret(sn));
     const Skeleton kc = Turtle(dc.symbols(), cpfgTurtleSettings(obj.view.empty() ? nullptr : &view, {})).run(dc.interpret(sc));
     REQUIRE(kn.internodes.size() == kc.internodes.size());
@@ -159,9 +183,17 @@ TEST_CASE("every shipped grammar runs as a cpfg .l file in a vlab object folder"
     for (size_t i = 0; i < kn.organs.size(); ++i) {
       REQUIRE(glm::length(kn.organs[i].position - kc.organs[i].position) < 1e-9);
       REQUIRE(kn.organs[i].radius == Approx(kc.organs[i].radius));
+      // `~l`: the leaf surface's mesh, its base at the turtle and its tip a leaf length
+      // (the radius) along the heading.
+      REQUIRE(kc.organs[i].triangles.empty() == (kn.organs[i].kind != Organ::Kind::Surface));
+      if (kc.organs[i].triangles.empty()) continue;
+      const Organ& o = kc.organs[i];
+      REQUIRE(o.points.size() == 7 * 5);
+      REQUIRE(glm::length(o.points[2] - o.position) < 1e-6);                              // s = 0, t = 1/2
+      REQUIRE(glm::length(o.points[32] - (o.position + o.radius * o.heading)) < 1e-6);  // s = 1, t = 1/2
     }
     ++converted;
   }
-  CHECK(converted == 15);  // the 16 shipped grammars but tree_lime
+  CHECK(converted == 16);
   CHECK(stored == 16);
 }

@@ -29,10 +29,14 @@ struct Drawn {
 };
 
 Drawn drawObject(const std::string& folder, bool withView) {
-  Grammar g = loadGrammar(cpfgAsset(folder + "/plant.l"));
-  REQUIRE(g.cpfgNotation());
   ViewFile view;
-  if (withView) view = loadViewFile(cpfgAsset(folder + "/plant.v"));
+  GrammarOverrides o;
+  if (withView) {
+    view = loadViewFile(cpfgAsset(folder + "/plant.v"));
+    for (const CpfgSurfaceEntry& e : view.surfaces) o.cpfgSurfaceIds += e.id;
+  }
+  Grammar g = loadGrammar(cpfgAsset(folder + "/plant.l"), o);
+  REQUIRE(g.cpfgNotation());
   Deriver d(g);
   const ModuleString& s = d.derive();
   Drawn out;
@@ -259,12 +263,11 @@ TEST_CASE("cpfg view file", "[lsystem][cpfg]") {
 
 TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg]") {
   SECTION("commands") {
-    CHECK(errorOf("axiom: A\nA --> F@#(10)F\n") == "t.l:2:8: cpfg's '@#' (contour of generalized cylinders) is not supported");
-    CHECK(errorOf("axiom: F@Gr(1)\n", "t.lsys") == "t.lsys:1:9: cpfg's '@Gr' (generalized cylinder radius tangents) is not supported");
+    CHECK(errorOf("axiom: F@Tx(1)\n", "t.lsys") == "t.lsys:1:9: cpfg's '@Tx' (texture) is not supported");
     CHECK(errorOf("axiom: F{(1)F}(1)\n") == "t.l:1:9: cpfg's '{(type)' (generalized cylinder) is not supported");
     CHECK(errorOf("axiom: A\nA --> F$A\n") ==
           "t.l:2:8: cpfg's '$' ends a sub-L-system call '?(n, scale)', and this file makes none (ABOP's roll to vertical is '@v' in cpfg)");
-    CHECK(errorOf("axiom: F~l\n") == "t.l:1:9: cpfg's '~' (surface from a view file's surface file) is not supported");
+    CHECK(errorOf("axiom: F~l\n") == "t.l:1:9: cpfg's '~l' names no surface: there is no view file with a 'surface:' line");
     CHECK(errorOf("axiom: ?P(0,0)A\n") == "no error");
     CHECK(errorOf("axiom: A\nhomomorphism\nA --> F?U(0,0,0)\n") ==
           "t.l:3:8: cpfg's query module '?U' in an interpretation rule is not supported (its values would be lost with "
@@ -302,7 +305,7 @@ TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg
     CHECK(errorOf("Start: { printf(\"%5.2f%%\\n\", 2); }\naxiom: A\n") == "no error");
   }
   SECTION("an error in a continued line is reported at its own line") {
-    CHECK(errorOf("axiom: A\nA --> F\n\tF@Gr(2)\n") == "t.l:3:3: cpfg's '@Gr' (generalized cylinder radius tangents) is not supported");
+    CHECK(errorOf("axiom: A\nA --> F\n\tF@Tx(2)\n") == "t.l:3:3: cpfg's '@Tx' (texture) is not supported");
   }
 }
 
@@ -499,14 +502,14 @@ TEST_CASE("cpfg's C preprocessor", "[lsystem][cpfg]") {
   SECTION("an error in an included file is at its own file:line:col") {
     const std::string file = cpfgAsset("preprocessor_errors/plant.l");
     CHECK(errorOf(readFile(file), file) == cpfgAsset("preprocessor_errors/rules.h") +
-                                                    ":2:8: cpfg's '@Gr' (generalized cylinder radius tangents) is not supported");
+                                                    ":2:8: cpfg's '@Tx' (texture) is not supported");
   }
   SECTION("an error inside a macro's expansion is at the macro's use") {
-    CHECK(errorOf("#define LEAF [@Gr(1)]\naxiom: F LEAF\n") == "t.l:2:10: cpfg's '@Gr' (generalized cylinder radius tangents) is not supported");
+    CHECK(errorOf("#define LEAF [@Tx(1)]\naxiom: F LEAF\n") == "t.l:2:10: cpfg's '@Tx' (texture) is not supported");
     CHECK(errorOf("#define B(x) F(x)\naxiom: A B(1, 2) C\n") ==
           "t.l:2:10: macro 'B' takes 1 argument(s) (defined at t.l:1), or its expansion nests deeper than 64 levels");
     // Columns after an expansion are the file's own.
-    CHECK(errorOf("#define S F(1)F(1)\naxiom: S@Gr(1)\n") == "t.l:2:9: cpfg's '@Gr' (generalized cylinder radius tangents) is not supported");
+    CHECK(errorOf("#define S F(1)F(1)\naxiom: S@Tx(1)\n") == "t.l:2:9: cpfg's '@Tx' (texture) is not supported");
   }
   SECTION("cpp's identifiers: a macro named B is not expanded inside AB; a number body stays a value") {
     Grammar g = parseGrammar("#define B [+F]\n#define N (2 + 1)\naxiom: AB B F(N)\n", "t.l");
@@ -741,5 +744,373 @@ TEST_CASE("cpfg generalized cylinders", "[lsystem][cpfg]") {
     Skeleton straight = Turtle(s.symbols(), cpfgTurtleSettings(&view, {})).run(s.axiom());
     REQUIRE(straight.internodes.size() == 2);
     checkNear(straight.internodes[0].end, DVec3(-0.5, 0.5, 0));  // the chord (0,0)-(-1,1)
+  }
+}
+
+TEST_CASE("cpfg surface files and ~X", "[lsystem][cpfg]") {
+  SECTION("tests/assets/cpfg/surface: a bilinear patch placed after F(3) and a right turn, by hand") {
+    // plate.s is the bilinear patch x = 1 + 3t, y = 3s, z = 9st (Bezier points at thirds).
+    // Contact (1,0,0), SIZE 3, view size 6: p = 2 (f - contact) = (6t, 6s, 18st) in the
+    // surface frame (heading +Y, up +Z, left = heading x up = +X). The turtle is at (0,3,0)
+    // with H = +X, L = +Y, cpfg's up (0,0,-1); ~a(0.5) puts p at
+    // (0,3,0) + 0.5 (p.x L + p.y H + p.z up) = (3s, 3 + 3t, -9st).
+    const Drawn o = drawObject("surface", true);
+    REQUIRE(o.skeleton.organs.size() == 1);
+    const Organ& sf = o.skeleton.organs[0];
+    CHECK(sf.kind == Organ::Kind::Surface);
+    CHECK(sf.name == "a");
+    // The view file's precisions: s 3, t 2: 4 x 3 vertices, 3 x 2 cells of 2 triangles.
+    REQUIRE(sf.points.size() == 12);
+    REQUIRE(sf.normals.size() == 12);
+    REQUIRE(sf.triangles.size() == 36);
+    for (int si = 0; si <= 3; ++si)
+      for (int ti = 0; ti <= 2; ++ti) {
+        const double s = si / 3.0, t = ti / 2.0;
+        const size_t k = static_cast<size_t>(si * 3 + ti);
+        INFO("vertex s = " << s << ", t = " << t);
+        checkNear(sf.points[k], DVec3(3 * s, 3 + 3 * t, -9 * s * t));
+        // dP/dt x dP/ds = (-108s, -108t, 36) in the surface frame, (-108t, -108s, -36) placed.
+        checkNear(sf.normals[k], glm::normalize(DVec3(-108 * t, -108 * s, -36)));
+      }
+    for (size_t k = 0; k < sf.triangles.size(); k += 3) {
+      const DVec3 a = sf.points[sf.triangles[k]], b = sf.points[sf.triangles[k + 1]], c = sf.points[sf.triangles[k + 2]];
+      const DVec3 n = sf.normals[sf.triangles[k]] + sf.normals[sf.triangles[k + 1]] + sf.normals[sf.triangles[k + 2]];
+      CHECK(glm::dot(glm::cross(b - a, c - a), n) > 0);  // wound as the normals point
+    }
+    // The end point (1,3,0) is p = (0,6,0): the turtle moves 0.5 * 6 along H to (3,3,0).
+    REQUIRE(o.skeleton.internodes.size() == 2);
+    checkNear(o.skeleton.internodes[0].end, DVec3(0, 3, 0));
+    checkNear(o.skeleton.internodes[1].start, DVec3(3, 3, 0));
+    checkNear(o.skeleton.internodes[1].end, DVec3(4, 3, 0));
+    checkNear(o.end.frame.position, DVec3(4, 3, 0));
+  }
+  SECTION("precisions: the view file's, else the file's S precision for both, else 5") {
+    const std::string text = readFile(cpfgAsset("surface/plate.s"));
+    CpfgSurface a = CpfgSurface::parse(text, "plate.s", 3, 0, 0);
+    CHECK(a.sPrecision() == 7);
+    CHECK(a.tPrecision() == 7);  // cpfg reads 'T: 9' and uses S for both
+    CHECK(a.vertices().size() == 64);
+    std::string noPrecision = text;
+    noPrecision.erase(noPrecision.find("PRECISION"), std::string("PRECISION S: 7 T: 9\n").size());
+    CpfgSurface b = CpfgSurface::parse(noPrecision, "plate.s", 3, 0, 0);
+    CHECK(b.sPrecision() == 5);
+    CHECK(b.tPrecision() == 5);
+    // size 3 = SIZE: the patch is the file's, moved so that the contact point is the origin.
+    checkNear(b.point(0, 1.0, 1.0), DVec3(3, 3, 9));
+    checkNear(b.point(0, 0.5, 0.5), DVec3(1.5, 1.5, 9 * 0.25));
+  }
+  SECTION("cpfg's frame map: p = x left + y heading + z up, with left = heading x up") {
+    // HEADING +X, UP +Z: left = (0,-1,0); f - contact = (3,0,0) goes to 3 * left = (0,-3,0)
+    // (cpfg's patches.c; the transposed map would give (0,3,0)).
+    std::string text = readFile(cpfgAsset("surface/plate.s"));
+    text.replace(text.find("HEADING  X: 0 Y: 1"), std::string("HEADING  X: 0 Y: 1").size(), "HEADING  X: 1 Y: 0");
+    CpfgSurface s = CpfgSurface::parse(text, "plate.s", 3, 2, 2);
+    checkNear(s.point(0, 0.0, 1.0), DVec3(0, -3, 0));  // P[0][3] = (4,0,0)
+    checkNear(s.point(0, 1.0, 0.0), DVec3(3, 0, 0));   // P[3][0] = (1,3,0): 3 * heading
+    checkNear(s.endPoint(), DVec3(3, 0, 0));
+  }
+  SECTION("~X(sx, sy, sz) scales each axis; the end point moves by sx; a zero scale draws nothing") {
+    ViewFile view = loadViewFile(cpfgAsset("surface/plant.v"));
+    GrammarOverrides go;
+    go.cpfgSurfaceIds = "a";
+    Grammar g = parseGrammar("axiom: ~a(1, 2, -1) F ~a(0) F\n", "t.l", go);
+    Skeleton sk = Turtle(g.symbols(), cpfgTurtleSettings(&view, {})).run(g.axiom());
+    REQUIRE(sk.organs.size() == 1);
+    // At the origin, H = +Y, L = -X, cpfg's up (0,0,-1): p (6t, 6s, 18st) goes to
+    // (-6t, 2 * 6s, 18st) and the end point (0,6,0) moves the turtle 6 along H.
+    checkNear(sk.organs[0].points[11], DVec3(-6, 12, 18));  // s = 1, t = 1
+    REQUIRE(sk.internodes.size() == 2);
+    checkNear(sk.internodes[0].start, DVec3(0, 6, 0));
+    checkNear(sk.internodes[1].start, DVec3(0, 7, 0));  // ~a(0): nothing drawn, no move
+  }
+  SECTION("errors: ~X the view file does not define, malformed surface files and surface: lines") {
+    CHECK(errorOf("axiom: F~l(2)\n") == "t.l:1:9: cpfg's '~l' names no surface: there is no view file with a 'surface:' line");
+    GrammarOverrides go;
+    go.cpfgSurfaceIds = "ab";
+    try {
+      parseGrammar("axiom: F ~c\n", "t.l", go);
+      FAIL("no error");
+    } catch (const InputError& e) {
+      CHECK(e.diagnostics().front().message == "cpfg's '~c' names no surface: the view file has no 'surface: c ...' line (it defines 'ab')");
+    }
+    const std::string text = readFile(cpfgAsset("surface/plate.s"));
+    auto surfaceError = [&](std::string from, std::string to) {
+      std::string t = text;
+      t.replace(t.find(from), from.size(), to);
+      try {
+        CpfgSurface::parse(t, "p.s", 1, 0, 0);
+      } catch (const InputError& e) {
+        const Diagnostic& d = e.diagnostics().front();
+        return std::to_string(d.loc.line) + ":" + std::to_string(d.loc.col) + ": " + d.message;
+      }
+      return std::string("no error");
+    };
+    CHECK(surfaceError("SIZE: 3", "SIZE: 0") == "7:1: the surface's SIZE must be greater than 0");
+    CHECK(surfaceError("SIZE: 3", "SIZE 3") == "7:1: expected 'SIZE:' (the surface's size), got 'SIZE'");
+    CHECK(surfaceError("UP  X: 0 Y: 0 Z: 1", "UP  X: 0 Y: 2 Z: 0") == "5:1: the surface's HEADING and UP must be nonzero and not parallel");
+    CHECK(surfaceError("2 1 1", "2 one 1") == "14:10: expected a number (a control point's y), got 'one'");
+    CHECK(surfaceError("4 3 9\n", "4 3\n") == "16:25: the surface file ends before a control point's z");
+    CHECK(surfaceError("L: ~ R: ~", "L: ~ R: leaf") == "11:9: no patch 'leaf' in the file for patch 'plate''s R:");
+    CHECK(surfaceError("L: ~ R: ~", "L: ~ R: plate") == "11:9: patch 'plate' is 'plate''s R: but its L: is '~'");
+    CHECK(surfaceError("PRECISION S: 7", "PRECISION S: 11") == "2:14: a surface's precision is 1 to 10, got 11");
+    CHECK(viewErrorOf("surface: ab plate.s\n") == "t.v:1:10: a surface's id is one character (the letter after '~'), got 'ab'");
+    CHECK(viewErrorOf("surface: a\n") == "t.v:1:10: expected 'surface: X FILE.s [size [s-precision t-precision] [texture]]'");
+    CHECK(viewErrorOf("surface: ~ seg.s 1\n") == "t.v:1:10: cpfg's segment surface 'surface: ~' (F drawn as a surface) is not supported");
+    CHECK(viewErrorOf("surface: a ../x.s 1\n") == "t.v:1:12: the surface file '../x.s' is outside the object's folder (only files beside the view file, or in folders below it)");
+    CHECK(viewErrorOf("surface: a x.s big\n") == "t.v:1:16: expected the surface's size (a number), got 'big'");
+  }
+}
+
+TEST_CASE("cpfg curve files and curveX/Y/Z/GAL", "[lsystem][cpfg]") {
+  SECTION("tests/assets/cpfg/curve: values from its reference.py (scipy's B-splines, cpfg's arc length)") {
+    const ViewFile view = loadViewFile(cpfgAsset("curve/plant.v"));
+    REQUIRE(view.curves.size() == 5);
+    CHECK(view.curves[0].points().size() == 8);  // multiplicities 3, 1, 1, 3
+    CHECK(view.curves[2].points().size() == 8);  // closed: 5 and the first 3 again
+    CHECK(view.curves[4].points().size() == 6);  // phantom: 4 and a reflection at each end
+    GrammarOverrides o;
+    o.cpfgCurves = view.curves;
+    const std::string file = cpfgAsset("curve/plant.l");
+    Grammar g = parseGrammar(readFile(file), file, o);
+    const ModuleString s = derive(g);
+    const std::vector<double> want = {0.266539359281, -0.214051900902, 0.269398003817, 0.202474996448, 0.779429109754,
+                                      3.099130240169, 2.993557034044,  1.003131285432, 0.680681990305, 9.351512374022,
+                                      -0.940984014602, -0.692898328590, 4.930968087481, 2.866556877029, 0.623735391977,
+                                      0.000000000000, 0.267827417490, 1.888500363212};
+    std::vector<double> got;
+    for (size_t i = 0; i < s.size(); ++i)
+      for (double v : s.paramsOf(i)) got.push_back(v);
+    REQUIRE(got.size() == want.size());
+    for (size_t k = 0; k < want.size(); ++k) {
+      INFO("value " << k);
+      CHECK(got[k] == Approx(want[k]).margin(1e-9));
+    }
+  }
+  SECTION("errors: no curve files, a wrong number, malformed curve files") {
+    CHECK(errorOf("axiom: F(curveX(1, 0.5))\n") ==
+          "t.l:1:10: cpfg's curveX reads the view file's curve files, and it names none ('curve: NAME.con')");
+    GrammarOverrides o;
+    o.cpfgCurves = loadViewFile(cpfgAsset("curve/plant.v")).curves;
+    auto errorWith = [&](const std::string& text) {
+      try {
+        parseGrammar(text, "t.l", o);
+      } catch (const InputError& e) {
+        const Diagnostic& d = e.diagnostics().front();
+        return std::to_string(d.loc.line) + ":" + std::to_string(d.loc.col) + ": " + d.message;
+      }
+      return std::string("no error");
+    };
+    CHECK(errorWith("axiom: F(curveGAL(6))\n") == "1:10: curveGAL's first argument must be a number from 1 to 5 (the view file names 5 curve file(s))");
+    CHECK(errorWith("axiom: F(curveY(1))\n").find("curveY takes 2 arguments") != std::string::npos);
+    auto curveError = [](const std::string& text) {
+      try {
+        CpfgCurve::parse(text, "c.con", 100);
+      } catch (const InputError& e) {
+        const Diagnostic& d = e.diagnostics().front();
+        return std::to_string(d.loc.line) + ":" + std::to_string(d.loc.col) + ": " + d.message;
+      }
+      return std::string("no error");
+    };
+    CHECK(curveError("points: 4\n0 0\n1 1\n2 0\n") == "1:1: 'points: 4' but the file has 3 control point(s)");
+    CHECK(curveError("points: 4\n0 0\n1 1\n2 0 5\n3 3\n") == "4:1: a control point has 2 numbers (the dimension), got 3");
+    CHECK(curveError("points: 4\n0 0\n1 x\n2 0\n3 3\n") == "3:3: expected a number (a coordinate), got 'x'");
+    CHECK(curveError("dimension: 3\npoints: 4\n") == "1:1: 'dimension:' must follow the 'points:' line");
+    CHECK(curveError("points: 4\ntype: spiral\n") == "2:7: unknown curve type 'spiral' (bspline, bspline-closed, bspline-endpoint, bspline-phantom or bezier)");
+    CHECK(curveError("points: 5\ntype: bezier\n0 0\n1 1\n2 0\n3 3\n4 4\n") == "1:1: a Bezier curve has 3k + 1 control points (counting multiplicities), got 5");
+    CHECK(curveError("points: 4\ncolor: 3\n") == "2:1: unknown line in a curve file: 'color: 3'");
+    CHECK(curveError("points: 4\n1 1\n1 1\n1 1\n1 1\n") == "1:1: the curve has length 0 (all its points coincide)");
+    CHECK(curveError("points: 1\ndimension: 4\n0 0 0 2\npoints: 4\n") == "4:1: a second 'points:' line (cpfg's nested curves) is not supported");
+  }
+}
+
+TEST_CASE("cpfg contour files and generalized cylinders with @#(n)", "[lsystem][cpfg]") {
+  // Contour samples from tests/assets/cpfg/contour/reference.py (cpfg's MakeContour in numpy).
+  const std::vector<DVec3> blade = {{0.897527467856, 0.000000000000, 0},  {0.330524728563, 0.891423755803, 0},
+                                    {-0.650675635926, 1.100685813632, 0}, {-0.897527467856, 0.000000000000, 0},
+                                    {-0.330524728563, -0.891423755803, 0}, {0.650675635926, -1.100685813632, 0},
+                                    {0.897527467856, 0.000000000000, 0}};
+  const std::vector<DVec3> strip = {{-0.500000000000, 0.283333341281, 0}, {-0.271197024029, 0.382473459469, 0},
+                                    {-0.027807813170, 0.432723318993, 0}, {0.218184666413, 0.399404333018, 0},
+                                    {0.450000000000, 0.307783341169, 0}};
+  SECTION("contour files sampled as cpfg samples them") {
+    const ViewFile view = loadViewFile(cpfgAsset("contour/plant.v"));
+    REQUIRE(view.contours.size() == 2);
+    CHECK(view.contourSides == 6);
+    CHECK(view.contours[0].id == 1);
+    CHECK(view.contours[0].contour.closed());
+    CHECK(view.contours[0].contour.points().size() == 6);  // multiplicities 1, 2, 1, 2
+    CHECK_FALSE(view.contours[1].contour.closed());
+    const std::vector<DVec3> b = view.contours[0].contour.sample(6), s = view.contours[1].contour.sample(4);
+    REQUIRE(b.size() == blade.size());
+    REQUIRE(s.size() == strip.size());
+    for (size_t k = 0; k < b.size(); ++k) checkNear(b[k], blade[k]);
+    for (size_t k = 0; k < s.size(); ++k) checkNear(s[k], strip[k]);
+  }
+  SECTION("tests/assets/cpfg/contour: every ring point of the two cylinders") {
+    // Turtle at the origin, H = +Y, L = -X, cpfg's up U' = (0,0,-1), radius 0.4 / 2: a
+    // contour point (x, y) of a ring centred at c goes to c + 0.2 (x U' - y L) = c + (0.2y, 0, -0.2x).
+    const Drawn o = drawObject("contour", true);
+    CHECK(o.skeleton.internodes.empty());
+    REQUIRE(o.skeleton.organs.size() == 2);
+    auto placed = [](const DVec3& c, const DVec3& k) { return c + DVec3(0.2 * k.y, 0, -0.2 * k.x); };
+    const Organ& a = o.skeleton.organs[0];
+    REQUIRE(a.points.size() == 14);
+    REQUIRE(a.triangles.size() == 6 * 2 * 3);
+    for (size_t m = 0; m < 7; ++m) {
+      checkNear(a.points[m], placed(DVec3(0, 0, 0), blade[m]));
+      checkNear(a.points[7 + m], placed(DVec3(0, 2, 0), blade[m]));
+    }
+    // The branch: @!(4) sides, strip at (0,2,0) blended into the circle at (0,3,0).
+    const Organ& b = o.skeleton.organs[1];
+    REQUIRE(b.points.size() == 10);
+    const std::vector<DVec3> circle = {{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}, {1, 0, 0}};
+    for (size_t m = 0; m < 5; ++m) {
+      checkNear(b.points[m], placed(DVec3(0, 2, 0), strip[m]));
+      checkNear(b.points[5 + m], placed(DVec3(0, 3, 0), circle[m]));
+    }
+    // Every triangle's normal agrees with its vertices' normals.
+    for (size_t k = 0; k < a.triangles.size(); k += 3) {
+      const DVec3 n = glm::cross(a.points[a.triangles[k + 1]] - a.points[a.triangles[k]], a.points[a.triangles[k + 2]] - a.points[a.triangles[k]]);
+      CHECK(glm::dot(n, a.normals[a.triangles[k]]) > 0);
+    }
+  }
+  SECTION("a bent cylinder: a ring lies in the plane perpendicular to the curve's tangent") {
+    // @Gt(0): zero tangents make the segment from (0,0,0) to (-1,1,0) (after f(1), + and
+    // f(1)) the straight chord, its tangent along it; the middle ring (t = 1/2, of 2) is
+    // centred at (-0.5, 0.5, 0) and perpendicular to the chord.
+    ViewFile view = loadViewFile(cpfgAsset("contour/plant.v"));
+    Grammar g = parseGrammar("axiom: @Gt(0) @#(1) @Gs f(1) + f(1) @Ge(2)\n", "t.l");
+    Skeleton sk = Turtle(g.symbols(), cpfgTurtleSettings(&view, {})).run(g.axiom());
+    REQUIRE(sk.organs.size() == 1);
+    REQUIRE(sk.organs[0].points.size() == 3 * 7);
+    const DVec3 dir = glm::normalize(DVec3(-1, 1, 0));
+    for (size_t m = 0; m < 7; ++m) {
+      const DVec3 p = sk.organs[0].points[7 + m] - DVec3(-0.5, 0.5, 0);
+      CHECK(std::fabs(glm::dot(p, dir)) < 1e-9);
+      CHECK(glm::length(p) == Approx(0.2 * glm::length(blade[m])));  // the contour point's radius, scaled
+    }
+  }
+  SECTION("errors: an unknown contour id, a contour on F, malformed contour files") {
+    ViewFile view = loadViewFile(cpfgAsset("contour/plant.v"));
+    Grammar g = parseGrammar("axiom: @#(3) @Gs f(1) @Ge\n", "t.l");
+    try {
+      Turtle(g.symbols(), cpfgTurtleSettings(&view, {})).run(g.axiom());
+      FAIL("no error");
+    } catch (const InputError& e) {
+      CHECK(e.diagnostics().front().message == "cpfg's '@#(3)' names no contour: the view file has no 'contour: 3 ...' line");
+    }
+    Grammar f = parseGrammar("axiom: @#(1) F(1)\n", "t.l");
+    try {
+      Turtle(f.symbols(), cpfgTurtleSettings(&view, {})).run(f.axiom());
+      FAIL("no error");
+    } catch (const InputError& e) {
+      CHECK(e.diagnostics().front().message.find("cpfg's contour '@#(1)' on an 'F' segment") == 0);
+    }
+    auto contourError = [](const std::string& text) {
+      try {
+        CpfgContour::parse(text, "c.con");
+      } catch (const InputError& e) {
+        const Diagnostic& d = e.diagnostics().front();
+        return std::to_string(d.loc.line) + ":" + std::to_string(d.loc.col) + ": " + d.message;
+      }
+      return std::string("no error");
+    };
+    CHECK(contourError("cver 2 0\n") == "1:6: contour file version 2.0 is not supported (cpfg reads 'cver 1 1' to 'cver 1 3' and the older 'n dim closed|open')");
+    CHECK(contourError("cver 1 2\nname: x\npoints: 3 4\ntype: cr\n0 0 0 1\n1 0 0 1\n0 1 0 1\n") == "3:11: 'points: 3 4' but the multiplicities sum to 3");
+    CHECK(contourError("cver 1 2\nname: x\npoints: 3 3\ntype: xr\n") == "4:7: a contour's type is 'o' (open) or 'c' (closed) then 'r' (regular) or 'e', got 'xr'");
+    CHECK(contourError("4 2 open\n0 0\n1 1\n2 0\n") == "4:1: the contour file ends before point 4 of its 4");
+    CHECK(contourError("3 2 open\n0 0\n1 1\n2 0\n") == "1:1: an open contour needs at least 4 points (counting multiplicities), got 3");
+    CHECK(contourError("3 2 closed\n0 0\n1 one\n2 0\n") == "3:3: expected a number (a coordinate), got 'one'");
+    CHECK(viewErrorOf("contour: 0 a.con\n") == "t.v:1:10: contour id 0 is cpfg's circle; a contour file takes another id");
+    CHECK(viewErrorOf("contour sides: 2\n") == "t.v:1:16: 'contour sides:' is a whole number from 3 to 1024");
+  }
+}
+
+TEST_CASE("cpfg generalized cylinders: @Gr radius tangents", "[lsystem][cpfg]") {
+  // general.c, interpolate_connection: the rings are the Hermite cubic of the pairs
+  // (t, radius) from (0, r1) to (1, r2) with the radius tangents. @Gr(90, 1) makes both
+  // (0, 1): with r1 = r2 = 0.2, ring k of 4 (r = k/4) is at t = 3r^2 - 2r^3 with radius
+  // 0.2 + r - 3r^2 + 2r^3; @Gt(0) makes the curve p1 + (3t^2 - 2t^3)(p2 - p1).
+  ViewFile view = parseViewFile("initial line width: 0.4\nline style: cylinder\n", "t.v");
+  auto expect = [](const Skeleton& sk, double length) {
+    REQUIRE(sk.internodes.size() == 4);
+    auto at = [&](int k) {
+      const double r = k / 4.0, t = 3 * r * r - 2 * r * r * r;
+      return std::pair{DVec3(0, length * (3 * t * t - 2 * t * t * t), 0), 0.2 + r - 3 * r * r + 2 * r * r * r};
+    };
+    for (int k = 1; k <= 4; ++k) {
+      INFO("ring " << k);
+      checkNear(sk.internodes[static_cast<size_t>(k - 1)].start, at(k - 1).first);
+      checkNear(sk.internodes[static_cast<size_t>(k - 1)].end, at(k).first);
+      CHECK(sk.internodes[static_cast<size_t>(k - 1)].baseRadius == Approx(at(k - 1).second).margin(1e-12));
+      CHECK(sk.internodes[static_cast<size_t>(k - 1)].tipRadius == Approx(at(k).second).margin(1e-12));
+    }
+  };
+  Grammar g = parseGrammar("axiom: @Gt(0) @Gr(90, 1) @Gs f(1) @Ge(4)\n", "t.l");
+  expect(Turtle(g.symbols(), cpfgTurtleSettings(&view, {})).run(g.axiom()), 1.0);
+  // @Gr(1): tangents times the segment's length, so (0, 0.5) on a segment of 2 is (0, 1).
+  Grammar s = parseGrammar("axiom: @Gt(0) @Gr(1) @Gr(90, 0.5) @Gs f(2) @Ge(4)\n", "t.l");
+  expect(Turtle(s.symbols(), cpfgTurtleSettings(&view, {})).run(s.axiom()), 2.0);
+  // The middle ring of the first: r = 1/2 gives t = 1/2 and radius 0.2 (the curve's middle).
+  Grammar m = parseGrammar("axiom: @Gt(0) @Gr(90, 1) @Gs f(1) @Ge(2)\n", "t.l");
+  Skeleton mid = Turtle(m.symbols(), cpfgTurtleSettings(&view, {})).run(m.axiom());
+  REQUIRE(mid.internodes.size() == 2);
+  checkNear(mid.internodes[0].end, DVec3(0, 0.5, 0));
+  CHECK(mid.internodes[0].tipRadius == Approx(0.2));
+}
+
+TEST_CASE("cpfg view files: // comments", "[lsystem][cpfg]") {
+  // cpfg runs the view file through the C preprocessor, which removes // and /* */ comments
+  // (vlab's TexturedSurfaces has '// light: ...' lines).
+  const ViewFile v = parseViewFile("angle increment: 30 // degrees\n// light: V: 5 3 1 D: 1.3 1.5 1.3\n/* a\n b */ initial scale: 2\n", "t.v");
+  REQUIRE(v.angleDeg);
+  CHECK(*v.angleDeg == 30);
+  REQUIRE(v.initialScale);
+  CHECK(*v.initialScale == 2);
+  CHECK(viewErrorOf("// fine\nangel increment: 3\n") == "t.v:2:1: unknown view file command 'angel increment:' (did you mean 'angle increment'?)");
+}
+
+TEST_CASE("cpfg function sets: function set: and the functions' names", "[lsystem][cpfg]") {
+  const ViewFile view = loadViewFile(cpfgAsset("function_set/plant.v"));
+  REQUIRE(view.functions.size() == 2);  // the set replaces the 'function:' line before it
+  CHECK(view.functionNames == std::vector<std::string>{"WIDTH", "ANGLE"});
+  GrammarOverrides o;
+  o.cpfgFunctions = view.functions;
+  o.cpfgFunctionNames = view.functionNames;
+  const std::string file = cpfgAsset("function_set/plant.l");
+  const ModuleString s = derive(parseGrammar(readFile(file), file, o));
+  REQUIRE(s.size() == 1);
+  const std::vector<double> want = {0.15625, 0.783014893532, 0.066938758886};  // tests/assets/cpfg/function/reference.py
+  REQUIRE(s.paramsOf(0).size() == 3);
+  for (size_t k = 0; k < 3; ++k) CHECK(s.paramsOf(0)[k] == Approx(want[k]).margin(1e-9));
+  // A 'function:' line after the set: the names are no longer defined (cpfg's
+  // SetFunctionsFromGallery(FALSE)).
+  std::string v2 = readFile(cpfgAsset("function_set/plant.v")) + "function: ignored.func\n";
+  const std::string dir = cpfgAsset("function_set/");
+  const ViewFile after = parseViewFile(v2, dir + "plant.v");
+  CHECK(after.functions.size() == 3);
+  CHECK(after.functionNames.empty());
+  CHECK(viewErrorOf("function set: a.fset b\n") == "t.v:1:15: expected one function set file after 'function set:'");
+}
+
+TEST_CASE("cpfg generalized cylinders with @#(n): a roll between control points twists the rings", "[lsystem][cpfg]") {
+  // cpfg's twist angle: a straight segment whose second point is rolled by 90 degrees has
+  // its last ring in the rolled frame and its middle ring turned half way (45 degrees).
+  ViewFile view = loadViewFile(cpfgAsset("contour/plant.v"));
+  Grammar g = parseGrammar("axiom: @#(1) @Gs f(1) /(90) @Ge(2)\n", "t.l");
+  Skeleton sk = Turtle(g.symbols(), cpfgTurtleSettings(&view, {})).run(g.axiom());
+  REQUIRE(sk.organs.size() == 1);
+  const std::vector<DVec3>& p = sk.organs[0].points;
+  REQUIRE(p.size() == 3 * 7);
+  for (size_t m = 0; m < 6; ++m) {
+    const DVec3 a = p[m] - DVec3(0, 0, 0), b = p[7 + m] - DVec3(0, 0.5, 0), c = p[14 + m] - DVec3(0, 1, 0);
+    auto angle = [](const DVec3& x, const DVec3& y) { return std::acos(std::clamp(glm::dot(glm::normalize(x), glm::normalize(y)), -1.0, 1.0)); };
+    INFO("contour point " << m);
+    CHECK(std::fabs(a.y) < 1e-12);  // every ring perpendicular to the straight axis
+    CHECK(std::fabs(b.y) < 1e-12);
+    CHECK(std::fabs(c.y) < 1e-12);
+    CHECK(angle(a, c) == Approx(kPi / 2));
+    CHECK(angle(a, b) == Approx(kPi / 4));
+    CHECK(angle(b, c) == Approx(kPi / 4));
   }
 }

@@ -1,2 +1,2 @@
 /* productions of plant.l */
-A --> F@Gr(2)
+A --> F@Tx(2)

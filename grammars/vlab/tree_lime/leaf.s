@@ -1,0 +1,16 @@
+-0.55 0.55  0 1  0 0
+PRECISION S: 6 T: 4
+CONTACT POINT  X: 0 Y: 0 Z: 0
+END POINT  X: 0 Y: 1 Z: 0
+HEADING  X: 0 Y: 1 Z: 0
+UP  X: 0 Y: 0 Z: -1
+SIZE: 1
+blade
+TOP COLOR: 0 DIFFUSE: 0.00 BOTTOM COLOR: 0 DIFFUSE: 0.00
+AL: ~ A: ~ AR: ~
+L: ~ R: ~
+BL: ~ B: ~ BR: ~
+-0.03 0 0  -0.01 0 0  0.01 0 0  0.03 0 0
+-0.55 0.3 0  -0.18 0.3 0  0.18 0.3 0  0.55 0.3 0
+-0.45 0.75 0  -0.15 0.75 0  0.15 0.75 0  0.45 0.75 0
+-0.01 1 0  -0.003 1 0  0.003 1 0  0.01 1 0

@@ -1,0 +1,1 @@
+surface: l leaf.s 1 6 4

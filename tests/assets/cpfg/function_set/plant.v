@@ -1,0 +1,3 @@
+angle increment: 90
+function: ignored.func
+function set: plant.fset

@@ -1,0 +1,2 @@
+angle increment: 30
+surface: a plate.s 1
