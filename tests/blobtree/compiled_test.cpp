@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
 
+#include <map>
+
 #include "blobtree/blobtree.h"
 #include "blobtree/compiled.h"
 #include "core/rng.h"
@@ -302,6 +304,29 @@ TEST_CASE("CompiledBlob::surfaceCells", "[blobtree]") {
     double exactRatio = double(exact.cells.size()) / double(coarse.cells.size());
     double expected = std::pow(double(coarse.cellSize) / 0.0731, 2.0);
     CHECK(exactRatio == Approx(expected).epsilon(0.2));
+  }
+  SECTION("adjacent cells share their faces bit for bit (no cracks between them)") {
+    // A sphere off the grid's center and one centred on it (its faces pass through 0, where a
+    // crack of one ulp once let a ray with a direction component of 1e-16 miss every cell).
+    BlobTree t2;
+    CompiledBlob centred = compile(t2, t2.point(Vec3(0.0f), 0.37f));
+    for (const CellSet& set : {b.surfaceCells(0.0371f), centred.surfaceCells(0.0173f)}) {
+      std::map<std::array<int32_t, 3>, const Cell*> byIndex;
+      for (const Cell& c : set.cells) byIndex[c.index] = &c;
+      int shared = 0, cracked = 0;
+      for (const Cell& c : set.cells)
+        for (int axis = 0; axis < 3; ++axis) {
+          std::array<int32_t, 3> next = c.index;
+          ++next[size_t(axis)];
+          auto it = byIndex.find(next);
+          if (it == byIndex.end()) continue;
+          ++shared;
+          if (c.box.hi[axis] != it->second->box.lo[axis]) ++cracked;
+        }
+      INFO(set.cells.size() << " cells, " << shared << " shared faces");
+      CHECK(shared > 100);
+      CHECK(cracked == 0);
+    }
   }
   // Deterministic.
   CellSet again = b.surfaceCells(0.1f);
