@@ -333,3 +333,46 @@ TEST_CASE("CompiledBlob::surfaceCells", "[blobtree]") {
   REQUIRE(again.cells.size() == coarse.cells.size());
   for (size_t i = 0; i < again.cells.size(); ++i) CHECK(again.cells[i].index == coarse.cells[i].index);
 }
+
+TEST_CASE("CompiledBlob::sample contact gradient", "[blobtree]") {
+  // Two PCM cones meeting at a fork: in the propagation band, Attributes::contact is
+  // 1 − (c − f_j)/w of the weaker cone, and contactGradient is its gradient ∇f_j / w.
+  const uint64_t seed = 11;
+  INFO("seed " << seed);
+  BlobTree t;
+  PcmParams pp;
+  pp.width = 0.25f;
+  NodeId a = t.cone(Vec3(0, 0, 0), Vec3(0, 1, 0), 0.12f, 0.10f);
+  NodeId b = t.cone(Vec3(0, 0.05f, 0), Vec3(0.6f, 0.8f, 0.1f), 0.09f, 0.07f);
+  CompiledBlob blob = compile(t, t.pcm(a, b, pp));
+  Rng rng(seed);
+  int inBand = 0;
+  for (int i = 0; i < 4000 && inBand < 200; ++i) {
+    const Vec3 p = randomIn(rng, Vec3(-0.2f, 0.0f, -0.2f), Vec3(0.4f, 0.6f, 0.2f));
+    const Sample s = blob.sample(p);
+    const float c = s.attributes.contact;
+    if (!(c > 0.05f && c < 0.95f)) {
+      if (c == 0.0f) CHECK(s.attributes.contactGradient == Vec3(0.0f));
+      continue;
+    }
+    // Stay away from where the weaker cone changes (both contacts near): finite differences
+    // must not straddle the switch.
+    const float h = 1e-3f;
+    Vec3 fd;
+    bool smooth = true;
+    for (int k = 0; k < 3; ++k) {
+      Vec3 e(0.0f);
+      e[k] = h;
+      const float cp = blob.sample(p + e).attributes.contact, cm = blob.sample(p - e).attributes.contact;
+      fd[k] = (cp - cm) / (2 * h);
+      const float c2 = (cp + cm) / 2;
+      smooth = smooth && std::abs(c2 - c) < 1e-3f;
+    }
+    if (!smooth) continue;
+    ++inBand;
+    INFO("p " << p.x << "," << p.y << "," << p.z << " contact " << c);
+    CHECK(glm::length(s.attributes.contactGradient - fd) < 0.02f * std::max(1.0f, glm::length(fd)));
+    CHECK(glm::length(s.attributes.contactGradient) > 0.0f);
+  }
+  CHECK(inBand >= 50);
+}
