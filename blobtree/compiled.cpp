@@ -184,6 +184,7 @@ Sample CompiledBlob::sample(Vec3 p) const {
     }
     s.attributes.layerCount = uint8_t(n);
     s.attributes.contact = r.acc.contact;
+    s.attributes.contactGradient = r.acc.contactGrad;
   }
   return s;
 }

@@ -73,6 +73,10 @@ struct Attributes {
   /// primitives press together, 0 beyond the propagation width w). Marks the branch bark
   /// ridge, where real bark is compressed and darker (tree paper §5).
   float contact = 0.0f;
+  /// ∇contact (1/world units; zero where contact is 0 or 1): points toward the seam. Its
+  /// component in the tangent plane gives the ridge's direction on the surface (the seam runs
+  /// perpendicular to it), for shading the ridge (render::Material::ridgeRelief).
+  Vec3 contactGradient{0.0f};
 };
 
 /// Field value, analytic gradient and attributes at a point.

@@ -38,10 +38,16 @@ CellSet CompiledBlob::surfaceCells(float cellSize, const SurfaceCellOptions& opt
     std::array<int32_t, 3> idx;
     int level;
   };
+  // Both faces from the grid (origin + index·e), never lo + e: the neighbour's lo is computed
+  // the same way, so adjacent cells share their faces bit for bit and tile space without
+  // cracks (lo + e may round an ulp short, and a ray running inside that crack, such as one
+  // whose direction has an x component of 1e-16 through x = 0, would meet no cell). Halving
+  // e is exact, so the faces agree across levels too.
   auto boxOf = [&](const Item& it) {
     float e = E / float(1 << it.level);
     Vec3 lo = out.origin + Vec3(float(it.idx[0]), float(it.idx[1]), float(it.idx[2])) * e;
-    return Box3{lo, lo + Vec3(e)};
+    Vec3 hi = out.origin + Vec3(float(it.idx[0] + 1), float(it.idx[1] + 1), float(it.idx[2] + 1)) * e;
+    return Box3{lo, hi};
   };
   // Top levels sequentially, so each subtree below is an independent task.
   int split = std::min(depth, 3);

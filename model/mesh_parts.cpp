@@ -50,9 +50,7 @@ Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::Te
         wsum += w;
       }
     }
-    if (wsum > 0)
-      mesh.colors[v] = sum / wsum * (1.0f - std::clamp(material.contactDarkening * a.contact * a.contact * a.contact,
-                                                        0.0f, 1.0f));
+    if (wsum > 0) mesh.colors[v] = sum / wsum * static_cast<float>(1.0 - material.ridge.darkness(a.contact, mesh.positions[v]));
   }
   mesh.materials.assign(mesh.triangles.size(), kNoPartTexture);
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {

@@ -31,7 +31,8 @@ blobtree::PolygonizeOptions polygonizeOptions(const SpeciesRender& look);
 
 Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::TextureTable& textures, const Vec3& base);
 /// paintPolygonized with a material: its base colour, and its textureLayers and
-/// contactDarkening applied as render::Scene::attributeColor applies them.
+/// ridge darkening applied as render::Scene::attributeColor applies them (the ridge's
+/// relief is shading, not colour: not baked).
 Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::TextureTable& textures,
                       const render::Material& material);
 

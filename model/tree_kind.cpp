@@ -201,7 +201,16 @@ render::Geometry surfaceGeometry(const TreeSurface& tree, const SpeciesRender& l
   }
   render::Material wood = look.style.wood;
   wood.textureLayers = true;  // every cone's bark in its own coordinates (furrows along each branch)
-  wood.contactDarkening = static_cast<float>(tree.options.bark.ridgeDarkening);
+  {
+    const organisms::BarkOptions& b = tree.options.bark;
+    textures::RidgeOptions ridge;
+    ridge.darkening = b.ridgeDarkening;
+    ridge.lines = b.ridgeLines;
+    ridge.relief = b.ridgeRelief;
+    ridge.wanderScale = b.ridgeWidth > 0 ? 0.5 / b.ridgeWidth : ridge.wanderScale;  // one wave per two ridges
+    ridge.seed = tree.options.seed;
+    wood.ridge = textures::RidgeShade(ridge);
+  }
   render::Geometry out;
   if (mesh)
     out.parts.push_back(render::PolygonizedPart{mesh, wood, std::move(textures), tree.axes});
@@ -356,7 +365,7 @@ class TreeModel final : public KindModel {
     // per girth (several classes, each cone coloured in its own coordinates and the colours
     // blended) or darkened PCM seams, the wood keeps the renderer's vertex colours.
     const uint16_t barkId = static_cast<uint16_t>(tree.options.bark.texture);
-    const bool oneBark = tree.blob.barkClasses.size() == 1 && !(tree.options.bark.ridgeDarkening > 0);
+    const bool oneBark = tree.blob.barkClasses.size() == 1 && !(tree.options.bark.ridgeDarkening > 0);  // (relief is shading only)
     if (tree.options.bark.enabled && oneBark && barkId < implicit.textures.size() && parts[0].mesh.triangleCount() > 0) {
       const render::ColorTexture& bark = implicit.textures[barkId];
       textureBark(parts[0], [&bark](Vec2 uv) { return bark(uv, Vec3(0.0f)); });
@@ -713,6 +722,8 @@ organisms::TreeOptions readTreeOptions(const YNode& section, DiagnosticList& dia
     o.bark.ridgeWidth = p.number("ridge_width", o.bark.ridgeWidth, 0.0, 1e6);
     o.bark.matureRadius = p.number("mature_radius", o.bark.matureRadius, 0.0, 1e6);
     o.bark.ridgeDarkening = p.number("ridge_darkening", o.bark.ridgeDarkening, 0.0, 1.0);
+    o.bark.ridgeLines = static_cast<int>(p.integer("ridge_lines", o.bark.ridgeLines, 0, 64));
+    o.bark.ridgeRelief = p.number("ridge_relief", o.bark.ridgeRelief, 0.0, 4.0);
     textures::BarkOptions& b = o.bark.pattern;
     b.furrows = static_cast<int>(p.integer("furrows", b.furrows, 1, 1000));
     b.warp = p.number("warp", b.warp, 0.0, 100.0);

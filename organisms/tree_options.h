@@ -90,6 +90,12 @@ struct BarkOptions {
   /// Bark multiplied by 1 − ridgeDarkening·contact³ (blobtree::Attributes::contact: 1 on
   /// the PCM seam, 0 a propagation width away): the compressed bark of the branch bark ridge.
   double ridgeDarkening = 0.0;
+  /// Folds of bunched bark across the ridge's band, parallel to the seam and crowding toward
+  /// it (textures::RidgeOptions::lines; darkened by ridgeDarkening); 0: none.
+  int ridgeLines = 0;
+  /// Shading relief of the ridge (textures::RidgeOptions::relief: the normal tilts by a
+  /// slope of 1.5·ridgeRelief on the crest's flanks); 0: none. The geometry stays PCM's.
+  double ridgeRelief = 0.0;
   /// The pattern (furrows, warp, colors, lenticels, ...); furrows and maturity are replaced
   /// per class as above. Colors left unset take the wood color (furrows 0.3 of it).
   textures::BarkOptions pattern;

@@ -17,6 +17,7 @@
 #include "core/mesh.h"
 #include "core/shapes.h"
 #include "core/types.h"
+#include "textures/ridge.h"
 
 namespace sprig::blobtree {
 struct PolygonizeResult;
@@ -34,10 +35,11 @@ struct Material {
   /// and blend the colours by field weight (blobtree::Attributes::layers; trees' bark, so
   /// furrows follow each branch). false: each texture once at the field-blended uv.
   bool textureLayers = false;
-  /// Textured blobs: the colour is multiplied by 1 − contactDarkening·contact³, where
-  /// contact (blobtree::Attributes::contact) is 1 on a PCM seam (the branch bark ridge);
-  /// the cube narrows the band to the part of the propagation region nearest the seam.
-  float contactDarkening = 0.0f;
+  /// Textured blobs along a PCM seam (the branch bark ridge; blobtree::Attributes::contact
+  /// is 1 on the seam): the colour is multiplied by 1 − ridge.darkness(contact, p) (compressed
+  /// bark on the crest, folds of bunched bark parallel to it), and the shading normal is
+  /// tilted by the ridge's relief (ridge.shadingNormal). The default changes nothing.
+  textures::RidgeShade ridge;
 };
 
 /// A color texture: linear RGB at natural coordinates uv (and world position, for solid

@@ -333,8 +333,7 @@ Vec3 Scene::attributeColor(const blobtree::Attributes& a, const Vec3& p, const M
     }
   }
   if (!(wsum > 0)) return material.baseColor;
-  const float c = a.contact * a.contact * a.contact;  // a narrow band along the seam
-  return sum / wsum * (1.0f - std::clamp(material.contactDarkening * c, 0.0f, 1.0f));
+  return sum / wsum * static_cast<float>(1.0 - material.ridge.darkness(a.contact, p));
 }
 
 void Scene::commit() {
@@ -378,6 +377,9 @@ std::optional<SurfaceHit> Scene::intersect(const Vec3& origin, const Vec3& direc
     const blobtree::Hit& ih = context.implicitHit;
     hit.position = ih.point;
     hit.normal = hit.geometricNormal = ih.normal;
+    const Material& m = impl_->materials[hit.material];
+    if (ih.attributes.contact > 0)
+      hit.normal = m.ridge.shadingNormal(ih.normal, ih.attributes.contact, ih.attributes.contactGradient, ih.point);
     hit.color = attributeColor(ih.attributes, ih.point, impl_->materials[hit.material], rec.textureBase,
                                rec.textureCount);
     return hit;

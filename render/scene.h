@@ -136,7 +136,7 @@ class Scene {
   /// Color of blended attributes at p: Σ wᵢ·Tᵢ(uv, p) over the attribute's textures at the
   /// field-blended uv, or with material.textureLayers Σ wᵢ·T_idᵢ(uvᵢ, p) over its layers
   /// (the heaviest contributing primitives, each at its own natural uv); weights from the
-  /// field (tree paper §3.7); times 1 − material.contactDarkening·contact³. The material's
+  /// field (tree paper §3.7); times 1 − material.ridge.darkness(contact, p). The material's
   /// base color for a texture id without a registered texture, or when there is none.
   /// textureBase/textureCount select a part's texture table (default: the scene's whole table).
   Vec3 attributeColor(const blobtree::Attributes& attributes, const Vec3& p, const Material& material,

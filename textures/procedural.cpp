@@ -88,12 +88,25 @@ double BarkTexture::lenticelCover(Vec2 uv) const {
       if (rows > 0) cellY = ((cellY % rows) + rows) % rows;
       Rng rng(deriveSeed(o.seed, {0x1e27u, static_cast<uint64_t>(cellX), static_cast<uint64_t>(cellY)}));
       const bool present = rng.uniform() < o.lenticels;
-      const double cx = di + 0.5 + (rng.uniform() - 0.5) * 0.4;
-      const double cy = dj + 0.5 + (rng.uniform() - 0.5) * 0.4;
-      const double size = 0.75 + 0.5 * rng.uniform();
+      const double cx = di + 0.5 + (rng.uniform() - 0.5) * 0.6;
+      const double cy = dj + 0.5 + (rng.uniform() - 0.5) * 0.6;
+      const double size = 0.7 + 0.6 * rng.uniform();
       if (!present) continue;
-      // A diamond wider (across the branch) than long: |dx|/0.30 + |dy|/0.16 <= size.
-      const double d = (std::abs(fx - cx) / 0.30 + std::abs(fy - cy) / 0.16) / size;
+      // Each lenticel its own lens, wider (across the branch) than long: half-width a in
+      // [0.22, 0.38] cells, half-length b in [0.10, 0.20], and an outline between a diamond
+      // and an ellipse, (|dx|/a)^e + (|dy|/b)^e <= size^e with e in [1.2, 2.2], roughened
+      // by a little noise (so no two are stamped alike). It reaches at most 0.3 + 0.38·1.3 <
+      // 0.8 cells from its cell's centre: the 3x3 cells searched hold every lenticel that
+      // can cover the point.
+      const double a = 0.22 + 0.16 * rng.uniform(), b = 0.10 + 0.10 * rng.uniform();
+      const double e = 1.2 + 1.0 * rng.uniform();
+      const double dx = std::abs(fx - cx) / a, dy = std::abs(fy - cy) / b;
+      if (dx > 1.5 * size || dy > 1.5 * size) continue;
+      // (The noise is taken about the lenticel's own centre, keyed by its wrapped cell, so
+      // the pattern still closes at u = 1.)
+      const double rough =
+          1 + 0.08 * noise_(DVec3(6 * (fx - cx) + 3.1 * double(cellX), 6 * (fy - cy) + 1.7 * double(cellY), 1.7));
+      const double d = std::pow(std::pow(dx, e) + std::pow(dy, e), 1 / e) / size * rough;
       cover = std::max(cover, smoothstep(1.0, 0.75, d));
     }
   }

@@ -70,7 +70,8 @@ class NoiseTexture : public SeededTexture<NoiseColorOptions> {
 /// depth is 0.2 + 0.8 m and their profile exponent sharpness·(1 + 4 (1 − m)) (hairline
 /// cracks on young bark that widen and deepen as it ages); the cross cracks scale with m;
 /// the ridge color goes from youngColor (m = 0) to ridgeColor (m = 1). Lenticels (young
-/// bark's breathing pores, diamond-shaped on a poplar) sit one per cell of a jittered grid
+/// bark's breathing pores, lens- to diamond-shaped on a poplar, each of its own size, width
+/// and outline) sit one per cell of a jittered grid
 /// (one cell per ridge width around, lenticelFrequency rows per unit of v; the cell index
 /// around is taken modulo furrows, so they too close at u = 1), present in a fraction
 /// `lenticels` of the cells, darkening the bark by (1 − m).

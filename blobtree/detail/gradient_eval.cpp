@@ -89,6 +89,7 @@ SV pcmS(const Tape& T, const TNode& n, Vec3 p) {
   SV r;
   float fmax = 0.0f, dsum = 0.0f, dmax = 0.0f, dpmax = 0.0f;
   float close1 = 0.0f, close2 = 0.0f;  // the two largest closenesses to contact
+  Vec3 grad1{0.0f}, grad2{0.0f};        // and their gradients
   Vec3 gsum{0.0f}, gmax{0.0f};
   const PcmDerived& pp = params(T, n).pcm;
   childrenAt(T, n, p, [&](uint32_t c) {
@@ -98,8 +99,16 @@ SV pcmS(const Tape& T, const TNode& n, Vec3 p) {
     // Closeness is increasing in f, so the strongest child has the largest; the contact is
     // the second largest (the strongest non-maximal child's).
     const float close = f > 0.0f ? std::clamp(1.0f - (pp.c - f) / pp.w, 0.0f, 1.0f) : 0.0f;
-    if (close > close1) { close2 = close1; close1 = close; }
-    else if (close > close2) close2 = close;
+    const Vec3 grad = close > 0.0f && close < 1.0f ? s.g / pp.w : Vec3(0.0f);  // ∇close = ∇f / w inside the band
+    if (close > close1) {
+      close2 = close1;
+      grad2 = grad1;
+      close1 = close;
+      grad1 = grad;
+    } else if (close > close2) {
+      close2 = close;
+      grad2 = grad;
+    }
     float dp;
     float d = pcmD(pp, f, &dp);
     dsum += d;
@@ -108,7 +117,10 @@ SV pcmS(const Tape& T, const TNode& n, Vec3 p) {
     if (f > fmax) { fmax = f; dmax = d; dpmax = dp; gmax = s.g; }
   });
   if (fmax <= 0.0f) return r;
-  r.acc.contact = std::max(r.acc.contact, close2);
+  if (close2 > r.acc.contact) {
+    r.acc.contact = close2;
+    r.acc.contactGrad = grad2;
+  }
   r.v = fmax + dsum - dmax;
   if (r.v <= 0.0f) { r.v = 0.0f; return r; }
   r.g = gmax + gsum - dpmax * gmax;

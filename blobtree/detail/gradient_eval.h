@@ -36,6 +36,7 @@ struct AttrAcc {
   std::array<Attributes::Layer, Attributes::kMaxLayers> layers{};
   int layerCount = 0;
   float contact = 0.0f;  ///< Attributes::contact
+  Vec3 contactGrad{0.0f};  ///< Attributes::contactGradient
 
   void addLayer(const Attributes::Layer& l) {
     if (layerCount < Attributes::kMaxLayers) {
@@ -53,7 +54,10 @@ struct AttrAcc {
     wSum += o.wSum;
     for (int i = 0; i < o.count; ++i) addTexture(o.ids[size_t(i)], o.w[size_t(i)]);
     for (int i = 0; i < o.layerCount; ++i) addLayer(o.layers[size_t(i)]);
-    contact = std::max(contact, o.contact);
+    if (o.contact > contact) {
+      contact = o.contact;
+      contactGrad = o.contactGrad;
+    }
   }
 };
 

@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
 
+#include <map>
+
 #include "blobtree/blobtree.h"
 #include "blobtree/compiled.h"
 #include "core/rng.h"
@@ -303,6 +305,29 @@ TEST_CASE("CompiledBlob::surfaceCells", "[blobtree]") {
     double expected = std::pow(double(coarse.cellSize) / 0.0731, 2.0);
     CHECK(exactRatio == Approx(expected).epsilon(0.2));
   }
+  SECTION("adjacent cells share their faces bit for bit (no cracks between them)") {
+    // A sphere off the grid's center and one centred on it (its faces pass through 0, where a
+    // crack of one ulp once let a ray with a direction component of 1e-16 miss every cell).
+    BlobTree t2;
+    CompiledBlob centred = compile(t2, t2.point(Vec3(0.0f), 0.37f));
+    for (const CellSet& set : {b.surfaceCells(0.0371f), centred.surfaceCells(0.0173f)}) {
+      std::map<std::array<int32_t, 3>, const Cell*> byIndex;
+      for (const Cell& c : set.cells) byIndex[c.index] = &c;
+      int shared = 0, cracked = 0;
+      for (const Cell& c : set.cells)
+        for (int axis = 0; axis < 3; ++axis) {
+          std::array<int32_t, 3> next = c.index;
+          ++next[size_t(axis)];
+          auto it = byIndex.find(next);
+          if (it == byIndex.end()) continue;
+          ++shared;
+          if (c.box.hi[axis] != it->second->box.lo[axis]) ++cracked;
+        }
+      INFO(set.cells.size() << " cells, " << shared << " shared faces");
+      CHECK(shared > 100);
+      CHECK(cracked == 0);
+    }
+  }
   // Deterministic.
   CellSet again = b.surfaceCells(0.1f);
   REQUIRE(again.cells.size() == coarse.cells.size());
@@ -401,4 +426,47 @@ TEST_CASE("CellSet::tapes (pruned tapes per surface cell)", "[blobtree]") {
     CHECK(cells.tapes.empty());
     for (const Cell& c : cells.cells) CHECK(c.tape == Cell::kNoTape);
   }
+}
+
+TEST_CASE("CompiledBlob::sample contact gradient", "[blobtree]") {
+  // Two PCM cones meeting at a fork: in the propagation band, Attributes::contact is
+  // 1 − (c − f_j)/w of the weaker cone, and contactGradient is its gradient ∇f_j / w.
+  const uint64_t seed = 11;
+  INFO("seed " << seed);
+  BlobTree t;
+  PcmParams pp;
+  pp.width = 0.25f;
+  NodeId a = t.cone(Vec3(0, 0, 0), Vec3(0, 1, 0), 0.12f, 0.10f);
+  NodeId b = t.cone(Vec3(0, 0.05f, 0), Vec3(0.6f, 0.8f, 0.1f), 0.09f, 0.07f);
+  CompiledBlob blob = compile(t, t.pcm(a, b, pp));
+  Rng rng(seed);
+  int inBand = 0;
+  for (int i = 0; i < 4000 && inBand < 200; ++i) {
+    const Vec3 p = randomIn(rng, Vec3(-0.2f, 0.0f, -0.2f), Vec3(0.4f, 0.6f, 0.2f));
+    const Sample s = blob.sample(p);
+    const float c = s.attributes.contact;
+    if (!(c > 0.05f && c < 0.95f)) {
+      if (c == 0.0f) CHECK(s.attributes.contactGradient == Vec3(0.0f));
+      continue;
+    }
+    // Stay away from where the weaker cone changes (both contacts near): finite differences
+    // must not straddle the switch.
+    const float h = 1e-3f;
+    Vec3 fd;
+    bool smooth = true;
+    for (int k = 0; k < 3; ++k) {
+      Vec3 e(0.0f);
+      e[k] = h;
+      const float cp = blob.sample(p + e).attributes.contact, cm = blob.sample(p - e).attributes.contact;
+      fd[k] = (cp - cm) / (2 * h);
+      const float c2 = (cp + cm) / 2;
+      smooth = smooth && std::abs(c2 - c) < 1e-3f;
+    }
+    if (!smooth) continue;
+    ++inBand;
+    INFO("p " << p.x << "," << p.y << "," << p.z << " contact " << c);
+    CHECK(glm::length(s.attributes.contactGradient - fd) < 0.02f * std::max(1.0f, glm::length(fd)));
+    CHECK(glm::length(s.attributes.contactGradient) > 0.0f);
+  }
+  CHECK(inBand >= 50);
 }

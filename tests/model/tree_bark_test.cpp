@@ -82,7 +82,7 @@ TEST_CASE("tree bark: furrows along each branch, continuous through junctions", 
     double along = 0, around = 0;
     int n = 0;
     for (int i = 0; i < 240; ++i) {
-      const double theta = 2 * kPi * i / 240 + 0.0123;  // (no ray along a coordinate axis)
+      const double theta = 2 * kPi * i / 240;
       for (double y : {1.40, 1.47, 1.55}) {
         const double c = luminance(trunk.at(theta, y));
         along += std::abs(luminance(trunk.at(theta, y + d)) - c);
@@ -96,6 +96,27 @@ TEST_CASE("tree bark: furrows along each branch, continuous through junctions", 
     CHECK(around > 0.01);
     CHECK(along < 0.4 * around);
   }
+  SECTION("a ray whose direction has an x component of 1.8e-16 hits the near side") {
+    // θ = 3π/2: the ray runs along x = 0, a plane of the surface cells' grid. Before the
+    // cells shared their faces bit for bit, it ran inside a crack one ulp wide between the
+    // cells at x < 0 and x >= 0, met only the far side of the trunk (t = 2.135) and
+    // coloured the near side with the far side's bark.
+    const double theta = 1.5 * kPi;
+    const Vec3 dir(static_cast<float>(-std::cos(theta)), 0.0f, static_cast<float>(-std::sin(theta)));
+    REQUIRE(dir.x != 0.0f);
+    REQUIRE(std::abs(dir.x) < 1e-15f);
+    const Vec3 origin = -2.0f * dir + Vec3(0.0f, 0.93f, 0.0f);
+    auto hit = scene.intersect(origin, dir, 0.0f, 10.0f);
+    REQUIRE(hit);
+    // The same ray turned a little off the axis, where it always hit the near side.
+    const double off = theta + 1e-4;
+    const Vec3 dir2(static_cast<float>(-std::cos(off)), 0.0f, static_cast<float>(-std::sin(off)));
+    auto hit2 = scene.intersect(-2.0f * dir2 + Vec3(0.0f, 0.93f, 0.0f), dir2, 0.0f, 10.0f);
+    REQUIRE(hit2);
+    INFO("t " << hit->t << " at z " << hit->position.z << "; off axis t " << hit2->t);
+    CHECK(hit->position.z < 0.0f);
+    CHECK(hit->t == Approx(hit2->t).margin(1e-3));
+  }
   SECTION("no seam: colour changes shrink with the step across the junction and the u wrap") {
     // A vertical line through the joint of the middle and top internodes (different bark
     // classes blending) and a circle round the trunk just below the lateral's junction
@@ -108,10 +129,9 @@ TEST_CASE("tree bark: furrows along each branch, continuous through junctions", 
       CHECK(coarse > 0.002);
       CHECK(fine < 0.5 * coarse);
     }
-    // The phase keeps every ray off the coordinate axes: a ray whose x component is
-    // cos(3π/2) = −1.8e-16 misses the near side of the exact surface in the Embree scene
-    // (it hits the far side), a tracer edge case outside the bark's scope.
-    auto circle = [&](double s) { return trunk.at(2 * kPi * s + 0.1234, 0.93); };
+    // The circle passes through θ = 3π/2, whose ray has an x component of cos(3π/2) = 1.8e-16
+    // (see the regression section above).
+    auto circle = [&](double s) { return trunk.at(2 * kPi * s, 0.93); };
     double atCoarse = 0, atFine = 0;
     const double coarse = maxJump(circle, 1500, &atCoarse), fine = maxJump(circle, 6000, &atFine);
     INFO("circle: max step " << coarse << " at 1/1500 (at " << atCoarse << "), " << fine << " at 1/6000 (at " << atFine
