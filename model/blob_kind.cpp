@@ -807,10 +807,14 @@ class BlobModel final : public StillKindModel {
     po.progress = progress;
     ExportPart part;
     part.name = "blob";
-    part.mesh = paintPolygonized(blobtree::polygonizeDetailed(*compiled_, po), textureTable(blob_.textures), look.surface.baseColor);
+    const render::TextureTable textures = textureTable(blob_.textures);
+    part.mesh = paintPolygonized(blobtree::polygonizeDetailed(*compiled_, po), textures, look.surface.baseColor);
     fig.clean = cleanMesh(part.mesh, clean);
     part.mesh.materials.clear();
     part.material = {"blob", look.surface.baseColor, look.surface.roughness, false};
+    render::Material painted;
+    painted.baseColor = look.surface.baseColor;
+    atlasBlobPart(part, *compiled_, textures, painted);
     return {std::move(part)};
   }
 

@@ -10,6 +10,7 @@
 #include "core/paths.h"
 #include "core/polymesh.h"
 #include "core/timer.h"
+#include "model/mesh_parts.h"
 #include "model/model.h"
 #include "organisms/analysis.h"
 #include "organisms/base_mesh.h"
@@ -643,6 +644,7 @@ class OrganismModel final : public KindModel {
     part.name = "organism";
     part.mesh = mesh(timeOf(stage), look.surface.baseColor);
     part.material = {"organism", look.surface.baseColor, look.surface.roughness, false};
+    atlasVertexColors(part);  // the shader's colours, interpolated as the renderer does, unclamped
     figures.triangles = part.mesh.triangleCount();
     figures.primitives = spec_.base.faceCount();
     return {std::move(part)};
