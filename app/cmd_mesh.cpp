@@ -98,7 +98,10 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
          c.componentsBefore, c.componentsAfter, c.specks, c.voids, c.removedTriangles, c.facesAgainstBefore,
          c.facesAgainstAfter, c.fixedNormals);
   for (const PartWriteReport& r : written) {
-    if (r.textureWidth > 0)
+    if (r.atlasCell > 0)
+      note(g, std::cout, "%s: texture atlas %dx%d baked from the renderer's colours, %dx%d texels per triangle", r.name.c_str(),
+           r.textureWidth, r.textureHeight, r.atlasCell, r.atlasCell);
+    else if (r.textureWidth > 0)
       note(g, std::cout, "%s: texture %dx%d baked from the species' %s", r.name.c_str(), r.textureWidth, r.textureHeight,
            r.name == "wood" ? "bark" : "shell texture");
     if (r.creaseVertices > 0 || r.seamCorners > 0)

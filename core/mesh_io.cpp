@@ -373,8 +373,12 @@ PartCorners partCorners(const ExportPart& part) {
     c.report.creaseVertices = cn.splitVertices;
     c.normals = std::move(cn.normals);
   }
-  if (mesh.uvs.size() == n) {
-    const PartTexture* tex = part.material.texture.get();
+  const PartTexture* tex = part.material.texture.get();
+  if (tex && tex->isAtlas()) {
+    c.uvs = tex->atlas;
+    c.report.atlasCell = tex->atlasCell;
+    c.report.textureWidth = tex->image.width, c.report.textureHeight = tex->image.height;
+  } else if (mesh.uvs.size() == n) {
     c.uvs = cornerUvs(mesh, tex ? tex->seams : UvSeamOptions{});
     c.report.seamCorners = c.uvs.values.size() - n;
     if (tex) c.report.textureWidth = tex->image.width, c.report.textureHeight = tex->image.height;
@@ -398,8 +402,18 @@ void checkParts(const std::vector<ExportPart>& parts) {
     validate(p.mesh);
     names.push_back(p.name);
     if (const PartTexture* tex = p.material.texture.get()) {
-      if (p.mesh.uvs.size() != p.mesh.positions.size())
+      if (tex->isAtlas()) {
+        const CornerTable<Vec2>& a = tex->atlas;
+        if (a.index.size() != p.mesh.triangles.size() * 3)
+          throw std::invalid_argument("exported part '" + p.name + "' has an atlas whose corners do not match its triangles");
+        for (uint32_t i : a.index)
+          if (i >= a.values.size()) throw std::invalid_argument("exported part '" + p.name + "' has an atlas index out of range");
+        for (const Vec2& uv : a.values)
+          if (!(uv.x >= 0 && uv.x <= 1 && uv.y >= 0 && uv.y <= 1))
+            throw std::invalid_argument("exported part '" + p.name + "' has an atlas coordinate outside [0,1]");
+      } else if (p.mesh.uvs.size() != p.mesh.positions.size()) {
         throw std::invalid_argument("exported part '" + p.name + "' has a texture but no texture coordinates");
+      }
       const Image& im = tex->image;
       if (im.width <= 0 || im.height <= 0 || im.pixels.size() != size_t(im.width) * size_t(im.height) * 4)
         throw std::invalid_argument("exported part '" + p.name + "' has an empty or malformed texture image");
@@ -454,7 +468,7 @@ std::vector<PartWriteReport> writePartsGlb(const std::vector<ExportPart>& parts,
       model.images.push_back(image);
       tinygltf::Sampler sampler;
       sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
-      sampler.minFilter = TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
+      sampler.minFilter = tex->isAtlas() ? TINYGLTF_TEXTURE_FILTER_LINEAR : TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
       sampler.wrapS = tex->seams.repeatU ? TINYGLTF_TEXTURE_WRAP_REPEAT : TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
       sampler.wrapT = tex->seams.repeatV ? TINYGLTF_TEXTURE_WRAP_REPEAT : TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
       model.samplers.push_back(sampler);

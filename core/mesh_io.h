@@ -67,6 +67,14 @@ void writeObj(const Mesh& mesh, const std::filesystem::path& path, const MeshWri
 struct PartTexture {
   Image image;            ///< linear RGB (alpha ignored), top row = t of 1
   UvSeamOptions seams;    ///< which axes repeat (glTF sampler REPEAT, else CLAMP_TO_EDGE) and the seam rules
+  /// An atlas: when not empty, the texture coordinates of every triangle's corners (3 per
+  /// triangle of the part's mesh, values in [0,1]), used instead of the mesh's uvs (which
+  /// the mesh then need not have) and without seam rules. Each triangle owns a patch of
+  /// the image, so the glTF sampler has no mipmaps (a smaller level would mix patches) and
+  /// clamps at the edges.
+  CornerTable<Vec2> atlas;
+  int atlasCell = 0;  ///< texels per side of a triangle's patch in an atlas (reports)
+  bool isAtlas() const { return !atlas.index.empty(); }
 };
 
 /// The material of an exported part.
@@ -75,7 +83,8 @@ struct PartMaterial {
   Vec3 baseColor{0.8f};        ///< linear RGB in [0,1]: glTF baseColorFactor and MTL Kd, both as these linear numbers
   float roughness = 0.6f;      ///< glTF roughnessFactor in [0,1]
   bool doubleSided = false;    ///< glTF doubleSided (leaves: both faces are seen)
-  /// The part's colours as an image (the part's mesh must then have uvs), or null. A
+  /// The part's colours as an image (the part's mesh must then have uvs, or the texture an
+  /// atlas), or null. A
   /// textured material has baseColorFactor and Kd 1 (the image holds absolute colours; both
   /// formats multiply the factor in), keeps baseColor in glTF's material extras as
   /// `sprigBaseColor`, and has no COLOR_0 (it would multiply again).
@@ -115,6 +124,7 @@ struct PartWriteReport {
   size_t creaseVertices = 0;  ///< vertices given more than one normal (glTF, OBJ)
   size_t seamCorners = 0;     ///< uv values added at texture seams (glTF, OBJ)
   int textureWidth = 0, textureHeight = 0;  ///< the texture image's size, 0 without one
+  int atlasCell = 0;  ///< texels per side of each triangle's patch when the texture is an atlas, else 0
 };
 std::vector<PartWriteReport> writeParts(const std::vector<ExportPart>& parts, const std::filesystem::path& path);
 

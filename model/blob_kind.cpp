@@ -117,8 +117,8 @@ class NodeReader {
       if (m.has("radius")) {
         ra = rb = m.number("radius", 0.0);
       } else {
-        ra = required(m, "radius_a");
-        rb = required(m, "radius_b");
+        ra = required(m, "radius_a", 0.0, std::numeric_limits<double>::infinity(), false);
+        rb = required(m, "radius_b", 0.0, std::numeric_limits<double>::infinity(), false);
       }
       // `delta_a` names the factor 1.75 in a tree: section; here the radius r_B had the name.
       if (auto old = m.get("delta_a"))
@@ -246,6 +246,7 @@ class NodeReader {
   std::optional<NodeId> readScale(const std::string& kind, const YNode& key, const YNode& v) {
     return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
       std::optional<Vec3> f;
+      m.markRequired("factors");
       if (auto fv = m.get("factors")) {
         if (fv->isSequence())
           f = fv->asVec3(diags_, "'factors'", 1e-6, 1e6);
@@ -361,8 +362,11 @@ class NodeReader {
     return std::nullopt;
   }
 
+  // declare: list key in the schema's `required` (not for a key required only when
+  // another is absent, as a cone's radius_a without radius).
   std::optional<double> required(MapReader& m, std::string_view key, double min = 0.0,
-                                 double max = std::numeric_limits<double>::infinity()) {
+                                 double max = std::numeric_limits<double>::infinity(), bool declare = true) {
+    if (declare) m.markRequired(key);
     auto v = m.get(key);
     if (!v) {
       m.node().error(diags_, "missing required key " + quoted(key) + " in " + kindOf(m));
@@ -372,6 +376,7 @@ class NodeReader {
   }
 
   std::optional<Vec3> requiredVec3(MapReader& m, std::string_view key) {
+    m.markRequired(key);
     auto v = m.get(key);
     if (!v) {
       m.node().error(diags_, "missing required key " + quoted(key) + " in " + kindOf(m));
@@ -436,6 +441,7 @@ class NodeReader {
   }
 
   std::optional<std::vector<NodeId>> children(MapReader& m, const std::string& kind) {
+    m.markRequired("children");
     auto v = m.get("children");
     if (!v) {
       m.node().error(diags_, "missing required key 'children' in " + kind);
@@ -445,6 +451,7 @@ class NodeReader {
   }
 
   std::optional<NodeId> child(MapReader& m, const std::string& kind) {
+    m.markRequired("child");
     auto v = m.get("child");
     if (!v) {
       m.node().error(diags_, "missing required key 'child' in " + kind);
@@ -457,6 +464,7 @@ class NodeReader {
   std::optional<NodeId> controlled(const YNode& key, MapReader& m) {
     auto kids = children(m, "controlled");
     std::vector<std::vector<uint32_t>> groups;
+    m.markRequired("groups");
     auto gv = m.get("groups");
     if (!gv) {
       m.node().error(diags_, "missing required key 'groups' in controlled (a list of index lists, or chain)");
@@ -807,10 +815,14 @@ class BlobModel final : public StillKindModel {
     po.progress = progress;
     ExportPart part;
     part.name = "blob";
-    part.mesh = paintPolygonized(blobtree::polygonizeDetailed(*compiled_, po), textureTable(blob_.textures), look.surface.baseColor);
+    const render::TextureTable textures = textureTable(blob_.textures);
+    part.mesh = paintPolygonized(blobtree::polygonizeDetailed(*compiled_, po), textures, look.surface.baseColor);
     fig.clean = cleanMesh(part.mesh, clean);
     part.mesh.materials.clear();
     part.material = {"blob", look.surface.baseColor, look.surface.roughness, false};
+    render::Material painted;
+    painted.baseColor = look.surface.baseColor;
+    atlasBlobPart(part, *compiled_, textures, painted);
     return {std::move(part)};
   }
 

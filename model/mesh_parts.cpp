@@ -22,36 +22,39 @@ Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::Te
   return paintPolygonized(result, textures, material);
 }
 
+Vec3 paintedColor(const blobtree::Attributes& a, const Vec3& p, const render::TextureTable& textures,
+                  const render::Material& material) {
+  const Vec3 base = material.baseColor;
+  if (a.textureCount == 0 || textures.empty()) return base;
+  Vec3 sum(0);
+  float wsum = 0;
+  if (material.textureLayers) {
+    for (int i = 0; i < a.layerCount && i < blobtree::Attributes::kMaxLayers; ++i) {
+      const blobtree::Attributes::Layer& l = a.layers[size_t(i)];
+      if (!(l.weight > 0)) continue;
+      sum += l.weight * (l.textureId < textures.size() ? textures[l.textureId](l.uv, p) : base);
+      wsum += l.weight;
+    }
+  } else {
+    for (int i = 0; i < a.textureCount && i < blobtree::Attributes::kMaxTextures; ++i) {
+      const float w = a.textureWeights[size_t(i)];
+      if (!(w > 0)) continue;
+      const uint16_t id = a.textureIds[size_t(i)];
+      sum += w * (id < textures.size() ? textures[id](a.uv, p) : base);
+      wsum += w;
+    }
+  }
+  if (!(wsum > 0)) return base;
+  return sum / wsum * static_cast<float>(1.0 - material.ridge.darkness(a.contact, p));
+}
+
 Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::TextureTable& textures,
                       const render::Material& material) {
-  const Vec3 base = material.baseColor;
   Mesh mesh = result.mesh;
   const size_t n = mesh.positions.size();
   if (result.attributes.size() != n) throw std::invalid_argument("paintPolygonized: the mesh has no attributes");
-  mesh.colors.assign(n, base);
-  for (size_t v = 0; v < n; ++v) {
-    const blobtree::Attributes& a = result.attributes[v];
-    if (a.textureCount == 0 || textures.empty()) continue;
-    Vec3 sum(0);
-    float wsum = 0;
-    if (material.textureLayers) {
-      for (int i = 0; i < a.layerCount && i < blobtree::Attributes::kMaxLayers; ++i) {
-        const blobtree::Attributes::Layer& l = a.layers[size_t(i)];
-        if (!(l.weight > 0)) continue;
-        sum += l.weight * (l.textureId < textures.size() ? textures[l.textureId](l.uv, mesh.positions[v]) : base);
-        wsum += l.weight;
-      }
-    } else {
-      for (int i = 0; i < a.textureCount && i < blobtree::Attributes::kMaxTextures; ++i) {
-        const float w = a.textureWeights[size_t(i)];
-        if (!(w > 0)) continue;
-        const uint16_t id = a.textureIds[size_t(i)];
-        sum += w * (id < textures.size() ? textures[id](a.uv, mesh.positions[v]) : base);
-        wsum += w;
-      }
-    }
-    if (wsum > 0) mesh.colors[v] = sum / wsum * static_cast<float>(1.0 - material.ridge.darkness(a.contact, mesh.positions[v]));
-  }
+  mesh.colors.resize(n);
+  for (size_t v = 0; v < n; ++v) mesh.colors[v] = paintedColor(result.attributes[v], mesh.positions[v], textures, material);
   mesh.materials.assign(mesh.triangles.size(), kNoPartTexture);
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
     std::map<uint32_t, float> weight;
@@ -81,6 +84,117 @@ std::shared_ptr<PartTexture> bakeTexture(int width, int height, const std::funct
     }
   });
   return tex;
+}
+
+AtlasLayout atlasLayout(size_t triangles) {
+  AtlasLayout l;
+  if (triangles == 0) return l;
+  const size_t columns = size_t(std::ceil(std::sqrt(double(triangles))));
+  const int cell = std::min<int>(kAtlasMaxCell, int(size_t(kAtlasMaxSize) / columns));
+  if (cell < kAtlasMinCell) return l;
+  l.cell = cell;
+  l.columns = int(columns);
+  l.rows = int((triangles + columns - 1) / columns);
+  return l;
+}
+
+namespace {
+
+// Barycentric coordinates (of corners 1 and 2) of a point of the unit right triangle's
+// plane, clamped to the triangle (the nearest point of the triangle in that plane).
+Vec3 clampedBary(double l1, double l2) {
+  l1 = std::max(l1, 0.0), l2 = std::max(l2, 0.0);
+  if (l1 + l2 > 1) {
+    const double d = (l1 + l2 - 1) / 2;  // onto the hypotenuse along its normal
+    l1 -= d, l2 -= d;
+    if (l1 < 0) l2 = 1, l1 = 0;
+    if (l2 < 0) l1 = 1, l2 = 0;
+  }
+  return Vec3(float(1 - l1 - l2), float(l1), float(l2));
+}
+
+bool ownColors(const ExportPart& part) {
+  const Mesh& m = part.mesh;
+  if (m.colors.size() != m.positions.size() || m.triangles.empty()) return false;
+  for (const Vec3& c : m.colors)
+    if (glm::any(glm::greaterThan(glm::abs(c - part.material.baseColor), Vec3(1e-6f)))) return true;
+  return false;
+}
+
+}  // namespace
+
+std::shared_ptr<PartTexture> bakeAtlas(const Mesh& mesh, const SurfaceColor& colorAt) {
+  const AtlasLayout l = atlasLayout(mesh.triangles.size());
+  if (l.cell == 0) return nullptr;
+  auto tex = std::make_shared<PartTexture>();
+  const int W = l.width(), H = l.height(), c = l.cell;
+  tex->image = Image(W, H, Vec4(0, 0, 0, 1));
+  tex->atlasCell = c;
+  const size_t nt = mesh.triangles.size();
+  tex->atlas.values.resize(nt * 3);
+  tex->atlas.index.resize(nt * 3);
+  const Vec2 corner[3] = {Vec2(1, 1), Vec2(float(c - 1), 1), Vec2(1, float(c - 1))};
+  Image& im = tex->image;
+  parallelFor(0, nt, [&](size_t t) {
+    const int x0 = int(t % size_t(l.columns)) * c, y0 = int(t / size_t(l.columns)) * c;  // texels from bottom-left
+    const glm::uvec3& tri = mesh.triangles[t];
+    const Vec3 P[3] = {mesh.positions[tri.x], mesh.positions[tri.y], mesh.positions[tri.z]};
+    for (int k = 0; k < 3; ++k) {
+      tex->atlas.index[t * 3 + size_t(k)] = uint32_t(t * 3 + size_t(k));
+      tex->atlas.values[t * 3 + size_t(k)] = Vec2((float(x0) + corner[k].x) / float(W), (float(y0) + corner[k].y) / float(H));
+    }
+    const double leg = double(c - 2);
+    for (int j = 0; j < c; ++j)
+      for (int i = 0; i < c; ++i) {
+        const Vec3 b = clampedBary((i + 0.5 - 1) / leg, (j + 0.5 - 1) / leg);
+        const Vec3 p = b.x * P[0] + b.y * P[1] + b.z * P[2];
+        im.set(x0 + i, H - 1 - (y0 + j), Vec4(colorAt(t, p, b), 1.0f));
+      }
+  });
+  return tex;
+}
+
+Vec3 blobSurfaceColor(const blobtree::CompiledBlob& blob, const Vec3& p, float maxMove, const render::TextureTable& textures,
+                      const render::Material& material) {
+  Vec3 q = p;
+  for (int i = 0; i < 3; ++i) {
+    const float f = blob.value(q) - 0.5f;
+    if (std::abs(f) < 1e-6f) break;
+    const Vec3 g = blob.gradient(q);
+    const float g2 = glm::dot(g, g);
+    if (!(g2 > 1e-20f)) break;
+    const Vec3 next = q - (f / g2) * g;
+    if (!std::isfinite(next.x + next.y + next.z) || glm::length(next - p) > maxMove) break;
+    q = next;
+  }
+  return paintedColor(blob.sample(q).attributes, q, textures, material);
+}
+
+int atlasBlobPart(ExportPart& part, const blobtree::CompiledBlob& blob, const render::TextureTable& textures,
+                  const render::Material& material) {
+  if (part.material.texture || !ownColors(part)) return 0;
+  const Mesh& m = part.mesh;
+  auto tex = bakeAtlas(m, [&](size_t t, const Vec3& p, const Vec3&) {
+    const glm::uvec3& tri = m.triangles[t];
+    const Vec3 &a = m.positions[tri.x], &b = m.positions[tri.y], &c = m.positions[tri.z];
+    const float edge = std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
+    return blobSurfaceColor(blob, p, edge, textures, material);
+  });
+  if (!tex) return 0;
+  part.material.texture = tex;
+  return atlasLayout(part.mesh.triangles.size()).cell;
+}
+
+int atlasVertexColors(ExportPart& part) {
+  if (part.material.texture || !ownColors(part)) return 0;
+  const Mesh& m = part.mesh;
+  auto tex = bakeAtlas(m, [&m](size_t t, const Vec3&, const Vec3& b) {
+    const glm::uvec3& tri = m.triangles[t];
+    return b.x * m.colors[tri.x] + b.y * m.colors[tri.y] + b.z * m.colors[tri.z];
+  });
+  if (!tex) return 0;
+  part.material.texture = tex;
+  return atlasLayout(m.triangles.size()).cell;
 }
 
 void textureBark(ExportPart& part, const std::function<Vec3(Vec2 uv)>& bark) {

@@ -49,6 +49,63 @@ inline constexpr int kExportTextureAround = 1024;
 std::shared_ptr<PartTexture> bakeTexture(int width, int height, const std::function<Vec3(double s, double t)>& colorAt,
                                          const UvSeamOptions& seams);
 
+/// Texture budget of an atlas (bakeAtlas): every triangle gets its own square patch of
+/// kAtlasMaxCell x kAtlasMaxCell texels, smaller when the triangles would not fit an image
+/// of kAtlasMaxSize x kAtlasMaxSize, down to kAtlasMinCell; a part with more triangles than
+/// (kAtlasMaxSize / kAtlasMinCell)² = 1,048,576 gets no atlas (it keeps its vertex colours).
+inline constexpr int kAtlasMaxSize = 4096;
+inline constexpr int kAtlasMaxCell = 16;
+inline constexpr int kAtlasMinCell = 4;
+
+/// The patch size and grid of an atlas for a number of triangles: cell texels per side,
+/// columns x rows patches; cell is 0 when the triangles exceed the budget (or are none).
+struct AtlasLayout {
+  int cell = 0, columns = 0, rows = 0;
+  int width() const { return cell * columns; }
+  int height() const { return cell * rows; }
+};
+AtlasLayout atlasLayout(size_t triangles);
+
+/// Colour of triangle `triangle` of a mesh at the point with barycentric coordinates bary
+/// (point = Σ baryₖ·positionₖ, given too). Called in parallel: must be thread-safe.
+using SurfaceColor = std::function<Vec3(size_t triangle, const Vec3& point, const Vec3& bary)>;
+
+/// Bakes mesh's colours into an atlas (PartTexture::atlas): triangle i owns the cell-sized
+/// square patch i of atlasLayout (row-major from the image's bottom-left); its corners sit
+/// one texel inside the patch, at (1, 1), (cell − 1, 1) and (1, cell − 1) texels from the
+/// patch's corner, so a bilinear lookup anywhere in the triangle reads only its own patch.
+/// Every texel of the patch is colorAt at the barycentric point of its centre, clamped to
+/// the triangle (the texels outside the triangle are its gutter). Null when the mesh has
+/// no triangles or more than the budget. O(triangles · cell²) colorAt calls, in parallel;
+/// the result does not depend on the thread count.
+std::shared_ptr<PartTexture> bakeAtlas(const Mesh& mesh, const SurfaceColor& colorAt);
+
+/// The colour the renderer gives blended BlobTree attributes at p (as
+/// render::Scene::attributeColor: Σ wᵢ·textureᵢ / Σ wᵢ, per layer with
+/// material.textureLayers, times the contact darkening; base colour where none contributes).
+Vec3 paintedColor(const blobtree::Attributes& a, const Vec3& p, const render::TextureTable& textures,
+                  const render::Material& material);
+
+/// The renderer's colour of a BlobTree's surface near p: p moved onto F = 0.5 by up to
+/// three Newton steps along ∇F (stopping before a step that would leave p by more than
+/// maxMove, e.g. the triangle's longest edge), the attributes sampled there and coloured
+/// by paintedColor.
+Vec3 blobSurfaceColor(const blobtree::CompiledBlob& blob, const Vec3& p, float maxMove, const render::TextureTable& textures,
+                      const render::Material& material);
+
+/// Bakes a polygonized BlobTree part's colours (blobSurfaceColor at every texel's surface
+/// point) into an atlas and sets part.material.texture, when the part's vertex colours are
+/// not all its base colour and it has no texture yet. Returns the texture's triangles'
+/// patch size (0 when nothing was baked: constant colour, already textured, or above the
+/// budget).
+int atlasBlobPart(ExportPart& part, const blobtree::CompiledBlob& blob, const render::TextureTable& textures,
+                  const render::Material& material);
+
+/// Bakes a part's vertex colours, interpolated over each triangle as the renderer
+/// interpolates a mesh's vertex colours, into an atlas (when they are not all the base
+/// colour and the part has no texture). Returns the patch size as atlasBlobPart.
+int atlasVertexColors(ExportPart& part);
+
 /// Maps a bark texture onto a tree's wood: the mesh's uvs are the bark's (u, v) (u turns
 /// around the branch, v along it, as the polygonizer blends them); v is rescaled to
 /// t = (v − vMin)/(vMax − vMin) over the mesh's range and the image covers one period of u

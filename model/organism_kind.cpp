@@ -10,6 +10,7 @@
 #include "core/paths.h"
 #include "core/polymesh.h"
 #include "core/timer.h"
+#include "model/mesh_parts.h"
 #include "model/model.h"
 #include "organisms/analysis.h"
 #include "organisms/base_mesh.h"
@@ -127,8 +128,10 @@ class OrganismReader {
       } else if (kind == "revolution") {
         readRevolution(m);
       } else if (kind == "mesh") {
+        m.markRequired("file");  // (capture's 'file' is one of two)
         readMeshBase(m);
       } else if (kind == "species") {
+        m.markRequired("file");
         readSpeciesBase(m);
       }
     } catch (const std::invalid_argument& e) {
@@ -278,6 +281,7 @@ class OrganismReader {
   }
 
   void readRevolution(MapReader& m) {
+    m.markRequired("profile");
     auto profile = m.get("profile");
     std::optional<lsystem::Expression> r;
     if (!profile) {
@@ -459,6 +463,7 @@ class OrganismReader {
     if (auto c = m.get("color")) {
       if (auto v = c->asColor(diags_, "'color'")) spec_.blendColor = *v;
     }
+    m.markRequired("alpha");
     if (auto a = m.get("alpha")) readAlpha(*a);
     else m.node().error(diags_, "missing required key 'alpha' in blend (e.g. alpha: {plane: {normal: [1, 2, 0]}})");
     m.finish();
@@ -521,6 +526,7 @@ class OrganismReader {
     Modification mod;
     mod.center = m.vec3("center", mod.center);
     mod.radius = float(m.number("radius", mod.radius, 1e-6));
+    m.markRequired("gains");
     if (auto g = m.get("gains")) {
       for (const YNode& x : g->items())
         if (auto v = x.asNumber(diags_, "a gain", -100.0, 100.0)) mod.gains.push_back(float(*v));
@@ -643,6 +649,7 @@ class OrganismModel final : public KindModel {
     part.name = "organism";
     part.mesh = mesh(timeOf(stage), look.surface.baseColor);
     part.material = {"organism", look.surface.baseColor, look.surface.roughness, false};
+    atlasVertexColors(part);  // the shader's colours, interpolated as the renderer does, unclamped
     figures.triangles = part.mesh.triangleCount();
     figures.primitives = spec_.base.faceCount();
     return {std::move(part)};

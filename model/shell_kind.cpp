@@ -564,8 +564,14 @@ class ShellModel final : public KindModel {
       }
       parts.push_back(ExportPart{look.first, std::move(mesh), PartMaterial{look.first, look.second, implicit.material.roughness, false, nullptr}});
     }
-    for (ExportPart& p : parts)
-      if (p.name == "whorl") textureWhorl(p, *shell.painter);
+    render::Material painted;  // as paintPolygonized painted the surface
+    painted.baseColor = colors.whorlColor;
+    for (ExportPart& p : parts) {
+      if (p.name == "whorl")
+        textureWhorl(p, *shell.painter);
+      else  // varices, spines, bumps, inside: an atlas of the renderer's colours
+        atlasBlobPart(p, *shell.blob, implicit.textures, painted);
+    }
     return parts;
   }
 

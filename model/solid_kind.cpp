@@ -281,6 +281,7 @@ class SolidReader {
     MapReader m(one->second, diags_, one->first.scalar());
     const size_t errors = errorCount();
     *velocity = m.get("velocity");
+    m.markRequired("material");
     if (auto mat = m.get("material")) l.material = materialId(*mat);
     else one->second.error(diags_, "missing required key 'material' in " + one->first.scalar() + " (a material name or nothing)");
     if (auto t = m.get("thickness")) {
@@ -340,6 +341,7 @@ class SolidReader {
       out = groundPlaneField(DVec3(axisOf(m, "normal")), m.number("height", 0.0));
     } else if (kind == "transform") {
       FieldPtr child;
+      m.markRequired("distance_field");
       if (auto f = m.get("distance_field")) child = readField(*f);
       else value.error(diags_, "missing required key 'distance_field' in transform");
       const double scale = m.number("scale", 1.0, 1e-6, 1e6);
@@ -390,6 +392,7 @@ class SolidReader {
 
   /// A closed mesh file as a field; the first open edge is an error at its face.
   FieldPtr readMesh(MapReader& m, PolyMesh* keep = nullptr) {
+    m.markRequired("file");
     auto file = m.path("file", policy_);
     if (!file) {
       if (!m.has("file")) m.node().error(diags_, "missing required key 'file' in surface_mesh (an OBJ, PLY or OFF file)");
@@ -507,6 +510,7 @@ class SolidReader {
   /// pixels of the image darker than threshold (the sRGB encoding of the linear Rec. 709
   /// luminance: 0 black, 1 white) form the region; solids/extrude_field.h places and extrudes it.
   FieldPtr readExtrude(MapReader& m) {
+    m.markRequired("file");
     auto file = m.path("file", policy_);
     if (!file && !m.has("file"))
       m.node().error(diags_, "missing required key 'file' in extrude_2d (a PNG or PPM image; dark pixels are inside)");

@@ -58,6 +58,7 @@ solids::HammerOptions readHammer(MapReader& m, solids::MaterialTable& materials,
 
 solids::DisplaceOptions readDisplace(MapReader& m, const YNode& node, solids::MaterialTable& materials, DiagnosticList& diags) {
   solids::DisplaceOptions o;
+  m.markRequired("moving");
   if (!m.has("moving")) node.error(diags, "missing required key 'moving' in displace (the materials whose vertices move)");
   o.moving = materialList(m, "moving", materials, diags);
   o.offset = dvec(m.vec3("offset", Vec3(o.offset)));

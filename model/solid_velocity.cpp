@@ -246,6 +246,7 @@ std::function<float(const Vec3&)> readImagePaint(const YNode& node, DiagnosticLi
   std::optional<std::filesystem::path> file;
   if (policy) file = m.path("file", *policy);
   else m.get("file");
+  m.markRequired("file");
   if (!m.has("file")) node.error(diags, "missing required key 'file' in image (a PNG or EXR map; its luminance is the paint)");
   Vec3 axisIn = m.vec3("axis", Vec3(0, 1, 0));
   if (glm::length(axisIn) == 0) {

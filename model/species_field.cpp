@@ -61,6 +61,7 @@ solids::FieldPtr readSpeciesField(MapReader& m, const PathPolicy& policy) {
   DiagnosticList& diags = m.diagnostics();
   std::optional<int64_t> seed;
   if (m.has("seed")) seed = m.integer("seed", 0, 0);
+  m.markRequired("file");
   auto file = m.path("file", policy);
   if (!file) {
     if (!m.has("file")) m.node().error(diags, "missing required key 'file' in species (a blob, shell, tree or organism species file)");

@@ -369,6 +369,10 @@ class TreeModel final : public KindModel {
     if (tree.options.bark.enabled && oneBark && barkId < implicit.textures.size() && parts[0].mesh.triangleCount() > 0) {
       const render::ColorTexture& bark = implicit.textures[barkId];
       textureBark(parts[0], [&bark](Vec2 uv) { return bark(uv, Vec3(0.0f)); });
+    } else {
+      // Bark per girth or darkened seams: every triangle's own patch of an atlas, each
+      // texel the renderer's blend of the cones' barks at its surface point.
+      atlasBlobPart(parts[0], *tree.compiled, implicit.textures, implicit.material);
     }
     const organisms::TreeOptions& options = tree.options;
     const std::pair<organisms::OrganSet, const char*> sets[] = {{organisms::OrganSet::Leaves, "leaves"},
@@ -380,6 +384,7 @@ class TreeModel final : public KindModel {
       const render::Material& m = set == organisms::OrganSet::Leaves ? look.style.leaf : look.style.fruit;
       // Leaves are open polygons seen from both sides; fruit are closed spheres.
       parts.push_back(ExportPart{name, std::move(organs), PartMaterial{name, m.baseColor, m.roughness, set == organisms::OrganSet::Leaves, nullptr}});
+      atlasVertexColors(parts.back());  // each leaf's tint, unclamped
     }
     return parts;
   }

@@ -764,6 +764,10 @@ std::string MapReader::string(std::string_view key, std::string def) {
   return v->asString(*diags_, quoted(key)).value_or(def);
 }
 
+void MapReader::markRequired(std::string_view key) {
+  if (schema_) schema_->required.insert(std::string(key));
+}
+
 std::optional<std::string> MapReader::requiredString(std::string_view key) {
   if (schema_) schema_->required.insert(std::string(key));
   auto v = get(key);

@@ -218,6 +218,9 @@ class MapReader {
   std::string string(std::string_view key, std::string def = {});
   /// A required scalar: adds "missing required key 'K' in <context>" at the map when absent.
   std::optional<std::string> requiredString(std::string_view key);
+  /// Declares key required in this map for `sprig schema` (its `required` list); no effect
+  /// when reading. For readers that check a required key's presence themselves.
+  void markRequired(std::string_view key);
   /// true/false; `def` when absent.
   bool boolean(std::string_view key, bool def);
   /// `[x, y, z]`; `def` when absent.

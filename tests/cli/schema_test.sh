@@ -95,4 +95,38 @@ both solidbase 'solid: {volume: {distance_field: {sphere: {radius: 1}}, layers: 
 both solidbase "solid: {$sphere, operations: [{hammer: {rounds: 2}}]}" valid
 both solidbase "solid: {$sphere, operations: [{hammer: {rounds: 2, strength: 1}}]}" invalid
 both solidbase "solid: {$sphere, operations: [{polish: {shiny: 0.5}}, {dirt: {amount: 0.5, colour: 1}}]}" invalid
+# Required keys inside parts (the readers' own checks, recorded as `required`): one key
+# missing per part kind, each beside a twin that has it.
+printf 'kind: organism\n' > "$WORK/lib/species/orgbase.yaml"
+both blobbase 'blob: {cone: {a: [0, 0, 0], b: [0, 1, 0], radius: 0.2}}' valid
+both blobbase 'blob: {cone: {a: [0, 0, 0], radius: 0.2}}' invalid
+both blobbase 'blob: {scale: {factors: 2, child: {point: {radius: 1}}}}' valid
+both blobbase 'blob: {scale: {child: {point: {radius: 1}}}}' invalid
+both blobbase 'blob: {controlled: {groups: chain, children: [{point: {radius: 1}}, {point: {radius: 1}}]}}' valid
+both blobbase 'blob: {controlled: {groups: chain}}' invalid
+both blobbase 'blob: {controlled: {children: [{point: {radius: 1}}, {point: {radius: 1}}]}}' invalid
+both solidbase 'solid: {volume: {distance_field: {transform: {distance_field: {sphere: {radius: 1}}}}, layers: [{interior_layer: {material: wood, thickness: fill}}]}}' valid
+both solidbase 'solid: {volume: {distance_field: {transform: {}}, layers: [{interior_layer: {material: wood, thickness: fill}}]}}' invalid
+both solidbase 'solid: {volume: {distance_field: {sphere: {radius: 1}}, layers: [{interior_layer: {thickness: fill}}]}}' invalid
+both solidbase 'solid: {volume: {distance_field: {extrude_2d: {size: [1, 1]}}, layers: [{interior_layer: {material: wood, thickness: fill}}]}}' invalid
+both solidbase 'solid: {volume: {distance_field: {species: {seed: 1}}, layers: [{interior_layer: {material: wood, thickness: fill}}]}}' invalid
+both solidbase "solid: {$sphere, operations: [{displace: {offset: [0, 0.1, 0]}}]}" invalid
+both orgbase 'organism: {base: {revolution: {profile: "0.5"}}}' valid
+both orgbase 'organism: {base: {revolution: {}}}' invalid
+both orgbase 'organism: {base: {mesh: {}}}' invalid
+both orgbase 'organism: {base: {cube_sphere: {radius: 1}}, blend: {alpha: {plane: {normal: [1, 0, 0]}}}}' valid
+both orgbase 'organism: {base: {cube_sphere: {radius: 1}}, blend: {}}' invalid
+both orgbase 'organism: {base: {cube_sphere: {radius: 1}}, modify: [{gains: [1]}]}' valid
+both orgbase 'organism: {base: {cube_sphere: {radius: 1}}, modify: [{radius: 1}]}' invalid
+# What the schema cannot express: a name that must refer to something else in the file.
+# A solid layer's material is any word to the schema (JSON Schema cannot check that a
+# string names a key of another map, here 'materials:' or the built-in table); sprig check
+# rejects an unknown one with its position.
+both solidbase 'solid: {volume: {distance_field: {sphere: {radius: 1}}, layers: [{interior_layer: {material: wood, thickness: fill}}]}}' valid
+f="$WORK/lib/species/case.yaml"
+{ cat "$WORK/lib/species/solidbase.yaml"
+  echo 'solid: {volume: {distance_field: {sphere: {radius: 1}}, layers: [{interior_layer: {material: woood, thickness: fill}}]}}'; } > "$f"
+ajv validate -s "$WORK/schema.json" -d "$f" > /dev/null 2>&1 || fail "the schema rejects an unknown material name (it cannot know the names)"
+if (cd "$WORK/lib" && "$SPRIG" -q --root . check species/case.yaml > "$WORK/out" 2>&1); then fail "sprig check accepts material 'woood'"; fi
+grep -q "species/case.yaml:2:.*error:.*woood" "$WORK/out" || { cat "$WORK/out"; fail "sprig check does not name the unknown material at its line"; }
 echo "schema: ok ($n shipped species valid, ${#rejected[@]} bad inputs and $edits edits agree with sprig)"
