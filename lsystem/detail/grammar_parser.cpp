@@ -347,6 +347,8 @@ class GrammarParser {
         continue;
       }
       bool known = header && std::find(std::begin(kHeaders), std::end(kHeaders), header->key) != std::end(kHeaders);
+      // cpfg: `AXIOM : cond --> succ` is a production of a module named AXIOM (an axiom has no arrow).
+      if (known && header->key == "axiom" && prog_.dialect == Dialect::Cpfg && Scanner::findArrow(s).first >= 0) known = false;
       if (known) {
         handleHeader(line, b, *header, block);
         continue;

@@ -364,6 +364,8 @@ TEST_CASE("cpfg statements in productions", "[lsystem][cpfg]") {
     // comments, up to the arrow (vlab's Ridley, spiral.l:14).
     CHECK(derived("axiom: A(2)\nA(y) : y > 1 {  // a comment\n  x = y * 3;\n\n    while (x < 10) {\n x = x + 2;\n }\n} --> B(x)\nB(x) --> C(x)\n", 2) ==
           "C(10)");  // 6, 8, 10
+    // `AXIOM : cond --> succ` is a production of the modules A X I O M (vlab's Lilac), not an axiom.
+    CHECK(derived("Axiom: AXIOM\nAXIOM : 1 --> F(2)\n", 1) == "F(2)");
   }
   SECTION("stochastic productions run their own statements") {
     const std::string g = "seed: 3\naxiom: A(1)A(1)A(1)A(1)\nA(y) : { x = 10; } * --> X(x) : 1\nA(y) : { z = 20; } * --> Z(z) : 1\n";
