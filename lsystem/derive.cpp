@@ -243,6 +243,7 @@ struct Deriver::Impl {
     tmp.opt.trackBirthSteps = s.hasBirthSteps();
     tmp.cur = s;
     tmp.globals = globals;
+    tmp.arrays = arrays;
     // Interpretation recursion: depth 1 is one rewrite; deeper levels rewrite what the
     // previous level produced (modules no rule matches stay as they are).
     const RuleSet& rs = prog->interpretation;
@@ -261,6 +262,8 @@ struct Deriver::Impl {
 
   /// cpfg's global variables (Program::globals), kMaxVars registers.
   std::vector<double> globals;
+  /// The elements of cpfg's `define:` arrays (Program::cpfg.arrayInit at the start).
+  std::vector<double> arrays;
   /// What cpfg's `stop` and `srand` asked for (the stop flag is cleared at each start).
   detail::Effects effects;
   /// The seed before any `srand` (options or grammar): restart() begins with it again.
@@ -276,7 +279,8 @@ struct Deriver::Impl {
     Rng blockRng(deriveSeed(seed, {kBlockStream, static_cast<uint64_t>(step)}));
     const Instr* code = prog->code.data();
     const bool looped = std::isnan(
-        detail::evalCode(code + r.begin, code + r.end, globals.data(), &blockRng, &prog->strings, &effects, &prog->cpfg));
+        detail::evalCode(code + r.begin, code + r.end, globals.data(), &blockRng, &prog->strings, &effects, &prog->cpfg,
+                         arrays.data()));
     if (effects.reseed) {
       // cpfg's srand(s): the next step draws as the first step of a derivation with seed s.
       seed = static_cast<uint64_t>(static_cast<int64_t>(std::clamp(effects.seed, -9.2e18, 9.2e18)));
@@ -501,7 +505,7 @@ struct Deriver::Impl {
   void statements(const Production& p, const detail::CodeRange& r, double* vars, int step) {
     const Instr* code = prog->code.data();
     double v = detail::evalCode(code + r.begin, code + r.end, vars, p.usesRandom ? moduleRng() : nullptr, &prog->strings, &effects,
-                                &prog->cpfg);
+                                &prog->cpfg, arrays.data());
     if (std::isnan(v))
       throw InputError(p.loc, "the statements of production '" + p.text + "' loop more than " +
                                   std::to_string(detail::kMaxLoopJumps) + " times at step " + std::to_string(step),
@@ -521,7 +525,7 @@ struct Deriver::Impl {
     if (p.condition.empty()) return true;
     const Instr* code = prog->code.data();
     double v = detail::evalCode(code + p.condition.begin, code + p.condition.end, vars, p.usesRandom ? moduleRng() : nullptr,
-                                nullptr, nullptr, &prog->cpfg);
+                                nullptr, nullptr, &prog->cpfg, arrays.data());
     if (std::isnan(v))
       throw InputError(p.loc, "the condition of production '" + p.text + "' is not a number (nan) at step " + std::to_string(step), p.sourceLine);
     return v != 0.0;
@@ -593,7 +597,7 @@ struct Deriver::Impl {
       default: {
         const Instr* code = prog->code.data();
         v = detail::evalCode(code + a.code.begin, code + a.code.end, vars, p.usesRandom ? moduleRng() : nullptr, nullptr, nullptr,
-                             &prog->cpfg);
+                             &prog->cpfg, arrays.data());
       }
     }
     if (!std::isfinite(v)) [[unlikely]]
@@ -931,6 +935,7 @@ struct Deriver::Impl {
 
   void start() {
     globals.assign(detail::kMaxVars, 0.0);
+    arrays = prog->cpfg.arrayInit;
     effects = {};
     seed = baseSeed;
     streamBase = 0;

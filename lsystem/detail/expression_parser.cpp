@@ -50,6 +50,7 @@ int arityOf(Op op) {
     case Op::Neg: case Op::Not: case Op::Sin: case Op::Cos: case Op::Tan: case Op::Asin: case Op::Acos:
     case Op::Atan: case Op::Sqrt: case Op::Exp: case Op::Log: case Op::Abs: case Op::Floor: case Op::Ceil:
     case Op::Sign: case Op::Ran: case Op::Round: case Op::Srand: case Op::Stop: case Op::Func: case Op::Curve:
+    case Op::ArrayAt: case Op::ArrayLoad:
       return 1;
     case Op::CurveLength: return 0;
     case Op::Select: return 3;
@@ -66,6 +67,7 @@ struct ExpressionParser::Node {
   double value = 0;
   uint16_t var = 0;
   int kids[3] = {-1, -1, -1};
+  int col = 0;  ///< ArrayAt: the column of its `[`, for errors
 };
 
 struct ExpressionParser::Token {
@@ -132,7 +134,8 @@ void ExpressionParser::lex(State& st) {
     for (const char* op : two)
       if (i + 1 < st.span.e && s.compare(i, 2, op) == 0) len = 2;
     if (!len) {
-      if (std::string_view("+-*/^<>!(),?:%").find(c) == std::string_view::npos) {
+      const bool bracket = (c == '[' || c == ']') && tables_ && !tables_->arrays.empty();  // cpfg's arrays
+      if (std::string_view("+-*/^<>!(),?:%").find(c) == std::string_view::npos && !bracket) {
         scanner_.error(st.span.line, i, std::string("unexpected character '") + c + "' in expression");
         throw ExprFail{};
       }
@@ -261,7 +264,13 @@ int ExpressionParser::parsePrimary(State& st) {
   if (st.tok.kind == Token::Ident) {
     Token id = st.tok;
     lex(st);
-    return isPunct(st, "(") ? parseCall(st, id) : parseName(st, id);
+    if (isPunct(st, "(")) return parseCall(st, id);
+    if (const int a = arrayId(id.text); a >= 0) {
+      const int load = node(st, Op::ArrayLoad, parseIndices(st, id, a));
+      st.nodes[load].var = static_cast<uint16_t>(a);
+      return load;
+    }
+    return parseName(st, id);
   }
   unexpected(st, "a number, a name or '('");
 }
@@ -376,6 +385,78 @@ int ExpressionParser::parseCurve(State& st, const Token& id, const std::string& 
   return f;
 }
 
+int ExpressionParser::arrayId(std::string_view name) const {
+  if (!tables_) return -1;
+  for (size_t k = 0; k < tables_->arrays.size(); ++k)
+    if (tables_->arrays[k].name == name) return static_cast<int>(k);
+  return -1;
+}
+
+/// The indices `[i][j]...` of cpfg's array a, named by token id (the current token is
+/// after the name): a node computing the row-major flat index, each index checked.
+int ExpressionParser::parseIndices(State& st, const Token& id, int a) {
+  const CpfgArray& arr = tables_->arrays[static_cast<size_t>(a)];
+  const std::string usage = "cpfg's array '" + arr.name + "' takes " + std::to_string(arr.dims.size()) + " ind" +
+                            (arr.dims.size() == 1 ? "ex" : "ices");
+  int flat = -1;
+  for (size_t d = 0; d < arr.dims.size(); ++d) {
+    if (!isPunct(st, "[")) {
+      scanner_.error(st.span.line, d == 0 ? id.col : st.tok.col,
+                     d == 0 ? usage + ": write '" + arr.name + "[i]'" : usage + ", got " + std::to_string(d));
+      throw ExprFail{};
+    }
+    const int col = st.tok.col;
+    lex(st);
+    const int index = parseConditional(st);
+    if (!isPunct(st, "]")) unexpected(st, "']'");
+    lex(st);
+    const int at = node(st, Op::ArrayAt, index);
+    st.nodes[at].var = static_cast<uint16_t>(a);
+    st.nodes[at].value = static_cast<double>(d);
+    st.nodes[at].col = col;
+    if (flat < 0) {
+      flat = at;
+    } else {
+      const int size = node(st, Op::Const);
+      st.nodes[size].value = arr.dims[d];
+      flat = node(st, Op::Add, node(st, Op::Mul, flat, size), at);
+    }
+  }
+  if (isPunct(st, "[")) {
+    scanner_.error(st.span.line, st.tok.col, usage + ", got more");
+    throw ExprFail{};
+  }
+  return flat;
+}
+
+std::optional<int> ExpressionParser::compileElement(Span sp, const std::vector<std::string>& vars) {
+  State st;
+  st.span = sp;
+  st.vars = &vars;
+  st.pos = sp.b;
+  size_t before = code_.size();
+  try {
+    lex(st);
+    const Token id = st.tok;
+    const int a = id.kind == Token::Ident ? arrayId(id.text) : -1;
+    if (a < 0) unexpected(st, "the name of an array");
+    lex(st);
+    const int root = parseIndices(st, id, a);
+    if (st.tok.kind != Token::End) unexpected(st, "'='");
+    int depth = 0, maxDepth = 0;
+    emit(st, root, depth, maxDepth);
+    if (maxDepth > kMaxStack) {
+      scanner_.error(sp.line, sp.b, "the index is nested too deeply");
+      code_.resize(before);
+      return std::nullopt;
+    }
+    return a;
+  } catch (const ExprFail&) {
+    code_.resize(before);
+    return std::nullopt;
+  }
+}
+
 /// A formal parameter or a `#define` (in that order of precedence).
 int ExpressionParser::parseName(State& st, const Token& id) {
   std::string name(id.text);
@@ -425,14 +506,29 @@ bool ExpressionParser::emit(const State& st, int n, int& depth, int& maxDepth) {
   }
   bool allConst = true;
   for (int k = 0; k < arity; ++k) allConst &= emit(st, nd.kids[k], depth, maxDepth);
+  if (nd.op == Op::ArrayAt && allConst) {
+    // A constant index is checked here, at its `[`, and folded to its whole part.
+    const CpfgArray& arr = tables_->arrays[nd.var];
+    const int d = static_cast<int>(nd.value);
+    const double v = code_.back().c, i = std::trunc(v);
+    if (!(i >= 0 && i < arr.dims[static_cast<size_t>(d)])) {
+      scanner_.error(st.span.line, nd.col,
+                     "index " + formatNumber(v) + (arr.dims.size() > 1 ? " in dimension " + std::to_string(d + 1) : std::string()) +
+                         " of cpfg's array '" + arr.name + "' is out of range (indices 0 to " +
+                         std::to_string(arr.dims[static_cast<size_t>(d)] - 1) + ")");
+      throw ExprFail{};
+    }
+    code_.back().c = i;
+    return true;
+  }
   Instr in;
   in.op = nd.op;
-  if (nd.op == Op::Func || nd.op == Op::Curve) in.var = nd.var;
-  if (nd.op == Op::Curve) in.c = nd.value;
+  if (nd.op == Op::Func || nd.op == Op::Curve || nd.op == Op::ArrayAt || nd.op == Op::ArrayLoad) in.var = nd.var;
+  if (nd.op == Op::Curve || nd.op == Op::ArrayAt) in.c = nd.value;
   code_.push_back(in);
   depth -= arity - 1;
   if (allConst && nd.op != Op::Ran && nd.op != Op::Nran && nd.op != Op::Bran && nd.op != Op::Biran && nd.op != Op::Srand &&
-      nd.op != Op::Stop && nd.op != Op::Func && nd.op != Op::Curve) {
+      nd.op != Op::Stop && nd.op != Op::Func && nd.op != Op::Curve && nd.op != Op::ArrayLoad) {
     size_t first = code_.size() - 1 - arity;
     double v = evalCode(code_.data() + first, code_.data() + code_.size(), nullptr, nullptr);
     code_.resize(first);
@@ -524,7 +620,9 @@ std::optional<double> ExpressionParser::evaluate(Span sp, Rng* rng) {
     if (usesRandom_ && !rng) {
       scanner_.error(sp.line, sp.b, "random functions are not allowed here");
     } else {
-      double v = evalCode(code_.data() + before, code_.data() + code_.size(), nullptr, rng, nullptr, nullptr, tables_);
+      // cpfg's arrays read their initial elements here (an axiom's parameters); nothing stores.
+      double* init = tables_ ? const_cast<double*>(tables_->arrayInit.data()) : nullptr;
+      double v = evalCode(code_.data() + before, code_.data() + code_.size(), nullptr, rng, nullptr, nullptr, tables_, init);
       if (std::isfinite(v)) value = v;
       else scanner_.error(sp.line, sp.b, "parameter is not finite (" + formatNumber(v) + ")");
     }

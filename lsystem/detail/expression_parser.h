@@ -50,6 +50,12 @@ class ExpressionParser {
   /// error reported when it fails to compile, draws without an rng, or is not finite.
   /// The code vector is left unchanged; usesRandom() is not affected.
   std::optional<double> evaluate(Span sp, Rng* rng);
+  /// The left side `name[i][j]` of an assignment to an element of cpfg's array (in sp):
+  /// compiles its row-major flat index onto the code vector and returns the array's
+  /// number, or nullopt with an error reported (code unchanged).
+  std::optional<int> compileElement(Span sp, const std::vector<std::string>& vars);
+  /// The number of cpfg's array name (Program::cpfg.arrays), or -1.
+  int arrayId(std::string_view name) const;
 
   /// cpfg's global variables (assigned in `Start:` ... blocks): a name not among an
   /// expression's variables that is global k reads register kMaxVars - 1 - k. Null: none.
@@ -85,6 +91,7 @@ class ExpressionParser {
   int parseFunc(State& st, const Token& id);
   int parseCurve(State& st, const Token& id, const std::string& name);
   int parseName(State& st, const Token& id);
+  int parseIndices(State& st, const Token& id, int a);
   bool emit(const State& st, int n, int& depth, int& maxDepth);
 
   Scanner& scanner_;

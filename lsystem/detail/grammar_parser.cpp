@@ -66,8 +66,11 @@ struct UnsupportedHeader {
   const char* what;
 };
 constexpr UnsupportedHeader kUnsupportedHeaders[] = {
-    {"define", "define:", "array declarations"},
+    {"ring lsystem", "ring lsystem:", "ring L-system"},
 };
+
+/// Most elements of all of cpfg's `define: { array ... }` arrays together.
+constexpr uint32_t kMaxArrayElements = 1u << 24;
 
 /// cpfg's blocks of statements over global variables, by header key.
 const char* const kBlockHeaders[] = {"start", "end", "starteach", "start each", "endeach", "end each"};
@@ -329,6 +332,11 @@ class GrammarParser {
       }
       if (unsupportedHeader(line, b)) continue;
       auto header = Scanner::headerOf(s, b);
+      if (header && header->key == "define" && prog_.dialect == Dialect::Cpfg) {
+        if (!subs_.empty()) error(line, b, "'define:' in a sub-L-system is not supported (Sprig reads a sub-L-system's productions only)");
+        else defineBlock(line, *header);
+        continue;
+      }
       if (header && std::find(std::begin(kBlockHeaders), std::end(kBlockHeaders), header->key) != std::end(kBlockHeaders)) {
         if (!subs_.empty()) {
           error(line, b, "'" + header->key + ":' in a sub-L-system ('lsystem: " + subs_.back().label +
@@ -339,6 +347,8 @@ class GrammarParser {
         continue;
       }
       bool known = header && std::find(std::begin(kHeaders), std::end(kHeaders), header->key) != std::end(kHeaders);
+      // cpfg: `AXIOM : cond --> succ` is a production of a module named AXIOM (an axiom has no arrow).
+      if (known && header->key == "axiom" && prog_.dialect == Dialect::Cpfg && Scanner::findArrow(s).first >= 0) known = false;
       if (known) {
         handleHeader(line, b, *header, block);
         continue;
@@ -422,6 +432,120 @@ class GrammarParser {
     inGlobalBlock_ = false;
     expr_.setGlobals(&prog_.globals);
     if (ok) prog_.globals = names;
+  }
+
+  /// cpfg's `define: { array name[d1][d2]... = {v, v, ...}; ... }` (header h on line):
+  /// appends the arrays to Program::cpfg. Dimensions and values are constant expressions;
+  /// nested braces in an initializer are read as one flat row-major list, and elements
+  /// without a value are 0, as in C.
+  void defineBlock(int line, const Header& h) {
+    const std::string& s = scanner_.line(line);
+    Span v = scanner_.trim(Span{line, h.valueBegin, static_cast<int>(s.size())});
+    if (v.b == v.e || s[v.b] != '{') {
+      error(line, v.b, "expected '{ array name[size] = {...}; }' after 'define:'");
+      return;
+    }
+    const int close = matching(line, v.b, v.e, '{', '}');
+    if (close < 0) {
+      error(line, v.b, "unclosed '{' of 'define:'");
+      return;
+    }
+    Span rest = scanner_.trim(Span{line, close + 1, v.e});
+    if (rest.b != rest.e && !(rest.e == rest.b + 1 && s[rest.b] == ';')) error(line, rest.b, "unexpected text after the block");
+    CpfgTables& t = prog_.cpfg;
+    int i = v.b + 1;
+    for (;;) {
+      i = nextNonSpace(line, i, close);
+      while (i < close && s[i] == ';') i = nextNonSpace(line, i + 1, close);
+      if (i >= close) return;
+      if (wordAt(line, i, close) != "array") {
+        error(line, i, "expected 'array name[size] = {...};' in 'define:' (cpfg's define block declares arrays)");
+        return;
+      }
+      i = nextNonSpace(line, i + 5, close);
+      const std::string name = wordAt(line, i, close);
+      if (name.empty()) {
+        error(line, i, "expected the array's name after 'array'");
+        return;
+      }
+      const int nameCol = i;
+      if (defines_.count(name) || expr_.arrayId(name) >= 0 ||
+          std::find(prog_.globals.begin(), prog_.globals.end(), name) != prog_.globals.end()) {
+        error(line, i, "'" + name + "' is already a #define, an array or a global variable");
+        return;
+      }
+      CpfgArray a;
+      a.name = name;
+      a.offset = static_cast<uint32_t>(t.arrayInit.size());
+      i = nextNonSpace(line, i + static_cast<int>(name.size()), close);
+      double total = 1;
+      while (i < close && s[i] == '[') {
+        const int end = matching(line, i, close, '[', ']');
+        if (end < 0) {
+          error(line, i, "unclosed '[' of the array's size");
+          return;
+        }
+        auto n = expr_.constant(scanner_.trim(Span{line, i + 1, end}), "an array's size");
+        if (!n) return;
+        if (*n != std::floor(*n) || *n < 1) {
+          error(line, i + 1, "an array's size must be a whole number of at least 1, got " + formatNumber(*n));
+          return;
+        }
+        total *= *n;
+        if (total + static_cast<double>(t.arrayInit.size()) > kMaxArrayElements) {
+          error(line, i + 1, "cpfg's arrays have more than " + std::to_string(kMaxArrayElements) + " elements in all (Sprig's limit)");
+          return;
+        }
+        a.dims.push_back(static_cast<int>(*n));
+        i = nextNonSpace(line, end + 1, close);
+      }
+      if (a.dims.empty()) {
+        error(line, i, "expected '[size]' after the array's name '" + name + "'");
+        return;
+      }
+      std::vector<double> values(a.size(), 0.0);
+      if (i < close && s[i] == '=') {
+        i = nextNonSpace(line, i + 1, close);
+        if (i >= close || s[i] != '{') {
+          error(line, i, "expected '{' and the array's values after '='");
+          return;
+        }
+        const int end = matching(line, i, close, '{', '}');
+        if (end < 0) {
+          error(line, i, "unclosed '{' of the array's values");
+          return;
+        }
+        size_t count = 0;
+        int item = i + 1, depth = 0;
+        for (int k = i + 1; k <= end; ++k) {
+          const char c = s[k];
+          if (c == '(') ++depth;
+          if (c == ')') --depth;
+          if (k < end && depth > 0) continue;
+          if (k == end || c == ',' || c == '{' || c == '}') {
+            Span value = scanner_.trim(Span{line, item, k});
+            item = k + 1;
+            if (value.b == value.e) continue;
+            if (count == values.size()) {
+              error(line, value.b, "too many values for the array '" + name + "' (it has " + std::to_string(values.size()) + " elements)");
+              return;
+            }
+            auto x = expr_.constant(value, "an array's value");
+            if (!x) return;
+            values[count++] = *x;
+          }
+        }
+        i = end + 1;
+      }
+      i = nextNonSpace(line, i, close);
+      if (i < close && s[i] != ';') {
+        error(line, i, "expected ';' after the declaration of the array '" + name + "'");
+        return;
+      }
+      (void)nameCol;
+      t.arrays.push_back(std::move(a));
+      t.arrayInit.insert(t.arrayInit.end(), values.begin(), values.end());
+    }
   }
 
   /// Reports cpfg's headers Sprig does not implement (`Start:`, `define:`, `ring lsystem`)
@@ -989,6 +1113,39 @@ class GrammarParser {
         if (!compiled) return false;
         jump(Op::Jz, base, static_cast<double>(prog_.code.size() + 1));  // pops the value, jumps to the next instruction
         i = end + 1;
+      } else if (const int k2 = nextNonSpace(line, i, e); k2 < e && s[k2] == '[' && expr_.arrayId(word) >= 0) {
+        // Assignment to an element of cpfg's array, `name[i][j] = expression;`.
+        int eq = k2;
+        while (eq < e && s[eq] == '[') {
+          const int end = matching(line, eq, e, '[', ']');
+          if (end < 0) {
+            error(line, eq, "unclosed '['");
+            return false;
+          }
+          eq = nextNonSpace(line, end + 1, e);
+        }
+        if (eq >= e || s[eq] != '=' || (eq + 1 < e && s[eq + 1] == '=')) {
+          error(line, eq, "expected '=' after '" + word + "[...]'");
+          return false;
+        }
+        int end = scanner_.findTop(line, eq + 1, e, ';');
+        if (end < 0) {
+          error(line, at, "missing ';' after the assignment to '" + word + "[...]' (cpfg requires one after every statement)");
+          return false;
+        }
+        Span value = scanner_.trim(Span{line, eq + 1, end});
+        if (value.b == value.e) {
+          error(line, eq, "missing value after '" + word + "[...] ='");
+          return false;
+        }
+        auto a = expr_.compileElement(scanner_.trim(Span{line, at, eq}), varNames);
+        if (!a) return false;
+        if (!expr_.compile(value, varNames, "value")) return false;
+        Instr store;
+        store.op = Op::ArrayStore;
+        store.var = static_cast<uint16_t>(*a);
+        prog_.code.push_back(store);
+        i = end + 1;
       } else {
         // Assignment `name = expression;`.
         while (i < e && isSpace(s[i])) ++i;
@@ -1008,6 +1165,10 @@ class GrammarParser {
         }
         if (defines_.count(word)) {
           error(line, at, "cannot assign to '" + word + "': it is a #define");
+          return false;
+        }
+        if (expr_.arrayId(word) >= 0) {
+          error(line, at, "cannot assign to '" + word + "': it is an array (assign its elements, '" + word + "[i] = ...')");
           return false;
         }
         auto known = std::find(varNames.begin(), varNames.end(), word);

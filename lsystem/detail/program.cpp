@@ -48,4 +48,16 @@ void printFormatted(const std::string& format, const double* args, int n) {
   std::fputs(out.c_str(), stderr);
 }
 
+
+void arrayIndexError(const CpfgArray& a, int d, double i) {
+  std::string shape = a.name;
+  for (int n : a.dims) shape += "[" + std::to_string(n) + "]";
+  char index[64];
+  std::snprintf(index, sizeof index, "%.17g", i);
+  std::string where = a.dims.size() > 1 ? " in its dimension " + std::to_string(d + 1) : std::string();
+  throw InputError(SourceLoc{"sprig", 0, 0}, "index " + std::string(index) + where + " of cpfg's array '" + a.name +
+                                                 "' is out of range (it is " + shape + ", indices 0 to " +
+                                                 std::to_string(a.dims[d] - 1) + ")");
+}
+
 }  // namespace sprig::lsystem::detail

@@ -49,13 +49,34 @@ enum class Op : uint8_t {
   Func,    ///< cpfg's `func(n, x)`: function var (n - 1) of the view file's function files at x
   Curve,   ///< cpfg's `curveX/Y/Z(n, t)`: coordinate c (0, 1, 2) of curve var (n - 1) at arc length t
   CurveLength,  ///< cpfg's `curveGAL(n)`: the length of curve var (n - 1); pops nothing
+  ArrayAt,     ///< cpfg's `a[i]`: checks index i of dimension c of array var, pushes it truncated
+  ArrayLoad,   ///< pops a flat index, pushes element of array var
+  ArrayStore,  ///< pops a value, then a flat index; stores the value into element of array var
+};
+
+/// One of cpfg's `define: { array name[d1][d2]... = {...}; }` arrays: its elements are
+/// arrayInit[offset .. offset + size) at the start of every derivation, row-major.
+struct CpfgArray {
+  std::string name;
+  std::vector<int> dims;
+  uint32_t offset = 0;
+  uint32_t size() const {
+    uint32_t n = 1;
+    for (int d : dims) n *= static_cast<uint32_t>(d);
+    return n;
+  }
 };
 
 /// The view file's function and curve files, which `func` and `curveX...` read.
 struct CpfgTables {
   std::vector<CpfgFunction> functions;  ///< `function:` lines (`func(n, x)`), n = 1, 2, ...
   std::vector<CpfgCurve> curves;        ///< `curve:` lines (`curveX(n, t)`), n = 1, 2, ...
+  std::vector<CpfgArray> arrays;        ///< `define: { array ... }` declarations
+  std::vector<double> arrayInit;        ///< every array's initial elements, one after another
 };
+
+/// Throws the run-time error of an index i out of range in dimension d of array a.
+[[noreturn]] void arrayIndexError(const CpfgArray& a, int d, double i);
 
 /// What cpfg's `srand` and `stop` ask of the Deriver, recorded by evalCode.
 struct Effects {
@@ -122,7 +143,7 @@ void printFormatted(const std::string& format, const double* args, int n);
 /// curve files `func` and `curveX...` read (NaN without them).
 inline double evalCode(const Instr* code, const Instr* end, const double* vars, Rng* rng,
                        const std::vector<std::string>* strings = nullptr, Effects* effects = nullptr,
-                       const CpfgTables* tables = nullptr) {
+                       const CpfgTables* tables = nullptr, double* arrays = nullptr) {
   double stack[kMaxStack];
   int sp = 0;
   long backJumps = 0;
@@ -205,6 +226,21 @@ inline double evalCode(const Instr* code, const Instr* end, const double* vars, 
         break;
       case Op::CurveLength:
         stack[sp++] = tables && in->var < tables->curves.size() ? tables->curves[in->var].length() : std::nan("");
+        break;
+      case Op::ArrayAt: {
+        const CpfgArray& a = tables->arrays[in->var];
+        const int d = static_cast<int>(in->c);
+        const double i = std::trunc(stack[sp - 1]);
+        if (!(i >= 0 && i < a.dims[d])) arrayIndexError(a, d, stack[sp - 1]);
+        stack[sp - 1] = i;
+        break;
+      }
+      case Op::ArrayLoad:
+        stack[sp - 1] = arrays ? arrays[tables->arrays[in->var].offset + static_cast<uint32_t>(stack[sp - 1])] : std::nan("");
+        break;
+      case Op::ArrayStore:
+        sp -= 2;
+        arrays[tables->arrays[in->var].offset + static_cast<uint32_t>(stack[sp])] = stack[sp + 1];
         break;
       case Op::Printf: {
         const int n = static_cast<int>(in->c);

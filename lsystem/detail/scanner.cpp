@@ -109,7 +109,8 @@ void Scanner::load(std::string_view text) {
       const std::string& o = clean_[open];
       int depth = 0;
       for (char c : o) depth += c == '{' ? 1 : c == '}' ? -1 : 0;
-      continues = depth > 0 && o.find(':') != std::string::npos && findArrow(o).first < 0 && !t.empty();
+      // Blank lines inside the braces go on too, as in cpfg's reader.
+      continues = depth > 0 && o.find(':') != std::string::npos && findArrow(o).first < 0;
     }
     if (continues) {
       std::string& o = clean_[open];

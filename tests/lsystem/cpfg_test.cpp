@@ -279,7 +279,6 @@ TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg
   }
   SECTION("statements, blocks, preprocessor, several L-systems") {
     CHECK(errorOf("axiom: A(1)\nA(y) : { x = y / 2; x < 10 --> B(x)\n") == "t.l:2:8: unclosed '{' of a statement block");
-    CHECK(errorOf("define: { array a[2]; }\naxiom: A\n") == "t.l:1:1: cpfg's 'define:' (array declarations) is not supported");
     CHECK(errorOf("#if 1\naxiom: A\n#endif\n") ==
           "t.l:1:1: cpfg's C preprocessor directive '#if' is not supported (Sprig's preprocessor reads #define, "
           "#undef, #include, #ifdef, #ifndef, #else and #endif)");
@@ -361,6 +360,12 @@ TEST_CASE("cpfg statements in productions", "[lsystem][cpfg]") {
   }
   SECTION("a block over several lines (cpfg notation)") {
     CHECK(derived("axiom: A(2)\nA(y) : {\n\tx = y * 3;\n} x > 5 --> B(x)\n", 1) == "B(6)");
+    // cpfg's reader goes on inside the open braces without tabs, across blank lines and
+    // comments, up to the arrow (vlab's Ridley, spiral.l:14).
+    CHECK(derived("axiom: A(2)\nA(y) : y > 1 {  // a comment\n  x = y * 3;\n\n    while (x < 10) {\n x = x + 2;\n }\n} --> B(x)\nB(x) --> C(x)\n", 2) ==
+          "C(10)");  // 6, 8, 10
+    // `AXIOM : cond --> succ` is a production of the modules A X I O M (vlab's Lilac), not an axiom.
+    CHECK(derived("Axiom: AXIOM\nAXIOM : 1 --> F(2)\n", 1) == "F(2)");
   }
   SECTION("stochastic productions run their own statements") {
     const std::string g = "seed: 3\naxiom: A(1)A(1)A(1)A(1)\nA(y) : { x = 10; } * --> X(x) : 1\nA(y) : { z = 20; } * --> Z(z) : 1\n";
@@ -1112,5 +1117,52 @@ TEST_CASE("cpfg generalized cylinders with @#(n): a roll between control points 
     CHECK(angle(a, c) == Approx(kPi / 2));
     CHECK(angle(a, b) == Approx(kPi / 4));
     CHECK(angle(b, c) == Approx(kPi / 4));
+  }
+}
+
+TEST_CASE("cpfg define: arrays", "[lsystem][cpfg]") {
+  // Row-major flat initializers as cpfg reads them; blank lines inside the open block.
+  const std::string g =
+      "#define N 3\n"
+      "define: {\n"
+      "\tarray w[N] = {1, 2.5, 4};\n"
+      "\n"
+      "\tarray m[2][N] =\n"
+      "\t\t{1, 2, 3,\n"
+      "\t\t 4, 5, 6};\n"
+      "\tarray z[4];\n"
+      "}\n"
+      "Start: { z[1] = m[1][2] + w[0]; }\n"
+      "axiom: A(0)\n"
+      "A(i) : i < N { k = w[i]; z[2] = z[2] + 1; } --> F(k) B(m[1][i], z[1], z[2]) A(i+1)\n";
+  SECTION("reads, stores in Start: and in a production's block") {
+    // Step 1: A(0): k = w[0] = 1, z[2] = 1; m[1][0] = 4; z[1] = m[1][2] + w[0] = 6 + 1 = 7.
+    // Step 2: A(1): k = 2.5, z[2] = 2, m[1][1] = 5. Step 3: A(2): k = 4, z[2] = 3, m[1][2] = 6.
+    CHECK(derived(g, 2) == "F(1)B(4,7,1)F(2.5)B(5,7,2)A(2)");
+    CHECK(derived(g, 4) == "F(1)B(4,7,1)F(2.5)B(5,7,2)F(4)B(6,7,3)A(3)");  // A(3): i < N fails, nothing runs
+  }
+  SECTION("missing values are 0; nested braces read as one flat list; the axiom reads initial values") {
+    CHECK(derived("define: { array a[2][2] = {{1, 2}, {3}}; }\naxiom: X(a[0][1], a[1][0], a[1][1])\n", 0) == "X(2,3,0)");
+    CHECK(derived("define: { array a[3] = {5, 6}; }\naxiom: A\nA --> X(a[2] + a[1], a[1.9])\n", 1) == "X(6,6)");
+  }
+  SECTION("an index out of range at run time names the array and the index") {
+    CHECK_THROWS_WITH(derived("define: { array a[3]; }\naxiom: A(3)\nA(i) --> X(a[i])\n", 1),
+                      Catch::Matchers::Contains("index 3 of cpfg's array 'a' is out of range (it is a[3], indices 0 to 2)"));
+    CHECK_THROWS_WITH(derived("define: { array a[2][3]; }\naxiom: A(-1)\nA(i) --> X(a[1][i])\n", 1),
+                      Catch::Matchers::Contains("index -1 in its dimension 2 of cpfg's array 'a' is out of range"));
+  }
+  SECTION("errors") {
+    CHECK(errorOf("define: { array a[2]; }\naxiom: X(a[2])\n") ==
+          "t.l:2:11: index 2 of cpfg's array 'a' is out of range (indices 0 to 1)");
+    CHECK(errorOf("define: { array a[2][2]; }\naxiom: X(a[1])\n") == "t.l:2:14: cpfg's array 'a' takes 2 indices, got 1");
+    CHECK(errorOf("define: { array a[2] = {1, 2, 3}; }\naxiom: A\n") ==
+          "t.l:1:31: too many values for the array 'a' (it has 2 elements)");
+    CHECK(errorOf("define: { array a[0]; }\naxiom: A\n") ==
+          "t.l:1:19: an array's size must be a whole number of at least 1, got 0");
+    CHECK(errorOf("define: { int a[2]; }\naxiom: A\n") ==
+          "t.l:1:11: expected 'array name[size] = {...};' in 'define:' (cpfg's define block declares arrays)");
+    CHECK(errorOf("define: { array a; }\naxiom: A\n") == "t.l:1:18: expected '[size]' after the array's name 'a'");
+    CHECK(errorOf("define: { array a[2]; }\nStart: { a = 1; }\naxiom: A\n") ==
+          "t.l:2:10: cannot assign to 'a': it is an array (assign its elements, 'a[i] = ...')");
   }
 }
