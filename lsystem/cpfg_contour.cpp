@@ -5,29 +5,14 @@
 #include <sstream>
 
 #include "core/diagnostics.h"
+#include "lsystem/detail/cpfg_text.h"
 
 namespace sprig::lsystem {
 
 namespace {
 
-struct Word {
-  std::string text;
-  size_t col;
-};
-
-std::vector<Word> wordsOf(const std::string& s, size_t from = 0) {
-  std::vector<Word> out;
-  size_t i = from;
-  while (i < s.size()) {
-    while (i < s.size() && (s[i] == ' ' || s[i] == '\t' || s[i] == '\r')) ++i;
-    if (i >= s.size()) break;
-    size_t j = i;
-    while (j < s.size() && s[j] != ' ' && s[j] != '\t' && s[j] != '\r') ++j;
-    out.push_back({s.substr(i, j - i), i});
-    i = j;
-  }
-  return out;
-}
+using detail::Word;
+using detail::wordsOf;
 
 /// The lines of a contour file and a reader over them, with positions for errors.
 struct Reader {

@@ -6,44 +6,15 @@
 #include <sstream>
 
 #include "core/diagnostics.h"
+#include "lsystem/detail/cpfg_text.h"
 
 namespace sprig::lsystem {
 
 namespace {
 
-/// Cox-de Boor basis over cpfg's clamped integer knots for n + 1 points (curveXYZ.cpp,
-/// uk/Nk1..Nk4): knot j is 0 below 4, n - 2 above n, else j - 3; half-open intervals.
-struct ClampedBasis {
-  int n;
-  int knot(int j) const { return j < 4 ? 0 : j > n ? n - 2 : j - 3; }
-  double operator()(int k, int t, double u) const {
-    if (t == 1) return knot(k) <= u && u < knot(k + 1) ? 1.0 : 0.0;
-    double sum = 0;
-    if (int d = knot(k + t - 1) - knot(k)) sum = (u - knot(k)) / d * (*this)(k, t - 1, u);
-    if (int d = knot(k + t) - knot(k + 1)) sum += (knot(k + t) - u) / d * (*this)(k + 1, t - 1, u);
-    return sum;
-  }
-};
-
-/// A word of a line with its column.
-struct Word {
-  std::string text;
-  size_t col;
-};
-
-std::vector<Word> words(const std::string& s, size_t from) {
-  std::vector<Word> out;
-  size_t i = from;
-  while (i < s.size()) {
-    while (i < s.size() && (s[i] == ' ' || s[i] == '\t' || s[i] == '\r')) ++i;
-    if (i >= s.size()) break;
-    size_t j = i;
-    while (j < s.size() && s[j] != ' ' && s[j] != '\t' && s[j] != '\r') ++j;
-    out.push_back({s.substr(i, j - i), i});
-    i = j;
-  }
-  return out;
-}
+using detail::ClampedBasis;
+using detail::Word;
+using detail::wordsOf;
 
 }  // namespace
 
@@ -122,7 +93,7 @@ CpfgCurve CpfgCurve::parse(const std::string& text, const std::string& fileName,
     const size_t b = s.find_first_not_of(" \t\r");
     if (b == std::string::npos || s.compare(b, 2, "//") == 0) continue;
     auto is = [&](const char* key) { return s.compare(b, std::string(key).size(), key) == 0; };
-    auto after = [&](const char* key) { return words(s, b + std::string(key).size()); };
+    auto after = [&](const char* key) { return wordsOf(s, b + std::string(key).size()); };
     bool known = false;
     for (const Keyed& k : kKeys)
       if (is(k.key)) {
@@ -173,7 +144,7 @@ CpfgCurve CpfgCurve::parse(const std::string& text, const std::string& fileName,
     if (s.find(':') != std::string::npos) fail(l, b, "unknown line in a curve file: '" + s.substr(b) + "'");
     // A control point.
     if (count < 0) fail(l, b, "a control point before the 'points:' line");
-    const std::vector<Word> w = words(s, b);
+    const std::vector<Word> w = wordsOf(s, b);
     if (static_cast<int>(w.size()) != dim)
       fail(l, b, "a control point has " + std::to_string(dim) + " numbers (the dimension), got " + std::to_string(w.size()));
     if (static_cast<int>(read) >= count) fail(l, b, "more control points than 'points: " + std::to_string(count) + "'");

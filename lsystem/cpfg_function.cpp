@@ -7,24 +7,11 @@
 #include <sstream>
 
 #include "core/diagnostics.h"
+#include "lsystem/detail/cpfg_text.h"
 
 namespace sprig::lsystem {
 
 namespace {
-
-/// Cox-de Boor basis N_{k,t}(u) over cpfg's clamped integer knots for n + 1 points
-/// (splinefun.cpp, Uk/Nk1/Nkt): knot j is 0 below 4, n - 2 above n, else j - 3.
-struct Basis {
-  int n;
-  int knot(int j) const { return j < 4 ? 0 : j > n ? n - 2 : j - 3; }
-  double operator()(int k, int t, double u) const {
-    if (t == 1) return knot(k) <= u && u < knot(k + 1) ? 1.0 : 0.0;
-    double sum = 0;
-    if (int d = knot(k + t - 1) - knot(k)) sum = (u - knot(k)) / d * (*this)(k, t - 1, u);
-    if (int d = knot(k + t) - knot(k + 1)) sum += (knot(k + t) - u) / d * (*this)(k + 1, t - 1, u);
-    return sum;
-  }
-};
 
 /// The lines of a function file with 1-based numbers, for positions in errors.
 struct Lines {
@@ -72,7 +59,7 @@ std::vector<double> numbers(const Lines& ls, size_t l, size_t c) {
 
 glm::dvec2 CpfgFunction::point(double d) const {
   const int n = static_cast<int>(points_.size()) - 1;
-  const Basis basis{n};
+  const detail::ClampedBasis basis{n};
   const double u = d * (n - 2);
   glm::dvec2 sum(0.0);
   for (int k = 0; k <= n; ++k) sum += points_[static_cast<size_t>(k)] * basis(k, 4, u);
