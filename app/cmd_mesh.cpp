@@ -68,7 +68,10 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
   std::string simplified;
   const double simplify = a.simplify >= 0 ? a.simplify : species.render.simplify;
   if (simplify > 0) {
-    const std::vector<organisms::SimplifyReport> reports = simplifyParts(parts, simplify);
+    std::vector<std::string> dropped;
+    const std::vector<organisms::SimplifyReport> reports = simplifyParts(parts, simplify, &dropped);
+    for (const std::string& name : dropped)
+      note(g, std::cerr, "%s: simplified, so its texture atlas is dropped and its vertex colours kept", name.c_str());
     fig.triangles = 0;
     for (size_t i = 0; i < parts.size(); ++i) {
       fig.triangles += parts[i].mesh.triangleCount();

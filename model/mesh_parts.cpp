@@ -258,7 +258,8 @@ blobtree::PolygonizeResult polygonizeForLook(const blobtree::CompiledBlob& blob,
   return r;
 }
 
-std::vector<organisms::SimplifyReport> simplifyParts(std::vector<ExportPart>& parts, double relativeError) {
+std::vector<organisms::SimplifyReport> simplifyParts(std::vector<ExportPart>& parts, double relativeError,
+                                                     std::vector<std::string>* droppedAtlases) {
   auto extent = [](const Box3& b) { return b.empty() ? 0.0f : std::max({b.size().x, b.size().y, b.size().z}); };
   Box3 all;
   for (const ExportPart& p : parts)
@@ -270,6 +271,11 @@ std::vector<organisms::SimplifyReport> simplifyParts(std::vector<ExportPart>& pa
     const float own = extent(m.bounds());
     if (m.triangles.empty() || !(own > 0)) continue;
     m = organisms::simplifyToError(m, float(absolute / double(own)), &reports[i]);
+    PartMaterial& mat = parts[i].material;
+    if (mat.texture && mat.texture->isAtlas()) {
+      mat.texture = nullptr;
+      if (droppedAtlases) droppedAtlases->push_back(parts[i].name);
+    }
   }
   return reports;
 }

@@ -128,7 +128,11 @@ blobtree::PolygonizeResult polygonizeForLook(const blobtree::CompiledBlob& blob,
 /// relativeError is a fraction of the whole model's extent (the largest side of the
 /// bounding box of all parts), so every part gets the same error in model units.
 /// Normals, texture coordinates and colours stay at the vertices that remain; a closed,
-/// manifold part stays so. Returns one report per part, in order. O(T log T).
-std::vector<organisms::SimplifyReport> simplifyParts(std::vector<ExportPart>& parts, double relativeError);
+/// manifold part stays so. A part textured by an atlas (one patch per triangle) loses the
+/// atlas, since its triangles change, and keeps its vertex colours (the renderer's colours
+/// at the vertices that remain); its name is appended to droppedAtlases when given.
+/// Returns one report per part, in order. O(T log T).
+std::vector<organisms::SimplifyReport> simplifyParts(std::vector<ExportPart>& parts, double relativeError,
+                                                     std::vector<std::string>* droppedAtlases = nullptr);
 
 }  // namespace sprig
