@@ -74,6 +74,26 @@ TetMesh ramp(int perUnit) {
 
 double topHeight(double x) { return x <= 1 ? 1.0 : 1.0 - 0.5 * (x - 1); }
 
+/// The ramp (16 cells per unit) of stone, dirtied, then washed by 16,384 drops (four
+/// batches: the later three see the earlier tracks) of radius 0.06 and strength 0.01, seed
+/// 5, with the given attraction and meander (scale 0.15), at the given thread count.
+TetMesh washedRamp(double attraction, double meander, int threads) {
+  const std::vector<Material> mats = {*findBuiltinMaterial("stone")};
+  ThreadLimit limit(threads);
+  TetMesh m = ramp(16);
+  dirt(m, mats, DirtOptions{});
+  ParticleOptions o = particleDefaults(ParticleTool::Wash);
+  o.particles = 16384;
+  o.radius = 0.06;
+  o.strength = 0.01;
+  o.attraction = attraction;
+  o.meander = meander;
+  o.meanderScale = 0.15;
+  o.seed = 5;
+  runParticles(m, mats, o);
+  return m;
+}
+
 }  // namespace
 
 TEST_CASE("cutByField: a block cut at a sphere", "[solids][weathering]") {
@@ -263,20 +283,7 @@ TEST_CASE("wash attraction: later drops follow washed tracks, so the slope washe
   // The ramp's slope, washed with and without attraction. Streaks are variation across the
   // fall line: the dirt left on the slope's top vertices, averaged per column of equal z, varies
   // more between columns when drops steer toward what earlier batches cleaned.
-  const std::vector<Material> mats = {*findBuiltinMaterial("stone")};
-  auto run = [&](double attraction, int threads) {
-    ThreadLimit limit(threads);
-    TetMesh m = ramp(16);
-    dirt(m, mats, DirtOptions{});
-    ParticleOptions o = particleDefaults(ParticleTool::Wash);
-    o.particles = 16384;  // four batches: the later three see the earlier tracks
-    o.radius = 0.06;
-    o.strength = 0.01;
-    o.attraction = attraction;
-    o.seed = 5;
-    runParticles(m, mats, o);
-    return m;
-  };
+  auto run = [](double attraction, int threads) { return washedRamp(attraction, 0, threads); };
   auto columnSpread = [](const TetMesh& m) {
     std::map<long, std::pair<double, int>> col;
     for (size_t v = 0; v < m.positions.size(); ++v) {
@@ -308,22 +315,7 @@ TEST_CASE("wash meander: streaks wander off the fall line", "[solids][weathering
   // streaks run down the fall line (x), so the dirt left across the slope (per column of
   // equal z) in the slope's upper part matches the lower part's; meandering ones drift
   // sideways between the two, and the two profiles correlate less.
-  const std::vector<Material> mats = {*findBuiltinMaterial("stone")};
-  auto run = [&](double meander, int threads) {
-    ThreadLimit limit(threads);
-    TetMesh m = ramp(16);
-    dirt(m, mats, DirtOptions{});
-    ParticleOptions o = particleDefaults(ParticleTool::Wash);
-    o.particles = 16384;
-    o.radius = 0.06;
-    o.strength = 0.01;
-    o.attraction = 4;
-    o.meander = meander;
-    o.meanderScale = 0.15;
-    o.seed = 5;
-    runParticles(m, mats, o);
-    return m;
-  };
+  auto run = [](double meander, int threads) { return washedRamp(4, meander, threads); };
   // Correlation of the column means of the dirt left for x in [1.25, 1.45] and in [1.65, 1.85].
   auto upperLower = [](const TetMesh& m) {
     std::map<long, std::array<double, 4>> col;  // z -> upper sum, count, lower sum, count
