@@ -156,18 +156,26 @@ std::shared_ptr<PartTexture> bakeAtlas(const Mesh& mesh, const SurfaceColor& col
 
 Vec3 blobSurfaceColor(const blobtree::CompiledBlob& blob, const Vec3& p, float maxMove, const render::TextureTable& textures,
                       const render::Material& material) {
+  // Each Newton step takes one sample() (value, gradient and attributes in one walk of the
+  // tape), and the walk stops once the step would move the point less than a thousandth
+  // of maxMove (far below a texel of the triangle's patch): a texel of a fine mesh lies
+  // that close to the surface already and costs one walk, where value, gradient and a
+  // final sample at each of three steps cost seven.
+  const float settle = 1e-3f * maxMove;
   Vec3 q = p;
+  blobtree::Sample s = blob.sample(q);
   for (int i = 0; i < 3; ++i) {
-    const float f = blob.value(q) - 0.5f;
-    if (std::abs(f) < 1e-6f) break;
-    const Vec3 g = blob.gradient(q);
-    const float g2 = glm::dot(g, g);
+    const float f = s.value - 0.5f;
+    const float g2 = glm::dot(s.gradient, s.gradient);
     if (!(g2 > 1e-20f)) break;
-    const Vec3 next = q - (f / g2) * g;
+    const Vec3 step = (f / g2) * s.gradient;
+    if (!(glm::length(step) > settle)) break;
+    const Vec3 next = q - step;
     if (!std::isfinite(next.x + next.y + next.z) || glm::length(next - p) > maxMove) break;
     q = next;
+    s = blob.sample(q);
   }
-  return paintedColor(blob.sample(q).attributes, q, textures, material);
+  return paintedColor(s.attributes, q, textures, material);
 }
 
 int atlasBlobPart(ExportPart& part, const blobtree::CompiledBlob& blob, const render::TextureTable& textures,

@@ -88,8 +88,9 @@ Vec3 paintedColor(const blobtree::Attributes& a, const Vec3& p, const render::Te
 
 /// The renderer's colour of a BlobTree's surface near p: p moved onto F = 0.5 by up to
 /// three Newton steps along ∇F (stopping before a step that would leave p by more than
-/// maxMove, e.g. the triangle's longest edge), the attributes sampled there and coloured
-/// by paintedColor.
+/// maxMove, e.g. the triangle's longest edge, and once a step would be shorter than
+/// maxMove/1000), the attributes sampled there and coloured by paintedColor. One
+/// CompiledBlob::sample per step.
 Vec3 blobSurfaceColor(const blobtree::CompiledBlob& blob, const Vec3& p, float maxMove, const render::TextureTable& textures,
                       const render::Material& material);
 
