@@ -2,6 +2,7 @@
 #   make test     build and run the whole test suite (ctest)
 #   make gallery  render every shipped species into gallery/out/
 #   make sanitize build with clang, AddressSanitizer and UBSan in build-asan/, run ctest there
+#                 (all but the tests labelled heavy and tagged [slow]: docs/ROBUSTNESS.md, "CI")
 #   make fuzz     build the libFuzzer targets (build-asan/fuzz/) and run each FUZZ_SECONDS
 BUILD   ?= build
 JOBS    ?= $(shell nproc)
@@ -51,7 +52,7 @@ bench: build
 sanitize: deps
 	@$(ASAN_CONFIG) >/dev/null
 	@cmake --build $(ASAN_BUILD) -j $(JOBS)
-	@cd $(ASAN_BUILD) && ctest --output-on-failure -j $(JOBS)
+	@cd $(ASAN_BUILD) && ctest --output-on-failure -j $(JOBS) -LE heavy
 
 fuzz: deps
 	@$(ASAN_CONFIG) >/dev/null
