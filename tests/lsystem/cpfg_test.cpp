@@ -562,6 +562,15 @@ TEST_CASE("cpfg predecessors of several modules in decomposition and homomorphis
     // A meets C at depth 0 and is drawn; C --> B at depth 1 does not make A B.
     CHECK(interpreted("axiom: AC\nhomomorphism\nmaximum depth: 2\nC --> B\nA B --> X\n") == "AB");
   }
+  SECTION("a query module in a homomorphism predecessor, first or later, is an error at it") {
+    CHECK(errorOf("axiom: A\nhomomorphism\nA ?P(x,y,z) --> F\n") ==
+          "t.l:3:3: cpfg's query module '?P' in an interpretation rule is not supported (its values would be lost with "
+          "the interpreted string)");
+  }
+  SECTION("homomorphism successors are not decomposed (cpfg's InterpretHomomorphism skips decomposition)") {
+    CHECK(interpreted("axiom: A\ndecomposition\nB --> X\nhomomorphism\nA --> B\n") == "B");
+    CHECK(derived("axiom: A\ndecomposition\nB --> X\nhomomorphism\nA --> B\n", 0) == "A");
+  }
 }
 
 TEST_CASE("cpfg's C preprocessor", "[lsystem][cpfg]") {
