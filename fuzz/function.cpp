@@ -1,17 +1,49 @@
-/// Fuzz target: cpfg's function file reader (lsystem::CpfgFunction::parse, both formats) and
-/// the evaluation of the function it makes, on any bytes.
+/// Fuzz target: the readers of cpfg's side files, which a view file names, on any bytes.
+/// The first byte picks the reader (its value modulo 4), the rest is the file:
+///   0  function file (lsystem::CpfgFunction::parse, both formats), then func(n, x) at a
+///      few arguments;
+///   1  curve file (CpfgCurve::parse), then curveX/Y/Z at a few lengths;
+///   2  contour file (CpfgContour::parse, every version), then its resampling at a few
+///      side counts;
+///   3  surface file (CpfgSurface::parse), tessellated at the file's precision, and at a
+///      view file's size and precisions.
 #include "fuzz/fuzz.h"
 #include <string>
 
 #include "core/diagnostics.h"
+#include "lsystem/cpfg_contour.h"
+#include "lsystem/cpfg_curve.h"
 #include "lsystem/cpfg_function.h"
+#include "lsystem/cpfg_surface.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-  if (size > sprig::fuzz::kMaxInput) return 0;
+  using namespace sprig::lsystem;
+  if (size < 1 || size > sprig::fuzz::kMaxInput) return 0;
+  const std::string text(sprig::fuzz::text(data + 1, size - 1));
   try {
-    const sprig::lsystem::CpfgFunction f =
-        sprig::lsystem::CpfgFunction::parse(std::string(sprig::fuzz::text(data, size)), "fuzz.func", -1);
-    for (double x : {0.0, 0.25, 0.5, 1.0}) (void)f.value(x);
+    switch (data[0] % 4) {
+      case 0: {
+        const CpfgFunction f = CpfgFunction::parse(text, "fuzz.func", -1);
+        for (double x : {0.0, 0.25, 0.5, 1.0}) (void)f.value(x);
+        break;
+      }
+      case 1: {
+        const CpfgCurve c = CpfgCurve::parse(text, "fuzz.crv", 20);
+        for (double t : {-1.0, 0.0, 0.3, 1.0, 2.0}) (void)c.atLength(t);
+        (void)c.point(1.0);
+        break;
+      }
+      case 2: {
+        const CpfgContour c = CpfgContour::parse(text, "fuzz.con");
+        for (int sides : {CpfgContour::kMinSides, CpfgContour::kDefaultSides, 37}) (void)c.sample(sides);
+        break;
+      }
+      default: {
+        (void)CpfgSurface::parse(text, "fuzz.s", 0.0, 0, 0);
+        (void)CpfgSurface::parse(text, "fuzz.s", 2.5, 3, 7);
+        break;
+      }
+    }
   } catch (const sprig::InputError&) {
   }
   return 0;

@@ -31,7 +31,17 @@ seed() {
     view)
       for f in tests/assets/cpfg/*/*.v; do cp "$f" "$dir/$(basename "$(dirname "$f")").v"; done ;;
     function)
-      cp tests/assets/cpfg/function/*.func "$dir"/ ;;
+      # The first byte picks the reader (fuzz/function.cpp): 0 function, 1 curve, 2 contour,
+      # 3 surface file.
+      for f in tests/assets/cpfg/*/*.func; do { printf '\x00'; cat "$f"; } >"$dir/$(basename "$f")"; done
+      for f in tests/assets/cpfg/curve/*.con; do { printf '\x01'; cat "$f"; } >"$dir/curve-$(basename "$f")"; done
+      for f in tests/assets/cpfg/contour/*.con; do { printf '\x02'; cat "$f"; } >"$dir/$(basename "$f")"; done
+      for f in tests/assets/cpfg/*/*.s grammars/vlab/*/*.s; do { printf '\x03'; cat "$f"; } >"$dir/$(basename "$(dirname "$f")")-$(basename "$f")"; done
+      # Two patches that name each other as neighbours (the connection check).
+      patch() { printf '%s\nTOP COLOR: 1 DIFFUSE: 0.5 BOTTOM COLOR: 2 DIFFUSE: 0.5\nAL: ~ A: ~ AR: ~\nL: %s R: %s\nBL: ~ B: ~ BR: ~\n' "$1" "$2" "$3"
+               for r in 0 1 2 3; do printf '%s 0 %s  %s 1 %s  %s 2 %s  %s 3 %s\n' $4 $r $4 $r $4 $r $4 $r; done; }
+      { printf '\x03-1 1 0 3 0 3\nCONTACT POINT X: 0 Y: 0 Z: 0\nEND POINT X: 0 Y: 3 Z: 0\nHEADING X: 0 Y: 1 Z: 0\nUP X: 0 Y: 0 Z: 1\nSIZE: 3\n'
+        patch left '~' right 0; patch right left '~' 1; } >"$dir/two_patches.s" ;;
     expression)
       for e in 't' 'x*0.9' 'sin(t)*x' 'max(0, 1 - t^2)' 'sqrt(x) + pow(t, 2) / 3' 'atan2(x, t) > 45 && t < 1' \
                'floor(x) == ceil(x) || !t' '-(-(-x))' 'min(t, max(x, 1e-3))' 'exp(log(t + 1))'; do
@@ -71,6 +81,7 @@ dict_of() {
   case $1 in
     grammar | derive) echo fuzz/dict/grammar.dict ;;
     view) echo fuzz/dict/view.dict ;;
+    function) echo fuzz/dict/cpfg_files.dict ;;
     expression) echo fuzz/dict/expression.dict ;;
     species_*) echo fuzz/dict/yaml.dict ;;
     polymesh) echo fuzz/dict/mesh.dict ;;

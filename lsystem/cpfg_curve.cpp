@@ -24,7 +24,8 @@ DVec3 CpfgCurve::point(double u) const {
     const ClampedBasis basis{n - 1};
     const double t = u * (n - 3.000001);
     DVec3 sum(0.0);
-    for (int k = 0; k < n; ++k) sum += points_[static_cast<size_t>(k)] * basis(k, 4, t);
+    const int first = basis.first(t);
+    for (int k = first; k < std::min(n, first + 4); ++k) sum += points_[static_cast<size_t>(k)] * basis(k, 4, t);
     return sum;
   }
   if (type_ == Type::Bezier) {

@@ -1,5 +1,6 @@
 #include "lsystem/cpfg_function.h"
 
+#include <algorithm>
 #include <cstdio>
 
 #include <charconv>
@@ -62,7 +63,8 @@ glm::dvec2 CpfgFunction::point(double d) const {
   const detail::ClampedBasis basis{n};
   const double u = d * (n - 2);
   glm::dvec2 sum(0.0);
-  for (int k = 0; k <= n; ++k) sum += points_[static_cast<size_t>(k)] * basis(k, 4, u);
+  const int first = basis.first(u);
+  for (int k = first; k <= std::min(n, first + 3); ++k) sum += points_[static_cast<size_t>(k)] * basis(k, 4, u);
   return sum;
 }
 

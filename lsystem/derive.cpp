@@ -151,9 +151,9 @@ class Writer {
 
 }  // namespace
 
-/// Decomposition recurses once per level: deeper than this (a `maximum depth` above it that
-/// the rules reach) is an error rather than a stack overflow.
-constexpr int kMaxDecompositionNesting = 256;
+/// Decomposition nested deeper than this (a `maximum depth` above it that the rules reach)
+/// is an error: the levels are kept on an explicit stack, one frame each (docs/GRAMMAR.md).
+constexpr int kMaxDecompositionNesting = 100000;
 
 /// Stream id of the random draws of cpfg's Start/StartEach/EndEach/End blocks (with the step).
 constexpr uint64_t kBlockStream = 0xfffffffffffe0000ull;
@@ -169,8 +169,6 @@ struct Deriver::Impl {
   uint64_t written = 0;
   ModuleString cur, next;
   std::vector<int32_t> match;  ///< bracket partner per module (context-sensitive grammars)
-  std::vector<std::vector<double>> scratch;  ///< successor parameters per decomposition depth
-  ModuleString oneScratch;                   ///< a one-module string for stochastic decomposition
   /// Where module-limit errors point: the grammar's `derivation length:` when it sets the
   /// number of steps, else its axiom, else just the file.
   Diagnostic limitAt;
@@ -247,18 +245,37 @@ struct Deriver::Impl {
     // Interpretation recursion: depth 1 is one rewrite; deeper levels rewrite what the
     // previous level produced (modules no rule matches stay as they are).
     const RuleSet& rs = prog->interpretation;
+    // With predecessors of several modules, matching follows cpfg's depth-first recursion
+    // (interpret.c, InterpretHomomorphism): at a deeper level such a predecessor matches
+    // only modules of one successor, and a module no rule matched is drawn as it is, never
+    // rewritten at a later level. Each module then carries the successor it belongs to.
+    const bool multi = std::any_of(rs.productions.begin(), rs.productions.end(), [](const Production& p) { return !p.predRest.empty(); });
+    std::vector<uint32_t> segIn, segOut;
+    if (multi) {
+      segIn.assign(tmp.cur.size(), 0);
+      tmp.segIn = &segIn;
+      tmp.segOut = &segOut;
+    }
     for (int depth = 0; depth < rs.maxDepth; ++depth) {
       bool any = false;
-      for (SymbolId id : tmp.cur.symbols)
-        if (!rs.bySymbol[id].empty()) {
+      for (size_t i = 0; i < tmp.cur.size(); ++i)
+        if (!rs.bySymbol[tmp.cur.symbols[i]].empty() && (!multi || segIn[i] != kFrozen)) {
           any = true;
           break;
         }
       if (!any) break;
       tmp.rewrite(rs, step, kInterpretStream - static_cast<uint64_t>(depth), false);
+      if (multi) std::swap(segIn, segOut);
     }
     return std::move(tmp.cur);
   }
+
+  /// Interpretation with predecessors of several modules (interpreted()): the successor
+  /// each module of cur belongs to (kFrozen: a module no rule matched), and the same for
+  /// the string rewrite() writes.
+  static constexpr uint32_t kFrozen = std::numeric_limits<uint32_t>::max();
+  const std::vector<uint32_t>* segIn = nullptr;
+  std::vector<uint32_t>* segOut = nullptr;
 
   /// cpfg's global variables (Program::globals), kMaxVars registers.
   std::vector<double> globals;
@@ -461,6 +478,7 @@ struct Deriver::Impl {
       size_t j = i + 1;
       for (const PatternItem& it : p.predRest) {
         if (j >= s.size() || s.symbols[j] != it.symbol || s.paramCount(j) != it.paramCount) return false;
+        if (segIn && &s == &cur && (*segIn)[j] != (*segIn)[i]) return false;  // another successor's module
         bind(s, j, it.firstVar, it.paramCount, vars);
         ++j;
       }
@@ -623,53 +641,106 @@ struct Deriver::Impl {
     }
   }
 
-  /// Writes p's successor (decomposing it when the grammar has decomposition rules).
-  void emit(Writer& w, const Production& p, const double* vars, int32_t birth, int step, int depth) {
-    if (prog->decomposition.empty()) {
+  /// Writes p's successor, decomposed when `decompose` (a derivation step of a grammar with
+  /// decomposition rules; cpfg does not decompose the successors of interpretation rules).
+  void emit(Writer& w, const Production& p, const double* vars, int32_t birth, int step, bool decompose) {
+    if (!decompose) {
       emitPlain(w, p, vars, birth, step);
       return;
     }
-    if (scratch.size() <= static_cast<size_t>(depth)) scratch.resize(depth + 1);
+    decompStack.clear();
+    decompFrames.clear();
+    pushSuccessor(p, vars, step, 0);
+    decomposeFrames(w, birth, step, 0);
+  }
+
+  // ---- decomposition ----------------------------------------------------------------------
+  //
+  // cpfg's decomposition (generate.c, ApplyRecursiveProductions), depth first and without
+  // recursion: each module of a successor is matched against the decomposition rules (a
+  // predecessor of several modules matches the modules after it in the same successor, and
+  // replaces them all); a rule's successor is decomposed in turn, one level deeper, up to
+  // `maximum depth`; a module no rule matches, or one at maximum depth, is written as it
+  // is. The successors being decomposed are kept on an explicit stack (decompStack, one
+  // frame per level, each frame's modules after its parent's), so the depth is bounded by
+  // kMaxDecompositionNesting and memory, not by the C++ stack.
+
+  /// A successor being decomposed: its modules [begin, end) of decompStack, the next one at pos.
+  struct DecompFrame {
+    size_t begin, end, pos;
+  };
+  ModuleString decompStack;
+  std::vector<DecompFrame> decompFrames;
+
+  /// Appends p's successor (evaluated with vars) to decompStack as a new frame, whose
+  /// modules are at depth `depth` (the decomposition rules applied on the way to them).
+  void pushSuccessor(const Production& p, const double* vars, int step, int depth) {
+    const size_t begin = decompStack.size();
+    if (depth > kMaxDecompositionNesting)
+      throw InputError(p.loc, "decomposition nested deeper than " + std::to_string(kMaxDecompositionNesting) +
+                                  " levels at step " + std::to_string(step) + " (maximum depth " +
+                                  std::to_string(prog->decomposition.maxDepth) + "): not supported",
+                       p.sourceLine);
     for (const SuccModule& m : p.successor) {
-      std::vector<double>& tmp = scratch[depth];
-      tmp.resize(m.argCount);
-      for (int k = 0; k < m.argCount; ++k) tmp[k] = evalArg(p, m, k, vars, step);
-      emitDecomposed(w, m.symbol, tmp.data(), m.argCount, birth, step, depth);
+      decompStack.symbols.push_back(m.symbol);
+      for (int k = 0; k < m.argCount; ++k) decompStack.params.push_back(evalArg(p, m, k, vars, step));
+      decompStack.offsets.push_back(static_cast<uint32_t>(decompStack.params.size()));
+    }
+    decompFrames.push_back({begin, decompStack.size(), begin});
+  }
+
+  /// Decomposes the frames on the stack (the bottom one at depth base) into w until the
+  /// stack is empty. Frame k of decompFrames is at depth base + k.
+  void decomposeFrames(Writer& w, int32_t birth, int step, int base) {
+    const RuleSet& rs = prog->decomposition;
+    double vars[detail::kMaxVars];
+    loadGlobals(vars);
+    while (!decompFrames.empty()) {
+      DecompFrame& f = decompFrames.back();
+      if (f.pos >= f.end) {
+        // Done with this successor: drop its modules (the top frame's are the last).
+        decompStack.symbols.resize(f.begin);
+        decompStack.offsets.resize(f.begin + 1);
+        decompStack.params.resize(decompStack.offsets[f.begin]);
+        decompFrames.pop_back();
+        continue;
+      }
+      const size_t i = f.pos;
+      const int depth = base + static_cast<int>(decompFrames.size()) - 1;
+      const Production* p = depth < rs.maxDepth && !rs.bySymbol[decompStack.symbols[i]].empty()
+                                ? choose(rs, decompStack, i, vars, step)
+                                : nullptr;
+      if (!p) {
+        const uint32_t count = decompStack.paramCount(i);
+        w.reserve(1, count);
+        w.copy(decompStack.symbols[i], decompStack.params.data() + decompStack.offsets[i], count, birth);
+        ++f.pos;
+        continue;
+      }
+      f.pos += 1 + p->predRest.size();  // f is not used past this point: the push may move it
+      pushSuccessor(*p, vars, step, depth + 1);
     }
   }
 
-  /// Writes one module, replacing it by its decomposition (recursively, up to maximum depth).
-  void emitDecomposed(Writer& w, SymbolId sym, const double* params, uint32_t count, int32_t birth, int step, int depth) {
+  /// Writes module i of s (the string being rewritten, which no production changed at i)
+  /// decomposed: a decomposition rule's predecessor of several modules matches the modules
+  /// of s after i, as cpfg's does. Returns the number of modules after i it replaced.
+  size_t emitDecomposed(Writer& w, const ModuleString& s, size_t i, int32_t birth, int step) {
     const RuleSet& rs = prog->decomposition;
-    if (depth < rs.maxDepth && !rs.bySymbol[sym].empty()) {
-      double vars[detail::kMaxVars];
-      loadGlobals(vars);
-      for (uint32_t idx : rs.bySymbol[sym]) {
-        const Production& p = rs.productions[idx];
-        if (count != p.predParams) continue;
-        for (uint32_t k = 0; k < count; ++k) vars[p.predFirstVar + k] = params[k];
-        if (!condition(p, vars, step)) continue;
-        if (depth >= kMaxDecompositionNesting)
-          throw InputError(p.loc, "decomposition nested deeper than " + std::to_string(kMaxDecompositionNesting) +
-                                      " levels at step " + std::to_string(step) + " (maximum depth " +
-                                      std::to_string(rs.maxDepth) + "): not supported",
-                           p.sourceLine);
-        // Stochastic decomposition rules: weighted choice among the matching ones.
-        const Production* chosen = &p;
-        if (!p.stochastic) afterStatements(p, vars, step);
-        if (p.stochastic) {
-          ModuleString& one = oneScratch;
-          one.clear();
-          one.push(sym, {params, count});
-          chosen = choose(rs, one, 0, vars, step);
-          if (!chosen) break;
-        }
-        emit(w, *chosen, vars, birth, step, depth + 1);
-        return;
-      }
+    double vars[detail::kMaxVars];
+    loadGlobals(vars);
+    const Production* p = rs.maxDepth > 0 && !rs.bySymbol[s.symbols[i]].empty() ? choose(rs, s, i, vars, step) : nullptr;
+    if (!p) {
+      const uint32_t count = s.paramCount(i);
+      w.reserve(1, count);
+      w.copy(s.symbols[i], s.params.data() + s.offsets[i], count, birth);
+      return 0;
     }
-    w.reserve(1, count);
-    w.copy(sym, params, count, birth);
+    decompStack.clear();
+    decompFrames.clear();
+    pushSuccessor(*p, vars, step, 1);
+    decomposeFrames(w, birth, step, 1);
+    return p->predRest.size();
   }
 
   // ---- steps ----------------------------------------------------------------------------
@@ -794,7 +865,7 @@ struct Deriver::Impl {
       const Production* p = rs.rules[sym].count == 0 ? nullptr : choose(rs, in, i, vars, step);
       size_t last = i;
       if (p) {
-        emit(w, *p, vars, step, step, 0);
+        emit(w, *p, vars, step, step, false);
         last = i + p->predRest.size();
       } else {
         const uint32_t count = in.paramCount(i);
@@ -823,6 +894,10 @@ struct Deriver::Impl {
     const size_t n = in.size();
     const bool births = opt.trackBirthSteps;
     const bool decompose = !prog->decomposition.empty() && productionStep;
+    // Each module through the general path below: decomposition, or successors tracked.
+    const bool general = decompose || segIn;
+    if (segOut) segOut->clear();
+    uint32_t segments = 0;
     const SymbolId* syms = in.symbols.data();
     const uint32_t* offs = in.offsets.data();
     const double* pars = in.params.data();
@@ -834,7 +909,7 @@ struct Deriver::Impl {
     // derive/crash-0836...).
     if (rs.anyContext || !rs.dispatches.empty()) computeBrackets(in);
     choices.clear();
-    auto [reserveModules, reserveParams] = decompose ? std::pair<size_t, size_t>{0, 0} : sizePass(rs, step);
+    auto [reserveModules, reserveParams] = general ? std::pair<size_t, size_t>{0, 0} : sizePass(rs, step);
     Writer w(next, births, opt.maxModules, limitAt, step, reserveModules, reserveParams);
     double vars[detail::kMaxVars];
     loadGlobals(vars);
@@ -844,11 +919,11 @@ struct Deriver::Impl {
       SymbolId sym = syms[i];
       int32_t birth = births ? in.birthSteps[i] : 0;
       const detail::SymbolRules& r = rules[sym];
-      if (r.count == 0 && !decompose) {
+      if (r.count == 0 && !general) {
         i = copyUntouched(w, rules, i);
         continue;
       }
-      if (r.simple && !decompose) {
+      if (r.simple && !general) {
         const Production& p = *r.simple;
         uint32_t count = offs[i + 1] - offs[i];
         if (count == p.predParams) {
@@ -862,7 +937,7 @@ struct Deriver::Impl {
           continue;
         }
       }
-      if (r.dispatch >= 0 && !decompose && offs[i + 1] == offs[i]) {
+      if (r.dispatch >= 0 && !general && offs[i + 1] == offs[i]) {
         int32_t idx = choices[nextChoice++];
         if (idx < 0) {
           w.reserve(1, 0);
@@ -875,19 +950,22 @@ struct Deriver::Impl {
       rngReady = false;
       rngItem = i;
       leftCached = rightCached = false;
-      const Production* p = r.count == 0 ? nullptr : choose(rs, in, i, vars, step);
+      const size_t before = w.modules();
+      const Production* p = r.count == 0 || (segIn && (*segIn)[i] == kFrozen) ? nullptr : choose(rs, in, i, vars, step);
       if (!p) {
         if (decompose && productionStep) {
-          emitDecomposed(w, sym, pars + offs[i], offs[i + 1] - offs[i], birth, step, 0);
+          i += emitDecomposed(w, in, i, birth, step);
         } else {
           uint32_t count = offs[i + 1] - offs[i];
           w.reserve(1, count);
           w.copy(sym, pars + offs[i], count, birth);
         }
+        if (segOut) segOut->insert(segOut->end(), w.modules() - before, kFrozen);
         continue;
       }
-      emit(w, *p, vars, productionStep ? step : birth, step, 0);
+      emit(w, *p, vars, productionStep ? step : birth, step, decompose);
       i += p->predRest.size();  // a predecessor of several modules replaces them all
+      if (segOut) segOut->insert(segOut->end(), w.modules() - before, segments++);
     }
     w.finish();
     written += w.modules();

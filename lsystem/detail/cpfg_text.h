@@ -2,6 +2,8 @@
 /// Pieces shared by the readers of cpfg's data files (function, curve and contour files):
 /// the words of a line with their columns, and cpfg's clamped B-spline basis.
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -35,6 +37,12 @@ inline std::vector<Word> wordsOf(const std::string& s, size_t from = 0) {
 struct ClampedBasis {
   int n;
   int knot(int j) const { return j < 4 ? 0 : j > n ? n - 2 : j - 3; }
+  /// The first k whose N_{k,4}(u) may be nonzero: only k to k + 3 are (at u in [m, m + 1),
+  /// points m to m + 3), so an evaluation costs 4 basis functions, not n + 1.
+  int first(double u) const {
+    const double m = std::floor(u);
+    return m <= 0 || !(m == m) ? 0 : m >= n - 3 ? std::max(n - 3, 0) : static_cast<int>(m);
+  }
   double operator()(int k, int t, double u) const {
     if (t == 1) return knot(k) <= u && u < knot(k + 1) ? 1.0 : 0.0;
     double sum = 0;

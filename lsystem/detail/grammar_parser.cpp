@@ -740,20 +740,16 @@ class GrammarParser {
       error(line, pred.b, "a predecessor must be a single module");
       return;
     }
-    if (predMods.size() > 1 && block != Block::Main) {
-      error(line, predMods[1].col, std::string("a predecessor of several modules is not allowed in ") + blockName(block) +
-                                       " rules (only in productions)");
-      return;
-    }
     for (const RawModule& m : predMods)
       if (m.name == "[" || m.name == "]") {
         error(line, m.col, "a bracket cannot be a predecessor");
         return;
       }
-    if (block == Block::Interpretation && isQuery(predMods[0].name)) {
-      error(line, predMods[0].col, queryInInterpretation(predMods[0].name));
-      return;
-    }
+    for (const RawModule& m : predMods)
+      if (block == Block::Interpretation && isQuery(m.name)) {
+        error(line, m.col, queryInInterpretation(m.name));
+        return;
+      }
     // Contexts (textual order: left, predecessor, right).
     lc = scanner_.trim(lc);
     rc = scanner_.trim(rc);

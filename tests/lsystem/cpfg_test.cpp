@@ -402,14 +402,30 @@ TEST_CASE("cpfg consider: with brackets; maximum depth beyond 256", "[lsystem][c
           "support (it always follows them): list them, as in 'consider: BA[]'");
     CHECK(errorOf("consider: BA\naxiom: A\n", "t.lsys") == "no error");  // Sprig's notation: brackets always followed
   }
-  SECTION("maximum depth 1000 is read; decomposition nested deeper than 256 levels is an error") {
+  SECTION("decomposition 5000 levels deep (vlab's Ridley needs 3000)") {
+    // B(n) --> F B(n - 1) nests one level per F: B(5000) ends as 5000 F and B(0), which no
+    // rule matches, at depth 5000 <= maximum depth.
+    Grammar g = parseGrammar("axiom: A(5000)\nA(n) --> B(n)\ndecomposition\nmaximum depth: 6000\nB(n) : n > 0 --> F B(n - 1)\n", "t.l");
+    Deriver d(g, DeriveOptions{.steps = 1});
+    const ModuleString& s = d.derive();
+    REQUIRE(s.size() == 5001);
+    CHECK(formatModuleString(s, d.symbols()) == std::string(5000, 'F') + "B(0)");
+    // maximum depth 4000 stops there: 4000 F and B(1000), not decomposed further.
+    Grammar g4 = parseGrammar("axiom: A(5000)\nA(n) --> B(n)\ndecomposition\nmaximum depth: 4000\nB(n) : n > 0 --> F B(n - 1)\n", "t.l");
+    Deriver d4(g4, DeriveOptions{.steps = 1});
+    CHECK(formatModuleString(d4.derive(), d4.symbols()) == std::string(4000, 'F') + "B(1000)");
+  }
+  SECTION("decomposition nested deeper than 100000 levels is an error") {
     CHECK(derived("axiom: A\nA --> B\ndecomposition\nmaximum depth: 1000\nB --> CD\n", 1) == "CD");
+    // C --> FC nests without end: 1000 levels at maximum depth 1000; past 100000, an error.
+    CHECK(derived("axiom: C\ndecomposition\nmaximum depth: 1000\nC --> FC\n", 0) == std::string(1000, 'F') + "C");
     try {
-      derived("derivation length: 1\naxiom: A\ndecomposition\nmaximum depth: 1000\nA --> FA\n", 1);
+      derived("derivation length: 1\naxiom: A\ndecomposition\nmaximum depth: 1000000\nA --> FA\n", 1);
       FAIL("no error");
     } catch (const InputError& e) {
+      CHECK(e.diagnostics().front().loc.line == 5);
       CHECK(e.diagnostics().front().message ==
-            "decomposition nested deeper than 256 levels at step 0 (maximum depth 1000): not supported");
+            "decomposition nested deeper than 100000 levels at step 0 (maximum depth 1000000): not supported");
     }
   }
 }
@@ -494,6 +510,66 @@ TEST_CASE("cpfg predecessors of several modules", "[lsystem][cpfg]") {
   SECTION("stochastic choice among predecessors of different lengths counts each once") {
     Grammar g = parseGrammar("derivation length: 1\nseed: 3\naxiom: AB\nA B --> X : 1\nA --> Y : 0\n", "t.l");
     CHECK(formatModuleString(derive(g), g.symbols()) == "X");
+  }
+}
+
+TEST_CASE("cpfg predecessors of several modules in decomposition and homomorphism", "[lsystem][cpfg]") {
+  // cpfg (generate.c ApplyRecursiveProductions, interpret.c InterpretHomomorphism): the
+  // rule's modules match the modules after the first in the string being decomposed or
+  // interpreted (a successor, or at depth 0 the L-system string itself) and are all
+  // replaced; a successor's end ends the match.
+  auto interpreted = [](const std::string& text) {
+    Grammar g = parseGrammar(text, "t.l");
+    Deriver d(g);
+    return formatModuleString(d.interpret(d.derive()), d.symbols());
+  };
+  SECTION("decomposition: inside a production's successor") {
+    // S --> A B C A D; A B matches at 0 (X), C stays, the second A is followed by D: Y.
+    CHECK(derived("axiom: S\nS --> ABCAD\ndecomposition\nA B --> X\nA --> Y\n", 1) == "XCYD");
+    CHECK(derived("axiom: S\nS --> A(1)B(2)\ndecomposition\nA(x) B(y) --> C(x + y)\n", 1) == "C(3)");
+  }
+  SECTION("decomposition: a successor's end ends the match") {
+    // S --> A and T --> B are two successors: A is the whole of the first.
+    CHECK(derived("axiom: ST\nS --> A\nT --> B\ndecomposition\nA B --> X\n", 1) == "AB");
+  }
+  SECTION("decomposition: a module no production rewrites matches the string after it, whose modules it consumes") {
+    // The axiom: A B --> X(1), C stays.
+    CHECK(derived("axiom: ABC\ndecomposition\nA B --> X(1)\n", 0) == "X(1)C");
+    // Step 1: A meets C(1) (the string before rewriting), n = 1: no match; C(1) --> C(2).
+    // Step 2: A meets C(2): X, and C(2) is consumed (its production does not apply).
+    const std::string g = "axiom: AC(1)\nC(n) --> C(n + 1)\ndecomposition\nA C(n) : n > 1 --> X\n";
+    CHECK(derived(g, 1) == "AC(2)");
+    CHECK(derived(g, 2) == "X");
+  }
+  SECTION("decomposition: recursively, up to maximum depth") {
+    // S --> A B (depth 1) --> C D (depth 2) --> E D (depth 3).
+    const std::string rules = "S --> AB\nA B --> CD\nC --> E\n";
+    CHECK(derived("axiom: S\ndecomposition\nmaximum depth: 3\n" + rules, 0) == "ED");
+    CHECK(derived("axiom: S\ndecomposition\nmaximum depth: 2\n" + rules, 0) == "CD");
+    CHECK(derived("axiom: S\ndecomposition\n" + rules, 0) == "AB");
+  }
+  SECTION("homomorphism: at depth 0 over the whole string") {
+    CHECK(interpreted("axiom: ABABC\nhomomorphism\nA B --> F\n") == "FFC");
+    CHECK(interpreted("axiom: A(1)B(2)\nhomomorphism\nA(x) B(y) --> F(x * y)\n") == "F(2)");
+  }
+  SECTION("homomorphism: inside one successor, recursively") {
+    CHECK(interpreted("axiom: S\nhomomorphism\nmaximum depth: 2\nS --> ABG\nA B --> X\n") == "XG");
+    CHECK(interpreted("axiom: S\nhomomorphism\nS --> ABG\nA B --> X\n") == "ABG");
+  }
+  SECTION("homomorphism: a successor's end ends the match; a module drawn is not rewritten later") {
+    // P --> A and Q --> B are two successors.
+    CHECK(interpreted("axiom: PQ\nhomomorphism\nmaximum depth: 2\nP --> A\nQ --> B\nA B --> X\n") == "AB");
+    // A meets C at depth 0 and is drawn; C --> B at depth 1 does not make A B.
+    CHECK(interpreted("axiom: AC\nhomomorphism\nmaximum depth: 2\nC --> B\nA B --> X\n") == "AB");
+  }
+  SECTION("a query module in a homomorphism predecessor, first or later, is an error at it") {
+    CHECK(errorOf("axiom: A\nhomomorphism\nA ?P(x,y,z) --> F\n") ==
+          "t.l:3:3: cpfg's query module '?P' in an interpretation rule is not supported (its values would be lost with "
+          "the interpreted string)");
+  }
+  SECTION("homomorphism successors are not decomposed (cpfg's InterpretHomomorphism skips decomposition)") {
+    CHECK(interpreted("axiom: A\ndecomposition\nB --> X\nhomomorphism\nA --> B\n") == "B");
+    CHECK(derived("axiom: A\ndecomposition\nB --> X\nhomomorphism\nA --> B\n", 0) == "A");
   }
 }
 

@@ -147,7 +147,6 @@ TEST_CASE("parseGrammar errors: exact messages and positions", "[lsystem]") {
       {"maximum depth: 2\naxiom: F\n", "g.lsys:1:1: error: 'maximum depth:' belongs in a 'decomposition:' or 'interpretation:' block"},
       {"axiom: F\ndecomposition:\nmaximum depth: 0\n", "g.lsys:3:16: error: maximum depth must be a whole number from 1 to 1000000, got 0"},
       {"axiom: F\n --> F\n", "g.lsys:2:2: error: missing predecessor before '-->'"},
-      {"axiom: F\ninterpretation:\nAB --> F\n", "g.lsys:3:2: error: a predecessor of several modules is not allowed in interpretation rules (only in productions)"},
       {"axiom: F\n[ --> F\n", "g.lsys:2:1: error: a bracket cannot be a predecessor"},
       {"axiom: F\ndecomposition:\nA < B --> F\n", "g.lsys:3:1: error: context is not allowed in decomposition rules"},
       {"axiom: F\ninterpretation:\nB > A --> F\n", "g.lsys:3:5: error: context is not allowed in interpretation rules"},
