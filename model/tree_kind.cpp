@@ -193,6 +193,9 @@ render::Geometry surfaceGeometry(const TreeSurface& tree, const SpeciesRender& l
       bo.furrowColor = b.furrowColor.value_or(wood * 0.3f);
       bo.youngColor = b.youngColor.value_or(bo.ridgeColor);
       if (b.lenticelColor) bo.lenticelColor = *b.lenticelColor;
+      if (b.peelColor) bo.peelColor = *b.peelColor;
+      // Peeling patches as wide around as they are long, in world units, when ridges have a width.
+      if (b.ridgeWidth > 0) bo.peelPerRidge = bo.peelFrequency * std::abs(b.vScale) * b.ridgeWidth;
       bo.furrows = c.furrows;
       bo.maturity = c.maturity;
       auto bark = std::make_shared<textures::BarkTexture>(bo);
@@ -209,7 +212,10 @@ render::Geometry surfaceGeometry(const TreeSurface& tree, const SpeciesRender& l
     ridge.relief = b.ridgeRelief;
     ridge.wanderScale = b.ridgeWidth > 0 ? 0.5 / b.ridgeWidth : ridge.wanderScale;  // one wave per two ridges
     ridge.seed = tree.options.seed;
-    wood.ridge = textures::RidgeShade(ridge);
+    std::shared_ptr<const textures::RidgeArcs> arcs;
+    if (b.enabled && (b.ridgeArc.darkening > 0 || b.ridgeArc.relief > 0))
+      arcs = std::make_shared<const textures::RidgeArcs>(organisms::ridgeArcs(tree.blob), b.ridgeArc);
+    wood.ridge = textures::RidgeShade(ridge, std::move(arcs));
   }
   render::Geometry out;
   if (mesh)
@@ -365,7 +371,8 @@ class TreeModel final : public KindModel {
     // per girth (several classes, each cone coloured in its own coordinates and the colours
     // blended) or darkened PCM seams, the wood keeps the renderer's vertex colours.
     const uint16_t barkId = static_cast<uint16_t>(tree.options.bark.texture);
-    const bool oneBark = tree.blob.barkClasses.size() == 1 && !(tree.options.bark.ridgeDarkening > 0);  // (relief is shading only)
+    const bool oneBark = tree.blob.barkClasses.size() == 1 && !(tree.options.bark.ridgeDarkening > 0) &&
+                         !(tree.options.bark.ridgeArc.darkening > 0);  // (relief is shading only)
     if (tree.options.bark.enabled && oneBark && barkId < implicit.textures.size() && parts[0].mesh.triangleCount() > 0) {
       const render::ColorTexture& bark = implicit.textures[barkId];
       textureBark(parts[0], [&bark](Vec2 uv) { return bark(uv, Vec3(0.0f)); });
@@ -729,6 +736,13 @@ organisms::TreeOptions readTreeOptions(const YNode& section, DiagnosticList& dia
     o.bark.ridgeDarkening = p.number("ridge_darkening", o.bark.ridgeDarkening, 0.0, 1.0);
     o.bark.ridgeLines = static_cast<int>(p.integer("ridge_lines", o.bark.ridgeLines, 0, 64));
     o.bark.ridgeRelief = p.number("ridge_relief", o.bark.ridgeRelief, 0.0, 4.0);
+    textures::RidgeArcOptions& arc = o.bark.ridgeArc;
+    arc.darkening = p.number("ridge_arc", arc.darkening, 0.0, 1.0);
+    arc.relief = p.number("ridge_arc_relief", arc.relief, 0.0, 4.0);
+    arc.rise = p.number("ridge_arc_rise", arc.rise, -10.0, 10.0);
+    arc.droop = p.number("ridge_arc_droop", arc.droop, 0.0, 10.0);
+    arc.spread = p.number("ridge_arc_spread", arc.spread, 0.1, 20.0);
+    arc.width = p.number("ridge_arc_width", arc.width, 0.01, 5.0);
     textures::BarkOptions& b = o.bark.pattern;
     b.furrows = static_cast<int>(p.integer("furrows", b.furrows, 1, 1000));
     b.warp = p.number("warp", b.warp, 0.0, 100.0);
@@ -739,6 +753,9 @@ organisms::TreeOptions readTreeOptions(const YNode& section, DiagnosticList& dia
     b.maturity = p.number("maturity", b.maturity, 0.0, 1.0);
     b.lenticels = p.number("lenticels", b.lenticels, 0.0, 1.0);
     b.lenticelFrequency = p.number("lenticel_frequency", b.lenticelFrequency, 0.0, 1e4);
+    b.braid = p.number("braid", b.braid, -1e3, 1e3);
+    b.peel = p.number("peel", b.peel, 0.0, 1.0);
+    b.peelFrequency = p.number("peel_frequency", b.peelFrequency, 1e-3, 1e4);
     auto optColor = [&p, &diags](std::string_view key) -> std::optional<Vec3> {
       auto n = p.get(key);
       if (!n) return std::nullopt;
@@ -748,6 +765,7 @@ organisms::TreeOptions readTreeOptions(const YNode& section, DiagnosticList& dia
     o.bark.furrowColor = optColor("furrow_color");
     o.bark.youngColor = optColor("young_color");
     o.bark.lenticelColor = optColor("lenticel_color");
+    o.bark.peelColor = optColor("peel_color");
     p.finish();
   }
   if (auto s = m.section("leaves")) {

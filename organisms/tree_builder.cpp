@@ -167,6 +167,43 @@ TreeBlob buildTreeBlob(const lsystem::Skeleton& skeleton, const TreeOptions& opt
   return out;
 }
 
+std::vector<textures::RidgeArc> ridgeArcs(const TreeBlob& blob) {
+  std::vector<textures::RidgeArc> out;
+  const std::vector<ConePart>& parts = blob.plan.parts;
+  auto direction = [](const ConePart& p) {
+    const DVec3 chord = p.end - p.start;
+    const double len = glm::length(chord);
+    if (!(len > 0)) return DVec3(0.0);
+    // A bent cone leaves its start along the chord turned by the bend angle toward the bow.
+    return std::cos(p.bendAngle) * (chord / len) + std::sin(p.bendAngle) * p.bendToward;
+  };
+  for (const Junction& j : blob.plan.junctions) {
+    if (j.branches.size() < 2 || j.basal < 0) continue;
+    const ConePart& basal = parts[static_cast<size_t>(j.basal)];
+    const DVec3 up = direction(basal);
+    int32_t leader = -1;
+    double best = -2;
+    for (int32_t b : j.branches) {
+      const double c = glm::dot(direction(parts[static_cast<size_t>(b)]), up);
+      if (c > best) best = c, leader = b;
+    }
+    const ConePart& lead = parts[static_cast<size_t>(leader)];
+    const DVec3 axis = direction(lead);
+    for (int32_t b : j.branches) {
+      if (b == leader) continue;
+      const ConePart& branch = parts[static_cast<size_t>(b)];
+      textures::RidgeArc arc;
+      arc.point = Vec3(j.point);
+      arc.parentAxis = Vec3(axis);
+      arc.branchAxis = Vec3(direction(branch));
+      arc.parentRadius = static_cast<float>(std::max(basal.endRadius, lead.startRadius));
+      arc.branchRadius = static_cast<float>(branch.startRadius);
+      out.push_back(arc);
+    }
+  }
+  return out;
+}
+
 CurveSet treeAxes(const TreeBlob& blob) {
   CurveSet out;
   constexpr int kArcSegments = 4;

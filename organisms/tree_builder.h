@@ -22,6 +22,7 @@
 #include "lsystem/skeleton.h"
 #include "organisms/tree_options.h"
 #include "organisms/tree_plan.h"
+#include "textures/ridge.h"
 
 namespace sprig::organisms {
 
@@ -50,6 +51,13 @@ TreeBlob buildTreeBlob(const lsystem::Skeleton& skeleton, const TreeOptions& opt
 /// a minimum pixel width where the cones are thinner than a pixel. Pruned parts and stubs
 /// are left out. O(parts).
 CurveSet treeAxes(const TreeBlob& blob);
+
+/// The branch bark ridge arcs of the tree (textures::RidgeArcs): one per branch that leaves
+/// a junction beside its leader (the branch closest in direction to the basal internode),
+/// on the leader's bark above P, with the leader's direction and the larger of A's and the
+/// leader's radius at P, and the branch's start tangent and base radius. Stubs (scars)
+/// keep theirs: the ridge outlives the branch. O(parts).
+std::vector<textures::RidgeArc> ridgeArcs(const TreeBlob& blob);
 
 /// Leaf geometry for the skeleton's organs: polygons `{ . }` are fan-triangulated, spheres
 /// become small UV spheres, named surfaces `~` become an ovate leaf blade in the turtle frame

@@ -9,6 +9,7 @@
 
 #include "core/types.h"
 #include "textures/procedural.h"
+#include "textures/ridge.h"
 
 namespace sprig::organisms {
 
@@ -96,10 +97,14 @@ struct BarkOptions {
   /// Shading relief of the ridge (textures::RidgeOptions::relief: the normal tilts by a
   /// slope of 1.5·ridgeRelief on the crest's flanks); 0: none. The geometry stays PCM's.
   double ridgeRelief = 0.0;
+  /// The branch bark ridge as an arc over each branch beside a leader, curving down both
+  /// sides of it (organisms::ridgeArcs, textures::RidgeArcs); off while darkening and
+  /// relief are 0. Shading and colour only: the geometry stays PCM's.
+  textures::RidgeArcOptions ridgeArc;
   /// The pattern (furrows, warp, colors, lenticels, ...); furrows and maturity are replaced
   /// per class as above. Colors left unset take the wood color (furrows 0.3 of it).
   textures::BarkOptions pattern;
-  std::optional<Vec3> ridgeColor, furrowColor, youngColor, lenticelColor;
+  std::optional<Vec3> ridgeColor, furrowColor, youngColor, lenticelColor, peelColor;
 };
 
 /// One bark class: the furrow count and age shared by the cones of similar girth.

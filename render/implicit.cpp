@@ -163,12 +163,11 @@ uint32_t Scene::addPolygonized(const blobtree::PolygonizeResult& result, uint32_
   Mesh mesh = result.mesh;
   const Material& m = impl_->materials[material];
   // The ridge's relief tilts the vertex normals as it tilts exact hits' (Scene::intersect).
-  if (m.ridge.options().relief > 0 && mesh.normals.size() == mesh.positions.size() &&
+  if (m.ridge.tilts() && mesh.normals.size() == mesh.positions.size() &&
       result.attributes.size() == mesh.positions.size())
     for (size_t i = 0; i < mesh.positions.size(); ++i) {
       const blobtree::Attributes& a = result.attributes[i];
-      if (a.contact > 0)
-        mesh.normals[i] = m.ridge.shadingNormal(mesh.normals[i], a.contact, a.contactGradient, mesh.positions[i]);
+      mesh.normals[i] = m.ridge.shadingNormal(mesh.normals[i], a.contact, a.contactGradient, mesh.positions[i]);
     }
   const size_t count = textureCount == kAllTextures ? impl_->textures.size() : textureCount;
   if (count > 0 && result.attributes.size() == mesh.positions.size()) {

@@ -378,7 +378,7 @@ std::optional<SurfaceHit> Scene::intersect(const Vec3& origin, const Vec3& direc
     hit.position = ih.point;
     hit.normal = hit.geometricNormal = ih.normal;
     const Material& m = impl_->materials[hit.material];
-    if (ih.attributes.contact > 0)
+    if (m.ridge.tilts())
       hit.normal = m.ridge.shadingNormal(ih.normal, ih.attributes.contact, ih.attributes.contactGradient, ih.point);
     hit.color = attributeColor(ih.attributes, ih.point, impl_->materials[hit.material], rec.textureBase,
                                rec.textureCount);

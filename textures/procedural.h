@@ -75,6 +75,17 @@ class NoiseTexture : public SeededTexture<NoiseColorOptions> {
 /// (one cell per ridge width around, lenticelFrequency rows per unit of v; the cell index
 /// around is taken modulo furrows, so they too close at u = 1), present in a fraction
 /// `lenticels` of the cells, darkening the bark by (1 − m).
+///
+/// Braided bark (`braid` ≠ 0): a second set of furrows, drifting the other way (below).
+///
+/// Peeling bark (`peel` > 0; an arbutus, a madrone, a plane): the outer bark comes away in
+/// irregular patches. A level set of a domain-warped fbm on the cylinder point (about
+/// `peelFrequency` patches per unit of v, `peelPerRidge` per ridge width around, so patches
+/// keep their size in world units on every branch when the tree sets it from its ridge
+/// width) splits the bark into old bark still on (`peelColor`, scaly with fine cracks) over
+/// a cover of peel·(0.4 + 0.6 m), and the smooth fresh bark beneath (the furrow pattern
+/// above, coloured as set, mottled). A patch's edge curls away: a pale lip (the patch's
+/// underside) on its rim and a thin dark shadow on the fresh bark just outside it.
 struct BarkOptions {
   int furrows = 9;                     ///< ridges around the branch, >= 1
   double warp = 0.6;                   ///< how far the furrows wander sideways (in ridge widths)
@@ -92,6 +103,14 @@ struct BarkOptions {
   double lenticelFrequency = 4.0;      ///< lenticel rows per unit of v (whole rows per tile when tileV > 0)
   Vec3 youngColor{0.20f, 0.14f, 0.09f};    ///< ridge color of young bark (maturity 0)
   Vec3 lenticelColor{0.05f, 0.04f, 0.035f};
+  /// Braided furrows (a lime, an ash): two sets of furrows drifting sideways by ±braid
+  /// ridge widths per unit of v cross at a shallow angle, and the bark is ridge only where
+  /// both say so: long lens-shaped ridges between interlacing furrows. 0: one set.
+  double braid = 0.0;
+  double peel = 0.0;                   ///< share of old bark still on in peeling patches at m = 1, in [0, 1] (0 = none)
+  double peelFrequency = 4.0;          ///< peeling patches per unit of v
+  double peelPerRidge = 0.5;           ///< peeling patches per ridge width around
+  Vec3 peelColor{0.36f, 0.31f, 0.26f}; ///< old, grey-brown bark of the patches
   uint64_t seed = 0;
 };
 /// Bark texture.
@@ -105,6 +124,10 @@ class BarkTexture : public SeededTexture<BarkOptions> {
   Vec3 color(Vec2 uv) const;
   /// Lenticel cover in [0, 1] at (u, v) before the maturity fade (0 when lenticels = 0).
   double lenticelCover(Vec2 uv) const;
+  /// Peeling patches at (u, v): the signed distance-like level e of the patch field (> 0 on
+  /// old bark still on, < 0 on fresh bark; 0 at a patch's edge), in units of the field.
+  /// Returns -1 (all fresh bark) when peel is 0.
+  double peelLevel(Vec2 uv) const;
 };
 
 /// Shell stripes: bands at constant v (growth lines) or at constant u (spiral bands).

@@ -139,3 +139,80 @@ TEST_CASE("tree bark: furrows along each branch, continuous through junctions", 
     CHECK(fine < 0.5 * coarse);
   }
 }
+
+TEST_CASE("tree bark: the branch bark ridge arcs over the lateral, darker above it than below", "[model]") {
+  // The same tree with and without `ridge_arc`: the ratio of their colours is 1 − the arc's
+  // darkness wherever the arc lies (the seam's darkening is the same in both).
+  std::string withArc = kTree;
+  const std::string key = "ridge_darkening: 0.5}";
+  withArc.replace(withArc.find(key), key.size(), "ridge_darkening: 0.5, ridge_arc: 0.7, ridge_arc_relief: 1}");
+  Species plainSpecies = parseSpecies(kTree, "bark.yaml"), arcSpecies = parseSpecies(withArc, "arc.yaml");
+  SpeciesModel plainModel(plainSpecies), arcModel(arcSpecies);
+  render::Scene plain, arc;
+  plainModel.addToScene(plain, plainModel.finalStage(), GeometryMode::Exact, plainSpecies.render);
+  arcModel.addToScene(arc, arcModel.finalStage(), GeometryMode::Exact, arcSpecies.render);
+  plain.commit();
+  arc.commit();
+  const TrunkProbe p{plain}, a{arc};
+  constexpr double kPi = 3.14159265358979323846;
+  auto ratio = [&](double theta, double y) {
+    return luminance(a.at(theta, y)) / std::max(1e-6, luminance(p.at(theta, y)));
+  };
+  // Above the lateral, horizontal rays would meet the lateral itself (it rises at 40° from
+  // the trunk); rays falling at 60° toward the trunk pass above it. They aim at radius 0.14
+  // at height y and meet the bark (r ≈ 0.15) about 0.017 higher.
+  auto fromAbove = [](const render::Scene& scene, double theta, double y) {
+    const double e = 60.0 * kPi / 180.0;
+    const Vec3 dir(static_cast<float>(-std::cos(e) * std::cos(theta)), static_cast<float>(-std::sin(e)),
+                   static_cast<float>(-std::cos(e) * std::sin(theta)));
+    const Vec3 target(static_cast<float>(0.14 * std::cos(theta)), static_cast<float>(y),
+                      static_cast<float>(0.14 * std::sin(theta)));
+    auto hit = scene.intersect(target - 2.0f * dir, dir, 0.0f, 10.0f);
+    REQUIRE(hit);
+    return hit->color;
+  };
+  auto ratioAbove = [&](double theta, double y) {
+    return luminance(fromAbove(arc, theta, y)) / std::max(1e-6, luminance(fromAbove(plain, theta, y)));
+  };
+  // Along each line up the trunk (every 2.5°), the darkest point; the apex is the highest
+  // of those among the lines that reach the crest's full darkness.
+  auto darkestOn = [&](double theta, double& y0) {
+    double r0 = 2;
+    for (int j = 0; j <= 100; ++j) {
+      const double y = 1.0 + 0.5 * j / 100;
+      const double r = ratioAbove(theta, y);
+      if (r < r0) r0 = r, y0 = y;
+    }
+    return r0;
+  };
+  double apexTheta = 0, apexY = -1, apexRatio = 2;
+  for (int i = 0; i < 144; ++i) {
+    const double theta = 2 * kPi * i / 144;
+    double y = 0;
+    const double r = darkestOn(theta, y);
+    if (r < 0.4 && y > apexY) apexY = y, apexTheta = theta, apexRatio = r;
+  }
+  INFO("apex: ratio " << apexRatio << " at theta " << apexTheta << ", y " << apexY);
+  // The crest: 1 − 0.7 at its darkest, above the branch's footprint (the lateral, r 0.05 at
+  // 40°, pierces the trunk, r 0.15, about 0.18 above P at y = 1; its footprint reaches
+  // 0.05 / sin 40° = 0.08 higher).
+  CHECK(apexRatio == Approx(0.3).margin(0.05));  // (samples 0.005 apart on a crest 0.035 wide)
+  CHECK(apexY > 1.2);
+  CHECK(apexY < 1.45);
+  // Below the branch on the same line, on the trunk's far side, and on the basal internode
+  // below P: unchanged.
+  for (int j = 0; j <= 20; ++j) {
+    const double y = 0.5 + 0.45 * j / 20;
+    CHECK(ratio(apexTheta, y) == Approx(1.0).margin(1e-4));
+    CHECK(ratio(apexTheta + kPi, y + 0.5) == Approx(1.0).margin(1e-4));
+  }
+  // The arms run down both sides: 0.45 rad to either side (1.35 r_B around) the crest, as
+  // dark, lies lower (by 0.8·(√(1.35² + 0.64) − 0.8)·r_B = 0.031 on the chart).
+  for (double side : {-0.45, 0.45}) {
+    double y0 = 0;
+    const double r0 = darkestOn(apexTheta + side, y0);
+    INFO("side " << side << ": darkest " << r0 << " at y " << y0);
+    CHECK(r0 < 0.4);
+    CHECK(y0 < apexY - 0.015);
+  }
+}

@@ -239,6 +239,66 @@ TEST_CASE("BarkTexture maturity and lenticels", "[textures]") {
   }
 }
 
+TEST_CASE("BarkTexture braided furrows and peeling patches", "[textures]") {
+  SECTION("braid: a vertical line crosses 2·braid furrows per unit of v (none without braid)") {
+    // Without wander (warp 0) the two furrow sets drift by ±braid ridge widths per unit of v,
+    // so a line at fixed u enters a furrow of each set braid times per unit of v. (On the
+    // lines u = k/20 the two sets' furrows cross it half a period apart; elsewhere they may
+    // pass close enough to merge into one, which is where the braid's furrows join.)
+    for (double braid : {0.0, 4.0}) {
+      BarkOptions o;
+      o.furrows = 10;
+      o.warp = 0;
+      o.cracks = 0;
+      o.braid = braid;
+      BarkTexture bark(o);
+      for (float u : {0.05f, 0.35f, 0.8f}) {
+        int entries = 0;
+        bool inFurrow = bark.height(Vec2(u, 0.0f)) < 0.2;
+        for (int i = 1; i <= 50000; ++i) {
+          const bool now = bark.height(Vec2(u, static_cast<float>(5.0 * i / 50000))) < 0.2;
+          if (now && !inFurrow) ++entries;
+          inFurrow = now;
+        }
+        INFO("braid " << braid << ", u " << u);
+        CHECK(std::abs(entries - static_cast<int>(2 * braid * 5)) <= 1);
+      }
+      // Still closed around the branch.
+      for (float v : {0.1f, 0.77f, 2.3f}) CHECK(bark.height(Vec2(0.0f, v)) == Approx(bark.height(Vec2(1.0f, v))).margin(1e-9));
+    }
+  }
+  SECTION("peel: the share of old bark is peel·(0.4 + 0.6·maturity), patches close at u = 1") {
+    for (double maturity : {0.0, 1.0}) {
+      BarkOptions o;
+      o.furrows = 12;
+      o.peel = 0.5;
+      o.peelFrequency = 3;
+      o.maturity = maturity;
+      o.seed = 7;
+      BarkTexture bark(o);
+      int old = 0, n = 0;
+      for (int j = 0; j < 400; ++j)
+        for (int i = 0; i < 100; ++i, ++n)
+          if (bark.peelLevel(Vec2(static_cast<float>(i / 100.0), static_cast<float>(j * 0.05))) > 0) ++old;
+      const double share = double(old) / n, expected = 0.5 * (0.4 + 0.6 * maturity);
+      INFO("maturity " << maturity << ": old bark on " << share << " of the surface, expected " << expected);
+      CHECK(share == Approx(expected).margin(0.08));
+      for (float v : {0.3f, 4.1f}) CHECK(bark.peelLevel(Vec2(0.0f, v)) == Approx(bark.peelLevel(Vec2(1.0f, v))).margin(1e-9));
+      // Inside a patch the colour is the old bark's, a greyer colour than the fresh bark.
+      for (int j = 0; j < 400; ++j) {
+        const Vec2 uv(0.25f, static_cast<float>(j * 0.05));
+        if (bark.peelLevel(uv) > 0.05) {
+          const Vec3 c = bark.color(uv);
+          CHECK(c.x / std::max(1e-6f, c.z) == Approx(o.peelColor.x / o.peelColor.z).margin(1e-4));
+        }
+      }
+    }
+    BarkOptions none;
+    BarkTexture plain(none);
+    CHECK(plain.peelLevel(Vec2(0.3f, 0.4f)) == -1.0);
+  }
+}
+
 TEST_CASE("StripesTexture and SpotsTexture", "[textures]") {
   SECTION("stripes without wobble: band centers and gaps, exactly periodic") {
     StripesOptions o;
