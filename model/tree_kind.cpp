@@ -479,9 +479,47 @@ std::vector<Vec3> readCpfgColormap(const fs::path& path) {
   return palette;
 }
 
+/// cpfg's materials file (`-M NAME.mat`, written by vlab's medit; irisGL.c,
+/// load_in_materials): records of 15 bytes, the material's colour index, then transparency,
+/// ambient, diffuse, emissive and specular red-green-blue and shininess. The palette holds
+/// the diffuse colours; an index no record names keeps cpfg's default material (diffuse
+/// white). A size that is not a whole number of records is an InputError at the file. A
+/// transparent material is drawn opaque, said in a note.
+std::vector<Vec3> readCpfgMaterials(const fs::path& path, std::vector<Diagnostic>& notes) {
+  std::string bytes;
+  try {
+    bytes = readFile(path);
+  } catch (const std::exception&) {
+    throw InputError(SourceLoc{path.string(), 0, 0}, "cannot read the materials file");
+  }
+  if (bytes.empty() || bytes.size() % 15 != 0)
+    throw InputError(SourceLoc{path.string(), 0, 0},
+                     "a cpfg materials file holds records of 15 bytes (colour index, transparency, ambient, diffuse, "
+                     "emissive, specular, shininess), this file has " +
+                         std::to_string(bytes.size()) + " bytes");
+  auto byte = [&](size_t i) { return static_cast<unsigned char>(bytes[i]); };
+  std::vector<Vec3> palette(256, Vec3(1.0f));
+  for (size_t r = 0; r < bytes.size(); r += 15) {
+    const unsigned index = byte(r);
+    for (int c = 0; c < 3; ++c) palette[index][c] = static_cast<float>(byte(r + 5 + static_cast<size_t>(c))) / 255.0f;
+    if (byte(r + 1) != 0) {
+      Diagnostic d;
+      d.severity = Severity::Note;
+      d.loc = SourceLoc{path.string(), 0, 0};
+      char t[16];
+      std::snprintf(t, sizeof t, "%.2f", static_cast<double>(byte(r + 1)) / 255.0);
+      d.message = "material " + std::to_string(index) + " has transparency " + t + ": Sprig draws it opaque";
+      notes.push_back(std::move(d));
+    }
+  }
+  return palette;
+}
+
 /// A bare grammar (viewFile: its cpfg view file, empty for none; colormap: its colour map,
-/// empty for none).
-Species grammarSpecies(const fs::path& path, const fs::path& viewFile, const fs::path& colormap = {}) {
+/// empty for none; materials: its materials file, empty for none, which colours organs in
+/// place of the colour map as cpfg's -M does).
+Species grammarSpecies(const fs::path& path, const fs::path& viewFile, const fs::path& colormap = {},
+                       const fs::path& materials = {}) {
   Species s;
   s.kind = "tree";
   s.bareGrammar = true;
@@ -502,6 +540,8 @@ Species grammarSpecies(const fs::path& path, const fs::path& viewFile, const fs:
   }
   // The colour map colours organs by their colour index (`;`, `,`, `initial color:`).
   if (!colormap.empty()) s.render.style.palette = readCpfgColormap(colormap);
+  // A materials file (`-M NAME.mat`) colours them by their materials' diffuse colours.
+  if (!materials.empty()) s.render.style.palette = readCpfgMaterials(materials, s.notes);
   s.spec = spec;
   DiagnosticList diags;
   checkGrammar(s, *spec, diags);
@@ -552,7 +592,7 @@ Species speciesFromGrammarFile(const fs::path& path) {
 
 Species speciesFromCpfgObject(const fs::path& folder) {
   std::error_code ec;
-  fs::path grammar, view, colormap;
+  fs::path grammar, view, colormap, materials;
   // The `specifications` file's cpfg command line names the grammar, the view file and the
   // colour map (`-m NAME.map`).
   try {
@@ -562,7 +602,10 @@ Species speciesFromCpfgObject(const fs::path& folder) {
       std::vector<std::string> w;
       for (std::string x; words >> x;) w.push_back(x);
       if (w.empty() || w[0] != "cpfg") continue;
-      for (const std::string& x : w) {
+      for (size_t k = 0; k < w.size(); ++k) {
+        const std::string& x = w[k];
+        if (x == "-M" && k + 1 < w.size() && materials.empty()) materials = folder / w[k + 1];
+        if (x == "-m" && k + 1 < w.size() && colormap.empty()) colormap = folder / w[k + 1];
         const std::string e = lowerExtension(x);
         if (e == ".l" && grammar.empty()) grammar = folder / x;
         if (e == ".v" && view.empty()) view = folder / x;
@@ -573,13 +616,14 @@ Species speciesFromCpfgObject(const fs::path& folder) {
   } catch (const std::exception&) {
   }
   if (grammar.empty()) {
-    std::vector<fs::path> grammars, views, maps;
+    std::vector<fs::path> grammars, views, maps, mats;
     for (const auto& e : fs::directory_iterator(folder, ec)) {
       if (!e.is_regular_file()) continue;
       const std::string x = lowerExtension(e.path());
       if (x == ".l" && hasAxiom(e.path())) grammars.push_back(e.path());
       if (x == ".v") views.push_back(e.path());
       if (x == ".map") maps.push_back(e.path());
+      if (x == ".mat") mats.push_back(e.path());
     }
     std::sort(grammars.begin(), grammars.end());
     if (grammars.size() != 1) {
@@ -597,12 +641,17 @@ Species speciesFromCpfgObject(const fs::path& folder) {
     fs::path sameMap = fs::path(grammar).replace_extension(".map");
     if (fs::is_regular_file(sameMap, ec)) colormap = sameMap;
     else if (maps.size() == 1) colormap = maps[0];
+    fs::path sameMat = fs::path(grammar).replace_extension(".mat");
+    if (fs::is_regular_file(sameMat, ec)) materials = sameMat;
+    else if (mats.size() == 1) materials = mats[0];
   }
   if (!fs::is_regular_file(grammar, ec)) throw InputError(SourceLoc{grammar.string(), 0, 0}, "cannot open file");
   if (!view.empty() && !fs::is_regular_file(view, ec)) throw InputError(SourceLoc{view.string(), 0, 0}, "cannot open the view file");
   if (!colormap.empty() && !fs::is_regular_file(colormap, ec))
     throw InputError(SourceLoc{colormap.string(), 0, 0}, "cannot open the colour map");
-  return grammarSpecies(grammar, view, colormap);
+  if (!materials.empty() && !fs::is_regular_file(materials, ec))
+    throw InputError(SourceLoc{materials.string(), 0, 0}, "cannot open the materials file");
+  return grammarSpecies(grammar, view, colormap, materials);
 }
 
 const TreeSpec& treeSpec(const Species& species) {

@@ -145,3 +145,40 @@ TEST_CASE("cpfg colour map of a vlab object", "[model][cpfg]") {
     std::filesystem::remove_all(dir);
   }
 }
+
+TEST_CASE("cpfg materials file of a vlab object", "[model][cpfg]") {
+  SECTION("tests/assets/cpfg/materials: the specifications' -M materials.mat, material i's diffuse colour for colour index i") {
+    const Species s = loadSpecies(std::filesystem::path(SPRIG_SOURCE_DIR) / "tests/assets/cpfg/materials");
+    REQUIRE(s.render.style.palette.size() == 256);
+    // Record 1: diffuse bytes e4 c5 ff (Lilac's petal purple); record 2: 88 b2 46 (green).
+    CHECK(s.render.style.palette[1] == Vec3(0xe4 / 255.0f, 0xc5 / 255.0f, 0xff / 255.0f));
+    CHECK(s.render.style.palette[2] == Vec3(0x88 / 255.0f, 0xb2 / 255.0f, 0x46 / 255.0f));
+    // No record names 3 or 0: cpfg's default material, diffuse white.
+    CHECK(s.render.style.palette[3] == Vec3(1.0f));
+    CHECK(s.render.style.palette[0] == Vec3(1.0f));
+    // Material 1's transparency byte 0x99 is said, not silently dropped.
+    int transparencyNotes = 0;
+    for (const Diagnostic& d : s.notes)
+      if (d.message == "material 1 has transparency 0.60: Sprig draws it opaque") ++transparencyNotes;
+    CHECK(transparencyNotes == 1);
+    GrowthEngine engine(s);
+    const lsystem::Skeleton sk = engine.skeletonAt(engine.lastStep());
+    REQUIRE(sk.organs.size() == 3);
+    for (int k = 0; k < 3; ++k) CHECK(sk.organs[static_cast<size_t>(k)].color == k + 1);
+  }
+  SECTION("a materials file that is not whole records is an error at the file") {
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "sprig-cpfg-materials-test";
+    std::filesystem::create_directories(dir);
+    writeFileAtomic(dir / "plant.l", "axiom: F\n");
+    writeFileAtomic(dir / "plant.mat", std::string(16, '\0'));
+    try {
+      loadSpecies(dir);
+      FAIL("no error");
+    } catch (const InputError& e) {
+      CHECK(e.diagnostics().front().message ==
+            "a cpfg materials file holds records of 15 bytes (colour index, transparency, ambient, diffuse, emissive, "
+            "specular, shininess), this file has 16 bytes");
+    }
+    std::filesystem::remove_all(dir);
+  }
+}
