@@ -416,6 +416,10 @@ TEST_CASE("Every shipped species meshes to closed parts", "[.][all_species]") {
       // and the head hold the clay core inside the bronze too: the cat is hollow there, the
       // bronze (and shiny bronze) shell and its two inner cavities (body, head).
       {"fig_solid_06_lost_wax", {3, 1, true}},
+      // Fig. 11: three branching structures side by side (the axiom steps aside with f(1.6));
+      // the tentacled tree grows on that mesh, so it is three pieces too.
+      {"fig_tree_11_branching", {3, 3, true}},
+      {"org_tentacled_tree", {3, 3, true}},
   };
   std::vector<std::string> files;
   for (const auto& e : std::filesystem::directory_iterator(std::string(SPRIG_SOURCE_DIR) + "/species"))
