@@ -388,9 +388,9 @@ TEST_CASE("SpeciesModel::exportParts atlas: same bytes at 1 and 2 threads", "[mo
 
 // Every shipped species' surface parts (not leaves or fruit, which are open or apart by
 // design) weld into closed, manifold, consistently oriented components, each enclosing a
-// positive volume, as many as the species implies. Hidden (run on request, about half an
-// hour on two shared cores: `build/test_model "[all_species]"`); the table of its last run
-// is in docs/MESHES.md. The CI runs "exportParts of shipped species" above instead.
+// positive volume, as many as the species implies. Hidden (run on request, one to several
+// hours on two shared cores, most of it the trees and the shells' atlases:
+// `build/test_model "[all_species]"`); the tables of its runs are in docs/MESHES.md. The CI runs "exportParts of shipped species" above instead.
 TEST_CASE("Every shipped species meshes to closed parts", "[.][all_species]") {
   // Species whose surface is not one closed outward piece, and why: {pieces, of which
   // outward (the rest are voids), closed}.
