@@ -137,10 +137,13 @@ CompiledBlob compile(const BlobTree& tree, NodeId root) {
     std::iota(items.begin(), items.end(), 0u);
     tape->instBvh = buildBvh(*tape, tape->instBox, items);
   }
-  float mf = 0.0f;
-  for (const Prim& P : tape->prims)
+  float mf = 0.0f, ml = 0.0f;
+  for (const Prim& P : tape->prims) {
     if (P.isoRadiusMin > 0.0f) mf = mf == 0.0f ? P.isoRadiusMin : std::min(mf, P.isoRadiusMin);
+    if (P.isoRadiusMax > 0.0f) ml = ml == 0.0f ? P.isoRadiusMax : std::min(ml, P.isoRadiusMax);
+  }
   tape->minFeature = mf;
+  tape->minLimb = ml;
   CompiledBlob b;
   b.tape_ = std::move(tape);
   return b;
@@ -215,5 +218,6 @@ float CompiledBlob::lipschitz() const { return tape_->empty ? 0.0f : tape_->node
 size_t CompiledBlob::primitiveCount() const { return tape_->instBox.size(); }
 size_t CompiledBlob::nodeCount() const { return tape_->empty ? 0 : tape_->nodes.size(); }
 float CompiledBlob::smallestFeature() const { return tape_->minFeature; }
+float CompiledBlob::thinnestLimb() const { return tape_->minLimb; }
 
 }  // namespace sprig::blobtree

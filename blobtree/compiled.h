@@ -198,6 +198,10 @@ class CompiledBlob {
   /// The smallest 0.5-iso radius of any point/segment/cone/torus primitive (0 if none):
   /// a natural scale for default cell sizes.
   float smallestFeature() const;
+  /// The smallest, over the point/segment/cone/torus primitives, of each one's largest
+  /// 0.5-iso radius (a cylinder's radius, a cone's thick end; 0 if none): every primitive
+  /// is at least this thick somewhere, where smallestFeature() may be a tapered tip.
+  float thinnestLimb() const;
   /// F(p) visiting every primitive of the tape with no culling (the brute-force baseline
   /// of benchmarks and tests).
   float valueNoCulling(Vec3 p) const;

@@ -126,7 +126,9 @@ float resolveCellSize(const CompiledBlob& blob, const PolygonizeOptions& options
   return autoCellSize(blob, CellSizeRule{.featureFraction = options.featureFraction,
                                          .coarsestDivisions = options.sizeDivisions,
                                          .finestDivisions = options.maxDivisions,
-                                         .noFeatureDivisions = options.sizeDivisions});
+                                         .noFeatureDivisions = options.sizeDivisions,
+                                         .limbFraction = options.limbFraction,
+                                         .limbFinestDivisions = options.limbMaxDivisions});
 }
 
 namespace {

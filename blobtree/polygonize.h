@@ -53,7 +53,8 @@ struct PolygonizeOptions {
   /// Requested cell edge length in world units; 0 = automatic: the smaller of
   /// featureFraction · smallestFeature() (so the thinnest twig gets several cells across)
   /// and the model's bounds diagonal / sizeDivisions, but never finer than the diagonal /
-  /// maxDivisions. The grid's cells have exactly this edge.
+  /// maxDivisions, unless the thinnest limb needs it (limbFraction). The grid's cells have
+  /// exactly this edge (blobtree/cell_size.h has the rule).
   float cellSize = 0.0f;
   /// Automatic cell size as a fraction of the smallest primitive radius.
   float featureFraction = 0.5f;
@@ -66,6 +67,14 @@ struct PolygonizeOptions {
   /// featureFraction (2.5 cells per radius); only thinner tips end early. An explicit
   /// cellSize is never clamped.
   float maxDivisions = 2500.0f;
+  /// The floor above is lowered to limbFraction · thinnestLimb() where that is finer, so
+  /// that every primitive keeps at least its thick end in one piece (a twig thinner than a
+  /// cell fell apart into specks; CellSizeRule explains the bound); 0 turns this off.
+  float limbFraction = 1.1f;
+  /// ... but only where that edge is at least the diagonal / limbMaxDivisions (at most
+  /// 2.56 times the triangles of the maxDivisions floor); a thinner limb leaves the floor
+  /// alone, may fall apart, and the mesh cleaning then removes its pieces as specks.
+  float limbMaxDivisions = 4000.0f;
   /// Maximum root-search iterations per vertex (0 = keep the linear interpolation).
   int refineSteps = 12;
   /// Root search stops when |F − 0.5| falls below this.

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <map>
 
+#include "core/mesh_clean.h"
 #include "core/inr_volume.h"
 #include "core/paths.h"
 #include "core/polymesh.h"
@@ -223,6 +224,9 @@ class OrganismReader {
         throw UsageError("species " + file->string() + " has no surface (a tree needs a tree: section)");
       ModelFigures figures;
       out = model.buildMesh(model.finalStage(), 0.0f, false, &figures);
+      // The polygonized surface cleaned as `sprig mesh` cleans it: shell_top's 133 voids and
+      // 2 specks would otherwise each become a separate piece of the organism.
+      cleanMesh(*out);
     } catch (const InputError& e) {
       diags_.append(e.diagnostics());
     } catch (const std::exception& e) {

@@ -25,7 +25,7 @@ Prim makePrim(const Node& n, Kernel kernel) {
       P.R0 = supportRadius(kernel, n.ra);
       P.box = sphereBox(P.a, P.R0);
       P.lipschitz = slope / P.R0;
-      P.isoRadiusMin = n.ra;
+      P.isoRadiusMin = P.isoRadiusMax = n.ra;
       P.axis = Vec3(0, 1, 0);
       P.e1 = perpendicular(P.axis, n.texture.refDir);
       P.e2 = glm::cross(P.axis, P.e1);
@@ -46,6 +46,7 @@ Prim makePrim(const Node& n, Kernel kernel) {
       float m = P.dR / P.len;
       P.lipschitz = slope * std::sqrt(1.0f + m * m) / std::min(P.R0, R1);
       P.isoRadiusMin = std::min(n.ra, rb);
+      P.isoRadiusMax = std::max(n.ra, rb);
       P.axis = P.ab / P.len;
       P.e1 = perpendicular(P.axis, n.texture.refDir);
       P.e2 = glm::cross(P.axis, P.e1);
@@ -58,7 +59,7 @@ Prim makePrim(const Node& n, Kernel kernel) {
       P.R0 = supportRadius(kernel, n.rb);
       P.box = cylinderBox(P.a, P.axis, -P.R0, P.R0, P.major + P.R0);
       P.lipschitz = slope / P.R0;
-      P.isoRadiusMin = n.rb;
+      P.isoRadiusMin = P.isoRadiusMax = n.rb;
       P.e1 = perpendicular(P.axis, n.texture.refDir);
       P.e2 = glm::cross(P.axis, P.e1);
       break;

@@ -53,6 +53,7 @@ struct Prim {
   Box3 box;
   float lipschitz = 0.0f;
   float isoRadiusMin = 0.0f;
+  float isoRadiusMax = 0.0f;  ///< largest 0.5-iso radius (a cone's thick end); 0 for unsized kinds
 };
 
 /// Builds the Prim of a primitive node.

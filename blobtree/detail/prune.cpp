@@ -150,6 +150,7 @@ std::shared_ptr<const Tape> buildPruned(const std::shared_ptr<const Tape>& base,
   T->root = decode(*base, key, pos, *T);
   T->empty = false;
   T->minFeature = base->minFeature;
+  T->minLimb = base->minLimb;
   return T;
 }
 

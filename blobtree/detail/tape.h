@@ -54,6 +54,7 @@ struct Tape {
   std::vector<uint32_t> instPrim;
   int32_t instBvh = -1;
   float minFeature = 0.0f;
+  float minLimb = 0.0f;  ///< smallest isoRadiusMax of a sized primitive (CompiledBlob::thinnestLimb)
   std::shared_ptr<const Tape> base;  ///< set on pruned tapes: the owner of prims and params
 
   /// Primitive i (this tape's or, for a pruned tape, its base's).

@@ -1,12 +1,14 @@
 #include <catch2/catch.hpp>
 
 #include <cstring>
+#include <algorithm>
 #include <map>
 #include <set>
 
 #include "blobtree/blobtree.h"
 #include "blobtree/compiled.h"
 #include "blobtree/polygonize.h"
+#include "core/mesh_clean.h"
 #include "core/parallel.h"
 #include "core/rng.h"
 #include "tests/blobtree/mesh_checks.h"
@@ -157,6 +159,53 @@ TEST_CASE("polygonize::deterministic", "[blobtree]") {
   CHECK(signedVolume(one) > 0.0);
 }
 
+TEST_CASE("polygonize::automatic cell size keeps thin limbs whole", "[blobtree]") {
+  // A sphere of radius 0.5 with a twig: a cylinder of radius 0.02 leaving it along an
+  // oblique axis, then a cone tapering from 0.02 to 0.005. The smallest feature is the
+  // cone's tip (0.005); the thinnest limb is the cylinder (and the cone's thick end), 0.02.
+  BlobTree tree;
+  const Vec3 d = glm::normalize(Vec3(1.0f, 1.3f, 0.7f));
+  std::vector<NodeId> kids = {tree.point(Vec3(0), 0.5f), tree.segment(0.4f * d, 1.4f * d, 0.02f),
+                              tree.cone(1.4f * d, 1.7f * d, 0.02f, 0.005f)};
+  CompiledBlob blob = compile(tree, tree.blend(kids));
+  CHECK(blob.smallestFeature() == Approx(0.005f));
+  CHECK(blob.thinnestLimb() == Approx(0.02f));
+  const float diag = glm::length(blob.bounds().size());
+  PolygonizeOptions opt;
+  opt.maxDivisions = 80.0f;  // a floor of diag / 80, over twice the twig's radius
+  opt.limbMaxDivisions = 1000.0f;
+  REQUIRE(diag / 80.0f > 2.0f * 0.02f);
+  REQUIRE(diag / 1000.0f < 0.02f);
+  REQUIRE(diag / 150.0f > 1.1f * 0.02f);
+  // How far along d the mesh reaches, and its pieces.
+  auto measure = [&](const Mesh& m) {
+    float reach = 0.0f;
+    for (const Vec3& p : m.positions) reach = std::max(reach, glm::dot(p, d));
+    size_t pieces = 0;
+    triangleComponents(m, &pieces);
+    return std::pair<float, size_t>(reach, pieces);
+  };
+  // The limb term lowers the floor to 1.1 x the limb's radius: one piece reaching the
+  // cylinder's end.
+  CHECK(resolveCellSize(blob, opt) == Approx(1.1f * 0.02f));
+  const auto [reach, pieces] = measure(polygonize(blob, opt));
+  CHECK(pieces == 1);
+  CHECK(reach > 1.4f);
+  // Without it the twig at diag / 80 falls apart or is lost short of its end.
+  opt.limbFraction = 0.0f;
+  CHECK(resolveCellSize(blob, opt) == Approx(diag / 80.0f));
+  const auto [reachOld, piecesOld] = measure(polygonize(blob, opt));
+  CHECK((piecesOld > 1 || reachOld < 1.2f));
+  // limbMaxDivisions bounds the limb term: a limb that would need cells finer than
+  // diag / limbMaxDivisions leaves the floor alone.
+  opt.limbFraction = 1.1f;
+  opt.limbMaxDivisions = 150.0f;
+  CHECK(resolveCellSize(blob, opt) == Approx(diag / 80.0f));
+  opt.limbMaxDivisions = 1000.0f;
+  opt.limbFraction = 1.5f;
+  CHECK(resolveCellSize(blob, opt) == Approx(1.5f * 0.02f));
+}
+
 TEST_CASE("polygonize::automatic cell size bounds", "[blobtree]") {
   // A sphere of radius 1 with a speck of radius 0.01: the feature rule asks for 0.005.
   BlobTree tree;
@@ -165,6 +214,7 @@ TEST_CASE("polygonize::automatic cell size bounds", "[blobtree]") {
   const float diag = glm::length(blob.bounds().size());
   PolygonizeOptions opt;
   opt.maxDivisions = 100.0f;  // the floor binds: diag / 100 is about 0.03
+  opt.limbFraction = 0.0f;    // (the speck is a whole primitive: the limb term would resolve it)
   PolygonizeResult r = polygonizeDetailed(blob, opt);
   CHECK(r.cellSize == Approx(diag / 100.0f).epsilon(1e-6));
   CHECK(r.mesh.triangleCount() > 0);
