@@ -377,14 +377,12 @@ float BlobTree::value(NodeId id, Vec3 p) const {
       return std::max(0.0f, std::min(value(n.children[0], p), 1.0f - value(n.children[1], p)));
     case NodeKind::Pcm: {
       PcmDerived d = derivePcm(n.pcm);
-      float fmax = 0.0f, dsum = 0.0f, dmax = 0.0f;
+      PcmAccum acc;
       for (NodeId c : n.children) {
         float f = std::max(0.0f, value(c, p));
-        float dd = pcmD(d, f, nullptr);
-        dsum += dd;
-        if (f > fmax) { fmax = f; dmax = dd; }
+        acc.add(f, pcmD(d, f, nullptr));
       }
-      return fmax > 0.0f ? std::max(0.0f, fmax + dsum - dmax) : 0.0f;
+      return acc.value();
     }
     case NodeKind::Negative: return -n.weight * value(n.children[0], p);
     case NodeKind::Transform: return value(n.children[0], Vec3(n.localFromWorld * Vec4(p, 1.0f)));

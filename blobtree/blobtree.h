@@ -221,9 +221,12 @@ class BlobTree {
   /// groups meet as a union. Realized as max over groups of the group's sum; a child in
   /// no group forms its own group.
   NodeId controlledBlend(std::span<const NodeId> children, const std::vector<std::vector<uint32_t>>& groups);
-  /// Precise Contact Modeling of two or more objects (tree paper Eq. 3): F = f_max +
-  /// Σ_{j≠max} d(f_j) with d of PcmParams. Each deformed object fᵢ + Σ_{j≠i} d(f_j) > c
-  /// is disjoint from the others when slope <= 1 (the contact surface fᵢ = f_j).
+  /// Precise Contact Modeling of two or more objects (tree paper Eq. 3), d of PcmParams:
+  /// F = f_max + Σ_{j≠max, f_j <= c} d(f_j) + min(0, c − f_second): every bulge adds, only
+  /// the deepest compression counts, so F >= c inside every child (summed compressions
+  /// opened voids where three objects interpenetrate; docs/BLOBTREE.md). For two objects
+  /// F = f_max + d(f_other); each deformed object fᵢ + d(f_j) > c is disjoint from the
+  /// other when slope <= 1 (the contact surface fᵢ = f_j).
   NodeId pcm(std::span<const NodeId> children, PcmParams params = {});
   /// Binary PCM.
   NodeId pcm(NodeId a, NodeId b, PcmParams params = {});

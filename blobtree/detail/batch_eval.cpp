@@ -168,20 +168,34 @@ void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* 
       return;
     }
     case NodeKind::Pcm: {
-      alignas(32) float dsum[kBlock], dmax[kBlock];
+      // PcmAccum per point, as structure of arrays: out holds f1.
+      alignas(32) float d1[kBlock], f2[kBlock], d2[kBlock], bulge[kBlock];
       std::fill(out, out + pts.n8, 0.0f);
-      std::fill(dsum, dsum + pts.n8, 0.0f);
-      std::fill(dmax, dmax + pts.n8, 0.0f);
+      std::fill(d1, d1 + pts.n8, 0.0f);
+      std::fill(f2, f2 + pts.n8, 0.0f);
+      std::fill(d2, d2 + pts.n8, 0.0f);
+      std::fill(bulge, bulge + pts.n8, 0.0f);
       childrenIn(T, n, pbox, [&](uint32_t c) {
         evalB(T, c, pts, pbox, tmp);
         for (int i = 0; i < pts.n; ++i) {
           float f = std::max(0.0f, tmp[i]);
           float d = pcmD(params(T, n).pcm, f, nullptr);
-          dsum[i] += d;
-          if (f > out[i]) { out[i] = f; dmax[i] = d; }
+          bulge[i] += std::max(0.0f, d);
+          if (f > out[i]) {
+            f2[i] = out[i];
+            d2[i] = d1[i];
+            out[i] = f;
+            d1[i] = d;
+          } else if (f > f2[i]) {
+            f2[i] = f;
+            d2[i] = d;
+          }
         }
       });
-      for (int i = 0; i < pts.n; ++i) out[i] = out[i] > 0.0f ? std::max(0.0f, out[i] + dsum[i] - dmax[i]) : 0.0f;
+      for (int i = 0; i < pts.n; ++i) {
+        const PcmAccum acc{out[i], d1[i], f2[i], d2[i], bulge[i]};
+        out[i] = acc.value();
+      }
       return;
     }
     case NodeKind::Negative:

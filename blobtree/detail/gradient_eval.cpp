@@ -84,13 +84,16 @@ SV differenceS(const Tape& T, const TNode& n, Vec3 p) {
   return r;
 }
 
-/// PCM (tree paper Eq. 3): F = f_max + Σ_{j≠max} d(f_j); ∇F = ∇f_max + Σ_{j≠max} d'(f_j)∇f_j.
+/// PCM (tree paper Eq. 3, PcmAccum): F = f_max + Σ_{j≠max, f_j <= c} d(f_j) + min(0, d(f_second));
+/// ∇F = ∇f_max + Σ_{j≠max, f_j <= c} d'(f_j)∇f_j + [f_second > c] d'(f_second)∇f_second.
 SV pcmS(const Tape& T, const TNode& n, Vec3 p) {
   SV r;
-  float fmax = 0.0f, dsum = 0.0f, dmax = 0.0f, dpmax = 0.0f;
+  PcmAccum acc;
+  float dp1 = 0.0f, dp2 = 0.0f;          // d'(f) of the strongest and second strongest child
+  Vec3 g1{0.0f}, g2{0.0f};               // and their field gradients
+  Vec3 gBulge{0.0f};                     // Σ d'(f_j)∇f_j over the children with f_j <= c
   float close1 = 0.0f, close2 = 0.0f;  // the two largest closenesses to contact
   Vec3 grad1{0.0f}, grad2{0.0f};        // and their gradients
-  Vec3 gsum{0.0f}, gmax{0.0f};
   const PcmDerived& pp = params(T, n).pcm;
   childrenAt(T, n, p, [&](uint32_t c) {
     SV s = evalS(T, c, p);
@@ -111,19 +114,29 @@ SV pcmS(const Tape& T, const TNode& n, Vec3 p) {
     }
     float dp;
     float d = pcmD(pp, f, &dp);
-    dsum += d;
-    gsum += dp * s.g;
+    if (d >= 0.0f) gBulge += dp * s.g;
     r.acc.merge(s.acc);
-    if (f > fmax) { fmax = f; dmax = d; dpmax = dp; gmax = s.g; }
+    if (f > acc.f1) {
+      dp2 = dp1;
+      g2 = g1;
+      dp1 = dp;
+      g1 = s.g;
+    } else if (f > acc.f2) {
+      dp2 = dp;
+      g2 = s.g;
+    }
+    acc.add(f, d);
   });
-  if (fmax <= 0.0f) return r;
+  if (acc.f1 <= 0.0f) return r;
   if (close2 > r.acc.contact) {
     r.acc.contact = close2;
     r.acc.contactGrad = grad2;
   }
-  r.v = fmax + dsum - dmax;
+  r.v = acc.value();
   if (r.v <= 0.0f) { r.v = 0.0f; return r; }
-  r.g = gmax + gsum - dpmax * gmax;
+  r.g = g1 + gBulge;
+  if (acc.d1 >= 0.0f) r.g -= dp1 * g1;
+  if (acc.d2 < 0.0f) r.g += dp2 * g2;
   return r;
 }
 

@@ -86,17 +86,20 @@ Interval evalI(const Tape& T, uint32_t ni, const Box3& box) {
       return {std::max(0.0f, std::min(a.lo, 1.0f - b.hi)), std::max(0.0f, std::min(a.hi, 1.0f - b.lo))};
     }
     case NodeKind::Pcm: {
-      float maxLo = 0.0f, maxHi = 0.0f, dLo = 0.0f, dHi = 0.0f;
+      // PcmAccum: F >= f_max + min(0, c − f_second) with f_second <= the second largest hi,
+      // and F >= min(f_max, c); F <= f_max + a₀ per child whose field may be in the band.
+      float maxLo = 0.0f, maxHi = 0.0f, hi2 = 0.0f, dHi = 0.0f;
       const PcmDerived& d = params(T, n).pcm;
       childrenIn(T, n, box, [&](uint32_t c) {
         Interval i = evalI(T, c, box);
         float lo = std::max(0.0f, i.lo), hi = std::max(0.0f, i.hi);
         maxLo = std::max(maxLo, lo);
+        hi2 = std::max(hi2, std::min(maxHi, hi));
         maxHi = std::max(maxHi, hi);
-        dLo += std::min(0.0f, d.c - hi);
         if (hi > d.c - d.w && lo < d.c) dHi += d.a0;
       });
-      return {std::max(0.0f, maxLo + dLo), std::max(0.0f, maxHi + dHi)};
+      const float lo = std::max(std::min(maxLo, d.c), maxLo + std::min(0.0f, d.c - hi2));
+      return {std::max(0.0f, lo), std::max(0.0f, maxHi + dHi)};
     }
     case NodeKind::Negative: {
       Interval i = evalI(T, T.kids[n.first], box);

@@ -46,4 +46,39 @@ inline float pcmD(const PcmDerived& d, float fOther, float* dd) {
   return v;
 }
 
+/// The PCM combination of a node's children, accumulated one child at a time (tree paper
+/// Eq. 3, Gascuel's contact surfaces kept with any number of objects):
+///   F = f_max + Σ_{j≠max, f_j < c} h(c − f_j) + min(0, c − f_second)
+/// Every bulge adds; of the compressions only the deepest one counts, the one by the second
+/// strongest child. The object of f_max is compressed back to its contact surface with each
+/// object j (f_max = f_j) by c − f_j alone; summing the compressions of several objects that
+/// interpenetrate at one point would push F below c deeper inside (a gap between the
+/// deformed objects: a void inside a junction of three or more branches). With this form
+/// F >= min(f_max, c): inside any child, F >= c. `add` takes the child's clamped field f >= 0
+/// and its d = pcmD(f).
+struct PcmAccum {
+  float f1 = 0.0f, d1 = 0.0f;  ///< the strongest child's field and deformation
+  float f2 = 0.0f, d2 = 0.0f;  ///< the second strongest's
+  float bulge = 0.0f;          ///< Σ max(0, d) over all children
+
+  void add(float f, float d) {
+    bulge += std::max(0.0f, d);
+    if (f > f1) {
+      f2 = f1;
+      d2 = d1;
+      f1 = f;
+      d1 = d;
+    } else if (f > f2) {
+      f2 = f;
+      d2 = d;
+    }
+  }
+  /// F, clamped to >= 0; 0 where no child reaches.
+  float value() const {
+    if (f1 <= 0.0f) return 0.0f;
+    // (f1 + compression) first: >= c whenever f1 >= f2 > c; the bulges (>= 0) only add.
+    return std::max(0.0f, (f1 + std::min(0.0f, d2)) + (bulge - std::max(0.0f, d1)));
+  }
+};
+
 }  // namespace sprig::blobtree::detail

@@ -41,16 +41,14 @@ float evalV(const Tape& T, uint32_t ni, Vec3 p, bool cull) {
       return std::max(0.0f, std::min(a, 1.0f - evalV(T, T.kids[n.first + 1], p, cull)));
     }
     case NodeKind::Pcm: {
-      float fmax = 0.0f, dsum = 0.0f, dmax = 0.0f;
+      PcmAccum acc;
       auto add = [&](uint32_t c) {
         float f = std::max(0.0f, evalV(T, c, p, cull));
-        float d = pcmD(params(T, n).pcm, f, nullptr);
-        dsum += d;
-        if (f > fmax) { fmax = f; dmax = d; }
+        acc.add(f, pcmD(params(T, n).pcm, f, nullptr));
       };
       if (cull) childrenAt(T, n, p, add);
       else for (uint32_t i = 0; i < n.count; ++i) add(T.kids[n.first + i]);
-      return fmax > 0.0f ? std::max(0.0f, fmax + dsum - dmax) : 0.0f;
+      return acc.value();
     }
     case NodeKind::Negative: return -n.weight * evalV(T, T.kids[n.first], p, cull);
     case NodeKind::Transform:

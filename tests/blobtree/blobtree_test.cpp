@@ -3,7 +3,10 @@
 #include "blobtree/blobtree.h"
 #include "blobtree/compiled.h"
 #include "blobtree/detail/field.h"
+#include "blobtree/polygonize.h"
+#include "core/mesh_clean.h"
 #include "core/rng.h"
+#include "tests/blobtree/mesh_checks.h"
 
 #include <cmath>
 #include <cstdio>
@@ -223,6 +226,161 @@ TEST_CASE("BlobTree::pcm", "[blobtree]") {
       REQUIRE(fa > kIso);
       CHECK(fa + pcmDeform(pp, fb) == Approx(kIso).margin(1e-6));
     }
+  }
+}
+
+namespace {
+
+// The five-branch junction of "BlobTree Trees" Fig. 13 as species/fig_tree_13_pcm_higher.yaml
+// plans it (organisms/tree_plan.h, Eq. 7-8): the basal cone A, shortened by δA below
+// P = (0, 1, 0), and five branches of radii 0.04 … 0.15, each moved δB_i = r_A − r_i out of
+// P along its axis; F_J = f_A + PCM(f_B0 … f_B4) (Eq. 5-6) with the trees' PCM width 0.25
+// and bulge 2 (a₀ = 0.125).
+struct Fig13Junction {
+  BlobTree tree;
+  NodeId basal = 0, pcm = 0, root = 0;
+  std::vector<NodeId> branches;
+  PcmParams params;
+};
+
+Fig13Junction fig13Junction() {
+  Fig13Junction j;
+  j.params.width = 0.25f;
+  j.params.bulgeScale = 2.0f;
+  j.basal = j.tree.cone(Vec3(0, 0, 0), Vec3(0, 0.7375f, 0), 0.18f, 0.1579f);
+  const struct {
+    Vec3 a, b;
+    float r;
+  } b[] = {{{-0.0737f, 1.0516f, 0}, {-0.5734f, 1.4015f, 0}, 0.06f},
+           {{0.0257f, 1.0306f, 0}, {0.5785f, 1.6894f, 0}, 0.11f},
+           {{0, 1.0707f, -0.0843f}, {0, 1.3214f, -0.3830f}, 0.04f},
+           {{0, 1.0450f, 0.0536f}, {0, 1.4500f, 0.5362f}, 0.08f},
+           {{0, 1.0f, 0}, {0, 2.0f, 0}, 0.15f}};
+  for (const auto& c : b) j.branches.push_back(j.tree.cone(c.a, c.b, c.r, c.r));
+  j.pcm = j.tree.pcm(j.branches, j.params);
+  j.root = j.tree.blend(std::vector<NodeId>{j.basal, j.pcm});
+  return j;
+}
+
+}  // namespace
+
+// Several branches interpenetrate near P (three of Fig. 13's five at once). Summing their
+// compressions, f_max + Σ_{j≠max} d(f_j), fell below c inside all three: two closed voids in
+// the species' mesh. The deepest compression alone keeps F >= c inside every branch.
+TEST_CASE("BlobTree::pcm of several interpenetrating objects (Fig. 13)", "[blobtree]") {
+  const Fig13Junction j = fig13Junction();
+  const float c = j.params.iso;
+  const CompiledBlob F = compile(j.tree, j.root), pcm = compile(j.tree, j.pcm), A = compile(j.tree, j.basal);
+  std::vector<CompiledBlob> B;
+  for (NodeId b : j.branches) B.push_back(compile(j.tree, b));
+
+  SECTION("F >= c inside the union of the branches, equal to the closed form") {
+    int inside = 0, triple = 0, summedVoid = 0, below = 0, offForm = 0;
+    const float h = 0.0075f;
+    for (float x = -0.2f; x <= 0.2f; x += h)
+      for (float y = 0.9f; y <= 1.2f; y += h)
+        for (float z = -0.2f; z <= 0.2f; z += h) {
+          const Vec3 p(x, y, z);
+          float f[5], f1 = 0.0f, f2 = 0.0f, bulge = 0.0f, summed = 0.0f;
+          int over = 0, strongest = 0;
+          for (int i = 0; i < 5; ++i) {
+            f[i] = B[size_t(i)].value(p);
+            over += f[i] > c ? 1 : 0;
+            if (f[i] > f[strongest]) strongest = i;
+          }
+          f1 = f[strongest];
+          if (f1 <= c) continue;
+          ++inside;
+          triple += over >= 3 ? 1 : 0;
+          for (int i = 0; i < 5; ++i) {
+            if (i == strongest) continue;
+            const float d = pcmDeform(j.params, f[i]);
+            summed += d;
+            bulge += std::max(0.0f, d);
+            f2 = std::max(f2, f[i]);
+          }
+          // What the summed compressions gave at this point, with A's field added (Eq. 6).
+          if (f1 + summed + A.value(p) < c) ++summedVoid;
+          const float v = pcm.value(p);
+          if (v < c || F.value(p) < c) ++below;
+          if (std::abs(v - (f1 + bulge + std::min(0.0f, c - f2))) > 1e-5f) ++offForm;
+        }
+    std::printf("Fig. 13 junction: %d grid points inside a branch, %d inside three or more; "
+                "summed compressions below c at %d\n", inside, triple, summedVoid);
+    CHECK(inside > 40000);
+    CHECK(triple > 3000);
+    CHECK(summedVoid > 1500);  // the old form's voids lie in the sampled region
+    CHECK(below == 0);
+    CHECK(offForm == 0);
+  }
+  SECTION("two objects: the contact surface is unchanged, F = f_max + d(f_other)") {
+    BlobTree t;
+    const NodeId a = t.cone(Vec3(0), Vec3(0.6f, 1, 0), 0.1f, 0.1f), b = t.cone(Vec3(0), Vec3(-0.6f, 1, 0), 0.1f, 0.1f);
+    const CompiledBlob two = compile(t, t.pcm(a, b, j.params)), ca = compile(t, a), cb = compile(t, b);
+    Rng rng(5);
+    for (int i = 0; i < 2000; ++i) {
+      const Vec3 p = randomIn(rng, Vec3(-0.5f, -0.2f, -0.2f), Vec3(0.5f, 1.0f, 0.2f));
+      const float fa = ca.value(p), fb = cb.value(p);
+      if (std::max(fa, fb) <= 0.0f) continue;
+      const float want = std::max(fa, fb) + pcmDeform(j.params, std::min(fa, fb));
+      CHECK(two.value(p) == Approx(std::max(0.0f, want)).margin(1e-6));
+    }
+  }
+  SECTION("batches, gradients and interval bounds agree with the point values") {
+    Rng rng(13);
+    const Box3 box{Vec3(-0.25f, 0.85f, -0.25f), Vec3(0.25f, 1.25f, 0.25f)};
+    std::vector<Vec3> pts(512);
+    for (Vec3& p : pts) p = randomIn(rng, box.lo, box.hi);
+    std::vector<float> out(pts.size());
+    F.values(pts, out);
+    for (size_t i = 0; i < pts.size(); ++i) {
+      CHECK(out[i] == Approx(F.value(pts[i])).margin(1e-6));
+      CHECK(F.value(pts[i]) == Approx(j.tree.value(j.root, pts[i])).margin(1e-5));
+    }
+    int compared = 0;
+    const float h = 2e-4f;
+    for (const Vec3& p : pts) {
+      const float f = F.value(p);
+      if (f < 0.02f) continue;
+      Vec3 fd(0.0f);
+      bool kink = false;
+      for (int a = 0; a < 3; ++a) {
+        Vec3 e(0.0f);
+        e[a] = h;
+        const double fp = F.value(p + e), fm = F.value(p - e);
+        fd[a] = float((fp - fm) / (2.0 * h));
+        // Skip points next to a switch of the strongest or second strongest branch.
+        if (std::abs(float((fp - f) / h) - float((f - fm) / h)) > 0.05f * (1.0f + std::abs(fd[a]))) kink = true;
+      }
+      if (kink) continue;
+      ++compared;
+      INFO("p = (" << p.x << ", " << p.y << ", " << p.z << ")");
+      CHECK(glm::length(F.gradient(p) - fd) <= 0.01f * (1.0f + glm::length(fd)));
+    }
+    CHECK(compared > 200);
+    for (int i = 0; i < 200; ++i) {
+      const Vec3 m = randomIn(rng, box.lo, box.hi);
+      const float e = float(rng.uniform(0.005, 0.1));
+      const Box3 q{m - e, m + e};
+      const Interval iv = F.valueBounds(q), ip = pcm.valueBounds(q);
+      for (int k = 0; k < 30; ++k) {
+        const Vec3 p = randomIn(rng, q.lo, q.hi);
+        CHECK(F.value(p) >= iv.lo - 1e-5f);
+        CHECK(F.value(p) <= iv.hi + 1e-5f);
+        CHECK(pcm.value(p) >= ip.lo - 1e-5f);
+        CHECK(pcm.value(p) <= ip.hi + 1e-5f);
+      }
+    }
+  }
+  SECTION("the junction meshes to one closed, outward piece") {
+    PolygonizeOptions opt;
+    opt.cellSize = 0.01f;
+    const Mesh m = polygonize(F, opt);
+    size_t pieces = 0;
+    triangleComponents(m, &pieces);
+    CHECK(pieces == 1);
+    test::requireClosedManifold(m);
+    CHECK(signedVolume(m) > 0);
   }
 }
 

@@ -4,8 +4,10 @@
 
 #include "model/tree_kind.h"
 #include "model/growth.h"
+#include "model/model.h"
 #include "blobtree/polygonize.h"
 #include "core/atomic_file.h"
+#include "core/mesh_clean.h"
 #include "core/mesh_io.h"
 #include "core/parallel.h"
 
@@ -115,6 +117,32 @@ TEST_CASE("tree species: same file and seed, same mesh bytes", "[model]") {
   CHECK(one == a);
   CHECK(two == a);
   std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("tree species: Fig. 13's five-branch PCM junction meshes to one closed part", "[model]") {
+  // Three of the five branches interpenetrate near the branching point; the wood is one
+  // closed, outward piece before any cleaning (it was three: two voids inside the junction,
+  // too large for the cleaning's volume fraction).
+  PathPolicy policy;
+  policy.root = SPRIG_SOURCE_DIR;
+  const Species species =
+      loadSpecies(std::filesystem::path(SPRIG_SOURCE_DIR) / "species" / "fig_tree_13_pcm_higher.yaml", policy);
+  SpeciesModel model(species, ModelOptions{});
+  ModelFigures fig;
+  const std::vector<ExportPart> parts = model.exportParts(model.finalStage(), 0.0f, false, {}, &fig);
+  REQUIRE(parts.size() == 1);
+  const Mesh& wood = parts[0].mesh;
+  CHECK(parts[0].name == "wood");
+  CHECK(wood.triangleCount() > 10000);
+  CHECK(fig.clean.componentsBefore == 1);
+  size_t pieces = 0;
+  triangleComponents(wood, &pieces);
+  CHECK(pieces == 1);
+  const MeshTopology topo = analyzeTopology(wood);
+  CHECK(topo.closed());
+  CHECK(topo.manifold());
+  CHECK(topo.inconsistentEdges == 0);
+  CHECK(signedVolume(wood) > 0);
 }
 
 TEST_CASE("cpfg colour map of a vlab object", "[model][cpfg]") {
