@@ -2,6 +2,7 @@
 #include "core/timer.h"
 
 #include "blobtree/polygonize.h"
+#include "model/bark_keys.h"
 #include "model/detail/key_recorder.h"
 #include "model/mesh_parts.h"
 #include "render/scene.h"
@@ -555,7 +556,8 @@ const std::vector<std::string> kTextureKinds = {"image", "color", "noise", "bark
 uint64_t readSeed(MapReader& m) { return uint64_t(m.integer("seed", 0, 0)); }
 
 // One procedural texture's options map (null reads as all defaults).
-std::optional<textures::Texture> readProcedural(const std::string& kind, const YNode& v, DiagnosticList& diags) {
+std::optional<textures::Texture> readProcedural(const std::string& kind, const YNode& v, DiagnosticList& diags,
+                                                std::optional<textures::BarkLook>* ridge) {
   if (!v.isMap() && !v.isNull()) {
     v.error(diags, sprig::quoted(kind) + " must be a map of its options, e.g. {" + kind + ": {seed: 1}}");
     return std::nullopt;
@@ -575,23 +577,20 @@ std::optional<textures::Texture> readProcedural(const std::string& kind, const Y
     o.seed = readSeed(m);
     out = textures::NoiseTexture(o);
   } else if (kind == "bark") {
-    textures::BarkOptions o;
-    o.furrows = int(m.integer("furrows", o.furrows, 1, 1000));
-    o.warp = m.number("warp", o.warp, 0.0, 100.0);
-    o.alongFrequency = m.number("along_frequency", o.alongFrequency, 0.0, 1e4);
-    o.sharpness = m.number("sharpness", o.sharpness, 1e-3, 100.0);
-    o.grain = m.number("grain", o.grain, 0.0, 10.0);
-    o.cracks = m.number("cracks", o.cracks, 0.0, 10.0);
-    o.tileV = int(m.integer("tile_v", o.tileV, 0, 100000));
-    o.ridgeColor = m.color("ridge_color", o.ridgeColor);
-    o.furrowColor = m.color("furrow_color", o.furrowColor);
-    o.maturity = m.number("maturity", o.maturity, 0.0, 1.0);
-    o.lenticels = m.number("lenticels", o.lenticels, 0.0, 1.0);
-    o.lenticelFrequency = m.number("lenticel_frequency", o.lenticelFrequency, 0.0, 1e4);
-    o.youngColor = m.color("young_color", o.ridgeColor);
-    o.lenticelColor = m.color("lenticel_color", o.lenticelColor);
+    // The bark keys tree species read too (model/bark_keys.h), plus the texture's tiling and seed.
+    textures::BarkLook look;
+    look.pattern.tileV = int(m.integer("tile_v", look.pattern.tileV, 0, 100000));
+    readBarkLook(m, look);
+    textures::BarkOptions o = look.resolved(look.pattern.ridgeColor, look.pattern.furrowColor);
     o.seed = readSeed(m);
     out = textures::BarkTexture(o);
+    if (ridge && look.hasRidge()) {
+      if (*ridge)
+        v.error(diags, "the branch bark ridge keys (ridge_darkening, ridge_relief, ridge_arc, ...) shade the whole "
+                       "blob: set them on one bark texture only");
+      else
+        *ridge = look;
+    }
   } else if (kind == "stripes") {
     textures::StripesOptions o;
     o.frequency = m.number("frequency", o.frequency, 0.0, 1e6);
@@ -653,7 +652,8 @@ std::optional<textures::Texture> readImage(const YNode& v, const PathPolicy& pol
 }  // namespace
 
 std::shared_ptr<const textures::TextureRegistry> readBlobTextures(const YNode& list, const PathPolicy& policy,
-                                                                  DiagnosticList& diags) {
+                                                                  DiagnosticList& diags,
+                                                                  std::optional<textures::BarkLook>* ridge) {
   auto registry = std::make_shared<textures::TextureRegistry>();
   if (!list.isSequence()) {
     list.error(diags, "'textures' must be a sequence of textures, e.g. [{image: maps/bark.png}, {stripes: {}}]");
@@ -666,12 +666,16 @@ std::shared_ptr<const textures::TextureRegistry> readBlobTextures(const YNode& l
     return registry;
   }
   for (const YNode& entry : items) {
-    if (!entry.isMap() || entry.pairs().size() != 1 || !entry.pairs()[0].first.isScalar()) {
-      entry.error(diags, "a texture must be a map with one key naming its kind, e.g. {image: maps/bark.png} "
-                         "or {stripes: {frequency: 8}}");
-      continue;
+    auto kindAndValue = describeOneKey(entry, kTextureKinds, "texture");  // `sprig schema`: one kind's keys
+    if (!kindAndValue) {
+      if (!entry.isMap() || entry.pairs().size() != 1 || !entry.pairs()[0].first.isScalar()) {
+        entry.error(diags, "a texture must be a map with one key naming its kind, e.g. {image: maps/bark.png} "
+                           "or {stripes: {frequency: 8}}");
+        continue;
+      }
+      kindAndValue = entry.pairs()[0];  // a copy: pairs() is a temporary
     }
-    const auto [key, value] = entry.pairs()[0];  // a copy: pairs() is a temporary
+    const auto [key, value] = *kindAndValue;
     const std::string kind = key.scalar();
     std::optional<textures::Texture> t;
     if (kind == "image") {
@@ -679,7 +683,7 @@ std::shared_ptr<const textures::TextureRegistry> readBlobTextures(const YNode& l
     } else if (kind == "color") {
       if (auto c = value.asColor(diags, "'color'")) t = textures::ConstantTexture{*c};
     } else if (std::find(kTextureKinds.begin(), kTextureKinds.end(), kind) != kTextureKinds.end()) {
-      t = readProcedural(kind, value, diags);
+      t = readProcedural(kind, value, diags, ridge);
     } else {
       key.error(diags, "unknown texture kind " + sprig::quoted(kind) + didYouMean(kind, kTextureKinds) +
                            " (image, color, noise, bark, stripes, spots or leaf)");
@@ -704,9 +708,10 @@ std::optional<BlobSpecies> readBlobSpecies(MapReader& top, DiagnosticList& diags
   }
   // Textures first, so primitives' texture ids can be checked against their count.
   std::shared_ptr<const textures::TextureRegistry> registry;
+  std::optional<textures::BarkLook> ridge;
   int textureCount = 0;
   if (auto list = top.get("textures")) {
-    registry = readBlobTextures(*list, policy, diags);
+    registry = readBlobTextures(*list, policy, diags, &ridge);
     // Ids are checked against the list's length (not the registry's, which leaves out
     // broken entries), so one mistake is reported once; no list checks nothing more.
     textureCount = list->isSequence() ? int(list->items().size()) : -1;
@@ -716,7 +721,8 @@ std::optional<BlobSpecies> readBlobSpecies(MapReader& top, DiagnosticList& diags
                 .tree = blobtree::BlobTree(kernel == "soft" ? blobtree::Kernel::SoftObject : blobtree::Kernel::Wyvill),
                 .root = 0,
                 .cellSize = cell,
-                .textures = registry};
+                .textures = registry,
+                .ridge = ridge};
   auto root = readBlobNode(*blob, s.tree, diags, textureCount);
   if (!root) return std::nullopt;
   s.root = *root;
@@ -750,6 +756,96 @@ BlobSpecies loadBlobSpecies(const std::filesystem::path& path, const PathPolicy&
   DiagnosticList diags;
   auto file = YamlFile::load(path, diags);
   return readWhole(file, diags, path.stem().string(), policy);
+}
+
+std::vector<textures::RidgeArc> blobRidgeArcs(const BlobTree& tree, NodeId root) {
+  using blobtree::NodeKind;
+  // Step 1: the segments and cones in world space.
+  struct Axis {
+    Vec3 a, b;
+    float ra, rb;
+  };
+  std::vector<Axis> axes;
+  std::function<void(NodeId, const Mat4&, int)> collect = [&](NodeId id, const Mat4& worldFromLocal, int depth) {
+    if (depth > kMaxDepth) return;
+    const blobtree::Node& n = tree.node(id);
+    switch (n.kind) {
+      case NodeKind::Segment:
+      case NodeKind::Cone: {
+        if (!(n.weight > 0)) return;
+        const float scale = std::cbrt(std::abs(glm::determinant(Mat3(worldFromLocal))));
+        axes.push_back({Vec3(worldFromLocal * Vec4(n.p0, 1.0f)), Vec3(worldFromLocal * Vec4(n.p1, 1.0f)),
+                        n.ra * scale, (n.kind == NodeKind::Segment ? n.ra : n.rb) * scale});
+        return;
+      }
+      case NodeKind::Transform:
+        for (NodeId c : n.children) collect(c, worldFromLocal * n.worldFromLocal, depth + 1);
+        return;
+      case NodeKind::Difference:
+      case NodeKind::Intersect:  // the first child is the body, the rest cut it
+        if (!n.children.empty()) collect(n.children[0], worldFromLocal, depth + 1);
+        return;
+      case NodeKind::Blend:
+      case NodeKind::Ricci:
+      case NodeKind::Union:
+      case NodeKind::Pcm:
+        for (NodeId c : n.children) collect(c, worldFromLocal, depth + 1);
+        return;
+      default:  // other primitives, negative fields, warps
+        return;
+    }
+  };
+  collect(root, Mat4(1.0f), 0);
+
+  // Step 2: for each start point, the parts through it, ending at it and starting at it.
+  std::vector<textures::RidgeArc> out;
+  auto direction = [](const Axis& x) { return glm::normalize(x.b - x.a); };
+  for (size_t bi = 0; bi < axes.size(); ++bi) {
+    const Axis& branch = axes[bi];
+    const Vec3 p = branch.a;
+    const float tol = 1e-3f * std::max(branch.ra, 1e-6f);
+    int through = -1, basal = -1;
+    std::vector<size_t> starting;
+    for (size_t k = 0; k < axes.size(); ++k) {
+      const Axis& x = axes[k];
+      const Vec3 d = x.b - x.a;
+      const float len2 = glm::dot(d, d);
+      if (!(len2 > 0)) continue;
+      const float t = glm::dot(p - x.a, d) / len2;
+      const float len = std::sqrt(len2);
+      if (t < -tol / len || t > 1 + tol / len) continue;
+      if (glm::length(x.a + glm::clamp(t, 0.0f, 1.0f) * d - p) > tol) continue;
+      if (t * len <= tol)
+        starting.push_back(k);
+      else if ((1 - t) * len <= tol) {
+        if (basal < 0 || x.rb > axes[size_t(basal)].rb) basal = int(k);
+      } else if (through < 0 || x.ra > axes[size_t(through)].ra) {
+        through = int(k);
+      }
+    }
+    textures::RidgeArc arc;
+    arc.point = p;
+    arc.branchAxis = direction(branch);
+    arc.branchRadius = branch.ra;
+    if (through >= 0) {  // a branch out of the side of a part
+      const Axis& parent = axes[size_t(through)];
+      const float t = glm::dot(p - parent.a, parent.b - parent.a) / glm::dot(parent.b - parent.a, parent.b - parent.a);
+      arc.parentAxis = direction(parent);
+      arc.parentRadius = parent.ra + t * (parent.rb - parent.ra);
+    } else if (basal >= 0) {  // a junction: the leader continues the basal part
+      const Vec3 up = direction(axes[size_t(basal)]);
+      size_t leader = starting.front();
+      for (size_t k : starting)
+        if (glm::dot(direction(axes[k]), up) > glm::dot(direction(axes[leader]), up)) leader = k;
+      if (leader == bi) continue;
+      arc.parentAxis = direction(axes[leader]);
+      arc.parentRadius = std::max(axes[size_t(basal)].rb, axes[leader].ra);
+    } else {
+      continue;
+    }
+    out.push_back(arc);
+  }
+  return out;
 }
 
 namespace {
@@ -786,14 +882,15 @@ class BlobModel final : public StillKindModel {
     BuiltStage out;
     const auto t0 = std::chrono::steady_clock::now();
     out.figures.primitives = compiled_->primitiveCount();
+    const render::Material surface = withRidge(look.surface);
     if (mode == GeometryMode::Mesh) {
       blobtree::PolygonizeOptions po = polygonizeOptions(look);
       po.cellSize = blob_.cellSize;
       auto mesh = std::make_shared<blobtree::PolygonizeResult>(polygonizeForLook(*compiled_, po, look));
       out.figures.triangles = mesh->mesh.triangleCount();
-      out.geometry.parts.push_back(render::PolygonizedPart{std::move(mesh), look.surface, textureTable(blob_.textures)});
+      out.geometry.parts.push_back(render::PolygonizedPart{std::move(mesh), surface, textureTable(blob_.textures)});
     } else {
-      out.geometry.parts.push_back(render::ImplicitPart{compiled_, look.surface, {}, textureTable(blob_.textures)});
+      out.geometry.parts.push_back(render::ImplicitPart{compiled_, surface, {}, textureTable(blob_.textures)});
     }
     out.figures.buildSeconds = secondsSince(t0);
     return out;
@@ -816,17 +913,29 @@ class BlobModel final : public StillKindModel {
     ExportPart part;
     part.name = "blob";
     const render::TextureTable textures = textureTable(blob_.textures);
-    part.mesh = paintPolygonized(blobtree::polygonizeDetailed(*compiled_, po), textures, look.surface.baseColor);
+    render::Material painted;  // the colours the renderer gives: texture and ridge darkening
+    painted.baseColor = look.surface.baseColor;
+    painted = withRidge(painted);
+    part.mesh = paintPolygonized(blobtree::polygonizeDetailed(*compiled_, po), textures, painted);
     fig.clean = cleanMesh(part.mesh, clean);
     part.mesh.materials.clear();
     part.material = {"blob", look.surface.baseColor, look.surface.roughness, false};
-    render::Material painted;
-    painted.baseColor = look.surface.baseColor;
     atlasBlobPart(part, *compiled_, textures, painted);
     return {std::move(part)};
   }
 
  private:
+  /// material with the bark texture's branch bark ridge (seams and arcs), if it sets one.
+  render::Material withRidge(render::Material material) const {
+    if (!blob_.ridge) return material;
+    const textures::BarkLook& look = *blob_.ridge;
+    std::shared_ptr<const textures::RidgeArcs> arcs;
+    if (look.hasArcs())
+      arcs = std::make_shared<const textures::RidgeArcs>(blobRidgeArcs(blob_.tree, blob_.root), look.ridgeArc);
+    material.ridge = textures::RidgeShade(look.ridge(), std::move(arcs));
+    return material;
+  }
+
   const BlobSpecies& blob_;
   std::shared_ptr<const blobtree::CompiledBlob> compiled_;
   std::optional<Box3> frame_;

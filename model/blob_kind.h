@@ -35,11 +35,13 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "model/kinds.h"
 #include "model/yaml_reader.h"
 #include "blobtree/blobtree.h"
 #include "core/diagnostics.h"
+#include "textures/bark_look.h"
 #include "textures/registry.h"
 
 namespace sprig {
@@ -52,6 +54,10 @@ struct BlobSpecies {
   float cellSize = 0.0f;      ///< `mesh: {cell: ...}`; 0 = polygonizer's automatic size
   /// `textures:` in id order (null when the file has none): the primitives' texture ids.
   std::shared_ptr<const textures::TextureRegistry> textures;
+  /// The branch bark ridge keys of the bark texture that sets them (`ridge_darkening`,
+  /// `ridge_lines`, `ridge_relief`, `ridge_arc*`; at most one texture may): they shade the
+  /// whole surface, its `pcm` seams and arcs over its branches (blobRidgeArcs). nullopt: none.
+  std::optional<textures::BarkLook> ridge;
 };
 
 /// Texture id of primitives that name no texture: no texture is registered under it, so
@@ -62,10 +68,24 @@ inline constexpr uint16_t kNoTexture = 65535;
 /// (relative to the species file, checked with policy; opened through OpenImageIO now, so
 /// a missing or unreadable file is an error at the path: "cannot read texture ..."),
 /// `color: [r, g, b]`, or a procedural texture with its options (`noise`, `bark`,
-/// `stripes`, `spots`, `leaf`). Errors go to diags; returns the registry (entries with
-/// errors are left out, so check diags before using it).
+/// `stripes`, `spots`, `leaf`). A bark texture reads the bark keys of tree species
+/// (readBarkLook) plus `tile_v` and `seed`; when ridge is given, the first bark texture that
+/// sets a branch bark ridge key stores its look there (a second one is an error). Errors go
+/// to diags; returns the registry (entries with errors are left out, so check diags before
+/// using it).
 std::shared_ptr<const textures::TextureRegistry> readBlobTextures(const YNode& list, const PathPolicy& policy,
-                                                                  DiagnosticList& diags);
+                                                                  DiagnosticList& diags,
+                                                                  std::optional<textures::BarkLook>* ridge = nullptr);
+
+/// The branches of a blob, as the branch bark ridge arcs need them: a segment or cone whose
+/// start a lies on another's axis. Where a segment or cone passes through a (not at its
+/// ends), it is the parent; where cones meet end to start, the one that ends at a is the
+/// basal part, the starting one that best continues its direction the leader (the parent),
+/// and every other one starting at a a branch; with no basal part there is no parent.
+/// Primitives under bend, twist and taper warps, cutters (the second and later children
+/// of difference and intersect) and negative fields are not branches; transforms apply
+/// (radii scaled by the cube root of the determinant). Cost: O(n²) in the segments and cones.
+std::vector<textures::RidgeArc> blobRidgeArcs(const blobtree::BlobTree& tree, blobtree::NodeId root);
 
 /// Reads the blob keys (`kernel`, `blob`, `mesh`, `textures`) of a `kind: blob` species
 /// from its top-level map; the caller reads `kind`, `name` and the other shared keys and

@@ -11,6 +11,7 @@
 #include "core/atomic_file.h"
 #include "core/paths.h"
 #include "core/progress.h"
+#include "model/bark_keys.h"
 #include "model/growth.h"
 #include "model/mesh_parts.h"
 #include "organisms/skeleton_geometry.h"
@@ -187,13 +188,8 @@ render::Geometry surfaceGeometry(const TreeSurface& tree, const SpeciesRender& l
     // Ids below bark.texture hold the wood color; then one texture per bark class.
     for (int i = 0; i < b.texture; ++i) textures.push_back([wood](Vec2, const Vec3&) { return wood; });
     for (const organisms::BarkClass& c : tree.blob.barkClasses) {
-      textures::BarkOptions bo = b.pattern;
+      textures::BarkOptions bo = b.resolved(wood, wood * 0.3f);
       bo.seed = tree.options.seed;
-      bo.ridgeColor = b.ridgeColor.value_or(wood);
-      bo.furrowColor = b.furrowColor.value_or(wood * 0.3f);
-      bo.youngColor = b.youngColor.value_or(bo.ridgeColor);
-      if (b.lenticelColor) bo.lenticelColor = *b.lenticelColor;
-      if (b.peelColor) bo.peelColor = *b.peelColor;
       // Peeling patches as wide around as they are long, in world units, when ridges have a width.
       if (b.ridgeWidth > 0) bo.peelPerRidge = bo.peelFrequency * std::abs(b.vScale) * b.ridgeWidth;
       bo.furrows = c.furrows;
@@ -206,14 +202,11 @@ render::Geometry surfaceGeometry(const TreeSurface& tree, const SpeciesRender& l
   wood.textureLayers = true;  // every cone's bark in its own coordinates (furrows along each branch)
   {
     const organisms::BarkOptions& b = tree.options.bark;
-    textures::RidgeOptions ridge;
-    ridge.darkening = b.ridgeDarkening;
-    ridge.lines = b.ridgeLines;
-    ridge.relief = b.ridgeRelief;
+    textures::RidgeOptions ridge = b.ridge();
     ridge.wanderScale = b.ridgeWidth > 0 ? 0.5 / b.ridgeWidth : ridge.wanderScale;  // one wave per two ridges
     ridge.seed = tree.options.seed;
     std::shared_ptr<const textures::RidgeArcs> arcs;
-    if (b.enabled && (b.ridgeArc.darkening > 0 || b.ridgeArc.relief > 0))
+    if (b.enabled && b.hasArcs())
       arcs = std::make_shared<const textures::RidgeArcs>(organisms::ridgeArcs(tree.blob), b.ridgeArc);
     wood.ridge = textures::RidgeShade(ridge, std::move(arcs));
   }
@@ -782,39 +775,7 @@ organisms::TreeOptions readTreeOptions(const YNode& section, DiagnosticList& dia
     o.bark.vScale = p.number("v_scale", o.bark.vScale, -kInf, kInf);
     o.bark.ridgeWidth = p.number("ridge_width", o.bark.ridgeWidth, 0.0, 1e6);
     o.bark.matureRadius = p.number("mature_radius", o.bark.matureRadius, 0.0, 1e6);
-    o.bark.ridgeDarkening = p.number("ridge_darkening", o.bark.ridgeDarkening, 0.0, 1.0);
-    o.bark.ridgeLines = static_cast<int>(p.integer("ridge_lines", o.bark.ridgeLines, 0, 64));
-    o.bark.ridgeRelief = p.number("ridge_relief", o.bark.ridgeRelief, 0.0, 4.0);
-    textures::RidgeArcOptions& arc = o.bark.ridgeArc;
-    arc.darkening = p.number("ridge_arc", arc.darkening, 0.0, 1.0);
-    arc.relief = p.number("ridge_arc_relief", arc.relief, 0.0, 4.0);
-    arc.rise = p.number("ridge_arc_rise", arc.rise, -10.0, 10.0);
-    arc.droop = p.number("ridge_arc_droop", arc.droop, 0.0, 10.0);
-    arc.spread = p.number("ridge_arc_spread", arc.spread, 0.1, 20.0);
-    arc.width = p.number("ridge_arc_width", arc.width, 0.01, 5.0);
-    textures::BarkOptions& b = o.bark.pattern;
-    b.furrows = static_cast<int>(p.integer("furrows", b.furrows, 1, 1000));
-    b.warp = p.number("warp", b.warp, 0.0, 100.0);
-    b.alongFrequency = p.number("along_frequency", b.alongFrequency, 0.0, 1e4);
-    b.sharpness = p.number("sharpness", b.sharpness, 1e-3, 100.0);
-    b.grain = p.number("grain", b.grain, 0.0, 10.0);
-    b.cracks = p.number("cracks", b.cracks, 0.0, 10.0);
-    b.maturity = p.number("maturity", b.maturity, 0.0, 1.0);
-    b.lenticels = p.number("lenticels", b.lenticels, 0.0, 1.0);
-    b.lenticelFrequency = p.number("lenticel_frequency", b.lenticelFrequency, 0.0, 1e4);
-    b.braid = p.number("braid", b.braid, -1e3, 1e3);
-    b.peel = p.number("peel", b.peel, 0.0, 1.0);
-    b.peelFrequency = p.number("peel_frequency", b.peelFrequency, 1e-3, 1e4);
-    auto optColor = [&p, &diags](std::string_view key) -> std::optional<Vec3> {
-      auto n = p.get(key);
-      if (!n) return std::nullopt;
-      return n->asColor(diags, "'" + std::string(key) + "'");
-    };
-    o.bark.ridgeColor = optColor("ridge_color");
-    o.bark.furrowColor = optColor("furrow_color");
-    o.bark.youngColor = optColor("young_color");
-    o.bark.lenticelColor = optColor("lenticel_color");
-    o.bark.peelColor = optColor("peel_color");
+    readBarkLook(p, o.bark);  // the keys a blob species' bark texture reads too
     p.finish();
   }
   if (auto s = m.section("leaves")) {

@@ -8,8 +8,7 @@
 #include <vector>
 
 #include "core/types.h"
-#include "textures/procedural.h"
-#include "textures/ridge.h"
+#include "textures/bark_look.h"
 
 namespace sprig::organisms {
 
@@ -81,30 +80,17 @@ struct BendOptions {
 /// min(1, r / matureRadius) in steps of 1/8 when matureRadius > 0 (young twigs smooth with
 /// lenticels, the trunk furrowed). Each class is one texture (textureIds texture,
 /// texture + 1, …, in TreeBlob::barkClasses order).
-struct BarkOptions {
+/// The look (pattern, colours, ridge and arcs) is textures::BarkLook, read by the same keys
+/// as a blob species' bark texture; the rest maps it onto the tree's cones.
+struct BarkOptions : textures::BarkLook {
   bool enabled = true;
   int texture = 0;               ///< texture id of the first bark class, 0..16383 (0: a fresh scene's first texture)
   double uScale = 1.0;           ///< texture u per full turn around the branch
   double vScale = 1.0;           ///< texture v per world unit along the axis (continuous from the root)
   double ridgeWidth = 0.0;       ///< world width of a bark ridge (> 0); 0: pattern.furrows on every cone
   double matureRadius = 0.0;     ///< branch radius with fully furrowed bark (> 0); 0: pattern.maturity everywhere
-  /// Bark multiplied by 1 − ridgeDarkening·contact³ (blobtree::Attributes::contact: 1 on
-  /// the PCM seam, 0 a propagation width away): the compressed bark of the branch bark ridge.
-  double ridgeDarkening = 0.0;
-  /// Folds of bunched bark across the ridge's band, parallel to the seam and crowding toward
-  /// it (textures::RidgeOptions::lines; darkened by ridgeDarkening); 0: none.
-  int ridgeLines = 0;
-  /// Shading relief of the ridge (textures::RidgeOptions::relief: the normal tilts by a
-  /// slope of 1.5·ridgeRelief on the crest's flanks); 0: none. The geometry stays PCM's.
-  double ridgeRelief = 0.0;
-  /// The branch bark ridge as an arc over each branch beside a leader, curving down both
-  /// sides of it (organisms::ridgeArcs, textures::RidgeArcs); off while darkening and
-  /// relief are 0. Shading and colour only: the geometry stays PCM's.
-  textures::RidgeArcOptions ridgeArc;
-  /// The pattern (furrows, warp, colors, lenticels, ...); furrows and maturity are replaced
-  /// per class as above. Colors left unset take the wood color (furrows 0.3 of it).
-  textures::BarkOptions pattern;
-  std::optional<Vec3> ridgeColor, furrowColor, youngColor, lenticelColor, peelColor;
+  // pattern.furrows and pattern.maturity are replaced per class as above; colours left
+  // unset take the wood color (furrows 0.3 of it).
 };
 
 /// One bark class: the furrow count and age shared by the cones of similar girth.
