@@ -374,7 +374,11 @@ class TreeModel final : public KindModel {
     }
     fig.buildSeconds = secondsSince(t0);
     out.geometry = surfaceGeometry(tree, look, mesh);
-    if (tree.options.leaves.enabled) addTexturedSurfaces(out.geometry, skeleton, look.style);
+    if (tree.options.leaves.enabled) {
+      addTexturedSurfaces(out.geometry, skeleton, look.style);
+      for (const lsystem::Organ& o : skeleton.organs)
+        if (o.texture >= 0) fig.triangles += o.triangles.size() / 3;  // not among tree.leaves
+    }
     return out;
   }
 
