@@ -32,7 +32,7 @@ seed() {
       for f in tests/assets/cpfg/*/*.v; do cp "$f" "$dir/$(basename "$(dirname "$f")").v"; done ;;
     function)
       # The first byte picks the reader (fuzz/function.cpp): 0 function, 1 curve, 2 contour,
-      # 3 surface file.
+      # 3 surface, 4 materials file.
       for f in tests/assets/cpfg/*/*.func; do { printf '\x00'; cat "$f"; } >"$dir/$(basename "$f")"; done
       for f in tests/assets/cpfg/curve/*.con; do { printf '\x01'; cat "$f"; } >"$dir/curve-$(basename "$f")"; done
       for f in tests/assets/cpfg/contour/*.con; do { printf '\x02'; cat "$f"; } >"$dir/$(basename "$f")"; done
@@ -41,7 +41,12 @@ seed() {
       patch() { printf '%s\nTOP COLOR: 1 DIFFUSE: 0.5 BOTTOM COLOR: 2 DIFFUSE: 0.5\nAL: ~ A: ~ AR: ~\nL: %s R: %s\nBL: ~ B: ~ BR: ~\n' "$1" "$2" "$3"
                for r in 0 1 2 3; do printf '%s 0 %s  %s 1 %s  %s 2 %s  %s 3 %s\n' $4 $r $4 $r $4 $r $4 $r; done; }
       { printf '\x03-1 1 0 3 0 3\nCONTACT POINT X: 0 Y: 0 Z: 0\nEND POINT X: 0 Y: 3 Z: 0\nHEADING X: 0 Y: 1 Z: 0\nUP X: 0 Y: 0 Z: 1\nSIZE: 3\n'
-        patch left '~' right 0; patch right left '~' 1; } >"$dir/two_patches.s" ;;
+        patch left '~' right 0; patch right left '~' 1; } >"$dir/two_patches.s"
+      # 4: materials files (binary records of 15 bytes): the test objects', one record, and
+      # the same index twice with a transparency.
+      for f in tests/assets/cpfg/*/*.mat; do { printf '\x04'; cat "$f"; } >"$dir/$(basename "$(dirname "$f")")-$(basename "$f")"; done
+      printf '\x04\x07\x00\x10\x20\x30\x40\x50\x60\x00\x00\x00\xff\xff\xff\x20' >"$dir/one_material.mat"
+      printf '\x04\x01\x80\x00\x00\x00\xff\x00\x00\x00\x00\x00\x00\x00\x00\x00\x01\x00\x00\x00\x00\x00\xff\x00\x00\x00\x00\x00\x00\x00\x00' >"$dir/twice.mat" ;;
     expression)
       for e in 't' 'x*0.9' 'sin(t)*x' 'max(0, 1 - t^2)' 'sqrt(x) + pow(t, 2) / 3' 'atan2(x, t) > 45 && t < 1' \
                'floor(x) == ceil(x) || !t' '-(-(-x))' 'min(t, max(x, 1e-3))' 'exp(log(t + 1))'; do

@@ -157,6 +157,7 @@ void CpfgSurface::tessellate() {
         const double u = double(s) / sPrecision_, v = double(t) / tPrecision_;
         vertices_.push_back(point(p, u, v));
         normals_.push_back(normal(p, u, v));
+        patchUvs_.emplace_back(u, v);
       }
     for (uint32_t s = 0; s < static_cast<uint32_t>(sPrecision_); ++s)
       for (uint32_t t = 0; t < static_cast<uint32_t>(tPrecision_); ++t) {
@@ -165,6 +166,17 @@ void CpfgSurface::tessellate() {
         triangles_.insert(triangles_.end(), {a, c, b, b, c, d});
       }
   }
+  // One image over the whole surface (patches.c, set_texture_coordinates): s and t are x
+  // and y across the tessellation's bounds, in the surface frame.
+  glm::dvec2 lo(0), hi(0);
+  for (size_t k = 0; k < vertices_.size(); ++k) {
+    const glm::dvec2 xy(vertices_[k].x, vertices_[k].y);
+    lo = k ? glm::min(lo, xy) : xy;
+    hi = k ? glm::max(hi, xy) : xy;
+  }
+  const glm::dvec2 span = hi - lo;
+  for (const DVec3& q : vertices_)
+    surfaceUvs_.emplace_back(span.x > 0 ? (q.x - lo.x) / span.x : 0.0, span.y > 0 ? (q.y - lo.y) / span.y : 0.0);
 }
 
 CpfgSurface CpfgSurface::parse(const std::string& text, const std::string& fileName, double size, int sPrecision,

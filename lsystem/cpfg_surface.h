@@ -74,6 +74,10 @@ class CpfgSurface {
   const std::vector<DVec3>& vertices() const { return vertices_; }
   const std::vector<DVec3>& normals() const { return normals_; }
   const std::vector<uint32_t>& triangles() const { return triangles_; }
+  /// Texture coordinates of vertices() (patches.c, set_texture_coordinates): per patch
+  /// (s, t) = the vertex's (k / sPrecision, l / tPrecision); per surface (perSurface) its x
+  /// and y in the surface frame, mapped from the tessellation's bounds to [0, 1].
+  const std::vector<glm::dvec2>& uvs(bool perSurface) const { return perSurface ? surfaceUvs_ : patchUvs_; }
 
  private:
   void tessellate();
@@ -86,12 +90,17 @@ class CpfgSurface {
   std::vector<DVec3> vertices_;
   std::vector<DVec3> normals_;
   std::vector<uint32_t> triangles_;
+  std::vector<glm::dvec2> patchUvs_;
+  std::vector<glm::dvec2> surfaceUvs_;
 };
 
 /// A surface of the view file with its id (the letter after `~`).
 struct CpfgSurfaceEntry {
   char id = 0;
   CpfgSurface surface;
+  /// The `surface:` line's texture number: -1 (none given) the turtle's texture (`@Tx`),
+  /// 0 no texture, n the view file's texture n (patches.c, s_textures).
+  int texture = -1;
 };
 
 }  // namespace sprig::lsystem

@@ -46,6 +46,10 @@ struct Organ {
   int32_t internode = -1;      ///< internode it is attached to, -1 if none
   int step = 0;
   int color = 0;               ///< turtle color index (`'`) when created
+  /// cpfg: the view file's texture (0-based: `@Tx(1)` is 0) on a surface file's mesh, -1
+  /// for none; then uvs holds the texture coordinates of points (lsystem/cpfg_texture.h).
+  int texture = -1;
+  std::vector<Vec2> uvs;
 };
 
 /// A whole plant skeleton.

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <string_view>
 
 #include <glm/gtc/quaternion.hpp>
@@ -162,6 +164,8 @@ Turtle::Turtle(const SymbolTable& symbols, TurtleSettings settings) : symbols_(s
       c = Command::Contour;
     } else if (n == "@!") {
       c = Command::ContourSides;
+    } else if (n == "@Tx") {
+      c = Command::Texture;
     } else if (n == "?P" || n == "?H" || n == "?L" || n == "?U") {
       c = Command::Query;
     } else if (n.size() > 1 && n[0] == '~') {
@@ -323,6 +327,7 @@ class TurtleWalk {
         case Command::GcPoint: gcPoint(i, false); break;
         case Command::GcEnd: gcPoint(i, true); break;
         case Command::Contour: contour(i); break;
+        case Command::Texture: texture(i); break;
         case Command::GcRadiusTangents: gcRadiusTangents(i); break;
         case Command::ContourSides:
           // cpfg's `@!(n)`: points around a contour (at least 3; 8 without a parameter).
@@ -409,6 +414,7 @@ class TurtleWalk {
       throw InputError(SourceLoc{"sprig", 0, 0}, "cpfg's contour '@#(" + std::to_string(st_.contour) +
                                         ")' on an 'F' segment (a cylinder outside a generalized cylinder) is not supported: "
                                         "select it for '@Gs ... @Gc' cylinders drawn with 'f'");
+    untextured("an 'F' segment (a cylinder)");
     Internode in;
     in.start = start;
     in.end = st_.frame.position;
@@ -600,6 +606,7 @@ class TurtleWalk {
           in.step = stepOf(i);
           in.module = static_cast<uint32_t>(i);
           in.up = st_.frame.up;
+          untextured("a generalized cylinder");
           if (growing_) buf_.internodeGrowth.push_back(g);
           if constexpr (kSummary) {
             const int32_t keep = st_.internode;
@@ -648,6 +655,32 @@ class TurtleWalk {
     if (n >= 4) gc_.radiusOut = tangent(2);
   }
 
+  /// cpfg's `@Tx(n)` (blackbox.c): the view file's texture n (its n-th `texture:` line, cpfg
+  /// truncating n) on the surfaces `~X` drawn after it on this branch; `@Tx` or `@Tx(0)`:
+  /// none. A number no `texture:` line has is an error (cpfg draws untextured).
+  void texture(size_t i) {
+    const double v = hasParam(i) ? param(i) : 0.0;
+    const size_t count = settings_.cpfgTextures ? settings_.cpfgTextures->size() : 0;
+    if (!std::isfinite(v) || v < 0 || v >= static_cast<double>(count) + 1) {
+      char shown[32];
+      std::snprintf(shown, sizeof shown, "%g", v);
+      throw InputError(SourceLoc{"sprig", 0, 0},
+                       std::string("cpfg's '@Tx(") + shown + ")' names no texture: the view file has " +
+                           (count == 0 ? std::string("no 'texture:' line")
+                                       : std::to_string(count) + " 'texture:' line" + (count == 1 ? "" : "s")));
+    }
+    st_.texture = static_cast<int>(v) - 1;
+  }
+
+  /// Throws when a texture is selected (`@Tx`) and what is drawn is not a surface file:
+  /// cpfg textures cylinders, generalized cylinders and polygons too, which Sprig does not.
+  void untextured(const char* what) const {
+    if (st_.texture < 0) return;
+    throw InputError(SourceLoc{"sprig", 0, 0}, "cpfg's texture '@Tx(" + std::to_string(st_.texture + 1) + ")' on " + what +
+                                                   " is not supported: Sprig textures surfaces ('~X') only; end the texture "
+                                                   "with '@Tx' or close its branch before drawing it");
+  }
+
   /// cpfg's `@#(id)`: the contour of the generalized cylinders from here on (0 or no
   /// parameter: the circle). An id the view file does not define is an error.
   void contour(size_t i) {
@@ -680,6 +713,7 @@ class TurtleWalk {
   /// organ per segment, its triangles joining consecutive rings.
   void gcContourMesh(size_t i, const DVec3& p1, const DVec3& t1, const DVec3& a2, const DVec3& a3, double len,
                      const std::vector<glm::dvec2>& ring) {
+    untextured("a generalized cylinder");
     const int rings = static_cast<int>(ring.size()) - 1;
     const CpfgContour circle = CpfgContour::circle();
     const CpfgContour* c1 = gc_.contour ? findContour(gc_.contour) : &circle;
@@ -973,6 +1007,7 @@ class TurtleWalk {
   void polygonEnd(size_t i) {
     if (buf_.polygons.empty()) return;
     if (buf_.polygons.back().points.size() >= 3 && growth(i) > 0) {
+      untextured("a polygon '{ }'");
       Organ o = organHere(Organ::Kind::Polygon, i);
       o.points = std::move(buf_.polygons.back().points);
       o.position = o.points.front();
@@ -1001,8 +1036,12 @@ class TurtleWalk {
   void cpfgSurface(size_t i, char id) {
     if (!settings_.cpfgSurfaces) return;
     const CpfgSurface* sf = nullptr;
+    const CpfgSurfaceEntry* entry = nullptr;
     for (const CpfgSurfaceEntry& e : *settings_.cpfgSurfaces)
-      if (e.id == id) sf = &e.surface;
+      if (e.id == id) {
+        sf = &e.surface;
+        entry = &e;
+      }
     if (!sf) return;
     const uint32_t n = paramCount(i);
     DVec3 sc(1.0);
@@ -1015,6 +1054,15 @@ class TurtleWalk {
       Organ o = organHere(Organ::Kind::Surface, i);
       o.radius = sc.y;
       o.name = std::string(1, id);
+      // The surface's own texture number overrides the turtle's (patches.c, s_textures).
+      o.texture = entry->texture < 0 ? st_.texture : entry->texture - 1;
+      if (o.texture >= 0 && settings_.cpfgTextures && static_cast<size_t>(o.texture) < settings_.cpfgTextures->size()) {
+        const std::vector<glm::dvec2>& uv = sf->uvs((*settings_.cpfgTextures)[static_cast<size_t>(o.texture)].perSurface);
+        o.uvs.reserve(uv.size());
+        for (const glm::dvec2& q : uv) o.uvs.emplace_back(static_cast<float>(q.x), static_cast<float>(q.y));
+      } else {
+        o.texture = -1;
+      }
       const glm::dmat3 m(sc.x * f.left, sc.y * f.heading, sc.z * cpfgUp);  // columns
       // Normals transform by the inverse transpose (cofactor form: no division by zero).
       const glm::dmat3 nm(glm::cross(m[1], m[2]), glm::cross(m[2], m[0]), glm::cross(m[0], m[1]));

@@ -22,6 +22,7 @@
 #include "core/types.h"
 #include "lsystem/cpfg_contour.h"
 #include "lsystem/cpfg_surface.h"
+#include "lsystem/cpfg_texture.h"
 #include "lsystem/module_string.h"
 #include "lsystem/skeleton.h"
 
@@ -78,6 +79,9 @@ struct TurtleSettings {
   std::vector<CpfgTropism> tropisms;  ///< cpfg: the view file's `tropism:` lines (at most kMaxTropisms)
   /// cpfg: the view file's surfaces (`surface:` lines), which `~X` draws as meshes; null for none.
   std::shared_ptr<const std::vector<CpfgSurfaceEntry>> cpfgSurfaces;
+  /// cpfg: the view file's textures (`texture:` lines), which `@Tx(n)` selects for the
+  /// surfaces `~X` draws; null for none.
+  std::shared_ptr<const std::vector<CpfgTexture>> cpfgTextures;
   /// cpfg: the view file's contours (`contour:` lines), which `@#(id)` selects as the
   /// cross-section of generalized cylinders; null for none.
   std::shared_ptr<const std::vector<CpfgContourEntry>> cpfgContours;
@@ -120,6 +124,7 @@ struct TurtleState {
   std::array<double, kMaxTropisms> elasticities{};  ///< cpfg: the current elasticity of each tropism
   int contour = 0;            ///< cpfg: the contour id `@#(id)` selected (0: the circle)
   int contourSides = 0;       ///< cpfg: points around a contour, `@!(n)` (0: the view file's)
+  int texture = -1;           ///< cpfg: the texture `@Tx(n)` selected, 0-based (-1: none)
 };
 
 /// Interprets module strings of one grammar. Construction builds the symbol -> command
@@ -165,7 +170,8 @@ class Turtle {
     RollLeft, RollRight, TurnAround, RollToVertical, Push, Pop, Width, Color, PolygonBegin, Vertex,
     PolygonEnd, Surface, SurfaceNamed, Cut, Tropism, Sphere, WidthUp, ColorUp, ColorDown, Circle, Disc,
     TropismUp, TropismDown, TwistAdjust, TwistForce, MoveTo, SetHeading, ScaleSet, ScaleUp, ScaleDown, OldElasticity,
-    Query, SubCall, SubEnd, GcStart, GcPoint, GcEnd, GcTangents, Contour, ContourSides, GcRadiusTangents
+    Query, SubCall, SubEnd, GcStart, GcPoint, GcEnd, GcTangents, Contour, ContourSides, GcRadiusTangents,
+    Texture
   };
   /// The command bound to symbol id `s` (None for ids outside the table).
   Command commandOf(SymbolId s) const { return s < commands_.size() ? commands_[s] : Command::None; }

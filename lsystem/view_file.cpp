@@ -26,7 +26,7 @@ const char* const kViewerKeys[] = {
     "viewing angle",      "twist of cylinders",   "interpretation step", "environment display",
     "antialiasing",       "min zoom",             "max zoom",       "generate on view change",
     "concave polygons",   "shadow map",           "PS linecap",     "rayshade objects",
-    "rayshade scale",     "texture",              "interpretation past %",
+    "rayshade scale",     "interpretation past %",
 };
 
 /// Keys naming files whose uses (`~`, `func`, `curveX`, `@#`, `inblob`) are errors in the
@@ -50,6 +50,7 @@ const char* const kReadKeys[] = {
     "angle factor",  "angle increment",   "initial color", "color increment", "initial line width",
     "line width increment", "line style", "initial scale", "scale multiplier", "tropism", "torque",
     "tropism direction", "initial elasticity", "elasticity increment", "function", "function set", "surface", "curve", "contour", "contour sides",
+    "texture",
 };
 
 /// The view file's text with `/* */` and `//` comments blanked (newlines kept, so positions
@@ -110,6 +111,13 @@ class ViewParser {
       raw_ = k < raws.size() ? raws[k] : std::string();
       readLine(static_cast<int>(k) + 1, cleans[k]);
     }
+    // A surface's texture number names a `texture:` line, which may come after it.
+    for (const SurfaceTexture& st : surfaceTextures_)
+      if (static_cast<size_t>(st.texture) > view_.textures.size()) {
+        raw_ = st.raw;
+        error(st.line, st.col, "the surface's texture " + std::to_string(st.texture) + " names no texture: the view file has " +
+                                   std::to_string(view_.textures.size()) + " 'texture:' line" + (view_.textures.size() == 1 ? "" : "s"));
+      }
     diags_.throwIfErrors();
     if (!viewerKeys_.empty()) {
       raw_ = viewerRaw_;
@@ -262,6 +270,8 @@ class ViewParser {
       readFunctionSet(line, vcol, value);
     } else if (is("surface")) {
       readSurface(line, vcol, value);
+    } else if (is("texture")) {
+      readTexture(line, vcol, value);
     } else if (is("curve")) {
       readCurve(line, vcol, value);
     } else if (is("contour")) {
@@ -593,8 +603,14 @@ class ViewParser {
           return;
         }
     }
-    if (ints.size() == 1 || ints.size() == 3)
-      warn(line, words.back().second, "the surface's texture index is ignored (Sprig draws surfaces untextured)");
+    int texture = -1;
+    if (ints.size() == 1 || ints.size() == 3) {
+      texture = ints.back();
+      if (texture < 0) {
+        error(line, words.back().second, "a surface's texture is 0 (none) or the number of a 'texture:' line, got " + std::to_string(texture));
+        return;
+      }
+    }
     const std::string& name = words[1].first;
     const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path();
     const std::filesystem::path file = (folder / name).lexically_normal();
@@ -611,7 +627,8 @@ class ViewParser {
       return;
     }
     try {
-      view_.surfaces.push_back({id[0], CpfgSurface::parse(text, file.string(), size, s, t)});
+      view_.surfaces.push_back({id[0], CpfgSurface::parse(text, file.string(), size, s, t), texture});
+      if (texture > 0) surfaceTextures_.push_back({line, words.back().second, texture, raw_});
     } catch (const InputError& e) {
       for (const Diagnostic& d : e.diagnostics()) diags_.add(d);
     }
@@ -675,6 +692,127 @@ class ViewParser {
     view_.tropisms.push_back(t);
   }
 
+  /// `texture: F: NAME.png [H: n|l] [L: n|l] [E: m|d] [S] [R: ratio]` (textures.c,
+  /// read_texture): cpfg's options are one letter each, separated from their values by
+  /// spaces, tabs, colons or commas. The image must be beside the view file or below it.
+  void readTexture(int line, size_t vcol, const std::string& value) {
+    std::vector<std::pair<std::string, size_t>> words;  // each word and its column
+    const size_t base = vcol - std::min(vcol, value.find_first_not_of(" \t"));
+    auto sep = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == ':' || c == ','; };
+    for (size_t i = 0; i < value.size();) {
+      if (sep(value[i])) {
+        ++i;
+        continue;
+      }
+      size_t j = i;
+      while (j < value.size() && !sep(value[j])) ++j;
+      words.emplace_back(value.substr(i, j - i), base + i);
+      i = j;
+    }
+    if (view_.textures.size() >= kMaxCpfgTextures) {
+      error(line, vcol, "a view file has at most " + std::to_string(kMaxCpfgTextures) + " textures (cpfg's limit)");
+      return;
+    }
+    CpfgTexture tex;
+    std::string name;
+    size_t nameCol = vcol;
+    for (size_t k = 0; k < words.size(); ++k) {
+      const std::string& w = words[k].first;
+      const size_t col = words[k].second;
+      if (w == "S") {
+        tex.perSurface = true;
+        continue;
+      }
+      if (w != "F" && w != "H" && w != "L" && w != "E" && w != "R") {
+        error(line, col, "unknown texture option '" + w + "' (cpfg's are F: image, H: and L: filters, E: mode, S, R: ratio)");
+        return;
+      }
+      if (k + 1 >= words.size()) {
+        error(line, col, "the texture option '" + w + ":' needs a value");
+        return;
+      }
+      const std::string& v = words[++k].first;
+      const size_t vc = words[k].second;
+      if (w == "F") {
+        name = v;
+        nameCol = vc;
+      } else if (w == "H" || w == "L") {
+        if (v == "n" || v == "l") {
+          if (w == "H") tex.linear = v == "l";  // Sprig samples every hit with the H: filter
+        } else if (w == "L" && v[0] == 'm') {
+          error(line, vc, "the mipmapped minification filter 'L: " + v + "' is not supported (use n or l)");
+          return;
+        } else {
+          error(line, vc, "a texture filter '" + w + ":' is n (nearest) or l (linear), got '" + v + "'");
+          return;
+        }
+      } else if (w == "E") {
+        if (v == "m" || v == "d") {
+          tex.decal = v == "d";
+        } else if (v == "b") {
+          error(line, vc, "the texture mode 'E: b' (blend) is not supported (use m, modulate, or d, decal)");
+          return;
+        } else {
+          error(line, vc, "a texture mode 'E:' is m (modulate) or d (decal), got '" + v + "'");
+          return;
+        }
+      } else {
+        auto r = parseFiniteNumber(v);
+        if (!r || !(*r > 0)) {
+          error(line, vc, "a texture's ratio 'R:' is a number greater than 0, got '" + v + "'");
+          return;
+        }
+        tex.ratio = *r;
+      }
+    }
+    if (name.empty()) {
+      error(line, vcol, "a texture needs its image: 'texture: F: NAME.png'");
+      return;
+    }
+    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path();
+    const std::filesystem::path file = (folder / name).lexically_normal();
+    const std::string rel = file.lexically_relative(folder.empty() ? "." : folder).generic_string();
+    if (std::filesystem::path(name).is_absolute() || rel.empty() || rel.rfind("..", 0) == 0) {
+      error(line, nameCol, "the texture image '" + name + "' is outside the object's folder (only files beside the view file, or in folders below it)");
+      return;
+    }
+    tex.file = file.string();
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(file, ec)) {
+      error(line, nameCol, "cannot read the texture image '" + file.string() + "': no such file");
+      return;
+    }
+    try {
+      Image img = readImage(file);
+      if (img.width <= 0 || img.height <= 0) throw ImageReadError(file, "the image has no pixels");
+      for (size_t p = 0; p + 3 < img.pixels.size(); p += 4) {
+        const float a = img.pixels[p + 3];
+        if (a < 0.999f) tex.transparent = true;
+        if (a > 0.0f && a < 1.0f)
+          for (size_t c = 0; c < 3; ++c) img.pixels[p + c] = std::min(img.pixels[p + c] / a, 1.0f);  // straight alpha
+      }
+      tex.image = std::make_shared<const Image>(std::move(img));
+    } catch (const ImageReadError& e) {
+      error(line, nameCol, "cannot read the texture image '" + file.string() + "': " + e.reason());
+      return;
+    } catch (const std::exception& e) {
+      error(line, nameCol, "cannot read the texture image '" + file.string() + "': " + e.what());
+      return;
+    }
+    if (tex.transparent)
+      warn(line, nameCol, "the texture image '" + name + "' has transparent texels: cpfg leaves them out (alpha test), Sprig draws them opaque in their own colour");
+    view_.textures.push_back(std::move(tex));
+  }
+
+  /// A `surface:` line's texture number, checked against the `texture:` lines at the end.
+  struct SurfaceTexture {
+    int line;
+    size_t col;
+    int texture;
+    std::string raw;
+  };
+  std::vector<SurfaceTexture> surfaceTextures_;
+
   ViewFile view_;
   DiagnosticList diags_;
   std::vector<Diagnostic> warnings_;
@@ -711,6 +849,7 @@ TurtleSettings cpfgTurtleSettings(const ViewFile* view, TurtleSettings t) {
   t.scaleMultiplier = v.scaleMultiplier.value_or(1.0);
   t.tropisms = v.tropisms;
   t.cpfgSurfaces = v.surfaces.empty() ? nullptr : std::make_shared<const std::vector<CpfgSurfaceEntry>>(v.surfaces);
+  t.cpfgTextures = v.textures.empty() ? nullptr : std::make_shared<const std::vector<CpfgTexture>>(v.textures);
   t.cpfgContours = v.contours.empty() ? nullptr : std::make_shared<const std::vector<CpfgContourEntry>>(v.contours);
   t.contourSides = v.contourSides.value_or(CpfgContour::kDefaultSides);
   // cpfg's old tropism (its defaults: direction +Y, elasticity 0, increment 0).

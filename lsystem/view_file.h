@@ -14,6 +14,7 @@
 #include "lsystem/cpfg_curve.h"
 #include "lsystem/cpfg_function.h"
 #include "lsystem/cpfg_surface.h"
+#include "lsystem/cpfg_texture.h"
 #include "lsystem/turtle.h"
 
 namespace sprig::lsystem {
@@ -49,6 +50,9 @@ struct ViewFile {
   /// `surface: X NAME.s [size [s t]] [texture]`: the surface files, read and tessellated when
   /// the view file is, which `~X` draws.
   std::vector<CpfgSurfaceEntry> surfaces;
+  /// `texture: F: NAME.png [options]`: the textures, in file order (`@Tx(1)` selects the
+  /// first), their images read when the view file is.
+  std::vector<CpfgTexture> textures;
   /// `curve: NAME [samples]`: the curve files, in file order (`curveX(1, t)` reads the first).
   std::vector<CpfgCurve> curves;
   /// `contour: id NAME.con`: the contours `@#(id)` selects for generalized cylinders.

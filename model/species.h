@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "lsystem/cpfg_texture.h"
 #include "model/yaml_reader.h"
 #include "render/camera.h"
 #include "render/geometry.h"
@@ -42,6 +43,9 @@ struct SkeletonStyle {
   /// Base colors by turtle color index (`'`); an organ whose index has an entry uses it.
   std::vector<Vec3> palette;
   bool organs = true;  ///< draw organs (polygons, spheres, named surfaces)
+  /// A cpfg grammar's view file textures (`texture:` lines), which its textured surfaces
+  /// (Organ::texture) wear; null for none.
+  std::shared_ptr<const std::vector<lsystem::CpfgTexture>> cpfgTextures;
 };
 
 /// How a species is shown (`render:`): the renderer's settings for its image, camera,

@@ -11,6 +11,7 @@
 #include "core/atomic_file.h"
 #include "core/paths.h"
 #include "core/progress.h"
+#include "lsystem/cpfg_materials.h"
 #include "model/bark_keys.h"
 #include "model/growth.h"
 #include "model/mesh_parts.h"
@@ -148,7 +149,61 @@ void appendMesh(Mesh& a, const Mesh& b) {
   a.materials.clear();
 }
 
-/// The skeleton preview: internodes as curves, organs as flat leaves and spheres.
+/// A cpfg texture shading one colour: texture number and the organ's colour index (-1:
+/// the leaf colour), the key of a group of textured surfaces drawn as one part.
+struct TexturedGroup {
+  int texture = -1;
+  int color = -1;
+  Mesh mesh;
+};
+
+/// The skeleton's textured cpfg surfaces (Organ::texture), grouped by texture and colour, each
+/// group's mesh with its positions, normals and texture coordinates. Colours follow the
+/// preview's rule: the palette entry of the organ's colour index (> 0), else the leaf colour.
+std::vector<TexturedGroup> texturedGroups(const lsystem::Skeleton& skeleton, const SkeletonStyle& style) {
+  std::vector<TexturedGroup> groups;
+  const size_t textureCount = style.cpfgTextures ? style.cpfgTextures->size() : 0;
+  for (const lsystem::Organ& o : skeleton.organs) {
+    if (o.texture < 0 || o.triangles.empty()) continue;
+    if (static_cast<size_t>(o.texture) >= textureCount || o.uvs.size() != o.points.size())
+      throw std::logic_error("a textured cpfg surface without its texture");
+    const int color = o.color > 0 && static_cast<size_t>(o.color) < style.palette.size() ? o.color : -1;
+    auto it = std::find_if(groups.begin(), groups.end(), [&](const TexturedGroup& g) { return g.texture == o.texture && g.color == color; });
+    if (it == groups.end()) {
+      groups.push_back(TexturedGroup{o.texture, color, {}});
+      it = groups.end() - 1;
+    }
+    Mesh& m = it->mesh;
+    const uint32_t base = static_cast<uint32_t>(m.positions.size());
+    for (size_t k = 0; k < o.points.size(); ++k) {
+      m.positions.push_back(Vec3(o.points[k]));
+      m.normals.push_back(k < o.normals.size() ? Vec3(o.normals[k]) : Vec3(o.up));
+      m.uvs.push_back(o.uvs[k]);
+    }
+    for (size_t k = 0; k + 2 < o.triangles.size(); k += 3)
+      m.triangles.emplace_back(base + o.triangles[k], base + o.triangles[k + 1], base + o.triangles[k + 2]);
+  }
+  return groups;
+}
+
+Vec3 groupColor(const TexturedGroup& g, const SkeletonStyle& style) {
+  return g.color >= 0 ? style.palette[static_cast<size_t>(g.color)] : style.leaf.baseColor;
+}
+
+/// Adds the skeleton's textured cpfg surfaces to out: one mesh part per texture and colour,
+/// the leaf material with the texture shading the colour (modulate or decal).
+void addTexturedSurfaces(render::Geometry& out, const lsystem::Skeleton& skeleton, const SkeletonStyle& style) {
+  for (TexturedGroup& g : texturedGroups(skeleton, style)) {
+    auto tex = std::make_shared<const lsystem::CpfgTexture>((*style.cpfgTextures)[static_cast<size_t>(g.texture)]);
+    const Vec3 color = groupColor(g, style);
+    render::Material m = style.leaf;
+    m.texture = 0;
+    render::TextureTable table;
+    table.push_back([tex, color](Vec2 uv, const Vec3&) { return tex->shade(uv.x, uv.y, color); });
+    out.parts.push_back(render::MeshPart{std::move(g.mesh), m, {}, std::move(table)});
+  }
+}
+
 }  // namespace
 
 render::Geometry skeletonPreview(const lsystem::Skeleton& skeleton, const SkeletonStyle& style) {
@@ -165,6 +220,7 @@ render::Geometry skeletonPreview(const lsystem::Skeleton& skeleton, const Skelet
   if (!g.leaves.triangles.empty())
     out.parts.push_back(render::MeshPart{std::move(g.leaves), style.leaf, std::move(g.leafColors), {}});
   if (!g.fruit.empty()) out.parts.push_back(render::SpheresPart{std::move(g.fruit), style.fruit});
+  if (style.organs) addTexturedSurfaces(out, skeleton, style);
   return out;
 }
 
@@ -311,6 +367,11 @@ class TreeModel final : public KindModel {
     }
     fig.buildSeconds = secondsSince(t0);
     out.geometry = surfaceGeometry(tree, look, mesh);
+    if (tree.options.leaves.enabled) {
+      addTexturedSurfaces(out.geometry, skeleton, look.style);
+      for (const lsystem::Organ& o : skeleton.organs)
+        if (o.texture >= 0) fig.triangles += o.triangles.size() / 3;  // not among tree.leaves
+    }
     return out;
   }
 
@@ -385,6 +446,23 @@ class TreeModel final : public KindModel {
       // Leaves are open polygons seen from both sides; fruit are closed spheres.
       parts.push_back(ExportPart{name, std::move(organs), PartMaterial{name, m.baseColor, m.roughness, set == organisms::OrganSet::Leaves, nullptr}});
       atlasVertexColors(parts.back());  // each leaf's tint, unclamped
+    }
+    // Textured cpfg surfaces: one part per texture and colour, the image shading the colour
+    // baked at the image's own size over the surfaces' texture coordinates.
+    if (options.leaves.enabled) {
+      for (TexturedGroup& g : texturedGroups(skeleton, look.style)) {
+        const lsystem::CpfgTexture& tex = (*look.style.cpfgTextures)[static_cast<size_t>(g.texture)];
+        const Vec3 color = groupColor(g, look.style);
+        auto baked = std::make_shared<PartTexture>();
+        const int w = tex.image->width, h = tex.image->height;
+        baked->image = Image(w, h);
+        for (int y = 0; y < h; ++y)
+          for (int x = 0; x < w; ++x)  // texel centres; the image's top row is t of 1
+            baked->image.set(x, y, Vec4(tex.shade((x + 0.5) / w, 1.0 - (y + 0.5) / h, color), 1.0f));
+        const std::string name = "textured_leaves_" + std::to_string(parts.size());
+        const render::Material& m = look.style.leaf;
+        parts.push_back(ExportPart{name, std::move(g.mesh), PartMaterial{name, color, m.roughness, true, std::move(baked)}});
+      }
     }
     return parts;
   }
@@ -485,27 +563,7 @@ std::vector<Vec3> readCpfgMaterials(const fs::path& path, std::vector<Diagnostic
   } catch (const std::exception&) {
     throw InputError(SourceLoc{path.string(), 0, 0}, "cannot read the materials file");
   }
-  if (bytes.empty() || bytes.size() % 15 != 0)
-    throw InputError(SourceLoc{path.string(), 0, 0},
-                     "a cpfg materials file holds records of 15 bytes (colour index, transparency, ambient, diffuse, "
-                     "emissive, specular, shininess), this file has " +
-                         std::to_string(bytes.size()) + " bytes");
-  auto byte = [&](size_t i) { return static_cast<unsigned char>(bytes[i]); };
-  std::vector<Vec3> palette(256, Vec3(1.0f));
-  for (size_t r = 0; r < bytes.size(); r += 15) {
-    const unsigned index = byte(r);
-    for (int c = 0; c < 3; ++c) palette[index][c] = static_cast<float>(byte(r + 5 + static_cast<size_t>(c))) / 255.0f;
-    if (byte(r + 1) != 0) {
-      Diagnostic d;
-      d.severity = Severity::Note;
-      d.loc = SourceLoc{path.string(), 0, 0};
-      char t[16];
-      std::snprintf(t, sizeof t, "%.2f", static_cast<double>(byte(r + 1)) / 255.0);
-      d.message = "material " + std::to_string(index) + " has transparency " + t + ": Sprig draws it opaque";
-      notes.push_back(std::move(d));
-    }
-  }
-  return palette;
+  return lsystem::parseCpfgMaterials(bytes, path.string(), notes);
 }
 
 /// A bare grammar (viewFile: its cpfg view file, empty for none; colormap: its colour map,
@@ -535,6 +593,8 @@ Species grammarSpecies(const fs::path& path, const fs::path& viewFile, const fs:
   if (!colormap.empty()) s.render.style.palette = readCpfgColormap(colormap);
   // A materials file (`-M NAME.mat`) colours them by their materials' diffuse colours.
   if (!materials.empty()) s.render.style.palette = readCpfgMaterials(materials, s.notes);
+  if (spec->view && !spec->view->textures.empty())
+    s.render.style.cpfgTextures = std::make_shared<const std::vector<lsystem::CpfgTexture>>(spec->view->textures);
   s.spec = spec;
   DiagnosticList diags;
   checkGrammar(s, *spec, diags);

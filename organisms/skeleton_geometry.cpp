@@ -125,7 +125,9 @@ SkeletonGeometry buildSkeletonGeometry(const lsystem::Skeleton& skeleton, const 
       for (const auto& p : organ.points) pts.push_back(toVec3(p));
       addFlatPolygon(g, pts, organColor(organ, o.leafColor));
     } else if (organ.kind == lsystem::Organ::Kind::Surface && !organ.triangles.empty()) {
-      // A cpfg surface file's mesh, placed by the turtle.
+      // A cpfg surface file's mesh, placed by the turtle; a textured one (`@Tx`) is left to
+      // the caller, which holds the view file's images (model/tree_kind.cpp).
+      if (organ.texture >= 0) continue;
       const Vec3 color = organColor(organ, o.leafColor);
       const uint32_t base = static_cast<uint32_t>(g.leaves.positions.size());
       for (size_t k = 0; k < organ.points.size(); ++k) {

@@ -32,7 +32,8 @@ struct SkeletonGeometry {
   SphereSet fruit;               ///< sphere organs
 };
 
-/// Builds the preview geometry of skeleton. Cost: O(internodes + organ points).
+/// Builds the preview geometry of skeleton. Cost: O(internodes + organ points). A cpfg
+/// surface with a texture (Organ::texture) is left out: its images are the view file's.
 SkeletonGeometry buildSkeletonGeometry(const lsystem::Skeleton& skeleton, const SkeletonGeometryOptions& options = {});
 
 }  // namespace sprig::organisms

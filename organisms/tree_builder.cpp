@@ -359,6 +359,7 @@ Mesh organMesh(const lsystem::Skeleton& skeleton, const TreeOptions& opt, std::o
   for (size_t i = 0; i < skeleton.organs.size(); ++i) {
     const auto& o = skeleton.organs[i];
     if (set && (*set == OrganSet::Fruit) != (o.kind == lsystem::Organ::Kind::Sphere)) continue;
+    if (o.texture >= 0 && !o.triangles.empty()) continue;  // a textured cpfg surface: model/tree_kind.cpp draws it
     Rng rng(deriveSeed(opt.seed, {kSeedLeaf, static_cast<uint64_t>(i)}));
     const Vec3 color = leafColor(o.color, rng);
     switch (o.kind) {

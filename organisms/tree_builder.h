@@ -63,7 +63,8 @@ std::vector<textures::RidgeArc> ridgeArcs(const TreeBlob& blob);
 /// become small UV spheres, named surfaces `~` become an ovate leaf blade in the turtle frame
 /// (heading along the midrib, up as the normal). uvs map the blade's unit square; colours
 /// are a seeded green per organ; every triangle gets options.leaves.material. Empty when
-/// leaves are disabled or there are no organs. Deterministic.
+/// leaves are disabled or there are no organs. Deterministic. A cpfg surface with a texture
+/// (Organ::texture) is left out: its images are the view file's (model/tree_kind.cpp).
 Mesh buildLeafMesh(const lsystem::Skeleton& skeleton, const TreeOptions& options);
 
 /// Which organs buildOrganMesh builds.

@@ -14,7 +14,6 @@ struct Unsupported {
 };
 
 constexpr Unsupported kUnsupported[] = {
-    {"@Tx", "texture"},
     {"@bo", "circle boundary"},
     {"@bc", "circle boundary"},
     {"@PS", "L-system defined surface patch"},
@@ -51,6 +50,8 @@ std::optional<std::string> cpfgUnsupported(std::string_view name, size_t args, b
   };
   for (const Unsupported& u : kUnsupported)
     if (name == u.name) return notSupported(name, u.what);
+  if (name == "@Tx" && dialect != Dialect::Cpfg)
+    return std::string("cpfg's '@Tx' (texture) is supported only in cpfg's notation (a .l file), with a view file's 'texture:' lines");
   if (name == "@") {
     std::string shown = "@";
     if (next && next != '(' && next != ' ' && next != '\t') shown += next;

@@ -263,7 +263,7 @@ TEST_CASE("cpfg view file", "[lsystem][cpfg]") {
 
 TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg]") {
   SECTION("commands") {
-    CHECK(errorOf("axiom: F@Tx(1)\n", "t.lsys") == "t.lsys:1:9: cpfg's '@Tx' (texture) is not supported");
+    CHECK(errorOf("axiom: F@Tx(1)\n", "t.lsys") == "t.lsys:1:9: cpfg's '@Tx' (texture) is supported only in cpfg's notation (a .l file), with a view file's 'texture:' lines");
     CHECK(errorOf("axiom: F{(1)F}(1)\n") == "t.l:1:9: cpfg's '{(type)' (generalized cylinder) is not supported");
     CHECK(errorOf("axiom: A\nA --> F$A\n") ==
           "t.l:2:8: cpfg's '$' ends a sub-L-system call '?(n, scale)', and this file makes none (ABOP's roll to vertical is '@v' in cpfg)");
@@ -274,7 +274,7 @@ TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg
           "the interpreted string)");
     CHECK(errorOf("axiom: A\nA --> ?(2,1)B$\n") ==
           "t.l:2:7: '?(2, ...)' calls a sub-L-system the file does not define (no 'lsystem: 2' after an 'endlsystem')");
-    CHECK(errorOf("axiom: F@Tx(1)\n") == "t.l:1:9: cpfg's '@Tx' (texture) is not supported");
+    CHECK(errorOf("axiom: F@bo(1)\n") == "t.l:1:9: cpfg's '@bo' (circle boundary) is not supported");
     CHECK(errorOf("axiom: F@Q\n") == "t.l:1:9: unknown cpfg command '@Q'");
   }
   SECTION("statements, blocks, preprocessor, several L-systems") {
@@ -304,7 +304,7 @@ TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg
     CHECK(errorOf("Start: { printf(\"%5.2f%%\\n\", 2); }\naxiom: A\n") == "no error");
   }
   SECTION("an error in a continued line is reported at its own line") {
-    CHECK(errorOf("axiom: A\nA --> F\n\tF@Tx(2)\n") == "t.l:3:3: cpfg's '@Tx' (texture) is not supported");
+    CHECK(errorOf("axiom: A\nA --> F\n\tF@bo(2)\n") == "t.l:3:3: cpfg's '@bo' (circle boundary) is not supported");
   }
 }
 
@@ -583,14 +583,14 @@ TEST_CASE("cpfg's C preprocessor", "[lsystem][cpfg]") {
   SECTION("an error in an included file is at its own file:line:col") {
     const std::string file = cpfgAsset("preprocessor_errors/plant.l");
     CHECK(errorOf(readFile(file), file) == cpfgAsset("preprocessor_errors/rules.h") +
-                                                    ":2:8: cpfg's '@Tx' (texture) is not supported");
+                                                    ":2:8: cpfg's '@bo' (circle boundary) is not supported");
   }
   SECTION("an error inside a macro's expansion is at the macro's use") {
-    CHECK(errorOf("#define LEAF [@Tx(1)]\naxiom: F LEAF\n") == "t.l:2:10: cpfg's '@Tx' (texture) is not supported");
+    CHECK(errorOf("#define LEAF [@bo(1)]\naxiom: F LEAF\n") == "t.l:2:10: cpfg's '@bo' (circle boundary) is not supported");
     CHECK(errorOf("#define B(x) F(x)\naxiom: A B(1, 2) C\n") ==
           "t.l:2:10: macro 'B' takes 1 argument(s) (defined at t.l:1), or its expansion nests deeper than 64 levels");
     // Columns after an expansion are the file's own.
-    CHECK(errorOf("#define S F(1)F(1)\naxiom: S@Tx(1)\n") == "t.l:2:9: cpfg's '@Tx' (texture) is not supported");
+    CHECK(errorOf("#define S F(1)F(1)\naxiom: S@bo(1)\n") == "t.l:2:9: cpfg's '@bo' (circle boundary) is not supported");
   }
   SECTION("cpp's identifiers: a macro named B is not expanded inside AB; a number body stays a value") {
     Grammar g = parseGrammar("#define B [+F]\n#define N (2 + 1)\naxiom: AB B F(N)\n", "t.l");

@@ -1,2 +1,2 @@
 /* productions of plant.l */
-A --> F@Tx(2)
+A --> F@bo(2)

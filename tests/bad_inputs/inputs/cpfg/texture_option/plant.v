@@ -1,0 +1,1 @@
+texture: F: halves.png E: b

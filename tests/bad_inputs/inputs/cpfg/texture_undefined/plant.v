@@ -1,0 +1,2 @@
+surface: a flat.s 1
+texture: F: halves.png
