@@ -19,40 +19,19 @@
 #include "model/model.h"
 #include "model/species.h"
 #include "tests/core/cube_mesh.h"
+#include "tests/model/weld_parts.h"
 
 using namespace sprig;
 
 namespace {
 
-// The parts' triangles in one mesh, each part's boundary vertices merged with the other
-// parts' boundary vertices at identical positions (a shell's parts are cut from one surface
-// along shared vertices). Interior vertices stay apart, even where two coincide.
+// The named parts welded (test::weldBoundaries): a shell's parts are cut from one surface
+// along shared vertices, a solid's at material changes and creases.
 Mesh weld(const std::vector<ExportPart>& parts, const std::vector<std::string>& names) {
-  Mesh out;
-  std::map<std::tuple<float, float, float>, uint32_t> index;
-  for (const ExportPart& p : parts) {
-    if (std::find(names.begin(), names.end(), p.name) == names.end()) continue;
-    std::map<std::pair<uint32_t, uint32_t>, int> edges;  // undirected edge -> use count
-    for (const auto& t : p.mesh.triangles)
-      for (int k = 0; k < 3; ++k) ++edges[std::minmax(t[k], t[(k + 1) % 3])];
-    std::vector<char> boundary(p.mesh.positions.size(), 0);
-    for (const auto& [e, n] : edges)
-      if (n == 1) boundary[e.first] = boundary[e.second] = 1;
-    std::vector<uint32_t> remap(p.mesh.positions.size());
-    for (size_t v = 0; v < p.mesh.positions.size(); ++v) {
-      const Vec3& q = p.mesh.positions[v];
-      if (!boundary[v]) {
-        remap[v] = uint32_t(out.positions.size());
-        out.positions.push_back(q);
-        continue;
-      }
-      auto [it, fresh] = index.emplace(std::make_tuple(q.x, q.y, q.z), uint32_t(out.positions.size()));
-      if (fresh) out.positions.push_back(q);
-      remap[v] = it->second;
-    }
-    for (const auto& t : p.mesh.triangles) out.triangles.push_back(glm::uvec3(remap[t.x], remap[t.y], remap[t.z]));
-  }
-  return out;
+  std::vector<const Mesh*> meshes;
+  for (const ExportPart& p : parts)
+    if (std::find(names.begin(), names.end(), p.name) != names.end()) meshes.push_back(&p.mesh);
+  return test::weldBoundaries(meshes);
 }
 
 // The bilinearly filtered colour of a baked texture at (s, t) (t = 0 at the bottom row),
