@@ -5,6 +5,7 @@
 #include <chrono>
 
 #include "core/diagnostics.h"
+#include "core/mesh_clean.h"
 #include "render/camera.h"
 
 namespace sprig {
@@ -38,6 +39,13 @@ Mesh SpeciesModel::buildMesh(const Stage& stage, float cellSize, bool progress, 
   fig.triangles = out.triangleCount();
   fig.buildSeconds = secondsSince(t0);
   if (figures) *figures = fig;
+  return out;
+}
+
+Mesh SpeciesModel::cleanSurface(const MeshCleanOptions& clean, MeshCleanReport* report, ModelFigures* figures) {
+  Mesh out = buildMesh(finalStage(), 0.0f, false, figures);
+  const MeshCleanReport r = cleanMesh(out, clean);
+  if (report) *report = r;
   return out;
 }
 

@@ -99,6 +99,13 @@ class SpeciesModel {
   /// cellSize 0 = automatic. progress shows a bar on a terminal.
   Mesh buildMesh(const Stage& stage, float cellSize, bool progress, ModelFigures* figures = nullptr);
 
+  /// The final stage's surface as another species takes it (an organism's `base: {species}`,
+  /// a solid's `distance_field: {species}`): buildMesh at the automatic cell, then cleaned
+  /// as `sprig mesh` cleans a polygonized surface (cleanMesh with clean: the components
+  /// below its fraction of the model's volume removed, specks outside and voids inside;
+  /// normals made to agree with the winding). report receives what the cleaning did.
+  Mesh cleanSurface(const MeshCleanOptions& clean = {}, MeshCleanReport* report = nullptr, ModelFigures* figures = nullptr);
+
   /// The stage's surface as named parts in the species' colours (KindModel::exportParts),
   /// polygonized BlobTrees cleaned with clean. Fills figures (triangles: all parts', build time).
   std::vector<ExportPart> exportParts(const Stage& stage, float cellSize, bool progress, const MeshCleanOptions& clean = {},

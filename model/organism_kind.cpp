@@ -222,11 +222,9 @@ class OrganismReader {
       SpeciesModel model(base);
       if (!model.hasSurfaceSettings())
         throw UsageError("species " + file->string() + " has no surface (a tree needs a tree: section)");
-      ModelFigures figures;
-      out = model.buildMesh(model.finalStage(), 0.0f, false, &figures);
-      // The polygonized surface cleaned as `sprig mesh` cleans it: shell_top's 133 voids and
-      // 2 specks would otherwise each become a separate piece of the organism.
-      cleanMesh(*out);
+      // Cleaned as `sprig mesh` cleans it: shell_top's 133 voids and 2 specks would otherwise
+      // each become a separate piece of the organism.
+      out = model.cleanSurface();
     } catch (const InputError& e) {
       diags_.append(e.diagnostics());
     } catch (const std::exception& e) {

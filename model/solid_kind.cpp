@@ -815,7 +815,10 @@ std::vector<Mesh> visibleMeshes(const TetMesh& mesh, std::vector<uint16_t>* part
   // Normals are smoothed over the faces around a vertex whose normals lie within 60° of
   // each other; sharper edges (a cut-away's rim, a box's edges) stay creased.
   constexpr float kCreaseCos = 0.5f;
-  const std::vector<InterfaceTriangle> tris = visibleInterface(mesh);
+  // The visible interface with pieces that touch along an edge or at a vertex only pulled
+  // apart (solids::boundarySurface): every part together is a closed 2-manifold.
+  const solids::BoundarySurface surface = solids::boundarySurface(mesh);
+  const std::vector<InterfaceTriangle>& tris = surface.triangles;
   std::map<uint16_t, std::vector<size_t>> byMaterial;
   for (size_t i = 0; i < tris.size(); ++i) byMaterial[tris[i].material].push_back(i);
   std::vector<Mesh> out;
@@ -826,7 +829,7 @@ std::vector<Mesh> visibleMeshes(const TetMesh& mesh, std::vector<uint16_t>* part
     std::map<uint32_t, std::vector<uint32_t>> around;
     for (size_t f = 0; f < list.size(); ++f) {
       const auto& v = tris[list[f]].v;
-      const Vec3 a(mesh.positions[v[0]]), b(mesh.positions[v[1]]), c(mesh.positions[v[2]]);
+      const Vec3 a(surface.positions[v[0]]), b(surface.positions[v[1]]), c(surface.positions[v[2]]);
       faceNormal[f] = glm::cross(b - a, c - a);
       for (uint32_t x : v) around[x].push_back(uint32_t(f));
     }
@@ -841,10 +844,11 @@ std::vector<Mesh> visibleMeshes(const TetMesh& mesh, std::vector<uint16_t>* part
         while (g < groups.size() && glm::dot(glm::normalize(groups[g].first), n) < kCreaseCos) ++g;
         if (g == groups.size()) {
           groups.push_back({Vec3(0.0f), uint32_t(m.positions.size())});
-          m.positions.push_back(Vec3(mesh.positions[x]));
+          m.positions.push_back(Vec3(surface.positions[x]));
           m.normals.push_back(Vec3(0.0f));
           if (tinted) {
-            const Vec4& t = mesh.tints[x];
+            const auto& [sa, sb] = surface.sources[x];  // an inserted midpoint takes the mean of its edge's ends
+            const Vec4 t = 0.5f * (mesh.tints[sa] + mesh.tints[sb]);
             m.colors.push_back(glm::mix((*materials)[mat].color, Vec3(t), std::clamp(t.w, 0.0f, 1.0f)));
           }
         }

@@ -106,7 +106,9 @@ solids::FieldPtr readSpeciesField(MapReader& m, const PathPolicy& policy) {
       at.error(diags, "species " + name + " has no surface (a tree needs a tree: section)");
       return nullptr;
     }
-    const Mesh surface = model.buildMesh(model.finalStage(), 0.0f, false);
+    // Cleaned as `sprig mesh` cleans it (and as an organism's species base is): a speck
+    // beside the surface or a void inside it would otherwise be solid of its own.
+    const Mesh surface = model.cleanSurface();
     const PolyMesh mesh = welded(surface);
     if (mesh.faceSizes.empty()) {
       at.error(diags, "the surface of species " + name + " is empty");

@@ -1,8 +1,8 @@
 #pragma once
 /// A Sprig species as a distance field of a solid (`{species: {file, seed}}`, docs/SOLIDS.md):
 /// the species is loaded and meshed as `sprig mesh` does (loadSpecies, SpeciesModel,
-/// buildMesh of the final stage), and its closed triangle mesh becomes OpenVDB's signed
-/// distance through solids::meshField. This lives in model/ because solids/ knows no
+/// cleanSurface: the final stage's mesh without its specks and voids), and its closed
+/// triangle mesh becomes OpenVDB's signed distance through solids::meshField. This lives in model/ because solids/ knows no
 /// species; model/solid_kind.cpp calls it.
 
 #include "model/yaml_reader.h"

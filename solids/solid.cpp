@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <stdexcept>
 
 #include "core/parallel.h"
@@ -714,6 +715,205 @@ std::vector<InterfaceTriangle> materialInterfaces(const TetMesh& mesh) {
       out.push_back(triangleOf(mesh, faces[i + 1]));
     }
     ++i;
+  }
+  return out;
+}
+
+BoundarySurface boundarySurface(const TetMesh& mesh, const std::vector<uint8_t>& selected, double pull) {
+  auto in = [&](uint32_t t) { return selected.empty() || selected[t] != 0; };
+  // 1. The boundary triangles: faces of a selected tetrahedron no other selected one shares.
+  const std::vector<FaceRef> faces = sortedFaces(mesh);
+  std::vector<InterfaceTriangle> tris;
+  std::vector<uint32_t> tetOf;
+  for (size_t i = 0; i < faces.size();) {
+    size_t j = i + 1;
+    while (j < faces.size() && faces[j].key == faces[i].key) ++j;
+    size_t n = 0, last = i;
+    for (size_t k = i; k < j; ++k)
+      if (in(faces[k].tet)) ++n, last = k;
+    if (n == 1) {
+      tris.push_back(triangleOf(mesh, faces[last]));
+      tetOf.push_back(faces[last].tet);
+    }
+    i = j;
+  }
+  const size_t nt = tris.size();
+
+  // 2. Pair the triangles at each edge: two at an edge are one wedge; at an edge of 2k > 2,
+  // the selected tetrahedra around it are joined through their faces at the edge into
+  // wedges, and each wedge's two boundary triangles are paired.
+  std::vector<std::pair<uint64_t, uint32_t>> halfEdges;  // (edge, triangle)
+  halfEdges.reserve(nt * 3);
+  for (size_t t = 0; t < nt; ++t)
+    for (int e = 0; e < 3; ++e) halfEdges.push_back({edgeKey(tris[t].v[size_t(e)], tris[t].v[size_t((e + 1) % 3)]), uint32_t(t)});
+  std::sort(halfEdges.begin(), halfEdges.end());
+  std::vector<uint32_t> parent(nt * 3);
+  for (size_t c = 0; c < parent.size(); ++c) parent[c] = uint32_t(c);
+  auto find = [&](uint32_t a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  };
+  auto corner = [&](uint32_t t, uint32_t v) {
+    const auto& q = tris[t].v;
+    return uint32_t(3 * t + size_t(std::find(q.begin(), q.end(), v) - q.begin()));
+  };
+  auto pair = [&](uint32_t s, uint32_t t, uint64_t e) {
+    for (uint32_t v : {uint32_t(e >> 32), uint32_t(e & 0xffffffffu)}) parent[find(corner(s, v))] = find(corner(t, v));
+  };
+  std::vector<uint32_t> start, items;  // selected tetrahedra by vertex, built at the first pinched edge
+  struct Wedge {
+    uint64_t edge;  ///< mesh vertex ids
+    uint32_t s, t;  ///< its two triangles
+  };
+  std::vector<Wedge> wedges;  // at the edges of more than two triangles, in edge order
+  for (size_t i = 0; i < halfEdges.size();) {
+    size_t j = i + 1;
+    while (j < halfEdges.size() && halfEdges[j].first == halfEdges[i].first) ++j;
+    const uint64_t e = halfEdges[i].first;
+    if (j - i == 2) pair(halfEdges[i].second, halfEdges[i + 1].second, e);
+    if (j - i > 2) {
+      if (start.empty()) {
+        start.assign(mesh.positions.size() + 1, 0);
+        for (size_t t = 0; t < mesh.tets.size(); ++t)
+          if (in(uint32_t(t)))
+            for (uint32_t v : mesh.tets[t]) ++start[v + 1];
+        for (size_t v = 0; v + 1 < start.size(); ++v) start[v + 1] += start[v];
+        items.resize(start.back());
+        std::vector<uint32_t> at(start.begin(), start.end() - 1);
+        for (size_t t = 0; t < mesh.tets.size(); ++t)
+          if (in(uint32_t(t)))
+            for (uint32_t v : mesh.tets[t]) items[at[v]++] = uint32_t(t);
+      }
+      const uint32_t a = uint32_t(e >> 32), b = uint32_t(e & 0xffffffffu);
+      std::vector<uint32_t> star;
+      for (uint32_t k = start[a]; k < start[a + 1]; ++k) {
+        const auto& q = mesh.tets[items[k]];
+        if (std::find(q.begin(), q.end(), b) != q.end()) star.push_back(items[k]);
+      }
+      std::vector<uint32_t> wedge(star.size());
+      for (size_t k = 0; k < wedge.size(); ++k) wedge[k] = uint32_t(k);
+      auto root = [&](uint32_t x) {
+        while (wedge[x] != x) x = wedge[x] = wedge[wedge[x]];
+        return x;
+      };
+      for (size_t x = 0; x < star.size(); ++x)
+        for (size_t y = x + 1; y < star.size(); ++y) {
+          int common = 0;
+          for (uint32_t v : mesh.tets[star[x]])
+            common += std::find(mesh.tets[star[y]].begin(), mesh.tets[star[y]].end(), v) != mesh.tets[star[y]].end() ? 1 : 0;
+          if (common == 3) wedge[root(uint32_t(x))] = root(uint32_t(y));
+        }
+      // Each triangle's wedge; the two triangles of a wedge are paired.
+      std::vector<std::pair<uint32_t, uint32_t>> byWedge;  // (wedge root, triangle)
+      for (size_t k = i; k < j; ++k) {
+        const uint32_t t = halfEdges[k].second;
+        const size_t x = size_t(std::find(star.begin(), star.end(), tetOf[t]) - star.begin());
+        byWedge.push_back({root(uint32_t(x)), t});
+      }
+      std::sort(byWedge.begin(), byWedge.end());
+      for (size_t k = 0; k + 1 < byWedge.size(); ++k)
+        if (byWedge[k].first == byWedge[k + 1].first) {
+          pair(byWedge[k].second, byWedge[k + 1].second, e);
+          wedges.push_back({e, byWedge[k].second, byWedge[k + 1].second});
+          ++k;
+        }
+    }
+    i = j;
+  }
+
+  // 3. One surface vertex per group of corners, numbered by (mesh vertex, first corner).
+  struct Group {
+    uint32_t vertex, first, root;
+  };
+  std::vector<Group> groups;
+  std::vector<uint32_t> seen(nt * 3, UINT32_MAX);
+  for (uint32_t c = 0; c < nt * 3; ++c) {
+    const uint32_t r = find(c);
+    if (seen[r] != UINT32_MAX) continue;
+    seen[r] = 0;
+    groups.push_back({tris[c / 3].v[c % 3], c, r});
+  }
+  std::sort(groups.begin(), groups.end(), [](const Group& x, const Group& y) {
+    return x.vertex != y.vertex ? x.vertex < y.vertex : x.first < y.first;
+  });
+  BoundarySurface out;
+  for (size_t g = 0; g < groups.size(); ++g) {
+    seen[groups[g].root] = uint32_t(g);
+    out.sources.push_back({groups[g].vertex, groups[g].vertex});
+    out.positions.push_back(mesh.positions[groups[g].vertex]);
+    if (g > 0 && groups[g].vertex == groups[g - 1].vertex && (g < 2 || groups[g - 2].vertex != groups[g].vertex)) ++out.splitVertices;
+  }
+  out.triangles = tris;
+  for (uint32_t c = 0; c < nt * 3; ++c) out.triangles[c / 3].v[c % 3] = seen[find(c)];
+
+  // 4. Edges still of more than two triangles: the first wedge keeps the edge, each other
+  // wedge's triangles are split at a midpoint vertex of their own.
+  std::vector<uint8_t> moved(out.positions.size(), 0);
+  for (size_t g = 0; g < groups.size(); ++g)
+    moved[g] = (g > 0 && groups[g - 1].vertex == groups[g].vertex) || (g + 1 < groups.size() && groups[g + 1].vertex == groups[g].vertex);
+  tetOf.resize(nt);
+  {
+    std::map<uint64_t, std::vector<uint32_t>> onEdge;  // surface edge -> its wedges (indices into wedges)
+    std::vector<std::pair<uint32_t, uint32_t>> halves;  // (triangle, a half split off it)
+    for (size_t w = 0; w < wedges.size(); ++w) {
+      const uint32_t a = uint32_t(wedges[w].edge >> 32), b = uint32_t(wedges[w].edge & 0xffffffffu);
+      const auto& q = out.triangles[wedges[w].s].v;
+      const uint32_t sa = q[size_t(std::find(tris[wedges[w].s].v.begin(), tris[wedges[w].s].v.end(), a) - tris[wedges[w].s].v.begin())];
+      const uint32_t sb = q[size_t(std::find(tris[wedges[w].s].v.begin(), tris[wedges[w].s].v.end(), b) - tris[wedges[w].s].v.begin())];
+      onEdge[edgeKey(sa, sb)].push_back(uint32_t(w));
+    }
+    for (const auto& [key, list] : onEdge) {
+      if (list.size() < 2) continue;
+      for (size_t k = 1; k < list.size(); ++k) {
+        const Wedge& w = wedges[list[k]];
+        const uint32_t m = uint32_t(out.positions.size());
+        const uint32_t a = uint32_t(w.edge >> 32), b = uint32_t(w.edge & 0xffffffffu);
+        out.positions.push_back(0.5 * (mesh.positions[a] + mesh.positions[b]));
+        out.sources.push_back({a, b});
+        moved.push_back(1);
+        ++out.splitEdges;
+        for (uint32_t t0 : {w.s, w.t}) {
+          // The triangle holding the edge: t0 or a half of it split at another edge.
+          auto edgeAt = [&](uint32_t t) {
+            const auto& v = out.triangles[t].v;
+            for (int e = 0; e < 3; ++e)
+              if (edgeKey(v[size_t(e)], v[size_t((e + 1) % 3)]) == key) return e;
+            return -1;
+          };
+          uint32_t t = t0;
+          int e = edgeAt(t);
+          for (size_t h = 0; e < 0 && h < halves.size(); ++h)
+            if (halves[h].first == t0) e = edgeAt(t = halves[h].second);
+          if (e < 0) continue;
+          // (p, q, r) with p-q the edge, in the triangle's order -> (p, m, r) and (m, q, r).
+          InterfaceTriangle second = out.triangles[t];
+          out.triangles[t].v[size_t((e + 1) % 3)] = m;
+          second.v[size_t(e)] = m;
+          halves.push_back({t0, uint32_t(out.triangles.size())});
+          out.triangles.push_back(second);
+          tetOf.push_back(tetOf[t]);
+        }
+      }
+    }
+  }
+
+  // 5. Pull the moved surface vertices into their own sheets.
+  if (pull > 0 && std::find(moved.begin(), moved.end(), 1) != moved.end()) {
+    const size_t ns = out.positions.size();
+    std::vector<DVec3> toward(ns, DVec3(0.0)), at(ns);
+    for (size_t s = 0; s < ns; ++s) at[s] = 0.5 * (mesh.positions[out.sources[s][0]] + mesh.positions[out.sources[s][1]]);
+    std::vector<double> shortest(ns, INFINITY);
+    for (size_t t = 0; t < out.triangles.size(); ++t)
+      for (size_t c = 0; c < 3; ++c) {
+        const uint32_t s = out.triangles[t].v[c];
+        if (!moved[s]) continue;
+        const auto& q = mesh.tets[tetOf[t]];
+        toward[s] += (mesh.positions[q[0]] + mesh.positions[q[1]] + mesh.positions[q[2]] + mesh.positions[q[3]]) * 0.25 - at[s];
+        for (uint32_t o : out.triangles[t].v)
+          if (o != s) shortest[s] = std::min(shortest[s], glm::length(at[o] - at[s]));
+      }
+    for (size_t s = 0; s < ns; ++s)
+      if (moved[s] && glm::length(toward[s]) > 0) out.positions[s] = at[s] + pull * shortest[s] * glm::normalize(toward[s]);
   }
   return out;
 }

@@ -209,6 +209,46 @@ std::vector<InterfaceTriangle> visibleInterface(const TetMesh& mesh, size_t* bad
 /// faces bound it closed.
 std::vector<InterfaceTriangle> materialInterfaces(const TetMesh& mesh);
 
+/// The boundary of a set of tetrahedra as a closed 2-manifold: its triangles (faces of a
+/// selected tetrahedron with no selected tetrahedron on their other side, oriented outward,
+/// in visibleInterface's order) on surface vertices of their own. The boundary of a union
+/// of tetrahedra is in general only a pseudo-manifold: pieces that touch along an edge
+/// only (four or more triangles at the edge) or at a vertex only (more than one fan of
+/// triangles around it) are left by removals (polish and erode between two bronze
+/// tetrahedra, a fracture), by snapping in meshSolid, and in one material's boundary
+/// wherever other materials alternate with it around an edge (the shine of polish,
+/// procedural materials). Here
+///  1. every such mesh vertex gets one surface vertex per sheet of solid around it: at an
+///     edge, the two triangles bounding one wedge of the tetrahedra around it (joined
+///     through their faces at the edge) are paired; at a vertex, the triangles joined
+///     through paired edges make one fan;
+///  2. an edge whose wedges are still joined around both its ends (the solid meets itself
+///     there through other sheets, as a material between two others around an edge does)
+///     keeps its first wedge; each other wedge's two triangles are split at a surface
+///     vertex of their own at the edge's midpoint;
+///  3. each surface vertex of a split mesh vertex, or at a midpoint, is moved `pull` times
+///     the shortest edge of its triangles at it toward the centroids of their tetrahedra
+///     (into its own sheet of solid), so the sheets that touched are apart by a positive
+///     distance: a consumer that welds vertices at equal positions gets the same manifold.
+/// Where nothing touches, the surface vertices are the mesh's boundary vertices in
+/// ascending order at their exact positions, and the triangles are visibleInterface's.
+struct BoundarySurface {
+  std::vector<InterfaceTriangle> triangles;  ///< v: ids into positions / sources; material of the tetrahedron
+  std::vector<DVec3> positions;              ///< one per surface vertex
+  /// The mesh vertices each surface vertex stands for (for tints): {v, v}, or the ends
+  /// {a, b} of the edge at whose midpoint it was inserted.
+  std::vector<std::array<uint32_t, 2>> sources;
+  size_t splitVertices = 0;  ///< mesh vertices with more than one surface vertex (step 1)
+  size_t splitEdges = 0;     ///< midpoint vertices inserted (step 2)
+};
+
+/// The boundary surface of the tetrahedra with selected[t] (empty: every tetrahedron, so
+/// the visible interface; one material's tetrahedra: that material's closed boundary,
+/// visible faces and interfaces to other materials). pull >= 0 (see BoundarySurface).
+/// Deterministic. Cost O(T log T) in the boundary triangles, plus the tetrahedra around
+/// the pinched edges.
+BoundarySurface boundarySurface(const TetMesh& mesh, const std::vector<uint8_t>& selected = {}, double pull = 1e-3);
+
 /// Tetrahedron faces in local vertex order, oriented outward for a positive tetrahedron.
 constexpr std::array<std::array<int, 3>, 4> kTetFaces = {{{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}}};
 

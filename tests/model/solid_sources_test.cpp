@@ -6,6 +6,7 @@
 
 #include "core/image.h"
 #include "core/mesh.h"
+#include "core/mesh_clean.h"
 #include "model/model.h"
 #include "model/solid_kind.h"
 #include "model/species.h"
@@ -138,4 +139,34 @@ TEST_CASE("kind: solid reads another species as a distance field", "[model][soli
     strict.root = dir.path;
     CHECK(loadError(dir.path / "s.yaml", strict).find("s.yaml:5:38: error:") != std::string::npos);  // absolute path refused
   }
+}
+
+// A species field takes the species' surface cleaned as `sprig mesh` cleans it, the same
+// surface an organism's species base takes (SpeciesModel::cleanSurface): a ball of radius
+// 0.45 meshes with a speck beside it (a ball of radius 0.02, 8.8e-5 of the volume, below
+// the cleaning's 1e-4), which the solid does not see.
+TEST_CASE("kind: solid's species field leaves out the species' specks", "[model][solid]") {
+  test::TempDir dir("species-field-speck");
+  PathPolicy policy;
+  policy.allowOutside = true;
+  writeText(dir.path / "speck.yaml", "kind: blob\nblob:\n  union:\n    - {point: {center: [0, 0, 0], radius: 0.45}}\n"
+                                     "    - {point: {center: [1, 0, 0], radius: 0.02}}\nmesh: {cell: 0.01}\n");
+  SpeciesModel base(loadSpecies(dir.path / "speck.yaml", policy));
+  size_t raw = 0, cleaned = 0;
+  triangleComponents(base.buildMesh(base.finalStage(), 0.0f, false), &raw);
+  MeshCleanReport report;
+  triangleComponents(base.cleanSurface({}, &report), &cleaned);
+  CHECK(raw == 2);
+  CHECK(cleaned == 1);
+  CHECK(report.specks == 1);
+  CHECK(report.voids == 0);
+
+  writeText(dir.path / "s.yaml", "kind: solid\nsolid:\n  grid: {cell: 0.1}\n  volume:\n    distance_field: {species: {file: speck.yaml}}\n"
+                                 "    layers: [{interior_layer: {material: wood, thickness: fill}}]\n");
+  const Species s = loadSpecies(dir.path / "s.yaml", policy);
+  const solids::FieldPtr f = dynamic_cast<const SolidSpec&>(*s.spec).solid.volumes[0].field;
+  const std::vector<float> d = f->sample({Vec3(1, 0, 0), Vec3(0, 0, 0), Vec3(0.75, 0, 0)}, 0.02, 0.6);
+  CHECK(d[0] == Approx(0.55).margin(0.02));  // the speck's centre: outside, 0.55 from the ball
+  CHECK(d[1] == Approx(-0.45).margin(0.02));
+  CHECK(d[2] == Approx(0.3).margin(0.02));
 }

@@ -12,6 +12,7 @@
 
 #include "core/atomic_file.h"
 #include "core/mesh.h"
+#include "core/mesh_clean.h"
 #include "core/parallel.h"
 #include "solids/distance_field.h"
 #include "solids/octree.h"
@@ -545,4 +546,179 @@ TEST_CASE("meshSolid: coarsening across interfaces where the fields are affine t
   opt.coarsenTolerance = 0;
   const TetMesh exact = meshSolid(s, g, opt);
   for (const auto& [mat, vol] : volumeByMaterial(exact)) CHECK(vol == Approx(vu.at(mat)).epsilon(1e-9));
+}
+
+namespace {
+
+/// Two bronze tetrahedra (material 0) that share the edge (0,0,0)-(0,0,1) only, on opposite
+/// sides of it; with clay, a third tetrahedron (material 1) fills one of the two gaps
+/// between them, so together they are one wedge.
+TetMesh edgeContact(bool clay) {
+  TetMesh m;
+  m.positions = {{0, 0, 0}, {0, 0, 1}, {1, 0, 0.5}, {0, 1, 0.5}, {-1, 0, 0.5}, {0, -1, 0.5}};
+  m.tets = {{0, 1, 2, 3}, {0, 1, 4, 5}};
+  m.materials = {0, 0};
+  if (clay) {
+    m.tets.push_back({0, 1, 3, 4});
+    m.materials.push_back(1);
+  }
+  return m;
+}
+
+/// Two tetrahedra that share the vertex 0 only.
+TetMesh vertexContact() {
+  TetMesh m;
+  m.positions = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {-1, 0, 0}, {0, -1, 0}, {0, 0, -1}};
+  m.tets = {{0, 1, 2, 3}, {0, 5, 4, 6}};
+  m.materials = {0, 0};
+  return m;
+}
+
+Mesh meshOf(const BoundarySurface& s) {
+  Mesh out;
+  for (const DVec3& p : s.positions) out.positions.push_back(Vec3(p));
+  for (const auto& t : s.triangles) out.triangles.push_back({t.v[0], t.v[1], t.v[2]});
+  return out;
+}
+
+size_t componentsOf(const Mesh& m) {
+  size_t n = 0;
+  triangleComponents(m, &n);
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("boundarySurface: pieces touching along an edge or at a vertex are pulled apart", "[solids]") {
+  SECTION("an edge-only contact: four triangles at the edge in the visible interface, two sheets here") {
+    const TetMesh m = edgeContact(false);
+    for (size_t t = 0; t < m.tets.size(); ++t) REQUIRE(m.volume(t) > 0);
+    const MeshTopology pinched = analyzeTopology(meshOf(m, visibleInterface(m)));
+    CHECK(pinched.nonManifoldEdges == 1);
+    const BoundarySurface s = boundarySurface(m);
+    REQUIRE(s.triangles.size() == 8);
+    CHECK(s.splitVertices == 2);
+    CHECK(s.splitEdges == 0);
+    CHECK(s.positions.size() == 8);  // 6 vertices, the edge's two each in two sheets
+    const Mesh surface = meshOf(s);
+    const MeshTopology topo = analyzeTopology(surface);
+    CHECK(topo.closed());
+    CHECK(topo.manifold());
+    CHECK(componentsOf(surface) == 2);
+    CHECK(signedVolume(surface) < m.volume(0) + m.volume(1));  // the copies moved inward
+    CHECK(signedVolume(surface) == Approx(m.volume(0) + m.volume(1)).epsilon(1e-2));
+    // Each copy of (0,0,0) moved 1e-3 of its shortest edge (the contact edge, length 1)
+    // toward its own tetrahedron's centroid: (±0.25, ±0.25, 0.5) normalized.
+    std::vector<DVec3> copies;
+    for (size_t v = 0; v < s.positions.size(); ++v)
+      if (s.sources[v][0] == 0) copies.push_back(s.positions[v]);
+    REQUIRE(copies.size() == 2);
+    const DVec3 towardA = glm::normalize(DVec3(0.25, 0.25, 0.5)), towardB = glm::normalize(DVec3(-0.25, -0.25, 0.5));
+    CHECK(glm::length(copies[0] - 1e-3 * towardA) < 1e-12);
+    CHECK(glm::length(copies[1] - 1e-3 * towardB) < 1e-12);
+    // The vertices no sheet shares stay where they were, in ascending order.
+    for (size_t v = 0; v < s.positions.size(); ++v)
+      if (s.sources[v][0] >= 2) CHECK(s.positions[v] == m.positions[s.sources[v][0]]);
+    for (size_t v = 0; v < s.positions.size(); ++v) CHECK(s.sources[v][0] == s.sources[v][1]);
+    CHECK(std::is_sorted(s.sources.begin(), s.sources.end()));
+  }
+  SECTION("pull 0 keeps the copies in place, still two sheets by their ids") {
+    const BoundarySurface s = boundarySurface(edgeContact(false), {}, 0.0);
+    CHECK(s.splitVertices == 2);
+    for (size_t v = 0; v < s.positions.size(); ++v) CHECK(s.positions[v] == edgeContact(false).positions[s.sources[v][0]]);
+    CHECK(analyzeTopology(meshOf(s)).manifold());
+    CHECK(componentsOf(meshOf(s)) == 2);
+  }
+  SECTION("a vertex-only contact: one piece by its vertices in the visible interface, two here") {
+    const TetMesh m = vertexContact();
+    for (size_t t = 0; t < m.tets.size(); ++t) REQUIRE(m.volume(t) > 0);
+    CHECK(componentsOf(meshOf(m, visibleInterface(m))) == 1);
+    const BoundarySurface s = boundarySurface(m);
+    CHECK(s.splitVertices == 1);
+    CHECK(s.positions.size() == 8);
+    const Mesh surface = meshOf(s);
+    CHECK(analyzeTopology(surface).closed());
+    CHECK(analyzeTopology(surface).manifold());
+    CHECK(componentsOf(surface) == 2);
+  }
+  SECTION("one material's boundary: the clay closes the visible interface, the bronze alone still touches along the edge") {
+    const TetMesh m = edgeContact(true);
+    for (size_t t = 0; t < m.tets.size(); ++t) REQUIRE(m.volume(t) > 0);
+    const BoundarySurface all = boundarySurface(m);
+    CHECK(all.splitVertices == 0);
+    CHECK(all.triangles.size() == 8);
+    CHECK(analyzeTopology(meshOf(all)).closed());
+    CHECK(analyzeTopology(meshOf(all)).manifold());
+    const BoundarySurface bronze = boundarySurface(m, {1, 1, 0});
+    CHECK(bronze.triangles.size() == 8);
+    CHECK(bronze.splitVertices == 2);
+    CHECK(analyzeTopology(meshOf(bronze)).closed());
+    CHECK(analyzeTopology(meshOf(bronze)).manifold());
+    CHECK(componentsOf(meshOf(bronze)) == 2);
+    const BoundarySurface clay = boundarySurface(m, {0, 0, 1});
+    CHECK(clay.triangles.size() == 4);
+    CHECK(clay.splitVertices == 0);
+  }
+  SECTION("material between others around an edge, joined around both ends: split edge") {
+    // An octahedron around the edge (0,0,0)-(0,0,1): four tetrahedra, bronze (0) and clay
+    // (1) in turn; bronze caps below and above join the two bronze wedges around each end.
+    TetMesh m;
+    m.positions = {{0, 0, 0}, {0, 0, 1}, {1, 0, 0.5}, {0, 1, 0.5}, {-1, 0, 0.5}, {0, -1, 0.5}, {0, 0, -1}, {0, 0, 2}};
+    for (uint32_t i = 0; i < 4; ++i) {
+      const uint32_t p = 2 + i, q = 2 + (i + 1) % 4;
+      m.tets.push_back({0, 1, p, q});
+      m.materials.push_back(uint16_t(i % 2));
+      m.tets.push_back({0, q, p, 6});
+      m.materials.push_back(0);
+      m.tets.push_back({1, p, q, 7});
+      m.materials.push_back(0);
+    }
+    for (size_t t = 0; t < m.tets.size(); ++t)
+      if (m.volume(t) < 0) std::swap(m.tets[t][2], m.tets[t][3]);
+    for (size_t t = 0; t < m.tets.size(); ++t) REQUIRE(m.volume(t) > 0);
+    std::vector<uint8_t> bronze(m.tets.size());
+    for (size_t t = 0; t < bronze.size(); ++t) bronze[t] = m.materials[t] == 0;
+    const BoundarySurface b = boundarySurface(m, bronze);
+    // The bronze meets itself along the axis (the clay on both sides) and along each clay
+    // tetrahedron's equator edge (its caps, the clay on one side, outside on the other), and
+    // is joined around the ends of all three: each is split once.
+    CHECK(b.splitVertices == 0);
+    CHECK(b.splitEdges == 3);
+    // The caps' 8 outer faces, the clay tetrahedra's 4 faces each, and 3 · 2 halves.
+    CHECK(b.triangles.size() == 8 + 8 + 6);
+    const Mesh surface = meshOf(b);
+    const MeshTopology topo = analyzeTopology(surface);
+    CHECK(topo.closed());
+    CHECK(topo.manifold());
+    CHECK(componentsOf(surface) == 1);
+    double clay = 0, all = 0;
+    for (size_t t = 0; t < m.tets.size(); ++t) (m.materials[t] == 1 ? clay : all) += m.volume(t);
+    CHECK(signedVolume(surface) == Approx(all).epsilon(1e-2));
+    // The midpoint vertex stands for the edge's ends, 1e-3 of its shortest edge (0.5) from
+    // the midpoint, into its wedge (the bronze tetrahedron between (-1,0,.5) and (0,-1,.5)).
+    const auto axis = std::find(b.sources.begin(), b.sources.end(), std::array<uint32_t, 2>{0, 1});
+    REQUIRE(axis != b.sources.end());
+    const DVec3 mid = b.positions[size_t(axis - b.sources.begin())];
+    CHECK(glm::length(mid - DVec3(0, 0, 0.5)) == Approx(0.5e-3));
+    CHECK(mid.x < 0);
+    CHECK(mid.y < 0);
+    // Every tetrahedron together: no contact.
+    const BoundarySurface whole = boundarySurface(m);
+    CHECK(whole.splitVertices + whole.splitEdges == 0);
+    CHECK(analyzeTopology(meshOf(whole)).manifold());
+    (void)clay;
+  }
+  SECTION("without contacts it is the visible interface, vertex for vertex") {
+    Solid s = sphereSolid(0.6, {{true, 0.15, "pink_frosting"}, {true, 0, "chocolate"}, {false, 0.1, "white_chocolate"}});
+    const TetMesh m = meshSolid(s, gridAround(0.8, 0.1));
+    const std::vector<InterfaceTriangle> visible = visibleInterface(m);
+    const BoundarySurface b = boundarySurface(m);
+    REQUIRE(b.triangles.size() == visible.size());
+    CHECK(b.splitVertices == 0);
+    bool same = true;
+    for (size_t t = 0; t < visible.size(); ++t)
+      for (size_t c = 0; c < 3; ++c) same = same && b.sources[b.triangles[t].v[c]][0] == visible[t].v[c] && b.triangles[t].material == visible[t].material;
+    CHECK(same);
+    for (size_t v = 0; v < b.positions.size(); ++v) CHECK(b.positions[v] == m.positions[b.sources[v][0]]);
+  }
 }
