@@ -862,7 +862,11 @@ BoundarySurface boundarySurface(const TetMesh& mesh, const std::vector<uint8_t>&
       const uint32_t sb = q[size_t(std::find(tris[wedges[w].s].v.begin(), tris[wedges[w].s].v.end(), b) - tris[wedges[w].s].v.begin())];
       onEdge[edgeKey(sa, sb)].push_back(uint32_t(w));
     }
-    for (const auto& [key, list] : onEdge) {
+    for (const auto& entry : onEdge) {
+      // Not a structured binding: the lambda below uses the key, and clang 14 (the sanitizer
+      // build's compiler) does not let lambdas capture structured bindings.
+      const auto key = entry.first;
+      const auto& list = entry.second;
       if (list.size() < 2) continue;
       for (size_t k = 1; k < list.size(); ++k) {
         const Wedge& w = wedges[list[k]];
