@@ -325,10 +325,14 @@ class SolidReader {
     if (kind == "surface_mesh") {
       PolyMesh mesh;
       out = readMesh(m, &mesh);
+      out = withOffset(m, out);
       if (auto v = m.get("velocity")) {
         std::optional<VelocityWrap> w = readVelocity(*v, diags_, &mesh, false, &policy_);
         out = w && out ? (*w)(out) : nullptr;
       }
+    } else if (kind == "species") {
+      out = readSpeciesField(m, policy_);
+      out = withOffset(m, out);
     } else if (kind == "sphere") {
       out = sphereField(DVec3(m.vec3("center", Vec3(0.0f))), m.number("radius", 1.0, 1e-6, 1e6));
     } else if (kind == "box") {
@@ -357,11 +361,16 @@ class SolidReader {
       if (child) out = transformField(child, scale, DVec3(axis), angle, DVec3(t));
     } else if (kind == "extrude_2d") {
       out = readExtrude(m);
-    } else if (kind == "species") {
-      out = readSpeciesField(m, policy_);
     }
     m.finish();
     return out;
+  }
+
+  /// A mesh field grown by its `offset` (world units, >= 0; 0: as it is), so walls thinner
+  /// than the grid's cells survive meshing (docs/SOLIDS.md).
+  FieldPtr withOffset(MapReader& m, FieldPtr field) {
+    const double by = m.number("offset", 0.0, 0.0, 1e6);
+    return field && by > 0 ? offsetField(std::move(field), by) : field;
   }
 
   /// A unit direction at key (default +y); zero is an error.

@@ -163,6 +163,30 @@ class TransformField final : public DistanceField {
   DVec3 t_;
 };
 
+/// The child grown by d: its value less d, so the zero set moves d outward. Asks the child
+/// for a band d wider, so values near the new zero set and its layers are not clamped.
+class OffsetField final : public DistanceField {
+ public:
+  OffsetField(FieldPtr child, double d) : child_(std::move(child)), d_(d) {
+    if (!(d >= 0)) throw std::invalid_argument("the offset must not be negative");
+  }
+  std::vector<float> sample(const std::vector<Vec3>& points, double cell, double band) const override {
+    std::vector<float> out = child_->sample(points, cell, band + d_);
+    for (float& v : out) v = float(double(v) - d_);
+    return out;
+  }
+  std::optional<DBox3> bounds() const override {
+    std::optional<DBox3> b = child_->bounds();
+    if (!b) return std::nullopt;
+    return DBox3{b->lo - d_, b->hi + d_};
+  }
+  double reach() const override { return child_->reach(); }
+
+ private:
+  FieldPtr child_;
+  double d_;
+};
+
 }  // namespace
 
 FieldPtr meshField(const PolyMesh& mesh) { return std::make_shared<MeshField>(mesh); }
@@ -205,6 +229,7 @@ FieldPtr subtractionField(FieldPtr a, FieldPtr b) { return std::make_shared<Subt
 FieldPtr transformField(FieldPtr child, double scale, const DVec3& axis, double angleDeg, const DVec3& t) {
   return std::make_shared<TransformField>(std::move(child), scale, axis, angleDeg, t);
 }
+FieldPtr offsetField(FieldPtr child, double by) { return std::make_shared<OffsetField>(std::move(child), by); }
 
 std::optional<OpenEdge> firstOpenEdge(const PolyMesh& mesh) {
   std::map<std::pair<uint32_t, uint32_t>, int> uses;

@@ -59,6 +59,11 @@ FieldPtr subtractionField(FieldPtr a, FieldPtr b);
 /// child scaled by s > 0, turned by angleDeg about unit axis, then moved by translate:
 /// d(p) = s · child(R⁻¹(p - t) / s), still a Euclidean distance.
 FieldPtr transformField(FieldPtr child, double scale, const DVec3& axis, double angleDeg, const DVec3& translate);
+/// child grown by `by` >= 0 world units: d(p) = child(p) - by. Where child is a Euclidean
+/// distance, its solid {d <= 0} is the child's dilated by a ball of radius `by` (and d is
+/// the exact distance outside it), so walls thicken by 2·by and holes narrower than 2·by
+/// close. Bounds grow by `by`. Throws std::invalid_argument when `by` < 0.
+FieldPtr offsetField(FieldPtr child, double by);
 
 /// The first edge of mesh used by only one face, as "between vertices A and B (1-based)
 /// of the face at LOC"; nullopt when the mesh is closed. faceLocs say where.

@@ -170,3 +170,73 @@ TEST_CASE("kind: solid's species field leaves out the species' specks", "[model]
   CHECK(d[1] == Approx(-0.45).margin(0.02));
   CHECK(d[2] == Approx(0.3).margin(0.02));
 }
+
+// A wall thinner than the grid's cell (a plate 0.018 thick, tilted against the grid of cell
+// 0.05) meshes to a lace of 64 fragments holding 5% of its volume: only the nodes within
+// 0.009 of its mid-plane are inside. Grown by an offset of 0.044 (0.88 of the cell, above the
+// lattice's covering radius √3/2 cell: every point of the plate then has a node inside
+// within the offset), it is 0.106 thick and meshes to one closed piece, the plate dilated by
+// a ball of radius 0.044.
+TEST_CASE("kind: solid's surface_mesh offset keeps a wall thinner than the cell whole", "[model][solid]") {
+  test::TempDir dir("thin-wall");
+  const Vec3 n = glm::normalize(Vec3(1, 2, 3));
+  const Vec3 u = glm::normalize(glm::cross(n, Vec3(0, 0, 1)));
+  const Vec3 v = glm::cross(u, n);  // (u, n, v) right-handed: the cube's faces stay outward
+  const float half[3] = {0.4f, 0.009f, 0.4f};
+  {
+    std::ofstream obj(dir.path / "plate.obj");
+    for (int k = 0; k < 8; ++k) {
+      const Vec3 p = float((k & 1) ? 1 : -1) * half[0] * u + float((k & 2) ? 1 : -1) * half[1] * n +
+                     float((k & 4) ? 1 : -1) * half[2] * v + Vec3(0.013f, -0.021f, 0.007f);
+      obj << "v " << p.x << " " << p.y << " " << p.z << "\n";
+    }
+    obj << "f 1 5 7 3\nf 2 4 8 6\nf 1 2 6 5\nf 3 7 8 4\nf 1 3 4 2\nf 5 6 8 7\n";
+  }
+  auto mesh = [&](const std::string& offset) {
+    writeText(dir.path / "s.yaml", "kind: solid\nsolid:\n  grid: {cell: 0.05}\n  volume:\n    distance_field: {surface_mesh: {file: plate.obj" +
+                                       offset + "}}\n    layers: [{interior_layer: {material: wood, thickness: fill}}]\n");
+    PathPolicy policy;
+    policy.allowOutside = true;
+    const Species s = loadSpecies(dir.path / "s.yaml", policy);
+    const auto& spec = dynamic_cast<const SolidSpec&>(*s.spec);
+    return std::make_pair(spec.solid.volumes[0].field, solids::meshSolid(spec.solid, spec.grid));
+  };
+  auto pieces = [](const solids::TetMesh& m) {
+    const solids::BoundarySurface b = solids::boundarySurface(m);
+    Mesh out;
+    for (const DVec3& p : b.positions) out.positions.push_back(Vec3(p));
+    for (const auto& t : b.triangles) out.triangles.push_back({t.v[0], t.v[1], t.v[2]});
+    size_t count = 0;
+    triangleComponents(out, &count);
+    const MeshTopology topo = analyzeTopology(out);
+    CHECK(topo.closed());
+    CHECK(topo.manifold());
+    return count;
+  };
+  auto volume = [](const solids::TetMesh& m) {
+    double sum = 0;
+    for (size_t t = 0; t < m.tets.size(); ++t) sum += m.volume(t);
+    return sum;
+  };
+
+  const auto [thin, thinMesh] = mesh("");
+  const size_t before = pieces(thinMesh);
+  CHECK(before == 64);
+  CHECK(volume(thinMesh) < 0.06 * 0.8 * 0.8 * 0.018);
+
+  const auto [grown, grownMesh] = mesh(", offset: 0.044");
+  const Vec3 c(0.013f, -0.021f, 0.007f);
+  const std::vector<float> d = grown->sample({c, c + 0.1f * n, c + 0.5f * u}, 0.01, 0.2);
+  CHECK(d[0] == Approx(-0.009 - 0.044).margin(1e-3));  // the plate's mid-plane
+  CHECK(d[1] == Approx(0.1 - 0.009 - 0.044).margin(1e-3));
+  CHECK(d[2] == Approx(0.1 - 0.044).margin(1e-3));  // beyond the rim
+  CHECK(pieces(grownMesh) == 1);
+  // The plate (a, b, t) dilated by a ball of radius o: abt + 2o(ab + bt + ta) + πo²(a + b + t) + 4πo³/3.
+  // Its faces are planes, which the linear tetrahedra hold exactly; its rounded rim, of a
+  // radius below the cell, they cut by chords, so the mesh holds a little less.
+  const double a = 0.8, b = 0.8, t = 0.018, o = 0.044;
+  const double exact = a * b * t + 2 * o * (a * b + b * t + t * a) + M_PI * o * o * (a + b + t) + 4 * M_PI * o * o * o / 3;
+  INFO("volume " << volume(grownMesh) << " of " << exact);
+  CHECK(volume(grownMesh) < exact);
+  CHECK(volume(grownMesh) > 0.95 * exact);
+}
