@@ -228,6 +228,20 @@ TEST_CASE("distance fields", "[solids]") {
     CHECK(d[2] == Approx(0.2).margin(0.01));  // nearest: the vertex (0.6, 0, 0)
     CHECK(d[3] > 0);
   }
+  SECTION("an offset grows a field: its value less the offset, its box wider, its child's band wider") {
+    const FieldPtr grown = offsetField(meshField(octahedron(0.6f)), 0.1);
+    const auto d = grown->sample({{0.5f, 0, 0}, {0.8f, 0, 0}, {0.88f, 0, 0}}, 0.02, 0.2);
+    CHECK(d[0] == Approx(-0.1 / std::sqrt(3.0) - 0.1).margin(0.01));
+    CHECK(d[1] == Approx(0.1).margin(0.01));
+    // 0.28 from the mesh: within the child's band 0.2 + 0.1, not clamped (at band 0.2 it is 0.22)
+    CHECK(d[2] == Approx(0.18).margin(0.01));
+    const std::optional<DBox3> box = grown->bounds();
+    REQUIRE(box);
+    CHECK(box->lo.x == Approx(-0.7));
+    CHECK(box->hi.y == Approx(0.7));
+    CHECK(offsetField(sphereField(DVec3(0.0), 1), 0.0)->sample({{2, 0, 0}}, 0.1, 1)[0] == Approx(1.0));
+    CHECK_THROWS_AS(offsetField(sphereField(DVec3(0.0), 1), -0.1), std::invalid_argument);
+  }
   SECTION("the first open edge of a mesh") {
     PolyMesh p = octahedron(1);
     CHECK_FALSE(firstOpenEdge(p));
