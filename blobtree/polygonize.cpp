@@ -52,7 +52,14 @@ class CellHash {
   explicit CellHash(size_t n) {
     size_t cap = 64;
     while (cap < 2 * n) cap <<= 1;
-    slots_.assign(cap, Slot{kEmpty, kNoCell});
+    // Filled in parallel: the table of a fine grid is 100+ MB, and its first touch (page
+    // faults, then the fill) on one thread was a serial step of the polygonizer.
+    slots_.reset(new Slot[cap]);
+    capacity_ = cap;
+    constexpr size_t kChunk = size_t(1) << 16;
+    parallelFor(0, (cap + kChunk - 1) / kChunk, [&](size_t c) {
+      std::fill(slots_.get() + c * kChunk, slots_.get() + std::min(cap, (c + 1) * kChunk), Slot{kEmpty, kNoCell});
+    }, 1);
     mask_ = cap - 1;
   }
   void insert(uint64_t key, uint32_t id) {
@@ -60,6 +67,20 @@ class CellHash {
     while (slots_[i].key != kEmpty && slots_[i].key != key) i = (i + 1) & mask_;
     slots_[i] = Slot{key, id};
   }
+  /// insert() safe to call from several threads at once for distinct keys (a slot is
+  /// claimed by a compare-and-swap of its key). Which slot a key takes may depend on the
+  /// threads' timing; what find() returns does not.
+  void insertConcurrent(uint64_t key, uint32_t id) {
+    for (size_t i = slot(key);; i = (i + 1) & mask_) {
+      uint64_t expected = kEmpty;
+      if (std::atomic_ref<uint64_t>(slots_[i].key).compare_exchange_strong(expected, key, std::memory_order_relaxed)) {
+        slots_[i].id = id;
+        return;
+      }
+    }
+  }
+  /// Number of slots (at least twice the count given to the constructor).
+  size_t capacity() const { return capacity_; }
   uint32_t find(uint64_t key) const {
     for (size_t i = slot(key);; i = (i + 1) & mask_) {
       const Slot& s = slots_[i];
@@ -85,8 +106,20 @@ class CellHash {
     block ^= block >> 33;
     return size_t((block << 6) | local) & mask_;
   }
-  std::vector<Slot> slots_;
-  size_t mask_ = 0;
+  std::unique_ptr<Slot[]> slots_;
+  size_t capacity_ = 0, mask_ = 0;
+};
+
+// The active cells by grid key: the cell hash (kept cells, and after the closure the added
+// ones too) and each cell's active index. A second hash of the active cells cost a serial
+// pass of 2.6 M inserts and 128 MB of slots on the 2,000-cone benchmark.
+struct ActiveIndex {
+  const CellHash& cells;
+  std::vector<uint32_t> activeOf;  // per cell: its index in Grid::active, or kNoCell
+  uint32_t find(uint64_t key) const {
+    uint32_t j = cells.find(key);
+    return j == kNoCell ? kNoCell : activeOf[j];
+  }
 };
 
 // A surface-crossing grid edge: its inside and outside grid point indices.
@@ -186,10 +219,10 @@ CellSet keptCells(const CompiledBlob& blob, float requested) {
 // numbering does not depend on the thread count.
 void numberCorners(Grid& g) {
   const size_t nCells = g.cs.cells.size();
-  for (size_t i = 0; i < nCells; ++i) {
+  parallelFor(0, nCells, [&](size_t i) {
     const auto& idx = g.cs.cells[i].index;
-    g.cellIndex.insert(pointKey(idx[0], idx[1], idx[2]), uint32_t(i));
-  }
+    g.cellIndex.insertConcurrent(pointKey(idx[0], idx[1], idx[2]), uint32_t(i));
+  }, 4096);
   g.cornerPoint.resize(nCells * 8);  // first the owner slot, then the point index
   g.ownedMask.resize(nCells);
   g.pointBase.assign(nCells + 1, 0);
@@ -347,6 +380,14 @@ void closeFaces(const CompiledBlob& blob, Grid& g) {
     }
     g.extraCells += wanted.size();
   }
+  // The added cells join the cell hash (activeCellIndex finds every active cell there);
+  // from here on it maps a key to its index in cellCoords. Rebuilt larger in the (never
+  // seen) case that they would fill more than 3/4 of its slots.
+  if (4 * g.cellCoords.size() > 3 * g.cellIndex.capacity()) {
+    g.cellIndex = CellHash(g.cellCoords.size());
+    for (size_t i = 0; i < g.cs.cells.size(); ++i) g.cellIndex.insert(pointKey(g.cellCoords[i].x, g.cellCoords[i].y, g.cellCoords[i].z), uint32_t(i));
+  }
+  for (const auto& [key, id] : addedCells) g.cellIndex.insert(key, id);
 }
 
 // The mesh's vertices, one per crossing grid edge: numbered by owner cell, then by edge
@@ -358,20 +399,17 @@ struct Vertices {
   std::vector<EdgeRec> edges;        // per vertex
 };
 
-// The active cells by grid key.
-CellHash activeCellIndex(const Grid& g) {
-  CellHash index(g.active.size());
-  for (size_t a = 0; a < g.active.size(); ++a) {
-    glm::ivec3 q = g.cellCoords[g.active[a]];
-    index.insert(pointKey(q.x, q.y, q.z), uint32_t(a));
-  }
+// The active cells by grid key (the closure's added cells must be in g.cellIndex).
+ActiveIndex activeCellIndex(const Grid& g) {
+  ActiveIndex index{g.cellIndex, std::vector<uint32_t>(g.cellCoords.size(), kNoCell)};
+  for (size_t a = 0; a < g.active.size(); ++a) index.activeOf[g.active[a]] = uint32_t(a);
   return index;
 }
 
 // Step 4a: every crossing edge P -> P + d (d a corner code) belongs to the cell with low
 // corner P; that cell has the crossing between its corners 0 and d, so it is active (kept
 // by the bounds or added by the closure). Vertices are numbered by owner cell, then by d.
-Vertices numberVertices(const Grid& g, const CellHash& activeIndex, uint8_t directions) {
+Vertices numberVertices(const Grid& g, const ActiveIndex& activeIndex, uint8_t directions) {
   const size_t nActive = g.active.size();
   Vertices v;
   v.crossMask.resize(nActive);
@@ -551,7 +589,7 @@ void fixFlatNormals(Mesh& mesh, const std::vector<uint8_t>& flatGradient) {
 // file comment for PolygonizeOptions::Mesher::DualMarchingCubes.
 void dualMesh(const CompiledBlob& blob, const PolygonizeOptions& options, const Grid& g, PolygonizeResult& res) {
   const size_t nActive = g.active.size();
-  CellHash activeIndex = activeCellIndex(g);
+  const ActiveIndex activeIndex = activeCellIndex(g);
   // Crossing axis edges (directions 1, 2, 4), each owned by the cell at its low end.
   Vertices v = numberVertices(g, activeIndex, uint8_t((1u << 1) | (1u << 2) | (1u << 4)));
   auto edgePoint = [&](size_t a, int e) {
@@ -619,7 +657,75 @@ void dualMesh(const CompiledBlob& blob, const PolygonizeOptions& options, const 
   constexpr int kNewtonSteps = 3;
   std::atomic<size_t> sampleCount{0};
   constexpr size_t kCellBlock = 256;
-  parallelFor(0, (nActive + kCellBlock - 1) / kCellBlock, [&](size_t blk) {
+  // The start of patch k of active cell a (the mean of its crossings) and the cell's box.
+  auto patchStart = [&](size_t a, const detail::CellPatches& cp, Vec3* start, Vec3& lo, Vec3& hi) {
+    std::array<Vec3, 4> sum{};
+    std::array<int, 4> n{};
+    for (int e = 0; e < 12; ++e)
+      if (cp.patch[e] >= 0) {
+        sum[size_t(cp.patch[e])] += cross[edgePoint(a, e)];
+        ++n[size_t(cp.patch[e])];
+      }
+    lo = gridPosition(g.cs, g.cellCoords[g.active[a]]);
+    hi = lo + Vec3(g.cs.cellSize);
+    for (int k = 0; k < cp.count; ++k) start[k] = sum[size_t(k)] / float(n[size_t(k)]);
+  };
+  if (options.batchedNewton) {
+    // The same steps as the scalar path below, in lockstep over the patches of a block of
+    // cells: each step one valuesAndGradients() call over the block's unconverged vertices
+    // (consecutive cells in octree order: a compact cluster).
+    parallelFor(0, (nActive + kCellBlock - 1) / kCellBlock, [&](size_t blk) {
+      const size_t begin = blk * kCellBlock, end = std::min(nActive, begin + kCellBlock);
+      const size_t first = patchBase[begin], n = patchBase[end] - first;
+      std::vector<Vec3> p(n), lo(n), hi(n), grad(n), pts(n), gOut(n);
+      std::vector<float> val(n), vOut(n);
+      std::vector<uint32_t> live(n);
+      for (size_t a = begin; a < end; ++a) {
+        Vec3 l, h;
+        patchStart(a, patches[a], &p[patchBase[a] - first], l, h);
+        for (uint32_t k = patchBase[a] - uint32_t(first); k < patchBase[a + 1] - first; ++k) lo[k] = l, hi[k] = h;
+      }
+      size_t samples = n;
+      blob.valuesAndGradients(p, val, grad);
+      size_t nLive = 0;
+      if (options.refineSteps > 0)
+        for (size_t k = 0; k < n; ++k) live[nLive++] = uint32_t(k);
+      for (int step = 0; step < kNewtonSteps && nLive > 0; ++step) {
+        size_t moved = 0;
+        for (size_t j = 0; j < nLive; ++j) {
+          const uint32_t k = live[j];
+          const float r = val[k] - kIso, gg = glm::dot(grad[k], grad[k]);
+          if (std::fabs(r) < options.fieldTolerance || !(gg > 1e-30f) || !std::isfinite(gg)) continue;
+          const Vec3 q = glm::clamp(p[k] - (r / gg) * grad[k], lo[k], hi[k]);
+          if (q == p[k]) continue;
+          p[k] = q;
+          pts[moved] = q;
+          live[moved++] = k;
+        }
+        nLive = moved;
+        if (nLive == 0) break;
+        blob.valuesAndGradients(std::span<const Vec3>(pts.data(), nLive), std::span<float>(vOut.data(), nLive),
+                                std::span<Vec3>(gOut.data(), nLive));
+        samples += nLive;
+        for (size_t j = 0; j < nLive; ++j) val[live[j]] = vOut[j], grad[live[j]] = gOut[j];
+      }
+      for (size_t k = 0; k < n; ++k) {
+        const size_t vi = first + k;
+        mesh.positions[vi] = p[k];
+        if (options.attributes) {
+          storeSample(options, blob.sample(p[k]), vi, res, flatGradient);
+          ++samples;
+        } else if (options.normals) {
+          Sample smp;
+          smp.value = val[k];
+          smp.gradient = grad[k];
+          storeSample(options, smp, vi, res, flatGradient);
+        }
+      }
+      sampleCount += samples;
+      if (bar) bar->advance(end - begin);
+    });
+  } else parallelFor(0, (nActive + kCellBlock - 1) / kCellBlock, [&](size_t blk) {
     size_t begin = blk * kCellBlock, end = std::min(nActive, begin + kCellBlock), samples = 0;
     for (size_t a = begin; a < end; ++a) {
       const detail::CellPatches& cp = patches[a];
