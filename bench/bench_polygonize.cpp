@@ -82,10 +82,22 @@ int main(int argc, char** argv) {
   // tetrahedra (the reference) and by dual marching cubes, in this order.
   double tetSeconds = 0;
   size_t tetTriangles = 0;
-  for (auto mesher : {PolygonizeOptions::Mesher::MarchingTetrahedra, PolygonizeOptions::Mesher::DualMarchingCubes}) {
+  // The dual mesher twice: its Newton steps through scalar sample() calls (the baseline),
+  // then batched (PolygonizeOptions::batchedNewton, the default).
+  struct Run {
+    PolygonizeOptions::Mesher mesher;
+    bool batched;
+    const char* name;
+  };
+  double dualScalarCpu = 0;
+  for (const Run& run : {Run{PolygonizeOptions::Mesher::MarchingTetrahedra, false, "marching tetrahedra"},
+                         Run{PolygonizeOptions::Mesher::DualMarchingCubes, false, "dual marching cubes, scalar Newton"},
+                         Run{PolygonizeOptions::Mesher::DualMarchingCubes, true, "dual marching cubes, batched Newton"}}) {
+    const auto mesher = run.mesher;
     const bool dual = mesher == PolygonizeOptions::Mesher::DualMarchingCubes;
     PolygonizeOptions opt;
     opt.mesher = mesher;
+    opt.batchedNewton = run.batched;
     opt.cellSize = cellOverride > 0.0f ? cellOverride : 0.5f * rMin;
     auto t0 = Clock::now();
     double c0 = processCpuSeconds();
@@ -94,7 +106,7 @@ int main(int argc, char** argv) {
     MeshTopology topo = analyzeTopology(r.mesh);
     std::printf("sparse %s, cell %.4f (requested %.4f): %.2f s wall, %.2f s CPU, %zu triangles (%.2f M triangles/s wall, "
                 "%.2f M per CPU second), %zu vertices\n",
-                dual ? "dual marching cubes" : "marching tetrahedra", r.cellSize, opt.cellSize, s, cpu,
+                run.name, r.cellSize, opt.cellSize, s, cpu,
                 r.mesh.triangleCount(), r.mesh.triangleCount() / s * 1e-6, r.mesh.triangleCount() / cpu * 1e-6,
                 r.mesh.vertexCount());
     std::printf("  %zu surface cells, %zu with a sign change, %zu grid samples, %zu field evaluations (%.1f M/s); "
@@ -106,6 +118,8 @@ int main(int argc, char** argv) {
     if (dual) {
       std::printf("  dual / tetrahedra: %.2fx the time, %.2fx the triangles\n", s / tetSeconds,
                   double(r.mesh.triangleCount()) / double(tetTriangles));
+      if (!run.batched) dualScalarCpu = cpu;
+      else std::printf("  batched / scalar Newton: %.2fx the CPU time\n", cpu / dualScalarCpu);
       continue;
     }
     tetSeconds = s;

@@ -2,6 +2,7 @@
 
 #include "blobtree/detail/accel.h"
 #include "blobtree/detail/batch_eval.h"
+#include "blobtree/detail/batch_grad_eval.h"
 #include "blobtree/detail/gradient_eval.h"
 #include "blobtree/detail/interval_eval.h"
 #include "blobtree/detail/point_eval.h"
@@ -199,6 +200,17 @@ void CompiledBlob::values(std::span<const Vec3> points, std::span<float> out) co
     return;
   }
   evalBatch(*tape_, points, out);
+}
+
+void CompiledBlob::valuesAndGradients(std::span<const Vec3> points, std::span<float> out,
+                                      std::span<Vec3> gradients) const {
+  assert(out.size() >= points.size() && gradients.size() >= points.size());
+  if (tape_->empty) {
+    std::fill(out.begin(), out.begin() + long(points.size()), 0.0f);
+    std::fill(gradients.begin(), gradients.begin() + long(points.size()), Vec3(0.0f));
+    return;
+  }
+  evalBatchGradient(*tape_, points, out, gradients);
 }
 
 void CompiledBlob::valuesInCell(const Cell& cell, std::span<const Vec3> points, std::span<float> out) const {

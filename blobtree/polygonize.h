@@ -50,6 +50,12 @@ struct PolygonizeOptions {
   /// third of the triangles, closed and 2-manifold by construction.
   enum class Mesher { MarchingTetrahedra, DualMarchingCubes };
   Mesher mesher = Mesher::MarchingTetrahedra;
+  /// DualMarchingCubes only: the patch vertices' Newton steps evaluate F and ∇F for blocks
+  /// of vertices at once (CompiledBlob::valuesAndGradients), then one sample() per vertex
+  /// for its attributes (none when normals come from the last step and attributes are
+  /// off). false: one scalar sample() per step, the path it replaced, kept for comparison
+  /// (same vertices to rounding; bench_polygonize runs both).
+  bool batchedNewton = true;
   /// Requested cell edge length in world units; 0 = automatic: the smaller of
   /// featureFraction · smallestFeature() (so the thinnest twig gets several cells across)
   /// and the model's bounds diagonal / sizeDivisions, but never finer than the diagonal /

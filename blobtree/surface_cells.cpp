@@ -129,14 +129,27 @@ CellSet CompiledBlob::surfaceCells(float cellSize, const SurfaceCellOptions& opt
         for (Cell& c : cellsOf[k]) c.lipschitz = out.tapes[c.tape].lipschitz(c.box);
       }, 1);
   }
+  // Subtrees concatenated in order, in parallel into arrays sized once (the cells of a
+  // fine grid are hundreds of MB: growing them by push_back copied and faulted them in
+  // again at every doubling, on one thread).
+  std::vector<size_t> cellBase(frontier.size() + 1, 0), primBase(frontier.size() + 1, 0);
   for (size_t k = 0; k < frontier.size(); ++k) {
-    uint32_t base = uint32_t(out.primitives.size());
-    for (Cell c : cellsOf[k]) {
-      c.firstPrimitive += base;
-      out.cells.push_back(c);
-    }
-    out.primitives.insert(out.primitives.end(), primsOf[k].begin(), primsOf[k].end());
+    cellBase[k + 1] = cellBase[k] + cellsOf[k].size();
+    primBase[k + 1] = primBase[k] + primsOf[k].size();
   }
+  out.cells.resize(cellBase.back());
+  out.primitives.resize(primBase.back());
+  parallelFor(0, frontier.size(), [&](size_t k) {
+    const uint32_t base = uint32_t(primBase[k]);
+    Cell* dst = out.cells.data() + cellBase[k];
+    for (const Cell& c : cellsOf[k]) {
+      *dst = c;
+      dst->firstPrimitive += base;
+      ++dst;
+    }
+    std::copy(primsOf[k].begin(), primsOf[k].end(), out.primitives.begin() + long(primBase[k]));
+    std::vector<Cell>().swap(cellsOf[k]);
+  }, 1);
   return out;
 }
 

@@ -470,3 +470,36 @@ TEST_CASE("CompiledBlob::sample contact gradient", "[blobtree]") {
   }
   CHECK(inBand >= 50);
 }
+
+TEST_CASE("CompiledBlob::valuesAndGradients", "[blobtree]") {
+  // The batched value-and-gradient evaluator against sample() (the scalar evaluator) on the
+  // scene of every operator, and on unions, intersections and a PCM of three children.
+  uint64_t seed = GENERATE(21u, 22u, 23u);
+  INFO("seed " << seed);
+  auto&& [rng, t, root, sceneBlob] = SeededScene(seed);
+  NodeId a = t.point(Vec3(0, 0, 0), 0.6f), c = t.segment(Vec3(0.5f, 0, 0), Vec3(0.5f, 1, 0), 0.3f);
+  NodeId d = t.cone(Vec3(-0.4f, -0.3f, 0), Vec3(0.2f, 0.9f, 0.3f), 0.35f, 0.2f);
+  NodeId extra = t.blend(std::vector<NodeId>{t.unite(std::vector<NodeId>{a, c}), t.translate(t.intersect(std::vector<NodeId>{a, d}), Vec3(2, 0, 0)),
+                                             t.translate(t.pcm(std::vector<NodeId>{a, c, d}), Vec3(0, 2, 0))});
+  for (const CompiledBlob& b : {sceneBlob, compile(t, extra)}) {
+    Box3 box = b.bounds();
+    std::vector<Vec3> pts;
+    for (int k = 0; k < 20; ++k) {  // coherent clusters (one grid cell) and scattered points
+      Vec3 ctr = randomIn(rng, box.lo, box.hi);
+      for (int i = 0; i < 50; ++i) pts.push_back(ctr + randomIn(rng, Vec3(-0.05f), Vec3(0.05f)));
+    }
+    for (int i = 0; i < 1000; ++i) pts.push_back(randomIn(rng, box.lo, box.hi));
+    std::vector<float> v(pts.size());
+    std::vector<Vec3> g(pts.size());
+    b.valuesAndGradients(pts, v, g);
+    int nonzero = 0;
+    for (size_t i = 0; i < pts.size(); ++i) {
+      Sample s = b.sample(pts[i]);
+      INFO("p = (" << pts[i].x << ", " << pts[i].y << ", " << pts[i].z << ")");
+      CHECK(v[i] == Approx(s.value).margin(1e-5));
+      CHECK(glm::length(g[i] - s.gradient) <= 1e-4f * (1.0f + glm::length(s.gradient)));
+      nonzero += v[i] > 0.0f;
+    }
+    CHECK(nonzero > 100);  // the points reach the field, not just empty space
+  }
+}

@@ -201,3 +201,58 @@ TEST_CASE("dual mesher: a branching blend of cones, deterministic at any thread 
   CHECK(off * 200 < f.size());
   CHECK(worst < 0.05f);
 }
+
+TEST_CASE("dual mesher: batched Newton steps place the vertices of the scalar path", "[blobtree]") {
+  // PolygonizeOptions::batchedNewton takes the scalar path's steps with F and ∇F from the
+  // batched evaluator, equal to sample()'s up to the rounding of sums in a different child
+  // order: the same mesh, vertices within 1e-4 of the cell (a step differing by rounding
+  // near a clamp or a kink can end a few ulps elsewhere), exactly the same triangles.
+  Rng rng(deriveSeed(1234, {19}));
+  BlobTree tree;
+  std::vector<NodeId> kids;
+  Vec3 at(0);
+  for (int i = 0; i < 40; ++i) {
+    Vec3 next = at + Vec3(rng.uniform(-0.5f, 0.5f), rng.uniform(0.2f, 0.6f), rng.uniform(-0.5f, 0.5f));
+    kids.push_back(tree.cone(at, next, rng.uniform(0.08f, 0.15f), rng.uniform(0.03f, 0.08f)));
+    at = i % 10 == 9 ? Vec3(rng.uniform(-1.0f, 1.0f), 0, rng.uniform(-1.0f, 1.0f)) : next;
+  }
+  // A PCM contact and a bent, cut limb: the batched evaluator's other operators on the way.
+  NodeId contact = tree.pcm(tree.point(Vec3(2, 0.5f, 0), 0.5f), tree.point(Vec3(2.6f, 0.5f, 0), 0.45f));
+  NodeId bent = tree.bend(tree.segment(Vec3(-1, -1, 1), Vec3(1, -1, 1), 0.2f), Vec3(-1, -1, 1), Vec3(1, -1, 1), 0.4f, Vec3(0, 1, 0));
+  kids.push_back(contact);
+  kids.push_back(tree.difference(bent, tree.box(Vec3(0.5f, -2, 0), Vec3(2, 0, 2))));
+  CompiledBlob blob = compile(tree, tree.blend(kids));
+  const float cell = 0.03f;
+  for (bool attributes : {true, false}) {
+    INFO("attributes " << attributes);
+    PolygonizeOptions scalarOpt = dual(cell), batchedOpt = dual(cell);
+    scalarOpt.batchedNewton = false;
+    scalarOpt.attributes = batchedOpt.attributes = attributes;
+    PolygonizeResult s = polygonizeDetailed(blob, scalarOpt), b = polygonizeDetailed(blob, batchedOpt);
+    REQUIRE(s.mesh.vertexCount() == b.mesh.vertexCount());
+    REQUIRE(s.mesh.triangleCount() == b.mesh.triangleCount());
+    REQUIRE(b.mesh.vertexCount() > 10000);
+    requireClosedManifold(b.mesh);
+    float worst = 0.0f, worstNormal = 0.0f;
+    size_t moved = 0;
+    for (size_t i = 0; i < b.mesh.vertexCount(); ++i) {
+      float d = glm::length(b.mesh.positions[i] - s.mesh.positions[i]);
+      worst = std::max(worst, d);
+      moved += d > 0.0f;
+      worstNormal = std::max(worstNormal, glm::length(b.mesh.normals[i] - s.mesh.normals[i]));
+    }
+    INFO("vertices not bit-identical " << moved << " of " << b.mesh.vertexCount() << ", worst " << worst
+                                       << ", worst normal difference " << worstNormal);
+    CHECK(worst <= 1e-4f * cell);
+    CHECK(worstNormal <= 1e-3f);
+    // Triangles: the same quads split along the same diagonals except where the two
+    // diagonals are equal to rounding (none in practice).
+    size_t sameTriangles = 0;
+    for (size_t i = 0; i < b.mesh.triangleCount(); ++i) sameTriangles += b.mesh.triangles[i] == s.mesh.triangles[i];
+    CHECK(sameTriangles + 8 >= b.mesh.triangleCount());
+    if (attributes) {
+      REQUIRE(b.attributes.size() == s.attributes.size());
+      for (size_t i = 0; i < b.mesh.vertexCount(); i += 97) CHECK(glm::length(b.mesh.uvs[i] - s.mesh.uvs[i]) <= 1e-3f);
+    }
+  }
+}
