@@ -111,6 +111,15 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
       note(g, std::cout, "%s: %zu vertices split at creases (faces more than 90 degrees apart), %zu texture-seam uvs added",
            r.name.c_str(), r.creaseVertices, r.seamCorners);
   }
+  for (const ExportPart& p : parts) {
+    if (p.material.alphaCutoff < 0.0f || !p.material.texture || p.mesh.triangles.empty()) continue;
+    const std::vector<float>& px = p.material.texture->image.pixels;
+    size_t partial = 0;
+    for (size_t i = 3; i < px.size(); i += 4) partial += px[i] > p.material.alphaCutoff && px[i] < 1.0f;
+    note(g, std::cout, "%s: cut out where the texture's alpha is at or below %g (glTF alphaMode MASK, MTL map_d)%s", p.name.c_str(),
+         p.material.alphaCutoff,
+         partial ? (": " + std::to_string(partial) + " partly transparent texels are drawn opaque (renders blend them)").c_str() : "");
+  }
   if (lowerExtension(a.out) == ".glb")
     for (const ExportPart& p : parts)
       if (size_t k = clampedColorChannels(p))

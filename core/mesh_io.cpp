@@ -386,13 +386,14 @@ PartCorners partCorners(const ExportPart& part) {
   return c;
 }
 
-// The PNG bytes of a texture image (8-bit sRGB RGB), through a temporary file beside
-// `near` (core/image.h owns image files; the temporary is removed when this returns).
-std::string pngBytes(const Image& image, const fs::path& near) {
+// The PNG bytes of a texture image (8-bit sRGB RGB; RGBA with `alpha`), through a temporary
+// file beside `near` (core/image.h owns image files; the temporary is removed when this
+// returns).
+std::string pngBytes(const Image& image, const fs::path& near, bool alpha) {
   fs::path dest = near;
   dest.replace_extension(".png");
   TempPath temp(dest);
-  writeImage(image, temp.path(), ImageEncoding::TextureMap);
+  writeImage(image, temp.path(), alpha ? ImageEncoding::Picture : ImageEncoding::TextureMap);
   return readFile(temp.path());
 }
 
@@ -453,7 +454,12 @@ std::vector<PartWriteReport> writePartsGlb(const std::vector<ExportPart>& parts,
       tinygltf::Value::Object extras;
       extras["sprigBaseColor"] = tinygltf::Value(rgb);
       mat.extras = tinygltf::Value(extras);
-      const std::string png = pngBytes(tex->image, path);
+      const bool cutOut = part.material.alphaCutoff >= 0.0f;
+      if (cutOut) {
+        mat.alphaMode = "MASK";
+        mat.alphaCutoff = part.material.alphaCutoff;
+      }
+      const std::string png = pngBytes(tex->image, path, cutOut);
       while (data.size() % 4) data.push_back(0);
       tinygltf::BufferView view;
       view.buffer = 0;
@@ -467,8 +473,12 @@ std::vector<PartWriteReport> writePartsGlb(const std::vector<ExportPart>& parts,
       image.bufferView = int(model.bufferViews.size() - 1);
       model.images.push_back(image);
       tinygltf::Sampler sampler;
-      sampler.magFilter = TINYGLTF_TEXTURE_FILTER_LINEAR;
-      sampler.minFilter = tex->isAtlas() ? TINYGLTF_TEXTURE_FILTER_LINEAR : TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
+      sampler.magFilter = tex->magFilter == PartTexture::Filter::Nearest ? TINYGLTF_TEXTURE_FILTER_NEAREST
+                                                                          : TINYGLTF_TEXTURE_FILTER_LINEAR;
+      sampler.minFilter = tex->minFilter == PartTexture::Filter::Nearest  ? TINYGLTF_TEXTURE_FILTER_NEAREST
+                          : tex->minFilter == PartTexture::Filter::Linear ? TINYGLTF_TEXTURE_FILTER_LINEAR
+                          : tex->isAtlas()                                ? TINYGLTF_TEXTURE_FILTER_LINEAR
+                                                                          : TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
       sampler.wrapS = tex->seams.repeatU ? TINYGLTF_TEXTURE_WRAP_REPEAT : TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
       sampler.wrapT = tex->seams.repeatV ? TINYGLTF_TEXTURE_WRAP_REPEAT : TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
       model.samplers.push_back(sampler);
@@ -539,7 +549,12 @@ std::vector<PartWriteReport> writePartsObj(const std::vector<ExportPart>& parts,
   mtlPath.replace_extension(".mtl");
   std::string mtl = "# written by Sprig\n";
   std::string out = "# written by Sprig\nmtllib " + mtlPath.filename().string() + "\n";
-  std::vector<std::pair<fs::path, const Image*>> images;
+  struct ImageFile {
+    fs::path png;
+    const Image* image;
+    bool alpha;
+  };
+  std::vector<ImageFile> images;
   uint64_t base = 0, uvBase = 0, nBase = 0;
   for (const ExportPart& part : parts) {
     if (part.mesh.triangles.empty()) continue;
@@ -561,8 +576,10 @@ std::vector<PartWriteReport> writePartsObj(const std::vector<ExportPart>& parts,
     if (tex) {
       fs::path png = path;
       png.replace_filename(path.stem().string() + "_" + objName(part.name) + ".png");
-      images.emplace_back(png, &tex->image);
+      const bool cutOut = part.material.alphaCutoff >= 0.0f;
+      images.push_back({png, &tex->image, cutOut});
       mtl += "map_Kd " + png.filename().string() + "\n";
+      if (cutOut) mtl += "map_d " + png.filename().string() + "\n";
     }
     mtl += "\n";
     const bool hasN = !lines.normals.empty(), hasUv = !lines.uvs.empty();
@@ -589,9 +606,9 @@ std::vector<PartWriteReport> writePartsObj(const std::vector<ExportPart>& parts,
   // Images first, then the MTL naming them, then the OBJ; a failure removes the images.
   std::vector<fs::path> written;
   try {
-    for (const auto& [png, image] : images) {
-      writeImage(*image, png, ImageEncoding::TextureMap);
-      written.push_back(png);
+    for (const ImageFile& f : images) {
+      writeImage(*f.image, f.png, f.alpha ? ImageEncoding::Picture : ImageEncoding::TextureMap);
+      written.push_back(f.png);
     }
     writeAtomic(mtlPath, mtl);
     writeAtomic(path, out);

@@ -65,7 +65,9 @@ void writeObj(const Mesh& mesh, const std::filesystem::path& path, const MeshWri
 /// there, absolute (not relative to the base colour). The writers store it as an 8-bit sRGB
 /// PNG: embedded in glb, beside the OBJ.
 struct PartTexture {
-  Image image;            ///< linear RGB (alpha ignored), top row = t of 1
+  /// Linear RGB, top row = t of 1. Alpha is ignored unless the part's material has an
+  /// alphaCutoff: then the writers keep it (8-bit sRGB RGBA PNG).
+  Image image;
   UvSeamOptions seams;    ///< which axes repeat (glTF sampler REPEAT, else CLAMP_TO_EDGE) and the seam rules
   /// An atlas: when not empty, the texture coordinates of every triangle's corners (3 per
   /// triangle of the part's mesh, values in [0,1]), used instead of the mesh's uvs (which
@@ -74,6 +76,11 @@ struct PartTexture {
   /// clamps at the edges.
   CornerTable<Vec2> atlas;
   int atlasCell = 0;  ///< texels per side of a triangle's patch in an atlas (reports)
+  /// glTF sampler filters. Default: magFilter LINEAR, minFilter LINEAR_MIPMAP_LINEAR
+  /// (atlases LINEAR); Nearest and Linear set the filter to that, without mipmaps.
+  enum class Filter { Default, Nearest, Linear };
+  Filter magFilter = Filter::Default;
+  Filter minFilter = Filter::Default;
   bool isAtlas() const { return !atlas.index.empty(); }
 };
 
@@ -89,6 +96,10 @@ struct PartMaterial {
   /// formats multiply the factor in), keeps baseColor in glTF's material extras as
   /// `sprigBaseColor`, and has no COLOR_0 (it would multiply again).
   std::shared_ptr<const PartTexture> texture;
+  /// Cut-out: when >= 0 (with a texture), the texture's alpha is kept and texels whose alpha
+  /// is below this are not drawn: glTF alphaMode MASK with this alphaCutoff, MTL map_d
+  /// naming the texture image. Negative: opaque.
+  float alphaCutoff = -1.0f;
 };
 
 /// One named part of an exported model (wood, leaves, whorl, a solid's material, ...).

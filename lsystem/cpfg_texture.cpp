@@ -15,7 +15,7 @@ int wrap(long long x, int n) {
 
 }  // namespace
 
-Vec4 CpfgTexture::sample(double s, double t) const {
+Vec4 CpfgTexture::sample(double s, double t, bool minified) const {
   if (!image || image->width <= 0 || image->height <= 0) return Vec4(1.0f);
   const int w = image->width, h = image->height;
   if (!std::isfinite(s) || !std::isfinite(t)) return image->at(0, h - 1);
@@ -24,7 +24,7 @@ Vec4 CpfgTexture::sample(double s, double t) const {
   // Texel (x, y) counted from the bottom row covers [x/w, (x+1)/w] x [y/h, (y+1)/h].
   const double x = s * w, y = t * h;
   auto texel = [&](long long tx, long long ty) { return image->at(wrap(tx, w), h - 1 - wrap(ty, h)); };
-  if (!linear) return texel(static_cast<long long>(std::floor(x)), static_cast<long long>(std::floor(y)));
+  if (!(minified ? minLinear : magLinear)) return texel(static_cast<long long>(std::floor(x)), static_cast<long long>(std::floor(y)));
   const double fx = x - 0.5, fy = y - 0.5;
   const long long x0 = static_cast<long long>(std::floor(fx)), y0 = static_cast<long long>(std::floor(fy));
   const float ax = static_cast<float>(fx - static_cast<double>(x0)), ay = static_cast<float>(fy - static_cast<double>(y0));
@@ -33,10 +33,10 @@ Vec4 CpfgTexture::sample(double s, double t) const {
   return glm::mix(bottom, top, ay);
 }
 
-Vec3 CpfgTexture::shade(double s, double t, const Vec3& base) const {
-  const Vec4 c = sample(s, t);
-  if (decal) return glm::mix(base, Vec3(c), std::clamp(c.a, 0.0f, 1.0f));
-  return Vec3(c) * base;
+Vec4 CpfgTexture::fragment(double s, double t, const Vec3& base, bool minified) const {
+  const Vec4 c = sample(s, t, minified);
+  if (decal) return Vec4(glm::mix(base, Vec3(c), std::clamp(c.a, 0.0f, 1.0f)), 1.0f);
+  return Vec4(Vec3(c) * base, c.a);
 }
 
 }  // namespace sprig::lsystem

@@ -35,8 +35,8 @@ struct Organ {
   enum class Kind { Polygon, Sphere, Surface };
   Kind kind = Kind::Polygon;
   std::vector<DVec3> points;   ///< polygon vertices in order (Polygon), or a surface file's mesh vertices (Surface)
-  std::vector<DVec3> normals;  ///< Surface from a cpfg surface file: unit normal per vertex of points
-  std::vector<uint32_t> triangles;  ///< Surface from a cpfg surface file: 3 indices into points per triangle
+  std::vector<DVec3> normals;  ///< Surface from a cpfg surface file, or a textured Polygon: unit normal per vertex of points
+  std::vector<uint32_t> triangles;  ///< Surface from a cpfg surface file, or a textured Polygon (a fan): 3 indices into points per triangle
   DVec3 position{0};           ///< center (Sphere) or turtle position (Surface)
   DVec3 heading{0, 1, 0};      ///< turtle frame when created (Surface)
   DVec3 left{-1, 0, 0};
@@ -46,8 +46,8 @@ struct Organ {
   int32_t internode = -1;      ///< internode it is attached to, -1 if none
   int step = 0;
   int color = 0;               ///< turtle color index (`'`) when created
-  /// cpfg: the view file's texture (0-based: `@Tx(1)` is 0) on a surface file's mesh, -1
-  /// for none; then uvs holds the texture coordinates of points (lsystem/cpfg_texture.h).
+  /// cpfg: the view file's texture (0-based: `@Tx(1)` is 0) on a surface file's mesh or a polygon,
+  /// -1 for none; then uvs holds the texture coordinates of points (lsystem/cpfg_texture.h).
   int texture = -1;
   std::vector<Vec2> uvs;
 };

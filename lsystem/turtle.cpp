@@ -190,6 +190,11 @@ constexpr int kMaxGcRings = 1024;
 struct OpenPolygon {
   std::vector<DVec3> points;
   int32_t internode;  ///< the internode the polygon grows from (at its `{`)
+  /// cpfg textures a polygon by its first vertex's state (irisGL.c, PolygonToMesh): its
+  /// texture (-1: none), and its frame's H and -L, the texture's t and s axes.
+  int texture = -1;
+  DVec3 sAxis{1, 0, 0};
+  DVec3 tAxis{0, 1, 0};
 };
 
 /// The working buffers of one run, besides the skeleton it draws.
@@ -513,8 +518,16 @@ class TurtleWalk {
     }
   }
 
-  /// Adds p to the innermost open polygon.
-  void addPolygonPoint(DVec3 p) { buf_.polygons.back().points.push_back(p); }
+  /// Adds p to the innermost open polygon (the first point records the texture and frame).
+  void addPolygonPoint(DVec3 p) {
+    OpenPolygon& poly = buf_.polygons.back();
+    if (poly.points.empty()) {
+      poly.texture = st_.texture;
+      poly.sAxis = -st_.frame.left;
+      poly.tAxis = st_.frame.heading;
+    }
+    poly.points.push_back(p);
+  }
 
   /// `!`: sets the width, or thins it: Sprig's notation multiplies it by the width
   /// factor, cpfg's subtracts the width increment (times the turtle scale; at least 1e-7).
@@ -672,12 +685,12 @@ class TurtleWalk {
     st_.texture = static_cast<int>(v) - 1;
   }
 
-  /// Throws when a texture is selected (`@Tx`) and what is drawn is not a surface file:
-  /// cpfg textures cylinders, generalized cylinders and polygons too, which Sprig does not.
+  /// Throws when a texture is selected (`@Tx`) and what is drawn is neither a surface file
+  /// nor a polygon: cpfg textures cylinders and generalized cylinders too, which Sprig does not.
   void untextured(const char* what) const {
     if (st_.texture < 0) return;
     throw InputError(SourceLoc{"sprig", 0, 0}, "cpfg's texture '@Tx(" + std::to_string(st_.texture + 1) + ")' on " + what +
-                                                   " is not supported: Sprig textures surfaces ('~X') only; end the texture "
+                                                   " is not supported: Sprig textures surfaces ('~X') and polygons ('{ }') only; end the texture "
                                                    "with '@Tx' or close its branch before drawing it");
   }
 
@@ -1007,14 +1020,40 @@ class TurtleWalk {
   void polygonEnd(size_t i) {
     if (buf_.polygons.empty()) return;
     if (buf_.polygons.back().points.size() >= 3 && growth(i) > 0) {
-      untextured("a polygon '{ }'");
+      OpenPolygon& poly = buf_.polygons.back();
       Organ o = organHere(Organ::Kind::Polygon, i);
-      o.points = std::move(buf_.polygons.back().points);
+      o.points = std::move(poly.points);
       o.position = o.points.front();
-      o.internode = buf_.polygons.back().internode;
+      o.internode = poly.internode;
+      if (poly.texture >= 0) texturePolygon(o, poly);
       sk_.organs.push_back(std::move(o));
     }
     buf_.polygons.pop_back();
+  }
+
+  /// A textured polygon as cpfg draws it (irisGL.c PolygonToMesh, textures.c
+  /// SetPolygonTextureParams): a fan of triangles from its first point, each point's texture
+  /// coordinates its position along the first point's -L (s) and H (t), over the polygon's
+  /// extent along them (0 to 1; a polygon without extent along an axis gets 0 on it). The
+  /// normals are the polygon's Newell normal, as untextured polygons are drawn.
+  static void texturePolygon(Organ& o, const OpenPolygon& poly) {
+    o.texture = poly.texture;
+    double s0 = std::numeric_limits<double>::infinity(), s1 = -s0, t0 = s0, t1 = -s0;
+    DVec3 n(0);
+    for (size_t k = 0; k < o.points.size(); ++k) {
+      const DVec3& p = o.points[k];
+      s0 = std::min(s0, glm::dot(p, poly.sAxis)), s1 = std::max(s1, glm::dot(p, poly.sAxis));
+      t0 = std::min(t0, glm::dot(p, poly.tAxis)), t1 = std::max(t1, glm::dot(p, poly.tAxis));
+      n += glm::cross(p, o.points[(k + 1) % o.points.size()]);
+    }
+    const double ln = glm::length(n);
+    const DVec3 normal = ln > 0 ? n / ln : o.up;
+    for (const DVec3& p : o.points) {
+      o.uvs.emplace_back(s1 > s0 ? static_cast<float>((glm::dot(p, poly.sAxis) - s0) / (s1 - s0)) : 0.0f,
+                         t1 > t0 ? static_cast<float>((glm::dot(p, poly.tAxis) - t0) / (t1 - t0)) : 0.0f);
+      o.normals.push_back(normal);
+    }
+    for (uint32_t k = 1; k + 1 < o.points.size(); ++k) o.triangles.insert(o.triangles.end(), {0u, k, k + 1});
   }
 
   /// Adds a surface organ named name with scale radius for module i (not when growth

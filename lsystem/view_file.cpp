@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "core/atomic_file.h"
+#include "core/srgb.h"
 #include "core/text.h"
 
 namespace sprig::lsystem {
@@ -738,7 +739,7 @@ class ViewParser {
         nameCol = vc;
       } else if (w == "H" || w == "L") {
         if (v == "n" || v == "l") {
-          if (w == "H") tex.linear = v == "l";  // Sprig samples every hit with the H: filter
+          (w == "H" ? tex.magLinear : tex.minLinear) = v == "l";
         } else if (w == "L" && v[0] == 'm') {
           error(line, vc, "the mipmapped minification filter 'L: " + v + "' is not supported (use n or l)");
           return;
@@ -785,11 +786,17 @@ class ViewParser {
     try {
       Image img = readImage(file);
       if (img.width <= 0 || img.height <= 0) throw ImageReadError(file, "the image has no pixels");
+      // readImage's colour comes multiplied by alpha in the file's encoding (OpenImageIO
+      // multiplies the sRGB values of 8-bit files): divided back there, to straight alpha.
+      const bool srgb = readImageInfo(file).srgb;
       for (size_t p = 0; p + 3 < img.pixels.size(); p += 4) {
         const float a = img.pixels[p + 3];
         if (a < 0.999f) tex.transparent = true;
         if (a > 0.0f && a < 1.0f)
-          for (size_t c = 0; c < 3; ++c) img.pixels[p + c] = std::min(img.pixels[p + c] / a, 1.0f);  // straight alpha
+          for (size_t c = 0; c < 3; ++c) {
+            float& v = img.pixels[p + c];
+            v = srgb ? srgbToLinear(std::min(linearToSrgb(v) / a, 1.0f)) : std::min(v / a, 1.0f);
+          }
       }
       tex.image = std::make_shared<const Image>(std::move(img));
     } catch (const ImageReadError& e) {
@@ -799,8 +806,6 @@ class ViewParser {
       error(line, nameCol, "cannot read the texture image '" + file.string() + "': " + e.what());
       return;
     }
-    if (tex.transparent)
-      warn(line, nameCol, "the texture image '" + name + "' has transparent texels: cpfg leaves them out (alpha test), Sprig draws them opaque in their own colour");
     view_.textures.push_back(std::move(tex));
   }
 

@@ -191,16 +191,18 @@ Vec3 groupColor(const TexturedGroup& g, const SkeletonStyle& style) {
 }
 
 /// Adds the skeleton's textured cpfg surfaces to out: one mesh part per texture and colour,
-/// the leaf material with the texture shading the colour (modulate or decal).
+/// the leaf material with the texture's image map shading the colour (modulate or decal,
+/// by the H: or L: filter per lookup) and, modulated, cut out by its alpha as cpfg does.
 void addTexturedSurfaces(render::Geometry& out, const lsystem::Skeleton& skeleton, const SkeletonStyle& style) {
   for (TexturedGroup& g : texturedGroups(skeleton, style)) {
     auto tex = std::make_shared<const lsystem::CpfgTexture>((*style.cpfgTextures)[static_cast<size_t>(g.texture)]);
     const Vec3 color = groupColor(g, style);
-    render::Material m = style.leaf;
-    m.texture = 0;
-    render::TextureTable table;
-    table.push_back([tex, color](Vec2 uv, const Vec3&) { return tex->shade(uv.x, uv.y, color); });
-    out.parts.push_back(render::MeshPart{std::move(g.mesh), m, {}, std::move(table)});
+    auto map = std::make_shared<render::ImageMap>();
+    map->width = tex->image->width;
+    map->height = tex->image->height;
+    map->sample = [tex, color](Vec2 uv, bool minified) { return tex->fragment(uv.x, uv.y, color, minified); };
+    map->alphaCutoff = tex->cutsOut() ? lsystem::kCpfgAlphaCutoff : -1.0f;
+    out.parts.push_back(render::MeshPart{std::move(g.mesh), style.leaf, {}, {}, std::move(map)});
   }
 }
 
@@ -457,11 +459,15 @@ class TreeModel final : public KindModel {
         const int w = tex.image->width, h = tex.image->height;
         baked->image = Image(w, h);
         for (int y = 0; y < h; ++y)
-          for (int x = 0; x < w; ++x)  // texel centres; the image's top row is t of 1
-            baked->image.set(x, y, Vec4(tex.shade((x + 0.5) / w, 1.0 - (y + 0.5) / h, color), 1.0f));
+          for (int x = 0; x < w; ++x)  // texel centres (either filter gives the texel); top row is t of 1
+            baked->image.set(x, y, tex.fragment((x + 0.5) / w, 1.0 - (y + 0.5) / h, color));
+        baked->magFilter = tex.magLinear ? PartTexture::Filter::Linear : PartTexture::Filter::Nearest;
+        baked->minFilter = tex.minLinear ? PartTexture::Filter::Linear : PartTexture::Filter::Nearest;
         const std::string name = "textured_leaves_" + std::to_string(parts.size());
         const render::Material& m = look.style.leaf;
-        parts.push_back(ExportPart{name, std::move(g.mesh), PartMaterial{name, color, m.roughness, true, std::move(baked)}});
+        PartMaterial material{name, color, m.roughness, true, std::move(baked)};
+        material.alphaCutoff = tex.cutsOut() ? lsystem::kCpfgAlphaCutoff : -1.0f;  // glTF MASK, the image's alpha kept
+        parts.push_back(ExportPart{name, std::move(g.mesh), std::move(material)});
       }
     }
     return parts;

@@ -121,6 +121,7 @@ SkeletonGeometry buildSkeletonGeometry(const lsystem::Skeleton& skeleton, const 
   const double surfaceScale = box.empty() ? 1.0 : 0.02 * glm::length(box.size());
   for (const auto& organ : skeleton.organs) {
     if (organ.kind == lsystem::Organ::Kind::Polygon) {
+      if (organ.texture >= 0) continue;  // textured (`@Tx`): left to the caller, as surfaces
       std::vector<Vec3> pts;
       for (const auto& p : organ.points) pts.push_back(toVec3(p));
       addFlatPolygon(g, pts, organColor(organ, o.leafColor));

@@ -77,13 +77,37 @@ struct SpheresPart {
   Material material;
 };
 
+/// An image laid on a MeshPart by its vertices' uvs and sampled at each hit as an OpenGL
+/// texture unit samples it (cpfg's textures):
+/// - filter: the magnification or the minification filter, chosen per lookup from GL's
+///   texel footprint ρ (texels per pixel: the camera's pixel at the hit, carried onto the
+///   triangle along the view ray and through its uv mapping; ρ > 1 minifies). Scenes
+///   without a camera (Scene::setPixelFootprint not called) magnify;
+/// - alpha test: hits whose alpha is at or below alphaCutoff are cut out (OpenGL's
+///   GL_GREATER): camera and shadow rays pass through them;
+/// - alpha blending: a hit with alpha between the cutoff and 1 covers that fraction (the
+///   renderer composites it over what lies behind; a shadow or sky ray passes it with
+///   probability 1 − alpha, decided by a hash of the ray, so the same at any thread count).
+struct ImageMap {
+  int width = 0;   ///< texels along u (the footprint's scale)
+  int height = 0;  ///< texels along v
+  /// The surface's linear RGB colour and alpha at uv; `minified`: the lookup's pixel covers
+  /// more than one texel, so the minification filter applies. Must be thread-safe.
+  std::function<Vec4(Vec2 uv, bool minified)> sample;
+  /// Alpha test threshold; negative: no alpha test and no blending (alpha is ignored).
+  float alphaCutoff = -1.0f;
+};
+
 /// A triangle mesh. triangleColors, when not empty (one per triangle), replace the
 /// material's and the vertices' colours; per-triangle `mesh.materials` are not used here.
+/// image, when set, colours the mesh instead (and may cut it out): the mesh must then have
+/// one uv per vertex.
 struct MeshPart {
   Mesh mesh;
   Material material;
   std::vector<Vec3> triangleColors;
   TextureTable textures;
+  std::shared_ptr<const ImageMap> image;
 };
 
 /// A compiled BlobTree ray cast exactly; hit colours blend the table's textures.

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <mutex>
 #include <stdexcept>
 #include <string>
@@ -20,7 +21,95 @@ void onEmbreeError(void* userPtr, RTCError code, const char* str) {
   if (code != RTC_ERROR_NONE && message->empty()) *message = "Embree error " + std::to_string(code) + ": " + (str ? str : "");
 }
 
+uint64_t mix64(uint64_t z) {
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+  return z ^ (z >> 31);
+}
+
+uint64_t floatBits(float f) {
+  uint32_t u;
+  std::memcpy(&u, &f, sizeof u);
+  return u;
+}
+
+/// A number in [0, 1) from ray i of a filter call and primitive prim: the same for the same
+/// ray and primitive at any thread count.
+float rayUnit(const RTCFilterFunctionNArguments* args, unsigned i, uint32_t prim) {
+  uint64_t h = 0x9e3779b97f4a7c15ull ^ prim;
+  for (float f : {RTCRayN_org_x(args->ray, args->N, i), RTCRayN_org_y(args->ray, args->N, i),
+                  RTCRayN_org_z(args->ray, args->N, i), RTCRayN_dir_x(args->ray, args->N, i),
+                  RTCRayN_dir_y(args->ray, args->N, i), RTCRayN_dir_z(args->ray, args->N, i)})
+    h = mix64(h ^ floatBits(f));
+  return static_cast<float>(h >> 40) * (1.0f / 16777216.0f);
+}
+
+/// Camera rays skip the hits an image map cuts out (alpha at or below its cutoff).
+void imageIntersectFilter(const RTCFilterFunctionNArguments* args) {
+  const auto* data = static_cast<const detail::ImageMapData*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] == 0) continue;
+    const float a = data->sample(RTCHitN_primID(args->hit, args->N, i), RTCHitN_u(args->hit, args->N, i),
+                                 RTCHitN_v(args->hit, args->N, i)).a;
+    if (!(a > data->map->alphaCutoff)) args->valid[i] = 0;
+  }
+}
+
+/// Shadow and sky rays pass the hits an image map cuts out, and pass a partly covering hit
+/// (alpha below 1) with probability 1 - alpha (a hash of the ray and the triangle).
+void imageOcclusionFilter(const RTCFilterFunctionNArguments* args) {
+  const auto* data = static_cast<const detail::ImageMapData*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] == 0) continue;
+    const uint32_t prim = RTCHitN_primID(args->hit, args->N, i);
+    const float a = data->sample(prim, RTCHitN_u(args->hit, args->N, i), RTCHitN_v(args->hit, args->N, i)).a;
+    if (!(a > data->map->alphaCutoff) || (a < 1.0f && rayUnit(args, i, prim) >= a)) args->valid[i] = 0;
+  }
+}
+
+/// The record of a triangle mesh with one material (Scene::addMesh); throws as addMesh.
+GeometryRecord meshRecord(const Scene::Impl& impl, const Mesh& mesh, uint32_t material,
+                          const std::vector<Vec3>& triangleColors);
+
 }  // namespace
+
+double detail::ImageMapData::texelsPerPixel(uint32_t prim, float u, float v) const {
+  if (!view) return 0.0;
+  using D3 = glm::dvec3;
+  using D2 = glm::dvec2;
+  const glm::uvec3& tri = triangles[prim];
+  const D3 p0(positions[tri.x]), p1(positions[tri.y]), p2(positions[tri.z]);
+  const D3 e1 = p1 - p0, e2 = p2 - p0;
+  const D3 p = (1.0 - double(u) - double(v)) * p0 + double(u) * p1 + double(v) * p2;
+  const D3 d = p - D3(view->eye);  // the view ray to the hit
+  const double depth = glm::dot(d, D3(view->forward));
+  const double a11 = glm::dot(e1, e1), a12 = glm::dot(e1, e2), a22 = glm::dot(e2, e2);
+  const double det = a11 * a22 - a12 * a12;
+  if (!(depth > 0.0) || !(det > 0.0)) return 0.0;
+  const D3 n = glm::cross(e1, e2);
+  const double nd = glm::dot(n, d);
+  if (nd == 0.0) return std::numeric_limits<double>::infinity();
+  const D2 size(map->width, map->height);
+  const D2 duv1 = D2(uvs[tri.y] - uvs[tri.x]) * size, duv2 = D2(uvs[tri.z] - uvs[tri.x]) * size;
+  const double pixel = double(view->pixelPerDepth) * depth;  // world size of a pixel at the hit's depth
+  double rho = 0.0;
+  for (const Vec3& axis : {view->right, view->up}) {
+    // The neighbouring pixel's view ray meets the triangle's plane at p + dp (first order).
+    const D3 step = pixel * D3(axis);
+    const D3 dp = step - d * (glm::dot(n, step) / nd);
+    // dp = a e1 + b e2 in the plane (normal equations), so its texel step is a duv1 + b duv2.
+    const double b1 = glm::dot(e1, dp), b2 = glm::dot(e2, dp);
+    const double a = (a22 * b1 - a12 * b2) / det, b = (a11 * b2 - a12 * b1) / det;
+    rho = std::max(rho, glm::length(a * duv1 + b * duv2));
+  }
+  return rho;
+}
+
+Vec4 detail::ImageMapData::sample(uint32_t prim, float u, float v) const {
+  const glm::uvec3& tri = triangles[prim];
+  const Vec2 uv = (1.0f - u - v) * uvs[tri.x] + u * uvs[tri.y] + v * uvs[tri.z];
+  return map->sample(uv, texelsPerPixel(prim, u, v) > 1.0);
+}
 
 uint32_t Scene::Impl::attach(RTCGeometry geometry, GeometryRecord record) {
   rtcCommitGeometry(geometry);
@@ -62,6 +151,11 @@ uint32_t Scene::Impl::addTriangles(GeometryRecord record) {
   }
   stats.triangles += record.triangles.size();
   record.kind = GeometryRecord::Kind::Triangles;
+  if (record.image && record.image->map->alphaCutoff >= 0.0f) {
+    rtcSetGeometryUserData(g, const_cast<detail::ImageMapData*>(record.image.get()));
+    rtcSetGeometryIntersectFilterFunction(g, imageIntersectFilter);
+    rtcSetGeometryOccludedFilterFunction(g, imageOcclusionFilter);
+  }
   return attach(g, std::move(record));
 }
 
@@ -89,18 +183,6 @@ const Material& Scene::material(uint32_t id) const { return impl_->materials.at(
 
 namespace {
 
-uint64_t mix64(uint64_t z) {
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  return z ^ (z >> 31);
-}
-
-uint64_t floatBits(float f) {
-  uint32_t u;
-  std::memcpy(&u, &f, sizeof u);
-  return u;
-}
-
 /// Shadow and sky rays pass a widened curve with probability 1 - opacity: a hash of the
 /// ray and the segment, so the decision is the same at any thread count.
 void thinOcclusionFilter(const RTCFilterFunctionNArguments* args) {
@@ -111,13 +193,7 @@ void thinOcclusionFilter(const RTCFilterFunctionNArguments* args) {
     const float u = RTCHitN_u(args->hit, args->N, i);
     const float opacity = data->opacity(prim, std::clamp(u, 0.0f, 1.0f));
     if (opacity >= 1.0f) continue;
-    uint64_t h = 0x9e3779b97f4a7c15ull ^ prim;
-    for (float f : {RTCRayN_org_x(args->ray, args->N, i), RTCRayN_org_y(args->ray, args->N, i),
-                    RTCRayN_org_z(args->ray, args->N, i), RTCRayN_dir_x(args->ray, args->N, i),
-                    RTCRayN_dir_y(args->ray, args->N, i), RTCRayN_dir_z(args->ray, args->N, i)})
-      h = mix64(h ^ floatBits(f));
-    const float x = static_cast<float>(h >> 40) * (1.0f / 16777216.0f);
-    if (x >= opacity) args->valid[i] = 0;
+    if (rayUnit(args, i, prim) >= opacity) args->valid[i] = 0;
   }
 }
 
@@ -125,6 +201,19 @@ void thinOcclusionFilter(const RTCFilterFunctionNArguments* args) {
 
 void Scene::setPixelFootprint(const Camera& camera, int width, int height, float minPixels) {
   if (impl_->anyGeometry) throw std::logic_error("Scene::setPixelFootprint after geometry was added");
+  impl_->view.reset();
+  if (width >= 1 && height >= 1) {
+    // The camera's basis, as Camera::generateRay builds it.
+    detail::PixelView v;
+    v.eye = camera.position;
+    v.forward = glm::normalize(camera.target - camera.position);
+    Vec3 up = camera.up;
+    if (glm::length(glm::cross(v.forward, up)) < 1e-6f) up = std::abs(v.forward.y) < 0.9f ? Vec3(0, 1, 0) : Vec3(0, 0, 1);
+    v.right = glm::normalize(glm::cross(v.forward, up));
+    v.up = glm::cross(v.right, v.forward);
+    v.pixelPerDepth = 2.0f * std::tan(0.5f * static_cast<float>(radians(camera.fovYDeg))) / static_cast<float>(height);
+    impl_->view = v;
+  }
   if (minPixels <= 0.0f || width < 1 || height < 1) {
     impl_->footprint.reset();
     return;
@@ -250,7 +339,22 @@ std::vector<uint32_t> Scene::add(const Geometry& geometry) {
       const uint32_t base = impl_->addTextureTable(m->textures);
       Material material = m->material;
       if (material.texture >= 0) material.texture += static_cast<int>(base);
-      ids.push_back(addMesh(m->mesh, addMaterial(material), m->triangleColors));
+      if (!m->image) {
+        ids.push_back(addMesh(m->mesh, addMaterial(material), m->triangleColors));
+        continue;
+      }
+      const ImageMap& map = *m->image;
+      if (!map.sample || map.width < 1 || map.height < 1 || m->mesh.uvs.size() != m->mesh.positions.size())
+        throw std::invalid_argument("Scene::add: a mesh part's image map needs a size, a sample function and one uv per vertex");
+      GeometryRecord rec = meshRecord(*impl_, m->mesh, addMaterial(material), m->triangleColors);
+      auto data = std::make_shared<detail::ImageMapData>();
+      data->map = m->image;
+      data->positions = m->mesh.positions;
+      data->triangles = m->mesh.triangles;
+      data->uvs = m->mesh.uvs;
+      data->view = impl_->view;
+      rec.image = std::move(data);
+      ids.push_back(impl_->addTriangles(std::move(rec)));
     } else if (const auto* im = std::get_if<ImplicitPart>(&part)) {
       const uint32_t base = impl_->addTextureTable(im->textures);
       const uint32_t material = addMaterial(im->material);
@@ -270,18 +374,25 @@ std::vector<uint32_t> Scene::add(const Geometry& geometry) {
 }
 
 uint32_t Scene::addMesh(const Mesh& mesh, uint32_t material, const std::vector<Vec3>& triangleColors) {
-  if (impl_->committed) throw std::logic_error("Scene::addMesh after commit");
-  if (material >= impl_->materials.size()) throw std::invalid_argument("Scene::addMesh: unknown material id");
+  return impl_->addTriangles(meshRecord(*impl_, mesh, material, triangleColors));
+}
+
+namespace {
+
+GeometryRecord meshRecord(const Scene::Impl& impl, const Mesh& mesh, uint32_t material,
+                          const std::vector<Vec3>& triangleColors) {
+  if (impl.committed) throw std::logic_error("Scene::addMesh after commit");
+  if (material >= impl.materials.size()) throw std::invalid_argument("Scene::addMesh: unknown material id");
   GeometryRecord rec;
   rec.material = material;
   rec.positions = mesh.positions;
   rec.triangles = mesh.triangles;
   if (mesh.normals.size() == mesh.positions.size()) rec.normals = mesh.normals;
   if (mesh.colors.size() == mesh.positions.size()) rec.vertexColors = mesh.colors;
-  if (mesh.uvs.size() == mesh.positions.size() && impl_->materials[material].texture >= 0) rec.uvs = mesh.uvs;
+  if (mesh.uvs.size() == mesh.positions.size() && impl.materials[material].texture >= 0) rec.uvs = mesh.uvs;
   if (mesh.materials.size() == mesh.triangles.size()) {
     for (uint32_t m : mesh.materials)
-      if (m >= impl_->materials.size()) throw std::invalid_argument("Scene::addMesh: unknown per-triangle material id");
+      if (m >= impl.materials.size()) throw std::invalid_argument("Scene::addMesh: unknown per-triangle material id");
     rec.primitiveMaterials = mesh.materials;
   }
   if (!triangleColors.empty()) {
@@ -292,8 +403,10 @@ uint32_t Scene::addMesh(const Mesh& mesh, uint32_t material, const std::vector<V
   for (const auto& t : mesh.triangles)
     if (t.x >= mesh.positions.size() || t.y >= mesh.positions.size() || t.z >= mesh.positions.size())
       throw std::invalid_argument("Scene::addMesh: triangle index out of range");
-  return impl_->addTriangles(std::move(rec));
+  return rec;
 }
+
+}  // namespace
 
 uint32_t Scene::addTexture(ColorTexture texture) {
   if (!texture) throw std::invalid_argument("Scene::addTexture: empty texture");
@@ -430,6 +543,16 @@ std::optional<SurfaceHit> Scene::intersect(const Vec3& origin, const Vec3& direc
     int tex = impl_->materials[hit.material].texture;
     if (!rec.uvs.empty() && tex >= 0 && static_cast<size_t>(tex) < impl_->textures.size())
       hit.color = impl_->textures[tex](w * rec.uvs[tri.x] + u * rec.uvs[tri.y] + v * rec.uvs[tri.z], hit.position);
+    if (rec.image) {
+      const Vec4 c = rec.image->sample(prim, rh.hit.u, rh.hit.v);
+      hit.color = Vec3(c);
+      // Partial coverage (the intersect filter left out alpha at or below the cutoff): the
+      // renderer blends the hit over what it sees from just past the triangle.
+      if (rec.image->map->alphaCutoff >= 0.0f && c.a < 1.0f) {
+        hit.opacity = c.a;
+        hit.behind = hit.t + 1e-4f * hit.t + 1e-6f;
+      }
+    }
   }
   if (!rec.primitiveColors.empty()) hit.color = rec.primitiveColors[prim];
   float len = glm::length(ng);

@@ -89,6 +89,8 @@ class Scene {
   /// their coverage instead of breaking into dots; implicit and polygonized parts draw
   /// their thinAxes that way. Call before adding geometry (throws std::logic_error after);
   /// minPixels <= 0 turns it off. Scenes without a footprint draw curves as they are.
+  /// The camera's pixel also sets the texel footprint of image maps (MeshPart::image: the
+  /// choice of their magnification or minification filter), whatever minPixels is.
   void setPixelFootprint(const Camera& camera, int width, int height, float minPixels = kThinMinPixels);
   /// Default minimum width of thin geometry, pixels.
   static constexpr float kThinMinPixels = 2.0f;

@@ -36,6 +36,34 @@ struct CurveData {
   }
 };
 
+/// The camera's pixel: its basis and its world size per unit depth (square pixels).
+struct PixelView {
+  Vec3 eye{0};
+  Vec3 forward{0, 0, -1};  ///< unit view direction
+  Vec3 right{1, 0, 0};     ///< unit film x
+  Vec3 up{0, 1, 0};        ///< unit film y
+  float pixelPerDepth = 0.0f;
+};
+
+/// A triangle geometry coloured by an ImageMap: its triangles and uvs, for the hit colour
+/// and the payload of its alpha filter functions.
+struct ImageMapData {
+  std::shared_ptr<const ImageMap> map;
+  std::vector<Vec3> positions;
+  std::vector<glm::uvec3> triangles;
+  std::vector<Vec2> uvs;
+  std::optional<PixelView> view;  ///< the camera, when the scene has one
+  /// GL's texel footprint ρ (texels per pixel) at barycentric (u, v) of triangle prim: the
+  /// camera's two pixel steps at the hit, carried along the view ray onto the triangle's
+  /// plane, through its uv mapping, scaled by the image size; the larger of the two
+  /// lengths. 0 without a camera, for a degenerate triangle or a point behind the camera;
+  /// infinite where the view ray grazes the plane.
+  double texelsPerPixel(uint32_t prim, float u, float v) const;
+  /// The map's colour and alpha at barycentric (u, v) of triangle prim: its interpolated uv,
+  /// minified when texelsPerPixel > 1 (OpenGL's λ > 0 without mipmaps).
+  Vec4 sample(uint32_t prim, float u, float v) const;
+};
+
 /// What the renderer needs to know about one Embree geometry to shade its hits.
 struct GeometryRecord {
   enum class Kind { Curves, Triangles, Spheres, Implicit } kind = Kind::Triangles;
@@ -49,6 +77,7 @@ struct GeometryRecord {
   std::vector<uint32_t> primitiveMaterials;  ///< optional per-primitive material ids
   std::shared_ptr<const ImplicitData> implicit;  ///< Implicit
   std::shared_ptr<const CurveData> curves;       ///< Curves
+  std::shared_ptr<const ImageMapData> image;     ///< Triangles coloured by an image map
   uint32_t textureBase = 0;                      ///< the part's texture table in Scene::Impl::textures
   uint32_t textureCount = Scene::kAllTextures;   ///< its size (kAllTextures: the scene's whole table)
 };
@@ -76,6 +105,7 @@ struct Scene::Impl {
   bool committed = false;
   bool anyGeometry = false;               ///< something was added (the footprint is fixed then)
   std::optional<PixelFootprint> footprint;  ///< minimum width of thin curves, when set
+  std::optional<detail::PixelView> view;    ///< the camera's pixel, when set (image maps)
 
   /// Commits geometry, attaches it under the next id and records how to shade it.
   uint32_t attach(RTCGeometry geometry, detail::GeometryRecord record);
@@ -86,7 +116,8 @@ struct Scene::Impl {
   void setBallVertices(RTCGeometry geometry, const std::vector<Vec4>& balls);
   /// Adds curves (widened to the footprint when there is one) as Embree round linear curves.
   uint32_t addCurveGeometry(std::shared_ptr<detail::CurveData> data, uint32_t material);
-  /// Adds record's triangles as Embree triangle geometry.
+  /// Adds record's triangles as Embree triangle geometry (with alpha filter functions when
+  /// record.image cuts out).
   uint32_t addTriangles(detail::GeometryRecord record);
 };
 

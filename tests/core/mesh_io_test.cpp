@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "core/atomic_file.h"
+#include "core/image.h"
 #include "core/mesh_io.h"
 #include "tests/core/cube_mesh.h"
 
@@ -410,5 +411,41 @@ TEST_CASE("writeParts::texture", "[core]") {
     bad.mesh.uvs.clear();
     CHECK_THROWS_AS(writeParts({bad}, dir.path / "bad.obj"), std::invalid_argument);
     CHECK(dir.entries() == 0);
+  }  SECTION("a cut-out: alpha kept (RGBA PNG), glTF MASK with its cutoff, MTL map_d, the sampler's filters") {
+    ExportPart cut = quad;
+    auto tex = std::make_shared<PartTexture>(*quad.material.texture);
+    tex->image.set(1, 0, Vec4(1, 0, 0, 0));  // one transparent texel
+    tex->magFilter = PartTexture::Filter::Nearest;
+    tex->minFilter = PartTexture::Filter::Linear;
+    cut.material.texture = tex;
+    cut.material.alphaCutoff = 0.1f;
+    const fs::path glb = dir.path / "c.glb";
+    writeParts({cut}, glb);
+    tinygltf::Model model;
+    tinygltf::TinyGLTF loader;
+    std::string err, warn;
+    REQUIRE(loader.LoadBinaryFromFile(&model, &err, &warn, glb.string()));
+    CHECK(model.materials[0].alphaMode == "MASK");
+    CHECK(model.materials[0].alphaCutoff == Approx(0.1));
+    const auto& image = model.images[0];
+    REQUIRE(image.component == 4);
+    CHECK(int(image.image[3]) == 255);
+    CHECK(int(image.image[4 + 3]) == 0);
+    CHECK(model.samplers[0].magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST);
+    CHECK(model.samplers[0].minFilter == TINYGLTF_TEXTURE_FILTER_LINEAR);
+    const fs::path obj = dir.path / "c.obj";
+    writeParts({cut}, obj);
+    CHECK(readFile(dir.path / "c.mtl").find("map_Kd c_bark.png\nmap_d c_bark.png\n") != std::string::npos);
+    const Image png = readImage(dir.path / "c_bark.png");
+    CHECK(png.at(0, 0).a == 1.0f);
+    CHECK(png.at(1, 0).a == 0.0f);
+    // Opaque parts keep the default: OPAQUE, an RGB PNG (no map_d).
+    writeParts({quad}, dir.path / "o.glb");
+    tinygltf::Model opaque;
+    REQUIRE(loader.LoadBinaryFromFile(&opaque, &err, &warn, (dir.path / "o.glb").string()));
+    CHECK(opaque.materials[0].alphaMode == "OPAQUE");
+    writeParts({quad}, dir.path / "o.obj");
+    CHECK(readFile(dir.path / "o.mtl").find("map_d") == std::string::npos);
+    CHECK(readImageInfo(dir.path / "o_bark.png").channels == 3);
   }
 }

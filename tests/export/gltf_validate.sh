@@ -44,4 +44,9 @@ for entry in "${species[@]}"; do
   done
   python3 scripts/gltf-parts.py "species/$s.yaml" "$f" "${expect[@]}"
 done
+# A cpfg object whose texture cuts out (alphaMode MASK with alphaCutoff, an RGBA PNG, nearest
+# samplers) beside an opaque decal one.
+f="$out/cpfg_cutout.${#files[@]}.glb"
+"$sprig" mesh tests/assets/cpfg/texture/cutout -o "$f" >/dev/null
+files+=("$f")
 node scripts/gltf-validate.js "${files[@]}"

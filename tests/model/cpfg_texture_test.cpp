@@ -1,17 +1,20 @@
 // cpfg textures (`texture:` lines of a view file, `@Tx(n)`): texture coordinates on surface
 // files, the colours the renderer gives the textured surfaces, and their export.
 #include <catch2/catch.hpp>
+#include <tiny_gltf.h>
 
 #include <filesystem>
 #include <string>
 
 #include "core/atomic_file.h"
+#include "core/image.h"
 #include "core/mesh_io.h"
 #include "lsystem/skeleton.h"
 #include "model/growth.h"
 #include "model/model.h"
 #include "model/species.h"
 #include "model/tree_kind.h"
+#include "render/renderer.h"
 #include "render/scene.h"
 
 using namespace sprig;
@@ -20,6 +23,7 @@ namespace fs = std::filesystem;
 namespace {
 
 fs::path textureObject() { return fs::path(SPRIG_SOURCE_DIR) / "tests/assets/cpfg/texture"; }
+fs::path cutoutObject() { return textureObject() / "cutout"; }
 
 /// The colour the scene's surface shows at (x, y) seen along +Z (the flat squares face -Z).
 Vec3 colorAt(const render::Scene& scene, float x, float y) {
@@ -44,7 +48,10 @@ TEST_CASE("cpfg textures on surface files", "[model][cpfg]") {
   REQUIRE(textures.size() == 2);
   CHECK(textures[0].decal);
   CHECK_FALSE(textures[0].perSurface);
-  CHECK_FALSE(textures[0].linear);
+  CHECK_FALSE(textures[0].magLinear);
+  CHECK_FALSE(textures[0].minLinear);
+  CHECK_FALSE(textures[1].magLinear);
+  CHECK(textures[1].minLinear);
   CHECK_FALSE(textures[1].decal);
   CHECK(textures[1].perSurface);
   REQUIRE(textures[0].image->width == 2);
@@ -168,9 +175,242 @@ TEST_CASE("cpfg texture errors", "[model][cpfg]") {
   CHECK(errorOf("surface: b flat.s 3 2\n", "~b") ==
         "plant.v:2:21: the surface's texture 2 names no texture: the view file has 0 'texture:' lines");
   CHECK(errorOf("texture: F: halves.png\n", "@Tx(1)F") ==
-        "cpfg's texture '@Tx(1)' on an 'F' segment (a cylinder) is not supported: Sprig textures surfaces ('~X') only; "
+        "cpfg's texture '@Tx(1)' on an 'F' segment (a cylinder) is not supported: Sprig textures surfaces ('~X') and polygons ('{ }') only; "
         "end the texture with '@Tx' or close its branch before drawing it");
-  CHECK(errorOf("texture: F: halves.png\n", "@Tx(1){.f.+f.}").find("on a polygon '{ }' is not supported") !=
+  CHECK(errorOf("texture: F: halves.png\n", "@Tx(1){.f+f}") == "no error");  // polygons are textured
+  CHECK(errorOf("texture: F: halves.png\n", "@Tx(1)@Gs f @Gc(2) f @Ge(2)").find("on a generalized cylinder is not supported") !=
         std::string::npos);
   fs::remove_all(dir);
+}
+
+TEST_CASE("cpfg cut-out textures: alpha test and blending", "[model][cpfg]") {
+  const Species s = loadSpecies(cutoutObject());
+  REQUIRE(s.render.style.cpfgTextures);
+  const auto& textures = *s.render.style.cpfgTextures;
+  REQUIRE(textures.size() == 2);
+  CHECK(textures[0].cutsOut());        // modulate: the texel's alpha is the fragment's
+  CHECK_FALSE(textures[1].cutsOut());  // decal: the fragment is opaque
+  // cutout.png: 5 x 1 red texels of alpha 255, 0, 128, 26, 25 (of 255).
+  const float alpha[] = {1.0f, 0.0f, 128 / 255.0f, 26 / 255.0f, 25 / 255.0f};
+  for (int k = 0; k < 5; ++k) CHECK(textures[0].sample((k + 0.5) / 5, 0.5).a == Approx(alpha[k]).margin(1e-6));
+
+  GrowthEngine engine(s);
+  const lsystem::Skeleton sk = engine.skeletonAt(engine.lastStep());
+  // [@Tx(1)~a] [^(90)f(2)&(90)~a] +(90)f(5)-(90) [@Tx(2)~a] F(1): the cut-out square at z = 0,
+  // x in [-3, 0]; the untextured one 2 behind it (z = 2); the decal one at x in [-8, -5].
+  REQUIRE(sk.organs.size() == 3);
+  CHECK(sk.organs[0].texture == 0);
+  CHECK(sk.organs[1].texture == -1);
+  CHECK(sk.organs[2].texture == 1);
+  CHECK(sk.organs[1].points[0].z == Approx(2.0));
+
+  render::Scene scene;
+  scene.add(skeletonPreview(sk, s.render.style));
+  scene.commit();
+  const Vec3 red(1, 0, 0), leaf = s.render.style.leaf.baseColor;
+  // Per patch, s runs along y: texel k covers y in [0.6 k, 0.6 (k + 1)], centre 0.3 + 0.6 k.
+  auto texelY = [](int k) { return 0.3f + 0.6f * static_cast<float>(k); };
+  auto ray = [&](float x, float y, float tnear = 0.0f) { return scene.intersect(Vec3(x, y, -10), Vec3(0, 0, 1), tnear, 100.0f); };
+
+  SECTION("camera rays: the opaque texel hits the leaf, the cut ones the square behind") {
+    for (float x : {-0.4f, -1.5f, -2.6f}) {
+      INFO("x " << x);
+      auto opaque = ray(x, texelY(0));
+      REQUIRE(opaque);
+      CHECK(opaque->t == Approx(10.0f));
+      CHECK(opaque->opacity == 1.0f);
+      checkColor(opaque->color, red * leaf);
+      for (int k : {1, 4}) {  // alpha 0 and 25/255 (at or below cpfg's 0.1): left out
+        INFO("texel " << k);
+        auto through = ray(x, texelY(k));
+        REQUIRE(through);
+        CHECK(through->t == Approx(12.0f));
+        checkColor(through->color, leaf);
+      }
+      for (int k : {2, 3}) {  // alpha 128/255 and 26/255: drawn, covering that much
+        INFO("texel " << k);
+        auto part = ray(x, texelY(k));
+        REQUIRE(part);
+        CHECK(part->t == Approx(10.0f));
+        CHECK(part->opacity == Approx(alpha[k]).margin(1e-6));
+        CHECK(part->behind > part->t);
+        CHECK(part->behind < 10.01f);
+        CHECK(glm::length(part->color - red * leaf) < 0.02f);  // 8-bit premultiplied red, unassociated
+        auto behind = ray(x, texelY(k), part->behind);  // what the renderer blends it over
+        REQUIRE(behind);
+        CHECK(behind->t == Approx(12.0f));
+      }
+    }
+  }
+
+  SECTION("shadows: a light beyond the cut-out square is blocked by its opaque texels only") {
+    // From between the squares (z = 1) toward the light at -Z.
+    auto blocked = [&](float x, float y) { return scene.occluded(Vec3(x, y, 1), Vec3(0, 0, -1), 0.0f, 100.0f); };
+    for (float x : {-0.4f, -1.5f, -2.6f}) {
+      CHECK(blocked(x, texelY(0)));
+      CHECK_FALSE(blocked(x, texelY(1)));
+      CHECK_FALSE(blocked(x, texelY(4)));
+      CHECK_FALSE(blocked(x, 3.5f));  // beside the square
+    }
+    // Partly covering texels block that fraction of the rays (a hash of each ray): 20 x 20
+    // rays over the inner part of each texel.
+    for (int k : {2, 3}) {
+      int count = 0;
+      for (int i = 0; i < 20; ++i)
+        for (int j = 0; j < 20; ++j)
+          count += blocked(-0.1f - 2.8f * static_cast<float>(i) / 19.0f, 0.6f * static_cast<float>(k) + 0.05f + 0.5f * static_cast<float>(j) / 19.0f);
+      INFO("texel " << k << ": " << count << " of 400 blocked");
+      CHECK(std::abs(count / 400.0 - alpha[k]) < 0.06);
+    }
+  }
+
+  SECTION("decal: the texels' alpha blends the colours, nothing is cut out") {
+    for (int k = 0; k < 5; ++k) {
+      INFO("texel " << k);
+      auto hit = ray(-6.5f, texelY(k));
+      REQUIRE(hit);
+      CHECK(hit->t == Approx(10.0f));
+      CHECK(hit->opacity == 1.0f);
+      CHECK(glm::length(hit->color - glm::mix(leaf, red, alpha[k])) < 0.02f);
+    }
+  }
+
+  SECTION("export: glTF alphaMode MASK at 0.1, the image's alpha kept, the samplers nearest") {
+    SpeciesModel model(s, ModelOptions{});
+    std::vector<ExportPart> parts = model.exportParts(model.finalStage(), 0.0f, false);
+    std::vector<ExportPart> textured;
+    for (ExportPart& p : parts)
+      if (p.name.rfind("textured_leaves_", 0) == 0) textured.push_back(std::move(p));
+    REQUIRE(textured.size() == 2);  // modulate (cut out), decal (opaque)
+    CHECK(textured[0].material.alphaCutoff == 0.1f);
+    CHECK(textured[1].material.alphaCutoff < 0.0f);
+    const Image& img = textured[0].material.texture->image;
+    REQUIRE(img.width == 5);
+    for (int k = 0; k < 5; ++k) CHECK(img.at(k, 0).a == Approx(alpha[k]).margin(1e-6));
+    const fs::path dir = fs::temp_directory_path() / "sprig-cpfg-cutout-test";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const fs::path file = dir / "cutout.glb";
+    writeParts(textured, file);
+    tinygltf::Model gltf;
+    tinygltf::TinyGLTF loader;
+    std::string err, warn;
+    REQUIRE(loader.LoadBinaryFromFile(&gltf, &err, &warn, file.string()));
+    REQUIRE(gltf.materials.size() == 2);
+    CHECK(gltf.materials[0].alphaMode == "MASK");
+    CHECK(gltf.materials[0].alphaCutoff == Approx(0.1));
+    CHECK(gltf.materials[1].alphaMode == "OPAQUE");
+    for (const tinygltf::Sampler& sampler : gltf.samplers) {  // H: n, L: n (cpfg's defaults)
+      CHECK(sampler.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST);
+      CHECK(sampler.minFilter == TINYGLTF_TEXTURE_FILTER_NEAREST);
+    }
+    const tinygltf::Image& png = gltf.images[size_t(gltf.textures[size_t(gltf.materials[0].pbrMetallicRoughness.baseColorTexture.index)].source)];
+    REQUIRE(png.width == 5);
+    REQUIRE(png.component == 4);
+    const int alpha8[] = {255, 0, 128, 26, 25};
+    for (int k = 0; k < 5; ++k) CHECK(int(png.image[size_t(4 * k + 3)]) == alpha8[k]);
+    fs::remove_all(dir);
+  }
+}
+
+TEST_CASE("cpfg texture filters: magnification or minification by the texel footprint", "[model][cpfg]") {
+  const Species s = loadSpecies(textureObject());
+  const auto& textures = *s.render.style.cpfgTextures;
+  // Texture 2 is H: n, L: l. At s = 3/8 (a quarter texel left of the boundary between the red
+  // and the blue texel centres at 1/4 and 3/4): nearest is red, bilinear 3/4 red + 1/4 blue.
+  const Vec4 red(1, 0, 0, 1), mixed(0.75f, 0, 0.25f, 1);
+  CHECK(textures[1].sample(0.375, 0.5, false) == red);
+  CHECK(textures[1].sample(0.375, 0.5, true) == mixed);
+  CHECK(textures[0].sample(0.375, 0.5, true) == red);  // texture 1: L: n
+
+  GrowthEngine engine(s);
+  const lsystem::Skeleton sk = engine.skeletonAt(engine.lastStep());
+  const Vec3 leaf = s.render.style.leaf.baseColor;
+  // The second square (texture 2, per surface): s = -x / 3 over x in [-3, 0], t = (y - 4) / 3.
+  // A camera straight in front of p = (-9/8, 5.5, 0) at depth d, 90 degrees over 16 pixels:
+  // a pixel is d / 8 wide there, 2/3 texel along s (2 texels over 3 units), 1/3 along t, so
+  // GL's footprint is rho = d / 12: magnified nearer than 12, minified beyond.
+  const Vec3 p(-1.125f, 5.5f, 0.0f);
+  auto colorSeenFrom = [&](float depth) {
+    render::Camera camera;
+    camera.position = p - Vec3(0, 0, depth);
+    camera.target = p;
+    camera.fovYDeg = 90.0f;
+    render::Scene scene;
+    scene.setPixelFootprint(camera, 16, 16, 0.0f);  // no thin-curve widening; the pixel still counts
+    scene.add(skeletonPreview(sk, s.render.style));
+    scene.commit();
+    auto hit = scene.intersect(camera.position, Vec3(0, 0, 1), 0.0f, 100.0f);
+    REQUIRE(hit);
+    CHECK(hit->t == Approx(depth));
+    return hit->color;
+  };
+  checkColor(colorSeenFrom(6.0f), Vec3(red) * leaf);     // rho 0.5
+  checkColor(colorSeenFrom(11.8f), Vec3(red) * leaf);    // rho 0.983
+  checkColor(colorSeenFrom(12.2f), Vec3(mixed) * leaf);  // rho 1.017
+  checkColor(colorSeenFrom(40.0f), Vec3(mixed) * leaf);
+  // Without a camera every lookup magnifies.
+  render::Scene plain;
+  plain.add(skeletonPreview(sk, s.render.style));
+  plain.commit();
+  auto hit = plain.intersect(p - Vec3(0, 0, 40), Vec3(0, 0, 1), 0.0f, 100.0f);
+  REQUIRE(hit);
+  checkColor(hit->color, Vec3(red) * leaf);
+}
+
+TEST_CASE("cpfg textures on polygons", "[model][cpfg]") {
+  const fs::path dir = fs::temp_directory_path() / "sprig-cpfg-polygon-texture-test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  fs::copy_file(textureObject() / "halves.png", dir / "halves.png");
+  writeFileAtomic(dir / "plant.v", "angle increment: 90\ntexture: F: halves.png E: d\n");
+  writeFileAtomic(dir / "plant.l", "lsystem: 1\nderivation length: 0\naxiom: @Tx(1){.f+f}\nendlsystem\n");
+  const Species s = loadSpecies(dir);
+  GrowthEngine engine(s);
+  const lsystem::Skeleton sk = engine.skeletonAt(engine.lastStep());
+  // Points (0,0,0), (0,1,0), (-1,1,0); the first point's frame has H = +Y and -L = +X, so
+  // t = y over [0, 1] and s = x over [-1, 0] (irisGL.c PolygonToMesh): a fan of 1 triangle.
+  REQUIRE(sk.organs.size() == 1);
+  const lsystem::Organ& o = sk.organs[0];
+  CHECK(o.kind == lsystem::Organ::Kind::Polygon);
+  CHECK(o.texture == 0);
+  CHECK(o.triangles == std::vector<uint32_t>{0, 1, 2});
+  REQUIRE(o.uvs.size() == 3);
+  CHECK(o.uvs[0] == Vec2(1, 0));
+  CHECK(o.uvs[1] == Vec2(1, 1));
+  CHECK(o.uvs[2] == Vec2(0, 1));
+  REQUIRE(o.normals.size() == 3);
+  CHECK(std::abs(o.normals[0].z) == Approx(1.0));
+  render::Scene scene;
+  scene.add(skeletonPreview(sk, s.render.style));
+  scene.commit();
+  // Decal halves.png: red for s below 1/2 (x < -1/2), blue above; drawn once (not also as
+  // an untextured polygon: no other hit behind the first).
+  checkColor(colorAt(scene, -0.6f, 0.9f), Vec3(1, 0, 0));
+  checkColor(colorAt(scene, -0.25f, 0.75f), Vec3(0, 0, 1));
+  CHECK_FALSE(scene.intersect(Vec3(-0.6f, 0.9f, -10), Vec3(0, 0, 1), 10.001f, 100.0f));
+  fs::remove_all(dir);
+}
+
+TEST_CASE("cpfg cut-out textures render the same bytes at 1 and 2 threads", "[model][cpfg]") {
+  // Shadow and sky rays through partly covering texels are decided by a hash of the ray.
+  const Species s = loadSpecies(cutoutObject());
+  GrowthEngine engine(s);
+  const lsystem::Skeleton sk = engine.skeletonAt(engine.lastStep());
+  render::Camera camera;
+  camera.position = Vec3(-4, 1.5f, -12);
+  camera.target = Vec3(-4, 1.5f, 0);
+  auto renderAt = [&](int threads) {
+    render::Scene scene;
+    scene.setPixelFootprint(camera, 64, 48);
+    scene.add(skeletonPreview(sk, s.render.style));
+    scene.commit();
+    render::RenderSettings rs;
+    rs.width = 64;
+    rs.height = 48;
+    rs.spp = 2;
+    rs.threads = threads;
+    return render::renderImage(scene, camera, rs);
+  };
+  CHECK(renderAt(1).pixels == renderAt(2).pixels);
 }
