@@ -1,6 +1,7 @@
 #include "organisms/tree_builder.h"
 
 #include <algorithm>
+#include <array>
 #include <stdexcept>
 #include <string>
 #include <cmath>
@@ -268,29 +269,38 @@ std::optional<bt::NodeId> raisedRidgeArc(bt::BlobTree& tree, bt::NodeId field, c
       continue;
     }
     const double target = options.height * rB * c.weight;
+    if (!(target > 0)) {  // the support just reaches the bark: no raise
+      v.axisPoint = Vec3(p + (*t0 - R) * n);
+      continue;
+    }
+    // F over [t0, t0 + R], where the raised surface lies, sampled once and interpolated.
+    constexpr int kSamples = 48;
+    std::array<double, kSamples + 1> Fs;
+    for (int k = 0; k <= kSamples; ++k) Fs[size_t(k)] = F(*t0 + R * k / kSamples);
+    auto Fat = [&](double t) {
+      const double x = std::clamp((t - *t0) / R * kSamples, 0.0, double(kSamples));
+      const int k = std::min(static_cast<int>(x), kSamples - 1);
+      return Fs[size_t(k)] + (x - k) * (Fs[size_t(k) + 1] - Fs[size_t(k)]);
+    };
     auto raise = [&](double e) {
       const double axis = *t0 - e;
       auto G = [&](double t) {
         const double s = (t - axis) * (t - axis) / (R * R);
-        return F(t) + (s < 1 ? static_cast<double>(bt::kernelValue(kernel, static_cast<float>(s))) : 0.0);
+        return Fat(t) + (s < 1 ? static_cast<double>(bt::kernelValue(kernel, static_cast<float>(s))) : 0.0);
       };
       const std::optional<double> t1 = crossing(G, *t0, axis + R);
       return t1 ? *t1 - *t0 : 0.0;
     };
-    double e = R;
-    if (target > 0) {
-      if (raise(0) <= target) {
-        e = 0;
-      } else {
-        double lo = 0, hi = R;
-        for (int k = 0; k < 30; ++k) {
-          const double mid = 0.5 * (lo + hi);
-          (raise(mid) > target ? lo : hi) = mid;
-        }
-        e = 0.5 * (lo + hi);
+    double e = 0;
+    if (raise(0) > target) {
+      double lo = 0, hi = R;
+      for (int k = 0; k < 30; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        (raise(mid) > target ? lo : hi) = mid;
       }
-      v.raised = true;
+      e = 0.5 * (lo + hi);
     }
+    v.raised = true;
     v.axisPoint = Vec3(p + (*t0 - e) * n);
   }
 
