@@ -261,7 +261,7 @@ std::optional<bt::NodeId> raisedRidgeArc(bt::BlobTree& tree, bt::NodeId field, c
     const DVec3 p(c.position), n(c.normal);
     const double r = c.halfWidth, R = bt::supportRadius(kernel, static_cast<float>(r));
     auto F = [&](double t) { return static_cast<double>(tree.value(field, Vec3(p + t * n))); };
-    const std::optional<double> t0 = crossing(F, -0.5 * arc.parentRadius, R);
+    const std::optional<double> t0 = crossing(F, -0.5 * arc.parentRadius, 0.5 * arc.parentRadius + R);
     Vertex& v = vertices[i];
     v.radius = static_cast<float>(r);
     if (!t0) {  // no bark surface found here: the skeleton stays clear of it
