@@ -59,6 +59,11 @@ struct TextureAttr {
   /// Direction that defines u = 0 around a cone/segment/torus axis (projected
   /// perpendicular to the axis); zero picks a fixed perpendicular.
   Vec3 refDir{0.0f};
+  /// A relief primitive: a detail raised on other primitives' surface (a bark ridge). It
+  /// carries no attributes (the surface keeps the texture of what it lies on) and counts
+  /// as neither a feature nor a limb for cell sizes (CompiledBlob::smallestFeature,
+  /// thinnestLimb). Its field is an ordinary primitive's.
+  bool relief = false;
 };
 
 /// Parameters of Precise Contact Modeling (Gascuel 1993; Cani-Gascuel 1998; tree paper Eq. 3).

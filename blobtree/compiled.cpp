@@ -140,6 +140,7 @@ CompiledBlob compile(const BlobTree& tree, NodeId root) {
   }
   float mf = 0.0f, ml = 0.0f;
   for (const Prim& P : tape->prims) {
+    if (P.tex.relief) continue;
     if (P.isoRadiusMin > 0.0f) mf = mf == 0.0f ? P.isoRadiusMin : std::min(mf, P.isoRadiusMin);
     if (P.isoRadiusMax > 0.0f) ml = ml == 0.0f ? P.isoRadiusMax : std::min(ml, P.isoRadiusMax);
   }

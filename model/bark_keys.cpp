@@ -18,6 +18,7 @@ void readBarkLook(MapReader& m, textures::BarkLook& look) {
   arc.droop = m.number("ridge_arc_droop", arc.droop, 0.0, 10.0);
   arc.spread = m.number("ridge_arc_spread", arc.spread, 0.1, 20.0);
   arc.width = m.number("ridge_arc_width", arc.width, 0.01, 5.0);
+  arc.height = m.number("ridge_arc_height", arc.height, 0.0, 2.0);
 
   // The pattern.
   textures::BarkOptions& b = look.pattern;

@@ -16,7 +16,7 @@ namespace sprig {
 /// `lenticel_color`, `peel_color`), the ridge on PCM seams (`ridge_darkening`,
 /// `ridge_lines`, `ridge_relief`) and the arcs over branches (`ridge_arc`,
 /// `ridge_arc_relief`, `ridge_arc_rise`, `ridge_arc_droop`, `ridge_arc_spread`,
-/// `ridge_arc_width`). Values out of range and wrong types are reported to m's diagnostics
+/// `ridge_arc_width`, and `ridge_arc_height`: the arc raised as geometry). Values out of range and wrong types are reported to m's diagnostics
 /// at their `file:line:col`. The caller reads its kind's own keys and calls m.finish().
 void readBarkLook(MapReader& m, textures::BarkLook& look);
 

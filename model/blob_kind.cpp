@@ -3,6 +3,7 @@
 
 #include "blobtree/polygonize.h"
 #include "model/bark_keys.h"
+#include "organisms/tree_builder.h"
 #include "model/detail/key_recorder.h"
 #include "model/mesh_parts.h"
 #include "render/scene.h"
@@ -726,6 +727,13 @@ std::optional<BlobSpecies> readBlobSpecies(MapReader& top, DiagnosticList& diags
   auto root = readBlobNode(*blob, s.tree, diags, textureCount);
   if (!root) return std::nullopt;
   s.root = *root;
+  if (ridge && ridge->ridgeArc.height > 0) {
+    // The raised branch bark ridges over the blob's branches, summed into the whole blob.
+    std::vector<blobtree::NodeId> raised{s.root};
+    for (const textures::RidgeArc& arc : blobRidgeArcs(s.tree, s.root))
+      if (auto r = organisms::raisedRidgeArc(s.tree, s.root, arc, ridge->ridgeArc)) raised.push_back(*r);
+    if (raised.size() > 1) s.root = s.tree.blend(raised);
+  }
   return s;
 }
 
@@ -772,7 +780,7 @@ std::vector<textures::RidgeArc> blobRidgeArcs(const BlobTree& tree, NodeId root)
     switch (n.kind) {
       case NodeKind::Segment:
       case NodeKind::Cone: {
-        if (!(n.weight > 0)) return;
+        if (!(n.weight > 0) || n.texture.relief) return;  // relief: a raised ridge, no branch
         const float scale = std::cbrt(std::abs(glm::determinant(Mat3(worldFromLocal))));
         axes.push_back({Vec3(worldFromLocal * Vec4(n.p0, 1.0f)), Vec3(worldFromLocal * Vec4(n.p1, 1.0f)),
                         n.ra * scale, (n.kind == NodeKind::Segment ? n.ra : n.rb) * scale});

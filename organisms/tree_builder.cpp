@@ -1,6 +1,7 @@
 #include "organisms/tree_builder.h"
 
 #include <algorithm>
+#include <array>
 #include <stdexcept>
 #include <string>
 #include <cmath>
@@ -102,6 +103,54 @@ bt::NodeId partNode(bt::BlobTree& tree, const ConePart& p, const std::vector<DVe
   return id;
 }
 
+/// The ridge arcs of junction j (see ridgeArcs).
+std::vector<textures::RidgeArc> junctionArcs(const TreePlan& plan, const Junction& j) {
+  std::vector<textures::RidgeArc> out;
+  const std::vector<ConePart>& parts = plan.parts;
+  auto direction = [](const ConePart& p) {
+    const DVec3 chord = p.end - p.start;
+    const double len = glm::length(chord);
+    if (!(len > 0)) return DVec3(0.0);
+    // A bent cone leaves its start along the chord turned by the bend angle toward the bow.
+    return std::cos(p.bendAngle) * (chord / len) + std::sin(p.bendAngle) * p.bendToward;
+  };
+  if (j.branches.size() < 2 || j.basal < 0) return out;
+  const ConePart& basal = parts[static_cast<size_t>(j.basal)];
+  const DVec3 up = direction(basal);
+  int32_t leader = -1;
+  double best = -2;
+  for (int32_t b : j.branches) {
+    const double c = glm::dot(direction(parts[static_cast<size_t>(b)]), up);
+    if (c > best) best = c, leader = b;
+  }
+  const ConePart& lead = parts[static_cast<size_t>(leader)];
+  const DVec3 axis = direction(lead);
+  for (int32_t b : j.branches) {
+    if (b == leader) continue;
+    const ConePart& branch = parts[static_cast<size_t>(b)];
+    textures::RidgeArc arc;
+    arc.point = Vec3(j.point);
+    arc.parentAxis = Vec3(axis);
+    arc.branchAxis = Vec3(direction(branch));
+    arc.parentRadius = static_cast<float>(std::max(basal.endRadius, lead.startRadius));
+    arc.branchRadius = static_cast<float>(branch.startRadius);
+    out.push_back(arc);
+  }
+  return out;
+}
+
+/// Where F(p + t·n) crosses 0.5 going outward in [lo, hi] (F(lo) > 0.5 >= F(hi)), by
+/// bisection; nullopt when the span does not bracket a crossing.
+template <class F>
+std::optional<double> crossing(const F& field, double lo, double hi) {
+  if (!(field(lo) > 0.5) || field(hi) > 0.5) return std::nullopt;
+  for (int k = 0; k < 40; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (field(mid) > 0.5 ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
 }  // namespace
 
 BarkClass barkClassFor(const BarkOptions& bark, double r) {
@@ -151,7 +200,15 @@ TreeBlob buildTreeBlob(const lsystem::Skeleton& skeleton, const TreeOptions& opt
       }
       if (contact.size() == 1) sum.push_back(contact[0]);
       if (contact.size() > 1) sum.push_back(tree.pcm(contact, pcm));  // Eq. 5
-      groups.push_back(tree.blend(sum));                              // Eq. 6
+      bt::NodeId group = tree.blend(sum);                             // Eq. 6
+      if (opt.bark.ridgeArc.height > 0) {
+        // The raised branch bark ridges over the junction's branches, summed into it.
+        std::vector<bt::NodeId> raised{group};
+        for (const textures::RidgeArc& arc : junctionArcs(plan, j))
+          if (auto ridge = raisedRidgeArc(tree, group, arc, opt.bark.ridgeArc)) raised.push_back(*ridge);
+        if (raised.size() > 1) group = tree.blend(raised);
+      }
+      groups.push_back(group);
     }
     // Parts in no junction (a lone internode) are their own group.
     for (size_t i = 0; i < plan.parts.size(); ++i)
@@ -169,39 +226,96 @@ TreeBlob buildTreeBlob(const lsystem::Skeleton& skeleton, const TreeOptions& opt
 
 std::vector<textures::RidgeArc> ridgeArcs(const TreeBlob& blob) {
   std::vector<textures::RidgeArc> out;
-  const std::vector<ConePart>& parts = blob.plan.parts;
-  auto direction = [](const ConePart& p) {
-    const DVec3 chord = p.end - p.start;
-    const double len = glm::length(chord);
-    if (!(len > 0)) return DVec3(0.0);
-    // A bent cone leaves its start along the chord turned by the bend angle toward the bow.
-    return std::cos(p.bendAngle) * (chord / len) + std::sin(p.bendAngle) * p.bendToward;
-  };
   for (const Junction& j : blob.plan.junctions) {
-    if (j.branches.size() < 2 || j.basal < 0) continue;
-    const ConePart& basal = parts[static_cast<size_t>(j.basal)];
-    const DVec3 up = direction(basal);
-    int32_t leader = -1;
-    double best = -2;
-    for (int32_t b : j.branches) {
-      const double c = glm::dot(direction(parts[static_cast<size_t>(b)]), up);
-      if (c > best) best = c, leader = b;
-    }
-    const ConePart& lead = parts[static_cast<size_t>(leader)];
-    const DVec3 axis = direction(lead);
-    for (int32_t b : j.branches) {
-      if (b == leader) continue;
-      const ConePart& branch = parts[static_cast<size_t>(b)];
-      textures::RidgeArc arc;
-      arc.point = Vec3(j.point);
-      arc.parentAxis = Vec3(axis);
-      arc.branchAxis = Vec3(direction(branch));
-      arc.parentRadius = static_cast<float>(std::max(basal.endRadius, lead.startRadius));
-      arc.branchRadius = static_cast<float>(branch.startRadius);
-      out.push_back(arc);
-    }
+    const std::vector<textures::RidgeArc> arcs = junctionArcs(blob.plan, j);
+    out.insert(out.end(), arcs.begin(), arcs.end());
   }
   return out;
+}
+
+std::optional<bt::NodeId> raisedRidgeArc(bt::BlobTree& tree, bt::NodeId field, const textures::RidgeArc& arc,
+                                         const textures::RidgeArcOptions& options) {
+  if (!(options.height > 0)) return std::nullopt;
+  // Crest points about a quarter branch radius apart along the crest.
+  const double length = 2 * options.spread * std::sqrt(1 + options.droop * options.droop);
+  const int count = std::clamp(static_cast<int>(std::ceil(length / 0.25)) + 1, 9, 257);
+  const std::vector<textures::RidgeCrestPoint> crest = textures::RidgeArcs::crest(arc, options, count);
+  if (crest.empty()) return std::nullopt;
+  const double rB = arc.branchRadius;
+  const bt::Kernel kernel = tree.kernel();
+
+  // Step 1: per crest point, the axis of the ridge's skeleton. Along the normal n through
+  // the crest point c, the surface of `field` lies at t0 (F(c + t0·n) = 0.5). A cone of
+  // iso radius r (support R) whose axis crosses that line at depth e below t0 adds
+  // g(((t − t0 + e)/R)²); summed with F, the surface moves out to t1. The raise t1 − t0
+  // falls from its largest at e = 0 to 0 at e = R (the support just reaches the surface):
+  // bisect e so the raise is height·r_B·weight (e = 0 when even that falls short).
+  struct Vertex {
+    Vec3 axisPoint{0.0f};
+    float radius = 0.0f;
+    bool raised = false;
+  };
+  std::vector<Vertex> vertices(crest.size());
+  for (size_t i = 0; i < crest.size(); ++i) {
+    const textures::RidgeCrestPoint& c = crest[i];
+    const DVec3 p(c.position), n(c.normal);
+    const double r = c.halfWidth, R = bt::supportRadius(kernel, static_cast<float>(r));
+    auto F = [&](double t) { return static_cast<double>(tree.value(field, Vec3(p + t * n))); };
+    const std::optional<double> t0 = crossing(F, -0.5 * arc.parentRadius, 0.5 * arc.parentRadius + R);
+    Vertex& v = vertices[i];
+    v.radius = static_cast<float>(r);
+    if (!t0) {  // no bark surface found here: the skeleton stays clear of it
+      v.axisPoint = Vec3(p - (0.5 * arc.parentRadius + R) * n);
+      continue;
+    }
+    const double target = options.height * rB * c.weight;
+    if (!(target > 0)) {  // the support just reaches the bark: no raise
+      v.axisPoint = Vec3(p + (*t0 - R) * n);
+      continue;
+    }
+    // F over [t0, t0 + R], where the raised surface lies, sampled once and interpolated.
+    constexpr int kSamples = 48;
+    std::array<double, kSamples + 1> Fs;
+    for (int k = 0; k <= kSamples; ++k) Fs[size_t(k)] = F(*t0 + R * k / kSamples);
+    auto Fat = [&](double t) {
+      const double x = std::clamp((t - *t0) / R * kSamples, 0.0, double(kSamples));
+      const int k = std::min(static_cast<int>(x), kSamples - 1);
+      return Fs[size_t(k)] + (x - k) * (Fs[size_t(k) + 1] - Fs[size_t(k)]);
+    };
+    auto raise = [&](double e) {
+      const double axis = *t0 - e;
+      auto G = [&](double t) {
+        const double s = (t - axis) * (t - axis) / (R * R);
+        return Fat(t) + (s < 1 ? static_cast<double>(bt::kernelValue(kernel, static_cast<float>(s))) : 0.0);
+      };
+      const std::optional<double> t1 = crossing(G, *t0, axis + R);
+      return t1 ? *t1 - *t0 : 0.0;
+    };
+    double e = 0;
+    if (raise(0) > target) {
+      double lo = 0, hi = R;
+      for (int k = 0; k < 30; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        (raise(mid) > target ? lo : hi) = mid;
+      }
+      e = 0.5 * (lo + hi);
+    }
+    v.raised = true;
+    v.axisPoint = Vec3(p + (*t0 - e) * n);
+  }
+
+  // Step 2: cones between neighbouring points with a raise at either end, united (the
+  // field of the nearest one: a tube along the crest without bulges at the joints).
+  bt::TextureAttr relief;
+  relief.relief = true;
+  std::vector<bt::NodeId> cones;
+  for (size_t i = 0; i + 1 < vertices.size(); ++i) {
+    if (!vertices[i].raised && !vertices[i + 1].raised) continue;
+    cones.push_back(tree.cone(vertices[i].axisPoint, vertices[i + 1].axisPoint, vertices[i].radius,
+                              vertices[i + 1].radius, relief));
+  }
+  if (cones.empty()) return std::nullopt;
+  return cones.size() == 1 ? cones[0] : tree.unite(cones);
 }
 
 CurveSet treeAxes(const TreeBlob& blob) {

@@ -15,6 +15,7 @@
 /// u around the axis from the turtle's up vector, v = distance from the root (§3.7).
 
 #include <cstdint>
+#include <optional>
 
 #include "blobtree/blobtree.h"
 #include "core/mesh.h"
@@ -58,6 +59,21 @@ CurveSet treeAxes(const TreeBlob& blob);
 /// leader's radius at P, and the branch's start tangent and base radius. Stubs (scars)
 /// keep theirs: the ridge outlives the branch. O(parts).
 std::vector<textures::RidgeArc> ridgeArcs(const TreeBlob& blob);
+
+/// The raised branch bark ridge over `arc` (options.height > 0; buildTreeBlob sums it into
+/// each junction's group, F_J + ridge): cones along the arc's crest
+/// (textures::RidgeArcs::crest), their iso radius the band's half-width, each crest point's
+/// axis sunk below the surface of `field` (found along the parent's normal there) so that,
+/// summed with `field`, the surface over the crest rises by height·r_B·weight (the shading's
+/// weight: full at the apex, fading toward the ends and near the branch), capped at the
+/// raise the cone gives with its axis on the surface. United, the cones act as one tube
+/// along the crest. They are relief primitives (TextureAttr::relief): the bark keeps its
+/// texture and the cell sizes their limbs. nullopt when height is 0, the arc degenerate
+/// or no crest point raised. Cost: about 80 reference evaluations of `field` per raised
+/// crest point (40 to find the bark, 49 samples above it; crest points a quarter branch
+/// radius apart).
+std::optional<blobtree::NodeId> raisedRidgeArc(blobtree::BlobTree& tree, blobtree::NodeId field,
+                                               const textures::RidgeArc& arc, const textures::RidgeArcOptions& options);
 
 /// Leaf geometry for the skeleton's organs: polygons `{ . }` are fan-triangulated, spheres
 /// become small UV spheres, named surfaces `~` become an ovate leaf blade in the turtle frame

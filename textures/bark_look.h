@@ -28,8 +28,8 @@ struct BarkLook {
   /// 1.5·ridgeRelief on the crest's flanks); 0: none. The geometry stays PCM's.
   double ridgeRelief = 0.0;
   /// The branch bark ridge as an arc over each branch beside a leader, curving down both
-  /// sides of it (RidgeArcs); off while darkening and relief are 0. Shading and colour
-  /// only: the geometry stays as it is.
+  /// sides of it (RidgeArcs); off while darkening and relief are 0. ridgeArc.height > 0
+  /// also raises the bark along the arc's crest (geometry: organisms::raisedRidgeArc).
   RidgeArcOptions ridgeArc;
 
   /// The pattern with its colours: an unset ridge colour is `ridge`, an unset furrow colour
@@ -54,8 +54,8 @@ struct BarkLook {
   }
   /// True when the arcs change colour or shading.
   bool hasArcs() const { return ridgeArc.darkening > 0 || ridgeArc.relief > 0; }
-  /// True when a ridge (seam or arc) changes colour or shading.
-  bool hasRidge() const { return ridgeDarkening > 0 || ridgeRelief > 0 || hasArcs(); }
+  /// True when a ridge (seam or arc) changes colour, shading or geometry.
+  bool hasRidge() const { return ridgeDarkening > 0 || ridgeRelief > 0 || hasArcs() || ridgeArc.height > 0; }
 };
 
 }  // namespace sprig::textures

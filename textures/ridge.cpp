@@ -89,33 +89,35 @@ double smooth01(double e0, double e1, double x) {
 
 }  // namespace
 
+std::optional<RidgeArcs::Arc> RidgeArcs::chart(const RidgeArc& in, const RidgeArcOptions& o) {
+  const float la = glm::length(in.parentAxis), lb = glm::length(in.branchAxis);
+  if (!(la > 0) || !(lb > 0) || !(in.parentRadius > 0) || !(in.branchRadius > 0)) return std::nullopt;
+  Arc a;
+  a.in = in;
+  a.in.parentAxis = in.parentAxis / la;
+  a.in.branchAxis = in.branchAxis / lb;
+  const Vec3 radial = a.in.branchAxis - glm::dot(a.in.branchAxis, a.in.parentAxis) * a.in.parentAxis;
+  const float lr = glm::length(radial);
+  if (!(lr > 1e-3f)) return std::nullopt;  // a branch along its parent has no side to arch over
+  a.out = radial / lr;
+  a.side = glm::cross(a.in.parentAxis, a.out);
+  a.sinAlpha = std::max(static_cast<double>(lr), kMinSinAlpha);
+  const double cosAlpha = glm::dot(a.in.branchAxis, a.in.parentAxis);
+  a.zPierce = a.in.parentRadius * cosAlpha / a.sinAlpha;
+  a.zApex = 1 / a.sinAlpha + o.rise;
+  // Influence: a sphere around the pierce point holding the chart's whole arc and the
+  // band beside it, plus a branch radius outward (the crotch's fillet).
+  const double rB = a.in.branchRadius;
+  const double reach = rB * (std::hypot(o.spread, std::abs(a.zApex) + o.droop * o.spread) + o.width + 1.5);
+  const Vec3 c = a.in.point + static_cast<float>(a.zPierce) * a.in.parentAxis + a.in.parentRadius * a.out;
+  a.lo = c - Vec3(static_cast<float>(reach));
+  a.hi = c + Vec3(static_cast<float>(reach));
+  return a;
+}
+
 RidgeArcs::RidgeArcs(const std::vector<RidgeArc>& arcs, const RidgeArcOptions& options) : options_(options) {
-  const RidgeArcOptions& o = options_;
-  for (const RidgeArc& in : arcs) {
-    const float la = glm::length(in.parentAxis), lb = glm::length(in.branchAxis);
-    if (!(la > 0) || !(lb > 0) || !(in.parentRadius > 0) || !(in.branchRadius > 0)) continue;
-    Arc a;
-    a.in = in;
-    a.in.parentAxis = in.parentAxis / la;
-    a.in.branchAxis = in.branchAxis / lb;
-    const Vec3 radial = a.in.branchAxis - glm::dot(a.in.branchAxis, a.in.parentAxis) * a.in.parentAxis;
-    const float lr = glm::length(radial);
-    if (!(lr > 1e-3f)) continue;  // a branch along its parent has no side to arch over
-    a.out = radial / lr;
-    a.side = glm::cross(a.in.parentAxis, a.out);
-    a.sinAlpha = std::max(static_cast<double>(lr), kMinSinAlpha);
-    const double cosAlpha = glm::dot(a.in.branchAxis, a.in.parentAxis);
-    a.zPierce = a.in.parentRadius * cosAlpha / a.sinAlpha;
-    a.zApex = 1 / a.sinAlpha + o.rise;
-    // Influence: a sphere around the pierce point holding the chart's whole arc and the
-    // band beside it, plus a branch radius outward (the crotch's fillet).
-    const double rB = a.in.branchRadius;
-    const double reach = rB * (std::hypot(o.spread, std::abs(a.zApex) + o.droop * o.spread) + o.width + 1.5);
-    const Vec3 c = a.in.point + static_cast<float>(a.zPierce) * a.in.parentAxis + a.in.parentRadius * a.out;
-    a.lo = c - Vec3(static_cast<float>(reach));
-    a.hi = c + Vec3(static_cast<float>(reach));
-    arcs_.push_back(a);
-  }
+  for (const RidgeArc& in : arcs)
+    if (auto a = chart(in, options_)) arcs_.push_back(*a);
   if (arcs_.empty()) return;
   // The grid: cells about twice the median reach, at most 64 per axis.
   Vec3 lo(arcs_[0].lo), hi(arcs_[0].hi);
@@ -222,6 +224,36 @@ RidgeArcs::Sample RidgeArcs::sample(const Vec3& p) const {
       const DVec3 around = glm::cross(axis, q / rho);
       out.heightGradient += Vec3(options_.relief * w * (gx * around + gz * axis));
     }
+  }
+  return out;
+}
+
+std::vector<RidgeCrestPoint> RidgeArcs::crest(const RidgeArc& arc, const RidgeArcOptions& o, int count) {
+  std::vector<RidgeCrestPoint> out;
+  const std::optional<Arc> a = chart(arc, o);
+  if (!a || count < 2) return out;
+  const double rA = a->in.parentRadius, rB = a->in.branchRadius;
+  const DVec3 axis(a->in.parentAxis), outward(a->out), side(a->side), b(a->in.branchAxis), P(a->in.point);
+  out.reserve(static_cast<size_t>(count));
+  for (int i = 0; i < count; ++i) {
+    // The crest z_c(x) and the band's half-width and fade, as in profile().
+    const double x = o.spread * (2.0 * i / (count - 1) - 1);
+    const double zc = a->zApex - o.droop * (std::sqrt(x * x + kApexRound * kApexRound) - kApexRound);
+    const double r = std::abs(x) / o.spread;
+    const double hw = o.width * (1 - 0.5 * r * r);
+    const double fade = 1 - smooth01(0.55, 1.0, r);
+    // The chart point on the parent's cylinder, and the weights of sample() there (near = 1).
+    const double theta = x * rB / rA;
+    const DVec3 n = std::cos(theta) * outward + std::sin(theta) * side;
+    const DVec3 p = P + (a->zPierce + zc * rB) * axis + rA * n;
+    const DVec3 d = p - P;
+    const double offAxis = glm::length(d - std::max(0.0, glm::dot(d, b)) * b) / rB;
+    RidgeCrestPoint c;
+    c.position = Vec3(p);
+    c.normal = Vec3(n);
+    c.halfWidth = static_cast<float>(hw * rB);
+    c.weight = static_cast<float>(fade * smooth01(0.0, 0.35, std::cos(theta)) * smooth01(1.0, 1.2, offAxis));
+    out.push_back(c);
   }
   return out;
 }

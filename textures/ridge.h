@@ -15,6 +15,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 #include "core/types.h"
@@ -55,6 +56,18 @@ struct RidgeArcOptions {
   double droop = 0.8;      ///< slope of the arms (z per x, far from the apex)
   double spread = 3.0;     ///< half-length of the arc around the parent
   double width = 0.35;     ///< half-width of the band at the apex (half that at the ends)
+  /// The raised ridge (geometry, not shading): the surface over the crest rises by
+  /// height·r_B at the apex, fading with the band toward the ends and near the branch
+  /// (organisms::raisedRidgeArc). 0: the geometry stays as it is.
+  double height = 0.0;
+};
+
+/// One point of an arc's crest on its parent's bark (world units).
+struct RidgeCrestPoint {
+  Vec3 position{0.0f};     ///< on the parent's cylinder of radius RidgeArc::parentRadius
+  Vec3 normal{0.0f};       ///< unit, away from the parent's axis
+  float halfWidth = 0.0f;  ///< the band's half-width there
+  float weight = 0.0f;     ///< [0, 1]: the fade toward the ends, off the parent's front and near the branch
 };
 
 /// The branch bark ridge arcs of a tree: dark, raised arcs of compressed bark above each
@@ -76,6 +89,11 @@ class RidgeArcs {
   };
   Sample sample(const Vec3& p) const;
 
+  /// The crest of `arc` (the line the shading darkens most) sampled at `count` >= 2 points
+  /// evenly in x from −spread to spread, with the same weights the shading applies on the
+  /// parent's cylinder: 0 at both ends. Empty for an arc the constructor leaves out.
+  static std::vector<RidgeCrestPoint> crest(const RidgeArc& arc, const RidgeArcOptions& options, int count);
+
  private:
   struct Arc {
     RidgeArc in;
@@ -83,6 +101,8 @@ class RidgeArcs {
     double sinAlpha = 1, zPierce = 0, zApex = 0;
     Vec3 lo{0.0f}, hi{0.0f};     ///< box of influence
   };
+  /// The chart of one arc; nullopt when it is degenerate.
+  static std::optional<Arc> chart(const RidgeArc& in, const RidgeArcOptions& o);
   /// Darkness and height (in branch radii) of one arc at the chart point (x, z) in branch
   /// radii, before the weights that do not depend on x and z.
   void profile(const Arc& a, double x, double z, double& dark, double& height) const;

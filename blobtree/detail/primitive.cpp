@@ -18,6 +18,7 @@ Prim makePrim(const Node& n, Kernel kernel) {
   P.kernel = kernel;
   P.weight = n.weight;
   P.tex = n.texture;
+  P.hasAttributes = !n.texture.relief;
   float slope = kernelSlope(kernel) * std::abs(n.weight);
   switch (n.kind) {
     case NodeKind::Point: {

@@ -242,3 +242,38 @@ TEST_CASE("blob bark: the branch bark ridge arc over a blob's branch", "[model]"
   }
   CHECK(arc.colorAt(Vec3(0, 1.12f, 5), back) == plain.colorAt(Vec3(0, 1.12f, 5), back));
 }
+
+TEST_CASE("blob bark: ridge_arc_height raises the arc over a blob's branch", "[model]") {
+  // The blob of the test above: the arc's apex on the trunk's front at y = 1.112 (the sum
+  // blend bulges the trunk there beyond its radius 0.2). With ridge_arc_height 0.3 the
+  // surface there comes 0.3·r_B = 0.021 nearer a ray from the front; below the lateral, on
+  // the back and far above the arc nothing moves.
+  auto species = [](const std::string& arc) {
+    return "kind: blob\n"
+           "textures:\n"
+           "  - bark: {furrows: 8, seed: 1" + arc + "}\n"
+           "blob:\n"
+           "  blend:\n"
+           "    - cone: {a: [0, 0, 0], b: [0, 1, 0], radius_a: 0.2, radius_b: 0.2, texture: {id: 0}}\n"
+           "    - cone: {a: [0, 1, 0], b: [0, 2, 0], radius_a: 0.2, radius_b: 0.2, texture: {id: 0}}\n"
+           "    - cone: {a: [0, 1, 0], b: [0, 1, -1], radius_a: 0.07, radius_b: 0.06, texture: {id: 0}}\n";
+  };
+  auto hitDistance = [](const Species& s, Vec3 from, Vec3 dir) {
+    SpeciesModel model(s);
+    render::Scene scene;
+    model.addToScene(scene, model.finalStage(), GeometryMode::Exact, s.render);
+    scene.commit();
+    auto hit = scene.intersect(from, dir, 0.0f, 100.0f);
+    REQUIRE(hit);
+    return glm::length(hit->position - from);
+  };
+  const Species plain = parseSpecies(species(", ridge_arc: 0.5, ridge_arc_width: 0.5"), "plain.yaml");
+  const Species raised = parseSpecies(species(", ridge_arc: 0.5, ridge_arc_width: 0.5, ridge_arc_height: 0.3"), "raised.yaml");
+  const Vec3 front(0, 0, 1), back(0, 0, -1);
+  const float rise = hitDistance(plain, Vec3(0, 1.112f, -5), front) - hitDistance(raised, Vec3(0, 1.112f, -5), front);
+  INFO("raise at the apex " << rise);
+  CHECK(rise == Approx(0.3 * 0.07).margin(0.15 * 0.3 * 0.07));
+  for (float y : {0.8f, 0.9f, 1.3f})
+    CHECK(hitDistance(plain, Vec3(0, y, -5), front) == hitDistance(raised, Vec3(0, y, -5), front));
+  CHECK(hitDistance(plain, Vec3(0, 1.112f, 5), back) == hitDistance(raised, Vec3(0, 1.112f, 5), back));
+}

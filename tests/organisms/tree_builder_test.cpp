@@ -456,3 +456,169 @@ TEST_CASE("buildTreeBlob::pruned tapes of a PCM tree with bends", "[organisms]")
   CHECK(double(nodes) / double(sampled) < 0.1 * double(blob.nodeCount()));
   CHECK(cells.tapes.size() < cells.cells.size() / 4);
 }
+
+namespace {
+
+// A trunk of radius 0.25 (basal to P = (0,1,0), leader above) and one lateral of radius
+// 0.08 leaving P 75° from vertical toward +X: the geometry of fig_tree_18b.
+Skeleton lateralOnTrunk() {
+  Skeleton sk;
+  sk.internodes.push_back(seg({0, 0, 0}, {0, 1, 0}, 0.25, 0.25, -1, 0));
+  const double a = radians(75.0);
+  const DVec3 p(0, 1, 0);
+  sk.internodes.push_back(seg(p, {0, 2.6, 0}, 0.24, 0.24, 0, 0));
+  sk.internodes.push_back(seg(p, p + 1.2 * DVec3(std::sin(a), std::cos(a), 0), 0.08, 0.08, 0, 1));
+  return sk;
+}
+
+TreeOptions raisedRidgeOptions(double height) {
+  TreeOptions opt;
+  opt.junctions = JunctionModel::Pcm;
+  textures::RidgeArcOptions& arc = opt.bark.ridgeArc;
+  arc.rise = 1.1;
+  arc.droop = 1.2;
+  arc.spread = 4.5;
+  arc.width = 0.5;
+  arc.height = height;
+  return opt;
+}
+
+}  // namespace
+
+TEST_CASE("raisedRidgeArc: the bark rises along the arc's crest by the height", "[organisms]") {
+  const Skeleton sk = lateralOnTrunk();
+  const double rB = 0.08, height = 0.3;
+  const Field plain = compiled(buildTreeBlob(sk, raisedRidgeOptions(0)));
+  const Field raised = compiled(buildTreeBlob(sk, raisedRidgeOptions(height)));
+  REQUIRE(raised.blob.tree.size() > plain.blob.tree.size());
+  const std::vector<textures::RidgeArc> arcs = ridgeArcs(raised.blob);
+  REQUIRE(arcs.size() == 1);
+  const double rA = arcs[0].parentRadius;
+  // The bark's height along the parent's normal through a point, from the parent's axis.
+  auto bark = [&](const Field& f, Vec3 onBark, Vec3 normal) {
+    return surfaceDistance(f, onBark - float(rA) * normal, normal, 2 * rA);
+  };
+
+  SECTION("along the crest: raised by height·r_B·weight") {
+    const std::vector<textures::RidgeCrestPoint> crest =
+        textures::RidgeArcs::crest(arcs[0], raisedRidgeOptions(height).bark.ridgeArc, 41);
+    REQUIRE(crest.size() == 41);
+    CHECK(crest[20].weight == Approx(1.0));  // the apex
+    CHECK(crest.front().weight == 0.0f);
+    CHECK(crest.back().weight == 0.0f);
+    double worst = 0;
+    int measured = 0;
+    for (const textures::RidgeCrestPoint& c : crest) {
+      if (c.weight < 0.3f) continue;
+      const double raise = bark(raised, c.position, c.normal) - bark(plain, c.position, c.normal);
+      const double want = height * rB * c.weight;
+      worst = std::max(worst, std::abs(raise - want) / (height * rB));
+      ++measured;
+      INFO("crest point at " << c.position.x << ", " << c.position.y << ", " << c.position.z << ", weight " << c.weight);
+      CHECK(raise == Approx(want).margin(0.1 * height * rB));
+    }
+    std::printf("raised ridge: %d crest points, largest error %.1f%% of the height %.4f\n", measured, 100 * worst,
+                height * rB);
+    CHECK(measured >= 15);
+    const textures::RidgeCrestPoint& apex = crest[20];
+    CHECK(bark(raised, apex.position, apex.normal) - bark(plain, apex.position, apex.normal) ==
+          Approx(height * rB).margin(0.05 * height * rB));
+  }
+  SECTION("far from the arc: the same surface") {
+    // The parent's back, below the lateral, high above the apex: exactly unchanged.
+    for (double y : {0.4, 0.8, 1.0, 1.3, 1.6, 2.2}) {
+      const Vec3 back(-float(rA), float(y), 0), n(-1, 0, 0);
+      CHECK(bark(raised, back, n) == bark(plain, back, n));
+    }
+    for (double y : {0.3, 0.6, 1.9, 2.2}) {
+      const Vec3 front(float(rA), float(y), 0), n(1, 0, 0);
+      CHECK(bark(raised, front, n) == bark(plain, front, n));
+    }
+    // The lateral's own surface beyond the junction.
+    const double a = radians(75.0);
+    const Vec3 along = Vec3(float(std::sin(a)), float(std::cos(a)), 0), up = Vec3(-float(std::cos(a)), float(std::sin(a)), 0);
+    const Vec3 axisPoint = Vec3(0, 1, 0) + 0.7f * along;
+    CHECK(surfaceDistance(raised, axisPoint, up, 0.3) == surfaceDistance(plain, axisPoint, up, 0.3));
+  }
+}
+
+TEST_CASE("raisedRidgeArc: every evaluator sees the ridge", "[organisms]") {
+  const TreeBlob plainBlob = buildTreeBlob(lateralOnTrunk(), raisedRidgeOptions(0));
+  const TreeBlob raisedBlob = buildTreeBlob(lateralOnTrunk(), raisedRidgeOptions(0.3));
+  const blobtree::CompiledBlob plain = blobtree::compile(plainBlob.tree, plainBlob.root);
+  const blobtree::CompiledBlob raised = blobtree::compile(raisedBlob.tree, raisedBlob.root);
+  const std::vector<textures::RidgeArc> arcs = ridgeArcs(raisedBlob);
+  REQUIRE(arcs.size() == 1);
+  const std::vector<textures::RidgeCrestPoint> crest =
+      textures::RidgeArcs::crest(arcs[0], raisedRidgeOptions(0.3).bark.ridgeArc, 41);
+  // The relief cones are not limbs: the cell size rules see the tree without them.
+  CHECK(raised.thinnestLimb() == plain.thinnestLimb());
+  CHECK(raised.smallestFeature() == plain.smallestFeature());
+
+  const uint64_t seed = 20;
+  INFO("seed " << seed);
+  Rng rng(seed);
+  // Points about the crest, from inside the bark to past the ridge's top.
+  std::vector<Vec3> points;
+  for (int i = 0; i < 512; ++i) {
+    const textures::RidgeCrestPoint& c = crest[size_t(rng.uniform(8, 33))];
+    const Vec3 jitter(float(rng.uniform(-0.02, 0.02)), float(rng.uniform(-0.02, 0.02)), float(rng.uniform(-0.02, 0.02)));
+    points.push_back(c.position + float(rng.uniform(-0.02, 0.04)) * c.normal + jitter);
+  }
+  std::vector<float> batch(points.size()), batchPlain(points.size());
+  raised.values(points, batch);
+  plain.values(points, batchPlain);
+  int higher = 0;
+  for (size_t i = 0; i < points.size(); ++i) {
+    const Vec3 p = points[i];
+    const float v = raised.value(p);
+    // point and batch agree (to the rounding of the sums)
+    CHECK(batch[i] == Approx(v).margin(1e-5));
+    // the reference evaluator agrees
+    CHECK(raisedBlob.tree.value(raisedBlob.root, p) == Approx(v).margin(1e-5));
+    // the ridge only adds
+    CHECK(v >= plain.value(p) - 1e-6f);
+    if (v > batchPlain[i] + 1e-3f) ++higher;
+    // the gradient against central differences
+    const Vec3 g = raised.gradient(p);
+    const float h = 1e-4f;
+    const Vec3 fd((raised.value(p + Vec3(h, 0, 0)) - raised.value(p - Vec3(h, 0, 0))) / (2 * h),
+                  (raised.value(p + Vec3(0, h, 0)) - raised.value(p - Vec3(0, h, 0))) / (2 * h),
+                  (raised.value(p + Vec3(0, 0, h)) - raised.value(p - Vec3(0, 0, h))) / (2 * h));
+    CHECK(glm::length(g - fd) <= 0.02f * glm::length(fd) + 0.05f);
+  }
+  CHECK(higher > 512 / 3);  // a good part of the points lie within the ridge's support
+  // Half the ridge's height above the plain bark at the apex: outside the plain tree,
+  // inside the raised one.
+  const textures::RidgeCrestPoint& apex = crest[20];
+  double lo = -0.05, hi = 0.05;  // along the normal from the crest point: inside, outside
+  REQUIRE(plain.value(apex.position + float(lo) * apex.normal) > 0.5f);
+  REQUIRE(plain.value(apex.position + float(hi) * apex.normal) < 0.5f);
+  for (int k = 0; k < 40; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (plain.value(apex.position + float(mid) * apex.normal) > 0.5f ? lo : hi) = mid;
+  }
+  const Vec3 above = apex.position + float(lo + 0.5 * 0.3 * 0.08) * apex.normal;
+  CHECK(plain.value(above) < 0.5f);
+  CHECK(raised.value(above) > 0.5f);
+
+  // Interval and Lipschitz bounds over random boxes about the crest hold at random points.
+  for (int i = 0; i < 400; ++i) {
+    const Vec3 c = points[size_t(i)];
+    const float half = float(rng.uniform(0.001, 0.04));
+    const Box3 box{c - Vec3(half), c + Vec3(half)};
+    const blobtree::Interval iv = raised.valueBounds(box);
+    const float L = raised.lipschitz(box);
+    Vec3 prev = c;
+    float prevValue = raised.value(c);
+    for (int k = 0; k < 8; ++k) {
+      const Vec3 q = c + half * Vec3(float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1)));
+      const float v = raised.value(q);
+      CHECK(iv.lo <= v + 1e-6f);
+      CHECK(v <= iv.hi + 1e-6f);
+      CHECK(std::abs(v - prevValue) <= L * glm::length(q - prev) * 1.0001f + 1e-6f);
+      prev = q;
+      prevValue = v;
+    }
+  }
+}
