@@ -568,7 +568,7 @@ TEST_CASE("raisedRidgeArc: every evaluator sees the ridge", "[organisms]") {
   std::vector<float> batch(points.size()), batchPlain(points.size());
   raised.values(points, batch);
   plain.values(points, batchPlain);
-  int higher = 0;
+  int higher = 0, onSeam = 0;
   for (size_t i = 0; i < points.size(); ++i) {
     const Vec3 p = points[i];
     const float v = raised.value(p);
@@ -579,14 +579,26 @@ TEST_CASE("raisedRidgeArc: every evaluator sees the ridge", "[organisms]") {
     // the ridge only adds
     CHECK(v >= plain.value(p) - 1e-6f);
     if (v > batchPlain[i] + 1e-3f) ++higher;
-    // the gradient against central differences
+    // the gradient against central differences, where the field is smooth within h: the
+    // relief cones are united by max, so a point on a seam between two of them has one-sided
+    // differences that disagree, and there no gradient exists to compare with.
     const Vec3 g = raised.gradient(p);
     const float h = 1e-4f;
-    const Vec3 fd((raised.value(p + Vec3(h, 0, 0)) - raised.value(p - Vec3(h, 0, 0))) / (2 * h),
-                  (raised.value(p + Vec3(0, h, 0)) - raised.value(p - Vec3(0, h, 0))) / (2 * h),
-                  (raised.value(p + Vec3(0, 0, h)) - raised.value(p - Vec3(0, 0, h))) / (2 * h));
+    Vec3 forward, backward;
+    for (int axis = 0; axis < 3; ++axis) {
+      Vec3 e(0.0f);
+      e[axis] = h;
+      forward[axis] = (raised.value(p + e) - v) / h;
+      backward[axis] = (v - raised.value(p - e)) / h;
+    }
+    const Vec3 fd = 0.5f * (forward + backward);
+    if (glm::length(forward - backward) > 0.02f * glm::length(fd) + 0.05f) {
+      ++onSeam;
+      continue;
+    }
     CHECK(glm::length(g - fd) <= 0.02f * glm::length(fd) + 0.05f);
   }
+  CHECK(onSeam < 512 / 20);  // seams are thin: nearly every point is compared
   CHECK(higher > 512 / 3);  // a good part of the points lie within the ridge's support
   // Half the ridge's height above the plain bark at the apex: outside the plain tree,
   // inside the raised one.
