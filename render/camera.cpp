@@ -6,26 +6,22 @@
 
 namespace sprig::render {
 
-namespace {
-
-struct Basis {
-  Vec3 right, up, forward;
-};
-
-Basis cameraBasis(const Camera& c) {
-  Basis b;
-  b.forward = glm::normalize(c.target - c.position);
-  Vec3 up = c.up;
-  if (glm::length(glm::cross(b.forward, up)) < 1e-6f) up = std::abs(b.forward.y) < 0.9f ? Vec3(0, 1, 0) : Vec3(0, 0, 1);
-  b.right = glm::normalize(glm::cross(b.forward, up));
+CameraBasis Camera::basis() const {
+  CameraBasis b;
+  b.forward = glm::normalize(target - position);
+  Vec3 u = up;
+  if (glm::length(glm::cross(b.forward, u)) < 1e-6f) u = std::abs(b.forward.y) < 0.9f ? Vec3(0, 1, 0) : Vec3(0, 0, 1);
+  b.right = glm::normalize(glm::cross(b.forward, u));
   b.up = glm::cross(b.right, b.forward);
   return b;
 }
 
-}  // namespace
+float Camera::pixelPerDepth(int height) const {
+  return 2.0f * std::tan(0.5f * static_cast<float>(radians(fovYDeg))) / static_cast<float>(height);
+}
 
 Ray Camera::generateRay(float px, float py, int width, int height) const {
-  Basis b = cameraBasis(*this);
+  const CameraBasis b = basis();
   float tanY = std::tan(0.5f * static_cast<float>(radians(fovYDeg)));
   float tanX = tanY * static_cast<float>(width) / static_cast<float>(height);
   float sx = (2.0f * px / static_cast<float>(width) - 1.0f) * tanX;
@@ -34,7 +30,7 @@ Ray Camera::generateRay(float px, float py, int width, int height) const {
 }
 
 bool Camera::project(const Vec3& p, int width, int height, Vec2& film) const {
-  Basis b = cameraBasis(*this);
+  const CameraBasis b = basis();
   Vec3 d = p - position;
   float z = glm::dot(d, b.forward);
   if (z <= 0) return false;

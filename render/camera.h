@@ -16,6 +16,11 @@ struct Ray {
   Vec3 direction{0, 0, -1};  ///< unit direction
 };
 
+/// A camera's orthonormal frame: film x, film y and the view direction.
+struct CameraBasis {
+  Vec3 right, up, forward;
+};
+
 /// Pinhole camera looking from `position` toward `target`.
 struct Camera {
   Vec3 position{0, 0, 5};  ///< eye, world units
@@ -27,6 +32,10 @@ struct Camera {
   Ray generateRay(float px, float py, int width, int height) const;
   /// Projects a world point to film pixels; returns false when it lies behind the camera.
   bool project(const Vec3& p, int width, int height, Vec2& film) const;
+  /// The frame generateRay and project use (up rolled to be perpendicular to the view).
+  CameraBasis basis() const;
+  /// World size of one pixel of a height-pixel image at unit depth along the view.
+  float pixelPerDepth(int height) const;
 };
 
 /// A viewing direction for automatic framing.

@@ -202,26 +202,21 @@ void thinOcclusionFilter(const RTCFilterFunctionNArguments* args) {
 void Scene::setPixelFootprint(const Camera& camera, int width, int height, float minPixels) {
   if (impl_->anyGeometry) throw std::logic_error("Scene::setPixelFootprint after geometry was added");
   impl_->view.reset();
-  if (width >= 1 && height >= 1) {
-    // The camera's basis, as Camera::generateRay builds it.
-    detail::PixelView v;
-    v.eye = camera.position;
-    v.forward = glm::normalize(camera.target - camera.position);
-    Vec3 up = camera.up;
-    if (glm::length(glm::cross(v.forward, up)) < 1e-6f) up = std::abs(v.forward.y) < 0.9f ? Vec3(0, 1, 0) : Vec3(0, 0, 1);
-    v.right = glm::normalize(glm::cross(v.forward, up));
-    v.up = glm::cross(v.right, v.forward);
-    v.pixelPerDepth = 2.0f * std::tan(0.5f * static_cast<float>(radians(camera.fovYDeg))) / static_cast<float>(height);
-    impl_->view = v;
-  }
-  if (minPixels <= 0.0f || width < 1 || height < 1) {
-    impl_->footprint.reset();
-    return;
-  }
+  impl_->footprint.reset();
+  if (width < 1 || height < 1) return;
+  const CameraBasis b = camera.basis();
+  detail::PixelView v;
+  v.eye = camera.position;
+  v.forward = b.forward;
+  v.right = b.right;
+  v.up = b.up;
+  v.pixelPerDepth = camera.pixelPerDepth(height);
+  impl_->view = v;
+  if (minPixels <= 0.0f) return;
   PixelFootprint f;
-  f.eye = camera.position;
-  f.forward = glm::normalize(camera.target - camera.position);
-  f.pixelPerDepth = 2.0f * std::tan(0.5f * static_cast<float>(radians(camera.fovYDeg))) / static_cast<float>(height);
+  f.eye = v.eye;
+  f.forward = v.forward;
+  f.pixelPerDepth = v.pixelPerDepth;
   f.minPixels = minPixels;
   impl_->footprint = f;
 }
