@@ -28,6 +28,7 @@ struct GlobalOptions {
   int threads = 0;  ///< 0 = all cores
   std::string root = ".";
   bool allowOutsidePaths = false;
+  bool fullTape = false;  ///< `--full-tape`: implicit surfaces trace the whole tape per cell
 
   /// Where species files may reference files from.
   PathPolicy pathPolicy() const {

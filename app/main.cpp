@@ -12,6 +12,7 @@
 #include "core/diagnostics.h"
 #include "core/parallel.h"
 #include "core/progress.h"
+#include "render/scene.h"
 
 int main(int argc, char** argv) {
   using namespace sprig;
@@ -28,6 +29,9 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingDirectory);
   app.add_flag("--allow-outside-paths", global.allowOutsidePaths,
                "let species reference absolute paths and files outside the root");
+  app.add_flag("--full-tape", global.fullTape,
+               "exact renders trace the whole BlobTree tape in every cell instead of its pruned tape (the reference, "
+               "for comparing images; slower)");
 
   CommandRun run;
   addDeriveCommand(app, global, run);
@@ -55,6 +59,7 @@ int main(int argc, char** argv) {
     ProgressSettings::setQuiet(global.quiet);
     std::optional<ThreadLimit> limit;
     if (global.threads > 0) limit.emplace(global.threads);
+    render::Scene::setPrunedTapesDefault(!global.fullTape);
     return run ? run() : kExitUsage;
   } catch (const InputError& e) {
     std::cerr << e.what() << "\n";

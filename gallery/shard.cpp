@@ -11,6 +11,7 @@
 
 #include "core/diagnostics.h"
 #include "model/yaml_reader.h"
+#include "render/scene.h"
 #include "gallery/manifest.h"
 #include "core/atomic_file.h"
 #include "core/image.h"
@@ -299,7 +300,8 @@ GalleryRunResult renderGallery(std::vector<fs::path> files, const fs::path& outD
   for (Manifest& m : loadManifests(outDir))
     for (ManifestEntry& e : m.entries) previous[e.item.source] = std::move(e);
 
-  const std::string optionText = "gallery-format=2;quality=" + qualityName(options.quality);
+  const std::string optionText = "gallery-format=2;quality=" + qualityName(options.quality) +
+                                 (render::Scene::prunedTapesDefault() ? "" : ";full-tape");
   Manifest manifest;
   manifest.shard = options.shard;
   manifest.quality = qualityName(options.quality);

@@ -134,7 +134,7 @@ uint32_t Scene::addImplicit(const blobtree::CompiledBlob& blob, uint32_t materia
   if (!support.empty()) {
     float cellSize = options.cellSize > 0 ? options.cellSize : blobtree::autoCellSize(blob, kTracerCells);
     blobtree::SurfaceCellOptions cellOptions;
-    cellOptions.prunedTapes = options.batched && options.prunedTapes;
+    cellOptions.prunedTapes = options.batched && options.prunedTapes && impl_->prunedTapes;
     data->cells = blob.surfaceCells(cellSize, cellOptions);
   }
   RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_USER);

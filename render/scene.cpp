@@ -3,6 +3,7 @@
 #include "render/detail/scene_impl.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -322,6 +323,15 @@ uint32_t Scene::Impl::addTextureTable(const TextureTable& table) {
   }
   return base;
 }
+
+void Scene::setPrunedTapes(bool on) { impl_->prunedTapes = on; }
+
+namespace {
+std::atomic<bool> gPrunedTapesDefault{true};
+}  // namespace
+
+void Scene::setPrunedTapesDefault(bool on) { gPrunedTapesDefault.store(on); }
+bool Scene::prunedTapesDefault() { return gPrunedTapesDefault.load(); }
 
 std::vector<uint32_t> Scene::add(const Geometry& geometry) {
   std::vector<uint32_t> ids;

@@ -92,6 +92,14 @@ class Scene {
   /// The camera's pixel also sets the texel footprint of image maps (MeshPart::image: the
   /// choice of their magnification or minification filter), whatever minPixels is.
   void setPixelFootprint(const Camera& camera, int width, int height, float minPixels = kThinMinPixels);
+  /// false: every implicit part added afterwards traces the whole tape in each cell, whatever
+  /// its ImplicitOptions::prunedTapes says (the reference the pruned tapes are checked
+  /// against). Default: prunedTapesDefault().
+  void setPrunedTapes(bool on);
+  /// The process-wide default of setPrunedTapes for scenes constructed afterwards (true;
+  /// the global flag `sprig --full-tape` sets false, to compare images with the reference).
+  static void setPrunedTapesDefault(bool on);
+  static bool prunedTapesDefault();
   /// Default minimum width of thin geometry, pixels.
   static constexpr float kThinMinPixels = 2.0f;
 

@@ -103,6 +103,7 @@ struct Scene::Impl {
   Box3 bounds;
   SceneStats stats;
   bool committed = false;
+  bool prunedTapes = Scene::prunedTapesDefault();  ///< setPrunedTapes
   bool anyGeometry = false;               ///< something was added (the footprint is fixed then)
   std::optional<PixelFootprint> footprint;  ///< minimum width of thin curves, when set
   std::optional<detail::PixelView> view;    ///< the camera's pixel, when set (image maps)

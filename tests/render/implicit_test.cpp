@@ -213,6 +213,28 @@ TEST_CASE("Scene::addImplicit pruned tapes", "[render]") {
   CHECK(images[0].pixels == images[1].pixels);
 }
 
+TEST_CASE("Scene::setPrunedTapes and the process default (sprig --full-tape)", "[render]") {
+  // Pruned tapes are on by default; the scene switch and the process-wide default each turn
+  // them off for implicit parts added afterwards, whatever the part's options say.
+  auto tapesOf = [](Scene& scene) {
+    scene.addImplicit(branchBlob(), scene.addMaterial(Material{}));
+    scene.commit();
+    return scene.stats().implicitTapes;
+  };
+  REQUIRE(Scene::prunedTapesDefault());
+  Scene pruned;
+  CHECK(tapesOf(pruned) > 0);
+  Scene switched;
+  switched.setPrunedTapes(false);
+  CHECK(tapesOf(switched) == 0);
+  Scene::setPrunedTapesDefault(false);
+  Scene byDefault;
+  Scene::setPrunedTapesDefault(true);
+  CHECK(tapesOf(byDefault) == 0);
+  Scene after;
+  CHECK(tapesOf(after) > 0);
+}
+
 TEST_CASE("Scene::addImplicit batched tracing", "[render]") {
   // The Embree scene (the tracer over each surface cell) and CompiledBlob::intersect (the
   // same tracer over whole rays, empty space skipped by interval bounds, no cells) find the
