@@ -249,12 +249,16 @@ render::Geometry skeletonPreview(const lsystem::Skeleton& skeleton, const Skelet
 
 namespace {
 
-/// Primitives and triangles of a skeleton preview (internodes + organs; n - 2 per n-gon).
+/// Primitives and triangles of a skeleton preview (internodes + organs; n - 2 per n-gon, and
+/// the triangles of the textured cpfg organs drawn as meshes: surfaces, polygons and tubes).
 void previewFigures(const lsystem::Skeleton& skeleton, ModelFigures& fig) {
   fig.primitives = skeleton.internodes.size() + skeleton.organs.size();
   fig.triangles = 0;
   for (const auto& o : skeleton.organs)
-    if (o.kind == lsystem::Organ::Kind::Polygon && o.points.size() >= 3) fig.triangles += o.points.size() - 2;
+    if (o.texture >= 0 && !o.triangles.empty())
+      fig.triangles += o.triangles.size() / 3;
+    else if (o.kind == lsystem::Organ::Kind::Polygon && o.points.size() >= 3)
+      fig.triangles += o.points.size() - 2;
 }
 
 /// The BlobTree tree as geometry: wood (exact or polygonized) with its bark texture, leaves.
@@ -375,7 +379,7 @@ class TreeModel final : public KindModel {
     if (mode == GeometryMode::Skeleton || skeleton.internodes.empty()) {
       // Skeleton mode, or nothing to build a surface from yet (the axiom draws nothing):
       // the preview shows the organs.
-      if (mode == GeometryMode::Skeleton) previewFigures(skeleton, fig);
+      previewFigures(skeleton, fig);
       fig.buildSeconds = secondsSince(t0);
       out.geometry = skeletonPreview(skeleton, look.style);
       return out;
