@@ -497,6 +497,12 @@ class TreeModel final : public KindModel {
         for (int y = 0; y < h; ++y)
           for (int x = 0; x < w; ++x)  // texel centres (either filter gives the texel); top row is t of 1
             baked->image.set(x, y, tex.fragment((x + 0.5) / w, 1.0 - (y + 0.5) / h, color));
+        if (g.tube) {
+          // Tubes: s runs 0 to 1 around (the seam has its own vertices) and t on along the
+          // branch beyond 1: the sampler repeats (cpfg's GL_REPEAT), the uvs are kept.
+          baked->seams.repeatU = baked->seams.repeatV = true;
+          baked->seams.continuous = true;
+        }
         baked->magFilter = tex.magLinear ? PartTexture::Filter::Linear : PartTexture::Filter::Nearest;
         baked->minFilter = tex.minLinear ? PartTexture::Filter::Linear : PartTexture::Filter::Nearest;
         const std::string name = (g.tube ? "textured_wood_" : "textured_leaves_") + std::to_string(parts.size());

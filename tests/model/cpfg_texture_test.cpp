@@ -620,7 +620,12 @@ TEST_CASE("cpfg textured cylinders beside untextured wood: parts and export", "[
   CHECK(hi.x == 1.0f);
   CHECK(lo.y == Approx(1 - 4 / pi));  // glTF's v runs down the image: 1 - t
   CHECK(hi.y == 1.0f);
-  CHECK(m.materials[static_cast<size_t>(prim.material)].pbrMetallicRoughness.baseColorTexture.index >= 0);
+  const int texIndex = m.materials[static_cast<size_t>(prim.material)].pbrMetallicRoughness.baseColorTexture.index;
+  REQUIRE(texIndex >= 0);
+  // t runs on along the branch (beyond 1): the sampler repeats both ways, as GL_REPEAT.
+  const tinygltf::Sampler& sampler = m.samplers[static_cast<size_t>(m.textures[static_cast<size_t>(texIndex)].sampler)];
+  CHECK(sampler.wrapS == TINYGLTF_TEXTURE_WRAP_REPEAT);
+  CHECK(sampler.wrapT == TINYGLTF_TEXTURE_WRAP_REPEAT);
   fs::remove_all(dir);
 }
 
