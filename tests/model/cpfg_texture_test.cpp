@@ -651,3 +651,50 @@ TEST_CASE("cpfg textured cylinders render the same bytes at 1 and 2 threads", "[
   const Image a = renderAt(1);
   CHECK(a.pixels == renderAt(2).pixels);
 }
+
+TEST_CASE("cpfg cut-out textures on cylinders", "[model][cpfg]") {
+  // cutout.png: five red texels along s of alpha 255, 0, 128, 26 and 25, modulated, on an F
+  // of diameter 2 (radius 1) up +Y: texel k covers s in [k/5, (k+1)/5), s = b / 360 at angle
+  // b from L (-X) toward cpfg's up (-Z); a ray through the axis meets the far wall at b + 180.
+  const fs::path dir = fs::temp_directory_path() / "sprig-cpfg-cylinder-cutout-test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  fs::copy_file(cutoutObject() / "cutout.png", dir / "cutout.png");
+  writeFileAtomic(dir / "plant.v", "line style: cylinder\ntexture: F: cutout.png E: m\n");
+  writeFileAtomic(dir / "plant.l", "lsystem: 1\nderivation length: 0\naxiom: !(2)@Tx(1)F(1)\nendlsystem\n");
+  const Species s = loadSpecies(dir);
+  GrowthEngine engine(s);
+  const lsystem::Skeleton sk = engine.skeletonAt(engine.lastStep());
+  render::Scene scene;
+  scene.add(skeletonPreview(sk, s.render.style));
+  scene.commit();
+  const Vec3 wood = s.render.style.wood.baseColor;
+  auto rayAt = [&](double bDeg) {
+    const double b = bDeg * 3.14159265358979323846 / 180.0;
+    const Vec3 d(static_cast<float>(-std::cos(b)), 0.0f, static_cast<float>(-std::sin(b)));
+    return scene.intersect(Vec3(0, 0.5f, 0) + 10.0f * d, -d, 0.0f, 100.0f);
+  };
+  // b = 36: s = 0.1, the opaque texel: red times the wood colour, opaque, on the near wall.
+  auto opaque = rayAt(36);
+  REQUIRE(opaque);
+  CHECK(opaque->t == Approx(9.0f).margin(0.005f));
+  CHECK(opaque->opacity == 1.0f);
+  checkColor(opaque->color, Vec3(1, 0, 0) * wood);
+  // b = 112: s = 0.31 (alpha 0) near, s = 0.81 (alpha 25/255, at or below 0.1) far: both cut
+  // out, the ray passes through the tube.
+  CHECK_FALSE(rayAt(112));
+  // b = 150: s = 0.42 (alpha 128/255): the near wall covers half, blended over what lies behind.
+  auto half = rayAt(150);
+  REQUIRE(half);
+  CHECK(half->t == Approx(9.0f).margin(0.005f));
+  CHECK(half->opacity == Approx(128.0f / 255.0f).margin(1e-3f));
+  // Shadow rays are cut the same way: blocked by the opaque texel, not through the cut ones.
+  auto occludedAt = [&](double bDeg) {
+    const double b = bDeg * 3.14159265358979323846 / 180.0;
+    const Vec3 d(static_cast<float>(-std::cos(b)), 0.0f, static_cast<float>(-std::sin(b)));
+    return scene.occluded(Vec3(0, 0.5f, 0) + 10.0f * d, -d, 0.0f, 100.0f);
+  };
+  CHECK(occludedAt(36));
+  CHECK_FALSE(occludedAt(112));
+  fs::remove_all(dir);
+}
