@@ -106,7 +106,9 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
            r.textureWidth, r.textureHeight, r.atlasCell, r.atlasCell);
     else if (r.textureWidth > 0)
       note(g, std::cout, "%s: texture %dx%d baked from the species' %s", r.name.c_str(), r.textureWidth, r.textureHeight,
-           r.name == "wood" ? "bark" : r.name.rfind("textured_leaves_", 0) == 0 ? "cpfg texture" : "shell texture");
+           r.name == "wood"                                                                   ? "bark"
+           : r.name.rfind("textured_leaves_", 0) == 0 || r.name.rfind("textured_wood_", 0) == 0 ? "cpfg texture"
+                                                                                                : "shell texture");
     if (r.creaseVertices > 0 || r.seamCorners > 0)
       note(g, std::cout, "%s: %zu vertices split at creases (faces more than 90 degrees apart), %zu texture-seam uvs added",
            r.name.c_str(), r.creaseVertices, r.seamCorners);

@@ -1,10 +1,12 @@
 /// `sprig preview FILE -o OUT.png [--stage K] [--width W --height H] [--view AZ,EL[,FOV]]`
 
+#include <algorithm>
 #include <iostream>
 #include <sstream>
 
 #include "app/cmd_common.h"
 #include "app/watch.h"
+#include "lsystem/turtle.h"
 #include "model/growth.h"
 #include "model/species.h"
 #include "model/tree_kind.h"
@@ -60,7 +62,15 @@ int previewOnce(const PreviewArgs& a, const GlobalOptions& g) {
   rs.progressLabel = "render " + species.name;
   Image image = render::renderImage(scene, camera, rs);
   writeImage(image, a.out);
-  note(g, std::cerr, "%s: %dx%d, %zu internodes", a.out.c_str(), width, height, shown.internodes.size());
+  // cpfg's textured cylinders are meshes (organs), not internodes: counted apart.
+  const size_t tubes = static_cast<size_t>(std::count_if(shown.organs.begin(), shown.organs.end(), [](const lsystem::Organ& o) {
+    return o.texture >= 0 && (o.name == lsystem::kTexturedCylinderName || o.name == lsystem::kTexturedGcName);
+  }));
+  if (tubes > 0)
+    note(g, std::cerr, "%s: %dx%d, %zu internodes, %zu textured cylinder segments", a.out.c_str(), width, height,
+         shown.internodes.size(), tubes);
+  else
+    note(g, std::cerr, "%s: %dx%d, %zu internodes", a.out.c_str(), width, height, shown.internodes.size());
   return kExitOk;
 }
 

@@ -99,7 +99,7 @@ CornerTable<Vec2> cornerUvs(const Mesh& mesh, const UvSeamOptions& options) {
     int shift[3][2] = {};
     for (int k = 0; k < 3; ++k) uv[k] = mesh.uvs[tri[k]];
     for (int axis = 0; axis < 2; ++axis) {
-      if (!(axis == 0 ? options.repeatU : options.repeatV)) continue;
+      if (!(axis == 0 ? options.repeatU : options.repeatV) || options.continuous) continue;
       const float hi = std::max({uv[0][axis], uv[1][axis], uv[2][axis]});
       for (int k = 0; k < 3; ++k)
         if (uv[k][axis] < hi - 0.5f) {

@@ -49,13 +49,17 @@ CreaseNormals splitCreaseNormals(const Mesh& mesh);
 struct UvSeamOptions {
   bool repeatU = false;  ///< u is periodic with period 1 (the texture repeats in u)
   bool repeatV = false;  ///< v is periodic with period 1
+  /// The uvs already run on across the repeats (cpfg's textured tubes, whose t grows along
+  /// a branch beyond 1): the sampler repeats the axes above, and no corner is shifted.
+  bool continuous = false;
   /// A triangle whose corners span more than this in u or v (after wrapping) straddles a
   /// discontinuity of the parameterization: all its corners take its first corner's uv.
   Vec2 maxSpan{std::numeric_limits<float>::infinity()};
 };
 
 /// Per-corner uvs of mesh (which must have uvs): values[v] is mesh.uvs[v]; a triangle
-/// crossing the seam of a repeating axis (corners more than 0.5 apart) gets value + 1 on
+/// crossing the seam of a repeating axis (corners more than 0.5 apart; not when
+/// options.continuous) gets value + 1 on
 /// its low corners (appended values, shared per vertex); then a triangle spanning more than
 /// maxSpan takes its first corner's uv everywhere. O(T).
 CornerTable<Vec2> cornerUvs(const Mesh& mesh, const UvSeamOptions& options);

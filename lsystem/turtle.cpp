@@ -185,6 +185,8 @@ constexpr int kDiscSides = 32;
 constexpr int kDefaultGcRings = 4;
 /// Most rings per segment Sprig draws (a larger `@Gc(n)` draws this many).
 constexpr int kMaxGcRings = 1024;
+/// Fewest points around a textured tube (a multiple of cpfg's count; see texturedSides).
+constexpr int kMinTexturedSides = 32;
 
 /// An open `{` polygon.
 struct OpenPolygon {
@@ -392,6 +394,69 @@ class TurtleWalk {
     const double l = (hasParam(i) ? param(i) : settings_.stepLength) * st_.scale;
     return growing_ ? l * growth(i) : l;
   }
+  /// The radius a segment of this length is drawn with at full growth: the width's,
+  /// capped by TurtleSettings::maxWidthToLength.
+  double drawnRadius(double length) const {
+    const double r = st_.width * radiusScale_;
+    return maxRadiusPerLength_ > 0 ? std::min(r, maxRadiusPerLength_ * length) : r;
+  }
+
+  /// Length of the move of module i at full growth.
+  double fullLength(size_t i) const { return (hasParam(i) ? param(i) : settings_.stepLength) * st_.scale; }
+
+  /// cpfg's update_segment_texture (textures.c): how far the texture's t advances along a
+  /// cylinder of this diameter and length, length / (pi diameter) times the image's
+  /// width / height, divided by the texture's `R:` ratio: a square texel stays square
+  /// around a cylinder whose circumference holds the image's width once. 0 without a
+  /// texture or for a zero diameter.
+  double texStep(int texture, double diameter, double length) const {
+    if (texture < 0 || !settings_.cpfgTextures || static_cast<size_t>(texture) >= settings_.cpfgTextures->size()) return 0.0;
+    if (!(diameter > 0)) return 0.0;
+    const CpfgTexture& tex = (*settings_.cpfgTextures)[static_cast<size_t>(texture)];
+    const double aspect = tex.image && tex.image->height > 0 ? static_cast<double>(tex.image->width) / tex.image->height : 1.0;
+    return length / (kPi * diameter) * aspect / tex.ratio;
+  }
+
+  /// Points around a textured tube: cpfg's count (`@!(n)`, else `contour sides:`) times
+  /// the least factor that gives at least kMinTexturedSides, so cpfg's vertices (and their
+  /// s) are among them and the silhouette stays round.
+  static int texturedSides(int cpfgSides) {
+    const int n = std::max(cpfgSides, 3);
+    return n * ((kMinTexturedSides + n - 1) / n);
+  }
+
+  /// cpfg's textured `F` cylinder (irisGL.c, iGlEndNode and MakeCylinder): an open tube in
+  /// the frame f of its start, from f.position along f.heading, of the given radius; its
+  /// point at angle a lies at r (cos a L + sin a U') (U' = -U, cpfg's up vector), with
+  /// texture coordinates s = a / 2 pi (the seam, s = 0 and 1, along L) and t = t0 at the
+  /// base, t1 at the top. A Surface organ named kTexturedCylinderName, with the texture
+  /// selected.
+  void texturedCylinder(size_t i, const TurtleFrame& f, double length, double radius, double t0, double t1) {
+    Organ o = organHere(Organ::Kind::Surface, i);
+    o.name = kTexturedCylinderName;
+    o.texture = st_.texture;
+    o.position = f.position;
+    o.heading = f.heading;
+    o.left = f.left;
+    o.up = f.up;
+    o.radius = radius;
+    const int sides = texturedSides(st_.contourSides > 0 ? st_.contourSides : settings_.contourSides);
+    const uint32_t per = static_cast<uint32_t>(sides) + 1;
+    for (int ring = 0; ring < 2; ++ring)
+      for (int m = 0; m <= sides; ++m) {
+        const double a = 2 * kPi * (m % sides) / sides;
+        const DVec3 d = std::cos(a) * f.left - std::sin(a) * f.up;
+        o.points.push_back(f.position + (ring ? length : 0.0) * f.heading + radius * d);
+        o.normals.push_back(d);
+        o.uvs.emplace_back(static_cast<float>(static_cast<double>(m) / sides), static_cast<float>(ring ? t1 : t0));
+      }
+    for (uint32_t m = 0; m < static_cast<uint32_t>(sides); ++m) {
+      const uint32_t a = m, b = a + 1, c = a + per, d = c + 1;
+      o.triangles.insert(o.triangles.end(), {a, c, b, b, c, d});
+    }
+    sk_.organs.push_back(std::move(o));
+  }
+
   /// Number of parameters of module i.
   uint32_t paramCount(size_t i) const { return off_[i + 1] - off_[i]; }
   /// Parameter k of module i (which must have it).
@@ -402,6 +467,9 @@ class TurtleWalk {
   void forward(size_t i, bool withVertex) {
     if (settings_.cpfg) cpfgTropisms();
     DVec3 start = st_.frame.position;
+    const TurtleFrame drawnIn = st_.frame;  // cpfg draws the cylinder in its start node's frame
+    const double texT0 = st_.texT;
+    st_.texT += texStep(st_.texture, 2 * drawnRadius(fullLength(i)), fullLength(i));
     st_.frame.position += st_.frame.heading * length(i);
     if (settings_.cpfg) {
       cpfgOldBend();
@@ -419,7 +487,13 @@ class TurtleWalk {
       throw InputError(SourceLoc{"sprig", 0, 0}, "cpfg's contour '@#(" + std::to_string(st_.contour) +
                                         ")' on an 'F' segment (a cylinder outside a generalized cylinder) is not supported: "
                                         "select it for '@Gs ... @Gc' cylinders drawn with 'f'");
-    untextured("an 'F' segment (a cylinder)");
+    if (st_.texture >= 0) {
+      double radius = st_.width * radiusScale_ * g;
+      if (maxRadiusPerLength_ > 0) radius = std::min(radius, maxRadiusPerLength_ * length(i));
+      texturedCylinder(i, drawnIn, length(i), radius, texT0, st_.texT);
+      st_.internode = -1;  // a mesh, not an internode: the next segment starts a new axis
+      return;
+    }
     Internode in;
     in.start = start;
     in.end = st_.frame.position;
@@ -469,6 +543,7 @@ class TurtleWalk {
   /// `f` and `g`: moves without drawing (`f` adds a polygon point when withVertex).
   void move(size_t i, bool withVertex) {
     if (settings_.cpfg) cpfgTropisms();
+    st_.texT += texStep(st_.texture, 2 * drawnRadius(fullLength(i)), fullLength(i));
     st_.frame.position += st_.frame.heading * length(i);
     if (settings_.cpfg) cpfgOldBend();
     if (!buf_.polygons.empty() && withVertex) addPolygonPoint(st_.frame.position);
@@ -596,8 +671,24 @@ class TurtleWalk {
           const glm::dvec2 v = k == rings ? glm::dvec2(1, 0.5 * w2) : ((c3 * r + c2) * r + r0) * r + c0;
           ring[static_cast<size_t>(k)] = glm::dvec2(v.x, 2 * v.y);
         }
-        if (gc_.contour != 0 || st_.contour != 0) {
-          gcContourMesh(i, p1, t1, a2, a3, len, ring);
+        // cpfg's texture t (general.c, interpolate_connection): from the first point's, each
+        // ring adds update_segment_texture over the chord from the ring before at the ring's
+        // width; the turtle's t becomes the last ring's. Textured when both control points
+        // select a texture, with the first one's (cpfg's tu1.texture).
+        std::vector<double> ringT(static_cast<size_t>(rings) + 1, gc_.texT);
+        DVec3 prev = p1;
+        for (int k = 1; k <= rings; ++k) {
+          const double t = ring[static_cast<size_t>(k)].x;
+          const DVec3 at = k == rings ? p2 : p1 + t * (t1 + t * (a2 + t * a3));
+          ringT[static_cast<size_t>(k)] =
+              ringT[static_cast<size_t>(k) - 1] +
+              texStep(gc_.texture, 2 * radiusScale_ * ring[static_cast<size_t>(k)].y, glm::length(at - prev));
+          prev = at;
+        }
+        st_.texT = ringT.back();
+        const int texture = gc_.texture >= 0 && st_.texture >= 0 ? gc_.texture : -1;
+        if (gc_.contour != 0 || st_.contour != 0 || texture >= 0) {
+          gcContourMesh(i, p1, t1, a2, a3, len, ring, texture, ringT);
           rings = 0;  // drawn as a mesh
         }
         DVec3 from = p1;
@@ -619,7 +710,6 @@ class TurtleWalk {
           in.step = stepOf(i);
           in.module = static_cast<uint32_t>(i);
           in.up = st_.frame.up;
-          untextured("a generalized cylinder");
           if (growing_) buf_.internodeGrowth.push_back(g);
           if constexpr (kSummary) {
             const int32_t keep = st_.internode;
@@ -646,6 +736,8 @@ class TurtleWalk {
     gc_.sides = st_.contourSides > 0 ? st_.contourSides : settings_.contourSides;
     gc_.pointTangentOut = gc_.tangentOut;
     gc_.pointRadiusOut = gc_.radiusOut;
+    gc_.texture = st_.texture;
+    gc_.texT = st_.texT;
     if (end) gc_.active = gc_.hasPoint = false;
   }
 
@@ -669,8 +761,9 @@ class TurtleWalk {
   }
 
   /// cpfg's `@Tx(n)` (blackbox.c): the view file's texture n (its n-th `texture:` line, cpfg
-  /// truncating n) on the surfaces `~X` drawn after it on this branch; `@Tx` or `@Tx(0)`:
-  /// none. A number no `texture:` line has is an error (cpfg draws untextured).
+  /// truncating n) on the surfaces `~X`, polygons, `F` cylinders and generalized cylinders
+  /// drawn after it on this branch; `@Tx` or `@Tx(0)`: none. A number no `texture:` line
+  /// has is an error (cpfg draws untextured).
   void texture(size_t i) {
     const double v = hasParam(i) ? param(i) : 0.0;
     const size_t count = settings_.cpfgTextures ? settings_.cpfgTextures->size() : 0;
@@ -683,15 +776,6 @@ class TurtleWalk {
                                        : std::to_string(count) + " 'texture:' line" + (count == 1 ? "" : "s")));
     }
     st_.texture = static_cast<int>(v) - 1;
-  }
-
-  /// Throws when a texture is selected (`@Tx`) and what is drawn is neither a surface file
-  /// nor a polygon: cpfg textures cylinders and generalized cylinders too, which Sprig does not.
-  void untextured(const char* what) const {
-    if (st_.texture < 0) return;
-    throw InputError(SourceLoc{"sprig", 0, 0}, "cpfg's texture '@Tx(" + std::to_string(st_.texture + 1) + ")' on " + what +
-                                                   " is not supported: Sprig textures surfaces ('~X') and polygons ('{ }') only; end the texture "
-                                                   "with '@Tx' or close its branch before drawing it");
   }
 
   /// cpfg's `@#(id)`: the contour of the generalized cylinders from here on (0 or no
@@ -724,20 +808,24 @@ class TurtleWalk {
   /// ring is the second point's frame), L = H x U'; a contour point
   /// (x, y, z) goes to the ring's centre + r (x U' - y L) + r z H / |p2 - p1|. One Surface
   /// organ per segment, its triangles joining consecutive rings.
+  /// texture >= 0: cpfg's texture coordinates (general.c, make_contour): contour point k of
+  /// n has s = 1 - k / n (the seam, s = 1 and 0, at the contour's first point, along U' on
+  /// the circle), ring k has t = ringT[k]; the organ is named kTexturedGcName and a circle gets
+  /// texturedSides points so that it stays round.
   void gcContourMesh(size_t i, const DVec3& p1, const DVec3& t1, const DVec3& a2, const DVec3& a3, double len,
-                     const std::vector<glm::dvec2>& ring) {
-    untextured("a generalized cylinder");
+                     const std::vector<glm::dvec2>& ring, int texture, const std::vector<double>& ringT) {
     const int rings = static_cast<int>(ring.size()) - 1;
     const CpfgContour circle = CpfgContour::circle();
     const CpfgContour* c1 = gc_.contour ? findContour(gc_.contour) : &circle;
     const CpfgContour* c2 = st_.contour ? findContour(st_.contour) : &circle;
     if (!c1) c1 = &circle;
     if (!c2) c2 = &circle;
-    const int sides = gc_.sides;
+    const int sides = texture >= 0 && c1->isCircle() && c2->isCircle() ? texturedSides(gc_.sides) : gc_.sides;
     const std::vector<DVec3> k1 = c1->sample(sides), k2 = c2->sample(sides);
     const double g = growth(i);
     Organ o = organHere(Organ::Kind::Surface, i);
-    o.name = "@#";
+    o.name = texture >= 0 ? kTexturedGcName : "@#";
+    o.texture = texture;
     o.position = p1;
     const DVec3 h0 = gc_.heading, u0 = -gc_.up;  // cpfg's up vector at the first point
     // The minimal rotation taking h0 to h, applied to u0 (Rodrigues).
@@ -775,6 +863,8 @@ class TurtleWalk {
       for (uint32_t m = 0; m < per; ++m) {
         const DVec3 c = k1[m] * (1 - t) + k2[m] * t;
         o.points.push_back(pos + r * (c.x * u - c.y * l) + (r * c.z / len) * h);
+        if (texture >= 0)
+          o.uvs.emplace_back(static_cast<float>(1.0 - static_cast<double>(m) / sides), static_cast<float>(ringT[static_cast<size_t>(k)]));
       }
     }
     for (uint32_t k = 0; k < static_cast<uint32_t>(rings); ++k)
@@ -1246,6 +1336,8 @@ class TurtleWalk {
     double tangentIn = 1.2, tangentOut = 1.2;  ///< `@Gt(in, out)`: the turtle's (cpfg's defaults)
     double pointTangentOut = 1.2;              ///< tangentOut at the previous control point
     int32_t lastInternode = -1;                ///< the last piece drawn (parent of the next)
+    int texture = -1;                          ///< the texture selected at the previous control point
+    double texT = 0.0;                         ///< the turtle's texture t there
   };
   GcState gc_;
   std::vector<GcState> gcStack_;  ///< saved by `[` when the string has generalized cylinders

@@ -37,6 +37,12 @@ enum class RadiusModel {
 /// Most tropisms a cpfg view file may define (cpfg's MAXMOVEMENTS).
 inline constexpr int kMaxTropisms = 10;
 
+/// Organ::name of cpfg's textured tubes, drawn as Surface organs (triangles, normals and
+/// uvs; docs/GRAMMAR.md, "Textures"): an `F` cylinder and a generalized cylinder's segment.
+/// (No surface file's name has a space.)
+inline constexpr const char* kTexturedCylinderName = "F cylinder";
+inline constexpr const char* kTexturedGcName = "@Gc cylinder";
+
 /// One tropism of a cpfg view file (`tropism: T: x y z A: angle I: intensity E: e S: step`),
 /// applied by cpfg's own rule (docs/TURTLE.md, "cpfg tropisms").
 struct CpfgTropism {
@@ -125,6 +131,9 @@ struct TurtleState {
   int contour = 0;            ///< cpfg: the contour id `@#(id)` selected (0: the circle)
   int contourSides = 0;       ///< cpfg: points around a contour, `@!(n)` (0: the view file's)
   int texture = -1;           ///< cpfg: the texture `@Tx(n)` selected, 0-based (-1: none)
+  /// cpfg's tex_t (interpret.c, textures.c update_segment_texture): the texture's t along
+  /// the branch, accumulated by every move while a texture is selected; 0 at the start.
+  double texT = 0.0;
 };
 
 /// Interprets module strings of one grammar. Construction builds the symbol -> command

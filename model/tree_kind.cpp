@@ -12,6 +12,7 @@
 #include "core/paths.h"
 #include "core/progress.h"
 #include "lsystem/cpfg_materials.h"
+#include "lsystem/turtle.h"
 #include "model/bark_keys.h"
 #include "model/growth.h"
 #include "model/mesh_parts.h"
@@ -149,28 +150,46 @@ void appendMesh(Mesh& a, const Mesh& b) {
   a.materials.clear();
 }
 
-/// A cpfg texture shading one colour: texture number and the organ's colour index (-1:
-/// the leaf colour), the key of a group of textured surfaces drawn as one part.
+/// A cpfg texture shading one colour: texture number, the organ's colour index (-1: the
+/// leaf colour, or the wood colour for tubes) and whether the organs are textured tubes
+/// (`F` cylinders, generalized cylinders), the key of a group drawn as one part.
 struct TexturedGroup {
   int texture = -1;
   int color = -1;
+  bool tube = false;
   Mesh mesh;
 };
 
-/// The skeleton's textured cpfg surfaces (Organ::texture), grouped by texture and colour, each
-/// group's mesh with its positions, normals and texture coordinates. Colours follow the
-/// preview's rule: the palette entry of the organ's colour index (> 0), else the leaf colour.
-std::vector<TexturedGroup> texturedGroups(const lsystem::Skeleton& skeleton, const SkeletonStyle& style) {
+/// Whether a textured organ is one of cpfg's tubes (wood) rather than a surface or polygon.
+bool isTexturedTube(const lsystem::Organ& o) {
+  return o.name == lsystem::kTexturedCylinderName || o.name == lsystem::kTexturedGcName;
+}
+
+/// Which textured organs a caller wants: the surfaces and polygons (leaves), the tubes (wood).
+struct TexturedKinds {
+  bool leaves = true;
+  bool tubes = true;
+};
+
+/// The skeleton's textured cpfg organs (Organ::texture) of the kinds asked for, grouped by
+/// texture, colour and kind, each group's mesh with its positions, normals and texture
+/// coordinates. Colours follow the preview's rule: the palette entry of the organ's colour
+/// index (> 0), else the leaf colour (the wood colour for tubes).
+std::vector<TexturedGroup> texturedGroups(const lsystem::Skeleton& skeleton, const SkeletonStyle& style,
+                                          TexturedKinds kinds = {}) {
   std::vector<TexturedGroup> groups;
   const size_t textureCount = style.cpfgTextures ? style.cpfgTextures->size() : 0;
   for (const lsystem::Organ& o : skeleton.organs) {
     if (o.texture < 0 || o.triangles.empty()) continue;
+    const bool tube = isTexturedTube(o);
+    if (!(tube ? kinds.tubes : kinds.leaves)) continue;
     if (static_cast<size_t>(o.texture) >= textureCount || o.uvs.size() != o.points.size())
       throw std::logic_error("a textured cpfg surface without its texture");
     const int color = o.color > 0 && static_cast<size_t>(o.color) < style.palette.size() ? o.color : -1;
-    auto it = std::find_if(groups.begin(), groups.end(), [&](const TexturedGroup& g) { return g.texture == o.texture && g.color == color; });
+    auto it = std::find_if(groups.begin(), groups.end(),
+                           [&](const TexturedGroup& g) { return g.texture == o.texture && g.color == color && g.tube == tube; });
     if (it == groups.end()) {
-      groups.push_back(TexturedGroup{o.texture, color, {}});
+      groups.push_back(TexturedGroup{o.texture, color, tube, {}});
       it = groups.end() - 1;
     }
     Mesh& m = it->mesh;
@@ -187,14 +206,16 @@ std::vector<TexturedGroup> texturedGroups(const lsystem::Skeleton& skeleton, con
 }
 
 Vec3 groupColor(const TexturedGroup& g, const SkeletonStyle& style) {
-  return g.color >= 0 ? style.palette[static_cast<size_t>(g.color)] : style.leaf.baseColor;
+  return g.color >= 0 ? style.palette[static_cast<size_t>(g.color)] : (g.tube ? style.wood : style.leaf).baseColor;
 }
 
-/// Adds the skeleton's textured cpfg surfaces to out: one mesh part per texture and colour,
-/// the leaf material with the texture's image map shading the colour (modulate or decal,
-/// by the H: or L: filter per lookup) and, modulated, cut out by its alpha as cpfg does.
-void addTexturedSurfaces(render::Geometry& out, const lsystem::Skeleton& skeleton, const SkeletonStyle& style) {
-  for (TexturedGroup& g : texturedGroups(skeleton, style)) {
+/// Adds the skeleton's textured cpfg organs of the kinds asked for to out: one mesh part per
+/// texture, colour and kind, the leaf material (the wood material for tubes) with the
+/// texture's image map shading the colour (modulate or decal, by the H: or L: filter per
+/// lookup) and, modulated, cut out by its alpha as cpfg does.
+void addTexturedSurfaces(render::Geometry& out, const lsystem::Skeleton& skeleton, const SkeletonStyle& style,
+                         TexturedKinds kinds = {}) {
+  for (TexturedGroup& g : texturedGroups(skeleton, style, kinds)) {
     auto tex = std::make_shared<const lsystem::CpfgTexture>((*style.cpfgTextures)[static_cast<size_t>(g.texture)]);
     const Vec3 color = groupColor(g, style);
     auto map = std::make_shared<render::ImageMap>();
@@ -202,7 +223,7 @@ void addTexturedSurfaces(render::Geometry& out, const lsystem::Skeleton& skeleto
     map->height = tex->image->height;
     map->sample = [tex, color](Vec2 uv, bool minified) { return tex->fragment(uv.x, uv.y, color, minified); };
     map->alphaCutoff = tex->cutsOut() ? lsystem::kCpfgAlphaCutoff : -1.0f;
-    out.parts.push_back(render::MeshPart{std::move(g.mesh), style.leaf, {}, {}, std::move(map)});
+    out.parts.push_back(render::MeshPart{std::move(g.mesh), g.tube ? style.wood : style.leaf, {}, {}, std::move(map)});
   }
 }
 
@@ -222,18 +243,22 @@ render::Geometry skeletonPreview(const lsystem::Skeleton& skeleton, const Skelet
   if (!g.leaves.triangles.empty())
     out.parts.push_back(render::MeshPart{std::move(g.leaves), style.leaf, std::move(g.leafColors), {}});
   if (!g.fruit.empty()) out.parts.push_back(render::SpheresPart{std::move(g.fruit), style.fruit});
-  if (style.organs) addTexturedSurfaces(out, skeleton, style);
+  addTexturedSurfaces(out, skeleton, style, TexturedKinds{style.organs, true});  // tubes are wood
   return out;
 }
 
 namespace {
 
-/// Primitives and triangles of a skeleton preview (internodes + organs; n - 2 per n-gon).
+/// Primitives and triangles of a skeleton preview (internodes + organs; n - 2 per n-gon, and
+/// the triangles of the textured cpfg organs drawn as meshes: surfaces, polygons and tubes).
 void previewFigures(const lsystem::Skeleton& skeleton, ModelFigures& fig) {
   fig.primitives = skeleton.internodes.size() + skeleton.organs.size();
   fig.triangles = 0;
   for (const auto& o : skeleton.organs)
-    if (o.kind == lsystem::Organ::Kind::Polygon && o.points.size() >= 3) fig.triangles += o.points.size() - 2;
+    if (o.texture >= 0 && !o.triangles.empty())
+      fig.triangles += o.triangles.size() / 3;
+    else if (o.kind == lsystem::Organ::Kind::Polygon && o.points.size() >= 3)
+      fig.triangles += o.points.size() - 2;
 }
 
 /// The BlobTree tree as geometry: wood (exact or polygonized) with its bark texture, leaves.
@@ -354,7 +379,7 @@ class TreeModel final : public KindModel {
     if (mode == GeometryMode::Skeleton || skeleton.internodes.empty()) {
       // Skeleton mode, or nothing to build a surface from yet (the axiom draws nothing):
       // the preview shows the organs.
-      if (mode == GeometryMode::Skeleton) previewFigures(skeleton, fig);
+      previewFigures(skeleton, fig);
       fig.buildSeconds = secondsSince(t0);
       out.geometry = skeletonPreview(skeleton, look.style);
       return out;
@@ -369,26 +394,32 @@ class TreeModel final : public KindModel {
     }
     fig.buildSeconds = secondsSince(t0);
     out.geometry = surfaceGeometry(tree, look, mesh);
-    if (tree.options.leaves.enabled) {
-      addTexturedSurfaces(out.geometry, skeleton, look.style);
-      for (const lsystem::Organ& o : skeleton.organs)
-        if (o.texture >= 0) fig.triangles += o.triangles.size() / 3;  // not among tree.leaves
-    }
+    const TexturedKinds kinds{tree.options.leaves.enabled, true};  // textured tubes are wood, drawn always
+    addTexturedSurfaces(out.geometry, skeleton, look.style, kinds);
+    for (const lsystem::Organ& o : skeleton.organs)
+      if (o.texture >= 0 && (isTexturedTube(o) ? kinds.tubes : kinds.leaves))
+        fig.triangles += o.triangles.size() / 3;  // not among tree.leaves
     return out;
   }
 
   /// The stage's skeleton (swayed by the stage's wind when sway) and its BlobTree surface,
-  /// for `sprig mesh`; fills fig's modules, internodes and primitives. Throws InputError
-  /// when the stage draws no internode.
-  TreeSurface meshSurface(const Stage& stage, bool sway, ModelFigures& fig, lsystem::Skeleton& skeleton) const {
+  /// for `sprig mesh`; fills fig's modules, internodes and primitives. When the stage draws
+  /// no internode: nothing if tubesSuffice and it draws textured cpfg tubes (they are
+  /// meshes of their own), else throws InputError.
+  std::optional<TreeSurface> meshSurface(const Stage& stage, bool sway, ModelFigures& fig, lsystem::Skeleton& skeleton,
+                                         bool tubesSuffice = false) const {
     const int step = stage.step < 0 ? engine_.lastStep() : stage.step;
     skeleton = engine_.skeletonAt(step, stage.fraction);
     if (sway) skeleton = windy(std::move(skeleton), stage);
     fig.modules = engine_.moduleCount(step);
     fig.internodes = skeleton.internodes.size();
-    if (skeleton.internodes.empty())
+    if (skeleton.internodes.empty()) {
+      if (tubesSuffice && std::any_of(skeleton.organs.begin(), skeleton.organs.end(),
+                                      [](const lsystem::Organ& o) { return o.texture >= 0 && isTexturedTube(o); }))
+        return std::nullopt;
       throw InputError(species_.loc(), "the species draws no internodes at " + stageName(stage) +
                                            ": there is no surface to mesh");
+    }
     TreeSurface tree = buildTreeSurface(skeleton, spec_.surface.value_or(organisms::TreeOptions{}));
     fig.primitives = tree.compiled->primitiveCount();
     return tree;
@@ -396,7 +427,7 @@ class TreeModel final : public KindModel {
 
   Mesh buildMesh(const Stage& stage, float cellSize, bool progress, ModelFigures& fig) override {
     lsystem::Skeleton skeleton;
-    TreeSurface tree = meshSurface(stage, true, fig, skeleton);
+    TreeSurface tree = *meshSurface(stage, true, fig, skeleton);
     blobtree::PolygonizeOptions po;
     po.cellSize = cellSize;
     po.progress = progress;
@@ -408,51 +439,56 @@ class TreeModel final : public KindModel {
   std::vector<ExportPart> exportParts(const Stage& stage, float cellSize, bool progress, const SpeciesRender& look,
                                       const MeshCleanOptions& clean, ModelFigures& fig) override {
     lsystem::Skeleton skeleton;
-    TreeSurface tree = meshSurface(stage, false, fig, skeleton);
-    blobtree::PolygonizeOptions po = polygonizeOptions(look);
-    po.cellSize = cellSize;
-    po.progress = progress;
-    // The wood: coloured by its bark as the renderer colours it, then cleaned.
-    const render::Geometry geometry = surfaceGeometry(tree, look, nullptr);
-    const auto& implicit = std::get<render::ImplicitPart>(geometry.parts.front());
-    std::vector<ExportPart> parts(1);
-    parts[0].name = "wood";
-    parts[0].mesh = paintPolygonized(blobtree::polygonizeDetailed(*tree.compiled, po), implicit.textures,
-                                     implicit.material);
-    fig.clean = cleanMesh(parts[0].mesh, clean);
-    parts[0].mesh.materials.clear();
-    parts[0].material = {"wood", look.style.wood.baseColor, look.style.wood.roughness, false, nullptr};
-    // The bark as an image over the wood's (u, v), the renderer's own bark function baked.
-    // One image reproduces the render only where every cone wears the same bark: with bark
-    // per girth (several classes, each cone coloured in its own coordinates and the colours
-    // blended) or darkened PCM seams, the wood keeps the renderer's vertex colours.
-    const uint16_t barkId = static_cast<uint16_t>(tree.options.bark.texture);
-    const bool oneBark = tree.blob.barkClasses.size() == 1 && !(tree.options.bark.ridgeDarkening > 0) &&
-                         !(tree.options.bark.ridgeArc.darkening > 0);  // (relief is shading only)
-    if (tree.options.bark.enabled && oneBark && barkId < implicit.textures.size() && parts[0].mesh.triangleCount() > 0) {
-      const render::ColorTexture& bark = implicit.textures[barkId];
-      textureBark(parts[0], [&bark](Vec2 uv) { return bark(uv, Vec3(0.0f)); });
-    } else {
-      // Bark per girth or darkened seams: every triangle's own patch of an atlas, each
-      // texel the renderer's blend of the cones' barks at its surface point.
-      atlasBlobPart(parts[0], *tree.compiled, implicit.textures, implicit.material);
+    // A stage drawn only with textured cpfg tubes has no BlobTree: its parts are the tubes.
+    std::optional<TreeSurface> surface = meshSurface(stage, false, fig, skeleton, true);
+    const organisms::TreeOptions& options = surface ? surface->options : spec_.surface.value_or(organisms::TreeOptions{});
+    std::vector<ExportPart> parts;
+    if (surface) {
+      TreeSurface& tree = *surface;
+      blobtree::PolygonizeOptions po = polygonizeOptions(look);
+      po.cellSize = cellSize;
+      po.progress = progress;
+      // The wood: coloured by its bark as the renderer colours it, then cleaned.
+      const render::Geometry geometry = surfaceGeometry(tree, look, nullptr);
+      const auto& implicit = std::get<render::ImplicitPart>(geometry.parts.front());
+      parts.resize(1);
+      parts[0].name = "wood";
+      parts[0].mesh = paintPolygonized(blobtree::polygonizeDetailed(*tree.compiled, po), implicit.textures,
+                                       implicit.material);
+      fig.clean = cleanMesh(parts[0].mesh, clean);
+      parts[0].mesh.materials.clear();
+      parts[0].material = {"wood", look.style.wood.baseColor, look.style.wood.roughness, false, nullptr};
+      // The bark as an image over the wood's (u, v), the renderer's own bark function baked.
+      // One image reproduces the render only where every cone wears the same bark: with bark
+      // per girth (several classes, each cone coloured in its own coordinates and the colours
+      // blended) or darkened PCM seams, the wood keeps the renderer's vertex colours.
+      const uint16_t barkId = static_cast<uint16_t>(tree.options.bark.texture);
+      const bool oneBark = tree.blob.barkClasses.size() == 1 && !(tree.options.bark.ridgeDarkening > 0) &&
+                           !(tree.options.bark.ridgeArc.darkening > 0);  // (relief is shading only)
+      if (tree.options.bark.enabled && oneBark && barkId < implicit.textures.size() && parts[0].mesh.triangleCount() > 0) {
+        const render::ColorTexture& bark = implicit.textures[barkId];
+        textureBark(parts[0], [&bark](Vec2 uv) { return bark(uv, Vec3(0.0f)); });
+      } else {
+        // Bark per girth or darkened seams: every triangle's own patch of an atlas, each
+        // texel the renderer's blend of the cones' barks at its surface point.
+        atlasBlobPart(parts[0], *tree.compiled, implicit.textures, implicit.material);
+      }
+      const std::pair<organisms::OrganSet, const char*> sets[] = {{organisms::OrganSet::Leaves, "leaves"},
+                                                                   {organisms::OrganSet::Fruit, "fruit"}};
+      for (const auto& [set, name] : sets) {
+        Mesh organs = organisms::buildOrganMesh(skeleton, options, set);
+        if (organs.triangleCount() == 0) continue;
+        organs.materials.clear();
+        const render::Material& m = set == organisms::OrganSet::Leaves ? look.style.leaf : look.style.fruit;
+        // Leaves are open polygons seen from both sides; fruit are closed spheres.
+        parts.push_back(ExportPart{name, std::move(organs), PartMaterial{name, m.baseColor, m.roughness, set == organisms::OrganSet::Leaves, nullptr}});
+        atlasVertexColors(parts.back());  // each leaf's tint, unclamped
+      }
     }
-    const organisms::TreeOptions& options = tree.options;
-    const std::pair<organisms::OrganSet, const char*> sets[] = {{organisms::OrganSet::Leaves, "leaves"},
-                                                                 {organisms::OrganSet::Fruit, "fruit"}};
-    for (const auto& [set, name] : sets) {
-      Mesh organs = organisms::buildOrganMesh(skeleton, options, set);
-      if (organs.triangleCount() == 0) continue;
-      organs.materials.clear();
-      const render::Material& m = set == organisms::OrganSet::Leaves ? look.style.leaf : look.style.fruit;
-      // Leaves are open polygons seen from both sides; fruit are closed spheres.
-      parts.push_back(ExportPart{name, std::move(organs), PartMaterial{name, m.baseColor, m.roughness, set == organisms::OrganSet::Leaves, nullptr}});
-      atlasVertexColors(parts.back());  // each leaf's tint, unclamped
-    }
-    // Textured cpfg surfaces: one part per texture and colour, the image shading the colour
-    // baked at the image's own size over the surfaces' texture coordinates.
-    if (options.leaves.enabled) {
-      for (TexturedGroup& g : texturedGroups(skeleton, look.style)) {
+    // Textured cpfg surfaces and tubes: one part per texture, colour and kind, the image
+    // shading the colour baked at the image's own size over the organs' texture coordinates.
+    {
+      for (TexturedGroup& g : texturedGroups(skeleton, look.style, TexturedKinds{options.leaves.enabled, true})) {
         const lsystem::CpfgTexture& tex = (*look.style.cpfgTextures)[static_cast<size_t>(g.texture)];
         const Vec3 color = groupColor(g, look.style);
         auto baked = std::make_shared<PartTexture>();
@@ -461,10 +497,17 @@ class TreeModel final : public KindModel {
         for (int y = 0; y < h; ++y)
           for (int x = 0; x < w; ++x)  // texel centres (either filter gives the texel); top row is t of 1
             baked->image.set(x, y, tex.fragment((x + 0.5) / w, 1.0 - (y + 0.5) / h, color));
+        if (g.tube) {
+          // Tubes: s runs 0 to 1 around (the seam has its own vertices) and t on along the
+          // branch beyond 1: the sampler repeats (cpfg's GL_REPEAT), the uvs are kept.
+          baked->seams.repeatU = baked->seams.repeatV = true;
+          baked->seams.continuous = true;
+        }
         baked->magFilter = tex.magLinear ? PartTexture::Filter::Linear : PartTexture::Filter::Nearest;
         baked->minFilter = tex.minLinear ? PartTexture::Filter::Linear : PartTexture::Filter::Nearest;
-        const std::string name = "textured_leaves_" + std::to_string(parts.size());
-        const render::Material& m = look.style.leaf;
+        const std::string name = (g.tube ? "textured_wood_" : "textured_leaves_") + std::to_string(parts.size());
+        const render::Material& m = g.tube ? look.style.wood : look.style.leaf;
+        // Both sides: leaves are open polygons, tubes open at their ends (cpfg draws no caps).
         PartMaterial material{name, color, m.roughness, true, std::move(baked)};
         material.alphaCutoff = tex.cutsOut() ? lsystem::kCpfgAlphaCutoff : -1.0f;  // glTF MASK, the image's alpha kept
         parts.push_back(ExportPart{name, std::move(g.mesh), std::move(material)});

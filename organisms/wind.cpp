@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "core/rng.h"
+#include "lsystem/turtle.h"
 
 namespace sprig::organisms {
 
@@ -119,12 +120,15 @@ lsystem::Skeleton swayInWind(const lsystem::Skeleton& sk, const WindOptions& w, 
     // Flutter about the attachment point, across the blade.
     const DVec3 pivot = g.kind == lsystem::Organ::Kind::Polygon && !g.points.empty() ? g.points[0] : g.position;
     const DVec3 heading = glm::length(g.heading) > 0 ? glm::normalize(g.heading) : upAxis;
-    const double f = w.flutterPerSpeed * w.speed *
-                     std::sin(twoPi * w.flutterHz * t + phase(w.seed, kSeedLeaf, oi));
+    // cpfg's textured cylinders are wood drawn as meshes: they follow their internode, no flutter.
+    const bool tube = g.name == lsystem::kTexturedCylinderName || g.name == lsystem::kTexturedGcName;
+    const double f = tube ? 0.0
+                          : w.flutterPerSpeed * w.speed * std::sin(twoPi * w.flutterHz * t + phase(w.seed, kSeedLeaf, oi));
     const DMat3 flutter = rotation(perpendicular(heading, toward), f);
     const DMat3 all = r * flutter;
     auto move = [&](const DVec3& x) { return to + r * (pivot - from) + all * (x - pivot); };
     for (DVec3& p : g.points) p = move(p);
+    for (DVec3& nrm : g.normals) nrm = all * nrm;  // surface files' and textured organs' normals turn with them
     g.position = move(g.position);
     g.heading = all * g.heading;
     g.left = all * g.left;

@@ -114,6 +114,14 @@ TEST_CASE("cornerUvs", "[core]") {
     const Mesh u = unweld(m, {}, c);
     CHECK(u.vertexCount() == 7);  // 1 and 3 are used with both u and u + 1
   }
+  SECTION("continuous uvs (they run on across the repeats): repeating axes shift nothing") {
+    UvSeamOptions o;
+    o.repeatU = o.repeatV = true;
+    o.continuous = true;
+    const CornerTable<Vec2> c = cornerUvs(m, o);
+    CHECK(c.values == m.uvs);
+    CHECK(c.index == std::vector<uint32_t>{0, 1, 2, 1, 3, 2, 1, 4, 3});
+  }
   SECTION("a triangle spanning more than maxSpan takes its first corner's uv") {
     UvSeamOptions o;
     o.maxSpan = Vec2(10.0f, 0.5f);

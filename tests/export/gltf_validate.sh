@@ -49,4 +49,12 @@ done
 f="$out/cpfg_cutout.${#files[@]}.glb"
 "$sprig" mesh tests/assets/cpfg/texture/cutout -o "$f" >/dev/null
 files+=("$f")
+# cpfg's textured tubes: F cylinders and generalized cylinders as textured_wood parts with
+# TEXCOORD_0 (t beyond 1: the image repeats along the branch); every segment is textured,
+# so there is no BlobTree 'wood' part.
+for o in cylinder bark; do
+  f="$out/cpfg_$o.${#files[@]}.glb"
+  "$sprig" mesh "tests/assets/cpfg/texture/$o" -o "$f" >/dev/null
+  files+=("$f")
+done
 node scripts/gltf-validate.js "${files[@]}"

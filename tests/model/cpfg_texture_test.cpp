@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 #include <tiny_gltf.h>
 
+#include <cstring>
 #include <filesystem>
 #include <string>
 
@@ -10,6 +11,7 @@
 #include "core/image.h"
 #include "core/mesh_io.h"
 #include "lsystem/skeleton.h"
+#include "lsystem/turtle.h"
 #include "model/growth.h"
 #include "model/model.h"
 #include "model/species.h"
@@ -24,6 +26,7 @@ namespace {
 
 fs::path textureObject() { return fs::path(SPRIG_SOURCE_DIR) / "tests/assets/cpfg/texture"; }
 fs::path cutoutObject() { return textureObject() / "cutout"; }
+fs::path cylinderObject() { return textureObject() / "cylinder"; }
 
 /// The colour the scene's surface shows at (x, y) seen along +Z (the flat squares face -Z).
 Vec3 colorAt(const render::Scene& scene, float x, float y) {
@@ -174,12 +177,10 @@ TEST_CASE("cpfg texture errors", "[model][cpfg]") {
   CHECK(errorOf("texture: F: ../halves.png\n", "~a").find("is outside the object's folder") != std::string::npos);
   CHECK(errorOf("surface: b flat.s 3 2\n", "~b") ==
         "plant.v:2:21: the surface's texture 2 names no texture: the view file has 0 'texture:' lines");
-  CHECK(errorOf("texture: F: halves.png\n", "@Tx(1)F") ==
-        "cpfg's texture '@Tx(1)' on an 'F' segment (a cylinder) is not supported: Sprig textures surfaces ('~X') and polygons ('{ }') only; "
-        "end the texture with '@Tx' or close its branch before drawing it");
-  CHECK(errorOf("texture: F: halves.png\n", "@Tx(1){.f+f}") == "no error");  // polygons are textured
-  CHECK(errorOf("texture: F: halves.png\n", "@Tx(1)@Gs f @Gc(2) f @Ge(2)").find("on a generalized cylinder is not supported") !=
-        std::string::npos);
+  // Cylinders, generalized cylinders (with the circle or a contour) and polygons are textured.
+  CHECK(errorOf("texture: F: halves.png\n", "@Tx(1)F") == "no error");
+  CHECK(errorOf("texture: F: halves.png\n", "@Tx(1){.f+f}") == "no error");
+  CHECK(errorOf("texture: F: halves.png\n", "@Tx(1)@Gs f @Gc(2) f @Ge(2)") == "no error");
   fs::remove_all(dir);
 }
 
@@ -413,4 +414,287 @@ TEST_CASE("cpfg cut-out textures render the same bytes at 1 and 2 threads", "[mo
     return render::renderImage(scene, camera, rs);
   };
   CHECK(renderAt(1).pixels == renderAt(2).pixels);
+}
+
+namespace {
+
+/// The colour seen by a ray toward the point c of a tube's axis, coming from the direction
+/// d = cos b L + sin b U' (U' is cpfg's up vector, -U): from 10 units out along d. The
+/// tube's radius is r (32 sides: the hit lies within 0.5% of it).
+Vec3 colorToward(const render::Scene& scene, const Vec3& c, const Vec3& left, const Vec3& upCpfg, double bDeg, float r) {
+  const double b = bDeg * 3.14159265358979323846 / 180.0;
+  const Vec3 d = static_cast<float>(std::cos(b)) * left + static_cast<float>(std::sin(b)) * upCpfg;
+  INFO("ray toward (" << c.x << ", " << c.y << ", " << c.z << ") from angle " << bDeg);
+  auto hit = scene.intersect(c + 10.0f * d, -d, 0.0f, 100.0f);
+  REQUIRE(hit);
+  CHECK(hit->t == Approx(10.0f - r).margin(0.005f * r));
+  return hit->color;
+}
+
+/// colorToward for a tube of radius 1 along +Y through (x0, 0, 0) in the turtle's starting
+/// frame (L = -X, U' = -Z), at height y.
+Vec3 colorAround(const render::Scene& scene, float x0, float y, double bDeg) {
+  return colorToward(scene, Vec3(x0, y, 0), Vec3(-1, 0, 0), Vec3(0, 0, -1), bDeg, 1.0f);
+}
+
+}  // namespace
+
+TEST_CASE("cpfg textures on cylinders and generalized cylinders", "[model][cpfg]") {
+  const Species s = loadSpecies(cylinderObject());
+  GrowthEngine engine(s);
+  const lsystem::Skeleton sk = engine.skeletonAt(engine.lastStep());
+  const double pi = 3.14159265358979323846;
+  // Every segment is a textured tube (no internode): F(4), two generalized-cylinder
+  // segments, then F(2), the branch's +F(1), F(1) at width 1, and F(1) after f(1).
+  CHECK(sk.internodes.empty());
+  REQUIRE(sk.organs.size() == 7);
+  const char* names[] = {lsystem::kTexturedCylinderName, lsystem::kTexturedGcName, lsystem::kTexturedGcName,
+                         lsystem::kTexturedCylinderName, lsystem::kTexturedCylinderName, lsystem::kTexturedCylinderName,
+                         lsystem::kTexturedCylinderName};
+  // t accumulates along the branch by length / (pi d) * 2 (textures.c): d = 2 gives
+  // length / pi; the generalized cylinder starts at the turtle's t (4 / pi) and adds its
+  // length (3 per segment, straight); the side branch starts at its parent's t, and so does
+  // the continuation after ']'; !(1) doubles the rate, and the move f(1) adds to t too.
+  const double t0[] = {0, 4, 7, 10, 12, 12, 16}, t1[] = {4, 7, 10, 12, 13, 14, 18};
+  for (size_t k = 0; k < 7; ++k) {
+    INFO("organ " << k);
+    const lsystem::Organ& o = sk.organs[k];
+    CHECK(o.name == names[k]);
+    CHECK(o.texture == 0);
+    CHECK(o.kind == lsystem::Organ::Kind::Surface);
+    // 8 sides (cpfg's default) times 4: 33 points per ring (the seam twice), 2 rings for F,
+    // 4 + 1 rings for a generalized-cylinder segment @Gc(3)/@Ge(3) (3 pieces).
+    const size_t rings = std::string(names[k]) == lsystem::kTexturedCylinderName ? 2 : 4;
+    REQUIRE(o.points.size() == 33 * rings);
+    REQUIRE(o.uvs.size() == o.points.size());
+    CHECK(o.triangles.size() == 3 * 2 * 32 * (rings - 1));
+    CHECK(o.uvs.front().y == Approx(t0[k] / pi));
+    CHECK(o.uvs.back().y == Approx(t1[k] / pi));
+    for (size_t m = 0; m <= 32; ++m) {
+      INFO("point " << m);
+      // F: s = m / 32 from the seam along L; a generalized cylinder: s = 1 - m / 32 (general.c).
+      const float sWant = rings == 2 ? m / 32.0f : 1.0f - m / 32.0f;
+      CHECK(o.uvs[m].x == Approx(sWant));
+      CHECK(o.uvs[m].y == Approx(t0[k] / pi));
+      CHECK(o.uvs[o.uvs.size() - 33 + m].x == Approx(sWant));
+    }
+  }
+  // The F at width 1 has radius 1/2; the others radius 1.
+  CHECK(glm::length(sk.organs[5].points[0] - sk.organs[5].position) == Approx(0.5));
+  CHECK(glm::length(sk.organs[3].points[0] - sk.organs[3].position) == Approx(1.0));
+  // The F's seam (s = 0) is along L (-X), a quarter turn (s = 1/4) toward cpfg's up (-Z).
+  CHECK(sk.organs[0].points[0].x == Approx(-1.0));
+  CHECK(sk.organs[0].points[8].z == Approx(-1.0));
+  // The generalized cylinder's seam is along cpfg's up (-Z), s = 1/4 along L (-X).
+  CHECK(sk.organs[1].points[0].z == Approx(-1.0));
+  CHECK(sk.organs[1].points[24].x == Approx(10.0 - 1.0));
+
+  // The renderer's colours (decal: the texel itself) where rays meet the tubes. F(4) at the
+  // origin: s = b / 360 at angle b from L toward U' (red, green, blue, white quarters), t =
+  // y / pi (bottom row below 1/2, top row above, repeating).
+  render::Scene scene;
+  scene.add(skeletonPreview(sk, s.render.style));
+  scene.commit();
+  const Vec3 red(1, 0, 0), green(0, 1, 0), blue(0, 0, 1), white(1), cyan(0, 1, 1), magenta(1, 0, 1), yellow(1, 1, 0);
+  checkColor(colorAround(scene, 0, 0.5f, 40), red);  // t = 0.16
+  checkColor(colorAround(scene, 0, 0.5f, 130), green);
+  checkColor(colorAround(scene, 0, 0.5f, 220), blue);
+  checkColor(colorAround(scene, 0, 0.5f, 310), white);
+  checkColor(colorAround(scene, 0, 2.0f, 40), cyan);  // t = 0.64
+  checkColor(colorAround(scene, 0, 2.0f, 130), magenta);
+  checkColor(colorAround(scene, 0, 2.0f, 220), yellow);
+  checkColor(colorAround(scene, 0, 3.5f, 130), green);  // t = 1.11: the image again
+  // The generalized cylinder at x = 10: s = 1 - b' / 360 with b' from U' toward -L, so at
+  // angle b from L toward U' s = (90 - b) / 360 (mod 1): the same bisector at 45 degrees,
+  // mirrored; t = (4 + y) / pi.
+  checkColor(colorAround(scene, 10, 0.5f, 40), red);    // s = 0.014, t = 1.43
+  checkColor(colorAround(scene, 10, 0.5f, 310), green);  // s = 0.361
+  checkColor(colorAround(scene, 10, 0.5f, 220), blue);   // s = 0.611
+  checkColor(colorAround(scene, 10, 0.5f, 130), white);  // s = 0.861
+  checkColor(colorAround(scene, 10, 2.0f, 310), magenta);  // t = 1.91
+  checkColor(colorAround(scene, 10, 4.5f, 310), magenta);  // second segment, t = 2.71
+  checkColor(colorAround(scene, 10, 5.5f, 310), green);    // t = 3.02
+
+  // The same tubes in the exact and mesh modes (no internode, so no BlobTree: the
+  // preview's parts).
+  SpeciesModel model(s, ModelOptions{});
+  for (GeometryMode mode : {GeometryMode::Exact, GeometryMode::Mesh}) {
+    render::Scene other;
+    model.addToScene(other, model.finalStage(), mode, s.render);
+    other.commit();
+    checkColor(colorAround(other, 0, 0.5f, 40), red);
+    checkColor(colorAround(other, 10, 2.0f, 310), magenta);
+  }
+
+  // The export: one textured wood part (one texture, one colour) holding every tube, its
+  // uvs the organs' (s in [0, 1], t from 0 to 18 / pi), double sided, the image baked.
+  const std::vector<ExportPart> parts = model.exportParts(model.finalStage(), 0.0f, false);
+  REQUIRE(parts.size() == 1);
+  CHECK(parts[0].name == "textured_wood_0");
+  CHECK(parts[0].mesh.triangleCount() == 64 * 5 + 3 * 64 * 2);
+  REQUIRE(parts[0].mesh.uvs.size() == parts[0].mesh.positions.size());
+  Vec2 lo(1e9f), hi(-1e9f);
+  for (const Vec2& uv : parts[0].mesh.uvs) {
+    lo = glm::min(lo, uv);
+    hi = glm::max(hi, uv);
+  }
+  CHECK(lo.x == 0.0f);
+  CHECK(hi.x == 1.0f);
+  CHECK(lo.y == 0.0f);
+  CHECK(hi.y == Approx(18 / pi));
+  REQUIRE(parts[0].material.texture);
+  CHECK(parts[0].material.texture->image.width == 4);
+  CHECK(parts[0].material.texture->image.height == 2);
+  CHECK(parts[0].material.alphaCutoff < 0);
+}
+
+TEST_CASE("cpfg textured cylinders beside untextured wood: parts and export", "[model][cpfg]") {
+  const fs::path dir = fs::temp_directory_path() / "sprig-cpfg-cylinder-texture-test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  fs::copy_file(cylinderObject() / "quadrants.png", dir / "quadrants.png");
+  writeFileAtomic(dir / "plant.v", "angle increment: 45\nline style: cylinder\ntexture: F: quadrants.png R: 2\n");
+  // An untextured trunk, a textured branch (modulate: texel times the wood colour), and the
+  // trunk again after ']' (untextured: the bracket ended the texture).
+  writeFileAtomic(dir / "plant.l", "lsystem: 1\nderivation length: 0\naxiom: !(0.5)F(2)[+@Tx(1)F(1)F(1)]F(2)\nendlsystem\n");
+  const Species s = loadSpecies(dir);
+  GrowthEngine engine(s);
+  const lsystem::Skeleton sk = engine.skeletonAt(engine.lastStep());
+  CHECK(sk.internodes.size() == 2);
+  REQUIRE(sk.organs.size() == 2);
+  // R: 2 halves the rate: 1 / (pi 0.5) * 2 / 2 = 2 / pi per unit length.
+  const double pi = 3.14159265358979323846;
+  CHECK(sk.organs[0].uvs.back().y == Approx(2 / pi));
+  CHECK(sk.organs[1].uvs.front().y == Approx(2 / pi));
+  CHECK(sk.organs[1].uvs.back().y == Approx(4 / pi));
+  // Rays at the branch, 1/2 along its first segment (t = 1 / pi): angle 40 (s = 0.11) is
+  // red, 130 green, times the wood colour, in every mode (the trunk a BlobTree in the
+  // exact and mesh modes, the textured branch a mesh beside it).
+  const Vec3 wood = s.render.style.wood.baseColor;
+  const Vec3 h(-std::sqrt(0.5f), std::sqrt(0.5f), 0), left(-std::sqrt(0.5f), -std::sqrt(0.5f), 0), upCpfg(0, 0, -1);
+  SpeciesModel model(s, ModelOptions{});
+  for (GeometryMode mode : {GeometryMode::Skeleton, GeometryMode::Exact, GeometryMode::Mesh}) {
+    INFO("mode " << static_cast<int>(mode));
+    render::Scene scene;
+    model.addToScene(scene, model.finalStage(), mode, s.render);
+    scene.commit();
+    checkColor(colorToward(scene, Vec3(0, 2, 0) + 0.5f * h, left, upCpfg, 40, 0.25f), Vec3(1, 0, 0) * wood);
+    checkColor(colorToward(scene, Vec3(0, 2, 0) + 0.5f * h, left, upCpfg, 130, 0.25f), Vec3(0, 1, 0) * wood);
+  }
+  const std::vector<ExportPart> parts = model.exportParts(model.finalStage(), 0.0f, false);
+  std::vector<std::string> names;
+  for (const ExportPart& p : parts) names.push_back(p.name);
+  REQUIRE(names.size() == 2);
+  CHECK(names[0] == "wood");
+  CHECK(names[1] == "textured_wood_1");
+  // The baked image: each texel times the wood colour (modulate); top row of the image is
+  // the texture's upper row (t above 1/2): cyan first.
+  const Image& img = parts[1].material.texture->image;
+  CHECK(glm::length(Vec3(img.at(0, 1)) - Vec3(1, 0, 0) * wood) < 1e-6f);
+  CHECK(glm::length(Vec3(img.at(0, 0)) - Vec3(0, 1, 1) * wood) < 1e-6f);
+  // glb written and read back: two meshes, the textured one with TEXCOORD_0 (s, 1 - t) over
+  // s in [0, 1] and t in [0, 4 / pi].
+  const fs::path glb = dir / "plant.glb";
+  writeParts(parts, glb);
+  tinygltf::Model m;
+  tinygltf::TinyGLTF loader;
+  std::string err, warn;
+  REQUIRE(loader.LoadBinaryFromFile(&m, &err, &warn, glb.string()));
+  REQUIRE(m.meshes.size() == 2);
+  const tinygltf::Primitive& prim = m.meshes[1].primitives[0];
+  REQUIRE(prim.attributes.count("TEXCOORD_0"));
+  const tinygltf::Accessor& uv = m.accessors[static_cast<size_t>(prim.attributes.at("TEXCOORD_0"))];
+  REQUIRE(uv.componentType == TINYGLTF_COMPONENT_TYPE_FLOAT);
+  REQUIRE(uv.type == TINYGLTF_TYPE_VEC2);
+  const tinygltf::BufferView& view = m.bufferViews[static_cast<size_t>(uv.bufferView)];
+  const size_t stride = view.byteStride ? view.byteStride : 2 * sizeof(float);
+  Vec2 lo(1e9f), hi(-1e9f);
+  for (size_t k = 0; k < uv.count; ++k) {
+    Vec2 v;
+    std::memcpy(&v, m.buffers[static_cast<size_t>(view.buffer)].data.data() + view.byteOffset + uv.byteOffset + k * stride, sizeof v);
+    lo = glm::min(lo, v);
+    hi = glm::max(hi, v);
+  }
+  CHECK(uv.count == parts[1].mesh.positions.size());
+  CHECK(lo.x == 0.0f);
+  CHECK(hi.x == 1.0f);
+  CHECK(lo.y == Approx(1 - 4 / pi));  // glTF's v runs down the image: 1 - t
+  CHECK(hi.y == 1.0f);
+  const int texIndex = m.materials[static_cast<size_t>(prim.material)].pbrMetallicRoughness.baseColorTexture.index;
+  REQUIRE(texIndex >= 0);
+  // t runs on along the branch (beyond 1): the sampler repeats both ways, as GL_REPEAT.
+  const tinygltf::Sampler& sampler = m.samplers[static_cast<size_t>(m.textures[static_cast<size_t>(texIndex)].sampler)];
+  CHECK(sampler.wrapS == TINYGLTF_TEXTURE_WRAP_REPEAT);
+  CHECK(sampler.wrapT == TINYGLTF_TEXTURE_WRAP_REPEAT);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("cpfg textured cylinders render the same bytes at 1 and 2 threads", "[model][cpfg]") {
+  const Species s = loadSpecies(cylinderObject());
+  GrowthEngine engine(s);
+  const lsystem::Skeleton sk = engine.skeletonAt(engine.lastStep());
+  render::Camera camera;
+  camera.position = Vec3(10, 4, -30);
+  camera.target = Vec3(10, 4, 0);
+  auto renderAt = [&](int threads) {
+    render::Scene scene;
+    scene.setPixelFootprint(camera, 64, 48);
+    scene.add(skeletonPreview(sk, s.render.style));
+    scene.commit();
+    render::RenderSettings rs;
+    rs.width = 64;
+    rs.height = 48;
+    rs.spp = 2;
+    rs.threads = threads;
+    return render::renderImage(scene, camera, rs);
+  };
+  const Image a = renderAt(1);
+  CHECK(a.pixels == renderAt(2).pixels);
+}
+
+TEST_CASE("cpfg cut-out textures on cylinders", "[model][cpfg]") {
+  // cutout.png: five red texels along s of alpha 255, 0, 128, 26 and 25, modulated, on an F
+  // of diameter 2 (radius 1) up +Y: texel k covers s in [k/5, (k+1)/5), s = b / 360 at angle
+  // b from L (-X) toward cpfg's up (-Z); a ray through the axis meets the far wall at b + 180.
+  const fs::path dir = fs::temp_directory_path() / "sprig-cpfg-cylinder-cutout-test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  fs::copy_file(cutoutObject() / "cutout.png", dir / "cutout.png");
+  writeFileAtomic(dir / "plant.v", "line style: cylinder\ntexture: F: cutout.png E: m\n");
+  writeFileAtomic(dir / "plant.l", "lsystem: 1\nderivation length: 0\naxiom: !(2)@Tx(1)F(1)\nendlsystem\n");
+  const Species s = loadSpecies(dir);
+  GrowthEngine engine(s);
+  const lsystem::Skeleton sk = engine.skeletonAt(engine.lastStep());
+  render::Scene scene;
+  scene.add(skeletonPreview(sk, s.render.style));
+  scene.commit();
+  const Vec3 wood = s.render.style.wood.baseColor;
+  auto rayAt = [&](double bDeg) {
+    const double b = bDeg * 3.14159265358979323846 / 180.0;
+    const Vec3 d(static_cast<float>(-std::cos(b)), 0.0f, static_cast<float>(-std::sin(b)));
+    return scene.intersect(Vec3(0, 0.5f, 0) + 10.0f * d, -d, 0.0f, 100.0f);
+  };
+  // b = 36: s = 0.1, the opaque texel: red times the wood colour, opaque, on the near wall.
+  auto opaque = rayAt(36);
+  REQUIRE(opaque);
+  CHECK(opaque->t == Approx(9.0f).margin(0.005f));
+  CHECK(opaque->opacity == 1.0f);
+  checkColor(opaque->color, Vec3(1, 0, 0) * wood);
+  // b = 112: s = 0.31 (alpha 0) near, s = 0.81 (alpha 25/255, at or below 0.1) far: both cut
+  // out, the ray passes through the tube.
+  CHECK_FALSE(rayAt(112));
+  // b = 150: s = 0.42 (alpha 128/255): the near wall covers half, blended over what lies behind.
+  auto half = rayAt(150);
+  REQUIRE(half);
+  CHECK(half->t == Approx(9.0f).margin(0.005f));
+  CHECK(half->opacity == Approx(128.0f / 255.0f).margin(1e-3f));
+  // Shadow rays are cut the same way: blocked by the opaque texel, not through the cut ones.
+  auto occludedAt = [&](double bDeg) {
+    const double b = bDeg * 3.14159265358979323846 / 180.0;
+    const Vec3 d(static_cast<float>(-std::cos(b)), 0.0f, static_cast<float>(-std::sin(b)));
+    return scene.occluded(Vec3(0, 0.5f, 0) + 10.0f * d, -d, 0.0f, 100.0f);
+  };
+  CHECK(occludedAt(36));
+  CHECK_FALSE(occludedAt(112));
+  fs::remove_all(dir);
 }

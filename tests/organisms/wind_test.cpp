@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "lsystem/turtle.h"
 #include "organisms/wind.h"
 #include "tests/organisms/internode.h"
 
@@ -114,4 +115,37 @@ TEST_CASE("swayInWind: no popping between frames", "[organisms][wind]") {
   std::printf("wind 15 m/s: largest move of a point between frames at 12 fps %.4f (tree height 4)\n", worst);
   CHECK(worst > 0.0);
   CHECK(worst < 0.04 * 4.0);
+}
+
+TEST_CASE("swayInWind: cpfg's textured cylinders follow their internode without flutter", "[organisms][wind]") {
+  // A textured cylinder (a mesh organ) continuing the trunk's top internode, beside a leaf
+  // hanging on the same internode; the trunk tip's rotation carries both, the leaf flutters.
+  Skeleton sk = windTree();
+  const DVec3 top = sk.internodes[3].end;
+  lsystem::Organ tube;
+  tube.kind = lsystem::Organ::Kind::Surface;
+  tube.name = lsystem::kTexturedCylinderName;
+  tube.texture = 0;
+  tube.position = top;
+  tube.heading = DVec3(0, 1, 0);
+  tube.points = {top + DVec3(0.1, 0, 0), top + DVec3(0.1, 1, 0)};
+  tube.normals = {DVec3(1, 0, 0), DVec3(1, 0, 0)};
+  tube.internode = 3;
+  lsystem::Organ leaf = tube;
+  leaf.name = "a";
+  sk.organs.push_back(tube);
+  sk.organs.push_back(leaf);
+  const Skeleton a = swayInWind(sk, wind(12), 0.7);
+  const lsystem::Organ& t = a.organs[3];
+  const lsystem::Organ& l = a.organs[4];
+  // The tube's axis stays the trunk's continuation: its points are the internode's tip plus
+  // the tip's own rotation of their offsets, so the tube's direction is the internode's.
+  const DVec3 dir = glm::normalize(a.internodes[3].end - a.internodes[3].start);
+  CHECK(glm::length(glm::normalize(t.points[1] - t.points[0]) - dir) < 1e-9);
+  CHECK(glm::length(t.position - a.internodes[3].end) < 1e-12);
+  // Its normals turn with it (perpendicular to the axis, unit length).
+  CHECK(std::abs(glm::dot(t.normals[0], dir)) < 1e-9);
+  CHECK(glm::length(t.normals[0]) == Approx(1.0));
+  // The leaf on the same internode flutters away from that direction.
+  CHECK(glm::length(glm::normalize(l.points[1] - l.points[0]) - dir) > 1e-4);
 }
