@@ -203,12 +203,46 @@ void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* 
       for (int i = 0; i < pts.n8; ++i) out[i] *= -n.weight;
       return;
     case NodeKind::Bend: {
+      // Only the points that may reach the child's support (inside the bend's world box and
+      // its oriented box, BendFrame::mayReach) are mapped, an atan2 and a square root each,
+      // and evaluated; the others get 0, as evalS's culling gives them (the child is 0
+      // outside its support's image).
+      const BendFrame& bend = params(T, n).bend;
       alignas(32) float lx[kBlock], ly[kBlock], lz[kBlock];
-      params(T, n).bend.localFromWorld(pts.x, pts.y, pts.z, lx, ly, lz, pts.n8);
+      alignas(32) float cx[kBlock], cy[kBlock], cz[kBlock];
+      uint16_t at[kBlock];
+      const bool inBox = n.box.contains(pbox.lo) && n.box.contains(pbox.hi);
+      int m = 0;
+      for (int i = 0; i < pts.n; ++i) {
+        const float x = pts.x[i], y = pts.y[i], z = pts.z[i];
+        cx[m] = x;
+        cy[m] = y;
+        cz[m] = z;
+        at[m] = uint16_t(i);
+        m += (inBox || n.box.contains(Vec3(x, y, z))) && bend.mayReach(x, y, z) ? 1 : 0;
+      }
+      if (m == pts.n) {
+        bend.localFromWorld(pts.x, pts.y, pts.z, lx, ly, lz, pts.n8);
+        Box3 lb;
+        for (int i = 0; i < pts.n8; ++i) lb.extend(Vec3(lx[i], ly[i], lz[i]));
+        Pts lp{lx, ly, lz, pts.n, pts.n8};
+        evalB(T, T.kids[n.first], lp, lb, out);
+        return;
+      }
+      std::fill(out, out + pts.n8, 0.0f);
+      if (m == 0) return;
+      const int m8 = (m + 7) & ~7;
+      for (int i = m; i < m8; ++i) {
+        cx[i] = cx[m - 1];
+        cy[i] = cy[m - 1];
+        cz[i] = cz[m - 1];
+      }
+      bend.localFromWorld(cx, cy, cz, lx, ly, lz, m8);
       Box3 lb;
-      for (int i = 0; i < pts.n8; ++i) lb.extend(Vec3(lx[i], ly[i], lz[i]));
-      Pts lp{lx, ly, lz, pts.n, pts.n8};
-      evalB(T, T.kids[n.first], lp, lb, out);
+      for (int i = 0; i < m; ++i) lb.extend(Vec3(lx[i], ly[i], lz[i]));
+      Pts lp{lx, ly, lz, m, m8};
+      evalB(T, T.kids[n.first], lp, lb, tmp);
+      for (int k = 0; k < m; ++k) out[at[k]] = tmp[k];
       return;
     }
     case NodeKind::Transform:
