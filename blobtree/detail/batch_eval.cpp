@@ -101,6 +101,37 @@ void primBatch(const Prim& P, const Pts& pts, float* out) {
   }
 }
 
+/// The box of count points (count a multiple of 4, > 0) given as coordinate arrays: the
+/// same box as Box3::extend point by point, four lanes per SSE min/max.
+Box3 boxOfPoints(const float* x, const float* y, const float* z, int count) {
+  __m128 lx = _mm_loadu_ps(x), ly = _mm_loadu_ps(y), lz = _mm_loadu_ps(z);
+  __m128 hx = lx, hy = ly, hz = lz;
+  for (int i = 4; i < count; i += 4) {
+    const __m128 px = _mm_loadu_ps(x + i), py = _mm_loadu_ps(y + i), pz = _mm_loadu_ps(z + i);
+    lx = _mm_min_ps(lx, px);
+    ly = _mm_min_ps(ly, py);
+    lz = _mm_min_ps(lz, pz);
+    hx = _mm_max_ps(hx, px);
+    hy = _mm_max_ps(hy, py);
+    hz = _mm_max_ps(hz, pz);
+  }
+  alignas(16) float a[6][4];
+  _mm_store_ps(a[0], lx);
+  _mm_store_ps(a[1], ly);
+  _mm_store_ps(a[2], lz);
+  _mm_store_ps(a[3], hx);
+  _mm_store_ps(a[4], hy);
+  _mm_store_ps(a[5], hz);
+  Box3 b;
+  b.lo = Vec3(std::min(std::min(a[0][0], a[0][1]), std::min(a[0][2], a[0][3])),
+              std::min(std::min(a[1][0], a[1][1]), std::min(a[1][2], a[1][3])),
+              std::min(std::min(a[2][0], a[2][1]), std::min(a[2][2], a[2][3])));
+  b.hi = Vec3(std::max(std::max(a[3][0], a[3][1]), std::max(a[3][2], a[3][3])),
+              std::max(std::max(a[4][0], a[4][1]), std::max(a[4][2], a[4][3])),
+              std::max(std::max(a[5][0], a[5][1]), std::max(a[5][2], a[5][3])));
+  return b;
+}
+
 void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* out) {
   const TNode& n = T.nodes[ni];
   if (!pbox.overlaps(n.box)) {
@@ -223,8 +254,7 @@ void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* 
       }
       if (m == pts.n) {
         bend.localFromWorld(pts.x, pts.y, pts.z, lx, ly, lz, pts.n8);
-        Box3 lb;
-        for (int i = 0; i < pts.n8; ++i) lb.extend(Vec3(lx[i], ly[i], lz[i]));
+        const Box3 lb = boxOfPoints(lx, ly, lz, pts.n8);
         Pts lp{lx, ly, lz, pts.n, pts.n8};
         evalB(T, T.kids[n.first], lp, lb, out);
         return;
@@ -238,8 +268,7 @@ void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* 
         cz[i] = cz[m - 1];
       }
       bend.localFromWorld(cx, cy, cz, lx, ly, lz, m8);
-      Box3 lb;
-      for (int i = 0; i < m; ++i) lb.extend(Vec3(lx[i], ly[i], lz[i]));
+      const Box3 lb = boxOfPoints(lx, ly, lz, m8);  // lanes m..m8 repeat lane m - 1
       Pts lp{lx, ly, lz, m, m8};
       evalB(T, T.kids[n.first], lp, lb, tmp);
       for (int k = 0; k < m; ++k) out[at[k]] = tmp[k];
