@@ -132,6 +132,28 @@ Box3 boxOfPoints(const float* x, const float* y, const float* z, int count) {
   return b;
 }
 
+/// Bits 0-3: which of the four points x[0..3], y[0..3], z[0..3] lie in world box b and, when
+/// the frame is bounded, in the bend's oriented support box (BendFrame::mayReach's test).
+inline int mayReach4(const BendFrame& f, const Box3& b, const float* x, const float* y, const float* z) {
+  const __m128 px = _mm_loadu_ps(x), py = _mm_loadu_ps(y), pz = _mm_loadu_ps(z);
+  __m128 in = _mm_and_ps(_mm_and_ps(_mm_cmpge_ps(px, _mm_set1_ps(b.lo.x)), _mm_cmple_ps(px, _mm_set1_ps(b.hi.x))),
+                         _mm_and_ps(_mm_cmpge_ps(py, _mm_set1_ps(b.lo.y)), _mm_cmple_ps(py, _mm_set1_ps(b.hi.y))));
+  in = _mm_and_ps(in, _mm_and_ps(_mm_cmpge_ps(pz, _mm_set1_ps(b.lo.z)), _mm_cmple_ps(pz, _mm_set1_ps(b.hi.z))));
+  if (f.bounded) {
+    const __m128 rx = _mm_sub_ps(px, _mm_set1_ps(f.C.x)), ry = _mm_sub_ps(py, _mm_set1_ps(f.C.y)),
+                 rz = _mm_sub_ps(pz, _mm_set1_ps(f.C.z));
+    auto dot = [&](const Vec3& a) {
+      return _mm_add_ps(_mm_add_ps(_mm_mul_ps(rx, _mm_set1_ps(a.x)), _mm_mul_ps(ry, _mm_set1_ps(a.y))),
+                        _mm_mul_ps(rz, _mm_set1_ps(a.z)));
+    };
+    const __m128 uu = dot(f.u), vv = dot(f.n), ww = dot(f.z);
+    in = _mm_and_ps(in, _mm_and_ps(_mm_cmpge_ps(uu, _mm_set1_ps(f.uLo)), _mm_cmple_ps(uu, _mm_set1_ps(f.uHi))));
+    in = _mm_and_ps(in, _mm_and_ps(_mm_cmpge_ps(vv, _mm_set1_ps(f.vLo)), _mm_cmple_ps(vv, _mm_set1_ps(f.vHi))));
+    in = _mm_and_ps(in, _mm_and_ps(_mm_cmpge_ps(ww, _mm_set1_ps(f.wLo)), _mm_cmple_ps(ww, _mm_set1_ps(f.wHi))));
+  }
+  return _mm_movemask_ps(in);
+}
+
 void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* out) {
   const TNode& n = T.nodes[ni];
   if (!pbox.overlaps(n.box)) {
@@ -241,17 +263,12 @@ void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* 
       const BendFrame& bend = params(T, n).bend;
       alignas(32) float lx[kBlock], ly[kBlock], lz[kBlock];
       alignas(32) float cx[kBlock], cy[kBlock], cz[kBlock];
-      uint16_t at[kBlock];
-      const bool inBox = n.box.contains(pbox.lo) && n.box.contains(pbox.hi);
+      uint64_t bits[kBlock / 64] = {};
+      for (int i = 0; i < pts.n8; i += 4)
+        bits[i >> 6] |= uint64_t(mayReach4(bend, n.box, pts.x + i, pts.y + i, pts.z + i)) << (i & 63);
+      if (pts.n & 63) bits[pts.n >> 6] &= (uint64_t(1) << (pts.n & 63)) - 1;  // padding lanes
       int m = 0;
-      for (int i = 0; i < pts.n; ++i) {
-        const float x = pts.x[i], y = pts.y[i], z = pts.z[i];
-        cx[m] = x;
-        cy[m] = y;
-        cz[m] = z;
-        at[m] = uint16_t(i);
-        m += (inBox || n.box.contains(Vec3(x, y, z))) && bend.mayReach(x, y, z) ? 1 : 0;
-      }
+      for (uint64_t w : bits) m += __builtin_popcountll(w);
       if (m == pts.n) {
         bend.localFromWorld(pts.x, pts.y, pts.z, lx, ly, lz, pts.n8);
         const Box3 lb = boxOfPoints(lx, ly, lz, pts.n8);
@@ -261,6 +278,16 @@ void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* 
       }
       std::fill(out, out + pts.n8, 0.0f);
       if (m == 0) return;
+      uint16_t at[kBlock];
+      m = 0;
+      for (int k = 0; k < kBlock / 64; ++k)
+        for (uint64_t w = bits[k]; w != 0; w &= w - 1) {
+          const int i = k * 64 + __builtin_ctzll(w);
+          cx[m] = pts.x[i];
+          cy[m] = pts.y[i];
+          cz[m] = pts.z[i];
+          at[m++] = uint16_t(i);
+        }
       const int m8 = (m + 7) & ~7;
       for (int i = m; i < m8; ++i) {
         cx[i] = cx[m - 1];
