@@ -154,6 +154,45 @@ inline int mayReach4(const BendFrame& f, const Box3& b, const float* x, const fl
   return _mm_movemask_ps(in);
 }
 
+/// One child's step of PcmAccum (pcmD, then PcmAccum::add) for four points in SSE: the
+/// scalar code's operations in the same order, branches as blends, so the same bits.
+struct PcmStep4 {
+  explicit PcmStep4(const PcmDerived& d)
+      : c(_mm_set1_ps(d.c)), w(_mm_set1_ps(d.w)), half(_mm_set1_ps(0.5f * d.w)),
+        kHalf(_mm_set1_ps(d.k * (0.5f * d.w))), a0(_mm_set1_ps(d.a0)) {}
+
+  /// Adds child values fc[0..3] to the accumulators (f1, d1, f2, d2, bulge).
+  void add(const float* fc, float* f1p, float* d1p, float* f2p, float* d2p, float* bulgep) const {
+    const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), two = _mm_set1_ps(2.0f), three = _mm_set1_ps(3.0f);
+    const __m128 f = _mm_max_ps(_mm_loadu_ps(fc), zero);  // std::max(0, f): +0 for −0 and NaN
+    const __m128 x = _mm_sub_ps(c, f);
+    // pcmH on [0, half]: kHalf·H10 + a0·H01 with t = x / half.
+    __m128 t = _mm_div_ps(x, half);
+    __m128 t2 = _mm_mul_ps(t, t), t3 = _mm_mul_ps(t2, t);
+    const __m128 H10 = _mm_add_ps(_mm_sub_ps(t3, _mm_mul_ps(two, t2)), t);
+    const __m128 H01 = _mm_add_ps(_mm_mul_ps(_mm_set1_ps(-2.0f), t3), _mm_mul_ps(three, t2));
+    const __m128 near = _mm_add_ps(_mm_mul_ps(kHalf, H10), _mm_mul_ps(a0, H01));
+    // pcmH on (half, w]: a0·H00 with t = (x − half) / half.
+    t = _mm_div_ps(_mm_sub_ps(x, half), half);
+    t2 = _mm_mul_ps(t, t);
+    t3 = _mm_mul_ps(t2, t);
+    const __m128 far = _mm_mul_ps(a0, _mm_add_ps(_mm_sub_ps(_mm_mul_ps(two, t3), _mm_mul_ps(three, t2)), one));
+    __m128 d = _mm_blendv_ps(far, near, _mm_cmple_ps(x, half));
+    d = _mm_blendv_ps(d, zero, _mm_cmpge_ps(x, w));
+    d = _mm_blendv_ps(d, x, _mm_cmplt_ps(x, zero));
+    // PcmAccum::add.
+    _mm_storeu_ps(bulgep, _mm_add_ps(_mm_loadu_ps(bulgep), _mm_max_ps(d, zero)));
+    const __m128 f1 = _mm_loadu_ps(f1p), d1 = _mm_loadu_ps(d1p), f2 = _mm_loadu_ps(f2p), d2 = _mm_loadu_ps(d2p);
+    const __m128 gt1 = _mm_cmpgt_ps(f, f1), gt2 = _mm_cmpgt_ps(f, f2);
+    _mm_storeu_ps(f2p, _mm_blendv_ps(_mm_blendv_ps(f2, f, gt2), f1, gt1));
+    _mm_storeu_ps(d2p, _mm_blendv_ps(_mm_blendv_ps(d2, d, gt2), d1, gt1));
+    _mm_storeu_ps(f1p, _mm_blendv_ps(f1, f, gt1));
+    _mm_storeu_ps(d1p, _mm_blendv_ps(d1, d, gt1));
+  }
+
+  __m128 c, w, half, kHalf, a0;
+};
+
 void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* out) {
   const TNode& n = T.nodes[ni];
   if (!pbox.overlaps(n.box)) {
@@ -228,22 +267,10 @@ void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* 
       std::fill(f2, f2 + pts.n8, 0.0f);
       std::fill(d2, d2 + pts.n8, 0.0f);
       std::fill(bulge, bulge + pts.n8, 0.0f);
+      const PcmStep4 step(params(T, n).pcm);
       childrenIn(T, n, pbox, [&](uint32_t c) {
         evalB(T, c, pts, pbox, tmp);
-        for (int i = 0; i < pts.n; ++i) {
-          float f = std::max(0.0f, tmp[i]);
-          float d = pcmD(params(T, n).pcm, f, nullptr);
-          bulge[i] += std::max(0.0f, d);
-          if (f > out[i]) {
-            f2[i] = out[i];
-            d2[i] = d1[i];
-            out[i] = f;
-            d1[i] = d;
-          } else if (f > f2[i]) {
-            f2[i] = f;
-            d2[i] = d;
-          }
-        }
+        for (int i = 0; i < pts.n8; i += 4) step.add(tmp + i, out + i, d1 + i, f2 + i, d2 + i, bulge + i);
       });
       for (int i = 0; i < pts.n; ++i) {
         const PcmAccum acc{out[i], d1[i], f2[i], d2[i], bulge[i]};
