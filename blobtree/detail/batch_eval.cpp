@@ -101,6 +101,98 @@ void primBatch(const Prim& P, const Pts& pts, float* out) {
   }
 }
 
+/// The box of count points (count a multiple of 4, > 0) given as coordinate arrays: the
+/// same box as Box3::extend point by point, four lanes per SSE min/max.
+Box3 boxOfPoints(const float* x, const float* y, const float* z, int count) {
+  __m128 lx = _mm_loadu_ps(x), ly = _mm_loadu_ps(y), lz = _mm_loadu_ps(z);
+  __m128 hx = lx, hy = ly, hz = lz;
+  for (int i = 4; i < count; i += 4) {
+    const __m128 px = _mm_loadu_ps(x + i), py = _mm_loadu_ps(y + i), pz = _mm_loadu_ps(z + i);
+    lx = _mm_min_ps(lx, px);
+    ly = _mm_min_ps(ly, py);
+    lz = _mm_min_ps(lz, pz);
+    hx = _mm_max_ps(hx, px);
+    hy = _mm_max_ps(hy, py);
+    hz = _mm_max_ps(hz, pz);
+  }
+  alignas(16) float a[6][4];
+  _mm_store_ps(a[0], lx);
+  _mm_store_ps(a[1], ly);
+  _mm_store_ps(a[2], lz);
+  _mm_store_ps(a[3], hx);
+  _mm_store_ps(a[4], hy);
+  _mm_store_ps(a[5], hz);
+  Box3 b;
+  b.lo = Vec3(std::min(std::min(a[0][0], a[0][1]), std::min(a[0][2], a[0][3])),
+              std::min(std::min(a[1][0], a[1][1]), std::min(a[1][2], a[1][3])),
+              std::min(std::min(a[2][0], a[2][1]), std::min(a[2][2], a[2][3])));
+  b.hi = Vec3(std::max(std::max(a[3][0], a[3][1]), std::max(a[3][2], a[3][3])),
+              std::max(std::max(a[4][0], a[4][1]), std::max(a[4][2], a[4][3])),
+              std::max(std::max(a[5][0], a[5][1]), std::max(a[5][2], a[5][3])));
+  return b;
+}
+
+/// Bits 0-3: which of the four points x[0..3], y[0..3], z[0..3] lie in world box b and, when
+/// the frame is bounded, in the bend's oriented support box (BendFrame::mayReach's test).
+inline int mayReach4(const BendFrame& f, const Box3& b, const float* x, const float* y, const float* z) {
+  const __m128 px = _mm_loadu_ps(x), py = _mm_loadu_ps(y), pz = _mm_loadu_ps(z);
+  __m128 in = _mm_and_ps(_mm_and_ps(_mm_cmpge_ps(px, _mm_set1_ps(b.lo.x)), _mm_cmple_ps(px, _mm_set1_ps(b.hi.x))),
+                         _mm_and_ps(_mm_cmpge_ps(py, _mm_set1_ps(b.lo.y)), _mm_cmple_ps(py, _mm_set1_ps(b.hi.y))));
+  in = _mm_and_ps(in, _mm_and_ps(_mm_cmpge_ps(pz, _mm_set1_ps(b.lo.z)), _mm_cmple_ps(pz, _mm_set1_ps(b.hi.z))));
+  if (f.bounded) {
+    const __m128 rx = _mm_sub_ps(px, _mm_set1_ps(f.C.x)), ry = _mm_sub_ps(py, _mm_set1_ps(f.C.y)),
+                 rz = _mm_sub_ps(pz, _mm_set1_ps(f.C.z));
+    auto dot = [&](const Vec3& a) {
+      return _mm_add_ps(_mm_add_ps(_mm_mul_ps(rx, _mm_set1_ps(a.x)), _mm_mul_ps(ry, _mm_set1_ps(a.y))),
+                        _mm_mul_ps(rz, _mm_set1_ps(a.z)));
+    };
+    const __m128 uu = dot(f.u), vv = dot(f.n), ww = dot(f.z);
+    in = _mm_and_ps(in, _mm_and_ps(_mm_cmpge_ps(uu, _mm_set1_ps(f.uLo)), _mm_cmple_ps(uu, _mm_set1_ps(f.uHi))));
+    in = _mm_and_ps(in, _mm_and_ps(_mm_cmpge_ps(vv, _mm_set1_ps(f.vLo)), _mm_cmple_ps(vv, _mm_set1_ps(f.vHi))));
+    in = _mm_and_ps(in, _mm_and_ps(_mm_cmpge_ps(ww, _mm_set1_ps(f.wLo)), _mm_cmple_ps(ww, _mm_set1_ps(f.wHi))));
+  }
+  return _mm_movemask_ps(in);
+}
+
+/// One child's step of PcmAccum (pcmD, then PcmAccum::add) for four points in SSE: the
+/// scalar code's operations in the same order, branches as blends, so the same bits.
+struct PcmStep4 {
+  explicit PcmStep4(const PcmDerived& d)
+      : c(_mm_set1_ps(d.c)), w(_mm_set1_ps(d.w)), half(_mm_set1_ps(0.5f * d.w)),
+        kHalf(_mm_set1_ps(d.k * (0.5f * d.w))), a0(_mm_set1_ps(d.a0)) {}
+
+  /// Adds child values fc[0..3] to the accumulators (f1, d1, f2, d2, bulge).
+  void add(const float* fc, float* f1p, float* d1p, float* f2p, float* d2p, float* bulgep) const {
+    const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), two = _mm_set1_ps(2.0f), three = _mm_set1_ps(3.0f);
+    const __m128 f = _mm_max_ps(_mm_loadu_ps(fc), zero);  // std::max(0, f): +0 for −0 and NaN
+    const __m128 x = _mm_sub_ps(c, f);
+    // pcmH on [0, half]: kHalf·H10 + a0·H01 with t = x / half.
+    __m128 t = _mm_div_ps(x, half);
+    __m128 t2 = _mm_mul_ps(t, t), t3 = _mm_mul_ps(t2, t);
+    const __m128 H10 = _mm_add_ps(_mm_sub_ps(t3, _mm_mul_ps(two, t2)), t);
+    const __m128 H01 = _mm_add_ps(_mm_mul_ps(_mm_set1_ps(-2.0f), t3), _mm_mul_ps(three, t2));
+    const __m128 near = _mm_add_ps(_mm_mul_ps(kHalf, H10), _mm_mul_ps(a0, H01));
+    // pcmH on (half, w]: a0·H00 with t = (x − half) / half.
+    t = _mm_div_ps(_mm_sub_ps(x, half), half);
+    t2 = _mm_mul_ps(t, t);
+    t3 = _mm_mul_ps(t2, t);
+    const __m128 far = _mm_mul_ps(a0, _mm_add_ps(_mm_sub_ps(_mm_mul_ps(two, t3), _mm_mul_ps(three, t2)), one));
+    __m128 d = _mm_blendv_ps(far, near, _mm_cmple_ps(x, half));
+    d = _mm_blendv_ps(d, zero, _mm_cmpge_ps(x, w));
+    d = _mm_blendv_ps(d, x, _mm_cmplt_ps(x, zero));
+    // PcmAccum::add.
+    _mm_storeu_ps(bulgep, _mm_add_ps(_mm_loadu_ps(bulgep), _mm_max_ps(d, zero)));
+    const __m128 f1 = _mm_loadu_ps(f1p), d1 = _mm_loadu_ps(d1p), f2 = _mm_loadu_ps(f2p), d2 = _mm_loadu_ps(d2p);
+    const __m128 gt1 = _mm_cmpgt_ps(f, f1), gt2 = _mm_cmpgt_ps(f, f2);
+    _mm_storeu_ps(f2p, _mm_blendv_ps(_mm_blendv_ps(f2, f, gt2), f1, gt1));
+    _mm_storeu_ps(d2p, _mm_blendv_ps(_mm_blendv_ps(d2, d, gt2), d1, gt1));
+    _mm_storeu_ps(f1p, _mm_blendv_ps(f1, f, gt1));
+    _mm_storeu_ps(d1p, _mm_blendv_ps(d1, d, gt1));
+  }
+
+  __m128 c, w, half, kHalf, a0;
+};
+
 void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* out) {
   const TNode& n = T.nodes[ni];
   if (!pbox.overlaps(n.box)) {
@@ -175,22 +267,10 @@ void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* 
       std::fill(f2, f2 + pts.n8, 0.0f);
       std::fill(d2, d2 + pts.n8, 0.0f);
       std::fill(bulge, bulge + pts.n8, 0.0f);
+      const PcmStep4 step(params(T, n).pcm);
       childrenIn(T, n, pbox, [&](uint32_t c) {
         evalB(T, c, pts, pbox, tmp);
-        for (int i = 0; i < pts.n; ++i) {
-          float f = std::max(0.0f, tmp[i]);
-          float d = pcmD(params(T, n).pcm, f, nullptr);
-          bulge[i] += std::max(0.0f, d);
-          if (f > out[i]) {
-            f2[i] = out[i];
-            d2[i] = d1[i];
-            out[i] = f;
-            d1[i] = d;
-          } else if (f > f2[i]) {
-            f2[i] = f;
-            d2[i] = d;
-          }
-        }
+        for (int i = 0; i < pts.n8; i += 4) step.add(tmp + i, out + i, d1 + i, f2 + i, d2 + i, bulge + i);
       });
       for (int i = 0; i < pts.n; ++i) {
         const PcmAccum acc{out[i], d1[i], f2[i], d2[i], bulge[i]};
@@ -203,12 +283,49 @@ void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* 
       for (int i = 0; i < pts.n8; ++i) out[i] *= -n.weight;
       return;
     case NodeKind::Bend: {
+      // Only the points that may reach the child's support (inside the bend's world box and
+      // its oriented box, BendFrame::mayReach) are mapped, an atan2 and a square root each,
+      // and evaluated; the others get 0, as evalS's culling gives them (the child is 0
+      // outside its support's image).
+      const BendFrame& bend = params(T, n).bend;
       alignas(32) float lx[kBlock], ly[kBlock], lz[kBlock];
-      params(T, n).bend.localFromWorld(pts.x, pts.y, pts.z, lx, ly, lz, pts.n8);
-      Box3 lb;
-      for (int i = 0; i < pts.n8; ++i) lb.extend(Vec3(lx[i], ly[i], lz[i]));
-      Pts lp{lx, ly, lz, pts.n, pts.n8};
-      evalB(T, T.kids[n.first], lp, lb, out);
+      alignas(32) float cx[kBlock], cy[kBlock], cz[kBlock];
+      uint64_t bits[kBlock / 64] = {};
+      for (int i = 0; i < pts.n8; i += 4)
+        bits[i >> 6] |= uint64_t(mayReach4(bend, n.box, pts.x + i, pts.y + i, pts.z + i)) << (i & 63);
+      if (pts.n & 63) bits[pts.n >> 6] &= (uint64_t(1) << (pts.n & 63)) - 1;  // padding lanes
+      int m = 0;
+      for (uint64_t w : bits) m += __builtin_popcountll(w);
+      if (m == pts.n) {
+        bend.localFromWorld(pts.x, pts.y, pts.z, lx, ly, lz, pts.n8);
+        const Box3 lb = boxOfPoints(lx, ly, lz, pts.n8);
+        Pts lp{lx, ly, lz, pts.n, pts.n8};
+        evalB(T, T.kids[n.first], lp, lb, out);
+        return;
+      }
+      std::fill(out, out + pts.n8, 0.0f);
+      if (m == 0) return;
+      uint16_t at[kBlock];
+      m = 0;
+      for (int k = 0; k < kBlock / 64; ++k)
+        for (uint64_t w = bits[k]; w != 0; w &= w - 1) {
+          const int i = k * 64 + __builtin_ctzll(w);
+          cx[m] = pts.x[i];
+          cy[m] = pts.y[i];
+          cz[m] = pts.z[i];
+          at[m++] = uint16_t(i);
+        }
+      const int m8 = (m + 7) & ~7;
+      for (int i = m; i < m8; ++i) {
+        cx[i] = cx[m - 1];
+        cy[i] = cy[m - 1];
+        cz[i] = cz[m - 1];
+      }
+      bend.localFromWorld(cx, cy, cz, lx, ly, lz, m8);
+      const Box3 lb = boxOfPoints(lx, ly, lz, m8);  // lanes m..m8 repeat lane m - 1
+      Pts lp{lx, ly, lz, m, m8};
+      evalB(T, T.kids[n.first], lp, lb, tmp);
+      for (int k = 0; k < m; ++k) out[at[k]] = tmp[k];
       return;
     }
     case NodeKind::Transform:

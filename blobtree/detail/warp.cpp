@@ -4,6 +4,8 @@
 
 #include <glm/geometric.hpp>
 
+#include <smmintrin.h>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -46,6 +48,7 @@ BendFrame makeBendFrame(const Bend& b, const Box3& childBox) {
   if (xmax >= 0.98f * float(kPi) * f.rho * f.stretch)
     throw std::invalid_argument("bend: the child's support would wrap past a half turn");
   f.yMinChild = ymin;
+  f.setSupport(childBox);
   return f;
 }
 
@@ -120,7 +123,47 @@ void BendFrame::localFromWorld(const float* x, const float* y, const float* z, f
     std::copy(z, z + count, lz);
     return;
   }
-  for (int i = 0; i < count; ++i) bendLocal(*this, x[i], y[i], z[i], lx[i], ly[i], lz[i]);
+  // Four points per step: the operations of bendLocal and atan2Fast in the same order, each
+  // correctly rounded in SSE as in scalar code (no FMA on the x86-64-v2 target), so the
+  // same bits; the selects are blends.
+  const __m128 Cx = _mm_set1_ps(C.x), Cy = _mm_set1_ps(C.y), Cz = _mm_set1_ps(C.z);
+  const __m128 ux = _mm_set1_ps(u.x), uy = _mm_set1_ps(u.y), uz = _mm_set1_ps(u.z);
+  const __m128 nx = _mm_set1_ps(n.x), ny = _mm_set1_ps(n.y), nz = _mm_set1_ps(n.z);
+  const __m128 zx = _mm_set1_ps(this->z.x), zy = _mm_set1_ps(this->z.y), zz = _mm_set1_ps(this->z.z);
+  const __m128 Mx = _mm_set1_ps(M.x), My = _mm_set1_ps(M.y), Mz = _mm_set1_ps(M.z);
+  const __m128 k = _mm_set1_ps(rho * stretch), rhoV = _mm_set1_ps(rho);
+  const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), sign = _mm_set1_ps(-0.0f);
+  int i = 0;
+  for (; i + 4 <= count; i += 4) {
+    const __m128 rx = _mm_sub_ps(_mm_loadu_ps(x + i), Cx);
+    const __m128 ry = _mm_sub_ps(_mm_loadu_ps(y + i), Cy);
+    const __m128 rz = _mm_sub_ps(_mm_loadu_ps(z + i), Cz);
+    const __m128 uu = _mm_add_ps(_mm_add_ps(_mm_mul_ps(rx, ux), _mm_mul_ps(ry, uy)), _mm_mul_ps(rz, uz));
+    const __m128 vv = _mm_add_ps(_mm_add_ps(_mm_mul_ps(rx, nx), _mm_mul_ps(ry, ny)), _mm_mul_ps(rz, nz));
+    const __m128 ww = _mm_add_ps(_mm_add_ps(_mm_mul_ps(rx, zx), _mm_mul_ps(ry, zy)), _mm_mul_ps(rz, zz));
+    const __m128 rp = _mm_sqrt_ps(_mm_add_ps(_mm_mul_ps(uu, uu), _mm_mul_ps(vv, vv)));
+    // atan2Fast(uu, vv)
+    const __m128 ax = _mm_andnot_ps(sign, vv), ay = _mm_andnot_ps(sign, uu);
+    const __m128 mx = _mm_max_ps(ax, ay), mn = _mm_min_ps(ax, ay);
+    __m128 a = _mm_div_ps(mn, _mm_blendv_ps(one, mx, _mm_cmpgt_ps(mx, zero)));
+    const __m128 upper = _mm_cmpgt_ps(a, _mm_set1_ps(0.41421356f));
+    const __m128 reduced = _mm_div_ps(_mm_sub_ps(a, one), _mm_add_ps(a, one));
+    a = _mm_blendv_ps(a, reduced, upper);
+    const __m128 w2 = _mm_mul_ps(a, a);
+    __m128 r = _mm_sub_ps(_mm_mul_ps(_mm_set1_ps(8.05374449538e-2f), w2), _mm_set1_ps(1.38776856032e-1f));
+    r = _mm_add_ps(_mm_mul_ps(r, w2), _mm_set1_ps(1.99777106478e-1f));
+    r = _mm_sub_ps(_mm_mul_ps(r, w2), _mm_set1_ps(3.33329491539e-1f));
+    r = _mm_add_ps(_mm_mul_ps(_mm_mul_ps(r, w2), a), a);
+    r = _mm_blendv_ps(r, _mm_add_ps(r, _mm_set1_ps(0.78539816f)), upper);
+    r = _mm_blendv_ps(r, _mm_sub_ps(_mm_set1_ps(1.57079633f), r), _mm_cmpgt_ps(ay, ax));
+    r = _mm_blendv_ps(r, _mm_sub_ps(_mm_set1_ps(3.14159265f), r), _mm_cmplt_ps(vv, zero));
+    r = _mm_blendv_ps(r, _mm_xor_ps(r, sign), _mm_cmplt_ps(uu, zero));
+    const __m128 px = _mm_mul_ps(r, k), py = _mm_sub_ps(rp, rhoV);
+    _mm_storeu_ps(lx + i, _mm_add_ps(_mm_add_ps(_mm_add_ps(Mx, _mm_mul_ps(px, ux)), _mm_mul_ps(py, nx)), _mm_mul_ps(ww, zx)));
+    _mm_storeu_ps(ly + i, _mm_add_ps(_mm_add_ps(_mm_add_ps(My, _mm_mul_ps(px, uy)), _mm_mul_ps(py, ny)), _mm_mul_ps(ww, zy)));
+    _mm_storeu_ps(lz + i, _mm_add_ps(_mm_add_ps(_mm_add_ps(Mz, _mm_mul_ps(px, uz)), _mm_mul_ps(py, nz)), _mm_mul_ps(ww, zz)));
+  }
+  for (; i < count; ++i) bendLocal(*this, x[i], y[i], z[i], lx[i], ly[i], lz[i]);
 }
 
 Vec3 BendFrame::worldFromLocal(Vec3 q) const {
@@ -158,14 +201,15 @@ float rectMinDist(Range U, Range V) {
 }
 }  // namespace
 
-Box3 BendFrame::worldBox(const Box3& childBox) const {
-  if (straight || childBox.empty() || isHuge(childBox)) return childBox;
-  Range x, y, w;
-  frameRanges(childBox, M, u, n, z, x, y, w);
-  float k = 1.0f / (rho * stretch);
+namespace {
+/// The image of childBox under the bend, in the frame about C: U along u, V along n (both
+/// widened for rounding) and w along z.
+void supportRanges(const BendFrame& f, const Box3& childBox, Range& U, Range& V, Range& w) {
+  Range x, y;
+  frameRanges(childBox, f.M, f.u, f.n, f.z, x, y, w);
+  float k = 1.0f / (f.rho * f.stretch);
   float th0 = x.lo * k, th1 = x.hi * k;
-  float r0 = rho + y.lo, r1 = rho + y.hi;
-  Range U, V;
+  float r0 = f.rho + y.lo, r1 = f.rho + y.hi;
   const float pi = float(kPi);
   float angles[7] = {th0, th1, -pi, -0.5f * pi, 0.0f, 0.5f * pi, pi};
   for (float a : angles) {
@@ -178,7 +222,32 @@ Box3 BendFrame::worldBox(const Box3& childBox) const {
   // Inflate slightly for rounding.
   float eps = 1e-5f * (r1 + 1.0f);
   U.lo -= eps; U.hi += eps; V.lo -= eps; V.hi += eps;
+}
+}  // namespace
+
+Box3 BendFrame::worldBox(const Box3& childBox) const {
+  if (straight || childBox.empty() || isHuge(childBox)) return childBox;
+  Range U, V, w;
+  supportRanges(*this, childBox, U, V, w);
   return boxFromFrame(C, u, n, z, U, V, w);
+}
+
+void BendFrame::setSupport(const Box3& childBox) {
+  bounded = false;
+  if (straight || childBox.empty() || isHuge(childBox)) return;
+  Range U, V, w;
+  supportRanges(*this, childBox, U, V, w);
+  // w is measured from M in supportRanges and from C in mayReach (C − M is along n, so
+  // the same in exact arithmetic): widen it as U and V are.
+  const float eps = 1e-5f * (std::max(std::abs(U.lo), std::abs(U.hi)) + std::max(std::abs(V.lo), std::abs(V.hi)) +
+                             std::max(std::abs(w.lo), std::abs(w.hi)) + 1.0f);
+  uLo = U.lo - eps;
+  uHi = U.hi + eps;
+  vLo = V.lo - eps;
+  vHi = V.hi + eps;
+  wLo = w.lo - eps;
+  wHi = w.hi + eps;
+  bounded = true;
 }
 
 Box3 BendFrame::localBox(const Box3& worldB, const Box3& childBox) const {

@@ -3,6 +3,7 @@
 #include "blobtree/blobtree.h"
 #include "blobtree/compiled.h"
 #include "blobtree/detail/field.h"
+#include "blobtree/detail/warp.h"
 #include "blobtree/polygonize.h"
 #include "core/mesh_clean.h"
 #include "core/rng.h"
@@ -438,6 +439,71 @@ TEST_CASE("BlobTree::bend", "[blobtree]") {
     CHECK(k.value(b) == Approx(1.0f).margin(1e-5));
     CHECK(k.value(Vec3(2, 2, 0)) == Approx(1.0f).margin(1e-5));
     CHECK(k.value(Vec3(1, 2, 0)) < 0.5f);  // the straight middle is now outside
+  }
+  SECTION("BendFrame::localFromWorld over arrays (4 points per SSE step) gives the point map's bits") {
+    Rng rng(43);
+    for (int k = 0; k < 20; ++k) {
+      Vec3 p0(float(rng.uniform(-2, 2)), float(rng.uniform(-2, 2)), float(rng.uniform(-2, 2)));
+      Vec3 p1 = p0 + Vec3(float(rng.uniform(-2, 2)), float(rng.uniform(-2, 2)), float(rng.uniform(-2, 2)));
+      Bend bd = Bend::fromAngle(p0, p1, Vec3(0.2f, 1, -0.4f), float(rng.uniform(0.01, 2.5)));
+      const detail::BendFrame f = detail::makeBendFrame(bd, Box3{});
+      // 4,003 points (a scalar tail): around the chord, far away in every quadrant of the
+      // bend plane, and on the frame's axes through the centre (atan2's special cases).
+      std::vector<float> x, y, z;
+      auto add = [&](Vec3 p) {
+        x.push_back(p.x);
+        y.push_back(p.y);
+        z.push_back(p.z);
+      };
+      for (int i = 0; i < 3000; ++i) {
+        float s = i < 1000 ? 0.5f : (i < 2000 ? 5.0f : 50.0f);
+        add(glm::mix(p0, p1, float(rng.uniform())) +
+            s * Vec3(float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1))));
+      }
+      for (int i = 0; i < 1003; ++i) {
+        float t = float(rng.uniform(-3, 3));
+        add(f.C + t * (i % 3 == 0 ? f.u : (i % 3 == 1 ? f.n : f.u + f.n)));
+      }
+      std::vector<float> lx(x.size()), ly(x.size()), lz(x.size());
+      f.localFromWorld(x.data(), y.data(), z.data(), lx.data(), ly.data(), lz.data(), int(x.size()));
+      int differ = 0;
+      for (size_t i = 0; i < x.size(); ++i) {
+        Vec3 q = f.localFromWorld(Vec3(x[i], y[i], z[i]));
+        differ += q.x != lx[i] || q.y != ly[i] || q.z != lz[i];
+      }
+      CHECK(differ == 0);
+    }
+  }
+  SECTION("BendFrame::mayReach is conservative: the child is exactly 0 wherever it says no") {
+    Rng rng(41);
+    int rejectedInBox = 0;
+    for (int k = 0; k < 40; ++k) {
+      BlobTree t;
+      Vec3 p0(float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1)));
+      Vec3 dir = glm::normalize(Vec3(float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1))));
+      Vec3 p1 = p0 + float(rng.uniform(0.5, 2.0)) * dir;
+      NodeId cone = t.cone(p0, p1, float(rng.uniform(0.05, 0.2)), float(rng.uniform(0.03, 0.1)));
+      Bend bd = Bend::fromAngle(p0, p1, glm::cross(dir, Vec3(0.3f, 1, 0.2f)), float(rng.uniform(0.05, 0.8)));
+      const Box3 childBox = t.node(cone).bounds;
+      const detail::BendFrame f = detail::makeBendFrame(bd, childBox);
+      REQUIRE(f.bounded);
+      const Box3 world = f.worldBox(childBox);
+      const Box3 around = world.expanded(0.1f * glm::length(world.size()));
+      for (int i = 0; i < 4000; ++i) {
+        Vec3 p(float(rng.uniform(around.lo.x, around.hi.x)), float(rng.uniform(around.lo.y, around.hi.y)),
+               float(rng.uniform(around.lo.z, around.hi.z)));
+        if (f.mayReach(p.x, p.y, p.z)) continue;
+        rejectedInBox += world.contains(p);
+        INFO("bend " << k << ", p = (" << p.x << ", " << p.y << ", " << p.z << ")");
+        CHECK(t.value(cone, f.localFromWorld(p)) == 0.0f);
+      }
+      // On the support itself (the bent axis) it says yes.
+      for (int i = 0; i <= 20; ++i) {
+        Vec3 q = f.worldFromLocal(glm::mix(p0, p1, float(i) / 20.0f));
+        CHECK(f.mayReach(q.x, q.y, q.z));
+      }
+    }
+    CHECK(rejectedInBox > 10000);  // tighter than the world box of slanted bends
   }
   SECTION("a support that would reach the bend centre is refused") {
     BlobTree t;
