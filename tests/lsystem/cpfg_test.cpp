@@ -657,14 +657,90 @@ TEST_CASE("cpfg sub-L-systems", "[lsystem][cpfg]") {
     // Step 2: the inner A is in L-system 1 again.
     CHECK(formatModuleString(d.step(), d.symbols()) == "?(2)?(1)AX$$AXX");
   }
+  SECTION("tests/assets/cpfg/sub_lsystem_rules: each L-system's decomposition, interpretation and ignore: inside its calls") {
+    Grammar g = loadGrammar(cpfgAsset("sub_lsystem_rules/plant.l"));
+    CHECK(g.hasInterpretation());
+    Deriver d(g);
+    CHECK(formatModuleString(d.current(), d.symbols()) == "A");
+    CHECK(formatModuleString(d.step(), d.symbols()) == "II[+?(2,0.5)B$]A");
+    CHECK(formatModuleString(d.step(), d.symbols()) == "IIII[+?(2,0.5)IWZK+B$]II[+?(2,0.5)B$]A");
+    const ModuleString& s = d.step();
+    CHECK(formatModuleString(s, d.symbols()) == "IIIIIIII[+?(2,0.5)IWZK+Q$]IIII[+?(2,0.5)IWZK+B$]II[+?(2,0.5)B$]A");
+    const ModuleString shown = d.interpret(s);
+    CHECK(formatModuleString(shown, d.symbols()) ==
+          "F(1)F(1)F(1)F(1)F(1)F(1)F(1)F(1)[+?(2,0.5)IF(2)?(3,2)F(5)$F(3)K+Q$]F(1)F(1)F(1)F(1)"
+          "[+?(2,0.5)IF(2)?(3,2)F(5)$F(3)K+B$]F(1)F(1)[+?(2,0.5)B$]A");
+    // Drawn with the view file's 90 degrees: L-system 2 at half scale, L-system 3 inside it
+    // at twice that (F(5) is 5 long), back to half after its '$' (F(3) is 1.5 long).
+    Drawn o = drawObject("sub_lsystem_rules", true);
+    std::vector<std::pair<DVec3, DVec3>> want;
+    auto axis = [&](double y0, int n) {
+      for (int k = 0; k < n; ++k) want.push_back({{0, y0 + k, 0}, {0, y0 + k + 1, 0}});
+    };
+    auto branch = [&](double y) {
+      want.push_back({{0, y, 0}, {-1, y, 0}});
+      want.push_back({{-1, y, 0}, {-6, y, 0}});
+      want.push_back({{-6, y, 0}, {-7.5, y, 0}});
+    };
+    axis(0, 8);
+    branch(8);
+    axis(8, 4);
+    branch(12);
+    axis(12, 2);
+    REQUIRE(o.skeleton.internodes.size() == want.size());
+    for (size_t k = 0; k < want.size(); ++k) {
+      INFO("internode " << k);
+      checkNear(o.skeleton.internodes[k].start, want[k].first);
+      checkNear(o.skeleton.internodes[k].end, want[k].second);
+    }
+    const double r0 = o.skeleton.internodes[0].baseRadius;
+    REQUIRE(r0 > 0);
+    CHECK(o.skeleton.internodes[8].baseRadius == Approx(0.5 * r0));
+    CHECK(o.skeleton.internodes[9].baseRadius == Approx(r0));
+    CHECK(o.skeleton.internodes[10].baseRadius == Approx(0.5 * r0));
+  }
+  SECTION("interpretation: each L-system's own maximum depth, and the rules of the L-system current at each module") {
+    const std::string head = "lsystem: 1\naxiom: W?(2)W$W\nhomomorphism\nmaximum depth: 5\nW --> V\nV --> F(1)\nendlsystem\n"
+                             "lsystem: 2\nhomomorphism\nW --> ?(3)I$V\nendlsystem\nlsystem: 3\nhomomorphism\n";
+    // Inside call 2, W --> ?(3)I$V at depth 0; I at depth 1 is L-system 3's, whose
+    // maximum depth (1 by default) stops it; V after the '$' is L-system 2's, which has no
+    // rule for it: only the main L-system's W's become F(1) (two levels).
+    Grammar shallow = parseGrammar(head + "I --> F(5)\nendlsystem\n", "t.l");
+    Deriver a(shallow);
+    CHECK(formatModuleString(a.interpret(a.current()), a.symbols()) == "F(1)?(2)?(3)I$V$F(1)");
+    Grammar deep = parseGrammar(head + "maximum depth: 2\nI --> F(5)\nendlsystem\n", "t.l");
+    Deriver b(deep);
+    CHECK(formatModuleString(b.interpret(b.current()), b.symbols()) == "F(1)?(2)?(3)F(5)$V$F(1)");
+    // A rule that replaces the call itself: the turtle never reaches the '?(2)', so what
+    // follows stays in the main L-system (cpfg switches on the modules it draws).
+    Grammar replaced = parseGrammar("lsystem: 1\naxiom: ?(2)W$\nhomomorphism\n?(n) --> G\nW --> F(1)\nendlsystem\n"
+                                    "lsystem: 2\nhomomorphism\nW --> F(2)\nendlsystem\n",
+                                    "t.l");
+    Deriver c(replaced);
+    CHECK(formatModuleString(c.interpret(c.current()), c.symbols()) == "GF(1)$");
+  }
+  SECTION("decomposition: the axiom too, each module by the L-system it is in") {
+    Grammar g = parseGrammar("lsystem: 1\nderivation length: 1\naxiom: X?(2)X$X\nX --> XX\ndecomposition\nX --> Y\nendlsystem\n"
+                             "lsystem: 2\nX --> X\ndecomposition\nmaximum depth: 2\nX --> ZX\nendlsystem\n",
+                             "t.l");
+    Deriver d(g);
+    // The axiom: X --> Y outside, X --> ZX twice (depth 2) inside.
+    CHECK(formatModuleString(d.current(), d.symbols()) == "Y?(2)ZZX$Y");
+    // Y, Z have no productions; the inner X --> X is decomposed by L-system 2 again.
+    CHECK(formatModuleString(d.step(), d.symbols()) == "Y?(2)ZZZZX$Y");
+  }
   SECTION("errors") {
-    CHECK(errorOf("axiom: ?(2)A$\nendlsystem\nlsystem: 2\nignore: F\nA --> B\n") ==
-          "t.l:4:1: 'ignore:' in a sub-L-system ('lsystem: 2') is not supported (Sprig reads a sub-L-system's productions only)");
+    CHECK(errorOf("axiom: ?(2)A$\nendlsystem\nlsystem: 2\nseed: 3\nA --> B\n") ==
+          "t.l:4:1: 'seed:' in a sub-L-system ('lsystem: 2') is not supported (Sprig reads a sub-L-system's productions, "
+          "decomposition and interpretation rules and 'ignore:' or 'consider:')");
+    CHECK(errorOf("axiom: ?(2)A$\nendlsystem\nlsystem: 2\nignore: F\nignore: G\nA --> B\n") ==
+          "t.l:5:1: duplicate 'ignore:' (first at line 4)");
+    CHECK(errorOf("axiom: ?(2)A$\nendlsystem\nlsystem: 2\nhomomorphism\nA --> ?P(1,2)\n") ==
+          "t.l:5:7: cpfg's query module '?P' in an interpretation rule is not supported (its values would be lost with the "
+          "interpreted string)");
+    CHECK(errorOf("axiom: ?(2)A$\nignore: F\nendlsystem\nlsystem: 2\nignore: F\nA --> B\n") == "no error");
     CHECK(errorOf("axiom: A\nendlsystem\nlsystem: 2\nendlsystem\nlsystem: 2\n") ==
           "t.l:5:1: 'lsystem: 2' is defined twice (first at line 3)");
-    CHECK(errorOf("axiom: A\nhomomorphism\nA --> F\nendlsystem\nlsystem: 2\nA --> B\n") ==
-          "t.l:5:1: sub-L-systems together with interpretation rules are not supported (cpfg applies each L-system's own "
-          "rules inside its '?(n, scale) ... $' calls)");
     CHECK(errorOf("axiom: ?(2)A$\nendlsystem\nlsystem: 2\nA --> B\n", "t.lsys") ==
           "t.lsys:1:8: cpfg's '?(n, scale)' (sub-L-system call) is supported only in cpfg's notation (a .l file), where '$' ends it");
     CHECK(errorOf("axiom: ?(2,1,3)A$\n") == "t.l:1:8: cpfg's sub-L-system call '?(n, scale)' takes 1 or 2 parameters, got 3");
