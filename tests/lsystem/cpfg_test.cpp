@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <filesystem>
 #include <string>
 
 #include "core/atomic_file.h"
@@ -247,6 +248,21 @@ TEST_CASE("cpfg view file", "[lsystem][cpfg]") {
     CHECK(v.warnings[0].loc.line == 2);
     CHECK(v.warnings[0].message == "ignored, as they set how cpfg's window shows the model, not its geometry: "
                                    "'viewpoint:', 'render mode:', 'z buffer:'");
+  }
+  SECTION("line style: as cpfg reads it, a word it does not know keeps the style in effect") {
+    ViewFile v = parseViewFile("line style: cylinder\nline style: wireframe\n", "t.v");
+    CHECK(*v.lineStyle == CpfgLineStyle::Cylinder);
+    REQUIRE(v.warnings.size() == 1);
+    CHECK(v.warnings[0].loc.line == 2);
+    CHECK(v.warnings[0].message == "'line style: wireframe' is none of cpfg's line styles (pixel, polygon, cylinder): as cpfg "
+                                   "does, the line style in effect is kept");
+    CHECK(*parseViewFile("line style: 2\n", "t.v").lineStyle == CpfgLineStyle::Polygon);  // cpfg's digits 1 to 3
+    CHECK(viewErrorOf("line style: 7\n") == "t.v:1:13: 'line style:' is pixel, polygon or cylinder (or 1, 2, 3), got '7'");
+  }
+  SECTION("an object given by a relative path starting with './' reads its files") {
+    const std::string rel = "./" + std::filesystem::relative(cpfgAsset("function/plant.v")).generic_string();
+    ViewFile v = loadViewFile(rel);
+    CHECK(v.functions.size() == 3);
   }
   SECTION("errors") {
     CHECK(viewErrorOf("angle increment: 30\nangel factor: 8\n") ==
@@ -591,6 +607,12 @@ TEST_CASE("cpfg's C preprocessor", "[lsystem][cpfg]") {
           "t.l:2:10: macro 'B' takes 1 argument(s) (defined at t.l:1), or its expansion nests deeper than 64 levels");
     // Columns after an expansion are the file's own.
     CHECK(errorOf("#define S F(1)F(1)\naxiom: S@bo(1)\n") == "t.l:2:9: cpfg's '@bo' (circle boundary) is not supported");
+  }
+  SECTION("cpp's line splicing: a directive ending in a backslash goes on with the next line") {
+    Grammar g = parseGrammar("#define LEAF [+F \\\n\t-F] \\\n  G\n#define N 1 + \\\n 2\naxiom: A LEAF F(N)\n", "t.l");
+    CHECK(formatModuleString(g.axiom(), g.symbols()) == "A[+F-F]GF(3)");
+    // The lines a directive took are blank: later lines keep their numbers.
+    CHECK(errorOf("#define LEAF [+F \\\n\t-F]\naxiom: A LEAF @bo(1)\n") == "t.l:3:15: cpfg's '@bo' (circle boundary) is not supported");
   }
   SECTION("cpp's identifiers: a macro named B is not expanded inside AB; a number body stays a value") {
     Grammar g = parseGrammar("#define B [+F]\n#define N (2 + 1)\naxiom: AB B F(N)\n", "t.l");
