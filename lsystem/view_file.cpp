@@ -700,7 +700,7 @@ class ViewParser {
     view_.tropisms.push_back(t);
   }
 
-  /// `texture: F: NAME.png [H: n|l] [L: n|l] [E: m|d] [S] [R: ratio]` (textures.c,
+  /// `texture: F: NAME.png [H: n|l] [L: n|l|m...] [E: m|d|b] [S] [R: ratio]` (textures.c,
   /// read_texture): cpfg's options are one letter each, separated from their values by
   /// spaces, tabs, colons or commas. The image must be beside the view file or below it.
   void readTexture(int line, size_t vcol, const std::string& value) {
@@ -747,21 +747,24 @@ class ViewParser {
       } else if (w == "H" || w == "L") {
         if (v == "n" || v == "l") {
           (w == "H" ? tex.magLinear : tex.minLinear) = v == "l";
-        } else if (w == "L" && v[0] == 'm') {
-          error(line, vc, "the mipmapped minification filter 'L: " + v + "' is not supported (use n or l)");
-          return;
+        } else if (w == "L" && v[0] == 'm' && v.size() <= 3 && v.find_first_not_of("nl", 1) == std::string::npos) {
+          // textures.c: m is GL_LINEAR_MIPMAP_LINEAR; m followed by n or l names the filter
+          // within a level, then n selects GL_*_MIPMAP_NEAREST (anything else _LINEAR).
+          tex.mipmap = true;
+          tex.minLinear = v.size() < 2 || v[1] == 'l';
+          tex.mipLinear = v.size() < 3 || v[2] != 'n';
         } else {
-          error(line, vc, "a texture filter '" + w + ":' is n (nearest) or l (linear), got '" + v + "'");
+          error(line, vc, "a texture filter '" + w + ":' is n (nearest) or l (linear)" +
+                              (w == "L" ? std::string(", or m, mn, ml, mnn, mnl, mln, mll (mipmaps)") : std::string()) +
+                              ", got '" + v + "'");
           return;
         }
       } else if (w == "E") {
-        if (v == "m" || v == "d") {
+        if (v == "m" || v == "d" || v == "b") {
           tex.decal = v == "d";
-        } else if (v == "b") {
-          error(line, vc, "the texture mode 'E: b' (blend) is not supported (use m, modulate, or d, decal)");
-          return;
+          tex.blend = v == "b";
         } else {
-          error(line, vc, "a texture mode 'E:' is m (modulate) or d (decal), got '" + v + "'");
+          error(line, vc, "a texture mode 'E:' is m (modulate), d (decal) or b (blend), got '" + v + "'");
           return;
         }
       } else {
@@ -806,6 +809,7 @@ class ViewParser {
           }
       }
       tex.image = std::make_shared<const Image>(std::move(img));
+      if (tex.mipmap) tex.buildMipmaps(srgb);
     } catch (const ImageReadError& e) {
       error(line, nameCol, "cannot read the texture image '" + file.string() + "': " + e.reason());
       return;

@@ -201,6 +201,7 @@ void addTexturedSurfaces(render::Geometry& out, const lsystem::Skeleton& skeleto
     map->width = tex->image->width;
     map->height = tex->image->height;
     map->sample = [tex, color](Vec2 uv, bool minified) { return tex->fragment(uv.x, uv.y, color, minified); };
+    map->sampleFootprint = [tex, color](Vec2 uv, double rho) { return tex->combine(tex->sampleFootprint(uv.x, uv.y, rho), color); };
     map->alphaCutoff = tex->cutsOut() ? lsystem::kCpfgAlphaCutoff : -1.0f;
     out.parts.push_back(render::MeshPart{std::move(g.mesh), style.leaf, {}, {}, std::move(map)});
   }
@@ -462,7 +463,10 @@ class TreeModel final : public KindModel {
           for (int x = 0; x < w; ++x)  // texel centres (either filter gives the texel); top row is t of 1
             baked->image.set(x, y, tex.fragment((x + 0.5) / w, 1.0 - (y + 0.5) / h, color));
         baked->magFilter = tex.magLinear ? PartTexture::Filter::Linear : PartTexture::Filter::Nearest;
-        baked->minFilter = tex.minLinear ? PartTexture::Filter::Linear : PartTexture::Filter::Nearest;
+        // Mipmapped (L: m...): glTF's LINEAR_MIPMAP_LINEAR, the viewer building the levels.
+        baked->minFilter = tex.mipmap      ? PartTexture::Filter::Default
+                           : tex.minLinear ? PartTexture::Filter::Linear
+                                           : PartTexture::Filter::Nearest;
         const std::string name = "textured_leaves_" + std::to_string(parts.size());
         const render::Material& m = look.style.leaf;
         PartMaterial material{name, color, m.roughness, true, std::move(baked)};
