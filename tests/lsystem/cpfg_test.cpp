@@ -447,6 +447,11 @@ TEST_CASE("cpfg consider: with brackets; maximum depth beyond 256", "[lsystem][c
 }
 
 TEST_CASE("cpfg Start, StartEach, EndEach and End blocks over global variables", "[lsystem][cpfg]") {
+  SECTION("a global variable in the axiom is an error, not a crash (vlab's two-trees and pallaea)") {
+    CHECK(errorOf("Start: { d = 3; }\naxiom: S A(1, d + 1)\n") ==
+          "t.l:2:15: cpfg's global variable 'd' in the axiom is not supported (Sprig reads the axiom before the "
+          "'Start:' block assigns it): write its value");
+  }
   SECTION("a counter the conditions read") {
     // i is 0 at step 1, 1 at step 2, ...: A grows F while i < 3.
     const std::string g =
