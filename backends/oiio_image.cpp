@@ -1,5 +1,6 @@
 /// core/detail/image_backend.h through OpenImageIO: still images and animated GIFs.
 
+#include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
 
 #include <stdexcept>
@@ -101,10 +102,19 @@ std::unique_ptr<ImageFileReader> open(const std::string& path, std::string& erro
   return std::make_unique<OiioReader>(std::move(in));
 }
 
+bool resizeBox(const float* in, int width, int height, float* out, int outWidth, int outHeight, std::string& error) {
+  const OIIO::ImageBuf src(OIIO::ImageSpec(width, height, 4, OIIO::TypeDesc::FLOAT), const_cast<float*>(in));
+  OIIO::ImageBuf dst(OIIO::ImageSpec(outWidth, outHeight, 4, OIIO::TypeDesc::FLOAT), out);
+  // The filter's width is in output pixels: 1 averages the input pixels under each one.
+  const bool ok = OIIO::ImageBufAlgo::resize(dst, src, "box", 1.0f, OIIO::ROI(0, outWidth, 0, outHeight, 0, 1, 0, 4), 1);
+  if (!ok) error = dst.geterror();
+  return ok;
+}
+
 }  // namespace
 
 const detail::ImageBackend& oiioImage() {
-  static const detail::ImageBackend table{&write, &writeGif, &open};
+  static const detail::ImageBackend table{&write, &writeGif, &open, &resizeBox};
   return table;
 }
 

@@ -140,6 +140,18 @@ ImageInfo infoOf(const detail::ImageFileHeader& header) {
 
 ImageInfo readImageInfo(const fs::path& path) { return infoOf(openInput(path)->header()); }
 
+Image resizeImage(const Image& image, int width, int height) {
+  if (image.width <= 0 || image.height <= 0 || image.pixels.size() != static_cast<size_t>(image.width) * image.height * 4)
+    throw std::invalid_argument("cannot resize an empty or malformed image");
+  if (width < 1 || height < 1)
+    throw std::invalid_argument("cannot resize an image to " + std::to_string(width) + " x " + std::to_string(height) + " pixels");
+  Image out(width, height);
+  std::string error;
+  if (!detail::imageBackend().resizeBox(image.pixels.data(), image.width, image.height, out.pixels.data(), width, height, error))
+    throw std::runtime_error("cannot resize an image: " + error);
+  return out;
+}
+
 Image readImage(const fs::path& path) {
   auto in = openInput(path);
   const ImageInfo info = infoOf(in->header());

@@ -106,6 +106,14 @@ inline constexpr uint64_t kMaxImagePixels = uint64_t(1) << 26;
 /// Most channels an image file may hold to be read.
 inline constexpr int kMaxImageChannels = 16;
 
+/// image resized to width x height by OpenImageIO's ImageBufAlgo::resize with a box filter
+/// one output pixel wide: each output pixel is the mean of the input pixels whose centres
+/// it covers (halving a dimension averages pairs of pixels exactly), channel by channel,
+/// in the values as stored (no sRGB decoding, no alpha weighting). Throws
+/// std::invalid_argument for an empty or malformed image or a size below 1,
+/// std::runtime_error when OpenImageIO fails.
+Image resizeImage(const Image& image, int width, int height);
+
 /// Reads an image file into linear RGBA. sRGB files (ImageInfo::srgb) are read as 8-bit
 /// values, color decoded with srgbToLinear(float) of value / 255 and alpha taken as
 /// value / 255; other files are read as floats and taken as linear. A gray file gives gray

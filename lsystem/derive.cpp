@@ -207,7 +207,7 @@ struct Deriver::Impl {
       queryTurtle = std::make_unique<Turtle>(prog->symbols, t);
     }
     std::vector<Turtle::QueryHit> hits;
-    if (prog->interpretation.empty()) {
+    if (!prog->anyInterpretation()) {
       hits = queryTurtle->query(cur);
     } else {
       ModuleString shown = interpreted(cur, done);
@@ -235,6 +235,7 @@ struct Deriver::Impl {
   ModuleString interpreted(const ModuleString& s, int step) const {
     Impl tmp;
     tmp.prog = prog;
+    tmp.ignoredTab = prog->ignored.data();
     tmp.seed = seed;
     tmp.opt.maxModules = opt.maxModules;
     tmp.limitAt = limitAt;
@@ -242,6 +243,13 @@ struct Deriver::Impl {
     tmp.cur = s;
     tmp.globals = globals;
     tmp.arrays = arrays;
+    if (!prog->subLsystems.empty()) {
+      ModuleString out;
+      Writer w(out, s.hasBirthSteps(), opt.maxModules, limitAt, step, s.size() + 16, s.params.size() + 16);
+      tmp.homomorphismWithSubLsystems(s, w, step);
+      w.finish();
+      return out;
+    }
     // Interpretation recursion: depth 1 is one rewrite; deeper levels rewrite what the
     // previous level produced (modules no rule matches stay as they are).
     const RuleSet& rs = prog->interpretation;
@@ -327,6 +335,9 @@ struct Deriver::Impl {
   // ---- matching -------------------------------------------------------------------------
 
   std::vector<int32_t> bracketStack;
+  /// Per symbol: skipped by context matching (the main L-system's table, or inside a
+  /// sub-L-system's call its own).
+  const uint8_t* ignoredTab = nullptr;
 
   void computeBrackets(const ModuleString& s) {
     size_t n = s.size();
@@ -366,7 +377,7 @@ struct Deriver::Impl {
       SymbolId c = s.symbols[j];
       if (c == prog->openBracket) j = static_cast<size_t>(match[j]) + 1;
       else if (c == prog->closeBracket) return n;
-      else if (prog->ignored[c]) ++j;
+      else if (ignoredTab[c]) ++j;
       else return j;
     }
   }
@@ -379,7 +390,7 @@ struct Deriver::Impl {
       if (c == prog->closeBracket) {
         if (match[j] < 0) return -1;
         j = match[j] - 1;
-      } else if (c == prog->openBracket || prog->ignored[c]) {
+      } else if (c == prog->openBracket || ignoredTab[c]) {
         --j;
       } else {
         return j;
@@ -417,7 +428,7 @@ struct Deriver::Impl {
           j = static_cast<size_t>(match[j]) + 1;
         } else if (c == prog->closeBracket) {
           return false;
-        } else if (prog->ignored[c]) {
+        } else if (ignoredTab[c]) {
           ++j;
         } else {
           break;
@@ -641,17 +652,20 @@ struct Deriver::Impl {
     }
   }
 
-  /// Writes p's successor, decomposed when `decompose` (a derivation step of a grammar with
-  /// decomposition rules; cpfg does not decompose the successors of interpretation rules).
-  void emit(Writer& w, const Production& p, const double* vars, int32_t birth, int step, bool decompose) {
+  /// Writes p's successor, decomposed by decomp when `decompose` (a derivation step of a
+  /// grammar with decomposition rules; cpfg does not decompose the successors of
+  /// interpretation rules).
+  void emit(Writer& w, const Production& p, const double* vars, int32_t birth, int step, bool decompose,
+            const RuleSet* decomp = nullptr) {
     if (!decompose) {
       emitPlain(w, p, vars, birth, step);
       return;
     }
+    const RuleSet& rs = decomp ? *decomp : prog->decomposition;
     decompStack.clear();
     decompFrames.clear();
-    pushSuccessor(p, vars, step, 0);
-    decomposeFrames(w, birth, step, 0);
+    pushSuccessor(p, vars, step, 0, rs);
+    decomposeFrames(w, birth, step, 0, rs);
   }
 
   // ---- decomposition ----------------------------------------------------------------------
@@ -674,12 +688,13 @@ struct Deriver::Impl {
 
   /// Appends p's successor (evaluated with vars) to decompStack as a new frame, whose
   /// modules are at depth `depth` (the decomposition rules applied on the way to them).
-  void pushSuccessor(const Production& p, const double* vars, int step, int depth) {
+  void pushSuccessor(const Production& p, const double* vars, int step, int depth, const RuleSet& rs,
+                     const char* what = "decomposition") {
     const size_t begin = decompStack.size();
     if (depth > kMaxDecompositionNesting)
-      throw InputError(p.loc, "decomposition nested deeper than " + std::to_string(kMaxDecompositionNesting) +
+      throw InputError(p.loc, std::string(what) + " nested deeper than " + std::to_string(kMaxDecompositionNesting) +
                                   " levels at step " + std::to_string(step) + " (maximum depth " +
-                                  std::to_string(prog->decomposition.maxDepth) + "): not supported",
+                                  std::to_string(rs.maxDepth) + "): not supported",
                        p.sourceLine);
     for (const SuccModule& m : p.successor) {
       decompStack.symbols.push_back(m.symbol);
@@ -691,8 +706,7 @@ struct Deriver::Impl {
 
   /// Decomposes the frames on the stack (the bottom one at depth base) into w until the
   /// stack is empty. Frame k of decompFrames is at depth base + k.
-  void decomposeFrames(Writer& w, int32_t birth, int step, int base) {
-    const RuleSet& rs = prog->decomposition;
+  void decomposeFrames(Writer& w, int32_t birth, int step, int base, const RuleSet& rs) {
     double vars[detail::kMaxVars];
     loadGlobals(vars);
     while (!decompFrames.empty()) {
@@ -718,15 +732,14 @@ struct Deriver::Impl {
         continue;
       }
       f.pos += 1 + p->predRest.size();  // f is not used past this point: the push may move it
-      pushSuccessor(*p, vars, step, depth + 1);
+      pushSuccessor(*p, vars, step, depth + 1, rs);
     }
   }
 
   /// Writes module i of s (the string being rewritten, which no production changed at i)
   /// decomposed: a decomposition rule's predecessor of several modules matches the modules
   /// of s after i, as cpfg's does. Returns the number of modules after i it replaced.
-  size_t emitDecomposed(Writer& w, const ModuleString& s, size_t i, int32_t birth, int step) {
-    const RuleSet& rs = prog->decomposition;
+  size_t emitDecomposed(Writer& w, const ModuleString& s, size_t i, int32_t birth, int step, const RuleSet& rs) {
     double vars[detail::kMaxVars];
     loadGlobals(vars);
     const Production* p = rs.maxDepth > 0 && !rs.bySymbol[s.symbols[i]].empty() ? choose(rs, s, i, vars, step) : nullptr;
@@ -738,8 +751,8 @@ struct Deriver::Impl {
     }
     decompStack.clear();
     decompFrames.clear();
-    pushSuccessor(*p, vars, step, 1);
-    decomposeFrames(w, birth, step, 1);
+    pushSuccessor(*p, vars, step, 1, rs);
+    decomposeFrames(w, birth, step, 1, rs);
     return p->predRest.size();
   }
 
@@ -765,7 +778,7 @@ struct Deriver::Impl {
     ptrdiff_t lastSeen = -1;
     leftStack.clear();
     const bool trackLeft = !rs.dispatches.empty();
-    const uint8_t* ignored = prog->ignored.data();
+    const uint8_t* ignored = ignoredTab;
     for (size_t i = 0; i < n; ++i) {
       const detail::SymbolRules& r = rules[syms[i]];
       uint32_t count = offs[i + 1] - offs[i];
@@ -825,12 +838,31 @@ struct Deriver::Impl {
     return j - 1;
   }
 
-  /// The productions `?(id, ...)` calls at step (the main ones for the main L-system's
-  /// number); an unknown id is an InputError.
-  const RuleSet& subRules(double id, int step) const {
+  /// The rules of one L-system of a grammar with cpfg's sub-L-systems: the main one's or a
+  /// sub-L-system's (generate.c and interpret.c take each from the L-system on top of their
+  /// stack: LSYSDATA's productions, Decomposition, Homomorphism and ignore table).
+  struct LsystemRules {
+    const RuleSet* productions = nullptr;
+    const RuleSet* decomposition = nullptr;
+    const RuleSet* interpretation = nullptr;
+    const uint8_t* ignored = nullptr;
+  };
+  /// [0] the main L-system, then the sub-L-systems in file order (filled on first use).
+  std::vector<LsystemRules> lsystems;
+
+  void makeLsystems() {
+    if (!lsystems.empty()) return;
+    lsystems.push_back({&prog->productions, &prog->decomposition, &prog->interpretation, prog->ignored.data()});
     for (const detail::SubLsystem& sub : prog->subLsystems)
-      if (sub.id == id) return sub.productions;
-    if (prog->mainLsystemId && *prog->mainLsystemId == id) return prog->productions;
+      lsystems.push_back({&sub.productions, &sub.decomposition, &sub.interpretation, sub.ignored.data()});
+  }
+
+  /// The index in lsystems of the L-system `?(id, ...)` calls at step (0, the main one, for
+  /// its own number); an unknown id is an InputError.
+  size_t calledLsystem(double id, int step) const {
+    for (size_t k = 0; k < prog->subLsystems.size(); ++k)
+      if (prog->subLsystems[k].id == id) return k + 1;
+    if (prog->mainLsystemId && *prog->mainLsystemId == id) return 0;
     std::string known;
     if (prog->mainLsystemId) known = numberText(*prog->mainLsystemId);
     for (const detail::SubLsystem& sub : prog->subLsystems) known += (known.empty() ? "" : ", ") + numberText(sub.id);
@@ -839,12 +871,23 @@ struct Deriver::Impl {
                      prog->subLsystems.front().sourceLine);
   }
 
-  /// One derivation step of a grammar with cpfg's sub-L-systems (generate.c, CheckPred):
-  /// a stack of L-systems starts with the main one; each module is rewritten by the
-  /// productions on top, then the modules it matched switch L-systems: `?(n, s)` pushes
-  /// sub-L-system n, `$` pops (an unmatched `$` leaves the main one, as cpfg does after
-  /// its warning).
-  void rewriteWithSubLsystems(int step, uint64_t stream) {
+  /// Switches the L-system stack at module i of s: `?(n, s)` pushes L-system n, `$` pops
+  /// (an unmatched `$` leaves the main one, as cpfg does after its warning).
+  void switchLsystem(std::vector<size_t>& stack, const ModuleString& s, size_t i, int step) const {
+    const SymbolId sym = s.symbols[i];
+    if (prog->subCall && sym == *prog->subCall && s.paramCount(i) >= 1) stack.push_back(calledLsystem(s.params[s.offsets[i]], step));
+    else if (sym == prog->subEnd && stack.size() > 1) stack.pop_back();
+  }
+
+  /// One derivation step of a grammar with cpfg's sub-L-systems (generate.c, Derive,
+  /// ApplyProd and CheckPred): a stack of L-systems starts with the main one; each module is
+  /// rewritten by the productions of the L-system on top (contexts matched with its ignore
+  /// table), and what they write, or the module itself when none applies, is decomposed by
+  /// that L-system's decomposition rules up to its maximum depth; then the modules the
+  /// production matched switch L-systems: `?(n, s)` pushes sub-L-system n, `$` pops.
+  /// Without productions (applyProductions false) this decomposes the axiom.
+  void rewriteWithSubLsystems(int step, uint64_t stream, bool applyProductions) {
+    makeLsystems();
     const ModuleString& in = cur;
     const size_t n = in.size();
     const bool births = opt.trackBirthSteps;
@@ -853,41 +896,106 @@ struct Deriver::Impl {
     double vars[detail::kMaxVars];
     loadGlobals(vars);
     rngStream = stream;
-    std::vector<const RuleSet*> stack{&prog->productions};
-    const SymbolId call = prog->subCall.value_or(static_cast<SymbolId>(-1));
+    std::vector<size_t> stack{0};
     for (size_t i = 0; i < n; ++i) {
-      const RuleSet& rs = *stack.back();
+      const LsystemRules& ls = lsystems[stack.back()];
+      ignoredTab = ls.ignored;
       const SymbolId sym = in.symbols[i];
       const int32_t birth = births ? in.birthSteps[i] : 0;
       rngReady = false;
       rngItem = i;
       leftCached = rightCached = false;
-      const Production* p = rs.rules[sym].count == 0 ? nullptr : choose(rs, in, i, vars, step);
+      const Production* p = !applyProductions || ls.productions->rules[sym].count == 0 ? nullptr : choose(*ls.productions, in, i, vars, step);
+      const bool decompose = !ls.decomposition->empty();
       size_t last = i;
       if (p) {
-        emit(w, *p, vars, step, step, false);
+        emit(w, *p, vars, step, step, decompose, ls.decomposition);
         last = i + p->predRest.size();
+      } else if (decompose) {
+        last = i + emitDecomposed(w, in, i, birth, step, *ls.decomposition);
       } else {
         const uint32_t count = in.paramCount(i);
         w.reserve(1, count);
         w.copy(sym, in.params.data() + in.offsets[i], count, birth);
       }
-      for (size_t k = i; k <= last; ++k) {
-        if (in.symbols[k] == call && in.paramCount(k) >= 1) stack.push_back(&subRules(in.params[in.offsets[k]], step));
-        else if (in.symbols[k] == prog->subEnd && stack.size() > 1) stack.pop_back();
-      }
+      for (size_t k = i; k <= last; ++k) switchLsystem(stack, in, k, step);
       i = last;
     }
+    ignoredTab = prog->ignored.data();
     w.finish();
     written += w.modules();
     std::swap(cur, next);
     if (prog->usesCut) applyCuts(cur);
   }
 
+  /// cpfg's homomorphism in a grammar with sub-L-systems (interpret.c, TurtleDrawNsteps,
+  /// InterpretHomomorphism and UpdateCurrentLsystem), writing s as the turtle reads it into
+  /// w: depth first, each module is rewritten by the interpretation rules of the L-system
+  /// current when the turtle reaches it, up to that L-system's maximum depth; a module no
+  /// rule rewrites is drawn, and a drawn `?(n, s)` or `$` switches L-systems for everything
+  /// after it, inside a successor too. A predecessor of several modules matches the modules
+  /// after it in s at the first level, in one successor deeper.
+  void homomorphismWithSubLsystems(const ModuleString& s, Writer& w, int step) {
+    makeLsystems();
+    const bool births = s.hasBirthSteps();
+    double vars[detail::kMaxVars];
+    loadGlobals(vars);
+    std::vector<size_t> stack{0};
+    auto draw = [&](const ModuleString& from, size_t i, int32_t birth) {
+      const uint32_t count = from.paramCount(i);
+      w.reserve(1, count);
+      w.copy(from.symbols[i], from.params.data() + from.offsets[i], count, birth);
+      switchLsystem(stack, from, i, step);
+    };
+    uint64_t item = 0;
+    // The rule of the current L-system for module i of from at depth, or null.
+    auto rule = [&](const ModuleString& from, size_t i, int depth) -> const Production* {
+      const RuleSet& rs = *lsystems[stack.back()].interpretation;
+      if (rs.empty() || depth >= rs.maxDepth || rs.bySymbol[from.symbols[i]].empty()) return nullptr;
+      rngReady = false;
+      rngStream = kInterpretStream - static_cast<uint64_t>(depth);
+      rngItem = item++;
+      leftCached = rightCached = false;
+      return choose(rs, from, i, vars, step);
+    };
+    for (size_t i = 0; i < s.size(); ++i) {
+      const int32_t birth = births ? s.birthSteps[i] : 0;
+      const Production* p = rule(s, i, 0);
+      if (!p) {
+        draw(s, i, birth);
+        continue;
+      }
+      i += p->predRest.size();
+      decompStack.clear();
+      decompFrames.clear();
+      pushSuccessor(*p, vars, step, 1, *lsystems[stack.back()].interpretation, "interpretation");
+      while (!decompFrames.empty()) {
+        DecompFrame& f = decompFrames.back();
+        if (f.pos >= f.end) {
+          decompStack.symbols.resize(f.begin);
+          decompStack.offsets.resize(f.begin + 1);
+          decompStack.params.resize(decompStack.offsets[f.begin]);
+          decompFrames.pop_back();
+          continue;
+        }
+        const size_t k = f.pos;
+        const int depth = static_cast<int>(decompFrames.size());
+        const Production* q = rule(decompStack, k, depth);
+        if (!q) {
+          draw(decompStack, k, birth);
+          ++f.pos;
+          continue;
+        }
+        f.pos += 1 + q->predRest.size();  // f is not used past this point: the push may move it
+        pushSuccessor(*q, vars, step, depth + 1, *lsystems[stack.back()].interpretation, "interpretation");
+      }
+    }
+  }
+
   /// Rewrites cur into next with rules rs (one derivation step when rs is the main block).
   void rewrite(const RuleSet& rs, int step, uint64_t stream, bool productionStep) {
     if (productionStep && !prog->subLsystems.empty() && &rs == &prog->productions) {
-      rewriteWithSubLsystems(step, stream);
+      rewriteWithSubLsystems(step, stream, true);
       return;
     }
     const ModuleString& in = cur;
@@ -954,7 +1062,7 @@ struct Deriver::Impl {
       const Production* p = r.count == 0 || (segIn && (*segIn)[i] == kFrozen) ? nullptr : choose(rs, in, i, vars, step);
       if (!p) {
         if (decompose && productionStep) {
-          i += emitDecomposed(w, in, i, birth, step);
+          i += emitDecomposed(w, in, i, birth, step, prog->decomposition);
         } else {
           uint32_t count = offs[i + 1] - offs[i];
           w.reserve(1, count);
@@ -1022,7 +1130,11 @@ struct Deriver::Impl {
     cur = prog->axiom;
     if (cur.size() > opt.maxModules) Writer::overLimit(opt.maxModules, limitAt, 0);
     if (opt.trackBirthSteps) cur.birthSteps.assign(cur.size(), 0);
-    if (!prog->decomposition.empty()) {
+    const bool subDecomposition = std::any_of(prog->subLsystems.begin(), prog->subLsystems.end(),
+                                              [](const detail::SubLsystem& sub) { return !sub.decomposition.empty(); });
+    if (!prog->subLsystems.empty() && (subDecomposition || !prog->decomposition.empty())) {
+      rewriteWithSubLsystems(0, 0, false);
+    } else if (!prog->decomposition.empty()) {
       RuleSet none;
       none.bySymbol.assign(prog->symbols.size(), {});
       none.finalize();
@@ -1038,6 +1150,7 @@ struct Deriver::Impl {
 Deriver::Deriver(const Grammar& grammar, DeriveOptions options) : impl_(std::make_unique<Impl>()) {
   impl_->grammar = grammar;
   impl_->prog = &grammar.program();
+  impl_->ignoredTab = impl_->prog->ignored.data();
   impl_->steps = options.steps.value_or(grammar.derivationLength());
   impl_->seed = impl_->baseSeed = options.seed.value_or(grammar.seed());
   impl_->baseSteps = impl_->steps;
@@ -1081,10 +1194,10 @@ int Deriver::steps() const { return impl_->steps; }
 uint64_t Deriver::seed() const { return impl_->seed; }
 const SymbolTable& Deriver::symbols() const { return impl_->prog->symbols; }
 uint64_t Deriver::modulesWritten() const { return impl_->written; }
-bool Deriver::hasInterpretation() const { return !impl_->prog->interpretation.empty(); }
+bool Deriver::hasInterpretation() const { return impl_->prog->anyInterpretation(); }
 
 ModuleString Deriver::interpret(const ModuleString& s) const {
-  if (impl_->prog->interpretation.empty()) return s;
+  if (!impl_->prog->anyInterpretation()) return s;
   // A private Impl shares the program and seed so interpret() stays const on this Deriver.
   return impl_->interpreted(s, impl_->done);
 }

@@ -28,7 +28,7 @@ std::vector<std::string> Grammar::defineNames() const {
   return names;
 }
 size_t Grammar::productionCount() const { return program_->productions.productions.size(); }
-bool Grammar::hasInterpretation() const { return !program_->interpretation.empty(); }
+bool Grammar::hasInterpretation() const { return program_->anyInterpretation(); }
 bool Grammar::cpfgNotation() const { return program_->dialect == detail::Dialect::Cpfg; }
 bool Grammar::usesDefaultAngle() const { return program_->bareTurn; }
 

@@ -243,11 +243,18 @@ class ViewParser {
     } else if (is("line width increment")) {
       if (auto v = values(line, vcol, key, value, 1, 1)) view_.widthIncrement = (*v)[0];
     } else if (is("line style")) {
+      // cpfg (interpret.c, "line style:") reads one word: pixel, polygon, cylinder, or a
+      // digit 1 to 3 for them; any other word leaves the style in effect (vlab's
+      // Sierpinski and canalization objects write `wireframe`, a render mode).
       const std::string v = trimmed(value);
-      if (v == "pixel") view_.lineStyle = CpfgLineStyle::Pixel;
-      else if (v == "polygon") view_.lineStyle = CpfgLineStyle::Polygon;
-      else if (v == "cylinder") view_.lineStyle = CpfgLineStyle::Cylinder;
-      else error(line, vcol, "'line style:' is pixel, polygon or cylinder, got '" + v + "'");
+      const std::string word = v.substr(0, v.find_first_of(" \t"));
+      if (word == "pixel" || word == "1") view_.lineStyle = CpfgLineStyle::Pixel;
+      else if (word == "polygon" || word == "2") view_.lineStyle = CpfgLineStyle::Polygon;
+      else if (word == "cylinder" || word == "3") view_.lineStyle = CpfgLineStyle::Cylinder;
+      else if (word.empty() || std::isdigit(static_cast<unsigned char>(word[0])))
+        error(line, vcol, "'line style:' is pixel, polygon or cylinder (or 1, 2, 3), got '" + v + "'");
+      else
+        warn(line, vcol, "'line style: " + word + "' is none of cpfg's line styles (pixel, polygon, cylinder): as cpfg does, the line style in effect is kept");
     } else if (is("initial scale")) {
       if (auto v = values(line, vcol, key, value, 1, 1)) view_.initialScale = (*v)[0];
     } else if (is("scale multiplier")) {
@@ -335,7 +342,7 @@ class ViewParser {
         return;
       }
     }
-    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path();
+    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path().lexically_normal();
     const std::filesystem::path file = (folder / name).lexically_normal();
     const std::string rel = file.lexically_relative(folder.empty() ? "." : folder).generic_string();
     if (std::filesystem::path(name).is_absolute() || rel.empty() || rel.rfind("..", 0) == 0) {
@@ -366,7 +373,7 @@ class ViewParser {
       error(line, vcol, "expected one function set file after 'function set:'");
       return;
     }
-    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path();
+    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path().lexically_normal();
     const std::filesystem::path file = (folder / name).lexically_normal();
     const std::string rel = file.lexically_relative(folder.empty() ? "." : folder).generic_string();
     if (std::filesystem::path(name).is_absolute() || rel.empty() || rel.rfind("..", 0) == 0) {
@@ -466,7 +473,7 @@ class ViewParser {
       error(line, vcol, "a view file has at most 31 contours (cpfg's limit)");
       return;
     }
-    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path();
+    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path().lexically_normal();
     const std::filesystem::path file = (folder / name).lexically_normal();
     const std::string rel = file.lexically_relative(folder.empty() ? "." : folder).generic_string();
     const size_t ncol = vcol - std::min(vcol, value.find_first_not_of(" \t")) + value.find(name, value.find(idText) + idText.size());
@@ -512,7 +519,7 @@ class ViewParser {
         return;
       }
     }
-    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path();
+    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path().lexically_normal();
     const std::filesystem::path file = (folder / name).lexically_normal();
     const std::string rel = file.lexically_relative(folder.empty() ? "." : folder).generic_string();
     if (std::filesystem::path(name).is_absolute() || rel.empty() || rel.rfind("..", 0) == 0) {
@@ -613,7 +620,7 @@ class ViewParser {
       }
     }
     const std::string& name = words[1].first;
-    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path();
+    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path().lexically_normal();
     const std::filesystem::path file = (folder / name).lexically_normal();
     const std::string rel = file.lexically_relative(folder.empty() ? "." : folder).generic_string();
     if (std::filesystem::path(name).is_absolute() || rel.empty() || rel.rfind("..", 0) == 0) {
@@ -693,7 +700,7 @@ class ViewParser {
     view_.tropisms.push_back(t);
   }
 
-  /// `texture: F: NAME.png [H: n|l] [L: n|l] [E: m|d] [S] [R: ratio]` (textures.c,
+  /// `texture: F: NAME.png [H: n|l] [L: n|l|m...] [E: m|d|b] [S] [R: ratio]` (textures.c,
   /// read_texture): cpfg's options are one letter each, separated from their values by
   /// spaces, tabs, colons or commas. The image must be beside the view file or below it.
   void readTexture(int line, size_t vcol, const std::string& value) {
@@ -740,21 +747,24 @@ class ViewParser {
       } else if (w == "H" || w == "L") {
         if (v == "n" || v == "l") {
           (w == "H" ? tex.magLinear : tex.minLinear) = v == "l";
-        } else if (w == "L" && v[0] == 'm') {
-          error(line, vc, "the mipmapped minification filter 'L: " + v + "' is not supported (use n or l)");
-          return;
+        } else if (w == "L" && v[0] == 'm' && v.size() <= 3 && v.find_first_not_of("nl", 1) == std::string::npos) {
+          // textures.c: m is GL_LINEAR_MIPMAP_LINEAR; m followed by n or l names the filter
+          // within a level, then n selects GL_*_MIPMAP_NEAREST (anything else _LINEAR).
+          tex.mipmap = true;
+          tex.minLinear = v.size() < 2 || v[1] == 'l';
+          tex.mipLinear = v.size() < 3 || v[2] != 'n';
         } else {
-          error(line, vc, "a texture filter '" + w + ":' is n (nearest) or l (linear), got '" + v + "'");
+          error(line, vc, "a texture filter '" + w + ":' is n (nearest) or l (linear)" +
+                              (w == "L" ? std::string(", or m, mn, ml, mnn, mnl, mln, mll (mipmaps)") : std::string()) +
+                              ", got '" + v + "'");
           return;
         }
       } else if (w == "E") {
-        if (v == "m" || v == "d") {
+        if (v == "m" || v == "d" || v == "b") {
           tex.decal = v == "d";
-        } else if (v == "b") {
-          error(line, vc, "the texture mode 'E: b' (blend) is not supported (use m, modulate, or d, decal)");
-          return;
+          tex.blend = v == "b";
         } else {
-          error(line, vc, "a texture mode 'E:' is m (modulate) or d (decal), got '" + v + "'");
+          error(line, vc, "a texture mode 'E:' is m (modulate), d (decal) or b (blend), got '" + v + "'");
           return;
         }
       } else {
@@ -770,7 +780,7 @@ class ViewParser {
       error(line, vcol, "a texture needs its image: 'texture: F: NAME.png'");
       return;
     }
-    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path();
+    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path().lexically_normal();
     const std::filesystem::path file = (folder / name).lexically_normal();
     const std::string rel = file.lexically_relative(folder.empty() ? "." : folder).generic_string();
     if (std::filesystem::path(name).is_absolute() || rel.empty() || rel.rfind("..", 0) == 0) {
@@ -799,6 +809,7 @@ class ViewParser {
           }
       }
       tex.image = std::make_shared<const Image>(std::move(img));
+      if (tex.mipmap) tex.buildMipmaps(srgb);
     } catch (const ImageReadError& e) {
       error(line, nameCol, "cannot read the texture image '" + file.string() + "': " + e.reason());
       return;

@@ -222,6 +222,7 @@ void addTexturedSurfaces(render::Geometry& out, const lsystem::Skeleton& skeleto
     map->width = tex->image->width;
     map->height = tex->image->height;
     map->sample = [tex, color](Vec2 uv, bool minified) { return tex->fragment(uv.x, uv.y, color, minified); };
+    map->sampleFootprint = [tex, color](Vec2 uv, double rho) { return tex->combine(tex->sampleFootprint(uv.x, uv.y, rho), color); };
     map->alphaCutoff = tex->cutsOut() ? lsystem::kCpfgAlphaCutoff : -1.0f;
     out.parts.push_back(render::MeshPart{std::move(g.mesh), g.tube ? style.wood : style.leaf, {}, {}, std::move(map)});
   }
@@ -504,7 +505,10 @@ class TreeModel final : public KindModel {
           baked->seams.continuous = true;
         }
         baked->magFilter = tex.magLinear ? PartTexture::Filter::Linear : PartTexture::Filter::Nearest;
-        baked->minFilter = tex.minLinear ? PartTexture::Filter::Linear : PartTexture::Filter::Nearest;
+        // Mipmapped (L: m...): glTF's LINEAR_MIPMAP_LINEAR, the viewer building the levels.
+        baked->minFilter = tex.mipmap      ? PartTexture::Filter::Default
+                           : tex.minLinear ? PartTexture::Filter::Linear
+                                           : PartTexture::Filter::Nearest;
         const std::string name = (g.tube ? "textured_wood_" : "textured_leaves_") + std::to_string(parts.size());
         const render::Material& m = g.tube ? look.style.wood : look.style.leaf;
         // Both sides: leaves are open polygons, tubes open at their ends (cpfg draws no caps).

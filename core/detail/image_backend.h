@@ -68,6 +68,11 @@ struct ImageBackend {
                    size_t frameCount, const std::function<std::vector<uint8_t>(size_t)>& frameBytes);
   /// Opens path for reading; null with the library's message (possibly empty) in error.
   std::unique_ptr<ImageFileReader> (*open)(const std::string& path, std::string& error);
+  /// Resizes width x height pixels of 4 floats (in) to outWidth x outHeight (out, which
+  /// holds 4 * outWidth * outHeight floats) with a box filter one output pixel wide (each
+  /// output pixel the mean of the input pixels whose centres it covers). False with the
+  /// library's message in error when it fails.
+  bool (*resizeBox)(const float* in, int width, int height, float* out, int outWidth, int outHeight, std::string& error);
 };
 
 /// The image file operations of this program (see the file comment). Throws

@@ -617,7 +617,17 @@ std::optional<double> ExpressionParser::evaluate(Span sp, Rng* rng) {
   usesRandom_ = false;
   std::optional<double> value;
   if (compile(sp, kNoVars, "parameter")) {
-    if (usesRandom_ && !rng) {
+    // A variable here can only be one of cpfg's global variables (no formal parameters):
+    // the axiom is read before any 'Start:' block runs, so it has no value yet.
+    const auto global = std::find_if(code_.begin() + static_cast<std::ptrdiff_t>(before), code_.end(),
+                                     [](const Instr& in) { return in.op == Op::Var || in.op == Op::Store; });
+    if (global != code_.end()) {
+      const size_t k = static_cast<size_t>(kMaxVars - 1 - global->var);
+      const std::string name = globals_ && k < globals_->size() ? (*globals_)[k] : std::string("?");
+      scanner_.error(sp.line, sp.b, "cpfg's global variable '" + name +
+                                        "' in the axiom is not supported (Sprig reads the axiom before the 'Start:' block "
+                                        "assigns it): write its value");
+    } else if (usesRandom_ && !rng) {
       scanner_.error(sp.line, sp.b, "random functions are not allowed here");
     } else {
       // cpfg's arrays read their initial elements here (an axiom's parameters); nothing stores.

@@ -72,6 +72,10 @@ constexpr UnsupportedHeader kUnsupportedHeaders[] = {
 /// Most elements of all of cpfg's `define: { array ... }` arrays together.
 constexpr uint32_t kMaxArrayElements = 1u << 24;
 
+/// What Sprig reads of a sub-L-system (the end of the error for anything else in one).
+constexpr const char* kSubReads =
+    "Sprig reads a sub-L-system's productions, decomposition and interpretation rules and 'ignore:' or 'consider:'";
+
 /// cpfg's blocks of statements over global variables, by header key.
 const char* const kBlockHeaders[] = {"start", "end", "starteach", "start each", "endeach", "end each"};
 
@@ -134,8 +138,8 @@ class GrammarParser {
       checkArities();
       checkWrittenArities();
       for (const RuleSet* rs : {&prog_.productions, &prog_.decomposition, &prog_.interpretation}) checkWeights(*rs);
-      for (const SubLsystem& sub : prog_.subLsystems) checkWeights(sub.productions);
-      checkSubLsystems();
+      for (const SubLsystem& sub : prog_.subLsystems)
+        for (const RuleSet* rs : {&sub.productions, &sub.decomposition, &sub.interpretation}) checkWeights(*rs);
       checkSubLsystemCalls();
     }
     finish();
@@ -333,14 +337,14 @@ class GrammarParser {
       if (unsupportedHeader(line, b)) continue;
       auto header = Scanner::headerOf(s, b);
       if (header && header->key == "define" && prog_.dialect == Dialect::Cpfg) {
-        if (!subs_.empty()) error(line, b, "'define:' in a sub-L-system is not supported (Sprig reads a sub-L-system's productions only)");
+        if (!subs_.empty()) error(line, b, "'define:' in a sub-L-system is not supported (" + std::string(kSubReads) + ")");
         else defineBlock(line, *header);
         continue;
       }
       if (header && std::find(std::begin(kBlockHeaders), std::end(kBlockHeaders), header->key) != std::end(kBlockHeaders)) {
         if (!subs_.empty()) {
           error(line, b, "'" + header->key + ":' in a sub-L-system ('lsystem: " + subs_.back().label +
-                             "') is not supported (Sprig reads a sub-L-system's productions only)");
+                             "') is not supported (" + kSubReads + ")");
           continue;
         }
         globalBlock(line, b, *header);
@@ -569,10 +573,24 @@ class GrammarParser {
     return false;
   }
 
-  /// Records header key at line; a second one is an error.
+  /// Records header key at line (per L-system: a sub-L-system has its own); a second one is
+  /// an error.
   void once(const std::string& key, int line, int col) {
-    auto [it, inserted] = seen_.emplace(key, line);
+    auto [it, inserted] = seen_.emplace(scoped(key), line);
     if (!inserted) error(line, col, "duplicate '" + key + ":' (first at " + scanner_.lineRef(it->second) + ")");
+  }
+
+  /// key in seen_ for the L-system being read (the main one's keys are bare).
+  std::string scoped(const std::string& key) const {
+    return subs_.empty() ? key : "lsystem " + std::to_string(subs_.size()) + ": " + key;
+  }
+  /// The decomposition or interpretation rules of the L-system being read.
+  RuleSet& blockRules(Block block) {
+    if (!subs_.empty()) {
+      SubLsystem& sub = prog_.subLsystems.back();
+      return block == Block::Main ? sub.productions : block == Block::Decomposition ? sub.decomposition : sub.interpretation;
+    }
+    return block == Block::Main ? prog_.productions : block == Block::Decomposition ? prog_.decomposition : prog_.interpretation;
   }
 
   /// A known header h at column b of line (`decomposition:` and `interpretation:` switch block).
@@ -584,14 +602,18 @@ class GrammarParser {
       subLsystemHeader(line, b, value);
       return;
     }
-    if (!subs_.empty() && h.key != "derivation length" && h.key != "axiom") {
-      // cpfg reads a sub-L-system's productions; its own derivation length and axiom
-      // matter only when it is the main one (lsys_input.y), so Sprig skips them too.
-      error(line, b, "'" + h.key + ":' in a sub-L-system ('lsystem: " + subs_.back().label +
-                         "') is not supported (Sprig reads a sub-L-system's productions only)");
-      return;
+    if (!subs_.empty()) {
+      // cpfg reads a sub-L-system's productions, decomposition and interpretation rules and
+      // its ignore: or consider: list; its own derivation length and axiom matter only when
+      // it is the main one (lsys_input.y), so Sprig skips them too.
+      static const char* const kSubHeaders[] = {"ignore", "consider", "decomposition", "interpretation", "homomorphism", "maximum depth"};
+      if (h.key == "derivation length" || h.key == "axiom") return;
+      if (std::find(std::begin(kSubHeaders), std::end(kSubHeaders), h.key) == std::end(kSubHeaders)) {
+        error(line, b, "'" + h.key + ":' in a sub-L-system ('lsystem: " + subs_.back().label +
+                           "') is not supported (" + kSubReads + ")");
+        return;
+      }
     }
-    if (!subs_.empty()) return;
     if (h.key == "lsystem") {
       if (seen_.count("lsystem")) {
         error(line, b, "several L-systems in one file (cpfg's sub-L-systems) are not supported (the first is at line " +
@@ -658,7 +680,9 @@ class GrammarParser {
             if (h.key == "ignore") error(line, m.col, "brackets cannot be ignored: context matching always follows them");
             (m.name == "[" ? open : close) = true;
           } else {
-            (h.key == "ignore" ? ignoreList_ : considerList_).push_back(prog_.symbols.intern(m.name));
+            std::vector<SymbolId>& list = subs_.empty() ? (h.key == "ignore" ? ignoreList_ : considerList_)
+                                                        : (h.key == "ignore" ? subs_.back().ignoreList : subs_.back().considerList);
+            list.push_back(prog_.symbols.intern(m.name));
           }
         }
         if (h.key == "consider" && prog_.dialect == Dialect::Cpfg && !(open && close))
@@ -666,7 +690,8 @@ class GrammarParser {
                 "cpfg's 'consider:' without '[' and ']' ignores brackets in context matching, which Sprig does not "
                 "support (it always follows them): list them, as in 'consider: " + std::string(scanner_.view(value)) + "[]'");
       }
-      if (seen_.count("ignore") && seen_.count("consider") && h.key == (seen_["ignore"] < seen_["consider"] ? "consider" : "ignore"))
+      const std::string ign = scoped("ignore"), con = scoped("consider");
+      if (seen_.count(ign) && seen_.count(con) && h.key == (seen_[ign] < seen_[con] ? "consider" : "ignore"))
         error(line, b, "use either 'ignore:' or 'consider:', not both");
     } else if (h.key == "decomposition") {
       once(h.key, line, b);
@@ -687,7 +712,7 @@ class GrammarParser {
         if (*d < 1 || *d != std::floor(*d) || *d > 1e6)
           error(line, value.b, "maximum depth must be a whole number from 1 to 1000000, got " + formatNumber(*d));
         else
-          (block == Block::Decomposition ? prog_.decomposition : prog_.interpretation).maxDepth = static_cast<int>(*d);
+          blockRules(block).maxDepth = static_cast<int>(*d);
       }
     }
   }
@@ -817,9 +842,7 @@ class GrammarParser {
       }
     }
     p.usesRandom = expr_.usesRandom();
-    RuleSet& rs = !subs_.empty() ? prog_.subLsystems.back().productions
-                  : block == Block::Main ? prog_.productions : block == Block::Decomposition ? prog_.decomposition : prog_.interpretation;
-    rs.productions.push_back(std::move(p));
+    blockRules(block).productions.push_back(std::move(p));
   }
 
   // ---- cpfg's statements ---------------------------------------------------------------
@@ -1336,17 +1359,6 @@ class GrammarParser {
     return std::any_of(std::begin(kTurtleSymbols), std::end(kTurtleSymbols), [&](const char* t) { return name == t; });
   }
 
-  /// Sub-L-systems with rules that apply to the whole string (decomposition,
-  /// interpretation): cpfg applies each L-system's own inside its calls, which Sprig does not.
-  void checkSubLsystems() {
-    if (prog_.subLsystems.empty()) return;
-    for (const RuleSet* rs : {&prog_.decomposition, &prog_.interpretation})
-      if (!rs->empty())
-        error(subs_.front().line, subs_.front().col,
-              std::string("sub-L-systems together with ") + (rs == &prog_.decomposition ? "decomposition" : "interpretation") +
-                  " rules are not supported (cpfg applies each L-system's own rules inside its '?(n, scale) ... $' calls)");
-  }
-
   /// A predecessor whose stochastic productions all have weight 0 could never be rewritten
   /// by them (the derivation would silently keep the module): an error at the first.
   void checkWeights(const RuleSet& rs) {
@@ -1458,12 +1470,24 @@ class GrammarParser {
     }
     for (SymbolId id : ignoreList_) prog_.ignored[id] = 1;
     prog_.ignored[prog_.openBracket] = prog_.ignored[prog_.closeBracket] = 0;
+    // Each sub-L-system's own table (cpfg: LSYSDATA::ignore), used inside its calls.
+    for (size_t k = 0; k < prog_.subLsystems.size() && k < subs_.size(); ++k) {
+      std::vector<uint8_t>& ignored = prog_.subLsystems[k].ignored;
+      ignored.assign(prog_.symbols.size(), subs_[k].considerList.empty() ? 0 : 1);
+      for (SymbolId id : subs_[k].considerList) ignored[id] = 0;
+      for (SymbolId id : subs_[k].ignoreList) ignored[id] = 1;
+      ignored[prog_.openBracket] = ignored[prog_.closeBracket] = 0;
+    }
     for (SymbolId id : prog_.axiom.symbols) prog_.usesCut |= id == prog_.cut;
     for (const char* q : {"?P", "?H", "?L", "?U"}) prog_.usesQuery |= prog_.symbols.find(q) >= 0;
     std::vector<RuleSet*> sets{&prog_.productions, &prog_.decomposition, &prog_.interpretation};
-    for (SubLsystem& sub : prog_.subLsystems) sets.push_back(&sub.productions);
+    std::vector<const RuleSet*> interpretations{&prog_.interpretation};
+    for (SubLsystem& sub : prog_.subLsystems) {
+      sets.insert(sets.end(), {&sub.productions, &sub.decomposition, &sub.interpretation});
+      interpretations.push_back(&sub.interpretation);
+    }
     for (const RuleSet* rs : sets)
-      if (rs != &prog_.interpretation)
+      if (std::find(interpretations.begin(), interpretations.end(), rs) == interpretations.end())
         for (const Production& p : rs->productions)
           for (const SuccModule& m : p.successor) prog_.usesCut |= m.symbol == prog_.cut;
     if (int q = prog_.symbols.find("?"); q >= 0) prog_.subCall = static_cast<SymbolId>(q);
@@ -1502,6 +1526,7 @@ class GrammarParser {
   struct SubHeader {
     std::string label;
     int line = 0, col = 0;
+    std::vector<SymbolId> ignoreList, considerList;  ///< its `ignore:` or `consider:`
   };
   std::vector<SubHeader> subs_;
   bool inGlobalBlock_ = false;  ///< compiling a Start/End block: its variables are the globals

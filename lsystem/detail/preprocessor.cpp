@@ -264,9 +264,38 @@ void Scanner::preprocess(int file, const std::vector<std::string>& raw, const st
            std::any_of(constants_.begin(), constants_.end(), [&](const auto& c) { return c.first == name; });
   };
   const size_t openAtStart = conditionals_.size();
+  size_t joinedUntil = 0;  // the last line a directive's backslash continuation took
   for (size_t k = 0; k < clean.size(); ++k) {
-    const std::string& s = clean[k];
-    size_t b = static_cast<size_t>(firstNonSpace(s));
+    if (k > 0 && k <= joinedUntil) {  // part of the directive above: blank here
+      emit(k, "", {});
+      continue;
+    }
+    const std::string* line = &clean[k];
+    size_t b = static_cast<size_t>(firstNonSpace(*line));
+    // cpp's line splicing: a directive whose line ends in a backslash goes on with the next
+    // line (`#define LEAF [+F \` then the rest); the lines it takes stay blank.
+    std::string joined;
+    if (b < line->size() && (*line)[b] == '#') {
+      auto continues = [](const std::string& t) {
+        size_t e = t.size();
+        while (e > 0 && isSpace(t[e - 1])) --e;
+        return e > 0 && t[e - 1] == '\\' ? e : std::string::npos;
+      };
+      size_t j = k, cut = continues(clean[k]);
+      if (cut != std::string::npos) {
+        joined = clean[k];
+        while (cut != std::string::npos && j + 1 < clean.size()) {
+          joined.resize(cut - 1);
+          joined += ' ';
+          joined += clean[++j];
+          cut = continues(joined);
+        }
+        if (cut != std::string::npos) joined.resize(cut - 1);
+        joinedUntil = j;
+        line = &joined;
+      }
+    }
+    const std::string& s = *line;
     if (b < s.size() && s[b] == '#') {
       size_t i = b + 1;
       while (i < s.size() && isSpace(s[i])) ++i;

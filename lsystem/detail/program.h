@@ -400,12 +400,18 @@ struct RuleSet {
 };
 
 /// One of cpfg's sub-L-systems (`lsystem: n` after the main one's `endlsystem`): its
-/// productions rewrite the modules between a `?(n, scale)` and its `$`.
+/// productions rewrite the modules between a `?(n, scale)` and its `$`, its decomposition
+/// rules decompose what they write there, its interpretation rules draw the modules the
+/// turtle reaches inside the call, and its `ignore:`/`consider:` table is the one context
+/// matching uses there (generate.c, Derive and ApplyProd; interpret.c, InterpretHomomorphism).
 struct SubLsystem {
   double id = 0;           ///< n
   SourceLoc loc;           ///< its `lsystem:` header
   std::string sourceLine;
   RuleSet productions;
+  RuleSet decomposition;
+  RuleSet interpretation;
+  std::vector<uint8_t> ignored;  ///< per symbol: skipped by context matching inside its calls
 };
 
 /// A compiled grammar.
@@ -437,6 +443,13 @@ struct Program {
   RuleSet interpretation;
   /// cpfg's sub-L-systems, in file order (empty for most grammars; only in cpfg's notation).
   std::vector<SubLsystem> subLsystems;
+  /// True when the main L-system or a sub-L-system has interpretation rules.
+  bool anyInterpretation() const {
+    if (!interpretation.empty()) return true;
+    for (const SubLsystem& sub : subLsystems)
+      if (!sub.interpretation.empty()) return true;
+    return false;
+  }
   /// The main L-system's number (its `lsystem:` label, when a number): `?(n, s)` with this
   /// n calls the main productions again.
   std::optional<double> mainLsystemId;

@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <filesystem>
 #include <string>
 
 #include "core/atomic_file.h"
@@ -248,6 +249,21 @@ TEST_CASE("cpfg view file", "[lsystem][cpfg]") {
     CHECK(v.warnings[0].message == "ignored, as they set how cpfg's window shows the model, not its geometry: "
                                    "'viewpoint:', 'render mode:', 'z buffer:'");
   }
+  SECTION("line style: as cpfg reads it, a word it does not know keeps the style in effect") {
+    ViewFile v = parseViewFile("line style: cylinder\nline style: wireframe\n", "t.v");
+    CHECK(*v.lineStyle == CpfgLineStyle::Cylinder);
+    REQUIRE(v.warnings.size() == 1);
+    CHECK(v.warnings[0].loc.line == 2);
+    CHECK(v.warnings[0].message == "'line style: wireframe' is none of cpfg's line styles (pixel, polygon, cylinder): as cpfg "
+                                   "does, the line style in effect is kept");
+    CHECK(*parseViewFile("line style: 2\n", "t.v").lineStyle == CpfgLineStyle::Polygon);  // cpfg's digits 1 to 3
+    CHECK(viewErrorOf("line style: 7\n") == "t.v:1:13: 'line style:' is pixel, polygon or cylinder (or 1, 2, 3), got '7'");
+  }
+  SECTION("an object given by a relative path starting with './' reads its files") {
+    const std::string rel = "./" + std::filesystem::relative(cpfgAsset("function/plant.v")).generic_string();
+    ViewFile v = loadViewFile(rel);
+    CHECK(v.functions.size() == 3);
+  }
   SECTION("errors") {
     CHECK(viewErrorOf("angle increment: 30\nangel factor: 8\n") ==
           "t.v:2:1: unknown view file command 'angel factor:' (did you mean 'angle factor'?)");
@@ -431,6 +447,11 @@ TEST_CASE("cpfg consider: with brackets; maximum depth beyond 256", "[lsystem][c
 }
 
 TEST_CASE("cpfg Start, StartEach, EndEach and End blocks over global variables", "[lsystem][cpfg]") {
+  SECTION("a global variable in the axiom is an error, not a crash (vlab's two-trees and pallaea)") {
+    CHECK(errorOf("Start: { d = 3; }\naxiom: S A(1, d + 1)\n") ==
+          "t.l:2:15: cpfg's global variable 'd' in the axiom is not supported (Sprig reads the axiom before the "
+          "'Start:' block assigns it): write its value");
+  }
   SECTION("a counter the conditions read") {
     // i is 0 at step 1, 1 at step 2, ...: A grows F while i < 3.
     const std::string g =
@@ -592,6 +613,12 @@ TEST_CASE("cpfg's C preprocessor", "[lsystem][cpfg]") {
     // Columns after an expansion are the file's own.
     CHECK(errorOf("#define S F(1)F(1)\naxiom: S@bo(1)\n") == "t.l:2:9: cpfg's '@bo' (circle boundary) is not supported");
   }
+  SECTION("cpp's line splicing: a directive ending in a backslash goes on with the next line") {
+    Grammar g = parseGrammar("#define LEAF [+F \\\n\t-F] \\\n  G\n#define N 1 + \\\n 2\naxiom: A LEAF F(N)\n", "t.l");
+    CHECK(formatModuleString(g.axiom(), g.symbols()) == "A[+F-F]GF(3)");
+    // The lines a directive took are blank: later lines keep their numbers.
+    CHECK(errorOf("#define LEAF [+F \\\n\t-F]\naxiom: A LEAF @bo(1)\n") == "t.l:3:15: cpfg's '@bo' (circle boundary) is not supported");
+  }
   SECTION("cpp's identifiers: a macro named B is not expanded inside AB; a number body stays a value") {
     Grammar g = parseGrammar("#define B [+F]\n#define N (2 + 1)\naxiom: AB B F(N)\n", "t.l");
     CHECK(formatModuleString(g.axiom(), g.symbols()) == "AB[+F]F(3)");
@@ -657,14 +684,90 @@ TEST_CASE("cpfg sub-L-systems", "[lsystem][cpfg]") {
     // Step 2: the inner A is in L-system 1 again.
     CHECK(formatModuleString(d.step(), d.symbols()) == "?(2)?(1)AX$$AXX");
   }
+  SECTION("tests/assets/cpfg/sub_lsystem_rules: each L-system's decomposition, interpretation and ignore: inside its calls") {
+    Grammar g = loadGrammar(cpfgAsset("sub_lsystem_rules/plant.l"));
+    CHECK(g.hasInterpretation());
+    Deriver d(g);
+    CHECK(formatModuleString(d.current(), d.symbols()) == "A");
+    CHECK(formatModuleString(d.step(), d.symbols()) == "II[+?(2,0.5)B$]A");
+    CHECK(formatModuleString(d.step(), d.symbols()) == "IIII[+?(2,0.5)IWZK+B$]II[+?(2,0.5)B$]A");
+    const ModuleString& s = d.step();
+    CHECK(formatModuleString(s, d.symbols()) == "IIIIIIII[+?(2,0.5)IWZK+Q$]IIII[+?(2,0.5)IWZK+B$]II[+?(2,0.5)B$]A");
+    const ModuleString shown = d.interpret(s);
+    CHECK(formatModuleString(shown, d.symbols()) ==
+          "F(1)F(1)F(1)F(1)F(1)F(1)F(1)F(1)[+?(2,0.5)IF(2)?(3,2)F(5)$F(3)K+Q$]F(1)F(1)F(1)F(1)"
+          "[+?(2,0.5)IF(2)?(3,2)F(5)$F(3)K+B$]F(1)F(1)[+?(2,0.5)B$]A");
+    // Drawn with the view file's 90 degrees: L-system 2 at half scale, L-system 3 inside it
+    // at twice that (F(5) is 5 long), back to half after its '$' (F(3) is 1.5 long).
+    Drawn o = drawObject("sub_lsystem_rules", true);
+    std::vector<std::pair<DVec3, DVec3>> want;
+    auto axis = [&](double y0, int n) {
+      for (int k = 0; k < n; ++k) want.push_back({{0, y0 + k, 0}, {0, y0 + k + 1, 0}});
+    };
+    auto branch = [&](double y) {
+      want.push_back({{0, y, 0}, {-1, y, 0}});
+      want.push_back({{-1, y, 0}, {-6, y, 0}});
+      want.push_back({{-6, y, 0}, {-7.5, y, 0}});
+    };
+    axis(0, 8);
+    branch(8);
+    axis(8, 4);
+    branch(12);
+    axis(12, 2);
+    REQUIRE(o.skeleton.internodes.size() == want.size());
+    for (size_t k = 0; k < want.size(); ++k) {
+      INFO("internode " << k);
+      checkNear(o.skeleton.internodes[k].start, want[k].first);
+      checkNear(o.skeleton.internodes[k].end, want[k].second);
+    }
+    const double r0 = o.skeleton.internodes[0].baseRadius;
+    REQUIRE(r0 > 0);
+    CHECK(o.skeleton.internodes[8].baseRadius == Approx(0.5 * r0));
+    CHECK(o.skeleton.internodes[9].baseRadius == Approx(r0));
+    CHECK(o.skeleton.internodes[10].baseRadius == Approx(0.5 * r0));
+  }
+  SECTION("interpretation: each L-system's own maximum depth, and the rules of the L-system current at each module") {
+    const std::string head = "lsystem: 1\naxiom: W?(2)W$W\nhomomorphism\nmaximum depth: 5\nW --> V\nV --> F(1)\nendlsystem\n"
+                             "lsystem: 2\nhomomorphism\nW --> ?(3)I$V\nendlsystem\nlsystem: 3\nhomomorphism\n";
+    // Inside call 2, W --> ?(3)I$V at depth 0; I at depth 1 is L-system 3's, whose
+    // maximum depth (1 by default) stops it; V after the '$' is L-system 2's, which has no
+    // rule for it: only the main L-system's W's become F(1) (two levels).
+    Grammar shallow = parseGrammar(head + "I --> F(5)\nendlsystem\n", "t.l");
+    Deriver a(shallow);
+    CHECK(formatModuleString(a.interpret(a.current()), a.symbols()) == "F(1)?(2)?(3)I$V$F(1)");
+    Grammar deep = parseGrammar(head + "maximum depth: 2\nI --> F(5)\nendlsystem\n", "t.l");
+    Deriver b(deep);
+    CHECK(formatModuleString(b.interpret(b.current()), b.symbols()) == "F(1)?(2)?(3)F(5)$V$F(1)");
+    // A rule that replaces the call itself: the turtle never reaches the '?(2)', so what
+    // follows stays in the main L-system (cpfg switches on the modules it draws).
+    Grammar replaced = parseGrammar("lsystem: 1\naxiom: ?(2)W$\nhomomorphism\n?(n) --> G\nW --> F(1)\nendlsystem\n"
+                                    "lsystem: 2\nhomomorphism\nW --> F(2)\nendlsystem\n",
+                                    "t.l");
+    Deriver c(replaced);
+    CHECK(formatModuleString(c.interpret(c.current()), c.symbols()) == "GF(1)$");
+  }
+  SECTION("decomposition: the axiom too, each module by the L-system it is in") {
+    Grammar g = parseGrammar("lsystem: 1\nderivation length: 1\naxiom: X?(2)X$X\nX --> XX\ndecomposition\nX --> Y\nendlsystem\n"
+                             "lsystem: 2\nX --> X\ndecomposition\nmaximum depth: 2\nX --> ZX\nendlsystem\n",
+                             "t.l");
+    Deriver d(g);
+    // The axiom: X --> Y outside, X --> ZX twice (depth 2) inside.
+    CHECK(formatModuleString(d.current(), d.symbols()) == "Y?(2)ZZX$Y");
+    // Y, Z have no productions; the inner X --> X is decomposed by L-system 2 again.
+    CHECK(formatModuleString(d.step(), d.symbols()) == "Y?(2)ZZZZX$Y");
+  }
   SECTION("errors") {
-    CHECK(errorOf("axiom: ?(2)A$\nendlsystem\nlsystem: 2\nignore: F\nA --> B\n") ==
-          "t.l:4:1: 'ignore:' in a sub-L-system ('lsystem: 2') is not supported (Sprig reads a sub-L-system's productions only)");
+    CHECK(errorOf("axiom: ?(2)A$\nendlsystem\nlsystem: 2\nseed: 3\nA --> B\n") ==
+          "t.l:4:1: 'seed:' in a sub-L-system ('lsystem: 2') is not supported (Sprig reads a sub-L-system's productions, "
+          "decomposition and interpretation rules and 'ignore:' or 'consider:')");
+    CHECK(errorOf("axiom: ?(2)A$\nendlsystem\nlsystem: 2\nignore: F\nignore: G\nA --> B\n") ==
+          "t.l:5:1: duplicate 'ignore:' (first at line 4)");
+    CHECK(errorOf("axiom: ?(2)A$\nendlsystem\nlsystem: 2\nhomomorphism\nA --> ?P(1,2)\n") ==
+          "t.l:5:7: cpfg's query module '?P' in an interpretation rule is not supported (its values would be lost with the "
+          "interpreted string)");
+    CHECK(errorOf("axiom: ?(2)A$\nignore: F\nendlsystem\nlsystem: 2\nignore: F\nA --> B\n") == "no error");
     CHECK(errorOf("axiom: A\nendlsystem\nlsystem: 2\nendlsystem\nlsystem: 2\n") ==
           "t.l:5:1: 'lsystem: 2' is defined twice (first at line 3)");
-    CHECK(errorOf("axiom: A\nhomomorphism\nA --> F\nendlsystem\nlsystem: 2\nA --> B\n") ==
-          "t.l:5:1: sub-L-systems together with interpretation rules are not supported (cpfg applies each L-system's own "
-          "rules inside its '?(n, scale) ... $' calls)");
     CHECK(errorOf("axiom: ?(2)A$\nendlsystem\nlsystem: 2\nA --> B\n", "t.lsys") ==
           "t.lsys:1:8: cpfg's '?(n, scale)' (sub-L-system call) is supported only in cpfg's notation (a .l file), where '$' ends it");
     CHECK(errorOf("axiom: ?(2,1,3)A$\n") == "t.l:1:8: cpfg's sub-L-system call '?(n, scale)' takes 1 or 2 parameters, got 3");

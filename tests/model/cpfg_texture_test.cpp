@@ -10,6 +10,7 @@
 #include "core/atomic_file.h"
 #include "core/image.h"
 #include "core/mesh_io.h"
+#include "core/srgb.h"
 #include "lsystem/skeleton.h"
 #include "lsystem/turtle.h"
 #include "model/growth.h"
@@ -27,6 +28,7 @@ namespace {
 fs::path textureObject() { return fs::path(SPRIG_SOURCE_DIR) / "tests/assets/cpfg/texture"; }
 fs::path cutoutObject() { return textureObject() / "cutout"; }
 fs::path cylinderObject() { return textureObject() / "cylinder"; }
+fs::path mipmapObject() { return textureObject() / "mipmap"; }
 
 /// The colour the scene's surface shows at (x, y) seen along +Z (the flat squares face -Z).
 Vec3 colorAt(const render::Scene& scene, float x, float y) {
@@ -167,10 +169,14 @@ TEST_CASE("cpfg texture errors", "[model][cpfg]") {
   CHECK(errorOf("texture: F: halves.png\n", "@Tx(2)~a") ==
         "cpfg's '@Tx(2)' names no texture: the view file has 1 'texture:' line");
   CHECK(errorOf("", "@Tx(1)~a") == "cpfg's '@Tx(1)' names no texture: the view file has no 'texture:' line");
-  CHECK(errorOf("texture: F: halves.png E: b\n", "~a") ==
-        "plant.v:2:27: the texture mode 'E: b' (blend) is not supported (use m, modulate, or d, decal)");
-  CHECK(errorOf("texture: F: halves.png L: m\n", "~a") ==
-        "plant.v:2:27: the mipmapped minification filter 'L: m' is not supported (use n or l)");
+  CHECK(errorOf("texture: F: halves.png E: b\n", "~a") == "no error");
+  CHECK(errorOf("texture: F: halves.png L: m\n", "~a") == "no error");
+  CHECK(errorOf("texture: F: halves.png E: x\n", "~a") ==
+        "plant.v:2:27: a texture mode 'E:' is m (modulate), d (decal) or b (blend), got 'x'");
+  CHECK(errorOf("texture: F: halves.png L: mx\n", "~a") ==
+        "plant.v:2:27: a texture filter 'L:' is n (nearest) or l (linear), or m, mn, ml, mnn, mnl, mln, mll (mipmaps), got 'mx'");
+  CHECK(errorOf("texture: F: halves.png H: m\n", "~a") ==
+        "plant.v:2:27: a texture filter 'H:' is n (nearest) or l (linear), got 'm'");
   CHECK(errorOf("texture: F: halves.png Q: 1\n", "~a") ==
         "plant.v:2:24: unknown texture option 'Q' (cpfg's are F: image, H: and L: filters, E: mode, S, R: ratio)");
   CHECK(errorOf("texture: H: l\n", "~a") == "plant.v:2:10: a texture needs its image: 'texture: F: NAME.png'");
@@ -697,4 +703,157 @@ TEST_CASE("cpfg cut-out textures on cylinders", "[model][cpfg]") {
   CHECK(occludedAt(36));
   CHECK_FALSE(occludedAt(112));
   fs::remove_all(dir);
+}
+
+namespace {
+
+/// The linear colour of 8-bit sRGB-encoded values e (0..1 each).
+Vec4 fromSrgb(float r, float g, float b, float a = 1.0f) { return Vec4(srgbToLinear(r), srgbToLinear(g), srgbToLinear(b), a); }
+
+void checkTexel(const Vec4& got, const Vec4& want, float tolerance = 1e-5f) {
+  INFO("got (" << got.r << ", " << got.g << ", " << got.b << ", " << got.a << "), expected (" << want.r << ", " << want.g
+               << ", " << want.b << ", " << want.a << ")");
+  CHECK(glm::length(got - want) < tolerance);
+}
+
+}  // namespace
+
+TEST_CASE("cpfg mipmapped textures: the level of log2 of the texel footprint", "[model][cpfg]") {
+  const Species s = loadSpecies(mipmapObject());
+  REQUIRE(s.render.style.cpfgTextures);
+  const auto& textures = *s.render.style.cpfgTextures;
+  REQUIRE(textures.size() == 5);
+  const lsystem::CpfgTexture& trilinear = textures[0];
+  const lsystem::CpfgTexture& nearest = textures[1];
+  CHECK(trilinear.mipmap);
+  CHECK(trilinear.minLinear);  // L: m is GL_LINEAR_MIPMAP_LINEAR (textures.c)
+  CHECK(trilinear.mipLinear);
+  CHECK(nearest.mipmap);
+  CHECK_FALSE(nearest.minLinear);  // L: mnn is GL_NEAREST_MIPMAP_NEAREST
+  CHECK_FALSE(nearest.mipLinear);
+  CHECK_FALSE(textures[2].mipmap);
+  // quads.png (4 x 4): levels 2 x 2 and 1 x 1, each texel the mean of four in sRGB values.
+  REQUIRE(trilinear.levels.size() == 2);
+  CHECK(trilinear.levels[0]->width == 2);
+  CHECK(trilinear.levels[0]->height == 2);
+  CHECK(trilinear.levels[1]->width == 1);
+  CHECK(trilinear.levels[1]->height == 1);
+  const Vec4 red(1, 0, 0, 1), blue(0, 0, 1, 1), green(0, 1, 0, 1), white(1, 1, 1, 1);
+  const Vec4 purple = fromSrgb(0.5f, 0.0f, 0.5f);          // level 1, top left: R B / B R
+  const Vec4 mean = fromSrgb(0.375f, 0.5f, 0.625f);        // level 2: purple, green, white, blue
+  checkTexel(trilinear.levels[0]->at(0, 0), purple);
+  checkTexel(trilinear.levels[0]->at(1, 0), green);
+  checkTexel(trilinear.levels[0]->at(0, 1), white);
+  checkTexel(trilinear.levels[0]->at(1, 1), blue);
+  checkTexel(trilinear.levels[1]->at(0, 0), mean);
+
+  SECTION("GL_LINEAR_MIPMAP_LINEAR: lambda = log2 rho, levels floor(lambda) and the next mixed by its fraction") {
+    // (1/8, 7/8) is the top-left texel (R); (1/4, 3/4) the centre of level 1's top-left texel.
+    checkTexel(trilinear.sampleFootprint(0.125, 0.875, 0.0), red);   // no footprint: magnified
+    checkTexel(trilinear.sampleFootprint(0.125, 0.875, 0.5), red);   // lambda -1: magnified, H: n
+    checkTexel(trilinear.sampleFootprint(0.125, 0.875, 1.0), red);   // lambda 0: still magnified (c = 0)
+    checkTexel(trilinear.sampleFootprint(0.25, 0.75, 2.0), purple);  // lambda 1: level 1 at its texel's centre
+    checkTexel(trilinear.sampleFootprint(0.25, 0.75, 4.0), mean);    // lambda 2: the last level
+    checkTexel(trilinear.sampleFootprint(0.25, 0.75, 1000.0), mean);  // clamped to the last level
+    checkTexel(trilinear.sampleFootprint(0.25, 0.75, 2.0 * std::sqrt(2.0)), 0.5f * (purple + mean));  // lambda 1.5
+    // Bilinear within level 1: halfway between its purple and green texels.
+    checkTexel(trilinear.sampleFootprint(0.5, 0.75, 2.0), 0.5f * (purple + green));
+    // Between levels 0 and 1 at lambda 0.5: level 0 bilinear at (1/4, 3/4) is the mean of
+    // R B / B R in linear values, level 1 the mean in sRGB values.
+    const Vec4 linearMean = 0.5f * (red + blue);
+    checkTexel(trilinear.sampleFootprint(0.25, 0.75, std::sqrt(2.0)), 0.5f * (linearMean + purple));
+  }
+  SECTION("GL_NEAREST_MIPMAP_NEAREST: level ceil(lambda + 1/2) - 1, nearest texel") {
+    checkTexel(nearest.sampleFootprint(0.125, 0.875, std::pow(2.0, 0.4)), red);       // lambda 0.4: level 0
+    checkTexel(nearest.sampleFootprint(0.125, 0.875, std::pow(2.0, 1.4)), purple);    // lambda 1.4: level 1
+    checkTexel(nearest.sampleFootprint(0.125, 0.875, std::pow(2.0, 1.6)), mean);      // lambda 1.6: level 2
+    checkTexel(nearest.sampleFootprint(0.625, 0.875, std::pow(2.0, 1.4)), green);
+  }
+  SECTION("an image whose sides are not powers of two is scaled to the nearest ones first (GLU)") {
+    const lsystem::CpfgTexture& odd = textures[4];  // cutout.png, 5 x 1
+    CHECK(odd.image->width == 4);
+    CHECK(odd.image->height == 1);
+    REQUIRE(odd.levels.size() == 2);
+    CHECK(odd.levels[0]->width == 2);
+    CHECK(odd.levels[1]->width == 1);
+    CHECK(odd.levels[1]->height == 1);
+  }
+  SECTION("the renderer's footprint picks the level: a camera in front of the square at depth d sees rho = d / 6") {
+    GrowthEngine engine(s);
+    const lsystem::Skeleton sk = engine.skeletonAt(engine.lastStep());
+    const Vec3 leaf = s.render.style.leaf.baseColor;
+    // Square 1 (per surface): s = -x / 3 over x in [-3, 0], t = y / 3. 90 degrees over 16
+    // pixels: a pixel is d / 8 wide at depth d, 4/3 texels per unit, so rho = d / 6.
+    auto colorSeen = [&](Vec3 p, float depth) {
+      render::Camera camera;
+      camera.position = p - Vec3(0, 0, depth);
+      camera.target = p;
+      camera.fovYDeg = 90.0f;
+      render::Scene scene;
+      scene.setPixelFootprint(camera, 16, 16, 0.0f);
+      scene.add(skeletonPreview(sk, s.render.style));
+      scene.commit();
+      auto hit = scene.intersect(camera.position, Vec3(0, 0, 1), 0.0f, 100.0f);
+      REQUIRE(hit);
+      CHECK(hit->t == Approx(depth));
+      return hit->color;
+    };
+    checkColor(colorSeen(Vec3(-0.375f, 2.625f, 0), 3.0f), Vec3(red) * leaf);  // rho 0.5: level 0
+    const Vec3 atLevel1 = colorSeen(Vec3(-0.75f, 2.25f, 0), 12.0f);           // rho 2
+    CHECK(glm::length(atLevel1 - Vec3(purple) * leaf) < 1e-4f);
+    // rho 4 (log2 of the computed footprint may fall a hair below 2: level 1 then weighs ~1e-6)
+    CHECK(glm::length(colorSeen(Vec3(-0.75f, 2.25f, 0), 24.0f) - Vec3(mean) * leaf) < 1e-4f);
+  }
+  SECTION("export: the glTF sampler minifies with LINEAR_MIPMAP_LINEAR") {
+    SpeciesModel model(s, ModelOptions{});
+    const std::vector<ExportPart> parts = model.exportParts(model.finalStage(), 0.0f, false);
+    int textured = 0, mipmapped = 0;
+    for (const ExportPart& part : parts) {
+      if (part.name.rfind("textured_leaves_", 0) != 0) continue;  // not the wood's bark
+      REQUIRE(part.material.texture);
+      ++textured;
+      if (part.material.texture->minFilter == PartTexture::Filter::Default) ++mipmapped;
+    }
+    CHECK(textured == 3);   // textures 1, 3 and 4 (texture 2 and 5 are drawn nowhere)
+    CHECK(mipmapped == 1);  // texture 1
+  }
+}
+
+TEST_CASE("cpfg blended textures (E: b): the colour times one minus the texel", "[model][cpfg]") {
+  const Species s = loadSpecies(mipmapObject());
+  const auto& textures = *s.render.style.cpfgTextures;
+  const lsystem::CpfgTexture& blend = textures[2];
+  const lsystem::CpfgTexture& cut = textures[3];
+  CHECK(blend.blend);
+  CHECK_FALSE(blend.decal);
+  CHECK_FALSE(blend.cutsOut());  // opaque texels
+  CHECK(cut.cutsOut());          // GL_BLEND keeps the texel's alpha: alpha-tested as modulate
+  // C = Cf (1 - Ct) + Cc Ct with cpfg's environment colour Cc GL's default (0, 0, 0, 0); A = Af At.
+  const Vec3 base(0.2f, 0.6f, 0.8f);
+  checkTexel(blend.combine(Vec4(1, 0, 0, 1), base), Vec4(0, 0.6f, 0.8f, 1));
+  checkTexel(blend.combine(Vec4(0.25f, 0.5f, 1, 0.5f), base), Vec4(0.15f, 0.3f, 0, 0.5f));
+  checkTexel(blend.fragment(0.875, 0.875, base), Vec4(0.2f, 0, 0.8f, 1));  // green texel
+  checkTexel(blend.fragment(0.125, 0.125, base), Vec4(0, 0, 0, 1));        // white texel: black
+
+  GrowthEngine engine(s);
+  const lsystem::Skeleton sk = engine.skeletonAt(engine.lastStep());
+  render::Scene scene;
+  scene.add(skeletonPreview(sk, s.render.style));
+  scene.commit();
+  const Vec3 leaf = s.render.style.leaf.baseColor;
+  // Square 2 (texture 3, per surface) at y in [4, 7]: s = -x / 3, t = (y - 4) / 3.
+  checkColor(colorAt(scene, -0.375f, 6.625f), leaf * Vec3(0, 1, 1));   // red texel
+  checkColor(colorAt(scene, -2.625f, 6.625f), leaf * Vec3(1, 0, 1));   // green texel
+  checkColor(colorAt(scene, -0.375f, 4.375f), Vec3(0));                // white texel
+  // Square 3 (texture 4, per patch) at y in [8, 11]: s along y, texel k at y = 8.3 + 0.6 k.
+  auto ray = [&](float x, float y) { return scene.intersect(Vec3(x, y, -10), Vec3(0, 0, 1), 0.0f, 100.0f); };
+  auto opaque = ray(-1.5f, 8.3f);
+  REQUIRE(opaque);
+  CHECK(opaque->t == Approx(10.0f));
+  checkColor(opaque->color, leaf * Vec3(0, 1, 1));
+  CHECK_FALSE(ray(-1.5f, 8.9f));  // alpha 0: cut out, nothing behind
+  CHECK_FALSE(ray(-1.5f, 10.7f));  // alpha 25/255: cut out
+  auto part = ray(-1.5f, 9.5f);  // alpha 128/255: drawn, covering that much
+  REQUIRE(part);
+  CHECK(part->opacity == Approx(128 / 255.0f).margin(1e-6));
 }

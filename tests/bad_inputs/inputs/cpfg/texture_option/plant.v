@@ -1,1 +1,1 @@
-texture: F: halves.png E: b
+texture: F: halves.png L: mx
