@@ -704,6 +704,16 @@ struct Deriver::Impl {
     decompFrames.push_back({begin, decompStack.size(), begin});
   }
 
+  /// Done with the top frame's successor: drops its modules (the top frame's are the last)
+  /// and the frame.
+  void popDecompFrame() {
+    const size_t begin = decompFrames.back().begin;
+    decompStack.symbols.resize(begin);
+    decompStack.offsets.resize(begin + 1);
+    decompStack.params.resize(decompStack.offsets[begin]);
+    decompFrames.pop_back();
+  }
+
   /// Decomposes the frames on the stack (the bottom one at depth base) into w until the
   /// stack is empty. Frame k of decompFrames is at depth base + k.
   void decomposeFrames(Writer& w, int32_t birth, int step, int base, const RuleSet& rs) {
@@ -712,11 +722,7 @@ struct Deriver::Impl {
     while (!decompFrames.empty()) {
       DecompFrame& f = decompFrames.back();
       if (f.pos >= f.end) {
-        // Done with this successor: drop its modules (the top frame's are the last).
-        decompStack.symbols.resize(f.begin);
-        decompStack.offsets.resize(f.begin + 1);
-        decompStack.params.resize(decompStack.offsets[f.begin]);
-        decompFrames.pop_back();
+        popDecompFrame();
         continue;
       }
       const size_t i = f.pos;
@@ -972,10 +978,7 @@ struct Deriver::Impl {
       while (!decompFrames.empty()) {
         DecompFrame& f = decompFrames.back();
         if (f.pos >= f.end) {
-          decompStack.symbols.resize(f.begin);
-          decompStack.offsets.resize(f.begin + 1);
-          decompStack.params.resize(decompStack.offsets[f.begin]);
-          decompFrames.pop_back();
+          popDecompFrame();
           continue;
         }
         const size_t k = f.pos;
