@@ -221,8 +221,7 @@ void addTexturedSurfaces(render::Geometry& out, const lsystem::Skeleton& skeleto
     auto map = std::make_shared<render::ImageMap>();
     map->width = tex->image->width;
     map->height = tex->image->height;
-    map->sample = [tex, color](Vec2 uv, bool minified) { return tex->fragment(uv.x, uv.y, color, minified); };
-    map->sampleFootprint = [tex, color](Vec2 uv, double rho) { return tex->combine(tex->sampleFootprint(uv.x, uv.y, rho), color); };
+    map->sample = [tex, color](Vec2 uv, double rho) { return tex->combine(tex->sampleFootprint(uv.x, uv.y, rho), color); };
     map->alphaCutoff = tex->cutsOut() ? lsystem::kCpfgAlphaCutoff : -1.0f;
     out.parts.push_back(render::MeshPart{std::move(g.mesh), g.tube ? style.wood : style.leaf, {}, {}, std::move(map)});
   }

@@ -91,13 +91,10 @@ struct SpheresPart {
 struct ImageMap {
   int width = 0;   ///< texels along u (the footprint's scale)
   int height = 0;  ///< texels along v
-  /// The surface's linear RGB colour and alpha at uv; `minified`: the lookup's pixel covers
-  /// more than one texel, so the minification filter applies. Must be thread-safe.
-  std::function<Vec4(Vec2 uv, bool minified)> sample;
-  /// When set, used instead of sample: the colour and alpha at uv of a lookup whose pixel
-  /// covers texelsPerPixel texels (GL's ρ; 0 without a camera), for filters that need ρ
-  /// itself (mipmaps: level log2 ρ). Must be thread-safe.
-  std::function<Vec4(Vec2 uv, double texelsPerPixel)> sampleFootprint;
+  /// The surface's linear RGB colour and alpha at uv for a lookup whose pixel covers
+  /// texelsPerPixel texels (GL's ρ; 0 without a camera): above 1 the minification filter
+  /// applies, and mipmaps take level log2 ρ. Must be thread-safe.
+  std::function<Vec4(Vec2 uv, double texelsPerPixel)> sample;
   /// Alpha test threshold; negative: no alpha test and no blending (alpha is ignored).
   float alphaCutoff = -1.0f;
 };

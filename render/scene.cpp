@@ -109,8 +109,7 @@ double detail::ImageMapData::texelsPerPixel(uint32_t prim, float u, float v) con
 Vec4 detail::ImageMapData::sample(uint32_t prim, float u, float v) const {
   const glm::uvec3& tri = triangles[prim];
   const Vec2 uv = (1.0f - u - v) * uvs[tri.x] + u * uvs[tri.y] + v * uvs[tri.z];
-  const double rho = texelsPerPixel(prim, u, v);
-  return map->sampleFootprint ? map->sampleFootprint(uv, rho) : map->sample(uv, rho > 1.0);
+  return map->sample(uv, texelsPerPixel(prim, u, v));
 }
 
 uint32_t Scene::Impl::attach(RTCGeometry geometry, GeometryRecord record) {

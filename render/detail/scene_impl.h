@@ -59,9 +59,8 @@ struct ImageMapData {
   /// lengths. 0 without a camera, for a degenerate triangle or a point behind the camera;
   /// infinite where the view ray grazes the plane.
   double texelsPerPixel(uint32_t prim, float u, float v) const;
-  /// The map's colour and alpha at barycentric (u, v) of triangle prim: its interpolated uv,
-  /// minified when texelsPerPixel > 1 (OpenGL's λ > 0 without mipmaps), or the map's
-  /// sampleFootprint at texelsPerPixel when it has one.
+  /// The map's colour and alpha at barycentric (u, v) of triangle prim: its interpolated uv
+  /// at this hit's texelsPerPixel.
   Vec4 sample(uint32_t prim, float u, float v) const;
 };
 
