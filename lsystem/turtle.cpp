@@ -391,7 +391,7 @@ class TurtleWalk {
   }
   /// Length of the move of module i (its parameter, or the step length), scaled by growth.
   double length(size_t i) const {
-    const double l = (hasParam(i) ? param(i) : settings_.stepLength) * st_.scale;
+    const double l = fullLength(i);
     return growing_ ? l * growth(i) : l;
   }
   /// The radius a segment of this length is drawn with at full growth: the width's,

@@ -212,10 +212,12 @@ Vec3 groupColor(const TexturedGroup& g, const SkeletonStyle& style) {
 /// Adds the skeleton's textured cpfg organs of the kinds asked for to out: one mesh part per
 /// texture, colour and kind, the leaf material (the wood material for tubes) with the
 /// texture's image map shading the colour (modulate or decal, by the H: or L: filter per
-/// lookup) and, modulated, cut out by its alpha as cpfg does.
-void addTexturedSurfaces(render::Geometry& out, const lsystem::Skeleton& skeleton, const SkeletonStyle& style,
-                         TexturedKinds kinds = {}) {
+/// lookup) and, modulated, cut out by its alpha as cpfg does. Returns the triangles added.
+size_t addTexturedSurfaces(render::Geometry& out, const lsystem::Skeleton& skeleton, const SkeletonStyle& style,
+                           TexturedKinds kinds = {}) {
+  size_t triangles = 0;
   for (TexturedGroup& g : texturedGroups(skeleton, style, kinds)) {
+    triangles += g.mesh.triangleCount();
     auto tex = std::make_shared<const lsystem::CpfgTexture>((*style.cpfgTextures)[static_cast<size_t>(g.texture)]);
     const Vec3 color = groupColor(g, style);
     auto map = std::make_shared<render::ImageMap>();
@@ -225,6 +227,7 @@ void addTexturedSurfaces(render::Geometry& out, const lsystem::Skeleton& skeleto
     map->alphaCutoff = tex->cutsOut() ? lsystem::kCpfgAlphaCutoff : -1.0f;
     out.parts.push_back(render::MeshPart{std::move(g.mesh), g.tube ? style.wood : style.leaf, {}, {}, std::move(map)});
   }
+  return triangles;
 }
 
 }  // namespace
@@ -394,11 +397,8 @@ class TreeModel final : public KindModel {
     }
     fig.buildSeconds = secondsSince(t0);
     out.geometry = surfaceGeometry(tree, look, mesh);
-    const TexturedKinds kinds{tree.options.leaves.enabled, true};  // textured tubes are wood, drawn always
-    addTexturedSurfaces(out.geometry, skeleton, look.style, kinds);
-    for (const lsystem::Organ& o : skeleton.organs)
-      if (o.texture >= 0 && (isTexturedTube(o) ? kinds.tubes : kinds.leaves))
-        fig.triangles += o.triangles.size() / 3;  // not among tree.leaves
+    // Textured tubes are wood, drawn always; their triangles are not among tree.leaves.
+    fig.triangles += addTexturedSurfaces(out.geometry, skeleton, look.style, TexturedKinds{tree.options.leaves.enabled, true});
     return out;
   }
 
