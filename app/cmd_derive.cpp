@@ -8,6 +8,7 @@
 #include "core/json_writer.h"
 #include "model/species.h"
 #include "model/growth.h"
+#include "model/tree_kind.h"
 #include "core/atomic_file.h"
 #include "lsystem/derive.h"
 
@@ -103,7 +104,14 @@ int runDerive(const DeriveArgs& a, const GlobalOptions& g) {
     t.skeleton = engine.skeletonAt(last, &t.end);
     t.summary = {t.skeleton.internodes.size(), t.skeleton.totalLength(), t.skeleton.bounds(), {}};
   }
-  if (a.print) std::cout << lsystem::formatModuleString(t.modules, t.symbols) << "\n";
+  if (a.print) {
+    lsystem::FormatOptions fo;
+    const TreeSpec& tree = treeSpec(species);
+    // cpfg's parameters are floats
+    fo.floatParams = tree.grammar ? tree.grammar->cpfgNotation()
+                                  : tree.grammarFile.size() > 2 && tree.grammarFile.compare(tree.grammarFile.size() - 2, 2, ".l") == 0;
+    std::cout << lsystem::formatModuleString(t.modules, t.symbols, fo) << "\n";
+  }
   if (a.json) std::cout << reportJson(t) << "\n";
   if (!a.print && !a.json)
     std::cout << species.name << ": " << t.steps << " steps, " << t.modules.size() << " modules, "

@@ -226,7 +226,8 @@ struct Deriver::Impl {
       DVec3 v = name == "?P" ? h.frame.position : name == "?H" ? h.frame.heading : name == "?L" ? h.frame.left : -h.frame.up;
       const uint32_t count = std::min<uint32_t>(cur.paramCount(h.index), 3);
       double* p = cur.params.data() + cur.offsets[h.index];
-      for (uint32_t c = 0; c < count; ++c) p[c] = v[static_cast<int>(c)];
+      for (uint32_t c = 0; c < count; ++c)
+        p[c] = prog->floatParams ? static_cast<double>(static_cast<float>(v[static_cast<int>(c)])) : v[static_cast<int>(c)];
     }
   }
 
@@ -398,11 +399,16 @@ struct Deriver::Impl {
     }
   }
 
-  /// lpfg right context: skips ignored symbols and whole [...] branches; fails at `]`.
+  /// Right context: skips ignored symbols and whole [...] branches; fails at `]`. A `]` in
+  /// the pattern skips the rest of the current branch and consumes its `]` (lpfg's rule) in
+  /// Sprig's notation; in cpfg's it must be the next module (after ignored symbols and
+  /// whole branches), as cpfg's RconDiff compares it, and cpfg's `=` moves to the `]` that
+  /// closes the current branch (or the end of the string) without consuming it.
   bool matchRight(const ModuleString& s, size_t i, const std::vector<PatternItem>& pat, double* vars) {
     const size_t n = s.size();
+    const bool cpfg = prog->dialect == detail::Dialect::Cpfg;
     size_t j = i + 1;
-    if (!pat[0].openBracket && !pat[0].closeBracket) {  // shared first step
+    if (!pat[0].openBracket && !pat[0].closeBracket && !pat[0].skipBranch) {  // shared first step
       if (!rightCached) {
         rightNeighbour = walkRight(s, i + 1);
         rightCached = true;
@@ -411,11 +417,12 @@ struct Deriver::Impl {
       if (j >= n) return false;
     }
     for (const PatternItem& it : pat) {
-      if (it.closeBracket) {  // skip the rest of the current branch, consume its `]`
+      if (it.skipBranch || (it.closeBracket && !cpfg)) {  // to the `]` closing the current branch
         while (j < n && s.symbols[j] != prog->closeBracket) {
           if (s.symbols[j] == prog->openBracket) j = static_cast<size_t>(match[j]);
           ++j;
         }
+        if (it.skipBranch) continue;
         if (j >= n) return false;
         ++j;
         continue;
@@ -427,6 +434,7 @@ struct Deriver::Impl {
           if (it.openBracket) break;
           j = static_cast<size_t>(match[j]) + 1;
         } else if (c == prog->closeBracket) {
+          if (it.closeBracket) break;
           return false;
         } else if (ignoredTab[c]) {
           ++j;
@@ -434,8 +442,8 @@ struct Deriver::Impl {
           break;
         }
       }
-      if (it.openBracket) {
-        if (s.symbols[j] != prog->openBracket) return false;
+      if (it.openBracket || it.closeBracket) {
+        if (s.symbols[j] != (it.openBracket ? prog->openBracket : prog->closeBracket)) return false;
         ++j;
         continue;
       }
@@ -465,6 +473,13 @@ struct Deriver::Impl {
       --j;
     }
     return true;
+  }
+
+  /// The cut symbol while a derivation step of a grammar in cpfg's notation runs (its `%`
+  /// then cuts where the step meets it: pendingCutAt), else -1.
+  int32_t cutSym = -1;
+  void setCutSym(bool productionStep) {
+    cutSym = productionStep && prog->usesCut && prog->dialect == detail::Dialect::Cpfg ? static_cast<int32_t>(prog->cut) : -1;
   }
 
   std::vector<int32_t> choices;  ///< productions found by context dispatch in the size pass
@@ -618,8 +633,14 @@ struct Deriver::Impl {
     const Arg& a = p.args[m.firstArg + k];
     double v;
     switch (a.kind) {
-      case ArgKind::Const: return a.c;
-      case ArgKind::Var: return vars[a.var];
+      case ArgKind::Const:
+        if (!prog->floatParams) return a.c;
+        v = a.c;
+        break;
+      case ArgKind::Var:
+        if (!prog->floatParams) return vars[a.var];
+        v = vars[a.var];
+        break;
       case ArgKind::VarAddConst: v = vars[a.var] + a.c; break;
       case ArgKind::VarMulConst: v = vars[a.var] * a.c; break;
       case ArgKind::VarDivConst: v = vars[a.var] / a.c; break;
@@ -629,6 +650,7 @@ struct Deriver::Impl {
                              &prog->cpfg, arrays.data());
       }
     }
+    if (prog->floatParams) v = static_cast<double>(static_cast<float>(v));  // cpfg's string holds floats
     if (!std::isfinite(v)) [[unlikely]]
       nonFinite(p, m, k, v, step);
     return v;
@@ -638,11 +660,12 @@ struct Deriver::Impl {
   [[gnu::always_inline]] inline void emitPlain(Writer& w, const Production& p, const double* vars, int32_t birth, int step) {
     w.reserve(p.successor.size(), p.args.size());
     const Arg* args = p.args.data();
+    const bool floats = prog->floatParams;
     for (const SuccModule& m : p.successor) {
       w.begin(m.symbol, birth);
       for (int k = 0; k < m.argCount; ++k) {
         const Arg& a = args[m.firstArg + k];
-        switch (a.kind) {
+        switch (floats ? ArgKind::Expr : a.kind) {
           case ArgKind::Const: w.param(a.c); break;
           case ArgKind::Var: w.param(vars[a.var]); break;
           default: w.param(evalArg(p, m, k, vars, step));
@@ -785,6 +808,7 @@ struct Deriver::Impl {
     leftStack.clear();
     const bool trackLeft = !rs.dispatches.empty();
     const uint8_t* ignored = ignoredTab;
+    size_t cutUntil = 0;  // modules before it are in a cut branch the step skips
     for (size_t i = 0; i < n; ++i) {
       const detail::SymbolRules& r = rules[syms[i]];
       uint32_t count = offs[i + 1] - offs[i];
@@ -799,7 +823,9 @@ struct Deriver::Impl {
           lastSeen = static_cast<ptrdiff_t>(i - 1);
         }
       }
+      if (i < cutUntil) continue;
       if (r.count == 0 || (r.simple && count != r.simple->predParams)) {
+        if (r.count == 0 && pendingCutAt(in, i)) cutUntil = cutEnd(in, i, n);
         boundM += 1;
         boundP += count;
       } else if (r.simple) {
@@ -808,6 +834,7 @@ struct Deriver::Impl {
       } else if (r.dispatch >= 0 && count == 0) {
         int32_t idx = dispatchAt(rs.dispatches[r.dispatch], in, i, lastSeen);
         choices.push_back(idx);
+        if (idx < 0 && pendingCutAt(in, i)) cutUntil = cutEnd(in, i, n);
         boundM += idx < 0 ? 1 : rs.productions[static_cast<size_t>(idx)].successor.size();
         boundP += idx < 0 ? 0 : rs.productions[static_cast<size_t>(idx)].args.size();
       } else {
@@ -831,7 +858,7 @@ struct Deriver::Impl {
     const uint32_t* offs = in.offsets.data();
     const bool births = opt.trackBirthSteps;
     size_t j = i + 1;
-    while (j < n && rules[syms[j]].count == 0) ++j;
+    while (j < n && rules[syms[j]].count == 0 && static_cast<int32_t>(syms[j]) != cutSym) ++j;
     if (j - i >= 8) {  // a long run: bulk copies pay off
       w.copyRun(syms + i, offs + i, in.params.data(), j - i, births ? in.birthSteps.data() + i : nullptr);
     } else {
@@ -891,8 +918,7 @@ struct Deriver::Impl {
   /// table), and what they write, or the module itself when none applies, is decomposed by
   /// that L-system's decomposition rules up to its maximum depth; then the modules the
   /// production matched switch L-systems: `?(n, s)` pushes sub-L-system n, `$` pops.
-  /// Without productions (applyProductions false) this decomposes the axiom.
-  void rewriteWithSubLsystems(int step, uint64_t stream, bool applyProductions) {
+  void rewriteWithSubLsystems(int step, uint64_t stream) {
     makeLsystems();
     const ModuleString& in = cur;
     const size_t n = in.size();
@@ -903,6 +929,7 @@ struct Deriver::Impl {
     loadGlobals(vars);
     rngStream = stream;
     std::vector<size_t> stack{0};
+    setCutSym(true);
     for (size_t i = 0; i < n; ++i) {
       const LsystemRules& ls = lsystems[stack.back()];
       ignoredTab = ls.ignored;
@@ -911,8 +938,12 @@ struct Deriver::Impl {
       rngReady = false;
       rngItem = i;
       leftCached = rightCached = false;
-      const Production* p = !applyProductions || ls.productions->rules[sym].count == 0 ? nullptr : choose(*ls.productions, in, i, vars, step);
+      const Production* p = ls.productions->rules[sym].count == 0 ? nullptr : choose(*ls.productions, in, i, vars, step);
       const bool decompose = !ls.decomposition->empty();
+      if (!p && pendingCutAt(in, i) && !(decompose && !ls.decomposition->bySymbol[sym].empty())) {
+        i = cutEnd(in, i, n) - 1;  // cpfg's cut, made when the step reaches it (up to the call's `$`)
+        continue;
+      }
       size_t last = i;
       if (p) {
         emit(w, *p, vars, step, step, decompose, ls.decomposition);
@@ -931,7 +962,7 @@ struct Deriver::Impl {
     w.finish();
     written += w.modules();
     std::swap(cur, next);
-    if (prog->usesCut) applyCuts(cur);
+    cutAfterStep();
   }
 
   /// cpfg's homomorphism in a grammar with sub-L-systems (interpret.c, TurtleDrawNsteps,
@@ -998,15 +1029,18 @@ struct Deriver::Impl {
   /// Rewrites cur into next with rules rs (one derivation step when rs is the main block).
   void rewrite(const RuleSet& rs, int step, uint64_t stream, bool productionStep) {
     if (productionStep && !prog->subLsystems.empty() && &rs == &prog->productions) {
-      rewriteWithSubLsystems(step, stream, true);
+      rewriteWithSubLsystems(step, stream);
       return;
     }
     const ModuleString& in = cur;
     const size_t n = in.size();
     const bool births = opt.trackBirthSteps;
     const bool decompose = !prog->decomposition.empty() && productionStep;
+    setCutSym(productionStep);
     // Each module through the general path below: decomposition, or successors tracked.
-    const bool general = decompose || segIn;
+    // (A production for cpfg's pending `%` leaves the size pass unable to tell which
+    // modules the step skips.)
+    const bool general = decompose || segIn || (cutSym >= 0 && rs.rules[static_cast<size_t>(cutSym)].count > 0);
     if (segOut) segOut->clear();
     uint32_t segments = 0;
     const SymbolId* syms = in.symbols.data();
@@ -1030,6 +1064,10 @@ struct Deriver::Impl {
       SymbolId sym = syms[i];
       int32_t birth = births ? in.birthSteps[i] : 0;
       const detail::SymbolRules& r = rules[sym];
+      if (r.count == 0 && pendingCutAt(in, i) && !(decompose && !prog->decomposition.bySymbol[sym].empty())) {
+        i = cutEnd(in, i, n) - 1;  // cpfg's cut, made when the step reaches it
+        continue;
+      }
       if (r.count == 0 && !general) {
         i = copyUntouched(w, rules, i);
         continue;
@@ -1050,7 +1088,9 @@ struct Deriver::Impl {
       }
       if (r.dispatch >= 0 && !general && offs[i + 1] == offs[i]) {
         int32_t idx = choices[nextChoice++];
-        if (idx < 0) {
+        if (idx < 0 && pendingCutAt(in, i)) {
+          i = cutEnd(in, i, n) - 1;
+        } else if (idx < 0) {
           w.reserve(1, 0);
           w.copy(sym, nullptr, 0, birth);
         } else {
@@ -1063,6 +1103,10 @@ struct Deriver::Impl {
       leftCached = rightCached = false;
       const size_t before = w.modules();
       const Production* p = r.count == 0 || (segIn && (*segIn)[i] == kFrozen) ? nullptr : choose(rs, in, i, vars, step);
+      if (!p && pendingCutAt(in, i) && !(decompose && !prog->decomposition.bySymbol[sym].empty())) {
+        i = cutEnd(in, i, n) - 1;
+        continue;
+      }
       if (!p) {
         if (decompose && productionStep) {
           i += emitDecomposed(w, in, i, birth, step, prog->decomposition);
@@ -1081,7 +1125,30 @@ struct Deriver::Impl {
     w.finish();
     written += w.modules();
     std::swap(cur, next);
-    if (prog->usesCut) applyCuts(cur);
+    cutAfterStep();
+  }
+
+  /// The end of the cut `%` at module i of s makes, looking no further than end: the index
+  /// of the `]` closing its branch, of the `$` ending the sub-L-system call it is in (cpfg's
+  /// SkipCutPart), or end.
+  size_t cutEnd(const ModuleString& s, size_t i, size_t end) const {
+    int depth = 0, subDepth = 0;
+    const bool subs = !prog->subLsystems.empty();
+    size_t j = i + 1;
+    for (; j < end; ++j) {
+      SymbolId c = s.symbols[j];
+      if (c == prog->openBracket) ++depth;
+      else if (c == prog->closeBracket && depth-- == 0) break;
+      else if (subs && prog->subCall && c == *prog->subCall && s.paramCount(j) >= 1) ++subDepth;
+      else if (subs && c == prog->subEnd && subDepth-- == 0) break;
+    }
+    return j;
+  }
+
+  /// True when module i of s is a `%` that cuts when a cpfg step reaches it (cutSym: the
+  /// cut symbol in cpfg's notation during a derivation step, else none).
+  bool pendingCutAt(const ModuleString& s, size_t i) const {
+    return static_cast<int32_t>(s.symbols[i]) == cutSym && s.paramCount(i) == 0;
   }
 
   /// Removes every `%` and the rest of its branch (up to, not including, the closing `]`).
@@ -1094,17 +1161,7 @@ struct Deriver::Impl {
     while (i < n) {
       if (s.symbols[i] == prog->cut) {
         any = true;
-        int depth = 0, subDepth = 0;
-        const bool subs = !prog->subLsystems.empty();
-        ++i;
-        for (; i < n; ++i) {
-          SymbolId c = s.symbols[i];
-          if (c == prog->openBracket) ++depth;
-          else if (c == prog->closeBracket && depth-- == 0) break;
-          // cpfg's cut also ends at the `$` closing the sub-L-system it is in (SkipCutPart).
-          else if (subs && prog->subCall && c == *prog->subCall && s.paramCount(i) >= 1) ++subDepth;
-          else if (subs && c == prog->subEnd && subDepth-- == 0) break;
-        }
+        i = cutEnd(s, i, n);
         continue;
       }
       uint32_t b = s.offsets[i], e = s.offsets[i + 1];
@@ -1122,6 +1179,13 @@ struct Deriver::Impl {
     if (births) s.birthSteps.resize(j);
   }
 
+  /// After a step: Sprig's notation removes the cut branches now; cpfg's keeps each `%` and
+  /// the rest of its branch in the string until the next step skips them (generate.c,
+  /// ApplyProd: SkipCutPart), so its final string holds them and the turtle skips them.
+  void cutAfterStep() {
+    if (prog->usesCut && prog->dialect != detail::Dialect::Cpfg) applyCuts(cur);
+  }
+
   void start() {
     globals.assign(detail::kMaxVars, 0.0);
     arrays = prog->cpfg.arrayInit;
@@ -1133,17 +1197,16 @@ struct Deriver::Impl {
     cur = prog->axiom;
     if (cur.size() > opt.maxModules) Writer::overLimit(opt.maxModules, limitAt, 0);
     if (opt.trackBirthSteps) cur.birthSteps.assign(cur.size(), 0);
-    const bool subDecomposition = std::any_of(prog->subLsystems.begin(), prog->subLsystems.end(),
-                                              [](const detail::SubLsystem& sub) { return !sub.decomposition.empty(); });
-    if (!prog->subLsystems.empty() && (subDecomposition || !prog->decomposition.empty())) {
-      rewriteWithSubLsystems(0, 0, false);
-    } else if (!prog->decomposition.empty()) {
+    // cpfg's notation: cpfg neither decomposes nor cuts the axiom before the first step
+    // (control.c, Rewind: CreateParameterString); step 1 decomposes the modules no
+    // production rewrites, as every step does (generate.c, ApplyProd).
+    if (prog->dialect != detail::Dialect::Cpfg && !prog->decomposition.empty()) {
       RuleSet none;
       none.bySymbol.assign(prog->symbols.size(), {});
       none.finalize();
       rewrite(none, 0, 0, true);
-    } else if (prog->usesCut) {
-      applyCuts(cur);
+    } else {
+      cutAfterStep();
     }
     written = 0;
     fillQueries();
@@ -1231,7 +1294,8 @@ std::string formatModuleString(const ModuleString& s, const SymbolTable& symbols
       auto p = s.paramsOf(i);
       for (uint32_t k = 0; k < count; ++k) {
         if (k) out += ',';
-        auto r = std::to_chars(buf, buf + sizeof buf, p[k]);
+        auto r = options.floatParams ? std::to_chars(buf, buf + sizeof buf, static_cast<float>(p[k]))
+                                     : std::to_chars(buf, buf + sizeof buf, p[k]);
         out.append(buf, r.ptr);
       }
       out += ')';

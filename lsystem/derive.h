@@ -8,7 +8,8 @@
 /// Stochastic choices and `ran`/`nran` draw from an Rng seeded per module with
 /// deriveSeed(seed, {step, moduleIndex}), so results never depend on thread count.
 /// After each step the `decomposition:` rules are applied (depth-limited) and `%` cuts
-/// remove the rest of their branch.
+/// remove the rest of their branch (in cpfg's notation when the next step reaches them,
+/// as cpfg does).
 
 #include <cstddef>
 #include <cstdint>
@@ -53,7 +54,8 @@ struct DeriveOptions {
 /// a NaN condition. After an error the Deriver keeps the string of the last completed step.
 class Deriver {
  public:
-  /// Starts from the grammar's axiom (decomposed, cut). The Deriver shares the grammar's
+  /// Starts from the grammar's axiom: decomposed and cut in Sprig's notation; in cpfg's as
+  /// written (cpfg decomposes and cuts it in the first step). The Deriver shares the grammar's
   /// compiled program, so the Grammar object itself may go away.
   explicit Deriver(const Grammar& grammar, DeriveOptions options = {});
   ~Deriver();
@@ -102,10 +104,14 @@ ModuleString derive(const Grammar& grammar, const DeriveOptions& options = {});
 struct FormatOptions {
   /// Characters per line before wrapping at a module boundary; 0 = one line.
   size_t wrapColumn = 0;
+  /// Print each parameter in the shortest form that reads back as the same 32-bit float
+  /// (a grammar in cpfg's notation, whose parameters are floats: 1.99999 rather than
+  /// 1.9999899864196777).
+  bool floatParams = false;
 };
 
 /// s in the grammar's own notation: `F(1.5)[+A(2,3)]`. Numbers print in their shortest
-/// round-trip form; a space separates a multi-character name from a following module
+/// round-trip form (as doubles, or floats with FormatOptions::floatParams); a space separates a multi-character name from a following module
 /// whose name would otherwise merge with it.
 std::string formatModuleString(const ModuleString& s, const SymbolTable& symbols, const FormatOptions& options = {});
 

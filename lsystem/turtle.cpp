@@ -1272,10 +1272,13 @@ class TurtleWalk {
 
   /// `%`: the branch ends here: marks its last internode as cut and skips to the matching
   /// `]`. Returns the index before that `]` (or the last index), for the loop's ++i.
+  /// In cpfg's notation a `%` in the string is a cut the next derivation step makes (cpfg
+  /// keeps it until then): the rest of the branch is skipped as cpfg's SkipCutPart does,
+  /// also up to the `$` that ends the sub-L-system call it is in, and nothing is marked.
   size_t cut(size_t i) {
     if constexpr (!kSummary)
-      if (st_.internode >= 0) sk_.internodes[st_.internode].cut = true;
-    int depth = 0;
+      if (st_.internode >= 0 && !settings_.cpfg) sk_.internodes[st_.internode].cut = true;
+    int depth = 0, calls = 0;
     size_t j = i + 1;
     for (; j < n_; ++j) {
       Command cj = commandAt(j);
@@ -1284,6 +1287,10 @@ class TurtleWalk {
       } else if (cj == Command::Pop) {
         if (depth == 0) break;
         --depth;
+      } else if (cj == Command::SubCall && paramCount(j) >= 1) {
+        ++calls;
+      } else if (cj == Command::SubEnd && calls-- == 0) {
+        break;
       }
     }
     return j - 1;

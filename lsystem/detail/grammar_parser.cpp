@@ -110,6 +110,7 @@ class GrammarParser {
       : overrides_(overrides), scanner_(fileName) {
     prog_.fileName = fileName;
     prog_.dialect = dialectOf(fileName);
+    prog_.floatParams = prog_.dialect == Dialect::Cpfg;
     scanner_.setDialect(prog_.dialect);
     for (size_t k = 0; k < kCpfgMultiNameCount; ++k) scanner_.addMultiName(kCpfgMultiNames[k]);
     expr_.setGlobals(&prog_.globals);
@@ -1414,6 +1415,10 @@ class GrammarParser {
         }
         it.openBracket = m.name == "[";
         it.closeBracket = m.name == "]";
+      } else if (m.name == "=" && !left && prog_.dialect == Dialect::Cpfg) {
+        // cpfg's `=`: skip the rest of the current branch (RconDiff in generate.c)
+        if (m.hasParens) error(sp.line, m.col, "cpfg's '=' in a right context (skip the rest of the branch) takes no parameters");
+        it.skipBranch = true;
       } else {
         it.symbol = prog_.symbols.intern(m.name);
         it.firstVar = static_cast<uint16_t>(varNames.size());
@@ -1437,6 +1442,7 @@ class GrammarParser {
     bool ok = true;
     for (const Span& a : m.args) {
       std::optional<double> v = expr_.evaluate(scanner_.trim(a), rng);
+      if (v && prog_.floatParams) v = static_cast<double>(static_cast<float>(*v));  // cpfg's floats
       if (v) params_.push_back(*v);
       else ok = false;
     }
@@ -1500,6 +1506,55 @@ class GrammarParser {
       }
       rs->finalize();
     }
+    if (prog_.dialect == Dialect::Cpfg) checkSplitCommands(sets);
+  }
+
+  /// cpfg keeps one character per module: its commands `@o(d)`, `?P(x,y,z)`, `~l` are the
+  /// module `@` (`?`, `~`) followed by the modules of the letters after it, and a rule whose
+  /// predecessor or context is one of those letters rewrites or reads them there. Sprig
+  /// reads such a command as one module, so a rule naming a letter of a command the
+  /// grammar writes is an error (else it would silently not apply where cpfg's does).
+  void checkSplitCommands(const std::vector<RuleSet*>& sets) {
+    // Per symbol: bit n set when the axiom or a successor writes it with n parameters.
+    std::vector<uint64_t> counts(prog_.symbols.size(), 0);
+    auto wrote = [&](SymbolId id, size_t n) { counts[id] |= uint64_t(1) << std::min<size_t>(n, 63); };
+    for (size_t i = 0; i < prog_.axiom.size(); ++i) wrote(prog_.axiom.symbols[i], prog_.axiom.paramCount(i));
+    for (const RuleSet* rs : sets)
+      for (const Production& p : rs->productions)
+        for (const SuccModule& m : p.successor) wrote(m.symbol, m.argCount);
+    // The written command a rule's module (letter, n parameters) would match in cpfg's string:
+    // its last letter carries the command's parameters, the others none.
+    auto command = [&](SymbolId id, size_t n) -> std::optional<std::string> {
+      const std::string& letter = prog_.symbols.name(id);
+      if (letter.size() != 1) return std::nullopt;
+      for (size_t c = 0; c < counts.size(); ++c) {
+        const std::string& name = prog_.symbols.name(static_cast<SymbolId>(c));
+        if (!counts[c] || name.size() < 2 || (name[0] != '@' && name[0] != '?' && name[0] != '~')) continue;
+        for (size_t k = 1; k < name.size(); ++k)
+          if (name[k] == letter[0] && (k + 1 == name.size() ? (counts[c] >> std::min<size_t>(n, 63)) & 1 : n == 0)) return name;
+      }
+      return std::nullopt;
+    };
+    for (const RuleSet* rs : sets)
+      for (const Production& p : rs->productions) {
+        std::vector<std::pair<SymbolId, size_t>> mods{{p.predecessor, p.predParams}};
+        for (const auto* side : {&p.predRest, &p.left, &p.right})
+          for (const PatternItem& it : *side)
+            if (!it.openBracket && !it.closeBracket && !it.skipBranch) mods.emplace_back(it.symbol, it.paramCount);
+        for (const auto& [id, n] : mods)
+          if (std::optional<std::string> cmd = command(id, n)) {
+            const std::string& letter = prog_.symbols.name(id);
+            std::string parts;
+            for (char c : *cmd) parts += (parts.empty() ? "'" : ", '") + std::string(1, c) + "'";
+            diags().error(p.loc,
+                          "cpfg reads '" + *cmd + "' as the modules " + parts + " (one character each), so this rule's '" +
+                              letter + "' also matches the '" + letter + "' of the '" + *cmd +
+                              "' the grammar writes; Sprig reads '" + *cmd + "' as one module: not supported (rename the module '" +
+                              letter + "')",
+                          p.sourceLine);
+            break;
+          }
+      }
   }
 
   GrammarOverrides overrides_;

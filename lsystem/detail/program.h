@@ -278,6 +278,9 @@ struct PatternItem {
   uint16_t firstVar = 0;  ///< register of its first formal parameter
   bool openBracket = false;
   bool closeBracket = false;
+  /// cpfg's `=` in a right context (generate.c, RconDiff): the match moves to the `]` that
+  /// closes the current branch (or the end of the string) without consuming it.
+  bool skipBranch = false;
 };
 
 /// One compiled production `lc < pred > rc : cond --> succ : weight`.
@@ -311,7 +314,9 @@ struct Production {
   /// Contexts of at most one symbol on each side (no brackets): matched against the
   /// cached neighbours directly.
   bool simpleContext() const {
-    auto plain = [](const std::vector<PatternItem>& v) { return v.size() <= 1 && (v.empty() || (!v[0].openBracket && !v[0].closeBracket)); };
+    auto plain = [](const std::vector<PatternItem>& v) {
+      return v.size() <= 1 && (v.empty() || (!v[0].openBracket && !v[0].closeBracket && !v[0].skipBranch));
+    };
     return plain(left) && plain(right) && predRest.empty();
   }
 };
@@ -423,6 +428,11 @@ struct Program {
   bool hasAngle = false;
   double angleDeg = 0;
   Dialect dialect = Dialect::Sprig;  ///< the notation the file is read in (by its extension)
+  /// cpfg's notation: module parameters are 32-bit floats, as cpfg's string stores them
+  /// (generate.c, AppendParameter), while expressions compute in double as cpfg's Eval
+  /// does: every parameter written into a string (axiom, successors, decomposition,
+  /// interpretation, query modules) is rounded to the nearest float.
+  bool floatParams = false;
   /// True when the axiom or a successor turns without an angle (`+`, `&`, ...), so that
   /// the default angle matters.
   bool bareTurn = false;

@@ -1,0 +1,180 @@
+// Parity with vlab's cpfg: the objects under tests/assets/cpfg/parity/, each derived by Sprig
+// and compared module by module with the string the real cpfg derived from it (cpfg.str,
+// made by the command in that folder's README).
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+#include "core/atomic_file.h"
+#include "lsystem/derive.h"
+#include "lsystem/grammar.h"
+#include "lsystem/turtle.h"
+#include "lsystem/view_file.h"
+
+using namespace sprig;
+using namespace sprig::lsystem;
+
+namespace {
+
+std::string parityAsset(const std::string& name) {
+  return std::string(SPRIG_SOURCE_DIR) + "/tests/assets/cpfg/parity/" + name;
+}
+
+/// cpfg's string file: `%g` parameters, lines wrapped at 70 characters between any two
+/// characters of cpfg's (so `?` and `P` of `?P` may be on two lines): the lines joined.
+std::string cpfgString(const std::string& folder) {
+  std::string text = readFile(parityAsset(folder + "/cpfg.str")), out;
+  for (char c : text)
+    if (c != '\n' && c != '\r') out += c;
+  return out;
+}
+
+/// A parity object: its grammar (with its view file's turtle for the query modules, when it
+/// has one), derived to its own length.
+struct Parity {
+  Grammar grammar;
+  std::optional<TurtleSettings> turtle;
+};
+
+Parity loadParity(const std::string& folder) {
+  Parity p;
+  p.grammar = loadGrammar(parityAsset(folder + "/plant.l"));
+  REQUIRE(p.grammar.cpfgNotation());
+  const std::string v = parityAsset(folder + "/plant.v");
+  if (std::filesystem::exists(v)) {
+    const ViewFile view = loadViewFile(v);
+    p.turtle = cpfgTurtleSettings(&view, TurtleSettings{});
+  } else {
+    p.turtle = cpfgTurtleSettings(nullptr, TurtleSettings{});
+  }
+  return p;
+}
+
+/// Compares Sprig's string with cpfg's: the same modules, parameters within 1e-5 (relative
+/// or absolute: cpfg prints 6 significant digits).
+void checkSame(const ModuleString& got, const SymbolTable& symbols, const std::string& cpfg) {
+  SymbolTable table = symbols;
+  const ModuleString want = parseModuleString(cpfg, table);
+  INFO("cpfg:  " << cpfg);
+  INFO("Sprig: " << formatModuleString(got, symbols, FormatOptions{0, true}));
+  REQUIRE(got.size() == want.size());
+  for (size_t i = 0; i < got.size(); ++i) {
+    INFO("module " << i);
+    REQUIRE(symbols.name(got.symbols[i]) == table.name(want.symbols[i]));
+    REQUIRE(got.paramCount(i) == want.paramCount(i));
+    for (uint32_t k = 0; k < got.paramCount(i); ++k) {
+      const double a = got.paramsOf(i)[k], b = want.paramsOf(i)[k];
+      CHECK(std::fabs(a - b) <= 1e-5 * std::max(1.0, std::fabs(b)));
+    }
+  }
+}
+
+ModuleString deriveParity(Parity& p) {
+  DeriveOptions opt;
+  opt.queryTurtle = p.turtle;
+  Deriver d(p.grammar, opt);
+  return d.derive();
+}
+
+}  // namespace
+
+TEST_CASE("cpfg parity: '=' and ']' in right contexts", "[lsystem][cpfg]") {
+  Parity p = loadParity("skip_branch");
+  const ModuleString s = deriveParity(p);
+  checkSame(s, p.grammar.symbols(), cpfgString("skip_branch"));
+  SECTION("the same grammar in Sprig's notation keeps lpfg's ']' and '=' as a module") {
+    std::string text = readFile(parityAsset("skip_branch/plant.l"));
+    Grammar g = parseGrammar(text, "plant.lsys");
+    Deriver d(g);
+    // lpfg: X > [B]C matches X[BD]C (']' skips the rest of the branch); '=' is a symbol no
+    // module of the string is, so I, E and S stay.
+    CHECK(formatModuleString(d.derive(), d.symbols()) == "I(1)[+I(2)F][I(3)FF]I(4)Q[BD]CR[B]C[EFH]GS[+T]");
+  }
+  SECTION("'=' takes no parameters") {
+    try {
+      parseGrammar("axiom: A\nA > [B=(1)] --> C\n", "t.l");
+      FAIL("no error");
+    } catch (const InputError& e) {
+      CHECK(std::string(e.what()).find("t.l:2:7: error: cpfg's '=' in a right context (skip the rest of the branch) takes no "
+                                       "parameters") != std::string::npos);
+    }
+  }
+}
+
+TEST_CASE("cpfg parity: parameters are floats, expressions doubles", "[lsystem][cpfg]") {
+  Parity p = loadParity("float_params");
+  const ModuleString s = deriveParity(p);
+  checkSame(s, p.grammar.symbols(), cpfgString("float_params"));
+  // A's age after 100 steps of 0.02 is the float 1.99999, so it has not fired after 101.
+  CHECK(countSymbol(s, p.grammar.symbols(), "F") == 0);
+  SECTION("printed as floats") {
+    // 2.0199988 is the float cpfg's %g prints as 2.02
+    CHECK(formatModuleString(s, p.grammar.symbols(), FormatOptions{0, true}).substr(0, 13) == "A(2.0199988)B");
+  }
+  SECTION("Sprig's notation keeps doubles: the age reaches 2 and fires") {
+    Grammar g = parseGrammar(readFile(parityAsset("float_params/plant.l")), "plant.lsys");
+    Deriver d(g);
+    CHECK(countSymbol(d.derive(), d.symbols(), "F") == 1);
+  }
+}
+
+TEST_CASE("cpfg parity: query modules of the final string", "[lsystem][cpfg]") {
+  // cpfg fills query modules whenever it interprets the string: before each step and when it
+  // draws the result, so the final string holds the drawn turtle's values (cpfg -g leaves
+  // them as they were only when the view file's 'box:' spares it the drawing).
+  Parity p = loadParity("query_timing");
+  checkSame(deriveParity(p), p.grammar.symbols(), cpfgString("query_timing"));
+}
+
+TEST_CASE("cpfg parity: a cut is made when the next step reaches it", "[lsystem][cpfg]") {
+  for (const char* folder : {"pending_cut", "decomposition_cut"}) {
+    INFO(folder);
+    Parity p = loadParity(folder);
+    checkSame(deriveParity(p), p.grammar.symbols(), cpfgString(folder));
+  }
+  SECTION("drawn, the pending cut is skipped and marks nothing: the skeleton of the string cut") {
+    Parity p = loadParity("pending_cut");
+    const ModuleString s = deriveParity(p);
+    SymbolTable table = p.grammar.symbols();
+    const ModuleString cut = parseModuleString("X[F(1)]F(2)[F(1)]F(2)[A]BE", table);
+    REQUIRE(table.size() == p.grammar.symbols().size());
+    Turtle t(p.grammar.symbols(), *p.turtle);
+    const Skeleton a = t.run(s), b = t.run(cut);
+    REQUIRE(a.internodes.size() == 4);
+    REQUIRE(a.internodes.size() == b.internodes.size());
+    for (size_t i = 0; i < a.internodes.size(); ++i) {
+      CHECK(glm::length(a.internodes[i].start - b.internodes[i].start) < 1e-12);
+      CHECK(glm::length(a.internodes[i].end - b.internodes[i].end) < 1e-12);
+      CHECK(a.internodes[i].parent == b.internodes[i].parent);
+      CHECK(!a.internodes[i].cut);
+    }
+  }
+  SECTION("Sprig's notation cuts at once") {
+    Grammar g = parseGrammar(readFile(parityAsset("pending_cut/plant.l")), "plant.lsys");
+    Deriver d(g);
+    CHECK(formatModuleString(d.derive(), d.symbols()) == "X[F(1)]F(2)[F(1)]F(2)[A]BE");
+  }
+}
+
+TEST_CASE("cpfg parity: a rule for a letter of a command the grammar writes is an error", "[lsystem][cpfg]") {
+  auto errorOf = [](const std::string& text) -> std::string {
+    try {
+      parseGrammar(text, "t.l");
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  // cpfg's string holds '@' then 'o(0.2)': its o(r) rule grows the sphere (vlab's Mycelis).
+  CHECK(errorOf("axiom: A@o(0.2)\no(r) --> o(r+0.03)\n").find(
+            "t.l:2:1: error: cpfg reads '@o' as the modules '@', 'o' (one character each), so this rule's 'o' also matches "
+            "the 'o' of the '@o' the grammar writes; Sprig reads '@o' as one module: not supported (rename the module 'o')") !=
+        std::string::npos);
+  CHECK(errorOf("axiom: A?P(0,0)\nA > P(x,y) --> B\n").find("cpfg reads '?P' as the modules '?', 'P'") != std::string::npos);
+  CHECK(errorOf("axiom: A@Ts(1,2)\nT --> B\n").find("cpfg reads '@Ts' as the modules '@', 'T', 's'") != std::string::npos);
+  // The letter's parameters differ from the command's: no cpfg module matches, no error.
+  CHECK(errorOf("axiom: A@o(0.2)@Ts(1,2)\ns --> A\no --> A\nT(x) --> A\n") == "no error");
+}
