@@ -107,6 +107,15 @@ void addInputOutput(CLI::App& sub, const char* name, std::string& file, std::str
 }
 
 void printNotes(const GlobalOptions& g, const Species& species) {
+  if (g.strict) {
+    std::vector<Diagnostic> errors;
+    for (Diagnostic d : species.notes)
+      if (d.severity == Severity::Warning) {
+        d.severity = Severity::Error;
+        errors.push_back(std::move(d));
+      }
+    if (!errors.empty()) throw InputError(std::move(errors));
+  }
   if (g.quiet) return;
   for (const Diagnostic& d : species.notes) std::cerr << d.format() << "\n";
 }

@@ -47,7 +47,8 @@ void addStageFlags(CLI::App& sub, StageFlags& flags);
 [[gnu::format(printf, 3, 4)]] void note(const GlobalOptions& g, std::ostream& os, const char* format, ...);
 
 /// Prints the notes and warnings of reading species (cpfg defaults used, view file keys
-/// ignored) to stderr, unless g.quiet.
+/// ignored) to stderr, unless g.quiet. Under `--strict` (g.strict) the warnings are
+/// thrown as errors instead (InputError).
 void printNotes(const GlobalOptions& g, const Species& species);
 
 /// Parses `--view AZ,EL` or `AZ,EL,FOV` (degrees) into view. Throws UsageError.

@@ -49,6 +49,9 @@ int previewOnce(const PreviewArgs& a, const GlobalOptions& g) {
   GrowthEngine engine(species, GrowthOptions{extra, -1, {}});
   const int last = engine.lastStep();
   const int step = a.stage >= 0 ? std::min(a.stage, last) : last;
+  if (a.stage > last && !g.quiet)
+    std::cerr << "sprig: note: --stage " << a.stage << " is past the last step of '" << species.name << "' (" << last
+              << "); showing step " << last << "\n";
   const lsystem::Skeleton shown = engine.skeletonAt(step);
   // Not `framingBox(step == last ? shown : ...)`: that conditional copies `shown`.
   const DBox3 frame = step == last ? framingBox(shown) : framingBox(engine.skeletonAt(last));

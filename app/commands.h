@@ -29,6 +29,7 @@ struct GlobalOptions {
   std::string root = ".";
   bool allowOutsidePaths = false;
   bool fullTape = false;  ///< `--full-tape`: implicit surfaces trace the whole tape per cell
+  bool strict = false;    ///< `--strict`: warnings about the input are errors
 
   /// Where species files may reference files from.
   PathPolicy pathPolicy() const {

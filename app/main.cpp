@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
       ->check(CLI::ExistingDirectory);
   app.add_flag("--allow-outside-paths", global.allowOutsidePaths,
                "let species reference absolute paths and files outside the root");
+  app.add_flag("--strict", global.strict, "treat warnings about the input (an undeclared multi-letter module name) as errors");
   app.add_flag("--full-tape", global.fullTape,
                "exact renders trace the whole BlobTree tape in every cell instead of its pruned tape (the reference, "
                "for comparing images; slower)");

@@ -31,6 +31,7 @@ size_t Grammar::productionCount() const { return program_->productions.productio
 bool Grammar::hasInterpretation() const { return program_->anyInterpretation(); }
 bool Grammar::cpfgNotation() const { return program_->dialect == detail::Dialect::Cpfg; }
 bool Grammar::usesDefaultAngle() const { return program_->bareTurn; }
+const std::vector<Diagnostic>& Grammar::warnings() const { return program_->warnings; }
 
 Grammar parseGrammar(std::string_view text, const std::string& fileName, const GrammarOverrides& overrides) {
   Grammar g;

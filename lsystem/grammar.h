@@ -50,6 +50,9 @@ struct GrammarOverrides {
   /// Replace `#define NAME` values; an unknown NAME is an InputError (with "did you mean").
   std::vector<DefineOverride> defines;
   std::optional<int> derivationLength;  ///< replaces `derivation length:`
+  /// Where derivationLength was written (a species' `steps:`); when known and the grammar
+  /// writes another length, parsing adds a note there naming both values.
+  SourceLoc derivationLengthLoc;
   std::optional<uint64_t> seed;         ///< replaces `seed:`
   /// cpfg's function files of the grammar's view file (ViewFile::functions), which
   /// `func(n, x)` reads; without them `func` is an error.
@@ -99,6 +102,10 @@ class Grammar {
   /// True when the axiom or a successor turns without an angle (`+`, `-`, `&`, `^`, `\`,
   /// `/` without a parameter), so that the default turn angle is used.
   bool usesDefaultAngle() const;
+
+  /// The warnings and notes of parsing, in file order (a multi-letter word written without
+  /// its `module` declaration, an overridden `derivation length:`).
+  const std::vector<Diagnostic>& warnings() const;
 
   /// The compiled program (internal; used by Deriver).
   const detail::Program& program() const { return *program_; }

@@ -127,9 +127,12 @@ void readDefines(MapReader& top, TreeSpec& s, DiagnosticList& diags) {
 }
 
 /// Parses the grammar with the species' own overrides, for its errors and counts.
-void checkGrammar(const Species& species, TreeSpec& spec, DiagnosticList& diags) {
+/// Parses the species' grammar into spec.grammar; its errors go to diags, its warnings and
+/// notes to the species' notes (printed by every command, errors under `--strict`).
+void checkGrammar(Species& species, TreeSpec& spec, DiagnosticList& diags) {
   try {
     spec.grammar = speciesGrammar(species);
+    for (Diagnostic& d : inSpeciesFile(species, spec, spec.grammar->warnings())) species.notes.push_back(std::move(d));
   } catch (const InputError& e) {
     diags.append(e.diagnostics());
   }
@@ -559,9 +562,10 @@ std::shared_ptr<const KindSpec> readTreeSpec(MapReader& top, Species& species, D
   TreeSpec& s = *spec;
   readGrammar(top, species, s, diags);
   readDefines(top, s, diags);
-  if (top.has("steps"))
+  if (top.has("steps")) {
     s.overrides.derivationLength = static_cast<int>(top.integer("steps", 0, 0, 100000));
-  else
+    s.overrides.derivationLengthLoc = top.get("steps")->loc();
+  } else
     top.allow({"steps"});
   if (top.has("seed"))
     s.overrides.seed = static_cast<uint64_t>(top.integer("seed", 0, 0));
@@ -762,7 +766,7 @@ Species speciesFromCpfgObject(const fs::path& folder) {
 const TreeSpec& treeSpec(const Species& species) {
   const auto* tree = dynamic_cast<const TreeSpec*>(species.spec.get());
   if (!tree)
-    throw InputError(species.loc(), "a " + species.kind +
+    throw InputError(species.loc(), std::string(species.kind == "organism" ? "an " : "a ") + species.kind +
                                         " species has no grammar (this command needs a tree species or a .lsys grammar)");
   return *tree;
 }
@@ -783,17 +787,20 @@ lsystem::Grammar speciesGrammar(const Species& species, const lsystem::GrammarOv
   try {
     return lsystem::parseGrammar(tree.grammarText, tree.grammarFile, o);
   } catch (const InputError& e) {
-    if (species.bareGrammar || !species.yaml || tree.grammarFile != species.yaml->displayPath()) throw;
-    // Inline grammar: move positions from the grammar text into the species file.
-    std::vector<Diagnostic> moved = e.diagnostics();
-    for (auto& d : moved) {
-      if (d.loc.file != tree.grammarFile || d.loc.line <= 0) continue;
-      d.loc.line += tree.grammarLineOffset;
-      if (d.loc.col > 0) d.loc.col += tree.grammarColOffset;
-      d.sourceLine = species.yaml->sourceLine(d.loc.line);
-    }
-    throw InputError(std::move(moved));
+    throw InputError(inSpeciesFile(species, tree, e.diagnostics()));
   }
+}
+
+std::vector<Diagnostic> inSpeciesFile(const Species& species, const TreeSpec& tree, std::vector<Diagnostic> diags) {
+  if (species.bareGrammar || !species.yaml || tree.grammarFile != species.yaml->displayPath()) return diags;
+  // Inline grammar: move positions from the grammar text into the species file.
+  for (auto& d : diags) {
+    if (d.loc.file != tree.grammarFile || d.loc.line <= 0) continue;
+    d.loc.line += tree.grammarLineOffset;
+    if (d.loc.col > 0) d.loc.col += tree.grammarColOffset;
+    d.sourceLine = species.yaml->sourceLine(d.loc.line);
+  }
+  return diags;
 }
 
 lsystem::TurtleSettings speciesTurtle(const Species& species, const lsystem::Grammar& grammar) {

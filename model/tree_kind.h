@@ -66,6 +66,10 @@ const TreeSpec& treeSpec(const Species& species);
 /// of an inline grammar point into the species file.
 lsystem::Grammar speciesGrammar(const Species& species, const lsystem::GrammarOverrides& extra = {});
 
+/// diags of the species' grammar, moved into the species file when the grammar is written
+/// inline (`grammar: |`); unchanged otherwise.
+std::vector<Diagnostic> inSpeciesFile(const Species& species, const TreeSpec& tree, std::vector<Diagnostic> diags);
+
 /// Turtle settings for species with grammar: the species' settings, with the angle from
 /// the grammar's `angle:` when the species sets none (90 when neither does).
 lsystem::TurtleSettings speciesTurtle(const Species& species, const lsystem::Grammar& grammar);

@@ -206,6 +206,36 @@ class Walker {
   std::set<std::pair<int, int>> reported_;
 };
 
+/// The first line (1-based) whose indentation holds a tab, with the tab's 0-based column,
+/// or line 0. YAML indents with spaces only; yaml-cpp reports such a line as some other
+/// syntax error ("illegal map value", "end of map not found") that never names the tab.
+std::pair<int, int> firstIndentTab(std::string_view text) {
+  int lineNo = 1;
+  for (size_t pos = 0; pos < text.size(); ++lineNo) {
+    size_t nl = text.find('\n', pos);
+    std::string_view line = text.substr(pos, nl == std::string_view::npos ? std::string_view::npos : nl - pos);
+    pos = nl == std::string_view::npos ? text.size() : nl + 1;
+    size_t i = line.find_first_not_of(" \t");
+    if (i == std::string_view::npos || line[i] == '#' || line[i] == '\r') continue;
+    if (size_t tab = line.substr(0, i).find('\t'); tab != std::string_view::npos) return {lineNo, static_cast<int>(tab)};
+  }
+  return {0, 0};
+}
+
+/// yaml-cpp's terse syntax message with what usually causes it.
+std::string explainYamlError(const std::string& msg) {
+  static const std::pair<const char*, const char*> kHints[] = {
+      {"illegal map value", "a ':' where no key can start (a value holding ': ' needs quotes)"},
+      {"end of map not found", "a key is indented differently from the keys beside it"},
+      {"end of map flow not found", "a '{' is not closed by '}'"},
+      {"end of sequence flow not found", "a '[' is not closed by ']'"},
+      {"end of sequence not found", "a '- ' item is indented differently from the items beside it"},
+  };
+  for (auto [m, hint] : kHints)
+    if (msg == m) return msg + ": " + hint;
+  return msg;
+}
+
 }  // namespace
 
 // ---- YamlFile ---------------------------------------------------------------------
@@ -255,9 +285,14 @@ std::shared_ptr<const YamlFile> YamlFile::parseAt(std::string text, std::string 
   try {
     file->root_ = YAML::Load(file->text_);
   } catch (const YAML::Exception& e) {
+    if (auto [line, col] = firstIndentTab(file->text_); line > 0) {
+      diags.error(SourceLoc{file->displayPath_, line, col + 1},
+                  "YAML syntax error: a tab in the indentation (YAML indents with spaces only)", file->sourceLine(line));
+      return nullptr;
+    }
     YAML::Mark mark = e.mark;
     if (mark.line < 0) mark.line = 0, mark.column = 0;
-    file->error(diags, mark, "YAML syntax error: " + e.msg);
+    file->error(diags, mark, "YAML syntax error: " + explainYamlError(e.msg));
     return nullptr;
   }
   Walker walker(*file, diags, options.maxNodes);

@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <tuple>
 #include <array>
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <map>
 #include <optional>
+#include <set>
 #include <unordered_map>
 
 #include "core/rng.h"
@@ -145,6 +147,7 @@ class GrammarParser {
     }
     finish();
     diags().throwIfErrors();
+    for (const Diagnostic& d : diags().items()) prog_.warnings.push_back(d);
     return std::make_shared<Program>(std::move(prog_));
   }
 
@@ -657,11 +660,14 @@ class GrammarParser {
       // Streamed module by module, never stored: an axiom may hold millions of modules.
       // finish() tokenizes the line again to append them, once the seed is known.
       BracketState brackets;
+      WordLint words;
       if (value.b == value.e) error(line, value.b, "the axiom is empty");
       else if (scanner_.tokenizeModules(line, value.b, value.e, [&](const RawModule& m) {
                  bracketModule(line, m, brackets, "the axiom");
                  noteWritten(line, m);
+                 lintWord(line, words, &m);
                }) && bracketEnd(line, brackets, "the axiom")) {
+        lintWord(line, words, nullptr);
         axiomSpan_ = value;
         axiomLine_ = line;
         std::tie(prog_.axiomLoc, prog_.axiomLine) = scanner_.locate(line, b);
@@ -762,6 +768,7 @@ class GrammarParser {
       return;
     }
     if (!scanner_.tokenizeModules(line, pred.b, pred.e, predMods)) return;
+    lintWords(line, predMods);
     if (predMods.empty()) {
       error(line, pred.b, "a predecessor must be a single module");
       return;
@@ -821,6 +828,7 @@ class GrammarParser {
       std::vector<RawModule> mods;
       if (scanner_.tokenizeModules(line, succ.b, succ.e, mods) && checkBrackets(line, mods, "the successor")) {
         noteWritten(line, mods);
+        lintWords(line, mods);
         for (const RawModule& m : mods) {
           if (block == Block::Interpretation && isQuery(m.name)) error(line, m.col, queryInInterpretation(m.name));
           SuccModule sm;
@@ -1259,6 +1267,64 @@ class GrammarParser {
     return bracketEnd(line, st, where);
   }
 
+  /// A note where the override of `derivation length:` was written (a species' `steps:`),
+  /// when the file writes a different length: the override is silent otherwise.
+  void noteLengthOverride() {
+    const SourceLoc& at = overrides_.derivationLengthLoc;
+    const int value = *overrides_.derivationLength;
+    if (at.file.empty() || prog_.lengthLoc.line <= 0 || value == prog_.derivationLength) return;
+    Diagnostic d;
+    d.severity = Severity::Note;
+    d.loc = at;
+    d.message = std::to_string(value) + " steps replace the grammar's 'derivation length: " +
+                std::to_string(prog_.derivationLength) + "' (" + prog_.lengthLoc.file + ":" +
+                std::to_string(prog_.lengthLoc.line) + ")";
+    diags().add(std::move(d));
+  }
+
+  /// A run of one-letter modules written with nothing between them (see lintWord).
+  struct WordLint {
+    int begin = -1;     ///< column of the run's first letter, -1 when no run is open
+    int next = -1;      ///< column where the run's next letter must stand
+    std::string word;   ///< the letters so far
+  };
+
+  /// Sprig's notation reads `Leaf(1)` without `module Leaf` as four modules `L e a f(1)`.
+  /// A run of one-letter modules that spells a capitalized word of three letters or more
+  /// (`Leaf`, `Apex`, `Bud`), written with nothing between its letters, is almost surely such
+  /// a name: warn, naming the declaration to add. m == nullptr ends the line.
+  void lintWord(int line, WordLint& w, const RawModule* m) {
+    if (prog_.dialect != Dialect::Sprig) return;
+    const bool letter = m && m->name.size() == 1 && std::isalpha(static_cast<unsigned char>(m->name[0]));
+    const bool joins = letter && m->col == w.next && !w.word.empty() &&
+                       std::islower(static_cast<unsigned char>(m->name[0]));
+    if (joins) {
+      w.word += m->name;
+    } else {
+      if (w.word.size() >= 3 && !lintedWords_.count(w.word)) {
+        lintedWords_.insert(w.word);  // once per word
+        auto [loc, text] = scanner_.locate(line, w.begin);
+        diags().warning(loc,
+                        "'" + w.word + "' is read as " + std::to_string(w.word.size()) +
+                            " one-letter modules; declare it with 'module " + w.word + "' to make it one module",
+                        std::move(text));
+      }
+      w.word.clear();
+      if (letter && std::isupper(static_cast<unsigned char>(m->name[0]))) {
+        w.word = m->name;
+        w.begin = m->col;
+      }
+    }
+    if (m) w.next = m->hasParens || !letter ? -1 : m->col + 1;
+  }
+
+  /// lintWord over one module string.
+  void lintWords(int line, const std::vector<RawModule>& mods) {
+    WordLint w;
+    for (const RawModule& m : mods) lintWord(line, w, &m);
+    lintWord(line, w, nullptr);
+  }
+
   /// Records the parameter count of every module written in an axiom or successor.
   void noteWritten(int line, const std::vector<RawModule>& mods) {
     for (const RawModule& m : mods) noteWritten(line, m);
@@ -1454,6 +1520,7 @@ class GrammarParser {
   /// Overrides, the axiom, the ignore table and the lookup tables (see the class comment).
   void finish() {
     if (overrides_.derivationLength) {
+      noteLengthOverride();
       prog_.lengthLoc = SourceLoc{};  // the length no longer comes from the file
       prog_.lengthLine.clear();
       if (*overrides_.derivationLength < 0) diags().error(SourceLoc{prog_.fileName, 0, 0}, "derivation length override must not be negative");
@@ -1597,6 +1664,7 @@ class GrammarParser {
   std::vector<ArityUse> arityUses_;
   /// Per symbol: the parameter counts it is written with, each with its first (line, col).
   std::map<std::string, std::map<int, std::pair<int, int>>> written_;
+  std::set<std::string> lintedWords_;  ///< words lintWord has warned about
 };
 
 }  // namespace

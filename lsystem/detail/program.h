@@ -478,6 +478,9 @@ struct Program {
   /// module-limit errors point here when the grammar's own length is used.
   SourceLoc lengthLoc;
   std::string lengthLine;
+  /// The warnings and notes of parsing (a likely undeclared module name, an overridden
+  /// `derivation length:`), in file order; errors are thrown instead.
+  std::vector<Diagnostic> warnings;
   /// The `axiom:` header and its line's text; module-limit errors point here when the
   /// number of steps comes from elsewhere (an override, --steps).
   SourceLoc axiomLoc;

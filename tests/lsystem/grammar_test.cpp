@@ -312,7 +312,64 @@ TEST_CASE("loadGrammar every shipped grammar", "[lsystem]") {
     CHECK(g.axiom().size() > 0);
     CHECK(g.derivationLength() > 0);
     CHECK(g.productionCount() > 0);
+    CHECK(g.warnings().empty());  // no shipped module string reads as an undeclared word
     ++count;
   }
   CHECK(count >= 12);  // ABOP 1.24a-f, 1.31a, 2.6-2.8, shrub, conifer, ...
+}
+
+namespace {
+
+/// The warnings and notes of parsing text, formatted without source lines, one per line.
+std::string warningsOf(const std::string& text, const std::string& fileName = "g.lsys", const GrammarOverrides& o = {}) {
+  std::string out;
+  for (const Diagnostic& d : parseGrammar(text, fileName, o).warnings()) {
+    Diagnostic bare = d;
+    bare.sourceLine.clear();
+    out += (out.empty() ? "" : "\n") + bare.format();
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("Grammar::warnings: a multi-letter name written without its module declaration", "[lsystem]") {
+  const std::string rules = "axiom: A Leaf(0)\nA --> F Leaf(1) [+Bud] Leaf(2)\nderivation length: 2\n";
+  SECTION("one warning per word, at its first place") {
+    CHECK(warningsOf(rules) ==
+          "g.lsys:1:11: warning: 'Leaf' is read as 4 one-letter modules; declare it with 'module Leaf' to make it one module\n"
+          "g.lsys:2:16: warning: 'Bud' is read as 3 one-letter modules; declare it with 'module Bud' to make it one module");
+    // The grammar is still what the text says: L e a f(0) are four modules.
+    Grammar g = parseGrammar(rules, "g.lsys");
+    CHECK(formatModuleString(g.axiom(), g.symbols()) == "ALeaf(0)");
+    CHECK(g.axiom().size() == 5);
+  }
+  SECTION("declared, the word is one module and there is no warning") {
+    Grammar g = parseGrammar("module Leaf, Bud\n" + rules, "g.lsys");
+    CHECK(g.warnings().empty());
+    CHECK(g.axiom().size() == 2);
+  }
+  SECTION("what is not such a word") {
+    CHECK(warningsOf("axiom: FFF A(1)B(2)C lea Le F(1)ab\nderivation length: 1\n").empty());  // no capitalized run of 3
+    CHECK(warningsOf("axiom: L e a f\nderivation length: 1\n").empty());                      // spaced letters
+    CHECK(warningsOf("axiom: L(1)eaf\nderivation length: 1\n").empty());                      // a parameter ends the run
+    CHECK(warningsOf("axiom: Leaf\nderivation length: 1\n", "g.l").empty());                  // cpfg has no declarations
+  }
+  SECTION("a predecessor counts too") {
+    CHECK(warningsOf("axiom: A\nApex --> F\nderivation length: 1\n") ==
+          "g.lsys:2:1: warning: 'Apex' is read as 4 one-letter modules; declare it with 'module Apex' to make it one module");
+  }
+}
+
+TEST_CASE("Grammar::warnings: a species' steps replacing the grammar's derivation length is a note", "[lsystem]") {
+  const std::string text = "axiom: A\nA --> AB\nderivation length: 10\n";
+  GrammarOverrides o;
+  o.derivationLength = 12;
+  CHECK(warningsOf(text, "g.lsys", o).empty());  // no place to point at: a command-line --steps
+  o.derivationLengthLoc = SourceLoc{"s.yaml", 3, 8};
+  CHECK(warningsOf(text, "g.lsys", o) == "s.yaml:3:8: note: 12 steps replace the grammar's 'derivation length: 10' (g.lsys:3)");
+  o.derivationLength = 10;
+  CHECK(warningsOf(text, "g.lsys", o).empty());  // the same value replaces nothing
+  o.derivationLength = 4;
+  CHECK(warningsOf("axiom: A\nA --> AB\n", "g.lsys", o).empty());  // the grammar writes no length
 }
