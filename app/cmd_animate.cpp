@@ -9,6 +9,7 @@
 #include "model/model.h"
 #include "model/species.h"
 #include "core/image.h"
+#include "core/phases.h"
 
 namespace sprig {
 
@@ -76,6 +77,7 @@ GrowthFrame parseAt(const std::string& text) {
 }
 
 int runAnimate(const AnimateArgs& a, const GlobalOptions& g) {
+  PhaseClock::declare({"read", "derive", "build", "cells", "scene", "render", "write"});
   AnimateOptions opt;
   opt.extra = a.growth.overrides();
   opt.framesPerStage = a.framesPerStage;

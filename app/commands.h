@@ -22,13 +22,15 @@ namespace sprig {
 /// Exit codes of `sprig`.
 enum ExitCode : int { kExitOk = 0, kExitBadInput = 1, kExitUsage = 2, kExitInternal = 3 };
 
-/// Options every subcommand shares (`--quiet`, `--threads`, `--root`, `--allow-outside-paths`).
+/// Options every subcommand shares (`--quiet`, `--threads`, `--root`, `--allow-outside-paths`,
+/// `--full-tape`, `--timings`).
 struct GlobalOptions {
   bool quiet = false;
   int threads = 0;  ///< 0 = all cores
   std::string root = ".";
   bool allowOutsidePaths = false;
   bool fullTape = false;  ///< `--full-tape`: implicit surfaces trace the whole tape per cell
+  std::string timings = "text";  ///< `--timings text|json|none`: the phases printed after the command
 
   /// Where species files may reference files from.
   PathPolicy pathPolicy() const {

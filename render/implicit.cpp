@@ -12,6 +12,7 @@
 #include "blobtree/cell_size.h"
 #include "blobtree/polygonize.h"
 #include "blobtree/tracer.h"
+#include "core/phases.h"
 #include "render/detail/scene_impl.h"
 #include "render/scene.h"
 
@@ -135,6 +136,7 @@ uint32_t Scene::addImplicit(const blobtree::CompiledBlob& blob, uint32_t materia
     float cellSize = options.cellSize > 0 ? options.cellSize : blobtree::autoCellSize(blob, kTracerCells);
     blobtree::SurfaceCellOptions cellOptions;
     cellOptions.prunedTapes = options.batched && options.prunedTapes && impl_->prunedTapes;
+    const Phase phase("cells");
     data->cells = blob.surfaceCells(cellSize, cellOptions);
   }
   RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_USER);
