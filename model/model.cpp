@@ -114,7 +114,9 @@ Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJo
   const render::Camera camera = modelCamera(look, frame, width, height);
   render::Scene scene;
   scene.setPixelFootprint(camera, width, height, look.image.thinMinPixels);
-  ModelFigures fig = model.addToScene(scene, job.stage, job.mode, look);
+  SpeciesRender seen = look;
+  seen.pixels = camera.pixelScale(height);
+  ModelFigures fig = model.addToScene(scene, job.stage, job.mode, seen);
   const auto t0 = std::chrono::steady_clock::now();
   {
     const Phase phase("scene");
