@@ -62,9 +62,7 @@ void parseCamera(const std::string& text, SpeciesRender& look) {
 
 int renderOnce(const RenderArgs& a, const GlobalOptions& g) {
   PhaseClock::declare({"read", "derive", "build", "cells", "scene", "render", "write"});
-  GeometryMode mode = a.mode == "mesh" ? GeometryMode::Mesh
-                      : a.mode == "skeleton" ? GeometryMode::Skeleton
-                                             : GeometryMode::Exact;
+  const GeometryMode mode = geometryModeNamed(a.mode);
   Species species = loadSpecies(a.file, g.pathPolicy());
   printNotes(g, species);
   SpeciesRender look = species.render;
