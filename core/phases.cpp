@@ -109,28 +109,36 @@ double PhaseClock::total() {
   return sum;
 }
 
-std::string PhaseClock::summary() {
+namespace {
+
+/// The phases, each printed with format (its name, then its seconds) and joined by separator;
+/// sum receives their total.
+std::string joinPhases(const char* format, const char* separator, double& sum) {
   std::string out;
-  double sum = 0;
+  sum = 0;
   char buf[96];
-  for (const auto& [name, seconds] : phases()) {
-    std::snprintf(buf, sizeof buf, "%s%s %.2f s", out.empty() ? "" : ", ", name.c_str(), seconds);
-    out += buf;
+  for (const auto& [name, seconds] : PhaseClock::phases()) {
+    std::snprintf(buf, sizeof buf, format, name.c_str(), seconds);
+    out += (out.empty() ? "" : separator) + std::string(buf);
     sum += seconds;
   }
+  return out;
+}
+
+}  // namespace
+
+std::string PhaseClock::summary() {
+  double sum = 0;
+  const std::string list = joinPhases("%s %.2f s", ", ", sum);
+  char buf[48];
   std::snprintf(buf, sizeof buf, "; %.2f s wall", sum);
-  return out + buf;
+  return list + buf;
 }
 
 std::string PhaseClock::json(const std::string& command) {
-  std::string body;
   double sum = 0;
-  char buf[96];
-  for (const auto& [name, seconds] : phases()) {
-    std::snprintf(buf, sizeof buf, "%s\"%s\":%.6f", body.empty() ? "" : ",", name.c_str(), seconds);
-    body += buf;
-    sum += seconds;
-  }
+  const std::string body = joinPhases("\"%s\":%.6f", ",", sum);
+  char buf[64];
   std::snprintf(buf, sizeof buf, "\",\"total\":%.6f,\"phases\":{", sum);
   return "{\"command\":\"" + command + buf + body + "}}";
 }
