@@ -9,6 +9,7 @@
 #include "model/model.h"
 #include "model/species.h"
 #include "core/image.h"
+#include "core/phases.h"
 
 namespace sprig {
 
@@ -29,6 +30,7 @@ struct AnimateArgs {
   int samples = 0;
   std::string wind;
   double windSeconds = 4;
+  std::string mode;  ///< empty = the species' default (SpeciesModel::defaultMode)
   GrowthFlags growth;
 };
 
@@ -76,6 +78,7 @@ GrowthFrame parseAt(const std::string& text) {
 }
 
 int runAnimate(const AnimateArgs& a, const GlobalOptions& g) {
+  PhaseClock::declare({"read", "derive", "build", "cells", "scene", "render", "write"});
   AnimateOptions opt;
   opt.extra = a.growth.overrides();
   opt.framesPerStage = a.framesPerStage;
@@ -88,6 +91,7 @@ int runAnimate(const AnimateArgs& a, const GlobalOptions& g) {
     if (!a.at.empty()) throw UsageError("--wind sways an animation over time; --at renders one still frame");
   }
   opt.windSeconds = a.windSeconds;
+  if (!a.mode.empty()) opt.mode = geometryModeNamed(a.mode);
   std::optional<GrowthFrame> single;
   if (!a.at.empty()) {
     requireExtension("-o", a.out, {".png", ".jpg", ".jpeg", ".exr"});
@@ -121,7 +125,7 @@ int runAnimate(const AnimateArgs& a, const GlobalOptions& g) {
     RenderJob job;
     job.width = opt.width;
     job.height = opt.height;
-    job.mode = model.defaultMode();
+    job.mode = opt.mode ? *opt.mode : model.defaultMode();
     job.stage = model.stageFromIndex(single->stage);
     job.stage.fraction = single->fraction;
     job.progress = false;
@@ -154,6 +158,10 @@ void addAnimateCommand(CLI::App& app, const GlobalOptions& global, CommandRun& r
   sub->add_option("--hold", args->hold, "GIF and MP4: seconds to show the grown plant before looping")
       ->check(CLI::Range(0.0, 60.0));
   sub->add_option("--at", args->at, "render the single frame STAGE[:FRACTION] to a PNG instead");
+  sub->add_option("--mode", args->mode,
+                  "exact (ray cast the implicit surface), mesh (polygonize first) or skeleton, as `sprig render --mode`; "
+                  "default: exact for species with a surface, skeleton for other trees")
+      ->check(CLI::IsMember({"exact", "mesh", "skeleton"}));
   sub->add_option("--width", args->width, "frame width in pixels")->check(CLI::Range(16, 8192));
   sub->add_option("--height", args->height, "frame height in pixels")->check(CLI::Range(16, 8192));
   sub->add_option("--samples", args->samples, "camera samples per pixel")->check(CLI::Range(1, 1024));

@@ -12,6 +12,7 @@
 #include "model/model.h"
 #include "core/mesh_io.h"
 #include "core/paths.h"
+#include "core/phases.h"
 
 namespace sprig {
 
@@ -31,6 +32,7 @@ struct MeshArgs {
 
 int runMesh(const MeshArgs& a, const GlobalOptions& g) {
   requireExtension("-o", a.out, {".ply", ".obj", ".glb", ".msh", ".vtu", ".mesh"});
+  PhaseClock::declare({"read", "derive", "build", "polygonize", "write"});
   auto start = std::chrono::steady_clock::now();
   // Volume meshes (tetrahedra with materials) of kinds that have them, by extension.
   const std::string ext = lowerExtension(a.out);
@@ -82,7 +84,10 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
       simplified += buf;
     }
   }
-  const std::vector<PartWriteReport> written = writeParts(parts, a.out);
+  const std::vector<PartWriteReport> written = [&] {
+    const Phase phase("write");
+    return writeParts(parts, a.out);
+  }();
   double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   size_t vertices = 0;
   std::string names;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "app/cmd_common.h"
@@ -13,6 +14,7 @@
 #include "render/camera.h"
 #include "render/scene.h"
 #include "core/image.h"
+#include "core/phases.h"
 
 namespace sprig {
 
@@ -31,6 +33,7 @@ struct PreviewArgs {
 };
 
 int previewOnce(const PreviewArgs& a, const GlobalOptions& g) {
+  PhaseClock::declare({"read", "derive", "scene", "render", "write"});
   lsystem::GrammarOverrides extra = a.growth.overrides();
   Species species = loadSpecies(a.file, g.pathPolicy());
   printNotes(g, species);
@@ -46,7 +49,9 @@ int previewOnce(const PreviewArgs& a, const GlobalOptions& g) {
 
   checkCameraRays(width, height, look.image.spp);  // before anything is derived or built
   // The skeleton as derived at the step shown, framed like the final step.
+  std::optional<Phase> phase(std::in_place, "read");
   GrowthEngine engine(species, GrowthOptions{extra, -1, {}});
+  phase.reset();
   const int last = engine.lastStep();
   const int step = a.stage >= 0 ? std::min(a.stage, last) : last;
   if (a.stage > last && !g.quiet)
@@ -58,12 +63,15 @@ int previewOnce(const PreviewArgs& a, const GlobalOptions& g) {
   const render::Camera camera = render::frameBounds(Box3{Vec3(frame.lo), Vec3(frame.hi)}, look.view,
                                                     static_cast<double>(width) / height);
   render::Scene scene;
+  phase.emplace("scene");
   scene.setPixelFootprint(camera, width, height, look.image.thinMinPixels);
   scene.add(skeletonPreview(shown, look.style));
   scene.commit();
+  phase.emplace("render");
   render::RenderSettings rs = look.settings(width, height);
   rs.progressLabel = "render " + species.name;
   Image image = render::renderImage(scene, camera, rs);
+  phase.reset();
   writeImage(image, a.out);
   // cpfg's textured cylinders are meshes (organs), not internodes: counted apart.
   const size_t tubes = static_cast<size_t>(std::count_if(shown.organs.begin(), shown.organs.end(), [](const lsystem::Organ& o) {

@@ -11,6 +11,7 @@
 #include "model/model.h"
 #include "model/species.h"
 #include "core/image.h"
+#include "core/phases.h"
 
 namespace sprig {
 
@@ -60,9 +61,8 @@ void parseCamera(const std::string& text, SpeciesRender& look) {
 }
 
 int renderOnce(const RenderArgs& a, const GlobalOptions& g) {
-  GeometryMode mode = a.mode == "mesh" ? GeometryMode::Mesh
-                      : a.mode == "skeleton" ? GeometryMode::Skeleton
-                                             : GeometryMode::Exact;
+  PhaseClock::declare({"read", "derive", "build", "cells", "scene", "render", "write"});
+  const GeometryMode mode = geometryModeNamed(a.mode);
   Species species = loadSpecies(a.file, g.pathPolicy());
   printNotes(g, species);
   SpeciesRender look = species.render;
@@ -93,11 +93,11 @@ int renderOnce(const RenderArgs& a, const GlobalOptions& g) {
   Image image = renderModel(model, look, job, &fig, &stats);
   writeImage(image, a.out);
   note(g, std::cerr,
-       "%s: %dx%d, %d spp, %s mode%s%s; %zu primitives, %zu cells, %zu triangles; build %.2f s, render %.2f s, "
+       "%s: %dx%d, %d spp, %s mode%s%s; %zu primitives, %zu cells, %zu triangles; "
        "%.2f Mrays/s",
        a.out.c_str(), image.width, image.height, job.samples > 0 ? job.samples : look.image.spp, geometryModeName(mode),
        model.stageName(job.stage).empty() ? "" : ", ", model.stageName(job.stage).c_str(), fig.primitives, fig.cells,
-       fig.triangles, fig.buildSeconds, stats.seconds, stats.raysPerSecond() / 1e6);
+       fig.triangles, stats.raysPerSecond() / 1e6);
   return kExitOk;
 }
 

@@ -22,7 +22,8 @@ namespace sprig {
 /// Exit codes of `sprig`.
 enum ExitCode : int { kExitOk = 0, kExitBadInput = 1, kExitUsage = 2, kExitInternal = 3 };
 
-/// Options every subcommand shares (`--quiet`, `--threads`, `--root`, `--allow-outside-paths`).
+/// Options every subcommand shares (`--quiet`, `--threads`, `--root`, `--allow-outside-paths`,
+/// `--full-tape`, `--timings`).
 struct GlobalOptions {
   bool quiet = false;
   int threads = 0;  ///< 0 = all cores
@@ -30,6 +31,7 @@ struct GlobalOptions {
   bool allowOutsidePaths = false;
   bool fullTape = false;  ///< `--full-tape`: implicit surfaces trace the whole tape per cell
   bool strict = false;    ///< `--strict`: warnings about the input are errors
+  std::string timings = "text";  ///< `--timings text|json|none`: the phases printed after the command
 
   /// Where species files may reference files from.
   PathPolicy pathPolicy() const {

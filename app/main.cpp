@@ -11,11 +11,27 @@
 #include "core/atomic_file.h"
 #include "core/diagnostics.h"
 #include "core/parallel.h"
+#include "core/phases.h"
 #include "core/progress.h"
 #include "render/scene.h"
 
+namespace {
+
+/// The command's phases (core/phases.h) as global.timings asks, on stderr: `--timings text`
+/// (unless --quiet) or `--timings json`.
+void printTimings(const sprig::GlobalOptions& global, const CLI::App& app) {
+  using sprig::PhaseClock;
+  std::string command;
+  for (const CLI::App* sub : app.get_subcommands()) command = sub->get_name();
+  if (global.timings == "json") std::cerr << PhaseClock::json(command) << "\n";
+  else if (global.timings == "text" && !global.quiet) std::cerr << "sprig " << command << ": " << PhaseClock::summary() << "\n";
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace sprig;
+  PhaseClock::start();
   installSignalCleanup();
   CLI::App app{"Sprig: procedural botanical modeling (L-systems, skeletons, BlobTree surfaces, shells)", "sprig"};
   app.set_version_flag("--version", SPRIG_VERSION);
@@ -33,6 +49,11 @@ int main(int argc, char** argv) {
   app.add_flag("--full-tape", global.fullTape,
                "exact renders trace the whole BlobTree tape in every cell instead of its pruned tape (the reference, "
                "for comparing images; slower)");
+
+  app.add_option("--timings", global.timings,
+                 "after the command, where its wall time went, phase by phase (read, derive, build, cells, scene, "
+                 "render, write, ...) on stderr: text (one line, the default), json (one JSON object: scripts) or none")
+      ->check(CLI::IsMember({"text", "json", "none"}));
 
   CommandRun run;
   addDeriveCommand(app, global, run);
@@ -61,7 +82,10 @@ int main(int argc, char** argv) {
     std::optional<ThreadLimit> limit;
     if (global.threads > 0) limit.emplace(global.threads);
     render::Scene::setPrunedTapesDefault(!global.fullTape);
-    return run ? run() : kExitUsage;
+    if (!run) return kExitUsage;
+    const int code = run();
+    printTimings(global, app);
+    return code;
   } catch (const InputError& e) {
     std::cerr << e.what() << "\n";
     return kExitBadInput;

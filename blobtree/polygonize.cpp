@@ -19,6 +19,7 @@
 #include "blobtree/detail/marching_tets.h"
 #include "core/diagnostics.h"
 #include "core/parallel.h"
+#include "core/phases.h"
 #include "core/progress.h"
 
 namespace sprig::blobtree {
@@ -846,6 +847,7 @@ void dualMesh(const CompiledBlob& blob, const PolygonizeOptions& options, const 
 }  // namespace
 
 PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOptions& options) {
+  const Phase phase("polygonize");
   PolygonizeResult res;
   float requested = resolveCellSize(blob, options);
   if (requested <= 0.0f || blob.bounds().empty()) return res;

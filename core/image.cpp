@@ -6,6 +6,7 @@
 #include "core/atomic_file.h"
 #include "core/detail/image_backend.h"
 #include "core/paths.h"
+#include "core/phases.h"
 #include "core/srgb.h"
 
 namespace sprig {
@@ -57,6 +58,7 @@ ImageFormat imageFormatFor(const fs::path& path) {
 }
 
 void writeImage(const Image& image, const fs::path& path, ImageEncoding encoding) {
+  const Phase phase("write");
   const ImageFormat format = imageFormatFor(path);
   if (image.width <= 0 || image.height <= 0 || image.pixels.size() != static_cast<size_t>(image.width) * image.height * 4)
     throw std::invalid_argument("cannot write image '" + path.string() + "': image is empty or malformed");

@@ -16,6 +16,7 @@
 #include "core/atomic_file.h"
 #include "core/diagnostics.h"
 #include "core/paths.h"
+#include "core/phases.h"
 #include "core/progress.h"
 #include "render/renderer.h"
 
@@ -192,12 +193,14 @@ AnimateResult animateModel(SpeciesModel& model, const SpeciesRender& baseLook, c
       gifFrames.insert(gifFrames.begin(), hold, gifFrames.back());
     else
       for (size_t i = 0; i < hold; ++i) gifFrames.push_back(gifFrames.back());
+    const Phase phase("write");
     writeAnimatedGif(gifFrames, options.fps, out);
   }
   if (format == AnimationFormat::Mp4)
     for (size_t i = 0; i < hold; ++i)
       fs::copy_file(frameFolder / frameName(frames.size() - 1), frameFolder / frameName(frames.size() + i));
   if (format == AnimationFormat::Mp4) {
+    const Phase phase("write");
     TempPath tmp(out);
     char rate[32];
     std::snprintf(rate, sizeof rate, "%g", options.fps);

@@ -4,6 +4,7 @@
 #include <optional>
 #include <stdexcept>
 
+#include "core/phases.h"
 #include "core/progress.h"
 #include "model/tree_kind.h"
 
@@ -35,6 +36,7 @@ uint64_t GrowthEngine::seed() const { return deriver_->seed(); }
 const lsystem::SymbolTable& GrowthEngine::symbols() const { return deriver_->symbols(); }
 
 void GrowthEngine::advanceTo(int step) {
+  const Phase phase("derive");
   if (step < 0 || step > lastStep_)
     throw std::invalid_argument("step " + std::to_string(step) + " is outside 0.." + std::to_string(lastStep_));
   if (interpretedStep_ == step) return;
@@ -67,6 +69,7 @@ size_t bytesOf(const lsystem::ModuleString& s) {
 
 void GrowthEngine::measure() {
   if (measured_) return;
+  const Phase phase("derive");
   size_t snapshotBytes = 0;
   bool keep = true;
   // One pass over every step: the camera's box, and each step's growthStart from the
@@ -120,6 +123,7 @@ size_t GrowthEngine::moduleCount(int step) {
 
 lsystem::Skeleton GrowthEngine::draw(const lsystem::ModuleString& interpreted, const lsystem::TurtleSettings& settings,
                                      lsystem::TurtleState* end) {
+  const Phase phase("derive");
   lsystem::Turtle turtle(deriver_->symbols(), settings);
   lsystem::Skeleton sk = turtle.run(interpreted, interpreted.birthSteps);
   if (end) *end = turtle.endState();
@@ -135,6 +139,7 @@ lsystem::Skeleton GrowthEngine::skeletonAt(int step, lsystem::TurtleState* end) 
 lsystem::SkeletonSummary GrowthEngine::summaryAt(int step, lsystem::TurtleState* end) {
   if (step < 0 || step > lastStep_)
     throw std::invalid_argument("step " + std::to_string(step) + " is outside 0.." + std::to_string(lastStep_));
+  const Phase phase("derive");
   const lsystem::ModuleString& interpreted = interpretedAt(step);
   lsystem::Turtle turtle(deriver_->symbols(), turtle_);
   lsystem::SkeletonSummary sum = turtle.summarize(interpreted, interpreted.birthSteps);

@@ -33,6 +33,12 @@ const char* geometryModeName(GeometryMode mode) {
   return i < std::size(kNames) ? kNames[i] : "?";
 }
 
+GeometryMode geometryModeNamed(const std::string& name) {
+  for (GeometryMode m : {GeometryMode::Exact, GeometryMode::Mesh, GeometryMode::Skeleton})
+    if (name == geometryModeName(m)) return m;
+  throw UsageError("--mode " + name + ": expected exact, mesh or skeleton");
+}
+
 Stage KindModel::stageAtAge(double) const { throw UsageError("--age applies to shell species only"); }
 
 std::string KindModel::writeVolumeMesh(const Stage&, const std::filesystem::path& path, bool) {

@@ -34,6 +34,8 @@ enum class GeometryMode {
 
 /// "exact", "mesh", "skeleton".
 const char* geometryModeName(GeometryMode mode);
+/// The mode named "exact", "mesh" or "skeleton"; throws UsageError for any other name.
+GeometryMode geometryModeNamed(const std::string& name);
 
 /// A growth stage. Trees use step and fraction, shells use age, organisms time; blobs have one stage.
 struct Stage {

@@ -254,7 +254,9 @@ std::vector<std::pair<uint32_t, Mesh>> splitByMaterial(const Mesh& mesh) {
 
 blobtree::PolygonizeResult polygonizeForLook(const blobtree::CompiledBlob& blob, const blobtree::PolygonizeOptions& options,
                                              const SpeciesRender& look) {
-  blobtree::PolygonizeResult r = blobtree::polygonizeDetailed(blob, options);
+  blobtree::PolygonizeOptions po = options;
+  if (look.pixels) po.cellSize = render::pixelCellSize(blobtree::resolveCellSize(blob, options), *look.pixels, blob.bounds());
+  blobtree::PolygonizeResult r = blobtree::polygonizeDetailed(blob, po);
   if (!(look.simplify > 0) || r.mesh.triangles.empty()) return r;
   std::vector<uint32_t> source;
   r.mesh = organisms::simplifyToError(r.mesh, float(look.simplify), nullptr, &source);

@@ -121,7 +121,9 @@ std::vector<std::pair<uint32_t, Mesh>> splitByMaterial(const Mesh& mesh);
 
 /// polygonizeDetailed(blob, options), simplified to look.simplify of the surface's extent
 /// when that is above 0 (the per-vertex attributes follow the vertices that remain): the
-/// surface of a mesh-mode render.
+/// surface of a mesh-mode render. With look.pixels (a render's camera) the cell is
+/// render::pixelCellSize of the blob's own (options.cellSize or the automatic cell): no
+/// finer than the image needs.
 blobtree::PolygonizeResult polygonizeForLook(const blobtree::CompiledBlob& blob, const blobtree::PolygonizeOptions& options,
                                              const SpeciesRender& look);
 

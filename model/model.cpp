@@ -6,6 +6,7 @@
 
 #include "core/diagnostics.h"
 #include "core/mesh_clean.h"
+#include "core/phases.h"
 #include "render/camera.h"
 
 namespace sprig {
@@ -16,6 +17,7 @@ namespace {
 }  // namespace
 
 SpeciesModel::SpeciesModel(const Species& species, const ModelOptions& options) : species_(species) {
+  const Phase phase("read");
   if (!species_.spec) throw InputError(species_.loc(), "invalid " + species_.kind + " species");
   kind_ = species_.spec->makeModel(species_, options);
 }
@@ -27,7 +29,11 @@ SpeciesModel::~SpeciesModel() = default;
 
 ModelFigures SpeciesModel::addToScene(render::Scene& scene, const Stage& stage, GeometryMode mode,
                                       const SpeciesRender& look) {
-  BuiltStage built = kind_->build(stage, mode, look);
+  BuiltStage built = [&] {
+    const Phase phase("build");
+    return kind_->build(stage, mode, look);
+  }();
+  const Phase phase("scene");
   scene.add(built.geometry);
   return built.figures;
 }
@@ -35,7 +41,10 @@ ModelFigures SpeciesModel::addToScene(render::Scene& scene, const Stage& stage, 
 Mesh SpeciesModel::buildMesh(const Stage& stage, float cellSize, bool progress, ModelFigures* figures) {
   ModelFigures fig;
   const auto t0 = std::chrono::steady_clock::now();
-  Mesh out = kind_->buildMesh(stage, cellSize, progress, fig);
+  Mesh out = [&] {
+    const Phase phase("build");
+    return kind_->buildMesh(stage, cellSize, progress, fig);
+  }();
   fig.triangles = out.triangleCount();
   fig.buildSeconds = secondsSince(t0);
   if (figures) *figures = fig;
@@ -53,7 +62,10 @@ std::vector<ExportPart> SpeciesModel::exportParts(const Stage& stage, float cell
                                                  const MeshCleanOptions& clean, ModelFigures* figures) {
   ModelFigures fig;
   const auto t0 = std::chrono::steady_clock::now();
-  std::vector<ExportPart> parts = kind_->exportParts(stage, cellSize, progress, species_.render, clean, fig);
+  std::vector<ExportPart> parts = [&] {
+    const Phase phase("build");
+    return kind_->exportParts(stage, cellSize, progress, species_.render, clean, fig);
+  }();
   fig.triangles = 0;
   for (const ExportPart& p : parts) fig.triangles += p.mesh.triangleCount();
   fig.buildSeconds = secondsSince(t0);
@@ -102,15 +114,21 @@ Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJo
   const render::Camera camera = modelCamera(look, frame, width, height);
   render::Scene scene;
   scene.setPixelFootprint(camera, width, height, look.image.thinMinPixels);
-  ModelFigures fig = model.addToScene(scene, job.stage, job.mode, look);
+  SpeciesRender seen = look;
+  seen.pixels = camera.pixelScale(height);
+  ModelFigures fig = model.addToScene(scene, job.stage, job.mode, seen);
   const auto t0 = std::chrono::steady_clock::now();
-  scene.commit();
+  {
+    const Phase phase("scene");
+    scene.commit();
+  }
   fig.buildSeconds += secondsSince(t0);
   fig.cells = scene.stats().implicitCells;
   render::RenderSettings rs = look.settings(width, height);
   if (job.samples > 0) rs.spp = job.samples;
   rs.progress = job.progress;
   rs.progressLabel = job.progressLabel;
+  const Phase phase("render");
   Image image = render::renderImage(scene, camera, rs, stats);
   if (figures) *figures = fig;
   return image;

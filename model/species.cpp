@@ -5,6 +5,7 @@
 
 #include "core/atomic_file.h"
 #include "core/paths.h"
+#include "core/phases.h"
 #include "model/kinds.h"
 #include "model/tree_kind.h"
 
@@ -148,6 +149,7 @@ render::RenderSettings SpeciesRender::settings(int imageWidth, int imageHeight) 
 }
 
 Species loadSpecies(const fs::path& path, const PathPolicy& policy) {
+  const Phase phase("read");
   const std::string ext = lowerExtension(path);
   std::error_code ec;
   if (fs::is_directory(path, ec)) return speciesFromCpfgObject(path);  // model/tree_kind.h

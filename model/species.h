@@ -73,6 +73,10 @@ struct SpeciesRender {
   /// edge collapses while the geometric error stays below this fraction of the surface's
   /// extent (organisms::simplifyToError, meshoptimizer); 0 (the default) keeps every triangle.
   double simplify = 0;
+  /// Set by renderModel (never read from the file): the camera's pixel, so a mesh-mode build
+  /// polygonizes at the cell the image needs (render::pixelCellSize); unset (`sprig mesh`,
+  /// exports) polygonizes at the model's own cell.
+  std::optional<render::PixelScale> pixels;
 
   /// Renderer settings for an image of width x height.
   render::RenderSettings settings(int imageWidth, int imageHeight) const;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 namespace sprig::render {
 
@@ -18,6 +19,30 @@ CameraBasis Camera::basis() const {
 
 float Camera::pixelPerDepth(int height) const {
   return 2.0f * std::tan(0.5f * static_cast<float>(radians(fovYDeg))) / static_cast<float>(height);
+}
+
+PixelScale Camera::pixelScale(int height) const {
+  PixelScale s;
+  s.eye = position;
+  s.forward = basis().forward;
+  s.pixelPerDepth = pixelPerDepth(height);
+  return s;
+}
+
+float PixelScale::nearestPixel(const Box3& box) const {
+  if (box.empty()) return 0.0f;
+  // The depth along forward is linear, so its minimum over the box is at a corner.
+  float depth = std::numeric_limits<float>::infinity();
+  for (int c = 0; c < 8; ++c) {
+    const Vec3 corner((c & 1) ? box.hi.x : box.lo.x, (c & 2) ? box.hi.y : box.lo.y, (c & 4) ? box.hi.z : box.lo.z);
+    depth = std::min(depth, glm::dot(corner - eye, forward));
+  }
+  return depth > 0.0f && std::isfinite(depth) ? pixelPerDepth * depth : 0.0f;
+}
+
+float pixelCellSize(float ownCell, const PixelScale& pixels, const Box3& box, float cellPixels) {
+  if (!(ownCell > 0.0f)) return ownCell;
+  return std::max(ownCell, cellPixels * pixels.nearestPixel(box));
 }
 
 Ray Camera::generateRay(float px, float py, int width, int height) const {

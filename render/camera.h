@@ -21,6 +21,33 @@ struct CameraBasis {
   Vec3 right, up, forward;
 };
 
+/// The camera's pixel carried into the world: how fine a model seen through it needs its
+/// acceleration (surface cells, pruned tapes, the mesh mode's polygonization cell) to be.
+/// A frame's cost then follows its pixels, not the model's finest feature.
+struct PixelScale {
+  Vec3 eye{0};                 ///< camera position
+  Vec3 forward{0, 0, -1};      ///< unit view direction
+  float pixelPerDepth = 0.0f;  ///< world size of one pixel at unit depth along forward
+  /// World size of one pixel at the point of box nearest the camera along its view (the
+  /// smallest pixel anywhere on the box: the finest the model inside can appear); 0 when
+  /// box is empty or reaches the plane through the eye across the view.
+  float nearestPixel(const Box3& box) const;
+};
+
+/// Pixels per acceleration cell (pixelCellSize): a cell at least two pixels wide where the
+/// model comes nearest. Two because thin parts narrower than two pixels are drawn as
+/// widened curves anyway (Scene::setPixelFootprint, RenderSettings::thinMinPixels), so a
+/// polygonization cell of two pixels loses nothing the image shows as a surface.
+constexpr float kCellPixels = 2.0f;
+
+/// The edge (world units) of the acceleration cells of a model whose support box is box,
+/// seen through pixels, when the model itself asks for ownCell (its species' cell, or the
+/// automatic cell from its finest feature):
+///   max(ownCell, cellPixels · pixels.nearestPixel(box)).
+/// Never finer than ownCell; ownCell itself when the rule does not bind (large images, a
+/// camera inside the box) or ownCell <= 0 (nothing to build).
+float pixelCellSize(float ownCell, const PixelScale& pixels, const Box3& box, float cellPixels = kCellPixels);
+
 /// Pinhole camera looking from `position` toward `target`.
 struct Camera {
   Vec3 position{0, 0, 5};  ///< eye, world units
@@ -36,6 +63,8 @@ struct Camera {
   CameraBasis basis() const;
   /// World size of one pixel of a height-pixel image at unit depth along the view.
   float pixelPerDepth(int height) const;
+  /// The camera's pixel in a height-pixel image, for pixelCellSize.
+  PixelScale pixelScale(int height) const;
 };
 
 /// A viewing direction for automatic framing.

@@ -51,6 +51,12 @@ struct ImplicitOptions {
   /// Edge of the surface cells (one Embree user primitive each), world units; 0 = automatic:
   /// 1.5x the smallest feature radius, clamped to [diagonal/1000, diagonal/40].
   float cellSize = 0.0f;
+  /// In a scene with a camera (Scene::setPixelFootprint), the cells (and their pruned
+  /// tapes) are no finer than the image needs: edge max(cellSize, kCellPixels x the pixel at
+  /// the nearest point of the blob's box) (render::pixelCellSize). The surface is the same
+  /// (the tracer is exact in any cell); only the acceleration is coarser. false: cellSize
+  /// whatever the camera.
+  bool followPixels = true;
   /// Root-finding tolerance (relative to the model's bounds diagonal) and step cap.
   blobtree::TraceOptions trace;
   /// March eight samples at a time with batched field evaluation (the same Lipschitz

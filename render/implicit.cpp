@@ -12,6 +12,7 @@
 #include "blobtree/cell_size.h"
 #include "blobtree/polygonize.h"
 #include "blobtree/tracer.h"
+#include "core/phases.h"
 #include "render/detail/scene_impl.h"
 #include "render/scene.h"
 
@@ -133,8 +134,16 @@ uint32_t Scene::addImplicit(const blobtree::CompiledBlob& blob, uint32_t materia
   Box3 support = blob.bounds();
   if (!support.empty()) {
     float cellSize = options.cellSize > 0 ? options.cellSize : blobtree::autoCellSize(blob, kTracerCells);
+    if (impl_->view && options.followPixels) {
+      PixelScale pixels;
+      pixels.eye = impl_->view->eye;
+      pixels.forward = impl_->view->forward;
+      pixels.pixelPerDepth = impl_->view->pixelPerDepth;
+      cellSize = pixelCellSize(cellSize, pixels, support);
+    }
     blobtree::SurfaceCellOptions cellOptions;
     cellOptions.prunedTapes = options.batched && options.prunedTapes && impl_->prunedTapes;
+    const Phase phase("cells");
     data->cells = blob.surfaceCells(cellSize, cellOptions);
   }
   RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_USER);
@@ -147,6 +156,7 @@ uint32_t Scene::addImplicit(const blobtree::CompiledBlob& blob, uint32_t materia
   for (const auto& c : data->cells.cells) cellBox.extend(c.box);
   if (!cellBox.empty()) impl_->bounds.extend(tightenBounds(blob, cellBox.intersected(support)));
   impl_->stats.implicitCells += data->cells.cells.size();
+  impl_->stats.implicitCellSize = std::max(impl_->stats.implicitCellSize, data->cells.cellSize);
   impl_->stats.implicitTapes += data->cells.tapes.size();
   for (const auto& c : data->cells.cells)
     impl_->stats.implicitTapeNodes += c.tape < data->cells.tapes.size() ? data->cells.tapes[c.tape].nodeCount() : 0;

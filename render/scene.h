@@ -62,6 +62,7 @@ struct SceneStats {
   size_t triangles = 0;      ///< mesh and leaf triangles
   size_t spheres = 0;        ///< sphere organs
   size_t implicitCells = 0;  ///< surface cells of implicit models (Embree user primitives)
+  float implicitCellSize = 0;  ///< the largest edge of those cells, world units
   size_t implicitTapes = 0;  ///< distinct pruned tapes of those cells (ImplicitOptions::prunedTapes)
   size_t implicitTapeNodes = 0;  ///< nodes of those tapes, summed over the cells
 };

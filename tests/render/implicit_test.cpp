@@ -311,3 +311,78 @@ TEST_CASE("Scene::addImplicit far from the camera", "[render]") {
     CHECK(scene.occluded(-dist * dir, dir, 0, 2.0f * dist));
   }
 }
+
+TEST_CASE("PixelScale::nearestPixel and pixelCellSize", "[render]") {
+  PixelScale px;
+  px.eye = Vec3(0, 0, 5);
+  px.forward = Vec3(0, 0, -1);
+  px.pixelPerDepth = 0.01f;
+  const Box3 box{Vec3(-1), Vec3(1)};
+  SECTION("the pixel at the nearest corner") {
+    // The nearest face is z = 1, at depth 4.
+    CHECK(px.nearestPixel(box) == Approx(0.04f));
+    CHECK(pixelCellSize(0.01f, px, box) == Approx(kCellPixels * 0.04f));
+    CHECK(pixelCellSize(0.01f, px, box, 1.0f) == Approx(0.04f));
+  }
+  SECTION("never finer than the model's own cell") {
+    CHECK(pixelCellSize(0.5f, px, box) == 0.5f);
+    CHECK(pixelCellSize(0.0f, px, box) == 0.0f);
+  }
+  SECTION("a camera inside the box, or the box behind it: the rule does not bind") {
+    px.eye = Vec3(0, 0, 0.5f);
+    CHECK(px.nearestPixel(box) == 0.0f);
+    CHECK(pixelCellSize(0.01f, px, box) == 0.01f);
+    px.eye = Vec3(0, 0, -5);
+    CHECK(px.nearestPixel(box) == 0.0f);
+    CHECK(px.nearestPixel(Box3{}) == 0.0f);
+  }
+  SECTION("a tilted view: the corner nearest along the view") {
+    px.eye = Vec3(4, 0, 4);
+    px.forward = glm::normalize(Vec3(-1, 0, -1));
+    CHECK(px.nearestPixel(box) == Approx(0.01f * glm::dot(Vec3(1, 1, 1) - px.eye, px.forward)));
+  }
+}
+
+TEST_CASE("Scene::addImplicit follows the pixels", "[render]") {
+  // The model's own cells (no camera), a large image (the rule does not bind: the same
+  // cells, the same bytes) and a thumbnail (cells of at least kCellPixels pixels).
+  const blobtree::CompiledBlob blob = branchBlob();
+  const Camera cam = frameBounds(blob.bounds(), ViewSpec{}, 1.0);
+  struct Built {
+    size_t cells = 0;
+    float edge = 0;
+    Image image;
+  };
+  auto build = [&](int imageSize) {
+    Scene scene;
+    if (imageSize > 0) scene.setPixelFootprint(cam, imageSize, imageSize, 0.0f);
+    scene.addImplicit(blob, scene.addMaterial(Material{}));
+    scene.commit();
+    Built b;
+    b.cells = scene.stats().implicitCells;
+    b.edge = scene.stats().implicitCellSize;
+    b.image = renderImage(scene, cam, quietSettings(64, 64));
+    return b;
+  };
+  const Built own = build(0), large = build(4096), thumb = build(32);
+  const float ownEdge = own.edge;
+  REQUIRE(own.cells > 1000);
+  // 4096 pixels: the pixel at the box's nearest corner is far below the model's cell.
+  REQUIRE(kCellPixels * cam.pixelScale(4096).nearestPixel(blob.bounds()) < ownEdge);
+  CHECK(large.cells == own.cells);
+  CHECK(large.edge == ownEdge);
+  CHECK(large.image.pixels == own.image.pixels);
+  // A 32-pixel thumbnail: the requested edge is kCellPixels pixels at the nearest corner;
+  // surfaceCells rounds it down to the root cube over a power of two (at most 2x).
+  const float wanted = kCellPixels * cam.pixelScale(32).nearestPixel(blob.bounds());
+  REQUIRE(wanted > 2.0f * ownEdge);
+  CHECK(thumb.edge <= wanted);
+  CHECK(thumb.edge > 0.5f * wanted);
+  CHECK(thumb.cells * 3 < own.cells);
+  CHECK(thumb.cells <= size_t(32 * 32));  // no more cells than the thumbnail has pixels
+  // The same surface (rendered at 64x64 both ways): only hits within the root tolerance differ.
+  double diff = 0;
+  for (size_t i = 0; i < own.image.pixels.size(); ++i)
+    diff = std::max(diff, double(std::abs(thumb.image.pixels[i] - own.image.pixels[i])));
+  CHECK(diff < 0.02);
+}
