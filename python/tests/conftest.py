@@ -45,27 +45,29 @@ def read_png(path):
     channels = 3 if colour == 2 else 4
     stride = width * channels
     raw = np.frombuffer(zlib.decompress(idat), np.uint8).reshape(height, stride + 1)
-    out = np.zeros((height, stride), np.int32)
-    prev = np.zeros(stride, np.int32)
+    out = np.zeros((height, stride), np.uint8)
+    prev = np.zeros(stride, np.uint8)
     for y in range(height):
-        kind, line = raw[y, 0], raw[y, 1:].astype(np.int32)
-        row = np.zeros(stride, np.int32)
-        for x in range(stride):
-            a = row[x - channels] if x >= channels else 0
-            b = prev[x]
-            c = prev[x - channels] if x >= channels else 0
-            if kind == 0:
-                p = 0
-            elif kind == 1:
-                p = a
-            elif kind == 2:
-                p = b
-            elif kind == 3:
-                p = (a + b) // 2
-            else:
-                pa, pb, pc = abs(b - c), abs(a - c), abs(a + b - 2 * c)
-                p = a if pa <= pb and pa <= pc else (b if pb <= pc else c)
-            row[x] = (line[x] + p) & 0xFF
+        kind, line = raw[y, 0], raw[y, 1:]
+        if kind == 0:
+            row = line.copy()
+        elif kind == 1:  # sub: a running sum along each channel
+            row = (np.cumsum(line.reshape(width, channels).astype(np.int64), axis=0) & 0xFF).astype(np.uint8).ravel()
+        elif kind == 2:  # up
+            row = line + prev
+        else:  # average (3) and Paeth (4), pixel by pixel
+            cur, up, r = line.tolist(), prev.tolist(), [0] * stride
+            for x in range(stride):
+                a = r[x - channels] if x >= channels else 0
+                b = up[x]
+                if kind == 3:
+                    p = (a + b) // 2
+                else:
+                    c = up[x - channels] if x >= channels else 0
+                    pa, pb, pc = abs(b - c), abs(a - c), abs(a + b - 2 * c)
+                    p = a if pa <= pb and pa <= pc else (b if pb <= pc else c)
+                r[x] = (cur[x] + p) & 0xFF
+            row = np.array(r, np.uint8)
         out[y] = row
         prev = row
-    return out.astype(np.uint8).reshape(height, width, channels)
+    return out.reshape(height, width, channels)
