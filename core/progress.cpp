@@ -10,6 +10,7 @@ namespace sprig {
 namespace {
 std::atomic<bool> gQuiet{false};
 std::atomic<bool> gCancel{false};
+std::atomic<ProgressObserver*> gObserver{nullptr};
 
 std::string formatSeconds(double s) {
   if (!std::isfinite(s) || s < 0) return "--:--";
@@ -27,10 +28,12 @@ void ProgressSettings::setQuiet(bool quiet) { gQuiet = quiet; }
 bool ProgressSettings::quiet() { return gQuiet; }
 void ProgressSettings::requestCancel() { gCancel = true; }
 bool ProgressSettings::cancelRequested() { return gCancel.load(std::memory_order_relaxed); }
+void ProgressSettings::clearCancel() { gCancel = false; }
+void ProgressSettings::setObserver(ProgressObserver* observer) { gObserver = observer; }
 
 Progress::Progress(std::string label, uint64_t total)
     : label_(std::move(label)), total_(total), start_(std::chrono::steady_clock::now()),
-      enabled_(!gQuiet && isatty(STDERR_FILENO)) {}
+      enabled_(!gQuiet && isatty(STDERR_FILENO)), observer_(gObserver.load()) {}
 
 Progress::~Progress() {
   if (enabled_ && !finished_) {
@@ -46,17 +49,20 @@ double Progress::elapsed() const {
 void Progress::advance(uint64_t n) {
   done_.fetch_add(n, std::memory_order_relaxed);
   if (gCancel.load(std::memory_order_relaxed)) throw Cancelled();
-  if (!enabled_) return;
+  if (!enabled_ && !observer_) return;
   int64_t now = std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - start_).count();
   int64_t due = nextDrawNs_.load(std::memory_order_relaxed);
   if (now < due) return;
   if (!nextDrawNs_.compare_exchange_strong(due, now + 100'000'000)) return;
+  if (observer_) observer_->update(label_, done_.load(std::memory_order_relaxed), total_);
+  if (!enabled_) return;
   std::unique_lock<std::mutex> lock(drawMutex_, std::try_to_lock);
   if (lock.owns_lock()) draw(false);
 }
 
 void Progress::finish() {
   if (finished_) return;
+  if (observer_) observer_->update(label_, done_.load(std::memory_order_relaxed), total_);
   if (enabled_) {
     std::lock_guard<std::mutex> lock(drawMutex_);
     draw(true);

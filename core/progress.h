@@ -13,6 +13,17 @@
 
 namespace sprig {
 
+/// Told of every Progress's state, for a program that embeds Sprig and shows progress its
+/// own way (the Python module, python/). Called from whichever thread advances a bar, at
+/// most ten times a second per bar and once when it finishes, so update() must be cheap and
+/// thread-safe; it may call ProgressSettings::requestCancel().
+class ProgressObserver {
+ public:
+  virtual ~ProgressObserver() = default;
+  /// label: the bar's label; done of total units (total 0 = unknown).
+  virtual void update(const std::string& label, uint64_t done, uint64_t total) = 0;
+};
+
 /// Process-wide switches for progress output and cancellation.
 struct ProgressSettings {
   /// Silences every bar (the CLI's --quiet).
@@ -23,6 +34,13 @@ struct ProgressSettings {
   static void requestCancel();
   /// True once requestCancel() was called.
   static bool cancelRequested();
+  /// Withdraws a cancellation request, so that a program that goes on after a cancelled
+  /// operation (the Python module after KeyboardInterrupt) can start the next one.
+  static void clearCancel();
+  /// Sets the one observer told of every bar's progress (null = none). Process-wide like
+  /// the switches above (an embedding program has one); the observer must outlive the bars
+  /// created while it is set.
+  static void setObserver(ProgressObserver* observer);
 };
 
 /// Thrown by long operations that noticed a cancellation request.
@@ -57,6 +75,7 @@ class Progress {
   std::chrono::steady_clock::time_point start_;
   std::mutex drawMutex_;
   bool enabled_;
+  ProgressObserver* observer_;  ///< ProgressSettings' observer when the bar was made
   bool finished_ = false;
 };
 

@@ -121,12 +121,7 @@ AnimateResult animateSpecies(const Species& species, const fs::path& out, const 
   return animateModel(model, species.render, out, options);
 }
 
-AnimateResult animateModel(SpeciesModel& model, const SpeciesRender& baseLook, const fs::path& out,
-                           const AnimateOptions& options) {
-  const auto t0 = std::chrono::steady_clock::now();
-  fs::path ffmpeg;
-  const AnimationFormat format = checkAnimation(out, options, ffmpeg);
-  AnimateResult result;
+std::vector<Stage> animationStages(SpeciesModel& model, const AnimateOptions& options, AnimateResult& result) {
   result.lastStage = std::max(0, model.finalStage().step);
   // A tree is derived only up to options.lastStage already; a solid's operation stages are
   // all there, so --stages A..B cuts the sequence here.
@@ -143,6 +138,16 @@ AnimateResult animateModel(SpeciesModel& model, const SpeciesRender& baseLook, c
     }
   }
   result.frames = static_cast<int>(frames.size());
+  return frames;
+}
+
+AnimateResult animateModel(SpeciesModel& model, const SpeciesRender& baseLook, const fs::path& out,
+                           const AnimateOptions& options) {
+  const auto t0 = std::chrono::steady_clock::now();
+  fs::path ffmpeg;
+  const AnimationFormat format = checkAnimation(out, options, ffmpeg);
+  AnimateResult result;
+  const std::vector<Stage> frames = animationStages(model, options, result);
   const GeometryMode mode = options.mode ? *options.mode : model.defaultMode();
 
   SpeciesRender look = baseLook;

@@ -70,6 +70,11 @@ AnimateResult animateSpecies(const Species& species, const std::filesystem::path
 AnimateResult animateModel(SpeciesModel& model, const SpeciesRender& look, const std::filesystem::path& out,
                            const AnimateOptions& options);
 
+/// The stages animateModel renders, in order (its frames, wind included), for model and
+/// options; result receives the first and last stage shown and the frame count. Used by
+/// programs that render the frames themselves (the Python module's Species.animate).
+std::vector<Stage> animationStages(SpeciesModel& model, const AnimateOptions& options, AnimateResult& result);
+
 /// The `ffmpeg` executable on PATH, or empty when there is none.
 std::filesystem::path findFfmpeg();
 
