@@ -105,12 +105,7 @@ int runDerive(const DeriveArgs& a, const GlobalOptions& g) {
     t.summary = {t.skeleton.internodes.size(), t.skeleton.totalLength(), t.skeleton.bounds(), {}};
   }
   if (a.print) {
-    lsystem::FormatOptions fo;
-    const TreeSpec& tree = treeSpec(species);
-    // cpfg's parameters are floats
-    fo.floatParams = tree.grammar ? tree.grammar->cpfgNotation()
-                                  : tree.grammarFile.size() > 2 && tree.grammarFile.compare(tree.grammarFile.size() - 2, 2, ".l") == 0;
-    std::cout << lsystem::formatModuleString(t.modules, t.symbols, fo) << "\n";
+    std::cout << lsystem::formatModuleString(t.modules, t.symbols, speciesStringFormat(species)) << "\n";
   }
   if (a.json) std::cout << reportJson(t) << "\n";
   if (!a.print && !a.json)

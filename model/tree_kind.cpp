@@ -791,6 +791,15 @@ lsystem::Grammar speciesGrammar(const Species& species, const lsystem::GrammarOv
   }
 }
 
+lsystem::FormatOptions speciesStringFormat(const Species& species) {
+  lsystem::FormatOptions fo;
+  const auto* tree = dynamic_cast<const TreeSpec*>(species.spec.get());
+  if (!tree) return fo;
+  const std::string& f = tree->grammarFile;
+  fo.floatParams = tree->grammar ? tree->grammar->cpfgNotation() : f.size() > 2 && f.compare(f.size() - 2, 2, ".l") == 0;
+  return fo;
+}
+
 std::vector<Diagnostic> inSpeciesFile(const Species& species, const TreeSpec& tree, std::vector<Diagnostic> diags) {
   if (species.bareGrammar || !species.yaml || tree.grammarFile != species.yaml->displayPath()) return diags;
   // Inline grammar: move positions from the grammar text into the species file.

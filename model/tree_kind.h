@@ -11,6 +11,7 @@
 
 #include "blobtree/compiled.h"
 #include "core/mesh.h"
+#include "lsystem/derive.h"
 #include "lsystem/grammar.h"
 #include "lsystem/turtle.h"
 #include "lsystem/view_file.h"
@@ -65,6 +66,10 @@ const TreeSpec& treeSpec(const Species& species);
 /// of the species' own (command line `-D`, `--steps`, `--seed`). Throws InputError; errors
 /// of an inline grammar point into the species file.
 lsystem::Grammar speciesGrammar(const Species& species, const lsystem::GrammarOverrides& extra = {});
+
+/// How the module strings of species print: cpfg's grammars (`.l`) hold 32-bit float
+/// parameters and print in their shortest float form; others as doubles. Any kind.
+lsystem::FormatOptions speciesStringFormat(const Species& species);
 
 /// diags of the species' grammar, moved into the species file when the grammar is written
 /// inline (`grammar: |`); unchanged otherwise.

@@ -32,6 +32,7 @@
 #include "model/mesh_parts.h"
 #include "model/model.h"
 #include "model/species.h"
+#include "model/tree_kind.h"
 #include "python/long_call.h"
 
 namespace py = pybind11;
@@ -195,7 +196,7 @@ py::dict derive(PySpecies& s, std::optional<int> stage, const py::object& progre
           throw UsageError("stage " + std::to_string(r.steps) + " is beyond the species' " +
                            std::to_string(engine.lastStep()) + " steps");
         r.seed = engine.seed();
-        r.string = lsystem::formatModuleString(engine.modulesAt(r.steps), engine.symbols());
+        r.string = lsystem::formatModuleString(engine.modulesAt(r.steps), engine.symbols(), speciesStringFormat(s.species));
         r.skeleton = engine.skeletonAt(r.steps);
         return r;
       },
@@ -214,12 +215,6 @@ struct RenderRequest {
   std::optional<std::vector<double>> view;
 };
 
-GeometryMode modeFrom(const std::string& mode) {
-  if (mode == "exact") return GeometryMode::Exact;
-  if (mode == "mesh") return GeometryMode::Mesh;
-  if (mode == "skeleton") return GeometryMode::Skeleton;
-  throw UsageError("mode '" + mode + "': expected exact, mesh or skeleton");
-}
 
 /// `--view AZ,EL[,FOV]` (app/cmd_common.cpp's parseView ranges).
 void applyView(const std::vector<double>& v, render::ViewSpec& view) {
@@ -241,7 +236,7 @@ Image renderImage(PySpecies& s, const RenderRequest& r) {
   job.width = r.width;
   job.height = r.height;
   job.samples = r.spp;
-  job.mode = modeFrom(r.mode);
+  job.mode = geometryModeNamed(r.mode);
   job.stage = resolveStage(*s.model, r.stage, r.fraction, r.age);
   job.progress = true;
   job.progressLabel = "render " + s.species.name;
