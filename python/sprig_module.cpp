@@ -215,7 +215,6 @@ struct RenderRequest {
   std::optional<std::vector<double>> view;
 };
 
-
 /// `--view AZ,EL[,FOV]` (app/cmd_common.cpp's parseView ranges).
 void applyView(const std::vector<double>& v, render::ViewSpec& view) {
   const bool ok = (v.size() == 2 || v.size() == 3) && v[0] >= -360 && v[0] <= 360 && v[1] >= -89 && v[1] <= 89 &&
