@@ -19,6 +19,7 @@ std::string checkOne(const std::string& file, const GlobalOptions& g, std::strin
   try {
     // Loading reads every section of the species (and its grammar) and reports every error.
     Species s = loadSpecies(file, g.pathPolicy());
+    if (!s.spec) throw InputError(s.loc(), "invalid " + s.kind + " species");  // (every reader says why first)
     printNotes(g, s);
     summary = s.kind + (s.bareGrammar ? " grammar" : " species") + s.spec->checkSummary(s);
     return {};

@@ -60,8 +60,10 @@ int previewOnce(const PreviewArgs& a, const GlobalOptions& g) {
   const lsystem::Skeleton shown = engine.skeletonAt(step);
   // Not `framingBox(step == last ? shown : ...)`: that conditional copies `shown`.
   const DBox3 frame = step == last ? framingBox(shown) : framingBox(engine.skeletonAt(last));
-  const render::Camera camera = render::frameBounds(Box3{Vec3(frame.lo), Vec3(frame.hi)}, look.view,
-                                                    static_cast<double>(width) / height);
+  const Box3 frameBox{Vec3(frame.lo), Vec3(frame.hi)};
+  if (!render::boxInRenderRange(frameBox))
+    throw InputError(species.loc(), "the skeleton's bounding box is not finite or reaches beyond 1e15: it cannot be rendered");
+  const render::Camera camera = render::frameBounds(frameBox, look.view, static_cast<double>(width) / height);
   render::Scene scene;
   phase.emplace("scene");
   scene.setPixelFootprint(camera, width, height, look.image.thinMinPixels);

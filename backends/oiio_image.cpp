@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "backends/backends.h"
+#include "backends/png_check.h"
 
 namespace sprig::backends {
 
@@ -67,9 +68,13 @@ void writeGif(const std::string& path, const std::string& displayPath, int width
   if (!writer->close()) throw std::runtime_error(displayPath + ": cannot write GIF: " + writer->geterror());
 }
 
+/// Pixels of a PNG read through libpng before OpenImageIO reads it (backends/png_check.h):
+/// core/image.h refuses larger images before it asks for their pixels.
+constexpr uint64_t kMaxCheckedPixels = uint64_t(1) << 26;
+
 class OiioReader final : public ImageFileReader {
  public:
-  explicit OiioReader(std::unique_ptr<OIIO::ImageInput> in) : in_(std::move(in)) {
+  OiioReader(std::unique_ptr<OIIO::ImageInput> in, std::string path) : in_(std::move(in)), path_(std::move(path)) {
     const OIIO::ImageSpec& spec = in_->spec();
     header_.width = spec.width;
     header_.height = spec.height;
@@ -82,6 +87,11 @@ class OiioReader final : public ImageFileReader {
   const ImageFileHeader& header() const override { return header_; }
 
   bool read(PixelType type, void* out, std::string& error) override {
+    error = pngReadProblem(path_, true, kMaxCheckedPixels);
+    if (!error.empty()) {
+      in_->close();
+      return false;
+    }
     const bool ok = in_->read_image(0, 0, 0, header_.channels, typeOf(type), out);
     error = in_->geterror();
     in_->close();
@@ -90,16 +100,20 @@ class OiioReader final : public ImageFileReader {
 
  private:
   std::unique_ptr<OIIO::ImageInput> in_;
+  std::string path_;
   ImageFileHeader header_;
 };
 
 std::unique_ptr<ImageFileReader> open(const std::string& path, std::string& error) {
+  // A PNG's header chunks are read first with libpng's messages kept (backends/png_check.h).
+  error = pngReadProblem(path, false, 0);
+  if (!error.empty()) return nullptr;
   auto in = OIIO::ImageInput::open(path);
   if (!in) {
     error = OIIO::geterror();
     return nullptr;
   }
-  return std::make_unique<OiioReader>(std::move(in));
+  return std::make_unique<OiioReader>(std::move(in), path);
 }
 
 bool resizeBox(const float* in, int width, int height, float* out, int outWidth, int outHeight, std::string& error) {

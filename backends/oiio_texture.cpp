@@ -3,6 +3,7 @@
 #include <OpenImageIO/texture.h>
 
 #include "backends/backends.h"
+#include "backends/png_check.h"
 
 namespace sprig::backends {
 
@@ -27,6 +28,10 @@ OIIO::TextureSystem::TextureHandle* oiioHandle(TextureHandle* h) {
 }
 
 TextureHandle* handle(const std::string& path, std::string& error) {
+  // The texture system reads the pixels later, in the render's threads: a PNG is read
+  // whole here first, with libpng's messages kept (backends/png_check.h).
+  error = pngReadProblem(path, true, uint64_t(1) << 26);
+  if (!error.empty()) return nullptr;
   OIIO::TextureSystem* ts = textureSystem();
   OIIO::TextureSystem::TextureHandle* h = ts->get_texture_handle(OIIO::ustring(path));
   if (!h || !ts->good(h)) {

@@ -6,6 +6,7 @@
 #include <atomic>
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <map>
 #include <memory>
@@ -864,10 +865,19 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
   {
     Vec3 size = blob.bounds().size();
     double cells = std::max({double(size.x), double(size.y), double(size.z)}) / double(requested);
-    if (!(cells < double(kAxisLimit - 2)))
-      throw InputError(SourceLoc{}, "a polygonization cell of " + std::to_string(requested) + " gives a grid of " +
-                                        std::to_string(int64_t(std::min(cells, 1e18))) + " cells on an axis, more than the limit of " +
-                                        std::to_string(kAxisLimit - 2) + " (2^20): use a larger cell (sprig mesh --cell, a blob's cell_size)");
+    if (!(cells < double(kAxisLimit - 2))) {
+      // The numbers as computed (double): a model reaching infinity gives no finite count.
+      char buf[160];
+      if (std::isfinite(cells))
+        std::snprintf(buf, sizeof buf, cells < 1e15 ? "a polygonization cell of %g gives a grid of %.0f cells on an axis"
+                                                    : "a polygonization cell of %g gives a grid of %g cells on an axis",
+                      double(requested), cells);
+      else
+        std::snprintf(buf, sizeof buf, "a polygonization cell of %g over a model whose bounds are not finite gives no finite grid",
+                      double(requested));
+      throw InputError(SourceLoc{}, std::string(buf) + ", more than the limit of " + std::to_string(kAxisLimit - 2) +
+                                        " (2^20): use a larger cell (sprig mesh --cell, a blob's cell_size)");
+    }
   }
   // 1. Cells that may hold the surface.
   Grid g(keptCells(blob, requested));

@@ -58,7 +58,21 @@ seed() {
         [ -f "$f" ] || continue
         grep -qx "kind: $kind" "$f" || continue
         grep -vx "kind: $kind" "$f" >"$dir/$(basename "$f")"
-      done ;;
+      done
+      # Species with the files they name carried in the input (fuzz/species.cpp, `#%file`):
+      # base meshes of an organism, an extrude_2d mask of a solid (healthy ones; the
+      # degenerate and extreme ones are in fuzz/regressions/<target>/, read as corpus too).
+      local tet='v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n'
+      local quad='v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n'
+      local mask='P3\n3 3\n255\n255 255 255 0 0 0 255 255 255\n0 0 0 0 0 0 0 0 0\n255 255 255 0 0 0 255 255 255\n'
+      case $kind in
+        organism)
+          printf "organism:\n  levels: 2\n  base: {mesh: {file: base.obj}}\n  detail:\n    - rock: {amplitude: 0.1, frequency: 2}\n#%%file base.obj\n$tet" >"$dir/file_tet.yaml"
+          printf "organism:\n  levels: 3\n  base: {mesh: {file: base.obj, center: true, size: 2}}\n#%%file base.obj\n$quad" >"$dir/file_quad.yaml" ;;
+        solid)
+          printf "solid:\n  volume:\n    distance_field: {extrude_2d: {file: mask.ppm, size: [2, 2], height: [0, 1]}}\n    layers: [{interior_layer: {material: wood, thickness: fill}}]\n#%%file mask.ppm\n$mask" >"$dir/file_extrude.yaml"
+          printf "solid:\n  volume:\n    distance_field: {surface_mesh: {file: base.obj}}\n    layers: [{interior_layer: {material: wood, thickness: fill}}]\n#%%file base.obj\n$tet" >"$dir/file_mesh.yaml" ;;
+      esac ;;
     polymesh)
       for f in species/meshes/*.off tests/bad_inputs/inputs/*.obj; do
         [ -f "$f" ] && [ "$(stat -c %s "$f")" -le 65536 ] || continue

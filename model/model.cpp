@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
 
 #include "core/diagnostics.h"
 #include "core/mesh_clean.h"
@@ -13,6 +14,25 @@ namespace sprig {
 
 namespace {
 
+std::string pointText(const Vec3& p) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "(%g, %g, %g)", double(p.x), double(p.y), double(p.z));
+  return buf;
+}
+
+/// Throws InputError at the species when the box the camera frames cannot be framed: not
+/// finite, reaching beyond render::kMaxRenderCoordinate, or of zero size (the whole model at
+/// one point). An empty box (nothing built) is framed as the unit cube.
+void checkFrameBox(const Species& species, const Box3& box) {
+  if (box.empty()) return;
+  if (!render::boxInRenderRange(box))
+    throw InputError(species.loc(), "the model's bounding box " + pointText(box.lo) + " - " + pointText(box.hi) +
+                                        " is not finite or reaches beyond 1e15: it cannot be rendered");
+  const Vec3 size = box.size();
+  if (!(std::max(size.x, std::max(size.y, size.z)) > 0))
+    throw InputError(species.loc(), "the model has zero size (all of it lies at " + pointText(box.lo) +
+                                        "): there is nothing to frame");
+}
 
 }  // namespace
 
@@ -111,7 +131,10 @@ Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJo
   if (job.height > 0 && job.width <= 0) width = std::max(16, lookWidth * job.height / lookHeight);
   checkCameraRays(width, height, job.samples > 0 ? job.samples : look.image.spp);
   const Box3 frame = job.frame ? *job.frame : model.frameBox();
+  checkFrameBox(model.species(), frame);
   const render::Camera camera = modelCamera(look, frame, width, height);
+  if (std::string why = render::cameraProblem(camera); !why.empty())
+    throw InputError(model.species().loc(), "render.camera: " + why);
   render::Scene scene;
   scene.setPixelFootprint(camera, width, height, look.image.thinMinPixels);
   SpeciesRender seen = look;

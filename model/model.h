@@ -138,7 +138,9 @@ void checkCameraRays(int width, int height, int samples);
 
 /// Renders one stage of model with look (camera framed on model.frameBox(), or the species'
 /// explicit camera). Fills figures and stats when given. Throws UsageError (checkCameraRays)
-/// for an image over kMaxCameraRays rays.
+/// for an image over kMaxCameraRays rays; InputError at the species for a framed box that is
+/// not finite, reaches beyond render::kMaxRenderCoordinate or has zero size, and for a
+/// camera that cannot make valid rays (render::cameraProblem).
 Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job,
                           ModelFigures* figures = nullptr, render::RenderStats* stats = nullptr);
 

@@ -63,6 +63,40 @@ struct MeshPlacement {
   }
 };
 
+/// Why base cannot be subdivided, or nullopt: no faces, a face that is not three or more
+/// distinct vertices in range, a position that is not finite, or no area at all (every face
+/// degenerate: the vertices coincide or lie on one line). Single degenerate faces among
+/// others are allowed (the frames of organisms/multires.h fall back where a normal vanishes).
+std::optional<std::string> baseMeshProblem(const ControlMesh& base) {
+  if (base.faceSizes.empty()) return std::string("has no faces");
+  const size_t n = base.positions.size();
+  for (size_t v = 0; v < n; ++v)
+    if (!std::isfinite(base.positions[v].x) || !std::isfinite(base.positions[v].y) || !std::isfinite(base.positions[v].z))
+      return "has a vertex (" + std::to_string(v) + ", 0-based) that is not a finite point";
+  double area = 0;
+  size_t corner = 0;
+  for (size_t f = 0; f < base.faceSizes.size(); ++f) {
+    const uint32_t size = base.faceSizes[f];
+    if (size < 3 || corner + size > base.faceVertices.size())
+      return "has a face (" + std::to_string(f) + ", 0-based) of fewer than 3 vertices";
+    const uint32_t* idx = base.faceVertices.data() + corner;
+    corner += size;
+    for (uint32_t k = 0; k < size; ++k) {
+      if (idx[k] >= n)
+        return "has a face (" + std::to_string(f) + ", 0-based) whose vertex index " + std::to_string(idx[k]) +
+               " is out of range (" + std::to_string(n) + " vertices)";
+      for (uint32_t j = 0; j < k; ++j)
+        if (idx[j] == idx[k])
+          return "has a face (" + std::to_string(f) + ", 0-based) that repeats vertex " + std::to_string(idx[k]);
+    }
+    DVec3 vectorArea(0.0);  // Newell: twice the polygon's vector area
+    for (uint32_t k = 0; k < size; ++k) vectorArea += glm::cross(DVec3(base.positions[idx[k]]), DVec3(base.positions[idx[(k + 1) % size]]));
+    area += glm::length(vectorArea);
+  }
+  if (!(area > 0)) return std::string("has zero area (every face is degenerate: its vertices coincide or lie on one line)");
+  return std::nullopt;
+}
+
 ControlMesh controlOf(const PolyMesh& m) {
   ControlMesh c;
   c.positions = m.positions;
@@ -80,8 +114,15 @@ class OrganismReader {
   void read(const YNode& section) {
     MapReader m(section, diags_, "organism");
     spec_.levels = int(m.integer("levels", spec_.levels, 1, kMaxLevels));
-    if (auto b = m.get("base")) readBase(*b);
-    else m.node().error(diags_, "missing required key 'base' in organism (e.g. base: {cube_sphere: {radius: 1}})");
+    if (auto b = m.get("base")) {
+      const size_t before = errorCount();
+      readBase(*b);
+      // A base read without an error may still be one the subdivision cannot take.
+      if (errorCount() == before)
+        if (std::optional<std::string> problem = baseMeshProblem(spec_.base)) b->error(diags_, "the base mesh" + baseName_ + " " + *problem);
+    } else {
+      m.node().error(diags_, "missing required key 'base' in organism (e.g. base: {cube_sphere: {radius: 1}})");
+    }
     if (!spec_.base.faceSizes.empty()) {
       const size_t finest = finestFaceCount(spec_.base, spec_.levels);
       if (finest > kMaxFinestFaces)
@@ -114,6 +155,8 @@ class OrganismReader {
     const auto& [key, value] = *one;
     const std::string kind = key.scalar();
     MapReader m(value, diags_, kind);
+    if (auto file = value.isMap() ? value.node()["file"] : YAML::Node(); file && file.IsScalar())
+      baseName_ = " " + sprig::quoted(file.Scalar());
     try {
       if (kind == "cube_sphere") {
         spec_.base = cubeSphere(float(m.number("radius", 1.0, 1e-6)), int(m.integer("quads", 2, 1, 64)));
@@ -562,6 +605,11 @@ class OrganismReader {
     spec_.planet = s;
   }
 
+  size_t errorCount() const {
+    return size_t(std::count_if(diags_.items().begin(), diags_.items().end(),
+                                [](const Diagnostic& d) { return d.severity == Severity::Error; }));
+  }
+
   std::optional<std::pair<YNode, YNode>> single(const YNode& node, const std::string& what,
                                                 const std::vector<std::string>& names) {
     return singleKey(node, diags_, what, names);
@@ -571,6 +619,7 @@ class OrganismReader {
   OrganismSpec& spec_;
   const PathPolicy& policy_;
   std::vector<Vec3> baseColors_;  // a mesh or species base's vertex colours (painted alpha)
+  std::string baseName_;          // " 'file'" of a mesh or species base, for messages
   bool captureGiven_ = false;  // a failed capture: 'captured' entries add no second error
 };
 

@@ -30,6 +30,23 @@ constexpr double kDefaultCellsAcross = 64;
 /// ...but never finer than the largest side over this.
 constexpr double kFinestCellsAcross = 200;
 
+/// Largest coordinate (absolute, world units) of a solid's volumes: the meshing samples
+/// the fields at single-precision points and squares distances.
+constexpr double kMaxSolidCoordinate = 1e15;
+
+bool withinSolidRange(const DBox3& box) {
+  for (int a = 0; a < 3; ++a)
+    if (!(std::abs(box.lo[a]) <= kMaxSolidCoordinate) || !(std::abs(box.hi[a]) <= kMaxSolidCoordinate)) return false;
+  return true;
+}
+
+/// A count or size computed in double, printed as it is: a whole number up to 1e15, else %g.
+std::string countText(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, std::abs(v) < 1e15 && v == std::floor(v) ? "%.0f" : "%g", v);
+  return buf;
+}
+
 const std::vector<std::string> kVolumeForms = {"volume", "precedence"};
 const std::vector<std::string> kFields = {"surface_mesh", "sphere",    "box",         "cylinder",
                                           "ground_plane", "union",     "intersection", "subtraction",
@@ -464,27 +481,43 @@ class SolidReader {
       }
       box = all;
     }
+    const YNode& at = gridNode ? *gridNode : section;
+    if (box->empty()) {  // (an intersection of volumes that do not meet)
+      at.error(diags_, "the solid's volumes hold no point: there is nothing to mesh");
+      return;
+    }
+    if (!withinSolidRange(*box)) {
+      char buf[256];
+      std::snprintf(buf, sizeof buf, "the solid's volumes reach (%g, %g, %g) - (%g, %g, %g): every coordinate must be finite and within %g",
+                    box->lo.x, box->lo.y, box->lo.z, box->hi.x, box->hi.y, box->hi.z, kMaxSolidCoordinate);
+      at.error(diags_, buf);
+      return;
+    }
     const DVec3 size = box->size();
     const double largest = std::max(size.x, std::max(size.y, size.z));
     if (cell <= 0) cell = std::max(std::min(largest / kDefaultCellsAcross, thinnest_ / 2), largest / kFinestCellsAcross);
+    if (!(cell > 0)) {  // a box of zero size (every volume a point) and no 'cell'
+      at.error(diags_, "the solid's volumes have zero size: there is nothing to mesh");
+      return;
+    }
     // One cell of margin around the box so the outermost interface closes inside the grid.
     const DBox3 padded = box->expanded(gridNode && gridNode->node()["bounds"].IsDefined() ? 0.0 : cell);
+    // Counts in double (the box and cell are finite, the quotients may still be huge).
+    double cells[3], nodes = 1;
+    for (int a = 0; a < 3; ++a) {
+      cells[a] = std::max(1.0, std::ceil((padded.hi[a] - padded.lo[a]) / cell - 1e-9));
+      nodes *= cells[a] + 1;
+    }
+    if (!(nodes <= double(kMaxGridNodes))) {
+      at.error(diags_, "'grid' of cell " + countText(cell) + " makes " + countText(cells[0]) + " x " + countText(cells[1]) +
+                           " x " + countText(cells[2]) + " cells (" + countText(nodes) + " nodes), more than the limit " +
+                           std::to_string(kMaxGridNodes) + "; use a larger 'cell'");
+      return;
+    }
     Grid g;
     g.origin = padded.lo;
     g.cell = cell;
-    size_t nodes = 1;
-    for (int a = 0; a < 3; ++a) {
-      const double n = std::ceil((padded.hi[a] - padded.lo[a]) / cell - 1e-9);
-      g.cells[a] = int(std::clamp(n, 1.0, 1e9));
-      nodes *= size_t(g.cells[a]) + 1;
-    }
-    if (nodes > kMaxGridNodes) {
-      char buf[256];
-      std::snprintf(buf, sizeof buf, "'grid' of cell %g makes %d x %d x %d cells (%zu nodes), more than the limit %zu; use a larger 'cell'",
-                    cell, g.cells[0], g.cells[1], g.cells[2], nodes, kMaxGridNodes);
-      (gridNode ? *gridNode : section).error(diags_, buf);
-      return;
-    }
+    for (int a = 0; a < 3; ++a) g.cells[a] = int(cells[a]);
     spec_.grid = g;
   }
 
@@ -542,6 +575,10 @@ class SolidReader {
         m.get("file")->error(diags_, "image " + sprig::quoted(file->string()) + " is " + std::to_string(info.width) + " x " +
                                          std::to_string(info.height) + " pixels, more than extrude_2d takes (" +
                                          std::to_string(kMaxMaskPixels) + ", 2048 x 2048)");
+        return nullptr;
+      }
+      if (std::string why = extrudeScaleProblem(info.width, info.height, o); !why.empty()) {
+        (m.has("size") ? *m.get("size") : *m.get("file")).error(diags_, why);
         return nullptr;
       }
       const Image image = readImage(*file);

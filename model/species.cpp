@@ -66,6 +66,8 @@ void readRender(MapReader& m, SpeciesRender& r, DiagnosticList& diags) {
     else cam.allow({"distance"});
     if (spec.position && spec.distance)
       c->error(diags, "render.camera: give either 'position' or 'distance', not both");
+    if (spec.position && spec.target && *spec.position == *spec.target)
+      c->error(diags, "render.camera: 'position' and 'target' are the same point (the camera would have no view direction)");
     cam.finish();
     r.camera = spec;
   }

@@ -618,7 +618,13 @@ std::optional<Vec3> YNode::asVec3(DiagnosticList& diags, std::string_view what, 
   bool ok = true;
   auto elems = items();
   for (int i = 0; i < 3; ++i) {
-    auto v = elems[i].asNumber(diags, std::string(what) + "[" + std::to_string(i) + "]", min, max);
+    const std::string element = std::string(what) + "[" + std::to_string(i) + "]";
+    auto v = elems[i].asNumber(diags, element, min, max);
+    if (v && !(std::abs(*v) <= double(std::numeric_limits<float>::max()))) {
+      // A point is kept in single precision: a larger number would become infinite.
+      elems[i].error(diags, element + " is " + elems[i].scalar() + ", beyond single precision (at most 3.4e+38 in magnitude)");
+      v.reset();
+    }
     if (v)
       out[i] = static_cast<float>(*v);
     else

@@ -12,6 +12,15 @@ namespace sprig::organisms {
 
 namespace {
 
+/// The index of the cell of side `cell` holding coordinate x, computed in double and clamped
+/// to +-2^30: a far or non-finite point lands in an edge cell instead of overflowing int (the
+/// grids' keys wrap at 2^21 anyway, which costs only extra distance tests).
+int cellIndex(float x, float cell) {
+  constexpr double kMax = 1073741824.0;
+  const double c = std::floor(double(x) / double(cell));
+  return c >= -kMax && c <= kMax ? int(c) : c > 0 ? int(kMax) : -int(kMax);
+}
+
 /// Closest point of triangle abc to p and its barycentric weights (Ericson, Real-Time
 /// Collision Detection, §5.1.5).
 Vec3 closestOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c, Vec3& bary) {
@@ -108,7 +117,7 @@ uint64_t PointGrid::key(int x, int y, int z) const {
 }
 
 glm::ivec3 PointGrid::cellOf(const Vec3& p) const {
-  return glm::ivec3(int(std::floor(p.x / cell_)), int(std::floor(p.y / cell_)), int(std::floor(p.z / cell_)));
+  return glm::ivec3(cellIndex(p.x, cell_), cellIndex(p.y, cell_), cellIndex(p.z, cell_));
 }
 
 const uint32_t* PointGrid::find(uint64_t k, size_t& count) const {
@@ -144,8 +153,7 @@ std::vector<uint32_t> poissonDisk(std::span<const Vec3> positions, std::span<con
   const float r2 = minDistance * minDistance;
   for (uint32_t v : order) {
     const Vec3& p = positions[v];
-    const glm::ivec3 c(int(std::floor(p.x / minDistance)), int(std::floor(p.y / minDistance)),
-                       int(std::floor(p.z / minDistance)));
+    const glm::ivec3 c(cellIndex(p.x, minDistance), cellIndex(p.y, minDistance), cellIndex(p.z, minDistance));
     bool free = true;
     for (int dx = -1; dx <= 1 && free; ++dx)
       for (int dy = -1; dy <= 1 && free; ++dy)

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 namespace sprig::render {
 
@@ -81,8 +82,44 @@ Camera orbitCamera(const Vec3& target, double azimuthDeg, double elevationDeg, d
   return c;
 }
 
+namespace {
+
+bool inRange(const Vec3& p) {
+  for (int a = 0; a < 3; ++a)
+    if (!(std::abs(p[a]) <= kMaxRenderCoordinate)) return false;  // (false for NaN)
+  return true;
+}
+
+}  // namespace
+
+bool boxInRenderRange(const Box3& box) { return box.empty() || (inRange(box.lo) && inRange(box.hi)); }
+
+std::string cameraProblem(const Camera& c) {
+  if (!inRange(c.position)) return "the camera's position is not finite or lies beyond 1e15";
+  if (!inRange(c.target)) return "the camera's target is not finite or lies beyond 1e15";
+  const Vec3 view = c.target - c.position;
+  if (!(glm::length(view) > 0)) return "the camera's target is its position (no view direction)";
+  if (!(glm::length(c.up) > 0) || !std::isfinite(glm::length(c.up))) return "the camera's up vector is zero or not finite";
+  if (!(c.fovYDeg > 0 && c.fovYDeg < 180)) return "the camera's field of view is outside (0, 180) degrees";
+  const CameraBasis b = c.basis();
+  for (const Vec3& v : {b.right, b.up, b.forward})
+    if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) return "the camera's frame is not finite";
+  return {};
+}
+
 Camera frameBounds(const Box3& boxIn, const ViewSpec& view, double aspect) {
+  if (!boxInRenderRange(boxIn)) throw std::invalid_argument("frameBounds: the box is not finite or lies beyond 1e15");
   Box3 box = boxIn.empty() ? Box3{Vec3(-0.5f), Vec3(0.5f)} : boxIn;
+  {
+    // Step 0: a box smaller than float resolution at its place grows to the least size.
+    const Vec3 reach = glm::max(glm::abs(box.lo), glm::abs(box.hi));
+    const float least = std::max(1e-15f, 1e-5f * std::max(reach.x, std::max(reach.y, reach.z)));
+    const Vec3 size = box.size();
+    if (std::max(size.x, std::max(size.y, size.z)) < least) {
+      const Vec3 c = box.center();
+      box = Box3{c - 0.5f * least, c + 0.5f * least};
+    }
+  }
   // Work in double precision in the camera frame centered on the box.
   glm::dvec3 center = glm::dvec3(box.center());
   glm::dvec3 toViewer = glm::dvec3(directionFromAngles(view.azimuthDeg, view.elevationDeg));

@@ -6,6 +6,8 @@
 /// depends only on the box, the view and the aspect ratio, so every stage of a growth
 /// sequence framed with the final stage's box shares one camera.
 
+#include <string>
+
 #include "core/types.h"
 
 namespace sprig::render {
@@ -67,6 +69,20 @@ struct Camera {
   PixelScale pixelScale(int height) const;
 };
 
+/// Largest coordinate (absolute, world units) a camera or a framed box may have: Embree
+/// traces rays whose origins lie within about 1.8e18 and whose directions are finite; 1e15
+/// leaves room for the camera's distance from the box.
+inline constexpr float kMaxRenderCoordinate = 1e15f;
+
+/// Why camera cannot make valid rays (a position or target that is not finite or lies beyond
+/// kMaxRenderCoordinate, a target at the position, a field of view outside (0, 180)
+/// degrees), or an empty string when it can.
+std::string cameraProblem(const Camera& camera);
+
+/// True when every coordinate of box is finite and within kMaxRenderCoordinate (an empty
+/// box, which frames the unit cube, counts as inside).
+bool boxInRenderRange(const Box3& box);
+
 /// A viewing direction for automatic framing.
 struct ViewSpec {
   double azimuthDeg = 30.0;    ///< around +Y, measured from +Z toward +X (0 = camera on +Z looking at -Z)
@@ -83,7 +99,10 @@ Camera orbitCamera(const Vec3& target, double azimuthDeg, double elevationDeg, d
 
 /// Camera looking along the view direction that tightly fits the eight corners of box in
 /// a width/height = aspect frame, leaving `margin` free on every side. The camera is panned
-/// (not turned) to center the projected box. An empty box frames the unit cube.
+/// (not turned) to center the projected box. An empty box frames the unit cube; a box too
+/// small for single precision at its position (a point) is framed as a box of the smallest
+/// size that is not (1e-5 of its largest coordinate, at least 1e-15), so the camera never
+/// stands on its target. Throws std::invalid_argument for a box outside boxInRenderRange.
 Camera frameBounds(const Box3& box, const ViewSpec& view, double aspect);
 
 }  // namespace sprig::render

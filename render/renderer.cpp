@@ -236,6 +236,10 @@ struct FilmSample {
 Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings& s, RenderStats* stats) {
   if (s.width < 1 || s.height < 1) throw std::invalid_argument("render: image size must be at least 1x1");
   if (s.spp < 1) throw std::invalid_argument("render: samples per pixel must be at least 1");
+  // Every ray starts at the camera or on the scene: both must lie where Embree traces.
+  if (std::string why = cameraProblem(camera); !why.empty()) throw std::invalid_argument("render: " + why);
+  if (!boxInRenderRange(scene.bounds()))
+    throw std::invalid_argument("render: the scene's bounds are not finite or lie beyond 1e15");
   auto start = std::chrono::steady_clock::now();
   std::unique_ptr<ThreadLimit> limit;
   if (s.threads > 0) limit = std::make_unique<ThreadLimit>(s.threads);

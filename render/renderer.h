@@ -91,7 +91,9 @@ struct RenderStats {
 };
 
 /// Renders scene (committed) through camera. Throws std::invalid_argument for a size or
-/// sample count below 1, Cancelled when cancellation was requested. Cost: about
+/// sample count below 1, a camera that cannot make valid rays (cameraProblem) or a scene
+/// whose bounds are not finite or beyond kMaxRenderCoordinate, Cancelled when cancellation
+/// was requested. Cost: about
 /// width*height*spp*(1 + shadows + skySamples) rays.
 Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings& settings, RenderStats* stats = nullptr);
 

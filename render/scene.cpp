@@ -45,6 +45,16 @@ float rayUnit(const RTCFilterFunctionNArguments* args, unsigned i, uint32_t prim
   return static_cast<float>(h >> 40) * (1.0f / 16777216.0f);
 }
 
+/// True when Embree can trace the ray (its RayK::valid(): origin and direction within
+/// ±1.8e18, tnear and tfar not NaN). Scene::intersect and Scene::occluded answer every other
+/// ray with a miss rather than hand it on (Embree asserts on it).
+bool traceable(const Vec3& origin, const Vec3& direction, float tnear, float tfar) {
+  constexpr float kLarge = 1.844e18f;
+  for (int a = 0; a < 3; ++a)
+    if (!(std::abs(origin[a]) <= kLarge) || !(std::abs(direction[a]) <= kLarge)) return false;
+  return !std::isnan(tnear) && !std::isnan(tfar) && tnear >= 0.0f;
+}
+
 /// Camera rays skip the hits an image map cuts out (alpha at or below its cutoff).
 void imageIntersectFilter(const RTCFilterFunctionNArguments* args) {
   const auto* data = static_cast<const detail::ImageMapData*>(args->geometryUserPtr);
@@ -465,6 +475,7 @@ Box3 Scene::bounds() const { return impl_->bounds; }
 SceneStats Scene::stats() const { return impl_->stats; }
 
 std::optional<SurfaceHit> Scene::intersect(const Vec3& origin, const Vec3& direction, float tnear, float tfar) const {
+  if (!traceable(origin, direction, tnear, tfar)) return std::nullopt;
   detail::HitContext context;
   rtcInitIntersectContext(&context.base);
   RTCRayHit rh{};
@@ -568,6 +579,7 @@ std::optional<SurfaceHit> Scene::intersect(const Vec3& origin, const Vec3& direc
 }
 
 bool Scene::occluded(const Vec3& origin, const Vec3& direction, float tnear, float tfar) const {
+  if (!traceable(origin, direction, tnear, tfar)) return false;
   RTCIntersectContext context;
   rtcInitIntersectContext(&context);
   RTCRay ray{};

@@ -165,9 +165,12 @@ class Scene {
   /// What the scene holds.
   SceneStats stats() const;
 
-  /// Closest hit along origin + t*direction for t in [tnear, tfar], or nothing.
+  /// Closest hit along origin + t*direction for t in [tnear, tfar], or nothing. A ray
+  /// Embree cannot trace (a coordinate of origin or direction not finite or beyond 1.8e18,
+  /// tnear negative or NaN, tfar NaN) misses.
   std::optional<SurfaceHit> intersect(const Vec3& origin, const Vec3& direction, float tnear, float tfar) const;
-  /// True when anything lies along origin + t*direction for t in [tnear, tfar].
+  /// True when anything lies along origin + t*direction for t in [tnear, tfar] (false for
+  /// a ray intersect() calls untraceable).
   bool occluded(const Vec3& origin, const Vec3& direction, float tnear, float tfar) const;
 
   struct Impl;  ///< Embree state (render/detail/scene_impl.h)

@@ -5,7 +5,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config
-  libglm-dev libembree-dev libtbb-dev libopenimageio-dev openimageio-tools
+  libglm-dev libembree-dev libtbb-dev libopenimageio-dev openimageio-tools libpng-dev
   libosd-dev libyaml-cpp-dev catch2 libcli11-dev libtinygltf-dev libopenvdb-dev libboost-iostreams-dev zlib1g-dev
   libbenchmark-dev parallel
   libmeshoptimizer-dev libcgal-demo

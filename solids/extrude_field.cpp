@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <stdexcept>
 #include <tuple>
@@ -13,13 +14,23 @@ namespace sprig::solids {
 namespace {
 
 /// Squared distance standing in for "no such pixel" (finite, so the envelope's
-/// intersections stay finite).
+/// intersections stay finite), unless the grid's own distances come near it (farFor).
 constexpr double kFar = 1e20;
+
+/// The "no such pixel" of a w x h grid of pixels pu x pv: above every squared distance
+/// within the grid. With pixel sides in [kMinExtrudePixel, kMaxExtrudePixel] it stays far
+/// below the point where the envelope's intersections (far / pixel) overflow.
+double farFor(int w, int h, double pu, double pv) {
+  const double span = std::max(pu, pv) * (double(w) + double(h));
+  return std::max(kFar, 4 * span * span);
+}
 
 /// The 1-D squared-distance transform of f over n samples spaced w apart (Felzenszwalb &
 /// Huttenlocher 2012, Algorithm 1): d[q] = min_p (w(q - p))² + f[p], the lower envelope of
 /// parabolas rooted at each sample. v, z are scratch of n and n + 1 entries.
 void transform1d(const double* f, int n, double w, double* d, std::vector<int>& v, std::vector<double>& z) {
+  // (k > 0 below: z[0] = -inf stops the walk back for every finite crossing; the test keeps
+  // a non-finite one, which extrudeScaleProblem rules out, from writing before v.)
   int k = 0;
   v[0] = 0;
   z[0] = -std::numeric_limits<double>::infinity();
@@ -30,7 +41,7 @@ void transform1d(const double* f, int n, double w, double* d, std::vector<int>& 
   };
   for (int q = 1; q < n; ++q) {
     double s = cross(q, v[k]);
-    while (s <= z[k]) {
+    while (k > 0 && s <= z[k]) {
       --k;
       s = cross(q, v[k]);
     }
@@ -51,7 +62,8 @@ void transform1d(const double* f, int n, double w, double* d, std::vector<int>& 
 /// target set: columns first, then rows (the transform is separable).
 std::vector<double> squaredDistance(const std::vector<uint8_t>& target, int w, int h, double pu, double pv) {
   std::vector<double> g(size_t(w) * h);
-  for (size_t i = 0; i < g.size(); ++i) g[i] = target[i] ? 0.0 : kFar;
+  const double far = farFor(w, h, pu, pv);
+  for (size_t i = 0; i < g.size(); ++i) g[i] = target[i] ? 0.0 : far;
   // Columns (along v), one per task.
   parallelForRange(0, size_t(w), [&](size_t b, size_t e) {
     std::vector<double> f(h), d(h), z(h + 1);
@@ -93,6 +105,7 @@ class ExtrudeField final : public DistanceField {
       throw std::invalid_argument("the mask has no pixels");
     if (!(o.size.x > 0 && o.size.y > 0)) throw std::invalid_argument("'size' must be positive");
     if (!(o.heightHi > o.heightLo)) throw std::invalid_argument("'height' needs lo < hi");
+    if (std::string why = extrudeScaleProblem(mask.width, mask.height, o); !why.empty()) throw std::invalid_argument(why);
     axis_ = glm::normalize(o.axis);
     std::tie(u_, v_) = imagePlaneAxes(axis_);
     pu_ = o.size.x / mask.width;
@@ -159,7 +172,18 @@ class ExtrudeField final : public DistanceField {
 
 std::pair<DVec3, DVec3> imagePlaneAxes(const DVec3& axis) { return {fromYTo(axis, DVec3(1, 0, 0)), fromYTo(axis, DVec3(0, 0, 1))}; }
 
+std::string extrudeScaleProblem(int width, int height, const ExtrudeOptions& o) {
+  const double pu = o.size.x / width, pv = o.size.y / height;
+  if (pu >= kMinExtrudePixel && pu <= kMaxExtrudePixel && pv >= kMinExtrudePixel && pv <= kMaxExtrudePixel) return {};
+  char buf[256];
+  std::snprintf(buf, sizeof buf, "'size' [%g, %g] over %d x %d pixels makes pixels of %g x %g world units; each side must lie in [%g, %g]",
+                o.size.x, o.size.y, width, height, pu, pv, kMinExtrudePixel, kMaxExtrudePixel);
+  return buf;
+}
+
 std::vector<float> signedDistance2d(const Mask2d& mask, double pixelU, double pixelV, int pad) {
+  if (!(pixelU >= kMinExtrudePixel && pixelU <= kMaxExtrudePixel && pixelV >= kMinExtrudePixel && pixelV <= kMaxExtrudePixel))
+    throw std::invalid_argument("signedDistance2d: pixel sides must lie in [1e-12, 1e12]");
   const int w = mask.width + 2 * pad, h = mask.height + 2 * pad;
   std::vector<uint8_t> in(size_t(w) * h, 0), out(size_t(w) * h, 1);
   for (int y = 0; y < mask.height; ++y)

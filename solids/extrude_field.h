@@ -17,6 +17,7 @@
 /// the slab distance dh = |h - mid| - half combine as a box's do:
 /// d = length(max((d2, dh), 0)) + min(max(d2, dh), 0), exact outside the slab's corner too.
 
+#include <string>
 #include <utility>
 #include <vector>
 
@@ -50,15 +51,26 @@ struct ExtrudeOptions {
 /// z axes turned by the smallest rotation taking +y to axis (ExtrudeOptions::axis).
 std::pair<DVec3, DVec3> imagePlaneAxes(const DVec3& axis);
 
+/// Smallest and largest side of a mask pixel (world units): the transform squares distances
+/// of up to a few thousand pixels and divides by the pixel side, in double precision, and
+/// keeps the distances as floats; within these bounds every step stays finite.
+inline constexpr double kMinExtrudePixel = 1e-12;
+inline constexpr double kMaxExtrudePixel = 1e12;
+
+/// Why options.size cannot be laid over a width x height mask (a pixel side, size over
+/// pixels, outside [kMinExtrudePixel, kMaxExtrudePixel]; NaN is outside too), or "".
+std::string extrudeScaleProblem(int width, int height, const ExtrudeOptions& options);
+
 /// 2-D signed distances of mask, in pixels of unit spacing scaled by (pixelU, pixelV)
 /// world units: negative inside. Returned row-major like the mask, over the mask padded
 /// by `pad` pixels on every side ((width + 2 pad) x (height + 2 pad) values).
-/// Felzenszwalb-Huttenlocher exact EDT, O(pixels).
+/// Felzenszwalb-Huttenlocher exact EDT, O(pixels). Throws std::invalid_argument for a pixel
+/// side outside [kMinExtrudePixel, kMaxExtrudePixel].
 std::vector<float> signedDistance2d(const Mask2d& mask, double pixelU, double pixelV, int pad);
 
 /// The mask extruded along options.axis between the two heights. An empty mask (no inside
 /// pixel) gives a field positive everywhere. Throws std::invalid_argument for a mask of no
-/// pixels, a non-positive size or heightHi <= heightLo.
+/// pixels, a non-positive size, pixels extrudeScaleProblem refuses or heightHi <= heightLo.
 /// Cost: construction O(pixels); each sample O(1).
 FieldPtr extrudeField(const Mask2d& mask, const ExtrudeOptions& options);
 

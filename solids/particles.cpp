@@ -58,9 +58,18 @@ struct Buckets {
   void build(const std::vector<std::pair<DVec3, DVec3>>& boxes, const DVec3& boxLo, const DVec3& boxHi, double cellSize) {
     lo = boxLo;
     cell = cellSize;
-    for (int k = 0; k < 3; ++k) n[size_t(k)] = std::max<int64_t>(1, int64_t(std::ceil((boxHi[k] - boxLo[k]) / cell)) + 1);
+    // Counted in double before any cast: a huge or non-finite quotient is refused, not wrapped.
+    constexpr double kMaxCells = double(size_t(1) << 28);
+    double cells = 1;
+    for (int k = 0; k < 3; ++k) {
+      const double q = std::ceil((boxHi[k] - boxLo[k]) / cell) + 1;
+      if (!(q <= kMaxCells)) throw std::invalid_argument("particle tools: the surface's lookup grid would need more than 2^28 cells");
+      const double nk = std::max(1.0, q);
+      cells *= nk;
+      if (!(cells <= kMaxCells)) throw std::invalid_argument("particle tools: the surface's lookup grid would need more than 2^28 cells");
+      n[size_t(k)] = int64_t(nk);
+    }
     const size_t total = size_t(n[0] * n[1] * n[2]);
-    if (total > (size_t(1) << 28)) throw std::invalid_argument("particle tools: the surface's lookup grid would need more than 2^28 cells");
     std::vector<uint32_t> count(total + 1, 0);
     auto each = [&](size_t i, auto&& f) {
       const auto a = cellOf(boxes[i].first), b = cellOf(boxes[i].second);

@@ -3,10 +3,13 @@
 #include <OpenImageIO/imageio.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+
+#include <unistd.h>
 
 #include "core/image.h"
 #include "core/paths.h"
@@ -17,6 +20,28 @@
 using namespace sprig;
 namespace fs = std::filesystem;
 using sprig::test::scratchDir;
+
+namespace {
+
+/// What run writes on stderr (file descriptor 2, where libpng prints).
+template <class F>
+std::string capturedStderr(F run) {
+  std::fflush(stderr);
+  std::FILE* sink = std::tmpfile();
+  const int saved = dup(2);
+  dup2(fileno(sink), 2);
+  run();
+  std::fflush(stderr);
+  dup2(saved, 2);
+  close(saved);
+  std::rewind(sink);
+  std::string text;
+  for (int c; (c = std::fgetc(sink)) != EOF;) text += char(c);
+  std::fclose(sink);
+  return text;
+}
+
+}  // namespace
 
 TEST_CASE("writeImage", "[core]") {
   Image img(8, 4, Vec4(0.5f, 0.25f, 1.0f, 1.0f));
@@ -100,6 +125,35 @@ TEST_CASE("readImage", "[core]") {
       CHECK(std::string(e.what()).rfind("cannot read image '", 0) == 0);
       CHECK_FALSE(e.reason().empty());
     }
+  }
+  SECTION("a damaged PNG: libpng's message is the reason, and nothing reaches stderr") {
+    writeImage(Image(16, 16, Vec4(0.5f)), dir / "good.png");
+    std::ifstream in(dir / "good.png", std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const size_t idat = bytes.find("IDAT");
+    REQUIRE(idat != std::string::npos);
+    std::string renamed = bytes;  // the image data's chunk type damaged: 'IDA\0'
+    renamed[idat + 3] = '\0';
+    std::ofstream(dir / "renamed.png", std::ios::binary) << renamed;
+    std::ofstream(dir / "cut.png", std::ios::binary) << bytes.substr(0, idat + 12);  // the image data cut short
+    const auto reasonOf = [](const fs::path& path, bool pixels, std::string& printed) {
+      std::string reason;
+      printed = capturedStderr([&] {
+        try {
+          if (pixels) readImage(path);
+          else readImageInfo(path);
+        } catch (const ImageReadError& e) {
+          reason = e.reason();
+        }
+      });
+      return reason;
+    };
+    std::string printed;
+    CHECK(reasonOf(dir / "renamed.png", false, printed) == "PNG read error: IDA[00]: invalid chunk type");
+    CHECK(printed.empty());
+    CHECK(reasonOf(dir / "cut.png", true, printed).rfind("PNG read error: ", 0) == 0);
+    CHECK(printed.empty());
+    CHECK(reasonOf(dir / "good.png", true, printed).empty());
   }
   fs::remove_all(dir);
 }

@@ -4,11 +4,13 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 
 #include "core/image.h"
 #include "render/camera.h"
 #include "render/renderer.h"
 #include "render/scene.h"
+#include "tests/core/cube_mesh.h"
 #include "tests/render/test_scenes.h"
 #include "tests/scratch_dir.h"
 
@@ -62,3 +64,55 @@ TEST_CASE("frameBounds", "[render]") {
   }
 }
 
+
+TEST_CASE("frameBounds and cameraProblem: degenerate boxes and cameras", "[render]") {
+  const float inf = std::numeric_limits<float>::infinity();
+  SECTION("a point box is framed by a camera apart from its target, with finite rays") {
+    for (const Vec3 p : {Vec3(1, 1, 1), Vec3(0), Vec3(-3e14f, 2e14f, 1e3f)}) {
+      INFO("point " << p.x << ", " << p.y << ", " << p.z);
+      const Camera cam = frameBounds(Box3{p, p}, ViewSpec{}, 1.0);
+      CHECK(cameraProblem(cam).empty());
+      CHECK(glm::length(cam.position - p) > 0);
+      const Ray ray = cam.generateRay(3.5f, 7.5f, 16, 16);
+      CHECK(std::isfinite(ray.direction.x + ray.direction.y + ray.direction.z));
+    }
+  }
+  SECTION("a box that is not finite or beyond 1e15 is refused") {
+    CHECK_THROWS_AS(frameBounds(Box3{Vec3(0), Vec3(inf, 1, 1)}, ViewSpec{}, 1.0), std::invalid_argument);
+    CHECK_THROWS_AS(frameBounds(Box3{Vec3(0), Vec3(2e15f, 1, 1)}, ViewSpec{}, 1.0), std::invalid_argument);
+    CHECK_FALSE(boxInRenderRange(Box3{Vec3(std::nanf("")), Vec3(1)}));
+    CHECK(boxInRenderRange(Box3{}));  // empty: frames the unit cube
+  }
+  SECTION("cameraProblem names what is wrong") {
+    Camera c;
+    c.position = c.target = Vec3(1, 2, 3);
+    CHECK(cameraProblem(c) == "the camera's target is its position (no view direction)");
+    c.position = Vec3(inf, 0, 0);
+    CHECK(cameraProblem(c) == "the camera's position is not finite or lies beyond 1e15");
+    c.position = Vec3(0, 0, 5);
+    c.fovYDeg = 180;
+    CHECK(cameraProblem(c) == "the camera's field of view is outside (0, 180) degrees");
+  }
+}
+
+TEST_CASE("Scene: rays Embree cannot trace miss", "[render]") {
+  Scene scene;
+  scene.addMesh(sprig::test::cube(false), scene.addMaterial({}));
+  scene.commit();
+  const float inf = std::numeric_limits<float>::infinity(), nan = std::nanf("");
+  // A valid ray hits the unit cube...
+  REQUIRE(scene.intersect(Vec3(0.5f, 0.5f, 5), Vec3(0, 0, -1), 0, inf));
+  CHECK(scene.occluded(Vec3(0.5f, 0.5f, 5), Vec3(0, 0, -1), 0, inf));
+  // ...and rays Embree would assert on are answered as misses.
+  CHECK_FALSE(scene.intersect(Vec3(nan, 0.5f, 5), Vec3(0, 0, -1), 0, inf));
+  CHECK_FALSE(scene.intersect(Vec3(0.5f, 0.5f, 5), Vec3(nan), 0, inf));
+  CHECK_FALSE(scene.intersect(Vec3(0.5f, 0.5f, 1e19f), Vec3(0, 0, -1), 0, inf));
+  CHECK_FALSE(scene.intersect(Vec3(0.5f, 0.5f, 5), Vec3(0, 0, -1), nan, inf));
+  CHECK_FALSE(scene.occluded(Vec3(0.5f, 0.5f, 5), Vec3(0, 0, -1), 0, nan));
+  CHECK_FALSE(scene.occluded(Vec3(0.5f, 0.5f, 5), Vec3(0, 0, inf), 0, 10));
+  SECTION("renderImage refuses a camera on its target before tracing") {
+    Camera c;
+    c.position = c.target = Vec3(0.5f);
+    CHECK_THROWS_WITH(renderImage(scene, c, quietSettings(8, 8)), "render: the camera's target is its position (no view direction)");
+  }
+}

@@ -149,3 +149,43 @@ TEST_CASE("extrudeField: a disc extruded into a cylinder", "[solids]") {
     CHECK_THROWS_AS(extrudeField(Mask2d{}, o), std::invalid_argument);
   }
 }
+
+TEST_CASE("extrudeScaleProblem: pixel sides the transform's arithmetic keeps finite", "[solids]") {
+  ExtrudeOptions o;
+  SECTION("a pixel of 1e-12 to 1e12 world units passes") {
+    o.size = {2048e-12, 2048e12};
+    CHECK(extrudeScaleProblem(2048, 2048, o).empty());
+  }
+  SECTION("tiny, huge and NaN pixel sides are refused, naming the sizes") {
+    o.size = {1e-300, 1.0};
+    CHECK(extrudeScaleProblem(2, 2, o) ==
+          "'size' [1e-300, 1] over 2 x 2 pixels makes pixels of 5e-301 x 0.5 world units; each side must lie in [1e-12, 1e+12]");
+    o.size = {1.0, 1e300};
+    CHECK_FALSE(extrudeScaleProblem(2, 2, o).empty());
+    o.size = {1.0, std::nan("")};
+    CHECK_FALSE(extrudeScaleProblem(2, 2, o).empty());
+  }
+  SECTION("extrudeField and signedDistance2d throw instead of running the transform") {
+    // 1e-300 over 2 pixels once made the lower envelope's crossing -inf and the walk back
+    // write before its array (heap corruption).
+    Mask2d m;
+    m.width = m.height = 2;
+    m.inside = {1, 0, 0, 1};
+    o.size = {1e-300, 1e-300};
+    CHECK_THROWS_AS(extrudeField(m, o), std::invalid_argument);
+    CHECK_THROWS_AS(signedDistance2d(m, 5e-301, 5e-301, 1), std::invalid_argument);
+  }
+  SECTION("at the smallest and largest pixel the distances are still exact") {
+    Mask2d m;
+    m.width = m.height = 9;
+    m.inside.assign(81, 0);
+    m.inside[4 * 9 + 4] = 1;
+    for (double px : {kMinExtrudePixel, kMaxExtrudePixel}) {
+      const std::vector<float> d = signedDistance2d(m, px, px, 0);
+      INFO("pixel " << px);
+      CHECK(d[4 * 9 + 4] == Approx(-0.5 * px));
+      CHECK(d[0] == Approx((std::hypot(4.0, 4.0) - 0.5) * px));
+      CHECK(d[4 * 9 + 8] == Approx(3.5 * px));
+    }
+  }
+}
