@@ -56,6 +56,31 @@ size_t facesAgainstWinding(const Mesh& mesh) {
   return n;
 }
 
+DegenerateReport removeDegenerateTriangles(Mesh& mesh, std::vector<size_t>* kept) {
+  DegenerateReport report;
+  const bool materials = mesh.materials.size() == mesh.triangles.size();
+  if (kept) kept->clear();
+  size_t out = 0;
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const glm::uvec3 f = mesh.triangles[t];
+    if (f[0] == f[1] || f[1] == f[2] || f[2] == f[0]) {
+      ++report.repeatedIndex;
+      continue;
+    }
+    const DVec3 a(mesh.positions[f[0]]), b(mesh.positions[f[1]]), c(mesh.positions[f[2]]);
+    if (glm::cross(b - a, c - a) == DVec3(0.0)) {
+      ++report.zeroArea;
+      continue;
+    }
+    if (kept) kept->push_back(t);
+    if (materials) mesh.materials[out] = mesh.materials[t];
+    mesh.triangles[out++] = f;
+  }
+  mesh.triangles.resize(out);
+  if (materials) mesh.materials.resize(out);
+  return report;
+}
+
 MeshCleanReport cleanMesh(Mesh& mesh, const MeshCleanOptions& options) {
   MeshCleanReport r;
   r.facesAgainstBefore = facesAgainstWinding(mesh);

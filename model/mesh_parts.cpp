@@ -5,6 +5,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "core/mesh_clean.h"
 #include "core/parallel.h"
 
 namespace sprig {
@@ -220,6 +221,30 @@ void textureBark(ExportPart& part, const std::function<Vec3(Vec2 uv)>& bark) {
   part.material.texture = bakeTexture(kExportTextureShort, kExportTextureLong, [&](double s, double t) {
     return bark(Vec2(float(s), float(lo + t * range)));
   }, seams);
+}
+
+ExportFinish finishExportParts(std::vector<ExportPart>& parts) {
+  ExportFinish finish;
+  Box3 box;
+  for (ExportPart& p : parts) {
+    std::vector<size_t> kept;
+    finish.removed.push_back(removeDegenerateTriangles(p.mesh, &kept));
+    const PartTexture* tex = p.material.texture.get();
+    if (finish.removed.back().total() > 0 && tex && tex->isAtlas()) {
+      auto copy = std::make_shared<PartTexture>(*tex);
+      copy->atlas.index.clear();
+      for (size_t t : kept)
+        for (size_t k = 0; k < 3; ++k) copy->atlas.index.push_back(tex->atlas.index[t * 3 + k]);
+      p.material.texture = std::move(copy);
+    }
+    if (!p.mesh.triangles.empty()) box.extend(p.mesh.bounds());
+  }
+  if (box.empty()) return finish;
+  const Vec3 centre = box.center();
+  finish.offset = Vec3(-centre.x, -box.lo.y, -centre.z);
+  for (ExportPart& p : parts)
+    for (Vec3& v : p.mesh.positions) v += finish.offset;
+  return finish;
 }
 
 std::vector<std::pair<uint32_t, Mesh>> splitByMaterial(const Mesh& mesh) {

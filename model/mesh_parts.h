@@ -11,6 +11,7 @@
 
 #include "blobtree/polygonize.h"
 #include "core/mesh.h"
+#include "core/mesh_clean.h"
 #include "core/mesh_io.h"
 #include "organisms/simplify.h"
 #include "model/species.h"
@@ -113,6 +114,19 @@ int atlasVertexColors(ExportPart& part);
 /// (repeating, the bark closes at u = 1) times that range, each texel bark((s, v(t))).
 /// Sets part.material.texture. Throws std::invalid_argument when the mesh has no uvs.
 void textureBark(ExportPart& part, const std::function<Vec3(Vec2 uv)>& bark);
+
+/// What finishExportParts did.
+struct ExportFinish {
+  Vec3 offset{0.0f};            ///< added to every position
+  std::vector<DegenerateReport> removed;  ///< degenerate triangles removed, per part
+};
+
+/// The last steps before `sprig mesh` writes parts: removes every part's degenerate
+/// triangles (removeDegenerateTriangles; an atlas keeps the corners of the others), then
+/// moves every part by one offset so that the box of the parts that have triangles has its
+/// lowest y at 0 and its centre at x = z = 0 (the model stands on the ground plane of a
+/// Y-up viewer at the origin). Textures and normals are unchanged. O(T + V).
+ExportFinish finishExportParts(std::vector<ExportPart>& parts);
 
 /// The triangles of mesh grouped by their Mesh::materials id, in increasing id order;
 /// each group is its own mesh (only the vertices it uses, in their original order; every
