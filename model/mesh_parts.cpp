@@ -134,7 +134,9 @@ std::shared_ptr<PartTexture> bakeAtlas(const Mesh& mesh, const SurfaceColor& col
   const size_t nt = mesh.triangles.size();
   tex->atlas.values.resize(nt * 3);
   tex->atlas.index.resize(nt * 3);
-  const Vec2 corner[3] = {Vec2(1, 1), Vec2(float(c - 1), 1), Vec2(1, float(c - 1))};
+  // Corners on texel centres: a lookup at a corner reads that texel alone, the colour
+  // there (texels at corners would average four, up to a quarter of a 4-texel patch apart).
+  const Vec2 corner[3] = {Vec2(1.5f, 1.5f), Vec2(float(c) - 1.5f, 1.5f), Vec2(1.5f, float(c) - 1.5f)};
   Image& im = tex->image;
   parallelFor(0, nt, [&](size_t t) {
     const int x0 = int(t % size_t(l.columns)) * c, y0 = int(t / size_t(l.columns)) * c;  // texels from bottom-left
@@ -144,10 +146,10 @@ std::shared_ptr<PartTexture> bakeAtlas(const Mesh& mesh, const SurfaceColor& col
       tex->atlas.index[t * 3 + size_t(k)] = uint32_t(t * 3 + size_t(k));
       tex->atlas.values[t * 3 + size_t(k)] = Vec2((float(x0) + corner[k].x) / float(W), (float(y0) + corner[k].y) / float(H));
     }
-    const double leg = double(c - 2);
+    const double leg = double(c - 3);
     for (int j = 0; j < c; ++j)
       for (int i = 0; i < c; ++i) {
-        const Vec3 b = clampedBary((i + 0.5 - 1) / leg, (j + 0.5 - 1) / leg);
+        const Vec3 b = clampedBary((i + 0.5 - 1.5) / leg, (j + 0.5 - 1.5) / leg);
         const Vec3 p = b.x * P[0] + b.y * P[1] + b.z * P[2];
         im.set(x0 + i, H - 1 - (y0 + j), Vec4(colorAt(t, p, b), 1.0f));
       }

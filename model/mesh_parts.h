@@ -73,8 +73,9 @@ using SurfaceColor = std::function<Vec3(size_t triangle, const Vec3& point, cons
 
 /// Bakes mesh's colours into an atlas (PartTexture::atlas): triangle i owns the cell-sized
 /// square patch i of atlasLayout (row-major from the image's bottom-left); its corners sit
-/// one texel inside the patch, at (1, 1), (cell − 1, 1) and (1, cell − 1) texels from the
-/// patch's corner, so a bilinear lookup anywhere in the triangle reads only its own patch.
+/// on the centres of the texels one inside the patch, at (1.5, 1.5), (cell − 1.5, 1.5) and
+/// (1.5, cell − 1.5) texels from the patch's corner, so a lookup at a corner reads the
+/// colour there alone and a bilinear lookup anywhere in the triangle reads only its own patch.
 /// Every texel of the patch is colorAt at the barycentric point of its centre, clamped to
 /// the triangle (the texels outside the triangle are its gutter). Null when the mesh has
 /// no triangles or more than the budget. O(triangles · cell²) colorAt calls, in parallel;

@@ -48,7 +48,7 @@ assert abs(x0 + x1) <= 1e-5 * ext and abs(z0 + z1) <= 1e-5 * ext, (x0, x1, z0, z
 PY
 }
 
-for entry in "fig_tree_12_pcm_offset" "shell_top --cell 0.05" "fig_org_05b_berry_level2"; do
+for entry in "fig_tree_12_pcm_offset" "fig_shell_10_opening_cut --cell 0.1" "fig_org_05b_berry_level2"; do
   read -r s flags <<<"$entry"
   # shellcheck disable=SC2086
   "$SPRIG" mesh "species/$s.yaml" -o "$WORK/$s.glb" -o "$WORK/$s.obj" $flags >"$WORK/$s.out"
@@ -61,11 +61,11 @@ for entry in "fig_tree_12_pcm_offset" "shell_top --cell 0.05" "fig_org_05b_berry
   check_placed "$o" "$s.obj"
 done
 # The shell's textures are baked once: one note per textured part, as with one output.
-"$SPRIG" mesh species/shell_top.yaml -o "$WORK/one.glb" --cell 0.05 >"$WORK/one.out"
-[ "$(grep -c 'baked from' "$WORK/shell_top.out")" = "$(grep -c 'baked from' "$WORK/one.out")" ] ||
-  fail "bake notes differ: $(cat "$WORK/shell_top.out")"
+"$SPRIG" mesh species/fig_shell_10_opening_cut.yaml -o "$WORK/one.glb" --cell 0.1 >"$WORK/one.out"
+[ "$(grep -c 'baked from' "$WORK/fig_shell_10_opening_cut.out")" = "$(grep -c 'baked from' "$WORK/one.out")" ] ||
+  fail "bake notes differ: $(cat "$WORK/fig_shell_10_opening_cut.out")"
 [ "$(grep -c 'baked from' "$WORK/one.out")" -ge 1 ] || fail "no bake note: $(cat "$WORK/one.out")"
-cmp -s "$WORK/one.glb" "$WORK/shell_top.glb" || fail "the glb of a two-output run differs from a one-output run's"
+cmp -s "$WORK/one.glb" "$WORK/fig_shell_10_opening_cut.glb" || fail "the glb of a two-output run differs from a one-output run's"
 
 # Refused before any work, nothing written.
 mkdir "$WORK/bad"
