@@ -60,8 +60,10 @@ struct DegenerateReport {
 
 /// Removes degenerate triangles in place: two equal vertex indices, or zero area (the cross
 /// product of two edges, computed in double from the float positions, is exactly zero).
-/// Keeps the order of the other triangles and their Mesh::materials; keeps every vertex (an
-/// unused vertex is harmless to the formats). kept, when given, receives the original index
+/// The coincident corners of a zero-area triangle become one vertex (the lower index, in
+/// every triangle), so removing it leaves no slit open in a closed surface. Keeps the order
+/// of the other triangles and their Mesh::materials; keeps every vertex (an unused vertex
+/// is harmless to the formats). kept, when given, receives the original index
 /// of each remaining triangle. O(T).
 DegenerateReport removeDegenerateTriangles(Mesh& mesh, std::vector<size_t>* kept = nullptr);
 
