@@ -122,6 +122,13 @@ size_t checkBakedColors(const std::string& stem, const std::vector<ExportPart>& 
   return textured;
 }
 
+// A shipped species by its file stem.
+Species shippedSpecies(const std::string& stem) {
+  PathPolicy policy;
+  policy.root = SPRIG_SOURCE_DIR;
+  return loadSpecies(std::string(SPRIG_SOURCE_DIR) + "/species/" + stem + ".yaml", policy);
+}
+
 const ExportPart* find(const std::vector<ExportPart>& parts, const std::string& name) {
   for (const ExportPart& p : parts)
     if (p.name == name) return &p;
@@ -524,9 +531,7 @@ TEST_CASE("Baked textures show the renderer's colours at >= 99 % of corners", "[
   };
   size_t textured = 0;
   for (const Case& c : cases) {
-    PathPolicy policy;
-    policy.root = SPRIG_SOURCE_DIR;
-    const Species species = loadSpecies(std::string(SPRIG_SOURCE_DIR) + "/species/" + c.species + ".yaml", policy);
+    const Species species = shippedSpecies(c.species);
     ModelOptions options;
     options.lastStep = c.lastStep;
     SpeciesModel model(species, options);
@@ -542,9 +547,7 @@ TEST_CASE("Baked textures show the renderer's colours at >= 99 % of corners", "[
 // for "[all_species]").
 TEST_CASE("Every shipped species' baked textures show the renderer's colours", "[.][all_species_colors]") {
   for (const std::string& stem : test::shippedSpecies(SPRIG_SOURCE_DIR)) {
-    PathPolicy policy;
-    policy.root = SPRIG_SOURCE_DIR;
-    const Species species = loadSpecies(std::string(SPRIG_SOURCE_DIR) + "/species/" + stem + ".yaml", policy);
+    const Species species = shippedSpecies(stem);
     SpeciesModel model(species, ModelOptions{});
     checkBakedColors(stem, model.exportParts(model.finalStage(), 0.0f, false), 4.0f / 255.0f, 0.99);
     std::fflush(stdout);
