@@ -89,11 +89,12 @@ Stage StageFlags::resolve(const SpeciesModel& model) const {
   return s;
 }
 
-void addInputOutput(CLI::App& sub, const char* name, std::string& file, std::string& out, const char* outputHelp) {
-  sub.add_option(name, file, "species file (.yaml), grammar (.lsys, cpfg's .l) or vlab object folder")->required();
-  // The folder the output goes into must exist before any work starts (a folder output,
-  // `frames/`, may itself be new: its parent must exist).
-  const CLI::Validator folderExists(
+namespace {
+
+/// The folder the output goes into must exist before any work starts (a folder output,
+/// `frames/`, may itself be new: its parent must exist).
+const CLI::Validator& outputFolderExists() {
+  static const CLI::Validator v(
       [](std::string& value) -> std::string {
         std::string trimmed = value;
         while (trimmed.size() > 1 && trimmed.back() == '/') trimmed.pop_back();
@@ -103,7 +104,19 @@ void addInputOutput(CLI::App& sub, const char* name, std::string& file, std::str
         return "folder '" + parent.string() + "' does not exist";
       },
       "", "output folder exists");
-  sub.add_option("-o,--output", out, outputHelp)->required()->check(folderExists);
+  return v;
+}
+
+}  // namespace
+
+void addInputOutput(CLI::App& sub, const char* name, std::string& file, std::string& out, const char* outputHelp) {
+  sub.add_option(name, file, "species file (.yaml), grammar (.lsys, cpfg's .l) or vlab object folder")->required();
+  sub.add_option("-o,--output", out, outputHelp)->required()->check(outputFolderExists());
+}
+
+void addInputOutputs(CLI::App& sub, const char* name, std::string& file, std::vector<std::string>& outs, const char* outputHelp) {
+  sub.add_option(name, file, "species file (.yaml), grammar (.lsys, cpfg's .l) or vlab object folder")->required();
+  sub.add_option("-o,--output", outs, outputHelp)->required()->allow_extra_args(false)->check(outputFolderExists());
 }
 
 void printNotes(const GlobalOptions& g, const Species& species) {

@@ -2,7 +2,9 @@
 
 #include "app/cmd_mesh.h"
 
+#include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <cstdio>
 #include <iostream>
 
@@ -20,7 +22,7 @@ namespace {
 
 struct MeshArgs {
   std::string file;
-  std::string out;
+  std::vector<std::string> outs;  ///< one or more -o; several only for surface meshes
   double cell = 0.0;
   StageFlags stage;
   GrowthFlags growth;
@@ -30,81 +32,44 @@ struct MeshArgs {
   double simplify = -1;  ///< < 0 = the species' render.simplify
 };
 
-int runMesh(const MeshArgs& a, const GlobalOptions& g) {
-  requireExtension("-o", a.out, {".ply", ".obj", ".glb", ".msh", ".vtu", ".mesh"});
-  PhaseClock::declare({"read", "derive", "build", "polygonize", "write"});
-  auto start = std::chrono::steady_clock::now();
-  // Volume meshes (tetrahedra with materials) of kinds that have them, by extension.
-  const std::string ext = lowerExtension(a.out);
-  const bool volume = ext == ".msh" || ext == ".vtu" || ext == ".mesh";
-  if (a.simplify > 0 && (a.interfaces || volume))
-    throw UsageError("--simplify applies to the surface parts written as .ply, .obj or .glb, not to --interfaces or volume meshes");
-  Species species = loadSpecies(a.file, g.pathPolicy());
-  printNotes(g, species);
-  if (!a.mesher.empty()) species.render.dualMesher = a.mesher == "dual";
-  SpeciesModel model(species, a.growth.overrides());
-  const Stage stage = a.stage.resolve(model);
-  if (a.interfaces) {
-    if (volume)
-      throw UsageError("--interfaces writes triangle meshes: give -o a .ply, .obj or .glb name");
-    const std::filesystem::path out(a.out);
-    for (auto& [name, mesh] : model.interfaceMeshes(stage)) {
-      const std::filesystem::path path = out.parent_path() / (out.stem().string() + "_" + name + out.extension().string());
-      MeshWriteOptions wopt;
-      wopt.materialName = name;
-      writeMesh(mesh, path, wopt);
-      note(g, std::cout, "%s: %zu triangles, %zu vertices", path.string().c_str(), mesh.triangleCount(), mesh.vertexCount());
-    }
-    return kExitOk;
+/// The -o paths' extensions, and several -o only for surface meshes, each path once.
+void checkOutputs(const MeshArgs& a) {
+  for (const std::string& out : a.outs) requireExtension("-o", out, {".ply", ".obj", ".glb", ".msh", ".vtu", ".mesh"});
+  if (a.outs.size() < 2) return;
+  std::vector<std::filesystem::path> seen;
+  for (const std::string& out : a.outs) {
+    const std::string ext = lowerExtension(out);
+    if (a.interfaces || (ext != ".ply" && ext != ".obj" && ext != ".glb"))
+      throw UsageError("-o: several outputs are surface meshes (.ply, .obj, .glb) written from one build; '" + out +
+                       "' is not" + (a.interfaces ? " (--interfaces writes one set of files)" : ""));
+    const std::filesystem::path p = std::filesystem::weakly_canonical(out);
+    if (std::find(seen.begin(), seen.end(), p) != seen.end()) throw UsageError("-o: '" + out + "' is given twice");
+    seen.push_back(p);
   }
-  if (volume) {
-    const std::string line = model.writeVolumeMesh(stage, a.out, !g.quiet);
-    double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    note(g, std::cout, "%s (total %.2f s)", line.c_str(), total);
-    return kExitOk;
-  }
-  ModelFigures fig;
-  MeshCleanOptions clean;
-  clean.minVolumeFraction = a.minVolume;
-  std::vector<ExportPart> parts = model.exportParts(stage, static_cast<float>(a.cell), !g.quiet, clean, &fig);
+}
+
+/// Simplifies the parts when asked (--simplify or the species' render.simplify); returns
+/// the note's text ("" when not simplified).
+std::string simplifyForMesh(std::vector<ExportPart>& parts, double simplify, const GlobalOptions& g) {
   std::string simplified;
-  const double simplify = a.simplify >= 0 ? a.simplify : species.render.simplify;
-  if (simplify > 0) {
-    std::vector<std::string> dropped;
-    const std::vector<organisms::SimplifyReport> reports = simplifyParts(parts, simplify, &dropped);
-    for (const std::string& name : dropped)
-      note(g, std::cerr, "%s: simplified, so its texture atlas is dropped and its vertex colours kept", name.c_str());
-    fig.triangles = 0;
-    for (size_t i = 0; i < parts.size(); ++i) {
-      fig.triangles += parts[i].mesh.triangleCount();
-      if (reports[i].inputTriangles == 0) continue;
-      char buf[160];
-      std::snprintf(buf, sizeof buf, "%s%s %zu -> %zu (error %.3g)", simplified.empty() ? "" : ", ", parts[i].name.c_str(),
-                    reports[i].inputTriangles, reports[i].faces, double(reports[i].absoluteError));
-      simplified += buf;
-    }
+  if (simplify <= 0) return simplified;
+  std::vector<std::string> dropped;
+  const std::vector<organisms::SimplifyReport> reports = simplifyParts(parts, simplify, &dropped);
+  for (const std::string& name : dropped)
+    note(g, std::cerr, "%s: simplified, so its texture atlas is dropped and its vertex colours kept", name.c_str());
+  for (size_t i = 0; i < parts.size(); ++i) {
+    if (reports[i].inputTriangles == 0) continue;
+    char buf[160];
+    std::snprintf(buf, sizeof buf, "%s%s %zu -> %zu (error %.3g)", simplified.empty() ? "" : ", ", parts[i].name.c_str(),
+                  reports[i].inputTriangles, reports[i].faces, double(reports[i].absoluteError));
+    simplified += buf;
   }
-  const std::vector<PartWriteReport> written = [&] {
-    const Phase phase("write");
-    return writeParts(parts, a.out);
-  }();
-  double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  size_t vertices = 0;
-  std::string names;
-  for (const ExportPart& p : parts) {
-    if (p.mesh.triangles.empty()) continue;
-    vertices += p.mesh.vertexCount();
-    names += (names.empty() ? "" : ", ") + p.name + " " + std::to_string(p.mesh.triangleCount());
-  }
-  note(g, std::cout, "%s: %zu triangles, %zu vertices, %zu primitives, built in %.2f s (total %.2f s)", a.out.c_str(),
-       fig.triangles, vertices, fig.primitives, fig.buildSeconds, total);
-  note(g, std::cout, "parts: %s", names.c_str());
-  if (!simplified.empty()) note(g, std::cout, "simplified to %g of the model's extent: %s", simplify, simplified.c_str());
-  const MeshCleanReport& c = fig.clean;
-  if (c.componentsBefore > 0)
-    note(g, std::cout, "cleaned: %zu components -> %zu (%zu specks, %zu voids, %zu triangles removed); %zu faces against their normals -> %zu (%zu normals fixed)",
-         c.componentsBefore, c.componentsAfter, c.specks, c.voids, c.removedTriangles, c.facesAgainstBefore,
-         c.facesAgainstAfter, c.fixedNormals);
+  return simplified;
+}
+
+/// The notes on textures, creases and seams (written: the reports of one output) and on
+/// cut-outs and clamped colours (glb: whether a .glb was written).
+void noteParts(const std::vector<ExportPart>& parts, const std::vector<PartWriteReport>& written, bool glb, const GlobalOptions& g) {
   for (const PartWriteReport& r : written) {
     if (r.atlasCell > 0)
       note(g, std::cout, "%s: texture atlas %dx%d baked from the renderer's colours, %dx%d texels per triangle", r.name.c_str(),
@@ -127,11 +92,92 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
          p.material.alphaCutoff,
          partial ? (": " + std::to_string(partial) + " partly transparent texels are drawn opaque (renders blend them)").c_str() : "");
   }
-  if (lowerExtension(a.out) == ".glb")
+  if (glb)
     for (const ExportPart& p : parts)
       if (size_t k = clampedColorChannels(p))
         note(g, std::cout, "%s: %zu vertex colour channels are brighter than the part's base colour and are clamped to it in COLOR_0",
              p.name.c_str(), k);
+}
+
+int runMesh(const MeshArgs& a, const GlobalOptions& g) {
+  checkOutputs(a);
+  const std::string& out = a.outs.front();
+  PhaseClock::declare({"read", "derive", "build", "polygonize", "write"});
+  auto start = std::chrono::steady_clock::now();
+  // Volume meshes (tetrahedra with materials) of kinds that have them, by extension.
+  const std::string ext = lowerExtension(out);
+  const bool volume = ext == ".msh" || ext == ".vtu" || ext == ".mesh";
+  if (a.simplify > 0 && (a.interfaces || volume))
+    throw UsageError("--simplify applies to the surface parts written as .ply, .obj or .glb, not to --interfaces or volume meshes");
+  Species species = loadSpecies(a.file, g.pathPolicy());
+  printNotes(g, species);
+  if (!a.mesher.empty()) species.render.dualMesher = a.mesher == "dual";
+  SpeciesModel model(species, a.growth.overrides());
+  const Stage stage = a.stage.resolve(model);
+  if (a.interfaces) {
+    if (volume)
+      throw UsageError("--interfaces writes triangle meshes: give -o a .ply, .obj or .glb name");
+    const std::filesystem::path outPath(out);
+    for (auto& [name, mesh] : model.interfaceMeshes(stage)) {
+      const std::filesystem::path path = outPath.parent_path() / (outPath.stem().string() + "_" + name + outPath.extension().string());
+      MeshWriteOptions wopt;
+      wopt.materialName = name;
+      writeMesh(mesh, path, wopt);
+      note(g, std::cout, "%s: %zu triangles, %zu vertices", path.string().c_str(), mesh.triangleCount(), mesh.vertexCount());
+    }
+    return kExitOk;
+  }
+  if (volume) {
+    const std::string line = model.writeVolumeMesh(stage, out, !g.quiet);
+    double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    note(g, std::cout, "%s (total %.2f s)", line.c_str(), total);
+    return kExitOk;
+  }
+  ModelFigures fig;
+  MeshCleanOptions clean;
+  clean.minVolumeFraction = a.minVolume;
+  // Built, cleaned and baked once, however many files are written.
+  std::vector<ExportPart> parts = model.exportParts(stage, static_cast<float>(a.cell), !g.quiet, clean, &fig);
+  const double simplify = a.simplify >= 0 ? a.simplify : species.render.simplify;
+  const std::string simplified = simplifyForMesh(parts, simplify, g);
+  const ExportFinish finish = finishExportParts(parts);
+  std::vector<PartWriteReport> written;
+  std::string names, files, degenerate;
+  bool glb = false;
+  for (const std::string& o : a.outs) {
+    std::vector<PartWriteReport> r = [&] {
+      const Phase phase("write");
+      return writeParts(parts, o);
+    }();
+    if (written.empty() || lowerExtension(o) != ".ply") written = std::move(r);  // PLY has no textures to report
+    files += (files.empty() ? "" : ", ") + o;
+    glb = glb || lowerExtension(o) == ".glb";
+  }
+  double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  size_t vertices = 0, triangles = 0;
+  for (size_t i = 0; i < parts.size(); ++i) {
+    const ExportPart& p = parts[i];
+    if (const DegenerateReport& d = finish.removed[i]; d.total() > 0)
+      degenerate += (degenerate.empty() ? "" : ", ") + p.name + " " + std::to_string(d.total()) + " (" +
+                    std::to_string(d.repeatedIndex) + " with a repeated corner)";
+    if (p.mesh.triangles.empty()) continue;
+    vertices += p.mesh.vertexCount();
+    triangles += p.mesh.triangleCount();
+    names += (names.empty() ? "" : ", ") + p.name + " " + std::to_string(p.mesh.triangleCount());
+  }
+  note(g, std::cout, "%s: %zu triangles, %zu vertices, %zu primitives, built in %.2f s (total %.2f s)", files.c_str(),
+       triangles, vertices, fig.primitives, fig.buildSeconds, total);
+  note(g, std::cout, "parts: %s", names.c_str());
+  if (!simplified.empty()) note(g, std::cout, "simplified to %g of the model's extent: %s", simplify, simplified.c_str());
+  const MeshCleanReport& c = fig.clean;
+  if (c.componentsBefore > 0)
+    note(g, std::cout, "cleaned: %zu components -> %zu (%zu specks, %zu voids, %zu triangles removed); %zu faces against their normals -> %zu (%zu normals fixed)",
+         c.componentsBefore, c.componentsAfter, c.specks, c.voids, c.removedTriangles, c.facesAgainstBefore,
+         c.facesAgainstAfter, c.fixedNormals);
+  if (!degenerate.empty()) note(g, std::cout, "degenerate triangles removed (zero area or a repeated corner): %s", degenerate.c_str());
+  note(g, std::cout, "placed: moved by (%g, %g, %g) to stand at the origin (lowest y = 0, centred in x and z; metres)",
+       double(finish.offset.x), double(finish.offset.y), double(finish.offset.z));
+  noteParts(parts, written, glb, g);
   return kExitOk;
 }
 
@@ -140,7 +186,9 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
 void addMeshCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run) {
   auto [sub, args] = subcommand<MeshArgs>(app, global, run, "mesh",
                                           "Polygonize a species' surface into a closed triangle mesh (.ply, .obj, .glb), or write a solid's tetrahedra (.msh, .vtu, .mesh)", runMesh);
-  addInputOutput(*sub, "SPECIES", args->file, args->out, "output mesh (.ply, .obj + .mtl, .glb; solids also .msh, .vtu, .mesh)");
+  addInputOutputs(*sub, "SPECIES", args->file, args->outs,
+                  "output mesh (.ply, .obj + .mtl, .glb; solids also .msh, .vtu, .mesh); give -o several times to write "
+                  "several surface meshes from one build and bake");
   sub->add_option("--cell", args->cell, "cell edge length in model units (default: automatic, from the smallest feature)")
       ->check(CLI::PositiveNumber);
   sub->add_flag("--interfaces", args->interfaces,

@@ -64,6 +64,9 @@ void addRenderCommand(CLI::App& app, const GlobalOptions& global, CommandRun& ru
 
 /// Registers the required input `name` (a species file or grammar) and output `-o`.
 void addInputOutput(CLI::App& sub, const char* name, std::string& file, std::string& out, const char* outputHelp);
+/// addInputOutput with an -o that may be given several times (`-o a.glb -o b.obj`), each
+/// occurrence taking one path.
+void addInputOutputs(CLI::App& sub, const char* name, std::string& file, std::vector<std::string>& outs, const char* outputHelp);
 
 /// Registers subcommand `name`: its flags fill an Args (returned for the caller to bind),
 /// and choosing it makes `run` call body(args, global).

@@ -1,6 +1,7 @@
 #include "core/mesh_clean.h"
 
 #include <cmath>
+#include <algorithm>
 #include <numeric>
 
 namespace sprig {
@@ -54,6 +55,61 @@ size_t facesAgainstWinding(const Mesh& mesh) {
       }
   }
   return n;
+}
+
+DegenerateReport removeDegenerateTriangles(Mesh& mesh, std::vector<size_t>* kept) {
+  // A zero-area triangle whose corners coincide (two vertices at one position: a
+  // polygonizer's root found at a grid corner shared by two edges) is a slit in the
+  // surface: removed alone it would leave its neighbours open along it. Its coincident
+  // vertices become one (the lower index, everywhere), which turns the neighbours across
+  // the slit into edge-sharing triangles again; collinear corners are only removed.
+  std::vector<uint32_t> to(mesh.positions.size());
+  std::iota(to.begin(), to.end(), 0u);
+  auto root = [&](uint32_t v) {
+    while (to[v] != v) v = to[v] = to[to[v]];
+    return v;
+  };
+  auto zeroArea = [&](const glm::uvec3& f) {
+    const DVec3 a(mesh.positions[f[0]]), b(mesh.positions[f[1]]), c(mesh.positions[f[2]]);
+    return glm::cross(b - a, c - a) == DVec3(0.0);
+  };
+  std::vector<char> cause(mesh.triangles.size(), 0);  // 1 repeated index, 2 zero area
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const glm::uvec3 f = mesh.triangles[t];
+    if (f[0] == f[1] || f[1] == f[2] || f[2] == f[0]) {
+      cause[t] = 1;
+    } else if (zeroArea(f)) {
+      cause[t] = 2;
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t a = f[k], b = f[(k + 1) % 3];
+        if (mesh.positions[a] != mesh.positions[b]) continue;
+        const uint32_t ra = root(a), rb = root(b);
+        to[std::max(ra, rb)] = std::min(ra, rb);
+      }
+    }
+  }
+  DegenerateReport report;
+  const bool materials = mesh.materials.size() == mesh.triangles.size();
+  if (kept) kept->clear();
+  size_t out = 0;
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    const glm::uvec3 f(root(mesh.triangles[t][0]), root(mesh.triangles[t][1]), root(mesh.triangles[t][2]));
+    const bool repeated = f[0] == f[1] || f[1] == f[2] || f[2] == f[0];
+    if (cause[t] == 1 || (cause[t] == 0 && repeated)) {
+      ++report.repeatedIndex;
+      continue;
+    }
+    if (cause[t] == 2 || repeated) {
+      ++report.zeroArea;
+      continue;
+    }
+    if (kept) kept->push_back(t);
+    if (materials) mesh.materials[out] = mesh.materials[t];
+    mesh.triangles[out++] = f;
+  }
+  mesh.triangles.resize(out);
+  if (materials) mesh.materials.resize(out);
+  return report;
 }
 
 MeshCleanReport cleanMesh(Mesh& mesh, const MeshCleanOptions& options) {

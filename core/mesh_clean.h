@@ -51,6 +51,22 @@ std::vector<uint32_t> triangleComponents(const Mesh& mesh, size_t* count = nullp
 /// winding normal) < 0. 0 when the mesh has no normals. O(T).
 size_t facesAgainstWinding(const Mesh& mesh);
 
+/// Degenerate triangles of removeDegenerateTriangles(), by cause.
+struct DegenerateReport {
+  size_t repeatedIndex = 0;  ///< two corners name the same vertex
+  size_t zeroArea = 0;       ///< three distinct vertices, collinear or coincident (zero area)
+  size_t total() const { return repeatedIndex + zeroArea; }
+};
+
+/// Removes degenerate triangles in place: two equal vertex indices, or zero area (the cross
+/// product of two edges, computed in double from the float positions, is exactly zero).
+/// The coincident corners of a zero-area triangle become one vertex (the lower index, in
+/// every triangle), so removing it leaves no slit open in a closed surface. Keeps the order
+/// of the other triangles and their Mesh::materials; keeps every vertex (an unused vertex
+/// is harmless to the formats). kept, when given, receives the original index
+/// of each remaining triangle. O(T).
+DegenerateReport removeDegenerateTriangles(Mesh& mesh, std::vector<size_t>* kept = nullptr);
+
 /// Removes debris components and fixes normals in place (see MeshCleanOptions); keeps the
 /// order of the remaining vertices and triangles and every per-vertex and per-triangle
 /// array. Deterministic. O(T + V).

@@ -578,8 +578,11 @@ std::vector<PartWriteReport> writePartsObj(const std::vector<ExportPart>& parts,
       png.replace_filename(path.stem().string() + "_" + objName(part.name) + ".png");
       const bool cutOut = part.material.alphaCutoff >= 0.0f;
       images.push_back({png, &tex->image, cutOut});
-      mtl += "map_Kd " + png.filename().string() + "\n";
-      if (cutOut) mtl += "map_d " + png.filename().string() + "\n";
+      // MTL's -clamp covers both axes at once: said where glTF's sampler clamps both (an
+      // atlas, cpfg's leaves); an image that repeats in one axis only is left repeating.
+      const std::string map = (!tex->seams.repeatU && !tex->seams.repeatV ? "-clamp on " : "") + png.filename().string();
+      mtl += "map_Kd " + map + "\n";
+      if (cutOut) mtl += "map_d " + map + "\n";
     }
     mtl += "\n";
     const bool hasN = !lines.normals.empty(), hasUv = !lines.uvs.empty();

@@ -5,6 +5,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "core/mesh_clean.h"
 #include "core/parallel.h"
 
 namespace sprig {
@@ -133,7 +134,9 @@ std::shared_ptr<PartTexture> bakeAtlas(const Mesh& mesh, const SurfaceColor& col
   const size_t nt = mesh.triangles.size();
   tex->atlas.values.resize(nt * 3);
   tex->atlas.index.resize(nt * 3);
-  const Vec2 corner[3] = {Vec2(1, 1), Vec2(float(c - 1), 1), Vec2(1, float(c - 1))};
+  // Corners on texel centres: a lookup at a corner reads that texel alone, the colour
+  // there (texels at corners would average four, up to a quarter of a 4-texel patch apart).
+  const Vec2 corner[3] = {Vec2(1.5f, 1.5f), Vec2(float(c) - 1.5f, 1.5f), Vec2(1.5f, float(c) - 1.5f)};
   Image& im = tex->image;
   parallelFor(0, nt, [&](size_t t) {
     const int x0 = int(t % size_t(l.columns)) * c, y0 = int(t / size_t(l.columns)) * c;  // texels from bottom-left
@@ -143,10 +146,10 @@ std::shared_ptr<PartTexture> bakeAtlas(const Mesh& mesh, const SurfaceColor& col
       tex->atlas.index[t * 3 + size_t(k)] = uint32_t(t * 3 + size_t(k));
       tex->atlas.values[t * 3 + size_t(k)] = Vec2((float(x0) + corner[k].x) / float(W), (float(y0) + corner[k].y) / float(H));
     }
-    const double leg = double(c - 2);
+    const double leg = double(c - 3);
     for (int j = 0; j < c; ++j)
       for (int i = 0; i < c; ++i) {
-        const Vec3 b = clampedBary((i + 0.5 - 1) / leg, (j + 0.5 - 1) / leg);
+        const Vec3 b = clampedBary((i + 0.5 - 1.5) / leg, (j + 0.5 - 1.5) / leg);
         const Vec3 p = b.x * P[0] + b.y * P[1] + b.z * P[2];
         im.set(x0 + i, H - 1 - (y0 + j), Vec4(colorAt(t, p, b), 1.0f));
       }
@@ -220,6 +223,30 @@ void textureBark(ExportPart& part, const std::function<Vec3(Vec2 uv)>& bark) {
   part.material.texture = bakeTexture(kExportTextureShort, kExportTextureLong, [&](double s, double t) {
     return bark(Vec2(float(s), float(lo + t * range)));
   }, seams);
+}
+
+ExportFinish finishExportParts(std::vector<ExportPart>& parts) {
+  ExportFinish finish;
+  Box3 box;
+  for (ExportPart& p : parts) {
+    std::vector<size_t> kept;
+    finish.removed.push_back(removeDegenerateTriangles(p.mesh, &kept));
+    const PartTexture* tex = p.material.texture.get();
+    if (finish.removed.back().total() > 0 && tex && tex->isAtlas()) {
+      auto copy = std::make_shared<PartTexture>(*tex);
+      copy->atlas.index.clear();
+      for (size_t t : kept)
+        for (size_t k = 0; k < 3; ++k) copy->atlas.index.push_back(tex->atlas.index[t * 3 + k]);
+      p.material.texture = std::move(copy);
+    }
+    if (!p.mesh.triangles.empty()) box.extend(p.mesh.bounds());
+  }
+  if (box.empty()) return finish;
+  const Vec3 centre = box.center();
+  finish.offset = Vec3(-centre.x, -box.lo.y, -centre.z);
+  for (ExportPart& p : parts)
+    for (Vec3& v : p.mesh.positions) v += finish.offset;
+  return finish;
 }
 
 std::vector<std::pair<uint32_t, Mesh>> splitByMaterial(const Mesh& mesh) {

@@ -11,6 +11,7 @@
 
 #include "blobtree/polygonize.h"
 #include "core/mesh.h"
+#include "core/mesh_clean.h"
 #include "core/mesh_io.h"
 #include "organisms/simplify.h"
 #include "model/species.h"
@@ -72,8 +73,9 @@ using SurfaceColor = std::function<Vec3(size_t triangle, const Vec3& point, cons
 
 /// Bakes mesh's colours into an atlas (PartTexture::atlas): triangle i owns the cell-sized
 /// square patch i of atlasLayout (row-major from the image's bottom-left); its corners sit
-/// one texel inside the patch, at (1, 1), (cell − 1, 1) and (1, cell − 1) texels from the
-/// patch's corner, so a bilinear lookup anywhere in the triangle reads only its own patch.
+/// on the centres of the texels one inside the patch, at (1.5, 1.5), (cell − 1.5, 1.5) and
+/// (1.5, cell − 1.5) texels from the patch's corner, so a lookup at a corner reads the
+/// colour there alone and a bilinear lookup anywhere in the triangle reads only its own patch.
 /// Every texel of the patch is colorAt at the barycentric point of its centre, clamped to
 /// the triangle (the texels outside the triangle are its gutter). Null when the mesh has
 /// no triangles or more than the budget. O(triangles · cell²) colorAt calls, in parallel;
@@ -113,6 +115,19 @@ int atlasVertexColors(ExportPart& part);
 /// (repeating, the bark closes at u = 1) times that range, each texel bark((s, v(t))).
 /// Sets part.material.texture. Throws std::invalid_argument when the mesh has no uvs.
 void textureBark(ExportPart& part, const std::function<Vec3(Vec2 uv)>& bark);
+
+/// What finishExportParts did.
+struct ExportFinish {
+  Vec3 offset{0.0f};            ///< added to every position
+  std::vector<DegenerateReport> removed;  ///< degenerate triangles removed, per part
+};
+
+/// The last steps before `sprig mesh` writes parts: removes every part's degenerate
+/// triangles (removeDegenerateTriangles; an atlas keeps the corners of the others), then
+/// moves every part by one offset so that the box of the parts that have triangles has its
+/// lowest y at 0 and its centre at x = z = 0 (the model stands on the ground plane of a
+/// Y-up viewer at the origin). Textures and normals are unchanged. O(T + V).
+ExportFinish finishExportParts(std::vector<ExportPart>& parts);
 
 /// The triangles of mesh grouped by their Mesh::materials id, in increasing id order;
 /// each group is its own mesh (only the vertices it uses, in their original order; every

@@ -403,36 +403,90 @@ namespace {
 /// Mesh cell of a shell when none is asked for: 1/340 of its diagonal.
 float shellMeshCell(const blobtree::CompiledBlob& blob) { return glm::length(blob.bounds().size()) / 340.0f; }
 
-/// A shell grown to any age.
-/// Maps the main whorl's texture onto the whorl part as an image over the helico-spiral
-/// coordinates of each vertex (organisms/shell_paint.h): s = angle around the generating
-/// curve / 360° (repeating), t = θ rescaled over the part's range. A triangle spanning more
-/// than 90° of θ or around (between two whorls, or at the apex) takes one corner's
-/// coordinates. The texels are the painter's own whorl colour at their coordinates.
-void textureWhorl(ExportPart& part, const organisms::ShellPainter& painter) {
-  Mesh& mesh = part.mesh;
-  if (mesh.triangleCount() == 0) return;
+/// The whorl's helico-spiral coordinates, one per vertex of mesh (world positions).
+std::vector<organisms::HelicoCoords> whorlCoords(const Mesh& mesh, const organisms::ShellPainter& painter) {
   std::vector<organisms::HelicoCoords> coords(mesh.positions.size());
   parallelFor(0, coords.size(), [&](size_t v) { coords[v] = painter.helicoCoordsOfWorld(mesh.positions[v]); }, 256);
+  return coords;
+}
+
+/// The whorl's image over (around, θ) cannot show what depends on a point's distance from
+/// the generating centre: the aperture's inside (ShellPainter::insideWeight), which shares
+/// (around, θ) with the outer wall in front of it. Moves every whorl triangle with a corner
+/// there to the `inside` part (made when the shell has none), whose atlas is baked from the
+/// renderer's colours at its surface points. Returns the remaining whorl's coordinates.
+std::vector<organisms::HelicoCoords> moveApertureToInside(std::vector<ExportPart>& parts, ExportPart& whorl,
+                                                          const organisms::ShellPainter& painter, float roughness) {
+  std::vector<organisms::HelicoCoords> coords = whorlCoords(whorl.mesh, painter);
+  Mesh& mesh = whorl.mesh;
+  mesh.materials.assign(mesh.triangleCount(), 0);
+  bool any = false;
+  for (size_t t = 0; t < mesh.triangleCount(); ++t)
+    for (int k = 0; k < 3; ++k)
+      if (painter.insideWeight(coords[mesh.triangles[t][k]]) > 0.0) mesh.materials[t] = 1, any = true;
+  if (!any) {
+    mesh.materials.clear();
+    return coords;
+  }
+  std::vector<char> kept(mesh.vertexCount(), 0);
+  for (size_t t = 0; t < mesh.triangleCount(); ++t)
+    if (mesh.materials[t] == 0)
+      for (int k = 0; k < 3; ++k) kept[mesh.triangles[t][k]] = 1;
+  std::vector<std::pair<uint32_t, Mesh>> groups = splitByMaterial(mesh);
+  Mesh aperture = std::move(groups.back().second);
+  mesh = groups.size() == 2 ? std::move(groups.front().second) : Mesh{};
+  std::vector<organisms::HelicoCoords> rest;
+  for (size_t v = 0; v < kept.size(); ++v)
+    if (kept[v]) rest.push_back(coords[v]);
+  auto inside = std::find_if(parts.begin(), parts.end(), [](const ExportPart& p) { return p.name == "inside"; });
+  if (inside != parts.end()) {
+    inside->mesh.append(aperture);
+  } else {
+    const Vec3 color = painter.options().insideColor;
+    parts.push_back(ExportPart{"inside", std::move(aperture), PartMaterial{"inside", color, roughness, false, nullptr}});
+  }
+  return rest;
+}
+
+/// Maps the main whorl's texture onto the whorl part as an image over the helico-spiral
+/// coordinates of each vertex (organisms/shell_paint.h): s = angle around the generating
+/// curve / 360° (repeating), t = θ over the part's range, the first and last θ on the
+/// centres of the first and last rows. A shell with varix bands has two such images
+/// stacked, the outer wall's (bottom) and the canal's (top, without the bands): a vertex
+/// farther than kShellCanalRadial from every generating centre takes the top one. A
+/// triangle spanning more than 90° of θ or around (between two whorls, at the apex, or
+/// between wall and canal) takes one corner's coordinates. The texels are the painter's
+/// whorl colour at their coordinates (whorlSurfaceColor); coords are the mesh's vertices'.
+void textureWhorl(ExportPart& part, const organisms::ShellPainter& painter, const std::vector<organisms::HelicoCoords>& coords) {
+  Mesh& mesh = part.mesh;
+  if (mesh.triangleCount() == 0) return;
   double lo = INFINITY, hi = -INFINITY;
-  for (const auto& h : coords) lo = std::min(lo, h.thetaDeg), hi = std::max(hi, h.thetaDeg);
+  bool canal = false;
+  for (const auto& h : coords) {
+    lo = std::min(lo, h.thetaDeg), hi = std::max(hi, h.thetaDeg);
+    canal = canal || h.radial >= organisms::kShellCanalRadial;
+  }
+  canal = canal && painter.hasVarixBands();
   const double range = std::max(hi - lo, 1e-6);
+  const int rows = kExportTextureLong, height = rows * (canal ? 2 : 1);
   mesh.uvs.resize(mesh.positions.size());
   for (size_t v = 0; v < coords.size(); ++v) {
     const double s = coords[v].aroundDeg / 360.0;
-    mesh.uvs[v] = Vec2(float(s < 0 ? s + 1.0 : s), float((coords[v].thetaDeg - lo) / range));
+    const int half = canal && coords[v].radial >= organisms::kShellCanalRadial ? 1 : 0;
+    const double row = half * rows + 0.5 + (coords[v].thetaDeg - lo) / range * (rows - 1);
+    mesh.uvs[v] = Vec2(float(s < 0 ? s + 1.0 : s), float(row / height));
   }
   UvSeamOptions seams;
   seams.repeatU = true;
-  seams.maxSpan = Vec2(0.25f, float(90.0 / range));
-  part.material.texture = bakeTexture(kExportTextureAround, kExportTextureLong, [&](double s, double t) {
-    organisms::HelicoCoords h;
-    h.aroundDeg = s > 0.5 ? 360.0 * s - 360.0 : 360.0 * s;  // helicoCoords' range (−180°, 180°]
-    h.thetaDeg = lo + t * range;
-    return painter.whorlColorAt(h);
+  seams.maxSpan = Vec2(0.25f, float(90.0 / range * rows / height));
+  part.material.texture = bakeTexture(kExportTextureAround, height, [&](double s, double t) {
+    const long j = std::lround(t * height - 0.5);  // the texel's row from the bottom
+    const double around = s > 0.5 ? 360.0 * s - 360.0 : 360.0 * s;  // helicoCoords' range (−180°, 180°]
+    return painter.whorlSurfaceColor(lo + double(j % rows) / (rows - 1) * range, around, j >= rows);
   }, seams);
 }
 
+/// A shell grown to any age.
 class ShellModel final : public KindModel {
  public:
   explicit ShellModel(const ShellSpec& spec) : spec_(spec) {}
@@ -566,10 +620,23 @@ class ShellModel final : public KindModel {
     }
     render::Material painted;  // as paintPolygonized painted the surface
     painted.baseColor = colors.whorlColor;
+    // A whorl with growth lines is an atlas of the renderer's colours like the other parts:
+    // the lines are sharp tents a third of their spacing wide (0.5° either side of every 3°
+    // line on the Murex, 812 lines over the image's 2,048 rows), which no image over θ
+    // holds. Without them (or above the atlas budget) the whorl is an image over its
+    // helico-spiral coordinates, and the aperture's inside moves to the inside part.
+    std::vector<organisms::HelicoCoords> whorlCoords;
+    const bool growthLines = colors.growthLineDeg > 0.0f && colors.growthLineStrength > 0.0f;
+    for (size_t i = 0; i < parts.size(); ++i)
+      if (parts[i].name == "whorl") {
+        if (!growthLines || atlasBlobPart(parts[i], *shell.blob, implicit.textures, painted) == 0)
+          whorlCoords = moveApertureToInside(parts, parts[i], *shell.painter, implicit.material.roughness);
+        break;
+      }
     for (ExportPart& p : parts) {
-      if (p.name == "whorl")
-        textureWhorl(p, *shell.painter);
-      else  // varices, spines, bumps, inside: an atlas of the renderer's colours
+      if (p.name == "whorl") {
+        if (!p.material.texture) textureWhorl(p, *shell.painter, whorlCoords);
+      } else  // varices, spines, bumps, inside: an atlas of the renderer's colours
         atlasBlobPart(p, *shell.blob, implicit.textures, painted);
     }
     return parts;

@@ -54,6 +54,30 @@ HelicoCoords ShellPainter::helicoCoordsOfWorld(Vec3 worldPoint) const {
 Vec3 ShellPainter::whorlColor(Vec3 shellPoint) const { return whorlColorAt(helicoCoords(shellPoint)); }
 
 Vec3 ShellPainter::whorlColorAt(const HelicoCoords& h) const {
+  const double w = insideWeight(h);
+  const Vec3 c = wallColor(h);
+  if (w > 0.0) return glm::mix(c, options_.insideColor, static_cast<float>(w));
+  return h.radial < kShellCanalRadial ? withVarixBand(c, h.thetaDeg) : c;
+}
+
+Vec3 ShellPainter::whorlSurfaceColor(double thetaDeg, double aroundDeg, bool canal) const {
+  HelicoCoords h;
+  h.thetaDeg = thetaDeg;
+  h.aroundDeg = aroundDeg;
+  const Vec3 c = wallColor(h);
+  return canal ? c : withVarixBand(c, thetaDeg);
+}
+
+double ShellPainter::insideWeight(const HelicoCoords& h) const {
+  // The inside of the aperture: the cut surface of the opening, inside the whorl's wall.
+  const ShellTextureOptions& o = options_;
+  if (!opening_ || o.insideRadial <= 0.0f || h.thetaDeg <= openingFromDeg_) return 0.0;
+  return std::clamp((o.insideRadial + 0.04 - h.radial) / 0.08, 0.0, 1.0);
+}
+
+bool ShellPainter::hasVarixBands() const { return varices_ && varixSpacingDeg_ > 0.0; }
+
+Vec3 ShellPainter::wallColor(const HelicoCoords& h) const {
   const ShellTextureOptions& o = options_;
   Vec3 c = o.whorlColor;
   // Spiral cords: bands that follow the spiral (constant angle around the curve).
@@ -73,19 +97,17 @@ Vec3 ShellPainter::whorlColorAt(const HelicoCoords& h) const {
     const float a = pigment_->sample(u, v);
     c = glm::mix(c, o.pigmentColor, o.pigmentStrength * a);
   }
-  // The inside of the aperture: the cut surface of the opening, inside the whorl's wall.
-  if (opening_ && o.insideRadial > 0.0f && h.thetaDeg > openingFromDeg_) {
-    const double w = std::clamp((o.insideRadial + 0.04 - h.radial) / 0.08, 0.0, 1.0);
-    if (w > 0.0) return glm::mix(c, o.insideColor, static_cast<float>(w));
-  }
-  // Pale bands where varices were laid down.
-  if (varices_ && varixSpacingDeg_ > 0.0) {
-    const double dv = std::abs(std::remainder(h.thetaDeg - startDeg_, varixSpacingDeg_));
-    // Only on the whorl proper: the canal's points lie far from every generating centre, and
-    // a band there (constant θ along the axis) would draw a pale line down the canal.
-    if (h.thetaDeg > startDeg_ + 0.5 * varixSpacingDeg_ && dv < 4.0 && h.radial < 1.25)
-      c = glm::mix(c, o.varixColor, static_cast<float>(0.6 * (1.0 - dv / 4.0)));
-  }
+  return c;
+}
+
+Vec3 ShellPainter::withVarixBand(Vec3 c, double thetaDeg) const {
+  // Pale bands where varices were laid down (only on the whorl proper: the canal's points
+  // lie far from every generating centre, and a band there, constant θ along the axis,
+  // would draw a pale line down the canal; whorlColorAt leaves them out there).
+  if (!hasVarixBands()) return c;
+  const double dv = std::abs(std::remainder(thetaDeg - startDeg_, varixSpacingDeg_));
+  if (thetaDeg > startDeg_ + 0.5 * varixSpacingDeg_ && dv < 4.0)
+    c = glm::mix(c, options_.varixColor, static_cast<float>(0.6 * (1.0 - dv / 4.0)));
   return c;
 }
 

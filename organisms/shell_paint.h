@@ -44,6 +44,10 @@ struct ShellTextureOptions {
   textures::PigmentRdOptions pigmentOptions;  ///< rows span the fully grown shell's θ range
 };
 
+/// Points of the whorl farther than this from every generating centre (in units of D(θ))
+/// are the canal's: the whorl's varix bands stop there (ShellPainter::whorlColorAt).
+inline constexpr double kShellCanalRadial = 1.25;
+
 /// Helico-spiral coordinates of a point in shell coordinates.
 struct HelicoCoords {
   double thetaDeg = 0.0;   ///< angle along the spiral of the generating curve nearest the point
@@ -67,14 +71,26 @@ class ShellPainter {
   HelicoCoords helicoCoords(Vec3 shellPoint) const;
   /// Helico-spiral coordinates of a world point (helicoCoords of its shell-space point).
   HelicoCoords helicoCoordsOfWorld(Vec3 worldPoint) const;
-  /// The main whorl's colour at helico-spiral coordinates (only thetaDeg and aroundDeg
-  /// matter): partColor(Whorl, p, uv) is whorlColorAt(helicoCoordsOfWorld(p)). Exports bake
-  /// it into an image over (aroundDeg, thetaDeg).
+  /// The main whorl's colour at helico-spiral coordinates: partColor(Whorl, p, uv) is
+  /// whorlColorAt(helicoCoordsOfWorld(p)). It depends on the radial coordinate in two places
+  /// only: the inside of the aperture (insideWeight > 0) and the canal (radial >=
+  /// kShellCanalRadial: no varix bands); elsewhere it is whorlSurfaceColor(θ, around, false).
   Vec3 whorlColorAt(const HelicoCoords& coords) const;
+  /// The whorl's colour at (θ, around) on its outer wall (canal false: with the varix
+  /// bands) or on the canal (canal true: without them), where insideWeight is 0: what
+  /// exports bake into an image over (aroundDeg, thetaDeg).
+  Vec3 whorlSurfaceColor(double thetaDeg, double aroundDeg, bool canal) const;
+  /// Weight in [0, 1] of the inside colour at these coordinates: > 0 only past the opening's
+  /// start (θ > θ_end − depth) and within insideRadial + 0.04 of the generating centre.
+  double insideWeight(const HelicoCoords& coords) const;
+  /// Whether the whorl has pale varix bands (so the canal's colour differs from the wall's).
+  bool hasVarixBands() const;
   const ShellTextureOptions& options() const { return options_; }
 
  private:
   Vec3 whorlColor(Vec3 shellPoint) const;
+  Vec3 wallColor(const HelicoCoords& coords) const;  ///< ground, cords, growth lines, pigment
+  Vec3 withVarixBand(Vec3 color, double thetaDeg) const;
 
   ShellTextureOptions options_;
   HelicoSpiral spiral_;

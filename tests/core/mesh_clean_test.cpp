@@ -81,3 +81,43 @@ TEST_CASE("cleanMesh", "[core]") {
     CHECK(m.normals[1] == movedCube(1, Vec3(0)).normals[1]);
   }
 }
+
+TEST_CASE("removeDegenerateTriangles", "[core]") {
+  // A closed cube (12 triangles) and five degenerate triangles among them: two with a
+  // repeated corner ({0,0,1}, {2,3,3}), three of zero area with distinct corners (vertex 8
+  // at vertex 0's position, vertex 9 halfway along the edge from 0 to 1, and three corners
+  // on one line), each with a material id.
+  Mesh mesh = test::cube(true);
+  mesh.positions.push_back(mesh.positions[0]);                                  // 8
+  mesh.positions.push_back(0.5f * (mesh.positions[0] + mesh.positions[1]));     // 9
+  const std::vector<glm::uvec3> bad = {{0, 0, 1}, {0, 8, 5}, {2, 3, 3}, {0, 9, 1}, {9, 1, 0}};
+  std::vector<glm::uvec3> triangles;
+  std::vector<uint32_t> materials;
+  for (size_t t = 0; t < 12; ++t) {
+    triangles.push_back(mesh.triangles[t]), materials.push_back(mesh.materials[t]);
+    if (t % 3 == 0) triangles.push_back(bad[t / 3]), materials.push_back(99);
+  }
+  triangles.push_back(bad[4]), materials.push_back(99);
+  mesh.triangles = triangles;
+  mesh.materials = materials;
+  REQUIRE(mesh.triangleCount() == 17);
+  const Mesh cube = test::cube(true);
+  std::vector<size_t> kept;
+  const DegenerateReport r = removeDegenerateTriangles(mesh, &kept);
+  CHECK(r.repeatedIndex == 2);
+  CHECK(r.zeroArea == 3);
+  CHECK(r.total() == 5);
+  // The cube's twelve remain, in order, with their materials; kept names their old places.
+  REQUIRE(mesh.triangleCount() == 12);
+  REQUIRE(kept.size() == 12);
+  for (size_t t = 0; t < 12; ++t) {
+    CHECK(mesh.triangles[t] == cube.triangles[t]);
+    CHECK(mesh.materials[t] == cube.materials[t]);
+    CHECK(triangles[kept[t]] == cube.triangles[t]);
+  }
+  CHECK(mesh.vertexCount() == 10);  // vertices stay
+  CHECK(analyzeTopology(mesh).closed());
+  // A second pass finds nothing.
+  CHECK(removeDegenerateTriangles(mesh).total() == 0);
+  CHECK(mesh.triangleCount() == 12);
+}

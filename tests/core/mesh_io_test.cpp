@@ -406,6 +406,24 @@ TEST_CASE("writeParts::texture", "[core]") {
     CHECK(readFile(file).find("f 1/1 2/2 3/3\n") != std::string::npos);
     CHECK(dir.entries() == 3);
   }
+  SECTION("obj: -clamp on where the glTF sampler clamps both axes, not where one repeats") {
+    ExportPart clamped = quad;
+    auto tex = std::make_shared<PartTexture>(*quad.material.texture);
+    tex->seams.repeatU = false;  // both axes clamp, as an atlas's and cpfg leaves' do
+    clamped.material.texture = tex;
+    clamped.material.alphaCutoff = 0.1f;
+    writeParts({clamped}, dir.path / "k.obj");
+    CHECK(readFile(dir.path / "k.mtl").find("map_Kd -clamp on k_bark.png\nmap_d -clamp on k_bark.png\n") != std::string::npos);
+    writeParts({clamped}, dir.path / "k.glb");
+    tinygltf::Model model;
+    tinygltf::TinyGLTF loader;
+    std::string err, warn;
+    REQUIRE(loader.LoadBinaryFromFile(&model, &err, &warn, (dir.path / "k.glb").string()));
+    CHECK(model.samplers[0].wrapS == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE);
+    CHECK(model.samplers[0].wrapT == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE);
+    writeParts({quad}, dir.path / "r.obj");  // s repeats: MTL cannot clamp t alone
+    CHECK(readFile(dir.path / "r.mtl").find("-clamp") == std::string::npos);
+  }
   SECTION("a texture without uvs is refused, nothing written") {
     ExportPart bad = quad;
     bad.mesh.uvs.clear();
