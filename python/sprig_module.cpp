@@ -253,7 +253,8 @@ struct MeshRequest {
   std::optional<double> simplify;
 };
 
-/// `sprig mesh`'s parts (app/cmd_mesh.cpp): exportParts, then simplifyParts when asked.
+/// `sprig mesh`'s parts (app/cmd_mesh.cpp): exportParts, simplifyParts when asked, then
+/// finishExportParts (degenerate triangles removed, the model placed at the origin).
 std::vector<ExportPart> meshParts(PySpecies& s, const MeshRequest& r) {
   if (r.cell < 0) throw UsageError("cell must be positive (0 = automatic)");
   if (r.minVolume < 0 || r.minVolume > 1) throw UsageError("min_volume must lie in [0, 1]");
@@ -265,6 +266,7 @@ std::vector<ExportPart> meshParts(PySpecies& s, const MeshRequest& r) {
   std::vector<ExportPart> parts = s.model->exportParts(stage, static_cast<float>(r.cell), true, clean, &fig);
   const double simplify = r.simplify ? *r.simplify : s.species.render.simplify;
   if (simplify > 0) simplifyParts(parts, simplify);
+  finishExportParts(parts);
   return parts;
 }
 
