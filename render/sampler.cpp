@@ -83,7 +83,10 @@ ZSobolSampler::ZSobolSampler(int width, int height, int spp, uint64_t seed)
     : log2Spp_(log2Ceil(static_cast<uint64_t>(std::max(spp, 1)))), seed_(seed) {
   const int log2Resolution = log2Ceil(static_cast<uint64_t>(std::max({width, height, 1})));
   base4Digits_ = log2Resolution + (log2Spp_ + 1) / 2;
-  for (uint32_t d = 0; d < kCachedDimensions; ++d) dimensionHashes_[d] = deriveSeed(seed_, {d});
+  for (uint32_t d = 0; d < kCachedDimensions; ++d) {
+    dimensionHashes_[d] = deriveSeed(seed_, {d});
+    cachedPixel_[d] = ~uint64_t{0};
+  }
 }
 
 void ZSobolSampler::startPixelSample(int x, int y, int k) {
@@ -92,22 +95,40 @@ void ZSobolSampler::startPixelSample(int x, int y, int k) {
   dimension_ = 0;
 }
 
-uint64_t ZSobolSampler::sampleIndex() const {
+uint64_t ZSobolSampler::permuteDigits(int from, int to) const {
   // Permute each base-4 digit of the Morton index by a permutation picked by the digits
-  // above it: a bijection on every aligned block of 4^j indices. With an odd log2(spp)
-  // the last digit is a single bit, flipped by a hash.
-  const bool oddBits = (log2Spp_ & 1) != 0;
-  const int lastDigit = oddBits ? 1 : 0;
-  const uint64_t dimKey = 0x55555555ull * dimension_;
+  // above it: a bijection on every aligned block of 4^j indices.
+  const int oddShift = (log2Spp_ & 1) != 0 ? 1 : 0;
+  const uint64_t key = 0x55555555ull * dimension_ ^ seed_;
   uint64_t index = 0;
-  for (int i = base4Digits_ - 1; i >= lastDigit; --i) {
-    const int shift = 2 * i - (oddBits ? 1 : 0);
+  for (int i = from - 1; i >= to; --i) {
+    const int shift = 2 * i - oddShift;
     const uint64_t digit = (mortonIndex_ >> shift) & 3;
-    const uint64_t higher = mortonIndex_ >> (shift + 2);
-    const uint64_t p = (mix64(higher ^ dimKey ^ seed_) >> 24) % 24;
+    const uint64_t p = (mix64((mortonIndex_ >> (shift + 2)) ^ key) >> 24) % 24;
     index |= static_cast<uint64_t>(kPermutations[p][digit]) << shift;
   }
-  if (oddBits) index |= (mortonIndex_ & 1) ^ (mix64((mortonIndex_ >> 1) ^ dimKey ^ seed_) & 1);
+  return index;
+}
+
+uint64_t ZSobolSampler::sampleIndex() {
+  // Digits i >= pixelDigit hold the pixel's Morton code alone: the same for all samples of
+  // the pixel, so they are permuted once per pixel and dimension. With an odd log2(spp)
+  // the last digit is a single bit, flipped by a hash.
+  const bool oddBits = (log2Spp_ & 1) != 0;
+  const int pixelDigit = (log2Spp_ + 1) / 2;
+  const uint64_t pixel = mortonIndex_ >> log2Spp_;
+  uint64_t index;
+  if (dimension_ < kCachedDimensions && cachedPixel_[dimension_] == pixel) {
+    index = cachedHigh_[dimension_];
+  } else {
+    index = permuteDigits(base4Digits_, pixelDigit);
+    if (dimension_ < kCachedDimensions) {
+      cachedPixel_[dimension_] = pixel;
+      cachedHigh_[dimension_] = index;
+    }
+  }
+  index |= permuteDigits(pixelDigit, oddBits ? 1 : 0);
+  if (oddBits) index |= (mortonIndex_ & 1) ^ (mix64((mortonIndex_ >> 1) ^ (0x55555555ull * dimension_ ^ seed_)) & 1);
   return index;
 }
 

@@ -57,11 +57,15 @@ class ZSobolSampler {
   float get1D();
 
  private:
-  uint64_t sampleIndex() const;
+  uint64_t sampleIndex();
+  /// The permuted base-4 digits from..to-1 (counted from the lowest) of the current index.
+  uint64_t permuteDigits(int from, int to) const;
   uint64_t dimensionHash() const;
 
   static constexpr uint32_t kCachedDimensions = 32;
   uint64_t dimensionHashes_[kCachedDimensions] = {};  ///< deriveSeed(seed, {d}) of the first dimensions
+  uint64_t cachedPixel_[kCachedDimensions] = {};      ///< the pixel (Morton code) cachedHigh_ was made for
+  uint64_t cachedHigh_[kCachedDimensions] = {};       ///< its permuted pixel digits, per dimension
   int log2Spp_ = 0;
   int base4Digits_ = 0;
   uint64_t seed_ = 0;
