@@ -110,7 +110,8 @@ struct RenderStats {
 
 /// Renders scene (committed) through camera. Throws std::invalid_argument for a size or
 /// sample count below 1, Cancelled when cancellation was requested. Cost: about
-/// width*height*spp*(1 + shadows + skySamples) rays.
+/// width*height*spp*(1 + shadows + skySamples) rays (up to unlitSkySamples sky rays where
+/// the sun is blocked).
 Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings& settings, RenderStats* stats = nullptr);
 
 }  // namespace sprig::render
