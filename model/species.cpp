@@ -28,6 +28,8 @@ void readRender(MapReader& m, SpeciesRender& r, DiagnosticList& diags) {
   im.width = static_cast<int>(m.integer("width", im.width, 16, 8192));
   im.height = static_cast<int>(m.integer("height", im.height, 16, 8192));
   im.spp = static_cast<int>(m.integer("samples", im.spp, 1, 1024));
+  im.sampler = m.choice("sampler", "zsobol", {"zsobol", "stratified"}) == "stratified" ? render::Sampling::Stratified
+                                                                                     : render::Sampling::ZSobol;
   im.thinMinPixels = static_cast<float>(m.number("thin_min_pixels", im.thinMinPixels, 0.0, 8.0));
   r.dualMesher = m.choice("mesher", r.dualMesher ? "dual" : "tetrahedra", {"tetrahedra", "dual"}) == "dual";
   r.simplify = m.number("simplify", r.simplify, 0.0, 0.1);
@@ -73,6 +75,7 @@ void readRender(MapReader& m, SpeciesRender& r, DiagnosticList& diags) {
   }
   im.fillStrength = static_cast<float>(m.number("fill", im.fillStrength, 0.0, 10.0));
   im.skyStrength = static_cast<float>(m.number("sky", im.skyStrength, 0.0, 10.0));
+  im.unlitSkySamples = static_cast<int>(m.integer("unlit_sky_samples", im.unlitSkySamples, 0, 16));
   r.surface.baseColor = m.color("color", r.surface.baseColor);
   r.surface.roughness = static_cast<float>(m.number("roughness", r.surface.roughness, 0.0, 1.0));
   r.surface.specular = static_cast<float>(m.number("specular", r.surface.specular, 0.0, 1.0));

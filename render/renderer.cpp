@@ -11,6 +11,7 @@
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "core/rng.h"
+#include "render/sampler.h"
 
 namespace sprig::render {
 
@@ -62,15 +63,30 @@ struct Counters {
   uint64_t camera = 0, shadow = 0, sky = 0;
 };
 
-/// Which strata of the pixel's light samples one camera sample uses: the sun disc and
-/// the sky hemisphere are stratified over all samples of a pixel, with a per-pixel
-/// cyclic shift so light strata do not follow the film strata.
+/// Where one camera sample's light samples come from. With a Sobol' sampler, its next
+/// dimensions. Otherwise (Sampling::Stratified) the sun disc and the sky hemisphere are
+/// stratified over all samples of a pixel, with a per-pixel cyclic shift so light strata
+/// do not follow the film strata, jittered by the pixel's generator.
 struct Strata {
   int sample = 0;     ///< camera sample index k in [0, spp)
   int spp = 1;
   int sunShift = 0;   ///< per-pixel shift of the sun stratum
   int skyShift = 0;   ///< per-pixel shift of the sky strata
+  ZSobolSampler* sobol = nullptr;  ///< the low-discrepancy source, positioned at this sample
 };
+
+/// The sun-disc sample of camera sample st.
+Vec2 sunSample(const Strata& st, Rng& rng) {
+  if (st.sobol) return st.sobol->get2D();
+  return stratified((st.sample + st.sunShift) % st.spp, st.spp, rng);
+}
+
+/// Sky ray k (of perSample) of camera sample st.
+Vec2 skySample(const Strata& st, int k, int perSample, Rng& rng) {
+  if (st.sobol) return st.sobol->get2D();
+  const int total = st.spp * perSample;
+  return stratified((st.sample * perSample + k + st.skyShift) % total, total, rng);
+}
 
 /// Per-render constants and the shading of one camera sample.
 class Integrator {
@@ -170,9 +186,10 @@ class Integrator {
     const Vec3 origin = h.position + eps_ * ng;
     const Vec3 albedo = glm::clamp(h.color, Vec3(0), Vec3(1));
     Vec3 radiance(0);
+    bool sunLit = false;
 
     if (s_.sun) {
-      Vec2 u = stratified((st.sample + st.sunShift) % st.spp, st.spp, rng);
+      Vec2 u = sunSample(st, rng);
       Vec3 l = sunCos_ < 1.0f ? sampleCone(sunDir_, sunCos_, u) : sunDir_;
       float cosL = glm::dot(n, l);
       if (cosL > 0.0f && glm::dot(ng, l) > -0.05f) {
@@ -187,6 +204,7 @@ class Integrator {
           float e = 2.0f / r4 - 2.0f;
           Vec3 hv = glm::normalize(l + v);
           float spec = e > 0.0f ? m.specular * (e + 8.0f) / 8.0f * std::pow(std::max(0.0f, glm::dot(n, hv)), e) : 0.0f;
+          sunLit = true;
           radiance += s_.sunColor * s_.sunStrength * cosL * (albedo + Vec3(spec));
         }
       }
@@ -196,14 +214,14 @@ class Integrator {
       if (s_.skySamples <= 0) {
         skyLight = sky(n, h.position);
       } else {
-        for (int k = 0; k < s_.skySamples; ++k) {
-          int total = st.spp * s_.skySamples;
-          Vec3 d = sampleCosine(n, stratified((st.sample * s_.skySamples + k + st.skyShift) % total, total, rng));
+        const int rays = sunLit ? s_.skySamples : std::max(s_.skySamples, s_.unlitSkySamples);
+        for (int k = 0; k < rays; ++k) {
+          Vec3 d = sampleCosine(n, skySample(st, k, rays, rng));
           if (glm::dot(d, ng) <= 0.0f) continue;
           ++c.sky;
           if (!scene_.occluded(origin, d, 0.0f, kInf)) skyLight += sky(d, h.position);
         }
-        skyLight /= static_cast<float>(s_.skySamples);
+        skyLight /= static_cast<float>(rays);
       }
       radiance += albedo * skyLight * s_.skyStrength;
     }
@@ -231,6 +249,36 @@ struct FilmSample {
   Vec4 value;
 };
 
+/// Traces the s.spp samples of pixel (x, y) into out: their film points from sobol when
+/// given (else a jittered grid from the pixel's generator) and the values seen there.
+void tracePixel(const Integrator& integrator, const RenderSettings& s, int x, int y, ZSobolSampler* sobol, FilmSample* out,
+                Counters& c) {
+  const int spp = s.spp;
+  Rng rng(deriveSeed(s.seed, {static_cast<uint64_t>(x), static_cast<uint64_t>(y)}));
+  Strata st;
+  st.spp = spp;
+  st.sobol = sobol;
+  if (!sobol) {
+    st.sunShift = static_cast<int>(rng.below(static_cast<uint32_t>(spp)));
+    st.skyShift = static_cast<int>(rng.below(static_cast<uint32_t>(spp * std::max(1, s.skySamples))));
+  }
+  const int gx = std::max(1, static_cast<int>(std::floor(std::sqrt(static_cast<double>(spp)))));
+  const int gy = (spp + gx - 1) / gx;
+  for (int k = 0; k < spp; ++k) {
+    Vec2 f;
+    if (sobol) {
+      sobol->startPixelSample(x, y, k);
+      f = sobol->get2D();
+    } else {
+      float jx = next(rng), jy = next(rng);
+      f = Vec2((static_cast<float>(k % gx) + jx) / static_cast<float>(gx), (static_cast<float>(k / gx) + jy) / static_cast<float>(gy));
+    }
+    const float fx = static_cast<float>(x) + f.x, fy = static_cast<float>(y) + f.y;
+    st.sample = k;
+    out[k] = {fx, fy, integrator.sample(fx, fy, st, rng, c)};
+  }
+}
+
 }  // namespace
 
 Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings& s, RenderStats* stats) {
@@ -249,8 +297,7 @@ Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings
   const float radius = tent ? s.filterRadius : 0.5f;
   const int apron = tent ? static_cast<int>(std::ceil(radius - 0.5f)) : 0;
   const int spp = s.spp;
-  const int gx = std::max(1, static_cast<int>(std::floor(std::sqrt(static_cast<double>(spp)))));
-  const int gy = (spp + gx - 1) / gx;
+  const ZSobolSampler sobolBase(s.width, s.height, spp, s.seed);
 
   const int tilesX = (s.width + kTile - 1) / kTile, tilesY = (s.height + kTile - 1) / kTile;
   const size_t tileCount = static_cast<size_t>(tilesX) * tilesY;
@@ -267,22 +314,12 @@ Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings
     const int ax1 = std::min(s.width, x1 + apron), ay1 = std::min(s.height, y1 + apron);
     const int aw = ax1 - ax0;
     std::vector<FilmSample> samples(static_cast<size_t>(aw) * (ay1 - ay0) * spp);
+    ZSobolSampler sobol = sobolBase;
+    ZSobolSampler* zsobol = s.sampler == Sampling::ZSobol ? &sobol : nullptr;
     Counters c;
     for (int y = ay0; y < ay1; ++y) {
       for (int x = ax0; x < ax1; ++x) {
-        Rng rng(deriveSeed(s.seed, {static_cast<uint64_t>(x), static_cast<uint64_t>(y)}));
-        Strata st;
-        st.spp = spp;
-        st.sunShift = static_cast<int>(rng.below(static_cast<uint32_t>(spp)));
-        st.skyShift = static_cast<int>(rng.below(static_cast<uint32_t>(spp * std::max(1, s.skySamples))));
-        FilmSample* out = &samples[(static_cast<size_t>(y - ay0) * aw + (x - ax0)) * spp];
-        for (int k = 0; k < spp; ++k) {
-          float jx = next(rng), jy = next(rng);
-          float fx = static_cast<float>(x) + (static_cast<float>(k % gx) + jx) / static_cast<float>(gx);
-          float fy = static_cast<float>(y) + (static_cast<float>(k / gx) + jy) / static_cast<float>(gy);
-          st.sample = k;
-          out[k] = {fx, fy, integrator.sample(fx, fy, st, rng, c)};
-        }
+        tracePixel(integrator, s, x, y, zsobol, &samples[(static_cast<size_t>(y - ay0) * aw + (x - ax0)) * spp], c);
       }
     }
     for (int y = y0; y < y1; ++y) {

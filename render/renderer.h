@@ -1,8 +1,10 @@
 #pragma once
 /// The tile renderer: camera rays, sun with soft shadows, sky light, ground, film.
 ///
-/// Each pixel draws `spp` stratified jittered samples from its own generator seeded with
-/// deriveSeed(seed, {x, y}), so a pixel's samples (and the image bytes) do not depend on
+/// Each pixel draws `spp` samples whose points depend only on (seed, x, y, sample,
+/// dimension): Owen-scrambled Sobol' points in Morton order (Sampling::ZSobol, the default;
+/// render/sampler.h) or stratified jittered samples from a generator seeded with
+/// deriveSeed(seed, {x, y}) (Sampling::Stratified); so the image bytes do not depend on
 /// the thread count or the tile order. Tiles of 32x32 pixels run in parallel; a tent
 /// filter also traces a one-pixel apron of neighbouring pixels' samples (identical to
 /// what their own tile traces) so the reconstruction crosses tile borders seamlessly.
@@ -27,6 +29,17 @@ enum class Background {
   Transparent,  ///< alpha 0 (color 0) where nothing is hit
 };
 
+/// Where a pixel's sample points come from.
+enum class Sampling {
+  /// Morton-ordered Owen-scrambled Sobol' points (render/sampler.h): stratified within a
+  /// pixel and across neighbouring pixels, for the film, the sun disc and every sky ray.
+  ZSobol,
+  /// The earlier sampler, kept as a baseline: a jittered near-square grid on the film and
+  /// jittered strata of the sun disc and the sky hemisphere with a per-pixel cyclic shift,
+  /// drawn from a per-pixel PCG32 stream.
+  Stratified,
+};
+
 /// Pixel reconstruction filter.
 enum class Filter {
   Box,   ///< average of the pixel's own samples
@@ -37,7 +50,8 @@ enum class Filter {
 struct RenderSettings {
   int width = 800;      ///< pixels
   int height = 600;     ///< pixels
-  int spp = 4;          ///< camera samples per pixel (stratified on a near-square grid)
+  int spp = 4;          ///< camera samples per pixel
+  Sampling sampler = Sampling::ZSobol;  ///< how the samples are placed
   int threads = 0;      ///< 0 = all cores
   uint64_t seed = 0;    ///< base seed of every per-pixel generator
 
@@ -61,6 +75,10 @@ struct RenderSettings {
   Vec3 skyHorizon{0.90f, 0.93f, 1.00f};  ///< sky radiance at the horizon
   float skyStrength = 0.5f;      ///< scale of the sky light
   int skySamples = 1;             ///< ambient-occlusion rays per camera sample (0 = unoccluded sky)
+  /// Ambient-occlusion rays per camera sample where the sun adds nothing (the point is in
+  /// its shadow or faces away from it), when more than skySamples: there the sky is the
+  /// only light and its rays the only noise. 0 = skySamples everywhere.
+  int unlitSkySamples = 0;
   float fillStrength = 0.0f;      ///< unshadowed light from the camera direction (0 = off)
 
   bool ground = true;             ///< analytic ground plane under the model
@@ -93,8 +111,8 @@ struct RenderStats {
 /// Renders scene (committed) through camera. Throws std::invalid_argument for a size or
 /// sample count below 1, a camera that cannot make valid rays (cameraProblem) or a scene
 /// whose bounds are not finite or beyond kMaxRenderCoordinate, Cancelled when cancellation
-/// was requested. Cost: about
-/// width*height*spp*(1 + shadows + skySamples) rays.
+/// was requested. Cost: about width*height*spp*(1 + shadows + skySamples) rays (up to
+/// unlitSkySamples sky rays where the sun is blocked).
 Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings& settings, RenderStats* stats = nullptr);
 
 }  // namespace sprig::render
