@@ -5,11 +5,7 @@
 # the three modes give three different pictures (so the comparison can fail).
 # Usage: tests/cli/animate_mode_test.sh path/to/sprig   (run from the repository root)
 set -euo pipefail
-SPRIG=$(realpath "$1")
-WORK=$(mktemp -d "${TMPDIR:-/tmp}/sprig-cli-test-XXXXXX")
-trap 'rm -rf "$WORK"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
-sprig() { "$SPRIG" --quiet "$@"; }
+. "$(dirname "$0")/lib.sh"
 SPECIES=species/fig_tree_11_branching.yaml
 size=(--width 48 --height 40)
 for mode in exact mesh skeleton; do

@@ -8,11 +8,7 @@
 #   4. the stages differ (each operation changes the picture), so the checks can fail.
 # Usage: tests/cli/animate_solid_test.sh path/to/sprig   (run from the repository root)
 set -euo pipefail
-SPRIG=$(realpath "$1")
-WORK=$(mktemp -d "${TMPDIR:-/tmp}/sprig-cli-test-XXXXXX")
-trap 'rm -rf "$WORK"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
-sprig() { "$SPRIG" --quiet "$@"; }
+. "$(dirname "$0")/lib.sh"
 
 cat >"$WORK/ball.yaml" <<'YAML'
 kind: solid

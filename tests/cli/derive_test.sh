@@ -14,11 +14,7 @@
 #      printf writes to stderr.
 # Usage: tests/cli/derive_test.sh path/to/sprig   (run from the repository root)
 set -euo pipefail
-SPRIG=$(realpath "$1")
-WORK=$(mktemp -d "${TMPDIR:-/tmp}/sprig-cli-test-XXXXXX")
-trap 'rm -rf "$WORK"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
-sprig() { "$SPRIG" --quiet "$@"; }
+. "$(dirname "$0")/lib.sh"
 
 # --- 1. the --json report of ABOP 1.24a --------------------------------------------------
 json=$(sprig derive grammars/abop_1_24a.lsys --json)

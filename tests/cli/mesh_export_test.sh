@@ -9,10 +9,7 @@
 #      for a tree, a shell and an organism.
 # Usage: tests/cli/mesh_export_test.sh path/to/sprig   (run from the repository root)
 set -euo pipefail
-SPRIG=$(realpath "$1")
-WORK=$(mktemp -d "${TMPDIR:-/tmp}/sprig-mesh-test-XXXXXX")
-trap 'rm -rf "$WORK"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
+. "$(dirname "$0")/lib.sh"
 
 # The glb's triangle count and its box (min and max of every POSITION accessor), and the
 # same from the OBJ's f and v lines: "triangles minx miny minz maxx maxy maxz".

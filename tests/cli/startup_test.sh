@@ -9,10 +9,7 @@
 #      no file.
 # Usage: tests/cli/startup_test.sh path/to/sprig   (run from the repository root)
 set -euo pipefail
-SPRIG=$(realpath "$1")
-WORK=$(mktemp -d "${TMPDIR:-/tmp}/sprig-startup-test-XXXXXX")
-trap 'rm -rf "$WORK"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
+. "$(dirname "$0")/lib.sh"
 heavy='lib(OpenImageIO|openvdb)[^/]*\.so'
 # The shared objects a run of sprig maps ("file=NAME [0];  needed by ..." / dlopen lines).
 loaded() { LD_DEBUG=files "$@" 2>&1 >/dev/null | grep -oE 'file=[^ ]+' | sort -u || true; }

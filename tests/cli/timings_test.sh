@@ -6,9 +6,7 @@
 # most the wall time measured from outside, and at least half of it).
 # Usage: tests/cli/timings_test.sh path/to/sprig   (run from the repository root)
 set -euo pipefail
-SPRIG=$(realpath "$1")
-WORK=$(mktemp -d "${TMPDIR:-/tmp}/sprig-timings-test-XXXXXX")
-trap 'rm -rf "$WORK"' EXIT
+. "$(dirname "$0")/lib.sh"
 python3 - "$SPRIG" "$WORK" <<'PY'
 import json, subprocess, sys, time
 sprig, work = sys.argv[1:]
