@@ -662,19 +662,30 @@ std::string pathRefusal(const std::string& written, const fs::path& resolved, co
   return {};
 }
 
+namespace {
+
+/// p.lexically_normal() without the trailing separator `a/b/..` leaves ("a/"); "." for empty.
+fs::path normalFolder(const fs::path& p) {
+  fs::path n = p.lexically_normal();
+  if (!n.has_filename() && n.has_relative_path()) n = n.parent_path();
+  return n.empty() ? fs::path(".") : n;
+}
+
+}  // namespace
+
 fs::path defaultLibraryRoot(const fs::path& speciesPath) {
   std::error_code ec;
   const fs::path start = fs::is_directory(speciesPath, ec) ? speciesPath : speciesPath.parent_path();
   fs::path spelled = start.empty() ? fs::path(".") : start;  // the candidate as the user spelled it
   fs::path dir = fs::weakly_canonical(fs::absolute(spelled, ec), ec);
   for (int up = 0; up < 256 && !dir.empty(); ++up) {
-    if (fs::is_regular_file(dir / ".sprig-root", ec)) return spelled.lexically_normal();
-    if (dir.filename() == "species") return (spelled / "..").lexically_normal();
+    if (fs::is_regular_file(dir / ".sprig-root", ec)) return normalFolder(spelled);
+    if (dir.filename() == "species") return normalFolder(spelled / "..");
     if (dir == dir.parent_path()) break;
     dir = dir.parent_path();
     spelled /= "..";
   }
-  return start.empty() ? fs::path(".") : start.lexically_normal();
+  return normalFolder(start);
 }
 
 // ---- MapReader ---------------------------------------------------------------------
