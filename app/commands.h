@@ -27,7 +27,7 @@ enum ExitCode : int { kExitOk = 0, kExitBadInput = 1, kExitUsage = 2, kExitInter
 struct GlobalOptions {
   bool quiet = false;
   int threads = 0;  ///< 0 = all cores
-  std::string root = ".";
+  std::string root;  ///< `--root`; empty: each species file's defaultLibraryRoot
   bool allowOutsidePaths = false;
   bool fullTape = false;  ///< `--full-tape`: implicit surfaces trace the whole tape per cell
   bool strict = false;    ///< `--strict`: warnings about the input are errors

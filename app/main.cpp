@@ -41,7 +41,9 @@ int main(int argc, char** argv) {
   GlobalOptions global;
   app.add_flag("-q,--quiet", global.quiet, "no progress bars or summaries");
   app.add_option("--threads", global.threads, "worker threads (0 = all cores)")->check(CLI::Range(0, 4096));
-  app.add_option("--root", global.root, "library root: species may only reference files inside it")
+  app.add_option("--root", global.root,
+                 "library root: species may only reference files inside it (default: the nearest folder above the "
+                 "species file holding a .sprig-root file or a species/ folder it lies in, else the species file's folder)")
       ->check(CLI::ExistingDirectory);
   app.add_flag("--allow-outside-paths", global.allowOutsidePaths,
                "let species reference absolute paths and files outside the root");

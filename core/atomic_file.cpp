@@ -1,5 +1,7 @@
 #include "core/atomic_file.h"
 
+#include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -94,27 +96,79 @@ void writeFileAtomic(const fs::path& path, std::string_view bytes) {
   tmp.commit();
 }
 
-std::string readFile(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error("cannot read '" + path.string() + "': " + std::strerror(errno));
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
+FileReadError::FileReadError(const fs::path& path, std::string reason)
+    : std::runtime_error(reason == "cannot find file" ? "cannot find file '" + path.string() + "'"
+                         : reason.rfind("cannot ", 0) == 0 ? "'" + path.string() + "': " + reason
+                                                           : "'" + path.string() + "' " + reason),
+      reason_(std::move(reason)) {}
+
+namespace {
+
+/// notRegularFileReason of a stat result.
+std::string reasonOfMode(mode_t mode) {
+  if (S_ISREG(mode)) return {};
+  if (S_ISDIR(mode)) return "is a folder, not a regular file";
+  if (S_ISFIFO(mode)) return "is a FIFO, not a regular file";
+  if (S_ISSOCK(mode)) return "is a socket, not a regular file";
+  if (S_ISCHR(mode) || S_ISBLK(mode)) return "is a device, not a regular file";
+  return "is not a regular file";
+}
+
+/// Closes a descriptor when it goes out of scope.
+struct FdCloser {
+  int fd;
+  ~FdCloser() { ::close(fd); }
+};
+
+}  // namespace
+
+std::string notRegularFileReason(const fs::path& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0)
+    return errno == ENOENT || errno == ENOTDIR ? "cannot find file" : std::string("cannot read it: ") + std::strerror(errno);
+  return reasonOfMode(st.st_mode);
+}
+
+void requireRegularFile(const fs::path& path) {
+  std::string reason = notRegularFileReason(path);
+  if (!reason.empty()) throw FileReadError(path, std::move(reason));
+}
+
+std::string readFile(const fs::path& path, uint64_t maxBytes) {
+  requireRegularFile(path);
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) throw FileReadError(path, std::string("cannot read it: ") + std::strerror(errno));
+  FdCloser closer{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) throw FileReadError(path, std::string("cannot read it: ") + std::strerror(errno));
+  if (std::string reason = reasonOfMode(st.st_mode); !reason.empty()) throw FileReadError(path, std::move(reason));
+  const uint64_t size = static_cast<uint64_t>(st.st_size);
+  if (size > maxBytes)
+    throw FileReadError(path, "has " + std::to_string(size) + " bytes, more than the limit of " + std::to_string(maxBytes) + " bytes");
+  std::string bytes;
+  bytes.reserve(size);
+  char buffer[1 << 16];
+  for (;;) {
+    const ssize_t n = ::read(fd, buffer, sizeof buffer);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) throw FileReadError(path, std::string("cannot read it: ") + std::strerror(errno));
+    if (n == 0) break;
+    if (bytes.size() + static_cast<uint64_t>(n) > maxBytes)  // the file grew while read
+      throw FileReadError(path, "has more than the limit of " + std::to_string(maxBytes) + " bytes");
+    bytes.append(buffer, static_cast<size_t>(n));
+  }
+  return bytes;
 }
 
 std::string readInputFile(const fs::path& path, const std::string& displayPath, uint64_t maxBytes,
-                          const std::string& what, const std::string& limitName) {
-  std::error_code ec;
-  const uint64_t size = fs::file_size(path, ec);
-  if (ec) throw InputError(SourceLoc{displayPath}, "cannot read this " + what + " file: " + ec.message());
-  if (size > maxBytes)
-    throw InputError(SourceLoc{displayPath}, "the file has " + std::to_string(size) + " bytes, more than the limit of " +
-                                                 std::to_string(maxBytes) + " bytes (" + limitName + ")");
-  std::string bytes(size, '\0');
-  std::ifstream f(path, std::ios::binary);
-  if (!f || !f.read(bytes.data(), std::streamsize(size)))
-    throw InputError(SourceLoc{displayPath}, "cannot read this " + what + " file");
-  return bytes;
+                          const std::string& limitName) {
+  try {
+    return readFile(path, maxBytes);
+  } catch (const FileReadError& e) {
+    std::string reason = e.reason();
+    if (reason.find("the limit of") != std::string::npos) reason = "the file " + reason + " (" + limitName + ")";
+    throw InputError(SourceLoc{displayPath}, reason);
+  }
 }
 
 int removeStaleTemporaries(const fs::path& folder) {

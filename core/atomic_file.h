@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 
@@ -41,14 +42,40 @@ class TempPath {
 /// Writes bytes to path atomically. Throws std::runtime_error when the folder cannot be written.
 void writeFileAtomic(const std::filesystem::path& path, std::string_view bytes);
 
-/// Reads a whole file. Throws std::runtime_error when it cannot be read.
-std::string readFile(const std::filesystem::path& path);
+/// Why a file cannot be read, as readFile and requireRegularFile report it.
+class FileReadError : public std::runtime_error {
+ public:
+  /// what() is "cannot find file 'P'", "'P' is a FIFO, not a regular file", ...;
+  /// reason() is the same without the path ("cannot find file", "is a FIFO, not a regular file").
+  FileReadError(const std::filesystem::path& path, std::string reason);
+  const std::string& reason() const { return reason_; }
 
-/// Reads a whole input file of at most maxBytes bytes. Throws InputError at displayPath
-/// ("cannot read this <what> file: ...", or the size against the limit named by limitName)
-/// before allocating.
+ private:
+  std::string reason_;
+};
+
+/// The reason a user-named path is not a readable regular file, from stat (symbolic links
+/// followed), without opening it: "" for a regular file, else "cannot find file" (only
+/// when nothing is there), "is a folder, not a regular file", "is a FIFO, not a regular
+/// file", "is a socket, not a regular file", "is a device, not a regular file" or
+/// "cannot read it: <system reason>".
+std::string notRegularFileReason(const std::filesystem::path& path);
+
+/// Throws FileReadError unless path is a regular file (for paths handed to a library that
+/// opens them itself, such as image readers).
+void requireRegularFile(const std::filesystem::path& path);
+
+/// Reads a whole file: the one way Sprig opens a file a user named. Only a regular file
+/// is read: the type is checked with stat before opening, the file is opened with
+/// O_NONBLOCK (a FIFO swapped in after the check never blocks) and checked again with
+/// fstat. Throws FileReadError (notRegularFileReason's reasons, or the size against
+/// maxBytes) before allocating.
+std::string readFile(const std::filesystem::path& path, uint64_t maxBytes = UINT64_MAX);
+
+/// readFile for parsers: an error is an InputError at displayPath (the reason; a size
+/// over maxBytes names the limit limitName).
 std::string readInputFile(const std::filesystem::path& path, const std::string& displayPath, uint64_t maxBytes,
-                          const std::string& what, const std::string& limitName);
+                          const std::string& limitName);
 
 /// Removes SIGINT/SIGTERM-interrupted temporaries (`.sprig-tmp-*`) in folder (not recursive).
 /// Returns how many were removed.

@@ -93,19 +93,42 @@ InputError::InputError(SourceLoc loc, std::string message, std::string sourceLin
     : InputError(std::vector<Diagnostic>{makeDiagnostic(Severity::Error, std::move(loc), std::move(message), std::move(sourceLine))}) {}
 
 void DiagnosticList::error(SourceLoc loc, std::string message, std::string sourceLine) {
+  if (items_.size() >= kMaxDiagnostics) return add(Diagnostic{Severity::Error, std::move(loc), {}, {}, 0, false});
   items_.push_back(makeDiagnostic(Severity::Error, std::move(loc), std::move(message), std::move(sourceLine)));
 }
 
 void DiagnosticList::warning(SourceLoc loc, std::string message, std::string sourceLine) {
+  if (items_.size() >= kMaxDiagnostics) return add(Diagnostic{Severity::Warning, std::move(loc), {}, {}, 0, false});
   items_.push_back(makeDiagnostic(Severity::Warning, std::move(loc), std::move(message), std::move(sourceLine)));
 }
 
+void DiagnosticList::add(Diagnostic d) {
+  if (items_.size() < kMaxDiagnostics) {
+    items_.push_back(std::move(d));
+    return;
+  }
+  if (suppressed_++ == 0) suppressedFile_ = d.loc.file;
+  if (d.severity == Severity::Error) suppressedError_ = true;
+}
+
+void DiagnosticList::append(const std::vector<Diagnostic>& ds) {
+  for (const Diagnostic& d : ds) add(d);
+}
+
 bool DiagnosticList::hasErrors() const {
+  if (suppressedError_) return true;
   return std::any_of(items_.begin(), items_.end(), [](const Diagnostic& d) { return d.severity == Severity::Error; });
 }
 
 void DiagnosticList::throwIfErrors() const {
-  if (hasErrors()) throw InputError(items_);
+  if (!hasErrors()) return;
+  if (suppressed_ == 0) throw InputError(items_);
+  std::vector<Diagnostic> all = items_;
+  all.push_back(makeDiagnostic(Severity::Note, SourceLoc{suppressedFile_},
+                               std::to_string(suppressed_) + " more diagnostic" + (suppressed_ == 1 ? "" : "s") +
+                                   " not shown (at most " + std::to_string(kMaxDiagnostics) + " are; kMaxDiagnostics)",
+                               {}));
+  throw InputError(std::move(all));
 }
 
 std::string lineOf(std::string_view text, int line) {

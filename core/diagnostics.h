@@ -24,6 +24,10 @@ struct SourceLoc {
 /// of this many columns around the caret, cut ends marked "...".
 inline constexpr size_t kDiagnosticWindow = 120;
 
+/// Most diagnostics one DiagnosticList keeps (and so one InputError prints): the rest are
+/// counted, and throwIfErrors ends with one note saying how many were not shown.
+inline constexpr size_t kMaxDiagnostics = 50;
+
 /// How serious a diagnostic is; only errors make DiagnosticList::throwIfErrors throw.
 enum class Severity { Error, Warning, Note };
 
@@ -70,6 +74,8 @@ class InputError : public std::runtime_error {
 };
 
 /// Collects diagnostics while a file is parsed; throwIfErrors() throws them all at once.
+/// It keeps the first kMaxDiagnostics and counts the rest (a file of 100,000 bad lines
+/// prints 51 messages, not 100,000).
 class DiagnosticList {
  public:
   /// Adds an error at loc (sourceLine: the text of that line, for the caret).
@@ -77,19 +83,25 @@ class DiagnosticList {
   /// Adds a warning at loc; warnings never make throwIfErrors throw.
   void warning(SourceLoc loc, std::string message, std::string sourceLine = {});
   /// Adds d as it is.
-  void add(Diagnostic d) { items_.push_back(std::move(d)); }
+  void add(Diagnostic d);
   /// Adds every diagnostic of ds, in order.
-  void append(const std::vector<Diagnostic>& ds) { items_.insert(items_.end(), ds.begin(), ds.end()); }
+  void append(const std::vector<Diagnostic>& ds);
 
-  /// True when any collected diagnostic is an error.
+  /// True when any collected diagnostic is an error (a suppressed one too).
   bool hasErrors() const;
-  /// Every collected diagnostic, in order.
+  /// The kept diagnostics, in order (at most kMaxDiagnostics).
   const std::vector<Diagnostic>& items() const { return items_; }
-  /// Throws InputError holding every diagnostic when any is an error.
+  /// How many diagnostics were counted but not kept.
+  size_t suppressed() const { return suppressed_; }
+  /// Throws InputError holding every kept diagnostic, then (when some were not kept) a note
+  /// "N more diagnostics not shown (at most 50 are; kMaxDiagnostics)", when any is an error.
   void throwIfErrors() const;
 
  private:
   std::vector<Diagnostic> items_;
+  size_t suppressed_ = 0;
+  bool suppressedError_ = false;
+  std::string suppressedFile_;  ///< the file of the first diagnostic not kept
 };
 
 /// The 1-based line `line` of text, without its line ending; empty if out of range.

@@ -1,7 +1,6 @@
 #include "core/file_watch.h"
 
 #include <algorithm>
-#include <fstream>
 #include <set>
 #include <thread>
 
@@ -10,6 +9,8 @@
 #include <sys/inotify.h>
 #include <unistd.h>
 #endif
+
+#include "core/atomic_file.h"
 
 namespace sprig {
 
@@ -37,16 +38,16 @@ void FileWatcher::closeWatches() {
 }
 
 std::optional<uint64_t> FileWatcher::contentHash(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) return std::nullopt;
+  std::string bytes;
+  try {
+    bytes = readFile(file);  // regular files only: a FIFO never blocks the watch
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
   uint64_t h = 1469598103934665603ull;
-  char buffer[1 << 16];
-  while (in) {
-    in.read(buffer, sizeof buffer);
-    for (std::streamsize i = 0; i < in.gcount(); ++i) {
-      h ^= static_cast<unsigned char>(buffer[i]);
-      h *= 1099511628211ull;
-    }
+  for (char c : bytes) {
+    h ^= static_cast<unsigned char>(c);
+    h *= 1099511628211ull;
   }
   return h;
 }

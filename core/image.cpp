@@ -122,6 +122,8 @@ namespace {
 
 /// The opened file, or ImageReadError with the reader's message.
 std::unique_ptr<detail::ImageFileReader> openInput(const fs::path& path) {
+  // The image library opens the file itself: only a regular file is handed to it (a FIFO would block it).
+  if (std::string reason = notRegularFileReason(path); !reason.empty()) throw ImageReadError(path, reason);
   std::string err;
   std::unique_ptr<detail::ImageFileReader> in = detail::imageBackend().open(path.string(), err);
   if (!in) throw ImageReadError(path, err.empty() ? "not an image OpenImageIO can read" : err);

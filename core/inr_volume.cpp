@@ -200,7 +200,7 @@ ScalarVolume parseInrVolume(std::string_view bytes, const std::string& displayPa
 ScalarVolume readInrVolume(const std::filesystem::path& path, std::string displayPath, const VolumeLimits& limits) {
   if (displayPath.empty()) displayPath = path.string();
   const uint64_t maxBytes = limits.maxVoxels * 8 + (uint64_t(1) << 20);
-  const std::string bytes = readInputFile(path, displayPath, maxBytes, "INR volume", "VolumeLimits::maxVoxels");
+  const std::string bytes = readInputFile(path, displayPath, maxBytes, "VolumeLimits::maxVoxels");
   return parseInrVolume(bytes, displayPath, limits);
 }
 

@@ -82,14 +82,6 @@ std::string quote(std::string_view text) {
   return "'" + std::string(text) + "'";
 }
 
-const char* formatName(MeshFileFormat f) {
-  switch (f) {
-    case MeshFileFormat::Obj: return "OBJ";
-    case MeshFileFormat::Ply: return "PLY";
-    case MeshFileFormat::Off: return "OFF";
-  }
-  return "mesh";
-}
 
 // Line and column (1-based) of byte offset pos in text.
 Where whereOffset(std::string_view text, size_t pos) {
@@ -892,7 +884,7 @@ PolyMesh parsePolyMesh(std::string_view bytes, MeshFileFormat format, std::strin
 PolyMesh readPolyMesh(const fs::path& path, std::string displayPath, const PolyMeshLimits& limits) {
   MeshFileFormat format = meshFileFormatFor(path);
   if (displayPath.empty()) displayPath = path.string();
-  std::string bytes = readInputFile(path, displayPath, limits.maxFileBytes, formatName(format), "PolyMeshLimits::maxFileBytes");
+  std::string bytes = readInputFile(path, displayPath, limits.maxFileBytes, "PolyMeshLimits::maxFileBytes");
   return parsePolyMesh(bytes, format, std::move(displayPath), limits);
 }
 

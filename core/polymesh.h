@@ -64,7 +64,7 @@ struct PolyMeshLimits {
 };
 
 /// Readers stop collecting errors after this many (the last says so).
-constexpr size_t kMaxPolyMeshErrors = 50;
+constexpr size_t kMaxPolyMeshErrors = kMaxDiagnostics;
 
 /// The format for a path's extension (.obj, .ply, .off; case-insensitive).
 /// Throws std::invalid_argument naming the path for any other extension.

@@ -1,18 +1,53 @@
 /// Fuzz target: cpfg's view file reader (lsystem::parseViewFile) and the turtle settings it
-/// makes, on any bytes. The input is read as /sprig-fuzz-sandbox/fuzz.v, a folder that does
-/// not exist, so the files its lines name (surface, function, curve, contour files, texture
-/// images) are missing: nothing outside the input is read (an image of the checkout could
-/// take a gigabyte of floats).
+/// makes, on any bytes. The input is read as fuzz.v in a fresh sandbox folder that holds
+/// only special files: `fifo` (a FIFO no one writes to) and `folder` (an empty folder). The
+/// files its lines name (surface, function, function set, curve, contour files, texture
+/// images) are therefore missing, or one of those two, which every reader must refuse
+/// without opening (a FIFO would block the run forever); nothing outside the sandbox is
+/// read (an image of the checkout could take a gigabyte of floats).
 #include "fuzz/fuzz.h"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
 #include <string>
 
 #include "lsystem/view_file.h"
 
+namespace {
+
+std::string gSandbox;
+
+void removeSandbox() {
+  std::error_code ec;
+  if (!gSandbox.empty()) std::filesystem::remove_all(gSandbox, ec);
+}
+
+/// The sandbox folder, made on first use (the replay build calls no initializer).
+const std::string& sandbox() {
+  if (gSandbox.empty()) {
+    char name[] = "/tmp/sprig-fuzz-view-XXXXXX";
+    if (const char* dir = ::mkdtemp(name)) {
+      gSandbox = dir;
+      ::mkfifo((gSandbox + "/fifo").c_str(), 0600);
+      ::mkdir((gSandbox + "/folder").c_str(), 0700);
+      std::atexit(removeSandbox);
+    } else {
+      gSandbox = "/sprig-fuzz-sandbox";  // a folder that does not exist: every name is missing
+    }
+  }
+  return gSandbox;
+}
+
+}  // namespace
+
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size > sprig::fuzz::kMaxInput) return 0;
   try {
-    const sprig::lsystem::ViewFile v = sprig::lsystem::parseViewFile(std::string(sprig::fuzz::text(data, size)),
-                                                                        "/sprig-fuzz-sandbox/fuzz.v");
+    const sprig::lsystem::ViewFile v =
+        sprig::lsystem::parseViewFile(std::string(sprig::fuzz::text(data, size)), sandbox() + "/fuzz.v");
     (void)sprig::lsystem::cpfgTurtleSettings(&v, {});
   } catch (const sprig::InputError&) {
   }

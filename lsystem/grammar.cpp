@@ -43,8 +43,8 @@ Grammar loadGrammar(const std::string& path, const GrammarOverrides& overrides) 
   std::string text;
   try {
     text = readFile(path);
-  } catch (const std::exception&) {
-    throw InputError(SourceLoc{path, 0, 0}, "cannot read the grammar file");
+  } catch (const FileReadError& e) {
+    throw InputError(SourceLoc{path, 0, 0}, e.reason());
   }
   return parseGrammar(text, path, overrides);
 }

@@ -125,6 +125,14 @@ class ViewParser {
       warn(viewerLine_, 0, "ignored, as they set how cpfg's window shows the model, not its geometry: " + viewerKeys_);
     }
     view_.warnings = warnings_;
+    if (warningsNotKept_ > 0) {
+      Diagnostic d;
+      d.severity = Severity::Note;
+      d.loc = SourceLoc{view_.file};
+      d.message = std::to_string(warningsNotKept_) + " more warning" + (warningsNotKept_ == 1 ? "" : "s") + " not shown (at most " +
+                  std::to_string(kMaxDiagnostics) + " are; kMaxDiagnostics)";
+      view_.warnings.push_back(std::move(d));
+    }
     return view_;
   }
 
@@ -152,6 +160,10 @@ class ViewParser {
     diags_.error(SourceLoc{view_.file, line, static_cast<int>(col0) + 1}, msg, raw_);
   }
   void warn(int line, size_t col0, const std::string& msg) {
+    if (warnings_.size() >= kMaxDiagnostics) {
+      ++warningsNotKept_;
+      return;
+    }
     Diagnostic d;
     d.severity = Severity::Warning;
     d.loc = SourceLoc{view_.file, line, static_cast<int>(col0) + 1};
@@ -352,8 +364,8 @@ class ViewParser {
     std::string text;
     try {
       text = readFile(file.string());
-    } catch (const std::exception&) {
-      error(line, vcol, "cannot read the function file '" + file.string() + "'");
+    } catch (const std::exception& e) {
+      error(line, vcol, e.what());
       return;
     }
     try {
@@ -383,8 +395,8 @@ class ViewParser {
     std::string text;
     try {
       text = readFile(file.string());
-    } catch (const std::exception&) {
-      error(line, vcol, "cannot read the function set file '" + file.string() + "'");
+    } catch (const std::exception& e) {
+      error(line, vcol, e.what());
       return;
     }
     std::vector<std::string> lines;
@@ -484,8 +496,8 @@ class ViewParser {
     std::string text;
     try {
       text = readFile(file.string());
-    } catch (const std::exception&) {
-      error(line, ncol, "cannot read the contour file '" + file.string() + "'");
+    } catch (const std::exception& e) {
+      error(line, ncol, e.what());
       return;
     }
     try {
@@ -529,8 +541,8 @@ class ViewParser {
     std::string text;
     try {
       text = readFile(file.string());
-    } catch (const std::exception&) {
-      error(line, vcol, "cannot read the curve file '" + file.string() + "'");
+    } catch (const std::exception& e) {
+      error(line, vcol, e.what());
       return;
     }
     try {
@@ -630,8 +642,8 @@ class ViewParser {
     std::string text;
     try {
       text = readFile(file.string());
-    } catch (const std::exception&) {
-      error(line, words[1].second, "cannot read the surface file '" + file.string() + "'");
+    } catch (const std::exception& e) {
+      error(line, words[1].second, e.what());
       return;
     }
     try {
@@ -788,12 +800,8 @@ class ViewParser {
       return;
     }
     tex.file = file.string();
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(file, ec)) {
-      error(line, nameCol, "cannot read the texture image '" + file.string() + "': no such file");
-      return;
-    }
     try {
+      requireRegularFile(file);
       Image img = readImage(file);
       if (img.width <= 0 || img.height <= 0) throw ImageReadError(file, "the image has no pixels");
       // readImage's colour comes multiplied by alpha in the file's encoding (OpenImageIO
@@ -810,6 +818,9 @@ class ViewParser {
       }
       tex.image = std::make_shared<const Image>(std::move(img));
       if (tex.mipmap) tex.buildMipmaps(srgb);
+    } catch (const FileReadError& e) {
+      error(line, nameCol, e.what());
+      return;
     } catch (const ImageReadError& e) {
       error(line, nameCol, "cannot read the texture image '" + file.string() + "': " + e.reason());
       return;
@@ -832,6 +843,7 @@ class ViewParser {
   ViewFile view_;
   DiagnosticList diags_;
   std::vector<Diagnostic> warnings_;
+  size_t warningsNotKept_ = 0;  ///< warnings past kMaxDiagnostics, counted only
   std::string raw_;
   std::string viewerKeys_;  ///< the viewer keys read, for one warning
   int viewerLine_ = 0;      ///< the line of the first
@@ -846,8 +858,8 @@ ViewFile loadViewFile(const std::string& path) {
   std::string text;
   try {
     text = readFile(path);
-  } catch (const std::exception&) {
-    throw InputError(SourceLoc{path, 0, 0}, "cannot read the view file");
+  } catch (const FileReadError& e) {
+    throw InputError(SourceLoc{path, 0, 0}, e.reason());
   }
   return parseViewFile(text, path);
 }

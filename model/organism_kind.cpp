@@ -13,6 +13,7 @@
 #include "core/timer.h"
 #include "model/mesh_parts.h"
 #include "model/model.h"
+#include "model/species_field.h"
 #include "organisms/analysis.h"
 #include "organisms/base_mesh.h"
 #include "organisms/iso_surface.h"
@@ -261,13 +262,12 @@ class OrganismReader {
     std::optional<Mesh> out;
     ++gSpeciesNesting;
     try {
-      const Species base = loadSpecies(*file, policy_);
-      SpeciesModel model(base);
-      if (!model.hasSurfaceSettings())
+      // Cleaned as `sprig mesh` cleans it (shell_top's 133 voids and 2 specks would otherwise
+      // each become a separate piece of the organism); built once per distinct reference.
+      const ReferencedSpecies base = referencedSpecies(*m.get(key), *file, policy_, std::nullopt);
+      if (!base.hasSurface)
         throw UsageError("species " + file->string() + " has no surface (a tree needs a tree: section)");
-      // Cleaned as `sprig mesh` cleans it: shell_top's 133 voids and 2 specks would otherwise
-      // each become a separate piece of the organism.
-      out = model.cleanSurface();
+      out = *base.surface;
     } catch (const InputError& e) {
       diags_.append(e.diagnostics());
     } catch (const std::exception& e) {

@@ -7,6 +7,7 @@
 #include "core/paths.h"
 #include "core/phases.h"
 #include "model/kinds.h"
+#include "model/species_field.h"
 #include "model/tree_kind.h"
 
 namespace sprig {
@@ -153,11 +154,14 @@ render::RenderSettings SpeciesRender::settings(int imageWidth, int imageHeight) 
   return rs;
 }
 
-Species loadSpecies(const fs::path& path, const PathPolicy& policy) {
+Species loadSpecies(const fs::path& path, const PathPolicy& given) {
   const Phase phase("read");
   const std::string ext = lowerExtension(path);
+  PathPolicy policy = given;
+  if (policy.root.empty()) policy.root = defaultLibraryRoot(path);
+  SpeciesBuildScope builds;  // the species it references are built once each, kMaxSpeciesBuilds at most
   std::error_code ec;
-  if (fs::is_directory(path, ec)) return speciesFromCpfgObject(path);  // model/tree_kind.h
+  if (fs::is_directory(path, ec)) return speciesFromCpfgObject(path, policy);  // model/tree_kind.h
   if (ext == ".lsys" || ext == ".l") return speciesFromGrammarFile(path);
   if (ext != ".yaml" && ext != ".yml")
     throw InputError(SourceLoc{path.string(), 0, 0},
@@ -172,6 +176,7 @@ Species loadSpecies(const fs::path& path, const PathPolicy& policy) {
 }
 
 Species parseSpecies(std::string text, const std::string& displayPath, const PathPolicy& policy) {
+  SpeciesBuildScope builds;
   DiagnosticList diags;
   auto yaml = YamlFile::parse(std::move(text), displayPath, diags);
   if (!yaml) diags.throwIfErrors();

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <cstring>
 #include <map>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -55,7 +56,77 @@ PolyMesh welded(const Mesh& mesh) {
   return out;
 }
 
+/// One cached build: its result, or the error it threw.
+struct CachedBuild {
+  ReferencedSpecies species;
+  std::optional<InputError> inputError;
+  std::string otherError;  ///< what() of any other exception
+};
+
+/// The cache and the build count of the open SpeciesBuildScope.
+struct BuildCache {
+  std::map<std::string, CachedBuild> builds;  // key: file identity, root, allowOutside, seed
+  std::map<const Mesh*, solids::FieldPtr> fields;  // the distance field of a cached surface
+  int count = 0;
+};
+
+thread_local BuildCache* gBuildCache = nullptr;
+
+CachedBuild build(const std::filesystem::path& file, const PathPolicy& policy, std::optional<uint64_t> seed) {
+  CachedBuild out;
+  try {
+    const Species species = loadSpecies(file, policy);
+    out.species.kind = species.kind;
+    if (species.kind == "solid" || (seed && species.kind != "tree")) return out;
+    ModelOptions options;
+    if (seed) options.extra.seed = *seed;
+    SpeciesModel model(species, options);
+    out.species.hasSurface = model.hasSurfaceSettings();
+    // Cleaned as `sprig mesh` cleans it: a speck beside the surface or a void inside it
+    // would otherwise be a separate piece (of a solid, of an organism).
+    if (out.species.hasSurface) out.species.surface = std::make_shared<const Mesh>(model.cleanSurface());
+  } catch (const InputError& e) {
+    out.inputError = e;
+  } catch (const std::exception& e) {
+    out.otherError = e.what();
+  }
+  return out;
+}
+
 }  // namespace
+
+SpeciesBuildScope::SpeciesBuildScope() {
+  if (gBuildCache) return;
+  gBuildCache = new BuildCache;
+  owner_ = true;
+}
+
+SpeciesBuildScope::~SpeciesBuildScope() {
+  if (!owner_) return;
+  delete gBuildCache;
+  gBuildCache = nullptr;
+}
+
+ReferencedSpecies referencedSpecies(const YNode& at, const std::filesystem::path& file, const PathPolicy& policy,
+                                    std::optional<uint64_t> seed) {
+  SpeciesBuildScope scope;  // a caller outside loadSpecies (a test) gets a scope of its own
+  BuildCache& cache = *gBuildCache;
+  const std::string key = identity(file).string() + '\n' + identity(std::filesystem::absolute(policy.root)).string() + '\n' +
+                          (policy.allowOutside ? "1" : "0") + '\n' + (seed ? std::to_string(*seed) : "-");
+  auto it = cache.builds.find(key);
+  if (it == cache.builds.end()) {
+    if (cache.count >= kMaxSpeciesBuilds)
+      throw InputError(at.loc(), "more than " + std::to_string(kMaxSpeciesBuilds) +
+                                     " different species referenced by one species (kMaxSpeciesBuilds); identical references are built once",
+                       at.file().sourceLine(at.loc().line));
+    ++cache.count;
+    it = cache.builds.emplace(key, build(file, policy, seed)).first;
+  }
+  const CachedBuild& b = it->second;
+  if (b.inputError) throw *b.inputError;
+  if (!b.otherError.empty()) throw std::runtime_error(b.otherError);
+  return b.species;
+}
 
 solids::FieldPtr readSpeciesField(MapReader& m, const PathPolicy& policy) {
   DiagnosticList& diags = m.diagnostics();
@@ -89,7 +160,8 @@ solids::FieldPtr readSpeciesField(MapReader& m, const PathPolicy& policy) {
   if (outer || gOpenFiles.back() != self) selfOpen.emplace(self);
   OpenFile targetOpen(target);
   try {
-    const Species species = loadSpecies(*file, policy);
+    const ReferencedSpecies species =
+        referencedSpecies(at, *file, policy, seed ? std::optional<uint64_t>(uint64_t(*seed)) : std::nullopt);
     if (species.kind == "solid") {
       at.error(diags, name + " is a solid species, and a solid species is not a distance field (name a blob, shell, tree or organism species)");
       return nullptr;
@@ -99,17 +171,15 @@ solids::FieldPtr readSpeciesField(MapReader& m, const PathPolicy& policy) {
                                       " species (its seeds are in its own file)");
       return nullptr;
     }
-    ModelOptions options;
-    if (seed) options.extra.seed = uint64_t(*seed);
-    SpeciesModel model(species, options);
-    if (!model.hasSurfaceSettings()) {
+    if (!species.hasSurface) {
       at.error(diags, "species " + name + " has no surface (a tree needs a tree: section)");
       return nullptr;
     }
-    // Cleaned as `sprig mesh` cleans it (and as an organism's species base is): a speck
-    // beside the surface or a void inside it would otherwise be solid of its own.
-    const Mesh surface = model.cleanSurface();
-    const PolyMesh mesh = welded(surface);
+    if (gBuildCache) {  // the same surface referenced again: its field too is made once
+      auto known = gBuildCache->fields.find(species.surface.get());
+      if (known != gBuildCache->fields.end()) return known->second;
+    }
+    const PolyMesh mesh = welded(*species.surface);
     if (mesh.faceSizes.empty()) {
       at.error(diags, "the surface of species " + name + " is empty");
       return nullptr;
@@ -123,7 +193,9 @@ solids::FieldPtr readSpeciesField(MapReader& m, const PathPolicy& policy) {
                           " has only one face (a distance field needs a closed mesh)");
       return nullptr;
     }
-    return solids::meshField(mesh);
+    solids::FieldPtr field = solids::meshField(mesh);
+    if (gBuildCache) gBuildCache->fields[species.surface.get()] = field;
+    return field;
   } catch (const InputError& e) {
     diags.append(e.diagnostics());
   } catch (const std::exception& e) {

@@ -74,15 +74,17 @@ void readTurtle(MapReader& m, TreeSpec& s) {
 }
 
 /// Reads `grammar:`: inline text (contains a newline) or a path relative to the species file.
-void readGrammar(MapReader& top, const Species& sp, TreeSpec& s, DiagnosticList& diags) {
+/// Returns false when it added an error (the grammar is then not checked: one error, not a
+/// second one about the empty text).
+bool readGrammar(MapReader& top, const Species& sp, TreeSpec& s, DiagnosticList& diags) {
   const PathPolicy& policy = sp.policy;
   auto g = top.get("grammar");
   if (!g) {
     top.node().error(diags, "missing required key 'grammar' in species file");
-    return;
+    return false;
   }
   auto text = g->asString(diags, "'grammar'");
-  if (!text) return;
+  if (!text) return false;
   if (text->find('\n') != std::string::npos) {
     s.grammarText = *text;
     s.grammarFile = sp.yaml->displayPath();
@@ -104,16 +106,18 @@ void readGrammar(MapReader& top, const Species& sp, TreeSpec& s, DiagnosticList&
         break;
       }
     }
-    return;
+    return true;
   }
-  if (auto p = resolveReference(*g, *text, policy, diags)) {
-    try {
-      s.grammarText = readFile(*p);
-      s.grammarFile = p->string();
-    } catch (const std::exception& e) {
-      g->error(diags, "cannot read grammar file '" + p->string() + "'");
-    }
+  auto p = resolveReference(*g, *text, policy, diags);
+  if (!p) return false;
+  try {
+    s.grammarText = readFile(*p);
+    s.grammarFile = p->string();
+  } catch (const std::exception& e) {
+    g->error(diags, e.what());
+    return false;
   }
+  return true;
 }
 
 void readDefines(MapReader& top, TreeSpec& s, DiagnosticList& diags) {
@@ -560,7 +564,7 @@ std::vector<GrowthFrame> growthFrames(int first, int last, int framesPerStage) {
 std::shared_ptr<const KindSpec> readTreeSpec(MapReader& top, Species& species, DiagnosticList& diags) {
   auto spec = std::make_shared<TreeSpec>();
   TreeSpec& s = *spec;
-  readGrammar(top, species, s, diags);
+  const bool grammarRead = readGrammar(top, species, s, diags);
   readDefines(top, s, diags);
   if (top.has("steps")) {
     s.overrides.derivationLength = static_cast<int>(top.integer("steps", 0, 0, 100000));
@@ -578,7 +582,7 @@ std::shared_ptr<const KindSpec> readTreeSpec(MapReader& top, Species& species, D
     readTurtle(turtle, s);
   }
   if (auto section = top.section("tree")) s.surface = readTreeOptions(*section, diags);
-  if (!s.grammarText.empty() || top.has("grammar")) {
+  if (grammarRead) {
     species.spec = spec;  // speciesGrammar reads the spec through the species
     checkGrammar(species, s, diags);
   }
@@ -594,8 +598,8 @@ std::vector<Vec3> readCpfgColormap(const fs::path& path) {
   std::string bytes;
   try {
     bytes = readFile(path);
-  } catch (const std::exception&) {
-    throw InputError(SourceLoc{path.string(), 0, 0}, "cannot read the colour map");
+  } catch (const FileReadError& e) {
+    throw InputError(SourceLoc{path.string(), 0, 0}, e.reason());
   }
   if (bytes.size() != 768)
     throw InputError(SourceLoc{path.string(), 0, 0}, "a cpfg colour map holds 256 entries of 3 bytes (768 bytes), this file has " +
@@ -616,8 +620,8 @@ std::vector<Vec3> readCpfgMaterials(const fs::path& path, std::vector<Diagnostic
   std::string bytes;
   try {
     bytes = readFile(path);
-  } catch (const std::exception&) {
-    throw InputError(SourceLoc{path.string(), 0, 0}, "cannot read the materials file");
+  } catch (const FileReadError& e) {
+    throw InputError(SourceLoc{path.string(), 0, 0}, e.reason());
   }
   return lsystem::parseCpfgMaterials(bytes, path.string(), notes);
 }
@@ -635,8 +639,8 @@ Species grammarSpecies(const fs::path& path, const fs::path& viewFile, const fs:
   auto spec = std::make_shared<TreeSpec>();
   try {
     spec->grammarText = readFile(path);
-  } catch (const std::exception&) {
-    throw InputError(SourceLoc{path.string(), 0, 0}, "cannot open file");
+  } catch (const FileReadError& e) {
+    throw InputError(SourceLoc{path.string(), 0, 0}, e.reason());
   }
   spec->grammarFile = path.string();
   // ABOP widths are pixel widths: keep a bare grammar's internodes slender (lsystem/turtle.h).
@@ -687,43 +691,94 @@ bool hasAxiom(const fs::path& p) {
   }
 }
 
+/// Throws InputError at path unless it is a regular file.
+void requireObjectFile(const fs::path& path) {
+  if (std::string reason = notRegularFileReason(path); !reason.empty()) throw InputError(SourceLoc{path.string(), 0, 0}, reason);
+}
+
+/// Whether the optional file path (a view file, colour map, ... found by its name) is there:
+/// false when nothing is, an InputError when something that is not a regular file is.
+bool optionalObjectFile(const fs::path& path) {
+  const std::string reason = notRegularFileReason(path);
+  if (reason == "cannot find file") return false;
+  requireObjectFile(path);
+  return true;
+}
+
 }  // namespace
 
 Species speciesFromGrammarFile(const fs::path& path) {
   fs::path view;
   if (lowerExtension(path) == ".l") {
     fs::path v = fs::path(path).replace_extension(".v");
-    std::error_code ec;
-    if (fs::is_regular_file(v, ec)) view = v;
+    if (optionalObjectFile(v)) view = v;
   }
   return grammarSpecies(path, view);
 }
 
-Species speciesFromCpfgObject(const fs::path& folder) {
-  std::error_code ec;
+namespace {
+
+/// The files a vlab object's cpfg command line names.
+struct CpfgObjectFiles {
   fs::path grammar, view, colormap, materials;
+};
+
+/// Reads the `cpfg` line of folder/specifications (if any): the grammar (`.l`), the view
+/// file (`.v`), the colour map (`-m NAME` or `.map`) and the materials (`-M NAME`). Each
+/// name passes policy (pathRefusal) or is an InputError at its word.
+CpfgObjectFiles readSpecifications(const fs::path& folder, const PathPolicy& policy) {
+  CpfgObjectFiles f;
+  const fs::path specPath = folder / "specifications";
+  std::string text;
+  try {
+    text = readFile(specPath);
+  } catch (const FileReadError& e) {
+    if (e.reason() == "cannot find file") return f;
+    throw InputError(SourceLoc{specPath.string(), 0, 0}, e.reason());
+  }
+  std::istringstream spec(text);
+  int lineNo = 0;
+  for (std::string line; std::getline(spec, line);) {
+    ++lineNo;
+    std::vector<std::pair<std::string, size_t>> w;  // word, 0-based column
+    for (size_t pos = line.find_first_not_of(" \t\r"); pos != std::string::npos; pos = line.find_first_not_of(" \t\r", pos)) {
+      const size_t end = std::min(line.find_first_of(" \t\r", pos), line.size());
+      w.emplace_back(line.substr(pos, end - pos), pos);
+      pos = end;
+    }
+    if (w.empty() || w[0].first != "cpfg") continue;
+    auto take = [&](fs::path& slot, size_t k) {
+      if (!slot.empty()) return;
+      const std::string& name = w[k].first;
+      const fs::path resolved = (folder / name).lexically_normal();
+      if (std::string refusal = pathRefusal(name, resolved, policy); !refusal.empty())
+        throw InputError(SourceLoc{specPath.string(), lineNo, static_cast<int>(w[k].second) + 1}, refusal, line);
+      slot = resolved;
+    };
+    for (size_t k = 1; k < w.size(); ++k) {
+      const std::string& x = w[k].first;
+      if ((x == "-M" || x == "-m") && k + 1 < w.size()) {
+        take(x == "-M" ? f.materials : f.colormap, k + 1);
+        ++k;
+        continue;
+      }
+      const std::string e = lowerExtension(x);
+      if (e == ".l") take(f.grammar, k);
+      if (e == ".v") take(f.view, k);
+      if (e == ".map") take(f.colormap, k);
+    }
+    break;
+  }
+  return f;
+}
+
+}  // namespace
+
+Species speciesFromCpfgObject(const fs::path& folder, const PathPolicy& policy) {
+  std::error_code ec;
   // The `specifications` file's cpfg command line names the grammar, the view file and the
   // colour map (`-m NAME.map`).
-  try {
-    std::istringstream spec(readFile(folder / "specifications"));
-    for (std::string line; std::getline(spec, line);) {
-      std::istringstream words(line);
-      std::vector<std::string> w;
-      for (std::string x; words >> x;) w.push_back(x);
-      if (w.empty() || w[0] != "cpfg") continue;
-      for (size_t k = 0; k < w.size(); ++k) {
-        const std::string& x = w[k];
-        if (x == "-M" && k + 1 < w.size() && materials.empty()) materials = folder / w[k + 1];
-        if (x == "-m" && k + 1 < w.size() && colormap.empty()) colormap = folder / w[k + 1];
-        const std::string e = lowerExtension(x);
-        if (e == ".l" && grammar.empty()) grammar = folder / x;
-        if (e == ".v" && view.empty()) view = folder / x;
-        if (e == ".map" && colormap.empty()) colormap = folder / x;
-      }
-      break;
-    }
-  } catch (const std::exception&) {
-  }
+  auto [grammar, view, colormap, materials] = readSpecifications(folder, policy);
   if (grammar.empty()) {
     std::vector<fs::path> grammars, views, maps, mats;
     for (const auto& e : fs::directory_iterator(folder, ec)) {
@@ -745,21 +800,17 @@ Species speciesFromCpfgObject(const fs::path& folder) {
     }
     grammar = grammars[0];
     fs::path same = fs::path(grammar).replace_extension(".v");
-    if (fs::is_regular_file(same, ec)) view = same;
+    if (optionalObjectFile(same)) view = same;
     else if (views.size() == 1) view = views[0];
     fs::path sameMap = fs::path(grammar).replace_extension(".map");
-    if (fs::is_regular_file(sameMap, ec)) colormap = sameMap;
+    if (optionalObjectFile(sameMap)) colormap = sameMap;
     else if (maps.size() == 1) colormap = maps[0];
     fs::path sameMat = fs::path(grammar).replace_extension(".mat");
-    if (fs::is_regular_file(sameMat, ec)) materials = sameMat;
+    if (optionalObjectFile(sameMat)) materials = sameMat;
     else if (mats.size() == 1) materials = mats[0];
   }
-  if (!fs::is_regular_file(grammar, ec)) throw InputError(SourceLoc{grammar.string(), 0, 0}, "cannot open file");
-  if (!view.empty() && !fs::is_regular_file(view, ec)) throw InputError(SourceLoc{view.string(), 0, 0}, "cannot open the view file");
-  if (!colormap.empty() && !fs::is_regular_file(colormap, ec))
-    throw InputError(SourceLoc{colormap.string(), 0, 0}, "cannot open the colour map");
-  if (!materials.empty() && !fs::is_regular_file(materials, ec))
-    throw InputError(SourceLoc{materials.string(), 0, 0}, "cannot open the materials file");
+  for (const fs::path& p : {grammar, view, colormap, materials})
+    if (!p.empty()) requireObjectFile(p);
   return grammarSpecies(grammar, view, colormap, materials);
 }
 

@@ -56,8 +56,10 @@ Species speciesFromGrammarFile(const std::filesystem::path& path);
 
 /// A vlab object folder: the cpfg grammar and view file its `specifications` name on its
 /// `cpfg` line, else its only `.l` file with an `axiom:` and the `.v` of the same name (or
-/// its only `.v`). Throws InputError when the folder holds no such grammar or several.
-Species speciesFromCpfgObject(const std::filesystem::path& folder);
+/// its only `.v`). Throws InputError when the folder holds no such grammar or several, and
+/// at the `specifications` line when a file it names leaves policy's root (the object's
+/// files pass the same path policy as a species file's references).
+Species speciesFromCpfgObject(const std::filesystem::path& folder, const PathPolicy& policy);
 
 /// The tree keys of species. Throws InputError when the species is not a tree.
 const TreeSpec& treeSpec(const Species& species);

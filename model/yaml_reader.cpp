@@ -8,6 +8,7 @@
 #include <set>
 #include <sstream>
 
+#include "core/atomic_file.h"
 #include "core/srgb.h"
 #include "core/text.h"
 #include "model/detail/key_recorder.h"
@@ -243,24 +244,16 @@ std::string explainYamlError(const std::string& msg) {
 std::shared_ptr<const YamlFile> YamlFile::load(const fs::path& path, DiagnosticList& diags,
                                                const YamlLoadOptions& options) {
   std::string display = path.string();
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) {
-    diags.error(SourceLoc{display, 0, 0}, fs::exists(path, ec) ? "not a regular file" : "cannot open file");
+  std::string text;
+  try {
+    text = readFile(path, options.maxBytes);
+  } catch (const FileReadError& e) {
+    const bool tooLarge = e.reason().find("the limit of") != std::string::npos;
+    diags.error(SourceLoc{display, 0, 0},
+                tooLarge ? "file is larger than " + std::to_string(options.maxBytes) + " bytes" : e.reason());
     return nullptr;
   }
-  auto size = fs::file_size(path, ec);
-  if (!ec && size > options.maxBytes) {
-    diags.error(SourceLoc{display, 0, 0}, "file is larger than " + std::to_string(options.maxBytes) + " bytes");
-    return nullptr;
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    diags.error(SourceLoc{display, 0, 0}, "cannot open file");
-    return nullptr;
-  }
-  std::ostringstream ss;
-  ss << in.rdbuf();
-  return parseAt(ss.str(), display, path, diags, options);
+  return parseAt(std::move(text), display, path, diags, options);
 }
 
 std::shared_ptr<const YamlFile> YamlFile::parse(std::string text, std::string displayPath, DiagnosticList& diags,
@@ -677,32 +670,63 @@ std::optional<fs::path> resolveReference(const YNode& at, std::string_view ref, 
     return std::nullopt;
   }
   fs::path p(r);
-  if (p.is_absolute() && !policy.allowOutside) {
-    at.error(diags, "refusing absolute path '" + r + "' (write it relative to the species file, or pass --allow-outside-paths)");
-    return std::nullopt;
-  }
   fs::path base = at.file().path().parent_path();
   fs::path resolved = p.is_absolute() ? p.lexically_normal() : (base / p).lexically_normal();
   if (resolved.empty()) resolved = ".";
-  if (!policy.allowOutside) {
-    std::error_code ec;
-    fs::path root = fs::weakly_canonical(policy.root.empty() ? fs::path(".") : policy.root, ec);
-    fs::path full = fs::weakly_canonical(resolved, ec);
-    fs::path rel = full.lexically_relative(root);
-    if (rel.empty() || *rel.begin() == "..") {
-      at.error(diags, "refusing path '" + r + "': it leaves the library root '" + policy.root.string() +
-                          "' (pass --allow-outside-paths to allow it)");
-      return std::nullopt;
-    }
+  if (std::string refusal = pathRefusal(r, resolved, policy); !refusal.empty()) {
+    at.error(diags, refusal);
+    return std::nullopt;
   }
   if (mustExist) {
-    std::error_code ec;
-    if (!fs::is_regular_file(resolved, ec)) {
-      at.error(diags, "cannot find file '" + r + "' (looked for '" + resolved.string() + "')");
+    if (std::string reason = notRegularFileReason(resolved); !reason.empty()) {
+      at.error(diags, FileReadError(r, reason).what() + std::string(" (looked for '") + resolved.string() + "')");
       return std::nullopt;
     }
   }
   return resolved;
+}
+
+std::string pathRefusal(const std::string& written, const fs::path& resolved, const PathPolicy& policy) {
+  if (policy.allowOutside) return {};
+  if (fs::path(written).is_absolute())
+    return "refusing absolute path '" + written + "' (write it relative to the species file, or pass --allow-outside-paths)";
+  // Both sides absolute before weakly_canonical: of a relative path that does not exist it
+  // returns the path unchanged, which no absolute root contains.
+  std::error_code ec;
+  const fs::path rootPath = policy.root.empty() ? fs::path(".") : policy.root;
+  fs::path root = fs::weakly_canonical(fs::absolute(rootPath, ec), ec);
+  fs::path full = fs::weakly_canonical(fs::absolute(resolved, ec), ec);
+  fs::path rel = full.lexically_relative(root);
+  if (rel.empty() || *rel.begin() == "..")
+    return "refusing path '" + written + "': it leaves the library root '" + rootPath.string() +
+           "' (pass --root FOLDER to read from a wider root, or --allow-outside-paths)";
+  return {};
+}
+
+namespace {
+
+/// p.lexically_normal() without the trailing separator `a/b/..` leaves ("a/"); "." for empty.
+fs::path normalFolder(const fs::path& p) {
+  fs::path n = p.lexically_normal();
+  if (!n.has_filename() && n.has_relative_path()) n = n.parent_path();
+  return n.empty() ? fs::path(".") : n;
+}
+
+}  // namespace
+
+fs::path defaultLibraryRoot(const fs::path& speciesPath) {
+  std::error_code ec;
+  const fs::path start = fs::is_directory(speciesPath, ec) ? speciesPath : speciesPath.parent_path();
+  fs::path spelled = start.empty() ? fs::path(".") : start;  // the candidate as the user spelled it
+  fs::path dir = fs::weakly_canonical(fs::absolute(spelled, ec), ec);
+  for (int up = 0; up < 256 && !dir.empty(); ++up) {
+    if (fs::is_regular_file(dir / ".sprig-root", ec)) return normalFolder(spelled);
+    if (dir.filename() == "species") return normalFolder(spelled / "..");
+    if (dir == dir.parent_path()) break;
+    dir = dir.parent_path();
+    spelled /= "..";
+  }
+  return normalFolder(start);
 }
 
 // ---- MapReader ---------------------------------------------------------------------

@@ -172,11 +172,24 @@ std::string quoted(std::string_view text);
 
 /// Where referenced files (grammars, textures, ...) may come from.
 struct PathPolicy {
-  /// The library root: references must resolve inside it (`--root`, default ".").
+  /// The library root: references must resolve inside it (`--root`). Empty: loadSpecies
+  /// chooses defaultLibraryRoot of the species file.
   std::filesystem::path root = ".";
   /// `--allow-outside-paths`: accept absolute paths and escapes above the root.
   bool allowOutside = false;
 };
+
+/// The library root of a species given without `--root`: the nearest folder at or above
+/// the species file's folder (a vlab object: the folder itself) that holds a `.sprig-root`
+/// marker file or is the parent of a folder named `species` on the way up; else the species
+/// file's own folder. Returned as a path relative to the species path's own spelling
+/// (`species/oak.yaml` -> `.`), absolute when the species path is absolute.
+std::filesystem::path defaultLibraryRoot(const std::filesystem::path& speciesPath);
+
+/// The refusal of `resolved` (written `written` in a file) under policy: "" when it may be
+/// read, else the message ("refusing absolute path ...", "refusing path ...: it leaves the
+/// library root ..."). Absolute paths are refused before anything is resolved.
+std::string pathRefusal(const std::string& written, const std::filesystem::path& resolved, const PathPolicy& policy);
 
 /// Resolves `ref` (as written at `at`) relative to the folder of at's file. Refuses URI
 /// schemes (`http://...`, `file:...`), absolute paths and paths that leave policy.root

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <filesystem>
 
+#include "core/atomic_file.h"
 #include "core/image.h"
 #include "core/srgb.h"
 #include "textures/detail/texture_backend.h"
@@ -20,9 +21,7 @@ ImageTexture ImageTexture::open(const std::string& path, const SourceLoc& where)
   auto fail = [&](const std::string& reason) -> ImageTexture {
     throw InputError(where, "cannot read texture '" + path + "': " + reason);
   };
-  std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) return fail("no such file");
-  if (!std::filesystem::is_regular_file(path, ec)) return fail("not a regular file");
+  if (std::string reason = notRegularFileReason(path); !reason.empty()) throw InputError(where, FileReadError(path, reason).what());
   ImageInfo info;
   try {
     info = readImageInfo(path);

@@ -416,10 +416,9 @@ void Scanner::preprocess(int file, const std::vector<std::string>& raw, const st
         }
         std::string text;
         try {
-          if (!fs::is_regular_file(path)) throw std::runtime_error("not a file");
           text = readFile(path);
-        } catch (const std::exception&) {
-          err(k, ni, "cannot read the included file '" + (from / target).string() + "'");
+        } catch (const FileReadError& e) {
+          err(k, ni, FileReadError(from / target, e.reason()).what());  // the name as written, not the canonical one
           continue;
         }
         files_.push_back((from / target).lexically_normal().string());

@@ -7,10 +7,14 @@
 #     temporary (.sprig-tmp-*) file is left beside the inputs.
 # A case is a block of lines `name:`, `args:` (split on spaces; $OUT is a fresh empty
 # folder), `exit:`, one or more `expect:` lines and optionally `maxlines: N` (stderr holds
-# at most N lines and N*200 bytes: a long line or a binary file is never echoed whole);
+# at most N lines and N*200 bytes: a long line or a binary file is never echoed whole),
+# `setup: SHELL COMMAND` (run by bash from the repository root before the case, with $IN a
+# fresh folder for inputs it makes: FIFOs, many generated files; $IN may appear in `args:`
+# and `expect:`) and `cd: DIR` (sprig runs in DIR, relative to the repository root);
 # blocks are separated by blank lines.
 set -u
 SPRIG=${1:?usage: run.sh PATH/TO/sprig}
+SPRIG=$(cd "$(dirname "$SPRIG")" && pwd)/$(basename "$SPRIG")  # absolute: `cd:` cases run elsewhere
 HERE=$(cd "$(dirname "$0")" && pwd)
 CASES="$HERE/cases.txt"
 WORK=$(mktemp -d)
@@ -18,21 +22,28 @@ trap 'rm -rf "$WORK"' EXIT
 
 pass=0
 fail=0
-name="" args="" code="" expects=() maxlines=""
+name="" args="" code="" expects=() maxlines="" setup="" dir=""
+ROOT=$(pwd)
 
 run_case() {
   [ -z "$name" ] && return
   local out="$WORK/$name"
-  mkdir -p "$out"
+  local in="$WORK/$name.in"
+  mkdir -p "$out" "$in"
   local expanded=${args//\$OUT/$out}
+  expanded=${expanded//\$IN/$in}
   local stderr_file="$WORK/$name.stderr"
+  if [ -n "$setup" ] && ! IN="$in" bash -c "$setup"; then
+    echo "FAIL $name: setup failed: $setup"; fail=$((fail + 1)); name="" args="" code="" expects=() maxlines="" setup="" dir=""; return
+  fi
   # shellcheck disable=SC2086
-  timeout 120 "$SPRIG" --quiet $expanded >"$WORK/$name.stdout" 2>"$stderr_file"
+  (cd "$ROOT/${dir:-.}" && timeout 120 "$SPRIG" --quiet $expanded) >"$WORK/$name.stdout" 2>"$stderr_file"
   local rc=$?
   local ok=1 why=""
   if [ "$rc" != "$code" ]; then ok=0; why="exit code $rc, expected $code"; fi
   for e in "${expects[@]}"; do
     e=${e//\$OUT/$out}
+    e=${e//\$IN/$in}
     if ! grep -qxF -- "$e" "$stderr_file"; then ok=0; why="$why${why:+; }missing line: $e"; fi
   done
   if [ -n "$maxlines" ]; then
@@ -56,7 +67,7 @@ run_case() {
     echo "  command: sprig --quiet $expanded"
     sed 's/^/  stderr: /' "$stderr_file"
   fi
-  name="" args="" code="" expects=() maxlines=""
+  name="" args="" code="" expects=() maxlines="" setup="" dir=""
 }
 
 while IFS= read -r line || [ -n "$line" ]; do
@@ -68,6 +79,8 @@ while IFS= read -r line || [ -n "$line" ]; do
     exit:\ *) code=${line#exit: } ;;
     expect:\ *) expects+=("${line#expect: }") ;;
     maxlines:\ *) maxlines=${line#maxlines: } ;;
+    setup:\ *) setup=${line#setup: } ;;
+    cd:\ *) dir=${line#cd: } ;;
     *) echo "cases.txt: cannot read line: $line"; exit 2 ;;
   esac
 done <"$CASES"

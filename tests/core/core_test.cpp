@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
 
+#include <sys/stat.h>
+
 #include <filesystem>
 #include <initializer_list>
 #include <tuple>
@@ -152,6 +154,34 @@ TEST_CASE("writeFileAtomic", "[core]") {
   SECTION("a missing folder is an error, not a crash") {
     CHECK_THROWS_AS(writeFileAtomic(dir / "no" / "such" / "x", "y"), std::runtime_error);
   }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("readFile reads regular files only, never blocking on a FIFO", "[core]") {
+  namespace fs = std::filesystem;
+  fs::path dir = fs::temp_directory_path() / "sprig_core_readfile_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "folder");
+  writeFileAtomic(dir / "a.txt", "abc");
+  REQUIRE(::mkfifo((dir / "fifo").c_str(), 0600) == 0);
+  CHECK(readFile(dir / "a.txt") == "abc");
+  CHECK(notRegularFileReason(dir / "a.txt").empty());
+  auto reasonOf = [](const fs::path& p) -> std::string {
+    try {
+      readFile(p);
+    } catch (const FileReadError& e) {
+      return e.reason();
+    }
+    return "read";
+  };
+  // The FIFO has no writer: opening it for reading without the check would block forever.
+  CHECK(reasonOf(dir / "fifo") == "is a FIFO, not a regular file");
+  CHECK(reasonOf(dir / "folder") == "is a folder, not a regular file");
+  CHECK(reasonOf(dir / "none") == "cannot find file");
+  CHECK(reasonOf(dir / "a.txt" / "x") == "cannot find file");
+  CHECK_THROWS_WITH(readFile(dir / "a.txt", 2), "'" + (dir / "a.txt").string() + "' has 3 bytes, more than the limit of 2 bytes");
+  CHECK_THROWS_WITH(requireRegularFile(dir / "fifo"), "'" + (dir / "fifo").string() + "' is a FIFO, not a regular file");
+  CHECK_THROWS_WITH(readInputFile(dir / "folder", "f", 10, "L"), "f: error: is a folder, not a regular file");
   fs::remove_all(dir);
 }
 

@@ -633,7 +633,7 @@ TEST_CASE("cpfg's C preprocessor", "[lsystem][cpfg]") {
   SECTION("errors") {
     CHECK(errorOf("#include \"../query/plant.v\"\naxiom: A\n", cpfgAsset("preprocessor/t.l")).find(
               ":1:10: '#include \"../query/plant.v\"' is outside the object's folder") != std::string::npos);
-    CHECK(errorOf("#include \"missing.h\"\naxiom: A\n") == "t.l:1:10: cannot read the included file 'missing.h'");
+    CHECK(errorOf("#include \"missing.h\"\naxiom: A\n") == "t.l:1:10: cannot find file 'missing.h'");
     CHECK(errorOf("#ifdef X\naxiom: A\n") == "t.l:1:1: '#if' block without '#endif'");
     CHECK(errorOf("axiom: A\n#endif\n") == "t.l:2:1: '#endif' without '#ifdef' or '#ifndef'");
     CHECK(errorOf("#define B F\n#define B G\naxiom: A\n") == "t.l:2:9: 'B' is already defined at t.l:1");
@@ -885,7 +885,7 @@ TEST_CASE("cpfg function files and func(n, x)", "[lsystem][cpfg]") {
     CHECK(errorIn("range: 0 1\npoints: 5\n0 0\n0.5 1\n") == "f.func:4:1: the function file ends after 2 of its 5 points");
     CHECK(errorOf("axiom: A(func(1, 0.5))\n") ==
           "t.l:1:10: cpfg's func(n, x) reads the view file's function files, and it names none ('function: NAME.func')");
-    CHECK(viewErrorOf("function: missing.func\n") == "t.v:1:11: cannot read the function file 'missing.func'");
+    CHECK(viewErrorOf("function: missing.func\n") == "t.v:1:11: cannot find file 'missing.func'");
     CHECK(viewErrorOf("function: ../x.func\n") ==
           "t.v:1:11: the function file '../x.func' is outside the object's folder (only files beside the view file, or in folders below it)");
   }

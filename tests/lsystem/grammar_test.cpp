@@ -278,7 +278,7 @@ TEST_CASE("loadGrammar", "[lsystem]") {
     loadGrammar("/nonexistent/x.lsys");
     FAIL("no error");
   } catch (const InputError& e) {
-    CHECK(std::string(e.what()) == "/nonexistent/x.lsys: error: cannot read the grammar file");
+    CHECK(std::string(e.what()) == "/nonexistent/x.lsys: error: cannot find file");
   }
 }
 

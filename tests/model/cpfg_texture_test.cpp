@@ -162,7 +162,7 @@ TEST_CASE("cpfg texture errors", "[model][cpfg]") {
   };
   CHECK(errorOf("texture: F: halves.png\n", "[@Tx(1)~a]F") == "no error");
   CHECK(errorOf("texture: F: missing.png\n", "~a") ==
-        "plant.v:2:13: cannot read the texture image '" + (dir / "missing.png").string() + "': no such file");
+        "plant.v:2:13: cannot find file '" + (dir / "missing.png").string() + "'");
   // A file that is no image: the image reader's reason.
   writeFileAtomic(dir / "bad.png", "not a png");
   CHECK(errorOf("texture: F: bad.png\n", "~a").rfind("plant.v:2:13: cannot read the texture image '" + (dir / "bad.png").string() + "': ", 0) == 0);

@@ -209,3 +209,36 @@ TEST_CASE("resolveReference", "[model]") {
   CHECK(!diags2.hasErrors());
   fs::remove_all(dir);
 }
+
+TEST_CASE("pathRefusal: a missing file in the current folder is inside the root '.'", "[model]") {
+  PathPolicy policy;  // root "."
+  // weakly_canonical leaves a relative path that does not exist relative: it must be made
+  // absolute first, or every missing name looks like an escape.
+  CHECK(pathRefusal("hornbeem.lsys", "hornbeem.lsys", policy).empty());
+  CHECK(pathRefusal("no/such/dir/x.lsys", "no/such/dir/x.lsys", policy).empty());
+  CHECK(pathRefusal("../x.lsys", "../x.lsys", policy) ==
+        "refusing path '../x.lsys': it leaves the library root '.' (pass --root FOLDER to read from a wider root, or --allow-outside-paths)");
+  CHECK(pathRefusal("/etc/passwd", "/etc/passwd", policy).rfind("refusing absolute path '/etc/passwd'", 0) == 0);
+  policy.allowOutside = true;
+  CHECK(pathRefusal("/etc/passwd", "/etc/passwd", policy).empty());
+}
+
+TEST_CASE("defaultLibraryRoot", "[model]") {
+  fs::path dir = fs::weakly_canonical(fs::temp_directory_path()) / "sprig_default_root_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir / "marked/a/b");
+  fs::create_directories(dir / "checkout/species/trees");
+  fs::create_directories(dir / "plain/x");
+  fs::create_directories(dir / "obj");
+  { std::ofstream(dir / "marked/.sprig-root") << "\n"; }
+  // A marker file at or above the species file's folder.
+  CHECK(defaultLibraryRoot(dir / "marked/a/b/s.yaml") == dir / "marked");
+  CHECK(defaultLibraryRoot(dir / "marked/s.yaml") == dir / "marked");
+  // The parent of the species/ folder the file lies in, at any depth below it.
+  CHECK(defaultLibraryRoot(dir / "checkout/species/s.yaml") == dir / "checkout");
+  CHECK(defaultLibraryRoot(dir / "checkout/species/trees/s.yaml") == dir / "checkout");
+  // Else the species file's own folder; a vlab object folder is its own root.
+  CHECK(defaultLibraryRoot(dir / "plain/x/s.yaml") == dir / "plain/x");
+  CHECK(defaultLibraryRoot(dir / "obj") == dir / "obj");
+  fs::remove_all(dir);
+}

@@ -396,8 +396,8 @@ TEST_CASE("ImageTexture", "[textures]") {
       FAIL("no throw");
     } catch (const InputError& e) {
       std::string msg = e.what();
-      CHECK(msg.rfind("species/oak.yaml:7:14: error: cannot read texture '", 0) == 0);
-      CHECK(msg.find("no_such_bark.png': no such file") != std::string::npos);
+      CHECK(msg.rfind("species/oak.yaml:7:14: error: cannot find file '", 0) == 0);
+      CHECK(msg.find("no_such_bark.png'") != std::string::npos);
     }
   }
   SECTION("an unreadable file is an InputError too") {
