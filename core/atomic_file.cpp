@@ -96,11 +96,19 @@ void writeFileAtomic(const fs::path& path, std::string_view bytes) {
   tmp.commit();
 }
 
+namespace {
+
+/// FileReadError's message: `cannot find file 'P'`, `'P': cannot ...` or `'P' is a FIFO, ...`.
+std::string fileReadMessage(const fs::path& path, const std::string& reason) {
+  const std::string quoted = "'" + path.string() + "'";
+  if (reason == "cannot find file") return reason + " " + quoted;
+  return quoted + (reason.rfind("cannot ", 0) == 0 ? ": " : " ") + reason;
+}
+
+}  // namespace
+
 FileReadError::FileReadError(const fs::path& path, std::string reason)
-    : std::runtime_error(reason == "cannot find file" ? "cannot find file '" + path.string() + "'"
-                         : reason.rfind("cannot ", 0) == 0 ? "'" + path.string() + "': " + reason
-                                                           : "'" + path.string() + "' " + reason),
-      reason_(std::move(reason)) {}
+    : std::runtime_error(fileReadMessage(path, reason)), reason_(std::move(reason)) {}
 
 namespace {
 
