@@ -292,50 +292,58 @@ class SPRIG_OT_import(bpy.types.Operator, ImportHelper):
         return {"FINISHED"}
 
 
-class SPRIG_OT_regenerate(bpy.types.Operator):
+class SpeciesOperator:
+    """An operator on the selected species (its empty or a part): run(context, empty); an
+    error of Sprig's is reported and cancels."""
+
+    @classmethod
+    def poll(cls, context):
+        return species_owner(context.object) is not None
+
+    def execute(self, context):
+        try:
+            return self.run(context, species_owner(context.object))
+        except Exception as e:
+            self.report({"ERROR"}, str(e))
+            return {"CANCELLED"}
+
+
+class SPRIG_OT_regenerate(SpeciesOperator, bpy.types.Operator):
     """Build the species' meshes again with the panel's values"""
     bl_idname = "sprig.regenerate"
     bl_label = "Regenerate"
     bl_options = {"REGISTER", "UNDO"}
 
-    def execute(self, context):
-        empty = species_owner(context.object)
-        if empty is None:
-            self.report({"ERROR"}, "no Sprig species selected")
-            return {"CANCELLED"}
+    def run(self, context, empty):
         live = empty.sprig.live
         empty.sprig.live = True
         try:
             regenerate(empty)
-        except Exception as e:
-            self.report({"ERROR"}, str(e))
-            return {"CANCELLED"}
         finally:
             empty.sprig.live = live
         return {"FINISHED"}
 
 
-class SPRIG_OT_reset(bpy.types.Operator):
+class SPRIG_OT_reset(SpeciesOperator, bpy.types.Operator):
     """Set every #define and the steps back to the file's values"""
     bl_idname = "sprig.reset"
     bl_label = "Reset to file"
     bl_options = {"REGISTER", "UNDO"}
 
-    def execute(self, context):
-        empty = species_owner(context.object)
-        if empty is None:
-            return {"CANCELLED"}
+    def run(self, context, empty):
         settings = empty.sprig
         settings.building = True
-        for d in settings.defines:
-            d.value = d.default
-        settings.steps = settings.max_steps
-        settings.building = False
+        try:
+            for d in settings.defines:
+                d.value = d.default
+            settings.steps = settings.max_steps
+        finally:
+            settings.building = False
         regenerate(empty)
         return {"FINISHED"}
 
 
-class SPRIG_OT_render(bpy.types.Operator):
+class SPRIG_OT_render(SpeciesOperator, bpy.types.Operator):
     """Render the species with Sprig's own renderer into the image "<species> (Sprig)\""""
     bl_idname = "sprig.render"
     bl_label = "Render with Sprig"
@@ -343,17 +351,9 @@ class SPRIG_OT_render(bpy.types.Operator):
     height: IntProperty(name="Height", default=0, min=0)
     spp: IntProperty(name="Samples", default=0, min=0, description="0: the species' own")
 
-    def execute(self, context):
-        empty = species_owner(context.object)
-        if empty is None:
-            self.report({"ERROR"}, "no Sprig species selected")
-            return {"CANCELLED"}
-        try:
-            pixels = load_species(empty.sprig).render(self.width or None, self.height or None, spp=self.spp or None,
-                                                      linear=True)
-        except Exception as e:
-            self.report({"ERROR"}, str(e))
-            return {"CANCELLED"}
+    def run(self, context, empty):
+        pixels = load_species(empty.sprig).render(self.width or None, self.height or None, spp=self.spp or None,
+                                                  linear=True)
         image = render_image(empty.name + " (Sprig)", np.asarray(pixels))
         for area in context.screen.areas if context.screen else []:
             if area.type == "IMAGE_EDITOR":

@@ -77,6 +77,7 @@ def main():
     assert tree.name == "ABOP 2.6 monopodial tree", tree.name
     assert [d.name for d in tree.sprig.defines] == ["r1", "r2", "a0", "a2", "d", "wr"]
     assert tree.sprig.max_steps == 10 and tree.sprig.steps == 10
+    imported = len(mesh_of(tree)[0])
     bpy.context.view_layer.objects.active = tree
     tree.sprig.steps = 4  # the slider's update callback rebuilds
     points = check_species(tree, "tree", ["wood"], textured=True)
@@ -84,11 +85,21 @@ def main():
     before = (len(points), points.max(0).copy())
     wood = tree.children[0].data.name
     # r1 (the main axis' length ratio) from 0.9 to 0.6: a shorter, smaller tree
-    next(d for d in tree.sprig.defines if d.name == "r1").value = 0.6
+    tree.sprig.defines["r1"].value = 0.6
     after, _ = mesh_of(tree)
     assert len(after) != before[0] or not np.allclose(after.max(0), before[1]), (len(after), before)
     assert after[:, 2].max() < before[1][2] - 0.1, (after.max(0), before[1])
     assert tree.children[0].data.name != wood and wood not in bpy.data.meshes, "the old mesh was not replaced"
+    # Live off: no rebuild until Regenerate; Reset: the file's values (10 steps) again
+    tree.sprig.live = False
+    tree.sprig.defines["r1"].value = 0.75
+    assert len(mesh_of(tree)[0]) == len(after)
+    assert bpy.ops.sprig.regenerate() == {"FINISHED"}
+    assert len(mesh_of(tree)[0]) not in (len(after), before[0]), len(mesh_of(tree)[0])
+    tree.sprig.live = True
+    assert bpy.ops.sprig.reset() == {"FINISHED"}
+    assert tree.sprig.steps == 10 and abs(tree.sprig.defines["r1"].value - 0.9) < 1e-6
+    assert len(mesh_of(tree)[0]) == imported, (len(mesh_of(tree)[0]), imported)
     print("tree: %d -> %d vertices, top %.2f -> %.2f m" % (before[0], len(after), before[1][2], after[:, 2].max()))
 
     # Sprig's renderer into an image datablock
