@@ -101,8 +101,9 @@ def texture_image(name, texture):
 
 
 def build_material(name, part):
-    """A Principled BSDF material: base colour and roughness from the part's material, its
-    vertex colours (Attribute node "Col") and its texture (Image Texture) when it has them."""
+    """A Principled BSDF material as Sprig's glTF export makes it: roughness from the part's
+    material; base colour from its texture (an Image Texture: the image holds the absolute
+    colours), else from its vertex colours (an Attribute node reading "Col"), else its base colour."""
     mat = bpy.data.materials.new(name)
     mat.use_nodes = True
     nodes, links = mat.node_tree.nodes, mat.node_tree.links
@@ -110,32 +111,20 @@ def build_material(name, part):
     bsdf.inputs["Base Color"].default_value = (*part["base_color"], 1.0)
     bsdf.inputs["Roughness"].default_value = part["roughness"]
     mat.use_backface_culling = not part["double_sided"]
-    colour = None
-    if part["colors"] is not None:
-        attribute = nodes.new("ShaderNodeAttribute")
-        attribute.attribute_name = "Col"
-        attribute.location = (-500, 300)
-        colour = attribute.outputs["Color"]
     if part["texture"] is not None:
         tex = nodes.new("ShaderNodeTexImage")
         tex.image = texture_image(name, part["texture"])
         tex.location = (-500, 0)
-        if colour is not None:
-            mix = nodes.new("ShaderNodeMixRGB")
-            mix.blend_type = "MULTIPLY"
-            mix.inputs["Fac"].default_value = 1.0
-            mix.location = (-250, 150)
-            links.new(colour, mix.inputs["Color1"])
-            links.new(tex.outputs["Color"], mix.inputs["Color2"])
-            colour = mix.outputs["Color"]
-        else:
-            colour = tex.outputs["Color"]
+        links.new(tex.outputs["Color"], bsdf.inputs["Base Color"])
         if part["alpha_cutoff"] is not None:
             links.new(tex.outputs["Alpha"], bsdf.inputs["Alpha"])
             mat.blend_method = "CLIP"
             mat.alpha_threshold = part["alpha_cutoff"]
-    if colour is not None:
-        links.new(colour, bsdf.inputs["Base Color"])
+    elif part["colors"] is not None:
+        attribute = nodes.new("ShaderNodeAttribute")
+        attribute.attribute_name = "Col"
+        attribute.location = (-500, 300)
+        links.new(attribute.outputs["Color"], bsdf.inputs["Base Color"])
     return mat
 
 

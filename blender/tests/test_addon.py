@@ -37,7 +37,7 @@ def mesh_of(empty):
     return np.concatenate(points), children
 
 
-def check_species(empty, kind, parts, textured=None):
+def check_species(empty, kind, parts, textured):
     """empty is named after the species, holds the expected parts, each with triangles and one material."""
     assert empty.type == "EMPTY" and empty.sprig.kind == kind, (empty.name, empty.sprig.kind)
     points, children = mesh_of(empty)
@@ -49,11 +49,13 @@ def check_species(empty, kind, parts, textured=None):
         assert len(obj.data.materials) == 1 and obj.data.materials[0].use_nodes, obj.name
         nodes = obj.data.materials[0].node_tree.nodes
         assert "Principled BSDF" in nodes
-        if "Col" in obj.data.color_attributes:
-            assert any(n.type == "ATTRIBUTE" and n.attribute_name == "Col" for n in nodes), obj.name
-        if textured is not None:
-            has_image = any(n.type == "TEX_IMAGE" and n.image and n.image.size[0] > 0 for n in nodes)
-            assert has_image == textured, (obj.name, has_image)
+        has_image = any(n.type == "TEX_IMAGE" and n.image and n.image.size[0] > 0 for n in nodes)
+        assert has_image == textured, (obj.name, has_image)
+        # the texture holds absolute colours; without one, the vertex colours give the base colour
+        has_attribute = any(n.type == "ATTRIBUTE" and n.attribute_name == "Col" for n in nodes)
+        assert has_attribute == (not textured and "Col" in obj.data.color_attributes), obj.name
+        base = nodes["Principled BSDF"].inputs["Base Color"]
+        assert base.is_linked == (has_image or has_attribute), obj.name
     return points
 
 
