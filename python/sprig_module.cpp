@@ -147,6 +147,20 @@ std::string summary(PySpecies& s) {
   return s.species.kind + (s.species.bareGrammar ? " grammar" : " species") + s.species.spec->checkSummary(s.species);
 }
 
+/// A tree's grammar as loaded (its own overrides, then sprig.load's): every `#define` in file
+/// order with its value, and the derivation length. Other kinds have neither.
+std::pair<std::vector<std::pair<std::string, double>>, std::optional<int>> grammarParameters(PySpecies& s) {
+  if (s.species.kind != "tree") return {};
+  return runLong(
+      [&] {
+        const lsystem::Grammar g = speciesGrammar(s.species, s.extra);
+        std::vector<std::pair<std::string, double>> defines;
+        for (const std::string& name : g.defineNames()) defines.emplace_back(name, g.define(name).value_or(0));
+        return std::make_pair(defines, std::optional<int>(g.derivationLength()));
+      },
+      py::none());
+}
+
 // ---- derive --------------------------------------------------------------------------
 
 /// `sprig derive`'s string and skeleton at one step.
@@ -500,6 +514,13 @@ void bindSpecies(py::module_& m) {
            }, py::arg("progress") = py::none())
       .def("summary", [](PySpecies& s, const py::object& progress) { return runLong([&] { return summary(s); }, progress); },
            py::arg("progress") = py::none())
+      .def("defines",
+           [](PySpecies& s) {
+             py::dict out;  // insertion-ordered: the file's order
+             for (const auto& [name, value] : grammarParameters(s).first) out[py::str(name)] = value;
+             return out;
+           })
+      .def_property_readonly("steps", [](PySpecies& s) { return grammarParameters(s).second; })
       .def("derive", &derive, py::arg("stage") = py::none(), py::arg("progress") = py::none())
       .def("_render",
            [](PySpecies& s, int width, int height, int spp, const std::string& mode, std::optional<int> stage,

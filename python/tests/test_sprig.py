@@ -57,6 +57,15 @@ def test_overrides_are_the_commands_defines_and_steps():
         sprig.load(TREE, overrides={"NOPE": 1})
 
 
+def test_defines_and_steps_are_the_grammars_after_overrides(tree):
+    assert tree.defines() == {"LEN": 1.0} and tree.steps == 2
+    other = sprig.load(TREE, overrides={"LEN": 2.5}, steps=1)
+    assert other.defines() == {"LEN": 2.5} and other.steps == 1
+    assert list(sprig.load("species/abop_2_6.yaml").defines()) == ["r1", "r2", "a0", "a2", "d", "wr"]
+    shell = sprig.load("species/shell_cone.yaml")
+    assert shell.defines() == {} and shell.steps is None
+
+
 def test_render_equals_the_commands_png(tree, tmp_path):
     image = tree.render()
     assert isinstance(image, sprig.Image) and image.shape == (128, 96, 4) and image.dtype == np.uint8

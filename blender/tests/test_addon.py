@@ -1,0 +1,136 @@
+"""The Sprig add-on in Blender's background mode (docs/BLENDER.md): enables it from the source
+folder, imports a tree, a shell, an organism and a solid, and checks their objects, meshes,
+materials, the Z-up conversion and that changing a #define rebuilds the tree.
+
+    blender -b --factory-startup --python blender/tests/test_addon.py [-- BUILD_PYTHON_FOLDER]
+
+Exits 1 on the first failure (ctest blender_addon, label heavy)."""
+
+import os
+import sys
+import time
+import traceback
+
+import addon_utils
+import bpy
+import numpy as np
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SOURCE = os.path.dirname(os.path.dirname(HERE))
+args = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+if args:
+    os.environ["SPRIG_PYTHONPATH"] = args[0]
+
+
+def species(name):
+    return os.path.join(SOURCE, "species", name)
+
+
+def mesh_of(empty):
+    """Every child's world-space vertex positions, stacked (N, 3), and the children."""
+    children = sorted(empty.children, key=lambda o: o.name)
+    points = []
+    for obj in children:
+        co = np.empty(len(obj.data.vertices) * 3, np.float32)
+        obj.data.vertices.foreach_get("co", co)
+        points.append(co.reshape(-1, 3))
+    return np.concatenate(points), children
+
+
+def check_species(empty, kind, parts, textured):
+    """empty is named after the species, holds the expected parts, each with triangles and one material."""
+    assert empty.type == "EMPTY" and empty.sprig.kind == kind, (empty.name, empty.sprig.kind)
+    points, children = mesh_of(empty)
+    names = sorted(o["sprig_part"] for o in children)
+    assert names == sorted(parts), (empty.name, names)
+    for obj in children:
+        assert obj.type == "MESH" and obj.parent == empty
+        assert len(obj.data.vertices) > 0 and len(obj.data.polygons) > 0, obj.name
+        assert len(obj.data.materials) == 1 and obj.data.materials[0].use_nodes, obj.name
+        nodes = obj.data.materials[0].node_tree.nodes
+        assert "Principled BSDF" in nodes
+        has_image = any(n.type == "TEX_IMAGE" and n.image and n.image.size[0] > 0 for n in nodes)
+        assert has_image == textured, (obj.name, has_image)
+        # the texture holds absolute colours; without one, the vertex colours give the base colour
+        has_attribute = any(n.type == "ATTRIBUTE" and n.attribute_name == "Col" for n in nodes)
+        assert has_attribute == (not textured and "Col" in obj.data.color_attributes), obj.name
+        base = nodes["Principled BSDF"].inputs["Base Color"]
+        assert base.is_linked == (has_image or has_attribute), obj.name
+    return points
+
+
+def main():
+    t0 = time.time()
+    sys.path.insert(0, os.path.join(SOURCE, "blender"))
+    addon_utils.enable("sprig_addon", default_set=True, handle_error=lambda e: (_ for _ in ()).throw(e))
+    assert hasattr(bpy.types.Object, "sprig"), "the add-on did not register"
+    for obj in list(bpy.data.objects):
+        bpy.data.objects.remove(obj)
+
+    def load(name, cell):
+        before = set(bpy.data.objects)
+        assert bpy.ops.sprig.import_species(filepath=species(name), root="/", cell=cell) == {"FINISHED"}
+        empties = [o for o in set(bpy.data.objects) - before if o.type == "EMPTY"]
+        assert len(empties) == 1, empties
+        return empties[0]
+
+    # A tree at 4 of its 10 steps, coarse (cell 0.05 m): Y-up 2.8 m tall becomes Z-up.
+    tree = load("abop_2_6.yaml", 0.05)
+    assert tree.name == "ABOP 2.6 monopodial tree", tree.name
+    assert [d.name for d in tree.sprig.defines] == ["r1", "r2", "a0", "a2", "d", "wr"]
+    assert tree.sprig.max_steps == 10 and tree.sprig.steps == 10
+    imported = len(mesh_of(tree)[0])
+    bpy.context.view_layer.objects.active = tree
+    tree.sprig.steps = 4  # the slider's update callback rebuilds
+    points = check_species(tree, "tree", ["wood"], textured=True)
+    assert points[:, 2].max() > 2.0 and points[:, 2].max() > points[:, 1].max() + 1.5, points.max(0)
+    before = (len(points), points.max(0).copy())
+    wood = tree.children[0].data.name
+    # r1 (the main axis' length ratio) from 0.9 to 0.6: a shorter, smaller tree
+    tree.sprig.defines["r1"].value = 0.6
+    after, _ = mesh_of(tree)
+    assert len(after) != before[0] or not np.allclose(after.max(0), before[1]), (len(after), before)
+    assert after[:, 2].max() < before[1][2] - 0.1, (after.max(0), before[1])
+    assert tree.children[0].data.name != wood and wood not in bpy.data.meshes, "the old mesh was not replaced"
+    # Live off: no rebuild until Regenerate; Reset: the file's values (10 steps) again
+    tree.sprig.live = False
+    tree.sprig.defines["r1"].value = 0.75
+    assert len(mesh_of(tree)[0]) == len(after)
+    assert bpy.ops.sprig.regenerate() == {"FINISHED"}
+    assert len(mesh_of(tree)[0]) not in (len(after), before[0]), len(mesh_of(tree)[0])
+    tree.sprig.live = True
+    assert bpy.ops.sprig.reset() == {"FINISHED"}
+    assert tree.sprig.steps == 10 and abs(tree.sprig.defines["r1"].value - 0.9) < 1e-6
+    assert len(mesh_of(tree)[0]) == imported, (len(mesh_of(tree)[0]), imported)
+    print("tree: %d -> %d vertices, top %.2f -> %.2f m" % (before[0], len(after), before[1][2], after[:, 2].max()))
+
+    # Sprig's renderer into an image datablock
+    assert bpy.ops.sprig.render(width=48, height=40, spp=1) == {"FINISHED"}
+    image = bpy.data.images["ABOP 2.6 monopodial tree (Sprig)"]
+    assert tuple(image.size) == (48, 40)
+    pixels = np.empty(48 * 40 * 4, np.float32)
+    image.pixels.foreach_get(pixels)
+    rgb = pixels.reshape(-1, 4)[:, :3]
+    assert np.abs(rgb - rgb[0]).max(axis=1).max() > 0.05, "the render is one colour"
+
+    shell = load("shell_cone.yaml", 2.0)
+    check_species(shell, "shell", ["whorl"], textured=True)
+    assert len(shell.sprig.defines) == 0 and shell.sprig.max_steps == 0
+    organism = load("fig_org_05a_berry_level1.yaml", 0.0)
+    check_species(organism, "organism", ["organism"], textured=False)
+    solid = load("solid_layered_sphere.yaml", 0.0)
+    points = check_species(solid, "solid", ["foil"], textured=False)
+    assert np.allclose(points.max(0), [0.98, 0.98, 0.98], atol=1e-4), points.max(0)
+    assert len([o for o in bpy.data.objects if o.type == "EMPTY"]) == 4
+    assert len([o for o in bpy.data.objects if o.type == "MESH"]) == 4
+    print("blender add-on test passed in %.1f s" % (time.time() - t0))
+
+
+try:
+    main()
+except Exception:
+    traceback.print_exc()
+    sys.stdout.flush()
+    os._exit(1)
+sys.stdout.flush()
+os._exit(0)
