@@ -265,7 +265,11 @@ struct Deriver::Impl {
     tmp.cpfgSemantics = cpfgSemantics;
     tmp.cpfgRandom = cpfgRandom;
     tmp.cpfgLocals = cpfgLocals;
-    if (!prog->subLsystems.empty()) {
+    // cpfg's interpretation rules that draw (or srand) run depth first, as cpfg's do, so
+    // that they draw in cpfg's order.
+    const bool cpfgDraws = cpfgSemantics && std::any_of(prog->interpretation.productions.begin(), prog->interpretation.productions.end(),
+                                                        [](const Production& p) { return p.usesRandom; });
+    if (!prog->subLsystems.empty() || cpfgDraws) {
       ModuleString out;
       Writer w(out, s.hasBirthSteps(), opt.maxModules, limitAt, step, s.size() + 16, s.params.size() + 16);
       tmp.homomorphismWithSubLsystems(s, w, step);

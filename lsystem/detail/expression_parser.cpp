@@ -286,9 +286,8 @@ int ExpressionParser::parseCall(State& st, const Token& id) {
     if (!ok) {
       scanner_.error(st.span.line, id.col,
                      name == "srand" ? std::string("cpfg's function 'srand' is supported only as a statement ('srand(s);') of a "
-                                                   "'Start:', 'StartEach:', 'EndEach:' or 'End:' block or of a production "
-                                                   "(not of an interpretation rule: the derivation has ended when the "
-                                                   "string is interpreted)")
+                                                   "'Start:', 'StartEach:', 'EndEach:' or 'End:' block, or of a rule's "
+                                                   "statements in a .l file (where it reseeds cpfg's own random stream)")
                                      : std::string(allowStopReason_));
       throw ExprFail{};
     }

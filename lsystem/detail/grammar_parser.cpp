@@ -1126,7 +1126,7 @@ class GrammarParser {
         // cpfg's srand and stop are statements of their own (Op::Srand, Op::Stop).
         const bool effectCall = word == "srand" || word == "stop";
         if (effectCall)
-          expr_.allowEffects(inGlobalBlock_ || (prog_.dialect == Dialect::Cpfg && statementBlock_ != Block::Interpretation),
+          expr_.allowEffects(inGlobalBlock_ || prog_.dialect == Dialect::Cpfg,
                              inGlobalBlock_ || statementBlock_ != Block::Interpretation,
                              "cpfg's function 'stop' in an interpretation rule is not supported (the derivation has ended "
                              "when the string is interpreted): call it in a production or a Start/EndEach block");

@@ -839,10 +839,10 @@ TEST_CASE("cpfg srand and stop", "[lsystem][cpfg]") {
   }
   SECTION("errors") {
     CHECK(errorOf("axiom: A\nA : {srand(2);} * --> B\n") == "no error");
-    CHECK(errorOf("axiom: A\nhomomorphism\nA : {srand(2);} * --> F\n") ==
-          "t.l:3:6: cpfg's function 'srand' is supported only as a statement ('srand(s);') of a 'Start:', 'StartEach:', "
-          "'EndEach:' or 'End:' block or of a production (not of an interpretation rule: the derivation has ended when the "
-          "string is interpreted)");
+    CHECK(errorOf("axiom: A\nhomomorphism\nA : {srand(2);} * --> F\n") == "no error");
+    CHECK(errorOf("axiom: A\nA : {srand(2);} * --> B\n", "t.lsys") ==
+          "t.lsys:2:6: cpfg's function 'srand' is supported only as a statement ('srand(s);') of a 'Start:', 'StartEach:', "
+          "'EndEach:' or 'End:' block, or of a rule's statements in a .l file (where it reseeds cpfg's own random stream)");
     CHECK(errorOf("axiom: A\nA : stop(1) --> B\n") == "t.l:2:5: cpfg's function 'stop' is supported only as a statement ('stop(1);')");
     CHECK(errorOf("axiom: A\nhomomorphism\nA : {stop(1);} * --> F\n") ==
           "t.l:3:6: cpfg's function 'stop' in an interpretation rule is not supported (the derivation has ended when the "
