@@ -44,7 +44,8 @@ enum class Op : uint8_t {
   Jz,      ///< pops a value; when it is 0, jumps to instruction c of the block
   Jmp,     ///< jumps to instruction c of the block
   Printf,  ///< cpfg's `printf(format, ...)`: pops c values, prints them to stderr with Program::strings[var]
-  Srand,   ///< cpfg's `srand(s)`: records s as the seed of later draws (Effects::reseed); value 0
+  Srand,   ///< cpfg's `srand(s)`: reseeds cpfg's stream (Draws::cpfg), or records s as the seed of
+           ///< later draws (Effects::reseed); value 0
   Stop,    ///< cpfg's `stop(x)`: asks the derivation to end after the current step (Effects::stop); value 0
   Func,    ///< cpfg's `func(n, x)`: function var (n - 1) of the view file's function files at x
   Curve,   ///< cpfg's `curveX/Y/Z(n, t)`: coordinate c (0, 1, 2) of curve var (n - 1) at arc length t
