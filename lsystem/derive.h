@@ -78,7 +78,8 @@ class Deriver {
   /// Target number of steps (options or grammar); after cpfg's `stop(x)` ran in a step
   /// (a production's or a Start/StartEach/EndEach block's statements), that step.
   int steps() const;
-  /// The seed in use (after cpfg's `srand(s)` in a Start/StartEach/EndEach/End block, s).
+  /// The seed in use (in a .lsys file, after `srand(s)` in a Start/StartEach/EndEach/End block, s;
+  /// a .l file's srand reseeds cpfg's own stream instead).
   uint64_t seed() const;
   /// The grammar's symbol table (ids in every string this Deriver produces).
   const SymbolTable& symbols() const;
