@@ -76,4 +76,28 @@ class Rng {
   uint64_t inc_ = 1;
 };
 
+/// The POSIX rand48 generator behind drand48/erand48: the 48-bit state steps as
+/// X' = (0x5DEECE66D X + 0xB) mod 2^48 and each draw is X' / 2^48 (exactly; 48 bits).
+/// Sprig implements it rather than calling libc (global state) so that cpfg files draw
+/// cpfg's own sequences (lsystem/, docs/GRAMMAR.md) on any platform and any thread.
+class Rand48 {
+ public:
+  /// A generator whose state is x (its low 48 bits).
+  explicit constexpr Rand48(uint64_t x = 0) : x_(x & kMask) {}
+  /// The state of erand48's array {w0, w1, w2} (w0 least significant), which seed48 sets.
+  static constexpr Rand48 fromWords(uint16_t w0, uint16_t w1, uint16_t w2) {
+    return Rand48(static_cast<uint64_t>(w0) | (static_cast<uint64_t>(w1) << 16) | (static_cast<uint64_t>(w2) << 32));
+  }
+  /// Next draw in [0, 1).
+  double next() {
+    x_ = (0x5DEECE66Dull * x_ + 0xBu) & kMask;
+    return static_cast<double>(x_) * 0x1.0p-48;
+  }
+  uint64_t state() const { return x_; }
+
+ private:
+  static constexpr uint64_t kMask = (1ull << 48) - 1;
+  uint64_t x_;
+};
+
 }  // namespace sprig

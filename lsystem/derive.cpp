@@ -6,6 +6,7 @@
 #include <limits>
 #include <cmath>
 #include <optional>
+#include <unordered_map>
 
 #include "core/rng.h"
 #include "lsystem/detail/huge_pages.h"
@@ -185,6 +186,21 @@ struct Deriver::Impl {
   Rng rng;
   bool rngReady = false;
   uint64_t rngStream = 0, rngItem = 0;
+  detail::Draws draws;
+  /// cpfg's notation: cpfg's own sequential streams (detail::CpfgRandom) replace the
+  /// per-module ones (a step visits the modules in string order, on one thread), and the
+  /// local variables of a production's statements keep their values from one application
+  /// to the next (cpfg's are the production's own symbols: generate.c, CreateVarTable
+  /// binds only the formal parameters).
+  bool cpfgSemantics = false;
+  /// cpfg's notation: the local variables of each production with statements, between uses.
+  std::unordered_map<const Production*, std::vector<double>> cpfgLocals;
+  detail::CpfgRandom cpfgRandom;
+  /// cpfg's stochastic choice for the module being rewritten: its drand48 draw, or -1
+  /// (not a production step of a stochastic L-system: the first applicable production).
+  double choiceDraw = -1;
+  /// Vars of each applicable production (cpfg's choice among productions with statements).
+  std::vector<double> candidateVars;
 
   /// The turtle that fills query modules (made on first use).
   std::unique_ptr<Turtle> queryTurtle;
@@ -244,7 +260,16 @@ struct Deriver::Impl {
     tmp.cur = s;
     tmp.globals = globals;
     tmp.arrays = arrays;
-    if (!prog->subLsystems.empty()) {
+    // cpfg's interpretation draws from a copy of the main stream (it never advances the
+    // derivation's: cpfg's depends on when it draws, docs/GRAMMAR.md).
+    tmp.cpfgSemantics = cpfgSemantics;
+    tmp.cpfgRandom = cpfgRandom;
+    tmp.cpfgLocals = cpfgLocals;
+    // cpfg's interpretation rules that draw (or srand) run depth first, as cpfg's do, so
+    // that they draw in cpfg's order.
+    const bool cpfgDraws = cpfgSemantics && std::any_of(prog->interpretation.productions.begin(), prog->interpretation.productions.end(),
+                                                        [](const Production& p) { return p.usesRandom; });
+    if (!prog->subLsystems.empty() || cpfgDraws) {
       ModuleString out;
       Writer w(out, s.hasBirthSteps(), opt.maxModules, limitAt, step, s.size() + 16, s.params.size() + 16);
       tmp.homomorphismWithSubLsystems(s, w, step);
@@ -303,9 +328,11 @@ struct Deriver::Impl {
   void runBlock(const detail::CodeRange& r, int step, int stepsBefore) {
     if (r.empty()) return;
     Rng blockRng(deriveSeed(seed, {kBlockStream, static_cast<uint64_t>(step)}));
+    detail::Draws blockDraws{&blockRng, nullptr};
+    if (cpfgSemantics) blockDraws = {nullptr, &cpfgRandom};
     const Instr* code = prog->code.data();
     const bool looped = std::isnan(
-        detail::evalCode(code + r.begin, code + r.end, globals.data(), &blockRng, &prog->strings, &effects, &prog->cpfg,
+        detail::evalCode(code + r.begin, code + r.end, globals.data(), &blockDraws, &prog->strings, &effects, &prog->cpfg,
                          arrays.data()));
     if (effects.reseed) {
       // cpfg's srand(s): the next step draws as the first step of a derivation with seed s.
@@ -319,18 +346,37 @@ struct Deriver::Impl {
                                                             std::to_string(step));
   }
 
+  /// cpfg's string holds one character per module of its own (`@v` is '@' then 'v'), and
+  /// a step that rewrites no predecessor at a character copies that character alone, so
+  /// every character takes its own choice draw: a module of several characters that no
+  /// production rewrites takes one more draw per character after its first (one draw in
+  /// all when a production or, as assumed here, a decomposition rule `decomp` rewrites it).
+  void copiedCharacterDraws(SymbolId sym, const RuleSet* decomp) {
+    if (decomp && !decomp->bySymbol[sym].empty()) return;
+    for (size_t k = 1; k < prog->symbols.name(sym).size(); ++k) cpfgRandom.choice.next();
+  }
+
+  /// cpfg's L-system is stochastic when the file has a `seed:` line (or a seed is given).
+  bool stochasticCpfg() const { return prog->hasSeed || seedGiven(); }
+  bool seedGiven() const { return prog->seedOverridden || opt.seed.has_value(); }
+
   /// Copies the globals into the top registers of a production's vars.
   void loadGlobals(double* vars) const {
     const size_t g = prog->globals.size();
     for (size_t k = 0; k < g; ++k) vars[detail::kMaxVars - 1 - k] = globals[k];
   }
 
-  Rng* moduleRng() {
+  detail::Draws* moduleRng() {
+    if (cpfgSemantics) {
+      draws = {nullptr, &cpfgRandom};
+      return &draws;
+    }
     if (!rngReady) {
       rng.reseed(deriveSeed(seed, {rngStream, rngItem}));
       rngReady = true;
     }
-    return &rng;
+    draws = {&rng, nullptr};
+    return &draws;
   }
 
   // ---- matching -------------------------------------------------------------------------
@@ -558,13 +604,31 @@ struct Deriver::Impl {
 
   /// p's statements after its condition, when p applies (its successor reads them).
   void afterStatements(const Production& p, double* vars, int step) {
-    if (!p.after.empty()) statements(p, p.after, vars, step);
+    if (p.after.empty()) return;
+    statements(p, p.after, vars, step);
+    if (cpfgSemantics) storeLocals(p, vars);
+  }
+
+  /// p's local variables into vars: 0 (Sprig's notation), or their values at p's last
+  /// use (cpfg's, 0 at first).
+  void loadLocals(const Production& p, double* vars) {
+    if (!cpfgSemantics) {
+      std::fill_n(vars + p.localFirst, p.localCount, 0.0);
+      return;
+    }
+    std::vector<double>& kept = cpfgLocals[&p];
+    kept.resize(p.localCount, 0.0);
+    std::copy_n(kept.data(), p.localCount, vars + p.localFirst);
+  }
+  void storeLocals(const Production& p, const double* vars) {
+    std::copy_n(vars + p.localFirst, p.localCount, cpfgLocals[&p].data());
   }
 
   bool condition(const Production& p, double* vars, int step) {
     if (p.hasStatements()) {
-      for (uint16_t k = 0; k < p.localCount; ++k) vars[p.localFirst + k] = 0.0;
+      loadLocals(p, vars);
       if (!p.before.empty()) statements(p, p.before, vars, step);
+      if (cpfgSemantics) storeLocals(p, vars);
     }
     if (p.condition.empty()) return true;
     const Instr* code = prog->code.data();
@@ -575,8 +639,49 @@ struct Deriver::Impl {
     return v != 0.0;
   }
 
+  /// cpfg's choice (generate.c, FindProd and SelectProd): without a draw (choiceDraw < 0)
+  /// the first applicable production; with one, every applicable production (its
+  /// condition evaluated, in order) weighs its probability (1 when it has none) and the
+  /// draw picks among them as cpfg does, in float; null when none is picked. The chosen
+  /// production's statements are not run again: its variables are those its condition
+  /// left.
+  const Production* chooseCpfg(const RuleSet& rs, const ModuleString& s, size_t i, double* vars, int step) {
+    const std::vector<uint32_t>& cand = rs.bySymbol[s.symbols[i]];
+    if (choiceDraw < 0) {
+      for (uint32_t id : cand) {
+        const Production& p = rs.productions[id];
+        if (!matches(p, s, i, vars) || !condition(p, vars, step)) continue;
+        afterStatements(p, vars, step);
+        return &p;
+      }
+      return nullptr;
+    }
+    std::vector<uint32_t>& ids = stochasticIds;
+    ids.clear();
+    candidateVars.clear();
+    float total = 0;
+    for (uint32_t id : cand) {
+      const Production& p = rs.productions[id];
+      if (!matches(p, s, i, vars) || !condition(p, vars, step)) continue;
+      ids.push_back(id);
+      candidateVars.insert(candidateVars.end(), vars, vars + detail::kMaxVars);
+      total += static_cast<float>(p.stochastic ? p.weight : 1.0);
+    }
+    float scaled = static_cast<float>(static_cast<double>(total) * choiceDraw);
+    for (size_t c = 0; c < ids.size(); ++c) {
+      const Production& p = rs.productions[ids[c]];
+      if ((scaled -= static_cast<float>(p.stochastic ? p.weight : 1.0)) <= 0) {
+        std::copy_n(candidateVars.data() + c * detail::kMaxVars, detail::kMaxVars, vars);
+        afterStatements(p, vars, step);
+        return &p;
+      }
+    }
+    return nullptr;
+  }
+
   /// The production applied to module i of s, with its parameters bound in vars; null to copy.
   const Production* choose(const RuleSet& rs, const ModuleString& s, size_t i, double* vars, int step) {
+    if (cpfgSemantics) return chooseCpfg(rs, s, i, vars, step);
     const std::vector<uint32_t>& cand = rs.bySymbol[s.symbols[i]];
     for (size_t k = 0; k < cand.size(); ++k) {
       const Production& p = rs.productions[cand[k]];
@@ -928,6 +1033,7 @@ struct Deriver::Impl {
     double vars[detail::kMaxVars];
     loadGlobals(vars);
     rngStream = stream;
+    const bool cpfgChoice = cpfgSemantics && stochasticCpfg();
     std::vector<size_t> stack{0};
     setCutSym(true);
     for (size_t i = 0; i < n; ++i) {
@@ -938,13 +1044,16 @@ struct Deriver::Impl {
       rngReady = false;
       rngItem = i;
       leftCached = rightCached = false;
+      choiceDraw = cpfgChoice ? cpfgRandom.choice.next() : -1;
       const Production* p = ls.productions->rules[sym].count == 0 ? nullptr : choose(*ls.productions, in, i, vars, step);
+      choiceDraw = -1;
       const bool decompose = !ls.decomposition->empty();
       if (!p && pendingCutAt(in, i) && !(decompose && !ls.decomposition->bySymbol[sym].empty())) {
         i = cutEnd(in, i, n) - 1;  // cpfg's cut, made when the step reaches it (up to the call's `$`)
         continue;
       }
       size_t last = i;
+      if (!p && cpfgChoice) copiedCharacterDraws(sym, decompose ? ls.decomposition : nullptr);
       if (p) {
         emit(w, *p, vars, step, step, decompose, ls.decomposition);
         last = i + p->predRest.size();
@@ -1040,7 +1149,10 @@ struct Deriver::Impl {
     // Each module through the general path below: decomposition, or successors tracked.
     // (A production for cpfg's pending `%` leaves the size pass unable to tell which
     // modules the step skips.)
-    const bool general = decompose || segIn || (cutSym >= 0 && rs.rules[static_cast<size_t>(cutSym)].count > 0);
+    // cpfg's stochastic L-system: one drand48 draw for every module a step visits.
+    const bool cpfgChoice = productionStep && cpfgSemantics && stochasticCpfg();
+    const bool general =
+        decompose || segIn || cpfgChoice || (cutSym >= 0 && rs.rules[static_cast<size_t>(cutSym)].count > 0);
     if (segOut) segOut->clear();
     uint32_t segments = 0;
     const SymbolId* syms = in.symbols.data();
@@ -1064,6 +1176,7 @@ struct Deriver::Impl {
       SymbolId sym = syms[i];
       int32_t birth = births ? in.birthSteps[i] : 0;
       const detail::SymbolRules& r = rules[sym];
+      const double draw = cpfgChoice ? cpfgRandom.choice.next() : -1;  // drawn before any cut, as cpfg does
       if (r.count == 0 && pendingCutAt(in, i) && !(decompose && !prog->decomposition.bySymbol[sym].empty())) {
         i = cutEnd(in, i, n) - 1;  // cpfg's cut, made when the step reaches it
         continue;
@@ -1102,12 +1215,15 @@ struct Deriver::Impl {
       rngItem = i;
       leftCached = rightCached = false;
       const size_t before = w.modules();
+      choiceDraw = draw;
       const Production* p = r.count == 0 || (segIn && (*segIn)[i] == kFrozen) ? nullptr : choose(rs, in, i, vars, step);
+      choiceDraw = -1;  // decomposition chooses the first applicable rule
       if (!p && pendingCutAt(in, i) && !(decompose && !prog->decomposition.bySymbol[sym].empty())) {
         i = cutEnd(in, i, n) - 1;
         continue;
       }
       if (!p) {
+        if (cpfgChoice) copiedCharacterDraws(sym, decompose ? &prog->decomposition : nullptr);
         if (decompose && productionStep) {
           i += emitDecomposed(w, in, i, birth, step, prog->decomposition);
         } else {
@@ -1191,6 +1307,10 @@ struct Deriver::Impl {
     arrays = prog->cpfg.arrayInit;
     effects = {};
     seed = baseSeed;
+    cpfgSemantics = prog->dialect == detail::Dialect::Cpfg;
+    cpfgLocals.clear();
+    // cpfg -g's drand48 starts unseeded; a seed given to Sprig seeds it as cpfg's window does.
+    cpfgRandom = detail::CpfgRandom::forSeed(seedGiven() ? seed : 0);
     streamBase = 0;
     steps = baseSteps;
     runBlock(prog->startBlock, 0, 0);

@@ -6,7 +6,10 @@
 /// are found through a table indexed by symbol id; successors are templates whose
 /// parameter expressions run on a small bytecode VM (lsystem/detail/program.h).
 /// Stochastic choices and `ran`/`nran` draw from an Rng seeded per module with
-/// deriveSeed(seed, {step, moduleIndex}), so results never depend on thread count.
+/// deriveSeed(seed, {step, moduleIndex}), so results never depend on thread count. Files
+/// in cpfg's notation draw cpfg's own sequences instead (detail::CpfgRandom: drand48 for
+/// the choice, one erand48 stream for the random functions), in string order, as a step
+/// visits the modules one after another on one thread.
 /// After each step the `decomposition:` rules are applied (depth-limited) and `%` cuts
 /// remove the rest of their branch (in cpfg's notation when the next step reaches them,
 /// as cpfg does).
@@ -75,7 +78,8 @@ class Deriver {
   /// Target number of steps (options or grammar); after cpfg's `stop(x)` ran in a step
   /// (a production's or a Start/StartEach/EndEach block's statements), that step.
   int steps() const;
-  /// The seed in use (after cpfg's `srand(s)` in a Start/StartEach/EndEach/End block, s).
+  /// The seed in use (in a .lsys file, after `srand(s)` in a Start/StartEach/EndEach/End block, s;
+  /// a .l file's srand reseeds cpfg's own stream instead).
   uint64_t seed() const;
   /// The grammar's symbol table (ids in every string this Deriver produces).
   const SymbolTable& symbols() const;

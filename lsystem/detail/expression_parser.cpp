@@ -285,9 +285,9 @@ int ExpressionParser::parseCall(State& st, const Token& id) {
     const bool ok = name == "srand" ? allowSrand_ : allowStop_;
     if (!ok) {
       scanner_.error(st.span.line, id.col,
-                     name == "srand" ? std::string("cpfg's function 'srand' is supported only as a statement of a 'Start:', 'StartEach:', "
-                                                   "'EndEach:' or 'End:' block ('srand(s);'): Sprig draws each module's numbers "
-                                                   "from the seed, which srand replaces for the later draws")
+                     name == "srand" ? std::string("cpfg's function 'srand' is supported only as a statement ('srand(s);') of a "
+                                                   "'Start:', 'StartEach:', 'EndEach:' or 'End:' block, or of a rule's "
+                                                   "statements in a .l file (where it reseeds cpfg's own random stream)")
                                      : std::string(allowStopReason_));
       throw ExprFail{};
     }
@@ -326,7 +326,8 @@ int ExpressionParser::parseCall(State& st, const Token& id) {
                                              (fn->arity == 1 ? "" : "s") + ", got " + std::to_string(args.size()));
     throw ExprFail{};
   }
-  if (fn->op == Op::Ran || fn->op == Op::Nran || fn->op == Op::Bran || fn->op == Op::Biran) usesRandom_ = true;
+  // srand counts as a draw: on cpfg's streams it reseeds the stream the draws take.
+  if (fn->op == Op::Ran || fn->op == Op::Nran || fn->op == Op::Bran || fn->op == Op::Biran || fn->op == Op::Srand) usesRandom_ = true;
   return node(st, fn->op, args[0], args.size() > 1 ? args[1] : -1);
 }
 
@@ -632,7 +633,9 @@ std::optional<double> ExpressionParser::evaluate(Span sp, Rng* rng) {
     } else {
       // cpfg's arrays read their initial elements here (an axiom's parameters); nothing stores.
       double* init = tables_ ? const_cast<double*>(tables_->arrayInit.data()) : nullptr;
-      double v = evalCode(code_.data() + before, code_.data() + code_.size(), nullptr, rng, nullptr, nullptr, tables_, init);
+      Draws draws{rng, nullptr};
+      double v = evalCode(code_.data() + before, code_.data() + code_.size(), nullptr, rng ? &draws : nullptr, nullptr, nullptr,
+                          tables_, init);
       if (std::isfinite(v)) value = v;
       else scanner_.error(sp.line, sp.b, "parameter is not finite (" + formatNumber(v) + ")");
     }

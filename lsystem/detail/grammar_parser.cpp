@@ -649,6 +649,7 @@ class GrammarParser {
         error(line, value.b, "seed must be a non-negative integer below 2^64, got '" + std::string(v) + "'");
       else
         prog_.seed = seed;
+      prog_.hasSeed = true;
     } else if (h.key == "angle") {
       once(h.key, line, b);
       if (auto d = expr_.constant(value, "angle")) {
@@ -1133,7 +1134,8 @@ class GrammarParser {
         // cpfg's srand and stop are statements of their own (Op::Srand, Op::Stop).
         const bool effectCall = word == "srand" || word == "stop";
         if (effectCall)
-          expr_.allowEffects(inGlobalBlock_, inGlobalBlock_ || statementBlock_ != Block::Interpretation,
+          expr_.allowEffects(inGlobalBlock_ || prog_.dialect == Dialect::Cpfg,
+                             inGlobalBlock_ || statementBlock_ != Block::Interpretation,
                              "cpfg's function 'stop' in an interpretation rule is not supported (the derivation has ended "
                              "when the string is interpreted): call it in a production or a Start/EndEach block");
         const bool compiled = expr_.compile(scanner_.trim(Span{line, at, end}), varNames, "statement");
@@ -1526,7 +1528,10 @@ class GrammarParser {
       if (*overrides_.derivationLength < 0) diags().error(SourceLoc{prog_.fileName, 0, 0}, "derivation length override must not be negative");
       prog_.derivationLength = *overrides_.derivationLength;
     }
-    if (overrides_.seed) prog_.seed = *overrides_.seed;
+    if (overrides_.seed) {
+      prog_.seed = *overrides_.seed;
+      prog_.seedOverridden = true;
+    }
     if (prog_.name.empty()) prog_.name = std::filesystem::path(prog_.fileName).stem().string();
     if (axiomLine_ == 0 && !seen_.count("axiom")) {
       diags().error(SourceLoc{prog_.fileName, 0, 0}, "missing 'axiom:'");

@@ -44,7 +44,8 @@ enum class Op : uint8_t {
   Jz,      ///< pops a value; when it is 0, jumps to instruction c of the block
   Jmp,     ///< jumps to instruction c of the block
   Printf,  ///< cpfg's `printf(format, ...)`: pops c values, prints them to stderr with Program::strings[var]
-  Srand,   ///< cpfg's `srand(s)`: records s as the seed of later draws (Effects::reseed); value 0
+  Srand,   ///< cpfg's `srand(s)`: reseeds cpfg's stream (Draws::cpfg), or records s as the seed of
+           ///< later draws (Effects::reseed); value 0
   Stop,    ///< cpfg's `stop(x)`: asks the derivation to end after the current step (Effects::stop); value 0
   Func,    ///< cpfg's `func(n, x)`: function var (n - 1) of the view file's function files at x
   Curve,   ///< cpfg's `curveX/Y/Z(n, t)`: coordinate c (0, 1, 2) of curve var (n - 1) at arc length t
@@ -89,15 +90,83 @@ struct Effects {
 /// evalCode stops and returns NaN, which the deriver reports.
 inline constexpr long kMaxLoopJumps = 10'000'000;
 
+/// cpfg's random streams (generate.c SelectProd, utility.c): a stochastic production is
+/// chosen with drand48, which `seed: s` (s not 0) seeds with seed48({s, 0, 155}); ran, nran,
+/// bran and biran draw from a separate erand48 stream that starts at {0x330E, 0, 0} and
+/// that only srand(a) reseeds, to {0x330E, a & 0xFFFF, a >> 16}.
+struct CpfgRandom {
+  Rand48 choice;
+  Rand48 main = Rand48::fromWords(0x330E, 0, 0);
+  int iset = 10;    ///< nran's state: 0 draws a new pair; cpfg starts it at 10 (first nran returns the mean)
+  double gset = 0;  ///< nran's second deviate of the pair
+
+  /// The streams of a derivation whose drand48 seed48 seeds with {seed, 0, 155} (0: not
+  /// seeded, drand48 starts at 0). cpfg -g never seeds it, whatever `seed:` says; its
+  /// interactive window seeds it with `seed:` (control.c, FirstRun).
+  static CpfgRandom forSeed(uint64_t seed) {
+    CpfgRandom r;
+    if (seed != 0) r.choice = Rand48::fromWords(static_cast<uint16_t>(seed), 0, 155);
+    return r;
+  }
+  void srand(double s) {
+    const long a = static_cast<long>(std::clamp(s, -9.2e18, 9.2e18));
+    main = Rand48::fromWords(0x330E, static_cast<uint16_t>(a & 0xFFFF), static_cast<uint16_t>((a >> 16) & 0xFFFF));
+    iset = 0;
+  }
+  /// cpfg's nran(mean, sd): the polar method, two deviates per pair of accepted draws.
+  double nran(double mean, double sd) {
+    if (iset != 0) {
+      iset = 0;
+      return gset * sd + mean;
+    }
+    double v1, v2, rsq;
+    do {
+      v1 = 2.0 * main.next() - 1.0;
+      v2 = 2.0 * main.next() - 1.0;
+      rsq = v1 * v1 + v2 * v2;
+    } while (rsq >= 1.0 || rsq == 0.0);
+    const double fac = std::sqrt(-2.0 * std::log(rsq) / rsq);
+    gset = v1 * fac;
+    iset = 1;
+    return v2 * fac * sd + mean;
+  }
+};
+
+/// Where an evaluation's random draws come from: Sprig's per-module PCG stream, or (a cpfg
+/// file) cpfg's sequential streams.
+struct Draws {
+  Rng* pcg = nullptr;
+  CpfgRandom* cpfg = nullptr;
+  double uniform() { return cpfg ? cpfg->main.next() : pcg->uniform(); }
+  double normal(double mean, double sd) { return cpfg ? cpfg->nran(mean, sd) : pcg->normal(mean, sd); }
+  /// A uniform draw that is not 0 (cpfg's bran redraws a 0).
+  double nonZero() {
+    double u;
+    do u = uniform();
+    while (u == 0);
+    return u;
+  }
+};
+
 /// A draw from the beta(a, b) distribution, by R.C.H. Cheng's rejection algorithm BA
 /// ("Generating beta variates with nonintegral shape parameters", CACM 21(4), 1978).
-/// NaN for non-positive shapes (the caller reports non-finite values).
-inline double betaDraw(Rng& rng, double a, double b) {
+/// NaN for non-positive shapes (the caller reports non-finite values). cpfg's streams draw
+/// as cpfg's brand does (each uniform redrawn while 0, no limit on the tries).
+inline double betaDraw(Draws& rng, double a, double b) {
   if (!(a > 0) || !(b > 0)) return std::nan("");
   const double alpha = a + b;
   const double beta = std::min(a, b) <= 1 ? std::min(a, b) : std::sqrt((alpha - 2) / (2 * a * b - alpha));
   const double lambda = std::min(a, b) <= 1 ? std::min(a, b) : 1 / beta;
   const double gamma = a + lambda;
+  if (rng.cpfg) {
+    for (long tries = 0; tries < 100000000; ++tries) {
+      const double u1 = rng.nonZero(), u2 = rng.nonZero();
+      const double v = (1 / lambda) * std::log(u1 / (1 - u1));
+      const double w = a * std::exp(v);
+      if (!(alpha * std::log(alpha / (b + w)) + gamma * v - std::log(4.0) < std::log(u1 * u1 * u2))) return w / (b + w);
+    }
+    return std::nan("");
+  }
   for (int tries = 0; tries < 100000; ++tries) {
     double u1 = rng.uniform(), u2 = rng.uniform();
     if (u1 <= 0 || u1 >= 1 || u2 <= 0) continue;
@@ -109,7 +178,7 @@ inline double betaDraw(Rng& rng, double a, double b) {
 }
 
 /// A draw from the binomial(n, p) distribution: n trials, each a success with probability p.
-inline double binomialDraw(Rng& rng, double n, double p) {
+inline double binomialDraw(Draws& rng, double n, double p) {
   if (!(n >= 0) || n > 1e7) return std::nan("");  // beyond 10^7 trials: a non-finite value
   const long trials = static_cast<long>(n);
   long k = 0;
@@ -137,11 +206,12 @@ void printFormatted(const std::string& format, const double* args, int n);
 
 /// Evaluates one expression, or runs one statement block (Store, Jz, Jmp write into vars,
 /// which must then be writable; jump targets count from code; a block returns 0, or NaN
-/// after kMaxLoopJumps backward jumps). rng is used only by the random draws (never null
-/// when the code draws: the compiler marks such productions usesRandom). effects, when
+/// after kMaxLoopJumps backward jumps). rng is used only by the random draws and, for cpfg's
+/// streams, `srand` (never null when the code draws: the compiler marks such productions
+/// usesRandom). effects, when
 /// given, records what `srand` and `stop` ask for; tables are the view file's function and
 /// curve files `func` and `curveX...` read (NaN without them).
-inline double evalCode(const Instr* code, const Instr* end, const double* vars, Rng* rng,
+inline double evalCode(const Instr* code, const Instr* end, const double* vars, Draws* rng,
                        const std::vector<std::string>* strings = nullptr, Effects* effects = nullptr,
                        const CpfgTables* tables = nullptr, double* arrays = nullptr) {
   double stack[kMaxStack];
@@ -206,7 +276,9 @@ inline double evalCode(const Instr* code, const Instr* end, const double* vars, 
         break;
       }
       case Op::Srand:
-        if (effects) {
+        if (rng && rng->cpfg) {
+          rng->cpfg->srand(stack[sp - 1]);  // cpfg's stream: reseeded at once, for the draws after it
+        } else if (effects) {
           effects->reseed = true;
           effects->seed = stack[sp - 1];
         }
@@ -425,6 +497,11 @@ struct Program {
   std::string name;
   int derivationLength = 0;
   uint64_t seed = 0;
+  /// The file has a `seed:` line: in cpfg's notation this makes the L-system stochastic
+  /// (without it cpfg applies the first applicable production, whatever its weight).
+  bool hasSeed = false;
+  /// The seed comes from GrammarOverrides (`--seed`), not from the file.
+  bool seedOverridden = false;
   bool hasAngle = false;
   double angleDeg = 0;
   Dialect dialect = Dialect::Sprig;  ///< the notation the file is read in (by its extension)

@@ -5,10 +5,13 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 
 #include "core/atomic_file.h"
+#include "core/parallel.h"
+#include "core/rng.h"
 #include "lsystem/derive.h"
 #include "lsystem/grammar.h"
 #include "lsystem/turtle.h"
@@ -177,4 +180,79 @@ TEST_CASE("cpfg parity: a rule for a letter of a command the grammar writes is a
   CHECK(errorOf("axiom: A@Ts(1,2)\nT --> B\n").find("cpfg reads '@Ts' as the modules '@', 'T', 's'") != std::string::npos);
   // The letter's parameters differ from the command's: no cpfg module matches, no error.
   CHECK(errorOf("axiom: A@o(0.2)@Ts(1,2)\ns --> A\no --> A\nT(x) --> A\n") == "no error");
+}
+
+#if defined(__unix__) || defined(__APPLE__)
+TEST_CASE("Rand48 draws the POSIX rand48 sequence (libc's erand48 and drand48)", "[lsystem][cpfg]") {
+  // libc is the oracle: the same states, the same doubles, bit for bit.
+  unsigned short x[3] = {0x330E, 0x1234, 0xABCD};
+  Rand48 r = Rand48::fromWords(0x330E, 0x1234, 0xABCD);
+  for (int i = 0; i < 2000; ++i) {
+    const double want = erand48(x);
+    REQUIRE(r.next() == want);
+    REQUIRE(r.state() == (uint64_t{x[0]} | uint64_t{x[1]} << 16 | uint64_t{x[2]} << 32));
+  }
+  unsigned short seed[3] = {7, 0, 155};
+  seed48(seed);
+  Rand48 d = Rand48::fromWords(7, 0, 155);
+  for (int i = 0; i < 2000; ++i) REQUIRE(d.next() == drand48());
+  // State 0 (drand48 never seeded, as cpfg -g draws): the first draw is 11 / 2^48.
+  Rand48 z;
+  CHECK(z.next() == 11.0 / 281474976710656.0);
+}
+#endif
+
+TEST_CASE("cpfg parity: cpfg's random sequences", "[lsystem][cpfg]") {
+  // stochastic: one drand48 draw for every module a step visits (those with no production
+  // too), chosen among every applicable production, in float; unseeded: 'seed: 0' draws
+  // the same (cpfg -g never seeds drand48, whatever the seed); random_functions: ran, nran
+  // (the first returns the mean), bran, biran from one erand48 stream, reseeded by srand in
+  // a production.
+  // interpretation_draws: interpretation rules draw depth first, after an srand in one of
+  // them (the query module holds the drawn length: 13.2645).
+  for (const char* folder : {"stochastic", "unseeded", "random_functions", "interpretation_draws"}) {
+    INFO(folder);
+    Parity p = loadParity(folder);
+    checkSame(deriveParity(p), p.grammar.symbols(), cpfgString(folder));
+  }
+  SECTION("the same string at 1 and 2 threads") {
+    for (const char* folder : {"stochastic", "random_functions"}) {
+      Parity p = loadParity(folder);
+      std::string one, two;
+      {
+        ThreadLimit limit(1);
+        one = formatModuleString(deriveParity(p), p.grammar.symbols());
+      }
+      {
+        ThreadLimit limit(2);
+        two = formatModuleString(deriveParity(p), p.grammar.symbols());
+      }
+      CHECK(one == two);
+    }
+  }
+  SECTION("a seed given to Sprig seeds drand48 as cpfg's window does: another string") {
+    Grammar g = loadGrammar(parityAsset("stochastic/plant.l"));
+    DeriveOptions opt;
+    opt.seed = 7;
+    Deriver d(g, opt);
+    CHECK(formatModuleString(d.derive(), d.symbols(), FormatOptions{0, true}) !=
+          formatModuleString(derive(g), g.symbols(), FormatOptions{0, true}));
+  }
+  SECTION("without 'seed:' cpfg applies the first applicable production, whatever its weight") {
+    Grammar g = parseGrammar("derivation length: 3\naxiom: A\nA --> AB : 1\nA --> C : 5\n", "t.l");
+    CHECK(formatModuleString(derive(g), g.symbols()) == "ABBB");
+  }
+}
+
+TEST_CASE("cpfg parity: local variables keep their values between applications", "[lsystem][cpfg]") {
+  // A(0) keeps the k of the A before it, j counts every application of B's production over
+  // the steps, and D(i) follows from C's loop.
+  Parity p = loadParity("local_variables");
+  const ModuleString s = deriveParity(p);
+  checkSame(s, p.grammar.symbols(), cpfgString("local_variables"));
+  CHECK(formatModuleString(s, p.grammar.symbols()) == "D(35)D(35)D(21)D(21)");
+  SECTION("Sprig's notation starts them at 0 every time") {
+    Grammar g = parseGrammar("derivation length: 1\naxiom: A(3)A(0)\nA(n) : { if (n > 0) { k = n * 10; } } * --> B(k)\n", "t.lsys");
+    CHECK(formatModuleString(derive(g), g.symbols()) == "B(30)B(0)");
+  }
 }
