@@ -568,7 +568,7 @@ std::shared_ptr<const KindSpec> readTreeSpec(MapReader& top, Species& species, D
   readDefines(top, s, diags);
   if (top.has("steps")) {
     s.overrides.derivationLength = static_cast<int>(top.integer("steps", 0, 0, 100000));
-    s.overrides.derivationLengthLoc = top.get("steps")->loc();
+    if (auto key = top.keyNode("steps")) s.overrides.derivationLengthLoc = key->loc();  // none while describing
   } else
     top.allow({"steps"});
   if (top.has("seed"))
