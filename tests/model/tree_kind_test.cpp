@@ -145,9 +145,21 @@ TEST_CASE("tree species: Fig. 13's five-branch PCM junction meshes to one closed
   CHECK(signedVolume(wood) > 0);
 }
 
+namespace {
+
+/// A vlab object of tests/assets/cpfg loaded as the CLI loads it without --root (the
+/// object's folder is its own library root), whatever the current folder.
+Species loadCpfgObject(const char* name) {
+  PathPolicy policy;
+  policy.root.clear();
+  return loadSpecies(std::filesystem::path(SPRIG_SOURCE_DIR) / "tests/assets/cpfg" / name, policy);
+}
+
+}  // namespace
+
 TEST_CASE("cpfg colour map of a vlab object", "[model][cpfg]") {
   SECTION("tests/assets/cpfg/colormap: the specifications' -m plant.map, entry i for colour index i") {
-    const Species s = loadSpecies(std::filesystem::path(SPRIG_SOURCE_DIR) / "tests/assets/cpfg/colormap");
+    const Species s = loadCpfgObject("colormap");
     REQUIRE(s.render.style.palette.size() == 256);
     CHECK(s.render.style.palette[1] == Vec3(1.0f, 1.0f, 0.0f));
     CHECK(s.render.style.palette[2] == Vec3(250 / 255.0f, 0.0f, 0.0f));
@@ -176,7 +188,7 @@ TEST_CASE("cpfg colour map of a vlab object", "[model][cpfg]") {
 
 TEST_CASE("cpfg materials file of a vlab object", "[model][cpfg]") {
   SECTION("tests/assets/cpfg/materials: the specifications' -M materials.mat, material i's diffuse colour for colour index i") {
-    const Species s = loadSpecies(std::filesystem::path(SPRIG_SOURCE_DIR) / "tests/assets/cpfg/materials");
+    const Species s = loadCpfgObject("materials");
     REQUIRE(s.render.style.palette.size() == 256);
     // Record 1: diffuse bytes e4 c5 ff (Lilac's petal purple); record 2: 88 b2 46 (green).
     CHECK(s.render.style.palette[1] == Vec3(0xe4 / 255.0f, 0xc5 / 255.0f, 0xff / 255.0f));
