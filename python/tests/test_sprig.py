@@ -150,7 +150,7 @@ def test_progress_callback_and_interrupt(tree):
 
 
 def test_bad_options_are_value_errors(tree):
-    with pytest.raises(ValueError, match="mode 'fast'"):
+    with pytest.raises(ValueError, match="--mode fast: expected exact, mesh or skeleton"):
         tree.render(mode="fast")
     with pytest.raises(ValueError):
         tree.render(stage=7)

@@ -323,7 +323,8 @@ namespace {
 /// The warnings and notes of parsing text, formatted without source lines, one per line.
 std::string warningsOf(const std::string& text, const std::string& fileName = "g.lsys", const GrammarOverrides& o = {}) {
   std::string out;
-  for (const Diagnostic& d : parseGrammar(text, fileName, o).warnings()) {
+  const Grammar g = parseGrammar(text, fileName, o);  // warnings() refers into g
+  for (const Diagnostic& d : g.warnings()) {
     Diagnostic bare = d;
     bare.sourceLine.clear();
     out += (out.empty() ? "" : "\n") + bare.format();
@@ -337,8 +338,8 @@ TEST_CASE("Grammar::warnings: a multi-letter name written without its module dec
   const std::string rules = "axiom: A Leaf(0)\nA --> F Leaf(1) [+Bud] Leaf(2)\nderivation length: 2\n";
   SECTION("one warning per word, at its first place") {
     CHECK(warningsOf(rules) ==
-          "g.lsys:1:11: warning: 'Leaf' is read as 4 one-letter modules; declare it with 'module Leaf' to make it one module\n"
-          "g.lsys:2:16: warning: 'Bud' is read as 3 one-letter modules; declare it with 'module Bud' to make it one module");
+          "g.lsys:1:10: warning: 'Leaf' is read as 4 one-letter modules; declare it with 'module Leaf' to make it one module\n"
+          "g.lsys:2:19: warning: 'Bud' is read as 3 one-letter modules; declare it with 'module Bud' to make it one module");
     // The grammar is still what the text says: L e a f(0) are four modules.
     Grammar g = parseGrammar(rules, "g.lsys");
     CHECK(formatModuleString(g.axiom(), g.symbols()) == "ALeaf(0)");
