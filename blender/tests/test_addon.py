@@ -114,15 +114,17 @@ def main():
     assert np.abs(rgb - rgb[0]).max(axis=1).max() > 0.05, "the render is one colour"
 
     shell = load("shell_cone.yaml", 2.0)
-    check_species(shell, "shell", ["whorl"], textured=True)
+    check_species(shell, "shell", ["inside", "whorl"], textured=True)
     assert len(shell.sprig.defines) == 0 and shell.sprig.max_steps == 0
     organism = load("fig_org_05a_berry_level1.yaml", 0.0)
     check_species(organism, "organism", ["organism"], textured=False)
     solid = load("solid_layered_sphere.yaml", 0.0)
     points = check_species(solid, "solid", ["foil"], textured=False)
-    assert np.allclose(points.max(0), [0.98, 0.98, 0.98], atol=1e-4), points.max(0)
+    # a sphere of radius 0.98, exported standing on the ground at the origin (Z up in Blender)
+    assert np.allclose(points.max(0) - points.min(0), [1.96, 1.96, 1.96], atol=2e-4), points.max(0) - points.min(0)
+    assert abs(points[:, 2].min()) < 1e-5 and np.allclose(points.max(0)[:2], [0.98, 0.98], atol=1e-4), points.max(0)
     assert len([o for o in bpy.data.objects if o.type == "EMPTY"]) == 4
-    assert len([o for o in bpy.data.objects if o.type == "MESH"]) == 4
+    assert len([o for o in bpy.data.objects if o.type == "MESH"]) == 5
     print("blender add-on test passed in %.1f s" % (time.time() - t0))
 
 
