@@ -256,3 +256,15 @@ TEST_CASE("cpfg parity: local variables keep their values between applications",
     CHECK(formatModuleString(derive(g), g.symbols()) == "B(30)B(0)");
   }
 }
+
+TEST_CASE("cpfg parity: a '\\\\' line continuation leaves a '\\' cpfg's expressions pass over", "[lsystem][cpfg]") {
+  Parity p = loadParity("line_continuation");
+  const ModuleString s = deriveParity(p);
+  checkSame(s, p.grammar.symbols(), cpfgString("line_continuation"));
+  // len(x) = 2x + 1 over x = 1, 2, 3.
+  CHECK(formatModuleString(s, p.grammar.symbols()) == "F(3)F(5)F(7)A(4)");
+  SECTION("Sprig's own notation still refuses it") {
+    CHECK_THROWS_WITH(parseGrammar("axiom: F\nA(x) --> B(x \\ 2)\n", "g.lsys"),
+                      Catch::Contains("g.lsys:2:14: error: unexpected character '\\' in expression"));
+  }
+}
