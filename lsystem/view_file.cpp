@@ -224,6 +224,16 @@ class ViewParser {
   void readKey(int line, size_t kcol, size_t vcol, const std::string& key, const std::string& value) {
     auto is = [&](const char* k) { return key == k; };
     if (is("angle increment") || is("angle factor")) {
+      if (trimmed(value) == "?") {
+        // vlab's exercises leave '?' for the student to fill in. cpfg (interpret.c) warns of
+        // invalid parameters and its fscanf leaves the angle in effect (45 degrees unless set):
+        // 'angle increment: ?' keeps it, 'angle factor: ?' still divides 360 by it.
+        warn(line, vcol, "'" + key + ": ?' has no number: as cpfg, the angle in effect is " +
+                             (is("angle factor") ? "the factor (the angle becomes 360 / it)" : "kept"));
+        const double current = view_.angleDeg.value_or(kCpfgDefaultAngleDeg);
+        if (is("angle factor") && current != 0) view_.angleDeg = 360.0 / current;
+        return;
+      }
       if (auto v = values(line, vcol, key, value, 1, 1)) {
         if (is("angle factor") && (*v)[0] == 0) error(line, vcol, "'angle factor:' must not be 0 (the angle is 360 / factor)");
         else view_.angleDeg = is("angle factor") ? 360.0 / (*v)[0] : (*v)[0];

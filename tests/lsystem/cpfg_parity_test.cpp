@@ -268,3 +268,21 @@ TEST_CASE("cpfg parity: a '\\\\' line continuation leaves a '\\' cpfg's expressi
                       Catch::Contains("g.lsys:2:14: error: unexpected character '\\' in expression"));
   }
 }
+
+TEST_CASE("cpfg parity: 'angle increment: ?' keeps the angle in effect", "[lsystem][cpfg]") {
+  Parity p = loadParity("view_angle_query");
+  const ModuleString s = deriveParity(p);
+  // The query modules stand at 30 and 60 degrees from the vertical: the first line's 30.
+  checkSame(s, p.grammar.symbols(), cpfgString("view_angle_query"));
+  const ViewFile v = loadViewFile(parityAsset("view_angle_query/plant.v"));
+  REQUIRE(v.angleDeg);
+  CHECK(*v.angleDeg == 30.0);
+  REQUIRE(v.warnings.size() == 1);
+  CHECK(v.warnings[0].loc.line == 2);
+  CHECK(v.warnings[0].message.find("'angle increment: ?' has no number") != std::string::npos);
+  SECTION("alone it leaves cpfg's default; 'angle factor: ?' divides 360 by the angle in effect") {
+    CHECK_FALSE(parseViewFile("angle increment: ?\n", "t.v").angleDeg);
+    CHECK(parseViewFile("angle factor: ?\n", "t.v").angleDeg == 8.0);
+    CHECK(parseViewFile("angle increment: 10\nangle factor: ?\n", "t.v").angleDeg == 36.0);
+  }
+}
