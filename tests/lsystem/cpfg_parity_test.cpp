@@ -286,3 +286,13 @@ TEST_CASE("cpfg parity: 'angle increment: ?' keeps the angle in effect", "[lsyst
     CHECK(parseViewFile("angle increment: 10\nangle factor: ?\n", "t.v").angleDeg == 36.0);
   }
 }
+
+TEST_CASE("cpfg parity: blanks between '@' and its letters", "[lsystem][cpfg]") {
+  Parity p = loadParity("at_blank");
+  const ModuleString s = deriveParity(p);
+  checkSame(s, p.grammar.symbols(), cpfgString("at_blank"));
+  CHECK(countSymbol(s, p.grammar.symbols(), "@c") == 4);
+  SECTION("a lone '@' is still refused") {
+    CHECK_THROWS_WITH(parseGrammar("axiom: F@ +F\n", "t.l"), Catch::Contains("t.l:1:9: error: unknown cpfg command '@'"));
+  }
+}
