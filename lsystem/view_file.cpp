@@ -829,16 +829,25 @@ class ViewParser {
       tex.image = std::make_shared<const Image>(std::move(img));
       if (tex.mipmap) tex.buildMipmaps(srgb);
     } catch (const FileReadError& e) {
-      error(line, nameCol, e.what());
-      return;
+      unreadable(tex, line, nameCol, e.what());
     } catch (const ImageReadError& e) {
-      error(line, nameCol, "cannot read the texture image '" + file.string() + "': " + e.reason());
-      return;
+      unreadable(tex, line, nameCol, "cannot read the texture image '" + file.string() + "': " + e.reason());
     } catch (const std::exception& e) {
-      error(line, nameCol, "cannot read the texture image '" + file.string() + "': " + e.what());
-      return;
+      unreadable(tex, line, nameCol, "cannot read the texture image '" + file.string() + "': " + e.what());
     }
     view_.textures.push_back(std::move(tex));
+  }
+
+  /// An image that could not be read: its error waits in the texture until an organ drawn
+  /// with it needs it (cpfg reads no image to derive).
+  void unreadable(CpfgTexture& tex, int line, size_t col0, const std::string& msg) {
+    tex.image.reset();
+    tex.levels.clear();
+    Diagnostic d;
+    d.loc = SourceLoc{view_.file, line, static_cast<int>(col0) + 1};
+    d.message = msg;
+    d.sourceLine = raw_;
+    tex.unreadable = std::move(d);
   }
 
   /// A `surface:` line's texture number, checked against the `texture:` lines at the end.

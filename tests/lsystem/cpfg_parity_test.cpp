@@ -296,3 +296,16 @@ TEST_CASE("cpfg parity: blanks between '@' and its letters", "[lsystem][cpfg]") 
     CHECK_THROWS_WITH(parseGrammar("axiom: F@ +F\n", "t.l"), Catch::Contains("t.l:1:9: error: unknown cpfg command '@'"));
   }
 }
+
+TEST_CASE("cpfg parity: a texture image that cannot be read does not stop a derivation", "[lsystem][cpfg]") {
+  Parity p = loadParity("texture_unread");
+  const ModuleString s = deriveParity(p);
+  // Whole numbers only: the text compares ('@Tx' is refused by Sprig's string reader).
+  CHECK(formatModuleString(s, p.grammar.symbols()) == cpfgString("texture_unread"));
+  const ViewFile v = loadViewFile(parityAsset("texture_unread/plant.v"));
+  REQUIRE(v.textures.size() == 1);
+  CHECK_FALSE(v.textures[0].image);
+  REQUIRE(v.textures[0].unreadable);
+  CHECK(v.textures[0].unreadable->loc.line == 1);
+  CHECK(v.textures[0].unreadable->loc.col == 13);
+}
