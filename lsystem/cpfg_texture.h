@@ -37,9 +37,11 @@
 /// by the first letter's filter.
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "core/diagnostics.h"
 #include "core/image.h"
 #include "core/types.h"
 
@@ -49,6 +51,10 @@ namespace sprig::lsystem {
 struct CpfgTexture {
   std::string file;                    ///< the image's path
   std::shared_ptr<const Image> image;  ///< linear RGB with straight (not premultiplied) alpha
+  /// The error of an image that could not be read (image is null then). cpfg reads images
+  /// only to draw (its -g mode reads none), so this error is given when a drawn organ takes
+  /// the texture is rendered or exported, not when the view file is read.
+  std::optional<Diagnostic> unreadable;
   bool magLinear = false;              ///< H: l (bilinear magnification); else nearest texel
   bool minLinear = false;              ///< L: l (bilinear minification); else nearest texel
                                        ///< (with mipmaps: the filter within a level)

@@ -224,6 +224,16 @@ class ViewParser {
   void readKey(int line, size_t kcol, size_t vcol, const std::string& key, const std::string& value) {
     auto is = [&](const char* k) { return key == k; };
     if (is("angle increment") || is("angle factor")) {
+      if (trimmed(value) == "?") {
+        // vlab's exercises leave '?' for the student to fill in. cpfg (interpret.c) warns of
+        // invalid parameters and its fscanf leaves the angle in effect (45 degrees unless set):
+        // 'angle increment: ?' keeps it, 'angle factor: ?' still divides 360 by it.
+        warn(line, vcol, "'" + key + ": ?' has no number: as cpfg, the angle in effect is " +
+                             (is("angle factor") ? "the factor (the angle becomes 360 / it)" : "kept"));
+        const double current = view_.angleDeg.value_or(kCpfgDefaultAngleDeg);
+        if (is("angle factor") && current != 0) view_.angleDeg = 360.0 / current;
+        return;
+      }
       if (auto v = values(line, vcol, key, value, 1, 1)) {
         if (is("angle factor") && (*v)[0] == 0) error(line, vcol, "'angle factor:' must not be 0 (the angle is 360 / factor)");
         else view_.angleDeg = is("angle factor") ? 360.0 / (*v)[0] : (*v)[0];
@@ -819,16 +829,25 @@ class ViewParser {
       tex.image = std::make_shared<const Image>(std::move(img));
       if (tex.mipmap) tex.buildMipmaps(srgb);
     } catch (const FileReadError& e) {
-      error(line, nameCol, e.what());
-      return;
+      unreadable(tex, line, nameCol, e.what());
     } catch (const ImageReadError& e) {
-      error(line, nameCol, "cannot read the texture image '" + file.string() + "': " + e.reason());
-      return;
+      unreadable(tex, line, nameCol, "cannot read the texture image '" + file.string() + "': " + e.reason());
     } catch (const std::exception& e) {
-      error(line, nameCol, "cannot read the texture image '" + file.string() + "': " + e.what());
-      return;
+      unreadable(tex, line, nameCol, "cannot read the texture image '" + file.string() + "': " + e.what());
     }
     view_.textures.push_back(std::move(tex));
+  }
+
+  /// An image that could not be read: its error waits in the texture until an organ drawn
+  /// with it needs it (cpfg reads no image to derive).
+  void unreadable(CpfgTexture& tex, int line, size_t col0, const std::string& msg) {
+    tex.image.reset();
+    tex.levels.clear();
+    Diagnostic d;
+    d.loc = SourceLoc{view_.file, line, static_cast<int>(col0) + 1};
+    d.message = msg;
+    d.sourceLine = raw_;
+    tex.unreadable = std::move(d);
   }
 
   /// A `surface:` line's texture number, checked against the `texture:` lines at the end.

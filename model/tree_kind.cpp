@@ -192,6 +192,9 @@ std::vector<TexturedGroup> texturedGroups(const lsystem::Skeleton& skeleton, con
     if (!(tube ? kinds.tubes : kinds.leaves)) continue;
     if (static_cast<size_t>(o.texture) >= textureCount || o.uvs.size() != o.points.size())
       throw std::logic_error("a textured cpfg surface without its texture");
+    // cpfg reads a texture's image only to draw: one that could not be read is an error now.
+    if (const auto& unreadable = (*style.cpfgTextures)[static_cast<size_t>(o.texture)].unreadable)
+      throw InputError(std::vector<Diagnostic>{*unreadable});
     const int color = o.color > 0 && static_cast<size_t>(o.color) < style.palette.size() ? o.color : -1;
     auto it = std::find_if(groups.begin(), groups.end(),
                            [&](const TexturedGroup& g) { return g.texture == o.texture && g.color == color && g.tube == tube; });

@@ -91,7 +91,11 @@ struct ExpressionParser::State {
 void ExpressionParser::lex(State& st) {
   const std::string& s = scanner_.line(st.span.line);
   int i = st.pos;
-  while (i < st.span.e && isSpace(s[i])) ++i;
+  // cpfg's expression lexer has no rule for '\': flex's default rule passes over it, so a
+  // stray backslash (the one a '#define f(x) \\' line continuation leaves in the body) is
+  // blank there.
+  const bool cpfg = scanner_.dialect() == Dialect::Cpfg;
+  while (i < st.span.e && (isSpace(s[i]) || (cpfg && s[i] == '\\'))) ++i;
   Token t;
   t.col = i;
   if (i >= st.span.e) {

@@ -186,12 +186,20 @@ bool Scanner::tokenizeModules(int line, int b, int e, const std::function<void(c
     m.col = i;
     m.args.clear();
     m.hasParens = false;
+    // cpfg's lexer drops blanks between symbols, and its string holds one character per
+    // symbol: '@ Tx(1)' is '@Tx(1)'. So in a .l file blanks may part '@' from its letters.
+    int rest = i + 1;
+    if (c == '@' && dialect_ == Dialect::Cpfg)
+      while (rest < e && isSpace(s[rest])) ++rest;
     size_t best = 0;
     for (const std::string& name : multiNames_)
-      if (name[0] == c && name.size() > best && static_cast<int>(name.size()) <= e - i && s.compare(i, name.size(), name) == 0) best = name.size();
+      if (name[0] == c && name.size() > best && static_cast<int>(name.size()) - 1 <= e - rest &&
+          s.compare(rest, name.size() - 1, name, 1, std::string::npos) == 0)
+        best = name.size();
     if (best) {
-      m.name.assign(s, i, best);
-      i += static_cast<int>(best);
+      m.name.assign(1, c);
+      m.name.append(s, rest, best - 1);
+      i = rest + static_cast<int>(best) - 1;
     } else if (c == '~' && i + 1 < e && std::isalpha(static_cast<unsigned char>(s[i + 1]))) {
       m.name.assign(s, i, 2);
       i += 2;

@@ -256,3 +256,56 @@ TEST_CASE("cpfg parity: local variables keep their values between applications",
     CHECK(formatModuleString(derive(g), g.symbols()) == "B(30)B(0)");
   }
 }
+
+TEST_CASE("cpfg parity: a '\\\\' line continuation leaves a '\\' cpfg's expressions pass over", "[lsystem][cpfg]") {
+  Parity p = loadParity("line_continuation");
+  const ModuleString s = deriveParity(p);
+  checkSame(s, p.grammar.symbols(), cpfgString("line_continuation"));
+  // len(x) = 2x + 1 over x = 1, 2, 3.
+  CHECK(formatModuleString(s, p.grammar.symbols()) == "F(3)F(5)F(7)A(4)");
+  SECTION("Sprig's own notation still refuses it") {
+    CHECK_THROWS_WITH(parseGrammar("axiom: F\nA(x) --> B(x \\ 2)\n", "g.lsys"),
+                      Catch::Contains("g.lsys:2:14: error: unexpected character '\\' in expression"));
+  }
+}
+
+TEST_CASE("cpfg parity: 'angle increment: ?' keeps the angle in effect", "[lsystem][cpfg]") {
+  Parity p = loadParity("view_angle_query");
+  const ModuleString s = deriveParity(p);
+  // The query modules stand at 30 and 60 degrees from the vertical: the first line's 30.
+  checkSame(s, p.grammar.symbols(), cpfgString("view_angle_query"));
+  const ViewFile v = loadViewFile(parityAsset("view_angle_query/plant.v"));
+  REQUIRE(v.angleDeg);
+  CHECK(*v.angleDeg == 30.0);
+  REQUIRE(v.warnings.size() == 1);
+  CHECK(v.warnings[0].loc.line == 2);
+  CHECK(v.warnings[0].message.find("'angle increment: ?' has no number") != std::string::npos);
+  SECTION("alone it leaves cpfg's default; 'angle factor: ?' divides 360 by the angle in effect") {
+    CHECK_FALSE(parseViewFile("angle increment: ?\n", "t.v").angleDeg);
+    CHECK(parseViewFile("angle factor: ?\n", "t.v").angleDeg == 8.0);
+    CHECK(parseViewFile("angle increment: 10\nangle factor: ?\n", "t.v").angleDeg == 36.0);
+  }
+}
+
+TEST_CASE("cpfg parity: blanks between '@' and its letters", "[lsystem][cpfg]") {
+  Parity p = loadParity("at_blank");
+  const ModuleString s = deriveParity(p);
+  checkSame(s, p.grammar.symbols(), cpfgString("at_blank"));
+  CHECK(countSymbol(s, p.grammar.symbols(), "@c") == 4);
+  SECTION("a lone '@' is still refused") {
+    CHECK_THROWS_WITH(parseGrammar("axiom: F@ +F\n", "t.l"), Catch::Contains("t.l:1:9: error: unknown cpfg command '@'"));
+  }
+}
+
+TEST_CASE("cpfg parity: a texture image that cannot be read does not stop a derivation", "[lsystem][cpfg]") {
+  Parity p = loadParity("texture_unread");
+  const ModuleString s = deriveParity(p);
+  // Whole numbers only: the text compares ('@Tx' is refused by Sprig's string reader).
+  CHECK(formatModuleString(s, p.grammar.symbols()) == cpfgString("texture_unread"));
+  const ViewFile v = loadViewFile(parityAsset("texture_unread/plant.v"));
+  REQUIRE(v.textures.size() == 1);
+  CHECK_FALSE(v.textures[0].image);
+  REQUIRE(v.textures[0].unreadable);
+  CHECK(v.textures[0].unreadable->loc.line == 1);
+  CHECK(v.textures[0].unreadable->loc.col == 13);
+}

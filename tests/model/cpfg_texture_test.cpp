@@ -150,7 +150,7 @@ TEST_CASE("cpfg texture errors", "[model][cpfg]") {
     try {
       const Species s = loadSpecies(dir);
       GrowthEngine engine(s);
-      engine.skeletonAt(engine.lastStep());
+      skeletonPreview(engine.skeletonAt(engine.lastStep()), s.render.style);  // draws the textures
     } catch (const InputError& e) {
       const Diagnostic& d = e.diagnostics().front();
       return (d.loc.line ? fs::path(d.loc.file).filename().string() + ":" + std::to_string(d.loc.line) + ":" +
@@ -161,11 +161,18 @@ TEST_CASE("cpfg texture errors", "[model][cpfg]") {
     return std::string("no error");
   };
   CHECK(errorOf("texture: F: halves.png\n", "[@Tx(1)~a]F") == "no error");
-  CHECK(errorOf("texture: F: missing.png\n", "~a") ==
+  // An image that cannot be read is an error when an organ with its texture is drawn (cpfg
+  // reads images only to draw), at the view file's line.
+  CHECK(errorOf("texture: F: missing.png\n", "~a") == "no error");
+  CHECK(errorOf("texture: F: missing.png\n", "[@Tx(1)]~a") == "no error");
+  CHECK(errorOf("texture: F: missing.png\n", "[@Tx(1)~a]~a") ==
+        "plant.v:2:13: cannot find file '" + (dir / "missing.png").string() + "'");
+  CHECK(errorOf("texture: F: missing.png\n", "@Tx(1)F") ==
         "plant.v:2:13: cannot find file '" + (dir / "missing.png").string() + "'");
   // A file that is no image: the image reader's reason.
   writeFileAtomic(dir / "bad.png", "not a png");
-  CHECK(errorOf("texture: F: bad.png\n", "~a").rfind("plant.v:2:13: cannot read the texture image '" + (dir / "bad.png").string() + "': ", 0) == 0);
+  CHECK(errorOf("texture: F: bad.png\n", "~a") == "no error");
+  CHECK(errorOf("texture: F: bad.png\n", "@Tx(1)~a").rfind("plant.v:2:13: cannot read the texture image '" + (dir / "bad.png").string() + "': ", 0) == 0);
   CHECK(errorOf("texture: F: halves.png\n", "@Tx(2)~a") ==
         "cpfg's '@Tx(2)' names no texture: the view file has 1 'texture:' line");
   CHECK(errorOf("", "@Tx(1)~a") == "cpfg's '@Tx(1)' names no texture: the view file has no 'texture:' line");

@@ -1,0 +1,1 @@
+texture: F: not_here.png H:n L:n E:m
