@@ -10,12 +10,8 @@
 #      build of it takes about as long as the whole run).
 # Usage: tests/cli/library_root_test.sh path/to/sprig   (run from the repository root)
 set -euo pipefail
-SPRIG=$(realpath "$1")
+. "$(dirname "$0")/lib.sh"
 CHECKOUT=$(pwd)
-WORK=$(mktemp -d "${TMPDIR:-/tmp}/sprig-root-test-XXXXXX")
-trap 'rm -rf "$WORK"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
-sprig() { "$SPRIG" --quiet "$@"; }
 
 # --- 1. a shipped species from three folders ---------------------------------------------
 sprig check species/shrub.yaml >/dev/null || fail "check from the checkout root"
