@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
 # `--timings json` (registered with ctest as `cli_timings`): an exact render of a small tree
 # reports every phase of the command (start-up, read, derive, build, cells, scene, render,
-# write, other), the phases add up to the reported total, the named phases (all but
-# "other") account for at least 95% of it, and the total is the process's wall time (at
-# most the wall time measured from outside, and at least half of it).
+# write, other), the phases add up to the reported total within 5 %, the named phases (all
+# but "other") account for at least 90 % of it, and the total is the process's wall time
+# (at most the wall time measured from outside, and at least 30 % of it).
 # Usage: tests/cli/timings_test.sh path/to/sprig   (run from the repository root)
 set -euo pipefail
 . "$(dirname "$0")/lib.sh"
@@ -34,12 +34,15 @@ for w in ["read", "derive", "build", "cells", "scene", "render", "write"]:
 total, summed = t["total"], sum(phases.values())
 if abs(summed - total) > 0.05 * total:
     sys.exit("FAIL: phases sum to %.4f s, total %.4f s" % (summed, total))
-if phases["other"] > 0.05 * total:
+# Unnamed time is small on an idle machine (4 % here); a loaded or sanitized run stretches
+# whatever is unnamed too, so the bound leaves room (one sanitized run under load failed at 5 %).
+if phases["other"] > 0.10 * total:
     sys.exit("FAIL: %.4f s of %.4f s in no named phase" % (phases["other"], total))
 # The total runs from the process's start to the JSON line, so it is at most the wall time
 # measured outside, and not far below it (the exit after the line, unloading libraries, is
-# all it misses; generous, as the machine may be loaded).
-if not (total <= wall + 0.01 and total >= 0.5 * wall):
+# all it misses, and LeakSanitizer's exit check in a sanitized build; generous, as the
+# machine may be loaded).
+if not (total <= wall + 0.01 and total >= 0.3 * wall):
     sys.exit("FAIL: reported total %.4f s, measured wall %.4f s" % (total, wall))
 print("ok: %.3f s reported, %.3f s measured; %s" % (total, wall, ", ".join("%s %.3f" % kv for kv in phases.items())))
 PY
