@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Sharded, resumable gallery, end to end (registered with ctest as `gallery_shards`):
 #   1. a 2-shard gallery built by GNU parallel and merged equals a 1-shard gallery
-#      (same files, same bytes; index.html compared without its timing cells);
+#      (same files, same bytes; index.html compared without its timing cells; the shards'
+#      manifests list the 1-shard manifest's items, timings aside);
 #   2. a re-run renders nothing new;
 #   3. a changed species file re-renders only that species; a rebuilt sprig re-renders all;
 #   4. a run killed mid-render (SIGKILL) leaves no partial image and resumes;
@@ -12,28 +13,13 @@ SPRIG=$(realpath "$1")
 SRC=$(pwd)
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/sprig-gallery-test-XXXXXX")
 trap 'rm -rf "$WORK"' EXIT
-fail() { echo "FAIL: $*" >&2; exit 1; }
+source "$SRC/tests/gallery/lib.sh"
 
 mkdir -p "$WORK/lib/species" "$WORK/lib/grammars"
 cp "$SRC"/tests/gallery/species/*.yaml "$WORK/lib/species/"
 cp "$SRC"/grammars/abop_1_24a.lsys "$SRC"/grammars/shrub.lsys "$SRC"/grammars/growth_timed.lsys "$WORK/lib/grammars/"
 cd "$WORK/lib"
 gallery() { "$SPRIG" --root . --threads 2 gallery species/*.yaml "$@"; }
-
-# Compares two gallery folders: every file but the manifests, the HTML pages without timings.
-same_gallery() {
-  local a=$1 b=$2
-  diff <(cd "$a" && find . -type f ! -path './manifests/*' | sort) \
-       <(cd "$b" && find . -type f ! -path './manifests/*' | sort) || fail "$a and $b hold different files"
-  while read -r f; do
-    if [ "$f" = ./index.html ] || [ "${f#./pages/}" != "$f" ]; then
-      cmp -s <(sed 's|<td class="time">[^<]*</td>|<td class="time"></td>|g' "$a/$f") \
-             <(sed 's|<td class="time">[^<]*</td>|<td class="time"></td>|g' "$b/$f") || fail "$f differs"
-    else
-      cmp -s "$a/$f" "$b/$f" || fail "$f differs between $a and $b"
-    fi
-  done < <(cd "$a" && find . -type f ! -path './manifests/*' | sort)
-}
 
 # 1. One shard, then two shards in parallel and a merge.
 gallery -o out1 2> log1 || { cat log1; fail "1-shard gallery failed"; }
@@ -47,6 +33,7 @@ parallel --halt now,fail=1 "$SPRIG" --root . --threads 1 -q gallery species/*.ya
 [ -f out2/manifests/shard-0-of-2.json ] && [ -f out2/manifests/shard-1-of-2.json ] || fail "shard manifests missing"
 "$SPRIG" -q gallery --merge out2 || fail "merge failed"
 same_gallery out1 out2
+same_manifest_items out1 out2
 
 # 2. A re-run renders nothing new (and rewrites no image).
 before=$(cd out1 && find . -type f ! -path './manifests/*' ! -path './thumbs/*' ! -path './pages/*' ! -name index.html ! -name contact_sheet.png \
