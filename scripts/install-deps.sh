@@ -15,6 +15,7 @@ packages=(
   gmsh
   clang-14 libclang-rt-14-dev ccache
   chromium  # tests: headless Chromium loads the gallery (tests/gallery/browser_test.sh)
+  slurm-wlm munge  # tests: a one-node Slurm cluster runs the gallery as a job array (tests/gallery/slurm_test.sh)
   pybind11-dev python3-dev python3-numpy python3-pytest  # the Python module (python/, docs/PYTHON.md) and its tests
   blender  # tests: the Blender add-on (blender/, docs/BLENDER.md), ctest blender_addon
 )
