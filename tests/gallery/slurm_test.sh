@@ -13,8 +13,10 @@
 #      renders that species alone (the others are up to date) and restores the same bytes.
 # slurm.conf is the block of docs/GALLERY.md "A one-node cluster", with this test's folder and
 # two free ports. Everything is stopped and removed when the test ends, also on failure.
-# Exits 77 (ctest: skipped, and says why) only where no cluster can be started: the Slurm
-# or munge programs are missing (scripts/install-deps.sh installs them), or not run as root.
+# slurm.conf's SlurmUser (and SlurmdUser) become the user running the test: root in CI, any
+# other user as well (jobs then run as that user). Exits 77 (ctest: skipped, and says why)
+# only where no cluster can be started: the Slurm or munge programs are missing
+# (scripts/install-deps.sh installs them).
 # Usage: tests/gallery/slurm_test.sh path/to/sprig   (run from the repository root)
 set -euo pipefail
 SPRIG=$(realpath "$1")
@@ -22,10 +24,11 @@ SRC=$(pwd)
 source "$SRC/tests/gallery/lib.sh"
 skip() { echo "SKIPPED: gallery_slurm: $* -- the gallery was NOT run on Slurm" >&2; exit 77; }
 
+# The daemons live in /usr/sbin, which a user's PATH may lack.
+PATH=$PATH:/usr/sbin:/sbin
 for p in munged mungekey slurmctld slurmd sbatch scontrol sinfo squeue scancel srun python3; do
   command -v "$p" > /dev/null || skip "the program $p is missing (Debian: slurm-wlm, munge; scripts/install-deps.sh)"
 done
-[ "$(id -u)" -eq 0 ] || skip "slurmd must run as root to start jobs (run the test as root)"
 
 # The cluster's folder: munged wants its socket's folder searchable by everyone and nothing
 # in it writable by others.
@@ -49,6 +52,8 @@ stop_cluster() {
   rm -rf "$WORK"
 }
 trap stop_cluster EXIT
+trap 'exit 130' INT
+trap 'exit 143' TERM
 dump_logs() {
   for f in "$WORK"/*.log "$WORK"/log/*; do echo "== $f"; tail -n 30 "$f"; done >&2
 }
@@ -80,13 +85,15 @@ pids+=($!)
 for _ in $(seq 100); do [ -S "$WORK/munge.socket" ] && break; sleep 0.1; done
 [ -S "$WORK/munge.socket" ] || { dump_logs; fail "munged did not start"; }
 
+# The daemons run as whoever runs the test (root in CI; another user runs jobs as itself).
+user=$(id -un)
 read -r ctld_port slurmd_port < <(python3 -c '
 import socket
 s = [socket.socket() for _ in range(2)]
 for x in s: x.bind(("127.0.0.1", 0))
 print(*[x.getsockname()[1] for x in s])')
 awk '/^<!-- slurm.conf:/ {want = 1; next} want && /^```/ {if (inside) exit; inside = 1; next} inside' "$SRC/docs/GALLERY.md" |
-  sed -e "s|FOLDER|$WORK|g" -e "s|^SlurmctldPort=.*|SlurmctldPort=$ctld_port|" -e "s|^SlurmdPort=.*|SlurmdPort=$slurmd_port|" \
+  sed -e "s|FOLDER|$WORK|g" -e "s|^SlurmUser=.*|SlurmUser=$user\nSlurmdUser=$user|" -e "s|^SlurmctldPort=.*|SlurmctldPort=$ctld_port|" -e "s|^SlurmdPort=.*|SlurmdPort=$slurmd_port|" \
   > "$WORK/slurm.conf"
 grep -q '^NodeName=' "$WORK/slurm.conf" && grep -q "^AuthInfo=socket=$WORK/munge.socket$" "$WORK/slurm.conf" ||
   fail "no slurm.conf block (with FOLDER/munge.socket) found in docs/GALLERY.md"
