@@ -21,13 +21,7 @@ command -v chromium >/dev/null || fail "chromium is not installed (scripts/insta
 mkdir -p "$WORK/lib/species" "$WORK/lib/grammars"
 cp "$SRC"/tests/gallery/species/edge.yaml "$SRC"/tests/gallery/species/shrub.yaml "$WORK/lib/species/"
 cp "$SRC"/grammars/abop_1_24a.lsys "$SRC"/grammars/shrub.lsys "$WORK/lib/grammars/"
-cat > "$WORK/lib/species/blob_ball.yaml" <<'YAML'
-name: Ball test
-description: One point primitive (gallery browser test).
-kind: blob
-blob: {point: {center: [0, 0, 0], radius: 1}}
-render: {width: 64, height: 48, samples: 1}
-YAML
+cp "$SRC"/tests/gallery/blob_ball.yaml "$WORK/lib/species/"
 cd "$WORK/lib"
 "$SPRIG" --root . --threads 2 -q gallery species/*.yaml -o out 2> log || { cat log; fail "gallery failed"; }
 

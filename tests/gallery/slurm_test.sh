@@ -3,8 +3,9 @@
 # cluster (munged, slurmctld, slurmd on localhost, as plain processes: no systemd) started
 # in a temporary folder, then docs/GALLERY.md's recipe run on it:
 #   1. the job script of docs/GALLERY.md "Slurm job array", submitted as an array of 3 tasks
-#      starting at 1 (so SLURM_ARRAY_TASK_MIN matters) over 4 species, and the merge as the
-#      dependent job of the same section; every task and the merge end with exit code 0;
+#      (--array=1-3, so SLURM_ARRAY_TASK_MIN and _STEP matter) over 4 species, and the
+#      merge as the dependent job of the same section; every task and the merge end with
+#      exit code 0;
 #   2. the merged gallery equals an unsharded gallery of the same species byte for byte
 #      (images, thumbnails, pages; index.html and pages without their timing cells) and the
 #      shards' manifests list the same items as the unsharded one (timings aside), each
@@ -62,13 +63,7 @@ dump_logs() {
 mkdir -p "$WORK/lib/species" "$WORK/lib/grammars" "$WORK/log" "$WORK/state" "$WORK/spool"
 cp "$SRC"/tests/gallery/species/*.yaml "$WORK/lib/species/"
 cp "$SRC"/grammars/abop_1_24a.lsys "$SRC"/grammars/shrub.lsys "$SRC"/grammars/growth_timed.lsys "$WORK/lib/grammars/"
-cat > "$WORK/lib/species/blob_ball.yaml" <<'YAML'
-name: Ball test
-description: One point primitive (gallery Slurm test).
-kind: blob
-blob: {point: {center: [0, 0, 0], radius: 1}}
-render: {width: 64, height: 48, samples: 1}
-YAML
+cp "$SRC"/tests/gallery/blob_ball.yaml "$WORK/lib/species/"
 # The job script calls build/sprig from the checkout: here the checkout is lib/.
 ln -s "$(dirname "$SPRIG")" "$WORK/lib/build"
 cd "$WORK/lib"
@@ -112,6 +107,30 @@ done
 [ "$state" = idle ] || { dump_logs; fail "the node is not idle 30 s after the daemons started (state: '$state')"; }
 echo "gallery_slurm: cluster up at ${SECONDS} s"
 
+# "TASK STATE EXIT" per task of job $1 ("-" for TASK outside an array), sorted. `scontrol`
+# keeps a finished job for MinJobAge (300 s): no accounting daemon is needed.
+job_table() {
+  scontrol -o show job "$1" 2> /dev/null | while read -r line; do
+    field() { grep -o " $1=[^ ]*" <<< " $line" | head -1 | cut -d= -f2; }
+    task=$(field ArrayTaskId)
+    echo "${task:--} $(field JobState) $(field ExitCode)"
+  done | sort
+}
+# Waits up to $2 seconds for every task of job $1 to end, polling twice a second. (`sbatch
+# --wait` looks 2, 10 and 42 s after submitting, measured with `--wrap 'sleep 11'`: on it
+# the array and merge below took 14 to 43 s.)
+wait_job() {
+  local end=$((SECONDS + $2)) states
+  while [ "$SECONDS" -lt "$end" ]; do
+    states=$(job_table "$1" | cut -d' ' -f2 | sort -u)
+    if [ -n "$states" ] && ! grep -qvE '^(COMPLETED|FAILED|CANCELLED|TIMEOUT|NODE_FAIL|OUT_OF_MEMORY|BOOT_FAIL|DEADLINE|PREEMPTED)$' <<< "$states"; then
+      return 0
+    fi
+    sleep 0.5
+  done
+  return 1
+}
+
 # --- 1. docs/GALLERY.md's job script as an array of 3 tasks, then the dependent merge -----
 awk '/^<!-- gallery.sbatch:/ {want = 1; next} want && /^```/ {if (inside) exit; inside = 1; next} inside' \
   "$SRC/docs/GALLERY.md" | sed "s|/shared/gallery|$WORK/out|g" > "$WORK/gallery.sbatch"
@@ -120,16 +139,12 @@ grep -q '^srun .*build/sprig .* gallery ' "$WORK/gallery.sbatch" || fail "no job
 # Two tasks run at a time (CPUs=2), each with one thread.
 submit=(sbatch --array=1-3 --cpus-per-task=1 --time=00:05:00 --output="$WORK/log/task-%a")
 jid=$("${submit[@]}" --parsable "$WORK/gallery.sbatch")
-timeout 240 sbatch --parsable --wait --dependency=afterany:"$jid" --output="$WORK/log/merge" \
-  --wrap "build/sprig gallery --merge $WORK/out" > /dev/null || { dump_logs; fail "the merge job failed"; }
-# Every task of the array ended, each with exit code 0 (`scontrol` keeps finished jobs for
-# MinJobAge, 300 s).
-tasks=$(scontrol -o show job "$jid" | while read -r line; do
-          field() { grep -o " $1=[^ ]*" <<< " $line" | head -1 | cut -d= -f2; }
-          echo "$(field ArrayTaskId) $(field JobState) $(field ExitCode)"
-        done | sort)
+mjid=$(sbatch --parsable --dependency=afterany:"$jid" --output="$WORK/log/merge" --wrap "build/sprig gallery --merge $WORK/out")
+wait_job "$mjid" 240 || { dump_logs; fail "the merge job has not ended after 240 s: $(job_table "$mjid")"; }
+[ "$(job_table "$mjid")" = "- COMPLETED 0:0" ] || { dump_logs; fail "the merge job: $(job_table "$mjid")"; }
+# Every task of the array ended before the merge, each with exit code 0.
+tasks=$(job_table "$jid")
 [ "$tasks" = "$(printf '1 COMPLETED 0:0\n2 COMPLETED 0:0\n3 COMPLETED 0:0')" ] || { dump_logs; fail "array tasks: $tasks"; }
-
 echo "gallery_slurm: array and merge done at ${SECONDS} s"
 wait "$ref_pid" || { cat "$WORK/log/reference"; fail "the unsharded gallery failed"; }
 
