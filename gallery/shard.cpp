@@ -183,8 +183,14 @@ std::optional<Shard> shardFromEnvironment(const std::function<const char*(const 
   if (auto id = read("SLURM_ARRAY_TASK_ID")) {
     auto count = read("SLURM_ARRAY_TASK_COUNT");
     if (!count) throw UsageError("SLURM_ARRAY_TASK_ID is set but SLURM_ARRAY_TASK_COUNT is not");
+    // Slurm sets the step for `--array=A-B:S` (a list such as `1,5,9` gets step 1, so only
+    // a contiguous list maps onto 0..count-1).
     const long min = read("SLURM_ARRAY_TASK_MIN").value_or(0);
-    return make(*id - min, *count, "SLURM_ARRAY_TASK_ID");
+    const long step = read("SLURM_ARRAY_TASK_STEP").value_or(1);
+    if (step < 1 || (*id - min) % step != 0)
+      throw UsageError("SLURM_ARRAY_TASK_ID=" + std::to_string(*id) + " is not SLURM_ARRAY_TASK_MIN=" +
+                       std::to_string(min) + " plus a multiple of SLURM_ARRAY_TASK_STEP=" + std::to_string(step));
+    return make((*id - min) / step, *count, "SLURM_ARRAY_TASK_ID");
   }
   if (auto id = read("JOB_COMPLETION_INDEX")) {
     auto count = read("SPRIG_SHARD_COUNT");

@@ -33,8 +33,9 @@ struct Shard {
 /// Parses `I/N` (0-based I < N, N >= 1). Throws UsageError naming the flag otherwise.
 Shard parseShard(std::string_view text);
 
-/// The shard from the environment: SLURM_ARRAY_TASK_ID (minus SLURM_ARRAY_TASK_MIN when
-/// set) of SLURM_ARRAY_TASK_COUNT, else Kubernetes' JOB_COMPLETION_INDEX of
+/// The shard from the environment: (SLURM_ARRAY_TASK_ID − SLURM_ARRAY_TASK_MIN) /
+/// SLURM_ARRAY_TASK_STEP (MIN 0 and STEP 1 when unset) of SLURM_ARRAY_TASK_COUNT, else
+/// Kubernetes' JOB_COMPLETION_INDEX of
 /// SPRIG_SHARD_COUNT; nullopt when neither is set. Throws UsageError for malformed
 /// values. getenv is a parameter so tests can pass their own.
 std::optional<Shard> shardFromEnvironment(const std::function<const char*(const char*)>& getenv);

@@ -56,6 +56,23 @@ TEST_CASE("shardFromEnvironment", "[gallery]") {
     env = {{"SLURM_ARRAY_TASK_ID", "1"}};
     CHECK_THROWS_WITH(shardFromEnvironment(get), Catch::Contains("SLURM_ARRAY_TASK_COUNT is not"));
   }
+  SECTION("Slurm job arrays with a step: --array=1-7:3 is tasks 1, 4 and 7 of 3") {
+    for (int id : {1, 4, 7}) {
+      env = {{"SLURM_ARRAY_TASK_ID", std::to_string(id)}, {"SLURM_ARRAY_TASK_COUNT", "3"},
+             {"SLURM_ARRAY_TASK_MIN", "1"}, {"SLURM_ARRAY_TASK_STEP", "3"}};
+      checkShard((id - 1) / 3, 3);
+    }
+    env = {{"SLURM_ARRAY_TASK_ID", "5"}, {"SLURM_ARRAY_TASK_COUNT", "3"}, {"SLURM_ARRAY_TASK_MIN", "1"},
+           {"SLURM_ARRAY_TASK_STEP", "3"}};
+    CHECK_THROWS_WITH(shardFromEnvironment(get), Catch::Contains("is not SLURM_ARRAY_TASK_MIN=1 plus a multiple of "
+                                                                 "SLURM_ARRAY_TASK_STEP=3"));
+    env = {{"SLURM_ARRAY_TASK_ID", "1"}, {"SLURM_ARRAY_TASK_COUNT", "3"}, {"SLURM_ARRAY_TASK_STEP", "0"}};
+    CHECK_THROWS_AS(shardFromEnvironment(get), UsageError);
+    // A list such as --array=1,5,9 comes with step 1: task 5 is past the count.
+    env = {{"SLURM_ARRAY_TASK_ID", "5"}, {"SLURM_ARRAY_TASK_COUNT", "3"}, {"SLURM_ARRAY_TASK_MIN", "1"},
+           {"SLURM_ARRAY_TASK_STEP", "1"}};
+    CHECK_THROWS_WITH(shardFromEnvironment(get), Catch::Contains("shard 4 of 3 is out of range"));
+  }
   SECTION("Kubernetes indexed jobs") {
     env = {{"JOB_COMPLETION_INDEX", "1"}, {"SPRIG_SHARD_COUNT", "3"}};
     checkShard(1, 3);
