@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "model/animate.h"
+#include "model/kind_name.h"
 #include "model/tree_kind.h"
 #include "app/cmd_common.h"
 #include "model/model.h"
@@ -106,10 +107,10 @@ int runAnimate(const AnimateArgs& a, const GlobalOptions& g) {
   Species species = loadSpecies(a.file, g.pathPolicy());
   printNotes(g, species);
   if (species.kind != "tree" && !a.wind.empty())
-    throw UsageError("--wind sways trees; a " + species.kind + " species has no wind");
+    throw UsageError("--wind sways trees; " + speciesOfKind(species.kind) + " has no wind");
   if (species.kind != "tree" && species.kind != "solid" && !a.stages.empty())
-    throw UsageError("--stages selects derivation steps of a tree or operation stages of a solid; a " + species.kind +
-                     " species animates its whole growth (use --frames-per-stage and --fps)");
+    throw UsageError("--stages selects derivation steps of a tree or operation stages of a solid; " +
+                     speciesOfKind(species.kind) + " animates its whole growth (use --frames-per-stage and --fps)");
   const SpeciesRender& look = species.render;
   const int lookWidth = look.image.width, lookHeight = look.image.height;
   opt.width = a.width > 0 ? a.width : lookWidth;

@@ -25,7 +25,7 @@
 /// torus, halfspace, box, and the generator spiral_points (point primitives on a
 /// logarithmic helico-spiral, murex paper Eq. 1-3). Operators: blend, ricci, union,
 /// intersect, difference, controlled, pcm, negative, translate, scale, rotate, bend,
-/// twist, taper. README.md ("`kind: blob` species") lists every key.
+/// twist, taper. docs/BLOBTREE.md ("`kind: blob` species") lists every key.
 ///
 /// Every mistake is reported as `file:line:col: error: ...` (unknown kinds and keys with
 /// "did you mean", wrong types, ranges, missing keys, invalid geometry from the builder);

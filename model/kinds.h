@@ -7,7 +7,7 @@
 ///   geometry (render/geometry.h) or a mesh.
 /// Commands, animation and the gallery see only these interfaces (through SpeciesModel,
 /// model/model.h), never a test of the kind. Adding a kind is a file pair and one line in
-/// the registry (model/kinds.cpp); README.md "Adding a species kind" is the recipe.
+/// the registry (model/kinds.cpp); docs/DEVELOPERS.md "Adding a species kind" is the recipe.
 
 #include <filesystem>
 #include <memory>

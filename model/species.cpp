@@ -6,6 +6,7 @@
 #include "core/atomic_file.h"
 #include "core/paths.h"
 #include "core/phases.h"
+#include "model/kind_name.h"
 #include "model/kinds.h"
 #include "model/species_field.h"
 #include "model/tree_kind.h"
@@ -134,7 +135,7 @@ Species readSpecies(std::shared_ptr<const YamlFile> yaml, const PathPolicy& poli
     MapReader render(*r, diags, "render");
     readRender(render, s.render, diags);
     if (auto w = render.keyNode("wind"); w && s.kind != "tree")
-      w->error(diags, "'render.wind' sways trees; a " + s.kind + " species has no wind");
+      w->error(diags, "'render.wind' sways trees; " + speciesOfKind(s.kind) + " has no wind");
   }
   for (const YNode& st : top.sequence("stages"))
     if (auto v = st.asInteger(diags, "'stages' entry", 0, 100000)) s.stages.push_back(static_cast<int>(*v));

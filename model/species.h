@@ -2,7 +2,7 @@
 /// Species files (`species/*.yaml`) and bare grammars, read completely when loaded.
 ///
 /// A species file names its kind and holds everything needed to grow and show one organism;
-/// README.md ("Species files") lists every key with its default. The keys every kind shares
+/// docs/MANUAL.md ("Species files") lists every key with its default. The keys every kind shares
 /// (name, description, kind, render, stages) are read here; the kind's own keys are read by
 /// the kind (model/kinds.h) into its typed value, Species::spec, in the same pass, so one
 /// load reports every error of every section, each at its `file:line:col`.

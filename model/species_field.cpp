@@ -9,6 +9,7 @@
 
 #include "core/mesh.h"
 #include "core/polymesh.h"
+#include "model/kind_name.h"
 #include "model/model.h"
 #include "model/species.h"
 
@@ -167,8 +168,8 @@ solids::FieldPtr readSpeciesField(MapReader& m, const PathPolicy& policy) {
       return nullptr;
     }
     if (seed && species.kind != "tree") {
-      m.get("seed")->error(diags, "'seed' replaces a tree's derivation seed; " + name + " is a " + species.kind +
-                                      " species (its seeds are in its own file)");
+      m.get("seed")->error(diags, "'seed' replaces a tree's derivation seed; " + name + " is " + speciesOfKind(species.kind) +
+                                      " (its seeds are in its own file)");
       return nullptr;
     }
     if (!species.hasSurface) {
