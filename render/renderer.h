@@ -80,6 +80,10 @@ struct RenderSettings {
   /// only light and its rays the only noise. 0 = skySamples everywhere.
   int unlitSkySamples = 0;
   float fillStrength = 0.0f;      ///< unshadowed light from the camera direction (0 = off)
+  /// Filter the sky term with the edge-avoiding à-trous filter (render/sky_filter.h): the
+  /// sky's irradiance is smoothed across pixels of the same surface, never across normals,
+  /// depth steps or albedo edges.
+  bool skyFilter = true;
 
   bool ground = true;             ///< analytic ground plane under the model
   bool groundAtModelBase = true;  ///< put the plane at the scene's lowest y (else at groundHeight)
