@@ -126,7 +126,11 @@ class Integrator {
     center_ = b.center();
     radius_ = std::max(0.5f * glm::length(b.size()), 1e-6f);
     eps_ = 2e-4f * radius_ + 1e-6f * glm::length(center_);
-    groundY_ = s.groundAtModelBase ? b.lo.y : s.groundHeight;
+    // The ground rests under the ground frame (default: the scene) and fades out around it.
+    const Box3 g = s.groundFrame && !s.groundFrame->empty() ? *s.groundFrame : b;
+    groundY_ = s.groundAtModelBase ? g.lo.y : s.groundHeight;
+    fadeCenter_ = g.center();
+    fadeRadius_ = std::max(0.5f * glm::length(g.size()), 1e-6f);
     sunDir_ = directionFromAngles(s.sunAzimuthDeg, s.sunElevationDeg);
     sunCos_ = static_cast<float>(std::cos(radians(std::max(0.0, s.sunAngleDeg))));
     groundMaterial_.roughness = 1.0f;
@@ -182,7 +186,7 @@ class Integrator {
       ShadeParts parts;
       Vec3 lit = shade(g, groundMaterial_, ray.direction, st, rng, c, parts);
       // Fade the far ground into the background so the horizon is soft.
-      float dist = glm::length(Vec3(g.position.x - center_.x, 0, g.position.z - center_.z)) / radius_;
+      float dist = glm::length(Vec3(g.position.x - fadeCenter_.x, 0, g.position.z - fadeCenter_.z)) / fadeRadius_;
       float f = std::clamp((dist - s_.groundFade) / (3.0f * s_.groundFade), 0.0f, 1.0f);
       f = f * f * (3.0f - 2.0f * f);
       out.add(parts, g.position, weight * (1.0f - f));
@@ -278,6 +282,8 @@ class Integrator {
   const RenderSettings& s_;
   Vec3 center_{0};
   float radius_ = 1;
+  Vec3 fadeCenter_{0};
+  float fadeRadius_ = 1;
   float eps_ = 1e-4f;
   float groundY_ = 0;
   Vec3 sunDir_{0, 1, 0};

@@ -14,6 +14,7 @@
 /// light from the camera; the ground is an analytic horizontal plane under the model.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "core/image.h"
@@ -90,6 +91,10 @@ struct RenderSettings {
   float groundHeight = 0.0f;      ///< plane height when groundAtModelBase is false
   Vec3 groundColor{0.45f, 0.42f, 0.37f};  ///< linear albedo of the ground
   float groundFade = 6.0f;        ///< ground fades into the background beyond this many model radii
+  /// The box the ground rests under (its lowest y, with groundAtModelBase) and fades around
+  /// (its centre and radius); unset: the scene's bounds. Stages of one model rendered with
+  /// one ground frame share one horizon.
+  std::optional<Box3> groundFrame;
 
   /// Minimum drawn width of thin curves and twigs, in pixels (Scene::setPixelFootprint;
   /// the callers that build the scene pass it on). 0 = draw them as they are.
