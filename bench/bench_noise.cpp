@@ -14,8 +14,10 @@
 /// build/bench_noise_cache/ so later runs skip it. Prints per scene the RMSE against the
 /// reference of each, in 8-bit sRGB levels (the display values, where dark sky-lit regions
 /// weigh as the eye sees them), and its ratios of error and CPU time to the stratified one.
-/// A third variant adds RenderSettings::unlitSkySamples = 2 to the Sobol' sampler. --out DIR
-/// writes DIR/NAME.png: stratified | Sobol' | Sobol' + unlit 2 | reference, side by side.
+/// A third variant adds RenderSettings::unlitSkySamples = 2 to the Sobol' sampler, a fourth and
+/// a fifth the sky filter (RenderSettings::skyFilter, render/sky_filter.h) to each sampler. --out DIR
+/// writes DIR/NAME.png: stratified | Sobol' | Sobol' + sky filter | reference, side by side,
+/// and DIR/NAME_error.png: 8 x the error of stratified | of Sobol' + sky filter.
 
 #include <cmath>
 #include <cstdio>
@@ -95,6 +97,22 @@ Image sideBySide(const std::vector<const Image*>& images) {
   return out;
 }
 
+/// The error of a against the reference per pixel: 8 x the mean absolute difference of the
+/// display values, as grey (linear light so that it writes back as those values).
+Image errorMap(const Image& a, const Image& reference) {
+  Image out(a.width, a.height);
+  for (int y = 0; y < a.height; ++y) {
+    for (int x = 0; x < a.width; ++x) {
+      double e = 0;
+      for (int c = 0; c < 3; ++c) e += std::abs(display(a.at(x, y)[c]) - display(reference.at(x, y)[c]));
+      const double v = std::min(1.0, 8.0 * e / 3.0);
+      const float lin = static_cast<float>(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
+      out.set(x, y, Vec4(Vec3(lin), 1));
+    }
+  }
+  return out;
+}
+
 void runScene(const NoiseScene& sc, const Options& o) {
   PathPolicy policy;
   policy.root = SPRIG_BENCH_SOURCE_DIR;
@@ -122,6 +140,7 @@ void runScene(const NoiseScene& sc, const Options& o) {
     ref.spp = o.reference;
     ref.seed = 0x5eed;
     ref.sampler = render::Sampling::ZSobol;
+    ref.skyFilter = false;
     const auto t1 = bench::Clock::now();
     reference = render::renderImage(scene, camera, ref);
     referenceSeconds = bench::seconds(t1);
@@ -133,17 +152,21 @@ void runScene(const NoiseScene& sc, const Options& o) {
     const char* name;
     render::Sampling sampler;
     int unlitSkySamples;
+    bool skyFilter;
   };
-  const Variant variants[] = {{"stratified", render::Sampling::Stratified, 0},
-                              {"zsobol", render::Sampling::ZSobol, 0},
-                              {"zsobol+unlit2", render::Sampling::ZSobol, 2}};
-  constexpr int kVariants = 3;
+  const Variant variants[] = {{"stratified", render::Sampling::Stratified, 0, false},
+                              {"zsobol", render::Sampling::ZSobol, 0, false},
+                              {"zsobol+unlit2", render::Sampling::ZSobol, 2, false},
+                              {"zsobol+filter", render::Sampling::ZSobol, 0, true},
+                              {"strat+filter", render::Sampling::Stratified, 0, true}};
+  constexpr int kVariants = 5;
   Image images[kVariants];
-  double best[kVariants] = {1e30, 1e30, 1e30};
+  double best[kVariants] = {1e30, 1e30, 1e30, 1e30, 1e30};
   for (int r = 0; r < o.repeat; ++r) {
     for (int i = 0; i < kVariants; ++i) {
       rs.sampler = variants[i].sampler;
       rs.unlitSkySamples = variants[i].unlitSkySamples;
+      rs.skyFilter = variants[i].skyFilter;
       const double cpu0 = bench::processCpuSeconds();
       images[i] = render::renderImage(scene, camera, rs);
       best[i] = std::min(best[i], bench::processCpuSeconds() - cpu0);
@@ -160,7 +183,9 @@ void runScene(const NoiseScene& sc, const Options& o) {
   std::fflush(stdout);
   if (!o.out.empty()) {
     fs::create_directories(o.out);
-    writeImage(sideBySide({&images[0], &images[1], &images[2], &reference}), fs::path(o.out) / (std::string(sc.name) + ".png"));
+    writeImage(sideBySide({&images[0], &images[1], &images[3], &reference}), fs::path(o.out) / (std::string(sc.name) + ".png"));
+    const Image e0 = errorMap(images[0], reference), e3 = errorMap(images[3], reference);
+    writeImage(sideBySide({&e0, &e3}), fs::path(o.out) / (std::string(sc.name) + "_error.png"));
   }
 }
 

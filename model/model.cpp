@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 
 #include "core/diagnostics.h"
@@ -122,6 +123,12 @@ void checkCameraRays(int width, int height, int samples) {
                    std::to_string(kMaxCameraRays) + " (2^34): lower --width, --height or --samples (render: width, height, samples in the species file)");
 }
 
+Box3 restingFrame(const Box3& frame, const Box3& stage, bool groundAtModelBase) {
+  if (!groundAtModelBase || stage.empty() || !std::isfinite(stage.lo.y)) return frame;
+  const Vec3 up(0, stage.lo.y - frame.lo.y, 0);
+  return Box3{frame.lo + up, frame.hi + up};
+}
+
 Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job, ModelFigures* figures,
                           render::RenderStats* stats) {
   const int lookWidth = look.image.width, lookHeight = look.image.height;
@@ -132,7 +139,7 @@ Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJo
   checkCameraRays(width, height, job.samples > 0 ? job.samples : look.image.spp);
   const Box3 frame = job.frame ? *job.frame : model.frameBox();
   checkFrameBox(model.species(), frame);
-  const render::Camera camera = modelCamera(look, frame, width, height);
+  render::Camera camera = modelCamera(look, frame, width, height);
   if (std::string why = render::cameraProblem(camera); !why.empty())
     throw InputError(model.species().loc(), "render.camera: " + why);
   render::Scene scene;
@@ -151,6 +158,9 @@ Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJo
   if (job.samples > 0) rs.spp = job.samples;
   rs.progress = job.progress;
   rs.progressLabel = job.progressLabel;
+  const Box3 resting = restingFrame(frame, scene.bounds(), rs.groundAtModelBase);
+  if (resting.lo.y != frame.lo.y) camera = modelCamera(look, resting, width, height);
+  rs.groundFrame = resting;
   const Phase phase("render");
   Image image = render::renderImage(scene, camera, rs, stats);
   if (figures) *figures = fig;

@@ -137,12 +137,20 @@ inline constexpr uint64_t kMaxCameraRays = uint64_t(1) << 34;
 void checkCameraRays(int width, int height, int samples);
 
 /// Renders one stage of model with look (camera framed on model.frameBox(), or the species'
-/// explicit camera). Fills figures and stats when given. Throws UsageError (checkCameraRays)
+/// explicit camera). Every stage is staged as the frame's: it rests on the ground, and the
+/// framed camera moves up or down with its lowest point so that the ground, its fade and the
+/// horizon are where the frame's are (the same row in every stage of a strip or animation). Fills figures and stats when given. Throws UsageError (checkCameraRays)
 /// for an image over kMaxCameraRays rays; InputError at the species for a framed box that is
 /// not finite, reaches beyond render::kMaxRenderCoordinate or has zero size, and for a
 /// camera that cannot make valid rays (render::cameraProblem).
 Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job,
                           ModelFigures* figures = nullptr, render::RenderStats* stats = nullptr);
+
+/// The frame box moved up or down so that its base is the stage's lowest point: the stage
+/// rests on the ground, and a camera framed on the result sees that ground from where the
+/// frame's camera sees the frame's (one horizon row for every stage). frame itself when the
+/// stage box is empty or not finite, or the ground is not at the model's base.
+Box3 restingFrame(const Box3& frame, const Box3& stage, bool groundAtModelBase);
 
 /// The camera for an image of width x height of a model framed on box with look.
 render::Camera modelCamera(const SpeciesRender& look, const Box3& box, int width, int height);

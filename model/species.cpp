@@ -78,6 +78,7 @@ void readRender(MapReader& m, SpeciesRender& r, DiagnosticList& diags) {
   im.fillStrength = static_cast<float>(m.number("fill", im.fillStrength, 0.0, 10.0));
   im.skyStrength = static_cast<float>(m.number("sky", im.skyStrength, 0.0, 10.0));
   im.unlitSkySamples = static_cast<int>(m.integer("unlit_sky_samples", im.unlitSkySamples, 0, 16));
+  im.skyFilter = m.boolean("sky_filter", im.skyFilter);
   r.surface.baseColor = m.color("color", r.surface.baseColor);
   r.surface.roughness = static_cast<float>(m.number("roughness", r.surface.roughness, 0.0, 1.0));
   r.surface.specular = static_cast<float>(m.number("specular", r.surface.specular, 0.0, 1.0));

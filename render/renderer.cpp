@@ -12,6 +12,7 @@
 #include "core/progress.h"
 #include "core/rng.h"
 #include "render/sampler.h"
+#include "render/sky_filter.h"
 
 namespace sprig::render {
 
@@ -63,6 +64,34 @@ struct Counters {
   uint64_t camera = 0, shadow = 0, sky = 0;
 };
 
+/// The sky term of one shaded point, for the sky filter (render/sky_filter.h): zero where
+/// the sky was not sampled by rays (no noise to filter).
+struct ShadeParts {
+  Vec3 sky{0};          ///< albedo * sky irradiance: the part of the radiance from the sky
+  Vec3 albedo{0};       ///< the albedo that multiplied the irradiance
+  Vec3 normal{0};       ///< shading normal, facing the viewer (zero: no sky term)
+  float irradianceLum = 0;
+};
+
+/// What one camera sample sees: its radiance and alpha, and the sky term with the guides of
+/// its first surface.
+struct SampleValue {
+  Vec4 value{0};
+  Vec3 sky{0}, albedo{0};
+  Vec3 normal{0}, position{0};  ///< of the first surface with a sky term (normal zero: none)
+  float irradianceLum = 0;      ///< of that surface
+  /// Adds the sky term of a surface seen with the given weight (its share of the sample).
+  void add(const ShadeParts& p, const Vec3& at, float weight) {
+    sky += weight * p.sky;
+    albedo += weight * p.albedo;
+    if (normal == Vec3(0) && p.normal != Vec3(0)) {
+      normal = p.normal;
+      position = at;
+      irradianceLum = p.irradianceLum;
+    }
+  }
+};
+
 /// Where one camera sample's light samples come from. With a Sobol' sampler, its next
 /// dimensions. Otherwise (Sampling::Stratified) the sun disc and the sky hemisphere are
 /// stratified over all samples of a pixel, with a per-pixel cyclic shift so light strata
@@ -97,15 +126,19 @@ class Integrator {
     center_ = b.center();
     radius_ = std::max(0.5f * glm::length(b.size()), 1e-6f);
     eps_ = 2e-4f * radius_ + 1e-6f * glm::length(center_);
-    groundY_ = s.groundAtModelBase ? b.lo.y : s.groundHeight;
+    // The ground rests under the ground frame (default: the scene) and fades out around it.
+    const Box3 g = s.groundFrame && !s.groundFrame->empty() ? *s.groundFrame : b;
+    groundY_ = s.groundAtModelBase ? g.lo.y : s.groundHeight;
+    fadeCenter_ = g.center();
+    fadeRadius_ = std::max(0.5f * glm::length(g.size()), 1e-6f);
     sunDir_ = directionFromAngles(s.sunAzimuthDeg, s.sunElevationDeg);
     sunCos_ = static_cast<float>(std::cos(radians(std::max(0.0, s.sunAngleDeg))));
     groundMaterial_.roughness = 1.0f;
     groundMaterial_.specular = 0.0f;
   }
 
-  /// Radiance and alpha seen through film point (fx, fy).
-  Vec4 sample(float fx, float fy, const Strata& st, Rng& rng, Counters& c) const {
+  /// Radiance and alpha seen through film point (fx, fy), with the sky term and guides.
+  SampleValue sample(float fx, float fy, const Strata& st, Rng& rng, Counters& c) const {
     Ray ray = camera_.generateRay(fx, fy, s_.width, s_.height);
     ++c.camera;
     Vec3 bg = background(fy);
@@ -115,27 +148,34 @@ class Integrator {
     // Widened thin curves (opacity < 1) are blended over what lies behind them, front to
     // back, for at most kLayers of them.
     constexpr int kLayers = 8;
-    Vec4 front(0);
+    SampleValue out;
     float through = 1.0f;
     float tnear = 0.0f;
     for (int layer = 0;; ++layer) {
       std::optional<SurfaceHit> hit = scene_.intersect(ray.origin, ray.direction, tnear, kInf);
       if (!hit || hit->t > tGround) break;
       const Material& m = scene_.material(hit->material);
-      const Vec4 lit(shade(*hit, m, ray.direction, st, rng, c), 1.0f);
-      if (hit->opacity >= 1.0f || layer + 1 == kLayers) return front + through * lit;
-      front += through * hit->opacity * lit;
+      ShadeParts parts;
+      const Vec4 lit(shade(*hit, m, ray.direction, st, rng, c, parts), 1.0f);
+      const bool last = hit->opacity >= 1.0f || layer + 1 == kLayers;
+      out.add(parts, hit->position, last ? through : through * hit->opacity);
+      if (last) {
+        out.value += through * lit;
+        return out;
+      }
+      out.value += through * hit->opacity * lit;
       through *= 1.0f - hit->opacity;
       tnear = hit->behind;
     }
-    if (through < 1.0f) return front + through * behindSurfaces(ray, tGround, bg, bgAlpha, st, rng, c);
-    return behindSurfaces(ray, tGround, bg, bgAlpha, st, rng, c);
+    out.value += through * behindSurfaces(ray, tGround, bg, bgAlpha, st, rng, c, out, through);
+    return out;
   }
 
  private:
-  /// The ground or the background seen along ray.
+  /// The ground or the background seen along ray; the ground's sky term goes into out
+  /// with the given weight.
   Vec4 behindSurfaces(const Ray& ray, float tGround, const Vec3& bg, float bgAlpha, const Strata& st, Rng& rng,
-                      Counters& c) const {
+                      Counters& c, SampleValue& out, float weight) const {
     if (tGround < kInf) {
       SurfaceHit g;
       g.t = tGround;
@@ -143,11 +183,13 @@ class Integrator {
       g.position.y = groundY_;
       g.normal = g.geometricNormal = Vec3(0, 1, 0);
       g.color = s_.groundColor;
-      Vec3 lit = shade(g, groundMaterial_, ray.direction, st, rng, c);
+      ShadeParts parts;
+      Vec3 lit = shade(g, groundMaterial_, ray.direction, st, rng, c, parts);
       // Fade the far ground into the background so the horizon is soft.
-      float dist = glm::length(Vec3(g.position.x - center_.x, 0, g.position.z - center_.z)) / radius_;
+      float dist = glm::length(Vec3(g.position.x - fadeCenter_.x, 0, g.position.z - fadeCenter_.z)) / fadeRadius_;
       float f = std::clamp((dist - s_.groundFade) / (3.0f * s_.groundFade), 0.0f, 1.0f);
       f = f * f * (3.0f - 2.0f * f);
+      out.add(parts, g.position, weight * (1.0f - f));
       return Vec4(glm::mix(lit, bg, f), bgAlpha + (1.0f - bgAlpha) * (1.0f - f));
     }
     return Vec4(bg, bgAlpha);
@@ -178,7 +220,9 @@ class Integrator {
     return glm::mix(s_.skyHorizon, s_.skyZenith, t);
   }
 
-  Vec3 shade(SurfaceHit h, const Material& m, const Vec3& dir, const Strata& st, Rng& rng, Counters& c) const {
+  /// Light leaving hit h toward -dir; its sky term and guides go into parts.
+  Vec3 shade(SurfaceHit h, const Material& m, const Vec3& dir, const Strata& st, Rng& rng, Counters& c,
+             ShadeParts& parts) const {
     // Face both normals toward the viewer: leaves and thin parts are two-sided.
     if (glm::dot(h.geometricNormal, dir) > 0.0f) h.geometricNormal = -h.geometricNormal;
     if (glm::dot(h.normal, dir) > 0.0f) h.normal = -h.normal;
@@ -222,6 +266,10 @@ class Integrator {
           if (!scene_.occluded(origin, d, 0.0f, kInf)) skyLight += sky(d, h.position);
         }
         skyLight /= static_cast<float>(rays);
+        parts.normal = n;
+        parts.albedo = albedo;
+        parts.sky = albedo * skyLight * s_.skyStrength;
+        parts.irradianceLum = luminance(skyLight * s_.skyStrength);
       }
       radiance += albedo * skyLight * s_.skyStrength;
     }
@@ -234,6 +282,8 @@ class Integrator {
   const RenderSettings& s_;
   Vec3 center_{0};
   float radius_ = 1;
+  Vec3 fadeCenter_{0};
+  float fadeRadius_ = 1;
   float eps_ = 1e-4f;
   float groundY_ = 0;
   Vec3 sunDir_{0, 1, 0};
@@ -246,7 +296,70 @@ class Integrator {
 
 struct FilmSample {
   float x, y;
-  Vec4 value;
+  SampleValue value;
+};
+
+/// The traced samples of one tile and its apron, and the reconstruction of its pixels.
+struct TileFilm {
+  int ax0, ay0, ax1, ay1;  ///< the traced pixels: [ax0, ax1) x [ay0, ay1)
+  int spp, apron;
+  bool tent;
+  float radius;
+  std::vector<FilmSample> samples;
+
+  TileFilm(int ax0_, int ay0_, int ax1_, int ay1_, int spp_, int apron_, bool tent_, float radius_)
+      : ax0(ax0_), ay0(ay0_), ax1(ax1_), ay1(ay1_), spp(spp_), apron(apron_), tent(tent_), radius(radius_),
+        samples(static_cast<size_t>(ax1 - ax0) * (ay1 - ay0) * spp) {}
+
+  FilmSample* pixel(int x, int y) { return &samples[(static_cast<size_t>(y - ay0) * (ax1 - ax0) + (x - ax0)) * spp]; }
+
+  /// The filter's weight of sample f for the pixel centred at (cx, cy).
+  float weight(const FilmSample& f, float cx, float cy) const {
+    if (!tent) return 1.0f;
+    return std::max(0.0f, 1.0f - std::abs(f.x - cx) / radius) * std::max(0.0f, 1.0f - std::abs(f.y - cy) / radius);
+  }
+
+  /// Writes pixel (x, y) of image (scaled by exposure) and, when layers is given, its sky
+  /// term and guides, reconstructed with the same filter.
+  void reconstruct(int x, int y, float exposure, Image& image, SkyLayers* layers) {
+    Vec4 sum(0);
+    Vec3 sky(0), albedo(0), normal(0), position(0);
+    float wsum = 0, wsurface = 0;
+    const float cx = static_cast<float>(x) + 0.5f, cy = static_cast<float>(y) + 0.5f;
+    for (int ny = std::max(ay0, y - apron); ny <= std::min(ay1 - 1, y + apron); ++ny) {
+      for (int nx = std::max(ax0, x - apron); nx <= std::min(ax1 - 1, x + apron); ++nx) {
+        const FilmSample* in = pixel(nx, ny);
+        for (int k = 0; k < spp; ++k) {
+          const float w = weight(in[k], cx, cy);
+          const SampleValue& v = in[k].value;
+          sum += w * v.value;
+          wsum += w;
+          if (!layers || v.normal == Vec3(0)) continue;
+          sky += w * v.sky;
+          albedo += w * v.albedo;
+          normal += w * v.normal;
+          position += w * v.position;
+          wsurface += w;
+        }
+      }
+    }
+    const Vec4 value = wsum > 0 ? sum / wsum : Vec4(0);
+    image.set(x, y, Vec4(Vec3(value) * exposure, value.a));
+    if (!layers || !(wsum > 0)) return;
+    const size_t i = layers->index(x, y);
+    layers->sky[i] = sky * (exposure / wsum);
+    layers->albedo[i] = albedo / wsum;
+    layers->normal[i] = normal;
+    if (wsurface > 0) layers->position[i] = position / wsurface;
+    const FilmSample* own = pixel(x, y);
+    for (int k = 0; k < spp; ++k) {
+      if (own[k].value.normal == Vec3(0)) continue;
+      const float l = own[k].value.irradianceLum;
+      layers->lumSum[i] += l;
+      layers->lumSquares[i] += l * l;
+      layers->count[i] += 1.0f;
+    }
+  }
 };
 
 /// Traces the s.spp samples of pixel (x, y) into out: their film points from sobol when
@@ -306,50 +419,30 @@ Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings
   std::optional<Progress> progress;
   if (s.progress) progress.emplace(s.progressLabel, tileCount);
   const float scale = std::exp2(s.exposure);
+  // The sky filter's layers, where the sky is sampled by rays (its only noise).
+  std::optional<SkyLayers> layers;
+  if (s.skyFilter && s.skyStrength > 0.0f && s.skySamples > 0) layers.emplace(s.width, s.height);
 
   parallelFor(0, tileCount, [&](size_t tile) {
     const int x0 = static_cast<int>(tile % tilesX) * kTile, y0 = static_cast<int>(tile / tilesX) * kTile;
     const int x1 = std::min(x0 + kTile, s.width), y1 = std::min(y0 + kTile, s.height);
     const int ax0 = std::max(0, x0 - apron), ay0 = std::max(0, y0 - apron);
     const int ax1 = std::min(s.width, x1 + apron), ay1 = std::min(s.height, y1 + apron);
-    const int aw = ax1 - ax0;
-    std::vector<FilmSample> samples(static_cast<size_t>(aw) * (ay1 - ay0) * spp);
+    TileFilm film(ax0, ay0, ax1, ay1, spp, apron, tent, radius);
     ZSobolSampler sobol = sobolBase;
     ZSobolSampler* zsobol = s.sampler == Sampling::ZSobol ? &sobol : nullptr;
     Counters c;
-    for (int y = ay0; y < ay1; ++y) {
-      for (int x = ax0; x < ax1; ++x) {
-        tracePixel(integrator, s, x, y, zsobol, &samples[(static_cast<size_t>(y - ay0) * aw + (x - ax0)) * spp], c);
-      }
-    }
-    for (int y = y0; y < y1; ++y) {
-      for (int x = x0; x < x1; ++x) {
-        Vec4 sum(0);
-        float wsum = 0;
-        const float cx = static_cast<float>(x) + 0.5f, cy = static_cast<float>(y) + 0.5f;
-        for (int ny = std::max(ay0, y - apron); ny <= std::min(ay1 - 1, y + apron); ++ny) {
-          for (int nx = std::max(ax0, x - apron); nx <= std::min(ax1 - 1, x + apron); ++nx) {
-            const FilmSample* in = &samples[(static_cast<size_t>(ny - ay0) * aw + (nx - ax0)) * spp];
-            for (int k = 0; k < spp; ++k) {
-              float w = 1.0f;
-              if (tent)
-                w = std::max(0.0f, 1.0f - std::abs(in[k].x - cx) / radius) *
-                    std::max(0.0f, 1.0f - std::abs(in[k].y - cy) / radius);
-              sum += w * in[k].value;
-              wsum += w;
-            }
-          }
-        }
-        Vec4 v = wsum > 0 ? sum / wsum : Vec4(0);
-        image.set(x, y, Vec4(Vec3(v) * scale, v.a));
-      }
-    }
+    for (int y = ay0; y < ay1; ++y)
+      for (int x = ax0; x < ax1; ++x) tracePixel(integrator, s, x, y, zsobol, film.pixel(x, y), c);
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x) film.reconstruct(x, y, scale, image, layers ? &*layers : nullptr);
     cameraRays += c.camera;
     shadowRays += c.shadow;
     skyRays += c.sky;
     if (progress) progress->advance();
   });
   if (progress) progress->finish();
+  if (layers) filterSkyTerm(image, *layers);
 
   if (stats) {
     stats->cameraRays = cameraRays;

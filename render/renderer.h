@@ -14,6 +14,7 @@
 /// light from the camera; the ground is an analytic horizontal plane under the model.
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include "core/image.h"
@@ -80,12 +81,20 @@ struct RenderSettings {
   /// only light and its rays the only noise. 0 = skySamples everywhere.
   int unlitSkySamples = 0;
   float fillStrength = 0.0f;      ///< unshadowed light from the camera direction (0 = off)
+  /// Filter the sky term with the edge-avoiding à-trous filter (render/sky_filter.h): the
+  /// sky's irradiance is smoothed across pixels of the same surface, never across normals,
+  /// depth steps or albedo edges.
+  bool skyFilter = true;
 
   bool ground = true;             ///< analytic ground plane under the model
   bool groundAtModelBase = true;  ///< put the plane at the scene's lowest y (else at groundHeight)
   float groundHeight = 0.0f;      ///< plane height when groundAtModelBase is false
   Vec3 groundColor{0.45f, 0.42f, 0.37f};  ///< linear albedo of the ground
   float groundFade = 6.0f;        ///< ground fades into the background beyond this many model radii
+  /// The box the ground rests under (its lowest y, with groundAtModelBase) and fades around
+  /// (its centre and radius); unset: the scene's bounds. Stages of one model rendered with
+  /// one ground frame share one horizon.
+  std::optional<Box3> groundFrame;
 
   /// Minimum drawn width of thin curves and twigs, in pixels (Scene::setPixelFootprint;
   /// the callers that build the scene pass it on). 0 = draw them as they are.

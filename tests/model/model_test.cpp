@@ -2,7 +2,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <string>
 
 #include "model/animate.h"
@@ -171,4 +173,43 @@ TEST_CASE("SpeciesModel::buildMesh", "[model]") {
     CHECK(mesh.triangleCount() > 100);
     CHECK(analyzeTopology(mesh).closed());
   }
+}
+
+TEST_CASE("restingFrame: a stage rests on the ground of its frame", "[model]") {
+  const Box3 frame{Vec3(-1, 0, -1), Vec3(1, 2, 1)};
+  const Box3 stage{Vec3(-0.1f, 0.5f, -0.1f), Vec3(0.1f, 0.7f, 0.1f)};
+  const Box3 r = restingFrame(frame, stage, true);
+  CHECK(r.lo.y == 0.5f);  // the ground is at the stage's lowest point
+  CHECK(r.size() == frame.size());
+  CHECK(r.lo.x == frame.lo.x);
+  CHECK(r.lo.z == frame.lo.z);
+  CHECK(restingFrame(frame, stage, false).lo.y == 0.0f);  // the ground at a fixed height
+  CHECK(restingFrame(frame, Box3{}, true).lo.y == 0.0f);  // an empty stage
+}
+
+TEST_CASE("renderModel: the stages of a strip share one horizon", "[model]") {
+  // A young top shell is a small shell high in the final shell's frame: before the stages
+  // were staged on their frame, its ground faded out around the small shell and its
+  // horizon sat rows away from the final shell's.
+  PathPolicy policy;
+  policy.root = SPRIG_SOURCE_DIR;
+  const Species species = loadSpecies(std::filesystem::path(SPRIG_SOURCE_DIR) / "species" / "shell_top.yaml", policy);
+  SpeciesModel model(species);
+  const std::vector<Stage> stages = model.stripStages(5);
+  REQUIRE(stages.size() >= 2);
+  RenderJob job;
+  job.width = 48;
+  job.height = 36;
+  job.samples = 1;
+  job.progress = false;
+  job.stage = stages.front();
+  const Image young = renderModel(model, species.render, job);
+  job.stage = stages.back();
+  const Image grown = renderModel(model, species.render, job);
+  // The shell stands in the middle: the four columns at each side are ground and sky.
+  float worst = 0;
+  for (int y = 0; y < job.height; ++y)
+    for (int x : {0, 1, 2, 3, job.width - 4, job.width - 3, job.width - 2, job.width - 1})
+      for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(young.at(x, y)[c] - grown.at(x, y)[c]));
+  CHECK(worst < 0.03f);
 }

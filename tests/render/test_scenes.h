@@ -5,6 +5,7 @@
 
 #include "core/image.h"
 #include "render/renderer.h"
+#include "render/scene.h"
 
 namespace sprig::render::test {
 
@@ -33,6 +34,25 @@ inline double alphaArea(const Image& img) {
   for (int y = 0; y < img.height; ++y)
     for (int x = 0; x < img.width; ++x) area += img.at(x, y).a;
   return area;
+}
+
+/// Two spheres on the ground lit by sun and sky: soft shadows, contact shadows, sky-only regions.
+inline void addSpheres(Scene& scene) {
+  SphereSet s;
+  s.spheres = {Vec4(0, 1, 0, 1), Vec4(1.6f, 0.45f, 0.6f, 0.45f)};
+  s.colors = {Vec3(0.7f), Vec3(0.6f, 0.5f, 0.4f)};
+  scene.addSpheres(s, scene.addMaterial(Material{}));
+  scene.commit();
+}
+
+/// Root-mean-square difference of all channels (alpha too) of two images of one size.
+inline double rmse(const Image& a, const Image& b) {
+  double sum = 0;
+  for (size_t i = 0; i < a.pixels.size(); ++i) {
+    const double d = a.pixels[i] - b.pixels[i];
+    sum += d * d;
+  }
+  return std::sqrt(sum / static_cast<double>(a.pixels.size()));
 }
 
 }  // namespace sprig::render::test

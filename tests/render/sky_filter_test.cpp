@@ -1,0 +1,168 @@
+// The edge-avoiding filter of the sky term (render/sky_filter.h): what it keeps exactly
+// (constant light, normal creases, depth steps, albedo edges, pixels without a sky term),
+// how much noise it removes, and the renders made with it.
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <vector>
+
+#include "core/rng.h"
+#include "render/camera.h"
+#include "render/renderer.h"
+#include "render/sky_filter.h"
+#include "tests/render/test_scenes.h"
+
+using namespace sprig;
+using namespace sprig::render;
+using namespace sprig::render::test;
+
+namespace {
+
+constexpr int kW = 40, kH = 30, kSamples = 4;
+
+/// Layers of a plane y = 0 seen from above, one world unit per pixel, albedo 0.5 grey,
+/// each pixel's four samples of irradiance luminance e(x, y) + noise(x, y, k).
+template <class Irradiance, class Noise>
+SkyLayers planeLayers(Irradiance e, Noise noise) {
+  SkyLayers l(kW, kH);
+  for (int y = 0; y < kH; ++y) {
+    for (int x = 0; x < kW; ++x) {
+      const size_t i = l.index(x, y);
+      float mean = 0;
+      for (int k = 0; k < kSamples; ++k) {
+        const float v = e(x, y) + noise(x, y, k);
+        mean += v / kSamples;
+        l.lumSum[i] += v;
+        l.lumSquares[i] += v * v;
+      }
+      l.count[i] = kSamples;
+      l.albedo[i] = Vec3(0.5f);
+      l.sky[i] = l.albedo[i] * Vec3(mean);
+      l.normal[i] = Vec3(0, kSamples, 0);
+      l.position[i] = Vec3(x, 0, y);
+    }
+  }
+  return l;
+}
+
+float zeroNoise(int, int, int) { return 0.0f; }
+
+/// Deterministic noise of standard deviation about 0.1 (uniform in [-0.17, 0.17]).
+float someNoise(int x, int y, int k) {
+  Rng rng(deriveSeed(7, {static_cast<uint64_t>(x), static_cast<uint64_t>(y), static_cast<uint64_t>(k)}));
+  return 0.34f * static_cast<float>(rng.uniform()) - 0.17f;
+}
+
+/// RMSE of the luminances of e against the constant c over pixels where pick(x) holds.
+template <class Pick>
+double errorAgainst(const std::vector<Vec3>& e, float c, Pick pick) {
+  double sum = 0;
+  int n = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x)
+      if (pick(x)) {
+        const double d = luminance(e[static_cast<size_t>(y) * kW + x]) - c;
+        sum += d * d;
+        ++n;
+      }
+  return std::sqrt(sum / n);
+}
+
+}  // namespace
+
+TEST_CASE("filteredIrradiance keeps what it must", "[render][sky_filter]") {
+  SECTION("a constant irradiance stays constant") {
+    const SkyLayers l = planeLayers([](int, int) { return 0.3f; }, zeroNoise);
+    for (const Vec3& e : filteredIrradiance(l)) CHECK(e.g == Approx(0.3f).epsilon(1e-5));
+  }
+  SECTION("a crease: nothing crosses surfaces turned 90 degrees apart") {
+    SkyLayers l = planeLayers([](int x, int) { return x < kW / 2 ? 0.2f : 0.8f; }, someNoise);
+    for (int y = 0; y < kH; ++y)
+      for (int x = kW / 2; x < kW; ++x) l.normal[l.index(x, y)] = Vec3(kSamples, 0, 0);
+    const std::vector<Vec3> e = filteredIrradiance(l);
+    float leftMax = 0, rightMin = 1;
+    for (int y = 0; y < kH; ++y) {
+      for (int x = 0; x < kW; ++x) {
+        const float v = luminance(e[l.index(x, y)]);
+        if (x < kW / 2) leftMax = std::max(leftMax, v);
+        else rightMin = std::min(rightMin, v);
+      }
+    }
+    // Each side stays within its own noise band (0.2 +- 0.17, 0.8 +- 0.17).
+    CHECK(leftMax < 0.2f + 0.17f);
+    CHECK(rightMin > 0.8f - 0.17f);
+  }
+  SECTION("a depth step: parallel planes far apart against the pixel footprint do not mix") {
+    SkyLayers l = planeLayers([](int x, int) { return x < kW / 2 ? 0.2f : 0.8f; }, zeroNoise);
+    for (int y = 0; y < kH; ++y)
+      for (int x = kW / 2; x < kW; ++x) l.position[l.index(x, y)].y = 1000.0f;
+    const std::vector<Vec3> e = filteredIrradiance(l);
+    CHECK(errorAgainst(e, 0.2f, [](int x) { return x < kW / 2; }) < 1e-6);
+    CHECK(errorAgainst(e, 0.8f, [](int x) { return x >= kW / 2; }) < 1e-6);
+  }
+  SECTION("filterSkyTerm: albedo edges and pixels without a sky term are untouched") {
+    SkyLayers l = planeLayers([](int, int) { return 0.4f; }, zeroNoise);
+    Image image(kW, kH, Vec4(0, 0, 0, 1));
+    for (int y = 0; y < kH; ++y) {
+      for (int x = 0; x < kW; ++x) {
+        const size_t i = l.index(x, y);
+        l.albedo[i] = (x / 3 + y / 3) % 2 ? Vec3(0.9f, 0.1f, 0.2f) : Vec3(0.05f, 0.6f, 0.3f);
+        l.sky[i] = l.albedo[i] * 0.4f;
+        if (x == 5) l.count[i] = 0;  // a column that met no surface
+        image.set(x, y, Vec4(l.sky[i] + Vec3(0.25f), 1));
+      }
+    }
+    const Image before = image;
+    filterSkyTerm(image, l);
+    for (int y = 0; y < kH; ++y) {
+      for (int x = 0; x < kW; ++x) {
+        INFO("pixel " << x << ", " << y);
+        for (int c = 0; c < 3; ++c) CHECK(image.at(x, y)[c] == Approx(before.at(x, y)[c]).margin(1e-6));
+      }
+    }
+    CHECK(image.at(5, 7) == before.at(5, 7));
+  }
+}
+
+TEST_CASE("filteredIrradiance removes noise", "[render][sky_filter]") {
+  const SkyLayers l = planeLayers([](int, int) { return 0.5f; }, someNoise);
+  std::vector<Vec3> raw(l.sky.size());
+  for (size_t i = 0; i < raw.size(); ++i) raw[i] = l.sky[i] / l.albedo[i];
+  const auto all = [](int) { return true; };
+  const double before = errorAgainst(raw, 0.5f, all), after = errorAgainst(filteredIrradiance(l), 0.5f, all);
+  INFO("RMSE " << before << " -> " << after);
+  CHECK(after < before / 4);
+}
+
+TEST_CASE("renderImage with the sky filter", "[render][sky_filter]") {
+  Scene scene;
+  addSpheres(scene);
+  const Camera cam = frameBounds(Box3{Vec3(-1.2f, 0, -1.2f), Vec3(2.2f, 2, 1.2f)}, ViewSpec{}, 1.4);
+  RenderSettings rs = quietSettings(70, 50);
+  rs.sun = false;  // the sky alone: its noise is the render's noise, apart from the edges'
+  rs.skyFilter = false;
+  rs.spp = 256;
+  const Image reference = renderImage(scene, cam, rs);
+  rs.spp = 4;
+  const Image noisy = renderImage(scene, cam, rs);
+  rs.skyFilter = true;
+  rs.threads = 2;
+  const Image filtered = renderImage(scene, cam, rs);
+  SECTION("same bytes at 1 and 2 threads") {
+    rs.threads = 1;
+    CHECK(renderImage(scene, cam, rs).pixels == filtered.pixels);
+  }
+  SECTION("much less error than the unfiltered render") {
+    // Measured 0.0141 -> 0.0079: what is left is the spheres' and the horizon's edges,
+    // which only more camera samples smooth.
+    const double before = rmse(noisy, reference), after = rmse(filtered, reference);
+    INFO("RMSE " << before << " -> " << after);
+    CHECK(after < 0.65 * before);
+  }
+  SECTION("alpha and the background are the unfiltered render's") {
+    for (int y = 0; y < rs.height; ++y)
+      for (int x = 0; x < rs.width; ++x) CHECK(filtered.at(x, y).a == noisy.at(x, y).a);
+    CHECK(filtered.at(0, 0) == noisy.at(0, 0));  // sky at the top-left corner
+  }
+}
