@@ -55,7 +55,7 @@ std::vector<float> floatList(const YNode& n, DiagnosticList& diags, std::string_
 }
 
 void readGenerating(MapReader& top, ShellParams& p, DiagnosticList& diags) {
-  auto g = top.get("generating");
+  auto g = top.get({"generating", "The generating surface swept along the spiral: `point`, `murex` or `{primitives: [...]}`."});
   if (!g) return;
   if (g->isScalar()) {
     static const std::vector<std::string> kinds = {"point", "murex"};
@@ -111,7 +111,7 @@ void readGenerating(MapReader& top, ShellParams& p, DiagnosticList& diags) {
 
 /// `canal:` shapes the canal of `generating: murex` (organisms::CanalOptions).
 void readCanal(MapReader& top, ShellParams& p, DiagnosticList& diags) {
-  auto sec = top.section("canal");
+  auto sec = top.section({"canal", "The Murex's siphonal canal (with `generating: murex` only)."});
   if (!sec) return;
   organisms::CanalOptions unused;  // the keys are still read (checked, and seen by `sprig schema`)
   if (!p.canal)
@@ -261,19 +261,19 @@ void readOpening(MapReader& top, ShellParams& p, DiagnosticList& diags) {
 }
 
 void readTextures(MapReader& top, organisms::ShellTextureOptions& t, DiagnosticList& diags) {
-  if (auto sec = top.section("textures")) {
+  if (auto sec = top.section({"textures", "Colours of the shell: whorl, cords, growth lines, varices, spine tips, axial spines, bumps, inside."})) {
     MapReader r(*sec, diags, "textures");
-    t.whorlColor = r.color("whorl", t.whorlColor);
-    t.cordColor = r.color("cord_color", t.cordColor);
-    t.cords = static_cast<int>(r.integer("cords", t.cords, 0, 200));
+    t.whorlColor = r.color({"whorl", "Base colour of the whorls."}, t.whorlColor);
+    t.cordColor = r.color({"cord_color", "Colour of the spiral cords."}, t.cordColor);
+    t.cords = static_cast<int>(r.integer({"cords", "Spiral cords around a whorl (0 = none)."}, t.cords, 0, 200));
     t.cordStrength = num(r, "cord_strength", t.cordStrength, 0.0, 1.0);
     t.growthLineDeg = num(r, "growth_lines", t.growthLineDeg, 0.0, 360.0);
     t.growthLineStrength = num(r, "growth_line_strength", t.growthLineStrength, 0.0, 1.0);
-    t.varixColor = r.color("varix", t.varixColor);
-    t.spineTipColor = r.color("spine_tip", t.spineTipColor);
-    t.axialColor = r.color("axial", t.axialColor);
-    t.bumpColor = r.color("bump", t.bumpColor);
-    t.insideColor = r.color("inside", t.insideColor);
+    t.varixColor = r.color({"varix", "Colour of the varices."}, t.varixColor);
+    t.spineTipColor = r.color({"spine_tip", "Colour of the spine tips."}, t.spineTipColor);
+    t.axialColor = r.color({"axial", "Colour of the axial (canal) spines."}, t.axialColor);
+    t.bumpColor = r.color({"bump", "Colour of the bumps."}, t.bumpColor);
+    t.insideColor = r.color({"inside", "Colour inside the opening."}, t.insideColor);
     t.insideRadial = num(r, "inside_radial", t.insideRadial, 0.0, 1.0);
     r.finish();
   }
@@ -314,27 +314,27 @@ std::optional<ShellSpec> readShellSection(const YNode& section, DiagnosticList& 
   ShellSpec s;
   s.loc = section.loc();
   MapReader top(section, diags, "shell");
-  const std::string preset = top.choice("preset", "none", {"none", "murex_cabritii"});
+  const std::string preset = top.choice({"preset", "Start from a preset: `murex_cabritii` is the paper's Murex (every key below still overrides it); `none` starts from the defaults."}, "none", {"none", "murex_cabritii"});
   ShellParams& p = s.params;
   if (preset == "murex_cabritii") {
     p = organisms::murexCabritii();
     s.textures.pigment = false;
   }
-  p.spiral.lambda = top.number("lambda", p.spiral.lambda, 1.0001, 100.0);
-  p.spiral.betaDeg = top.number("beta", p.spiral.betaDeg, 0.1, 90.0);
-  p.spiral.r0 = top.number("r0", p.spiral.r0, 1e-6, 1e6);
-  p.whorls = static_cast<int>(top.integer("whorls", p.whorls, 1, 40));
-  p.whorlDeg = top.number("whorl_angle", p.whorlDeg, 1.0, 3600.0);
-  p.sectionDeg = top.number("section_angle", p.sectionDeg, 1.0, 3600.0);
-  p.surfacesPerSection = static_cast<int>(top.integer("surfaces_per_section", p.surfacesPerSection, 1, 1000));
-  p.startDeg = top.number("start", p.startDeg, -36000.0, 36000.0);
-  if (top.has("age")) p.ageDeg = top.number("age", p.whorls * p.whorlDeg, 0.0, 40 * 3600.0);
+  p.spiral.lambda = top.number({"lambda", "λ, the ratio of the spiral's radii one turn apart (above 1; Eq. 1 of the Murex paper)."}, p.spiral.lambda, 1.0001, 100.0);
+  p.spiral.betaDeg = top.number({"beta", "β, the spiral's angle in degrees: 90 is planispiral (every whorl in one plane), smaller is taller."}, p.spiral.betaDeg, 0.1, 90.0);
+  p.spiral.r0 = top.number({"r0", "R₀, the spiral's radius at angle 0, in world units."}, p.spiral.r0, 1e-6, 1e6);
+  p.whorls = static_cast<int>(top.integer({"whorls", "Whorls of the grown shell."}, p.whorls, 1, 40));
+  p.whorlDeg = top.number({"whorl_angle", "Degrees per whorl."}, p.whorlDeg, 1.0, 3600.0);
+  p.sectionDeg = top.number({"section_angle", "Degrees per section (the controlled-blending unit of Eq. 10)."}, p.sectionDeg, 1.0, 3600.0);
+  p.surfacesPerSection = static_cast<int>(top.integer({"surfaces_per_section", "Generating surfaces per section (Δθ = section_angle / this)."}, p.surfacesPerSection, 1, 1000));
+  p.startDeg = top.number({"start", "Angle θ of the first generating surface, in degrees."}, p.startDeg, -36000.0, 36000.0);
+  if (top.has("age")) p.ageDeg = top.number({"age", "θ_end, the angle of the last generating surface, in degrees (default: whorls × whorl_angle)."}, p.whorls * p.whorlDeg, 0.0, 40 * 3600.0);
   for (const YNode& st : top.sequence("stages"))
     if (auto v = st.asNumber(diags, "'stages' entry", 0.0, 40 * 3600.0)) s.stages.push_back(*v);
-  p.seed = static_cast<uint64_t>(top.integer("seed", static_cast<int64_t>(p.seed), 0));
-  p.controlledBlending = top.boolean("controlled_blending", p.controlledBlending);
-  p.calibrateSize = top.boolean("calibrate", p.calibrateSize);
-  p.apexUp = top.boolean("apex_up", p.apexUp);
+  p.seed = static_cast<uint64_t>(top.integer({"seed", "Seed of the bumps and of the axial spines' bends."}, static_cast<int64_t>(p.seed), 0));
+  p.controlledBlending = top.boolean({"controlled_blending", "Blend each section only with its neighbours (Eq. 10; false: every section with every other, whorls fuse)."}, p.controlledBlending);
+  p.calibrateSize = top.boolean({"calibrate", "Calibrate the size and shift of the summed row of generating surfaces."}, p.calibrateSize);
+  p.apexUp = top.boolean({"apex_up", "Turn the shell apex up in world space."}, p.apexUp);
   readGenerating(top, p, diags);
   readCanal(top, p, diags);
   readVarices(top, p, diags);
@@ -662,7 +662,7 @@ class ShellModel final : public KindModel {
 }  // namespace
 
 std::shared_ptr<const KindSpec> readShellSpec(MapReader& top, Species&, DiagnosticList& diags) {
-  std::optional<YNode> section = top.section("shell");
+  std::optional<YNode> section = top.section({"shell", "The helico-spiral shell: spiral, generating surface, varices, spines, bumps, opening, textures, pigment (docs/SHELLS.md)."});
   if (!section) {
     if (!top.has("shell")) top.node().error(diags, "missing required key 'shell' in species file");
     return nullptr;
