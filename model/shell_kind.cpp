@@ -23,7 +23,7 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 
-float num(MapReader& r, std::string_view key, float def, double lo = -kInf, double hi = kInf) {
+float num(MapReader& r, Key key, float def, double lo = -kInf, double hi = kInf) {
   return static_cast<float>(r.number(key, def, lo, hi));
 }
 
@@ -152,9 +152,9 @@ void readVarices(MapReader& top, ShellParams& p, DiagnosticList& diags) {
   if (!sec) return;
   auto& v = p.varices;
   MapReader r(*sec, diags, "varices");
-  v.enabled = r.boolean("enabled", true);
-  v.spacingDeg = r.number("spacing", v.spacingDeg, 1.0, 3600.0);
-  if (auto spines = r.get("spines")) {
+  v.enabled = r.boolean({"enabled", "Grow the varices (false: none)."}, true);
+  v.spacingDeg = r.number({"spacing", "Angle between successive varices, in degrees; the first sits at this angle."}, v.spacingDeg, 1.0, 3600.0);
+  if (auto spines = r.get({"spines", "The spines of each varix: `murex_table1` (Table 1 of the Murex paper) or one row per whorl of [angle, size] pairs."})) {
     if (spines->isScalar() && spines->scalar() == "murex_table1") {
       v.spinesByWhorl = organisms::murexTable1();
     } else if (!spines->isSequence()) {
@@ -183,18 +183,18 @@ void readVarices(MapReader& top, ShellParams& p, DiagnosticList& diags) {
       }
     }
   }
-  v.spineLength = num(r, "spine_length", v.spineLength, 0.0, 20.0);
-  v.baseRadius = num(r, "base_radius", v.baseRadius, 1e-3, 5.0);
-  v.tipRadius = num(r, "tip_radius", v.tipRadius, 1e-3, 5.0);
-  v.shortTipRadius = num(r, "short_tip_radius", v.shortTipRadius, 1e-3, 5.0);
-  v.shortSize = num(r, "short_size", v.shortSize, 0.0, 100.0);
-  v.bendDeg = num(r, "bend", v.bendDeg, 0.0, 170.0);
-  v.edge = num(r, "edge", v.edge, 0.0, 3.0);
-  v.widenAcross = r.boolean("widen_across", v.widenAcross);
-  v.tori = r.boolean("tori", v.tori);
-  v.torusRadius = num(r, "torus_radius", v.torusRadius, 1e-3, 2.0);
-  v.torusOuter = num(r, "torus_outer", v.torusOuter, 0.0, 5.0);
-  v.lipVarix = r.boolean("lip", v.lipVarix);
+  v.spineLength = num(r, {"spine_length", "Unit-frame length of a spine of size 1, from the shell edge."}, v.spineLength, 0.0, 20.0);
+  v.baseRadius = num(r, {"base_radius", "Spine cone radius at the base (unit frame)."}, v.baseRadius, 1e-3, 5.0);
+  v.tipRadius = num(r, {"tip_radius", "Spine tip radius (unit frame)."}, v.tipRadius, 1e-3, 5.0);
+  v.shortTipRadius = num(r, {"short_tip_radius", "Tip radius of short spines (the thicker tips of Fig. 7)."}, v.shortTipRadius, 1e-3, 5.0);
+  v.shortSize = num(r, {"short_size", "Spines with a size below this get `short_tip_radius`."}, v.shortSize, 0.0, 100.0);
+  v.bendDeg = num(r, {"bend", "Spine curvature towards the apex side, in degrees (endpoint-preserving bend)."}, v.bendDeg, 0.0, 170.0);
+  v.edge = num(r, {"edge", "Where spine bases sit across the generating surface (unit frame, 1 = the shell edge)."}, v.edge, 0.0, 3.0);
+  v.widenAcross = r.boolean({"widen_across", "Scale each spine by σ_max across the varix (Eq. 12)."}, v.widenAcross);
+  v.tori = r.boolean({"tori", "Add the two tori along each varix."}, v.tori);
+  v.torusRadius = num(r, {"torus_radius", "Tube radius of the tori (unit frame)."}, v.torusRadius, 1e-3, 2.0);
+  v.torusOuter = num(r, {"torus_outer", "Major radius of the outer torus (the inner one sits at 1)."}, v.torusOuter, 0.0, 5.0);
+  v.lipVarix = r.boolean({"lip", "A varix at the growing edge θ_end as the shell grows."}, v.lipVarix);
   r.finish();
 }
 
@@ -203,14 +203,14 @@ void readBumps(MapReader& top, ShellParams& p, DiagnosticList& diags) {
   if (!sec) return;
   auto& b = p.bumps;
   MapReader r(*sec, diags, "bumps");
-  b.enabled = r.boolean("enabled", true);
-  b.setsPerSection = static_cast<int>(r.integer("sets", b.setsPerSection, 0, 100));
-  b.size = num(r, "size", b.size, 1e-3, 5.0);
-  b.sdFraction = num(r, "sd", b.sdFraction, 0.0, 1.0);
-  b.elongation = num(r, "elongation", b.elongation, 0.0, 10.0);
-  b.blendN = num(r, "blend_n", b.blendN, 1.0, 1000.0);
-  b.random = r.boolean("random", b.random);
-  b.edge = num(r, "edge", b.edge, 0.0, 3.0);
+  b.enabled = r.boolean({"enabled", "Grow the bumps (false: none)."}, true);
+  b.setsPerSection = static_cast<int>(r.integer({"sets", "Rows of bumps between two varices."}, b.setsPerSection, 0, 100));
+  b.size = num(r, {"size", "Mean bump radius s (unit frame)."}, b.size, 1e-3, 5.0);
+  b.sdFraction = num(r, {"sd", "Standard deviation of the bump sizes, as a fraction of `size`."}, b.sdFraction, 0.0, 1.0);
+  b.elongation = num(r, {"elongation", "Added to a bump's scale along the spiral: bumps are capsules this much longer."}, b.elongation, 0.0, 10.0);
+  b.blendN = num(r, {"blend_n", "Super-elliptic blend exponent of the bumps with the shell (1 = plain sum; 400 keeps them distinct)."}, b.blendN, 1.0, 1000.0);
+  b.random = r.boolean({"random", "Draw bump sizes from the normal distribution (false: all equal)."}, b.random);
+  b.edge = num(r, {"edge", "Distance of the bump centres from the generating centre (unit frame)."}, b.edge, 0.0, 3.0);
   r.finish();
 }
 
@@ -219,8 +219,8 @@ void readAxial(MapReader& top, ShellParams& p, DiagnosticList& diags) {
   if (!sec) return;
   auto& a = p.axialSpines;
   MapReader r(*sec, diags, "axial_spines");
-  a.enabled = r.boolean("enabled", true);
-  if (auto rows = r.get("rows")) {
+  a.enabled = r.boolean({"enabled", "Grow the axial (canal) spines (false: none)."}, true);
+  if (auto rows = r.get({"rows", "Spine sizes along the canal: `murex_table2` (Table 2 of the Murex paper) or lists of relative sizes."})) {
     if (rows->isScalar() && rows->scalar() == "murex_table2") {
       a.rows = organisms::murexTable2();
     } else if (!rows->isSequence()) {
@@ -230,17 +230,17 @@ void readAxial(MapReader& top, ShellParams& p, DiagnosticList& diags) {
       for (const YNode& row : rows->items()) a.rows.push_back(floatList(row, diags, "rows", 1e-3, 20.0));
     }
   }
-  a.length = num(r, "length", a.length, 0.0, 20.0);
-  a.baseRadius = num(r, "base_radius", a.baseRadius, 1e-3, 5.0);
-  a.tipRadius = num(r, "tip_radius", a.tipRadius, 1e-3, 5.0);
-  a.firstT = num(r, "first", a.firstT, 0.0, 1.0);
-  a.lastT = num(r, "last", a.lastT, 0.0, 1.0);
-  a.downTilt = num(r, "tilt", a.downTilt, -10.0, 10.0);
-  a.randomBends = r.boolean("random_bends", a.randomBends);
-  a.bendMinDeg = num(r, "bend_min", a.bendMinDeg, 0.0, 45.0);
-  a.bendMaxDeg = num(r, "bend_max", a.bendMaxDeg, 0.0, 45.0);
-  a.bendsMin = static_cast<int>(r.integer("bends_min", a.bendsMin, 0, 10));
-  a.bendsMax = static_cast<int>(r.integer("bends_max", a.bendsMax, 0, 10));
+  a.length = num(r, {"length", "Unit-frame length of an axial spine of size 1."}, a.length, 0.0, 20.0);
+  a.baseRadius = num(r, {"base_radius", "Axial spine radius at the base (unit frame)."}, a.baseRadius, 1e-3, 5.0);
+  a.tipRadius = num(r, {"tip_radius", "Axial spine tip radius (unit frame)."}, a.tipRadius, 1e-3, 5.0);
+  a.firstT = num(r, {"first", "Position of the first spine along the canal (0 = the canal's start)."}, a.firstT, 0.0, 1.0);
+  a.lastT = num(r, {"last", "Position of the last spine along the canal."}, a.lastT, 0.0, 1.0);
+  a.downTilt = num(r, {"tilt", "Downward tilt: a spine points along normalize(1, tilt, 0) in the unit frame."}, a.downTilt, -10.0, 10.0);
+  a.randomBends = r.boolean({"random_bends", "Bend each spine a random number of times by random angles (seeded by `seed`)."}, a.randomBends);
+  a.bendMinDeg = num(r, {"bend_min", "Smallest random bend, in degrees."}, a.bendMinDeg, 0.0, 45.0);
+  a.bendMaxDeg = num(r, {"bend_max", "Largest random bend, in degrees."}, a.bendMaxDeg, 0.0, 45.0);
+  a.bendsMin = static_cast<int>(r.integer({"bends_min", "Fewest random bends per spine."}, a.bendsMin, 0, 10));
+  a.bendsMax = static_cast<int>(r.integer({"bends_max", "Most random bends per spine."}, a.bendsMax, 0, 10));
   if (a.bendsMax < a.bendsMin) sec->error(diags, "'bends_max' must be >= 'bends_min'");
   if (a.bendMaxDeg < a.bendMinDeg) sec->error(diags, "'bend_max' must be >= 'bend_min'");
   r.finish();
@@ -251,12 +251,12 @@ void readOpening(MapReader& top, ShellParams& p, DiagnosticList& diags) {
   if (!sec) return;
   auto& o = p.opening;
   MapReader r(*sec, diags, "opening");
-  o.enabled = r.boolean("enabled", true);
-  o.innerScale = num(r, "inner_scale", o.innerScale, 0.05, 0.98);
-  o.depthDeg = r.number("depth", o.depthDeg, 0.0, 3600.0);
-  o.extendDeg = r.number("extend", o.extendDeg, 0.0, 360.0);
-  o.insideWall = r.boolean("inside_wall", o.insideWall);
-  o.subtractPrevious = r.boolean("subtract_previous", o.subtractPrevious);
+  o.enabled = r.boolean({"enabled", "Cut the opening (Eq. 14-15; false: none)."}, true);
+  o.innerScale = num(r, {"inner_scale", "Size of the inside generating surface relative to the main one."}, o.innerScale, 0.05, 0.98);
+  o.depthDeg = r.number({"depth", "How far back from θ_end the hollow reaches, in degrees."}, o.depthDeg, 0.0, 3600.0);
+  o.extendDeg = r.number({"extend", "How far past θ_end the cutter reaches (opens the lip), in degrees."}, o.extendDeg, 0.0, 360.0);
+  o.insideWall = r.boolean({"inside_wall", "Add the inside wall back (Eq. 15): a rounded lip ring."}, o.insideWall);
+  o.subtractPrevious = r.boolean({"subtract_previous", "Subtract the previous whorl from the hollow (Eq. 14)."}, o.subtractPrevious);
   r.finish();
 }
 

@@ -39,7 +39,11 @@ TEST_CASE("speciesSchemaJson", "[model]") {
     CHECK(steps.find("steps: an integer in [0, 100000]\"") != std::string::npos);
     CHECK(steps.find("\"default\"") == std::string::npos);
     // A key without a text keeps the generated part alone.
-    CHECK(propertyLine(schema, "spacing").find("\"description\": \"shell.varices") != std::string::npos);
+    CHECK(propertyLine(schema, "cells").find("\"description\": \"shell.pigment.cells: an integer in [3, 4096]; "
+                                            "default 160\"") != std::string::npos);
+    // The one-line help of a shell part's key.
+    CHECK(propertyLine(schema, "spacing").find("\"description\": \"Angle between successive varices") !=
+          std::string::npos);
   }
 
   SECTION("every key of render: says what it does") {
