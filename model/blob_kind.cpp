@@ -695,14 +695,14 @@ std::shared_ptr<const textures::TextureRegistry> readBlobTextures(const YNode& l
 }
 
 std::optional<BlobSpecies> readBlobSpecies(MapReader& top, DiagnosticList& diags, const PathPolicy& policy) {
-  std::string kernel = top.choice("kernel", "wyvill", {"wyvill", "soft"});
+  std::string kernel = top.choice({"kernel", "Field kernel of every primitive: `wyvill` (1 − s)³ or `soft` (the soft-object kernel, iso radius exactly R/2)."}, "wyvill", {"wyvill", "soft"});
   float cell = 0.0f;
-  if (auto mesh = top.section("mesh")) {
+  if (auto mesh = top.section({"mesh", "How `sprig mesh` polygonizes the blob: `cell` size (default automatic)."})) {
     MapReader mm(*mesh, diags, "mesh");
     cell = float(mm.number("cell", 0.0, 0.0, 1e6));
     mm.finish();
   }
-  auto blob = top.get("blob");
+  auto blob = top.get({"blob", "The BlobTree written out node by node: one node (a primitive, a blend, a CSG operation, a warp) with its children."});
   if (!blob) {
     top.node().error(diags, "missing required key 'blob' in species file (the BlobTree of a kind: blob species)");
     return std::nullopt;
@@ -711,7 +711,7 @@ std::optional<BlobSpecies> readBlobSpecies(MapReader& top, DiagnosticList& diags
   std::shared_ptr<const textures::TextureRegistry> registry;
   std::optional<textures::BarkLook> ridge;
   int textureCount = 0;
-  if (auto list = top.get("textures")) {
+  if (auto list = top.get({"textures", "Texture ids 0, 1, ... in order, each `{image: PATH}`, `{color: C}` or a procedural texture (`noise`, `bark`, `stripes`, `spots`, `leaf`); primitives name them with `texture: {id}`."})) {
     registry = readBlobTextures(*list, policy, diags, &ridge);
     // Ids are checked against the list's length (not the registry's, which leaves out
     // broken entries), so one mistake is reported once; no list checks nothing more.

@@ -114,8 +114,8 @@ class OrganismReader {
 
   void read(const YNode& section) {
     MapReader m(section, diags_, "organism");
-    spec_.levels = int(m.integer("levels", spec_.levels, 1, kMaxLevels));
-    if (auto b = m.get("base")) {
+    spec_.levels = int(m.integer({"levels", "Catmull-Clark subdivision levels of the base mesh (the finest level may have at most 16,777,216 faces)."}, spec_.levels, 1, kMaxLevels));
+    if (auto b = m.get({"base", "The control mesh: `cube_sphere`, `torus`, `cylinder`, `plane`, `revolution`, a `mesh` file or another `species`."})) {
       const size_t before = errorCount();
       readBase(*b);
       // A base read without an error may still be one the subdivision cannot take.
@@ -132,15 +132,15 @@ class OrganismReader {
                                " faces, more than the limit " + std::to_string(kMaxFinestFaces) +
                                "; use fewer levels or a coarser base");
     }
-    if (auto c = m.section("capture")) {
+    if (auto c = m.section({"capture", "Detail captured from a surface (§2.2 analysis): the levels of another mesh or species, replayed as detail."})) {
       captureGiven_ = true;
       readCapture(*c);
     }
-    for (const YNode& item : m.sequence("detail")) readProcedure(item, spec_.detail);
-    if (auto b = m.section("blend")) readBlend(*b);
-    for (const YNode& item : m.sequence("modify")) readModification(item);
-    if (auto s = m.section("shader")) readShader(*s);
-    spec_.frames = int(m.integer("frames", spec_.animated ? 24 : 1, 1, 10000));
+    for (const YNode& item : m.sequence({"detail", "Detail procedures (noise, berries, spurs, tentacles, mushrooms ...) added level by level, summed."})) readProcedure(item, spec_.detail);
+    if (auto b = m.section({"blend", "A second detail blended over the first by an alpha (§6): `detail`, `alpha` (required) and `color`."})) readBlend(*b);
+    for (const YNode& item : m.sequence({"modify", "Local modifications: per-level gains of the detail inside a sphere (§5.2)."})) readModification(item);
+    if (auto s = m.section({"shader", "The post-blend shader of §6.3 (`planet:`): colours by height and slope."})) readShader(*s);
+    spec_.frames = int(m.integer({"frames", "Animation stages over time 0 to 1 (default: 24 when something depends on time, else 1)."}, spec_.animated ? 24 : 1, 1, 10000));
     m.finish();
     const bool scalar = std::any_of(spec_.detail.begin(), spec_.detail.end(), [](auto& p) { return p->writesScalar(); }) ||
                         std::any_of(spec_.blendDetail.begin(), spec_.blendDetail.end(), [](auto& p) { return p->writesScalar(); });
@@ -798,7 +798,7 @@ Mesh buildOrganismMesh(const OrganismSpec& spec, double time, const Vec3& baseCo
 }
 
 std::shared_ptr<const KindSpec> readOrganismSpec(MapReader& top, Species& species, DiagnosticList& diags) {
-  std::optional<YNode> section = top.section("organism");
+  std::optional<YNode> section = top.section({"organism", "The subdivision organism: base mesh, levels, per-level detail procedures, blend, local modifications, shader and animation (docs/ORGANISMS.md)."});
   if (!section) {
     if (!top.has("organism")) top.node().error(diags, "missing required key 'organism' in species file");
     return nullptr;

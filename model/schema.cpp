@@ -26,6 +26,11 @@ constexpr int kPasses = 4096;
 /// its keys asked for; it stays open rather than reject a key the reader takes.
 constexpr int kMinFinishes = 8;
 
+/// The message editors show for a value that is not a colour, and for a component out of range.
+constexpr const char* kColorMessage =
+    "Expected a colour: \"#rrggbb\" (six hex digits, sRGB) or [r, g, b] (linear, each from 0 to 1).";
+constexpr const char* kColorItemMessage = "A colour's r, g and b are linear, each from 0 to 1.";
+
 std::string jsonText(const std::string& text) {
   std::string out = "\"";
   for (char c : text) {
@@ -45,6 +50,7 @@ std::string number(double v) {
 }
 
 std::string rangeText(const KeySchema& k) {
+  if (k.above) return " > " + number(*k.above) + (k.max ? " and <= " + number(*k.max) : "");
   if (k.min && k.max) return " in [" + number(*k.min) + ", " + number(*k.max) + "]";
   if (k.min) return " >= " + number(*k.min);
   if (k.max) return " <= " + number(*k.max);
@@ -53,7 +59,8 @@ std::string rangeText(const KeySchema& k) {
 
 std::string rangeJson(const KeySchema& k) {
   std::string out;
-  if (k.min) out += ", \"minimum\": " + number(*k.min);
+  if (k.above) out += ", \"exclusiveMinimum\": " + number(*k.above);
+  if (k.min && !k.above) out += ", \"minimum\": " + number(*k.min);
   if (k.max) out += ", \"maximum\": " + number(*k.max);
   return out;
 }
@@ -118,8 +125,19 @@ std::string emit(const KeySchema& k, const std::string& path, int depth) {
         what += (what.empty() ? "" : " or ") + std::string("true or false");
       } else if (t == "string") {
         // The reader takes any scalar as text (`name: 2.6`); a colour's hex string is above.
-        if (!k.types.count("color")) alternatives.push_back("{\"type\": [\"string\", \"number\", \"boolean\"]}");
-        if (!k.types.count("color")) what += (what.empty() ? "" : " or ") + std::string("text");
+        // One alternative per type: a union `type` list is an error in ajv's strict mode.
+        if (k.types.count("color")) continue;
+        if (!k.words.empty()) {  // a number or one of these words (describeValue)
+          std::string e = "{\"enum\": [";
+          for (size_t i = 0; i < k.words.size(); ++i) e += (i ? ", " : "") + jsonText(k.words[i]);
+          alternatives.push_back(e + "]}");
+          for (size_t i = 0; i < k.words.size(); ++i) what += (what.empty() ? "" : " or ") + k.words[i];
+          continue;
+        }
+        alternatives.push_back("{\"type\": \"string\"}");
+        for (const char* scalar : {"number", "boolean"})  // unless that type's own alternative is there
+          if (!k.types.count(scalar)) alternatives.push_back(std::string("{\"type\": \"") + scalar + "\"}");
+        what += (what.empty() ? "" : " or ") + std::string("text");
       } else if (t == "vec3") {
         if (k.types.count("color")) continue;
         std::string r = rangeJson(k);
@@ -127,11 +145,16 @@ std::string emit(const KeySchema& k, const std::string& path, int depth) {
                                r + "}}");
         what += (what.empty() ? "" : " or ") + std::string("[x, y, z]") + rangeText(k);
       } else if (t == "color") {
+        // errorMessage and patternErrorMessage: what yaml-language-server (and VS Code's
+        // JSON support) say instead of "Incorrect type. Expected array".
+        const std::string message = jsonText(kColorMessage);
         alternatives.push_back(
-            "{\"type\": \"array\", \"minItems\": 3, \"maxItems\": 3, \"items\": {\"type\": \"number\", \"minimum\": 0, "
-            "\"maximum\": 1}}");
-        alternatives.push_back("{\"type\": \"string\", \"pattern\": \"^\\\\s*#[0-9A-Fa-f]{6}\\\\s*$\"}");
-        what += (what.empty() ? "" : " or ") + std::string("a colour [r, g, b] (linear, 0..1) or \\\"#rrggbb\\\" (sRGB)");
+            "{\"type\": \"array\", \"minItems\": 3, \"maxItems\": 3, \"errorMessage\": " + message +
+            ", \"items\": {\"type\": \"number\", \"minimum\": 0, \"maximum\": 1, \"errorMessage\": " +
+            jsonText(kColorItemMessage) + "}}");
+        alternatives.push_back("{\"type\": \"string\", \"pattern\": \"^\\\\s*#[0-9A-Fa-f]{6}\\\\s*$\", \"errorMessage\": " +
+                               message + ", \"patternErrorMessage\": " + message + "}");
+        what += (what.empty() ? "" : " or ") + std::string("a colour [r, g, b] (linear, 0..1) or \"#rrggbb\" (sRGB)");
       } else if (t == "map") {
         alternatives.push_back(mapJson(k, path, depth));
         what += (what.empty() ? "" : " or ") +
@@ -143,12 +166,18 @@ std::string emit(const KeySchema& k, const std::string& path, int depth) {
       }
     }
   }
-  std::string desc = path;
+  // What the key does (the reader's Key::help), then where it sits, what it takes and its
+  // default: "Field of view ...\n\nrender.view.fov: a number in [1, 150]; default 35".
+  std::string desc = k.help.empty() ? "" : k.help + "\n\n";
+  desc += path;
   if (!k.context.empty() && k.context != path) desc += " (" + k.context + ")";
   desc += what.empty() ? "" : ": " + what;
-  if (!k.defaultJson.empty()) desc += "; default " + k.defaultJson;
+  // A help that states the default in words ("(default: the grammar's ...)") replaces the
+  // constant the reader passes for an absent key, which is then not the value used.
+  const bool defaultInWords = k.help.find("(default: ") != std::string::npos;
+  if (!k.defaultJson.empty() && !defaultInWords) desc += "; default " + k.defaultJson;
   std::string head = "{\"description\": " + jsonText(desc);
-  if (!k.defaultJson.empty()) head += ", \"default\": " + k.defaultJson;
+  if (!k.defaultJson.empty() && !defaultInWords) head += ", \"default\": " + k.defaultJson;
   // Several alternatives go under anyOf.
   std::string joined;
   for (size_t i = 0; i < alternatives.size(); ++i) joined += (i ? ", " : "") + alternatives[i];

@@ -23,7 +23,7 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 
-float num(MapReader& r, std::string_view key, float def, double lo = -kInf, double hi = kInf) {
+float num(MapReader& r, Key key, float def, double lo = -kInf, double hi = kInf) {
   return static_cast<float>(r.number(key, def, lo, hi));
 }
 
@@ -55,7 +55,7 @@ std::vector<float> floatList(const YNode& n, DiagnosticList& diags, std::string_
 }
 
 void readGenerating(MapReader& top, ShellParams& p, DiagnosticList& diags) {
-  auto g = top.get("generating");
+  auto g = top.get({"generating", "The generating surface swept along the spiral: `point`, `murex` or `{primitives: [...]}`."});
   if (!g) return;
   if (g->isScalar()) {
     static const std::vector<std::string> kinds = {"point", "murex"};
@@ -111,7 +111,7 @@ void readGenerating(MapReader& top, ShellParams& p, DiagnosticList& diags) {
 
 /// `canal:` shapes the canal of `generating: murex` (organisms::CanalOptions).
 void readCanal(MapReader& top, ShellParams& p, DiagnosticList& diags) {
-  auto sec = top.section("canal");
+  auto sec = top.section({"canal", "The Murex's siphonal canal (with `generating: murex` only)."});
   if (!sec) return;
   organisms::CanalOptions unused;  // the keys are still read (checked, and seen by `sprig schema`)
   if (!p.canal)
@@ -152,9 +152,9 @@ void readVarices(MapReader& top, ShellParams& p, DiagnosticList& diags) {
   if (!sec) return;
   auto& v = p.varices;
   MapReader r(*sec, diags, "varices");
-  v.enabled = r.boolean("enabled", true);
-  v.spacingDeg = r.number("spacing", v.spacingDeg, 1.0, 3600.0);
-  if (auto spines = r.get("spines")) {
+  v.enabled = r.boolean({"enabled", "Grow the varices (false: none)."}, true);
+  v.spacingDeg = r.number({"spacing", "Angle between successive varices, in degrees; the first sits at this angle."}, v.spacingDeg, 1.0, 3600.0);
+  if (auto spines = r.get({"spines", "The spines of each varix: `murex_table1` (Table 1 of the Murex paper) or one row per whorl of [angle, size] pairs."})) {
     if (spines->isScalar() && spines->scalar() == "murex_table1") {
       v.spinesByWhorl = organisms::murexTable1();
     } else if (!spines->isSequence()) {
@@ -183,18 +183,18 @@ void readVarices(MapReader& top, ShellParams& p, DiagnosticList& diags) {
       }
     }
   }
-  v.spineLength = num(r, "spine_length", v.spineLength, 0.0, 20.0);
-  v.baseRadius = num(r, "base_radius", v.baseRadius, 1e-3, 5.0);
-  v.tipRadius = num(r, "tip_radius", v.tipRadius, 1e-3, 5.0);
-  v.shortTipRadius = num(r, "short_tip_radius", v.shortTipRadius, 1e-3, 5.0);
-  v.shortSize = num(r, "short_size", v.shortSize, 0.0, 100.0);
-  v.bendDeg = num(r, "bend", v.bendDeg, 0.0, 170.0);
-  v.edge = num(r, "edge", v.edge, 0.0, 3.0);
-  v.widenAcross = r.boolean("widen_across", v.widenAcross);
-  v.tori = r.boolean("tori", v.tori);
-  v.torusRadius = num(r, "torus_radius", v.torusRadius, 1e-3, 2.0);
-  v.torusOuter = num(r, "torus_outer", v.torusOuter, 0.0, 5.0);
-  v.lipVarix = r.boolean("lip", v.lipVarix);
+  v.spineLength = num(r, {"spine_length", "Unit-frame length of a spine of size 1, from the shell edge."}, v.spineLength, 0.0, 20.0);
+  v.baseRadius = num(r, {"base_radius", "Spine cone radius at the base (unit frame)."}, v.baseRadius, 1e-3, 5.0);
+  v.tipRadius = num(r, {"tip_radius", "Spine tip radius (unit frame)."}, v.tipRadius, 1e-3, 5.0);
+  v.shortTipRadius = num(r, {"short_tip_radius", "Tip radius of short spines (the thicker tips of Fig. 7)."}, v.shortTipRadius, 1e-3, 5.0);
+  v.shortSize = num(r, {"short_size", "Spines with a size below this get `short_tip_radius`."}, v.shortSize, 0.0, 100.0);
+  v.bendDeg = num(r, {"bend", "Spine curvature towards the apex side, in degrees (endpoint-preserving bend)."}, v.bendDeg, 0.0, 170.0);
+  v.edge = num(r, {"edge", "Where spine bases sit across the generating surface (unit frame, 1 = the shell edge)."}, v.edge, 0.0, 3.0);
+  v.widenAcross = r.boolean({"widen_across", "Scale each spine by σ_max across the varix (Eq. 12)."}, v.widenAcross);
+  v.tori = r.boolean({"tori", "Add the two tori along each varix."}, v.tori);
+  v.torusRadius = num(r, {"torus_radius", "Tube radius of the tori (unit frame)."}, v.torusRadius, 1e-3, 2.0);
+  v.torusOuter = num(r, {"torus_outer", "Major radius of the outer torus (the inner one sits at 1)."}, v.torusOuter, 0.0, 5.0);
+  v.lipVarix = r.boolean({"lip", "A varix at the growing edge θ_end as the shell grows."}, v.lipVarix);
   r.finish();
 }
 
@@ -203,14 +203,14 @@ void readBumps(MapReader& top, ShellParams& p, DiagnosticList& diags) {
   if (!sec) return;
   auto& b = p.bumps;
   MapReader r(*sec, diags, "bumps");
-  b.enabled = r.boolean("enabled", true);
-  b.setsPerSection = static_cast<int>(r.integer("sets", b.setsPerSection, 0, 100));
-  b.size = num(r, "size", b.size, 1e-3, 5.0);
-  b.sdFraction = num(r, "sd", b.sdFraction, 0.0, 1.0);
-  b.elongation = num(r, "elongation", b.elongation, 0.0, 10.0);
-  b.blendN = num(r, "blend_n", b.blendN, 1.0, 1000.0);
-  b.random = r.boolean("random", b.random);
-  b.edge = num(r, "edge", b.edge, 0.0, 3.0);
+  b.enabled = r.boolean({"enabled", "Grow the bumps (false: none)."}, true);
+  b.setsPerSection = static_cast<int>(r.integer({"sets", "Rows of bumps between two varices."}, b.setsPerSection, 0, 100));
+  b.size = num(r, {"size", "Mean bump radius s (unit frame)."}, b.size, 1e-3, 5.0);
+  b.sdFraction = num(r, {"sd", "Standard deviation of the bump sizes, as a fraction of `size`."}, b.sdFraction, 0.0, 1.0);
+  b.elongation = num(r, {"elongation", "Added to a bump's scale along the spiral: bumps are capsules this much longer."}, b.elongation, 0.0, 10.0);
+  b.blendN = num(r, {"blend_n", "Super-elliptic blend exponent of the bumps with the shell (1 = plain sum; 400 keeps them distinct)."}, b.blendN, 1.0, 1000.0);
+  b.random = r.boolean({"random", "Draw bump sizes from the normal distribution (false: all equal)."}, b.random);
+  b.edge = num(r, {"edge", "Distance of the bump centres from the generating centre (unit frame)."}, b.edge, 0.0, 3.0);
   r.finish();
 }
 
@@ -219,8 +219,8 @@ void readAxial(MapReader& top, ShellParams& p, DiagnosticList& diags) {
   if (!sec) return;
   auto& a = p.axialSpines;
   MapReader r(*sec, diags, "axial_spines");
-  a.enabled = r.boolean("enabled", true);
-  if (auto rows = r.get("rows")) {
+  a.enabled = r.boolean({"enabled", "Grow the axial (canal) spines (false: none)."}, true);
+  if (auto rows = r.get({"rows", "Spine sizes along the canal: `murex_table2` (Table 2 of the Murex paper) or lists of relative sizes."})) {
     if (rows->isScalar() && rows->scalar() == "murex_table2") {
       a.rows = organisms::murexTable2();
     } else if (!rows->isSequence()) {
@@ -230,17 +230,17 @@ void readAxial(MapReader& top, ShellParams& p, DiagnosticList& diags) {
       for (const YNode& row : rows->items()) a.rows.push_back(floatList(row, diags, "rows", 1e-3, 20.0));
     }
   }
-  a.length = num(r, "length", a.length, 0.0, 20.0);
-  a.baseRadius = num(r, "base_radius", a.baseRadius, 1e-3, 5.0);
-  a.tipRadius = num(r, "tip_radius", a.tipRadius, 1e-3, 5.0);
-  a.firstT = num(r, "first", a.firstT, 0.0, 1.0);
-  a.lastT = num(r, "last", a.lastT, 0.0, 1.0);
-  a.downTilt = num(r, "tilt", a.downTilt, -10.0, 10.0);
-  a.randomBends = r.boolean("random_bends", a.randomBends);
-  a.bendMinDeg = num(r, "bend_min", a.bendMinDeg, 0.0, 45.0);
-  a.bendMaxDeg = num(r, "bend_max", a.bendMaxDeg, 0.0, 45.0);
-  a.bendsMin = static_cast<int>(r.integer("bends_min", a.bendsMin, 0, 10));
-  a.bendsMax = static_cast<int>(r.integer("bends_max", a.bendsMax, 0, 10));
+  a.length = num(r, {"length", "Unit-frame length of an axial spine of size 1."}, a.length, 0.0, 20.0);
+  a.baseRadius = num(r, {"base_radius", "Axial spine radius at the base (unit frame)."}, a.baseRadius, 1e-3, 5.0);
+  a.tipRadius = num(r, {"tip_radius", "Axial spine tip radius (unit frame)."}, a.tipRadius, 1e-3, 5.0);
+  a.firstT = num(r, {"first", "Position of the first spine along the canal (0 = the canal's start)."}, a.firstT, 0.0, 1.0);
+  a.lastT = num(r, {"last", "Position of the last spine along the canal."}, a.lastT, 0.0, 1.0);
+  a.downTilt = num(r, {"tilt", "Downward tilt: a spine points along normalize(1, tilt, 0) in the unit frame."}, a.downTilt, -10.0, 10.0);
+  a.randomBends = r.boolean({"random_bends", "Bend each spine a random number of times by random angles (seeded by `seed`)."}, a.randomBends);
+  a.bendMinDeg = num(r, {"bend_min", "Smallest random bend, in degrees."}, a.bendMinDeg, 0.0, 45.0);
+  a.bendMaxDeg = num(r, {"bend_max", "Largest random bend, in degrees."}, a.bendMaxDeg, 0.0, 45.0);
+  a.bendsMin = static_cast<int>(r.integer({"bends_min", "Fewest random bends per spine."}, a.bendsMin, 0, 10));
+  a.bendsMax = static_cast<int>(r.integer({"bends_max", "Most random bends per spine."}, a.bendsMax, 0, 10));
   if (a.bendsMax < a.bendsMin) sec->error(diags, "'bends_max' must be >= 'bends_min'");
   if (a.bendMaxDeg < a.bendMinDeg) sec->error(diags, "'bend_max' must be >= 'bend_min'");
   r.finish();
@@ -251,29 +251,29 @@ void readOpening(MapReader& top, ShellParams& p, DiagnosticList& diags) {
   if (!sec) return;
   auto& o = p.opening;
   MapReader r(*sec, diags, "opening");
-  o.enabled = r.boolean("enabled", true);
-  o.innerScale = num(r, "inner_scale", o.innerScale, 0.05, 0.98);
-  o.depthDeg = r.number("depth", o.depthDeg, 0.0, 3600.0);
-  o.extendDeg = r.number("extend", o.extendDeg, 0.0, 360.0);
-  o.insideWall = r.boolean("inside_wall", o.insideWall);
-  o.subtractPrevious = r.boolean("subtract_previous", o.subtractPrevious);
+  o.enabled = r.boolean({"enabled", "Cut the opening (Eq. 14-15; false: none)."}, true);
+  o.innerScale = num(r, {"inner_scale", "Size of the inside generating surface relative to the main one."}, o.innerScale, 0.05, 0.98);
+  o.depthDeg = r.number({"depth", "How far back from θ_end the hollow reaches, in degrees."}, o.depthDeg, 0.0, 3600.0);
+  o.extendDeg = r.number({"extend", "How far past θ_end the cutter reaches (opens the lip), in degrees."}, o.extendDeg, 0.0, 360.0);
+  o.insideWall = r.boolean({"inside_wall", "Add the inside wall back (Eq. 15): a rounded lip ring."}, o.insideWall);
+  o.subtractPrevious = r.boolean({"subtract_previous", "Subtract the previous whorl from the hollow (Eq. 14)."}, o.subtractPrevious);
   r.finish();
 }
 
 void readTextures(MapReader& top, organisms::ShellTextureOptions& t, DiagnosticList& diags) {
-  if (auto sec = top.section("textures")) {
+  if (auto sec = top.section({"textures", "Colours of the shell: whorl, cords, growth lines, varices, spine tips, axial spines, bumps, inside."})) {
     MapReader r(*sec, diags, "textures");
-    t.whorlColor = r.color("whorl", t.whorlColor);
-    t.cordColor = r.color("cord_color", t.cordColor);
-    t.cords = static_cast<int>(r.integer("cords", t.cords, 0, 200));
+    t.whorlColor = r.color({"whorl", "Base colour of the whorls."}, t.whorlColor);
+    t.cordColor = r.color({"cord_color", "Colour of the spiral cords."}, t.cordColor);
+    t.cords = static_cast<int>(r.integer({"cords", "Spiral cords around a whorl (0 = none)."}, t.cords, 0, 200));
     t.cordStrength = num(r, "cord_strength", t.cordStrength, 0.0, 1.0);
     t.growthLineDeg = num(r, "growth_lines", t.growthLineDeg, 0.0, 360.0);
     t.growthLineStrength = num(r, "growth_line_strength", t.growthLineStrength, 0.0, 1.0);
-    t.varixColor = r.color("varix", t.varixColor);
-    t.spineTipColor = r.color("spine_tip", t.spineTipColor);
-    t.axialColor = r.color("axial", t.axialColor);
-    t.bumpColor = r.color("bump", t.bumpColor);
-    t.insideColor = r.color("inside", t.insideColor);
+    t.varixColor = r.color({"varix", "Colour of the varices."}, t.varixColor);
+    t.spineTipColor = r.color({"spine_tip", "Colour of the spine tips."}, t.spineTipColor);
+    t.axialColor = r.color({"axial", "Colour of the axial (canal) spines."}, t.axialColor);
+    t.bumpColor = r.color({"bump", "Colour of the bumps."}, t.bumpColor);
+    t.insideColor = r.color({"inside", "Colour inside the opening."}, t.insideColor);
     t.insideRadial = num(r, "inside_radial", t.insideRadial, 0.0, 1.0);
     r.finish();
   }
@@ -314,27 +314,27 @@ std::optional<ShellSpec> readShellSection(const YNode& section, DiagnosticList& 
   ShellSpec s;
   s.loc = section.loc();
   MapReader top(section, diags, "shell");
-  const std::string preset = top.choice("preset", "none", {"none", "murex_cabritii"});
+  const std::string preset = top.choice({"preset", "Start from a preset: `murex_cabritii` is the paper's Murex (every key below still overrides it); `none` starts from the defaults."}, "none", {"none", "murex_cabritii"});
   ShellParams& p = s.params;
   if (preset == "murex_cabritii") {
     p = organisms::murexCabritii();
     s.textures.pigment = false;
   }
-  p.spiral.lambda = top.number("lambda", p.spiral.lambda, 1.0001, 100.0);
-  p.spiral.betaDeg = top.number("beta", p.spiral.betaDeg, 0.1, 90.0);
-  p.spiral.r0 = top.number("r0", p.spiral.r0, 1e-6, 1e6);
-  p.whorls = static_cast<int>(top.integer("whorls", p.whorls, 1, 40));
-  p.whorlDeg = top.number("whorl_angle", p.whorlDeg, 1.0, 3600.0);
-  p.sectionDeg = top.number("section_angle", p.sectionDeg, 1.0, 3600.0);
-  p.surfacesPerSection = static_cast<int>(top.integer("surfaces_per_section", p.surfacesPerSection, 1, 1000));
-  p.startDeg = top.number("start", p.startDeg, -36000.0, 36000.0);
-  if (top.has("age")) p.ageDeg = top.number("age", p.whorls * p.whorlDeg, 0.0, 40 * 3600.0);
+  p.spiral.lambda = top.number({"lambda", "λ, the ratio of the spiral's radii one turn apart (above 1; Eq. 1 of the Murex paper)."}, p.spiral.lambda, 1.0001, 100.0);
+  p.spiral.betaDeg = top.number({"beta", "β, the spiral's angle in degrees: 90 is planispiral (every whorl in one plane), smaller is taller."}, p.spiral.betaDeg, 0.1, 90.0);
+  p.spiral.r0 = top.number({"r0", "R₀, the spiral's radius at angle 0, in world units."}, p.spiral.r0, 1e-6, 1e6);
+  p.whorls = static_cast<int>(top.integer({"whorls", "Whorls of the grown shell."}, p.whorls, 1, 40));
+  p.whorlDeg = top.number({"whorl_angle", "Degrees per whorl."}, p.whorlDeg, 1.0, 3600.0);
+  p.sectionDeg = top.number({"section_angle", "Degrees per section (the controlled-blending unit of Eq. 10)."}, p.sectionDeg, 1.0, 3600.0);
+  p.surfacesPerSection = static_cast<int>(top.integer({"surfaces_per_section", "Generating surfaces per section (Δθ = section_angle / this)."}, p.surfacesPerSection, 1, 1000));
+  p.startDeg = top.number({"start", "Angle θ of the first generating surface, in degrees."}, p.startDeg, -36000.0, 36000.0);
+  if (top.has("age")) p.ageDeg = top.number({"age", "θ_end, the angle of the last generating surface, in degrees (default: whorls × whorl_angle)."}, p.whorls * p.whorlDeg, 0.0, 40 * 3600.0);
   for (const YNode& st : top.sequence("stages"))
     if (auto v = st.asNumber(diags, "'stages' entry", 0.0, 40 * 3600.0)) s.stages.push_back(*v);
-  p.seed = static_cast<uint64_t>(top.integer("seed", static_cast<int64_t>(p.seed), 0));
-  p.controlledBlending = top.boolean("controlled_blending", p.controlledBlending);
-  p.calibrateSize = top.boolean("calibrate", p.calibrateSize);
-  p.apexUp = top.boolean("apex_up", p.apexUp);
+  p.seed = static_cast<uint64_t>(top.integer({"seed", "Seed of the bumps and of the axial spines' bends."}, static_cast<int64_t>(p.seed), 0));
+  p.controlledBlending = top.boolean({"controlled_blending", "Blend each section only with its neighbours (Eq. 10; false: every section with every other, whorls fuse)."}, p.controlledBlending);
+  p.calibrateSize = top.boolean({"calibrate", "Calibrate the size and shift of the summed row of generating surfaces."}, p.calibrateSize);
+  p.apexUp = top.boolean({"apex_up", "Turn the shell apex up in world space."}, p.apexUp);
   readGenerating(top, p, diags);
   readCanal(top, p, diags);
   readVarices(top, p, diags);
@@ -662,7 +662,7 @@ class ShellModel final : public KindModel {
 }  // namespace
 
 std::shared_ptr<const KindSpec> readShellSpec(MapReader& top, Species&, DiagnosticList& diags) {
-  std::optional<YNode> section = top.section("shell");
+  std::optional<YNode> section = top.section({"shell", "The helico-spiral shell: spiral, generating surface, varices, spines, bumps, opening, textures, pigment (docs/SHELLS.md)."});
   if (!section) {
     if (!top.has("shell")) top.node().error(diags, "missing required key 'shell' in species file");
     return nullptr;

@@ -81,12 +81,12 @@ class SolidReader {
 
   void readSolid(const YNode& section) {
     MapReader m(section, diags_, "solid");
-    std::optional<YNode> grid = m.section("grid");
-    spec_.smoothRounds = int(m.integer("smooth", 0, 0, 10));
-    spec_.coarsenLevels = int(m.integer("coarsen", 0, 0, 6));
-    spec_.coarsenTolerance = m.number("coarsen_tolerance", 0, 0, 0.5);
+    std::optional<YNode> grid = m.section({"grid", "The tetrahedral grid: `cell` (edge of the cubic cells, world units) and `bounds` (the box meshed); default automatic."});
+    spec_.smoothRounds = int(m.integer({"smooth", "Rounds of smoothing alone after meshing."}, 0, 0, 10));
+    spec_.coarsenLevels = int(m.integer({"coarsen", "Octree levels merged where no interface crosses (§4.4, Fig. 4)."}, 0, 0, 6));
+    spec_.coarsenTolerance = m.number({"coarsen_tolerance", "With `coarsen`: blocks an interface crosses merge too where every field is affine to within this many cells."}, 0, 0, 0.5);
     double toleranceCells = 0;
-    if (std::optional<YNode> improve = m.section("improve")) {
+    if (std::optional<YNode> improve = m.section({"improve", "Quality improvement by flips, collapses and smoothing (§4.4): `quality_below`, `tolerance`, `target_tetrahedra`."})) {
       MapReader r(*improve, diags_, "improve");
       solids::ImproveOptions& o = spec_.improve.emplace();
       o.qualityBelow = double(r.integer("quality_below", 10, 1, 10));
@@ -94,7 +94,7 @@ class SolidReader {
       o.targetCount = size_t(r.integer("target_tetrahedra", 0, 0, 1000000000));
       r.finish();
     }
-    if (auto ops = m.get("operations")) spec_.operations = readSolidOperations(*ops, spec_.solid.materials, diags_);
+    if (auto ops = m.get({"operations", "Simulation tools applied in order after meshing: `hammer`, `displace`, `polish`, `dirt`, `wash`, `erode`, `lichen`."})) spec_.operations = readSolidOperations(*ops, spec_.solid.materials, diags_);
     readVolumes(m, section, "solid");
     m.finish();
     if (!diags_.hasErrors() && !spec_.solid.volumes.empty()) resolveGrid(grid, section);
@@ -209,7 +209,7 @@ class SolidReader {
     MapReader m(value, diags_, "volume");
     FieldPtr field;
     bool wraps = false;  // the field is the outermost interface of earlier volumes
-    if (auto f = m.get("distance_field")) {
+    if (auto f = m.get({"distance_field", "The volume's shape: a distance field (a primitive, a mesh, an image extruded, a union, a transform ...)."})) {
       field = readField(*f);
       wraps = f->isMap() && f->node().size() == 1 && f->node()["from_volume_surface"].IsDefined();
     } else {
@@ -220,7 +220,7 @@ class SolidReader {
     if (velocityNode) velocity = readVelocity(*velocityNode, diags_, nullptr, false);
     std::vector<Layer> layers;
     std::vector<std::optional<YNode>> layerVelocity;
-    const std::vector<YNode> items = m.sequence("layers");
+    const std::vector<YNode> items = m.sequence({"layers", "The volume's layers from its surface: `interior_layer` entries inward, `exterior_layer` entries outward."});
     if (items.empty() && !m.has("layers")) value.error(diags_, "missing required key 'layers' in volume");
     for (const YNode& item : items) {
       std::optional<YNode> lv;
@@ -299,9 +299,10 @@ class SolidReader {
     const size_t errors = errorCount();
     *velocity = m.get("velocity");
     m.markRequired("material");
-    if (auto mat = m.get("material")) l.material = materialId(*mat);
+    if (auto mat = m.get({"material", "The layer's material: one of the file's `materials:`, a built-in material, or `nothing` (air that claims its space)."})) l.material = materialId(*mat);
     else one->second.error(diags_, "missing required key 'material' in " + one->first.scalar() + " (a material name or nothing)");
-    if (auto t = m.get("thickness")) {
+    if (auto t = m.get({"thickness", "How thick the layer is, in world units, or `fill` (an interior layer fills the rest of the volume)."})) {
+      describeValue(*t, 0.0, {"fill"});
       if (t->isPlainScalar() && t->scalar() == "fill") {
         l.fill = true;
         if (!l.interior) t->error(diags_, "'thickness: fill' is for interior layers (an exterior layer needs a number)");
@@ -915,8 +916,8 @@ std::vector<Mesh> visibleMeshes(const TetMesh& mesh, std::vector<uint16_t>* part
 std::shared_ptr<const KindSpec> readSolidSpec(MapReader& top, Species& species, DiagnosticList& diags) {
   auto spec = std::make_shared<SolidSpec>();
   SolidReader reader(diags, *spec, species.policy);
-  if (auto m = top.section("materials")) reader.readMaterials(*m);
-  std::optional<YNode> section = top.section("solid");
+  if (auto m = top.section({"materials", "Materials of this file by name (beside the built-in ones), each a colour or a choice among materials by an expression (docs/SOLIDS.md)."})) reader.readMaterials(*m);
+  std::optional<YNode> section = top.section({"solid", "The layered solid: a volume (distance field and layers), more volumes, precedence and operations (docs/SOLIDS.md)."});
   if (!section) {
     if (!top.has("solid")) top.node().error(diags, "missing required key 'solid' in species file");
     return nullptr;

@@ -18,55 +18,55 @@ namespace fs = std::filesystem;
 namespace {
 
 void readView(MapReader& m, render::ViewSpec& v) {
-  v.azimuthDeg = m.number("azimuth", v.azimuthDeg, -360.0, 360.0);
-  v.elevationDeg = m.number("elevation", v.elevationDeg, -89.0, 89.0);
-  v.fovYDeg = m.number("fov", v.fovYDeg, 1.0, 150.0);
-  v.margin = m.number("margin", v.margin, 0.0, 0.9);
+  v.azimuthDeg = m.number({"azimuth", "Camera direction around the vertical (+Y) axis, in degrees from +Z toward +X."}, v.azimuthDeg, -360.0, 360.0);
+  v.elevationDeg = m.number({"elevation", "Camera height above the horizon, in degrees."}, v.elevationDeg, -89.0, 89.0);
+  v.fovYDeg = m.number({"fov", "Vertical field of view of the camera, in degrees."}, v.fovYDeg, 1.0, 150.0);
+  v.margin = m.number({"margin", "Free fraction of the half-frame left around the framed model."}, v.margin, 0.0, 0.9);
   m.finish();
 }
 
 void readRender(MapReader& m, SpeciesRender& r, DiagnosticList& diags) {
   render::RenderSettings& im = r.image;
-  im.width = static_cast<int>(m.integer("width", im.width, 16, 8192));
-  im.height = static_cast<int>(m.integer("height", im.height, 16, 8192));
-  im.spp = static_cast<int>(m.integer("samples", im.spp, 1, 1024));
-  im.sampler = m.choice("sampler", "zsobol", {"zsobol", "stratified"}) == "stratified" ? render::Sampling::Stratified
+  im.width = static_cast<int>(m.integer({"width", "Image width in pixels."}, im.width, 16, 8192));
+  im.height = static_cast<int>(m.integer({"height", "Image height in pixels."}, im.height, 16, 8192));
+  im.spp = static_cast<int>(m.integer({"samples", "Camera samples per pixel (more: less noise, proportionally slower)."}, im.spp, 1, 1024));
+  im.sampler = m.choice({"sampler", "Where the samples go: `zsobol` (Owen-scrambled Sobol' points in Morton order, less noise) or `stratified` (jittered strata, the older baseline)."}, "zsobol", {"zsobol", "stratified"}) == "stratified" ? render::Sampling::Stratified
                                                                                      : render::Sampling::ZSobol;
-  im.thinMinPixels = static_cast<float>(m.number("thin_min_pixels", im.thinMinPixels, 0.0, 8.0));
-  r.dualMesher = m.choice("mesher", r.dualMesher ? "dual" : "tetrahedra", {"tetrahedra", "dual"}) == "dual";
-  r.simplify = m.number("simplify", r.simplify, 0.0, 0.1);
-  if (auto w = m.section("wind")) {
+  im.thinMinPixels = static_cast<float>(m.number({"thin_min_pixels", "Curves and tree cones thinner than this many pixels are drawn this wide, with opacity true width / drawn width, so sub-pixel twigs stay continuous lines (0 = off)."}, im.thinMinPixels, 0.0, 8.0));
+  r.dualMesher = m.choice({"mesher", "How polygonized surfaces (mesh-mode renders, `sprig mesh`) are meshed: `tetrahedra` (marching tetrahedra) or `dual` (dual marching cubes, about a third of the triangles)."}, r.dualMesher ? "dual" : "tetrahedra", {"tetrahedra", "dual"}) == "dual";
+  r.simplify = m.number({"simplify", "Simplify polygonized surfaces by edge collapses while the geometric error stays below this fraction of the model's extent (0 = off)."}, r.simplify, 0.0, 0.1);
+  if (auto w = m.section({"wind", "Wind that sways a tree in animations: `speed` and `direction`."})) {
     MapReader wind(*w, diags, "render.wind");
-    r.windSpeed = wind.number("speed", r.windSpeed, 0.0, 60.0);
-    r.windDirectionDeg = wind.number("direction", r.windDirectionDeg, -360.0, 360.0);
+    r.windSpeed = wind.number({"speed", "Wind speed in m/s (0 = still air): the trunk leans with its square, branches sway and leaves flutter in proportion."}, r.windSpeed, 0.0, 60.0);
+    r.windDirectionDeg = wind.number({"direction", "Azimuth the wind blows toward, in degrees around +Y from +Z toward +X."}, r.windDirectionDeg, -360.0, 360.0);
     wind.finish();
   }
-  if (auto v = m.section("view")) {
+  if (auto v = m.section({"view", "Automatic framing of the model: `azimuth`, `elevation`, `fov`, `margin`."})) {
     MapReader view(*v, diags, "render.view");
     readView(view, r.view);
   }
-  std::string bg = m.choice("background", "gradient", {"gradient", "color", "transparent"});
+  std::string bg = m.choice({"background", "Behind the model: a sky `gradient`, a flat `color` (`background_color`), or `transparent` (alpha 0 in the PNG)."}, "gradient", {"gradient", "color", "transparent"});
   im.background = bg == "color" ? render::Background::Color
                  : bg == "transparent" ? render::Background::Transparent
                                        : render::Background::Gradient;
-  im.backgroundColor = m.color("background_color", im.backgroundColor);
-  im.ground = m.boolean("ground", im.ground);
-  im.groundColor = m.color("ground_color", im.groundColor);
-  if (auto s = m.section("sun")) {
+  im.backgroundColor = m.color({"background_color", "The background's colour with `background: color`."}, im.backgroundColor);
+  im.ground = m.boolean({"ground", "Draw a ground plane under the model."}, im.ground);
+  im.groundColor = m.color({"ground_color", "Colour of the ground plane."}, im.groundColor);
+  if (auto s = m.section({"sun", "Direction of the sun light: `azimuth` and `elevation` in degrees."})) {
     MapReader sun(*s, diags, "render.sun");
-    im.sunAzimuthDeg = sun.number("azimuth", im.sunAzimuthDeg, -360.0, 360.0);
-    im.sunElevationDeg = sun.number("elevation", im.sunElevationDeg, 1.0, 90.0);
+    im.sunAzimuthDeg = sun.number({"azimuth", "Sun direction around +Y, in degrees from +Z toward +X."}, im.sunAzimuthDeg, -360.0, 360.0);
+    im.sunElevationDeg = sun.number({"elevation", "Sun height above the horizon, in degrees."}, im.sunElevationDeg, 1.0, 90.0);
     sun.finish();
   }
-  im.exposure = static_cast<float>(m.number("exposure", im.exposure, -10.0, 10.0));
-  if (auto c = m.section("camera")) {
+  im.exposure = static_cast<float>(m.number({"exposure", "Exposure in stops: each +1 doubles the image's brightness."}, im.exposure, -10.0, 10.0));
+  if (auto c = m.section({"camera", "An explicit camera instead of the automatic framing: `position` or `distance`, and `target`."})) {
     MapReader cam(*c, diags, "render.camera");
     CameraSpec spec;
-    if (cam.has("position")) spec.position = cam.vec3("position", Vec3(0), -1e6f, 1e6f);
+    if (cam.has("position")) spec.position = cam.vec3({"position", "Camera position in world units (excludes `distance`)."}, Vec3(0), -1e6f, 1e6f);
     else cam.allow({"position"});
-    if (cam.has("target")) spec.target = cam.vec3("target", Vec3(0), -1e6f, 1e6f);
+    if (cam.has("target")) spec.target = cam.vec3({"target", "The point the camera looks at (default: the centre of the framed box)."}, Vec3(0), -1e6f, 1e6f);
     else cam.allow({"target"});
-    if (cam.has("distance")) spec.distance = cam.number("distance", 1.0, 1e-6, 1e6);
+    if (cam.has("distance")) spec.distance = cam.number({"distance", "Camera distance from the target along the view's direction (excludes `position`)."}, 1.0, 1e-6, 1e6);
     else cam.allow({"distance"});
     if (spec.position && spec.distance)
       c->error(diags, "render.camera: give either 'position' or 'distance', not both");
@@ -75,20 +75,20 @@ void readRender(MapReader& m, SpeciesRender& r, DiagnosticList& diags) {
     cam.finish();
     r.camera = spec;
   }
-  im.fillStrength = static_cast<float>(m.number("fill", im.fillStrength, 0.0, 10.0));
-  im.skyStrength = static_cast<float>(m.number("sky", im.skyStrength, 0.0, 10.0));
-  im.unlitSkySamples = static_cast<int>(m.integer("unlit_sky_samples", im.unlitSkySamples, 0, 16));
-  im.skyFilter = m.boolean("sky_filter", im.skyFilter);
-  r.surface.baseColor = m.color("color", r.surface.baseColor);
-  r.surface.roughness = static_cast<float>(m.number("roughness", r.surface.roughness, 0.0, 1.0));
-  r.surface.specular = static_cast<float>(m.number("specular", r.surface.specular, 0.0, 1.0));
-  r.style.wood.baseColor = m.color("wood", r.style.wood.baseColor);
-  r.style.leaf.baseColor = m.color("leaf", r.style.leaf.baseColor);
-  r.style.fruit.baseColor = m.color("fruit", r.style.fruit.baseColor);
-  for (const YNode& c : m.sequence("palette"))
+  im.fillStrength = static_cast<float>(m.number({"fill", "Strength of an unshadowed fill light from the camera (0 = none)."}, im.fillStrength, 0.0, 10.0));
+  im.skyStrength = static_cast<float>(m.number({"sky", "Strength of the sky light."}, im.skyStrength, 0.0, 10.0));
+  im.unlitSkySamples = static_cast<int>(m.integer({"unlit_sky_samples", "Sky rays per camera sample where the sun adds nothing (in its shadow or facing away): smooths shadows and cavities lit by the sky alone (0 = one ray, as elsewhere)."}, im.unlitSkySamples, 0, 16));
+  im.skyFilter = m.boolean({"sky_filter", "Smooth the sky light's noise with the edge-avoiding filter: never across creases, depth steps or colour edges (false: the raw samples)."}, im.skyFilter);
+  r.surface.baseColor = m.color({"color", "Base colour of BlobTree surfaces in `sprig render`."}, r.surface.baseColor);
+  r.surface.roughness = static_cast<float>(m.number({"roughness", "Roughness of BlobTree surfaces (0 mirror-like, 1 matte)."}, r.surface.roughness, 0.0, 1.0));
+  r.surface.specular = static_cast<float>(m.number({"specular", "Specular reflectance of BlobTree surfaces."}, r.surface.specular, 0.0, 1.0));
+  r.style.wood.baseColor = m.color({"wood", "Preview colour of internodes (branches and trunk)."}, r.style.wood.baseColor);
+  r.style.leaf.baseColor = m.color({"leaf", "Preview colour of polygons and surfaces (leaves)."}, r.style.leaf.baseColor);
+  r.style.fruit.baseColor = m.color({"fruit", "Preview colour of spheres (fruits, buds)."}, r.style.fruit.baseColor);
+  for (const YNode& c : m.sequence({"palette", "Colours by turtle colour index (the grammar's `'` and `;` modules): entry 0, 1, 2 ..."}))
     if (auto col = c.asColor(diags, "'palette' entry")) r.style.palette.push_back(*col);
-  r.style.radiusScale = m.number("radius_scale", r.style.radiusScale, 1e-6, 1e6);
-  r.style.organs = m.boolean("organs", r.style.organs);
+  r.style.radiusScale = m.number({"radius_scale", "Preview: multiplies every internode radius."}, r.style.radiusScale, 1e-6, 1e6);
+  r.style.organs = m.boolean({"organs", "Preview: draw organs (leaves, flowers, fruits)."}, r.style.organs);
   m.finish();
 }
 
@@ -115,10 +115,10 @@ Species readSpecies(std::shared_ptr<const YamlFile> yaml, const PathPolicy& poli
   for (size_t i = 0; i < names.size(); ++i)
     list += (i == 0 ? "" : i + 1 == names.size() ? " or " : ", ") + names[i];
 
-  s.name = top.string("name", yaml->path().stem().string());
-  s.description = top.string("description");
+  s.name = top.string({"name", "Shown in the gallery and in messages (default: the file's name without `.yaml`)."}, yaml->path().stem().string());
+  s.description = top.string({"description", "A sentence or two shown in the gallery."});
   s.kind = "tree";
-  if (auto k = top.get("kind")) {
+  if (auto k = top.get({"kind", "What the file describes: `tree`, `shell`, `blob`, `organism` or `solid`."})) {
     s.kindNode = k;
     if (auto text = k->asString(diags, "'kind'")) s.kind = *text;
   } else {
@@ -132,13 +132,13 @@ Species readSpecies(std::shared_ptr<const YamlFile> yaml, const PathPolicy& poli
       s.kindNode->error(diags, "unknown species kind '" + s.kind + "' (" + list + ")" + didYouMean(s.kind, names));
     return s;
   }
-  if (auto r = top.section("render")) {
+  if (auto r = top.section({"render", "Image size, camera, light and colours of renders and previews."})) {
     MapReader render(*r, diags, "render");
     readRender(render, s.render, diags);
     if (auto w = render.keyNode("wind"); w && s.kind != "tree")
       w->error(diags, "'render.wind' sways trees; " + speciesOfKind(s.kind) + " has no wind");
   }
-  for (const YNode& st : top.sequence("stages"))
+  for (const YNode& st : top.sequence({"stages", "Growth stages shown in the gallery's growth strip and by `--stage`: derivation steps of a tree, ages of a shell."}))
     if (auto v = st.asInteger(diags, "'stages' entry", 0, 100000)) s.stages.push_back(static_cast<int>(*v));
   s.spec = kind->read(top, s, diags);
   top.finish();

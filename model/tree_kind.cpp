@@ -44,32 +44,32 @@ std::vector<int> readInts(MapReader& m, std::string_view key, int64_t min, int64
 void readSelector(MapReader& m, BranchSelector& s) {
   if (m.has("orders")) s.orders = readInts(m, "orders", 0, 1000);
   if (m.has("internodes")) s.internodes = readInts(m, "internodes", 0, std::numeric_limits<int32_t>::max());
-  s.belowHeight = m.number("below_height", s.belowHeight);
-  s.aboveHeight = m.number("above_height", s.aboveHeight);
-  s.probability = m.number("probability", s.probability, 0.0, 1.0);
+  s.belowHeight = m.number({"below_height", "Select branches whose base lies below this height (world units)."}, s.belowHeight);
+  s.aboveHeight = m.number({"above_height", "Select branches whose base lies above this height (world units)."}, s.aboveHeight);
+  s.probability = m.number({"probability", "Select each branch with this probability, seeded per internode (0 = only the listed `internodes`)."}, s.probability, 0.0, 1.0);
 }
 
 void readTurtle(MapReader& m, TreeSpec& s) {
   auto& t = s.turtle;
-  t.stepLength = m.number("step", t.stepLength, 1e-9, 1e9);
+  t.stepLength = m.number({"step", "Length of `F f G g` without a parameter, in world units."}, t.stepLength, 1e-9, 1e9);
   if (m.has("angle")) {
-    t.angleDeg = m.number("angle", t.angleDeg, -360.0, 360.0);
+    t.angleDeg = m.number({"angle", "Turn of `+ - & ^ \\ /` without a parameter, in degrees (default: the grammar's `angle:`, else 90)."}, t.angleDeg, -360.0, 360.0);
     s.angleSet = true;
   } else {
     m.allow({"angle"});
   }
-  t.initialWidth = m.number("width", t.initialWidth, 0.0, 1e9);
-  t.widthScale = m.number("width_scale", t.widthScale, 1e-9, 1e9);
-  t.widthFactor = m.number("width_factor", t.widthFactor, 1e-6, 1e6);
-  t.tropism = DVec3(m.vec3("tropism", Vec3(t.tropism), -1e6, 1e6));
-  t.elasticity = m.number("elasticity", t.elasticity, -10.0, 10.0);
-  std::string radii = m.choice("radii", "width", {"width", "pipe"});
+  t.initialWidth = m.number({"width", "Initial line width (diameter units)."}, t.initialWidth, 0.0, 1e9);
+  t.widthScale = m.number({"width_scale", "World units per width unit: radius = 0.5 · width · width_scale (ABOP's widths are pixel widths: about 0.01 for its figures 2.6 and 2.7)."}, t.widthScale, 1e-9, 1e9);
+  t.widthFactor = m.number({"width_factor", "`!` without a parameter multiplies the width by this."}, t.widthFactor, 1e-6, 1e6);
+  t.tropism = DVec3(m.vec3({"tropism", "Tropism vector T that bends branches (ABOP section 2.2), e.g. [0, -1, 0] for gravity."}, Vec3(t.tropism), -1e6, 1e6));
+  t.elasticity = m.number({"elasticity", "Susceptibility e to the tropism (`@Ts(e)` changes it in the grammar; 0 = no bending)."}, t.elasticity, -10.0, 10.0);
+  std::string radii = m.choice({"radii", "Internode radii from the `!` widths (`width`) or from the pipe model (`pipe`)."}, "width", {"width", "pipe"});
   t.radii = radii == "pipe" ? lsystem::RadiusModel::Pipe : lsystem::RadiusModel::Width;
-  t.pipeExponent = m.number("pipe_exponent", t.pipeExponent, 0.5, 10.0);
-  t.tipRadius = m.number("tip_radius", t.tipRadius, 1e-9, 1e9);
-  t.taper = m.boolean("taper", t.taper);
-  t.surfaceScale = m.number("surface_scale", t.surfaceScale, 1e-9, 1e9);
-  t.maxWidthToLength = m.number("max_width_to_length", t.maxWidthToLength, 0.0, 1e6);
+  t.pipeExponent = m.number({"pipe_exponent", "Pipe model exponent e: r_parent^e = Σ r_child^e."}, t.pipeExponent, 0.5, 10.0);
+  t.tipRadius = m.number({"tip_radius", "Pipe model: the radius of every branch tip, in world units."}, t.tipRadius, 1e-9, 1e9);
+  t.taper = m.boolean({"taper", "Width model: an internode ends at its continuation's radius (false: cylinders)."}, t.taper);
+  t.surfaceScale = m.number({"surface_scale", "Size of a `~` surface without a parameter."}, t.surfaceScale, 1e-9, 1e9);
+  t.maxWidthToLength = m.number({"max_width_to_length", "Caps every internode's diameter at this multiple of its length (0 = off)."}, t.maxWidthToLength, 0.0, 1e6);
   m.finish();
 }
 
@@ -78,7 +78,7 @@ void readTurtle(MapReader& m, TreeSpec& s) {
 /// second one about the empty text).
 bool readGrammar(MapReader& top, const Species& sp, TreeSpec& s, DiagnosticList& diags) {
   const PathPolicy& policy = sp.policy;
-  auto g = top.get("grammar");
+  auto g = top.get({"grammar", "The L-system: a `.lsys` (or cpfg `.l`) path relative to the species file, or the grammar itself inline as a block scalar (`grammar: |`)."});
   if (!g) {
     top.node().error(diags, "missing required key 'grammar' in species file");
     return false;
@@ -121,7 +121,7 @@ bool readGrammar(MapReader& top, const Species& sp, TreeSpec& s, DiagnosticList&
 }
 
 void readDefines(MapReader& top, TreeSpec& s, DiagnosticList& diags) {
-  auto d = top.section("defines");
+  auto d = top.section({"defines", "Replace the grammar's `#define NAME` values: NAME: number (an unknown name is an error)."});
   if (!d) return;
   for (auto& [k, v] : d->pairs()) {
     if (!k.isScalar()) continue;
@@ -570,21 +570,21 @@ std::shared_ptr<const KindSpec> readTreeSpec(MapReader& top, Species& species, D
   const bool grammarRead = readGrammar(top, species, s, diags);
   readDefines(top, s, diags);
   if (top.has("steps")) {
-    s.overrides.derivationLength = static_cast<int>(top.integer("steps", 0, 0, 100000));
+    s.overrides.derivationLength = static_cast<int>(top.integer({"steps", "Derivation steps (default: the grammar's `derivation length:`; another value prints a note naming both)."}, 0, 0, 100000));
     if (auto key = top.keyNode("steps")) s.overrides.derivationLengthLoc = key->loc();  // none while describing
   } else
     top.allow({"steps"});
   if (top.has("seed"))
-    s.overrides.seed = static_cast<uint64_t>(top.integer("seed", 0, 0));
+    s.overrides.seed = static_cast<uint64_t>(top.integer({"seed", "Seed of stochastic productions and `ran`/`nran` (default: the grammar's `seed:`, else 0)."}, 0, 0));
   else
     top.allow({"seed"});
-  s.maxModules = static_cast<size_t>(top.integer("max_modules", static_cast<int64_t>(s.maxModules), 1,
+  s.maxModules = static_cast<size_t>(top.integer({"max_modules", "Module limit of the derivation: a grammar that grows past it stops with an error."}, static_cast<int64_t>(s.maxModules), 1,
                                                  int64_t(4'000'000'000)));
-  if (auto t = top.section("turtle")) {
+  if (auto t = top.section({"turtle", "How the module string is drawn: step, angle, widths, tropism, radii."})) {
     MapReader turtle(*t, diags, "turtle");
     readTurtle(turtle, s);
   }
-  if (auto section = top.section("tree")) s.surface = readTreeOptions(*section, diags);
+  if (auto section = top.section({"tree", "The BlobTree tree builder (δA offsets, PCM junctions, pruning, scars, bends, bark, leaves); without it a tree is its skeleton only."})) s.surface = readTreeOptions(*section, diags);
   if (grammarRead) {
     species.spec = spec;  // speciesGrammar reads the spec through the species
     checkGrammar(species, s, diags);
@@ -897,74 +897,74 @@ std::vector<int> growthStages(const Species& species, int steps, int count) {
 organisms::TreeOptions readTreeOptions(const YNode& section, DiagnosticList& diags, const organisms::TreeOptions& defaults) {
   organisms::TreeOptions o = defaults;
   MapReader m(section, diags, "tree");
-  o.junctions = m.choice("junctions", o.junctions == organisms::JunctionModel::Pcm ? "pcm" : "smooth",
+  o.junctions = m.choice({"junctions", "How a branch meets its parent: `smooth` summation (§3.3) or `pcm` (precise contact modelling with a ridge, §3.4)."}, o.junctions == organisms::JunctionModel::Pcm ? "pcm" : "smooth",
                          {"smooth", "pcm"}) == "pcm"
                     ? organisms::JunctionModel::Pcm
                     : organisms::JunctionModel::Smooth;
-  o.deltaA = m.number("delta_a", o.deltaA, 0.0, 10.0);
-  o.deltaAMulti = m.number("delta_a_multi", o.deltaAMulti, 0.0, 10.0);
-  o.basalOffset = m.boolean("basal_offset", o.basalOffset);
-  o.branchOffset = m.boolean("branch_offset", o.branchOffset);
-  o.pcmWidth = m.number("pcm_width", o.pcmWidth, 1e-3, 0.5);
-  o.pcmBulge = m.number("pcm_bulge", o.pcmBulge, 0.0, 4.0);
-  o.softKernel = m.choice("kernel", o.softKernel ? "soft" : "wyvill", {"wyvill", "soft"}) == "soft";
-  o.controlledBlend = m.boolean("controlled_blend", o.controlledBlend);
-  o.tips = m.choice("tips", o.tips == organisms::TipStyle::Taper ? "taper" : "hemisphere",
+  o.deltaA = m.number({"delta_a", "δA offset factor of Eq. 4 (BlobTree Trees): shortens a basal internode so the joint does not bulge."}, o.deltaA, 0.0, 10.0);
+  o.deltaAMulti = m.number({"delta_a_multi", "δA factor of Eq. 8, for junctions with several branches."}, o.deltaAMulti, 0.0, 10.0);
+  o.basalOffset = m.boolean({"basal_offset", "Apply the δA offset (false: Fig. 9 left, the joint bulges)."}, o.basalOffset);
+  o.branchOffset = m.boolean({"branch_offset", "PCM: apply δB_i of Eq. 7 (false: Fig. 12 left)."}, o.branchOffset);
+  o.pcmWidth = m.number({"pcm_width", "PCM propagation width w, in field units."}, o.pcmWidth, 1e-3, 0.5);
+  o.pcmBulge = m.number({"pcm_bulge", "PCM bulge a₀ = pcm_bulge · w / 4."}, o.pcmBulge, 0.0, 4.0);
+  o.softKernel = m.choice({"kernel", "Field kernel: `wyvill` (1 − s)³ or `soft` (the soft-object kernel, iso radius exactly R/2)."}, o.softKernel ? "soft" : "wyvill", {"wyvill", "soft"}) == "soft";
+  o.controlledBlend = m.boolean({"controlled_blend", "Blend each internode only with its skeleton neighbours (false: every internode blends with every other)."}, o.controlledBlend);
+  o.tips = m.choice({"tips", "Terminal internodes end in a `taper` (closing exactly at the end point) or a `hemisphere` (the paper's caps)."}, o.tips == organisms::TipStyle::Taper ? "taper" : "hemisphere",
                     {"taper", "hemisphere"}) == "taper"
                ? organisms::TipStyle::Taper
                : organisms::TipStyle::Hemisphere;
-  o.tipTaper = m.number("tip_taper", o.tipTaper, 0.01, 1.0);
-  o.radiusScale = m.number("radius_scale", o.radiusScale, 1e-6, 1e6);
-  o.minRadius = m.number("min_radius", o.minRadius, 0.0, 1e6);
-  o.seed = static_cast<uint64_t>(m.integer("seed", static_cast<int64_t>(o.seed), 0));
+  o.tipTaper = m.number({"tip_taper", "Tip radius / base radius of a terminal internode (with `tips: taper`)."}, o.tipTaper, 0.01, 1.0);
+  o.radiusScale = m.number({"radius_scale", "Multiplies every internode radius."}, o.radiusScale, 1e-6, 1e6);
+  o.minRadius = m.number({"min_radius", "Floor of every internode radius, in world units."}, o.minRadius, 0.0, 1e6);
+  o.seed = static_cast<uint64_t>(m.integer({"seed", "Seed of pruning, scars, bends, leaf tints and wind phases."}, static_cast<int64_t>(o.seed), 0));
 
-  if (auto s = m.section("prune")) {
+  if (auto s = m.section({"prune", "Pruning (§3.5, Fig. 14): which branches are sawn off and where; plus selector keys."})) {
     MapReader p(*s, diags, "prune");
-    o.prune.fromGrammar = p.boolean("from_grammar", o.prune.fromGrammar);
-    o.prune.cutFraction = p.number("cut_fraction", o.prune.cutFraction, 0.0, 1.0);
-    o.prune.minCutDistance = p.number("min_cut_distance", o.prune.minCutDistance, 0.0, 100.0);
+    o.prune.fromGrammar = p.boolean({"from_grammar", "Prune where the grammar says so (`%` marks the last internode drawn as cut)."}, o.prune.fromGrammar);
+    o.prune.cutFraction = p.number({"cut_fraction", "Where the saw cuts the first internode of a pruned branch, as a fraction of its length."}, o.prune.cutFraction, 0.0, 1.0);
+    o.prune.minCutDistance = p.number({"min_cut_distance", "The cut lies at least this many base radii from the branching point."}, o.prune.minCutDistance, 0.0, 100.0);
     readSelector(p, o.prune.select);
     p.finish();
   }
-  if (auto s = m.section("scars")) {
+  if (auto s = m.section({"scars", "Scars of lost branches (§3.5, Fig. 15): a stub and a negative field; plus selector keys."})) {
     MapReader p(*s, diags, "scars");
-    const std::string style = p.choice("style", "flush", {"flush", "knob"});
+    const std::string style = p.choice({"style", "`flush`: a round, shallow scar flush with the bark; `knob`: a raised stub dented at its end."}, "flush", {"flush", "knob"});
     o.scars.style = style == "knob" ? organisms::ScarStyle::Knob : organisms::ScarStyle::Flush;
     if (o.scars.style == organisms::ScarStyle::Knob || !p.has("stub_length"))
-      o.scars.stubLength = p.number("stub_length", o.scars.stubLength, 0.01, 100.0);
-    else if (auto stub = p.get("stub_length"))  // (sprig schema's describe mode may answer has() and get() differently)
+      o.scars.stubLength = p.number({"stub_length", "Knob scars: length of the stub along the branch, in branch radii (an error with `style: flush`)."}, o.scars.stubLength, 0.01, 100.0);
+    else if (auto stub = p.get({"stub_length", "Knob scars: length of the stub along the branch, in branch radii (an error with `style: flush`)."}))  // (sprig schema's describe mode may answer has() and get() differently)
       stub->error(diags, "'scars.stub_length' applies to style knob only (a flush scar's stub reaches the bark)");
-    o.scars.stubRadius = p.number("stub_radius", o.scars.stubRadius, 0.01, 10.0);
-    o.scars.negativeRadius = p.number("negative_radius", o.scars.negativeRadius, 0.0, 10.0);
-    o.scars.negativeWeight = p.number("negative_weight", o.scars.negativeWeight, 0.0, 10.0);
+    o.scars.stubRadius = p.number({"stub_radius", "Radius of the stub, in branch radii (at most 0.9 of its parent's)."}, o.scars.stubRadius, 0.01, 10.0);
+    o.scars.negativeRadius = p.number({"negative_radius", "Radius of the negative field at the stub's end, in branch radii."}, o.scars.negativeRadius, 0.0, 10.0);
+    o.scars.negativeWeight = p.number({"negative_weight", "Weight of the negative field (how deep the scar is)."}, o.scars.negativeWeight, 0.0, 10.0);
     readSelector(p, o.scars.select);
     p.finish();
   }
-  if (auto s = m.section("bends")) {
+  if (auto s = m.section({"bends", "Endpoint-preserving bends of lateral branches (§3.6, Fig. 16)."})) {
     MapReader p(*s, diags, "bends");
-    o.bends.angleDeg = p.number("angle", o.bends.angleDeg, 0.0, 80.0);
-    o.bends.orderScale = p.number("order_scale", o.bends.orderScale, 0.0, 10.0);
-    o.bends.randomness = p.number("randomness", o.bends.randomness, 0.0, 1.0);
-    o.bends.minBranchAngleDeg = p.number("min_branch_angle", o.bends.minBranchAngleDeg, 0.0, 90.0);
-    o.bends.trunk = p.boolean("trunk", o.bends.trunk);
+    o.bends.angleDeg = p.number({"angle", "Bend angle in degrees (0 = off)."}, o.bends.angleDeg, 0.0, 80.0);
+    o.bends.orderScale = p.number({"order_scale", "Multiplies the bend angle per branch order."}, o.bends.orderScale, 0.0, 10.0);
+    o.bends.randomness = p.number({"randomness", "Random share of each bend's angle (seeded)."}, o.bends.randomness, 0.0, 1.0);
+    o.bends.minBranchAngleDeg = p.number({"min_branch_angle", "Only branches leaving their basal internode's axis by more than this many degrees bend."}, o.bends.minBranchAngleDeg, 0.0, 90.0);
+    o.bends.trunk = p.boolean({"trunk", "Bend the trunk too."}, o.bends.trunk);
     p.finish();
   }
-  if (auto s = m.section("bark")) {
+  if (auto s = m.section({"bark", "The bark texture on the cones (see docs/TREES.md, Bark)."})) {
     MapReader p(*s, diags, "bark");
-    o.bark.enabled = p.boolean("enabled", o.bark.enabled);
-    o.bark.texture = static_cast<int>(p.integer("texture", o.bark.texture, 0, 16383));
-    o.bark.uScale = p.number("u_scale", o.bark.uScale, -kInf, kInf);
-    o.bark.vScale = p.number("v_scale", o.bark.vScale, -kInf, kInf);
-    o.bark.ridgeWidth = p.number("ridge_width", o.bark.ridgeWidth, 0.0, 1e6);
-    o.bark.matureRadius = p.number("mature_radius", o.bark.matureRadius, 0.0, 1e6);
+    o.bark.enabled = p.boolean({"enabled", "Put the bark texture on the cones."}, o.bark.enabled);
+    o.bark.texture = static_cast<int>(p.integer({"texture", "Texture id of the first bark class."}, o.bark.texture, 0, 16383));
+    o.bark.uScale = p.number({"u_scale", "Texture u per turn around the branch."}, o.bark.uScale, -kInf, kInf);
+    o.bark.vScale = p.number({"v_scale", "Texture v per world unit along the skeleton."}, o.bark.vScale, -kInf, kInf);
+    o.bark.ridgeWidth = p.number({"ridge_width", "World width of a bark ridge (0: `furrows` ridges on every cone)."}, o.bark.ridgeWidth, 0.0, 1e6);
+    o.bark.matureRadius = p.number({"mature_radius", "Branch radius with fully furrowed bark (0: `maturity` everywhere)."}, o.bark.matureRadius, 0.0, 1e6);
     readBarkLook(p, o.bark);  // the keys a blob species' bark texture reads too
     p.finish();
   }
-  if (auto s = m.section("leaves")) {
+  if (auto s = m.section({"leaves", "Leaves on the BlobTree tree."})) {
     MapReader p(*s, diags, "leaves");
-    o.leaves.enabled = p.boolean("enabled", o.leaves.enabled);
-    o.leaves.scale = p.number("scale", o.leaves.scale, 0.0, 1e6);
-    o.leaves.material = static_cast<uint32_t>(p.integer("material", o.leaves.material, 0, 65535));
+    o.leaves.enabled = p.boolean({"enabled", "Put leaves on the tree (false: bare branches)."}, o.leaves.enabled);
+    o.leaves.scale = p.number({"scale", "Multiplies the size of every leaf."}, o.leaves.scale, 0.0, 1e6);
+    o.leaves.material = static_cast<uint32_t>(p.integer({"material", "Material index of the leaves."}, o.leaves.material, 0, 65535));
     p.finish();
   }
   m.finish();

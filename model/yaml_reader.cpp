@@ -441,8 +441,14 @@ std::string jsonNumber(double v) {
   return o.str();
 }
 
+/// The shortest text that reads back as the same float (0.3f is "0.3", not "0.300000012").
+std::string jsonFloat(float v) {
+  char buffer[32];
+  return std::string(buffer, std::to_chars(buffer, buffer + sizeof buffer, v).ptr);
+}
+
 std::string jsonVec3(const Vec3& v) {
-  return "[" + jsonNumber(v.x) + ", " + jsonNumber(v.y) + ", " + jsonNumber(v.z) + "]";
+  return "[" + jsonFloat(v.x) + ", " + jsonFloat(v.y) + ", " + jsonFloat(v.z) + "]";
 }
 
 std::string jsonString(std::string_view text) {
@@ -759,12 +765,13 @@ bool MapReader::has(std::string_view key) const {
   return index_.find(key) != index_.end();
 }
 
-std::optional<YNode> MapReader::get(std::string_view key) {
-  known_.emplace(key);
-  auto it = index_.find(key);
+std::optional<YNode> MapReader::get(Key key) {
+  known_.emplace(key.name);
+  auto it = index_.find(key.name);
   if (schema_) {  // describing: an absent key reads as a placeholder, or stays absent
     detail::KeyRecorder* r = detail::KeyRecorder::active();
-    detail::KeySchema& child = schema_->property(std::string(key));
+    detail::KeySchema& child = schema_->property(std::string(key.name));
+    if (child.help.empty()) child.help = key.help;
     YAML::Node n;
     if (it == index_.end()) {  // the same answer each time this pass asks (axisOf reads twice)
       bool wasAbsent = false;
@@ -808,114 +815,114 @@ std::string quoted(std::string_view key) {
   return out;
 }
 
-double MapReader::number(std::string_view key, double def, double min, double max) {
-  if (schema_) schema_->property(std::string(key)).defaultJson = jsonNumber(def);
+double MapReader::number(Key key, double def, double min, double max) {
+  if (schema_) schema_->property(std::string(key.name)).defaultJson = jsonNumber(def);
   auto v = get(key);
   if (!v) return def;
-  return v->asNumber(*diags_, quoted(key), min, max).value_or(def);
+  return v->asNumber(*diags_, quoted(key.name), min, max).value_or(def);
 }
 
-int64_t MapReader::integer(std::string_view key, int64_t def, int64_t min, int64_t max) {
-  if (schema_) schema_->property(std::string(key)).defaultJson = std::to_string(def);
+int64_t MapReader::integer(Key key, int64_t def, int64_t min, int64_t max) {
+  if (schema_) schema_->property(std::string(key.name)).defaultJson = std::to_string(def);
   auto v = get(key);
   if (!v) return def;
-  return v->asInteger(*diags_, quoted(key), min, max).value_or(def);
+  return v->asInteger(*diags_, quoted(key.name), min, max).value_or(def);
 }
 
-std::string MapReader::string(std::string_view key, std::string def) {
-  if (schema_ && !def.empty()) schema_->property(std::string(key)).defaultJson = jsonString(def);
+std::string MapReader::string(Key key, std::string def) {
+  if (schema_ && !def.empty()) schema_->property(std::string(key.name)).defaultJson = jsonString(def);
   auto v = get(key);
   if (!v) return def;
-  return v->asString(*diags_, quoted(key)).value_or(def);
+  return v->asString(*diags_, quoted(key.name)).value_or(def);
 }
 
 void MapReader::markRequired(std::string_view key) {
   if (schema_) schema_->required.insert(std::string(key));
 }
 
-std::optional<std::string> MapReader::requiredString(std::string_view key) {
-  if (schema_) schema_->required.insert(std::string(key));
+std::optional<std::string> MapReader::requiredString(Key key) {
+  if (schema_) schema_->required.insert(std::string(key.name));
   auto v = get(key);
   if (!v) {
-    node_.error(*diags_, "missing required key '" + std::string(key) + "' in " + context_);
+    node_.error(*diags_, "missing required key '" + std::string(key.name) + "' in " + context_);
     return std::nullopt;
   }
-  return v->asString(*diags_, quoted(key));
+  return v->asString(*diags_, quoted(key.name));
 }
 
-bool MapReader::boolean(std::string_view key, bool def) {
-  if (schema_) schema_->property(std::string(key)).defaultJson = def ? "true" : "false";
+bool MapReader::boolean(Key key, bool def) {
+  if (schema_) schema_->property(std::string(key.name)).defaultJson = def ? "true" : "false";
   auto v = get(key);
   if (!v) return def;
-  return v->asBoolean(*diags_, quoted(key)).value_or(def);
+  return v->asBoolean(*diags_, quoted(key.name)).value_or(def);
 }
 
-Vec3 MapReader::vec3(std::string_view key, Vec3 def, double min, double max) {
-  if (schema_) schema_->property(std::string(key)).defaultJson = jsonVec3(def);
+Vec3 MapReader::vec3(Key key, Vec3 def, double min, double max) {
+  if (schema_) schema_->property(std::string(key.name)).defaultJson = jsonVec3(def);
   auto v = get(key);
   if (!v) return def;
-  return v->asVec3(*diags_, quoted(key), min, max).value_or(def);
+  return v->asVec3(*diags_, quoted(key.name), min, max).value_or(def);
 }
 
-Vec3 MapReader::color(std::string_view key, Vec3 def) {
-  if (schema_) schema_->property(std::string(key)).defaultJson = jsonVec3(def);
+Vec3 MapReader::color(Key key, Vec3 def) {
+  if (schema_) schema_->property(std::string(key.name)).defaultJson = jsonVec3(def);
   auto v = get(key);
   if (!v) return def;
-  return v->asColor(*diags_, quoted(key)).value_or(def);
+  return v->asColor(*diags_, quoted(key.name)).value_or(def);
 }
 
-std::string MapReader::choice(std::string_view key, std::string def, const std::vector<std::string>& choices) {
+std::string MapReader::choice(Key key, std::string def, const std::vector<std::string>& choices) {
   if (schema_) {
-    detail::KeySchema& k = schema_->property(std::string(key));
+    detail::KeySchema& k = schema_->property(std::string(key.name));
     for (const auto& c : choices)
       if (std::find(k.choices.begin(), k.choices.end(), c) == k.choices.end()) k.choices.push_back(c);
     if (!def.empty()) k.defaultJson = jsonString(def);
   }
   auto v = get(key);
   if (!v) return def;
-  auto s = v->asString(*diags_, quoted(key));
+  auto s = v->asString(*diags_, quoted(key.name));
   if (!s) return def;
   for (const auto& c : choices)
     if (c == *s) return *s;
   std::string list;
   for (size_t i = 0; i < choices.size(); ++i) list += (i ? ", " : "") + choices[i];
-  v->error(*diags_, quoted(key) + " must be one of " + list + ", got '" + *s + "'" + didYouMean(*s, choices));
+  v->error(*diags_, quoted(key.name) + " must be one of " + list + ", got '" + *s + "'" + didYouMean(*s, choices));
   return def;
 }
 
-std::optional<YNode> MapReader::section(std::string_view key) {
-  if (schema_) schema_->property(std::string(key)).types.insert("map");
+std::optional<YNode> MapReader::section(Key key) {
+  if (schema_) schema_->property(std::string(key.name)).types.insert("map");
   auto v = get(key);
   if (!v) return std::nullopt;
   if (!v->isMap()) {
-    v->error(*diags_, quoted(key) + " must be a map, " + gotText(*v));
+    v->error(*diags_, quoted(key.name) + " must be a map, " + gotText(*v));
     return std::nullopt;
   }
   return v;
 }
 
-std::vector<YNode> MapReader::sequence(std::string_view key) {
+std::vector<YNode> MapReader::sequence(Key key) {
   auto v = get(key);
   if (!v) return {};
   if (schema_ && detail::KeyRecorder::active()->isPlaceholder(v->node())) {  // describing: one placeholder element
     detail::KeyRecorder* r = detail::KeyRecorder::active();
-    detail::KeySchema& s = schema_->property(std::string(key));
+    detail::KeySchema& s = schema_->property(std::string(key.name));
     s.types.insert("sequence");
     YAML::Node element = r->placeholder();
     r->bind(element, s.item());
     return {YNode(node_.fileHandle(), element)};
   }
   if (!v->isSequence()) {
-    v->error(*diags_, quoted(key) + " must be a sequence, " + gotText(*v));
+    v->error(*diags_, quoted(key.name) + " must be a sequence, " + gotText(*v));
     return {};
   }
   return v->items();
 }
 
-std::optional<fs::path> MapReader::path(std::string_view key, const PathPolicy& policy, bool mustExist) {
+std::optional<fs::path> MapReader::path(Key key, const PathPolicy& policy, bool mustExist) {
   auto v = get(key);
   if (!v) return std::nullopt;
-  auto s = v->asString(*diags_, quoted(key));
+  auto s = v->asString(*diags_, quoted(key.name));
   if (!s) return std::nullopt;
   return resolveReference(*v, *s, policy, *diags_, mustExist);
 }
@@ -961,6 +968,14 @@ std::optional<std::pair<YNode, YNode>> describeOneKey(const YNode& node, const s
   r->bind(value, s->property(names[*pick]));
   YAML::Node key(names[*pick]);
   return std::make_pair(YNode(node.fileHandle(), key), YNode(node.fileHandle(), value));
+}
+
+void describeValue(const YNode& node, std::optional<double> above, const std::vector<std::string>& words) {
+  if (detail::KeySchema* s = describing(node.node())) {
+    if (above) s->above = s->above ? std::min(*s->above, *above) : *above;
+    for (const auto& w : words)
+      if (std::find(s->words.begin(), s->words.end(), w) == s->words.end()) s->words.push_back(w);
+  }
 }
 
 std::optional<std::pair<YNode, YNode>> singleKey(const YNode& node, DiagnosticList& diags, const std::string& what,

@@ -199,6 +199,21 @@ std::string pathRefusal(const std::string& written, const std::filesystem::path&
 std::optional<std::filesystem::path> resolveReference(const YNode& at, std::string_view ref, const PathPolicy& policy,
                                                       DiagnosticList& diags, bool mustExist = true);
 
+/// A key of a map as a reader asks for it: its name and, optionally, what it does in one
+/// sentence or two, e.g. `m.integer({"steps", "How many derivation steps to run."}, 5, 0, 1000)`.
+/// The text costs nothing when reading; `sprig schema` writes it into the key's description,
+/// beside the range and default the same call declares, and editors show it on hover. A help
+/// that says "(default: ...)" in words stands for the default (the constant in the call is
+/// then only the reader's placeholder). A bare name converts to a Key without help.
+struct Key {
+  std::string_view name;
+  std::string_view help;
+  Key(const char* keyName) : name(keyName) {}
+  Key(std::string_view keyName) : name(keyName) {}
+  Key(const std::string& keyName) : name(keyName) {}
+  Key(std::string_view keyName, std::string_view keyHelp) : name(keyName), help(keyHelp) {}
+};
+
 /// Reads one YAML map key by key. Every getter marks its key as known; finish() reports
 /// the keys of the map that no getter asked for. Getters return the default when the key
 /// is absent and also when its value is wrong (after adding a diagnostic), so reading
@@ -214,41 +229,42 @@ class MapReader {
   DiagnosticList& diagnostics() const { return *diags_; }
   /// True if the map has `key` (does not mark it as read).
   bool has(std::string_view key) const;
-  /// The value node of `key` (marks it as known), nullopt when absent.
-  std::optional<YNode> get(std::string_view key);
+  /// The value node of `key` (marks it as known), nullopt when absent. Every getter below
+  /// reads through get.
+  std::optional<YNode> get(Key key);
   /// The key node of `key` (for locations of the key itself).
   std::optional<YNode> keyNode(std::string_view key) const;
   /// Marks keys as known without reading them (keys another reader handles).
   void allow(std::initializer_list<std::string_view> keys);
 
   /// A finite real number within [min, max]; `def` when absent.
-  double number(std::string_view key, double def, double min = -std::numeric_limits<double>::infinity(),
+  double number(Key key, double def, double min = -std::numeric_limits<double>::infinity(),
                 double max = std::numeric_limits<double>::infinity());
   /// An integer within [min, max]; `def` when absent.
-  int64_t integer(std::string_view key, int64_t def, int64_t min = std::numeric_limits<int64_t>::min(),
+  int64_t integer(Key key, int64_t def, int64_t min = std::numeric_limits<int64_t>::min(),
                   int64_t max = std::numeric_limits<int64_t>::max());
   /// A scalar as text; `def` when absent.
-  std::string string(std::string_view key, std::string def = {});
+  std::string string(Key key, std::string def = {});
   /// A required scalar: adds "missing required key 'K' in <context>" at the map when absent.
-  std::optional<std::string> requiredString(std::string_view key);
+  std::optional<std::string> requiredString(Key key);
   /// Declares key required in this map for `sprig schema` (its `required` list); no effect
   /// when reading. For readers that check a required key's presence themselves.
   void markRequired(std::string_view key);
   /// true/false; `def` when absent.
-  bool boolean(std::string_view key, bool def);
+  bool boolean(Key key, bool def);
   /// `[x, y, z]`; `def` when absent.
-  Vec3 vec3(std::string_view key, Vec3 def, double min = -std::numeric_limits<double>::infinity(),
+  Vec3 vec3(Key key, Vec3 def, double min = -std::numeric_limits<double>::infinity(),
             double max = std::numeric_limits<double>::infinity());
   /// A colour: `[r, g, b]` linear in [0, 1] or `"#rrggbb"` sRGB (returned linear); `def` when absent.
-  Vec3 color(std::string_view key, Vec3 def);
+  Vec3 color(Key key, Vec3 def);
   /// One of `choices` (did-you-mean on a miss); `def` when absent.
-  std::string choice(std::string_view key, std::string def, const std::vector<std::string>& choices);
+  std::string choice(Key key, std::string def, const std::vector<std::string>& choices);
   /// A nested map; nullopt when absent or not a map (the latter adds an error).
-  std::optional<YNode> section(std::string_view key);
+  std::optional<YNode> section(Key key);
   /// A sequence's elements; empty when absent or not a sequence (the latter adds an error).
-  std::vector<YNode> sequence(std::string_view key);
+  std::vector<YNode> sequence(Key key);
   /// A file reference resolved with resolveReference; nullopt when absent or refused.
-  std::optional<std::filesystem::path> path(std::string_view key, const PathPolicy& policy, bool mustExist = true);
+  std::optional<std::filesystem::path> path(Key key, const PathPolicy& policy, bool mustExist = true);
 
   /// Reports every key of the map not read or allowed: "unknown key 'K' in <context>"
   /// plus "did you mean" among the known keys. Call once, after all getters.
@@ -278,6 +294,11 @@ class MapReader {
 /// alike; singleKey uses its `what` ("distance field" -> distance_field).
 std::optional<std::pair<YNode, YNode>> describeOneKey(const YNode& node, const std::vector<std::string>& names,
                                                       const std::string& definition = "");
+
+/// Describe mode (`sprig schema`) only, for a reader that checks a value itself rather
+/// than through a typed read's range: the number at node must be above `above` (exclusive),
+/// and `words` are the only texts it takes (`thickness: fill`). No effect when reading.
+void describeValue(const YNode& node, std::optional<double> above, const std::vector<std::string>& words = {});
 
 /// A map with exactly one key among names (`{sphere: {...}}`): that key and its value.
 /// Otherwise adds "WHAT must be a map with one key, one of: A, B" or "unknown WHAT 'K' (did

@@ -67,29 +67,42 @@ if [ ! -f "$validator_dir/package.json" ] || ! grep -q "\"version\": \"$validato
   mv "$tmp/package" "$validator_dir"
 fi
 
-# ajv-cli 5.0.0 (MIT), the independent JSON Schema validator that checks `sprig schema`
-# against every shipped species (tests/cli/schema_test.sh). npm ci installs exactly the
-# versions of scripts/ajv/package-lock.json, each checked by its integrity hash, under
-# tools/ajv (not committed).
-ajv_dir="$(dirname "$0")/../tools/ajv"
-if [ ! -x "$ajv_dir/node_modules/.bin/ajv" ] || ! cmp -s "$(dirname "$0")/ajv/package-lock.json" "$ajv_dir/package-lock.json"; then
-  echo "sprig: installing ajv-cli (scripts/ajv/package-lock.json)"
+# npm packages the tests run, each installed from its lock file under tools/NAME (not
+# committed): npm ci installs exactly the versions of scripts/NAME/package-lock.json, each
+# checked by its integrity hash. Usage: npm_locked NAME BIN (BIN: the installed program
+# whose presence means "installed").
+npm_locked() {
+  local name=$1 bin=$2 dir
+  dir="$(dirname "$0")/../tools/$name"
+  if [ -x "$dir/node_modules/.bin/$bin" ] && cmp -s "$(dirname "$0")/$name/package-lock.json" "$dir/package-lock.json"; then
+    return 0
+  fi
+  echo "sprig: installing $name (scripts/$name/package-lock.json)"
   if ! command -v npm >/dev/null; then  # Debian's nodejs comes without npm; NodeSource's has it
     $([ "$(id -u)" -ne 0 ] && echo sudo) apt-get install -y -q --no-install-recommends npm
   fi
-  mkdir -p "$ajv_dir"
-  cp "$(dirname "$0")/ajv/package.json" "$(dirname "$0")/ajv/package-lock.json" "$ajv_dir/"
+  mkdir -p "$dir"
+  cp "$(dirname "$0")/$name/package.json" "$(dirname "$0")/$name/package-lock.json" "$dir/"
   # As for the validator above, the lock file's integrity hashes (SHA-512 of every
   # tarball), not TLS, vouch for the packages: where a proxy re-signs HTTPS with a
   # certificate this system does not know, npm retries without verifying it.
-  if ! (cd "$ajv_dir" && npm ci --no-audit --no-fund --loglevel=error) 2>"$ajv_dir/npm-err.txt"; then
-    if grep -q "CERT\|certificate" "$ajv_dir/npm-err.txt"; then
+  if ! (cd "$dir" && npm ci --no-audit --no-fund --loglevel=error) 2>"$dir/npm-err.txt"; then
+    if grep -q "CERT\|certificate" "$dir/npm-err.txt"; then
       echo "sprig: the npm registry's TLS certificate is not trusted here; relying on the lock file's integrity hashes"
-      (cd "$ajv_dir" && npm ci --no-audit --no-fund --loglevel=error --strict-ssl=false)
+      (cd "$dir" && npm ci --no-audit --no-fund --loglevel=error --strict-ssl=false)
     else
-      cat "$ajv_dir/npm-err.txt" >&2
+      cat "$dir/npm-err.txt" >&2
       exit 1
     fi
   fi
-  rm -f "$ajv_dir/npm-err.txt"
-fi
+  rm -f "$dir/npm-err.txt"
+}
+
+# ajv-cli 5.0.0 (MIT), the independent JSON Schema validator that checks `sprig schema`
+# against every shipped species (tests/cli/schema_test.sh), into tools/ajv.
+npm_locked ajv ajv
+# yaml-language-server 1.25.0 (MIT), the YAML language server of VS Code's YAML extension,
+# Neovim's yamlls and most other editors: tests/editor/run.sh checks that it reports what
+# `sprig check` reports, through `sprig schema`; into tools/yaml-language-server. (2.x
+# needs Node.js 22 or newer; the project's machines have 20.)
+npm_locked yaml-language-server yaml-language-server

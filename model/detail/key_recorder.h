@@ -38,10 +38,13 @@ struct KeySchema {
   /// "sequence". Several = the reader accepts any of them there.
   std::set<std::string> types;
   std::optional<double> min, max;    ///< range of numbers (of each element for vec3)
+  std::optional<double> above;       ///< numbers must exceed this (describeValue)
+  std::vector<std::string> words;    ///< the only texts taken beside a number (describeValue)
   std::vector<std::string> choices;  ///< MapReader::choice's closed set
   std::vector<std::string> oneKey;   ///< singleKey: a map with exactly one of these keys
   std::string defaultJson;           ///< the default as JSON (empty: none / required)
   std::string context;               ///< the map's name in the reader's messages ("render.view")
+  std::string help;                  ///< what the key does (Key::help), for the description
   bool closed = false;               ///< a map whose finish() ran: other keys are errors
   int finishes = 0;                  ///< passes whose reader finished this map (how well its keys are known)
   bool dataKeys = false;             ///< a map whose keys are names the file chooses (materials, defines)

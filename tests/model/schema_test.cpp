@@ -1,0 +1,94 @@
+// speciesSchemaJson: what editors read from the schema beside the keys (descriptions, the
+// colour messages, values a reader checks itself). tests/cli/schema_test.sh validates the
+// schema with ajv and tests/editor/run.py runs it in yaml-language-server.
+
+#include <catch2/catch.hpp>
+
+#include <string>
+
+#include "model/schema.h"
+#include "model/yaml_reader.h"
+
+using namespace sprig;
+
+namespace {
+
+/// The JSON text of the first property `key` at or after `from` (its description up to
+/// the end of its line: the schema puts one property per line).
+std::string propertyLine(const std::string& schema, const std::string& key, size_t from = 0) {
+  const size_t at = schema.find("\"" + key + "\": {\"description\"", from);
+  if (at == std::string::npos) return "";
+  return schema.substr(at, schema.find('\n', at) - at);
+}
+
+}  // namespace
+
+TEST_CASE("speciesSchemaJson", "[model]") {
+  const std::string schema = speciesSchemaJson();
+
+  SECTION("a key's description says what it does, then its place, type, range and default") {
+    const size_t tree = schema.find("\"tree\": {\"type\": \"object\"");
+    REQUIRE(tree != std::string::npos);
+    CHECK(propertyLine(schema, "max_modules", tree) ==
+          "\"max_modules\": {\"description\": \"Module limit of the derivation: a grammar that grows past it stops "
+          "with an error.\\n\\nmax_modules: an integer in [1, 4e+09]; default 50000000\", \"default\": 50000000, "
+          "\"type\": \"integer\", \"minimum\": 1, \"maximum\": 4e+09},");
+    // A default stated in words replaces the reader's placeholder constant.
+    const std::string steps = propertyLine(schema, "steps", tree);
+    CHECK(steps.find("Derivation steps (default: the grammar's `derivation length:`") != std::string::npos);
+    CHECK(steps.find("steps: an integer in [0, 100000]\"") != std::string::npos);
+    CHECK(steps.find("\"default\"") == std::string::npos);
+    // A key without a text keeps the generated part alone.
+    CHECK(propertyLine(schema, "cells").find("\"description\": \"shell.pigment.cells: an integer in [3, 4096]; "
+                                            "default 160\"") != std::string::npos);
+    // The one-line help of a shell part's key.
+    CHECK(propertyLine(schema, "spacing").find("\"description\": \"Angle between successive varices") !=
+          std::string::npos);
+  }
+
+  SECTION("every key of render: says what it does") {
+    for (const char* key : {"width", "height", "samples", "sampler", "thin_min_pixels", "mesher", "simplify", "wind",
+                            "view", "background", "background_color", "ground", "ground_color", "sun", "exposure",
+                            "camera", "fill", "sky", "unlit_sky_samples", "color", "roughness", "specular", "wood",
+                            "leaf", "fruit", "palette", "radius_scale", "organs"}) {
+      const size_t render = schema.find("\"render\": {\"description\"");
+      REQUIRE(render != std::string::npos);
+      INFO(key);
+      const std::string line = propertyLine(schema, key, render);
+      const std::string generatedOnly = "\"" + std::string(key) + "\": {\"description\": \"render.";
+      REQUIRE(!line.empty());
+      CHECK(line.compare(0, generatedOnly.size(), generatedOnly) != 0);  // a text comes first
+    }
+  }
+
+  SECTION("a colour is a pattern or a triple, each with a readable message") {
+    const std::string wood = propertyLine(schema, "wood");
+    CHECK(wood.find("\"pattern\": \"^\\\\s*#[0-9A-Fa-f]{6}\\\\s*$\"") != std::string::npos);
+    CHECK(wood.find("\"patternErrorMessage\": \"Expected a colour: \\\"#rrggbb\\\" (six hex digits, sRGB) or [r, g, "
+                    "b] (linear, each from 0 to 1).\"") != std::string::npos);
+    CHECK(wood.find("\"errorMessage\": \"A colour's r, g and b are linear, each from 0 to 1.\"") != std::string::npos);
+  }
+
+  SECTION("a layer's thickness: a positive number or fill, as the reader checks it") {
+    const std::string thickness = propertyLine(schema, "thickness");
+    CHECK(thickness.find("a number > 0 or fill") != std::string::npos);
+    CHECK(thickness.find("{\"type\": \"number\", \"exclusiveMinimum\": 0}, {\"enum\": [\"fill\"]}") !=
+          std::string::npos);
+  }
+
+  SECTION("no union type lists (ajv's strict mode refuses them)") {
+    CHECK(schema.find("\"type\": [") == std::string::npos);
+  }
+}
+
+TEST_CASE("Key", "[model]") {
+  // A help text changes nothing when reading: the same value, the same messages.
+  DiagnosticList diags;
+  auto file = YamlFile::parse("steps: 7\nwidth: 9000\n", "k.yaml", diags);
+  REQUIRE(file);
+  MapReader m(file->rootNode(), diags, "species file");
+  CHECK(m.integer({"steps", "How many steps."}, 5, 0, 10) == 7);
+  CHECK(m.integer({"width", "Image width."}, 800, 16, 8192) == 800);
+  REQUIRE(diags.items().size() == 1);
+  CHECK(diags.items()[0].message == "'width' is 9000, out of range [16, 8192]");
+}
