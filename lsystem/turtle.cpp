@@ -166,6 +166,8 @@ Turtle::Turtle(const SymbolTable& symbols, TurtleSettings settings) : symbols_(s
       c = Command::ContourSides;
     } else if (n == "@Tx") {
       c = Command::Texture;
+    } else if (n == "@L") {
+      c = Command::Label;
     } else if (n == "?P" || n == "?H" || n == "?L" || n == "?U") {
       c = Command::Query;
     } else if (n.size() > 1 && n[0] == '~') {
@@ -335,6 +337,8 @@ class TurtleWalk {
         case Command::GcEnd: gcPoint(i, true); break;
         case Command::Contour: contour(i); break;
         case Command::Texture: texture(i); break;
+        case Command::Label:  // cpfg's @L("format", values) writes text at the turtle
+          throw InputError(SourceLoc{"sprig", 0, 0}, "cpfg's '@L' (label) is not supported: Sprig draws no text");
         case Command::GcRadiusTangents: gcRadiusTangents(i); break;
         case Command::ContourSides:
           // cpfg's `@!(n)`: points around a contour (at least 3; 8 without a parameter).

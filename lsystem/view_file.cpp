@@ -328,6 +328,10 @@ class ViewParser {
         }
       for (const char* k : kFileKeys)
         if (key == k) {
+          if (key == "tsurface") {
+            const size_t at = value.find_first_not_of(" \t");
+            if (at != std::string::npos) view_.tsurfaceIds += value[at];
+          }
           warn(line, kcol, "'" + key + ":' ignored: the grammar's uses of it are errors (not supported)");
           return;
         }

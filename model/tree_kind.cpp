@@ -834,6 +834,7 @@ lsystem::Grammar speciesGrammar(const Species& species, const lsystem::GrammarOv
     o.cpfgCurves = tree.view->curves;
     o.cpfgFunctionNames = tree.view->functionNames;
     for (const auto& sf : tree.view->surfaces) o.cpfgSurfaceIds += sf.id;
+    o.cpfgUndrawnSurfaceIds = tree.view->tsurfaceIds;
   }
   for (const auto& d : extra.defines) o.defines.push_back(d);
   if (extra.derivationLength) o.derivationLength = extra.derivationLength;

@@ -19,7 +19,6 @@ constexpr Unsupported kUnsupported[] = {
     {"@PS", "L-system defined surface patch"},
     {"@PC", "L-system defined surface patch"},
     {"@PD", "L-system defined surface patch"},
-    {"@L", "label"},
     {"@S", "system call"},
     {"@I", "rayshade object"},
     {"@J", "rayshade grid"},
@@ -50,6 +49,7 @@ std::optional<std::string> cpfgUnsupported(std::string_view name, size_t args, b
   };
   for (const Unsupported& u : kUnsupported)
     if (name == u.name) return notSupported(name, u.what);
+  if (name == "@L" && dialect != Dialect::Cpfg) return notSupported(name, "label");
   if (name == "@Tx" && dialect != Dialect::Cpfg)
     return std::string("cpfg's '@Tx' (texture) is supported only in cpfg's notation (a .l file), with a view file's 'texture:' lines");
   if (name == "@") {

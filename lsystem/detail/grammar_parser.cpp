@@ -62,6 +62,10 @@ std::optional<Header> bareBlockKeyword(const std::string& s, int b) {
 }
 
 
+/// cpfg's `@L("format", values)` outside an interpretation rule (it would be in the string).
+constexpr const char* kLabelOutsideInterpretation =
+    "cpfg's '@L' (label) is supported only in interpretation rules (Sprig draws no text: drawing one is an error)";
+
 /// Most elements of all of cpfg's `define: { array ... }` arrays together.
 constexpr uint32_t kMaxArrayElements = 1u << 24;
 
@@ -109,7 +113,7 @@ class GrammarParser {
     expr_.setGlobals(&prog_.globals);
     prog_.cpfg.functions = overrides.cpfgFunctions;
     prog_.cpfg.curves = overrides.cpfgCurves;
-    scanner_.setCpfgSurfaceIds(overrides.cpfgSurfaceIds);
+    scanner_.setCpfgSurfaceIds(overrides.cpfgSurfaceIds, overrides.cpfgUndrawnSurfaceIds);
     if (prog_.dialect == Dialect::Cpfg) scanner_.setPredefined(overrides.cpfgFunctionNames);
     expr_.setTables(&prog_.cpfg);
     for (const char* s : kTurtleSymbols) prog_.symbols.intern(s);
@@ -655,6 +659,7 @@ class GrammarParser {
       WordLint words;
       if (value.b == value.e) error(line, value.b, "the axiom is empty");
       else if (scanner_.tokenizeModules(line, value.b, value.e, [&](const RawModule& m) {
+                 if (m.name == "@L") error(line, m.col, kLabelOutsideInterpretation);
                  bracketModule(line, m, brackets, "the axiom");
                  noteWritten(line, m);
                  lintWord(line, words, &m);
@@ -817,11 +822,22 @@ class GrammarParser {
         lintWords(line, mods);
         for (const RawModule& m : mods) {
           if (block == Block::Interpretation && isQuery(m.name)) error(line, m.col, queryInInterpretation(m.name));
+          const bool label = m.name == "@L";
+          if (label && block != Block::Interpretation) error(line, m.col, kLabelOutsideInterpretation);
           SuccModule sm;
           sm.symbol = prog_.symbols.intern(m.name);
           sm.firstArg = static_cast<uint32_t>(p.args.size());
           sm.argCount = static_cast<uint16_t>(m.args.size());
-          for (const Span& a : m.args) p.args.push_back(expr_.compileArg(scanner_.trim(a), varNames));
+          for (const Span& a : m.args) {
+            const Span t = scanner_.trim(a);
+            if (label && t.b < t.e && scanner_.line(line)[t.b] == '"') {
+              // @L's format: its number among the program's strings (cpfg stores it so).
+              p.args.push_back(Arg{ArgKind::Const, 0, static_cast<double>(prog_.strings.size()), {}});
+              prog_.strings.push_back(scanner_.line(line).substr(t.b, t.e - t.b));
+              continue;
+            }
+            p.args.push_back(expr_.compileArg(t, varNames));
+          }
           p.successor.push_back(sm);
         }
       }

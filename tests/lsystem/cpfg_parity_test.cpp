@@ -409,3 +409,30 @@ TEST_CASE("cpfg parity: a ring L-system joins the ends of the string", "[lsystem
                                       "main L-system of a .l file"));
   }
 }
+
+TEST_CASE("cpfg parity: @L labels in interpretation rules are read; drawing one is an error", "[lsystem][cpfg]") {
+  Parity p = loadParity("label");
+  const ModuleString s = deriveParity(p);
+  checkSame(s, p.grammar.symbols(), cpfgString("label"));
+  Deriver d(p.grammar);
+  d.derive();
+  Turtle t(p.grammar.symbols(), *p.turtle);
+  CHECK(t.run(d.interpret(d.current())).internodes.size() == 3);  // SHOW is 0: no label reached
+  SECTION("a label drawn is an error, not a drawing without its text") {
+    std::string text = readFile(parityAsset("label/plant.l"));
+    text.replace(text.find("#define SHOW 0"), 14, "#define SHOW 1");
+    Grammar g = parseGrammar(text, "plant.l");
+    Deriver dl(g);
+    dl.derive();
+    Turtle tl(g.symbols(), *p.turtle);
+    CHECK_THROWS_WITH(tl.run(dl.interpret(dl.current())), Catch::Contains("cpfg's '@L' (label) is not supported: Sprig draws no text"));
+  }
+  SECTION("elsewhere @L is an error") {
+    CHECK_THROWS_WITH(parseGrammar("axiom: A\nA --> F@L(\"x\")\n", "t.l"),
+                      Catch::Contains("t.l:2:8: error: cpfg's '@L' (label) is supported only in interpretation rules"));
+    CHECK_THROWS_WITH(parseGrammar("axiom: F@L(\"x\")\n", "t.l"),
+                      Catch::Contains("t.l:1:9: error: cpfg's '@L' (label) is supported only in interpretation rules"));
+    CHECK_THROWS_WITH(parseGrammar("axiom: A\ninterpretation:\nA --> F@L(\"x\")\n", "t.lsys"),
+                      Catch::Contains("t.lsys:3:8: error: cpfg's '@L' (label) is not supported"));
+  }
+}

@@ -294,7 +294,7 @@ TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg
     CHECK(errorOf("axiom: F{(1)F}(1)\n") == "t.l:1:9: cpfg's '{(type)' (generalized cylinder) is not supported");
     CHECK(errorOf("axiom: A\nA --> F$A\n") ==
           "t.l:2:8: cpfg's '$' ends a sub-L-system call '?(n, scale)', and this file makes none (ABOP's roll to vertical is '@v' in cpfg)");
-    CHECK(errorOf("axiom: F~l\n") == "t.l:1:9: cpfg's '~l' names no surface: there is no view file with a 'surface:' line");
+    CHECK(errorOf("axiom: F~l\n") == "no error");  // draws nothing, as in cpfg (a warning: cpfg surface files)
     CHECK(errorOf("axiom: ?P(0,0)A\n") == "no error");
     CHECK(errorOf("axiom: A\nhomomorphism\nA --> F?U(0,0,0)\n") ==
           "t.l:3:8: cpfg's query module '?U' in an interpretation rule is not supported (its values would be lost with "
@@ -1052,16 +1052,30 @@ TEST_CASE("cpfg surface files and ~X", "[lsystem][cpfg]") {
     checkNear(sk.internodes[0].start, DVec3(0, 6, 0));
     checkNear(sk.internodes[1].start, DVec3(0, 7, 0));  // ~a(0): nothing drawn, no move
   }
-  SECTION("errors: ~X the view file does not define, malformed surface files and surface: lines") {
-    CHECK(errorOf("axiom: F~l(2)\n") == "t.l:1:9: cpfg's '~l' names no surface: there is no view file with a 'surface:' line");
+  SECTION("~X the view file does not define draws nothing, as in cpfg: a warning; a tsurface's ~X is an error") {
     GrammarOverrides go;
     go.cpfgSurfaceIds = "ab";
+    go.cpfgUndrawnSurfaceIds = "t";
+    const Grammar g = parseGrammar("axiom: F ~c(2) F ~c\n", "t.l", go);
+    REQUIRE(g.warnings().size() == 1);  // once per id
+    CHECK(g.warnings()[0].loc.col == 10);
+    CHECK(g.warnings()[0].message == "cpfg's '~c' names no surface (the view file has no 'surface: c ...' line; it defines "
+                                     "'ab'): it draws nothing, as in cpfg");
+    // Drawn: the two F and nothing else; ~c does not move the turtle (patches.c, determine_end_point).
+    const Skeleton sk = interpret(derive(g), g.symbols(), cpfgTurtleSettings(nullptr, TurtleSettings{}));
+    REQUIRE(sk.internodes.size() == 2);
+    CHECK(sk.organs.empty());
+    CHECK(sk.internodes[1].start.y == Approx(sk.internodes[0].end.y));
     try {
-      parseGrammar("axiom: F ~c\n", "t.l", go);
+      parseGrammar("axiom: F ~t\n", "t.l", go);
       FAIL("no error");
     } catch (const InputError& e) {
-      CHECK(e.diagnostics().front().message == "cpfg's '~c' names no surface: the view file has no 'surface: c ...' line (it defines 'ab')");
+      CHECK(e.diagnostics().front().message ==
+            "cpfg's '~t' names the view file's 'tsurface: t ...' (a triangulated surface), which is not supported");
     }
+    CHECK(parseViewFile("tsurface: t leaf.ts\n", "t.v").tsurfaceIds == "t");
+  }
+  SECTION("errors: malformed surface files and surface: lines") {
     const std::string text = readFile(cpfgAsset("surface/plate.s"));
     auto surfaceError = [&](std::string from, std::string to) {
       std::string t = text;
