@@ -1438,7 +1438,8 @@ class GrammarParser {
       if (!u.context) predecessors[u.name].emplace(u.arity, &u);
     for (const auto& [name, counts] : predecessors) {
       auto w = written_.find(name);
-      if (w == written_.end() || isTurtleSymbol(name)) continue;
+      // (cpfg's `_`, its old elasticity, is a turtle command too: `_(e)` or `_` alone.)
+      if (w == written_.end() || isTurtleSymbol(name) || (prog_.dialect == Dialect::Cpfg && name == "_")) continue;
       bool reported = std::any_of(counts.begin(), counts.end(), [&](const auto& c) { return !w->second.count(c.first); });
       if (reported) continue;
       const ArityUse& prod = *counts.begin()->second;

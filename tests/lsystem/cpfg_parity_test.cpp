@@ -387,6 +387,11 @@ TEST_CASE("cpfg parity: an expression statement is evaluated and dropped", "[lsy
   checkSame(deriveParity(p), p.grammar.symbols(), cpfgString("expression_statement"));
 }
 
+TEST_CASE("cpfg parity: '_' is a command, written with any parameter count", "[lsystem][cpfg]") {
+  Parity p = loadParity("elasticity_module");
+  checkSame(deriveParity(p), p.grammar.symbols(), cpfgString("elasticity_module"));
+}
+
 TEST_CASE("cpfg parity: the axiom reads the globals the Start: block set", "[lsystem][cpfg]") {
   Parity p = loadParity("axiom_globals");
   checkSame(deriveParity(p), p.grammar.symbols(), cpfgString("axiom_globals"));
