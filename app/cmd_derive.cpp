@@ -98,9 +98,12 @@ int runDerive(const DeriveArgs& a, const GlobalOptions& g) {
   const int last = engine.lastStep();
   const lsystem::ModuleString& modules = engine.modulesAt(last);
   Derived t{last, engine.seed(), modules, engine.symbols(), {}, {}, {}};
-  if (a.skeletonOut.empty()) {
+  // --print alone draws nothing: the string does not need the turtle (so a view file
+  // command Sprig cannot draw, such as cpfg's 'line:', does not stop it).
+  const bool drawn = a.json || !a.print || !a.skeletonOut.empty();
+  if (drawn && a.skeletonOut.empty()) {
     t.summary = engine.summaryAt(last, &t.end);
-  } else {
+  } else if (drawn) {
     t.skeleton = engine.skeletonAt(last, &t.end);
     t.summary = {t.skeleton.internodes.size(), t.skeleton.totalLength(), t.skeleton.bounds(), {}};
   }

@@ -204,6 +204,16 @@ struct Deriver::Impl {
 
   /// The turtle that fills query modules (made on first use).
   std::unique_ptr<Turtle> queryTurtle;
+  /// The current string's query modules wait for the next step to fill them
+  /// (DeriveOptions::queriesAfterLastStep).
+  bool queriesPending = false;
+
+  /// After step `stepDone` (0: the axiom): fills the query modules, or, for the last step
+  /// when cpfg -g would not draw it, leaves them to the next step.
+  void queriesAfter(int stepDone) {
+    queriesPending = !opt.queriesAfterLastStep && stepDone >= steps;
+    if (!queriesPending) fillQueries();
+  }
 
   /// cpfg's query modules: interprets cur (through the interpretation rules, which hold
   /// no query module) and writes the turtle's frame at each query module it reaches into
@@ -365,6 +375,11 @@ struct Deriver::Impl {
     const size_t g = prog->globals.size();
     for (size_t k = 0; k < g; ++k) vars[detail::kMaxVars - 1 - k] = globals[k];
   }
+  /// The globals a rule's statements assigned (cpfg's notation), for every rule after it.
+  void storeGlobals(const double* vars) {
+    const size_t g = prog->globals.size();
+    for (size_t k = 0; k < g; ++k) globals[k] = vars[detail::kMaxVars - 1 - k];
+  }
 
   detail::Draws* moduleRng() {
     if (cpfgSemantics) {
@@ -419,19 +434,29 @@ struct Deriver::Impl {
   /// from j; n when the walk fails (end of string or a `]`).
   size_t walkRight(const ModuleString& s, size_t j) const {
     const size_t n = s.size();
+    bool wrapped = false;
     for (;;) {
+      if (j >= n && prog->ring && !wrapped && n > 0) {  // cpfg's ring L-system: on from the start
+        j = 0;
+        wrapped = true;
+      }
       if (j >= n) return n;
       SymbolId c = s.symbols[j];
-      if (c == prog->openBracket) j = static_cast<size_t>(match[j]) + 1;
+      if (ignoredTab[c]) ++j;  // brackets only in cpfg's notation (RconDiff skips them first)
+      else if (c == prog->openBracket) j = static_cast<size_t>(match[j]) + 1;
       else if (c == prog->closeBracket) return n;
-      else if (ignoredTab[c]) ++j;
       else return j;
     }
   }
 
   /// Position of the first module a left pattern item compares with, walking left from j; -1 on failure.
   ptrdiff_t walkLeft(const ModuleString& s, ptrdiff_t j) const {
+    bool wrapped = false;
     for (;;) {
+      if (j < 0 && prog->ring && !wrapped) {  // cpfg's ring L-system: on from the end
+        j = static_cast<ptrdiff_t>(s.size()) - 1;
+        wrapped = true;
+      }
       if (j < 0) return -1;
       SymbolId c = s.symbols[j];
       if (c == prog->closeBracket) {
@@ -462,6 +487,13 @@ struct Deriver::Impl {
       j = rightNeighbour;
       if (j >= n) return false;
     }
+    size_t wraps = 0;  // cpfg's ring L-system: at the end of the string, on from the start
+    auto wrap = [&] {
+      if (j < n || !prog->ring || n == 0 || wraps > pat.size()) return false;
+      j = 0;
+      ++wraps;
+      return true;
+    };
     for (const PatternItem& it : pat) {
       if (it.skipBranch || (it.closeBracket && !cpfg)) {  // to the `]` closing the current branch
         while (j < n && s.symbols[j] != prog->closeBracket) {
@@ -474,16 +506,16 @@ struct Deriver::Impl {
         continue;
       }
       for (;;) {
-        if (j >= n) return false;
+        if (j >= n && !wrap()) return false;
         SymbolId c = s.symbols[j];
-        if (c == prog->openBracket) {
+        if (ignoredTab[c]) {
+          ++j;
+        } else if (c == prog->openBracket) {
           if (it.openBracket) break;
           j = static_cast<size_t>(match[j]) + 1;
         } else if (c == prog->closeBracket) {
           if (it.closeBracket) break;
           return false;
-        } else if (ignoredTab[c]) {
-          ++j;
         } else {
           break;
         }
@@ -544,6 +576,7 @@ struct Deriver::Impl {
   /// Binds p's formal parameters at module i when the predecessor and contexts match.
   bool matches(const Production& p, const ModuleString& s, size_t i, double* vars) {
     if (s.paramCount(i) != p.predParams) return false;
+    if (prog->rulesAssignGlobals) loadGlobals(vars);  // as the rules before this one left them
     bind(s, i, p.predFirstVar, p.predParams, vars);
     if (!p.predRest.empty()) {
       // cpfg's predecessor of several modules: the next modules as they stand (PredDiff).
@@ -596,6 +629,7 @@ struct Deriver::Impl {
     const Instr* code = prog->code.data();
     double v = detail::evalCode(code + r.begin, code + r.end, vars, p.usesRandom ? moduleRng() : nullptr, &prog->strings, &effects,
                                 &prog->cpfg, arrays.data());
+    if (prog->rulesAssignGlobals) storeGlobals(vars);
     if (std::isnan(v))
       throw InputError(p.loc, "the statements of production '" + p.text + "' loop more than " +
                                   std::to_string(detail::kMaxLoopJumps) + " times at step " + std::to_string(step),
@@ -672,6 +706,7 @@ struct Deriver::Impl {
       const Production& p = rs.productions[ids[c]];
       if ((scaled -= static_cast<float>(p.stochastic ? p.weight : 1.0)) <= 0) {
         std::copy_n(candidateVars.data() + c * detail::kMaxVars, detail::kMaxVars, vars);
+        if (prog->rulesAssignGlobals) loadGlobals(vars);  // every candidate's statements ran
         afterStatements(p, vars, step);
         return &p;
       }
@@ -1151,8 +1186,9 @@ struct Deriver::Impl {
     // modules the step skips.)
     // cpfg's stochastic L-system: one drand48 draw for every module a step visits.
     const bool cpfgChoice = productionStep && cpfgSemantics && stochasticCpfg();
-    const bool general =
-        decompose || segIn || cpfgChoice || (cutSym >= 0 && rs.rules[static_cast<size_t>(cutSym)].count > 0);
+    // (Rules that assign globals run one module after another, never in the size pass.)
+    const bool general = decompose || segIn || cpfgChoice || prog->rulesAssignGlobals || prog->ring ||
+                         (cutSym >= 0 && rs.rules[static_cast<size_t>(cutSym)].count > 0);
     if (segOut) segOut->clear();
     uint32_t segments = 0;
     const SymbolId* syms = in.symbols.data();
@@ -1176,7 +1212,10 @@ struct Deriver::Impl {
       SymbolId sym = syms[i];
       int32_t birth = births ? in.birthSteps[i] : 0;
       const detail::SymbolRules& r = rules[sym];
-      const double draw = cpfgChoice ? cpfgRandom.choice.next() : -1;  // drawn before any cut, as cpfg does
+      double draw = cpfgChoice ? cpfgRandom.choice.next() : -1;  // drawn before any cut, as cpfg does
+      // A command a rule for its letter rewrites: cpfg visits '@' first, the letter last.
+      const bool split = cpfgChoice && sym < prog->splitCommand.size() && prog->splitCommand[sym];
+      for (size_t k = 1; split && k < prog->symbols.name(sym).size(); ++k) draw = cpfgRandom.choice.next();
       if (r.count == 0 && pendingCutAt(in, i) && !(decompose && !prog->decomposition.bySymbol[sym].empty())) {
         i = cutEnd(in, i, n) - 1;  // cpfg's cut, made when the step reaches it
         continue;
@@ -1223,7 +1262,7 @@ struct Deriver::Impl {
         continue;
       }
       if (!p) {
-        if (cpfgChoice) copiedCharacterDraws(sym, decompose ? &prog->decomposition : nullptr);
+        if (cpfgChoice && !split) copiedCharacterDraws(sym, decompose ? &prog->decomposition : nullptr);
         if (decompose && productionStep) {
           i += emitDecomposed(w, in, i, birth, step, prog->decomposition);
         } else {
@@ -1302,6 +1341,25 @@ struct Deriver::Impl {
     if (prog->usesCut && prog->dialect != detail::Dialect::Cpfg) applyCuts(cur);
   }
 
+  /// cpfg's axiom parameters that read global variables, evaluated once the `Start:` block
+  /// has run (control.c, Rewind: EvaluateStartStatements, then CreateParameterString);
+  /// their random draws come from cpfg's stream, after the block's.
+  void evaluateDeferredAxiom() {
+    if (prog->axiomDeferred.empty()) return;
+    double vars[detail::kMaxVars] = {};
+    loadGlobals(vars);
+    detail::Draws d{nullptr, &cpfgRandom};
+    const Instr* code = prog->code.data();
+    for (const auto& [index, r] : prog->axiomDeferred) {
+      const double v =
+          detail::evalCode(code + r.begin, code + r.end, vars, &d, nullptr, nullptr, &prog->cpfg, arrays.data());
+      if (!std::isfinite(v))
+        throw InputError(prog->axiomLoc, "non-finite parameter value (" + numberText(v) + ") in the axiom, from the values "
+                                         "the 'Start:' block gave its global variables", prog->axiomLine);
+      cur.params[index] = static_cast<double>(static_cast<float>(v));
+    }
+  }
+
   void start() {
     globals.assign(detail::kMaxVars, 0.0);
     arrays = prog->cpfg.arrayInit;
@@ -1315,6 +1373,7 @@ struct Deriver::Impl {
     steps = baseSteps;
     runBlock(prog->startBlock, 0, 0);
     cur = prog->axiom;
+    evaluateDeferredAxiom();
     if (cur.size() > opt.maxModules) Writer::overLimit(opt.maxModules, limitAt, 0);
     if (opt.trackBirthSteps) cur.birthSteps.assign(cur.size(), 0);
     // cpfg's notation: cpfg neither decomposes nor cuts the axiom before the first step
@@ -1329,7 +1388,7 @@ struct Deriver::Impl {
       cutAfterStep();
     }
     written = 0;
-    fillQueries();
+    queriesAfter(0);
   }
 };
 
@@ -1357,6 +1416,10 @@ void Deriver::restart() {
 const ModuleString& Deriver::step() {
   Impl& m = *impl_;
   int step = m.done + 1;
+  if (m.queriesPending) {
+    m.queriesPending = false;
+    m.fillQueries();  // cpfg interprets the string when the next step starts
+  }
   m.runBlock(m.prog->startEachBlock, step, step - 1);
   m.rewrite(m.prog->productions, step, static_cast<uint64_t>(step - m.streamBase), true);
   m.runBlock(m.prog->endEachBlock, step, step);
@@ -1364,7 +1427,7 @@ const ModuleString& Deriver::step() {
   if (m.effects.stop) m.steps = step;
   if (step == m.steps) m.runBlock(m.prog->endBlock, step, step);
   m.done = step;
-  m.fillQueries();
+  m.queriesAfter(step);
   if (m.opt.onStep) m.opt.onStep(step, m.cur.size());
   return m.cur;
 }

@@ -44,6 +44,12 @@ struct DeriveOptions {
   /// frame) in its first 2 or 3 parameters. Unset: the grammar's own (cpfg's defaults for a
   /// `.l`, its `angle:` or 45 degrees).
   std::optional<TurtleSettings> queryTurtle;
+  /// Fill the query modules after the last step too (cpfg interprets the final string when
+  /// it draws it). False: the string of step steps() (and of any step past it) keeps its
+  /// query modules as that step wrote them, as `cpfg -g -str` writes it when the view file
+  /// has a `box:` line (control.c, CalculateViewVolume interprets only without one); a
+  /// later step() fills them first, as cpfg does when the next step starts.
+  bool queriesAfterLastStep = true;
   /// Called after every completed step with (step, module count); may be empty.
   std::function<void(int step, size_t modules)> onStep;
 };

@@ -61,8 +61,11 @@ struct GrammarOverrides {
   /// `curveY`, `curveZ` and `curveGAL(n)` read; without them these are errors.
   std::vector<CpfgCurve> cpfgCurves;
   /// The ids of the view file's surfaces (ViewFile::surfaces), which `~X` may name; any
-  /// other `~X` in a `.l` grammar is an error.
+  /// other `~X` in a `.l` grammar draws nothing, as in cpfg (a warning).
   std::string cpfgSurfaceIds;
+  /// The ids of the view file's `tsurface:` lines, which cpfg draws and Sprig does not read:
+  /// a `~X` of one is an error (any other id no `surface:` line defines draws nothing).
+  std::string cpfgUndrawnSurfaceIds;
   /// cpfg: the names of a view file's `function set:` functions (ViewFile::functionNames),
   /// which the preprocessor defines as 1, 2, ... in a `.l` grammar.
   std::vector<std::string> cpfgFunctionNames;

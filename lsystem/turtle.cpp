@@ -166,6 +166,8 @@ Turtle::Turtle(const SymbolTable& symbols, TurtleSettings settings) : symbols_(s
       c = Command::ContourSides;
     } else if (n == "@Tx") {
       c = Command::Texture;
+    } else if (n == "@L") {
+      c = Command::Label;
     } else if (n == "?P" || n == "?H" || n == "?L" || n == "?U") {
       c = Command::Query;
     } else if (n.size() > 1 && n[0] == '~') {
@@ -325,7 +327,7 @@ class TurtleWalk {
         case Command::Query:
           if (queries_) queries_->push_back({i, st_.frame});
           break;
-        case Command::SubCall: subCall(i); break;
+        case Command::SubCall: i = subCall(i); break;
         case Command::SubEnd: subEnd(); break;
         case Command::GcStart:
           gcRestart();
@@ -335,6 +337,8 @@ class TurtleWalk {
         case Command::GcEnd: gcPoint(i, true); break;
         case Command::Contour: contour(i); break;
         case Command::Texture: texture(i); break;
+        case Command::Label:  // cpfg's @L("format", values) writes text at the turtle
+          throw InputError(SourceLoc{"sprig", 0, 0}, "cpfg's '@L' (label) is not supported: Sprig draws no text");
         case Command::GcRadiusTangents: gcRadiusTangents(i); break;
         case Command::ContourSides:
           // cpfg's `@!(n)`: points around a contour (at least 3; 8 without a parameter).
@@ -897,14 +901,28 @@ class TurtleWalk {
   /// the enclosing one times s (unchanged without s), and so do the turtle scale and the
   /// line width (in proportion). The scales form a stack of their own, which `[` and `]`
   /// do not save.
-  void subCall(size_t i) {
-    if (!hasParam(i)) return;
+  /// cpfg's `?(n, s)` (a sub-L-system call); returns the last module it takes. A `?`
+  /// without parameters is cpfg's query whose letter is the next module (interpret.c, case
+  /// '?'): that module is taken and nothing drawn (cpfg warns "unknown query"), unless it
+  /// is a letter cpfg would fill (P H L U Q E), a bracket or a module of several
+  /// characters, which are errors.
+  size_t subCall(size_t i) {
+    if (!hasParam(i)) {
+      if (i + 1 >= n_) return i;
+      const std::string& next = symbols_.name(sym_[i + 1]);
+      if (next.size() != 1 || std::string_view("PHLUQE[]").find(next[0]) != std::string_view::npos)
+        throw InputError(SourceLoc{"sprig", 0, 0}, "cpfg's '?' followed by the module '" + next +
+                                                       "' (cpfg reads it as the query '?" + next +
+                                                       "') is not supported");
+      return i + 1;
+    }
     if (subScales_.empty()) subScales_.push_back(settings_.initialScale);
     const double outer = subScales_.back();
     const double inner = off_[i + 1] - off_[i] >= 2 ? outer * prm_[off_[i] + 1] : outer;
     subScales_.push_back(inner);
     st_.scale = inner;
     st_.width = outer != 0 ? st_.width * inner / outer : st_.width;
+    return i;
   }
 
   /// cpfg's `$`: back to the enclosing sub-L-system's scale (an unmatched `$` does nothing,

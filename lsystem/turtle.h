@@ -180,7 +180,7 @@ class Turtle {
     PolygonEnd, Surface, SurfaceNamed, Cut, Tropism, Sphere, WidthUp, ColorUp, ColorDown, Circle, Disc,
     TropismUp, TropismDown, TwistAdjust, TwistForce, MoveTo, SetHeading, ScaleSet, ScaleUp, ScaleDown, OldElasticity,
     Query, SubCall, SubEnd, GcStart, GcPoint, GcEnd, GcTangents, Contour, ContourSides, GcRadiusTangents,
-    Texture
+    Texture, Label
   };
   /// The command bound to symbol id `s` (None for ids outside the table).
   Command commandOf(SymbolId s) const { return s < commands_.size() ? commands_[s] : Command::None; }

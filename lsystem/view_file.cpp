@@ -316,16 +316,28 @@ class ViewParser {
     } else {
       for (const UnsupportedKey& u : kUnsupportedKeys)
         if (key == u.key) {
-          error(line, kcol, std::string("cpfg's view file command '") + u.key + ":' (" + u.what + ") is not supported");
+          // Only drawing needs it (cpfg -g derives without): an error when the plant is drawn.
+          if (!view_.unsupportedDrawing) {
+            Diagnostic d;
+            d.loc = SourceLoc{view_.file, line, static_cast<int>(kcol) + 1};
+            d.message = std::string("cpfg's view file command '") + u.key + ":' (" + u.what + ") is not supported";
+            d.sourceLine = raw_;
+            view_.unsupportedDrawing = d;
+          }
           return;
         }
       for (const char* k : kFileKeys)
         if (key == k) {
+          if (key == "tsurface") {
+            const size_t at = value.find_first_not_of(" \t");
+            if (at != std::string::npos) view_.tsurfaceIds += value[at];
+          }
           warn(line, kcol, "'" + key + ":' ignored: the grammar's uses of it are errors (not supported)");
           return;
         }
       for (const char* k : kViewerKeys)
         if (key == k) {
+          if (key == "box") view_.box = true;
           if (viewerKeys_.empty()) {
             viewerLine_ = line;
             viewerRaw_ = raw_;
@@ -647,6 +659,12 @@ class ViewParser {
     const std::string rel = file.lexically_relative(folder.empty() ? "." : folder).generic_string();
     if (std::filesystem::path(name).is_absolute() || rel.empty() || rel.rfind("..", 0) == 0) {
       error(line, words[1].second, "the surface file '" + name + "' is outside the object's folder (only files beside the view file, or in folders below it)");
+      return;
+    }
+    if (!std::filesystem::exists(file)) {
+      // cpfg reads a surface file only when it exists (interpret.c, access()), else the line
+      // defines nothing: a '~X' of it in the grammar is then an error.
+      warn(line, words[1].second, "the surface file '" + name + "' does not exist: the line is skipped, as cpfg skips it");
       return;
     }
     std::string text;

@@ -58,6 +58,17 @@ struct ViewFile {
   /// `contour: id NAME.con`: the contours `@#(id)` selects for generalized cylinders.
   std::vector<CpfgContourEntry> contours;
   std::optional<int> contourSides;  ///< `contour sides: n` (default CpfgContour::kDefaultSides)
+  /// A `box:` line (the view volume): cpfg -g then does not interpret the final string to
+  /// size its window, so that string's query modules keep the values they had before the
+  /// last step (DeriveOptions::queriesAfterLastStep).
+  bool box = false;
+  /// The ids of the `tsurface:` lines (cpfg's triangulated surfaces, not read): a `~X` of
+  /// one is an error in the grammar (GrammarOverrides::cpfgUndrawnSurfaceIds).
+  std::string tsurfaceIds;
+  /// The first command that changes the drawing and that Sprig does not implement (`line:`,
+  /// F drawn as a surface; `background scene:`): an error when the plant is drawn, not when
+  /// it is only derived (the string does not depend on it, as `cpfg -g` shows).
+  std::optional<Diagnostic> unsupportedDrawing;
   /// Warnings about keys read but not used (viewer settings), each at its line.
   std::vector<Diagnostic> warnings;
 };

@@ -25,6 +25,9 @@ GrowthEngine::GrowthEngine(const Species& species, const GrowthOptions& options)
   dopt.maxModules = tree.maxModules;
   dopt.trackBirthSteps = true;
   dopt.queryTurtle = turtle_;  // cpfg's query modules see the turtle that draws the tree
+  // cpfg -g draws no final string when the view file sets the view volume (`box:`)
+  dopt.queriesAfterLastStep = !(tree.view && tree.view->box);
+  if (tree.view) unsupportedDrawing_ = tree.view->unsupportedDrawing;
   deriver_ = std::make_unique<lsystem::Deriver>(*grammar_, dopt);
   lastStep_ = options.lastStep < 0 ? deriver_->steps() : std::min(options.lastStep, deriver_->steps());
 }
@@ -121,8 +124,13 @@ size_t GrowthEngine::moduleCount(int step) {
   return modulesAt(step).size();
 }
 
+void GrowthEngine::refuseDrawing() const {
+  if (unsupportedDrawing_) throw InputError(std::vector<Diagnostic>{*unsupportedDrawing_});
+}
+
 lsystem::Skeleton GrowthEngine::draw(const lsystem::ModuleString& interpreted, const lsystem::TurtleSettings& settings,
                                      lsystem::TurtleState* end) {
+  refuseDrawing();
   const Phase phase("derive");
   lsystem::Turtle turtle(deriver_->symbols(), settings);
   lsystem::Skeleton sk = turtle.run(interpreted, interpreted.birthSteps);
@@ -139,6 +147,7 @@ lsystem::Skeleton GrowthEngine::skeletonAt(int step, lsystem::TurtleState* end) 
 lsystem::SkeletonSummary GrowthEngine::summaryAt(int step, lsystem::TurtleState* end) {
   if (step < 0 || step > lastStep_)
     throw std::invalid_argument("step " + std::to_string(step) + " is outside 0.." + std::to_string(lastStep_));
+  refuseDrawing();
   const Phase phase("derive");
   const lsystem::ModuleString& interpreted = interpretedAt(step);
   lsystem::Turtle turtle(deriver_->symbols(), turtle_);

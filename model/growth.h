@@ -16,9 +16,11 @@
 /// the first time either is asked for.
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "core/diagnostics.h"
 #include "lsystem/derive.h"
 #include "lsystem/grammar.h"
 #include "lsystem/skeleton.h"
@@ -106,6 +108,10 @@ class GrowthEngine {
   /// interpreted_, or the deriver's current string.
   const lsystem::ModuleString& interpreted() const;
   int interpretedStep_ = -1;
+  /// A view file command that changes the drawing and that Sprig does not implement
+  /// (ViewFile::unsupportedDrawing): thrown by every drawing, not by a derivation.
+  std::optional<Diagnostic> unsupportedDrawing_;
+  void refuseDrawing() const;
 };
 
 }  // namespace sprig

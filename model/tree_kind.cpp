@@ -834,6 +834,7 @@ lsystem::Grammar speciesGrammar(const Species& species, const lsystem::GrammarOv
     o.cpfgCurves = tree.view->curves;
     o.cpfgFunctionNames = tree.view->functionNames;
     for (const auto& sf : tree.view->surfaces) o.cpfgSurfaceIds += sf.id;
+    o.cpfgUndrawnSurfaceIds = tree.view->tsurfaceIds;
   }
   for (const auto& d : extra.defines) o.defines.push_back(d);
   if (extra.derivationLength) o.derivationLength = extra.derivationLength;
@@ -991,6 +992,8 @@ TreeSurface buildTreeSurface(const lsystem::Skeleton& skeleton, const organisms:
 }
 
 std::string TreeSpec::checkSummary(const Species& species) const {
+  // A view file command Sprig cannot draw: the grammar derives, the species cannot be shown.
+  if (view && view->unsupportedDrawing) throw InputError(std::vector<Diagnostic>{*view->unsupportedDrawing});
   const size_t productions = grammar ? grammar->productionCount() : 0;
   const int steps = grammar ? grammar->derivationLength() : 0;
   return " '" + species.name + "', " + std::to_string(productions) + " productions, " + std::to_string(steps) +

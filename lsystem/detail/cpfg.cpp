@@ -19,7 +19,6 @@ constexpr Unsupported kUnsupported[] = {
     {"@PS", "L-system defined surface patch"},
     {"@PC", "L-system defined surface patch"},
     {"@PD", "L-system defined surface patch"},
-    {"@L", "label"},
     {"@S", "system call"},
     {"@I", "rayshade object"},
     {"@J", "rayshade grid"},
@@ -50,6 +49,7 @@ std::optional<std::string> cpfgUnsupported(std::string_view name, size_t args, b
   };
   for (const Unsupported& u : kUnsupported)
     if (name == u.name) return notSupported(name, u.what);
+  if (name == "@L" && dialect != Dialect::Cpfg) return notSupported(name, "label");
   if (name == "@Tx" && dialect != Dialect::Cpfg)
     return std::string("cpfg's '@Tx' (texture) is supported only in cpfg's notation (a .l file), with a view file's 'texture:' lines");
   if (name == "@") {
@@ -58,7 +58,12 @@ std::optional<std::string> cpfgUnsupported(std::string_view name, size_t args, b
     return "unknown cpfg command '" + shown + "'";
   }
   if (name == "?") {
-    if (!hasParens || args == 0) return notSupported("?", "a '?' without a query letter or a sub-L-system number");
+    if (!hasParens || args == 0) {
+      // cpfg's '?' without parameters: an ordinary module; its turtle reads the next module
+      // as a query letter (Turtle, SubCall).
+      if (dialect == Dialect::Cpfg && !hasParens) return std::nullopt;
+      return notSupported("?", "a '?' without a query letter or a sub-L-system number");
+    }
     if (args > 2) return std::string("cpfg's sub-L-system call '?(n, scale)' takes 1 or 2 parameters, got ") + std::to_string(args);
     if (dialect != Dialect::Cpfg)
       return std::string("cpfg's '?(n, scale)' (sub-L-system call) is supported only in cpfg's notation (a .l file), where '$' ends it");

@@ -616,7 +616,7 @@ Arg ExpressionParser::compileArg(Span sp, const std::vector<std::string>& vars) 
   return a;
 }
 
-std::optional<double> ExpressionParser::evaluate(Span sp, Rng* rng) {
+std::optional<double> ExpressionParser::evaluate(Span sp, Rng* rng, CodeRange* deferred) {
   size_t before = code_.size();
   bool rnd = usesRandom_;
   usesRandom_ = false;
@@ -626,6 +626,11 @@ std::optional<double> ExpressionParser::evaluate(Span sp, Rng* rng) {
     // the axiom is read before any 'Start:' block runs, so it has no value yet.
     const auto global = std::find_if(code_.begin() + static_cast<std::ptrdiff_t>(before), code_.end(),
                                      [](const Instr& in) { return in.op == Op::Var || in.op == Op::Store; });
+    if (global != code_.end() && deferred && global->op == Op::Var) {
+      *deferred = CodeRange{static_cast<uint32_t>(before), static_cast<uint32_t>(code_.size())};
+      usesRandom_ = rnd;
+      return 0.0;
+    }
     if (global != code_.end()) {
       const size_t k = static_cast<size_t>(kMaxVars - 1 - global->var);
       const std::string name = globals_ && k < globals_->size() ? (*globals_)[k] : std::string("?");

@@ -49,7 +49,10 @@ class ExpressionParser {
   /// to parseModuleString): its value, drawing from rng for `ran`/`nran`. nullopt with an
   /// error reported when it fails to compile, draws without an rng, or is not finite.
   /// The code vector is left unchanged; usesRandom() is not affected.
-  std::optional<double> evaluate(Span sp, Rng* rng);
+  /// deferred (cpfg's axiom): a parameter that reads cpfg's global variables keeps its code
+  /// in the code vector, *deferred is set to it and 0 is returned (the Deriver evaluates it
+  /// after the `Start:` block, as cpfg's Rewind does); without it that is an error.
+  std::optional<double> evaluate(Span sp, Rng* rng, CodeRange* deferred = nullptr);
   /// The left side `name[i][j]` of an assignment to an element of cpfg's array (in sp):
   /// compiles its row-major flat index onto the code vector and returns the array's
   /// number, or nullopt with an error reported (code unchanged).

@@ -61,15 +61,10 @@ std::optional<Header> bareBlockKeyword(const std::string& s, int b) {
   return std::nullopt;
 }
 
-/// cpfg headers Sprig does not implement, with what they are.
-struct UnsupportedHeader {
-  const char* key;
-  const char* shown;
-  const char* what;
-};
-constexpr UnsupportedHeader kUnsupportedHeaders[] = {
-    {"ring lsystem", "ring lsystem:", "ring L-system"},
-};
+
+/// cpfg's `@L("format", values)` outside an interpretation rule (it would be in the string).
+constexpr const char* kLabelOutsideInterpretation =
+    "cpfg's '@L' (label) is supported only in interpretation rules (Sprig draws no text: drawing one is an error)";
 
 /// Most elements of all of cpfg's `define: { array ... }` arrays together.
 constexpr uint32_t kMaxArrayElements = 1u << 24;
@@ -118,7 +113,7 @@ class GrammarParser {
     expr_.setGlobals(&prog_.globals);
     prog_.cpfg.functions = overrides.cpfgFunctions;
     prog_.cpfg.curves = overrides.cpfgCurves;
-    scanner_.setCpfgSurfaceIds(overrides.cpfgSurfaceIds);
+    scanner_.setCpfgSurfaceIds(overrides.cpfgSurfaceIds, overrides.cpfgUndrawnSurfaceIds);
     if (prog_.dialect == Dialect::Cpfg) scanner_.setPredefined(overrides.cpfgFunctionNames);
     expr_.setTables(&prog_.cpfg);
     for (const char* s : kTurtleSymbols) prog_.symbols.intern(s);
@@ -561,20 +556,20 @@ class GrammarParser {
   bool unsupportedHeader(int line, int b) {
     const std::string& s = scanner_.line(line);
     auto header = Scanner::headerOf(s, b);
-    if (header)
-      for (const UnsupportedHeader& u : kUnsupportedHeaders)
-        if (header->key == u.key) {
-          error(line, b, std::string("cpfg's '") + u.shown + "' (" + u.what + ") is not supported");
-          return true;
-        }
     std::string words;
-    for (int i = b; i < static_cast<int>(s.size()) && words.size() < 12; ++i)
+    for (int i = b; i < static_cast<int>(s.size()) && words.size() < 13; ++i)
       if (!isSpace(s[i])) words += static_cast<char>(std::tolower(static_cast<unsigned char>(s[i])));
-    if (words == "ringlsystem" && Scanner::findArrow(s).first < 0) {
-      error(line, b, "cpfg's 'ring lsystem' (ring L-system) is not supported");
-      return true;
+    const bool ring = (header && header->key == "ring lsystem") ||
+                      ((words == "ringlsystem" || words == "ringlsystem:") && Scanner::findArrow(s).first < 0);
+    if (!ring) return false;
+    if (prog_.dialect == Dialect::Cpfg && subs_.empty()) {
+      // cpfg's ring L-system (3.1.1): context matching joins the string's ends.
+      once("ring lsystem", line, b);
+      prog_.ring = true;
+    } else {
+      error(line, b, std::string("cpfg's 'ring lsystem' (ring L-system) is supported only for the main L-system of a .l file"));
     }
-    return false;
+    return true;
   }
 
   /// Records header key at line (per L-system: a sub-L-system has its own); a second one is
@@ -664,6 +659,7 @@ class GrammarParser {
       WordLint words;
       if (value.b == value.e) error(line, value.b, "the axiom is empty");
       else if (scanner_.tokenizeModules(line, value.b, value.e, [&](const RawModule& m) {
+                 if (m.name == "@L") error(line, m.col, kLabelOutsideInterpretation);
                  bracketModule(line, m, brackets, "the axiom");
                  noteWritten(line, m);
                  lintWord(line, words, &m);
@@ -678,25 +674,19 @@ class GrammarParser {
       if (block != Block::Main) error(line, b, "'" + h.key + ":' belongs before the decomposition and interpretation blocks");
       std::vector<RawModule> mods;
       if (scanner_.tokenizeModules(line, value.b, value.e, mods)) {
-        bool open = false, close = false;
         for (const RawModule& m : mods) {
           if (m.hasParens) {
             error(line, m.col, "'" + h.key + ":' lists symbols without parameters");
-          } else if (m.name == "[" || m.name == "]") {
-            // Sprig's context matching always follows brackets, which is what cpfg does when
-            // `consider:` lists them; ignoring them is not supported.
-            if (h.key == "ignore") error(line, m.col, "brackets cannot be ignored: context matching always follows them");
-            (m.name == "[" ? open : close) = true;
+          } else if ((m.name == "[" || m.name == "]") && prog_.dialect != Dialect::Cpfg) {
+            // Sprig's notation: context matching always follows brackets (lpfg's rule).
+            if (h.key == "ignore")
+              error(line, m.col, "brackets cannot be ignored in Sprig's notation: context matching always follows them");
           } else {
             std::vector<SymbolId>& list = subs_.empty() ? (h.key == "ignore" ? ignoreList_ : considerList_)
                                                         : (h.key == "ignore" ? subs_.back().ignoreList : subs_.back().considerList);
             list.push_back(prog_.symbols.intern(m.name));
           }
         }
-        if (h.key == "consider" && prog_.dialect == Dialect::Cpfg && !(open && close))
-          error(line, value.b,
-                "cpfg's 'consider:' without '[' and ']' ignores brackets in context matching, which Sprig does not "
-                "support (it always follows them): list them, as in 'consider: " + std::string(scanner_.view(value)) + "[]'");
       }
       const std::string ign = scoped("ignore"), con = scoped("consider");
       if (seen_.count(ign) && seen_.count(con) && h.key == (seen_[ign] < seen_[con] ? "consider" : "ignore"))
@@ -832,11 +822,22 @@ class GrammarParser {
         lintWords(line, mods);
         for (const RawModule& m : mods) {
           if (block == Block::Interpretation && isQuery(m.name)) error(line, m.col, queryInInterpretation(m.name));
+          const bool label = m.name == "@L";
+          if (label && block != Block::Interpretation) error(line, m.col, kLabelOutsideInterpretation);
           SuccModule sm;
           sm.symbol = prog_.symbols.intern(m.name);
           sm.firstArg = static_cast<uint32_t>(p.args.size());
           sm.argCount = static_cast<uint16_t>(m.args.size());
-          for (const Span& a : m.args) p.args.push_back(expr_.compileArg(scanner_.trim(a), varNames));
+          for (const Span& a : m.args) {
+            const Span t = scanner_.trim(a);
+            if (label && t.b < t.e && scanner_.line(line)[t.b] == '"') {
+              // @L's format: its number among the program's strings (cpfg stores it so).
+              p.args.push_back(Arg{ArgKind::Const, 0, static_cast<double>(prog_.strings.size()), {}});
+              prog_.strings.push_back(scanner_.line(line).substr(t.b, t.e - t.b));
+              continue;
+            }
+            p.args.push_back(expr_.compileArg(t, varNames));
+          }
           p.successor.push_back(sm);
         }
       }
@@ -1179,7 +1180,22 @@ class GrammarParser {
       } else {
         // Assignment `name = expression;`.
         while (i < e && isSpace(s[i])) ++i;
-        if (i >= e || s[i] != '=' || (i + 1 < e && s[i + 1] == '=')) {
+        const bool assignment = i < e && s[i] == '=' && !(i + 1 < e && s[i + 1] == '=');
+        const bool compound = i + 1 < e && std::string_view("+-*/%").find(s[i]) != std::string_view::npos && s[i + 1] == '=';
+        if (!assignment && !compound && prog_.dialect == Dialect::Cpfg) {
+          // cpfg's expression statement (`roll - roll/L0;` in vlab's paintbrush): evaluated,
+          // its value dropped.
+          int end = scanner_.findTop(line, at, e, ';');
+          if (end < 0) {
+            error(line, at, "missing ';' after the statement '" + word + " ...' (cpfg requires one after every statement)");
+            return false;
+          }
+          if (!expr_.compile(scanner_.trim(Span{line, at, end}), varNames, "statement")) return false;
+          jump(Op::Jz, base, static_cast<double>(prog_.code.size() + 1));  // pops the value
+          i = end + 1;
+          continue;
+        }
+        if (!assignment) {
           error(line, i, "expected '=' after '" + word + "' (statements are assignments, 'if', 'while' and 'do')");
           return false;
         }
@@ -1202,13 +1218,28 @@ class GrammarParser {
           return false;
         }
         auto known = std::find(varNames.begin(), varNames.end(), word);
-        if (!inGlobalBlock_ && known == varNames.end() &&
-            std::find(prog_.globals.begin(), prog_.globals.end(), word) != prog_.globals.end()) {
-          error(line, at, "cannot assign the global variable '" + word +
-                              "' in a production (Sprig assigns globals only in 'Start:', 'StartEach:', 'EndEach:' and 'End:' blocks)");
+        const auto global = std::find(prog_.globals.begin(), prog_.globals.end(), word);
+        const bool ruleGlobal = !inGlobalBlock_ && known == varNames.end() && global != prog_.globals.end();
+        if (ruleGlobal && (prog_.dialect != Dialect::Cpfg || statementBlock_ == Block::Interpretation)) {
+          error(line, at, "cannot assign the global variable '" + word + "' in " +
+                              (prog_.dialect != Dialect::Cpfg
+                                   ? std::string("a production of a .lsys file (Sprig assigns globals only in 'Start:', "
+                                                 "'StartEach:', 'EndEach:' and 'End:' blocks; a .l file's productions may)")
+                                   : std::string("an interpretation rule (cpfg would change it whenever it draws the "
+                                                 "string): not supported")));
           return false;
         }
         if (!expr_.compile(value, varNames, "value")) return false;
+        if (ruleGlobal) {
+          // cpfg: the global changes at once, for the modules rewritten after this one.
+          prog_.rulesAssignGlobals = true;
+          Instr store;
+          store.op = Op::Store;
+          store.var = static_cast<uint16_t>(kMaxVars - 1 - (global - prog_.globals.begin()));
+          prog_.code.push_back(store);
+          i = end + 1;
+          continue;
+        }
         auto it = std::find(varNames.begin(), varNames.end(), word);
         if (it == varNames.end()) {
           if (varNames.size() >= static_cast<size_t>(kMaxVars) - (inGlobalBlock_ ? 0 : prog_.globals.size())) {
@@ -1407,7 +1438,8 @@ class GrammarParser {
       if (!u.context) predecessors[u.name].emplace(u.arity, &u);
     for (const auto& [name, counts] : predecessors) {
       auto w = written_.find(name);
-      if (w == written_.end() || isTurtleSymbol(name)) continue;
+      // (cpfg's `_`, its old elasticity, is a turtle command too: `_(e)` or `_` alone.)
+      if (w == written_.end() || isTurtleSymbol(name) || (prog_.dialect == Dialect::Cpfg && name == "_")) continue;
       bool reported = std::any_of(counts.begin(), counts.end(), [&](const auto& c) { return !w->second.count(c.first); });
       if (reported) continue;
       const ArityUse& prod = *counts.begin()->second;
@@ -1509,7 +1541,11 @@ class GrammarParser {
     params_.clear();
     bool ok = true;
     for (const Span& a : m.args) {
-      std::optional<double> v = expr_.evaluate(scanner_.trim(a), rng);
+      CodeRange later;
+      const bool deferrable = &out == &prog_.axiom && prog_.dialect == Dialect::Cpfg;
+      std::optional<double> v = expr_.evaluate(scanner_.trim(a), rng, deferrable ? &later : nullptr);
+      if (!later.empty())
+        prog_.axiomDeferred.emplace_back(static_cast<uint32_t>(out.params.size() + params_.size()), later);
       if (v && prog_.floatParams) v = static_cast<double>(static_cast<float>(*v));  // cpfg's floats
       if (v) params_.push_back(*v);
       else ok = false;
@@ -1540,6 +1576,10 @@ class GrammarParser {
       scanner_.tokenizeModules(axiomLine_, axiomSpan_.b, axiomSpan_.e,
                                [&](const RawModule& m) { appendConstant(m, prog_.axiom, &rng); });
     }
+    if (prog_.ring && !prog_.subLsystems.empty())
+      diags().error(SourceLoc{prog_.fileName, 0, 0},
+                    "cpfg's 'ring lsystem' in a file with sub-L-systems is not supported (Sprig joins the ends of the "
+                    "main L-system's string only)");
     // Ignore / consider table over every symbol, including ones interned late.
     prog_.ignored.assign(prog_.symbols.size(), 0);
     if (!considerList_.empty()) {
@@ -1547,14 +1587,18 @@ class GrammarParser {
       for (SymbolId id : considerList_) prog_.ignored[id] = 0;
     }
     for (SymbolId id : ignoreList_) prog_.ignored[id] = 1;
-    prog_.ignored[prog_.openBracket] = prog_.ignored[prog_.closeBracket] = 0;
+    // cpfg skips the brackets its ignore table holds (`ignore: [`, or `consider:` without
+    // them) as any ignored symbol in a right context (generate.c, RconDiff); a left context
+    // follows them whatever the table says (LconDiff). Sprig's notation always follows them.
+    const bool bracketsIgnorable = prog_.dialect == Dialect::Cpfg;
+    if (!bracketsIgnorable) prog_.ignored[prog_.openBracket] = prog_.ignored[prog_.closeBracket] = 0;
     // Each sub-L-system's own table (cpfg: LSYSDATA::ignore), used inside its calls.
     for (size_t k = 0; k < prog_.subLsystems.size() && k < subs_.size(); ++k) {
       std::vector<uint8_t>& ignored = prog_.subLsystems[k].ignored;
       ignored.assign(prog_.symbols.size(), subs_[k].considerList.empty() ? 0 : 1);
       for (SymbolId id : subs_[k].considerList) ignored[id] = 0;
       for (SymbolId id : subs_[k].ignoreList) ignored[id] = 1;
-      ignored[prog_.openBracket] = ignored[prog_.closeBracket] = 0;
+      if (!bracketsIgnorable) ignored[prog_.openBracket] = ignored[prog_.closeBracket] = 0;
     }
     for (SymbolId id : prog_.axiom.symbols) prog_.usesCut |= id == prog_.cut;
     for (const char* q : {"?P", "?H", "?L", "?U"}) prog_.usesQuery |= prog_.symbols.find(q) >= 0;
@@ -1570,6 +1614,7 @@ class GrammarParser {
           for (const SuccModule& m : p.successor) prog_.usesCut |= m.symbol == prog_.cut;
     if (int q = prog_.symbols.find("?"); q >= 0) prog_.subCall = static_cast<SymbolId>(q);
     prog_.subEnd = static_cast<SymbolId>(prog_.symbols.find("$"));
+    if (prog_.dialect == Dialect::Cpfg) checkSplitCommands(sets);
     for (RuleSet* rs : sets) {
       rs->bySymbol.assign(prog_.symbols.size(), {});
       for (uint32_t i = 0; i < rs->productions.size(); ++i) {
@@ -1578,7 +1623,6 @@ class GrammarParser {
       }
       rs->finalize();
     }
-    if (prog_.dialect == Dialect::Cpfg) checkSplitCommands(sets);
   }
 
   /// cpfg keeps one character per module: its commands `@o(d)`, `?P(x,y,z)`, `~l` are the
@@ -1596,25 +1640,49 @@ class GrammarParser {
         for (const SuccModule& m : p.successor) wrote(m.symbol, m.argCount);
     // The written command a rule's module (letter, n parameters) would match in cpfg's string:
     // its last letter carries the command's parameters, the others none.
-    auto command = [&](SymbolId id, size_t n) -> std::optional<std::string> {
+    // Every written command whose letter a rule's module (letter, n parameters) matches.
+    auto commands = [&](SymbolId id, size_t n) {
+      std::vector<std::pair<SymbolId, bool>> found;  // (command, the letter is its last)
       const std::string& letter = prog_.symbols.name(id);
-      if (letter.size() != 1) return std::nullopt;
+      if (letter.size() != 1) return found;
       for (size_t c = 0; c < counts.size(); ++c) {
         const std::string& name = prog_.symbols.name(static_cast<SymbolId>(c));
         if (!counts[c] || name.size() < 2 || (name[0] != '@' && name[0] != '?' && name[0] != '~')) continue;
         for (size_t k = 1; k < name.size(); ++k)
-          if (name[k] == letter[0] && (k + 1 == name.size() ? (counts[c] >> std::min<size_t>(n, 63)) & 1 : n == 0)) return name;
+          if (name[k] == letter[0] && (k + 1 == name.size() ? (counts[c] >> std::min<size_t>(n, 63)) & 1 : n == 0)) {
+            found.emplace_back(static_cast<SymbolId>(c), k + 1 == name.size());
+            break;
+          }
       }
-      return std::nullopt;
+      return found;
     };
+    std::vector<Production> clones;
     for (const RuleSet* rs : sets)
       for (const Production& p : rs->productions) {
         std::vector<std::pair<SymbolId, size_t>> mods{{p.predecessor, p.predParams}};
         for (const auto* side : {&p.predRest, &p.left, &p.right})
           for (const PatternItem& it : *side)
             if (!it.openBracket && !it.closeBracket && !it.skipBranch) mods.emplace_back(it.symbol, it.paramCount);
-        for (const auto& [id, n] : mods)
-          if (std::optional<std::string> cmd = command(id, n)) {
+        for (size_t m = 0; m < mods.size(); ++m) {
+          const auto [id, n] = mods[m];
+          const auto found = commands(id, n);
+          if (found.empty()) continue;
+          // A production (no left context, statements or predecessor of several modules)
+          // whose successor starts with the letter again: cpfg rewrites the letter of the
+          // command and keeps its '@', which reads as the command once more (vlab's Mycelis
+          // grows '@o(r)' with 'o(r) --> o(r+0.03)'): the same production for the command.
+          const bool cloneable = m == 0 && rs == &prog_.productions && p.left.empty() && p.predRest.empty() &&
+                                 !p.hasStatements() && !p.successor.empty() && p.successor[0].symbol == id &&
+                                 std::all_of(found.begin(), found.end(), [](const auto& f) { return f.second; });
+          if (cloneable) {
+            for (const auto& f : found) {
+              clones.push_back(p);
+              clones.back().predecessor = clones.back().successor[0].symbol = f.first;
+            }
+            continue;
+          }
+          {
+            const std::optional<std::string> cmd = prog_.symbols.name(found.front().first);
             const std::string& letter = prog_.symbols.name(id);
             std::string parts;
             for (char c : *cmd) parts += (parts.empty() ? "'" : ", '") + std::string(1, c) + "'";
@@ -1626,7 +1694,13 @@ class GrammarParser {
                           p.sourceLine);
             break;
           }
+        }
       }
+    for (Production& c : clones) {
+      prog_.splitCommand.resize(prog_.symbols.size(), 0);
+      prog_.splitCommand[c.predecessor] = 1;
+      prog_.productions.productions.push_back(std::move(c));
+    }
   }
 
   GrammarOverrides overrides_;

@@ -516,6 +516,19 @@ struct Program {
   /// cpfg's global variables, in order of first assignment in the blocks below: global k
   /// is register k while a block runs, and register kMaxVars - 1 - k of every production.
   std::vector<std::string> globals;
+  /// cpfg's notation: a production or decomposition rule assigns a global in its
+  /// statements; the modules after it read the new value (cpfg rewrites left to right).
+  bool rulesAssignGlobals = false;
+  /// cpfg's `ring lsystem`: context matching joins the ends of the string (the first
+  /// module's left neighbour is the last module, and the other way round).
+  bool ring = false;
+  /// Per symbol (empty: none): a cpfg command (`@o`) that a production written for its
+  /// last letter rewrites (GrammarParser::checkSplitCommands); cpfg visits its characters
+  /// one by one, the letter last, each taking a choice draw.
+  std::vector<uint8_t> splitCommand;
+  /// cpfg's notation: axiom parameters that read global variables (index into
+  /// axiom.params, code), evaluated after the `Start:` block as cpfg's Rewind does.
+  std::vector<std::pair<uint32_t, CodeRange>> axiomDeferred;
   /// cpfg's blocks: `Start:` (before the derivation), `StartEach:` and `EndEach:` (around
   /// every step), `End:` (after the last step).
   CodeRange startBlock, startEachBlock, endEachBlock, endBlock;

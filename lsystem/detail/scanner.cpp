@@ -214,7 +214,10 @@ bool Scanner::tokenizeModules(int line, int b, int e, const std::function<void(c
       int depth = 0;
       int argStart = j + 1;
       int k = j;
+      bool quoted = false;  // cpfg's @L("format", ...): a string may hold ( ) and ,
       for (; k < e; ++k) {
+        if (s[k] == '"') quoted = !quoted;
+        if (quoted) continue;
         if (s[k] == '(') ++depth;
         else if (s[k] == ')') {
           if (--depth == 0) break;
@@ -245,11 +248,20 @@ bool Scanner::tokenizeModules(int line, int b, int e, const std::function<void(c
         error(line, m.col, "cpfg's '~' must be followed by a surface id (the letter of a view file's 'surface:' line)");
         return false;
       }
-      if (cpfgSurfaceIds_.find(id) == std::string::npos) {
-        error(line, m.col, std::string("cpfg's '~") + id + "' names no surface: " +
-                               (cpfgSurfaceIds_.empty() ? std::string("there is no view file with a 'surface:' line")
-                                                        : "the view file has no 'surface: " + std::string(1, id) + " ...' line (it defines '" + cpfgSurfaceIds_ + "')"));
+      if (cpfgUndrawnSurfaceIds_.find(id) != std::string::npos) {
+        error(line, m.col, std::string("cpfg's '~") + id + "' names the view file's 'tsurface: " + id +
+                               " ...' (a triangulated surface), which is not supported");
         return false;
+      }
+      if (cpfgSurfaceIds_.find(id) == std::string::npos && warnedSurfaceIds_.find(id) == std::string::npos) {
+        // cpfg draws nothing for a surface id it has not read (patches.c: FindSurfaceIndex
+        // returns -1; the turtle does not move), and neither does Sprig: a warning.
+        warnedSurfaceIds_ += id;
+        auto [loc, text] = locate(line, m.col);
+        diags_.warning(loc, std::string("cpfg's '~") + id + "' names no surface (" +
+                                (cpfgSurfaceIds_.empty() ? std::string("there is no view file with a 'surface:' line")
+                                                         : "the view file has no 'surface: " + std::string(1, id) + " ...' line; it defines '" + cpfgSurfaceIds_ + "'") +
+                                "): it draws nothing, as in cpfg", std::move(text));
       }
     }
     if (auto why = cpfgUnsupported(m.name, m.args.size(), m.hasParens, nameEnd < s.size() ? s[nameEnd] : '\0', dialect_)) {

@@ -112,7 +112,10 @@ class Scanner {
   void setDialect(Dialect d) { dialect_ = d; }
   Dialect dialect() const { return dialect_; }
   /// cpfg: the ids of the view file's surfaces; `~X` with another X is an error.
-  void setCpfgSurfaceIds(std::string ids) { cpfgSurfaceIds_ = std::move(ids); }
+  void setCpfgSurfaceIds(std::string ids, std::string undrawn = {}) {
+    cpfgSurfaceIds_ = std::move(ids);
+    cpfgUndrawnSurfaceIds_ = std::move(undrawn);
+  }
   /// cpfg: names the preprocessor defines before the file, the k-th (0-based) as k + 1
   /// (the functions of a view file's `function set:`).
   void setPredefined(std::vector<std::string> names) { predefined_ = std::move(names); }
@@ -185,6 +188,8 @@ class Scanner {
   std::pair<int, int> pendingComment_{0, 0};
   Dialect dialect_ = Dialect::Sprig;
   std::string cpfgSurfaceIds_;
+  std::string cpfgUndrawnSurfaceIds_;
+  std::string warnedSurfaceIds_;  ///< undefined ids already warned about
   std::vector<std::string> predefined_;
   DiagnosticList diags_;
 };

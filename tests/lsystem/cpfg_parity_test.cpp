@@ -40,6 +40,7 @@ std::string cpfgString(const std::string& folder) {
 struct Parity {
   Grammar grammar;
   std::optional<TurtleSettings> turtle;
+  bool box = false;  ///< the view file has a `box:` line
 };
 
 Parity loadParity(const std::string& folder) {
@@ -50,6 +51,7 @@ Parity loadParity(const std::string& folder) {
   if (std::filesystem::exists(v)) {
     const ViewFile view = loadViewFile(v);
     p.turtle = cpfgTurtleSettings(&view, TurtleSettings{});
+    p.box = view.box;
   } else {
     p.turtle = cpfgTurtleSettings(nullptr, TurtleSettings{});
   }
@@ -60,7 +62,7 @@ Parity loadParity(const std::string& folder) {
 /// or absolute: cpfg prints 6 significant digits).
 void checkSame(const ModuleString& got, const SymbolTable& symbols, const std::string& cpfg) {
   SymbolTable table = symbols;
-  const ModuleString want = parseModuleString(cpfg, table);
+  const ModuleString want = parseModuleString(cpfg, table, "cpfg.l");  // read in cpfg's notation
   INFO("cpfg:  " << cpfg);
   INFO("Sprig: " << formatModuleString(got, symbols, FormatOptions{0, true}));
   REQUIRE(got.size() == want.size());
@@ -78,6 +80,7 @@ void checkSame(const ModuleString& got, const SymbolTable& symbols, const std::s
 ModuleString deriveParity(Parity& p) {
   DeriveOptions opt;
   opt.queryTurtle = p.turtle;
+  opt.queriesAfterLastStep = !p.box;
   Deriver d(p.grammar, opt);
   return d.derive();
 }
@@ -132,6 +135,30 @@ TEST_CASE("cpfg parity: query modules of the final string", "[lsystem][cpfg]") {
   checkSame(deriveParity(p), p.grammar.symbols(), cpfgString("query_timing"));
 }
 
+TEST_CASE("cpfg parity: a view file's box: leaves the final string's query modules unfilled", "[lsystem][cpfg]") {
+  Parity p = loadParity("query_box");
+  REQUIRE(p.box);
+  const ModuleString s = deriveParity(p);
+  checkSame(s, p.grammar.symbols(), cpfgString("query_box"));
+  SECTION("a further step fills them first, as cpfg's next step does") {
+    DeriveOptions opt;
+    opt.queryTurtle = p.turtle;
+    opt.queriesAfterLastStep = false;
+    Deriver d(p.grammar, opt);
+    d.derive();
+    const ModuleString& more = d.step();
+    // B records ?P's y when step 4 started: 3 (three F(1) below it), not the 2 it held.
+    const std::string text = formatModuleString(more, d.symbols());
+    CHECK(text.find("B(2)B(3)?P(0,3,0)") != std::string::npos);
+  }
+  SECTION("without box: the final string is filled, as cpfg's drawing fills it") {
+    DeriveOptions opt;
+    opt.queryTurtle = p.turtle;
+    Deriver d(p.grammar, opt);
+    CHECK(formatModuleString(d.derive(), d.symbols()).find("B(2)?P(0,3,0)") != std::string::npos);
+  }
+}
+
 TEST_CASE("cpfg parity: a cut is made when the next step reaches it", "[lsystem][cpfg]") {
   for (const char* folder : {"pending_cut", "decomposition_cut"}) {
     INFO(folder);
@@ -162,6 +189,11 @@ TEST_CASE("cpfg parity: a cut is made when the next step reaches it", "[lsystem]
   }
 }
 
+TEST_CASE("cpfg parity: a production for a command's last letter rewrites the command", "[lsystem][cpfg]") {
+  Parity p = loadParity("split_command");
+  checkSame(deriveParity(p), p.grammar.symbols(), cpfgString("split_command"));
+}
+
 TEST_CASE("cpfg parity: a rule for a letter of a command the grammar writes is an error", "[lsystem][cpfg]") {
   auto errorOf = [](const std::string& text) -> std::string {
     try {
@@ -171,8 +203,10 @@ TEST_CASE("cpfg parity: a rule for a letter of a command the grammar writes is a
     }
     return "no error";
   };
-  // cpfg's string holds '@' then 'o(0.2)': its o(r) rule grows the sphere (vlab's Mycelis).
-  CHECK(errorOf("axiom: A@o(0.2)\no(r) --> o(r+0.03)\n").find(
+  // cpfg's string holds '@' then 'o(0.2)': its o(r) rule grows the sphere (vlab's Mycelis,
+  // supported: split_command); a successor that does not start with 'o' again is not.
+  CHECK(errorOf("axiom: A@o(0.2)\no(r) --> o(r+0.03)\n") == "no error");
+  CHECK(errorOf("axiom: A@o(0.2)\no(r) --> F o(r+0.03)\n").find(
             "t.l:2:1: error: cpfg reads '@o' as the modules '@', 'o' (one character each), so this rule's 'o' also matches "
             "the 'o' of the '@o' the grammar writes; Sprig reads '@o' as one module: not supported (rename the module 'o')") !=
         std::string::npos);
@@ -308,4 +342,102 @@ TEST_CASE("cpfg parity: a texture image that cannot be read does not stop a deri
   REQUIRE(v.textures[0].unreadable);
   CHECK(v.textures[0].unreadable->loc.line == 1);
   CHECK(v.textures[0].unreadable->loc.col == 13);
+}
+
+TEST_CASE("cpfg parity: '?' without parameters is a module; its turtle takes the next one", "[lsystem][cpfg]") {
+  Parity p = loadParity("bare_query");
+  const ModuleString s = deriveParity(p);
+  checkSame(s, p.grammar.symbols(), cpfgString("bare_query"));
+  // ????F(1)??F(2)F(1)?F(2)A: each '?' takes the module after it, so F(1), F(2) and F(1)
+  // are drawn (3 internodes, length 4) and the last F(2) is not.
+  Turtle t(p.grammar.symbols(), *p.turtle);
+  const Skeleton k = t.run(s);
+  REQUIRE(k.internodes.size() == 3);
+  CHECK(k.totalLength() == Approx(4.0).margin(1e-12));
+  SECTION("a '?' before a query letter, a bracket or a command is an error, not a different drawing") {
+    SymbolTable table = p.grammar.symbols();
+    for (const char* text : {"?P(1,2)F", "?[F]", "?@v"}) {
+      INFO(text);
+      const ModuleString q = parseModuleString(text, table, "t.l");
+      Turtle tq(table, *p.turtle);
+      if (std::string(text) == "?P(1,2)F") {
+        CHECK(tq.run(q).internodes.size() == 1);  // '?P' is one module: a query
+      } else {
+        CHECK_THROWS_WITH(tq.run(q), Catch::Contains("cpfg's '?' followed by the module"));
+      }
+    }
+  }
+}
+
+TEST_CASE("cpfg parity: productions assign global variables, left to right", "[lsystem][cpfg]") {
+  Parity p = loadParity("global_assign");
+  checkSame(deriveParity(p), p.grammar.symbols(), cpfgString("global_assign"));
+}
+
+TEST_CASE("cpfg parity: brackets in the ignore table", "[lsystem][cpfg]") {
+  for (const char* folder : {"ignored_brackets", "considered_brackets"}) {
+    INFO(folder);
+    Parity p = loadParity(folder);
+    checkSame(deriveParity(p), p.grammar.symbols(), cpfgString(folder));
+  }
+}
+
+TEST_CASE("cpfg parity: an expression statement is evaluated and dropped", "[lsystem][cpfg]") {
+  Parity p = loadParity("expression_statement");
+  checkSame(deriveParity(p), p.grammar.symbols(), cpfgString("expression_statement"));
+}
+
+TEST_CASE("cpfg parity: '_' is a command, written with any parameter count", "[lsystem][cpfg]") {
+  Parity p = loadParity("elasticity_module");
+  checkSame(deriveParity(p), p.grammar.symbols(), cpfgString("elasticity_module"));
+}
+
+TEST_CASE("cpfg parity: the axiom reads the globals the Start: block set", "[lsystem][cpfg]") {
+  Parity p = loadParity("axiom_globals");
+  checkSame(deriveParity(p), p.grammar.symbols(), cpfgString("axiom_globals"));
+}
+
+TEST_CASE("cpfg parity: a ring L-system joins the ends of the string", "[lsystem][cpfg]") {
+  Parity p = loadParity("ring");
+  checkSame(deriveParity(p), p.grammar.symbols(), cpfgString("ring"));
+  SECTION("without 'ring lsystem' the ends are not joined") {
+    std::string text = readFile(parityAsset("ring/plant.l"));
+    text.replace(text.find("ring lsystem"), 12, "");
+    Grammar g = parseGrammar(text, "plant.l");
+    Deriver d(g, DeriveOptions{.steps = 1});
+    // The first B has no left neighbour: it stays; A(1) still becomes B(1).
+    CHECK(formatModuleString(d.derive(), d.symbols()) == "B(0)B(0)[F]B(10)B(1)+");
+  }
+  SECTION("only the main L-system of a .l file") {
+    CHECK_THROWS_WITH(parseGrammar("ring lsystem\naxiom: A\n", "t.lsys"),
+                      Catch::Contains("t.lsys:1:1: error: cpfg's 'ring lsystem' (ring L-system) is supported only for the "
+                                      "main L-system of a .l file"));
+  }
+}
+
+TEST_CASE("cpfg parity: @L labels in interpretation rules are read; drawing one is an error", "[lsystem][cpfg]") {
+  Parity p = loadParity("label");
+  const ModuleString s = deriveParity(p);
+  checkSame(s, p.grammar.symbols(), cpfgString("label"));
+  Deriver d(p.grammar);
+  d.derive();
+  Turtle t(p.grammar.symbols(), *p.turtle);
+  CHECK(t.run(d.interpret(d.current())).internodes.size() == 3);  // SHOW is 0: no label reached
+  SECTION("a label drawn is an error, not a drawing without its text") {
+    std::string text = readFile(parityAsset("label/plant.l"));
+    text.replace(text.find("#define SHOW 0"), 14, "#define SHOW 1");
+    Grammar g = parseGrammar(text, "plant.l");
+    Deriver dl(g);
+    dl.derive();
+    Turtle tl(g.symbols(), *p.turtle);
+    CHECK_THROWS_WITH(tl.run(dl.interpret(dl.current())), Catch::Contains("cpfg's '@L' (label) is not supported: Sprig draws no text"));
+  }
+  SECTION("elsewhere @L is an error") {
+    CHECK_THROWS_WITH(parseGrammar("axiom: A\nA --> F@L(\"x\")\n", "t.l"),
+                      Catch::Contains("t.l:2:8: error: cpfg's '@L' (label) is supported only in interpretation rules"));
+    CHECK_THROWS_WITH(parseGrammar("axiom: F@L(\"x\")\n", "t.l"),
+                      Catch::Contains("t.l:1:9: error: cpfg's '@L' (label) is supported only in interpretation rules"));
+    CHECK_THROWS_WITH(parseGrammar("axiom: A\ninterpretation:\nA --> F@L(\"x\")\n", "t.lsys"),
+                      Catch::Contains("t.lsys:3:8: error: cpfg's '@L' (label) is not supported"));
+  }
 }

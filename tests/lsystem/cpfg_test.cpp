@@ -269,9 +269,18 @@ TEST_CASE("cpfg view file", "[lsystem][cpfg]") {
   SECTION("errors") {
     CHECK(viewErrorOf("angle increment: 30\nangel factor: 8\n") ==
           "t.v:2:1: unknown view file command 'angel factor:' (did you mean 'angle factor'?)");
-    CHECK(viewErrorOf("line: l leaf.s 1\n") == "t.v:1:1: cpfg's view file command 'line:' (F drawn as a surface) is not supported");
-    CHECK(viewErrorOf("background scene: a.dat\n") ==
-          "t.v:1:1: cpfg's view file command 'background scene:' (geometry from background files) is not supported");
+    // Commands Sprig cannot draw are read; their error waits for a drawing (GrowthEngine).
+    CHECK(viewErrorOf("line: l leaf.s 1\n") == "no error");
+    const ViewFile line = parseViewFile("angle factor: 8\n  line: l leaf.s 1\nbackground scene: a.dat\n", "t.v");
+    REQUIRE(line.unsupportedDrawing);
+    CHECK(line.unsupportedDrawing->loc.line == 2);
+    CHECK(line.unsupportedDrawing->loc.col == 3);
+    CHECK(line.unsupportedDrawing->message == "cpfg's view file command 'line:' (F drawn as a surface) is not supported");
+    const ViewFile scene = parseViewFile("background scene: a.dat\n", "t.v");
+    REQUIRE(scene.unsupportedDrawing);
+    CHECK(scene.unsupportedDrawing->message ==
+          "cpfg's view file command 'background scene:' (geometry from background files) is not supported");
+    CHECK_FALSE(parseViewFile("angle factor: 8\n", "t.v").unsupportedDrawing);
     CHECK(viewErrorOf("tropism direction: 0,0,0\n") == "t.v:1:20: 'tropism direction:' must not be the zero vector");
     CHECK(viewErrorOf("angle increment: thirty\n") == "t.v:1:18: 'angle increment:' expects 1 number, got 'thirty'");
     CHECK(viewErrorOf("tropism: E: 0.2\n") == "t.v:1:10: a tropism needs a non-zero vector 'T: x y z'");
@@ -285,7 +294,7 @@ TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg
     CHECK(errorOf("axiom: F{(1)F}(1)\n") == "t.l:1:9: cpfg's '{(type)' (generalized cylinder) is not supported");
     CHECK(errorOf("axiom: A\nA --> F$A\n") ==
           "t.l:2:8: cpfg's '$' ends a sub-L-system call '?(n, scale)', and this file makes none (ABOP's roll to vertical is '@v' in cpfg)");
-    CHECK(errorOf("axiom: F~l\n") == "t.l:1:9: cpfg's '~l' names no surface: there is no view file with a 'surface:' line");
+    CHECK(errorOf("axiom: F~l\n") == "no error");  // draws nothing, as in cpfg (a warning: cpfg surface files)
     CHECK(errorOf("axiom: ?P(0,0)A\n") == "no error");
     CHECK(errorOf("axiom: A\nhomomorphism\nA --> F?U(0,0,0)\n") ==
           "t.l:3:8: cpfg's query module '?U' in an interpretation rule is not supported (its values would be lost with "
@@ -304,7 +313,7 @@ TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg
     CHECK(errorOf("lsystem: 1\naxiom: A\nendlsystem\n", "t.l") == "no error");
     CHECK(errorOf("lsystem: 1\naxiom: A\nlsystem: 2\naxiom: B\n") ==
           "t.l:3:1: several L-systems in one file (cpfg's sub-L-systems) are not supported (the first is at line 1)");
-    CHECK(errorOf("ring lsystem\naxiom: A\n") == "t.l:1:1: cpfg's 'ring lsystem' (ring L-system) is not supported");
+    CHECK(errorOf("ring lsystem\naxiom: A\n") == "no error");  // cpfg_parity_test.cpp: ring
     CHECK(errorOf("axiom: A(1)\nA(x) --> A(srand(2))\n").find(
               "t.l:2:12: cpfg's function 'srand' is supported only as a statement ('srand(s);') of a 'Start:'") == 0);
     CHECK(errorOf("axiom: A(1)\nA(x) --> A(func(1, x))\n") ==
@@ -402,6 +411,7 @@ TEST_CASE("cpfg statements in productions", "[lsystem][cpfg]") {
     CHECK(errorOf("#define K 2\naxiom: A(1)\nA(y) : { K = 1; } * --> B(y)\n") == "t.l:3:10: cannot assign to 'K': it is a #define");
     CHECK(errorOf("Start: { srand(3); }\naxiom: A\n") == "no error");
     CHECK(derived("axiom: A(2)\nA(y) : { x = 1; fabs(y); x = x + 1; } * --> B(x)\n", 1) == "B(2)");  // a call alone: value dropped
+    CHECK(derived("axiom: A(2)\nA(y) : { x = y; x - x / 2; } * --> B(x)\n", 1) == "B(2)");  // an expression alone: dropped
     try {
       derived("axiom: A(1)\nA(y) : { while (1) { y = y; } } * --> B(y)\n", 1);
       FAIL("no error");
@@ -412,13 +422,16 @@ TEST_CASE("cpfg statements in productions", "[lsystem][cpfg]") {
 }
 
 TEST_CASE("cpfg consider: with brackets; maximum depth beyond 256", "[lsystem][cpfg]") {
-  SECTION("consider: listing [ and ] follows brackets, as Sprig always does") {
-    const std::string g = "consider: BA[]\naxiom: A[C]B\nA > B --> X\n";
-    CHECK(derived(g, 1) == "X[C]B");
-    CHECK(errorOf("consider: BA\naxiom: A\n") ==
-          "t.l:1:11: cpfg's 'consider:' without '[' and ']' ignores brackets in context matching, which Sprig does not "
-          "support (it always follows them): list them, as in 'consider: BA[]'");
-    CHECK(errorOf("consider: BA\naxiom: A\n", "t.lsys") == "no error");  // Sprig's notation: brackets always followed
+  SECTION("consider: listing [ and ] follows brackets; without them a right context passes over them") {
+    CHECK(derived("consider: BA[]\naxiom: A[C]B\nA > B --> X\n", 1) == "X[C]B");
+    // A's right context: the branch [B] is skipped, C is not considered, the string ends.
+    CHECK(derived("consider: BA[]\naxiom: A[B]C\nA > B --> X\n", 1) == "A[B]C");
+    // Without them cpfg ignores '[' and finds B inside the branch (RconDiff).
+    CHECK(derived("consider: BA\naxiom: A[B]C\nA > B --> X\n", 1) == "X[B]C");
+    // Sprig's notation always follows brackets.
+    Grammar g = parseGrammar("consider: BA\naxiom: A[B]C\nA > B --> X\n", "t.lsys");
+    Deriver d(g, DeriveOptions{.steps = 1});
+    CHECK(formatModuleString(d.derive(), d.symbols()) == "A[B]C");
   }
   SECTION("decomposition 5000 levels deep (vlab's Ridley needs 3000)") {
     // B(n) --> F B(n - 1) nests one level per F: B(5000) ends as 5000 F and B(0), which no
@@ -449,9 +462,13 @@ TEST_CASE("cpfg consider: with brackets; maximum depth beyond 256", "[lsystem][c
 }
 
 TEST_CASE("cpfg Start, StartEach, EndEach and End blocks over global variables", "[lsystem][cpfg]") {
-  SECTION("a global variable in the axiom is an error, not a crash (vlab's two-trees and pallaea)") {
-    CHECK(errorOf("Start: { d = 3; }\naxiom: S A(1, d + 1)\n") ==
-          "t.l:2:15: cpfg's global variable 'd' in the axiom is not supported (Sprig reads the axiom before the "
+  SECTION("the axiom reads the global variables the Start: block set (vlab's two-trees and pallaea)") {
+    CHECK(derived("Start: { d = 3; }\naxiom: S A(1, d + 1)\n", 0) == "SA(1,4)");
+    // Each derivation starts again from the Start: block.
+    CHECK(derived("Start: { d = 3; }\nEndEach: { d = d + 1; }\naxiom: A(d)\nA(x) --> A(x + d)\n", 2) == "A(10)");
+    // Sprig's notation reads the axiom before any block runs: an error there.
+    CHECK(errorOf("Start: { d = 3; }\naxiom: S A(1, d + 1)\n", "t.lsys") ==
+          "t.lsys:2:15: cpfg's global variable 'd' in the axiom is not supported (Sprig reads the axiom before the "
           "'Start:' block assigns it): write its value");
   }
   SECTION("a counter the conditions read") {
@@ -464,10 +481,20 @@ TEST_CASE("cpfg Start, StartEach, EndEach and End blocks over global variables",
     const std::string g = "Start: { n = 10; }\nStartEach: { n = n * 2; }\naxiom: A(0)\nA(x) : { y = x + n; } * --> A(y)\n";
     CHECK(derived(g, 2) == "A(60)");  // step 1: n 20, y 20; step 2: n 40, y 60
   }
+  SECTION("a production assigns a global: the modules after it see the new value, as in cpfg") {
+    // Each A counts itself into n; B copies the count of the A's to its left.
+    const std::string g = "Start: { n = 0; }\nStartEach: { n = 0; }\naxiom: A B A B\nA : { n = n + 1; } * --> A\n"
+                          "B --> B(n)\nB(x) --> B(n)\n";
+    CHECK(derived(g, 1) == "AB(1)AB(2)");
+    CHECK(derived(g, 2) == "AB(1)AB(2)");
+  }
   SECTION("errors") {
-    CHECK(errorOf("Start: { g = 1; }\naxiom: A\nA : * { g = 2; } --> B\n") ==
-          "t.l:3:9: cannot assign the global variable 'g' in a production (Sprig assigns globals only in 'Start:', "
-          "'StartEach:', 'EndEach:' and 'End:' blocks)");
+    CHECK(errorOf("Start: { g = 1; }\naxiom: A\nA : * { g = 2; } --> B\n", "t.lsys") ==
+          "t.lsys:3:9: cannot assign the global variable 'g' in a production of a .lsys file (Sprig assigns globals only "
+          "in 'Start:', 'StartEach:', 'EndEach:' and 'End:' blocks; a .l file's productions may)");
+    CHECK(errorOf("Start: { g = 1; }\naxiom: A\nhomomorphism\nA : * { g = 2; } --> B\n") ==
+          "t.l:4:9: cannot assign the global variable 'g' in an interpretation rule (cpfg would change it whenever it "
+          "draws the string): not supported");
     CHECK(errorOf("Start: i = 0;\naxiom: A\n") == "t.l:1:8: expected '{ statements }' after 'Start:'");
     CHECK(errorOf("Start: { i = 0; }\nStart: { j = 0; }\naxiom: A\n") == "t.l:2:1: duplicate 'start:' (first at line 1)");
   }
@@ -1025,16 +1052,30 @@ TEST_CASE("cpfg surface files and ~X", "[lsystem][cpfg]") {
     checkNear(sk.internodes[0].start, DVec3(0, 6, 0));
     checkNear(sk.internodes[1].start, DVec3(0, 7, 0));  // ~a(0): nothing drawn, no move
   }
-  SECTION("errors: ~X the view file does not define, malformed surface files and surface: lines") {
-    CHECK(errorOf("axiom: F~l(2)\n") == "t.l:1:9: cpfg's '~l' names no surface: there is no view file with a 'surface:' line");
+  SECTION("~X the view file does not define draws nothing, as in cpfg: a warning; a tsurface's ~X is an error") {
     GrammarOverrides go;
     go.cpfgSurfaceIds = "ab";
+    go.cpfgUndrawnSurfaceIds = "t";
+    const Grammar g = parseGrammar("axiom: F ~c(2) F ~c\n", "t.l", go);
+    REQUIRE(g.warnings().size() == 1);  // once per id
+    CHECK(g.warnings()[0].loc.col == 10);
+    CHECK(g.warnings()[0].message == "cpfg's '~c' names no surface (the view file has no 'surface: c ...' line; it defines "
+                                     "'ab'): it draws nothing, as in cpfg");
+    // Drawn: the two F and nothing else; ~c does not move the turtle (patches.c, determine_end_point).
+    const Skeleton sk = interpret(derive(g), g.symbols(), cpfgTurtleSettings(nullptr, TurtleSettings{}));
+    REQUIRE(sk.internodes.size() == 2);
+    CHECK(sk.organs.empty());
+    CHECK(sk.internodes[1].start.y == Approx(sk.internodes[0].end.y));
     try {
-      parseGrammar("axiom: F ~c\n", "t.l", go);
+      parseGrammar("axiom: F ~t\n", "t.l", go);
       FAIL("no error");
     } catch (const InputError& e) {
-      CHECK(e.diagnostics().front().message == "cpfg's '~c' names no surface: the view file has no 'surface: c ...' line (it defines 'ab')");
+      CHECK(e.diagnostics().front().message ==
+            "cpfg's '~t' names the view file's 'tsurface: t ...' (a triangulated surface), which is not supported");
     }
+    CHECK(parseViewFile("tsurface: t leaf.ts\n", "t.v").tsurfaceIds == "t");
+  }
+  SECTION("errors: malformed surface files and surface: lines") {
     const std::string text = readFile(cpfgAsset("surface/plate.s"));
     auto surfaceError = [&](std::string from, std::string to) {
       std::string t = text;
@@ -1060,6 +1101,13 @@ TEST_CASE("cpfg surface files and ~X", "[lsystem][cpfg]") {
     CHECK(viewErrorOf("surface: ~ seg.s 1\n") == "t.v:1:10: cpfg's segment surface 'surface: ~' (F drawn as a surface) is not supported");
     CHECK(viewErrorOf("surface: a ../x.s 1\n") == "t.v:1:12: the surface file '../x.s' is outside the object's folder (only files beside the view file, or in folders below it)");
     CHECK(viewErrorOf("surface: a x.s big\n") == "t.v:1:16: expected the surface's size (a number), got 'big'");
+  }
+  SECTION("a surface file that does not exist: the line is skipped with a warning, as cpfg skips it (vlab's Sedge)") {
+    const ViewFile v = parseViewFile("surface: b no_such_bract.s 1.5 3 3\n", "t.v");
+    CHECK(v.surfaces.empty());
+    REQUIRE(v.warnings.size() == 1);
+    CHECK(v.warnings[0].loc.col == 12);
+    CHECK(v.warnings[0].message == "the surface file 'no_such_bract.s' does not exist: the line is skipped, as cpfg skips it");
   }
 }
 

@@ -142,7 +142,7 @@ TEST_CASE("parseGrammar errors: exact messages and positions", "[lsystem]") {
       {"seed: -3\naxiom: F\n", "g.lsys:1:7: error: seed must be a non-negative integer below 2^64, got '-3'"},
       {"axiom:\n", "g.lsys:1:7: error: the axiom is empty"},
       {"ignore: F(1)\naxiom: F\n", "g.lsys:1:9: error: 'ignore:' lists symbols without parameters"},
-      {"ignore: [\naxiom: F\n", "g.lsys:1:9: error: brackets cannot be ignored: context matching always follows them"},
+      {"ignore: [\naxiom: F\n", "g.lsys:1:9: error: brackets cannot be ignored in Sprig's notation: context matching always follows them"},
       {"ignore: F\nconsider: G\naxiom: F\n", "g.lsys:2:1: error: use either 'ignore:' or 'consider:', not both"},
       {"maximum depth: 2\naxiom: F\n", "g.lsys:1:1: error: 'maximum depth:' belongs in a 'decomposition:' or 'interpretation:' block"},
       {"axiom: F\ndecomposition:\nmaximum depth: 0\n", "g.lsys:3:16: error: maximum depth must be a whole number from 1 to 1000000, got 0"},

@@ -1,2 +1,3 @@
 angle increment: 30
 surface: a plate.s 1
+tsurface: b bract.ts
