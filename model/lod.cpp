@@ -36,11 +36,18 @@ std::vector<uint32_t> triangleComponents(const Mesh& mesh, size_t& count) {
   return out;
 }
 
-// keep of mesh's pieces (components), evenly spread over their order (piece j is kept when
-// ⌊(j+1)·keep/pieces⌋ > ⌊j·keep/pieces⌋), each grown about its vertices' centroid by
-// √(pieces/keep) so that the kept pieces cover the area all of them did. Per-vertex arrays
-// follow the vertices kept; per-triangle materials the triangles.
-Mesh thinPieces(const Mesh& mesh, size_t targetTriangles) {
+double meshArea(const Mesh& m) {
+  double a = 0;
+  for (const glm::uvec3& t : m.triangles)
+    a += 0.5 * glm::length(glm::cross(glm::dvec3(m.positions[t.y] - m.positions[t.x]), glm::dvec3(m.positions[t.z] - m.positions[t.x])));
+  return a;
+}
+
+// About targetTriangles of mesh's triangles in whole pieces (components), evenly spread over
+// their order (piece j of P is kept when ⌊(j+1)·K/P⌋ > ⌊j·K/P⌋ for K pieces kept), each
+// grown about its vertices' centroid by one factor so that the kept pieces cover area.
+// Per-vertex arrays follow the vertices kept; per-triangle materials the triangles.
+Mesh thinPieces(const Mesh& mesh, size_t targetTriangles, double area) {
   size_t pieces = 0;
   const std::vector<uint32_t> piece = triangleComponents(mesh, pieces);
   const double fraction = double(targetTriangles) / double(std::max<size_t>(mesh.triangles.size(), 1));
@@ -55,8 +62,8 @@ Mesh thinPieces(const Mesh& mesh, size_t targetTriangles) {
     for (int k = 0; k < 3; ++k) vertexPiece[mesh.triangles[t][k]] = piece[t];
   for (size_t v = 0; v < mesh.positions.size(); ++v)
     if (vertexPiece[v] != UINT32_MAX) sum[vertexPiece[v]] += glm::dvec3(mesh.positions[v]), ++used[vertexPiece[v]];
-  const double grow = std::sqrt(double(pieces) / double(keep));
   Mesh out;
+  std::vector<glm::dvec3> centre;  // of each output vertex's piece
   const bool normals = mesh.normals.size() == mesh.positions.size(), uvs = mesh.uvs.size() == mesh.positions.size(),
              colors = mesh.colors.size() == mesh.positions.size(), materials = mesh.materials.size() == mesh.triangles.size();
   for (size_t t = 0; t < mesh.triangles.size(); ++t) {
@@ -66,8 +73,8 @@ Mesh thinPieces(const Mesh& mesh, size_t targetTriangles) {
       const uint32_t v = mesh.triangles[t][k];
       if (newIndex[v] == SIZE_MAX) {
         newIndex[v] = out.positions.size();
-        const glm::dvec3 c = sum[piece[t]] / double(used[piece[t]]);
-        out.positions.push_back(Vec3(c + (glm::dvec3(mesh.positions[v]) - c) * grow));
+        out.positions.push_back(mesh.positions[v]);
+        centre.push_back(sum[piece[t]] / double(used[piece[t]]));
         if (normals) out.normals.push_back(mesh.normals[v]);
         if (uvs) out.uvs.push_back(mesh.uvs[v]);
         if (colors) out.colors.push_back(mesh.colors[v]);
@@ -77,6 +84,10 @@ Mesh thinPieces(const Mesh& mesh, size_t targetTriangles) {
     out.triangles.push_back(tri);
     if (materials) out.materials.push_back(mesh.materials[t]);
   }
+  const double keptArea = meshArea(out);
+  const double grow = keptArea > 0 && area > 0 ? std::sqrt(area / keptArea) : 1.0;
+  for (size_t v = 0; v < out.positions.size(); ++v)
+    out.positions[v] = Vec3(centre[v] + (glm::dvec3(out.positions[v]) - centre[v]) * grow);
   return out;
 }
 
@@ -87,8 +98,19 @@ ExportPart reducePart(const ExportPart& part, size_t targetTriangles) {
   out.name = part.name;
   out.material = part.material;
   out.scattered = part.scattered;
-  out.mesh = part.scattered ? thinPieces(part.mesh, targetTriangles)
-                            : organisms::simplifyToCount(part.mesh, std::max<size_t>(targetTriangles, 1));
+  if (part.scattered) {
+    // Leaves: fewer triangles per leaf first (their outlines simplified, down to about two
+    // triangles a leaf), then fewer leaves; the leaves that remain grown to the area all
+    // of them covered, so that the crown keeps its leaf area.
+    size_t pieces = 0;
+    triangleComponents(part.mesh, pieces);
+    const size_t floor = std::max(targetTriangles, 2 * pieces);
+    const Mesh fewer =
+        floor < part.mesh.triangles.size() ? organisms::simplifyToCount(part.mesh, floor, nullptr, false) : part.mesh;
+    out.mesh = thinPieces(fewer, targetTriangles, meshArea(part.mesh));
+  } else {
+    out.mesh = organisms::simplifyToCount(part.mesh, std::max<size_t>(targetTriangles, 1));
+  }
   removeDegenerateTriangles(out.mesh);
   // An atlas has one patch per triangle of the full part: baked again from the colours of
   // the vertices that remain (or dropped where they are all the base colour). A part that

@@ -40,7 +40,8 @@ MeshTopology topologyOf(const std::vector<unsigned int>& indices) {
 
 }  // namespace
 
-SimplifiedMesh simplifyMesh(const Mesh& mesh, size_t targetFaces, float maxRelativeError, bool linkCheck) {
+SimplifiedMesh simplifyMesh(const Mesh& mesh, size_t targetFaces, float maxRelativeError, bool linkCheck, bool lockBorder) {
+  linkCheck = linkCheck && lockBorder;
   SimplifiedMesh out;
   SimplifyReport& report = out.report;
   report.inputTriangles = mesh.triangleCount();
@@ -91,7 +92,7 @@ SimplifiedMesh simplifyMesh(const Mesh& mesh, size_t targetFaces, float maxRelat
   std::vector<unsigned int> simplified(indices.size());
   float error = 0;
   size_t count = meshopt_simplify(simplified.data(), indices.data(), indices.size(), xyz, welded, sizeof(Vec3),
-                                  target * 3, maxRelativeError, meshopt_SimplifyLockBorder, &error);
+                                  target * 3, maxRelativeError, lockBorder ? meshopt_SimplifyLockBorder : 0u, &error);
   simplified.resize(count);
   float scale = meshopt_simplifyScale(xyz, welded, sizeof(Vec3));
   MeshTopology input = linkCheck ? topologyOf(indices) : MeshTopology{};
@@ -168,9 +169,9 @@ Mesh simplifyToError(const Mesh& mesh, float maxRelativeError, SimplifyReport* r
   return carried(mesh, s, report, source);
 }
 
-Mesh simplifyToCount(const Mesh& mesh, size_t targetFaces, SimplifyReport* report) {
+Mesh simplifyToCount(const Mesh& mesh, size_t targetFaces, SimplifyReport* report, bool lockBorder) {
   // An error bound of 1: the whole extent, so the face count alone stops the collapses.
-  SimplifiedMesh s = simplifyMesh(mesh, targetFaces, 1.0f, false);
+  SimplifiedMesh s = simplifyMesh(mesh, targetFaces, 1.0f, false, lockBorder);
   return carried(mesh, s, report, nullptr);
 }
 

@@ -62,7 +62,10 @@ struct SimplifiedMesh {
 /// core of a shared machine, 2.5-3.5 s more when the link-checked collapses run.
 /// linkCheck false keeps meshoptimizer's result as it is (faster on millions of triangles;
 /// a pinched edge now and then): for levels of detail, which are drawn, not refined.
-SimplifiedMesh simplifyMesh(const Mesh& mesh, size_t targetFaces, float maxRelativeError = 1e-1f, bool linkCheck = true);
+/// lockBorder false lets collapses run along open borders too (they move an open outline
+/// inward: leaves of a level of detail), and implies linkCheck false.
+SimplifiedMesh simplifyMesh(const Mesh& mesh, size_t targetFaces, float maxRelativeError = 1e-1f, bool linkCheck = true,
+                            bool lockBorder = true);
 
 /// simplifyMesh(...).mesh.
 PolyMesh simplifyToFaceCount(const Mesh& mesh, size_t targetFaces, float maxRelativeError = 1e-1f);
@@ -79,7 +82,8 @@ Mesh simplifyToError(const Mesh& mesh, float maxRelativeError, SimplifyReport* r
 /// Reduces mesh to about targetFaces triangles whatever the error (meshoptimizer's edge
 /// collapses, the border locked, without the link-checked replacement: linkCheck false of
 /// simplifyMesh) and keeps the input's per-vertex arrays at the vertices that remain, as
-/// simplifyToError: a level of detail. report as simplifyToError. Throws as simplifyMesh.
-Mesh simplifyToCount(const Mesh& mesh, size_t targetFaces, SimplifyReport* report = nullptr);
+/// simplifyToError: a level of detail. lockBorder false: open borders are simplified too
+/// (simplifyMesh). report as simplifyToError. Throws as simplifyMesh.
+Mesh simplifyToCount(const Mesh& mesh, size_t targetFaces, SimplifyReport* report = nullptr, bool lockBorder = true);
 
 }  // namespace sprig::organisms
