@@ -10,6 +10,7 @@
 
 #include "model/species.h"
 #include "app/cmd_common.h"
+#include "model/lod.h"
 #include "model/mesh_parts.h"
 #include "model/model.h"
 #include "core/mesh_io.h"
@@ -30,7 +31,39 @@ struct MeshArgs {
   double minVolume = MeshCleanOptions{}.minVolumeFraction;
   std::string mesher;  ///< empty = the species' render.mesher
   double simplify = -1;  ///< < 0 = the species' render.simplify
+  std::string lod = "auto";  ///< auto (the kind's LOD0 budget), none (the full mesh alone) or a budget
 };
+
+/// LOD0's triangle budget of --lod (0: none, the full mesh alone). Throws UsageError for
+/// anything but auto, none or a whole number of at least kLodMinBudget.
+size_t lodBudget(const std::string& value, size_t kindBudget) {
+  if (value == "auto") return kindBudget;
+  if (value == "none") return 0;
+  size_t budget = 0;
+  bool digits = !value.empty() && value.size() <= 10;
+  for (char c : value) digits = digits && c >= '0' && c <= '9';
+  if (digits) budget = std::stoull(value);
+  if (!digits || budget < kLodMinBudget)
+    throw UsageError("--lod: '" + value + "' is not auto, none or a triangle budget (a whole number of at least " +
+                     std::to_string(kLodMinBudget) + ")");
+  return budget;
+}
+
+/// The note on the levels of detail written ("" for one level).
+std::string lodNote(const std::vector<LodLevel>& levels, size_t budget, size_t fullTriangles, double seconds) {
+  if (levels.size() < 2) return {};
+  std::string text = "levels of detail (LOD0 budget " + std::to_string(budget) + " triangles, full mesh " +
+                     std::to_string(fullTriangles) + "):";
+  for (size_t k = 0; k < levels.size(); ++k) {
+    char buf[96];
+    std::snprintf(buf, sizeof buf, "%s LOD%zu %zu (screen coverage %g)", k ? "," : "", k, levels[k].triangles,
+                  levels[k].screenCoverage);
+    text += buf;
+  }
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "; made in %.2f s", seconds);
+  return text + buf;
+}
 
 /// The -o paths' extensions, and several -o only for surface meshes, each path once.
 void checkOutputs(const MeshArgs& a) {
@@ -102,13 +135,16 @@ void noteParts(const std::vector<ExportPart>& parts, const std::vector<PartWrite
 int runMesh(const MeshArgs& a, const GlobalOptions& g) {
   checkOutputs(a);
   const std::string& out = a.outs.front();
-  PhaseClock::declare({"read", "derive", "build", "polygonize", "write"});
+  PhaseClock::declare({"read", "derive", "build", "polygonize", "levels", "write"});
   auto start = std::chrono::steady_clock::now();
   // Volume meshes (tetrahedra with materials) of kinds that have them, by extension.
   const std::string ext = lowerExtension(out);
   const bool volume = ext == ".msh" || ext == ".vtu" || ext == ".mesh";
   if (a.simplify > 0 && (a.interfaces || volume))
     throw UsageError("--simplify applies to the surface parts written as .ply, .obj or .glb, not to --interfaces or volume meshes");
+  if (a.lod != "auto" && (a.interfaces || volume))
+    throw UsageError("--lod applies to the surface parts written as .ply, .obj or .glb, not to --interfaces or volume meshes");
+  lodBudget(a.lod, 0);  // a bad value fails before the build
   Species species = loadSpecies(a.file, g.pathPolicy());
   printNotes(g, species);
   if (!a.mesher.empty()) species.render.dualMesher = a.mesher == "dual";
@@ -141,22 +177,35 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
   const double simplify = a.simplify >= 0 ? a.simplify : species.render.simplify;
   const std::string simplified = simplifyForMesh(parts, simplify, g);
   const ExportFinish finish = finishExportParts(parts);
+  const size_t budget = lodBudget(a.lod, model.lodBudget());
+  const size_t fullTriangles = partTriangles(parts);
+  const auto lodStart = std::chrono::steady_clock::now();
+  Vec3 moved(0.0f);  // LOD0 stood on the ground again
+  const std::vector<LodLevel> levels = [&] {
+    const Phase phase("levels");
+    return lodLevels(std::move(parts), budget, &moved);
+  }();
+  const double lodSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - lodStart).count();
+  const std::vector<ExportPart>& top = levels[0].parts;  // LOD0: the file's scene
   std::vector<PartWriteReport> written;
-  std::string names, files, degenerate;
+  std::string names, files, degenerate, lodFiles;
   bool glb = false;
   for (const std::string& o : a.outs) {
     std::vector<PartWriteReport> r = [&] {
       const Phase phase("write");
-      return writeParts(parts, o);
+      return writeLevels(levels, o);
     }();
     if (written.empty() || lowerExtension(o) != ".ply") written = std::move(r);  // PLY has no textures to report
     files += (files.empty() ? "" : ", ") + o;
+    if (levels.size() > 1)  // a .glb's LOD0 has its own file too (writeLevels)
+      for (size_t k = lowerExtension(o) == ".glb" ? 0 : 1; k < levels.size(); ++k)
+        lodFiles += (lodFiles.empty() ? "" : ", ") + lodPath(o, k).string();
     glb = glb || lowerExtension(o) == ".glb";
   }
   double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   size_t vertices = 0, triangles = 0;
-  for (size_t i = 0; i < parts.size(); ++i) {
-    const ExportPart& p = parts[i];
+  for (size_t i = 0; i < top.size(); ++i) {
+    const ExportPart& p = top[i];
     if (const DegenerateReport& d = finish.removed[i]; d.total() > 0)
       degenerate += (degenerate.empty() ? "" : ", ") + p.name + " " + std::to_string(d.total()) + " (" +
                     std::to_string(d.repeatedIndex) + " with a repeated corner)";
@@ -176,8 +225,13 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
          c.facesAgainstAfter, c.fixedNormals);
   if (!degenerate.empty()) note(g, std::cout, "degenerate triangles removed (zero area or a repeated corner): %s", degenerate.c_str());
   note(g, std::cout, "placed: moved by (%g, %g, %g) to stand at the origin (lowest y = 0, centred in x and z; metres)",
-       double(finish.offset.x), double(finish.offset.y), double(finish.offset.z));
-  noteParts(parts, written, glb, g);
+       double(finish.offset.x + moved.x), double(finish.offset.y + moved.y), double(finish.offset.z + moved.z));
+  if (const std::string t = lodNote(levels, budget, fullTriangles, lodSeconds); !t.empty()) {
+    note(g, std::cout, "%s", t.c_str());
+    note(g, std::cout, "each level's own file: %s%s", lodFiles.c_str(),
+         glb ? "; the .glb holds every level (MSFT_lod); --lod none writes the full mesh alone" : "");
+  }
+  noteParts(top, written, glb, g);
   return kExitOk;
 }
 
@@ -208,6 +262,11 @@ void addMeshCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run)
                   "extent (meshoptimizer; e.g. 1e-3); closed parts stay closed and manifold; 0 keeps every triangle; "
                   "default: the species' render.simplify (0)")
       ->check(CLI::Range(0.0, 0.1));
+  sub->add_option("--lod", args->lod,
+                  "levels of detail: auto (trees 300000, shells and organisms 250000 triangles at LOD0, then a quarter "
+                  "per level; blobs and solids none), none (the full mesh alone), or LOD0's triangle budget; writes "
+                  "OUT_lod1.EXT, ... beside OUT and, in .glb, every level through MSFT_lod (docs/MESHES.md)")
+      ->capture_default_str();
   addStageFlags(*sub, args->stage);
   addGrowthFlags(*sub, args->growth);
 }

@@ -425,121 +425,167 @@ void checkParts(const std::vector<ExportPart>& parts) {
   if (dup != names.end()) throw std::invalid_argument("two exported parts are named '" + *dup + "'");
 }
 
-std::vector<PartWriteReport> writePartsGlb(const std::vector<ExportPart>& parts, const fs::path& path) {
-  std::vector<PartWriteReport> reports;
-  tinygltf::Model model;
-  model.asset.version = "2.0";
-  model.asset.generator = "Sprig";
-  tinygltf::Scene scene;
-  scene.name = "Sprig";
-  tinygltf::Buffer buffer;
-  std::vector<unsigned char>& data = buffer.data;
-  auto addAccessor = [&](const void* bytes, size_t byteLength, size_t count, int type, int componentType, int target) {
-    return addGltfAccessor(model, data, bytes, byteLength, count, type, componentType, target);
-  };
-  for (const ExportPart& part : parts) {
-    if (part.mesh.triangles.empty()) continue;
-    PartCorners corners = partCorners(part);
-    reports.push_back(corners.report);
-    const Mesh mesh = unweld(part.mesh, corners.normals, corners.uvs);
-    tinygltf::Material mat;
-    mat.name = part.material.name;
-    const Vec3& c = part.material.baseColor;
-    const PartTexture* tex = part.material.texture.get();
-    mat.pbrMetallicRoughness.baseColorFactor = {c.x, c.y, c.z, 1.0};
-    if (tex) {
-      // The image holds absolute colours: factor 1, the species' colour kept in extras.
-      mat.pbrMetallicRoughness.baseColorFactor = {1.0, 1.0, 1.0, 1.0};
-      tinygltf::Value::Array rgb{tinygltf::Value(double(c.x)), tinygltf::Value(double(c.y)), tinygltf::Value(double(c.z))};
-      tinygltf::Value::Object extras;
-      extras["sprigBaseColor"] = tinygltf::Value(rgb);
-      mat.extras = tinygltf::Value(extras);
-      const bool cutOut = part.material.alphaCutoff >= 0.0f;
-      if (cutOut) {
-        mat.alphaMode = "MASK";
-        mat.alphaCutoff = part.material.alphaCutoff;
-      }
-      const std::string png = pngBytes(tex->image, path, cutOut);
-      while (data.size() % 4) data.push_back(0);
-      tinygltf::BufferView view;
-      view.buffer = 0;
-      view.byteOffset = data.size();
-      view.byteLength = png.size();
-      data.insert(data.end(), png.begin(), png.end());
-      model.bufferViews.push_back(view);
-      tinygltf::Image image;
-      image.name = part.name;
-      image.mimeType = "image/png";
-      image.bufferView = int(model.bufferViews.size() - 1);
-      model.images.push_back(image);
-      tinygltf::Sampler sampler;
-      sampler.magFilter = tex->magFilter == PartTexture::Filter::Nearest ? TINYGLTF_TEXTURE_FILTER_NEAREST
-                                                                          : TINYGLTF_TEXTURE_FILTER_LINEAR;
-      sampler.minFilter = tex->minFilter == PartTexture::Filter::Nearest  ? TINYGLTF_TEXTURE_FILTER_NEAREST
-                          : tex->minFilter == PartTexture::Filter::Linear ? TINYGLTF_TEXTURE_FILTER_LINEAR
-                          : tex->isAtlas()                                ? TINYGLTF_TEXTURE_FILTER_LINEAR
-                                                                          : TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
-      sampler.wrapS = tex->seams.repeatU ? TINYGLTF_TEXTURE_WRAP_REPEAT : TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
-      sampler.wrapT = tex->seams.repeatV ? TINYGLTF_TEXTURE_WRAP_REPEAT : TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
-      model.samplers.push_back(sampler);
-      tinygltf::Texture texture;
-      texture.name = part.name;
-      texture.sampler = int(model.samplers.size() - 1);
-      texture.source = int(model.images.size() - 1);
-      model.textures.push_back(texture);
-      mat.pbrMetallicRoughness.baseColorTexture.index = int(model.textures.size() - 1);
-    }
-    mat.pbrMetallicRoughness.metallicFactor = 0.0;
-    mat.pbrMetallicRoughness.roughnessFactor = part.material.roughness;
-    mat.doubleSided = part.material.doubleSided;
-    model.materials.push_back(mat);
-
-    const size_t n = mesh.positions.size();
-    tinygltf::Primitive prim;
-    prim.mode = TINYGLTF_MODE_TRIANGLES;
-    prim.material = int(model.materials.size() - 1);
-    const int pos = addAccessor(mesh.positions.data(), n * sizeof(Vec3), n, TINYGLTF_TYPE_VEC3,
-                                TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
-    const Box3 box = mesh.bounds();
-    model.accessors[size_t(pos)].minValues = {box.lo.x, box.lo.y, box.lo.z};
-    model.accessors[size_t(pos)].maxValues = {box.hi.x, box.hi.y, box.hi.z};
-    prim.attributes["POSITION"] = pos;
-    if (!mesh.normals.empty())
-      prim.attributes["NORMAL"] = addAccessor(mesh.normals.data(), n * sizeof(Vec3), n, TINYGLTF_TYPE_VEC3,
-                                              TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
-    if (!mesh.uvs.empty()) {
-      std::vector<Vec2> flipped(n);
-      for (size_t i = 0; i < n; ++i) flipped[i] = {mesh.uvs[i].x, 1.0f - mesh.uvs[i].y};
-      prim.attributes["TEXCOORD_0"] = addAccessor(flipped.data(), n * sizeof(Vec2), n, TINYGLTF_TYPE_VEC2,
-                                                  TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
-    }
-    if (!tex && hasOwnColors(part)) {
-      std::vector<Vec3> rel(n);
-      for (size_t i = 0; i < n; ++i) rel[i] = relativeColor(mesh.colors[i], c);
-      prim.attributes["COLOR_0"] = addAccessor(rel.data(), n * sizeof(Vec3), n, TINYGLTF_TYPE_VEC3,
-                                               TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
-    }
-    prim.indices = addAccessor(mesh.triangles.data(), mesh.triangles.size() * sizeof(glm::uvec3),
-                               mesh.triangles.size() * 3, TINYGLTF_TYPE_SCALAR,
-                               TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
-    tinygltf::Mesh gm;
-    gm.name = part.name;
-    gm.primitives.push_back(prim);
-    model.meshes.push_back(gm);
-    tinygltf::Node node;
-    node.name = part.name;
-    node.mesh = int(model.meshes.size() - 1);
-    model.nodes.push_back(node);
-    scene.nodes.push_back(int(model.nodes.size() - 1));
+// A glTF binary built part by part: images shared between parts (levels of detail) stored once.
+class GlbBuilder {
+ public:
+  explicit GlbBuilder(const fs::path& path) : path_(path) {
+    model_.asset.version = "2.0";
+    model_.asset.generator = "Sprig";
+    scene_.name = "Sprig";
   }
-  if (!data.empty()) model.buffers.push_back(std::move(buffer));
-  model.scenes.push_back(scene);
-  model.defaultScene = 0;
+
+  /// Adds part as a node named nodeName (and its mesh and material); returns the node's index.
+  int addPart(const ExportPart& part, const std::string& nodeName, PartWriteReport* report);
+  /// Puts node in the scene.
+  void addToScene(int node) { scene_.nodes.push_back(node); }
+  tinygltf::Node& node(int i) { return model_.nodes[size_t(i)]; }
+  int addEmptyNode(const tinygltf::Node& n) {
+    model_.nodes.push_back(n);
+    return int(model_.nodes.size() - 1);
+  }
+  void useExtension(const std::string& name) { model_.extensionsUsed.push_back(name); }
+  /// Writes the file atomically.
+  void write();
+
+ private:
+  int addAccessor(const void* bytes, size_t byteLength, size_t count, int type, int componentType, int target) {
+    return addGltfAccessor(model_, data_, bytes, byteLength, count, type, componentType, target);
+  }
+  int addTexture(const ExportPart& part);
+  int addMaterial(const ExportPart& part);
+
+  fs::path path_;
+  tinygltf::Model model_;
+  tinygltf::Scene scene_;
+  std::vector<unsigned char> data_;
+  std::map<const PartTexture*, int> textures_;
+};
+
+int GlbBuilder::addTexture(const ExportPart& part) {
+  const PartTexture* tex = part.material.texture.get();
+  if (auto it = textures_.find(tex); it != textures_.end()) return it->second;
+  const std::string png = pngBytes(tex->image, path_, part.material.alphaCutoff >= 0.0f);
+  while (data_.size() % 4) data_.push_back(0);
+  tinygltf::BufferView view;
+  view.buffer = 0;
+  view.byteOffset = data_.size();
+  view.byteLength = png.size();
+  data_.insert(data_.end(), png.begin(), png.end());
+  model_.bufferViews.push_back(view);
+  tinygltf::Image image;
+  image.name = part.name;
+  image.mimeType = "image/png";
+  image.bufferView = int(model_.bufferViews.size() - 1);
+  model_.images.push_back(image);
+  tinygltf::Sampler sampler;
+  sampler.magFilter =
+      tex->magFilter == PartTexture::Filter::Nearest ? TINYGLTF_TEXTURE_FILTER_NEAREST : TINYGLTF_TEXTURE_FILTER_LINEAR;
+  sampler.minFilter = tex->minFilter == PartTexture::Filter::Nearest  ? TINYGLTF_TEXTURE_FILTER_NEAREST
+                      : tex->minFilter == PartTexture::Filter::Linear ? TINYGLTF_TEXTURE_FILTER_LINEAR
+                      : tex->isAtlas()                                ? TINYGLTF_TEXTURE_FILTER_LINEAR
+                                                                      : TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR;
+  sampler.wrapS = tex->seams.repeatU ? TINYGLTF_TEXTURE_WRAP_REPEAT : TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+  sampler.wrapT = tex->seams.repeatV ? TINYGLTF_TEXTURE_WRAP_REPEAT : TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
+  model_.samplers.push_back(sampler);
+  tinygltf::Texture texture;
+  texture.name = part.name;
+  texture.sampler = int(model_.samplers.size() - 1);
+  texture.source = int(model_.images.size() - 1);
+  model_.textures.push_back(texture);
+  return textures_[tex] = int(model_.textures.size() - 1);
+}
+
+int GlbBuilder::addMaterial(const ExportPart& part) {
+  tinygltf::Material mat;
+  mat.name = part.material.name;
+  const Vec3& c = part.material.baseColor;
+  mat.pbrMetallicRoughness.baseColorFactor = {c.x, c.y, c.z, 1.0};
+  if (part.material.texture) {
+    // The image holds absolute colours: factor 1, the species' colour kept in extras.
+    mat.pbrMetallicRoughness.baseColorFactor = {1.0, 1.0, 1.0, 1.0};
+    tinygltf::Value::Array rgb{tinygltf::Value(double(c.x)), tinygltf::Value(double(c.y)), tinygltf::Value(double(c.z))};
+    tinygltf::Value::Object extras;
+    extras["sprigBaseColor"] = tinygltf::Value(rgb);
+    mat.extras = tinygltf::Value(extras);
+    if (part.material.alphaCutoff >= 0.0f) {
+      mat.alphaMode = "MASK";
+      mat.alphaCutoff = part.material.alphaCutoff;
+    }
+    mat.pbrMetallicRoughness.baseColorTexture.index = addTexture(part);
+  }
+  mat.pbrMetallicRoughness.metallicFactor = 0.0;
+  mat.pbrMetallicRoughness.roughnessFactor = part.material.roughness;
+  mat.doubleSided = part.material.doubleSided;
+  model_.materials.push_back(mat);
+  return int(model_.materials.size() - 1);
+}
+
+int GlbBuilder::addPart(const ExportPart& part, const std::string& nodeName, PartWriteReport* report) {
+  PartCorners corners = partCorners(part);
+  if (report) *report = corners.report;
+  const Mesh mesh = unweld(part.mesh, corners.normals, corners.uvs);
+  const size_t n = mesh.positions.size();
+  tinygltf::Primitive prim;
+  prim.mode = TINYGLTF_MODE_TRIANGLES;
+  prim.material = addMaterial(part);
+  const int pos = addAccessor(mesh.positions.data(), n * sizeof(Vec3), n, TINYGLTF_TYPE_VEC3, TINYGLTF_COMPONENT_TYPE_FLOAT,
+                              TINYGLTF_TARGET_ARRAY_BUFFER);
+  const Box3 box = mesh.bounds();
+  model_.accessors[size_t(pos)].minValues = {box.lo.x, box.lo.y, box.lo.z};
+  model_.accessors[size_t(pos)].maxValues = {box.hi.x, box.hi.y, box.hi.z};
+  prim.attributes["POSITION"] = pos;
+  if (!mesh.normals.empty())
+    prim.attributes["NORMAL"] = addAccessor(mesh.normals.data(), n * sizeof(Vec3), n, TINYGLTF_TYPE_VEC3,
+                                            TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+  if (!mesh.uvs.empty()) {
+    std::vector<Vec2> flipped(n);
+    for (size_t i = 0; i < n; ++i) flipped[i] = {mesh.uvs[i].x, 1.0f - mesh.uvs[i].y};
+    prim.attributes["TEXCOORD_0"] = addAccessor(flipped.data(), n * sizeof(Vec2), n, TINYGLTF_TYPE_VEC2,
+                                                TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+  }
+  if (!part.material.texture && hasOwnColors(part)) {
+    std::vector<Vec3> rel(n);
+    for (size_t i = 0; i < n; ++i) rel[i] = relativeColor(mesh.colors[i], part.material.baseColor);
+    prim.attributes["COLOR_0"] = addAccessor(rel.data(), n * sizeof(Vec3), n, TINYGLTF_TYPE_VEC3,
+                                             TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+  }
+  prim.indices = addAccessor(mesh.triangles.data(), mesh.triangles.size() * sizeof(glm::uvec3), mesh.triangles.size() * 3,
+                             TINYGLTF_TYPE_SCALAR, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
+  tinygltf::Mesh gm;
+  gm.name = nodeName;
+  gm.primitives.push_back(prim);
+  model_.meshes.push_back(gm);
+  tinygltf::Node node;
+  node.name = nodeName;
+  node.mesh = int(model_.meshes.size() - 1);
+  model_.nodes.push_back(node);
+  return int(model_.nodes.size() - 1);
+}
+
+void GlbBuilder::write() {
+  if (!data_.empty()) {
+    tinygltf::Buffer buffer;
+    buffer.data = std::move(data_);
+    model_.buffers.push_back(std::move(buffer));
+  }
+  model_.scenes.push_back(scene_);
+  model_.defaultScene = 0;
   std::ostringstream stream;
   tinygltf::TinyGLTF writer;
-  if (!writer.WriteGltfSceneToStream(&model, stream, false, true))
-    throw std::runtime_error("cannot write '" + path.string() + "': glTF serialization failed");
-  writeAtomic(path, stream.str());
+  if (!writer.WriteGltfSceneToStream(&model_, stream, false, true))
+    throw std::runtime_error("cannot write '" + path_.string() + "': glTF serialization failed");
+  writeAtomic(path_, stream.str());
+}
+
+std::vector<PartWriteReport> writePartsGlb(const std::vector<ExportPart>& parts, const fs::path& path) {
+  std::vector<PartWriteReport> reports;
+  GlbBuilder glb(path);
+  for (const ExportPart& part : parts) {
+    if (part.mesh.triangles.empty()) continue;
+    reports.emplace_back();
+    glb.addToScene(glb.addPart(part, part.name, &reports.back()));
+  }
+  glb.write();
   return reports;
 }
 
@@ -664,6 +710,69 @@ std::vector<PartWriteReport> writeParts(const std::vector<ExportPart>& parts, co
     case MeshFormat::Glb: return writePartsGlb(parts, path);
   }
   return {};
+}
+
+std::vector<PartWriteReport> writePartLevels(const std::vector<LodLevel>& levels, const fs::path& path) {
+  if (meshFormatFor(path) != MeshFormat::Glb)
+    throw std::invalid_argument("levels of detail in one file are glTF (.glb): '" + path.string() + "' is not");
+  if (levels.empty()) throw std::invalid_argument("writePartLevels: no level to write");
+  if (levels.size() == 1) return writeParts(levels[0].parts, path);
+  const std::vector<ExportPart>& top = levels[0].parts;
+  for (const LodLevel& level : levels) {
+    checkParts(level.parts);
+    bool same = level.parts.size() == top.size();
+    for (size_t i = 0; same && i < top.size(); ++i) same = level.parts[i].name == top[i].name;
+    if (!same) throw std::invalid_argument("writePartLevels: the levels of detail do not have the same parts");
+  }
+  std::vector<PartWriteReport> reports;
+  GlbBuilder glb(path);
+  for (size_t i = 0; i < top.size(); ++i) {
+    if (top[i].mesh.triangles.empty()) continue;
+    reports.emplace_back();
+    const int node = glb.addPart(top[i], top[i].name, &reports.back());
+    glb.addToScene(node);
+    tinygltf::Value::Array ids, coverage{tinygltf::Value(levels[0].screenCoverage)};
+    for (size_t k = 1; k < levels.size(); ++k) {
+      const ExportPart& p = levels[k].parts[i];
+      const std::string name = p.name + "_lod" + std::to_string(k);
+      int id = -1;
+      if (p.mesh.triangles.empty()) {  // a part gone at this level: a node without a mesh
+        tinygltf::Node empty;
+        empty.name = name;
+        id = glb.addEmptyNode(empty);
+      } else {
+        id = glb.addPart(p, name, nullptr);
+      }
+      ids.push_back(tinygltf::Value(id));
+      coverage.push_back(tinygltf::Value(levels[k].screenCoverage));
+    }
+    tinygltf::Value::Object lod{{"ids", tinygltf::Value(ids)}};
+    glb.node(node).extensions["MSFT_lod"] = tinygltf::Value(lod);
+    tinygltf::Value::Object extras{{"MSFT_screencoverage", tinygltf::Value(coverage)}};
+    glb.node(node).extras = tinygltf::Value(extras);
+  }
+  glb.useExtension("MSFT_lod");
+  glb.write();
+  return reports;
+}
+
+fs::path lodPath(const fs::path& path, size_t k) {
+  fs::path out = path;
+  out.replace_filename(path.stem().string() + "_lod" + std::to_string(k) + path.extension().string());
+  return out;
+}
+
+std::vector<fs::path> partFiles(const std::vector<ExportPart>& parts, const fs::path& path) {
+  std::vector<fs::path> files{path};
+  if (meshFormatFor(path) != MeshFormat::Obj) return files;
+  fs::path mtl = path;
+  files.push_back(mtl.replace_extension(".mtl"));
+  for (const ExportPart& part : parts)
+    if (!part.mesh.triangles.empty() && part.material.texture) {
+      fs::path png = path;
+      files.push_back(png.replace_filename(path.stem().string() + "_" + objName(part.name) + ".png"));
+    }
+  return files;
 }
 
 }  // namespace sprig

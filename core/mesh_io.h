@@ -109,6 +109,18 @@ struct ExportPart {
   std::string name;  ///< node name in glTF, object name in OBJ
   Mesh mesh;
   PartMaterial material;
+  /// Many small separate pieces (leaves): levels of detail (model/lod.h) keep a share of
+  /// the pieces, grown to keep their area, instead of simplifying each piece.
+  bool scattered = false;
+};
+
+/// One level of detail of a model (model/lod.h buildLodChain makes them): the parts, with
+/// the same names in the same order at every level, and the MSFT_screencoverage threshold
+/// (the fraction of the screen's area below which the next level is drawn; 0: never culled).
+struct LodLevel {
+  std::vector<ExportPart> parts;
+  size_t triangles = 0;
+  double screenCoverage = 0;
 };
 
 /// Writes parts to path in the format its extension names, atomically, each part kept
@@ -138,6 +150,24 @@ struct PartWriteReport {
   int atlasCell = 0;  ///< texels per side of each triangle's patch when the texture is an atlas, else 0
 };
 std::vector<PartWriteReport> writeParts(const std::vector<ExportPart>& parts, const std::filesystem::path& path);
+
+/// Writes a model's levels of detail to one .glb, atomically: levels[0]'s parts as
+/// writeParts writes them (the scene's nodes, named after the parts), every further level's
+/// part as a node outside the scene named `PART_lodK` (its material keeps the part's name;
+/// an image shared between levels is stored once), and each LOD0 node carries the
+/// extension MSFT_lod (`ids`: its part's nodes of levels 1, 2, ...; listed in
+/// extensionsUsed, not extensionsRequired) and `extras.MSFT_screencoverage` (one threshold
+/// per level). A reader without the extension shows LOD0. One level writes what writeParts
+/// writes. Returns the reports of LOD0's parts. Throws as writeParts, and
+/// std::invalid_argument for a path that is not .glb or levels whose part names differ.
+std::vector<PartWriteReport> writePartLevels(const std::vector<LodLevel>& levels, const std::filesystem::path& path);
+
+/// The path of level k's own file beside path: `STEM_lodK.EXT`.
+std::filesystem::path lodPath(const std::filesystem::path& path, size_t k);
+
+/// Every file writeParts(parts, path) writes: path, and for OBJ its MTL and the images of
+/// its textured parts (`STEM_PART.png`).
+std::vector<std::filesystem::path> partFiles(const std::vector<ExportPart>& parts, const std::filesystem::path& path);
 
 /// How many colour channels writeParts clamps in glTF's COLOR_0 (a vertex brighter than its
 /// part's base colour in a channel); 0 means the glTF shows every vertex colour exactly

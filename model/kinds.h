@@ -114,6 +114,9 @@ class KindModel {
   /// buildMesh as one part "surface" in look.surface's colour.
   virtual std::vector<ExportPart> exportParts(const Stage& stage, float cellSize, bool progress, const SpeciesRender& look,
                                               const MeshCleanOptions& clean, ModelFigures& figures);
+  /// The triangle budget of LOD0 when `sprig mesh` writes levels of detail by default
+  /// (model/lod.h; docs/MESHES.md "Levels of detail"); 0 (the default): the full mesh alone.
+  virtual size_t lodBudget() const { return 0; }
   /// How the gallery animates it.
   virtual GalleryMotion galleryMotion(bool final) = 0;
   /// Extensions of the volume (tetrahedral) meshes the kind writes (".msh", ...); empty

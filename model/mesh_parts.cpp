@@ -239,14 +239,25 @@ ExportFinish finishExportParts(std::vector<ExportPart>& parts) {
         for (size_t k = 0; k < 3; ++k) copy->atlas.index.push_back(tex->atlas.index[t * 3 + k]);
       p.material.texture = std::move(copy);
     }
-    if (!p.mesh.triangles.empty()) box.extend(p.mesh.bounds());
   }
-  if (box.empty()) return finish;
-  const Vec3 centre = box.center();
-  finish.offset = Vec3(-centre.x, -box.lo.y, -centre.z);
-  for (ExportPart& p : parts)
-    for (Vec3& v : p.mesh.positions) v += finish.offset;
+  finish.offset = groundOffset(parts);
+  moveParts(parts, finish.offset);
   return finish;
+}
+
+Vec3 groundOffset(const std::vector<ExportPart>& parts) {
+  Box3 box;
+  for (const ExportPart& p : parts)
+    if (!p.mesh.triangles.empty()) box.extend(p.mesh.bounds());
+  if (box.empty()) return Vec3(0.0f);
+  const Vec3 centre = box.center();
+  return Vec3(-centre.x, -box.lo.y, -centre.z);
+}
+
+void moveParts(std::vector<ExportPart>& parts, const Vec3& offset) {
+  if (offset == Vec3(0.0f)) return;
+  for (ExportPart& p : parts)
+    for (Vec3& v : p.mesh.positions) v += offset;
 }
 
 std::vector<std::pair<uint32_t, Mesh>> splitByMaterial(const Mesh& mesh) {

@@ -129,6 +129,13 @@ struct ExportFinish {
 /// Y-up viewer at the origin). Textures and normals are unchanged. O(T + V).
 ExportFinish finishExportParts(std::vector<ExportPart>& parts);
 
+/// The offset that stands parts on the ground as finishExportParts does: the box of the
+/// parts that have triangles gets its lowest y at 0 and its centre at x = z = 0 (zero when
+/// no part has triangles). O(V).
+Vec3 groundOffset(const std::vector<ExportPart>& parts);
+/// Adds offset to every position of parts. O(V).
+void moveParts(std::vector<ExportPart>& parts, const Vec3& offset);
+
 /// The triangles of mesh grouped by their Mesh::materials id, in increasing id order;
 /// each group is its own mesh (only the vertices it uses, in their original order; every
 /// per-vertex array kept; materials cleared). mesh.materials must have one id per triangle.

@@ -85,6 +85,8 @@ class SpeciesModel {
   }
   /// The interfaces between materials as named meshes (KindModel::interfaceMeshes).
   std::vector<std::pair<std::string, Mesh>> interfaceMeshes(const Stage& stage) { return kind_->interfaceMeshes(stage); }
+  /// LOD0's triangle budget of `sprig mesh` by default (KindModel::lodBudget); 0: no levels.
+  size_t lodBudget() const { return kind_->lodBudget(); }
   /// How the gallery animates the species.
   GalleryMotion galleryMotion(bool final) { return kind_->galleryMotion(final); }
 

@@ -706,6 +706,9 @@ class OrganismModel final : public KindModel {
     return {std::move(part)};
   }
 
+  /// LOD0 of an organism within 250,000 triangles (docs/MESHES.md "Levels of detail").
+  size_t lodBudget() const override { return 250000; }
+
   GalleryMotion galleryMotion(bool) override {
     GalleryMotion m;
     m.turntable = !spec_.animated;

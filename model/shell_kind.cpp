@@ -642,6 +642,9 @@ class ShellModel final : public KindModel {
     return parts;
   }
 
+  /// LOD0 of a shell within 250,000 triangles (docs/MESHES.md "Levels of detail").
+  size_t lodBudget() const override { return 250000; }
+
   GalleryMotion galleryMotion(bool final) override {
     GalleryMotion m;
     m.framesPerStage = final ? 6 : 1;  // per whorl

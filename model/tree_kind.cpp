@@ -491,7 +491,8 @@ class TreeModel final : public KindModel {
         organs.materials.clear();
         const render::Material& m = set == organisms::OrganSet::Leaves ? look.style.leaf : look.style.fruit;
         // Leaves are open polygons seen from both sides; fruit are closed spheres.
-        parts.push_back(ExportPart{name, std::move(organs), PartMaterial{name, m.baseColor, m.roughness, set == organisms::OrganSet::Leaves, nullptr}});
+        const bool leaves = set == organisms::OrganSet::Leaves;
+        parts.push_back(ExportPart{name, std::move(organs), PartMaterial{name, m.baseColor, m.roughness, leaves, nullptr}, leaves});
         atlasVertexColors(parts.back());  // each leaf's tint, unclamped
       }
     }
@@ -523,11 +524,14 @@ class TreeModel final : public KindModel {
         // Both sides: leaves are open polygons, tubes open at their ends (cpfg draws no caps).
         PartMaterial material{name, color, m.roughness, true, std::move(baked)};
         material.alphaCutoff = tex.cutsOut() ? lsystem::kCpfgAlphaCutoff : -1.0f;  // glTF MASK, the image's alpha kept
-        parts.push_back(ExportPart{name, std::move(g.mesh), std::move(material)});
+        parts.push_back(ExportPart{name, std::move(g.mesh), std::move(material), !g.tube});  // leaves: scattered pieces
       }
     }
     return parts;
   }
+
+  /// LOD0 of a tree: wood, leaves and fruit within 300,000 triangles (docs/MESHES.md "Levels of detail").
+  size_t lodBudget() const override { return 300000; }
 
   GalleryMotion galleryMotion(bool final) override {
     // Exact frames rebuild the BlobTree each time: drafts show one frame per step.

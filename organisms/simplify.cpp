@@ -40,7 +40,8 @@ MeshTopology topologyOf(const std::vector<unsigned int>& indices) {
 
 }  // namespace
 
-SimplifiedMesh simplifyMesh(const Mesh& mesh, size_t targetFaces, float maxRelativeError) {
+SimplifiedMesh simplifyMesh(const Mesh& mesh, size_t targetFaces, float maxRelativeError, bool linkCheck, bool lockBorder) {
+  linkCheck = linkCheck && lockBorder;
   SimplifiedMesh out;
   SimplifyReport& report = out.report;
   report.inputTriangles = mesh.triangleCount();
@@ -91,11 +92,11 @@ SimplifiedMesh simplifyMesh(const Mesh& mesh, size_t targetFaces, float maxRelat
   std::vector<unsigned int> simplified(indices.size());
   float error = 0;
   size_t count = meshopt_simplify(simplified.data(), indices.data(), indices.size(), xyz, welded, sizeof(Vec3),
-                                  target * 3, maxRelativeError, meshopt_SimplifyLockBorder, &error);
+                                  target * 3, maxRelativeError, lockBorder ? meshopt_SimplifyLockBorder : 0u, &error);
   simplified.resize(count);
   float scale = meshopt_simplifyScale(xyz, welded, sizeof(Vec3));
-  MeshTopology input = topologyOf(indices);
-  if (input.manifold()) {
+  MeshTopology input = linkCheck ? topologyOf(indices) : MeshTopology{};
+  if (linkCheck && input.manifold()) {
     MeshTopology result = topologyOf(simplified);
     if (!result.manifold() || result.boundaryEdges != input.boundaryEdges || hasFoldedPair(simplified)) {
       EdgeCollapseResult own = collapseEdges(weldedPositions, indices, target, maxRelativeError * scale);
@@ -138,8 +139,11 @@ PolyMesh simplifyToFaceCount(const Mesh& mesh, size_t targetFaces, float maxRela
   return simplifyMesh(mesh, targetFaces, maxRelativeError).mesh;
 }
 
-Mesh simplifyToError(const Mesh& mesh, float maxRelativeError, SimplifyReport* report, std::vector<uint32_t>* source) {
-  SimplifiedMesh s = simplifyMesh(mesh, 0, maxRelativeError);
+namespace {
+
+// The triangle mesh of a simplification, every per-vertex array of the input carried to the
+// vertices that remain.
+Mesh carried(const Mesh& mesh, SimplifiedMesh& s, SimplifyReport* report, std::vector<uint32_t>* source) {
   if (report) *report = s.report;
   Mesh out;
   out.positions = std::move(s.mesh.positions);
@@ -156,6 +160,19 @@ Mesh simplifyToError(const Mesh& mesh, float maxRelativeError, SimplifyReport* r
   carry(mesh.colors, out.colors);
   if (source) *source = std::move(s.source);
   return out;
+}
+
+}  // namespace
+
+Mesh simplifyToError(const Mesh& mesh, float maxRelativeError, SimplifyReport* report, std::vector<uint32_t>* source) {
+  SimplifiedMesh s = simplifyMesh(mesh, 0, maxRelativeError);
+  return carried(mesh, s, report, source);
+}
+
+Mesh simplifyToCount(const Mesh& mesh, size_t targetFaces, SimplifyReport* report, bool lockBorder) {
+  // An error bound of 1: the whole extent, so the face count alone stops the collapses.
+  SimplifiedMesh s = simplifyMesh(mesh, targetFaces, 1.0f, false, lockBorder);
+  return carried(mesh, s, report, nullptr);
 }
 
 }  // namespace sprig::organisms

@@ -60,7 +60,12 @@ struct SimplifiedMesh {
 /// Throws std::invalid_argument for an index out of range or a position that is not
 /// finite. Cost: O(T log T) for T triangles: 1.3 M triangles to 500 in 1.2-2.3 s on one
 /// core of a shared machine, 2.5-3.5 s more when the link-checked collapses run.
-SimplifiedMesh simplifyMesh(const Mesh& mesh, size_t targetFaces, float maxRelativeError = 1e-1f);
+/// linkCheck false keeps meshoptimizer's result as it is (faster on millions of triangles;
+/// a pinched edge now and then): for levels of detail, which are drawn, not refined.
+/// lockBorder false lets collapses run along open borders too (they move an open outline
+/// inward: leaves of a level of detail), and implies linkCheck false.
+SimplifiedMesh simplifyMesh(const Mesh& mesh, size_t targetFaces, float maxRelativeError = 1e-1f, bool linkCheck = true,
+                            bool lockBorder = true);
 
 /// simplifyMesh(...).mesh.
 PolyMesh simplifyToFaceCount(const Mesh& mesh, size_t targetFaces, float maxRelativeError = 1e-1f);
@@ -73,5 +78,12 @@ PolyMesh simplifyToFaceCount(const Mesh& mesh, size_t targetFaces, float maxRela
 /// vertex of the result (for per-vertex data kept outside the mesh). Throws as simplifyMesh.
 Mesh simplifyToError(const Mesh& mesh, float maxRelativeError, SimplifyReport* report = nullptr,
                      std::vector<uint32_t>* source = nullptr);
+
+/// Reduces mesh to about targetFaces triangles whatever the error (meshoptimizer's edge
+/// collapses, the border locked, without the link-checked replacement: linkCheck false of
+/// simplifyMesh) and keeps the input's per-vertex arrays at the vertices that remain, as
+/// simplifyToError: a level of detail. lockBorder false: open borders are simplified too
+/// (simplifyMesh). report as simplifyToError. Throws as simplifyMesh.
+Mesh simplifyToCount(const Mesh& mesh, size_t targetFaces, SimplifyReport* report = nullptr, bool lockBorder = true);
 
 }  // namespace sprig::organisms

@@ -29,6 +29,7 @@
 #include "lsystem/derive.h"
 #include "model/animate.h"
 #include "model/growth.h"
+#include "model/lod.h"
 #include "model/mesh_parts.h"
 #include "model/model.h"
 #include "model/species.h"
@@ -328,7 +329,8 @@ py::list mesh(PySpecies& s, const MeshRequest& r, const py::object& progress) {
   return out;
 }
 
-/// `sprig mesh SPECIES -o path`: the parts written by writeParts, or a solid's volume mesh.
+/// `sprig mesh SPECIES -o path`: the parts written with their levels of detail (model/lod.h
+/// writeLevels, the kind's default budget), or a solid's volume mesh.
 void exportMesh(PySpecies& s, const std::filesystem::path& path, const MeshRequest& r, const py::object& progress) {
   const std::string ext = lowerExtension(path);
   const bool volume = ext == ".msh" || ext == ".vtu" || ext == ".mesh";
@@ -342,7 +344,7 @@ void exportMesh(PySpecies& s, const std::filesystem::path& path, const MeshReque
             throw UsageError("simplify applies to the surface parts written as .ply, .obj or .glb, not to volume meshes");
           s.model->writeVolumeMesh(resolveStage(*s.model, r.stage, r.fraction, r.age), path, true);
         } else {
-          writeParts(meshParts(s, r), path);
+          writeLevels(lodLevels(meshParts(s, r), s.model->lodBudget()), path);  // as `sprig mesh`: levels of detail
         }
         return 0;
       },

@@ -8,7 +8,8 @@ parts the kind may export and each part's colour: trees wood/leaves/fruit from `
 (wood, leaf, fruit) or the documented defaults; shells whorl/varices/spines/bumps/inside from
 `shell: textures:`; blobs and organisms from `render: color`; solids one part per material
 (the species' own `materials:` colours, or the built-in table in solids/material.cpp, sRGB).
-Then reads the GLB's JSON chunk and asserts: every node has a name the kind allows and a mesh
+Then reads the GLB's JSON chunk and asserts: every node has a name the kind allows (or a
+lower level of detail of one, PART_lodK) and a mesh
 whose primitives use the material of the same name; each material's baseColorFactor equals
 the expected colour (to 1e-6), alpha 1; leaves are double-sided and nothing else is; each
 --expect NAME is present. A material with a baseColorTexture (a baked bark or shell texture)
@@ -109,8 +110,10 @@ def main(argv):
     seen = []
     textured = []
     for node in gltf.get('nodes', []):
-        name = node.get('name')
-        seen.append(name)
+        # A part's lower levels of detail (MSFT_lod) are nodes named PART_lodK with the
+        # part's material: checked as the part.
+        seen.append(node.get('name'))
+        name = re.sub(r'_lod[0-9]+$', '', node.get('name') or '')
         if name not in allowed:
             bad.append('node %r is not a part the species has (%s)' % (name, ', '.join(sorted(allowed))))
             continue

@@ -11,8 +11,9 @@
 set -euo pipefail
 . "$(dirname "$0")/lib.sh"
 
-# The glb's triangle count and its box (min and max of every POSITION accessor), and the
-# same from the OBJ's f and v lines: "triangles minx miny minz maxx maxy maxz".
+# The glb's triangle count and its box (min and max of every POSITION accessor) of the
+# scene's nodes (LOD0; lower levels of detail are nodes outside the scene), and the same
+# from the OBJ's f and v lines: "triangles minx miny minz maxx maxy maxz".
 glb_stats() {
   python3 - "$1" <<'PY'
 import json, struct, sys
@@ -20,7 +21,7 @@ data = open(sys.argv[1], 'rb').read()
 n = struct.unpack_from('<I', data, 12)[0]
 g = json.loads(data[20:20 + n])
 tris, lo, hi = 0, [1e30] * 3, [-1e30] * 3
-for m in g['meshes']:
+for m in (g['meshes'][g['nodes'][i]['mesh']] for i in g['scenes'][0]['nodes']):
     for p in m['primitives']:
         tris += g['accessors'][p['indices']]['count'] // 3
         a = g['accessors'][p['attributes']['POSITION']]

@@ -17,6 +17,6 @@ for f in "${files[@]}"; do
   fi
   python3 scripts/gltf-parts.py "$f" "$out/$s.glb" || bad=1
   node scripts/gltf-validate.js "$out/$s.glb" || bad=1
-  rm -f "$out/$s.glb"
+  rm -f "$out/$s.glb" "$out/${s}"_lod*.glb  # and its levels of detail
 done
 exit $bad

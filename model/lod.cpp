@@ -1,0 +1,229 @@
+#include "model/lod.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "core/mesh_clean.h"
+#include "model/mesh_parts.h"
+#include "organisms/simplify.h"
+
+namespace sprig {
+
+namespace {
+
+// The connected component (triangles sharing a vertex) of every triangle, numbered in
+// order of their first triangle; count receives how many there are.
+std::vector<uint32_t> triangleComponents(const Mesh& mesh, size_t& count) {
+  std::vector<uint32_t> parent(mesh.positions.size());
+  std::iota(parent.begin(), parent.end(), 0u);
+  auto find = [&](uint32_t v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (const glm::uvec3& t : mesh.triangles) {
+    const uint32_t a = find(t.x), b = find(t.y), c = find(t.z);
+    parent[b] = a;
+    parent[find(c)] = a;
+  }
+  std::vector<uint32_t> id(mesh.positions.size(), UINT32_MAX), out(mesh.triangles.size());
+  count = 0;
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    uint32_t& c = id[find(mesh.triangles[t].x)];
+    if (c == UINT32_MAX) c = uint32_t(count++);
+    out[t] = c;
+  }
+  return out;
+}
+
+double meshArea(const Mesh& m) {
+  double a = 0;
+  for (const glm::uvec3& t : m.triangles)
+    a += 0.5 * glm::length(glm::cross(glm::dvec3(m.positions[t.y] - m.positions[t.x]), glm::dvec3(m.positions[t.z] - m.positions[t.x])));
+  return a;
+}
+
+// About targetTriangles of mesh's triangles in whole pieces (components), evenly spread over
+// their order (piece j of P is kept when ⌊(j+1)·K/P⌋ > ⌊j·K/P⌋ for K pieces kept), each
+// grown about its vertices' centroid by one factor so that the kept pieces cover area.
+// Per-vertex arrays follow the vertices kept; per-triangle materials the triangles.
+Mesh thinPieces(const Mesh& mesh, size_t targetTriangles, double area) {
+  size_t pieces = 0;
+  const std::vector<uint32_t> piece = triangleComponents(mesh, pieces);
+  const double fraction = double(targetTriangles) / double(std::max<size_t>(mesh.triangles.size(), 1));
+  const size_t keep = std::clamp<size_t>(size_t(std::floor(double(pieces) * fraction)), 1, pieces);
+  std::vector<char> kept(pieces, 0);
+  for (size_t j = 0; j < pieces; ++j) kept[j] = (j + 1) * keep / pieces > j * keep / pieces;
+  // Centroids of the kept pieces.
+  std::vector<glm::dvec3> sum(pieces, glm::dvec3(0.0));
+  std::vector<size_t> used(pieces, 0), newIndex(mesh.positions.size(), SIZE_MAX);
+  std::vector<uint32_t> vertexPiece(mesh.positions.size(), UINT32_MAX);
+  for (size_t t = 0; t < mesh.triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k) vertexPiece[mesh.triangles[t][k]] = piece[t];
+  for (size_t v = 0; v < mesh.positions.size(); ++v)
+    if (vertexPiece[v] != UINT32_MAX) sum[vertexPiece[v]] += glm::dvec3(mesh.positions[v]), ++used[vertexPiece[v]];
+  Mesh out;
+  std::vector<glm::dvec3> centre;  // of each output vertex's piece
+  const bool normals = mesh.normals.size() == mesh.positions.size(), uvs = mesh.uvs.size() == mesh.positions.size(),
+             colors = mesh.colors.size() == mesh.positions.size(), materials = mesh.materials.size() == mesh.triangles.size();
+  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
+    if (!kept[piece[t]]) continue;
+    glm::uvec3 tri;
+    for (int k = 0; k < 3; ++k) {
+      const uint32_t v = mesh.triangles[t][k];
+      if (newIndex[v] == SIZE_MAX) {
+        newIndex[v] = out.positions.size();
+        out.positions.push_back(mesh.positions[v]);
+        centre.push_back(sum[piece[t]] / double(used[piece[t]]));
+        if (normals) out.normals.push_back(mesh.normals[v]);
+        if (uvs) out.uvs.push_back(mesh.uvs[v]);
+        if (colors) out.colors.push_back(mesh.colors[v]);
+      }
+      tri[k] = uint32_t(newIndex[v]);
+    }
+    out.triangles.push_back(tri);
+    if (materials) out.materials.push_back(mesh.materials[t]);
+  }
+  const double keptArea = meshArea(out);
+  const double grow = keptArea > 0 && area > 0 ? std::sqrt(area / keptArea) : 1.0;
+  for (size_t v = 0; v < out.positions.size(); ++v)
+    out.positions[v] = Vec3(centre[v] + (glm::dvec3(out.positions[v]) - centre[v]) * grow);
+  return out;
+}
+
+// part reduced to about targetTriangles (unchanged when it has no more).
+ExportPart reducePart(const ExportPart& part, size_t targetTriangles) {
+  if (part.mesh.triangles.size() <= targetTriangles) return part;
+  ExportPart out;
+  out.name = part.name;
+  out.material = part.material;
+  out.scattered = part.scattered;
+  if (part.scattered) {
+    // Leaves: fewer triangles per leaf first (their outlines simplified, down to about two
+    // triangles a leaf), then fewer leaves; the leaves that remain grown to the area all
+    // of them covered, so that the crown keeps its leaf area.
+    size_t pieces = 0;
+    triangleComponents(part.mesh, pieces);
+    const size_t floor = std::max(targetTriangles, 2 * pieces);
+    const Mesh fewer =
+        floor < part.mesh.triangles.size() ? organisms::simplifyToCount(part.mesh, floor, nullptr, false) : part.mesh;
+    out.mesh = thinPieces(fewer, targetTriangles, meshArea(part.mesh));
+  } else {
+    out.mesh = organisms::simplifyToCount(part.mesh, std::max<size_t>(targetTriangles, 1));
+  }
+  removeDegenerateTriangles(out.mesh);
+  // An atlas has one patch per triangle of the full part: baked again from the colours of
+  // the vertices that remain (or dropped where they are all the base colour). A part that
+  // varies in colour without a texture had more triangles than an atlas holds: its level
+  // gets one too (atlasVertexColors bakes only where colours vary and no texture is set).
+  if (out.material.texture && out.material.texture->isAtlas()) out.material.texture.reset();
+  atlasVertexColors(out);
+  return out;
+}
+
+// Every part reduced to its target triangles.
+LodLevel reduceLevel(const std::vector<ExportPart>& parts, const std::vector<size_t>& targets) {
+  LodLevel level;
+  for (size_t i = 0; i < parts.size(); ++i) {
+    const ExportPart& p = parts[i];
+    level.parts.push_back(p.mesh.triangles.empty() ? p : reducePart(p, std::max<size_t>(targets[i], 1)));
+  }
+  level.triangles = partTriangles(level.parts);
+  return level;
+}
+
+// Every part's share of budget triangles: scattered parts (leaves) keep all their
+// triangles up to half the budget between them (in proportion to their triangles), the
+// surfaces share the rest in proportion to theirs.
+std::vector<size_t> budgetShares(const std::vector<ExportPart>& parts, size_t budget) {
+  size_t scattered = 0, surfaces = 0;
+  for (const ExportPart& p : parts) (p.scattered ? scattered : surfaces) += p.mesh.triangles.size();
+  const double scatteredShare = std::min(double(scattered), 0.5 * double(budget));
+  const double surfaceShare = double(budget) - scatteredShare;
+  std::vector<size_t> targets;
+  for (const ExportPart& p : parts) {
+    const double t = double(p.mesh.triangles.size());
+    const double share = p.scattered ? (scattered ? scatteredShare * t / double(scattered) : 0.0)
+                                     : (surfaces ? surfaceShare * t / double(surfaces) : 0.0);
+    targets.push_back(size_t(std::llround(std::min(t, share))));
+  }
+  return targets;
+}
+
+// Every part's triangles times fraction.
+std::vector<size_t> scaledShares(const std::vector<ExportPart>& parts, double fraction) {
+  std::vector<size_t> targets;
+  for (const ExportPart& p : parts) targets.push_back(size_t(std::llround(double(p.mesh.triangles.size()) * fraction)));
+  return targets;
+}
+
+}  // namespace
+
+size_t partTriangles(const std::vector<ExportPart>& parts) {
+  size_t n = 0;
+  for (const ExportPart& p : parts) n += p.mesh.triangles.size();
+  return n;
+}
+
+std::vector<LodLevel> buildLodChain(const std::vector<ExportPart>& parts, size_t budget, Vec3* moved) {
+  std::vector<LodLevel> levels;
+  const size_t total = partTriangles(parts);
+  if (total <= budget) {
+    levels.push_back(LodLevel{parts, total, 0});
+  } else {
+    // Parts that cannot reach their share (borders locked) leave LOD0 above the budget:
+    // then the budget shrinks by the overshoot, at most twice more.
+    double scaled = double(budget);
+    levels.push_back(reduceLevel(parts, budgetShares(parts, budget)));
+    for (int retry = 0; retry < 2 && levels[0].triangles > budget; ++retry) {
+      scaled *= double(budget) / double(levels[0].triangles) * 0.98;
+      levels[0] = reduceLevel(parts, budgetShares(parts, size_t(scaled)));
+    }
+  }
+  while (int(levels.size()) < kLodMaxLevels) {
+    const LodLevel& prev = levels.back();
+    if (double(prev.triangles) * kLodRatio < double(kLodMinTriangles)) break;
+    LodLevel next = reduceLevel(prev.parts, scaledShares(prev.parts, kLodRatio));
+    if (double(next.triangles) > double(prev.triangles) * kLodMaxKeep) break;
+    levels.push_back(std::move(next));
+  }
+  // Simplification removes vertices at the box's sides too: LOD0 stands on the ground again
+  // and every level moves with it, so the levels stay on top of each other.
+  const Vec3 offset = groundOffset(levels[0].parts);
+  for (LodLevel& level : levels) moveParts(level.parts, offset);
+  if (moved) *moved = offset;
+  for (size_t i = 0; i < levels.size(); ++i)
+    levels[i].screenCoverage = i + 1 == levels.size() ? 0.0 : std::pow(kLodRatio, double(i + 1));
+  return levels;
+}
+
+std::vector<LodLevel> lodLevels(std::vector<ExportPart> parts, size_t budget, Vec3* moved) {
+  if (moved) *moved = Vec3(0.0f);
+  if (budget > 0) return buildLodChain(parts, budget, moved);
+  std::vector<LodLevel> one(1);
+  one[0].triangles = partTriangles(parts);
+  one[0].parts = std::move(parts);
+  return one;
+}
+
+std::vector<PartWriteReport> writeLevels(const std::vector<LodLevel>& levels, const std::filesystem::path& path) {
+  std::vector<std::filesystem::path> written;
+  const bool glb = levels.size() > 1 && meshFormatFor(path) == MeshFormat::Glb;
+  try {
+    // A .glb holds every level (readers that ignore MSFT_lod may still import the lower
+    // levels' nodes: Blender 3.4 does), so LOD0 gets its own file too.
+    for (size_t k = glb ? 0 : 1; k < levels.size(); ++k) {
+      const std::filesystem::path file = lodPath(path, k);
+      writeParts(levels[k].parts, file);
+      for (const std::filesystem::path& f : partFiles(levels[k].parts, file)) written.push_back(f);
+    }
+    if (glb) return writePartLevels(levels, path);
+    return writeParts(levels.at(0).parts, path);
+  } catch (...) {
+    std::error_code ec;
+    for (const std::filesystem::path& f : written) std::filesystem::remove(f, ec);
+    throw;
+  }
+}
+
+}  // namespace sprig

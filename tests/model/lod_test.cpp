@@ -1,0 +1,258 @@
+#include <catch2/catch.hpp>
+
+#include <tiny_gltf.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+
+#include "core/atomic_file.h"
+#include "core/mesh_io.h"
+#include "model/lod.h"
+#include "model/mesh_parts.h"
+#include "model/model.h"
+#include "model/species.h"
+#include "tests/organisms/meshes.h"
+
+using namespace sprig;
+namespace fs = std::filesystem;
+
+namespace {
+
+// The attributes the test parts carry at a position: a vertex that remains after
+// simplification must still have exactly these (collapses move no vertex).
+Vec2 uvAt(const Vec3& p) { return {p.x * 0.5f + 0.5f, p.y * 0.25f + 0.5f}; }
+Vec3 colorAt(const Vec3& p) { return glm::abs(p) * 0.5f + Vec3(0.1f); }
+
+// A closed "wood" sphere of 20,480 triangles with normals, uvs and colours; "leaves": 400
+// unit-area squares (2 triangles each) of one colour each, double-sided and scattered, with
+// an atlas of their colours.
+std::vector<ExportPart> testParts() {
+  ExportPart wood{"wood", test::icosphere(5, Vec3(0.0f), 1.0f), PartMaterial{"wood", Vec3(0.3f, 0.2f, 0.1f), 0.7f, false}};
+  for (const Vec3& p : wood.mesh.positions) {
+    wood.mesh.normals.push_back(glm::normalize(p));
+    wood.mesh.uvs.push_back(uvAt(p));
+    wood.mesh.colors.push_back(colorAt(p));
+  }
+  ExportPart leaves{"leaves", Mesh{}, PartMaterial{"leaves", Vec3(0.1f, 0.4f, 0.05f), 0.5f, true}, true};
+  for (int i = 0; i < 400; ++i) {
+    const Vec3 o(float(i % 20) * 2.0f, 3.0f, float(i / 20) * 2.0f);
+    const auto b = uint32_t(leaves.mesh.positions.size());
+    for (Vec3 d : {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 0, 1), Vec3(0, 0, 1)}) {
+      leaves.mesh.positions.push_back(o + d);
+      leaves.mesh.normals.push_back(Vec3(0, 1, 0));
+      leaves.mesh.colors.push_back(Vec3(0.05f + 0.001f * float(i), 0.3f, 0.05f));
+    }
+    leaves.mesh.triangles.push_back({b, b + 2, b + 1});
+    leaves.mesh.triangles.push_back({b, b + 3, b + 2});
+  }
+  REQUIRE(atlasVertexColors(leaves) > 0);
+  return {wood, leaves};
+}
+
+double area(const Mesh& m) {
+  double a = 0;
+  for (const glm::uvec3& t : m.triangles)
+    a += 0.5 * glm::length(glm::cross(glm::dvec3(m.positions[t.y] - m.positions[t.x]), glm::dvec3(m.positions[t.z] - m.positions[t.x])));
+  return a;
+}
+
+struct TempDir {
+  fs::path path = fs::temp_directory_path() / ("sprig_lod_test_" + std::to_string(getpid()));
+  TempDir() {
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~TempDir() { fs::remove_all(path); }
+};
+
+tinygltf::Model readGlb(const fs::path& file) {
+  tinygltf::Model model;
+  tinygltf::TinyGLTF loader;
+  std::string err, warn;
+  REQUIRE(loader.LoadBinaryFromFile(&model, &err, &warn, file.string()));
+  return model;
+}
+
+// Triangles of a glTF node's mesh.
+size_t nodeTriangles(const tinygltf::Model& m, int node) {
+  size_t n = 0;
+  for (const tinygltf::Primitive& p : m.meshes[size_t(m.nodes[size_t(node)].mesh)].primitives)
+    n += m.accessors[size_t(p.indices)].count / 3;
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("buildLodChain", "[model][lod]") {
+  const std::vector<ExportPart> parts = testParts();
+  REQUIRE(partTriangles(parts) == 20480 + 800);
+
+  SECTION("LOD0 within the budget, then a quarter per level, the same parts with their attributes") {
+    Vec3 moved(1.0f);
+    const std::vector<LodLevel> levels = buildLodChain(parts, 8000, &moved);
+    // LOD0 stands on the ground at the origin, every level moved with it.
+    CHECK(glm::length(groundOffset(levels[0].parts)) < 1e-6f);
+    CHECK(glm::length(moved - groundOffset(parts)) < 0.05f);
+    // 8000 -> about 2000 -> about 500 (stops: a quarter of it would be below 500).
+    REQUIRE(levels.size() == 3);
+    CHECK(levels[0].triangles <= 8000);
+    CHECK(levels[0].triangles >= 7000);
+    for (size_t k = 1; k < levels.size(); ++k) {
+      CHECK(levels[k].triangles < levels[k - 1].triangles);
+      CHECK(double(levels[k].triangles) <= kLodMaxKeep * double(levels[k - 1].triangles));
+    }
+    CHECK(levels[0].screenCoverage == 0.25);
+    CHECK(levels[1].screenCoverage == 0.0625);
+    CHECK(levels[2].screenCoverage == 0.0);
+    for (const LodLevel& level : levels) {
+      REQUIRE(level.parts.size() == 2);
+      CHECK(level.parts[0].name == "wood");
+      CHECK(level.parts[1].name == "leaves");
+      CHECK(level.triangles == partTriangles(level.parts));
+      const Mesh& w = level.parts[0].mesh;
+      REQUIRE(w.triangles.size() > 0);
+      REQUIRE(w.normals.size() == w.positions.size());
+      REQUIRE(w.uvs.size() == w.positions.size());
+      REQUIRE(w.colors.size() == w.positions.size());
+      // Every vertex keeps its own attributes (a neighbour's differ by about 1e-2).
+      size_t own = 0;
+      for (size_t v = 0; v < w.positions.size(); ++v) {
+        const Vec3 p = w.positions[v] - moved;
+        own += glm::length(w.uvs[v] - uvAt(p)) < 1e-5f && glm::length(w.colors[v] - colorAt(p)) < 1e-5f &&
+               glm::length(w.normals[v] - glm::normalize(p)) < 1e-5f;
+      }
+      CHECK(own == w.positions.size());
+      // Its colours vary and it had no texture (as a part above the atlas budget): each
+      // level bakes them into an atlas.
+      REQUIRE(level.parts[0].material.texture);
+      CHECK(level.parts[0].material.texture->atlas.index.size() == w.triangles.size() * 3);
+      // The sphere stays closed: every edge in two triangles.
+      CHECK(analyzeTopology(w).boundaryEdges == 0);
+      // Leaves: all 400 kept at LOD0 (they fit in half the budget), then a quarter per level,
+      // grown so that they cover the same area; their atlas baked again per level.
+      const ExportPart& l = level.parts[1];
+      CHECK(area(l.mesh) == Approx(400.0).epsilon(1e-4));
+      REQUIRE(l.material.texture);
+      CHECK(l.material.texture->atlas.index.size() == l.mesh.triangles.size() * 3);
+      CHECK(l.material.doubleSided);
+    }
+    CHECK(levels[0].parts[1].mesh.triangles.size() == 800);
+    CHECK(levels[1].parts[1].mesh.triangles.size() == 200);
+    CHECK(levels[2].parts[1].mesh.triangles.size() == 50);
+  }
+  SECTION("a model within the budget is LOD0 unchanged") {
+    std::vector<ExportPart> placed = parts;
+    finishExportParts(placed);
+    const std::vector<LodLevel> levels = buildLodChain(placed, 30000);
+    // 21,280 -> about 5,320 -> about 1,330 (a quarter of it would be below 500).
+    REQUIRE(levels.size() == 3);
+    CHECK(levels[0].triangles == 21280);
+    CHECK(levels[0].parts[0].mesh.positions == placed[0].mesh.positions);
+    CHECK(levels[0].parts[1].material.texture == placed[1].material.texture);
+    CHECK(levels[2].triangles < levels[1].triangles);
+    CHECK(levels[1].triangles < levels[0].triangles);
+  }
+  SECTION("the same parts give the same levels") {
+    const std::vector<LodLevel> a = buildLodChain(parts, 8000), b = buildLodChain(parts, 8000);
+    REQUIRE(a.size() == b.size());
+    for (size_t k = 0; k < a.size(); ++k) {
+      CHECK(a[k].parts[0].mesh.triangles == b[k].parts[0].mesh.triangles);
+      CHECK(a[k].parts[1].mesh.positions == b[k].parts[1].mesh.positions);
+    }
+  }
+}
+
+TEST_CASE("writeLevels", "[model][lod]") {
+  TempDir dir;
+  const std::vector<LodLevel> levels = buildLodChain(testParts(), 8000);
+  REQUIRE(levels.size() == 3);
+  SECTION("glb: LOD0 in the scene, each part's lower levels through MSFT_lod; one file per level") {
+    const fs::path file = dir.path / "model.glb";
+    writeLevels(levels, file);
+    CHECK(lodPath(file, 1) == dir.path / "model_lod1.glb");
+    const tinygltf::Model m = readGlb(file);
+    CHECK(m.extensionsUsed == std::vector<std::string>{"MSFT_lod"});
+    CHECK(m.extensionsRequired.empty());
+    REQUIRE(m.scenes.size() == 1);
+    REQUIRE(m.scenes[0].nodes.size() == 2);
+    REQUIRE(m.nodes.size() == 6);
+    for (size_t i = 0; i < 2; ++i) {
+      const tinygltf::Node& top = m.nodes[size_t(m.scenes[0].nodes[i])];
+      CHECK(top.name == levels[0].parts[i].name);
+      CHECK(nodeTriangles(m, m.scenes[0].nodes[i]) == levels[0].parts[i].mesh.triangles.size());
+      REQUIRE(top.extensions.count("MSFT_lod") == 1);
+      const tinygltf::Value& ids = top.extensions.at("MSFT_lod").Get("ids");
+      REQUIRE(ids.ArrayLen() == 2);
+      const tinygltf::Value& coverage = top.extras.Get("MSFT_screencoverage");
+      REQUIRE(coverage.ArrayLen() == 3);
+      for (size_t k = 0; k < 3; ++k) CHECK(coverage.Get(int(k)).GetNumberAsDouble() == levels[k].screenCoverage);
+      for (size_t k = 1; k < 3; ++k) {
+        const int id = ids.Get(int(k - 1)).GetNumberAsInt();
+        CHECK(m.nodes[size_t(id)].name == levels[0].parts[i].name + "_lod" + std::to_string(k));
+        CHECK(nodeTriangles(m, id) == levels[k].parts[i].mesh.triangles.size());
+        // The material keeps the part's name.
+        const int mat = m.meshes[size_t(m.nodes[size_t(id)].mesh)].primitives[0].material;
+        CHECK(m.materials[size_t(mat)].name == levels[0].parts[i].name);
+      }
+    }
+    // Each level's own file (LOD0's too): the parts by their own names, that level's triangles.
+    for (size_t k = 0; k < 3; ++k) {
+      const tinygltf::Model f = readGlb(lodPath(file, k));
+      CHECK(f.extensionsUsed.empty());
+      REQUIRE(f.nodes.size() == 2);
+      for (size_t i = 0; i < 2; ++i) {
+        CHECK(f.nodes[i].name == levels[k].parts[i].name);
+        CHECK(nodeTriangles(f, int(i)) == levels[k].parts[i].mesh.triangles.size());
+      }
+    }
+    CHECK_FALSE(fs::exists(lodPath(file, 3)));
+  }
+  SECTION("OBJ: LOD0 in the file, every further level in its own OBJ, MTL and images") {
+    const fs::path file = dir.path / "model.obj";
+    writeLevels(levels, file);
+    for (const char* name : {"model.obj", "model.mtl", "model_leaves.png", "model_lod1.obj", "model_lod1.mtl",
+                             "model_lod1_leaves.png", "model_lod2.obj", "model_lod2.mtl", "model_lod2_leaves.png"})
+      CHECK(fs::exists(dir.path / name));
+    CHECK_FALSE(fs::exists(dir.path / "model_lod0.obj"));  // the OBJ itself is LOD0
+  }
+  SECTION("a failure leaves no file of the call behind") {
+    fs::create_directories(dir.path / "taken.glb" / "x");  // the file itself cannot be written
+    CHECK_THROWS(writeLevels(levels, dir.path / "taken.glb"));
+    CHECK_FALSE(fs::exists(dir.path / "taken_lod0.glb"));
+    CHECK_FALSE(fs::exists(dir.path / "taken_lod1.glb"));
+    CHECK_FALSE(fs::exists(dir.path / "taken_lod2.glb"));
+  }
+  SECTION("one level writes what writeParts writes") {
+    writeLevels({levels[2]}, dir.path / "one.glb");
+    writeParts(levels[2].parts, dir.path / "two.glb");
+    CHECK(readFile(dir.path / "one.glb") == readFile(dir.path / "two.glb"));
+    CHECK_FALSE(fs::exists(dir.path / "one_lod0.glb"));
+    CHECK_FALSE(fs::exists(dir.path / "one_lod1.glb"));
+  }
+}
+
+TEST_CASE("Levels of detail of a shipped tree", "[model][lod]") {
+  // The PCM junction of Fig. 12 (10,954 triangles of wood): LOD0 at a budget of 4,000.
+  PathPolicy policy;
+  policy.root = SPRIG_SOURCE_DIR;
+  const Species species = loadSpecies(std::string(SPRIG_SOURCE_DIR) + "/species/fig_tree_12_pcm_offset.yaml", policy);
+  SpeciesModel model(species);
+  CHECK(model.lodBudget() == 300000);
+  std::vector<ExportPart> parts = model.exportParts(model.finalStage(), 0.0f, false);
+  finishExportParts(parts);
+  const size_t full = partTriangles(parts);
+  CHECK(full == 10954);  // 11,044 polygonized, 90 zero-area slivers removed
+  CHECK(lodLevels(parts, 0).size() == 1);
+  CHECK(lodLevels(parts, 0)[0].triangles == full);
+  const std::vector<LodLevel> levels = lodLevels(parts, 4000);
+  REQUIRE(levels.size() == 2);
+  CHECK(levels[0].triangles <= 4000);
+  CHECK(levels[1].triangles < levels[0].triangles);
+  for (const LodLevel& l : levels) {
+    REQUIRE(l.parts.size() == parts.size());
+    CHECK(l.parts[0].name == "wood");
+    CHECK(analyzeTopology(l.parts[0].mesh).boundaryEdges == 0);
+  }
+}
