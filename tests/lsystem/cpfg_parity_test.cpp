@@ -85,6 +85,12 @@ ModuleString deriveParity(Parity& p) {
   return d.derive();
 }
 
+/// Derives the fixture in folder and compares it with the real cpfg's string kept there.
+void checkParity(const std::string& folder) {
+  Parity p = loadParity(folder);
+  checkSame(deriveParity(p), p.grammar.symbols(), cpfgString(folder));
+}
+
 }  // namespace
 
 TEST_CASE("cpfg parity: '=' and ']' in right contexts", "[lsystem][cpfg]") {
@@ -131,8 +137,7 @@ TEST_CASE("cpfg parity: query modules of the final string", "[lsystem][cpfg]") {
   // cpfg fills query modules whenever it interprets the string: before each step and when it
   // draws the result, so the final string holds the drawn turtle's values (cpfg -g leaves
   // them as they were only when the view file's 'box:' spares it the drawing).
-  Parity p = loadParity("query_timing");
-  checkSame(deriveParity(p), p.grammar.symbols(), cpfgString("query_timing"));
+  checkParity("query_timing");
 }
 
 TEST_CASE("cpfg parity: a view file's box: leaves the final string's query modules unfilled", "[lsystem][cpfg]") {
@@ -162,8 +167,7 @@ TEST_CASE("cpfg parity: a view file's box: leaves the final string's query modul
 TEST_CASE("cpfg parity: a cut is made when the next step reaches it", "[lsystem][cpfg]") {
   for (const char* folder : {"pending_cut", "decomposition_cut"}) {
     INFO(folder);
-    Parity p = loadParity(folder);
-    checkSame(deriveParity(p), p.grammar.symbols(), cpfgString(folder));
+    checkParity(folder);
   }
   SECTION("drawn, the pending cut is skipped and marks nothing: the skeleton of the string cut") {
     Parity p = loadParity("pending_cut");
@@ -190,8 +194,7 @@ TEST_CASE("cpfg parity: a cut is made when the next step reaches it", "[lsystem]
 }
 
 TEST_CASE("cpfg parity: a production for a command's last letter rewrites the command", "[lsystem][cpfg]") {
-  Parity p = loadParity("split_command");
-  checkSame(deriveParity(p), p.grammar.symbols(), cpfgString("split_command"));
+  checkParity("split_command");
 }
 
 TEST_CASE("cpfg parity: a rule for a letter of a command the grammar writes is an error", "[lsystem][cpfg]") {
@@ -246,8 +249,7 @@ TEST_CASE("cpfg parity: cpfg's random sequences", "[lsystem][cpfg]") {
   // them (the query module holds the drawn length: 13.2645).
   for (const char* folder : {"stochastic", "unseeded", "random_functions", "interpretation_draws"}) {
     INFO(folder);
-    Parity p = loadParity(folder);
-    checkSame(deriveParity(p), p.grammar.symbols(), cpfgString(folder));
+    checkParity(folder);
   }
   SECTION("the same string at 1 and 2 threads") {
     for (const char* folder : {"stochastic", "random_functions"}) {
@@ -370,31 +372,26 @@ TEST_CASE("cpfg parity: '?' without parameters is a module; its turtle takes the
 }
 
 TEST_CASE("cpfg parity: productions assign global variables, left to right", "[lsystem][cpfg]") {
-  Parity p = loadParity("global_assign");
-  checkSame(deriveParity(p), p.grammar.symbols(), cpfgString("global_assign"));
+  checkParity("global_assign");
 }
 
 TEST_CASE("cpfg parity: brackets in the ignore table", "[lsystem][cpfg]") {
   for (const char* folder : {"ignored_brackets", "considered_brackets"}) {
     INFO(folder);
-    Parity p = loadParity(folder);
-    checkSame(deriveParity(p), p.grammar.symbols(), cpfgString(folder));
+    checkParity(folder);
   }
 }
 
 TEST_CASE("cpfg parity: an expression statement is evaluated and dropped", "[lsystem][cpfg]") {
-  Parity p = loadParity("expression_statement");
-  checkSame(deriveParity(p), p.grammar.symbols(), cpfgString("expression_statement"));
+  checkParity("expression_statement");
 }
 
 TEST_CASE("cpfg parity: '_' is a command, written with any parameter count", "[lsystem][cpfg]") {
-  Parity p = loadParity("elasticity_module");
-  checkSame(deriveParity(p), p.grammar.symbols(), cpfgString("elasticity_module"));
+  checkParity("elasticity_module");
 }
 
 TEST_CASE("cpfg parity: the axiom reads the globals the Start: block set", "[lsystem][cpfg]") {
-  Parity p = loadParity("axiom_globals");
-  checkSame(deriveParity(p), p.grammar.symbols(), cpfgString("axiom_globals"));
+  checkParity("axiom_globals");
 }
 
 TEST_CASE("cpfg parity: a ring L-system joins the ends of the string", "[lsystem][cpfg]") {
