@@ -314,42 +314,48 @@ class ViewParser {
           view_.contourSides = static_cast<int>((*v)[0]);
       }
     } else {
-      for (const UnsupportedKey& u : kUnsupportedKeys)
-        if (key == u.key) {
-          // Only drawing needs it (cpfg -g derives without): an error when the plant is drawn.
-          if (!view_.unsupportedDrawing) {
-            Diagnostic d;
-            d.loc = SourceLoc{view_.file, line, static_cast<int>(kcol) + 1};
-            d.message = std::string("cpfg's view file command '") + u.key + ":' (" + u.what + ") is not supported";
-            d.sourceLine = raw_;
-            view_.unsupportedDrawing = d;
-          }
-          return;
-        }
-      for (const char* k : kFileKeys)
-        if (key == k) {
-          if (key == "tsurface") {
-            const size_t at = value.find_first_not_of(" \t");
-            if (at != std::string::npos) view_.tsurfaceIds += value[at];
-          }
-          warn(line, kcol, "'" + key + ":' ignored: the grammar's uses of it are errors (not supported)");
-          return;
-        }
-      for (const char* k : kViewerKeys)
-        if (key == k) {
-          if (key == "box") view_.box = true;
-          if (viewerKeys_.empty()) {
-            viewerLine_ = line;
-            viewerRaw_ = raw_;
-          }
-          viewerKeys_ += (viewerKeys_.empty() ? "'" : ", '") + key + ":'";
-          return;
-        }
-      std::vector<std::string> all(std::begin(kReadKeys), std::end(kReadKeys));
-      for (const char* k : kViewerKeys) all.emplace_back(k);
-      for (const char* k : kFileKeys) all.emplace_back(k);
-      error(line, kcol, "unknown view file command '" + key + ":'" + didYouMean(key, all));
+      readOtherKey(line, kcol, key, value);
     }
+  }
+
+  /// A key readKey does not read: one Sprig refuses when drawing, a file or viewer key
+  /// cpfg's derivation ignores, or an unknown one (an error naming the nearest keys).
+  void readOtherKey(int line, size_t kcol, const std::string& key, const std::string& value) {
+    for (const UnsupportedKey& u : kUnsupportedKeys)
+      if (key == u.key) {
+        // Only drawing needs it (cpfg -g derives without): an error when the plant is drawn.
+        if (!view_.unsupportedDrawing) {
+          Diagnostic d;
+          d.loc = SourceLoc{view_.file, line, static_cast<int>(kcol) + 1};
+          d.message = std::string("cpfg's view file command '") + u.key + ":' (" + u.what + ") is not supported";
+          d.sourceLine = raw_;
+          view_.unsupportedDrawing = d;
+        }
+        return;
+      }
+    for (const char* k : kFileKeys)
+      if (key == k) {
+        if (key == "tsurface") {
+          const size_t at = value.find_first_not_of(" \t");
+          if (at != std::string::npos) view_.tsurfaceIds += value[at];
+        }
+        warn(line, kcol, "'" + key + ":' ignored: the grammar's uses of it are errors (not supported)");
+        return;
+      }
+    for (const char* k : kViewerKeys)
+      if (key == k) {
+        if (key == "box") view_.box = true;
+        if (viewerKeys_.empty()) {
+          viewerLine_ = line;
+          viewerRaw_ = raw_;
+        }
+        viewerKeys_ += (viewerKeys_.empty() ? "'" : ", '") + key + ":'";
+        return;
+      }
+    std::vector<std::string> all(std::begin(kReadKeys), std::end(kReadKeys));
+    for (const char* k : kViewerKeys) all.emplace_back(k);
+    for (const char* k : kFileKeys) all.emplace_back(k);
+    error(line, kcol, "unknown view file command '" + key + ":'" + didYouMean(key, all));
   }
 
   /// `function: NAME.func [samples]` (interpret.c, case 52): the function file beside the

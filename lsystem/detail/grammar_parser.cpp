@@ -592,6 +592,52 @@ class GrammarParser {
     return block == Block::Main ? prog_.productions : block == Block::Decomposition ? prog_.decomposition : prog_.interpretation;
   }
 
+  /// `axiom: MODULES`: checked module by module; finish() reads it again once the seed is known.
+  void axiomHeader(int line, int b, Span value) {
+    once("axiom", line, b);
+    // Streamed module by module, never stored: an axiom may hold millions of modules.
+    // finish() tokenizes the line again to append them, once the seed is known.
+    BracketState brackets;
+    WordLint words;
+    if (value.b == value.e) error(line, value.b, "the axiom is empty");
+    else if (scanner_.tokenizeModules(line, value.b, value.e, [&](const RawModule& m) {
+               if (m.name == "@L") error(line, m.col, kLabelOutsideInterpretation);
+               bracketModule(line, m, brackets, "the axiom");
+               noteWritten(line, m);
+               lintWord(line, words, &m);
+             }) && bracketEnd(line, brackets, "the axiom")) {
+      lintWord(line, words, nullptr);
+      axiomSpan_ = value;
+      axiomLine_ = line;
+      std::tie(prog_.axiomLoc, prog_.axiomLine) = scanner_.locate(line, b);
+    }
+  }
+
+  /// `ignore:` or `consider:` (key): the symbols context matching skips or sees.
+  void contextListHeader(int line, int b, const std::string& key, Span value, Block block) {
+    once(key, line, b);
+    if (block != Block::Main) error(line, b, "'" + key + ":' belongs before the decomposition and interpretation blocks");
+    std::vector<RawModule> mods;
+    if (scanner_.tokenizeModules(line, value.b, value.e, mods)) {
+      for (const RawModule& m : mods) {
+        if (m.hasParens) {
+          error(line, m.col, "'" + key + ":' lists symbols without parameters");
+        } else if ((m.name == "[" || m.name == "]") && prog_.dialect != Dialect::Cpfg) {
+          // Sprig's notation: context matching always follows brackets (lpfg's rule).
+          if (key == "ignore")
+            error(line, m.col, "brackets cannot be ignored in Sprig's notation: context matching always follows them");
+        } else {
+          std::vector<SymbolId>& list = subs_.empty() ? (key == "ignore" ? ignoreList_ : considerList_)
+                                                      : (key == "ignore" ? subs_.back().ignoreList : subs_.back().considerList);
+          list.push_back(prog_.symbols.intern(m.name));
+        }
+      }
+    }
+    const std::string ign = scoped("ignore"), con = scoped("consider");
+    if (seen_.count(ign) && seen_.count(con) && key == (seen_[ign] < seen_[con] ? "consider" : "ignore"))
+      error(line, b, "use either 'ignore:' or 'consider:', not both");
+  }
+
   /// A known header h at column b of line (`decomposition:` and `interpretation:` switch block).
   void handleHeader(int line, int b, const Header& h, Block& block) {
     const std::string& s = scanner_.line(line);
@@ -652,45 +698,9 @@ class GrammarParser {
         prog_.angleDeg = *d;
       }
     } else if (h.key == "axiom") {
-      once(h.key, line, b);
-      // Streamed module by module, never stored: an axiom may hold millions of modules.
-      // finish() tokenizes the line again to append them, once the seed is known.
-      BracketState brackets;
-      WordLint words;
-      if (value.b == value.e) error(line, value.b, "the axiom is empty");
-      else if (scanner_.tokenizeModules(line, value.b, value.e, [&](const RawModule& m) {
-                 if (m.name == "@L") error(line, m.col, kLabelOutsideInterpretation);
-                 bracketModule(line, m, brackets, "the axiom");
-                 noteWritten(line, m);
-                 lintWord(line, words, &m);
-               }) && bracketEnd(line, brackets, "the axiom")) {
-        lintWord(line, words, nullptr);
-        axiomSpan_ = value;
-        axiomLine_ = line;
-        std::tie(prog_.axiomLoc, prog_.axiomLine) = scanner_.locate(line, b);
-      }
+      axiomHeader(line, b, value);
     } else if (h.key == "ignore" || h.key == "consider") {
-      once(h.key, line, b);
-      if (block != Block::Main) error(line, b, "'" + h.key + ":' belongs before the decomposition and interpretation blocks");
-      std::vector<RawModule> mods;
-      if (scanner_.tokenizeModules(line, value.b, value.e, mods)) {
-        for (const RawModule& m : mods) {
-          if (m.hasParens) {
-            error(line, m.col, "'" + h.key + ":' lists symbols without parameters");
-          } else if ((m.name == "[" || m.name == "]") && prog_.dialect != Dialect::Cpfg) {
-            // Sprig's notation: context matching always follows brackets (lpfg's rule).
-            if (h.key == "ignore")
-              error(line, m.col, "brackets cannot be ignored in Sprig's notation: context matching always follows them");
-          } else {
-            std::vector<SymbolId>& list = subs_.empty() ? (h.key == "ignore" ? ignoreList_ : considerList_)
-                                                        : (h.key == "ignore" ? subs_.back().ignoreList : subs_.back().considerList);
-            list.push_back(prog_.symbols.intern(m.name));
-          }
-        }
-      }
-      const std::string ign = scoped("ignore"), con = scoped("consider");
-      if (seen_.count(ign) && seen_.count(con) && h.key == (seen_[ign] < seen_[con] ? "consider" : "ignore"))
-        error(line, b, "use either 'ignore:' or 'consider:', not both");
+      contextListHeader(line, b, h.key, value, block);
     } else if (h.key == "decomposition") {
       once(h.key, line, b);
       if (value.b != value.e) error(line, value.b, "unexpected text after 'decomposition:'");
