@@ -61,6 +61,9 @@ if ! command -v debootstrap >/dev/null 2>&1; then
 fi
 
 root="$(mktemp -d /var/tmp/sprig-fresh.XXXXXX)"
+# mktemp makes the folder 0700; as the new system's / it must let its system users (munge's
+# post-installation script runs /bin/sh as `munge`) reach their programs.
+chmod 0755 "$root"
 mkdir -p "$cache/debootstrap" "$cache/apt"
 
 # Mount points under $root, innermost last; unmounted in reverse order.

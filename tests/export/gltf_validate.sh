@@ -6,6 +6,8 @@
 # and of each organism base and colouring. A shell's separate 'spines' part (the axial canal
 # spines of fig_shell_09a/09b and the Murex) is baked and written by the same code as the
 # varices; its export takes minutes (a million triangles), so it is not among these cases.
+# Levels of detail (MSFT_lod) are validated on a tree and an organism; the other cases write
+# the full mesh alone (--lod none), which is what each level is made from.
 # Usage: gltf_validate.sh path/to/sprig   (run from the repository root)
 set -euo pipefail
 sprig="$1"
@@ -13,14 +15,14 @@ out="$(mktemp -d)"
 trap 'rm -rf "$out"' EXIT
 # species  [parts it must have; *part: with a baked baseColorTexture]  (flags after '|')
 species=(
-  "abop_1_24a wood | --steps 3"            # tree, skeleton of an L-system
+  "abop_1_24a wood | --steps 3 --lod auto"  # tree, skeleton of an L-system, with its levels of detail
   "fig_tree_12_pcm_offset wood"             # tree, BlobTree with PCM, bark off: no image
   "tree_lime wood leaves | --steps 3 --cell 0.01"  # tree in leaf: wood and double-sided leaves apart (bark per girth: vertex colours)
   "tree_scarred *wood | --steps 4"        # one bark for every cone: baked into an image
   "shell_top *whorl inside"                 # shell, painted pigment
   "fig_shell_07b_varix_full *whorl varices" # shell with varices and their spines
   "blob_ricci_fig3 blob"                   # blob
-  "fig_org_05b_berry_level2 organism"      # organism on a primitive
+  "fig_org_05b_berry_level2 organism | --lod auto"  # organism on a primitive, with its levels of detail
   "fig_org_13a_mummified_skull_sharp organism"  # organism on a CT volume, blend colour
   "fig_org_14c_planet_blend organism"      # organism with the planet shader
   "org_painted_band organism"              # organism on a painted mesh
@@ -36,6 +38,7 @@ for entry in "${species[@]}"; do
   [[ "$entry" == *"|"* ]] && flags="${entry#*|}"
   # shellcheck disable=SC2086
   f="$out/$s.${#files[@]}.glb"
+  [[ "$flags" == *--lod* ]] || flags+=" --lod none"
   "$sprig" mesh "species/$s.yaml" -o "$f" $flags >/dev/null
   files+=("$f")
   expect=()
