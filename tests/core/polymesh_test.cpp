@@ -12,6 +12,7 @@
 #include "core/srgb.h"
 #include "tests/core/cube_mesh.h"
 #include "tests/scratch_dir.h"
+#include "tests/paths.h"
 
 using namespace sprig;
 namespace fs = std::filesystem;
@@ -457,7 +458,7 @@ TEST_CASE("readPolyMesh of CGAL's free meshes", "[core]") {
   }
   test::TempDir dir("cgal-meshes");
   fs::path out = dir.path / "meshes";
-  std::string cmd = "bash '" SPRIG_SOURCE_DIR "/scripts/extract-meshes.sh' '" + out.string() + "'";
+  std::string cmd = std::string("bash '") + SPRIG_SOURCE_DIR + "/scripts/extract-meshes.sh' '" + out.string() + "'";
   REQUIRE(std::system(cmd.c_str()) == 0);
   struct Expected {
     const char* file;

@@ -25,6 +25,7 @@
 #include "lsystem/turtle.h"
 #include "lsystem/view_file.h"
 #include "tests/scratch_dir.h"
+#include "tests/paths.h"
 
 using namespace sprig;
 using namespace sprig::lsystem;

@@ -14,6 +14,7 @@
 #include "lsystem/grammar.h"
 #include "lsystem/turtle.h"
 #include "lsystem/view_file.h"
+#include "tests/paths.h"
 
 using namespace sprig;
 using namespace sprig::lsystem;

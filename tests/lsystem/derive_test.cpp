@@ -8,6 +8,7 @@
 #include "core/rng.h"
 #include "lsystem/derive.h"
 #include "lsystem/grammar.h"
+#include "tests/paths.h"
 
 using namespace sprig;
 using namespace sprig::lsystem;

@@ -4,6 +4,7 @@
 
 #include "lsystem/derive.h"
 #include "lsystem/grammar.h"
+#include "tests/paths.h"
 
 using namespace sprig;
 using namespace sprig::lsystem;

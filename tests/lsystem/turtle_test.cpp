@@ -8,6 +8,7 @@
 #include "lsystem/derive.h"
 #include "lsystem/grammar.h"
 #include "lsystem/turtle.h"
+#include "tests/paths.h"
 
 using namespace sprig;
 using namespace sprig::lsystem;

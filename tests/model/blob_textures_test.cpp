@@ -16,6 +16,7 @@
 #include "textures/procedural.h"
 #include "textures/registry.h"
 #include "tests/scratch_dir.h"
+#include "tests/paths.h"
 
 using namespace sprig;
 namespace fs = std::filesystem;

@@ -19,6 +19,7 @@
 #include "model/tree_kind.h"
 #include "render/renderer.h"
 #include "render/scene.h"
+#include "tests/paths.h"
 
 using namespace sprig;
 namespace fs = std::filesystem;

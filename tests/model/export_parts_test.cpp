@@ -24,6 +24,7 @@
 #include "tests/core/cube_mesh.h"
 #include "tests/model/shipped_species.h"
 #include "tests/model/weld_parts.h"
+#include "tests/paths.h"
 
 using namespace sprig;
 

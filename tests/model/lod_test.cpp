@@ -14,6 +14,7 @@
 #include "model/model.h"
 #include "model/species.h"
 #include "tests/organisms/meshes.h"
+#include "tests/paths.h"
 
 using namespace sprig;
 namespace fs = std::filesystem;

@@ -12,6 +12,7 @@
 #include "model/tree_kind.h"
 #include "core/mesh.h"
 #include "core/parallel.h"
+#include "tests/paths.h"
 
 using namespace sprig;
 

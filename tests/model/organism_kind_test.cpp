@@ -14,6 +14,7 @@
 #include "tests/model/self_intersection.h"
 #include "tests/model/species_error.h"
 #include "tests/scratch_dir.h"
+#include "tests/paths.h"
 
 using namespace sprig;
 

@@ -19,6 +19,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include "tests/paths.h"
 
 using namespace sprig;
 

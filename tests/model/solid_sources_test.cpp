@@ -12,6 +12,7 @@
 #include "model/species.h"
 #include "solids/solid.h"
 #include "tests/scratch_dir.h"
+#include "tests/paths.h"
 
 using namespace sprig;
 

@@ -14,6 +14,7 @@
 #include "model/species.h"
 #include "model/tree_kind.h"
 #include "render/scene.h"
+#include "tests/paths.h"
 
 using namespace sprig;
 

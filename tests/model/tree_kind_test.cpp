@@ -10,6 +10,7 @@
 #include "core/mesh_clean.h"
 #include "core/mesh_io.h"
 #include "core/parallel.h"
+#include "tests/paths.h"
 
 using namespace sprig;
 using organisms::JunctionModel;

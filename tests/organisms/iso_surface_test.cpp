@@ -6,6 +6,7 @@
 #include "core/inr_volume.h"
 #include "core/polymesh.h"
 #include "organisms/iso_surface.h"
+#include "tests/paths.h"
 
 using namespace sprig;
 

@@ -13,6 +13,7 @@
 
 #include "core/mesh.h"
 #include "core/polymesh.h"
+#include "tests/paths.h"
 
 namespace sprig::test {
 
@@ -77,7 +78,7 @@ inline std::optional<std::filesystem::path> freeMeshes(const std::filesystem::pa
     return std::nullopt;
   }
   std::filesystem::path out = dir / "meshes";
-  std::string cmd = "bash '" SPRIG_SOURCE_DIR "/scripts/extract-meshes.sh' '" + out.string() + "' > /dev/null";
+  std::string cmd = std::string("bash '") + SPRIG_SOURCE_DIR + "/scripts/extract-meshes.sh' '" + out.string() + "' > /dev/null";
   REQUIRE(std::system(cmd.c_str()) == 0);
   return out;
 }

@@ -15,6 +15,7 @@
 #include "textures/noise.h"
 #include "textures/procedural.h"
 #include "textures/registry.h"
+#include "tests/paths.h"
 
 using namespace sprig;
 using namespace sprig::textures;
