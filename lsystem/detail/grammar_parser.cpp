@@ -822,36 +822,7 @@ class GrammarParser {
         else p.condition = CodeRange{static_cast<uint32_t>(before), static_cast<uint32_t>(prog_.code.size())};
       }
     }
-    // Successor.
-    succ = scanner_.trim(succ);
-    if (succ.b == succ.e) error(line, succ.b, "missing successor (write '*' for the empty string)");
-    else if (!scanner_.isStar(succ)) {
-      std::vector<RawModule> mods;
-      if (scanner_.tokenizeModules(line, succ.b, succ.e, mods) && checkBrackets(line, mods, "the successor")) {
-        noteWritten(line, mods);
-        lintWords(line, mods);
-        for (const RawModule& m : mods) {
-          if (block == Block::Interpretation && isQuery(m.name)) error(line, m.col, queryInInterpretation(m.name));
-          const bool label = m.name == "@L";
-          if (label && block != Block::Interpretation) error(line, m.col, kLabelOutsideInterpretation);
-          SuccModule sm;
-          sm.symbol = prog_.symbols.intern(m.name);
-          sm.firstArg = static_cast<uint32_t>(p.args.size());
-          sm.argCount = static_cast<uint16_t>(m.args.size());
-          for (const Span& a : m.args) {
-            const Span t = scanner_.trim(a);
-            if (label && t.b < t.e && scanner_.line(line)[t.b] == '"') {
-              // @L's format: its number among the program's strings (cpfg stores it so).
-              p.args.push_back(Arg{ArgKind::Const, 0, static_cast<double>(prog_.strings.size()), {}});
-              prog_.strings.push_back(scanner_.line(line).substr(t.b, t.e - t.b));
-              continue;
-            }
-            p.args.push_back(expr_.compileArg(t, varNames));
-          }
-          p.successor.push_back(sm);
-        }
-      }
-    }
+    successor(line, scanner_.trim(succ), block, varNames, p);
     // Weight.
     if (wcolon >= 0) {
       weight = scanner_.trim(weight);
@@ -864,6 +835,39 @@ class GrammarParser {
     }
     p.usesRandom = expr_.usesRandom();
     blockRules(block).productions.push_back(std::move(p));
+  }
+
+  /// A production's successor `succ` (trimmed), compiled into p's modules and arguments.
+  void successor(int line, Span succ, Block block, const std::vector<std::string>& varNames, Production& p) {
+    if (succ.b == succ.e) {
+      error(line, succ.b, "missing successor (write '*' for the empty string)");
+      return;
+    }
+    if (scanner_.isStar(succ)) return;
+    std::vector<RawModule> mods;
+    if (!scanner_.tokenizeModules(line, succ.b, succ.e, mods) || !checkBrackets(line, mods, "the successor")) return;
+    noteWritten(line, mods);
+    lintWords(line, mods);
+    for (const RawModule& m : mods) {
+      if (block == Block::Interpretation && isQuery(m.name)) error(line, m.col, queryInInterpretation(m.name));
+      const bool label = m.name == "@L";
+      if (label && block != Block::Interpretation) error(line, m.col, kLabelOutsideInterpretation);
+      SuccModule sm;
+      sm.symbol = prog_.symbols.intern(m.name);
+      sm.firstArg = static_cast<uint32_t>(p.args.size());
+      sm.argCount = static_cast<uint16_t>(m.args.size());
+      for (const Span& a : m.args) {
+        const Span t = scanner_.trim(a);
+        if (label && t.b < t.e && scanner_.line(line)[t.b] == '"') {
+          // @L's format: its number among the program's strings (cpfg stores it so).
+          p.args.push_back(Arg{ArgKind::Const, 0, static_cast<double>(prog_.strings.size()), {}});
+          prog_.strings.push_back(scanner_.line(line).substr(t.b, t.e - t.b));
+          continue;
+        }
+        p.args.push_back(expr_.compileArg(t, varNames));
+      }
+      p.successor.push_back(sm);
+    }
   }
 
   // ---- cpfg's statements ---------------------------------------------------------------
@@ -1086,6 +1090,8 @@ class GrammarParser {
     return semi + 1;
   }
 
+  /// A statement list `b..e` of a block, a production's or a function's body: assignments,
+  /// `if`/`else`, `while`, `do ... while`, calls and cpfg's expression statements.
   bool statementList(int line, int b, int e, std::vector<std::string>& varNames, uint32_t base) {
     const std::string& s = scanner_.line(line);
     int i = b;
@@ -1099,173 +1105,225 @@ class GrammarParser {
       }
       const int at = i;
       i += static_cast<int>(word.size());
+      const int k = nextNonSpace(line, i, e);
       if (word == "if") {
-        if ((i = parenthesized(line, i, e, varNames, "if")) < 0) return false;
-        size_t jz = jump(Op::Jz, base, 0);
-        if ((i = braced(line, i, e, varNames, base, "if (...)")) < 0) return false;
-        int k = i;
-        while (k < e && isSpace(s[k])) ++k;
-        if (wordAt(line, k, e) == "else") {
-          size_t jmp = jump(Op::Jmp, base, 0);
-          patch(jz, base);
-          if ((i = braced(line, k + 4, e, varNames, base, "else")) < 0) return false;
-          patch(jmp, base);
-        } else {
-          patch(jz, base);
-        }
+        i = ifStatement(line, i, e, varNames, base);
       } else if (word == "while") {
-        const double top = static_cast<double>(prog_.code.size());
-        if ((i = parenthesized(line, i, e, varNames, "while")) < 0) return false;
-        size_t jz = jump(Op::Jz, base, 0);
-        if ((i = braced(line, i, e, varNames, base, "while (...)")) < 0) return false;
-        jump(Op::Jmp, base, top);
-        patch(jz, base);
+        i = whileStatement(line, i, e, varNames, base);
       } else if (word == "do") {
-        const double top = static_cast<double>(prog_.code.size());
-        if ((i = braced(line, i, e, varNames, base, "do")) < 0) return false;
-        while (i < e && isSpace(s[i])) ++i;
-        if (wordAt(line, i, e) != "while") {
-          error(line, i, "expected 'while (...)' after 'do { ... }'");
-          return false;
-        }
-        if ((i = parenthesized(line, i + 5, e, varNames, "while")) < 0) return false;
-        Instr notOp;
-        notOp.op = Op::Not;
-        prog_.code.push_back(notOp);
-        jump(Op::Jz, base, top);
-      } else if (const int k = nextNonSpace(line, i, e); k < e && s[k] == '(' && word == "printf") {
-        if ((i = printfStatement(line, at, k, e, varNames)) < 0) return false;
+        i = doStatement(line, i, e, varNames, base);
+      } else if (k < e && s[k] == '(' && word == "printf") {
+        i = printfStatement(line, at, k, e, varNames);
       } else if (k < e && s[k] == '(') {
-        // A call alone, `f(...);` (cpfg's srand, ...): its value is dropped.
-        int end = scanner_.findTop(line, at, e, ';');
-        if (end < 0) {
-          error(line, at, "missing ';' after the call of '" + word + "' (cpfg requires one after every statement)");
-          return false;
-        }
-        // cpfg's srand and stop are statements of their own (Op::Srand, Op::Stop).
-        const bool effectCall = word == "srand" || word == "stop";
-        if (effectCall)
-          expr_.allowEffects(inGlobalBlock_ || prog_.dialect == Dialect::Cpfg,
-                             inGlobalBlock_ || statementBlock_ != Block::Interpretation,
-                             "cpfg's function 'stop' in an interpretation rule is not supported (the derivation has ended "
-                             "when the string is interpreted): call it in a production or a Start/EndEach block");
-        const bool compiled = expr_.compile(scanner_.trim(Span{line, at, end}), varNames, "statement");
-        if (effectCall) expr_.allowEffects(false, false, "cpfg's function 'stop' is supported only as a statement ('stop(1);')");
-        if (!compiled) return false;
-        jump(Op::Jz, base, static_cast<double>(prog_.code.size() + 1));  // pops the value, jumps to the next instruction
-        i = end + 1;
-      } else if (const int k2 = nextNonSpace(line, i, e); k2 < e && s[k2] == '[' && expr_.arrayId(word) >= 0) {
-        // Assignment to an element of cpfg's array, `name[i][j] = expression;`.
-        int eq = k2;
-        while (eq < e && s[eq] == '[') {
-          const int end = matching(line, eq, e, '[', ']');
-          if (end < 0) {
-            error(line, eq, "unclosed '['");
-            return false;
-          }
-          eq = nextNonSpace(line, end + 1, e);
-        }
-        if (eq >= e || s[eq] != '=' || (eq + 1 < e && s[eq + 1] == '=')) {
-          error(line, eq, "expected '=' after '" + word + "[...]'");
-          return false;
-        }
-        int end = scanner_.findTop(line, eq + 1, e, ';');
-        if (end < 0) {
-          error(line, at, "missing ';' after the assignment to '" + word + "[...]' (cpfg requires one after every statement)");
-          return false;
-        }
-        Span value = scanner_.trim(Span{line, eq + 1, end});
-        if (value.b == value.e) {
-          error(line, eq, "missing value after '" + word + "[...] ='");
-          return false;
-        }
-        auto a = expr_.compileElement(scanner_.trim(Span{line, at, eq}), varNames);
-        if (!a) return false;
-        if (!expr_.compile(value, varNames, "value")) return false;
-        Instr store;
-        store.op = Op::ArrayStore;
-        store.var = static_cast<uint16_t>(*a);
-        prog_.code.push_back(store);
-        i = end + 1;
+        i = callStatement(line, at, e, word, varNames, base);
+      } else if (k < e && s[k] == '[' && expr_.arrayId(word) >= 0) {
+        i = elementAssignment(line, at, k, e, word, varNames);
       } else {
-        // Assignment `name = expression;`.
-        while (i < e && isSpace(s[i])) ++i;
-        const bool assignment = i < e && s[i] == '=' && !(i + 1 < e && s[i + 1] == '=');
-        const bool compound = i + 1 < e && std::string_view("+-*/%").find(s[i]) != std::string_view::npos && s[i + 1] == '=';
-        if (!assignment && !compound && prog_.dialect == Dialect::Cpfg) {
-          // cpfg's expression statement (`roll - roll/L0;` in vlab's paintbrush): evaluated,
-          // its value dropped.
-          int end = scanner_.findTop(line, at, e, ';');
-          if (end < 0) {
-            error(line, at, "missing ';' after the statement '" + word + " ...' (cpfg requires one after every statement)");
-            return false;
-          }
-          if (!expr_.compile(scanner_.trim(Span{line, at, end}), varNames, "statement")) return false;
-          jump(Op::Jz, base, static_cast<double>(prog_.code.size() + 1));  // pops the value
-          i = end + 1;
-          continue;
-        }
-        if (!assignment) {
-          error(line, i, "expected '=' after '" + word + "' (statements are assignments, 'if', 'while' and 'do')");
-          return false;
-        }
-        int end = scanner_.findTop(line, i + 1, e, ';');
-        if (end < 0) {
-          error(line, at, "missing ';' after the assignment to '" + word + "' (cpfg requires one after every statement)");
-          return false;
-        }
-        Span value = scanner_.trim(Span{line, i + 1, end});
-        if (value.b == value.e) {
-          error(line, i, "missing value after '" + word + " ='");
-          return false;
-        }
-        if (defines_.count(word)) {
-          error(line, at, "cannot assign to '" + word + "': it is a #define");
-          return false;
-        }
-        if (expr_.arrayId(word) >= 0) {
-          error(line, at, "cannot assign to '" + word + "': it is an array (assign its elements, '" + word + "[i] = ...')");
-          return false;
-        }
-        auto known = std::find(varNames.begin(), varNames.end(), word);
-        const auto global = std::find(prog_.globals.begin(), prog_.globals.end(), word);
-        const bool ruleGlobal = !inGlobalBlock_ && known == varNames.end() && global != prog_.globals.end();
-        if (ruleGlobal && (prog_.dialect != Dialect::Cpfg || statementBlock_ == Block::Interpretation)) {
-          error(line, at, "cannot assign the global variable '" + word + "' in " +
-                              (prog_.dialect != Dialect::Cpfg
-                                   ? std::string("a production of a .lsys file (Sprig assigns globals only in 'Start:', "
-                                                 "'StartEach:', 'EndEach:' and 'End:' blocks; a .l file's productions may)")
-                                   : std::string("an interpretation rule (cpfg would change it whenever it draws the "
-                                                 "string): not supported")));
-          return false;
-        }
-        if (!expr_.compile(value, varNames, "value")) return false;
-        if (ruleGlobal) {
-          // cpfg: the global changes at once, for the modules rewritten after this one.
-          prog_.rulesAssignGlobals = true;
-          Instr store;
-          store.op = Op::Store;
-          store.var = static_cast<uint16_t>(kMaxVars - 1 - (global - prog_.globals.begin()));
-          prog_.code.push_back(store);
-          i = end + 1;
-          continue;
-        }
-        auto it = std::find(varNames.begin(), varNames.end(), word);
-        if (it == varNames.end()) {
-          if (varNames.size() >= static_cast<size_t>(kMaxVars) - (inGlobalBlock_ ? 0 : prog_.globals.size())) {
-            error(line, at, "too many parameters and local variables in one production (at most " + std::to_string(kMaxVars) + ")");
-            return false;
-          }
-          varNames.push_back(word);
-          it = varNames.end() - 1;
-        }
-        Instr store;
-        store.op = Op::Store;
-        store.var = static_cast<uint16_t>(it - varNames.begin());
-        prog_.code.push_back(store);
-        i = end + 1;
+        i = assignment(line, at, i, e, word, varNames, base);
       }
+      if (i < 0) return false;
     }
+  }
+
+  /// `if (...) { ... } [else { ... }]` from after `if`; the index after it, or -1.
+  int ifStatement(int line, int i, int e, std::vector<std::string>& varNames, uint32_t base) {
+    const std::string& s = scanner_.line(line);
+    if ((i = parenthesized(line, i, e, varNames, "if")) < 0) return -1;
+    size_t jz = jump(Op::Jz, base, 0);
+    if ((i = braced(line, i, e, varNames, base, "if (...)")) < 0) return -1;
+    int k = i;
+    while (k < e && isSpace(s[k])) ++k;
+    if (wordAt(line, k, e) != "else") {
+      patch(jz, base);
+      return i;
+    }
+    size_t jmp = jump(Op::Jmp, base, 0);
+    patch(jz, base);
+    if ((i = braced(line, k + 4, e, varNames, base, "else")) < 0) return -1;
+    patch(jmp, base);
+    return i;
+  }
+
+  /// `while (...) { ... }` from after `while`; the index after it, or -1.
+  int whileStatement(int line, int i, int e, std::vector<std::string>& varNames, uint32_t base) {
+    const double top = static_cast<double>(prog_.code.size());
+    if ((i = parenthesized(line, i, e, varNames, "while")) < 0) return -1;
+    size_t jz = jump(Op::Jz, base, 0);
+    if ((i = braced(line, i, e, varNames, base, "while (...)")) < 0) return -1;
+    jump(Op::Jmp, base, top);
+    patch(jz, base);
+    return i;
+  }
+
+  /// `do { ... } while (...)` from after `do`; the index after it, or -1.
+  int doStatement(int line, int i, int e, std::vector<std::string>& varNames, uint32_t base) {
+    const std::string& s = scanner_.line(line);
+    const double top = static_cast<double>(prog_.code.size());
+    if ((i = braced(line, i, e, varNames, base, "do")) < 0) return -1;
+    while (i < e && isSpace(s[i])) ++i;
+    if (wordAt(line, i, e) != "while") {
+      error(line, i, "expected 'while (...)' after 'do { ... }'");
+      return -1;
+    }
+    if ((i = parenthesized(line, i + 5, e, varNames, "while")) < 0) return -1;
+    Instr notOp;
+    notOp.op = Op::Not;
+    prog_.code.push_back(notOp);
+    jump(Op::Jz, base, top);
+    return i;
+  }
+
+  /// A call alone, `f(...);` (cpfg's srand, ...), starting at `at`: its value is dropped.
+  int callStatement(int line, int at, int e, const std::string& word, std::vector<std::string>& varNames, uint32_t base) {
+    const int end = scanner_.findTop(line, at, e, ';');
+    if (end < 0) {
+      error(line, at, "missing ';' after the call of '" + word + "' (cpfg requires one after every statement)");
+      return -1;
+    }
+    // cpfg's srand and stop are statements of their own (Op::Srand, Op::Stop).
+    const bool effectCall = word == "srand" || word == "stop";
+    if (effectCall)
+      expr_.allowEffects(inGlobalBlock_ || prog_.dialect == Dialect::Cpfg,
+                         inGlobalBlock_ || statementBlock_ != Block::Interpretation,
+                         "cpfg's function 'stop' in an interpretation rule is not supported (the derivation has ended "
+                         "when the string is interpreted): call it in a production or a Start/EndEach block");
+    const bool compiled = expr_.compile(scanner_.trim(Span{line, at, end}), varNames, "statement");
+    if (effectCall) expr_.allowEffects(false, false, "cpfg's function 'stop' is supported only as a statement ('stop(1);')");
+    if (!compiled) return -1;
+    jump(Op::Jz, base, static_cast<double>(prog_.code.size() + 1));  // pops the value, jumps to the next instruction
+    return end + 1;
+  }
+
+  /// Assignment to an element of cpfg's array, `name[i][j] = expression;`, whose first `[`
+  /// is at `open`.
+  int elementAssignment(int line, int at, int open, int e, const std::string& word, std::vector<std::string>& varNames) {
+    const std::string& s = scanner_.line(line);
+    int eq = open;
+    while (eq < e && s[eq] == '[') {
+      const int end = matching(line, eq, e, '[', ']');
+      if (end < 0) {
+        error(line, eq, "unclosed '['");
+        return -1;
+      }
+      eq = nextNonSpace(line, end + 1, e);
+    }
+    if (eq >= e || s[eq] != '=' || (eq + 1 < e && s[eq + 1] == '=')) {
+      error(line, eq, "expected '=' after '" + word + "[...]'");
+      return -1;
+    }
+    const int end = scanner_.findTop(line, eq + 1, e, ';');
+    if (end < 0) {
+      error(line, at, "missing ';' after the assignment to '" + word + "[...]' (cpfg requires one after every statement)");
+      return -1;
+    }
+    const Span value = scanner_.trim(Span{line, eq + 1, end});
+    if (value.b == value.e) {
+      error(line, eq, "missing value after '" + word + "[...] ='");
+      return -1;
+    }
+    auto a = expr_.compileElement(scanner_.trim(Span{line, at, eq}), varNames);
+    if (!a) return -1;
+    if (!expr_.compile(value, varNames, "value")) return -1;
+    Instr store;
+    store.op = Op::ArrayStore;
+    store.var = static_cast<uint16_t>(*a);
+    prog_.code.push_back(store);
+    return end + 1;
+  }
+
+  /// `name = expression;` (or, in a .l file, an expression statement whose value is
+  /// dropped), `name` at `at` and `i` just after it; the index after the `;`, or -1.
+  int assignment(int line, int at, int i, int e, const std::string& word, std::vector<std::string>& varNames,
+                 uint32_t base) {
+    const std::string& s = scanner_.line(line);
+    while (i < e && isSpace(s[i])) ++i;
+    const bool assign = i < e && s[i] == '=' && !(i + 1 < e && s[i + 1] == '=');
+    const bool compound = i + 1 < e && std::string_view("+-*/%").find(s[i]) != std::string_view::npos && s[i + 1] == '=';
+    if (!assign && !compound && prog_.dialect == Dialect::Cpfg) {
+      // cpfg's expression statement (`roll - roll/L0;` in vlab's paintbrush): evaluated,
+      // its value dropped.
+      const int end = scanner_.findTop(line, at, e, ';');
+      if (end < 0) {
+        error(line, at, "missing ';' after the statement '" + word + " ...' (cpfg requires one after every statement)");
+        return -1;
+      }
+      if (!expr_.compile(scanner_.trim(Span{line, at, end}), varNames, "statement")) return -1;
+      jump(Op::Jz, base, static_cast<double>(prog_.code.size() + 1));  // pops the value
+      return end + 1;
+    }
+    if (!assign) {
+      error(line, i, "expected '=' after '" + word + "' (statements are assignments, 'if', 'while' and 'do')");
+      return -1;
+    }
+    const int end = scanner_.findTop(line, i + 1, e, ';');
+    if (end < 0) {
+      error(line, at, "missing ';' after the assignment to '" + word + "' (cpfg requires one after every statement)");
+      return -1;
+    }
+    const Span value = scanner_.trim(Span{line, i + 1, end});
+    if (value.b == value.e) {
+      error(line, i, "missing value after '" + word + " ='");
+      return -1;
+    }
+    if (!assignable(line, at, word, varNames)) return -1;
+    if (!expr_.compile(value, varNames, "value")) return -1;
+    const auto slot = storeSlot(line, at, word, varNames);
+    if (!slot) return -1;
+    Instr store;
+    store.op = Op::Store;
+    store.var = *slot;
+    prog_.code.push_back(store);
+    return end + 1;
+  }
+
+  /// Whether `word` may be assigned here: not a #define, not an array, and not a global
+  /// unless a cpfg production assigns it (an error names the case).
+  bool assignable(int line, int at, const std::string& word, const std::vector<std::string>& varNames) {
+    if (defines_.count(word)) {
+      error(line, at, "cannot assign to '" + word + "': it is a #define");
+      return false;
+    }
+    if (expr_.arrayId(word) >= 0) {
+      error(line, at, "cannot assign to '" + word + "': it is an array (assign its elements, '" + word + "[i] = ...')");
+      return false;
+    }
+    if (ruleGlobal(word, varNames) && (prog_.dialect != Dialect::Cpfg || statementBlock_ == Block::Interpretation)) {
+      error(line, at, "cannot assign the global variable '" + word + "' in " +
+                          (prog_.dialect != Dialect::Cpfg
+                               ? std::string("a production of a .lsys file (Sprig assigns globals only in 'Start:', "
+                                             "'StartEach:', 'EndEach:' and 'End:' blocks; a .l file's productions may)")
+                               : std::string("an interpretation rule (cpfg would change it whenever it draws the "
+                                             "string): not supported")));
+      return false;
+    }
+    return true;
+  }
+
+  /// Whether an assignment to `word` in a rule assigns a global (no local of that name).
+  bool ruleGlobal(const std::string& word, const std::vector<std::string>& varNames) const {
+    return !inGlobalBlock_ && std::find(varNames.begin(), varNames.end(), word) == varNames.end() &&
+           std::find(prog_.globals.begin(), prog_.globals.end(), word) != prog_.globals.end();
+  }
+
+  /// The variable slot an assignment to `word` stores into, once its value is compiled: a
+  /// global a cpfg production assigns (it changes at once, for the modules rewritten after
+  /// this one), a known local, or a new local; nullopt when there are too many.
+  std::optional<uint16_t> storeSlot(int line, int at, const std::string& word, std::vector<std::string>& varNames) {
+    if (ruleGlobal(word, varNames)) {
+      prog_.rulesAssignGlobals = true;
+      const auto global = std::find(prog_.globals.begin(), prog_.globals.end(), word);
+      return static_cast<uint16_t>(kMaxVars - 1 - (global - prog_.globals.begin()));
+    }
+    auto it = std::find(varNames.begin(), varNames.end(), word);
+    if (it == varNames.end()) {
+      if (varNames.size() >= static_cast<size_t>(kMaxVars) - (inGlobalBlock_ ? 0 : prog_.globals.size())) {
+        error(line, at, "too many parameters and local variables in one production (at most " + std::to_string(kMaxVars) + ")");
+        return std::nullopt;
+      }
+      varNames.push_back(word);
+      it = varNames.end() - 1;
+    }
+    return static_cast<uint16_t>(it - varNames.begin());
   }
 
   /// Open brackets of a module string being checked (bracketModule, bracketEnd).
