@@ -500,17 +500,9 @@ class AsciiCursor {
   Where last_;
 };
 
-PlyHeader parsePlyHeader(std::string_view bytes, Errors& e, const PolyMeshLimits& limits) {
-  PlyHeader h;
-  if (!(bytes.substr(0, 4) == "ply\n" || bytes.substr(0, 5) == "ply\r\n"))
-    e.fatal({1, 1, {}}, "not a PLY file: the first line must be 'ply'");
-  size_t end = bytes.find("end_header");
-  while (end != std::string_view::npos && !(bytes[end - 1] == '\n' &&
-                                            (bytes.substr(end + 10, 1) == "\n" || bytes.substr(end + 10, 2) == "\r\n")))
-    end = bytes.find("end_header", end + 1);
-  requireText(bytes, end == std::string_view::npos ? bytes.size() : end, "a PLY header", e);
-  if (end == std::string_view::npos) e.fatal({1, 1, "ply"}, "the PLY header has no 'end_header' line");
-
+/// The PLY header's lines after "ply", through end_header, into h (format, elements and
+/// their properties); h.bodyOffset and h.bodyLine locate the body.
+void readPlyHeaderLines(std::string_view bytes, PlyHeader& h, Errors& e) {
   static const std::vector<std::string> kKeywords = {"format", "comment", "obj_info", "element", "property", "end_header"};
   std::vector<Token> toks;
   LineCursor lines(bytes);
@@ -566,7 +558,11 @@ PlyHeader parsePlyHeader(std::string_view bytes, Errors& e, const PolyMeshLimits
   h.bodyOffset = lines.offset();
   h.bodyLine = lines.number() + 1;
 
-  // Roles of the vertex and face properties.
+}
+
+/// The roles of the vertex and face properties (positions, colours, face indices),
+/// checked against limits.
+void assignPlyRoles(PlyHeader& h, Errors& e, const PolyMeshLimits& limits) {
   const PlyElement* vertex = nullptr;
   const PlyElement* face = nullptr;
   for (PlyElement& el : h.elements) {
@@ -616,9 +612,12 @@ PlyHeader parsePlyHeader(std::string_view bytes, Errors& e, const PolyMeshLimits
   if (!vertex) e.fatal({1, 1, "ply"}, "the PLY file has no 'vertex' element");
   if (!face) e.fatal({1, 1, "ply"}, "the PLY file has no 'face' element: Sprig reads meshes, not point clouds");
 
-  // Declared counts against the bytes that follow, before anything is allocated: each entry
-  // takes at least its fixed-size values and list counts (binary), or a byte and a
-  // separator per value (ASCII).
+}
+
+/// Declared counts against the bytes that follow, before anything is allocated: each entry
+/// takes at least its fixed-size values and list counts (binary), or a byte and a
+/// separator per value (ASCII).
+void checkPlyCounts(std::string_view bytes, const PlyHeader& h, Errors& e) {
   uint64_t available = bytes.size() - h.bodyOffset;
   uint64_t needed = 0;
   for (const PlyElement& el : h.elements) {
@@ -634,6 +633,22 @@ PlyHeader parsePlyHeader(std::string_view bytes, Errors& e, const PolyMeshLimits
     }
     needed += el.count * per;
   }
+}
+
+PlyHeader parsePlyHeader(std::string_view bytes, Errors& e, const PolyMeshLimits& limits) {
+  PlyHeader h;
+  if (!(bytes.substr(0, 4) == "ply\n" || bytes.substr(0, 5) == "ply\r\n"))
+    e.fatal({1, 1, {}}, "not a PLY file: the first line must be 'ply'");
+  size_t end = bytes.find("end_header");
+  while (end != std::string_view::npos && !(bytes[end - 1] == '\n' &&
+                                            (bytes.substr(end + 10, 1) == "\n" || bytes.substr(end + 10, 2) == "\r\n")))
+    end = bytes.find("end_header", end + 1);
+  requireText(bytes, end == std::string_view::npos ? bytes.size() : end, "a PLY header", e);
+  if (end == std::string_view::npos) e.fatal({1, 1, "ply"}, "the PLY header has no 'end_header' line");
+
+  readPlyHeaderLines(bytes, h, e);
+  assignPlyRoles(h, e, limits);
+  checkPlyCounts(bytes, h, e);
   return h;
 }
 

@@ -59,6 +59,30 @@ DVec3 CpfgCurve::atLength(double t) const {
   return point(u);
 }
 
+void CpfgCurve::addEndPoints() {
+  if (type_ == Type::BSplineClosed)
+    for (size_t k = 0; k < 3; ++k) points_.push_back(points_[k]);
+  if (type_ == Type::BSplinePhantom) {
+    const size_t n = points_.size();
+    const DVec3 first = 2.0 * points_[0] - points_[1], last = 2.0 * points_[n - 1] - points_[n - 2];
+    points_.insert(points_.begin(), first);
+    points_.push_back(last);
+  }
+}
+
+double CpfgCurve::tabulateLengths(int samples) {
+  lengths_.assign(static_cast<size_t>(samples), 0.0);
+  DVec3 prev = point(0.0);
+  double total = 0;
+  for (int i = 1; i < samples; ++i) {
+    const DVec3 p = point(i / double(samples - 1));
+    total += glm::length(p - prev);
+    lengths_[static_cast<size_t>(i)] = total;
+    prev = p;
+  }
+  return total;
+}
+
 CpfgCurve CpfgCurve::parse(const std::string& text, const std::string& fileName, int samples) {
   std::vector<std::string> lines;
   {
@@ -166,25 +190,8 @@ CpfgCurve CpfgCurve::parse(const std::string& text, const std::string& fileName,
   if (c.points_.size() < 4) fail(pointsLine, 0, "a curve needs at least 4 control points (counting multiplicities)");
   if (c.type_ == Type::Bezier && (c.points_.size() - 1) % 3 != 0)
     fail(pointsLine, 0, "a Bezier curve has 3k + 1 control points (counting multiplicities), got " + std::to_string(c.points_.size()));
-  if (c.type_ == Type::BSplineClosed)
-    for (size_t k = 0; k < 3; ++k) c.points_.push_back(c.points_[k]);
-  if (c.type_ == Type::BSplinePhantom) {
-    const size_t n = c.points_.size();
-    const DVec3 first = 2.0 * c.points_[0] - c.points_[1], last = 2.0 * c.points_[n - 1] - c.points_[n - 2];
-    c.points_.insert(c.points_.begin(), first);
-    c.points_.push_back(last);
-  }
-  if (samples < 2) samples = kDefaultSamples;
-  c.lengths_.resize(static_cast<size_t>(samples));
-  DVec3 prev = c.point(0.0);
-  double total = 0;
-  c.lengths_[0] = 0;
-  for (int i = 1; i < samples; ++i) {
-    const DVec3 p = c.point(i / double(samples - 1));
-    total += glm::length(p - prev);
-    c.lengths_[static_cast<size_t>(i)] = total;
-    prev = p;
-  }
+  c.addEndPoints();
+  const double total = c.tabulateLengths(samples < 2 ? kDefaultSamples : samples);
   double extent = 0;
   for (const DVec3& p : c.points_) extent = std::max(extent, glm::length(p - c.points_[0]));
   if (!(total > 1e-9 * extent) || extent == 0) fail(pointsLine, 0, "the curve has length 0 (all its points coincide)");

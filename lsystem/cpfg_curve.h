@@ -51,6 +51,13 @@ class CpfgCurve {
   static CpfgCurve parse(const std::string& text, const std::string& fileName, int samples);
 
  private:
+  /// The closed curve's first three points again at its end, or the phantom curve's two
+  /// mirrored end points (cpfg's bspline-closed and bspline-phantom).
+  void addEndPoints();
+  /// Fills lengths_ with the cumulative chord lengths at `samples` (>= 2) equal steps of the
+  /// parameter (not yet normalized); returns the total.
+  double tabulateLengths(int samples);
+
   std::vector<DVec3> points_;
   Type type_ = Type::BSpline;
   std::vector<double> lengths_;  ///< normalized cumulative lengths at the samples
