@@ -86,7 +86,7 @@ cleanup() {
   done
   local i
   for (( i=${#mounts[@]}-1; i>=0; i-- )); do
-    umount "${mounts[$i]}" 2>/dev/null || umount -l "${mounts[$i]}" 2>/dev/null || true
+    umount -R "${mounts[$i]}" 2>/dev/null || umount -l "${mounts[$i]}" 2>/dev/null || true
   done
   if grep -q " $root/" /proc/mounts; then
     echo "fresh-machine-test: error: mounts remain under $root; not deleting it" >&2
@@ -117,6 +117,11 @@ EOF
 cp /etc/resolv.conf "$root/etc/resolv.conf"
 mount_into proc -t proc proc
 mount_into sys -t sysfs sysfs
+# A booted Debian system has its control groups mounted; slurmd (the gallery_slurm test's
+# one-node cluster) refuses to start without them.
+# --rbind takes the hierarchies mounted under it; --make-rslave keeps the unmounting at the
+# end from reaching the host's own.
+if grep -q ' /sys/fs/cgroup ' /proc/mounts; then mount_into sys/fs/cgroup --rbind --make-rslave /sys/fs/cgroup; fi
 mount_into dev --bind /dev
 mount_into dev/pts --bind /dev/pts
 mount_into var/cache/apt/archives --bind "$cache/apt"

@@ -31,6 +31,10 @@ for p in munged mungekey slurmctld slurmd sbatch scontrol sinfo squeue scancel s
   command -v "$p" > /dev/null || skip "the program $p is missing (Debian: slurm-wlm, munge; scripts/install-deps.sh)"
 done
 
+# slurmd 22.05 starts only where the control groups are mounted (any booted system; not a
+# bare chroot or a container without them).
+grep -q ' /sys/fs/cgroup ' /proc/mounts || skip "no control groups mounted on /sys/fs/cgroup (slurmd needs them)"
+
 # The cluster's folder: munged wants its socket's folder searchable by everyone and nothing
 # in it writable by others.
 WORK=$(mktemp -d "${TMPDIR:-/tmp}/sprig-slurm-test-XXXXXX")
