@@ -6,7 +6,9 @@
 #include <cctype>
 #include <cmath>
 #include <iterator>
+#include <optional>
 #include <sstream>
+#include <utility>
 
 #include "core/atomic_file.h"
 #include "core/srgb.h"
@@ -358,44 +360,69 @@ class ViewParser {
     error(line, kcol, "unknown view file command '" + key + ":'" + didYouMean(key, all));
   }
 
+  /// The object file `name` a view file line names, which must lie beside the view file or
+  /// in a folder below it; nullopt after an error at (line, col) calling it `what`.
+  std::optional<std::filesystem::path> objectFile(int line, size_t col, const std::string& name, const std::string& what) {
+    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path().lexically_normal();
+    std::filesystem::path file = (folder / name).lexically_normal();
+    const std::string rel = file.lexically_relative(folder.empty() ? "." : folder).generic_string();
+    if (std::filesystem::path(name).is_absolute() || rel.empty() || rel.rfind("..", 0) == 0) {
+      error(line, col, what + " '" + name + "' is outside the object's folder (only files beside the view file, or in folders below it)");
+      return std::nullopt;
+    }
+    return file;
+  }
+
+  /// The text of an object file; nullopt after the read's error at (line, col).
+  std::optional<std::string> readObjectFile(int line, size_t col, const std::filesystem::path& file) {
+    try {
+      return readFile(file.string());
+    } catch (const std::exception& e) {
+      error(line, col, e.what());
+      return std::nullopt;
+    }
+  }
+
+  /// `NAME [samples]` after `key:` (function and curve lines): the name and the samples
+  /// (`fallback` when absent, else a whole number from `minimum` to 1000000); nullopt after
+  /// an error.
+  std::optional<std::pair<std::string, int>> nameAndSamples(int line, size_t vcol, const std::string& value,
+                                                           const std::string& key, int fallback, int minimum) {
+    std::istringstream in(value);
+    std::string name, extra;
+    in >> name;
+    if (name.empty()) {
+      error(line, vcol, "expected a " + key + " file after '" + key + ":'");
+      return std::nullopt;
+    }
+    if ((in >> extra).fail()) return std::make_pair(name, fallback);
+    int v = 0;
+    auto r = std::from_chars(extra.data(), extra.data() + extra.size(), v);
+    if (r.ec != std::errc() || r.ptr != extra.data() + extra.size() || v < minimum || v > 1000000) {
+      error(line, vcol + value.find(extra), "the number of samples after the " + key + " file is a whole number from " +
+                                                std::to_string(minimum) + " to 1000000, got '" + extra + "'");
+      return std::nullopt;
+    }
+    const int samples = v;
+    if (!(in >> extra).fail()) {
+      error(line, vcol + value.rfind(extra), "unexpected '" + extra + "' after '" + key + ": " + name + " " + std::to_string(samples) + "'");
+      return std::nullopt;
+    }
+    return std::make_pair(name, samples);
+  }
+
   /// `function: NAME.func [samples]` (interpret.c, case 52): the function file beside the
   /// view file (or in a folder below it), func(n, x)'s n-th in file order.
   void readFunction(int line, size_t vcol, const std::string& value) {
-    std::istringstream in(value);
-    std::string name, extra;
-    int samples = -1;
-    in >> name;
-    if (name.empty()) {
-      error(line, vcol, "expected a function file after 'function:'");
-      return;
-    }
-    if (!(in >> extra).fail()) {
-      int v = 0;
-      auto r = std::from_chars(extra.data(), extra.data() + extra.size(), v);
-      if (r.ec != std::errc() || r.ptr != extra.data() + extra.size() || v < 0 || v > 1000000) {
-        error(line, vcol + value.find(extra), "the number of samples after the function file is a whole number from 0 to 1000000, got '" + extra + "'");
-        return;
-      }
-      samples = v;
-      if (!(in >> extra).fail()) {
-        error(line, vcol + value.rfind(extra), "unexpected '" + extra + "' after 'function: " + name + " " + std::to_string(samples) + "'");
-        return;
-      }
-    }
-    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path().lexically_normal();
-    const std::filesystem::path file = (folder / name).lexically_normal();
-    const std::string rel = file.lexically_relative(folder.empty() ? "." : folder).generic_string();
-    if (std::filesystem::path(name).is_absolute() || rel.empty() || rel.rfind("..", 0) == 0) {
-      error(line, vcol, "the function file '" + name + "' is outside the object's folder (only files beside the view file, or in folders below it)");
-      return;
-    }
-    std::string text;
-    try {
-      text = readFile(file.string());
-    } catch (const std::exception& e) {
-      error(line, vcol, e.what());
-      return;
-    }
+    const auto head = nameAndSamples(line, vcol, value, "function", -1, 0);
+    if (!head) return;
+    const auto& [name, samples] = *head;
+    const auto found = objectFile(line, vcol, name, "the function file");
+    if (!found) return;
+    const std::filesystem::path& file = *found;
+    const auto read = readObjectFile(line, vcol, file);
+    if (!read) return;
+    const std::string& text = *read;
     try {
       view_.functions.push_back(CpfgFunction::parse(text, file.string(), samples));
     } catch (const InputError& e) {
@@ -413,20 +440,12 @@ class ViewParser {
       error(line, vcol, "expected one function set file after 'function set:'");
       return;
     }
-    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path().lexically_normal();
-    const std::filesystem::path file = (folder / name).lexically_normal();
-    const std::string rel = file.lexically_relative(folder.empty() ? "." : folder).generic_string();
-    if (std::filesystem::path(name).is_absolute() || rel.empty() || rel.rfind("..", 0) == 0) {
-      error(line, vcol, "the function set file '" + name + "' is outside the object's folder (only files beside the view file, or in folders below it)");
-      return;
-    }
-    std::string text;
-    try {
-      text = readFile(file.string());
-    } catch (const std::exception& e) {
-      error(line, vcol, e.what());
-      return;
-    }
+    const auto found = objectFile(line, vcol, name, "the function set file");
+    if (!found) return;
+    const std::filesystem::path& file = *found;
+    const auto read = readObjectFile(line, vcol, file);
+    if (!read) return;
+    const std::string& text = *read;
     std::vector<std::string> lines;
     {
       std::istringstream in(text);
@@ -513,21 +532,13 @@ class ViewParser {
       error(line, vcol, "a view file has at most 31 contours (cpfg's limit)");
       return;
     }
-    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path().lexically_normal();
-    const std::filesystem::path file = (folder / name).lexically_normal();
-    const std::string rel = file.lexically_relative(folder.empty() ? "." : folder).generic_string();
     const size_t ncol = vcol - std::min(vcol, value.find_first_not_of(" \t")) + value.find(name, value.find(idText) + idText.size());
-    if (std::filesystem::path(name).is_absolute() || rel.empty() || rel.rfind("..", 0) == 0) {
-      error(line, ncol, "the contour file '" + name + "' is outside the object's folder (only files beside the view file, or in folders below it)");
-      return;
-    }
-    std::string text;
-    try {
-      text = readFile(file.string());
-    } catch (const std::exception& e) {
-      error(line, ncol, e.what());
-      return;
-    }
+    const auto found = objectFile(line, ncol, name, "the contour file");
+    if (!found) return;
+    const std::filesystem::path& file = *found;
+    const auto read = readObjectFile(line, ncol, file);
+    if (!read) return;
+    const std::string& text = *read;
     try {
       view_.contours.push_back({id, CpfgContour::parse(text, file.string())});
     } catch (const InputError& e) {
@@ -538,41 +549,15 @@ class ViewParser {
   /// `curve: NAME [samples]` (interpret.c, case 53): the curve file beside the view file (or
   /// below it), sampled at samples points (default 100) for arc length.
   void readCurve(int line, size_t vcol, const std::string& value) {
-    std::istringstream in(value);
-    std::string name, extra;
-    int samples = CpfgCurve::kDefaultSamples;
-    in >> name;
-    if (name.empty()) {
-      error(line, vcol, "expected a curve file after 'curve:'");
-      return;
-    }
-    if (!(in >> extra).fail()) {
-      int v = 0;
-      auto r = std::from_chars(extra.data(), extra.data() + extra.size(), v);
-      if (r.ec != std::errc() || r.ptr != extra.data() + extra.size() || v < 2 || v > 1000000) {
-        error(line, vcol + value.find(extra), "the number of samples after the curve file is a whole number from 2 to 1000000, got '" + extra + "'");
-        return;
-      }
-      samples = v;
-      if (!(in >> extra).fail()) {
-        error(line, vcol + value.rfind(extra), "unexpected '" + extra + "' after 'curve: " + name + " " + std::to_string(samples) + "'");
-        return;
-      }
-    }
-    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path().lexically_normal();
-    const std::filesystem::path file = (folder / name).lexically_normal();
-    const std::string rel = file.lexically_relative(folder.empty() ? "." : folder).generic_string();
-    if (std::filesystem::path(name).is_absolute() || rel.empty() || rel.rfind("..", 0) == 0) {
-      error(line, vcol, "the curve file '" + name + "' is outside the object's folder (only files beside the view file, or in folders below it)");
-      return;
-    }
-    std::string text;
-    try {
-      text = readFile(file.string());
-    } catch (const std::exception& e) {
-      error(line, vcol, e.what());
-      return;
-    }
+    const auto head = nameAndSamples(line, vcol, value, "curve", CpfgCurve::kDefaultSamples, 2);
+    if (!head) return;
+    const auto& [name, samples] = *head;
+    const auto found = objectFile(line, vcol, name, "the curve file");
+    if (!found) return;
+    const std::filesystem::path& file = *found;
+    const auto read = readObjectFile(line, vcol, file);
+    if (!read) return;
+    const std::string& text = *read;
     try {
       view_.curves.push_back(CpfgCurve::parse(text, file.string(), samples));
     } catch (const InputError& e) {
@@ -660,26 +645,18 @@ class ViewParser {
       }
     }
     const std::string& name = words[1].first;
-    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path().lexically_normal();
-    const std::filesystem::path file = (folder / name).lexically_normal();
-    const std::string rel = file.lexically_relative(folder.empty() ? "." : folder).generic_string();
-    if (std::filesystem::path(name).is_absolute() || rel.empty() || rel.rfind("..", 0) == 0) {
-      error(line, words[1].second, "the surface file '" + name + "' is outside the object's folder (only files beside the view file, or in folders below it)");
-      return;
-    }
+    const auto found = objectFile(line, words[1].second, name, "the surface file");
+    if (!found) return;
+    const std::filesystem::path& file = *found;
     if (!std::filesystem::exists(file)) {
       // cpfg reads a surface file only when it exists (interpret.c, access()), else the line
       // defines nothing: a '~X' of it in the grammar is then an error.
       warn(line, words[1].second, "the surface file '" + name + "' does not exist: the line is skipped, as cpfg skips it");
       return;
     }
-    std::string text;
-    try {
-      text = readFile(file.string());
-    } catch (const std::exception& e) {
-      error(line, words[1].second, e.what());
-      return;
-    }
+    const auto read = readObjectFile(line, words[1].second, file);
+    if (!read) return;
+    const std::string& text = *read;
     try {
       view_.surfaces.push_back({id[0], CpfgSurface::parse(text, file.string(), size, s, t), texture});
       if (texture > 0) surfaceTextures_.push_back({line, words.back().second, texture, raw_});
@@ -826,13 +803,9 @@ class ViewParser {
       error(line, vcol, "a texture needs its image: 'texture: F: NAME.png'");
       return;
     }
-    const std::filesystem::path folder = std::filesystem::path(view_.file).parent_path().lexically_normal();
-    const std::filesystem::path file = (folder / name).lexically_normal();
-    const std::string rel = file.lexically_relative(folder.empty() ? "." : folder).generic_string();
-    if (std::filesystem::path(name).is_absolute() || rel.empty() || rel.rfind("..", 0) == 0) {
-      error(line, nameCol, "the texture image '" + name + "' is outside the object's folder (only files beside the view file, or in folders below it)");
-      return;
-    }
+    const auto found = objectFile(line, nameCol, name, "the texture image");
+    if (!found) return;
+    const std::filesystem::path& file = *found;
     tex.file = file.string();
     try {
       requireRegularFile(file);
