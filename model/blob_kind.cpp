@@ -62,40 +62,49 @@ class NodeReader {
  private:
   using Handler = std::optional<NodeId> (NodeReader::*)(const std::string& kind, const YNode& key, const YNode& v);
 
+  /// A node kind's reader and what the kind is (`sprig schema`'s text for its key).
+  struct KindEntry {
+    Handler read;
+    const char* help;
+  };
+
   /// Reads the node of kind `kind` (key) with value v through the kind's handler.
   std::optional<NodeId> dispatch(const std::string& kind, const YNode& key, const YNode& v) {
-    static const std::map<std::string, Handler, std::less<>> kHandlers = {
-        {"point", &NodeReader::readPoint},
-        {"segment", &NodeReader::readSegment},
-        {"cone", &NodeReader::readCone},
-        {"torus", &NodeReader::readTorus},
-        {"halfspace", &NodeReader::readHalfspace},
-        {"box", &NodeReader::readBox},
-        {"spiral_points", &NodeReader::readSpiralPoints},
-        {"blend", &NodeReader::readCombination},
-        {"union", &NodeReader::readCombination},
-        {"intersect", &NodeReader::readCombination},
-        {"difference", &NodeReader::readDifference},
-        {"ricci", &NodeReader::readRicci},
-        {"controlled", &NodeReader::readControlled},
-        {"pcm", &NodeReader::readPcm},
-        {"negative", &NodeReader::readNegative},
-        {"translate", &NodeReader::readTranslate},
-        {"scale", &NodeReader::readScale},
-        {"rotate", &NodeReader::readRotate},
-        {"bend", &NodeReader::readBend},
-        {"twist", &NodeReader::readTwist},
-        {"taper", &NodeReader::readTaper},
+    static const std::map<std::string, KindEntry, std::less<>> kHandlers = {
+        {"point", {&NodeReader::readPoint, "Point primitive: field w·g(d²/R²) around `center`, a sphere of iso radius `radius`."}},
+        {"segment", {&NodeReader::readSegment, "Segment primitive: a capsule of constant iso radius `radius` from `a` to `b`."}},
+        {"cone", {&NodeReader::readCone, "Cone primitive (the tree paper's internode, Fig. 7): iso radius `radius_a` at `a`, `radius_b` at `b`, linear between, spherical caps."}},
+        {"torus", {&NodeReader::readTorus, "Torus primitive: a core circle of radius `major` around `axis` at `center`, tube iso radius `minor`."}},
+        {"halfspace", {&NodeReader::readHalfspace, "CSG cutter: the half-space behind the plane through `point`, opposite to `normal` (field 1 inside, 0 outside); no texture."}},
+        {"box", {&NodeReader::readBox, "CSG cutter: the box [`lo`, `hi`] (field 1 inside, 0 outside, the surface exactly on the box); no texture."}},
+        {"spiral_points", {&NodeReader::readSpiralPoints, "Points on a logarithmic helico-spiral (Murex paper Eq. 1-3), summed: `count` points `step_deg` apart, each of iso radius size·D(θ)."}},
+        {"blend", {&NodeReader::readCombination, "Summation blend Σfᵢ of a list of nodes: they melt into each other."}},
+        {"union", {&NodeReader::readCombination, "CSG union max fᵢ of a list of nodes: they meet in a crease."}},
+        {"intersect", {&NodeReader::readCombination, "CSG intersection min fᵢ of a list of nodes."}},
+        {"difference", {&NodeReader::readDifference, "CSG difference [a, b], a minus b: min(f_a, 1 − f_b)."}},
+        {"ricci", {&NodeReader::readRicci, "Super-elliptic (Ricci) blend (Σfᵢⁿ)^(1/n) of `children`: n = 1 sums, large n approaches the union."}},
+        {"controlled", {&NodeReader::readControlled, "Controlled blending (Murex paper §2.2): `children` blend only within the listed `groups`; groups meet as a union."}},
+        {"pcm", {&NodeReader::readPcm, "Precise Contact Modeling (tree paper Eq. 3; Gascuel): `children` deform at their contact with a bulge around it instead of blending."}},
+        {"negative", {&NodeReader::readNegative, "Negative field −weight·f of `child`, subtracted where it is blended in (the tree paper's scars)."}},
+        {"translate", {&NodeReader::readTranslate, "`child` moved by `offset`."}},
+        {"scale", {&NodeReader::readScale, "`child` scaled about the origin by `factors` (the field is not rescaled)."}},
+        {"rotate", {&NodeReader::readRotate, "`child` rotated by `angle_deg` about `axis` through the origin."}},
+        {"bend", {&NodeReader::readBend, "Endpoint-preserving bend (tree paper §3.6): `child`, modelled straight from `a` to `b`, bent on a circular arc through both."}},
+        {"twist", {&NodeReader::readTwist, "`child` twisted about `axis` through `origin` by `rate_deg` per unit of height."}},
+        {"taper", {&NodeReader::readTaper, "`child`'s cross-section scaled linearly along `axis`, from `scale0` at `origin` to `scale1` at `length`."}},
     };
-    if (auto it = kHandlers.find(kind); it != kHandlers.end()) return (this->*it->second)(kind, key, v);
+    if (auto it = kHandlers.find(kind); it != kHandlers.end()) {
+      describeHelp(v, it->second.help);
+      return (this->*it->second.read)(kind, key, v);
+    }
     key.error(diags_, "unknown blob node " + sprig::quoted(kind) + didYouMean(kind, kKinds));
     return std::nullopt;
   }
 
   std::optional<NodeId> readPoint(const std::string& kind, const YNode& key, const YNode& v) {
     return primitive(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
-      Vec3 c = m.vec3("center", Vec3(0.0f));
-      auto r = required(m, "radius");
+      Vec3 c = m.vec3({"center", "Centre of the point."}, Vec3(0.0f));
+      auto r = required(m, {"radius", "Iso radius: the surface (F = 0.5) of the point alone lies this far from `center`."});
       auto tex = texture(m);
       if (!r) return std::nullopt;
       return build(key, [&] { return tree_.point(c, float(*r), tex); });
@@ -104,8 +113,8 @@ class NodeReader {
 
   std::optional<NodeId> readSegment(const std::string& kind, const YNode& key, const YNode& v) {
     return primitive(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
-      auto a = requiredVec3(m, "a"), b = requiredVec3(m, "b");
-      auto r = required(m, "radius");
+      auto a = requiredVec3(m, {"a", "First end of the segment."}), b = requiredVec3(m, {"b", "Second end of the segment."});
+      auto r = required(m, {"radius", "Iso radius of the capsule around the segment."});
       auto tex = texture(m);
       if (!a || !b || !r) return std::nullopt;
       return build(key, [&] { return tree_.segment(*a, *b, float(*r), tex); });
@@ -114,19 +123,19 @@ class NodeReader {
 
   std::optional<NodeId> readCone(const std::string& kind, const YNode& key, const YNode& v) {
     return primitive(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
-      auto a = requiredVec3(m, "a"), b = requiredVec3(m, "b");
+      auto a = requiredVec3(m, {"a", "Base of the cone (natural v = 0)."}), b = requiredVec3(m, {"b", "Tip of the cone."});
       std::optional<double> ra, rb;
       if (m.has("radius")) {
-        ra = rb = m.number("radius", 0.0);
+        ra = rb = m.number({"radius", "One iso radius for both ends, instead of `radius_a` and `radius_b`; > 0 (default: none)."}, 0.0);
       } else {
-        ra = required(m, "radius_a", 0.0, std::numeric_limits<double>::infinity(), false);
-        rb = required(m, "radius_b", 0.0, std::numeric_limits<double>::infinity(), false);
+        ra = required(m, {"radius_a", "Iso radius at `a` (required without `radius`)."}, 0.0, std::numeric_limits<double>::infinity(), false);
+        rb = required(m, {"radius_b", "Iso radius at `b` (required without `radius`)."}, 0.0, std::numeric_limits<double>::infinity(), false);
       }
       // `delta_a` names the factor 1.75 in a tree: section; here the radius r_B had the name.
-      if (auto old = m.get("delta_a"))
+      if (auto old = m.get({"delta_a", "Not a key here any more: an error naming `offset_radius`, its new name."}))
         old->error(diags_, "a blob cone's 'delta_a' is now 'offset_radius' (r_B of Eq. 4: the cone is shortened "
                            "by 1.75*offset_radius); 'delta_a' is the factor 1.75 of a tree: section");
-      double offsetRadius = m.number("offset_radius", 0.0, 0.0);
+      double offsetRadius = m.number({"offset_radius", "r_B of the tree paper's Eq. 4: the cone is shortened at `b` by δA = 1.75·offset_radius (0 = not shortened)."}, 0.0, 0.0);
       auto tex = texture(m);
       if (!a || !b || !ra || !rb) return std::nullopt;
       // Tree paper Eq. 4: the basal internode is shortened at its tip by δA = 1.75·r_B.
@@ -151,9 +160,10 @@ class NodeReader {
 
   std::optional<NodeId> readTorus(const std::string& kind, const YNode& key, const YNode& v) {
     return primitive(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
-      Vec3 c = m.vec3("center", Vec3(0.0f));
-      Vec3 axis = m.vec3("axis", Vec3(0, 1, 0));
-      auto major = required(m, "major"), minor = required(m, "minor");
+      Vec3 c = m.vec3({"center", "Centre of the torus."}, Vec3(0.0f));
+      Vec3 axis = m.vec3({"axis", "Axis the torus turns around."}, Vec3(0, 1, 0));
+      auto major = required(m, {"major", "Major radius: of the core circle around `axis`."}),
+           minor = required(m, {"minor", "Minor radius: iso radius of the tube around the core circle."});
       auto tex = texture(m);
       if (!major || !minor) return std::nullopt;
       return build(key, [&] { return tree_.torus(c, axis, float(*major), float(*minor), tex); });
@@ -162,9 +172,9 @@ class NodeReader {
 
   std::optional<NodeId> readHalfspace(const std::string& kind, const YNode& key, const YNode& v) {
     return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
-      Vec3 p = m.vec3("point", Vec3(0.0f));
-      auto n = requiredVec3(m, "normal");
-      double ramp = m.number("ramp", 1e-3, 1e-9);
+      Vec3 p = m.vec3({"point", "A point of the cutting plane."}, Vec3(0.0f));
+      auto n = requiredVec3(m, {"normal", "Outward normal of the plane: the inside is the side it points away from."});
+      double ramp = m.number({"ramp", "Width of the field's linear ramp from 1 to 0 across the plane, in world units."}, 1e-3, 1e-9);
       if (!n) return std::nullopt;
       return build(key, [&] { return tree_.halfspace(p, *n, float(ramp)); });
     });
@@ -172,8 +182,8 @@ class NodeReader {
 
   std::optional<NodeId> readBox(const std::string& kind, const YNode& key, const YNode& v) {
     return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
-      auto lo = requiredVec3(m, "lo"), hi = requiredVec3(m, "hi");
-      double ramp = m.number("ramp", 1e-3, 1e-9);
+      auto lo = requiredVec3(m, {"lo", "Lowest corner of the box."}), hi = requiredVec3(m, {"hi", "Highest corner of the box."});
+      double ramp = m.number({"ramp", "Width of the field's linear ramp from 1 to 0 across the box's faces, in world units."}, 1e-3, 1e-9);
       if (!lo || !hi) return std::nullopt;
       return build(key, [&] { return tree_.box(*lo, *hi, float(ramp)); });
     });
@@ -204,7 +214,7 @@ class NodeReader {
 
   std::optional<NodeId> readRicci(const std::string& kind, const YNode& key, const YNode& v) {
     return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
-      auto n = required(m, "n", 1.0, 1e4);
+      auto n = required(m, {"n", "Blend exponent n: 1 is the plain sum, 400 keeps the children distinct (the Murex's bumps)."}, 1.0, 1e4);
       auto kids = children(m, kind);
       if (!n || !kids) return std::nullopt;
       return build(key, [&] { return tree_.ricci(*kids, float(*n)); });
@@ -218,9 +228,9 @@ class NodeReader {
   std::optional<NodeId> readPcm(const std::string& kind, const YNode& key, const YNode& v) {
     return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
       blobtree::PcmParams p;
-      p.width = float(m.number("width", p.width, 1e-6, 1.0));
-      p.slope = float(m.number("slope", p.slope, 0.0, 10.0));
-      p.bulgeScale = float(m.number("bulge", p.bulgeScale, 0.0, 10.0));
+      p.width = float(m.number({"width", "w, width of the propagation region around the contact, in field units."}, p.width, 1e-6, 1.0));
+      p.slope = float(m.number({"slope", "k, slope of the bulge at the contact (1 gives a C¹ field; <= 1 never interpenetrates)."}, p.slope, 0.0, 10.0));
+      p.bulgeScale = float(m.number({"bulge", "Height of the bulge: a₀ = bulge · k·w/4 (0 = no bulge)."}, p.bulgeScale, 0.0, 10.0));
       auto kids = children(m, kind);
       if (!kids) return std::nullopt;
       return build(key, [&] { return tree_.pcm(*kids, p); });
@@ -229,7 +239,7 @@ class NodeReader {
 
   std::optional<NodeId> readNegative(const std::string& kind, const YNode& key, const YNode& v) {
     return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
-      double w = m.number("weight", 1.0, 0.0, 1e3);
+      double w = m.number({"weight", "Multiplier of the child's field before it is negated."}, 1.0, 0.0, 1e3);
       auto c = child(m, kind);
       if (!c) return std::nullopt;
       return build(key, [&] { return tree_.negative(*c, float(w)); });
@@ -238,7 +248,7 @@ class NodeReader {
 
   std::optional<NodeId> readTranslate(const std::string& kind, const YNode& key, const YNode& v) {
     return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
-      auto off = requiredVec3(m, "offset");
+      auto off = requiredVec3(m, {"offset", "Translation of the child, in world units."});
       auto c = child(m, kind);
       if (!off || !c) return std::nullopt;
       return build(key, [&] { return tree_.translate(*c, *off); });
@@ -249,7 +259,7 @@ class NodeReader {
     return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
       std::optional<Vec3> f;
       m.markRequired("factors");
-      if (auto fv = m.get("factors")) {
+      if (auto fv = m.get({"factors", "Scale factors: one number (uniform) or [x, y, z]."})) {
         if (fv->isSequence())
           f = fv->asVec3(diags_, "'factors'", 1e-6, 1e6);
         else if (auto s = fv->asNumber(diags_, "'factors'", 1e-6, 1e6))
@@ -265,8 +275,8 @@ class NodeReader {
 
   std::optional<NodeId> readRotate(const std::string& kind, const YNode& key, const YNode& v) {
     return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
-      Vec3 axis = m.vec3("axis", Vec3(0, 1, 0));
-      auto deg = required(m, "angle_deg", -3600.0, 3600.0);
+      Vec3 axis = m.vec3({"axis", "Axis of the rotation, through the origin."}, Vec3(0, 1, 0));
+      auto deg = required(m, {"angle_deg", "Angle of the rotation, in degrees."}, -3600.0, 3600.0);
       auto c = child(m, kind);
       if (!deg || !c) return std::nullopt;
       return build(key, [&] { return tree_.rotate(*c, axis, float(radians(*deg))); });
@@ -276,11 +286,12 @@ class NodeReader {
   std::optional<NodeId> readBend(const std::string& kind, const YNode& key, const YNode& v) {
     return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
       blobtree::Bend bend;
-      auto a = requiredVec3(m, "a"), b = requiredVec3(m, "b");
-      bend.direction = m.vec3("direction", bend.direction);
+      auto a = requiredVec3(m, {"a", "First end of the bent segment: it stays in place."}),
+           b = requiredVec3(m, {"b", "Second end of the bent segment: it stays in place."});
+      bend.direction = m.vec3({"direction", "Direction the arc bulges towards (made perpendicular to b − a)."}, bend.direction);
       bool hasAngle = m.has("angle_deg"), hasSagitta = m.has("sagitta");
-      double angle = m.number("angle_deg", 0.0, 0.0, 180.0);
-      double sagitta = m.number("sagitta", 0.0, 0.0);
+      double angle = m.number({"angle_deg", "Turning angle of the arc in degrees (exactly one of `angle_deg` and `sagitta`)."}, 0.0, 0.0, 180.0);
+      double sagitta = m.number({"sagitta", "Distance of the arc from the chord at its middle, in world units; at most |b − a|/2 (exactly one of `sagitta` and `angle_deg`)."}, 0.0, 0.0);
       if (hasAngle == hasSagitta)
         m.node().error(diags_, "bend needs exactly one of 'sagitta' and 'angle_deg'");
       auto c = child(m, kind);
@@ -294,9 +305,9 @@ class NodeReader {
   std::optional<NodeId> readTwist(const std::string& kind, const YNode& key, const YNode& v) {
     return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
       blobtree::Twist t;
-      t.origin = m.vec3("origin", t.origin);
-      t.axis = m.vec3("axis", t.axis);
-      auto rate = required(m, "rate_deg", -1e6, 1e6);
+      t.origin = m.vec3({"origin", "A point of the twist axis (height 0)."}, t.origin);
+      t.axis = m.vec3({"axis", "Axis of the twist."}, t.axis);
+      auto rate = required(m, {"rate_deg", "Twist in degrees per unit of height along the axis."}, -1e6, 1e6);
       auto c = child(m, kind);
       if (!rate || !c) return std::nullopt;
       t.rateRadPerUnit = float(radians(*rate));
@@ -307,11 +318,11 @@ class NodeReader {
   std::optional<NodeId> readTaper(const std::string& kind, const YNode& key, const YNode& v) {
     return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
       blobtree::Taper t;
-      t.origin = m.vec3("origin", t.origin);
-      t.axis = m.vec3("axis", t.axis);
-      auto len = required(m, "length", 0.0);
-      t.scale0 = float(m.number("scale0", 1.0, 0.0));
-      t.scale1 = float(m.number("scale1", 1.0, 0.0));
+      t.origin = m.vec3({"origin", "Where the taper starts (height 0, scale `scale0`)."}, t.origin);
+      t.axis = m.vec3({"axis", "Axis of the taper."}, t.axis);
+      auto len = required(m, {"length", "Height along the axis at which the scale reaches `scale1`."}, 0.0);
+      t.scale0 = float(m.number({"scale0", "Cross-section scale at `origin`; must stay positive over the child."}, 1.0, 0.0));
+      t.scale1 = float(m.number({"scale1", "Cross-section scale at height `length` (linear between)."}, 1.0, 0.0));
       auto c = child(m, kind);
       if (!len || !c) return std::nullopt;
       t.length = float(*len);
@@ -339,7 +350,7 @@ class NodeReader {
   template <class F>
   std::optional<NodeId> primitive(const YNode& key, const YNode& v, const std::string& kind, F&& f) {
     return operands(key, v, kind, [&](MapReader& m) -> std::optional<NodeId> {
-      double w = m.number("weight", 1.0, 0.0, 1e3);
+      double w = m.number({"weight", "Multiplier w of the primitive's field."}, 1.0, 0.0, 1e3);
       auto id = f(m);
       if (id && w != 1.0) return build(key, [&] { return tree_.setWeight(*id, float(w)); });
       return id;
@@ -366,25 +377,25 @@ class NodeReader {
 
   // declare: list key in the schema's `required` (not for a key required only when
   // another is absent, as a cone's radius_a without radius).
-  std::optional<double> required(MapReader& m, std::string_view key, double min = 0.0,
+  std::optional<double> required(MapReader& m, Key key, double min = 0.0,
                                  double max = std::numeric_limits<double>::infinity(), bool declare = true) {
-    if (declare) m.markRequired(key);
+    if (declare) m.markRequired(key.name);
     auto v = m.get(key);
     if (!v) {
-      m.node().error(diags_, "missing required key " + quoted(key) + " in " + kindOf(m));
+      m.node().error(diags_, "missing required key " + quoted(key.name) + " in " + kindOf(m));
       return std::nullopt;
     }
-    return v->asNumber(diags_, quoted(key), min, max);
+    return v->asNumber(diags_, quoted(key.name), min, max);
   }
 
-  std::optional<Vec3> requiredVec3(MapReader& m, std::string_view key) {
-    m.markRequired(key);
+  std::optional<Vec3> requiredVec3(MapReader& m, Key key) {
+    m.markRequired(key.name);
     auto v = m.get(key);
     if (!v) {
-      m.node().error(diags_, "missing required key " + quoted(key) + " in " + kindOf(m));
+      m.node().error(diags_, "missing required key " + quoted(key.name) + " in " + kindOf(m));
       return std::nullopt;
     }
-    return v->asVec3(diags_, quoted(key));
+    return v->asVec3(diags_, quoted(key.name));
   }
 
   std::string kindOf(MapReader& m) const {
@@ -397,10 +408,10 @@ class NodeReader {
   blobtree::TextureAttr texture(MapReader& m) {
     blobtree::TextureAttr t;
     t.textureId = kNoTexture;
-    auto tv = m.section("texture");
+    auto tv = m.section({"texture", "The primitive's texture: `id` into the species' `textures:` list and the mapping of its natural (u, v) (default: none, the material colour)."});
     if (!tv) return t;
     MapReader tm(*tv, diags_, "texture");
-    if (auto idNode = tm.get("id")) {
+    if (auto idNode = tm.get({"id", "Index of the texture in the species' `textures:` list (0 = the first); required."})) {
       if (textureCount_ == 0) {
         idNode->error(diags_, "texture id " + idNode->scalar() +
                                   " names no texture: the species has no 'textures:' list");
@@ -413,9 +424,11 @@ class NodeReader {
     } else {
       tm.node().error(diags_, "missing required key 'id' in texture (an index into the species' 'textures:' list)");
     }
-    t.uvScale = Vec2(float(tm.number("u_scale", 1.0)), float(tm.number("v_scale", 1.0)));
-    t.uvOffset = Vec2(float(tm.number("u_offset", 0.0)), float(tm.number("v_offset", 0.0)));
-    t.refDir = tm.vec3("ref_dir", t.refDir);
+    t.uvScale = Vec2(float(tm.number({"u_scale", "Multiplier of the natural u (uv = natural · scale + offset)."}, 1.0)),
+                     float(tm.number({"v_scale", "Multiplier of the natural v (uv = natural · scale + offset)."}, 1.0)));
+    t.uvOffset = Vec2(float(tm.number({"u_offset", "Added to u after `u_scale`."}, 0.0)),
+                      float(tm.number({"v_offset", "Added to v after `v_scale`."}, 0.0)));
+    t.refDir = tm.vec3({"ref_dir", "Direction of u = 0 around a cone's, segment's or torus's axis ([0, 0, 0]: a fixed perpendicular)."}, t.refDir);
     tm.finish();
     return t;
   }
@@ -444,7 +457,7 @@ class NodeReader {
 
   std::optional<std::vector<NodeId>> children(MapReader& m, const std::string& kind) {
     m.markRequired("children");
-    auto v = m.get("children");
+    auto v = m.get({"children", "The nodes it combines, a list of blob nodes (at least one)."});
     if (!v) {
       m.node().error(diags_, "missing required key 'children' in " + kind);
       return std::nullopt;
@@ -454,7 +467,7 @@ class NodeReader {
 
   std::optional<NodeId> child(MapReader& m, const std::string& kind) {
     m.markRequired("child");
-    auto v = m.get("child");
+    auto v = m.get({"child", "The blob node it acts on."});
     if (!v) {
       m.node().error(diags_, "missing required key 'child' in " + kind);
       return std::nullopt;
@@ -467,7 +480,7 @@ class NodeReader {
     auto kids = children(m, "controlled");
     std::vector<std::vector<uint32_t>> groups;
     m.markRequired("groups");
-    auto gv = m.get("groups");
+    auto gv = m.get({"groups", "Which children blend: lists of child indices, e.g. [[0, 1], [1, 2]], or `chain` (each child with the next)."});
     if (!gv) {
       m.node().error(diags_, "missing required key 'groups' in controlled (a list of index lists, or chain)");
       return std::nullopt;
@@ -510,13 +523,13 @@ class NodeReader {
   // origin, axis +Y), and the tangent-circle size D(θ) = R(θ)(λ−1)/((λ+1) sin β) scaled
   // by `size`.
   std::optional<NodeId> spiral(const YNode& key, MapReader& m) {
-    double r0 = m.number("r0", 1.0, 1e-6);
-    double lambda = m.number("lambda", 1.3, 1.0 + 1e-6, 100.0);
-    double beta = radians(m.number("beta_deg", 22.5, 1e-3, 90.0));
-    double theta0 = m.number("theta_deg", 0.0, -1e5, 1e5);
-    double step = m.number("step_deg", 20.0, -360.0, 360.0);
-    int64_t count = m.integer("count", 6, 1, 100000);
-    double size = m.number("size", 1.0, 1e-6, 100.0);
+    double r0 = m.number({"r0", "R₀, the spiral's radius at θ = 0: R(θ) = R₀·λ^(θ/360°)."}, 1.0, 1e-6);
+    double lambda = m.number({"lambda", "λ, the ratio of the spiral's radii one turn apart (Murex paper Eq. 1)."}, 1.3, 1.0 + 1e-6, 100.0);
+    double beta = radians(m.number({"beta_deg", "β in degrees: the spiral descends H(θ) = R(θ)·cot β (90 = flat)."}, 22.5, 1e-3, 90.0));
+    double theta0 = m.number({"theta_deg", "Angle θ of the first point, in degrees."}, 0.0, -1e5, 1e5);
+    double step = m.number({"step_deg", "Angle between successive points, in degrees."}, 20.0, -360.0, 360.0);
+    int64_t count = m.integer({"count", "Number of points."}, 6, 1, 100000);
+    double size = m.number({"size", "Multiplier of each point's iso radius D(θ) = R(θ)(λ−1)/((λ+1) sin β)."}, 1.0, 1e-6, 100.0);
     std::vector<NodeId> ids;
     for (int64_t i = 0; i < count; ++i) {
       double thetaDeg = theta0 + double(i) * step;
@@ -554,7 +567,21 @@ namespace {
 
 const std::vector<std::string> kTextureKinds = {"image", "color", "noise", "bark", "stripes", "spots", "leaf"};
 
-uint64_t readSeed(MapReader& m) { return uint64_t(m.integer("seed", 0, 0)); }
+/// What each texture kind is (`sprig schema`'s text for its key).
+std::string_view textureKindHelp(std::string_view kind) {
+  static const std::map<std::string_view, std::string_view> kHelp = {
+      {"image", "An image file (PNG, JPEG, EXR, ...; a path relative to the species file), looked up at (u, v)."},
+      {"color", "One constant colour."},
+      {"noise", "Two colours mixed by fractal noise (fBm or turbulence)."},
+      {"bark", "Procedural bark: ridged furrows along v, with the bark keys of trees' `tree.bark:`."},
+      {"stripes", "Bands of `stripe_color` on `base_color`, across v (or along u with `spiral`)."},
+      {"spots", "Round spots of `spot_color` on `base_color`, one per cell of a jittered grid."},
+      {"leaf", "A leaf blade with a midrib and lateral veins."}};
+  auto it = kHelp.find(kind);
+  return it == kHelp.end() ? std::string_view() : it->second;
+}
+
+uint64_t readSeed(MapReader& m) { return uint64_t(m.integer({"seed", "Seed of the texture's noise or random cells."}, 0, 0)); }
 
 // One procedural texture's options map (null reads as all defaults).
 std::optional<textures::Texture> readProcedural(const std::string& kind, const YNode& v, DiagnosticList& diags,
@@ -567,20 +594,20 @@ std::optional<textures::Texture> readProcedural(const std::string& kind, const Y
   std::optional<textures::Texture> out;
   if (kind == "noise") {
     textures::NoiseColorOptions o;
-    o.colorA = m.color("color_a", o.colorA);
-    o.colorB = m.color("color_b", o.colorB);
-    o.scale = m.number("scale", o.scale, 1e-6, 1e6);
-    o.fractal.octaves = int(m.integer("octaves", o.fractal.octaves, 1, 16));
-    o.fractal.lacunarity = m.number("lacunarity", o.fractal.lacunarity, 1.0, 16.0);
-    o.fractal.gain = m.number("gain", o.fractal.gain, 0.0, 1.0);
-    o.turbulence = m.boolean("turbulence", o.turbulence);
-    o.solid = m.boolean("solid", o.solid);
+    o.colorA = m.color({"color_a", "Colour where the noise is low."}, o.colorA);
+    o.colorB = m.color({"color_b", "Colour where the noise is high."}, o.colorB);
+    o.scale = m.number({"scale", "Noise features per unit."}, o.scale, 1e-6, 1e6);
+    o.fractal.octaves = int(m.integer({"octaves", "Layers of noise summed (fBm)."}, o.fractal.octaves, 1, 16));
+    o.fractal.lacunarity = m.number({"lacunarity", "Frequency ratio between successive octaves."}, o.fractal.lacunarity, 1.0, 16.0);
+    o.fractal.gain = m.number({"gain", "Amplitude ratio between successive octaves."}, o.fractal.gain, 0.0, 1.0);
+    o.turbulence = m.boolean({"turbulence", "Turbulence (sharp creases) instead of fBm."}, o.turbulence);
+    o.solid = m.boolean({"solid", "A solid texture: looked up at the 3-D point instead of (u, v, 0)."}, o.solid);
     o.seed = readSeed(m);
     out = textures::NoiseTexture(o);
   } else if (kind == "bark") {
     // The bark keys tree species read too (model/bark_keys.h), plus the texture's tiling and seed.
     textures::BarkLook look;
-    look.pattern.tileV = int(m.integer("tile_v", look.pattern.tileV, 0, 100000));
+    look.pattern.tileV = int(m.integer({"tile_v", "Repeat the pattern every this many units of v, frequencies along v rounded to whole cycles (0 = no tiling)."}, look.pattern.tileV, 0, 100000));
     readBarkLook(m, look);
     textures::BarkOptions o = look.resolved(look.pattern.ridgeColor, look.pattern.furrowColor);
     o.seed = readSeed(m);
@@ -594,35 +621,35 @@ std::optional<textures::Texture> readProcedural(const std::string& kind, const Y
     }
   } else if (kind == "stripes") {
     textures::StripesOptions o;
-    o.frequency = m.number("frequency", o.frequency, 0.0, 1e6);
-    o.duty = m.number("duty", o.duty, 0.0, 1.0);
-    o.wobble = m.number("wobble", o.wobble, 0.0, 100.0);
-    o.softness = m.number("softness", o.softness, 0.0, 1.0);
-    o.spiral = m.boolean("spiral", o.spiral);
-    o.baseColor = m.color("base_color", o.baseColor);
-    o.stripeColor = m.color("stripe_color", o.stripeColor);
+    o.frequency = m.number({"frequency", "Bands per unit."}, o.frequency, 0.0, 1e6);
+    o.duty = m.number({"duty", "Fraction of each period in `stripe_color`."}, o.duty, 0.0, 1.0);
+    o.wobble = m.number({"wobble", "Waviness of the bands, in periods."}, o.wobble, 0.0, 100.0);
+    o.softness = m.number({"softness", "Width of the bands' edges, in periods."}, o.softness, 0.0, 1.0);
+    o.spiral = m.boolean({"spiral", "Bands at constant u (along the growth direction) instead of constant v."}, o.spiral);
+    o.baseColor = m.color({"base_color", "Colour between the stripes."}, o.baseColor);
+    o.stripeColor = m.color({"stripe_color", "Colour of the stripes."}, o.stripeColor);
     o.seed = readSeed(m);
     out = textures::StripesTexture(o);
   } else if (kind == "spots") {
     textures::SpotsOptions o;
-    o.frequency = m.number("frequency", o.frequency, 0.0, 1e6);
-    o.radius = m.number("radius", o.radius, 0.0, 2.0);
-    o.radiusJitter = m.number("radius_jitter", o.radiusJitter, 0.0, 1.0);
-    o.jitter = m.number("jitter", o.jitter, 0.0, 1.0);
-    o.softness = m.number("softness", o.softness, 0.0, 1.0);
-    o.density = m.number("density", o.density, 0.0, 1.0);
-    o.baseColor = m.color("base_color", o.baseColor);
-    o.spotColor = m.color("spot_color", o.spotColor);
+    o.frequency = m.number({"frequency", "Grid cells per unit (one spot at most per cell)."}, o.frequency, 0.0, 1e6);
+    o.radius = m.number({"radius", "Mean spot radius, in cells."}, o.radius, 0.0, 2.0);
+    o.radiusJitter = m.number({"radius_jitter", "Relative variation of the spot radius."}, o.radiusJitter, 0.0, 1.0);
+    o.jitter = m.number({"jitter", "Displacement of the spot centres, in cells (up to ± jitter/2)."}, o.jitter, 0.0, 1.0);
+    o.softness = m.number({"softness", "Width of the spots' edges, in cells."}, o.softness, 0.0, 1.0);
+    o.density = m.number({"density", "Fraction of the cells that hold a spot."}, o.density, 0.0, 1.0);
+    o.baseColor = m.color({"base_color", "Colour between the spots."}, o.baseColor);
+    o.spotColor = m.color({"spot_color", "Colour of the spots."}, o.spotColor);
     o.seed = readSeed(m);
     out = textures::SpotsTexture(o);
   } else {  // leaf
     textures::LeafOptions o;
-    o.veins = int(m.integer("veins", o.veins, 0, 1000));
-    o.veinAngleDeg = m.number("vein_angle_deg", o.veinAngleDeg, 0.0, 90.0);
-    o.veinWidth = m.number("vein_width", o.veinWidth, 0.0, 0.5);
-    o.bladeColor = m.color("blade_color", o.bladeColor);
-    o.veinColor = m.color("vein_color", o.veinColor);
-    o.mottle = m.number("mottle", o.mottle, 0.0, 10.0);
+    o.veins = int(m.integer({"veins", "Pairs of lateral veins."}, o.veins, 0, 1000));
+    o.veinAngleDeg = m.number({"vein_angle_deg", "Angle of the lateral veins to the midrib, in degrees."}, o.veinAngleDeg, 0.0, 90.0);
+    o.veinWidth = m.number({"vein_width", "Half width of a vein, in units of u."}, o.veinWidth, 0.0, 0.5);
+    o.bladeColor = m.color({"blade_color", "Colour of the leaf blade."}, o.bladeColor);
+    o.veinColor = m.color({"vein_color", "Colour of the veins."}, o.veinColor);
+    o.mottle = m.number({"mottle", "Strength of the fBm mottling of the blade."}, o.mottle, 0.0, 10.0);
     o.seed = readSeed(m);
     out = textures::LeafTexture(o);
   }
@@ -678,6 +705,7 @@ std::shared_ptr<const textures::TextureRegistry> readBlobTextures(const YNode& l
     }
     const auto [key, value] = *kindAndValue;
     const std::string kind = key.scalar();
+    describeHelp(value, textureKindHelp(kind));
     std::optional<textures::Texture> t;
     if (kind == "image") {
       t = readImage(value, policy, diags);
@@ -699,7 +727,7 @@ std::optional<BlobSpecies> readBlobSpecies(MapReader& top, DiagnosticList& diags
   float cell = 0.0f;
   if (auto mesh = top.section({"mesh", "How `sprig mesh` polygonizes the blob: `cell` size (default automatic)."})) {
     MapReader mm(*mesh, diags, "mesh");
-    cell = float(mm.number("cell", 0.0, 0.0, 1e6));
+    cell = float(mm.number({"cell", "Cell size of the polygonizer, in world units (0 = automatic)."}, 0.0, 0.0, 1e6));
     mm.finish();
   }
   auto blob = top.get({"blob", "The BlobTree written out node by node: one node (a primitive, a blend, a CSG operation, a warp) with its children."});

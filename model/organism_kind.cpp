@@ -37,6 +37,30 @@ constexpr size_t kMaxFinestFaces = size_t(1) << 24;
 const std::vector<std::string> kBases = {"cube_sphere", "torus", "cylinder", "plane", "revolution", "mesh", "species"};
 const std::vector<std::string> kProcedures = {"rock", "berry", "tentacle", "spur", "mushroom", "captured"};
 
+/// What each base, detail procedure, alpha and shader is (`sprig schema`'s text for its key).
+std::string_view kindHelp(std::string_view what, std::string_view kind) {
+  static const std::map<std::pair<std::string_view, std::string_view>, std::string_view> kHelp = {
+      {{"base", "cube_sphere"}, "A cube of quads pushed onto a sphere about the origin: closed."},
+      {{"base", "torus"}, "A torus about the y axis: closed, every vertex regular."},
+      {{"base", "cylinder"}, "A cylinder about the y axis, with polygon caps or open."},
+      {{"base", "plane"}, "An open square of quads in the xz plane, normal +y."},
+      {{"base", "revolution"}, "A surface of revolution about the y axis: radius `profile`(t) at y = t."},
+      {{"base", "mesh"}, "A mesh or volume file as the control mesh; it must be manifold and consistently oriented."},
+      {{"base", "species"}, "Another species' final surface, reduced to about `faces` triangles."},
+      {{"detail", "rock"}, "Volumetric fractal (§4.2.1): noise along the normal, amplitude·gain^k at level first + k."},
+      {{"detail", "berry"}, "Hybrid fractal (§4.2.2): domes at Poisson-disk seeds, each level's smaller domes clustered on the last."},
+      {{"detail", "tentacle"}, "Tentacles (§4.2.3): each level moves the seed by a link, alternating sides; may turn and grow over time."},
+      {{"detail", "spur"}, "A spike: the seed moves `length` along its normal at each level of its range (Fig. 8a, 10)."},
+      {{"detail", "mushroom"}, "Hybrid morphogenic mushroom (§4.2.4): the footprint moves onto a cap-and-stalk profile; may grow over time."},
+      {{"detail", "captured"}, "The details of `capture:`, replayed (no keys)."},
+      {{"alpha", "plane"}, "Alpha from a plane: smoothstep of the signed distance over `width` (the paper's Fig. 12-13)."},
+      {{"alpha", "noise"}, "A procedural alpha: smoothstep of noise of the reference surface."},
+      {{"alpha", "painted"}, "Alpha painted on the base mesh's vertex colours (a `mesh` or `species` base with colours)."},
+      {{"shader", "planet"}, "The planet shader (§6.3): displaces by the rocks' scalar channel and colours by height bands."}};
+  auto it = kHelp.find({what, kind});
+  return it == kHelp.end() ? std::string_view() : it->second;
+}
+
 /// Organisms whose base is another species may nest this deep (a file naming itself fails).
 constexpr int kMaxSpeciesNesting = 4;
 thread_local int gSpeciesNesting = 0;
@@ -155,21 +179,28 @@ class OrganismReader {
     if (!one) return;
     const auto& [key, value] = *one;
     const std::string kind = key.scalar();
+    describeHelp(value, kindHelp("base", kind));
     MapReader m(value, diags_, kind);
     if (auto file = value.isMap() ? value.node()["file"] : YAML::Node(); file && file.IsScalar())
       baseName_ = " " + sprig::quoted(file.Scalar());
     try {
       if (kind == "cube_sphere") {
-        spec_.base = cubeSphere(float(m.number("radius", 1.0, 1e-6)), int(m.integer("quads", 2, 1, 64)));
+        spec_.base = cubeSphere(float(m.number({"radius", "Radius of the sphere."}, 1.0, 1e-6)),
+                                int(m.integer({"quads", "Quads along each cube edge: 6·quads² quads in all."}, 2, 1, 64)));
       } else if (kind == "torus") {
-        spec_.base = torus(float(m.number("major", 1.0, 1e-6)), float(m.number("minor", 0.35, 1e-6)),
-                           int(m.integer("around", 12, 3, 1024)), int(m.integer("across", 8, 3, 1024)));
+        spec_.base = torus(float(m.number({"major", "Major radius: of the core circle about the y axis."}, 1.0, 1e-6)),
+                           float(m.number({"minor", "Minor radius: of the tube."}, 0.35, 1e-6)),
+                           int(m.integer({"around", "Quads along the major circle."}, 12, 3, 1024)),
+                           int(m.integer({"across", "Quads around the tube."}, 8, 3, 1024)));
       } else if (kind == "cylinder") {
-        spec_.base = cylinder(float(m.number("radius", 0.5, 1e-6)), float(m.number("height", 2.0, 1e-6)),
-                              int(m.integer("around", 8, 3, 1024)), int(m.integer("rings", 4, 1, 1024)),
-                              m.boolean("caps", true));
+        spec_.base = cylinder(float(m.number({"radius", "Radius of the cylinder about the y axis."}, 0.5, 1e-6)),
+                              float(m.number({"height", "Height: from y = 0 to y = height."}, 2.0, 1e-6)),
+                              int(m.integer({"around", "Quads around the axis."}, 8, 3, 1024)),
+                              int(m.integer({"rings", "Rings of quads along the height."}, 4, 1, 1024)),
+                              m.boolean({"caps", "Close both ends with a polygon cap (false: an open tube)."}, true));
       } else if (kind == "plane") {
-        spec_.base = plane(float(m.number("size", 2.0, 1e-6)), int(m.integer("quads", 8, 1, 1024)));
+        spec_.base = plane(float(m.number({"size", "Edge length of the square in the xz plane, centred at the origin."}, 2.0, 1e-6)),
+                           int(m.integer({"quads", "Quads along each edge."}, 8, 1, 1024)));
       } else if (kind == "revolution") {
         readRevolution(m);
       } else if (kind == "mesh") {
@@ -187,12 +218,12 @@ class OrganismReader {
 
   MeshPlacement meshPlacement(MapReader& m) {
     MeshPlacement p;
-    p.center = m.boolean("center", false);
-    p.size = float(m.number("size", 0.0, 0.0, 1e6));
-    if (auto r = m.section("rotate")) {
+    p.center = m.boolean({"center", "Move the centre of the mesh's bounding box to the origin."}, false);
+    p.size = float(m.number({"size", "Scale the mesh so its bounding box's largest extent is this, in world units (0 = as it is)."}, 0.0, 0.0, 1e6));
+    if (auto r = m.section({"rotate", "Rotate the mesh: `axis` and `angle_deg` (after `center` and `size`)."})) {
       MapReader rm(*r, diags_, "rotate");
-      p.axis = rm.vec3("axis", p.axis);
-      p.angleDeg = float(rm.number("angle_deg", 0.0, -360.0, 360.0));
+      p.axis = rm.vec3({"axis", "Axis of the rotation, through the origin (not zero)."}, p.axis);
+      p.angleDeg = float(rm.number({"angle_deg", "Angle of the rotation, in degrees."}, 0.0, -360.0, 360.0));
       if (glm::length(p.axis) == 0) r->error(diags_, "the rotation 'axis' must not be zero");
       rm.finish();
     }
@@ -201,8 +232,9 @@ class OrganismReader {
 
   /// A polygon mesh file, checked (every error at its face's file:line:col), placed.
   std::optional<PolyMesh> readMeshFile(MapReader& m, const MeshPlacement& place) {
-    m.allow({"iso"});  // read below, once the file is known to be a volume
-    auto file = m.path("file", policy_);
+    // Read below, once the file is known to be a volume.
+    m.allow({{"iso", "Volume files (.inr) only, and required there: the value of the surface; the region above it is inside."}});
+    auto file = m.path({"file", "A mesh file (.obj, .ply, .off) or a volume (.inr, with `iso`), relative to the species file."}, policy_);
     if (!file) {
       if (!m.has("file")) m.node().error(diags_, "missing required key 'file' in " + std::string("mesh"));
       return std::nullopt;
@@ -238,7 +270,7 @@ class OrganismReader {
 
   void readMeshBase(MapReader& m) {
     const MeshPlacement place = meshPlacement(m);
-    const int64_t faces = m.integer("faces", 0, 0, 1'000'000);
+    const int64_t faces = m.integer({"faces", "Simplify the mesh to about this many faces (0 = as it is)."}, 0, 0, 1'000'000);
     std::optional<PolyMesh> mesh = readMeshFile(m, place);
     if (!mesh) return;
     if (faces > 0 && mesh->faceCount() > size_t(faces)) mesh = organisms::simplifyToFaceCount(triangulate(*mesh), size_t(faces));
@@ -249,7 +281,7 @@ class OrganismReader {
   /// The surface (final stage's mesh) of the species file at key `key`, or nullopt after
   /// an error. Species bases nest at most kMaxSpeciesNesting deep.
   std::optional<Mesh> speciesSurface(MapReader& m, const char* key) {
-    auto file = m.path(key, policy_);
+    auto file = m.path({key, "Another species file (relative to this one): its final surface, as `sprig mesh` makes it."}, policy_);
     if (!file) {
       if (!m.has(key)) m.node().error(diags_, std::string("missing required key '") + key + "' (a species file)");
       return std::nullopt;
@@ -279,7 +311,7 @@ class OrganismReader {
 
   /// Another species' surface reduced to about `faces` faces.
   void readSpeciesBase(MapReader& m) {
-    const int64_t faces = m.integer("faces", 1000, 4, 1'000'000);
+    const int64_t faces = m.integer({"faces", "Reduce the species' surface to about this many triangles (meshoptimizer)."}, 1000, 4, 1'000'000);
     const MeshPlacement place = meshPlacement(m);
     std::optional<Mesh> surface = speciesSurface(m, "file");
     if (!surface) return;
@@ -295,8 +327,8 @@ class OrganismReader {
     MapReader m(node, diags_, "capture");
     const MeshPlacement place = meshPlacement(m);
     organisms::AnalysisOptions o;
-    o.maxDistance = float(m.number("max_distance", o.maxDistance, 1e-9));
-    o.smoothing = int(m.integer("smoothing", o.smoothing, 0, 100));
+    o.maxDistance = float(m.number({"max_distance", "How far along each vertex normal (both ways) the rays look for the captured surface, in world units."}, o.maxDistance, 1e-9));
+    o.smoothing = int(m.integer({"smoothing", "Umbrella (Laplacian) smoothing steps before each decimation to the coarser level."}, o.smoothing, 0, 100));
     std::optional<Mesh> captured;
     if (m.has("species") == m.has("file")) {
       m.node().error(diags_, "capture takes one of 'file' (a mesh file) and 'species' (a species file)");
@@ -327,7 +359,7 @@ class OrganismReader {
 
   void readRevolution(MapReader& m) {
     m.markRequired("profile");
-    auto profile = m.get("profile");
+    auto profile = m.get({"profile", "The radius as an expression of t (the grammar's expression language: trigonometric functions take degrees)."});
     std::optional<lsystem::Expression> r;
     if (!profile) {
       m.node().error(diags_, "missing required key 'profile' in revolution (the radius as an expression of t)");
@@ -342,14 +374,15 @@ class OrganismReader {
       }
     }
     double t0 = 0, t1 = 1;
-    if (auto range = m.get("t")) {
+    if (auto range = m.get({"t", "[t0, t1], the range of t, with t1 > t0; the surface lies at y = t (default [0, 1])."})) {
       auto items = range->items();
       std::optional<double> a, b;
       if (items.size() == 2) a = items[0].asNumber(diags_, "'t'"), b = items[1].asNumber(diags_, "'t'");
       if (!a || !b || !(*b > *a)) range->error(diags_, "'t' must be [t0, t1] with t1 > t0");
       else t0 = *a, t1 = *b;
     }
-    const int around = int(m.integer("around", 12, 3, 1024)), rings = int(m.integer("rings", 12, 1, 4096));
+    const int around = int(m.integer({"around", "Quads around the y axis."}, 12, 3, 1024)),
+              rings = int(m.integer({"rings", "Rings of quads along t."}, 12, 1, 4096));
     if (!r) return;
     spec_.base = revolution([&](double t) { return (*r)({t}); }, t0, t1, around, rings);
   }
@@ -360,43 +393,44 @@ class OrganismReader {
     if (!one) return;
     const auto& [key, value] = *one;
     const std::string kind = key.scalar();
+    describeHelp(value, kindHelp("detail", kind));
     MapReader m(value, diags_, kind);
     std::shared_ptr<const DetailProcedure> p;
     if (kind == "rock") {
       RockOptions o;
-      o.amplitude = float(m.number("amplitude", o.amplitude, -1e6, 1e6));
-      o.frequency = float(m.number("frequency", o.frequency, 1e-6, 1e6));
-      o.gain = float(m.number("gain", o.gain, 0.0, 4.0));
-      o.lacunarity = float(m.number("lacunarity", o.lacunarity, 1.0, 8.0));
-      o.levels = levelRange(m, {1, spec_.levels});
-      o.seed = uint64_t(m.integer("seed", 1, 0));
-      o.scalar = m.choice("output", "displace", {"displace", "scalar"}) == "scalar";
+      o.amplitude = float(m.number({"amplitude", "Normal displacement of the first level, in world units; level first + k gets amplitude·gain^k."}, o.amplitude, -1e6, 1e6));
+      o.frequency = float(m.number({"frequency", "Noise frequency of the first level; level first + k uses frequency·lacunarity^k."}, o.frequency, 1e-6, 1e6));
+      o.gain = float(m.number({"gain", "Amplitude ratio between successive levels."}, o.gain, 0.0, 4.0));
+      o.lacunarity = float(m.number({"lacunarity", "Frequency ratio between successive levels."}, o.lacunarity, 1.0, 8.0));
+      o.levels = levelRange(m, {1, spec_.levels}, "(default: [1, levels])");
+      o.seed = uint64_t(m.integer({"seed", "Seed of the noise."}, 1, 0));
+      o.scalar = m.choice({"output", "`displace` moves the surface; `scalar` writes the scalar channel the planet shader reads."}, "displace", {"displace", "scalar"}) == "scalar";
       p = makeRock(o);
     } else if (kind == "berry") {
       BerryOptions o;
-      o.radius = float(m.number("radius", o.radius, 1e-6, 1e6));
-      o.ratio = float(m.number("ratio", o.ratio, 0.05, 0.95));
-      o.height = float(m.number("height", o.height, -10.0, 10.0));
-      o.cluster = float(m.number("cluster", o.cluster, 0.05, 1.0));
-      o.levels = levelRange(m, {1, std::min(3, spec_.levels)});
+      o.radius = float(m.number({"radius", "Radius R of the first level's domes, in world units."}, o.radius, 1e-6, 1e6));
+      o.ratio = float(m.number({"ratio", "Each finer level's domes: radius and seed spacing times this."}, o.ratio, 0.05, 0.95));
+      o.height = float(m.number({"height", "Multiplier of the dome height (1 = a spherical cap of radius R; negative: a pit)."}, o.height, -10.0, 10.0));
+      o.cluster = float(m.number({"cluster", "The next level's seeds lie within cluster·R of their parent dome's seed."}, o.cluster, 0.05, 1.0));
+      o.levels = levelRange(m, {1, std::min(3, spec_.levels)}, "(default: [1, min(3, levels)])");
       o.placement = placement(m, 1.8f * o.radius);
       p = makeBerry(o);
     } else if (kind == "tentacle") {
       TentacleOptions o;
-      o.length = float(m.number("length", o.length, -1e6, 1e6));
-      o.angleDeg = float(m.number("angle_deg", o.angleDeg, -3600.0, 3600.0));
-      o.spinDeg = float(m.number("spin_deg", o.spinDeg, -36000.0, 36000.0));
-      o.grow = float(m.number("grow", o.grow, 0.0, 1.0));
-      const std::string alt = m.choice("alternate", "tangent", {"tangent", "all", "none"});
+      o.length = float(m.number({"length", "Length of one link, in world units: the displacement of the tentacle's level k is length·k."}, o.length, -1e6, 1e6));
+      o.angleDeg = float(m.number({"angle_deg", "θ, the link direction's angle in the seed's tangent plane, in degrees."}, o.angleDeg, -3600.0, 3600.0));
+      o.spinDeg = float(m.number({"spin_deg", "Degrees θ turns over time 0 to 1 (θ = angle_deg + spin_deg·time)."}, o.spinDeg, -36000.0, 36000.0));
+      o.grow = float(m.number({"grow", "Time over which the tentacle grows to full length (0 = full from the start)."}, o.grow, 0.0, 1.0));
+      const std::string alt = m.choice({"alternate", "What even levels flip: `tangent` (links swing to alternate sides), `all` (the whole direction: pits), `none`."}, "tangent", {"tangent", "all", "none"});
       o.alternate = alt == "all" ? Alternate::All : alt == "none" ? Alternate::None : Alternate::Tangent;
-      o.levels = levelRange(m, {1, std::min(4, spec_.levels)});
+      o.levels = levelRange(m, {1, std::min(4, spec_.levels)}, "(default: [1, min(4, levels)])");
       o.placement = placement(m, 0.3f);
       spec_.animated |= o.spinDeg != 0 || o.grow > 0;
       p = makeTentacle(o);
     } else if (kind == "spur") {
       SpurOptions o;
-      o.length = float(m.number("length", o.length, -1e6, 1e6));
-      o.levels = levelRange(m, {1, 1});
+      o.length = float(m.number({"length", "How far the seed moves along its normal at each level of the range, in world units."}, o.length, -1e6, 1e6));
+      o.levels = levelRange(m, {1, 1}, "(default: [1, 1])");
       o.placement = placement(m, 0.3f);
       p = makeSpur(o);
     } else if (kind == "captured") {
@@ -405,14 +439,14 @@ class OrganismReader {
       p = spec_.captured;
     } else if (kind == "mushroom") {
       MushroomOptions o;
-      o.height = float(m.number("height", o.height, 1e-6, 1e6));
-      o.capRadius = float(m.number("cap_radius", o.capRadius, 1e-6, 1e6));
-      o.capTop = float(m.number("cap_top", o.capTop, 0.0, 1e6));
-      o.capUnder = float(m.number("cap_under", o.capUnder, 0.0, 1e6));
-      o.stalkRadius = float(m.number("stalk_radius", o.stalkRadius, 1e-6, 1e6));
-      o.footprint = float(m.number("footprint", o.footprint, 1e-6, 1e6));
-      o.grow = float(m.number("grow", o.grow, 0.0, 1.0));
-      o.levels = levelRange(m, {1, std::min(4, spec_.levels)});
+      o.height = float(m.number({"height", "H, height of the cap's rim above the surface, in world units (> cap_under)."}, o.height, 1e-6, 1e6));
+      o.capRadius = float(m.number({"cap_radius", "Radius of the cap's rim (stalk_radius < cap_radius < footprint)."}, o.capRadius, 1e-6, 1e6));
+      o.capTop = float(m.number({"cap_top", "Height of the cap's dome above the rim."}, o.capTop, 0.0, 1e6));
+      o.capUnder = float(m.number({"cap_under", "Depth of the cap's underside below the rim (< height)."}, o.capUnder, 0.0, 1e6));
+      o.stalkRadius = float(m.number({"stalk_radius", "Radius of the stalk."}, o.stalkRadius, 1e-6, 1e6));
+      o.footprint = float(m.number({"footprint", "Radius around the seed within which the surface moves onto the mushroom's profile."}, o.footprint, 1e-6, 1e6));
+      o.grow = float(m.number({"grow", "Time over which the mushroom grows to full size (0 = full from the start)."}, o.grow, 0.0, 1.0));
+      o.levels = levelRange(m, {1, std::min(4, spec_.levels)}, "(default: [1, min(4, levels)])");
       o.placement = placement(m, 2.5f * o.footprint);
       if (!(o.stalkRadius < o.capRadius && o.capRadius < o.footprint))
         m.node().error(diags_, "a mushroom needs stalk_radius < cap_radius < footprint");
@@ -424,9 +458,12 @@ class OrganismReader {
     if (p) into.push_back(std::move(p));
   }
 
-  /// `levels: [first, last]` within 0..spec levels.
-  LevelRange levelRange(MapReader& m, LevelRange def) {
-    auto node = m.get("levels");
+  /// `levels: [first, last]` within 0..spec levels; `defaultText` says def in words ("(default: [1, 1])").
+  LevelRange levelRange(MapReader& m, LevelRange def, const char* defaultText) {
+    const std::string help =
+        std::string("[first, last]: the synthesis levels it acts on (1 = the first subdivision), within 0..`levels` ") +
+        defaultText + ".";
+    auto node = m.get({"levels", help});
     if (!node) return def;
     auto items = node->items();
     std::optional<int64_t> a, b;
@@ -447,27 +484,27 @@ class OrganismReader {
   Placement placement(MapReader& parent, float defaultSpacing) {
     Placement p;
     p.spacing = defaultSpacing;
-    auto section = parent.section("seeds");
+    auto section = parent.section({"seeds", "Where the features sit (§5.1): one of `spacing`, `control_vertices`, `points`, `faces`, with `footprint` and `seed` (default: Poisson-disk seeds at the procedure's spacing)."});
     if (!section) return p;
     MapReader m(*section, diags_, "seeds");
     const int ways = int(m.has("spacing")) + int(m.has("control_vertices")) + int(m.has("points")) + int(m.has("faces"));
     if (ways > 1) m.node().error(diags_, "seeds take one of 'spacing', 'control_vertices', 'points' and 'faces'");
-    p.seed = uint64_t(m.integer("seed", 1, 0));
-    p.surfaceFootprint = m.choice("footprint", "vertex", {"vertex", "surface"}) == "surface";
+    p.seed = uint64_t(m.integer({"seed", "Seed of the Poisson-disk dart throwing (the order of the darts)."}, 1, 0));
+    p.surfaceFootprint = m.choice({"footprint", "`vertex`: a seed snaps to the nearest vertex of its level; `surface`: it is the nearest surface point, re-projected at every level."}, "vertex", {"vertex", "surface"}) == "surface";
     if (m.has("spacing")) {
       p.kind = Placement::Kind::Spacing;
-      p.spacing = float(m.number("spacing", defaultSpacing, 1e-6, 1e6));
+      p.spacing = float(m.number({"spacing", "Global: Poisson-disk vertices of the procedure's first level at least this far apart, in world units (default: 1.8 × radius for a berry, 2.5 × footprint for a mushroom, else 0.3)."}, defaultSpacing, 1e-6, 1e6));
     }
     if (m.has("control_vertices")) {
-      if (m.boolean("control_vertices", true)) p.kind = Placement::Kind::ControlVertices;
+      if (m.boolean({"control_vertices", "Global: true puts a seed at every vertex of the control mesh."}, true)) p.kind = Placement::Kind::ControlVertices;
     }
-    if (auto pts = m.get("points")) {
+    if (auto pts = m.get({"points", "Local: [[x, y, z], ...], each projected to the surface."})) {
       p.kind = Placement::Kind::Points;
       for (const YNode& q : pts->items())
         if (auto v = q.asVec3(diags_, "a seed point")) p.points.push_back(*v);
       if (p.points.empty()) pts->error(diags_, "'points' must be a list of [x, y, z]");
     }
-    if (auto faces = m.get("faces")) {
+    if (auto faces = m.get({"faces", "Local: [[face, u, v], ...], the bilinear point (u, v) of a control quad, then as `points`."})) {
       p.kind = Placement::Kind::Points;
       for (const YNode& q : faces->items()) facePoint(q, p.points);
       if (p.points.empty()) faces->error(diags_, "'faces' must be a list of [face, u, v]");
@@ -504,12 +541,12 @@ class OrganismReader {
   // ---- blend, modify, shader ----
   void readBlend(const YNode& node) {
     MapReader m(node, diags_, "blend");
-    for (const YNode& item : m.sequence("detail")) readProcedure(item, spec_.blendDetail);
-    if (auto c = m.get("color")) {
+    for (const YNode& item : m.sequence({"detail", "Shape B: detail procedures, summed, blended over shape A (`organism.detail`) by `alpha`."})) readProcedure(item, spec_.blendDetail);
+    if (auto c = m.get({"color", "Surface colour where alpha is 1, mixed in by alpha elsewhere (default: none, the render colour)."})) {
       if (auto v = c->asColor(diags_, "'color'")) spec_.blendColor = *v;
     }
     m.markRequired("alpha");
-    if (auto a = m.get("alpha")) readAlpha(*a);
+    if (auto a = m.get({"alpha", "Where shape B replaces shape A, per level: d_l = (1 − α_l)·d^A_l + α_l·d^B_l; `plane`, `noise` or `painted`."})) readAlpha(*a);
     else m.node().error(diags_, "missing required key 'alpha' in blend (e.g. alpha: {plane: {normal: [1, 2, 0]}})");
     m.finish();
   }
@@ -518,23 +555,24 @@ class OrganismReader {
     std::optional<std::pair<YNode, YNode>> one = single(node, "alpha", {"plane", "noise", "painted"});
     if (!one) return;
     const auto& [key, value] = *one;
+    describeHelp(value, kindHelp("alpha", key.scalar()));
     MapReader m(value, diags_, key.scalar());
     if (key.scalar() == "plane") {
       auto plane = std::make_shared<PlaneAlpha>();
-      plane->normal = m.vec3("normal", Vec3(1, 2, 0));
+      plane->normal = m.vec3({"normal", "Normal of the blend plane (not zero; the paper's [1, 2, 0]): alpha rises to 1 on its side."}, Vec3(1, 2, 0));
       if (glm::length(plane->normal) == 0) value.error(diags_, "the blend plane's 'normal' must not be zero");
-      plane->offset = float(m.number("offset", 0.0));
-      plane->speed = float(m.number("speed", 0.0));
-      plane->width = float(m.number("width", 0.5, 0.0));
-      plane->sharp = m.choice("transition", "sharp", {"sharp", "soft"}) == "sharp";
+      plane->offset = float(m.number({"offset", "Position of the plane along its normal, in world units."}, 0.0));
+      plane->speed = float(m.number({"speed", "The plane moves by speed·time (time 0 to 1 over the animation)."}, 0.0));
+      plane->width = float(m.number({"width", "Width c of the transition across the plane, in world units."}, 0.5, 0.0));
+      plane->sharp = m.choice({"transition", "`sharp`: the transition narrows to c/2^(l−1) at level l (Fig. 12, 13a); `soft`: width c at every level (Fig. 13b)."}, "sharp", {"sharp", "soft"}) == "sharp";
       spec_.animated |= plane->speed != 0;
       spec_.alpha = plane;
     } else if (key.scalar() == "painted") {
       // The base's vertex paint: one channel (or the luminance) of its linear colours.
-      const std::string channel = m.choice("channel", "luminance", {"red", "green", "blue", "luminance"});
+      const std::string channel = m.choice({"channel", "Which channel of the base's linear vertex colours is the paint m (luminance: Rec. 709)."}, "luminance", {"red", "green", "blue", "luminance"});
       auto painted = std::make_shared<PaintedAlpha>();
-      painted->width = float(m.number("width", 1.0, 1e-3, 1e3));
-      painted->sharp = m.choice("transition", "sharp", {"sharp", "soft"}) == "sharp";
+      painted->width = float(m.number({"width", "Width of the transition around m = 1/2, in units of paint."}, 1.0, 1e-3, 1e3));
+      painted->sharp = m.choice({"transition", "`sharp`: the transition narrows by half per level; `soft`: the same width at every level."}, "sharp", {"sharp", "soft"}) == "sharp";
       if (baseColors_.empty() && !spec_.base.faceSizes.empty()) {
         key.error(diags_, "a painted alpha needs a base mesh with vertex colours (a mesh or species base whose "
                           "vertices carry colours); this base has none");
@@ -549,10 +587,10 @@ class OrganismReader {
     } else {
       // A procedural alpha: smoothstep of noise of the reference position, the transition
       // narrowing per level like a sharp plane.
-      const double frequency = m.number("frequency", 1.0, 1e-6);
-      const double width = m.number("width", 0.3, 1e-6);
-      const double threshold = m.number("threshold", 0.0, -1.0, 1.0);
-      const uint64_t seed = uint64_t(m.integer("seed", 1, 0));
+      const double frequency = m.number({"frequency", "Noise frequency, per world unit of the reference surface."}, 1.0, 1e-6);
+      const double width = m.number({"width", "Width of the transition in noise units at level 1, halving per level."}, 0.3, 1e-6);
+      const double threshold = m.number({"threshold", "Noise value where alpha is 1/2."}, 0.0, -1.0, 1.0);
+      const uint64_t seed = uint64_t(m.integer({"seed", "Seed of the noise."}, 1, 0));
       auto noise = std::make_shared<textures::PerlinNoise>(seed);
       auto f = std::make_shared<FunctionAlpha>();
       f->f = [noise, frequency, width, threshold](const Vec3& p, int level, double) {
@@ -569,10 +607,10 @@ class OrganismReader {
   void readModification(const YNode& node) {
     MapReader m(node, diags_, "modify entry");
     Modification mod;
-    mod.center = m.vec3("center", mod.center);
-    mod.radius = float(m.number("radius", mod.radius, 1e-6));
+    mod.center = m.vec3({"center", "The modification centres on the vertex nearest this point."}, mod.center);
+    mod.radius = float(m.number({"radius", "Reach R, in world units along the surface (edge hops × the level's mean edge length), with a cubic drop-off."}, mod.radius, 1e-6));
     m.markRequired("gains");
-    if (auto g = m.get("gains")) {
+    if (auto g = m.get({"gains", "Gain g_l of each level's detail from level 0, each in [-100, 100]: 0 removes it, 1 keeps it, 2 doubles it."})) {
       for (const YNode& x : g->items())
         if (auto v = x.asNumber(diags_, "a gain", -100.0, 100.0)) mod.gains.push_back(float(*v));
       if (mod.gains.empty()) g->error(diags_, "'gains' must be a list of numbers, one per level from 0");
@@ -589,18 +627,19 @@ class OrganismReader {
   void readShader(const YNode& node) {
     std::optional<std::pair<YNode, YNode>> one = single(node, "shader", {"planet"});
     if (!one) return;
+    describeHelp(one->second, kindHelp("shader", "planet"));
     MapReader m(one->second, diags_, "planet");
     PlanetShader s;
-    s.relief = float(m.number("relief", s.relief));
-    s.seaLevel = float(m.number("sea_level", s.seaLevel));
-    s.mountain = float(m.number("mountain", s.mountain));
-    s.snow = float(m.number("snow", s.snow));
-    s.ocean = m.color("ocean", s.ocean);
-    s.lowland = m.color("lowland", s.lowland);
-    s.highland = m.color("highland", s.highland);
-    s.ice = m.color("ice", s.ice);
-    s.tint = m.color("tint", s.tint);
-    s.tintStrength = float(m.number("tint_strength", s.tintStrength, 0.0, 1.0));
+    s.relief = float(m.number({"relief", "Displacement along the normal per unit of scalar h: relief·max(h, sea_level)."}, s.relief));
+    s.seaLevel = float(m.number({"sea_level", "Scalar value of the sea: lower points stay flat and take `ocean`."}, s.seaLevel));
+    s.mountain = float(m.number({"mountain", "Scalar value above which the colour is `highland`."}, s.mountain));
+    s.snow = float(m.number({"snow", "Scalar value above which the colour is `ice`."}, s.snow));
+    s.ocean = m.color({"ocean", "Colour below `sea_level` (darker when deeper)."}, s.ocean);
+    s.lowland = m.color({"lowland", "Colour between `sea_level` and `mountain`."}, s.lowland);
+    s.highland = m.color({"highland", "Colour between `mountain` and `snow`."}, s.highland);
+    s.ice = m.color({"ice", "Colour above `snow`."}, s.ice);
+    s.tint = m.color({"tint", "Colour the blend's alpha shifts the bands towards."}, s.tint);
+    s.tintStrength = float(m.number({"tint_strength", "How far alpha = 1 shifts the colours towards `tint`."}, s.tintStrength, 0.0, 1.0));
     m.finish();
     spec_.planet = s;
   }

@@ -98,8 +98,9 @@ std::string mapJson(const KeySchema& k, const std::string& path, int depth) {
 }
 
 std::string emit(const KeySchema& k, const std::string& path, int depth) {
-  if (!k.ref.empty())
-    return "{\"description\": " + jsonText(path + ": " + k.ref) + ", \"$ref\": \"#/definitions/part_" + k.ref + "\"}";
+  if (!k.ref.empty())  // a shared definition: what the key does, then its place and the definition's name
+    return "{\"description\": " + jsonText((k.help.empty() ? "" : k.help + "\n\n") + path + ": " + k.ref) +
+           ", \"$ref\": \"#/definitions/part_" + k.ref + "\"}";
   std::vector<std::string> alternatives;
   std::string what;
   if (!k.choices.empty()) {

@@ -28,15 +28,15 @@ float num(MapReader& r, Key key, float def, double lo = -kInf, double hi = kInf)
 }
 
 /// A part section: absent (keeps `enabled`), `true`/`false`, or a map (enables it).
-std::optional<YNode> partSection(MapReader& top, std::string_view key, bool& enabled, DiagnosticList& diags) {
+std::optional<YNode> partSection(MapReader& top, Key key, bool& enabled, DiagnosticList& diags) {
   auto n = top.get(key);
   if (!n) return std::nullopt;
   if (n->isScalar()) {
-    if (auto b = n->asBoolean(diags, quoted(key))) enabled = *b;
+    if (auto b = n->asBoolean(diags, quoted(key.name))) enabled = *b;
     return std::nullopt;
   }
   if (!n->isMap() && !n->isNull()) {
-    n->error(diags, quoted(key) + " must be a map or true/false");
+    n->error(diags, quoted(key.name) + " must be a map or true/false");
     return std::nullopt;
   }
   enabled = true;
@@ -72,7 +72,7 @@ void readGenerating(MapReader& top, ShellParams& p, DiagnosticList& diags) {
   MapReader gen(*g, diags, "generating");
   p.generating.primitives.clear();
   p.canal.reset();
-  for (const YNode& item : gen.sequence("primitives")) {
+  for (const YNode& item : gen.sequence({"primitives", "Primitives summed into the generating surface, each `{point: {...}}` or `{cone: {...}}`, in the unit frame (1 = D(θ))."})) {
     if (!item.isMap() || item.pairs().size() != 1) {
       item.error(diags, "a generating primitive must be a map with one key: point or cone");
       continue;
@@ -84,24 +84,24 @@ void readGenerating(MapReader& top, ShellParams& p, DiagnosticList& diags) {
     MapReader r(value, diags, kind);
     if (kind == "point") {
       prim.kind = GeneratingPrimitive::Kind::Point;
-      prim.a = r.vec3("center", Vec3(0.0f), -100, 100);
-      prim.radiusA = prim.radiusB = num(r, "radius", 1.0f, 1e-4, 100);
+      prim.a = r.vec3({"center", "Centre of the point in the unit generating frame."}, Vec3(0.0f), -100, 100);
+      prim.radiusA = prim.radiusB = num(r, {"radius", "Radius of the point (its 0.5-iso radius), unit frame."}, 1.0f, 1e-4, 100);
     } else if (kind == "cone") {
       prim.kind = GeneratingPrimitive::Kind::Cone;
-      prim.a = r.vec3("a", Vec3(0.0f), -100, 100);
-      prim.b = r.vec3("b", Vec3(0.0f, 1.0f, 0.0f), -100, 100);
-      prim.radiusA = num(r, "radius_a", 0.3f, 1e-4, 100);
-      prim.radiusB = num(r, "radius_b", 0.2f, 1e-4, 100);
-      prim.bendDeg = num(r, "bend", 0.0f, 0.0, 180.0);
-      prim.bendDirection = r.vec3("bend_direction", Vec3(1, 0, 0), -1e3, 1e3);
-      prim.canal = r.boolean("canal", false);
+      prim.a = r.vec3({"a", "Start of the cone in the unit generating frame."}, Vec3(0.0f), -100, 100);
+      prim.b = r.vec3({"b", "End of the cone in the unit generating frame (must differ from `a`)."}, Vec3(0.0f, 1.0f, 0.0f), -100, 100);
+      prim.radiusA = num(r, {"radius_a", "Radius (0.5-iso) of the cone at `a`, unit frame."}, 0.3f, 1e-4, 100);
+      prim.radiusB = num(r, {"radius_b", "Radius (0.5-iso) of the cone at `b`, unit frame."}, 0.2f, 1e-4, 100);
+      prim.bendDeg = num(r, {"bend", "Bend of the cone in degrees, keeping `a` and `b` fixed (0 = straight)."}, 0.0f, 0.0, 180.0);
+      prim.bendDirection = r.vec3({"bend_direction", "Direction the bent cone bulges towards."}, Vec3(1, 0, 0), -1e3, 1e3);
+      prim.canal = r.boolean({"canal", "This cone is the siphonal canal: the axial spines sit along it."}, false);
       if (glm::length(prim.b - prim.a) < 1e-4f) value.error(diags, "cone 'a' and 'b' must differ");
     } else {
       static const std::vector<std::string> kinds = {"point", "cone"};
       keyNode.error(diags, "unknown generating primitive '" + kind + "' (point or cone)" + didYouMean(kind, kinds));
       continue;
     }
-    prim.lastDeg = r.number("last", 0.0, 0.0, 1e6);
+    prim.lastDeg = r.number({"last", "Sweep this primitive over the last DEG degrees before θ_end only (0 = the whole spiral)."}, 0.0, 0.0, 1e6);
     r.finish();
     p.generating.primitives.push_back(prim);
   }
@@ -119,19 +119,19 @@ void readCanal(MapReader& top, ShellParams& p, DiagnosticList& diags) {
                       "none (use generating: murex, or a cone with 'canal: true' among its primitives)");
   organisms::CanalOptions& c = p.canal ? *p.canal : unused;
   MapReader r(*sec, diags, "canal");
-  if (auto st = r.get("start")) {
+  if (auto st = r.get({"start", "[x, y] where the canal leaves the generating surface, unit frame (default [-0.45, 0.7]); x must lie farther from the axis than the tip."})) {
     const std::vector<float> xy = floatList(*st, diags, "start", -100.0, 100.0);
     if (xy.size() == 2)
       c.start = Vec2(xy[0], xy[1]);
     else if (st->isSequence())
       st->error(diags, "'start' must be [x, y] (the unit generating frame)");
   }
-  c.length = num(r, "length", c.length, 0.01, 100.0);
-  c.axisOffset = num(r, "axis_offset", c.axisOffset, -10.0, 10.0);
-  c.radiusStart = num(r, "radius_start", c.radiusStart, 1e-3, 10.0);
-  c.radiusEnd = num(r, "radius_end", c.radiusEnd, 1e-3, 10.0);
-  c.turnDeg = num(r, "turn", c.turnDeg, 1.0, 90.0);
-  c.sweepDeg = r.number("sweep", c.sweepDeg, 1.0, 40 * 3600.0);
+  c.length = num(r, {"length", "Axial extent of the canal from `start` to its tip, unit frame; at least the bend's own extent."}, c.length, 0.01, 100.0);
+  c.axisOffset = num(r, {"axis_offset", "Distance of the canal's straight part from the shell axis, unit frame."}, c.axisOffset, -10.0, 10.0);
+  c.radiusStart = num(r, {"radius_start", "Radius (0.5-iso) of the canal at `start`, unit frame; it runs linearly to `radius_end`."}, c.radiusStart, 1e-3, 10.0);
+  c.radiusEnd = num(r, {"radius_end", "Radius (0.5-iso) of the canal at its tip, unit frame."}, c.radiusEnd, 1e-3, 10.0);
+  c.turnDeg = num(r, {"turn", "Direction of the canal at `start`, in degrees from the axis direction (inwards); it bends until parallel to the axis."}, c.turnDeg, 1.0, 90.0);
+  c.sweepDeg = r.number({"sweep", "The canal is swept over the last DEG degrees before θ_end (default: 1.333 × whorl_angle, 464 for the Murex preset)."}, c.sweepDeg, 1.0, 40 * 3600.0);
   r.finish();
   if (!p.canal) return;
   if (!(c.start.x > c.tipX(p.spiral))) {
@@ -148,7 +148,7 @@ void readCanal(MapReader& top, ShellParams& p, DiagnosticList& diags) {
 }
 
 void readVarices(MapReader& top, ShellParams& p, DiagnosticList& diags) {
-  auto sec = partSection(top, "varices", p.varices.enabled, diags);
+  auto sec = partSection(top, {"varices", "Varices (Eq. 11-13, Fig. 7): ridges of spines every `spacing` degrees; `true`, `false` or a map of their keys (default: off; on in the `murex_cabritii` preset)."}, p.varices.enabled, diags);
   if (!sec) return;
   auto& v = p.varices;
   MapReader r(*sec, diags, "varices");
@@ -199,7 +199,7 @@ void readVarices(MapReader& top, ShellParams& p, DiagnosticList& diags) {
 }
 
 void readBumps(MapReader& top, ShellParams& p, DiagnosticList& diags) {
-  auto sec = partSection(top, "bumps", p.bumps.enabled, diags);
+  auto sec = partSection(top, {"bumps", "Bumps between the varices (Fig. 8), super-elliptically blended; `true`, `false` or a map of their keys (default: off; on in the `murex_cabritii` preset)."}, p.bumps.enabled, diags);
   if (!sec) return;
   auto& b = p.bumps;
   MapReader r(*sec, diags, "bumps");
@@ -215,7 +215,7 @@ void readBumps(MapReader& top, ShellParams& p, DiagnosticList& diags) {
 }
 
 void readAxial(MapReader& top, ShellParams& p, DiagnosticList& diags) {
-  auto sec = partSection(top, "axial_spines", p.axialSpines.enabled, diags);
+  auto sec = partSection(top, {"axial_spines", "Axial spines along the siphonal canal (Fig. 9, Table 2); `true`, `false` or a map of their keys (default: off; on in the `murex_cabritii` preset)."}, p.axialSpines.enabled, diags);
   if (!sec) return;
   auto& a = p.axialSpines;
   MapReader r(*sec, diags, "axial_spines");
@@ -247,7 +247,7 @@ void readAxial(MapReader& top, ShellParams& p, DiagnosticList& diags) {
 }
 
 void readOpening(MapReader& top, ShellParams& p, DiagnosticList& diags) {
-  auto sec = partSection(top, "opening", p.opening.enabled, diags);
+  auto sec = partSection(top, {"opening", "The opening (aperture) cut by CSG (Eq. 14-15, Fig. 10-11); `true`, `false` or a map of its keys (default: off; on in the `murex_cabritii` preset)."}, p.opening.enabled, diags);
   if (!sec) return;
   auto& o = p.opening;
   MapReader r(*sec, diags, "opening");
@@ -266,39 +266,39 @@ void readTextures(MapReader& top, organisms::ShellTextureOptions& t, DiagnosticL
     t.whorlColor = r.color({"whorl", "Base colour of the whorls."}, t.whorlColor);
     t.cordColor = r.color({"cord_color", "Colour of the spiral cords."}, t.cordColor);
     t.cords = static_cast<int>(r.integer({"cords", "Spiral cords around a whorl (0 = none)."}, t.cords, 0, 200));
-    t.cordStrength = num(r, "cord_strength", t.cordStrength, 0.0, 1.0);
-    t.growthLineDeg = num(r, "growth_lines", t.growthLineDeg, 0.0, 360.0);
-    t.growthLineStrength = num(r, "growth_line_strength", t.growthLineStrength, 0.0, 1.0);
+    t.cordStrength = num(r, {"cord_strength", "How strongly the cords mix `cord_color` into the whorl (0 = no cords)."}, t.cordStrength, 0.0, 1.0);
+    t.growthLineDeg = num(r, {"growth_lines", "Spacing of the axial growth lines along the spiral, in degrees of θ (0 = none)."}, t.growthLineDeg, 0.0, 360.0);
+    t.growthLineStrength = num(r, {"growth_line_strength", "How much a growth line darkens the whorl (0 = not at all)."}, t.growthLineStrength, 0.0, 1.0);
     t.varixColor = r.color({"varix", "Colour of the varices."}, t.varixColor);
     t.spineTipColor = r.color({"spine_tip", "Colour of the spine tips."}, t.spineTipColor);
     t.axialColor = r.color({"axial", "Colour of the axial (canal) spines."}, t.axialColor);
     t.bumpColor = r.color({"bump", "Colour of the bumps."}, t.bumpColor);
     t.insideColor = r.color({"inside", "Colour inside the opening."}, t.insideColor);
-    t.insideRadial = num(r, "inside_radial", t.insideRadial, 0.0, 1.0);
+    t.insideRadial = num(r, {"inside_radial", "With an opening: whorl points nearer the generating centre than this fraction of D(θ), within the opening's `depth` of the lip, take `inside` (0 = off)."}, t.insideRadial, 0.0, 1.0);
     r.finish();
   }
   bool on = t.pigment;
-  auto sec = partSection(top, "pigment", on, diags);
+  auto sec = partSection(top, {"pigment", "Pigment pattern from Meinhardt's activator-inhibitor reaction-diffusion along the growing edge; `true`, `false` or a map of its keys (default: off)."}, on, diags);
   t.pigment = on;
   if (!sec) return;
   auto& o = t.pigmentOptions;
   MapReader r(*sec, diags, "pigment");
-  o.cells = static_cast<int>(r.integer("cells", o.cells, 3, 4096));
-  o.rows = static_cast<int>(r.integer("rows", o.rows, 1, 8192));
-  o.stepsPerRow = static_cast<int>(r.integer("steps_per_row", o.stepsPerRow, 1, 1000));
-  o.warmupRows = static_cast<int>(r.integer("warmup", o.warmupRows, 0, 10000));
-  o.dt = r.number("dt", o.dt, 1e-4, 10.0);
-  o.diffusionA = r.number("da", o.diffusionA, 0.0, 10.0);
-  o.diffusionB = r.number("db", o.diffusionB, 0.0, 10.0);
-  o.decayA = r.number("ra", o.decayA, 1e-6, 10.0);
-  o.decayB = r.number("rb", o.decayB, 1e-6, 10.0);
-  o.baseA = r.number("ba", o.baseA, 0.0, 10.0);
-  o.baseB = r.number("bb", o.baseB, 0.0, 10.0);
-  o.saturation = r.number("saturation", o.saturation, 0.0, 100.0);
-  o.sourceNoise = r.number("noise", o.sourceNoise, 0.0, 1.0);
-  o.seed = static_cast<uint64_t>(r.integer("seed", static_cast<int64_t>(o.seed), 0));
-  t.pigmentColor = r.color("color", t.pigmentColor);
-  t.pigmentStrength = num(r, "strength", t.pigmentStrength, 0.0, 1.0);
+  o.cells = static_cast<int>(r.integer({"cells", "Cells around the growing edge (periodic): the pattern's resolution across the whorl."}, o.cells, 3, 4096));
+  o.rows = static_cast<int>(r.integer({"rows", "Rows of the pattern (moments of growth), spanning the fully grown shell's θ range."}, o.rows, 1, 8192));
+  o.stepsPerRow = static_cast<int>(r.integer({"steps_per_row", "Integration steps between two output rows."}, o.stepsPerRow, 1, 1000));
+  o.warmupRows = static_cast<int>(r.integer({"warmup", "Rows simulated before the output starts (the larval shell)."}, o.warmupRows, 0, 10000));
+  o.dt = r.number({"dt", "Time step of the explicit integration; dt × max(da, db) must stay below 0.5."}, o.dt, 1e-4, 10.0);
+  o.diffusionA = r.number({"da", "Dₐ, diffusion of the activator (cells²/time)."}, o.diffusionA, 0.0, 10.0);
+  o.diffusionB = r.number({"db", "D_b, diffusion of the inhibitor (cells²/time)."}, o.diffusionB, 0.0, 10.0);
+  o.decayA = r.number({"ra", "rₐ, decay rate of the activator."}, o.decayA, 1e-6, 10.0);
+  o.decayB = r.number({"rb", "r_b, decay rate of the inhibitor (below `ra`: travelling waves, oblique lines)."}, o.decayB, 1e-6, 10.0);
+  o.baseA = r.number({"ba", "bₐ, basic production of the activator."}, o.baseA, 0.0, 10.0);
+  o.baseB = r.number({"bb", "b_b, basic production of the inhibitor."}, o.baseB, 0.0, 10.0);
+  o.saturation = r.number({"saturation", "κ, saturation of the activator production (Meinhardt Eq. 2.5; 0 = none)."}, o.saturation, 0.0, 100.0);
+  o.sourceNoise = r.number({"noise", "Relative fluctuation of the source density s from cell to cell, uniform in ± this."}, o.sourceNoise, 0.0, 1.0);
+  o.seed = static_cast<uint64_t>(r.integer({"seed", "Seed of the source density's fluctuation."}, static_cast<int64_t>(o.seed), 0));
+  t.pigmentColor = r.color({"color", "Colour where the activator is high."}, t.pigmentColor);
+  t.pigmentStrength = num(r, {"strength", "How strongly the pattern mixes `color` into the whorl (0 = not at all)."}, t.pigmentStrength, 0.0, 1.0);
   if (o.dt * std::max(o.diffusionA, o.diffusionB) >= 0.5)
     sec->error(diags, "pigment: dt * max(da, db) must stay below 0.5 (explicit integration is unstable)");
   r.finish();
@@ -329,7 +329,7 @@ std::optional<ShellSpec> readShellSection(const YNode& section, DiagnosticList& 
   p.surfacesPerSection = static_cast<int>(top.integer({"surfaces_per_section", "Generating surfaces per section (Δθ = section_angle / this)."}, p.surfacesPerSection, 1, 1000));
   p.startDeg = top.number({"start", "Angle θ of the first generating surface, in degrees."}, p.startDeg, -36000.0, 36000.0);
   if (top.has("age")) p.ageDeg = top.number({"age", "θ_end, the angle of the last generating surface, in degrees (default: whorls × whorl_angle)."}, p.whorls * p.whorlDeg, 0.0, 40 * 3600.0);
-  for (const YNode& st : top.sequence("stages"))
+  for (const YNode& st : top.sequence({"stages", "Ages θ_end of a growth sequence in degrees, for the gallery's strip and `sprig animate` (default: evenly spaced ages up to `age`)."}))
     if (auto v = st.asNumber(diags, "'stages' entry", 0.0, 40 * 3600.0)) s.stages.push_back(*v);
   p.seed = static_cast<uint64_t>(top.integer({"seed", "Seed of the bumps and of the axial spines' bends."}, static_cast<int64_t>(p.seed), 0));
   p.controlledBlending = top.boolean({"controlled_blending", "Blend each section only with its neighbours (Eq. 10; false: every section with every other, whorls fuse)."}, p.controlledBlending);

@@ -53,6 +53,33 @@ const std::vector<std::string> kFields = {"surface_mesh", "sphere",    "box",   
                                           "transform",    "from_volume_surface", "extrude_2d", "species"};
 const std::vector<std::string> kLayers = {"interior_layer", "exterior_layer"};
 
+/// What the key `velocity` of a volume or a surface_mesh field does.
+constexpr const char* kVelocityHelp =
+    "Interface velocity (§2.4): a number, an expression of x, y, z, noise and turbulence, `{expression, noise, max}` or `{painted: ...}`; a layer is v times as thick where the speed is v (default: 1).";
+
+/// What each one-key alternative of a solid is (`sprig schema`'s text for its key).
+std::string_view alternativeHelp(std::string_view kind) {
+  static const std::map<std::string_view, std::string_view> kHelp = {
+      {"volume", "One layered volume: a `distance_field`, its `layers` and an optional `velocity`."},
+      {"precedence", "Volumes by precedence (§2.3): a list of `{volume: ...}` or `{precedence: [...]}`; the first claims its space, each next fills only what is still unclaimed."},
+      {"interior_layer", "A layer stacked inward from the volume's surface, in the order written."},
+      {"exterior_layer", "A layer stacked outward from the volume's surface, in the order written."},
+      {"surface_mesh", "The signed distance to a closed mesh file (OBJ, PLY or OFF)."},
+      {"sphere", "The exact distance to a sphere."},
+      {"box", "The exact distance to a box."},
+      {"cylinder", "The exact distance to a capped cylinder."},
+      {"ground_plane", "The half-space below n·p = height; unbounded, so give `grid.bounds`."},
+      {"union", "Union of a list of distance fields: their minimum."},
+      {"intersection", "Intersection of a list of distance fields: their maximum."},
+      {"subtraction", "[a, b]: a minus b, max(a, −b)."},
+      {"transform", "A field scaled, rotated and moved: d(p) = s·child(R⁻¹(p − t)/s), still Euclidean."},
+      {"from_volume_surface", "The outermost interface of a volume or precedence list as a new field (§2.3, Fig. 2c); the inner volumes are part of the solid."},
+      {"extrude_2d", "The paper's 2D_EXTRUDE (§5.2): the dark pixels of an image, extruded along `axis` between two heights."},
+      {"species", "A Sprig blob, shell, tree or organism species as a field: its final stage meshed as `sprig mesh` does, then its signed distance."}};
+  auto it = kHelp.find(kind);
+  return it == kHelp.end() ? std::string_view() : it->second;
+}
+
 
 /// Reads the solid section; every error goes to diags.
 class SolidReader {
@@ -89,9 +116,9 @@ class SolidReader {
     if (std::optional<YNode> improve = m.section({"improve", "Quality improvement by flips, collapses and smoothing (§4.4): `quality_below`, `tolerance`, `target_tetrahedra`."})) {
       MapReader r(*improve, diags_, "improve");
       solids::ImproveOptions& o = spec_.improve.emplace();
-      o.qualityBelow = double(r.integer("quality_below", 10, 1, 10));
-      toleranceCells = r.number("tolerance", 0, 0, 0.5);
-      o.targetCount = size_t(r.integer("target_tetrahedra", 0, 0, 1000000000));
+      o.qualityBelow = double(r.integer({"quality_below", "The last quality threshold of the paper's loop (q = 1, 2, ... up to this)."}, 10, 1, 10));
+      toleranceCells = r.number({"tolerance", "How far a collapse may move an interface, in cells (0: only where it is flat, so every material keeps its volume)."}, 0, 0, 0.5);
+      o.targetCount = size_t(r.integer({"target_tetrahedra", "The count whose share of the volume is the ideal tetrahedron volume (0 = the count after meshing)."}, 0, 0, 1000000000));
       r.finish();
     }
     if (auto ops = m.get({"operations", "Simulation tools applied in order after meshing: `hammer`, `displace`, `polish`, `dirt`, `wash`, `erode`, `lichen`."})) spec_.operations = readSolidOperations(*ops, spec_.solid.materials, diags_);
@@ -108,19 +135,19 @@ class SolidReader {
   void readConcrete(const std::string& name, const YNode& value) {
     MapReader m(value, diags_, "material " + sprig::quoted(name));
     Material mat;
-    if (auto b = m.get("base")) {
+    if (auto b = m.get({"base", "A built-in material to start from (its values, then the keys below override them)."})) {
       const std::string base = b->scalar();
       if (const Material* bm = findBuiltinMaterial(base)) mat = *bm;
       else b->error(diags_, "unknown built-in material " + sprig::quoted(base) + didYouMean(base, builtinNames()));
     }
     mat.name = name;
-    mat.color = m.color("color", mat.color);
-    mat.roughness = float(m.number("roughness", mat.roughness, 0.0, 1.0));
-    mat.specular = float(m.number("specular", mat.specular, 0.0, 1.0));
-    mat.density = m.number("density", mat.density, 1e-9, 1e6);
-    mat.youngsModulus = m.number("youngs_modulus", mat.youngsModulus, 1e-9, 1e15);
-    mat.poissonRatio = m.number("poisson_ratio", mat.poissonRatio, 0.0, 0.4999);
-    mat.strength = m.number("strength", mat.strength, 1e-9, 1e15);
+    mat.color = m.color({"color", "Render colour of the material."}, mat.color);
+    mat.roughness = float(m.number({"roughness", "Render roughness, 0 to 1."}, mat.roughness, 0.0, 1.0));
+    mat.specular = float(m.number({"specular", "Render specular reflectance."}, mat.specular, 0.0, 1.0));
+    mat.density = m.number({"density", "Density, kg/m³ (one world unit is one metre)."}, mat.density, 1e-9, 1e6);
+    mat.youngsModulus = m.number({"youngs_modulus", "Young's modulus, Pa: the stiffness the simulation tools use."}, mat.youngsModulus, 1e-9, 1e15);
+    mat.poissonRatio = m.number({"poisson_ratio", "Poisson's ratio, in [0, 0.5)."}, mat.poissonRatio, 0.0, 0.4999);
+    mat.strength = m.number({"strength", "Tensile strength, Pa: `hammer` breaks a tetrahedron whose stress exceeds it."}, mat.strength, 1e-9, 1e15);
     m.finish();
     spec_.solid.materials.materials.push_back(mat);
     names_[name] = int(spec_.solid.materials.materials.size() - 1);
@@ -130,8 +157,8 @@ class SolidReader {
     MapReader m(value, diags_, "material " + sprig::quoted(name));
     ProceduralMaterial p;
     p.name = name;
-    std::optional<YNode> sel = m.get("select");
-    std::vector<YNode> choices = m.sequence("choices");
+    std::optional<YNode> sel = m.get({"select", "An expression of x, y, z (the grammar's expression language): its value, truncated and clamped to the list, picks among `choices`."});
+    std::vector<YNode> choices = m.sequence({"choices", "The concrete materials `select` picks among; required."});
     m.finish();
     if (choices.empty()) {
       value.error(diags_, "missing required key 'choices' in material " + sprig::quoted(name) + " (the materials 'select' indexes)");
@@ -183,7 +210,7 @@ class SolidReader {
   bool readVolumes(MapReader& m, const YNode& node, const std::string& what) {
     bool any = false;
     for (const std::string& form : kVolumeForms)
-      if (auto v = m.get(form)) {
+      if (auto v = m.get({form, alternativeHelp(form)})) {
         if (any) v->error(diags_, "a " + what + " takes one 'volume' or one 'precedence' list, not both");
         any = true;
         readVolumeForm(form, *v);
@@ -202,7 +229,10 @@ class SolidReader {
       return;
     }
     for (const YNode& item : value.items())
-      if (auto one = singleKey(item, diags_, "precedence entry", kVolumeForms)) readVolumeForm(one->first.scalar(), one->second);
+      if (auto one = singleKey(item, diags_, "precedence entry", kVolumeForms)) {
+        describeHelp(one->second, alternativeHelp(one->first.scalar()));
+        readVolumeForm(one->first.scalar(), one->second);
+      }
   }
 
   void readVolume(const YNode& value) {
@@ -216,7 +246,7 @@ class SolidReader {
       value.error(diags_, "missing required key 'distance_field' in volume");
     }
     std::optional<VelocityWrap> velocity;
-    std::optional<YNode> velocityNode = m.get("velocity");
+    std::optional<YNode> velocityNode = m.get({"velocity", kVelocityHelp});
     if (velocityNode) velocity = readVelocity(*velocityNode, diags_, nullptr, false);
     std::vector<Layer> layers;
     std::vector<std::optional<YNode>> layerVelocity;
@@ -293,11 +323,12 @@ class SolidReader {
   std::optional<Layer> readLayer(const YNode& item, std::optional<YNode>* velocity) {
     auto one = singleKey(item, diags_, "layer", kLayers);
     if (!one) return std::nullopt;
+    describeHelp(one->second, alternativeHelp(one->first.scalar()));
     Layer l;
     l.interior = one->first.scalar() == "interior_layer";
     MapReader m(one->second, diags_, one->first.scalar());
     const size_t errors = errorCount();
-    *velocity = m.get("velocity");
+    *velocity = m.get({"velocity", "An exterior layer's own interface velocity (§2.4, LUMPY_CANDY): it starts a volume wrapping the ones before it (an error on an interior layer); forms as the volume's `velocity`."});
     m.markRequired("material");
     if (auto mat = m.get({"material", "The layer's material: one of the file's `materials:`, a built-in material, or `nothing` (air that claims its space)."})) l.material = materialId(*mat);
     else one->second.error(diags_, "missing required key 'material' in " + one->first.scalar() + " (a material name or nothing)");
@@ -321,6 +352,7 @@ class SolidReader {
     if (!one) return nullptr;
     const std::string kind = one->first.scalar();
     const YNode& value = one->second;
+    describeHelp(value, alternativeHelp(kind));
     if (kind == "from_volume_surface") return readVolumeSurface(value);
     if (kind == "union" || kind == "intersection" || kind == "subtraction") {
       if (!value.isSequence() || value.items().empty()) {
@@ -344,7 +376,7 @@ class SolidReader {
       PolyMesh mesh;
       out = readMesh(m, &mesh);
       out = withOffset(m, out);
-      if (auto v = m.get("velocity")) {
+      if (auto v = m.get({"velocity", kVelocityHelp})) {
         std::optional<VelocityWrap> w = readVelocity(*v, diags_, &mesh, false, &policy_);
         out = w && out ? (*w)(out) : nullptr;
       }
@@ -352,30 +384,34 @@ class SolidReader {
       out = readSpeciesField(m, policy_);
       out = withOffset(m, out);
     } else if (kind == "sphere") {
-      out = sphereField(DVec3(m.vec3("center", Vec3(0.0f))), m.number("radius", 1.0, 1e-6, 1e6));
+      out = sphereField(DVec3(m.vec3({"center", "Centre of the sphere."}, Vec3(0.0f))),
+                        m.number({"radius", "Radius of the sphere, world units."}, 1.0, 1e-6, 1e6));
     } else if (kind == "box") {
-      out = boxField(DVec3(m.vec3("center", Vec3(0.0f))), DVec3(m.vec3("size", Vec3(1.0f), 1e-6, 1e6)));
+      out = boxField(DVec3(m.vec3({"center", "Centre of the box."}, Vec3(0.0f))),
+                     DVec3(m.vec3({"size", "Edge lengths of the box along x, y and z, world units."}, Vec3(1.0f), 1e-6, 1e6)));
     } else if (kind == "cylinder") {
-      const Vec3 c = m.vec3("center", Vec3(0.0f));
-      const double r = m.number("radius", 0.5, 1e-6, 1e6), h = m.number("height", 1.0, 1e-6, 1e6);
-      out = cylinderField(DVec3(c), r, h, DVec3(axisOf(m, "axis")));
+      const Vec3 c = m.vec3({"center", "Centre of the cylinder (the middle of its axis)."}, Vec3(0.0f));
+      const double r = m.number({"radius", "Radius of the cylinder, world units."}, 0.5, 1e-6, 1e6),
+                   h = m.number({"height", "Height of the cylinder along its axis, world units."}, 1.0, 1e-6, 1e6);
+      out = cylinderField(DVec3(c), r, h, DVec3(axisOf(m, {"axis", "Direction of the cylinder's axis (not zero)."})));
     } else if (kind == "ground_plane") {
-      out = groundPlaneField(DVec3(axisOf(m, "normal")), m.number("height", 0.0));
+      out = groundPlaneField(DVec3(axisOf(m, {"normal", "Normal n of the plane, pointing out of the ground (not zero)."})),
+                             m.number({"height", "The plane is n·p = height; the ground lies below it."}, 0.0));
     } else if (kind == "transform") {
       FieldPtr child;
       m.markRequired("distance_field");
-      if (auto f = m.get("distance_field")) child = readField(*f);
+      if (auto f = m.get({"distance_field", "The distance field transformed."})) child = readField(*f);
       else value.error(diags_, "missing required key 'distance_field' in transform");
-      const double scale = m.number("scale", 1.0, 1e-6, 1e6);
+      const double scale = m.number({"scale", "Uniform scale s, applied first (the paper's scaling)."}, 1.0, 1e-6, 1e6);
       Vec3 axis(0, 1, 0);
       double angle = 0;
-      if (auto r = m.section("rotate")) {
+      if (auto r = m.section({"rotate", "Rotation `{axis, angle_deg}` about the origin, after the scale."})) {
         MapReader rm(*r, diags_, "rotate");
-        axis = axisOf(rm, "axis");
-        angle = rm.number("angle_deg", 0.0, -360.0, 360.0);
+        axis = axisOf(rm, {"axis", "Axis of the rotation (not zero)."});
+        angle = rm.number({"angle_deg", "Angle of the rotation, in degrees."}, 0.0, -360.0, 360.0);
         rm.finish();
       }
-      const Vec3 t = m.vec3("translate", Vec3(0.0f));
+      const Vec3 t = m.vec3({"translate", "Translation, applied last, world units."}, Vec3(0.0f));
       if (child) out = transformField(child, scale, DVec3(axis), angle, DVec3(t));
     } else if (kind == "extrude_2d") {
       out = readExtrude(m);
@@ -387,15 +423,15 @@ class SolidReader {
   /// A mesh field grown by its `offset` (world units, >= 0; 0: as it is), so walls thinner
   /// than the grid's cells survive meshing (docs/SOLIDS.md).
   FieldPtr withOffset(MapReader& m, FieldPtr field) {
-    const double by = m.number("offset", 0.0, 0.0, 1e6);
+    const double by = m.number({"offset", "Grow the solid by this distance before meshing, world units: walls thinner than a cell survive (0 = as it is)."}, 0.0, 0.0, 1e6);
     return field && by > 0 ? offsetField(std::move(field), by) : field;
   }
 
   /// A unit direction at key (default +y); zero is an error.
-  Vec3 axisOf(MapReader& m, const char* key) {
+  Vec3 axisOf(MapReader& m, Key key) {
     const Vec3 a = m.vec3(key, Vec3(0, 1, 0));
     if (glm::length(a) == 0) {
-      m.get(key)->error(diags_, sprig::quoted(key) + " must not be zero");
+      m.get(key)->error(diags_, sprig::quoted(key.name) + " must not be zero");
       return Vec3(0, 1, 0);
     }
     return glm::normalize(a);
@@ -408,7 +444,7 @@ class SolidReader {
     const size_t first = spec_.solid.volumes.size();
     const bool any = readVolumes(m, value, "from_volume_surface");
     std::optional<VelocityWrap> velocity;
-    std::optional<YNode> vn = m.get("velocity");
+    std::optional<YNode> vn = m.get({"velocity", "Speed of the front that measures the wrapped volumes' outer surface again as a distance (arrival time); forms as a volume's `velocity` (default: 1)."});
     if (vn) velocity = readVelocity(*vn, diags_, nullptr, true);
     m.finish();
     if (!any || spec_.solid.volumes.size() == first || (vn && !velocity)) return nullptr;
@@ -420,7 +456,7 @@ class SolidReader {
   /// A closed mesh file as a field; the first open edge is an error at its face.
   FieldPtr readMesh(MapReader& m, PolyMesh* keep = nullptr) {
     m.markRequired("file");
-    auto file = m.path("file", policy_);
+    auto file = m.path({"file", "A closed mesh file (OBJ, PLY or OFF), relative to the species file; required."}, policy_);
     if (!file) {
       if (!m.has("file")) m.node().error(diags_, "missing required key 'file' in surface_mesh (an OBJ, PLY or OFF file)");
       return nullptr;
@@ -459,10 +495,11 @@ class SolidReader {
     double cell = 0;
     if (gridNode) {
       MapReader gm(*gridNode, diags_, "grid");
-      cell = gm.number("cell", 0.0, 1e-6, 1e6);
-      if (auto b = gm.section("bounds")) {
+      cell = gm.number({"cell", "Edge of the cubic cells, world units (default: min(largest side / 64, thinnest layer / 2), at least largest side / 200)."}, 0.0, 1e-6, 1e6);
+      if (auto b = gm.section({"bounds", "The box meshed: `{min: [x, y, z], max: [x, y, z]}` (default: every volume's box and outermost layer, plus a cell)."})) {
         MapReader bm(*b, diags_, "bounds");
-        const Vec3 lo = bm.vec3("min", Vec3(-1.0f)), hi = bm.vec3("max", Vec3(1.0f));
+        const Vec3 lo = bm.vec3({"min", "Lowest corner of the box meshed."}, Vec3(-1.0f)),
+                   hi = bm.vec3({"max", "Highest corner of the box meshed."}, Vec3(1.0f));
         bm.finish();
         if (!(lo.x < hi.x && lo.y < hi.y && lo.z < hi.z)) b->error(diags_, "'bounds' needs min < max on every axis");
         box = DBox3{DVec3(lo), DVec3(hi)};
@@ -537,15 +574,15 @@ class SolidReader {
 
   // ---- extrude_2d ----
   /// `[a, b]` of finite numbers at key (def when absent; after an error too).
-  glm::dvec2 pairOf(MapReader& m, const char* key, glm::dvec2 def) {
+  glm::dvec2 pairOf(MapReader& m, Key key, glm::dvec2 def) {
     std::optional<YNode> v = m.get(key);
     if (!v) return def;
     const std::vector<YNode> items = v->items();
     if (!v->isSequence() || items.size() != 2) {
-      v->error(diags_, sprig::quoted(key) + " must be [a, b]");
+      v->error(diags_, sprig::quoted(key.name) + " must be [a, b]");
       return def;
     }
-    auto a = items[0].asNumber(diags_, sprig::quoted(key)), b = items[1].asNumber(diags_, sprig::quoted(key));
+    auto a = items[0].asNumber(diags_, sprig::quoted(key.name)), b = items[1].asNumber(diags_, sprig::quoted(key.name));
     return a && b ? glm::dvec2(*a, *b) : def;
   }
 
@@ -554,17 +591,17 @@ class SolidReader {
   /// luminance: 0 black, 1 white) form the region; solids/extrude_field.h places and extrudes it.
   FieldPtr readExtrude(MapReader& m) {
     m.markRequired("file");
-    auto file = m.path("file", policy_);
+    auto file = m.path({"file", "The image (PNG, PPM/PGM or any format OpenImageIO reads, at most 2048 × 2048), relative to the species file; required."}, policy_);
     if (!file && !m.has("file"))
       m.node().error(diags_, "missing required key 'file' in extrude_2d (a PNG or PPM image; dark pixels are inside)");
     ExtrudeOptions o;
-    o.size = pairOf(m, "size", glm::dvec2(1.0));
-    o.center = pairOf(m, "center", glm::dvec2(0.0));
-    o.axis = DVec3(axisOf(m, "axis"));
-    const glm::dvec2 h = pairOf(m, "height", glm::dvec2(0.0, 1.0));
+    o.size = pairOf(m, {"size", "[along columns, along rows]: the image's size in world units (default [1, 1])."}, glm::dvec2(1.0));
+    o.center = pairOf(m, {"center", "Plane coordinates of the image's centre (default [0, 0])."}, glm::dvec2(0.0));
+    o.axis = DVec3(axisOf(m, {"axis", "Extrusion axis; the image lies on the plane across it (for y: columns along +x, rows along +z)."}));
+    const glm::dvec2 h = pairOf(m, {"height", "[lo, hi]: the extrusion's extent along the axis, lo < hi (default [0, 1])."}, glm::dvec2(0.0, 1.0));
     o.heightLo = h.x;
     o.heightHi = h.y;
-    const double threshold = m.number("threshold", 0.5, 0.0, 1.0);
+    const double threshold = m.number({"threshold", "Pixels darker than this (sRGB-encoded luminance: 0 black, 1 white) are the region."}, 0.5, 0.0, 1.0);
     if (!(o.size.x > 0 && o.size.y > 0)) m.get("size")->error(diags_, "'size' must be positive, world units [along columns, along rows]");
     if (!(o.heightHi > o.heightLo)) m.get("height")->error(diags_, "'height' must be [lo, hi] with lo < hi");
     if (!file || !(o.size.x > 0 && o.size.y > 0) || !(o.heightHi > o.heightLo)) return nullptr;

@@ -178,14 +178,14 @@ std::optional<VelocityWrap> readExpression(const YNode& exprNode, const std::str
   uint64_t seed = 0;
   std::optional<double> max;
   if (m) {
-    if (auto nz = m->section("noise")) {
+    if (auto nz = m->section({"noise", "The noise the expression's `noise` and `turbulence` read: `scale`, `octaves`, `seed`."})) {
       MapReader nm(*nz, diags, "noise");
-      speed->scale = nm.number("scale", 1.0, 1e-6, 1e6);
-      speed->octaves.octaves = int(nm.integer("octaves", 4, 1, 12));
-      seed = uint64_t(nm.integer("seed", 0, 0, int64_t(1) << 53));
+      speed->scale = nm.number({"scale", "World units per noise lattice cell."}, 1.0, 1e-6, 1e6);
+      speed->octaves.octaves = int(nm.integer({"octaves", "Octaves of the turbulence."}, 4, 1, 12));
+      seed = uint64_t(nm.integer({"seed", "Seed of the noise."}, 0, 0, int64_t(1) << 53));
       nm.finish();
     }
-    if (auto mx = m->get("max")) max = mx->asNumber(diags, "'max'", double(solids::kMinSpeed), 1e6);
+    if (auto mx = m->get({"max", "The largest speed (default: probed over the field's box; required when the field is unbounded)."})) max = mx->asNumber(diags, "'max'", double(solids::kMinSpeed), 1e6);
   }
   speed->noise = std::make_shared<textures::PerlinNoise>(seed);
   const YNode where = exprNode;
@@ -226,15 +226,15 @@ std::optional<VelocityWrap> readExpression(const YNode& exprNode, const std::str
 }
 
 /// `[u, v]` of two finite numbers at key, or def.
-std::optional<glm::dvec2> pairAt(MapReader& m, const char* key, glm::dvec2 def, DiagnosticList& diags) {
+std::optional<glm::dvec2> pairAt(MapReader& m, Key key, glm::dvec2 def, DiagnosticList& diags) {
   auto n = m.get(key);
   if (!n) return def;
   const std::vector<YNode> items = n->isSequence() ? n->items() : std::vector<YNode>{};
   if (items.size() != 2) {
-    n->error(diags, sprig::quoted(key) + " must be [u, v]");
+    n->error(diags, sprig::quoted(key.name) + " must be [u, v]");
     return std::nullopt;
   }
-  auto a = items[0].asNumber(diags, sprig::quoted(key)), b = items[1].asNumber(diags, sprig::quoted(key));
+  auto a = items[0].asNumber(diags, sprig::quoted(key.name)), b = items[1].asNumber(diags, sprig::quoted(key.name));
   if (!a || !b) return std::nullopt;
   return glm::dvec2(*a, *b);
 }
@@ -244,11 +244,12 @@ std::function<float(const Vec3&)> readImagePaint(const YNode& node, DiagnosticLi
                                                  double high, const PathPolicy* policy) {
   MapReader m(node, diags, "image");
   std::optional<std::filesystem::path> file;
-  if (policy) file = m.path("file", *policy);
-  else m.get("file");
+  const Key fileKey{"file", "The paint image (PNG, JPEG, EXR; at most 8192 × 8192), relative to the species file; its linear luminance is the paint; required."};
+  if (policy) file = m.path(fileKey, *policy);
+  else m.get(fileKey);
   m.markRequired("file");
   if (!m.has("file")) node.error(diags, "missing required key 'file' in image (a PNG or EXR map; its luminance is the paint)");
-  Vec3 axisIn = m.vec3("axis", Vec3(0, 1, 0));
+  Vec3 axisIn = m.vec3({"axis", "The image lies on the plane across this axis and is projected along it onto the surface (not zero)."}, Vec3(0, 1, 0));
   if (glm::length(axisIn) == 0) {
     m.get("axis")->error(diags, "'axis' must not be zero");
     axisIn = Vec3(0, 1, 0);
@@ -260,8 +261,10 @@ std::function<float(const Vec3&)> readImagePaint(const YNode& node, DiagnosticLi
     const glm::dvec2 q(glm::dot(DVec3(p), u), glm::dot(DVec3(p), v));
     lo = glm::min(lo, q), hi = glm::max(hi, q);
   }
-  const std::optional<glm::dvec2> size = pairAt(m, "size", glm::max(hi - lo, glm::dvec2(1e-6)), diags);
-  const std::optional<glm::dvec2> center = pairAt(m, "center", (lo + hi) / 2.0, diags);
+  const std::optional<glm::dvec2> size =
+      pairAt(m, {"size", "[u, v]: the image's size in world units (default: the mesh's extent on the plane)."}, glm::max(hi - lo, glm::dvec2(1e-6)), diags);
+  const std::optional<glm::dvec2> center =
+      pairAt(m, {"center", "[u, v]: plane coordinates of the image's centre (default: the middle of the mesh's extent)."}, (lo + hi) / 2.0, diags);
   m.finish();
   if (size && !(size->x > 0 && size->y > 0)) {
     m.get("size")->error(diags, "'size' must be positive, world units [along columns, along rows]");
@@ -311,13 +314,13 @@ std::optional<VelocityWrap> readVelocity(const YNode& node, DiagnosticList& diag
   }
   MapReader m(node, diags, "velocity");
   std::optional<VelocityWrap> out;
-  if (auto e = m.get("expression")) {
+  if (auto e = m.get({"expression", "The speed as an expression of x, y, z, noise and turbulence (the grammar's expression language, degrees)."})) {
     if (auto text = e->asString(diags, "'expression'")) out = readExpression(*e, *text, &m, diags);
-  } else if (auto p = m.section("painted")) {
+  } else if (auto p = m.section({"painted", "`surface_mesh` only: speed low + (high − low)·luminance of the mesh's vertex colours, or of an `image` map."})) {
     MapReader pm(*p, diags, "painted");
-    const double low = pm.number("low", 1.0, double(solids::kMinSpeed), 1e6);
-    const double high = pm.number("high", 2.0, double(solids::kMinSpeed), 1e6);
-    std::optional<YNode> imageNode = pm.section("image");
+    const double low = pm.number({"low", "Speed where the paint is black."}, 1.0, double(solids::kMinSpeed), 1e6);
+    const double high = pm.number({"high", "Speed where the paint is white."}, 2.0, double(solids::kMinSpeed), 1e6);
+    std::optional<YNode> imageNode = pm.section({"image", "The paint from an image map laid on a plane: `file`, `axis`, `size`, `center` (default: the mesh's vertex colours)."});
     pm.finish();
     std::function<float(const Vec3&)> paint;
     if (!mesh) {

@@ -132,9 +132,9 @@ ReferencedSpecies referencedSpecies(const YNode& at, const std::filesystem::path
 solids::FieldPtr readSpeciesField(MapReader& m, const PathPolicy& policy) {
   DiagnosticList& diags = m.diagnostics();
   std::optional<int64_t> seed;
-  if (m.has("seed")) seed = m.integer("seed", 0, 0);
+  if (m.has("seed")) seed = m.integer({"seed", "Trees only: replaces the derivation seed, as `sprig mesh --seed` (default: the tree's own)."}, 0, 0);
   m.markRequired("file");
-  auto file = m.path("file", policy);
+  auto file = m.path({"file", "A blob, shell, tree or organism species file, relative to this one; required."}, policy);
   if (!file) {
     if (!m.has("file")) m.node().error(diags, "missing required key 'file' in species (a blob, shell, tree or organism species file)");
     return nullptr;

@@ -31,10 +31,10 @@ using organisms::BranchSelector;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 
-std::vector<int> readInts(MapReader& m, std::string_view key, int64_t min, int64_t max) {
+std::vector<int> readInts(MapReader& m, Key key, int64_t min, int64_t max) {
   std::vector<int> out;
   std::string what("'");
-  what.append(key).append("' element");
+  what.append(key.name).append("' element");
   for (const YNode& item : m.sequence(key))
     if (auto v = item.asInteger(m.diagnostics(), what, min, max))
       out.push_back(static_cast<int>(*v));
@@ -42,8 +42,8 @@ std::vector<int> readInts(MapReader& m, std::string_view key, int64_t min, int64
 }
 
 void readSelector(MapReader& m, BranchSelector& s) {
-  if (m.has("orders")) s.orders = readInts(m, "orders", 0, 1000);
-  if (m.has("internodes")) s.internodes = readInts(m, "internodes", 0, std::numeric_limits<int32_t>::max());
+  if (m.has("orders")) s.orders = readInts(m, {"orders", "Branch orders among which `probability` selects, e.g. [1, 2] (default: every order)."}, 0, 1000);
+  if (m.has("internodes")) s.internodes = readInts(m, {"internodes", "Skeleton indices of internodes always selected (figure files, tests; default none)."}, 0, std::numeric_limits<int32_t>::max());
   s.belowHeight = m.number({"below_height", "Select branches whose base lies below this height (world units)."}, s.belowHeight);
   s.aboveHeight = m.number({"above_height", "Select branches whose base lies above this height (world units)."}, s.aboveHeight);
   s.probability = m.number({"probability", "Select each branch with this probability, seeded per internode (0 = only the listed `internodes`)."}, s.probability, 0.0, 1.0);

@@ -799,10 +799,13 @@ std::optional<YNode> MapReader::keyNode(std::string_view key) const {
   return entries_[it->second].key;
 }
 
-void MapReader::allow(std::initializer_list<std::string_view> keys) {
-  for (auto k : keys) {
-    known_.emplace(k);
-    if (schema_) schema_->property(std::string(k));
+void MapReader::allow(std::initializer_list<Key> keys) {
+  for (const Key& k : keys) {
+    known_.emplace(k.name);
+    if (schema_) {
+      detail::KeySchema& p = schema_->property(std::string(k.name));
+      if (p.help.empty()) p.help = k.help;
+    }
   }
 }
 
@@ -976,6 +979,11 @@ void describeValue(const YNode& node, std::optional<double> above, const std::ve
     for (const auto& w : words)
       if (std::find(s->words.begin(), s->words.end(), w) == s->words.end()) s->words.push_back(w);
   }
+}
+
+void describeHelp(const YNode& value, std::string_view help) {
+  if (detail::KeySchema* s = describing(value.node()))
+    if (s->help.empty()) s->help = help;
 }
 
 std::optional<std::pair<YNode, YNode>> singleKey(const YNode& node, DiagnosticList& diags, const std::string& what,

@@ -234,8 +234,9 @@ class MapReader {
   std::optional<YNode> get(Key key);
   /// The key node of `key` (for locations of the key itself).
   std::optional<YNode> keyNode(std::string_view key) const;
-  /// Marks keys as known without reading them (keys another reader handles).
-  void allow(std::initializer_list<std::string_view> keys);
+  /// Marks keys as known without reading them (keys another reader handles, or reads only
+  /// in some cases: a Key's help then still reaches `sprig schema`).
+  void allow(std::initializer_list<Key> keys);
 
   /// A finite real number within [min, max]; `def` when absent.
   double number(Key key, double def, double min = -std::numeric_limits<double>::infinity(),
@@ -299,6 +300,12 @@ std::optional<std::pair<YNode, YNode>> describeOneKey(const YNode& node, const s
 /// than through a typed read's range: the number at node must be above `above` (exclusive),
 /// and `words` are the only texts it takes (`thickness: fill`). No effect when reading.
 void describeValue(const YNode& node, std::optional<double> above, const std::vector<std::string>& words = {});
+
+/// Describe mode (`sprig schema`) only: what the key holding `value` does, for a key no
+/// MapReader getter reads and so no `Key` names: a one-key map's alternative (`{cone: {...}}`
+/// from singleKey or describeOneKey). Call it on the alternative's value where the reader
+/// takes that alternative; the first text given for a position stays. No effect when reading.
+void describeHelp(const YNode& value, std::string_view help);
 
 /// A map with exactly one key among names (`{sphere: {...}}`): that key and its value.
 /// Otherwise adds "WHAT must be a map with one key, one of: A, B" or "unknown WHAT 'K' (did

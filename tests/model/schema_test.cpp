@@ -4,7 +4,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <string>
+#include <vector>
 
 #include "model/schema.h"
 #include "model/yaml_reader.h"
@@ -38,9 +40,17 @@ TEST_CASE("speciesSchemaJson", "[model]") {
     CHECK(steps.find("Derivation steps (default: the grammar's `derivation length:`") != std::string::npos);
     CHECK(steps.find("steps: an integer in [0, 100000]\"") != std::string::npos);
     CHECK(steps.find("\"default\"") == std::string::npos);
-    // A key without a text keeps the generated part alone.
-    CHECK(propertyLine(schema, "cells").find("\"description\": \"shell.pigment.cells: an integer in [3, 4096]; "
-                                            "default 160\"") != std::string::npos);
+    // A pigment key: its text, then the generated part.
+    CHECK(propertyLine(schema, "cells").find("\"description\": \"Cells around the growing edge (periodic): the "
+                                            "pattern's resolution across the whorl.\\n\\nshell.pigment.cells: an "
+                                            "integer in [3, 4096]; default 160\"") != std::string::npos);
+    // A one-key alternative (a blob node's kind, a distance field, a tool) says what it is.
+    CHECK(propertyLine(schema, "cone").find("\"description\": \"Cone primitive (the tree paper's internode") !=
+          std::string::npos);
+    CHECK(propertyLine(schema, "hammer").find("\"description\": \"A blow (§3.1)") != std::string::npos);
+    // A position holding a shared definition keeps its text beside the `$ref`.
+    CHECK(propertyLine(schema, "child").find("\"description\": \"The blob node it acts on.\\n\\n") !=
+          std::string::npos);
     // The one-line help of a shell part's key.
     CHECK(propertyLine(schema, "spacing").find("\"description\": \"Angle between successive varices") !=
           std::string::npos);
@@ -59,6 +69,31 @@ TEST_CASE("speciesSchemaJson", "[model]") {
       REQUIRE(!line.empty());
       CHECK(line.compare(0, generatedOnly.size(), generatedOnly) != 0);  // a text comes first
     }
+  }
+
+  SECTION("every key says what it does") {
+    // Each property sits on a line of its own, indented 6 or more (the kinds' and the shared
+    // parts' definitions sit at 4): `"key": {"description": "HELP\n\nplace: type; default"`.
+    // A key whose reader gives no help has the generated part alone, without the blank line.
+    std::vector<std::string> without;
+    int keys = 0;
+    size_t at = 0;
+    while (at < schema.size()) {
+      const size_t end = std::min(schema.find('\n', at), schema.size());
+      const std::string line = schema.substr(at, end - at);
+      at = end + 1;
+      const size_t indent = line.find_first_not_of(' ');
+      const size_t open = line.find("\": {\"description\": \"");
+      if (indent == std::string::npos || indent < 6 || line[indent] != '"' || open == std::string::npos) continue;
+      ++keys;
+      const size_t text = open + 20;
+      const std::string description = line.substr(text, line.find("\", \"", text) - text);
+      if (description.find("\\n\\n") == std::string::npos) without.push_back(description);
+    }
+    CHECK(keys > 900);
+    INFO("keys without help: " << without.size());
+    for (const std::string& d : without) UNSCOPED_INFO(d);
+    CHECK(without.empty());
   }
 
   SECTION("a colour is a pattern or a triple, each with a readable message") {
