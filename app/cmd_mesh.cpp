@@ -177,8 +177,7 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
   if (!a.mesher.empty()) species.render.dualMesher = a.mesher == "dual";
   SpeciesModel model(species, a.growth.overrides());
   const Stage stage = a.stage.resolve(model);
-  auto windSource = anyGlb && !a.interfaces && !volume ? model.windSource(stage) : std::nullopt;
-  if (!a.wind.empty() && !windSource) throw UsageError("--wind sways trees; " + speciesOfKind(species.kind) + " has no wind");
+  if (wind && !model.windSource(stage)) throw UsageError("--wind sways trees; " + speciesOfKind(species.kind) + " has no wind");
   if (a.interfaces) {
     if (volume)
       throw UsageError("--interfaces writes triangle meshes: give -o a .ply, .obj or .glb name");
@@ -214,11 +213,8 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
     const Phase phase("levels");
     return lodLevels(std::move(parts), budget, &moved);
   }();
-  if (windSource) {
-    organisms::WindOptions& w = windSource->second;
-    if (wind) w.speed = wind->first, w.directionDeg = wind->second;
-    addWind(levels, windSource->first, w, finish.offset + moved);
-  }
+  const std::optional<organisms::WindOptions> windUsed =
+      anyGlb ? addModelWind(model, stage, levels, finish.offset + moved, wind) : std::nullopt;
   const double lodSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - lodStart).count();
   const std::vector<ExportPart>& top = levels[0].parts;  // LOD0: the file's scene
   std::vector<PartWriteReport> written;
@@ -266,7 +262,7 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
          glb ? "; the .glb holds every level (MSFT_lod); --lod none writes the full mesh alone" : "");
   }
   noteParts(top, written, glb, g);
-  if (windSource) noteWind(top, windSource->second, g);
+  if (windUsed) noteWind(top, *windUsed, g);
   return kExitOk;
 }
 

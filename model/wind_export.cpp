@@ -7,6 +7,7 @@
 #include <string>
 
 #include "core/parallel.h"
+#include "model/model.h"
 
 namespace sprig {
 
@@ -295,6 +296,16 @@ void addWind(std::vector<LodLevel>& levels, const lsystem::Skeleton& skeleton, o
         if (!m.targets.empty()) part.morph = std::make_shared<const PartMorph>(std::move(m));
       }
     }
+}
+
+std::optional<organisms::WindOptions> addModelWind(SpeciesModel& model, const Stage& stage, std::vector<LodLevel>& levels,
+                                                   const Vec3& offset, const std::optional<std::pair<double, double>>& wind) {
+  auto source = model.windSource(stage);
+  if (!source) return std::nullopt;
+  organisms::WindOptions& w = source->second;
+  if (wind) w.speed = wind->first, w.directionDeg = wind->second;
+  addWind(levels, source->first, w, offset);
+  return w;
 }
 
 }  // namespace sprig

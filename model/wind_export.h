@@ -17,6 +17,8 @@
 /// offset is what placing the parts added to its positions.
 
 #include <cstdint>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include "core/mesh_io.h"
@@ -67,5 +69,16 @@ PartMorph windMorph(const organisms::WindRig& rig, const lsystem::Skeleton& skel
 /// internodes, the others to organs. wind.loopSeconds is set to kWindLoopSeconds.
 void addWind(std::vector<LodLevel>& levels, const lsystem::Skeleton& skeleton, organisms::WindOptions wind,
              const Vec3& offset);
+
+class SpeciesModel;
+struct Stage;
+
+/// What `sprig mesh` (and the Python module's export) does for a .glb: when model's kind has
+/// wind (trees: KindModel::windSource), addWind with the stage's still skeleton and the
+/// species' wind, its speed and direction replaced by wind (m/s, degrees) when given.
+/// Returns the wind's options, or nullopt for a kind without wind (levels unchanged).
+std::optional<organisms::WindOptions> addModelWind(SpeciesModel& model, const Stage& stage, std::vector<LodLevel>& levels,
+                                                   const Vec3& offset,
+                                                   const std::optional<std::pair<double, double>>& wind = std::nullopt);
 
 }  // namespace sprig
