@@ -118,7 +118,7 @@ class KindModel {
   virtual std::vector<ExportPart> exportParts(const Stage& stage, float cellSize, bool progress, const SpeciesRender& look,
                                               const MeshCleanOptions& clean, ModelFigures& figures);
   /// Trees: the stage's still skeleton (the one exportParts builds from) and the wind's
-  /// options of the species (seed; speed and direction from its `wind`), for the wind data
+  /// options of the species (seed; speed and direction from its `render: wind`), for the wind data
   /// of a glTF export (model/wind_export.h). nullopt (the default): the kind has no wind.
   virtual std::optional<std::pair<lsystem::Skeleton, organisms::WindOptions>> windSource(const Stage&) { return std::nullopt; }
   /// The triangle budget of LOD0 when `sprig mesh` writes levels of detail by default
