@@ -35,18 +35,6 @@ struct AnimateArgs {
   GrowthFlags growth;
 };
 
-/// Parses `SPEED[,DIRECTION]`: m/s in [0, 60] and degrees (default 0).
-void parseWind(const std::string& text, double& speed, double& direction) {
-  const size_t comma = text.find(',');
-  auto s = parseFiniteNumber(text.substr(0, comma));
-  std::optional<double> d = 0.0;
-  if (comma != std::string::npos) d = parseFiniteNumber(text.substr(comma + 1));
-  if (!s || *s < 0 || *s > 60 || !d || *d < -360 || *d > 360)
-    throw UsageError("--wind " + text + ": expected SPEED[,DIRECTION] with 0 <= SPEED <= 60 (m/s) and -360 <= DIRECTION <= 360 (degrees)");
-  speed = *s;
-  direction = *d;
-}
-
 /// Parses `A..B` (either side may be empty: `..B`, `A..`) into first/last (-1 = default).
 void parseStages(const std::string& text, int& first, int& last) {
   const size_t dots = text.find("..");

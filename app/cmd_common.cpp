@@ -47,6 +47,17 @@ lsystem::GrammarOverrides commandLineOverrides(const std::vector<std::string>& d
 }
 
 /// Parses `AZ,EL` or `AZ,EL,FOV` (degrees) into view.
+void parseWind(const std::string& text, double& speed, double& direction) {
+  const size_t comma = text.find(',');
+  auto s = parseFiniteNumber(text.substr(0, comma));
+  std::optional<double> d = 0.0;
+  if (comma != std::string::npos) d = parseFiniteNumber(text.substr(comma + 1));
+  if (!s || *s < 0 || *s > 60 || !d || *d < -360 || *d > 360)
+    throw UsageError("--wind " + text + ": expected SPEED[,DIRECTION] with 0 <= SPEED <= 60 (m/s) and -360 <= DIRECTION <= 360 (degrees)");
+  speed = *s;
+  direction = *d;
+}
+
 void parseView(const std::string& text, render::ViewSpec& view) {
   std::vector<double> values;
   std::stringstream ss(text);

@@ -51,6 +51,10 @@ void addStageFlags(CLI::App& sub, StageFlags& flags);
 /// thrown as errors instead (InputError).
 void printNotes(const GlobalOptions& g, const Species& species);
 
+/// Parses `--wind SPEED[,DIRECTION]`: m/s in [0, 60] and degrees in [-360, 360] (default
+/// 0). Throws UsageError.
+void parseWind(const std::string& text, double& speed, double& direction);
+
 /// Parses `--view AZ,EL` or `AZ,EL,FOV` (degrees) into view. Throws UsageError.
 void parseView(const std::string& text, render::ViewSpec& view);
 

@@ -12,6 +12,8 @@
 #include "app/cmd_common.h"
 #include "model/lod.h"
 #include "model/mesh_parts.h"
+#include "model/kind_name.h"
+#include "model/wind_export.h"
 #include "model/model.h"
 #include "core/mesh_io.h"
 #include "core/paths.h"
@@ -31,6 +33,7 @@ struct MeshArgs {
   double minVolume = MeshCleanOptions{}.minVolumeFraction;
   std::string mesher;  ///< empty = the species' render.mesher
   double simplify = -1;  ///< < 0 = the species' render.simplify
+  std::string wind;  ///< empty = the species' wind; else SPEED[,DIRECTION]
   std::string lod = "auto";  ///< auto (the kind's LOD0 budget), none (the full mesh alone) or a budget
 };
 
@@ -132,6 +135,28 @@ void noteParts(const std::vector<ExportPart>& parts, const std::vector<PartWrite
              p.name.c_str(), k);
 }
 
+/// --wind's speed and direction (nullopt: not given, the species' wind). Throws UsageError
+/// for a malformed value, or when no output is a .glb or with --interfaces.
+std::optional<std::pair<double, double>> windFlag(const MeshArgs& a, bool anyGlb) {
+  if (a.wind.empty()) return std::nullopt;
+  double speed = 0, direction = 0;
+  parseWind(a.wind, speed, direction);
+  if (!anyGlb || a.interfaces)
+    throw UsageError("--wind writes a tree's sway into glTF: give -o a .glb name (without --interfaces)");
+  return std::make_pair(speed, direction);
+}
+
+/// The note on a tree's wind in its .glb (model/wind_export.h).
+void noteWind(const std::vector<ExportPart>& top, const organisms::WindOptions& w, const GlobalOptions& g) {
+  size_t targets = 0;
+  for (const ExportPart& p : top) targets += p.morph ? p.morph->targets.size() : 0;
+  if (w.speed > 0)
+    note(g, std::cout, "wind %g m/s toward %g degrees: _WIND on every level's vertices; LOD0 sways in the animation 'wind' "
+         "(%zu morph targets, a %g s loop at %d keyframes per second)", w.speed, w.directionDeg, targets, kWindLoopSeconds, kWindFps);
+  else
+    note(g, std::cout, "_WIND on every level's vertices (no wind: no sway animation; --wind SPEED[,DIRECTION] adds one)");
+}
+
 int runMesh(const MeshArgs& a, const GlobalOptions& g) {
   checkOutputs(a);
   const std::string& out = a.outs.front();
@@ -145,11 +170,14 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
   if (a.lod != "auto" && (a.interfaces || volume))
     throw UsageError("--lod applies to the surface parts written as .ply, .obj or .glb, not to --interfaces or volume meshes");
   lodBudget(a.lod, 0);  // a bad value fails before the build
+  const bool anyGlb = std::any_of(a.outs.begin(), a.outs.end(), [](const std::string& o) { return lowerExtension(o) == ".glb"; });
+  const std::optional<std::pair<double, double>> wind = windFlag(a, anyGlb);
   Species species = loadSpecies(a.file, g.pathPolicy());
   printNotes(g, species);
   if (!a.mesher.empty()) species.render.dualMesher = a.mesher == "dual";
   SpeciesModel model(species, a.growth.overrides());
   const Stage stage = a.stage.resolve(model);
+  if (wind && !model.windSource(stage)) throw UsageError("--wind sways trees; " + speciesOfKind(species.kind) + " has no wind");
   if (a.interfaces) {
     if (volume)
       throw UsageError("--interfaces writes triangle meshes: give -o a .ply, .obj or .glb name");
@@ -181,10 +209,12 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
   const size_t fullTriangles = partTriangles(parts);
   const auto lodStart = std::chrono::steady_clock::now();
   Vec3 moved(0.0f);  // LOD0 stood on the ground again
-  const std::vector<LodLevel> levels = [&] {
+  std::vector<LodLevel> levels = [&] {
     const Phase phase("levels");
     return lodLevels(std::move(parts), budget, &moved);
   }();
+  const std::optional<organisms::WindOptions> windUsed =
+      anyGlb ? addModelWind(model, stage, levels, finish.offset + moved, wind) : std::nullopt;
   const double lodSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - lodStart).count();
   const std::vector<ExportPart>& top = levels[0].parts;  // LOD0: the file's scene
   std::vector<PartWriteReport> written;
@@ -232,6 +262,7 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
          glb ? "; the .glb holds every level (MSFT_lod); --lod none writes the full mesh alone" : "");
   }
   noteParts(top, written, glb, g);
+  if (windUsed) noteWind(top, *windUsed, g);
   return kExitOk;
 }
 
@@ -267,6 +298,10 @@ void addMeshCommand(CLI::App& app, const GlobalOptions& global, CommandRun& run)
                   "per level; blobs and solids none), none (the full mesh alone), or LOD0's triangle budget; writes "
                   "OUT_lod1.EXT, ... beside OUT and, in .glb, every level through MSFT_lod (docs/MESHES.md)")
       ->capture_default_str();
+  sub->add_option("--wind", args->wind,
+                  "SPEED[,DIRECTION]: trees in .glb: sway LOD0 in wind of SPEED m/s blowing toward azimuth DIRECTION degrees "
+                  "(0 = toward +Z) as morph targets and a looping animation 'wind' (docs/MESHES.md \"Wind\"); default: the "
+                  "species' wind; 0 writes no animation (every tree .glb carries the _WIND vertex attribute)");
   addStageFlags(*sub, args->stage);
   addGrowthFlags(*sub, args->growth);
 }

@@ -133,7 +133,7 @@ CornerTable<Vec2> cornerUvs(const Mesh& mesh, const UvSeamOptions& options) {
   return out;
 }
 
-Mesh unweld(const Mesh& mesh, const CornerTable<Vec3>& normals, const CornerTable<Vec2>& uvs) {
+Mesh unweld(const Mesh& mesh, const CornerTable<Vec3>& normals, const CornerTable<Vec2>& uvs, std::vector<uint32_t>* origin) {
   const size_t n = mesh.positions.size(), nt = mesh.triangles.size();
   const bool hasN = !normals.index.empty(), hasUv = !uvs.index.empty();
   if ((hasN && normals.index.size() != nt * 3) || (hasUv && uvs.index.size() != nt * 3))
@@ -145,6 +145,10 @@ Mesh unweld(const Mesh& mesh, const CornerTable<Vec3>& normals, const CornerTabl
   // Per vertex: the (normal, uv) pairs seen so far and their output vertex.
   std::vector<uint32_t> firstN(n, UINT32_MAX), firstUv(n, UINT32_MAX);
   std::map<std::tuple<uint32_t, uint32_t, uint32_t>, uint32_t> extra;
+  if (origin) {
+    origin->resize(n);
+    for (size_t v = 0; v < n; ++v) (*origin)[v] = uint32_t(v);
+  }
   for (size_t t = 0; t < nt; ++t)
     for (int k = 0; k < 3; ++k) {
       const uint32_t v = mesh.triangles[t][k];
@@ -167,6 +171,7 @@ Mesh unweld(const Mesh& mesh, const CornerTable<Vec3>& normals, const CornerTabl
         if (hasUv) out.uvs.push_back(uvs.values[ui]);
         else if (out.uvs.size() + 1 == out.positions.size()) out.uvs.push_back(mesh.uvs[v]);
         if (hasC) out.colors.push_back(mesh.colors[v]);
+        if (origin) origin->push_back(v);
       }
       out.triangles[t][k] = it->second;
     }

@@ -67,7 +67,9 @@ CornerTable<Vec2> cornerUvs(const Mesh& mesh, const UvSeamOptions& options);
 /// The mesh with one vertex per distinct (vertex, corner normal, corner uv): vertex v keeps
 /// index v with the values its first corner (in triangle order) uses; other combinations
 /// are appended in triangle order, copying position and colour. An empty table leaves
-/// that array as it is. Materials are kept. O(T).
-Mesh unweld(const Mesh& mesh, const CornerTable<Vec3>& normals, const CornerTable<Vec2>& uvs);
+/// that array as it is. Materials are kept. origin, when given, receives the vertex of
+/// mesh each output vertex copies. O(T).
+Mesh unweld(const Mesh& mesh, const CornerTable<Vec3>& normals, const CornerTable<Vec2>& uvs,
+            std::vector<uint32_t>* origin = nullptr);
 
 }  // namespace sprig

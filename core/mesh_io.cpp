@@ -397,11 +397,28 @@ std::string pngBytes(const Image& image, const fs::path& near, bool alpha) {
   return readFile(temp.path());
 }
 
+// A part's vertex attributes and morph targets fit its mesh.
+void checkExtras(const ExportPart& p) {
+  const size_t n = p.mesh.positions.size();
+  for (const VertexAttribute& a : p.attributes)
+    if (a.name.empty() || a.name[0] != '_' || a.values.size() != n)
+      throw std::invalid_argument("exported part '" + p.name + "' has a vertex attribute '" + a.name +
+                                  "' that does not start with '_' or has not one value per vertex");
+  if (!p.morph) return;
+  const PartMorph& m = *p.morph;
+  bool ok = !m.targets.empty() && m.names.size() == m.targets.size() && m.weights.size() == m.targets.size() &&
+            m.times.size() >= 2 && !m.animation.empty();
+  for (size_t k = 0; ok && k < m.targets.size(); ++k) ok = m.targets[k].size() == n && m.weights[k].size() == m.times.size();
+  for (size_t f = 1; ok && f < m.times.size(); ++f) ok = m.times[f] > m.times[f - 1];
+  if (!ok) throw std::invalid_argument("exported part '" + p.name + "' has morph targets or weights that do not fit its mesh");
+}
+
 void checkParts(const std::vector<ExportPart>& parts) {
   std::vector<std::string> names;
   for (const ExportPart& p : parts) {
     validate(p.mesh);
     names.push_back(p.name);
+    checkExtras(p);
     if (const PartTexture* tex = p.material.texture.get()) {
       if (tex->isAtlas()) {
         const CornerTable<Vec2>& a = tex->atlas;
@@ -453,6 +470,13 @@ class GlbBuilder {
   }
   int addTexture(const ExportPart& part);
   int addMaterial(const ExportPart& part);
+  void addExtras(const ExportPart& part, const std::vector<uint32_t>& origin, tinygltf::Primitive& prim, tinygltf::Mesh& gm);
+  void addAnimations();
+  /// A morph target's displacements: a plain accessor, or sparse (no buffer view; the
+  /// moved vertices' indices and displacements) when fewer than 3/4 of the vertices move.
+  int addTarget(const std::vector<Vec3>& values);
+
+  std::vector<std::pair<int, const PartMorph*>> animated_;  ///< nodes with morph animations
 
   fs::path path_;
   tinygltf::Model model_;
@@ -523,7 +547,8 @@ int GlbBuilder::addMaterial(const ExportPart& part) {
 int GlbBuilder::addPart(const ExportPart& part, const std::string& nodeName, PartWriteReport* report) {
   PartCorners corners = partCorners(part);
   if (report) *report = corners.report;
-  const Mesh mesh = unweld(part.mesh, corners.normals, corners.uvs);
+  std::vector<uint32_t> origin;
+  const Mesh mesh = unweld(part.mesh, corners.normals, corners.uvs, &origin);
   const size_t n = mesh.positions.size();
   tinygltf::Primitive prim;
   prim.mode = TINYGLTF_MODE_TRIANGLES;
@@ -553,16 +578,111 @@ int GlbBuilder::addPart(const ExportPart& part, const std::string& nodeName, Par
                              TINYGLTF_TYPE_SCALAR, TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, TINYGLTF_TARGET_ELEMENT_ARRAY_BUFFER);
   tinygltf::Mesh gm;
   gm.name = nodeName;
+  addExtras(part, origin, prim, gm);
   gm.primitives.push_back(prim);
   model_.meshes.push_back(gm);
   tinygltf::Node node;
   node.name = nodeName;
   node.mesh = int(model_.meshes.size() - 1);
   model_.nodes.push_back(node);
-  return int(model_.nodes.size() - 1);
+  const int index = int(model_.nodes.size() - 1);
+  if (part.morph) animated_.emplace_back(index, part.morph.get());
+  return index;
+}
+
+void GlbBuilder::addExtras(const ExportPart& part, const std::vector<uint32_t>& origin, tinygltf::Primitive& prim,
+                           tinygltf::Mesh& gm) {
+  const size_t n = origin.size();
+  for (const VertexAttribute& a : part.attributes) {
+    std::vector<glm::vec4> values(n);
+    for (size_t i = 0; i < n; ++i) values[i] = a.values[origin[i]];
+    prim.attributes[a.name] = addAccessor(values.data(), n * sizeof(glm::vec4), n, TINYGLTF_TYPE_VEC4,
+                                          TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+  }
+  if (!part.morph) return;
+  tinygltf::Value::Array names;
+  for (size_t k = 0; k < part.morph->targets.size(); ++k) {
+    const std::vector<Vec3>& target = part.morph->targets[k];
+    std::vector<Vec3> values(n);
+    Box3 box;
+    for (size_t i = 0; i < n; ++i) box.extend(values[i] = target[origin[i]]);
+    const int acc = addTarget(values);
+    model_.accessors[size_t(acc)].minValues = {box.lo.x, box.lo.y, box.lo.z};
+    model_.accessors[size_t(acc)].maxValues = {box.hi.x, box.hi.y, box.hi.z};
+    prim.targets.push_back({{"POSITION", acc}});
+    gm.weights.push_back(0.0);
+    names.push_back(tinygltf::Value(part.morph->names[k]));
+  }
+  gm.extras = tinygltf::Value(tinygltf::Value::Object{{"targetNames", tinygltf::Value(names)}});
+}
+
+int GlbBuilder::addTarget(const std::vector<Vec3>& values) {
+  std::vector<uint32_t> moved;
+  for (size_t i = 0; i < values.size(); ++i)
+    if (values[i] != Vec3(0.0f)) moved.push_back(uint32_t(i));
+  if (moved.empty() || moved.size() * 16 >= values.size() * 12)  // sparse: 4 bytes of index and 12 of value
+    return addAccessor(values.data(), values.size() * sizeof(Vec3), values.size(), TINYGLTF_TYPE_VEC3,
+                       TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+  // Sparse without a buffer view: zeros, and the moved vertices' displacements.
+  std::vector<Vec3> moves(moved.size());
+  for (size_t k = 0; k < moved.size(); ++k) moves[k] = values[moved[k]];
+  const int indices = addAccessor(moved.data(), moved.size() * 4, moved.size(), TINYGLTF_TYPE_SCALAR,
+                                  TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT, 0);
+  const int disp = addAccessor(moves.data(), moves.size() * sizeof(Vec3), moves.size(), TINYGLTF_TYPE_VEC3,
+                               TINYGLTF_COMPONENT_TYPE_FLOAT, 0);
+  tinygltf::Accessor acc;
+  acc.bufferView = -1;
+  acc.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+  acc.count = values.size();
+  acc.type = TINYGLTF_TYPE_VEC3;
+  acc.sparse.isSparse = true;
+  acc.sparse.count = int(moved.size());
+  acc.sparse.indices.bufferView = model_.accessors[size_t(indices)].bufferView;
+  acc.sparse.indices.byteOffset = 0;
+  acc.sparse.indices.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT;
+  acc.sparse.values.bufferView = model_.accessors[size_t(disp)].bufferView;
+  acc.sparse.values.byteOffset = 0;
+  // The two helper accessors are only a way to store the views: replace the last by the target.
+  model_.accessors.resize(model_.accessors.size() - 2);
+  model_.accessors.push_back(acc);
+  return int(model_.accessors.size() - 1);
+}
+
+void GlbBuilder::addAnimations() {
+  std::map<std::string, tinygltf::Animation> byName;
+  std::map<std::pair<std::string, std::vector<float>>, int> inputs;  // time accessors shared by equal keyframes
+  for (const auto& [node, m] : animated_) {
+    tinygltf::Animation& anim = byName[m->animation];
+    anim.name = m->animation;
+    auto [it, fresh] = inputs.try_emplace(std::make_pair(m->animation, m->times), -1);
+    if (fresh) {
+      it->second = addAccessor(m->times.data(), m->times.size() * sizeof(float), m->times.size(), TINYGLTF_TYPE_SCALAR,
+                               TINYGLTF_COMPONENT_TYPE_FLOAT, 0);
+      model_.accessors[size_t(it->second)].minValues = {double(m->times.front())};
+      model_.accessors[size_t(it->second)].maxValues = {double(m->times.back())};
+    }
+    // Output: every target's weight at keyframe 0, then at keyframe 1, ...
+    std::vector<float> out;
+    out.reserve(m->times.size() * m->weights.size());
+    for (size_t f = 0; f < m->times.size(); ++f)
+      for (const std::vector<float>& w : m->weights) out.push_back(w[f]);
+    tinygltf::AnimationSampler sampler;
+    sampler.input = it->second;
+    sampler.interpolation = "LINEAR";
+    sampler.output = addAccessor(out.data(), out.size() * sizeof(float), out.size(), TINYGLTF_TYPE_SCALAR,
+                                 TINYGLTF_COMPONENT_TYPE_FLOAT, 0);
+    anim.samplers.push_back(sampler);
+    tinygltf::AnimationChannel channel;
+    channel.sampler = int(anim.samplers.size() - 1);
+    channel.target_node = node;
+    channel.target_path = "weights";
+    anim.channels.push_back(channel);
+  }
+  for (auto& [name, anim] : byName) model_.animations.push_back(std::move(anim));
 }
 
 void GlbBuilder::write() {
+  addAnimations();
   if (!data_.empty()) {
     tinygltf::Buffer buffer;
     buffer.data = std::move(data_);

@@ -102,6 +102,29 @@ struct PartMaterial {
   float alphaCutoff = -1.0f;
 };
 
+/// An application-specific per-vertex attribute of a glTF export (e.g. a tree's `_WIND`,
+/// model/wind_export.h): VEC4 floats, one per vertex of the part's mesh. The name starts
+/// with '_' (glTF 2.0 §3.7.2.1); other formats do not write it.
+struct VertexAttribute {
+  std::string name;
+  std::vector<glm::vec4> values;
+};
+
+/// Morph targets of a part and the looping animation of their weights (glTF only; a tree's
+/// wind sway, model/wind_export.h). Each target is a displacement per vertex of the part's
+/// mesh; weights[k][f] is target k's weight at times[f]. The writer stores the targets
+/// with their names (mesh extras `targetNames`, the names Blender's shape keys and three.js'
+/// morphTargetDictionary take), default weights 0, and gathers the animations of every part
+/// with the same `animation` name into one glTF animation: one sampler (LINEAR) per node,
+/// its channel driving the node's `weights`.
+struct PartMorph {
+  std::vector<std::string> names;
+  std::vector<std::vector<Vec3>> targets;
+  std::string animation;
+  std::vector<float> times;
+  std::vector<std::vector<float>> weights;
+};
+
 /// One named part of an exported model (wood, leaves, whorl, a solid's material, ...).
 /// Vertex colours, when the mesh has them, are the part's colours at its vertices; the
 /// writers keep them relative to the material's base colour (see writeParts).
@@ -112,6 +135,10 @@ struct ExportPart {
   /// Many small separate pieces (leaves): levels of detail (model/lod.h) keep a share of
   /// the pieces, grown to keep their area, instead of simplifying each piece.
   bool scattered = false;
+  /// Application-specific vertex attributes (glTF only), each one value per vertex.
+  std::vector<VertexAttribute> attributes;
+  /// Morph targets and their animation (glTF only), or null.
+  std::shared_ptr<const PartMorph> morph;
 };
 
 /// One level of detail of a model (model/lod.h buildLodChain makes them): the parts, with

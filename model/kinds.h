@@ -11,6 +11,7 @@
 
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -19,7 +20,9 @@
 #include "core/mesh_io.h"
 #include "core/types.h"
 #include "lsystem/grammar.h"
+#include "lsystem/skeleton.h"
 #include "model/species.h"
+#include "organisms/wind.h"
 #include "model/yaml_reader.h"
 #include "render/geometry.h"
 
@@ -114,6 +117,10 @@ class KindModel {
   /// buildMesh as one part "surface" in look.surface's colour.
   virtual std::vector<ExportPart> exportParts(const Stage& stage, float cellSize, bool progress, const SpeciesRender& look,
                                               const MeshCleanOptions& clean, ModelFigures& figures);
+  /// Trees: the stage's still skeleton (the one exportParts builds from) and the wind's
+  /// options of the species (seed; speed and direction from its `render: wind`), for the wind data
+  /// of a glTF export (model/wind_export.h). nullopt (the default): the kind has no wind.
+  virtual std::optional<std::pair<lsystem::Skeleton, organisms::WindOptions>> windSource(const Stage&) { return std::nullopt; }
   /// The triangle budget of LOD0 when `sprig mesh` writes levels of detail by default
   /// (model/lod.h; docs/MESHES.md "Levels of detail"); 0 (the default): the full mesh alone.
   virtual size_t lodBudget() const { return 0; }

@@ -112,6 +112,11 @@ class SpeciesModel {
   /// polygonized BlobTrees cleaned with clean. Fills figures (triangles: all parts', build time).
   std::vector<ExportPart> exportParts(const Stage& stage, float cellSize, bool progress, const MeshCleanOptions& clean = {},
                                       ModelFigures* figures = nullptr);
+  /// The stage's still skeleton and the species' wind options (KindModel::windSource);
+  /// nullopt for kinds without wind.
+  std::optional<std::pair<lsystem::Skeleton, organisms::WindOptions>> windSource(const Stage& stage) {
+    return kind_->windSource(stage);
+  }
 
  private:
   Species species_;

@@ -530,6 +530,15 @@ class TreeModel final : public KindModel {
     return parts;
   }
 
+  std::optional<std::pair<lsystem::Skeleton, organisms::WindOptions>> windSource(const Stage& stage) override {
+    const int step = stage.step < 0 ? engine_.lastStep() : stage.step;
+    organisms::WindOptions w;
+    w.speed = species_.render.windSpeed;
+    w.directionDeg = species_.render.windDirectionDeg;
+    w.seed = spec_.surface ? spec_.surface->seed : organisms::TreeOptions{}.seed;
+    return std::make_pair(engine_.skeletonAt(step, stage.fraction), w);
+  }
+
   /// LOD0 of a tree: wood, leaves and fruit within 300,000 triangles (docs/MESHES.md "Levels of detail").
   size_t lodBudget() const override { return 300000; }
 

@@ -34,6 +34,7 @@
 #include "model/model.h"
 #include "model/species.h"
 #include "model/tree_kind.h"
+#include "model/wind_export.h"
 #include "python/long_call.h"
 
 namespace py = pybind11;
@@ -270,7 +271,7 @@ struct MeshRequest {
 
 /// `sprig mesh`'s parts (app/cmd_mesh.cpp): exportParts, simplifyParts when asked, then
 /// finishExportParts (degenerate triangles removed, the model placed at the origin).
-std::vector<ExportPart> meshParts(PySpecies& s, const MeshRequest& r) {
+std::vector<ExportPart> meshParts(PySpecies& s, const MeshRequest& r, Vec3* offset = nullptr) {
   if (r.cell < 0) throw UsageError("cell must be positive (0 = automatic)");
   if (r.minVolume < 0 || r.minVolume > 1) throw UsageError("min_volume must lie in [0, 1]");
   if (r.simplify && (*r.simplify < 0 || *r.simplify > 0.1)) throw UsageError("simplify must lie in [0, 0.1]");
@@ -281,7 +282,8 @@ std::vector<ExportPart> meshParts(PySpecies& s, const MeshRequest& r) {
   std::vector<ExportPart> parts = s.model->exportParts(stage, static_cast<float>(r.cell), true, clean, &fig);
   const double simplify = r.simplify ? *r.simplify : s.species.render.simplify;
   if (simplify > 0) simplifyParts(parts, simplify);
-  finishExportParts(parts);
+  const ExportFinish finish = finishExportParts(parts);
+  if (offset) *offset = finish.offset;
   return parts;
 }
 
@@ -344,7 +346,10 @@ void exportMesh(PySpecies& s, const std::filesystem::path& path, const MeshReque
             throw UsageError("simplify applies to the surface parts written as .ply, .obj or .glb, not to volume meshes");
           s.model->writeVolumeMesh(resolveStage(*s.model, r.stage, r.fraction, r.age), path, true);
         } else {
-          writeLevels(lodLevels(meshParts(s, r), s.model->lodBudget()), path);  // as `sprig mesh`: levels of detail
+          Vec3 offset(0.0f), moved(0.0f);  // as `sprig mesh`: levels of detail, a tree's wind in .glb
+          std::vector<LodLevel> levels = lodLevels(meshParts(s, r, &offset), s.model->lodBudget(), &moved);
+          if (ext == ".glb") addModelWind(*s.model, resolveStage(*s.model, r.stage, r.fraction, r.age), levels, offset + moved);
+          writeLevels(levels, path);
         }
         return 0;
       },

@@ -17,7 +17,7 @@ trap 'rm -rf "$out"' EXIT
 species=(
   "abop_1_24a wood | --steps 3 --lod auto"  # tree, skeleton of an L-system, with its levels of detail
   "fig_tree_12_pcm_offset wood"             # tree, BlobTree with PCM, bark off: no image
-  "tree_lime wood leaves | --steps 3 --cell 0.01"  # tree in leaf: wood and double-sided leaves apart (bark per girth: vertex colours)
+  "tree_lime wood leaves | --steps 3 --cell 0.01 --wind 6,45"  # tree in leaf: wood and double-sided leaves apart (bark per girth: vertex colours); wind: morph targets and the animation 'wind'; every tree: _WIND
   "tree_scarred *wood | --steps 4"        # one bark for every cone: baked into an image
   "shell_top *whorl inside"                 # shell, painted pigment
   "fig_shell_07b_varix_full *whorl varices" # shell with varices and their spines

@@ -13,10 +13,12 @@
 #include "model/mesh_parts.h"
 #include "model/model.h"
 #include "model/species.h"
+#include "tests/model/read_glb.h"
 #include "tests/organisms/meshes.h"
 #include "tests/paths.h"
 
 using namespace sprig;
+using test::readGlb;
 namespace fs = std::filesystem;
 
 namespace {
@@ -67,14 +69,6 @@ struct TempDir {
   }
   ~TempDir() { fs::remove_all(path); }
 };
-
-tinygltf::Model readGlb(const fs::path& file) {
-  tinygltf::Model model;
-  tinygltf::TinyGLTF loader;
-  std::string err, warn;
-  REQUIRE(loader.LoadBinaryFromFile(&model, &err, &warn, file.string()));
-  return model;
-}
 
 // Triangles of a glTF node's mesh.
 size_t nodeTriangles(const tinygltf::Model& m, int node) {
