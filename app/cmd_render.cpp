@@ -58,6 +58,7 @@ void parseCamera(const std::string& text, SpeciesRender& look) {
   if (v.size() == 6) c.target = Vec3(float(v[3]), float(v[4]), float(v[5]));
   else if (look.camera && look.camera->target) c.target = look.camera->target;
   look.camera = c;
+  look.closeUp.reset();  // the command line's camera replaces the species' close-up
 }
 
 int renderOnce(const RenderArgs& a, const GlobalOptions& g) {
@@ -90,7 +91,7 @@ int renderOnce(const RenderArgs& a, const GlobalOptions& g) {
 
   ModelFigures fig;
   render::RenderStats stats;
-  Image image = renderModel(model, look, job, &fig, &stats);
+  Image image = renderPicture(model, look, job, &fig, &stats);
   writeImage(image, a.out);
   note(g, std::cerr,
        "%s: %dx%d, %d spp, %s mode%s%s; %zu primitives, %zu cells, %zu triangles; "

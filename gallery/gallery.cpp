@@ -125,7 +125,7 @@ GalleryItem renderGalleryItem(const fs::path& speciesFile, const fs::path& outDi
     job.stage = model.finalStage();
     job.progressLabel = "render " + stem;
     ModelFigures fig;
-    Image preview = renderModel(model, look, job, &fig);
+    Image preview = renderPicture(model, look, job, &fig);
     writeImage(preview, outDir / item.preview);
     item.steps = std::max(0, job.stage.step);
     item.modules = fig.modules;

@@ -39,6 +39,10 @@ GeometryMode geometryModeNamed(const std::string& name) {
   throw UsageError("--mode " + name + ": expected exact, mesh or skeleton");
 }
 
+Box3 KindModel::partBox(const CloseUpSpec& target) {
+  throw InputError(target.loc, "render.close_up: this kind has no internodes or junctions to frame (frame a 'point' with a 'size')");
+}
+
 Stage KindModel::stageAtAge(double) const { throw UsageError("--age applies to shell species only"); }
 
 std::string KindModel::writeVolumeMesh(const Stage&, const std::filesystem::path& path, bool) {

@@ -105,6 +105,10 @@ class KindModel {
   virtual int stageNumber(const Stage& stage) const = 0;
   /// The box the camera frames for every stage.
   virtual Box3 frameBox() = 0;
+  /// The world box of the part a close-up names (`render.close_up`'s `internode` or
+  /// `junction`) in the final stage. Throws InputError at target.loc when the part does not
+  /// exist; the default throws that the kind has no named parts.
+  virtual Box3 partBox(const CloseUpSpec& target);
   /// The stage's geometry with the species' look. Throws UsageError for a mode the kind
   /// lacks, InputError for bad input found while building.
   virtual BuiltStage build(const Stage& stage, GeometryMode mode, const SpeciesRender& look) = 0;

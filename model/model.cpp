@@ -35,6 +35,23 @@ void checkFrameBox(const Species& species, const Box3& box) {
                                         "): there is nothing to frame");
 }
 
+/// The job's image size: its own, else the look's (one side given: the other keeps the look's aspect).
+std::pair<int, int> imageSize(const SpeciesRender& look, const RenderJob& job) {
+  const int lookWidth = look.image.width, lookHeight = look.image.height;
+  int width = job.width > 0 ? job.width : lookWidth;
+  int height = job.height > 0 ? job.height : lookHeight;
+  if (job.width > 0 && job.height <= 0) height = std::max(16, lookHeight * job.width / lookWidth);
+  if (job.height > 0 && job.width <= 0) width = std::max(16, lookWidth * job.height / lookHeight);
+  return {width, height};
+}
+
+void addStats(render::RenderStats& sum, const render::RenderStats& s) {
+  sum.cameraRays += s.cameraRays;
+  sum.shadowRays += s.shadowRays;
+  sum.skyRays += s.skyRays;
+  sum.seconds += s.seconds;
+}
+
 }  // namespace
 
 SpeciesModel::SpeciesModel(const Species& species, const ModelOptions& options) : species_(species) {
@@ -115,6 +132,23 @@ render::Camera modelCamera(const SpeciesRender& look, const Box3& box, int width
   return cam;
 }
 
+Box3 SpeciesModel::closeUpBox(const CloseUpSpec& target) {
+  return target.point ? Box3{*target.point, *target.point} : kind_->partBox(target);
+}
+
+render::Camera speciesCamera(SpeciesModel& model, const SpeciesRender& look, const Box3& frame, int width, int height) {
+  if (!look.closeUp) return modelCamera(look, frame, width, height);
+  const Box3 target = model.closeUpBox(*look.closeUp);
+  const double aspect = static_cast<double>(width) / height;
+  if (!(look.closeUp->size > 0)) return render::frameBounds(target, look.view, aspect);
+  // A size: the square of that side across the view at the target's centre fills the
+  // frame's shorter side, less the margin.
+  const double halfTan = std::tan(0.5 * radians(look.view.fovYDeg)) * std::min(1.0, aspect) *
+                         (1.0 - std::clamp(look.view.margin, 0.0, 0.9));
+  return render::orbitCamera(target.center(), look.view.azimuthDeg, look.view.elevationDeg,
+                             0.5 * look.closeUp->size / halfTan, look.view.fovYDeg);
+}
+
 void checkCameraRays(int width, int height, int samples) {
   const uint64_t rays = uint64_t(std::max(width, 0)) * uint64_t(std::max(height, 0)) * uint64_t(std::max(samples, 0));
   if (rays <= kMaxCameraRays) return;
@@ -131,15 +165,12 @@ Box3 restingFrame(const Box3& frame, const Box3& stage, bool groundAtModelBase) 
 
 Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job, ModelFigures* figures,
                           render::RenderStats* stats) {
-  const int lookWidth = look.image.width, lookHeight = look.image.height;
-  int width = job.width > 0 ? job.width : lookWidth;
-  int height = job.height > 0 ? job.height : lookHeight;
-  if (job.width > 0 && job.height <= 0) height = std::max(16, lookHeight * job.width / lookWidth);
-  if (job.height > 0 && job.width <= 0) width = std::max(16, lookWidth * job.height / lookHeight);
+  const auto [width, height] = imageSize(look, job);
   checkCameraRays(width, height, job.samples > 0 ? job.samples : look.image.spp);
   const Box3 frame = job.frame ? *job.frame : model.frameBox();
   checkFrameBox(model.species(), frame);
-  render::Camera camera = modelCamera(look, frame, width, height);
+  const bool fixedCamera = job.camera || look.closeUp;
+  render::Camera camera = job.camera ? *job.camera : speciesCamera(model, look, frame, width, height);
   if (std::string why = render::cameraProblem(camera); !why.empty())
     throw InputError(model.species().loc(), "render.camera: " + why);
   render::Scene scene;
@@ -159,12 +190,61 @@ Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJo
   rs.progress = job.progress;
   rs.progressLabel = job.progressLabel;
   const Box3 resting = restingFrame(frame, scene.bounds(), rs.groundAtModelBase);
-  if (resting.lo.y != frame.lo.y) camera = modelCamera(look, resting, width, height);
+  if (!fixedCamera && resting.lo.y != frame.lo.y) camera = modelCamera(look, resting, width, height);
   rs.groundFrame = resting;
   const Phase phase("render");
   Image image = render::renderImage(scene, camera, rs, stats);
   if (figures) *figures = fig;
   return image;
+}
+
+namespace {
+
+/// The box both panels of a pair frame: the union of the two species' frame boxes.
+Box3 pairFrame(SpeciesModel& model, SpeciesModel& other) {
+  Box3 frame = model.frameBox();
+  frame.extend(other.frameBox());
+  checkFrameBox(model.species(), frame);
+  return frame;
+}
+
+}  // namespace
+
+render::Camera pairCamera(SpeciesModel& model, SpeciesModel& other, const SpeciesRender& look, int width, int height) {
+  return speciesCamera(model, look, pairFrame(model, other), std::max(16, width / 2), height);
+}
+
+Image renderPair(SpeciesModel& model, SpeciesModel& other, const SpeciesRender& look, const RenderJob& job,
+                 ModelFigures* figures, render::RenderStats* stats) {
+  const auto [width, height] = imageSize(look, job);
+  const int panel = std::max(16, width / 2);
+  RenderJob panelJob = job;
+  panelJob.width = panel;
+  panelJob.height = height;
+  panelJob.camera = job.camera ? *job.camera : pairCamera(model, other, look, width, height);
+  if (!job.frame) panelJob.frame = pairFrame(model, other);  // one ground fade for both panels
+  render::RenderStats left, right;
+  const Image a = renderModel(model, look, panelJob, figures, &left);
+  panelJob.stage = other.finalStage();
+  const Image b = renderModel(other, look, panelJob, nullptr, &right);
+  Image out(2 * panel, height);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < panel; ++x) {
+      out.set(x, y, a.at(x, y));
+      out.set(panel + x, y, b.at(x, y));
+    }
+  if (stats) {
+    *stats = left;
+    addStats(*stats, right);
+  }
+  return out;
+}
+
+Image renderPicture(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job, ModelFigures* figures,
+                    render::RenderStats* stats) {
+  if (!look.pair) return renderModel(model, look, job, figures, stats);
+  SpeciesModel other(loadSpecies(*look.pair, model.species().policy));
+  return renderPair(model, other, look, job, figures, stats);
 }
 
 }  // namespace sprig

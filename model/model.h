@@ -77,6 +77,9 @@ class SpeciesModel {
   /// The box the camera frames for every stage: the final stage's bounds (trees: the union
   /// over their steps).
   Box3 frameBox() { return kind_->frameBox(); }
+  /// The box of a close-up's target (`render.close_up`): the point itself, or the named
+  /// part's box (KindModel::partBox). Throws InputError as partBox does.
+  Box3 closeUpBox(const CloseUpSpec& target);
   /// Extensions of the volume meshes the species writes (solids: .msh, .vtu, .mesh).
   std::vector<std::string> volumeMeshExtensions() const { return kind_->volumeMeshExtensions(); }
   /// Writes the stage's volume mesh (KindModel::writeVolumeMesh); returns the summary line.
@@ -131,6 +134,8 @@ struct RenderJob {
   GeometryMode mode = GeometryMode::Exact;
   Stage stage;
   std::optional<Box3> frame;  ///< the box the camera frames (default: the model's frameBox())
+  /// The camera, used as it is (no close-up, no resting shift); default: speciesCamera's.
+  std::optional<render::Camera> camera;
   bool progress = true;
   std::string progressLabel = "render";
 };
@@ -153,6 +158,25 @@ void checkCameraRays(int width, int height, int samples);
 Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job,
                           ModelFigures* figures = nullptr, render::RenderStats* stats = nullptr);
 
+/// The camera both panels of renderPair use for a width x height image (each panel half as
+/// wide): speciesCamera of model over the union of model's and other's frame boxes.
+render::Camera pairCamera(SpeciesModel& model, SpeciesModel& other, const SpeciesRender& look, int width, int height);
+
+/// Two species side by side (`render.pair`): model at job.stage in the left panel, other at
+/// its final stage in the right, each panel half the job's width (at least 16 pixels) and
+/// its height, both rendered with look and seen by one camera (job.camera, else pairCamera),
+/// each resting on its own ground, which fades around the union of the two frame boxes. Fills figures (model's) and stats (both panels') when
+/// given. Throws as renderModel.
+Image renderPair(SpeciesModel& model, SpeciesModel& other, const SpeciesRender& look, const RenderJob& job,
+                 ModelFigures* figures = nullptr, render::RenderStats* stats = nullptr);
+
+/// The species' picture, as `sprig render` and the gallery's final stage show it: with
+/// look.pair, renderPair with that species (loaded under the model's species' path policy;
+/// its own `pair` is not followed); else renderModel. Throws InputError for the other
+/// species' errors too.
+Image renderPicture(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job, ModelFigures* figures = nullptr,
+                    render::RenderStats* stats = nullptr);
+
 /// The frame box moved up or down so that its base is the stage's lowest point: the stage
 /// rests on the ground, and a camera framed on the result sees that ground from where the
 /// frame's camera sees the frame's (one horizon row for every stage). frame itself when the
@@ -161,5 +185,12 @@ Box3 restingFrame(const Box3& frame, const Box3& stage, bool groundAtModelBase);
 
 /// The camera for an image of width x height of a model framed on box with look.
 render::Camera modelCamera(const SpeciesRender& look, const Box3& box, int width, int height);
+
+/// The camera renderModel takes for model in a width x height image framed on frame: with a
+/// close-up (render.close_up), looking along look.view at the target (model.closeUpBox),
+/// either framing its box with the view's margin or, with a size, at the distance where a
+/// square of that side across the view fills the frame's shorter side less the margin;
+/// else modelCamera's. Throws InputError as closeUpBox does.
+render::Camera speciesCamera(SpeciesModel& model, const SpeciesRender& look, const Box3& frame, int width, int height);
 
 }  // namespace sprig

@@ -25,7 +25,75 @@ void readView(MapReader& m, render::ViewSpec& v) {
   m.finish();
 }
 
-void readRender(MapReader& m, SpeciesRender& r, DiagnosticList& diags) {
+void readLights(MapReader& m, render::RenderSettings& im, DiagnosticList& diags) {
+  if (auto s = m.section({"sun", "Direction of the sun light: `azimuth` and `elevation` in degrees, and its `strength`."})) {
+    MapReader sun(*s, diags, "render.sun");
+    im.sunAzimuthDeg = sun.number({"azimuth", "Sun direction around +Y, in degrees from +Z toward +X."}, im.sunAzimuthDeg, -360.0, 360.0);
+    im.sunElevationDeg = sun.number({"elevation", "Sun height above the horizon, in degrees (a low sun, 5 to 20, grazes the surface and shows its relief)."}, im.sunElevationDeg, 1.0, 90.0);
+    im.sunStrength = static_cast<float>(sun.number({"strength", "Strength of the sun light."}, im.sunStrength, 0.0, 10.0));
+    sun.finish();
+  }
+  if (auto r = m.section({"rim", "A rim light from behind the model, placed relative to the camera, that outlines silhouettes: `strength`, `azimuth`, `elevation`."})) {
+    MapReader rim(*r, diags, "render.rim");
+    im.rimStrength = static_cast<float>(rim.number({"strength", "Strength of the rim light (default 1 when `rim` is given; 0 = off)."}, 1.0, 0.0, 10.0));
+    im.rimAzimuthDeg = rim.number({"azimuth", "Direction of the rim light around +Y, in degrees from the camera's direction (180 = straight behind the model)."}, im.rimAzimuthDeg, -360.0, 360.0);
+    im.rimElevationDeg = rim.number({"elevation", "Height of the rim light above the horizon, in degrees."}, im.rimElevationDeg, 0.0, 90.0);
+    rim.finish();
+  }
+}
+
+void readCamera(MapReader& m, SpeciesRender& r, DiagnosticList& diags) {
+  if (auto c = m.section({"camera", "An explicit camera instead of the automatic framing: `position` or `distance`, and `target`."})) {
+    MapReader cam(*c, diags, "render.camera");
+    CameraSpec spec;
+    if (cam.has("position")) spec.position = cam.vec3({"position", "Camera position in world units (excludes `distance`)."}, Vec3(0), -1e6f, 1e6f);
+    else cam.allow({"position"});
+    if (cam.has("target")) spec.target = cam.vec3({"target", "The point the camera looks at (default: the centre of the framed box)."}, Vec3(0), -1e6f, 1e6f);
+    else cam.allow({"target"});
+    if (cam.has("distance")) spec.distance = cam.number({"distance", "Camera distance from the target along the view's direction (excludes `position`)."}, 1.0, 1e-6, 1e6);
+    else cam.allow({"distance"});
+    if (spec.position && spec.distance)
+      c->error(diags, "render.camera: give either 'position' or 'distance', not both");
+    if (spec.position && spec.target && *spec.position == *spec.target)
+      c->error(diags, "render.camera: 'position' and 'target' are the same point (the camera would have no view direction)");
+    cam.finish();
+    r.camera = spec;
+  }
+  if (auto c = m.section({"close_up", "A close-up: the camera looks along `view`'s direction at one target and frames it: `point` with `size`, or a tree's `internode` or `junction` by index (excludes `camera`)."})) {
+    MapReader close(*c, diags, "render.close_up");
+    CloseUpSpec spec;
+    spec.loc = c->loc();
+    int targets = 0;
+    if (close.has("point")) {
+      spec.point = close.vec3({"point", "The world point the close-up frames (needs `size`)."}, Vec3(0), -1e6f, 1e6f);
+      ++targets;
+    } else {
+      close.allow({"point"});
+    }
+    if (close.has("internode")) {
+      spec.internode = static_cast<int>(close.integer({"internode", "Trees: frame the final stage's internode of this index (drawing order, 0 = the first `F`)."}, 0, 0, 10000000));
+      ++targets;
+    } else {
+      close.allow({"internode"});
+    }
+    if (close.has("junction")) {
+      spec.junction = static_cast<int>(close.integer({"junction", "Trees: frame the junction where the internode of this index leaves its parent."}, 0, 0, 10000000));
+      ++targets;
+    } else {
+      close.allow({"junction"});
+    }
+    spec.size = close.number({"size", "World extent the frame's shorter side shows at the target's centre, less the margin (0: frame the part's own box; required with `point`)."}, 0.0, 0.0, 1e6);
+    close.finish();
+    if (targets != 1)
+      c->error(diags, "render.close_up: give exactly one target: 'point', 'internode' or 'junction'");
+    else if (spec.point && !(spec.size > 0))
+      c->error(diags, "render.close_up: a 'point' needs a 'size' above 0 (the world extent to frame)");
+    if (r.camera) c->error(diags, "render.close_up: give either 'camera' or 'close_up', not both");
+    r.closeUp = spec;
+  }
+}
+
+void readRender(MapReader& m, SpeciesRender& r, const PathPolicy& policy, DiagnosticList& diags) {
   render::RenderSettings& im = r.image;
   im.width = static_cast<int>(m.integer({"width", "Image width in pixels."}, im.width, 16, 8192));
   im.height = static_cast<int>(m.integer({"height", "Image height in pixels."}, im.height, 16, 8192));
@@ -52,29 +120,10 @@ void readRender(MapReader& m, SpeciesRender& r, DiagnosticList& diags) {
   im.backgroundColor = m.color({"background_color", "The background's colour with `background: color`."}, im.backgroundColor);
   im.ground = m.boolean({"ground", "Draw a ground plane under the model."}, im.ground);
   im.groundColor = m.color({"ground_color", "Colour of the ground plane."}, im.groundColor);
-  if (auto s = m.section({"sun", "Direction of the sun light: `azimuth` and `elevation` in degrees."})) {
-    MapReader sun(*s, diags, "render.sun");
-    im.sunAzimuthDeg = sun.number({"azimuth", "Sun direction around +Y, in degrees from +Z toward +X."}, im.sunAzimuthDeg, -360.0, 360.0);
-    im.sunElevationDeg = sun.number({"elevation", "Sun height above the horizon, in degrees."}, im.sunElevationDeg, 1.0, 90.0);
-    sun.finish();
-  }
+  readLights(m, im, diags);
   im.exposure = static_cast<float>(m.number({"exposure", "Exposure in stops: each +1 doubles the image's brightness."}, im.exposure, -10.0, 10.0));
-  if (auto c = m.section({"camera", "An explicit camera instead of the automatic framing: `position` or `distance`, and `target`."})) {
-    MapReader cam(*c, diags, "render.camera");
-    CameraSpec spec;
-    if (cam.has("position")) spec.position = cam.vec3({"position", "Camera position in world units (excludes `distance`)."}, Vec3(0), -1e6f, 1e6f);
-    else cam.allow({"position"});
-    if (cam.has("target")) spec.target = cam.vec3({"target", "The point the camera looks at (default: the centre of the framed box)."}, Vec3(0), -1e6f, 1e6f);
-    else cam.allow({"target"});
-    if (cam.has("distance")) spec.distance = cam.number({"distance", "Camera distance from the target along the view's direction (excludes `position`)."}, 1.0, 1e-6, 1e6);
-    else cam.allow({"distance"});
-    if (spec.position && spec.distance)
-      c->error(diags, "render.camera: give either 'position' or 'distance', not both");
-    if (spec.position && spec.target && *spec.position == *spec.target)
-      c->error(diags, "render.camera: 'position' and 'target' are the same point (the camera would have no view direction)");
-    cam.finish();
-    r.camera = spec;
-  }
+  readCamera(m, r, diags);
+  r.pair = m.path({"pair", "Another species file: the picture shows this species and that one (at its final stage) side by side, seen by one camera framing both (this species' camera, light and size; each panel half the width)."}, policy);
   im.fillStrength = static_cast<float>(m.number({"fill", "Strength of an unshadowed fill light from the camera (0 = none)."}, im.fillStrength, 0.0, 10.0));
   im.skyStrength = static_cast<float>(m.number({"sky", "Strength of the sky light."}, im.skyStrength, 0.0, 10.0));
   im.unlitSkySamples = static_cast<int>(m.integer({"unlit_sky_samples", "Sky rays per camera sample where the sun adds nothing (in its shadow or facing away): smooths shadows and cavities lit by the sky alone (0 = one ray, as elsewhere)."}, im.unlitSkySamples, 0, 16));
@@ -134,9 +183,13 @@ Species readSpecies(std::shared_ptr<const YamlFile> yaml, const PathPolicy& poli
   }
   if (auto r = top.section({"render", "Image size, camera, light and colours of renders and previews."})) {
     MapReader render(*r, diags, "render");
-    readRender(render, s.render, diags);
+    readRender(render, s.render, policy, diags);
     if (auto w = render.keyNode("wind"); w && s.kind != "tree")
       w->error(diags, "'render.wind' sways trees; " + speciesOfKind(s.kind) + " has no wind");
+    if (s.render.closeUp && s.kind != "tree" && (s.render.closeUp->internode >= 0 || s.render.closeUp->junction >= 0))
+      if (auto c = render.keyNode("close_up"))
+        c->error(diags, "'render.close_up' names an internode or a junction of a tree; " + speciesOfKind(s.kind) +
+                            " has none (frame a 'point' with a 'size')");
   }
   for (const YNode& st : top.sequence({"stages", "Growth stages shown in the gallery's growth strip and by `--stage`: derivation steps of a tree, ages of a shell."}))
     if (auto v = st.asInteger(diags, "'stages' entry", 0, 100000)) s.stages.push_back(static_cast<int>(*v));

@@ -32,6 +32,19 @@ struct CameraSpec {
   std::optional<double> distance;  ///< `distance`: eye at view.azimuth/elevation this far from target
 };
 
+/// A close-up (`render.close_up:`): the camera looks along `render.view`'s direction at one
+/// target and frames it (with the view's margin) instead of the whole model. The target is
+/// a world point with a size, or a part the kind can locate (trees: an internode or the
+/// junction at an internode's base, by index in drawing order). Exactly one of point,
+/// internode and junction is set.
+struct CloseUpSpec {
+  std::optional<Vec3> point;  ///< `point: [x, y, z]`: a world point (needs `size`)
+  int internode = -1;         ///< `internode: i` (trees): the box of the final stage's i-th internode, radius included
+  int junction = -1;          ///< `junction: i` (trees): where internode i leaves its parent, 4 of their radii across
+  double size = 0;            ///< `size`: world extent across the frame's shorter side at the target's centre (0: frame the part's box)
+  SourceLoc loc;              ///< the `close_up:` map, for targets found missing when the model is built
+};
+
 /// How a skeleton preview is sized and coloured (`render:` keys `wood`, `leaf`, `fruit`,
 /// `palette`, `radius_scale`, `organs`).
 struct SkeletonStyle {
@@ -57,6 +70,11 @@ struct SpeciesRender {
   render::ViewSpec view;               ///< `view: {azimuth, elevation, fov, margin}`
   SkeletonStyle style;                 ///< skeleton previews
   std::optional<CameraSpec> camera;    ///< `camera: {position, target, distance}`
+  std::optional<CloseUpSpec> closeUp;  ///< `close_up: {point, internode, junction, size}` (excludes `camera`)
+  /// `pair: other.yaml`: the species' picture (`sprig render`, the gallery's final stage) is
+  /// two panels side by side, this species and the other at its final stage, seen by one
+  /// camera (renderPair, model/model.h). Resolved against the species file's folder.
+  std::optional<std::filesystem::path> pair;
   render::Material surface{Vec3(0.72f, 0.60f, 0.48f), 0.45f, 0.05f};  ///< `color`, `roughness`, `specular`: blob surfaces
   /// Solids: a cut-away by the plane n·x = d (xyz = n, w = d); the side n·x > d is removed
   /// (`sprig render --section`).

@@ -381,6 +381,26 @@ class TreeModel final : public KindModel {
     return box.empty() ? Box3{Vec3(-0.5f), Vec3(0.5f)} : box;
   }
 
+  Box3 partBox(const CloseUpSpec& target) override {
+    const lsystem::Skeleton skeleton = engine_.skeletonAt(engine_.lastStep());
+    const std::vector<lsystem::Internode>& in = skeleton.internodes;
+    const bool junction = target.junction >= 0;
+    const int index = junction ? target.junction : target.internode;
+    if (index < 0 || static_cast<size_t>(index) >= in.size())
+      throw InputError(target.loc, std::string("render.close_up: ") + (junction ? "junction " : "internode ") +
+                                       std::to_string(index) + " is beyond the tree's " + std::to_string(in.size()) +
+                                       " internodes" + (in.empty() ? "" : " (0.." + std::to_string(in.size() - 1) + ")"));
+    const lsystem::Internode& i = in[static_cast<size_t>(index)];
+    if (junction) {
+      // The point where internode i leaves its parent, 4 of the larger radius across.
+      const double parentRadius = i.parent >= 0 ? in[static_cast<size_t>(i.parent)].tipRadius : 0.0;
+      const double r = 2.0 * std::max({i.baseRadius, parentRadius, 1e-6});
+      return Box3{Vec3(i.start - DVec3(r)), Vec3(i.start + DVec3(r))};
+    }
+    const double r = std::max({i.baseRadius, i.tipRadius, 1e-6});
+    return Box3{Vec3(glm::min(i.start, i.end) - DVec3(r)), Vec3(glm::max(i.start, i.end) + DVec3(r))};
+  }
+
   BuiltStage build(const Stage& stage, GeometryMode mode, const SpeciesRender& look) override {
     BuiltStage out;
     ModelFigures& fig = out.figures;

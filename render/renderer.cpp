@@ -133,6 +133,9 @@ class Integrator {
     fadeRadius_ = std::max(0.5f * glm::length(g.size()), 1e-6f);
     sunDir_ = directionFromAngles(s.sunAzimuthDeg, s.sunElevationDeg);
     sunCos_ = static_cast<float>(std::cos(radians(std::max(0.0, s.sunAngleDeg))));
+    const Vec3 toViewer = camera.position - camera.target;
+    const double cameraAzimuthDeg = std::atan2(double(toViewer.x), double(toViewer.z)) * (180.0 / kPi);
+    rimDir_ = directionFromAngles(cameraAzimuthDeg + s.rimAzimuthDeg, s.rimElevationDeg);
     groundMaterial_.roughness = 1.0f;
     groundMaterial_.specular = 0.0f;
   }
@@ -274,7 +277,20 @@ class Integrator {
       radiance += albedo * skyLight * s_.skyStrength;
     }
     if (s_.fillStrength > 0.0f) radiance += albedo * s_.fillStrength * std::max(0.0f, glm::dot(n, v));
+    if (s_.rimStrength > 0.0f) radiance += albedo * rimLight(n, ng, origin, c);
     return radiance;
+  }
+
+  /// Irradiance of the rim light at a point with shading normal n and geometric normal ng
+  /// (Lambert, hard shadow from origin).
+  Vec3 rimLight(const Vec3& n, const Vec3& ng, const Vec3& origin, Counters& c) const {
+    const float cosL = glm::dot(n, rimDir_);
+    if (cosL <= 0.0f || glm::dot(ng, rimDir_) <= -0.05f) return Vec3(0);
+    if (s_.shadows) {
+      ++c.shadow;
+      if (scene_.occluded(origin, rimDir_, 0.0f, kInf)) return Vec3(0);
+    }
+    return s_.rimColor * s_.rimStrength * cosL;
   }
 
   const Scene& scene_;
@@ -288,6 +304,7 @@ class Integrator {
   float groundY_ = 0;
   Vec3 sunDir_{0, 1, 0};
   float sunCos_ = 1;
+  Vec3 rimDir_{0, 0, -1};  ///< toward the rim light (RenderSettings::rimAzimuthDeg from the camera's azimuth)
   /// The ground's material, made once: a Material holds a seeded RidgeShade, whose noise
   /// table costs a 256-entry shuffle to build (once per ground hit, it was 15 % of a tree's
   /// exact render).

@@ -81,6 +81,13 @@ struct RenderSettings {
   /// only light and its rays the only noise. 0 = skySamples everywhere.
   int unlitSkySamples = 0;
   float fillStrength = 0.0f;      ///< unshadowed light from the camera direction (0 = off)
+  /// Rim light: a distant light from behind the model, placed relative to the camera, that
+  /// outlines silhouettes and lights the edges of ridges and cuts; it casts hard shadows
+  /// (one occlusion ray where it reaches a surface). 0 = off.
+  float rimStrength = 0.0f;
+  double rimAzimuthDeg = 150.0;   ///< around +Y from the camera's azimuth (180 = straight behind the model; 150 behind and to the camera's right)
+  double rimElevationDeg = 25.0;  ///< above the horizon
+  Vec3 rimColor{0.92f, 0.95f, 1.0f};  ///< linear RGB tint of the rim light
   /// Filter the sky term with the edge-avoiding à-trous filter (render/sky_filter.h): the
   /// sky's irradiance is smoothed across pixels of the same surface, never across normals,
   /// depth steps or albedo edges.
