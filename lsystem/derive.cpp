@@ -1306,7 +1306,9 @@ struct Deriver::Impl {
     return static_cast<int32_t>(s.symbols[i]) == cutSym && s.paramCount(i) == 0;
   }
 
-  /// Removes every `%` and the rest of its branch (up to, not including, the closing `]`).
+  /// Removes the rest of every `%`'s branch (up to, not including, the closing `]`). The
+  /// `%` stays, so that the turtle marks the internode it ends as cut (a saw face,
+  /// docs/TREES.md "Pruning"); once its branch is gone, later cuts leave it as it is.
   void applyCuts(ModuleString& s) const {
     const size_t n = s.size();
     const bool births = s.birthSteps.size() == n && n > 0;
@@ -1314,18 +1316,15 @@ struct Deriver::Impl {
     size_t i = 0;
     bool any = false;
     while (i < n) {
-      if (s.symbols[i] == prog->cut) {
-        any = true;
-        i = cutEnd(s, i, n);
-        continue;
-      }
+      const size_t next = s.symbols[i] == prog->cut ? cutEnd(s, i, n) : i + 1;
+      any = any || next > i + 1;
       uint32_t b = s.offsets[i], e = s.offsets[i + 1];
       s.symbols[j] = s.symbols[i];
       if (births) s.birthSteps[j] = s.birthSteps[i];
       for (uint32_t k = b; k < e; ++k) s.params[pj++] = s.params[k];
       s.offsets[j + 1] = static_cast<uint32_t>(pj);
       ++j;
-      ++i;
+      i = next;
     }
     if (!any) return;
     s.symbols.resize(j);
@@ -1334,7 +1333,7 @@ struct Deriver::Impl {
     if (births) s.birthSteps.resize(j);
   }
 
-  /// After a step: Sprig's notation removes the cut branches now; cpfg's keeps each `%` and
+  /// After a step: Sprig's notation removes the cut branches now (keeping each `%`); cpfg's keeps each `%` and
   /// the rest of its branch in the string until the next step skips them (generate.c,
   /// ApplyProd: SkipCutPart), so its final string holds them and the turtle skips them.
   void cutAfterStep() {

@@ -187,10 +187,10 @@ TEST_CASE("cpfg parity: a cut is made when the next step reaches it", "[lsystem]
       CHECK(!a.internodes[i].cut);
     }
   }
-  SECTION("Sprig's notation cuts at once") {
+  SECTION("Sprig's notation cuts at once, keeping the % that marks the cut internode") {
     Grammar g = parseGrammar(readFile(parityAsset("pending_cut/plant.l")), "plant.lsys");
     Deriver d(g);
-    CHECK(formatModuleString(d.derive(), d.symbols()) == "X[F(1)]F(2)[F(1)]F(2)[A]BE");
+    CHECK(formatModuleString(d.derive(), d.symbols()) == "X[F(1)%]F(2)[F(1)%]F(2)[A]BE");
   }
 }
 

@@ -457,11 +457,13 @@ L --> [+G]
 }
 
 TEST_CASE("Deriver::derive cut symbol %", "[lsystem]") {
-  CHECK(deriveText("axiom: A[B%CD]E\n", 0) == "A[B]E");
-  CHECK(deriveText("axiom: A[B%C[D]E]F\n", 0) == "A[B]F");
-  CHECK(deriveText("axiom: AB%CD\n", 0) == "AB");
-  CHECK(deriveText("axiom: A[X]B\nX --> Y%Z\nB --> BB\n", 1) == "A[Y]BB");
-  CHECK(deriveText("axiom: A[X[P]Q]B\nX --> %\n", 1) == "A[]B");
+  // The `%` stays (the turtle marks the internode it ends as cut); the rest of its branch goes.
+  CHECK(deriveText("axiom: A[B%CD]E\n", 0) == "A[B%]E");
+  CHECK(deriveText("axiom: A[B%C[D]E]F\n", 0) == "A[B%]F");
+  CHECK(deriveText("axiom: AB%CD\n", 0) == "AB%");
+  CHECK(deriveText("axiom: A[X]B\nX --> Y%Z\nB --> BB\n", 1) == "A[Y%]BB");
+  CHECK(deriveText("axiom: A[X]B\nX --> Y%Z\nB --> BB\n", 2) == "A[Y%]BBBB");
+  CHECK(deriveText("axiom: A[X[P]Q]B\nX --> %\n", 1) == "A[%]B");
 }
 
 TEST_CASE("Deriver::derive birth steps", "[lsystem]") {

@@ -324,6 +324,18 @@ TEST_CASE("Turtle::cut", "[lsystem]") {
     checkVec(r.end.frame.position, {0, 2, 0});
   }
   SECTION("% outside a branch ends the string") { CHECK(draw("FF%FFF").skeleton.internodes.size() == 2); }
+  SECTION("a derived % still marks the internode it ends (prune.from_grammar's saw cuts)") {
+    // In the axiom (cut before step 1) and produced by a step (cut after it).
+    Grammar g = parseGrammar("axiom: F[+F%F]F[-X]\nX --> F%F\n", "cut.lsys");
+    ModuleString s = derive(g, DeriveOptions{.steps = 1});
+    Turtle turtle(g.symbols(), TurtleSettings{});
+    const Skeleton sk = turtle.run(s);
+    REQUIRE(sk.internodes.size() == 4);
+    CHECK(!sk.internodes[0].cut);
+    CHECK(sk.internodes[1].cut);
+    CHECK(!sk.internodes[2].cut);
+    CHECK(sk.internodes[3].cut);
+  }
 }
 
 TEST_CASE("Turtle::tropism", "[lsystem]") {
