@@ -100,6 +100,9 @@ int runAnimate(const AnimateArgs& a, const GlobalOptions& g) {
     throw UsageError("--stages selects derivation steps of a tree or operation stages of a solid; " +
                      speciesOfKind(species.kind) + " animates its whole growth (use --frames-per-stage and --fps)");
   const SpeciesRender& look = species.render;
+  if (look.pair)
+    note(g, std::cerr, "sprig: note: render.pair ('%s') pairs the picture only (sprig render, the gallery's final stage); the animation shows '%s' alone",
+         look.pair->filename().c_str(), species.name.c_str());
   const int lookWidth = look.image.width, lookHeight = look.image.height;
   opt.width = a.width > 0 ? a.width : lookWidth;
   opt.height = a.height > 0 ? a.height : lookHeight;
