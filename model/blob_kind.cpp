@@ -569,7 +569,7 @@ const std::vector<std::string> kTextureKinds = {"image", "color", "noise", "bark
 
 /// What each texture kind is (`sprig schema`'s text for its key).
 std::string_view textureKindHelp(std::string_view kind) {
-  static const std::map<std::string_view, std::string_view> kHelp = {
+  static const HelpTable kHelp = {
       {"image", "An image file (PNG, JPEG, EXR, ...; a path relative to the species file), looked up at (u, v)."},
       {"color", "One constant colour."},
       {"noise", "Two colours mixed by fractal noise (fBm or turbulence)."},
@@ -577,8 +577,7 @@ std::string_view textureKindHelp(std::string_view kind) {
       {"stripes", "Bands of `stripe_color` on `base_color`, across v (or along u with `spiral`)."},
       {"spots", "Round spots of `spot_color` on `base_color`, one per cell of a jittered grid."},
       {"leaf", "A leaf blade with a midrib and lateral veins."}};
-  auto it = kHelp.find(kind);
-  return it == kHelp.end() ? std::string_view() : it->second;
+  return helpIn(kHelp, kind);
 }
 
 uint64_t readSeed(MapReader& m) { return uint64_t(m.integer({"seed", "Seed of the texture's noise or random cells."}, 0, 0)); }

@@ -603,20 +603,20 @@ class ShellModel final : public KindModel {
     std::vector<ExportPart> parts;
     for (auto& [id, mesh] : splitByMaterial(surface)) {
       const auto part = id == kNoPartTexture ? ShellPart::Whorl : ShellPart(id);
-      std::pair<const char*, Vec3> look = {"whorl", colors.whorlColor};
+      std::pair<const char*, Vec3> named = {"whorl", colors.whorlColor};
       switch (part) {
         case ShellPart::Whorl: break;
-        case ShellPart::VarixSpine: look = {"varices", colors.varixColor}; break;
-        case ShellPart::AxialSpine: look = {"spines", colors.axialColor}; break;
-        case ShellPart::Bump: look = {"bumps", colors.bumpColor}; break;
-        case ShellPart::Inside: look = {"inside", colors.insideColor}; break;
+        case ShellPart::VarixSpine: named = {"varices", colors.varixColor}; break;
+        case ShellPart::AxialSpine: named = {"spines", colors.axialColor}; break;
+        case ShellPart::Bump: named = {"bumps", colors.bumpColor}; break;
+        case ShellPart::Inside: named = {"inside", colors.insideColor}; break;
       }
-      auto same = std::find_if(parts.begin(), parts.end(), [&](const ExportPart& p) { return p.name == look.first; });
+      auto same = std::find_if(parts.begin(), parts.end(), [&](const ExportPart& p) { return p.name == named.first; });
       if (same != parts.end()) {
         same->mesh.append(mesh);  // no texture and the whorl's texture are both the whorl
         continue;
       }
-      parts.push_back(ExportPart{look.first, std::move(mesh), PartMaterial{look.first, look.second, implicit.material.roughness, false, nullptr}});
+      parts.push_back(ExportPart{named.first, std::move(mesh), PartMaterial{named.first, named.second, implicit.material.roughness, false, nullptr}});
     }
     render::Material painted;  // as paintPolygonized painted the surface
     painted.baseColor = colors.whorlColor;

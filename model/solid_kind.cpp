@@ -59,7 +59,7 @@ constexpr const char* kVelocityHelp =
 
 /// What each one-key alternative of a solid is (`sprig schema`'s text for its key).
 std::string_view alternativeHelp(std::string_view kind) {
-  static const std::map<std::string_view, std::string_view> kHelp = {
+  static const HelpTable kHelp = {
       {"volume", "One layered volume: a `distance_field`, its `layers` and an optional `velocity`."},
       {"precedence", "Volumes by precedence (§2.3): a list of `{volume: ...}` or `{precedence: [...]}`; the first claims its space, each next fills only what is still unclaimed."},
       {"interior_layer", "A layer stacked inward from the volume's surface, in the order written."},
@@ -76,8 +76,7 @@ std::string_view alternativeHelp(std::string_view kind) {
       {"from_volume_surface", "The outermost interface of a volume or precedence list as a new field (§2.3, Fig. 2c); the inner volumes are part of the solid."},
       {"extrude_2d", "The paper's 2D_EXTRUDE (§5.2): the dark pixels of an image, extruded along `axis` between two heights."},
       {"species", "A Sprig blob, shell, tree or organism species as a field: its final stage meshed as `sprig mesh` does, then its signed distance."}};
-  auto it = kHelp.find(kind);
-  return it == kHelp.end() ? std::string_view() : it->second;
+  return helpIn(kHelp, kind);
 }
 
 

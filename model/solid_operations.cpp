@@ -15,7 +15,7 @@ const std::vector<std::string> kTools = {"hammer", "displace", "polish", "dirt",
 
 /// What each tool does (`sprig schema`'s text for its key).
 std::string_view toolHelp(std::string_view tool) {
-  static const std::map<std::string_view, std::string_view> kHelp = {
+  static const HelpTable kHelp = {
       {"hammer", "A blow (§3.1): a Gaussian sphere of force; the FEM is solved and over-stressed tetrahedra break, loose pieces fall."},
       {"displace", "Push materials (§5.2): the `moving` materials' vertices move by `offset`, the rest follows by linear elasticity."},
       {"polish", "The paper's POLISH (§5.1): subtract a sphere from the `affects` materials and blend those near it toward `shiny`."},
@@ -23,8 +23,7 @@ std::string_view toolHelp(std::string_view tool) {
       {"wash", "REMOVE_DIRT (§3.2, §5.3): falling water particles wash the tint off along their paths."},
       {"erode", "Falling particles (§5.3) remove a sphere of `radius` where each one's life ends."},
       {"lichen", "Lichen (§5.3): particles with minimal motion blend upward-facing surface toward `color`."}};
-  auto it = kHelp.find(tool);
-  return it == kHelp.end() ? std::string_view() : it->second;
+  return helpIn(kHelp, tool);
 }
 
 DVec3 dvec(const Vec3& v) { return DVec3(v); }

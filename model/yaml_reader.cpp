@@ -986,6 +986,11 @@ void describeHelp(const YNode& value, std::string_view help) {
     if (s->help.empty()) s->help = help;
 }
 
+std::string_view helpIn(const HelpTable& table, std::string_view name) {
+  auto it = table.find(name);
+  return it == table.end() ? std::string_view() : it->second;
+}
+
 std::optional<std::pair<YNode, YNode>> singleKey(const YNode& node, DiagnosticList& diags, const std::string& what,
                                                  const std::vector<std::string>& names) {
   std::string definition;

@@ -307,6 +307,13 @@ void describeValue(const YNode& node, std::optional<double> above, const std::ve
 /// takes that alternative; the first text given for a position stays. No effect when reading.
 void describeHelp(const YNode& value, std::string_view help);
 
+/// The texts of choices whose names a reader matches itself (a texture's kind, a field's
+/// form, a tool), for `describeHelp` and `Key`s: name → what it does.
+using HelpTable = std::map<std::string_view, std::string_view>;
+
+/// name's text in table, or empty.
+std::string_view helpIn(const HelpTable& table, std::string_view name);
+
 /// A map with exactly one key among names (`{sphere: {...}}`): that key and its value.
 /// Otherwise adds "WHAT must be a map with one key, one of: A, B" or "unknown WHAT 'K' (did
 /// you mean ...)" at the node and returns nullopt.
