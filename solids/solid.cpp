@@ -371,13 +371,11 @@ std::vector<Vec3> gridNodes(const Grid& g) {
   return nodes;
 }
 
-TetMesh meshSolid(const Solid& solid, const Grid& grid, const MeshOptions& options, MeshStats* stats) {
-  MeshStats st;
-  auto t0 = std::chrono::steady_clock::now();
-  const size_t nv = solid.volumes.size();
-  // 1. Every volume's distance at the grid's nodes, within a band wider than its boundaries.
-  Work w;
-  const std::vector<Vec3> nodes = gridNodes(grid);
+namespace {
+
+/// Step 1 of meshSolid: every volume's distance at the grid's nodes, within a band wider
+/// than its boundaries; values very near a boundary snap onto it.
+void sampleFields(const Solid& solid, const Grid& grid, const std::vector<Vec3>& nodes, double snapFraction, Work& w) {
   w.positions.resize(nodes.size());
   const size_t nx = size_t(grid.cells[0]) + 1, ny = size_t(grid.cells[1]) + 1;
   parallelFor(0, nodes.size(), [&](size_t n) {
@@ -387,24 +385,26 @@ TetMesh meshSolid(const Solid& solid, const Grid& grid, const MeshOptions& optio
     double band = 0;
     for (double b : v.boundaries) band = std::max(band, std::abs(b));
     w.fields.push_back(v.field->sample(nodes, grid.cell, band + 2 * grid.cell));
-    // Snap nodes very near a boundary onto it.
     std::vector<float>& f = w.fields.back();
-    const double snap = options.snapFraction * grid.cell;
+    const double snap = snapFraction * grid.cell;
     parallelFor(0, f.size(), [&](size_t n) {
       for (double b : v.boundaries)
         if (std::abs(double(f[n]) - b) < snap) f[n] = float(b);
     }, 4096);
   }
-  st.fieldSeconds = secondsSince(t0);
-  t0 = std::chrono::steady_clock::now();
+}
 
-  // 2. Five tetrahedra per cube that some volume may claim, on the coarsened octree
-  // (§4.4): a node's class packs its region index in every volume; nodes on a boundary or
-  // in a procedural layer never merge.
-  std::vector<std::pair<double, double>> claims;
-  for (const Volume& v : solid.volumes) claims.push_back(v.claimed());
+/// The nodes' classes for the coarsened octree (§4.4): a node's class packs its region index
+/// in every volume; nodes on a boundary or in a procedural layer are kMixedClass (never
+/// merge) and marked in `procedural` when in a procedural layer.
+struct NodeClasses {
+  int levels = 0;  ///< octree levels of coarsening; 0 when the classes do not fit 63 bits
   std::vector<uint64_t> nodeClass;
-  int levels = options.coarsenLevels;
+  std::vector<uint8_t> procedural;
+};
+
+NodeClasses classifyNodes(const Solid& solid, const Work& w, int levels) {
+  NodeClasses out;
   std::vector<int> bits;
   int totalBits = 0;
   for (const Volume& v : solid.volumes) {
@@ -413,77 +413,88 @@ TetMesh meshSolid(const Solid& solid, const Grid& grid, const MeshOptions& optio
     bits.push_back(b);
     totalBits += b;
   }
-  if (totalBits > 63) levels = 0;
-  std::vector<uint8_t> procedural;  // per node: in a procedural layer (never merged)
-  if (levels > 0) {
-    nodeClass.resize(nodes.size());
-    procedural.assign(nodes.size(), 0);
-    parallelFor(0, nodes.size(), [&](size_t n) {
-      uint64_t k = 0;
-      int shift = 0;
-      bool claimed = false;
-      for (size_t v = 0; v < nv; ++v) {
-        const Volume& vol = solid.volumes[v];
-        const double d = w.fields[v][n];
-        const size_t r = size_t(std::upper_bound(vol.boundaries.begin(), vol.boundaries.end(), d) - vol.boundaries.begin());
-        const bool onBoundary = std::any_of(vol.boundaries.begin(), vol.boundaries.end(), [&](double b) { return double(float(b)) == d; });
-        if (!claimed && vol.regions[r] <= kProcedural0) procedural[n] = 1;
-        if (onBoundary || procedural[n]) {
-          nodeClass[n] = kMixedClass;
-          return;
-        }
-        claimed = claimed || vol.regions[r] != kUnclaimed;
-        k |= uint64_t(r) << shift;
-        shift += bits[v];
+  out.levels = totalBits > 63 ? 0 : levels;
+  if (out.levels <= 0) return out;
+  const size_t count = w.positions.size();
+  out.nodeClass.resize(count);
+  out.procedural.assign(count, 0);
+  parallelFor(0, count, [&](size_t n) {
+    uint64_t k = 0;
+    int shift = 0;
+    bool claimed = false;
+    for (size_t v = 0; v < solid.volumes.size(); ++v) {
+      const Volume& vol = solid.volumes[v];
+      const double d = w.fields[v][n];
+      const size_t r = size_t(std::upper_bound(vol.boundaries.begin(), vol.boundaries.end(), d) - vol.boundaries.begin());
+      const bool onBoundary = std::any_of(vol.boundaries.begin(), vol.boundaries.end(), [&](double b) { return double(float(b)) == d; });
+      if (!claimed && vol.regions[r] <= kProcedural0) out.procedural[n] = 1;
+      if (onBoundary || out.procedural[n]) {
+        out.nodeClass[n] = kMixedClass;
+        return;
       }
-      nodeClass[n] = k;
-    }, 4096);
-  }
-  // Blocks an interface crosses merge where every volume's field is affine on them to
-  // within the tolerance (§4.4: "accurately represented by interpolation"): the coarse
-  // tetrahedra's linear interpolation then puts each interface within that distance of
-  // where the fine cells put it. Volumes whose nodes in the block lie in one region (no
-  // boundary near) do not count; blocks with a node of a procedural layer never merge.
-  MergeTest interpolated;
-  if (levels > 0 && options.coarsenTolerance > 0) {
-    const double eps = options.coarsenTolerance * grid.cell;
-    interpolated = [&, eps](const std::array<int, 3>& base, int s) {
-      auto node = [&](int i, int j, int k) { return size_t(base[0] + i) + nx * (size_t(base[1] + j) + ny * size_t(base[2] + k)); };
+      claimed = claimed || vol.regions[r] != kUnclaimed;
+      k |= uint64_t(r) << shift;
+      shift += bits[v];
+    }
+    out.nodeClass[n] = k;
+  }, 4096);
+  return out;
+}
+
+/// Blocks an interface crosses merge where every volume's field is affine on them to within
+/// eps (§4.4: "accurately represented by interpolation"): the coarse tetrahedra's linear
+/// interpolation then puts each interface within that distance of where the fine cells put
+/// it. Volumes whose nodes in the block lie in one region (no boundary near) do not count;
+/// blocks with a node of a procedural layer never merge.
+MergeTest affineMergeTest(const Solid& solid, const Grid& grid, const Work& w, const std::vector<uint8_t>& procedural, double eps) {
+  const size_t nx = size_t(grid.cells[0]) + 1, ny = size_t(grid.cells[1]) + 1;
+  return [&solid, &w, &procedural, nx, ny, eps](const std::array<int, 3>& base, int s) {
+    auto node = [&](int i, int j, int k) { return size_t(base[0] + i) + nx * (size_t(base[1] + j) + ny * size_t(base[2] + k)); };
+    for (int k = 0; k <= s; ++k)
+      for (int j = 0; j <= s; ++j)
+        for (int i = 0; i <= s; ++i)
+          if (procedural[node(i, j, k)]) return false;
+    for (size_t v = 0; v < solid.volumes.size(); ++v) {
+      const Volume& vol = solid.volumes[v];
+      const std::vector<float>& f = w.fields[v];
+      auto region = [&](float d) { return std::upper_bound(vol.boundaries.begin(), vol.boundaries.end(), double(d)) - vol.boundaries.begin(); };
+      const auto r0 = region(f[node(0, 0, 0)]);
+      bool crossed = false;
+      for (int k = 0; k <= s && !crossed; ++k)
+        for (int j = 0; j <= s && !crossed; ++j)
+          for (int i = 0; i <= s && !crossed; ++i) crossed = region(f[node(i, j, k)]) != r0;
+      if (!crossed) continue;
+      // The affine function of the eight corners (least squares): mean and slopes per cell.
+      double c[8], mean = 0;
+      for (int q = 0; q < 8; ++q) mean += c[q] = f[node((q & 1) * s, ((q >> 1) & 1) * s, ((q >> 2) & 1) * s)];
+      mean /= 8;
+      double g[3] = {0, 0, 0};
+      for (int q = 0; q < 8; ++q)
+        for (int a = 0; a < 3; ++a) g[a] += ((q >> a) & 1 ? c[q] : -c[q]) / (4.0 * s);
+      const double half = s / 2.0;
       for (int k = 0; k <= s; ++k)
         for (int j = 0; j <= s; ++j)
-          for (int i = 0; i <= s; ++i)
-            if (procedural[node(i, j, k)]) return false;
-      for (size_t v = 0; v < nv; ++v) {
-        const Volume& vol = solid.volumes[v];
-        const std::vector<float>& f = w.fields[v];
-        auto region = [&](float d) { return std::upper_bound(vol.boundaries.begin(), vol.boundaries.end(), double(d)) - vol.boundaries.begin(); };
-        const auto r0 = region(f[node(0, 0, 0)]);
-        bool crossed = false;
-        for (int k = 0; k <= s && !crossed; ++k)
-          for (int j = 0; j <= s && !crossed; ++j)
-            for (int i = 0; i <= s && !crossed; ++i) crossed = region(f[node(i, j, k)]) != r0;
-        if (!crossed) continue;
-        // The affine function of the eight corners (least squares): mean and slopes per cell.
-        double c[8], mean = 0;
-        for (int q = 0; q < 8; ++q) mean += c[q] = f[node((q & 1) * s, ((q >> 1) & 1) * s, ((q >> 2) & 1) * s)];
-        mean /= 8;
-        double g[3] = {0, 0, 0};
-        for (int q = 0; q < 8; ++q)
-          for (int a = 0; a < 3; ++a) g[a] += ((q >> a) & 1 ? c[q] : -c[q]) / (4.0 * s);
-        const double half = s / 2.0;
-        for (int k = 0; k <= s; ++k)
-          for (int j = 0; j <= s; ++j)
-            for (int i = 0; i <= s; ++i) {
-              const double fit = mean + g[0] * (i - half) + g[1] * (j - half) + g[2] * (k - half);
-              if (std::abs(double(f[node(i, j, k)]) - fit) > eps) return false;
-            }
-      }
-      return true;
-    };
-  }
+          for (int i = 0; i <= s; ++i) {
+            const double fit = mean + g[0] * (i - half) + g[1] * (j - half) + g[2] * (k - half);
+            if (std::abs(double(f[node(i, j, k)]) - fit) > eps) return false;
+          }
+    }
+    return true;
+  };
+}
+
+/// Step 2 of meshSolid: five tetrahedra per cube that some volume may claim, on the
+/// coarsened octree (§4.4).
+void cellsOfSolid(const Solid& solid, const Grid& grid, const MeshOptions& options, Work& w, MeshStats& st) {
+  std::vector<std::pair<double, double>> claims;
+  for (const Volume& v : solid.volumes) claims.push_back(v.claimed());
+  const NodeClasses classes = classifyNodes(solid, w, options.coarsenLevels);
+  MergeTest interpolated;
+  if (classes.levels > 0 && options.coarsenTolerance > 0)
+    interpolated = affineMergeTest(solid, grid, w, classes.procedural, options.coarsenTolerance * grid.cell);
   CellStats cells;
-  w.tets = cellTetrahedra(grid, levels, nodeClass, [&](const uint32_t* corner) {
-    for (size_t v = 0; v < nv; ++v) {
+  w.tets = cellTetrahedra(grid, classes.levels, classes.nodeClass, [&](const uint32_t* corner) {
+    for (size_t v = 0; v < solid.volumes.size(); ++v) {
       float mn = std::numeric_limits<float>::max(), mx = std::numeric_limits<float>::lowest();
       for (int q = 0; q < 8; ++q) mn = std::min(mn, w.fields[v][corner[q]]), mx = std::max(mx, w.fields[v][corner[q]]);
       if (mx >= claims[v].first && mn <= claims[v].second) return true;
@@ -496,35 +507,29 @@ TetMesh meshSolid(const Solid& solid, const Grid& grid, const MeshOptions& optio
   st.transitionCubes = cells.transition;
   w.active.assign(w.tets.size(), 1);
   w.tag.assign(w.tets.size(), 0);
+}
 
-  // 3. Cut at every boundary of every volume, in precedence order; a volume cuts only where
-  // no earlier volume claims the space (but splits claimed tetrahedra along shared edges).
-  for (size_t v = 0; v < nv; ++v) {
-    if (v > 0)
-      parallelFor(0, w.tets.size(), [&](size_t t) {
-        if (w.active[t] && solid.volumes[v - 1].regionAt(w.centroidValue(v - 1, w.tets[t])) != kUnclaimed) w.active[t] = 0;
-      }, 4096);
-    for (double b : solid.volumes[v].boundaries) st.splits += cutAt(w, v, b);
+/// The region material of tetrahedron t: the first volume claiming its centroid (the fields
+/// are linear in it).
+int regionOf(const Solid& solid, const Work& w, size_t t) {
+  for (size_t v = 0; v < solid.volumes.size(); ++v) {
+    const int m = solid.volumes[v].regionAt(w.centroidValue(v, w.tets[t]));
+    if (m != kUnclaimed) return m;
   }
+  return kUnclaimed;
+}
 
-  // 4. The region material of each tetrahedron: the first volume claiming its centroid
-  // (the fields are linear in it).
-  auto regionOf = [&](size_t t) {
-    for (size_t v = 0; v < nv; ++v) {
-      const int m = solid.volumes[v].regionAt(w.centroidValue(v, w.tets[t]));
-      if (m != kUnclaimed) return m;
-    }
-    return kUnclaimed;
-  };
-  // 5. Tetrahedra of procedural layers are subdivided to follow the procedure (§4.3, last
-  // paragraph): an edge whose ends choose different materials is split where the choice
-  // changes (bisection to 1/1024 of the edge), in every tetrahedron that has it.
+/// Step 5 of meshSolid: tetrahedra of procedural layers are subdivided to follow the
+/// procedure (§4.3, last paragraph): an edge whose ends choose different materials is split
+/// where the choice changes (bisection to 1/1024 of the edge), in every tetrahedron that
+/// has it. Returns the edges split.
+size_t splitProceduralLayers(const Solid& solid, const MeshOptions& options, Work& w) {
+  size_t splits = 0;
   for (size_t p = 0; p < solid.materials.procedural.size(); ++p) {
     const ProceduralMaterial& proc = solid.materials.procedural[p];
     const int code = kProcedural0 - int(p);
     std::vector<uint8_t> in(w.tets.size());
-    parallelFor(0, w.tets.size(), [&](size_t t) { in[t] = regionOf(t) == code; }, 4096);
-    // Where along edge (a, c) the choice changes (bisection to 1/1024 of the edge).
+    parallelFor(0, w.tets.size(), [&](size_t t) { in[t] = regionOf(solid, w, t) == code; }, 4096);
     auto crossing = [&](uint32_t a, uint32_t c) {
       const DVec3 pa = w.positions[a], pc = w.positions[c];
       const int ma = proc.at(pa);
@@ -544,16 +549,20 @@ TetMesh meshSolid(const Solid& solid, const Grid& grid, const MeshOptions& optio
         return x > near && x < 1 - near;
       });
       if (keys.empty()) break;
-      st.splits += keys.size();
+      splits += keys.size();
       for (size_t t = 0; t < in.size(); ++t) w.tag[t] = in[t];
       splitEdges(w, keys, crossing, [](uint32_t) {});
       in.assign(w.tag.begin(), w.tag.end());  // pieces keep their parent's flag
     }
   }
-  // 6. Materials; procedural ones chosen at the centroid.
+  return splits;
+}
+
+/// Step 6 of meshSolid: each tetrahedron's material; procedural ones chosen at the centroid.
+std::vector<int> tetMaterials(const Solid& solid, const Work& w) {
   std::vector<int> material(w.tets.size(), kUnclaimed);
   parallelFor(0, w.tets.size(), [&](size_t t) {
-    int m = regionOf(t);
+    int m = regionOf(solid, w, t);
     if (m <= kProcedural0) {
       const Tet& q = w.tets[t];
       const DVec3 c = (w.positions[q[0]] + w.positions[q[1]] + w.positions[q[2]] + w.positions[q[3]]) * 0.25;
@@ -561,9 +570,31 @@ TetMesh meshSolid(const Solid& solid, const Grid& grid, const MeshOptions& optio
     }
     material[t] = m;
   }, 4096);
+  return material;
+}
 
-  // 7. Keep tetrahedra with a material; renumber the vertices they use in id order.
-  TetMesh mesh = compact(w, material);
+}  // namespace
+
+TetMesh meshSolid(const Solid& solid, const Grid& grid, const MeshOptions& options, MeshStats* stats) {
+  MeshStats st;
+  auto t0 = std::chrono::steady_clock::now();
+  Work w;
+  sampleFields(solid, grid, gridNodes(grid), options.snapFraction, w);  // 1. the fields at the nodes
+  st.fieldSeconds = secondsSince(t0);
+  t0 = std::chrono::steady_clock::now();
+  cellsOfSolid(solid, grid, options, w, st);  // 2. the cells some volume may claim
+  // 3. Cut at every boundary of every volume, in precedence order; a volume cuts only where
+  // no earlier volume claims the space (but splits claimed tetrahedra along shared edges).
+  for (size_t v = 0; v < solid.volumes.size(); ++v) {
+    if (v > 0)
+      parallelFor(0, w.tets.size(), [&](size_t t) {
+        if (w.active[t] && solid.volumes[v - 1].regionAt(w.centroidValue(v - 1, w.tets[t])) != kUnclaimed) w.active[t] = 0;
+      }, 4096);
+    for (double b : solid.volumes[v].boundaries) st.splits += cutAt(w, v, b);
+  }
+  st.splits += splitProceduralLayers(solid, options, w);  // 4-5. procedural layers
+  // 6-7. Keep tetrahedra with a material; renumber the vertices they use in id order.
+  TetMesh mesh = compact(w, tetMaterials(solid, w));
   st.tets = mesh.tets.size();
   st.meshSeconds = secondsSince(t0);
   if (stats) *stats = st;
