@@ -193,6 +193,115 @@ struct PcmStep4 {
   __m128 c, w, half, kHalf, a0;
 };
 
+void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* out);
+
+/// A Ricci blend of n's children: out = m·S^(1/k) per point (RicciAcc).
+void evalRicciB(const Tape& T, const TNode& n, const Pts& pts, const Box3& pbox, float* out) {
+  alignas(32) float tmp[kBlock];
+  alignas(32) float S[kBlock];
+  std::fill(out, out + pts.n8, 0.0f);  // running max m
+  std::fill(S, S + pts.n8, 0.0f);
+  // S >= 1 once a child contributes, so a term (f/m)^n < 2^-25 cannot change it in float:
+  // f < m·2^(-25/n) skips the pow with the same bits (most points of a shell with small
+  // bumps under n = 400). Likewise S == 1 (one contributor) gives m exactly.
+  const float negligible = std::exp2(-25.0f / n.exponent);
+  childrenIn(T, n, pbox, [&](uint32_t c) {
+    evalB(T, c, pts, pbox, tmp);
+    for (int i = 0; i < pts.n; ++i) {
+      if (tmp[i] < out[i] * negligible) continue;
+      RicciAcc a{out[i], S[i]};
+      a.add(tmp[i], n.exponent);
+      out[i] = a.m;
+      S[i] = a.s;
+    }
+  });
+  for (int i = 0; i < pts.n; ++i)
+    out[i] = out[i] > 0.0f ? (S[i] == 1.0f ? out[i] : out[i] * std::pow(S[i], 1.0f / n.exponent)) : 0.0f;
+}
+
+/// A PCM junction of n's children (PcmAccum per point, as structure of arrays).
+void evalPcmB(const Tape& T, const TNode& n, const Pts& pts, const Box3& pbox, float* out) {
+  alignas(32) float tmp[kBlock];
+  // PcmAccum per point, as structure of arrays: out holds f1.
+  alignas(32) float d1[kBlock], f2[kBlock], d2[kBlock], bulge[kBlock];
+  std::fill(out, out + pts.n8, 0.0f);
+  std::fill(d1, d1 + pts.n8, 0.0f);
+  std::fill(f2, f2 + pts.n8, 0.0f);
+  std::fill(d2, d2 + pts.n8, 0.0f);
+  std::fill(bulge, bulge + pts.n8, 0.0f);
+  const PcmStep4 step(params(T, n).pcm);
+  childrenIn(T, n, pbox, [&](uint32_t c) {
+    evalB(T, c, pts, pbox, tmp);
+    for (int i = 0; i < pts.n8; i += 4) step.add(tmp + i, out + i, d1 + i, f2 + i, d2 + i, bulge + i);
+  });
+  for (int i = 0; i < pts.n; ++i) {
+    const PcmAccum acc{out[i], d1[i], f2[i], d2[i], bulge[i]};
+    out[i] = acc.value();
+  }
+}
+
+/// A bend of n's child. Only the points that may reach the child's support (inside the
+/// bend's world box and its oriented box, BendFrame::mayReach) are mapped, an atan2 and a
+/// square root each, and evaluated; the others get 0, as evalS's culling gives them (the
+/// child is 0 outside its support's image).
+void evalBendB(const Tape& T, const TNode& n, const Pts& pts, const Box3& /*pbox*/, float* out) {
+  alignas(32) float tmp[kBlock];
+  const BendFrame& bend = params(T, n).bend;
+  alignas(32) float lx[kBlock], ly[kBlock], lz[kBlock];
+  alignas(32) float cx[kBlock], cy[kBlock], cz[kBlock];
+  uint64_t bits[kBlock / 64] = {};
+  for (int i = 0; i < pts.n8; i += 4)
+    bits[i >> 6] |= uint64_t(mayReach4(bend, n.box, pts.x + i, pts.y + i, pts.z + i)) << (i & 63);
+  if (pts.n & 63) bits[pts.n >> 6] &= (uint64_t(1) << (pts.n & 63)) - 1;  // padding lanes
+  int m = 0;
+  for (uint64_t w : bits) m += __builtin_popcountll(w);
+  if (m == pts.n) {
+    bend.localFromWorld(pts.x, pts.y, pts.z, lx, ly, lz, pts.n8);
+    const Box3 lb = boxOfPoints(lx, ly, lz, pts.n8);
+    Pts lp{lx, ly, lz, pts.n, pts.n8};
+    evalB(T, T.kids[n.first], lp, lb, out);
+    return;
+  }
+  std::fill(out, out + pts.n8, 0.0f);
+  if (m == 0) return;
+  uint16_t at[kBlock];
+  m = 0;
+  for (int k = 0; k < kBlock / 64; ++k)
+    for (uint64_t w = bits[k]; w != 0; w &= w - 1) {
+      const int i = k * 64 + __builtin_ctzll(w);
+      cx[m] = pts.x[i];
+      cy[m] = pts.y[i];
+      cz[m] = pts.z[i];
+      at[m++] = uint16_t(i);
+    }
+  const int m8 = (m + 7) & ~7;
+  for (int i = m; i < m8; ++i) {
+    cx[i] = cx[m - 1];
+    cy[i] = cy[m - 1];
+    cz[i] = cz[m - 1];
+  }
+  bend.localFromWorld(cx, cy, cz, lx, ly, lz, m8);
+  const Box3 lb = boxOfPoints(lx, ly, lz, m8);  // lanes m..m8 repeat lane m - 1
+  Pts lp{lx, ly, lz, m, m8};
+  evalB(T, T.kids[n.first], lp, lb, tmp);
+  for (int k = 0; k < m; ++k) out[at[k]] = tmp[k];
+}
+
+/// A transform, twist or taper of n's child: the points mapped into its frame.
+void evalWarpB(const Tape& T, const TNode& n, const Pts& pts, const Box3& /*pbox*/, float* out) {
+  alignas(32) float lx[kBlock], ly[kBlock], lz[kBlock];
+  Box3 lb;
+  for (int i = 0; i < pts.n8; ++i) {
+    Vec3 q = warpLocal(T, n, Vec3(pts.x[i], pts.y[i], pts.z[i]), nullptr);
+    lx[i] = q.x;
+    ly[i] = q.y;
+    lz[i] = q.z;
+    lb.extend(q);
+  }
+  Pts lp{lx, ly, lz, pts.n, pts.n8};
+  evalB(T, T.kids[n.first], lp, lb, out);
+}
+
 void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* out) {
   const TNode& n = T.nodes[ni];
   if (!pbox.overlaps(n.box)) {
@@ -237,113 +346,16 @@ void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* 
       evalB(T, T.kids[n.first + 1], pts, pbox, tmp);
       for (int i = 0; i < pts.n8; ++i) out[i] = std::max(0.0f, std::min(out[i], 1.0f - tmp[i]));
       return;
-    case NodeKind::Ricci: {
-      alignas(32) float S[kBlock];
-      std::fill(out, out + pts.n8, 0.0f);  // running max m
-      std::fill(S, S + pts.n8, 0.0f);
-      // S >= 1 once a child contributes, so a term (f/m)^n < 2^-25 cannot change it in float:
-      // f < m·2^(-25/n) skips the pow with the same bits (most points of a shell with small
-      // bumps under n = 400). Likewise S == 1 (one contributor) gives m exactly.
-      const float negligible = std::exp2(-25.0f / n.exponent);
-      childrenIn(T, n, pbox, [&](uint32_t c) {
-        evalB(T, c, pts, pbox, tmp);
-        for (int i = 0; i < pts.n; ++i) {
-          if (tmp[i] < out[i] * negligible) continue;
-          RicciAcc a{out[i], S[i]};
-          a.add(tmp[i], n.exponent);
-          out[i] = a.m;
-          S[i] = a.s;
-        }
-      });
-      for (int i = 0; i < pts.n; ++i)
-        out[i] = out[i] > 0.0f ? (S[i] == 1.0f ? out[i] : out[i] * std::pow(S[i], 1.0f / n.exponent)) : 0.0f;
-      return;
-    }
-    case NodeKind::Pcm: {
-      // PcmAccum per point, as structure of arrays: out holds f1.
-      alignas(32) float d1[kBlock], f2[kBlock], d2[kBlock], bulge[kBlock];
-      std::fill(out, out + pts.n8, 0.0f);
-      std::fill(d1, d1 + pts.n8, 0.0f);
-      std::fill(f2, f2 + pts.n8, 0.0f);
-      std::fill(d2, d2 + pts.n8, 0.0f);
-      std::fill(bulge, bulge + pts.n8, 0.0f);
-      const PcmStep4 step(params(T, n).pcm);
-      childrenIn(T, n, pbox, [&](uint32_t c) {
-        evalB(T, c, pts, pbox, tmp);
-        for (int i = 0; i < pts.n8; i += 4) step.add(tmp + i, out + i, d1 + i, f2 + i, d2 + i, bulge + i);
-      });
-      for (int i = 0; i < pts.n; ++i) {
-        const PcmAccum acc{out[i], d1[i], f2[i], d2[i], bulge[i]};
-        out[i] = acc.value();
-      }
-      return;
-    }
+    case NodeKind::Ricci: return evalRicciB(T, n, pts, pbox, out);
+    case NodeKind::Pcm: return evalPcmB(T, n, pts, pbox, out);
     case NodeKind::Negative:
       evalB(T, T.kids[n.first], pts, pbox, out);
       for (int i = 0; i < pts.n8; ++i) out[i] *= -n.weight;
       return;
-    case NodeKind::Bend: {
-      // Only the points that may reach the child's support (inside the bend's world box and
-      // its oriented box, BendFrame::mayReach) are mapped, an atan2 and a square root each,
-      // and evaluated; the others get 0, as evalS's culling gives them (the child is 0
-      // outside its support's image).
-      const BendFrame& bend = params(T, n).bend;
-      alignas(32) float lx[kBlock], ly[kBlock], lz[kBlock];
-      alignas(32) float cx[kBlock], cy[kBlock], cz[kBlock];
-      uint64_t bits[kBlock / 64] = {};
-      for (int i = 0; i < pts.n8; i += 4)
-        bits[i >> 6] |= uint64_t(mayReach4(bend, n.box, pts.x + i, pts.y + i, pts.z + i)) << (i & 63);
-      if (pts.n & 63) bits[pts.n >> 6] &= (uint64_t(1) << (pts.n & 63)) - 1;  // padding lanes
-      int m = 0;
-      for (uint64_t w : bits) m += __builtin_popcountll(w);
-      if (m == pts.n) {
-        bend.localFromWorld(pts.x, pts.y, pts.z, lx, ly, lz, pts.n8);
-        const Box3 lb = boxOfPoints(lx, ly, lz, pts.n8);
-        Pts lp{lx, ly, lz, pts.n, pts.n8};
-        evalB(T, T.kids[n.first], lp, lb, out);
-        return;
-      }
-      std::fill(out, out + pts.n8, 0.0f);
-      if (m == 0) return;
-      uint16_t at[kBlock];
-      m = 0;
-      for (int k = 0; k < kBlock / 64; ++k)
-        for (uint64_t w = bits[k]; w != 0; w &= w - 1) {
-          const int i = k * 64 + __builtin_ctzll(w);
-          cx[m] = pts.x[i];
-          cy[m] = pts.y[i];
-          cz[m] = pts.z[i];
-          at[m++] = uint16_t(i);
-        }
-      const int m8 = (m + 7) & ~7;
-      for (int i = m; i < m8; ++i) {
-        cx[i] = cx[m - 1];
-        cy[i] = cy[m - 1];
-        cz[i] = cz[m - 1];
-      }
-      bend.localFromWorld(cx, cy, cz, lx, ly, lz, m8);
-      const Box3 lb = boxOfPoints(lx, ly, lz, m8);  // lanes m..m8 repeat lane m - 1
-      Pts lp{lx, ly, lz, m, m8};
-      evalB(T, T.kids[n.first], lp, lb, tmp);
-      for (int k = 0; k < m; ++k) out[at[k]] = tmp[k];
-      return;
-    }
+    case NodeKind::Bend: return evalBendB(T, n, pts, pbox, out);
     case NodeKind::Transform:
     case NodeKind::Twist:
-    case NodeKind::Taper: {
-      alignas(32) float lx[kBlock], ly[kBlock], lz[kBlock];
-      Box3 lb;
-      for (int i = 0; i < pts.n8; ++i) {
-        Vec3 q = warpLocal(T, n, Vec3(pts.x[i], pts.y[i], pts.z[i]), nullptr);
-        lx[i] = q.x;
-        ly[i] = q.y;
-        lz[i] = q.z;
-        lb.extend(q);
-      }
-      Pts lp{lx, ly, lz, pts.n, pts.n8};
-      evalB(T, T.kids[n.first], lp, lb, out);
-      return;
-    }
+    case NodeKind::Taper: return evalWarpB(T, n, pts, pbox, out);
     default: std::fill(out, out + pts.n8, 0.0f); return;
   }
 }
