@@ -9,14 +9,82 @@
 #include "core/parallel.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
+#include <span>
 #include <string_view>
 #include <unordered_map>
+#include <vector>
 
 namespace sprig::blobtree {
 
 using namespace detail;
+
+namespace {
+
+/// A cube of the octree search: its index at its level (edge E / 2^level).
+struct Item {
+  std::array<int32_t, 3> idx;
+  int level;
+};
+
+/// The eight children of it, in the order c = x + 2y + 4z (or the reverse).
+template <class Fn>
+void forChildren(const Item& it, bool reverse, Fn&& fn) {
+  for (int k = 0; k < 8; ++k) {
+    const int c = reverse ? 7 - k : k;
+    fn(Item{{it.idx[0] * 2 + (c & 1), it.idx[1] * 2 + ((c >> 1) & 1), it.idx[2] * 2 + ((c >> 2) & 1)}, it.level + 1});
+  }
+}
+
+/// The distinct pruned-tape keys of every cell, in cell order (deterministic): keysOf[k]
+/// holds subtree k's keys end to end, keyEnd[k][i] ends cell i's. Sets each cell's `tape`
+/// to its key's index among the distinct ones.
+std::vector<std::span<const uint32_t>> distinctKeys(const std::vector<std::vector<uint32_t>>& keysOf,
+                                                    const std::vector<std::vector<uint32_t>>& keyEnd,
+                                                    std::vector<std::vector<Cell>>& cellsOf) {
+  std::unordered_map<std::string_view, uint32_t> index;
+  std::vector<std::span<const uint32_t>> distinct;
+  for (size_t k = 0; k < cellsOf.size(); ++k) {
+    uint32_t start = 0;
+    for (size_t i = 0; i < cellsOf[k].size(); ++i) {
+      std::span<const uint32_t> key(keysOf[k].data() + start, keyEnd[k][i] - start);
+      start = keyEnd[k][i];
+      std::string_view bytes(reinterpret_cast<const char*>(key.data()), key.size_bytes());
+      auto [it, fresh] = index.try_emplace(bytes, uint32_t(distinct.size()));
+      if (fresh) distinct.push_back(key);
+      cellsOf[k][i].tape = it->second;
+    }
+  }
+  return distinct;
+}
+
+/// Subtrees' cells and primitive lists concatenated in order into out, in parallel into
+/// arrays sized once (the cells of a fine grid are hundreds of MB: growing them by
+/// push_back copied and faulted them in again at every doubling, on one thread).
+void concatenate(std::vector<std::vector<Cell>>& cellsOf, const std::vector<std::vector<uint32_t>>& primsOf, CellSet& out) {
+  std::vector<size_t> cellBase(cellsOf.size() + 1, 0), primBase(cellsOf.size() + 1, 0);
+  for (size_t k = 0; k < cellsOf.size(); ++k) {
+    cellBase[k + 1] = cellBase[k] + cellsOf[k].size();
+    primBase[k + 1] = primBase[k] + primsOf[k].size();
+  }
+  out.cells.resize(cellBase.back());
+  out.primitives.resize(primBase.back());
+  parallelFor(0, cellsOf.size(), [&](size_t k) {
+    const uint32_t base = uint32_t(primBase[k]);
+    Cell* dst = out.cells.data() + cellBase[k];
+    for (const Cell& c : cellsOf[k]) {
+      *dst = c;
+      dst->firstPrimitive += base;
+      ++dst;
+    }
+    std::copy(primsOf[k].begin(), primsOf[k].end(), out.primitives.begin() + long(primBase[k]));
+    std::vector<Cell>().swap(cellsOf[k]);
+  }, 1);
+}
+
+}  // namespace
 
 CellSet CompiledBlob::surfaceCells(float cellSize, const SurfaceCellOptions& options) const {
   if (!(cellSize > 0.0f)) throw std::invalid_argument("surfaceCells: cellSize must be positive");
@@ -34,10 +102,6 @@ CellSet CompiledBlob::surfaceCells(float cellSize, const SurfaceCellOptions& opt
   out.cellSize = edge;
   const Tape& T = *tape_;
 
-  struct Item {
-    std::array<int32_t, 3> idx;
-    int level;
-  };
   // Both faces from the grid (origin + index·e), never lo + e: the neighbour's lo is computed
   // the same way, so adjacent cells share their faces bit for bit and tile space without
   // cracks (lo + e may round an ulp short, and a ray running inside that crack, such as one
@@ -56,8 +120,7 @@ CellSet CompiledBlob::surfaceCells(float cellSize, const SurfaceCellOptions& opt
     std::vector<Item> next;
     for (const Item& it : frontier) {
       if (!valueBounds(boxOf(it)).contains(kIso)) continue;
-      for (int c = 0; c < 8; ++c)
-        next.push_back({{it.idx[0] * 2 + (c & 1), it.idx[1] * 2 + ((c >> 1) & 1), it.idx[2] * 2 + ((c >> 2) & 1)}, l + 1});
+      forChildren(it, false, [&](const Item& child) { next.push_back(child); });
     }
     frontier = std::move(next);
   }
@@ -77,9 +140,7 @@ CellSet CompiledBlob::surfaceCells(float cellSize, const SurfaceCellOptions& opt
       Interval iv = valueBounds(b);
       if (!iv.contains(kIso)) continue;
       if (it.level < depth) {
-        for (int c = 7; c >= 0; --c)
-          stack.push_back({{it.idx[0] * 2 + (c & 1), it.idx[1] * 2 + ((c >> 1) & 1), it.idx[2] * 2 + ((c >> 2) & 1)},
-                           it.level + 1});
+        forChildren(it, true, [&](const Item& child) { stack.push_back(child); });
         continue;
       }
       Cell cell;
@@ -104,20 +165,8 @@ CellSet CompiledBlob::surfaceCells(float cellSize, const SurfaceCellOptions& opt
     }
   }, 1);
   if (options.prunedTapes) {
-    // Deduplicate keys in cell order (deterministic), then build each distinct tape once.
-    std::unordered_map<std::string_view, uint32_t> index;
-    std::vector<std::span<const uint32_t>> distinct;
-    for (size_t k = 0; k < frontier.size(); ++k) {
-      uint32_t start = 0;
-      for (size_t i = 0; i < cellsOf[k].size(); ++i) {
-        std::span<const uint32_t> key(keysOf[k].data() + start, keyEnd[k][i] - start);
-        start = keyEnd[k][i];
-        std::string_view bytes(reinterpret_cast<const char*>(key.data()), key.size_bytes());
-        auto [it, fresh] = index.try_emplace(bytes, uint32_t(distinct.size()));
-        if (fresh) distinct.push_back(key);
-        cellsOf[k][i].tape = it->second;
-      }
-    }
+    // Each distinct tape built once.
+    const std::vector<std::span<const uint32_t>> distinct = distinctKeys(keysOf, keyEnd, cellsOf);
     out.tapes.resize(distinct.size());
     parallelFor(0, distinct.size(), [&](size_t i) {
       CompiledBlob b;
@@ -129,27 +178,7 @@ CellSet CompiledBlob::surfaceCells(float cellSize, const SurfaceCellOptions& opt
         for (Cell& c : cellsOf[k]) c.lipschitz = out.tapes[c.tape].lipschitz(c.box);
       }, 1);
   }
-  // Subtrees concatenated in order, in parallel into arrays sized once (the cells of a
-  // fine grid are hundreds of MB: growing them by push_back copied and faulted them in
-  // again at every doubling, on one thread).
-  std::vector<size_t> cellBase(frontier.size() + 1, 0), primBase(frontier.size() + 1, 0);
-  for (size_t k = 0; k < frontier.size(); ++k) {
-    cellBase[k + 1] = cellBase[k] + cellsOf[k].size();
-    primBase[k + 1] = primBase[k] + primsOf[k].size();
-  }
-  out.cells.resize(cellBase.back());
-  out.primitives.resize(primBase.back());
-  parallelFor(0, frontier.size(), [&](size_t k) {
-    const uint32_t base = uint32_t(primBase[k]);
-    Cell* dst = out.cells.data() + cellBase[k];
-    for (const Cell& c : cellsOf[k]) {
-      *dst = c;
-      dst->firstPrimitive += base;
-      ++dst;
-    }
-    std::copy(primsOf[k].begin(), primsOf[k].end(), out.primitives.begin() + long(primBase[k]));
-    std::vector<Cell>().swap(cellsOf[k]);
-  }, 1);
+  concatenate(cellsOf, primsOf, out);
   return out;
 }
 
