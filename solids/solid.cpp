@@ -750,171 +750,209 @@ std::vector<InterfaceTriangle> materialInterfaces(const TetMesh& mesh) {
   return out;
 }
 
-BoundarySurface boundarySurface(const TetMesh& mesh, const std::vector<uint8_t>& selected, double pull) {
-  auto in = [&](uint32_t t) { return selected.empty() || selected[t] != 0; };
-  // 1. The boundary triangles: faces of a selected tetrahedron no other selected one shares.
-  const std::vector<FaceRef> faces = sortedFaces(mesh);
-  std::vector<InterfaceTriangle> tris;
-  std::vector<uint32_t> tetOf;
-  for (size_t i = 0; i < faces.size();) {
-    size_t j = i + 1;
-    while (j < faces.size() && faces[j].key == faces[i].key) ++j;
-    size_t n = 0, last = i;
-    for (size_t k = i; k < j; ++k)
-      if (in(faces[k].tet)) ++n, last = k;
-    if (n == 1) {
-      tris.push_back(triangleOf(mesh, faces[last]));
-      tetOf.push_back(faces[last].tet);
-    }
-    i = j;
-  }
-  const size_t nt = tris.size();
+namespace {
 
-  // 2. Pair the triangles at each edge: two at an edge are one wedge; at an edge of 2k > 2,
-  // the selected tetrahedra around it are joined through their faces at the edge into
-  // wedges, and each wedge's two boundary triangles are paired.
-  std::vector<std::pair<uint64_t, uint32_t>> halfEdges;  // (edge, triangle)
-  halfEdges.reserve(nt * 3);
-  for (size_t t = 0; t < nt; ++t)
-    for (int e = 0; e < 3; ++e) halfEdges.push_back({edgeKey(tris[t].v[size_t(e)], tris[t].v[size_t((e + 1) % 3)]), uint32_t(t)});
-  std::sort(halfEdges.begin(), halfEdges.end());
-  std::vector<uint32_t> parent(nt * 3);
-  for (size_t c = 0; c < parent.size(); ++c) parent[c] = uint32_t(c);
-  auto find = [&](uint32_t a) {
-    while (parent[a] != a) a = parent[a] = parent[parent[a]];
-    return a;
-  };
-  auto corner = [&](uint32_t t, uint32_t v) {
-    const auto& q = tris[t].v;
-    return uint32_t(3 * t + size_t(std::find(q.begin(), q.end(), v) - q.begin()));
-  };
-  auto pair = [&](uint32_t s, uint32_t t, uint64_t e) {
-    for (uint32_t v : {uint32_t(e >> 32), uint32_t(e & 0xffffffffu)}) parent[find(corner(s, v))] = find(corner(t, v));
-  };
-  std::vector<uint32_t> start, items;  // selected tetrahedra by vertex, built at the first pinched edge
+/// boundarySurface's work: the boundary triangles of the selected tetrahedra, their corners
+/// joined across edges by union-find, and the wedges at pinched edges.
+class BoundaryBuilder {
+ public:
+  BoundaryBuilder(const TetMesh& mesh, const std::vector<uint8_t>& selected) : mesh_(mesh), selected_(selected) {}
+
+  BoundarySurface build(double pull) {
+    collectTriangles();
+    pairAtEdges();
+    BoundarySurface out;
+    std::vector<uint8_t> moved = numberVertices(out);
+    splitPinchedEdges(out, moved);
+    pullMoved(out, moved, pull);
+    return out;
+  }
+
+ private:
   struct Wedge {
     uint64_t edge;  ///< mesh vertex ids
     uint32_t s, t;  ///< its two triangles
   };
-  std::vector<Wedge> wedges;  // at the edges of more than two triangles, in edge order
-  for (size_t i = 0; i < halfEdges.size();) {
-    size_t j = i + 1;
-    while (j < halfEdges.size() && halfEdges[j].first == halfEdges[i].first) ++j;
-    const uint64_t e = halfEdges[i].first;
-    if (j - i == 2) pair(halfEdges[i].second, halfEdges[i + 1].second, e);
-    if (j - i > 2) {
-      if (start.empty()) {
-        start.assign(mesh.positions.size() + 1, 0);
-        for (size_t t = 0; t < mesh.tets.size(); ++t)
-          if (in(uint32_t(t)))
-            for (uint32_t v : mesh.tets[t]) ++start[v + 1];
-        for (size_t v = 0; v + 1 < start.size(); ++v) start[v + 1] += start[v];
-        items.resize(start.back());
-        std::vector<uint32_t> at(start.begin(), start.end() - 1);
-        for (size_t t = 0; t < mesh.tets.size(); ++t)
-          if (in(uint32_t(t)))
-            for (uint32_t v : mesh.tets[t]) items[at[v]++] = uint32_t(t);
-      }
-      const uint32_t a = uint32_t(e >> 32), b = uint32_t(e & 0xffffffffu);
-      std::vector<uint32_t> star;
-      for (uint32_t k = start[a]; k < start[a + 1]; ++k) {
-        const auto& q = mesh.tets[items[k]];
-        if (std::find(q.begin(), q.end(), b) != q.end()) star.push_back(items[k]);
-      }
-      std::vector<uint32_t> wedge(star.size());
-      for (size_t k = 0; k < wedge.size(); ++k) wedge[k] = uint32_t(k);
-      auto root = [&](uint32_t x) {
-        while (wedge[x] != x) x = wedge[x] = wedge[wedge[x]];
-        return x;
-      };
-      for (size_t x = 0; x < star.size(); ++x)
-        for (size_t y = x + 1; y < star.size(); ++y) {
-          int common = 0;
-          for (uint32_t v : mesh.tets[star[x]])
-            common += std::find(mesh.tets[star[y]].begin(), mesh.tets[star[y]].end(), v) != mesh.tets[star[y]].end() ? 1 : 0;
-          if (common == 3) wedge[root(uint32_t(x))] = root(uint32_t(y));
-        }
-      // Each triangle's wedge; the two triangles of a wedge are paired.
-      std::vector<std::pair<uint32_t, uint32_t>> byWedge;  // (wedge root, triangle)
-      for (size_t k = i; k < j; ++k) {
-        const uint32_t t = halfEdges[k].second;
-        const size_t x = size_t(std::find(star.begin(), star.end(), tetOf[t]) - star.begin());
-        byWedge.push_back({root(uint32_t(x)), t});
-      }
-      std::sort(byWedge.begin(), byWedge.end());
-      for (size_t k = 0; k + 1 < byWedge.size(); ++k)
-        if (byWedge[k].first == byWedge[k + 1].first) {
-          pair(byWedge[k].second, byWedge[k + 1].second, e);
-          wedges.push_back({e, byWedge[k].second, byWedge[k + 1].second});
-          ++k;
-        }
-    }
-    i = j;
-  }
-
-  // 3. One surface vertex per group of corners, numbered by (mesh vertex, first corner).
   struct Group {
     uint32_t vertex, first, root;
   };
-  std::vector<Group> groups;
-  std::vector<uint32_t> seen(nt * 3, UINT32_MAX);
-  for (uint32_t c = 0; c < nt * 3; ++c) {
-    const uint32_t r = find(c);
-    if (seen[r] != UINT32_MAX) continue;
-    seen[r] = 0;
-    groups.push_back({tris[c / 3].v[c % 3], c, r});
-  }
-  std::sort(groups.begin(), groups.end(), [](const Group& x, const Group& y) {
-    return x.vertex != y.vertex ? x.vertex < y.vertex : x.first < y.first;
-  });
-  BoundarySurface out;
-  for (size_t g = 0; g < groups.size(); ++g) {
-    seen[groups[g].root] = uint32_t(g);
-    out.sources.push_back({groups[g].vertex, groups[g].vertex});
-    out.positions.push_back(mesh.positions[groups[g].vertex]);
-    if (g > 0 && groups[g].vertex == groups[g - 1].vertex && (g < 2 || groups[g - 2].vertex != groups[g].vertex)) ++out.splitVertices;
-  }
-  out.triangles = tris;
-  for (uint32_t c = 0; c < nt * 3; ++c) out.triangles[c / 3].v[c % 3] = seen[find(c)];
 
-  // 4. Edges still of more than two triangles: the first wedge keeps the edge, each other
-  // wedge's triangles are split at a midpoint vertex of their own.
-  std::vector<uint8_t> moved(out.positions.size(), 0);
-  for (size_t g = 0; g < groups.size(); ++g)
-    moved[g] = (g > 0 && groups[g - 1].vertex == groups[g].vertex) || (g + 1 < groups.size() && groups[g + 1].vertex == groups[g].vertex);
-  tetOf.resize(nt);
-  {
-    std::map<uint64_t, std::vector<uint32_t>> onEdge;  // surface edge -> its wedges (indices into wedges)
-    std::vector<std::pair<uint32_t, uint32_t>> halves;  // (triangle, a half split off it)
-    for (size_t w = 0; w < wedges.size(); ++w) {
-      const uint32_t a = uint32_t(wedges[w].edge >> 32), b = uint32_t(wedges[w].edge & 0xffffffffu);
-      const auto& q = out.triangles[wedges[w].s].v;
-      const uint32_t sa = q[size_t(std::find(tris[wedges[w].s].v.begin(), tris[wedges[w].s].v.end(), a) - tris[wedges[w].s].v.begin())];
-      const uint32_t sb = q[size_t(std::find(tris[wedges[w].s].v.begin(), tris[wedges[w].s].v.end(), b) - tris[wedges[w].s].v.begin())];
-      onEdge[edgeKey(sa, sb)].push_back(uint32_t(w));
+  bool in(uint32_t t) const { return selected_.empty() || selected_[t] != 0; }
+
+  uint32_t find(uint32_t a) {
+    while (parent_[a] != a) a = parent_[a] = parent_[parent_[a]];
+    return a;
+  }
+
+  uint32_t corner(uint32_t t, uint32_t v) const {
+    const auto& q = tris_[t].v;
+    return uint32_t(3 * t + size_t(std::find(q.begin(), q.end(), v) - q.begin()));
+  }
+
+  /// Joins the corners of triangles s and t at edge e's two vertices.
+  void pair(uint32_t s, uint32_t t, uint64_t e) {
+    for (uint32_t v : {uint32_t(e >> 32), uint32_t(e & 0xffffffffu)}) parent_[find(corner(s, v))] = find(corner(t, v));
+  }
+
+  /// 1. The boundary triangles: faces of a selected tetrahedron no other selected one shares.
+  void collectTriangles() {
+    const std::vector<FaceRef> faces = sortedFaces(mesh_);
+    for (size_t i = 0; i < faces.size();) {
+      size_t j = i + 1;
+      while (j < faces.size() && faces[j].key == faces[i].key) ++j;
+      size_t n = 0, last = i;
+      for (size_t k = i; k < j; ++k)
+        if (in(faces[k].tet)) ++n, last = k;
+      if (n == 1) {
+        tris_.push_back(triangleOf(mesh_, faces[last]));
+        tetOf_.push_back(faces[last].tet);
+      }
+      i = j;
     }
+    parent_.resize(tris_.size() * 3);
+    for (size_t c = 0; c < parent_.size(); ++c) parent_[c] = uint32_t(c);
+  }
+
+  /// 2. Pair the triangles at each edge: two at an edge are one wedge; at an edge of 2k > 2,
+  /// see pairPinched.
+  void pairAtEdges() {
+    std::vector<std::pair<uint64_t, uint32_t>> halfEdges;  // (edge, triangle)
+    halfEdges.reserve(tris_.size() * 3);
+    for (size_t t = 0; t < tris_.size(); ++t)
+      for (int e = 0; e < 3; ++e) halfEdges.push_back({edgeKey(tris_[t].v[size_t(e)], tris_[t].v[size_t((e + 1) % 3)]), uint32_t(t)});
+    std::sort(halfEdges.begin(), halfEdges.end());
+    for (size_t i = 0; i < halfEdges.size();) {
+      size_t j = i + 1;
+      while (j < halfEdges.size() && halfEdges[j].first == halfEdges[i].first) ++j;
+      if (j - i == 2) pair(halfEdges[i].second, halfEdges[i + 1].second, halfEdges[i].first);
+      if (j - i > 2) {
+        std::vector<uint32_t> around;
+        for (size_t k = i; k < j; ++k) around.push_back(halfEdges[k].second);
+        pairPinched(halfEdges[i].first, around);
+      }
+      i = j;
+    }
+  }
+
+  /// The selected tetrahedra by vertex (CSR), built at the first pinched edge.
+  void indexTetsByVertex() {
+    start_.assign(mesh_.positions.size() + 1, 0);
+    for (size_t t = 0; t < mesh_.tets.size(); ++t)
+      if (in(uint32_t(t)))
+        for (uint32_t v : mesh_.tets[t]) ++start_[v + 1];
+    for (size_t v = 0; v + 1 < start_.size(); ++v) start_[v + 1] += start_[v];
+    items_.resize(start_.back());
+    std::vector<uint32_t> at(start_.begin(), start_.end() - 1);
+    for (size_t t = 0; t < mesh_.tets.size(); ++t)
+      if (in(uint32_t(t)))
+        for (uint32_t v : mesh_.tets[t]) items_[at[v]++] = uint32_t(t);
+  }
+
+  /// An edge e of more than two boundary triangles (around): the selected tetrahedra around
+  /// it are joined through their faces at the edge into wedges, and each wedge's two
+  /// boundary triangles are paired.
+  void pairPinched(uint64_t e, const std::vector<uint32_t>& around) {
+    if (start_.empty()) indexTetsByVertex();
+    const uint32_t a = uint32_t(e >> 32), b = uint32_t(e & 0xffffffffu);
+    std::vector<uint32_t> star;
+    for (uint32_t k = start_[a]; k < start_[a + 1]; ++k) {
+      const auto& q = mesh_.tets[items_[k]];
+      if (std::find(q.begin(), q.end(), b) != q.end()) star.push_back(items_[k]);
+    }
+    std::vector<uint32_t> wedge(star.size());
+    for (size_t k = 0; k < wedge.size(); ++k) wedge[k] = uint32_t(k);
+    auto root = [&](uint32_t x) {
+      while (wedge[x] != x) x = wedge[x] = wedge[wedge[x]];
+      return x;
+    };
+    for (size_t x = 0; x < star.size(); ++x)
+      for (size_t y = x + 1; y < star.size(); ++y) {
+        int common = 0;
+        for (uint32_t v : mesh_.tets[star[x]])
+          common += std::find(mesh_.tets[star[y]].begin(), mesh_.tets[star[y]].end(), v) != mesh_.tets[star[y]].end() ? 1 : 0;
+        if (common == 3) wedge[root(uint32_t(x))] = root(uint32_t(y));
+      }
+    // Each triangle's wedge; the two triangles of a wedge are paired.
+    std::vector<std::pair<uint32_t, uint32_t>> byWedge;  // (wedge root, triangle)
+    for (uint32_t t : around) {
+      const size_t x = size_t(std::find(star.begin(), star.end(), tetOf_[t]) - star.begin());
+      byWedge.push_back({root(uint32_t(x)), t});
+    }
+    std::sort(byWedge.begin(), byWedge.end());
+    for (size_t k = 0; k + 1 < byWedge.size(); ++k)
+      if (byWedge[k].first == byWedge[k + 1].first) {
+        pair(byWedge[k].second, byWedge[k + 1].second, e);
+        wedges_.push_back({e, byWedge[k].second, byWedge[k + 1].second});
+        ++k;
+      }
+  }
+
+  /// 3. One surface vertex per group of corners, numbered by (mesh vertex, first corner).
+  /// Returns, per surface vertex, whether it is one of several for its mesh vertex.
+  std::vector<uint8_t> numberVertices(BoundarySurface& out) {
+    const size_t nt = tris_.size();
+    std::vector<Group> groups;
+    std::vector<uint32_t> seen(nt * 3, UINT32_MAX);
+    for (uint32_t c = 0; c < nt * 3; ++c) {
+      const uint32_t r = find(c);
+      if (seen[r] != UINT32_MAX) continue;
+      seen[r] = 0;
+      groups.push_back({tris_[c / 3].v[c % 3], c, r});
+    }
+    std::sort(groups.begin(), groups.end(), [](const Group& x, const Group& y) {
+      return x.vertex != y.vertex ? x.vertex < y.vertex : x.first < y.first;
+    });
+    for (size_t g = 0; g < groups.size(); ++g) {
+      seen[groups[g].root] = uint32_t(g);
+      out.sources.push_back({groups[g].vertex, groups[g].vertex});
+      out.positions.push_back(mesh_.positions[groups[g].vertex]);
+      if (g > 0 && groups[g].vertex == groups[g - 1].vertex && (g < 2 || groups[g - 2].vertex != groups[g].vertex)) ++out.splitVertices;
+    }
+    out.triangles = tris_;
+    for (uint32_t c = 0; c < nt * 3; ++c) out.triangles[c / 3].v[c % 3] = seen[find(c)];
+    std::vector<uint8_t> moved(out.positions.size(), 0);
+    for (size_t g = 0; g < groups.size(); ++g)
+      moved[g] = (g > 0 && groups[g - 1].vertex == groups[g].vertex) || (g + 1 < groups.size() && groups[g + 1].vertex == groups[g].vertex);
+    return moved;
+  }
+
+  /// The surface vertex of triangle t (in out) at mesh vertex v of its original.
+  uint32_t surfaceVertex(const BoundarySurface& out, uint32_t t, uint32_t v) const {
+    const auto& orig = tris_[t].v;
+    return out.triangles[t].v[size_t(std::find(orig.begin(), orig.end(), v) - orig.begin())];
+  }
+
+  /// 4. Edges still of more than two triangles: the first wedge keeps the edge, each other
+  /// wedge's triangles are split at a midpoint vertex of their own.
+  void splitPinchedEdges(BoundarySurface& out, std::vector<uint8_t>& moved) {
+    std::map<uint64_t, std::vector<uint32_t>> onEdge;  // surface edge -> its wedges (indices into wedges_)
+    for (size_t w = 0; w < wedges_.size(); ++w) {
+      const uint32_t a = uint32_t(wedges_[w].edge >> 32), b = uint32_t(wedges_[w].edge & 0xffffffffu);
+      onEdge[edgeKey(surfaceVertex(out, wedges_[w].s, a), surfaceVertex(out, wedges_[w].s, b))].push_back(uint32_t(w));
+    }
+    std::vector<std::pair<uint32_t, uint32_t>> halves;  // (triangle, a half split off it)
     for (const auto& entry : onEdge) {
       // Not a structured binding: the lambda below uses the key, and clang 14 (the sanitizer
       // build's compiler) does not let lambdas capture structured bindings.
       const auto key = entry.first;
       const auto& list = entry.second;
-      if (list.size() < 2) continue;
+      // The edge's place in triangle t, or -1.
+      auto edgeAt = [&](uint32_t t) {
+        const auto& v = out.triangles[t].v;
+        for (int e = 0; e < 3; ++e)
+          if (edgeKey(v[size_t(e)], v[size_t((e + 1) % 3)]) == key) return e;
+        return -1;
+      };
       for (size_t k = 1; k < list.size(); ++k) {
-        const Wedge& w = wedges[list[k]];
+        const Wedge& w = wedges_[list[k]];
         const uint32_t m = uint32_t(out.positions.size());
         const uint32_t a = uint32_t(w.edge >> 32), b = uint32_t(w.edge & 0xffffffffu);
-        out.positions.push_back(0.5 * (mesh.positions[a] + mesh.positions[b]));
+        out.positions.push_back(0.5 * (mesh_.positions[a] + mesh_.positions[b]));
         out.sources.push_back({a, b});
         moved.push_back(1);
         ++out.splitEdges;
         for (uint32_t t0 : {w.s, w.t}) {
           // The triangle holding the edge: t0 or a half of it split at another edge.
-          auto edgeAt = [&](uint32_t t) {
-            const auto& v = out.triangles[t].v;
-            for (int e = 0; e < 3; ++e)
-              if (edgeKey(v[size_t(e)], v[size_t((e + 1) % 3)]) == key) return e;
-            return -1;
-          };
           uint32_t t = t0;
           int e = edgeAt(t);
           for (size_t h = 0; e < 0 && h < halves.size(); ++h)
@@ -926,31 +964,45 @@ BoundarySurface boundarySurface(const TetMesh& mesh, const std::vector<uint8_t>&
           second.v[size_t(e)] = m;
           halves.push_back({t0, uint32_t(out.triangles.size())});
           out.triangles.push_back(second);
-          tetOf.push_back(tetOf[t]);
+          tetOf_.push_back(tetOf_[t]);
         }
       }
     }
   }
 
-  // 5. Pull the moved surface vertices into their own sheets.
-  if (pull > 0 && std::find(moved.begin(), moved.end(), 1) != moved.end()) {
+  /// 5. Pull the moved surface vertices into their own sheets.
+  void pullMoved(BoundarySurface& out, const std::vector<uint8_t>& moved, double pull) const {
+    if (!(pull > 0) || std::find(moved.begin(), moved.end(), 1) == moved.end()) return;
     const size_t ns = out.positions.size();
     std::vector<DVec3> toward(ns, DVec3(0.0)), at(ns);
-    for (size_t s = 0; s < ns; ++s) at[s] = 0.5 * (mesh.positions[out.sources[s][0]] + mesh.positions[out.sources[s][1]]);
+    for (size_t s = 0; s < ns; ++s) at[s] = 0.5 * (mesh_.positions[out.sources[s][0]] + mesh_.positions[out.sources[s][1]]);
     std::vector<double> shortest(ns, INFINITY);
     for (size_t t = 0; t < out.triangles.size(); ++t)
       for (size_t c = 0; c < 3; ++c) {
         const uint32_t s = out.triangles[t].v[c];
         if (!moved[s]) continue;
-        const auto& q = mesh.tets[tetOf[t]];
-        toward[s] += (mesh.positions[q[0]] + mesh.positions[q[1]] + mesh.positions[q[2]] + mesh.positions[q[3]]) * 0.25 - at[s];
+        const auto& q = mesh_.tets[tetOf_[t]];
+        toward[s] += (mesh_.positions[q[0]] + mesh_.positions[q[1]] + mesh_.positions[q[2]] + mesh_.positions[q[3]]) * 0.25 - at[s];
         for (uint32_t o : out.triangles[t].v)
           if (o != s) shortest[s] = std::min(shortest[s], glm::length(at[o] - at[s]));
       }
     for (size_t s = 0; s < ns; ++s)
       if (moved[s] && glm::length(toward[s]) > 0) out.positions[s] = at[s] + pull * shortest[s] * glm::normalize(toward[s]);
   }
-  return out;
+
+  const TetMesh& mesh_;
+  const std::vector<uint8_t>& selected_;
+  std::vector<InterfaceTriangle> tris_;
+  std::vector<uint32_t> tetOf_;   ///< the tetrahedron of each triangle (and of each half split off)
+  std::vector<uint32_t> parent_;  ///< union-find over triangle corners (3 t + i)
+  std::vector<uint32_t> start_, items_;
+  std::vector<Wedge> wedges_;     ///< at the edges of more than two triangles, in edge order
+};
+
+}  // namespace
+
+BoundarySurface boundarySurface(const TetMesh& mesh, const std::vector<uint8_t>& selected, double pull) {
+  return BoundaryBuilder(mesh, selected).build(pull);
 }
 
 }  // namespace sprig::solids
