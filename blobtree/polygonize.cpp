@@ -633,216 +633,252 @@ void fixFlatNormals(Mesh& mesh, const std::vector<uint8_t>& flatGradient) {
 // Dual marching cubes (blobtree/detail/dual_patches.h): a vertex per surface patch of each
 // active cell, a quad (two triangles) per crossing axis edge of the grid. Steps 4-5 of the
 // file comment for PolygonizeOptions::Mesher::DualMarchingCubes.
-void dualMesh(const CompiledBlob& blob, const PolygonizeOptions& options, const Grid& g, PolygonizeResult& res) {
-  const size_t nActive = g.active.size();
-  const ActiveIndex activeIndex = activeCellIndex(g);
-  // Crossing axis edges (directions 1, 2, 4), each owned by the cell at its low end.
-  Vertices v = numberVertices(g, activeIndex, uint8_t((1u << 1) | (1u << 2) | (1u << 4)));
-  auto edgePoint = [&](size_t a, int e) {
-    uint32_t owner = v.owners[a * 8 + size_t(detail::lowCorner(e))];
-    unsigned d = 1u << detail::edgeAxis(e);
-    if (owner == kNoCell || !((v.crossMask[owner] >> d) & 1)) throw std::logic_error("polygonize: crossing edge without an owner cell");
-    return v.vertexBase[owner] + uint32_t(std::popcount(unsigned(v.crossMask[owner]) & ((1u << d) - 1u)));
-  };
+class DualMesher {
+ public:
+  DualMesher(const CompiledBlob& blob, const PolygonizeOptions& options, const Grid& g, PolygonizeResult& res)
+      : blob_(blob), options_(options), g_(g), res_(res), nActive_(g.active.size()), activeIndex_(activeCellIndex(g)),
+        // Crossing axis edges (directions 1, 2, 4), each owned by the cell at its low end.
+        v_(numberVertices(g, activeIndex_, uint8_t((1u << 1) | (1u << 2) | (1u << 4)))) {}
 
-  // The crossing points on the edges, by the same root search as the tetrahedra's vertices.
-  PolygonizeOptions edgeOptions = options;
-  edgeOptions.normals = edgeOptions.attributes = edgeOptions.progress = false;
-  // The patch's Newton steps land the vertex on the surface; its starting mean needs only
-  // the crossings of the corner values' linear interpolation (as in Nielson's dual marching
-  // cubes), so no field is evaluated on the edges. Measured on the 2,000-cone scene: 11.9 M
-  // field evaluations instead of 18.3 M with three regula-falsi steps per edge, and the
-  // vertices that end more than 1e-3 off F = 0.5 (clamped in their cell at creases) 0.15 %
-  // instead of 0.09 % (tests/blobtree/dual_mesher_test.cpp bounds them).
-  edgeOptions.refineSteps = 0;
-  PolygonizeResult crossings;
-  std::vector<uint8_t> unusedFlat;
-  std::vector<uint8_t> evals = placeVertices(blob, edgeOptions, g, v.edges, crossings, unusedFlat);
-  const std::vector<Vec3>& cross = crossings.mesh.positions;
-
-  // The patches of every active cell, numbered by cell.
-  BigVector<detail::CellPatches> patches(nActive);
-  BigVector<uint32_t> patchBase(nActive + 1, 0);
-  parallelFor(0, nActive, [&](size_t a) {
-    auto valuesOf = [&](size_t cell, float* f) {
-      for (int c = 0; c < 8; ++c) f[c] = g.values[g.cornerPoint[cell * 8 + size_t(c)]] - kIso;
-    };
-    float f[8], fn[8];
-    valuesOf(g.active[a], f);
-    // Ambiguous faces whose diagonal corners both cells join are decided for manifoldness.
-    int8_t forced[6];
-    const glm::ivec3 q = g.cellCoords[g.active[a]];
-    for (int face = 0; face < 6; ++face) {
-      forced[face] = -1;
-      const int axis = face / 2, side = face % 2;
-      glm::ivec3 n = q;
-      n[axis] += side ? 1 : -1;
-      uint32_t j = n[axis] < 0 ? kNoCell : activeIndex.find(pointKey(n.x, n.y, n.z));
-      if (j == kNoCell) continue;
-      valuesOf(g.active[j], fn);
-      forced[face] = detail::forcedFaceDecision(f, fn, axis, side);
+  void run() {
+    const std::vector<uint8_t> evals = crossingPoints();
+    cellPatchesAll();
+    Mesh& mesh = res_.mesh;
+    const size_t nVerts = patchBase_[nActive_];
+    mesh.positions.resize(nVerts);
+    if (options_.normals) mesh.normals.resize(nVerts);
+    if (options_.attributes) {
+      mesh.uvs.resize(nVerts);
+      res_.attributes.resize(nVerts);
     }
-    patches[a] = detail::cellPatches(f, forced);
-    patchBase[a + 1] = uint32_t(patches[a].count);
-  }, 2048);
-  for (size_t a = 0; a < nActive; ++a) patchBase[a + 1] += patchBase[a];
-  const size_t nVerts = patchBase[nActive];
-
-  // Each patch's vertex: the mean of its crossing points, then Newton steps along the
-  // gradient toward F = 0.5, kept inside the cell (so the quads keep their layout).
-  Mesh& mesh = res.mesh;
-  mesh.positions.resize(nVerts);
-  if (options.normals) mesh.normals.resize(nVerts);
-  if (options.attributes) {
-    mesh.uvs.resize(nVerts);
-    res.attributes.resize(nVerts);
+    flatGradient_.assign(nVerts, 0);
+    if (options_.progress) bar_ = std::make_unique<Progress>("polygonize", nActive_);
+    // Each patch's vertex: the mean of its crossing points, then Newton steps along the
+    // gradient toward F = 0.5, kept inside the cell (so the quads keep their layout).
+    const size_t blocks = (nActive_ + kCellBlock - 1) / kCellBlock;
+    if (options_.batchedNewton) parallelFor(0, blocks, [&](size_t blk) { placeBlockBatched(blk); });
+    else parallelFor(0, blocks, [&](size_t blk) { placeBlockScalar(blk); });
+    if (bar_) bar_->finish();
+    quads();
+    if (options_.normals) fixFlatNormals(mesh, flatGradient_);
+    size_t total = g_.pointKeys.size() + sampleCount_.load();
+    for (uint8_t k : evals) total += k;
+    res_.fieldEvaluations = total;
   }
-  std::vector<uint8_t> flatGradient(nVerts, 0);
-  std::unique_ptr<Progress> bar;
-  if (options.progress) bar = std::make_unique<Progress>("polygonize", nActive);
-  constexpr int kNewtonSteps = 3;
-  std::atomic<size_t> sampleCount{0};
-  constexpr size_t kCellBlock = 256;
-  // The start of patch k of active cell a (the mean of its crossings) and the cell's box.
-  auto patchStart = [&](size_t a, const detail::CellPatches& cp, Vec3* start, Vec3& lo, Vec3& hi) {
+
+ private:
+  static constexpr int kNewtonSteps = 3;
+  static constexpr size_t kCellBlock = 256;
+
+  /// The crossing point's index of edge e of active cell a.
+  uint32_t edgePoint(size_t a, int e) const {
+    uint32_t owner = v_.owners[a * 8 + size_t(detail::lowCorner(e))];
+    unsigned d = 1u << detail::edgeAxis(e);
+    if (owner == kNoCell || !((v_.crossMask[owner] >> d) & 1)) throw std::logic_error("polygonize: crossing edge without an owner cell");
+    return v_.vertexBase[owner] + uint32_t(std::popcount(unsigned(v_.crossMask[owner]) & ((1u << d) - 1u)));
+  }
+
+  /// The crossing points on the edges, by the same root search as the tetrahedra's
+  /// vertices. The patch's Newton steps land the vertex on the surface; its starting mean
+  /// needs only the crossings of the corner values' linear interpolation (as in Nielson's
+  /// dual marching cubes), so no field is evaluated on the edges. Measured on the 2,000-cone
+  /// scene: 11.9 M field evaluations instead of 18.3 M with three regula-falsi steps per
+  /// edge, and the vertices that end more than 1e-3 off F = 0.5 (clamped in their cell at
+  /// creases) 0.15 % instead of 0.09 % (tests/blobtree/dual_mesher_test.cpp bounds them).
+  /// Returns the field evaluations per edge.
+  std::vector<uint8_t> crossingPoints() {
+    PolygonizeOptions edgeOptions = options_;
+    edgeOptions.normals = edgeOptions.attributes = edgeOptions.progress = false;
+    edgeOptions.refineSteps = 0;
+    PolygonizeResult crossings;
+    std::vector<uint8_t> unusedFlat;
+    std::vector<uint8_t> evals = placeVertices(blob_, edgeOptions, g_, v_.edges, crossings, unusedFlat);
+    cross_ = std::move(crossings.mesh.positions);
+    return evals;
+  }
+
+  /// The patches of every active cell, numbered by cell (patchBase_: prefix sums).
+  void cellPatchesAll() {
+    patches_ = BigVector<detail::CellPatches>(nActive_);
+    patchBase_ = BigVector<uint32_t>(nActive_ + 1, 0);
+    parallelFor(0, nActive_, [&](size_t a) {
+      auto valuesOf = [&](size_t cell, float* f) {
+        for (int c = 0; c < 8; ++c) f[c] = g_.values[g_.cornerPoint[cell * 8 + size_t(c)]] - kIso;
+      };
+      float f[8], fn[8];
+      valuesOf(g_.active[a], f);
+      // Ambiguous faces whose diagonal corners both cells join are decided for manifoldness.
+      int8_t forced[6];
+      const glm::ivec3 q = g_.cellCoords[g_.active[a]];
+      for (int face = 0; face < 6; ++face) {
+        forced[face] = -1;
+        const int axis = face / 2, side = face % 2;
+        glm::ivec3 n = q;
+        n[axis] += side ? 1 : -1;
+        uint32_t j = n[axis] < 0 ? kNoCell : activeIndex_.find(pointKey(n.x, n.y, n.z));
+        if (j == kNoCell) continue;
+        valuesOf(g_.active[j], fn);
+        forced[face] = detail::forcedFaceDecision(f, fn, axis, side);
+      }
+      patches_[a] = detail::cellPatches(f, forced);
+      patchBase_[a + 1] = uint32_t(patches_[a].count);
+    }, 2048);
+    for (size_t a = 0; a < nActive_; ++a) patchBase_[a + 1] += patchBase_[a];
+  }
+
+  /// The start of each patch of active cell a (the mean of its crossings) and the cell's box.
+  void patchStart(size_t a, Vec3* start, Vec3& lo, Vec3& hi) const {
+    const detail::CellPatches& cp = patches_[a];
     std::array<Vec3, 4> sum{};
     std::array<int, 4> n{};
     for (int e = 0; e < 12; ++e)
       if (cp.patch[e] >= 0) {
-        sum[size_t(cp.patch[e])] += cross[edgePoint(a, e)];
+        sum[size_t(cp.patch[e])] += cross_[edgePoint(a, e)];
         ++n[size_t(cp.patch[e])];
       }
-    lo = gridPosition(g.cs, g.cellCoords[g.active[a]]);
-    hi = lo + Vec3(g.cs.cellSize);
+    lo = gridPosition(g_.cs, g_.cellCoords[g_.active[a]]);
+    hi = lo + Vec3(g_.cs.cellSize);
     for (int k = 0; k < cp.count; ++k) start[k] = sum[size_t(k)] / float(n[size_t(k)]);
-  };
-  if (options.batchedNewton) {
-    // The same steps as the scalar path below, in lockstep over the patches of a block of
-    // cells: each step one valuesAndGradients() call over the block's unconverged vertices
-    // (consecutive cells in octree order: a compact cluster).
-    parallelFor(0, (nActive + kCellBlock - 1) / kCellBlock, [&](size_t blk) {
-      const size_t begin = blk * kCellBlock, end = std::min(nActive, begin + kCellBlock);
-      const size_t first = patchBase[begin], n = patchBase[end] - first;
-      std::vector<Vec3> p(n), lo(n), hi(n), grad(n), pts(n), gOut(n);
-      std::vector<float> val(n), vOut(n);
-      std::vector<uint32_t> live(n);
-      for (size_t a = begin; a < end; ++a) {
-        Vec3 l, h;
-        patchStart(a, patches[a], &p[patchBase[a] - first], l, h);
-        for (uint32_t k = patchBase[a] - uint32_t(first); k < patchBase[a + 1] - first; ++k) lo[k] = l, hi[k] = h;
-      }
-      size_t samples = n;
-      blob.valuesAndGradients(p, val, grad);
-      size_t nLive = 0;
-      if (options.refineSteps > 0)
-        for (size_t k = 0; k < n; ++k) live[nLive++] = uint32_t(k);
-      for (int step = 0; step < kNewtonSteps && nLive > 0; ++step) {
-        size_t moved = 0;
-        for (size_t j = 0; j < nLive; ++j) {
-          const uint32_t k = live[j];
-          const float r = val[k] - kIso, gg = glm::dot(grad[k], grad[k]);
-          if (std::fabs(r) < options.fieldTolerance || !(gg > 1e-30f) || !std::isfinite(gg)) continue;
-          const Vec3 q = glm::clamp(p[k] - (r / gg) * grad[k], lo[k], hi[k]);
-          if (q == p[k]) continue;
-          p[k] = q;
-          pts[moved] = q;
-          live[moved++] = k;
-        }
-        nLive = moved;
-        if (nLive == 0) break;
-        blob.valuesAndGradients(std::span<const Vec3>(pts.data(), nLive), std::span<float>(vOut.data(), nLive),
-                                std::span<Vec3>(gOut.data(), nLive));
-        samples += nLive;
-        for (size_t j = 0; j < nLive; ++j) val[live[j]] = vOut[j], grad[live[j]] = gOut[j];
-      }
-      for (size_t k = 0; k < n; ++k) {
-        const size_t vi = first + k;
-        mesh.positions[vi] = p[k];
-        if (options.attributes) {
-          storeSample(options, blob.sample(p[k]), vi, res, flatGradient);
-          ++samples;
-        } else if (options.normals) {
-          Sample smp;
-          smp.value = val[k];
-          smp.gradient = grad[k];
-          storeSample(options, smp, vi, res, flatGradient);
-        }
-      }
-      sampleCount += samples;
-      if (bar) bar->advance(end - begin);
-    });
-  } else parallelFor(0, (nActive + kCellBlock - 1) / kCellBlock, [&](size_t blk) {
-    size_t begin = blk * kCellBlock, end = std::min(nActive, begin + kCellBlock), samples = 0;
+  }
+
+  /// The same steps as placeBlockScalar, in lockstep over the patches of a block of cells:
+  /// each step one valuesAndGradients() call over the block's unconverged vertices
+  /// (consecutive cells in octree order: a compact cluster).
+  void placeBlockBatched(size_t blk) {
+    const size_t begin = blk * kCellBlock, end = std::min(nActive_, begin + kCellBlock);
+    const size_t first = patchBase_[begin], n = patchBase_[end] - first;
+    std::vector<Vec3> p(n), lo(n), hi(n), grad(n), pts(n), gOut(n);
+    std::vector<float> val(n), vOut(n);
+    std::vector<uint32_t> live(n);
     for (size_t a = begin; a < end; ++a) {
-      const detail::CellPatches& cp = patches[a];
-      std::array<Vec3, 4> sum{};
-      std::array<int, 4> n{};
-      for (int e = 0; e < 12; ++e)
-        if (cp.patch[e] >= 0) {
-          sum[size_t(cp.patch[e])] += cross[edgePoint(a, e)];
-          ++n[size_t(cp.patch[e])];
-        }
-      const Vec3 lo = gridPosition(g.cs, g.cellCoords[g.active[a]]), hi = lo + Vec3(g.cs.cellSize);
-      for (int k = 0; k < cp.count; ++k) {
-        Vec3 p = sum[size_t(k)] / float(n[size_t(k)]);
-        Sample smp = blob.sample(p);
+      Vec3 l, h;
+      patchStart(a, &p[patchBase_[a] - first], l, h);
+      for (uint32_t k = patchBase_[a] - uint32_t(first); k < patchBase_[a + 1] - first; ++k) lo[k] = l, hi[k] = h;
+    }
+    size_t samples = n;
+    blob_.valuesAndGradients(p, val, grad);
+    size_t nLive = 0;
+    if (options_.refineSteps > 0)
+      for (size_t k = 0; k < n; ++k) live[nLive++] = uint32_t(k);
+    for (int step = 0; step < kNewtonSteps && nLive > 0; ++step) {
+      size_t moved = 0;
+      for (size_t j = 0; j < nLive; ++j) {
+        const uint32_t k = live[j];
+        const float r = val[k] - kIso, gg = glm::dot(grad[k], grad[k]);
+        if (std::fabs(r) < options_.fieldTolerance || !(gg > 1e-30f) || !std::isfinite(gg)) continue;
+        const Vec3 q = glm::clamp(p[k] - (r / gg) * grad[k], lo[k], hi[k]);
+        if (q == p[k]) continue;
+        p[k] = q;
+        pts[moved] = q;
+        live[moved++] = k;
+      }
+      nLive = moved;
+      if (nLive == 0) break;
+      blob_.valuesAndGradients(std::span<const Vec3>(pts.data(), nLive), std::span<float>(vOut.data(), nLive),
+                               std::span<Vec3>(gOut.data(), nLive));
+      samples += nLive;
+      for (size_t j = 0; j < nLive; ++j) val[live[j]] = vOut[j], grad[live[j]] = gOut[j];
+    }
+    for (size_t k = 0; k < n; ++k) {
+      const size_t vi = first + k;
+      res_.mesh.positions[vi] = p[k];
+      if (options_.attributes) {
+        storeSample(options_, blob_.sample(p[k]), vi, res_, flatGradient_);
         ++samples;
-        for (int step = 0; step < kNewtonSteps && options.refineSteps > 0; ++step) {
+      } else if (options_.normals) {
+        Sample smp;
+        smp.value = val[k];
+        smp.gradient = grad[k];
+        storeSample(options_, smp, vi, res_, flatGradient_);
+      }
+    }
+    sampleCount_ += samples;
+    if (bar_) bar_->advance(end - begin);
+  }
+
+  /// Newton steps one vertex at a time, with F and ∇F from CompiledBlob::sample.
+  void placeBlockScalar(size_t blk) {
+    const size_t begin = blk * kCellBlock, end = std::min(nActive_, begin + kCellBlock);
+    size_t samples = 0;
+    for (size_t a = begin; a < end; ++a) {
+      Vec3 start[4], lo, hi;
+      patchStart(a, start, lo, hi);
+      for (int k = 0; k < patches_[a].count; ++k) {
+        Vec3 p = start[k];
+        Sample smp = blob_.sample(p);
+        ++samples;
+        for (int step = 0; step < kNewtonSteps && options_.refineSteps > 0; ++step) {
           float r = smp.value - kIso, gg = glm::dot(smp.gradient, smp.gradient);
-          if (std::fabs(r) < options.fieldTolerance || !(gg > 1e-30f) || !std::isfinite(gg)) break;
+          if (std::fabs(r) < options_.fieldTolerance || !(gg > 1e-30f) || !std::isfinite(gg)) break;
           Vec3 q = glm::clamp(p - (r / gg) * smp.gradient, lo, hi);
           if (q == p) break;
           p = q;
-          smp = blob.sample(p);
+          smp = blob_.sample(p);
           ++samples;
         }
-        size_t vi = patchBase[a] + size_t(k);
-        mesh.positions[vi] = p;
-        storeSample(options, smp, vi, res, flatGradient);
+        size_t vi = patchBase_[a] + size_t(k);
+        res_.mesh.positions[vi] = p;
+        storeSample(options_, smp, vi, res_, flatGradient_);
       }
     }
-    sampleCount += samples;
-    if (bar) bar->advance(end - begin);
-  });
-  if (bar) bar->finish();
+    sampleCount_ += samples;
+    if (bar_) bar_->advance(end - begin);
+  }
 
-  // A quad per crossing edge, joining its patch in the four cells around it, ordered
-  // counter-clockwise seen from the outside; split along its shorter diagonal.
-  mesh.triangles.resize(2 * v.edges.size());
-  parallelFor(0, nActive, [&](size_t a) {
-    const glm::ivec3 q = g.cellCoords[g.active[a]];
-    const bool lowInside = g.insideMask[g.active[a]] & 1;
-    for (int axis = 0; axis < 3; ++axis) {
-      const unsigned d = 1u << axis;
-      if (!((v.crossMask[a] >> d) & 1)) continue;
-      const int b = (axis + 1) % 3, c = (axis + 2) % 3;
-      static constexpr int kAround[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};  // counter-clockwise about +axis
-      uint32_t quad[4];
-      for (int k = 0; k < 4; ++k) {
-        glm::ivec3 cell = q;
-        cell[b] -= kAround[k][0];
-        cell[c] -= kAround[k][1];
-        uint32_t j = cell.x < 0 || cell.y < 0 || cell.z < 0 ? kNoCell : activeIndex.find(pointKey(cell.x, cell.y, cell.z));
-        int e = 4 * axis + kAround[k][0] + 2 * kAround[k][1];
-        if (j == kNoCell || patches[j].patch[size_t(e)] < 0) throw std::logic_error("polygonize: crossing edge without its four cells");
-        quad[k] = patchBase[j] + uint32_t(patches[j].patch[size_t(e)]);
+  /// A quad per crossing edge, joining its patch in the four cells around it, ordered
+  /// counter-clockwise seen from the outside; split along its shorter diagonal.
+  void quads() {
+    Mesh& mesh = res_.mesh;
+    mesh.triangles.resize(2 * v_.edges.size());
+    parallelFor(0, nActive_, [&](size_t a) {
+      const glm::ivec3 q = g_.cellCoords[g_.active[a]];
+      const bool lowInside = g_.insideMask[g_.active[a]] & 1;
+      for (int axis = 0; axis < 3; ++axis) {
+        const unsigned d = 1u << axis;
+        if (!((v_.crossMask[a] >> d) & 1)) continue;
+        const int b = (axis + 1) % 3, c = (axis + 2) % 3;
+        static constexpr int kAround[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};  // counter-clockwise about +axis
+        uint32_t quad[4];
+        for (int k = 0; k < 4; ++k) {
+          glm::ivec3 cell = q;
+          cell[b] -= kAround[k][0];
+          cell[c] -= kAround[k][1];
+          uint32_t j = cell.x < 0 || cell.y < 0 || cell.z < 0 ? kNoCell : activeIndex_.find(pointKey(cell.x, cell.y, cell.z));
+          int e = 4 * axis + kAround[k][0] + 2 * kAround[k][1];
+          if (j == kNoCell || patches_[j].patch[size_t(e)] < 0) throw std::logic_error("polygonize: crossing edge without its four cells");
+          quad[k] = patchBase_[j] + uint32_t(patches_[j].patch[size_t(e)]);
+        }
+        if (!lowInside) std::swap(quad[1], quad[3]);  // the outside is toward −axis
+        const size_t t = 2 * size_t(edgePoint(a, 4 * axis));
+        const std::vector<Vec3>& P = mesh.positions;
+        if (glm::length(P[quad[0]] - P[quad[2]]) <= glm::length(P[quad[1]] - P[quad[3]])) {
+          mesh.triangles[t] = {quad[0], quad[1], quad[2]};
+          mesh.triangles[t + 1] = {quad[0], quad[2], quad[3]};
+        } else {
+          mesh.triangles[t] = {quad[0], quad[1], quad[3]};
+          mesh.triangles[t + 1] = {quad[1], quad[2], quad[3]};
+        }
       }
-      if (!lowInside) std::swap(quad[1], quad[3]);  // the outside is toward −axis
-      const size_t t = 2 * size_t(edgePoint(a, 4 * axis));
-      const std::vector<Vec3>& P = mesh.positions;
-      if (glm::length(P[quad[0]] - P[quad[2]]) <= glm::length(P[quad[1]] - P[quad[3]])) {
-        mesh.triangles[t] = {quad[0], quad[1], quad[2]};
-        mesh.triangles[t + 1] = {quad[0], quad[2], quad[3]};
-      } else {
-        mesh.triangles[t] = {quad[0], quad[1], quad[3]};
-        mesh.triangles[t + 1] = {quad[1], quad[2], quad[3]};
-      }
-    }
-  }, 2048);
-  if (options.normals) fixFlatNormals(mesh, flatGradient);
-  size_t total = g.pointKeys.size() + sampleCount.load();
-  for (uint8_t k : evals) total += k;
-  res.fieldEvaluations = total;
+    }, 2048);
+  }
+
+  const CompiledBlob& blob_;
+  const PolygonizeOptions& options_;
+  const Grid& g_;
+  PolygonizeResult& res_;
+  const size_t nActive_;
+  const ActiveIndex activeIndex_;
+  const Vertices v_;
+  std::vector<Vec3> cross_;  ///< the crossing point of each crossing edge
+  BigVector<detail::CellPatches> patches_;
+  BigVector<uint32_t> patchBase_;
+  std::vector<uint8_t> flatGradient_;
+  std::unique_ptr<Progress> bar_;
+  std::atomic<size_t> sampleCount_{0};
+};
+
+void dualMesh(const CompiledBlob& blob, const PolygonizeOptions& options, const Grid& g, PolygonizeResult& res) {
+  DualMesher(blob, options, g, res).run();
 }
 
 }  // namespace
