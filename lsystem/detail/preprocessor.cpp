@@ -248,198 +248,231 @@ std::string Scanner::expand(const std::string& line, std::vector<int>& map, int 
   return out;
 }
 
+namespace {
+
+/// cpp's line splicing: a directive whose line ends in a backslash goes on with the next line
+/// (`#define LEAF [+F \` then the rest); the lines it takes stay blank. Returns line k of
+/// clean with its continuations joined, and sets joinedUntil to the last line taken (k when
+/// the line does not continue).
+std::string spliceDirective(const std::vector<std::string>& clean, size_t k, size_t& joinedUntil) {
+  auto continues = [](const std::string& t) {
+    size_t e = t.size();
+    while (e > 0 && isSpace(t[e - 1])) --e;
+    return e > 0 && t[e - 1] == '\\' ? e : std::string::npos;
+  };
+  size_t j = k, cut = continues(clean[k]);
+  std::string joined = clean[k];
+  while (cut != std::string::npos && j + 1 < clean.size()) {
+    joined.resize(cut - 1);
+    joined += ' ';
+    joined += clean[++j];
+    cut = continues(joined);
+  }
+  if (cut != std::string::npos) joined.resize(cut - 1);
+  joinedUntil = j;
+  return joined;
+}
+
+}  // namespace
+
+/// One directive line being read: where it is, its text and its first two words.
+struct Scanner::Directive {
+  int file;
+  size_t k;               ///< 0-based line in the file
+  const std::string& s;   ///< the line (continuations joined)
+  const std::string& raw; ///< the line as written
+  size_t hash;            ///< the '#' column
+  std::string word, name; ///< `define`, `LEAF`
+  size_t nameStart, nameEnd;
+  int depth;              ///< of #include
+  size_t openAtStart;     ///< conditionals open when the file began
+};
+
+void Scanner::emitLine(int file, size_t k, const std::string& raw, std::string text, std::vector<int> map) {
+  raw_.push_back(raw);
+  clean_.push_back(std::move(text));
+  origin_.push_back(Origin{file, static_cast<int>(k) + 1});
+  colMap_.push_back(std::move(map));
+}
+
+void Scanner::directiveError(const Directive& d, size_t col, const std::string& msg) {
+  diags_.error(SourceLoc{files_[d.file], static_cast<int>(d.k) + 1, static_cast<int>(col) + 1}, msg, d.raw);
+}
+
+bool Scanner::preprocessorActive() const { return conditionals_.empty() || conditionals_.back().active; }
+
+bool Scanner::conditionalDirective(const Directive& d) {
+  const std::string& word = d.word;
+  const Conditional opened{preprocessorActive(), preprocessorActive(), false, d.file, static_cast<int>(d.k) + 1, static_cast<int>(d.hash)};
+  if (word == "ifdef" || word == "ifndef") {
+    if (d.name.empty() || !isIdentStart(d.name[0])) directiveError(d, d.nameStart, "expected a name after '#" + word + "'");
+    const bool defined = std::any_of(macros_.begin(), macros_.end(), [&](const auto& m) { return m.first == d.name; }) ||
+                         std::any_of(constants_.begin(), constants_.end(), [&](const auto& c) { return c.first == d.name; });
+    Conditional c = opened;
+    c.active = preprocessorActive() && (defined == (word == "ifdef"));
+    conditionals_.push_back(c);
+    emitLine(d.file, d.k, d.raw, "", {});
+    return true;
+  }
+  if (word == "if") {  // not read: the grammar parser reports it; its #endif still closes it
+    conditionals_.push_back(opened);
+    emitLine(d.file, d.k, d.raw, d.s, {});
+    return true;
+  }
+  if (word != "else" && word != "endif") return false;
+  if (conditionals_.size() <= d.openAtStart) {
+    directiveError(d, d.hash, "'#" + word + "' without '#ifdef' or '#ifndef'");
+  } else if (word == "endif") {
+    conditionals_.pop_back();
+  } else if (conditionals_.back().elseSeen) {
+    directiveError(d, d.hash, "a second '#else' for the '#if' at line " + std::to_string(conditionals_.back().line));
+  } else {
+    Conditional& c = conditionals_.back();
+    c.elseSeen = true;
+    c.active = c.parentActive && !c.active;
+  }
+  emitLine(d.file, d.k, d.raw, "", {});
+  return true;
+}
+
+void Scanner::defineDirective(const Directive& d) {
+  const std::string& s = d.s;
+  const std::string& name = d.name;
+  const size_t ne = d.nameEnd;
+  Macro m;
+  m.file = d.file;
+  m.line = static_cast<int>(d.k) + 1;
+  size_t after = ne;
+  if (ne < s.size() && s[ne] == '(') {  // function-like: the '(' right after the name
+    size_t close = s.find(')', ne);
+    if (close == std::string::npos) {
+      directiveError(d, ne, "unclosed '(' in '#define " + name + "('");
+      emitLine(d.file, d.k, d.raw, "", {});
+      return;
+    }
+    std::string list = s.substr(ne + 1, close - ne - 1);
+    size_t p = 0;
+    while (p <= list.size()) {
+      size_t c = list.find(',', p);
+      if (c == std::string::npos) c = list.size();
+      std::string param = trimmed(list.substr(p, c - p), 0);
+      if (!param.empty() || c < list.size()) {
+        if (param.empty() || !isIdentStart(param[0]) || tokenEnd(param, 0) != param.size())
+          directiveError(d, ne + 1 + p, "invalid parameter name '" + param + "' in '#define " + name + "(...)'");
+        m.params.push_back(param);
+      }
+      p = c + 1;
+    }
+    m.functionLike = true;
+    after = close + 1;
+  }
+  m.body = trimmed(s, after);
+  if (!m.functionLike && isConstantBody(m.body, constants_, dialect_)) {
+    constants_.emplace_back(name, static_cast<int>(d.k) + 1);
+    emitLine(d.file, d.k, d.raw, s, {});  // read by the grammar parser (a value -D may override)
+    return;
+  }
+  auto prev = std::find_if(macros_.begin(), macros_.end(), [&](const auto& e) { return e.first == name; });
+  if (prev != macros_.end() || std::any_of(constants_.begin(), constants_.end(), [&](const auto& c) { return c.first == name; })) {
+    directiveError(d, d.nameStart, "'" + name + "' is already defined" +
+                                       (prev != macros_.end() ? " at " + files_[prev->second.file] + ":" + std::to_string(prev->second.line) : ""));
+  } else {
+    macros_.emplace_back(name, std::move(m));
+  }
+  emitLine(d.file, d.k, d.raw, "", {});
+}
+
+void Scanner::includeDirective(const Directive& d) {
+  const std::string& s = d.s;
+  const size_t ni = d.nameStart;
+  emitLine(d.file, d.k, d.raw, "", {});
+  char open = ni < s.size() ? s[ni] : '\0';
+  char closeCh = open == '"' ? '"' : open == '<' ? '>' : '\0';
+  size_t close = closeCh ? s.find(closeCh, ni + 1) : std::string::npos;
+  if (close == std::string::npos) {
+    directiveError(d, ni, "expected a file name in quotes after '#include'");
+    return;
+  }
+  const std::string target = s.substr(ni + 1, close - ni - 1);
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::path top = fs::path(fileName_).parent_path();
+  fs::path root = fs::weakly_canonical(fs::absolute(top.empty() ? fs::path(".") : top, ec), ec);
+  fs::path from = fs::path(files_[d.file]).parent_path();
+  fs::path path = fs::weakly_canonical(fs::absolute(from / target, ec), ec);
+  fs::path rel = path.lexically_relative(root);
+  if (fs::path(target).is_absolute() || rel.empty() || *rel.begin() == "..") {
+    directiveError(d, ni, "'#include \"" + target + "\"' is outside the object's folder: only files beside the L-system "
+                          "(or in folders below it) may be included");
+    return;
+  }
+  if (d.depth + 1 > kMaxIncludeDepth) {
+    directiveError(d, ni, "'#include' nested deeper than " + std::to_string(kMaxIncludeDepth) + " files (does a file include itself?)");
+    return;
+  }
+  std::string text;
+  try {
+    text = readFile(path);
+  } catch (const FileReadError& e) {
+    directiveError(d, ni, FileReadError(from / target, e.reason()).what());  // the name as written, not the canonical one
+    return;
+  }
+  files_.push_back((from / target).lexically_normal().string());
+  const int index = static_cast<int>(files_.size()) - 1;
+  std::pair<int, int> pending{0, 0};
+  std::string cleanText = blankComments(text, pending);
+  if (pending.first) diags_.error(SourceLoc{files_[index], pending.first, pending.second + 1}, "unterminated comment '/*'");
+  preprocess(index, splitAtNewlines(text), splitAtNewlines(cleanText), d.depth + 1);
+}
+
+void Scanner::directive(const Directive& d) {
+  if (conditionalDirective(d)) return;
+  if (!preprocessorActive()) {
+    emitLine(d.file, d.k, d.raw, "", {});
+    return;
+  }
+  if (d.word == "define" && !d.name.empty() && isIdentStart(d.name[0])) {
+    defineDirective(d);
+  } else if (d.word == "undef") {
+    macros_.erase(std::remove_if(macros_.begin(), macros_.end(), [&](const auto& e) { return e.first == d.name; }), macros_.end());
+    constants_.erase(std::remove_if(constants_.begin(), constants_.end(), [&](const auto& e) { return e.first == d.name; }), constants_.end());
+    emitLine(d.file, d.k, d.raw, "", {});
+  } else if (d.word == "include") {
+    includeDirective(d);
+  } else {
+    emitLine(d.file, d.k, d.raw, d.s, {});  // `#define` without a name and other directives: the grammar parser reports them
+  }
+}
+
 void Scanner::preprocess(int file, const std::vector<std::string>& raw, const std::vector<std::string>& clean, int depth) {
-  auto emit = [&](size_t k, std::string text, std::vector<int> map) {
-    raw_.push_back(raw[k]);
-    clean_.push_back(std::move(text));
-    origin_.push_back(Origin{file, static_cast<int>(k) + 1});
-    colMap_.push_back(std::move(map));
-  };
-  auto err = [&](size_t k, size_t col, const std::string& msg) {
-    diags_.error(SourceLoc{files_[file], static_cast<int>(k) + 1, static_cast<int>(col) + 1}, msg, raw[k]);
-  };
-  auto active = [&] { return conditionals_.empty() || conditionals_.back().active; };
-  auto defined = [&](const std::string& name) {
-    return std::any_of(macros_.begin(), macros_.end(), [&](const auto& m) { return m.first == name; }) ||
-           std::any_of(constants_.begin(), constants_.end(), [&](const auto& c) { return c.first == name; });
-  };
   const size_t openAtStart = conditionals_.size();
   size_t joinedUntil = 0;  // the last line a directive's backslash continuation took
   for (size_t k = 0; k < clean.size(); ++k) {
     if (k > 0 && k <= joinedUntil) {  // part of the directive above: blank here
-      emit(k, "", {});
+      emitLine(file, k, raw[k], "", {});
       continue;
     }
-    const std::string* line = &clean[k];
-    size_t b = static_cast<size_t>(firstNonSpace(*line));
-    // cpp's line splicing: a directive whose line ends in a backslash goes on with the next
-    // line (`#define LEAF [+F \` then the rest); the lines it takes stay blank.
-    std::string joined;
-    if (b < line->size() && (*line)[b] == '#') {
-      auto continues = [](const std::string& t) {
-        size_t e = t.size();
-        while (e > 0 && isSpace(t[e - 1])) --e;
-        return e > 0 && t[e - 1] == '\\' ? e : std::string::npos;
-      };
-      size_t j = k, cut = continues(clean[k]);
-      if (cut != std::string::npos) {
-        joined = clean[k];
-        while (cut != std::string::npos && j + 1 < clean.size()) {
-          joined.resize(cut - 1);
-          joined += ' ';
-          joined += clean[++j];
-          cut = continues(joined);
-        }
-        if (cut != std::string::npos) joined.resize(cut - 1);
-        joinedUntil = j;
-        line = &joined;
-      }
-    }
-    const std::string& s = *line;
-    if (b < s.size() && s[b] == '#') {
+    const size_t b = static_cast<size_t>(firstNonSpace(clean[k]));
+    if (b < clean[k].size() && clean[k][b] == '#') {
+      const std::string s = spliceDirective(clean, k, joinedUntil);
       size_t i = b + 1;
       while (i < s.size() && isSpace(s[i])) ++i;
       size_t we = i;
       while (we < s.size() && isIdentChar(s[we])) ++we;
-      const std::string word = s.substr(i, we - i);
       size_t ni = we;
       while (ni < s.size() && isSpace(s[ni])) ++ni;
       size_t ne = ni;
       while (ne < s.size() && isIdentChar(s[ne])) ++ne;
-      const std::string name = s.substr(ni, ne - ni);
-      if (word == "ifdef" || word == "ifndef") {
-        if (name.empty() || !isIdentStart(name[0])) err(k, ni, "expected a name after '#" + word + "'");
-        bool on = active() && (defined(name) == (word == "ifdef"));
-        conditionals_.push_back(Conditional{on, active(), false, file, static_cast<int>(k) + 1, static_cast<int>(b)});
-        emit(k, "", {});
-        continue;
-      }
-      if (word == "if") {  // not read: the grammar parser reports it; its #endif still closes it
-        conditionals_.push_back(Conditional{active(), active(), false, file, static_cast<int>(k) + 1, static_cast<int>(b)});
-        emit(k, s, {});
-        continue;
-      }
-      if (word == "else" || word == "endif") {
-        if (conditionals_.size() <= openAtStart) {
-          err(k, b, "'#" + word + "' without '#ifdef' or '#ifndef'");
-        } else if (word == "endif") {
-          conditionals_.pop_back();
-        } else if (conditionals_.back().elseSeen) {
-          err(k, b, "a second '#else' for the '#if' at line " + std::to_string(conditionals_.back().line));
-        } else {
-          Conditional& c = conditionals_.back();
-          c.elseSeen = true;
-          c.active = c.parentActive && !c.active;
-        }
-        emit(k, "", {});
-        continue;
-      }
-      if (!active()) {
-        emit(k, "", {});
-        continue;
-      }
-      if (word == "define" && !name.empty() && isIdentStart(name[0])) {
-        Macro m;
-        m.file = file;
-        m.line = static_cast<int>(k) + 1;
-        size_t after = ne;
-        if (ne < s.size() && s[ne] == '(') {  // function-like: the '(' right after the name
-          size_t close = s.find(')', ne);
-          if (close == std::string::npos) {
-            err(k, ne, "unclosed '(' in '#define " + name + "('");
-            emit(k, "", {});
-            continue;
-          }
-          std::string list = s.substr(ne + 1, close - ne - 1);
-          size_t p = 0;
-          while (p <= list.size()) {
-            size_t c = list.find(',', p);
-            if (c == std::string::npos) c = list.size();
-            std::string param = trimmed(list.substr(p, c - p), 0);
-            if (!param.empty() || c < list.size()) {
-              if (param.empty() || !isIdentStart(param[0]) || tokenEnd(param, 0) != param.size())
-                err(k, ne + 1 + p, "invalid parameter name '" + param + "' in '#define " + name + "(...)'");
-              m.params.push_back(param);
-            }
-            p = c + 1;
-          }
-          m.functionLike = true;
-          after = close + 1;
-        }
-        m.body = trimmed(s, after);
-        if (!m.functionLike && isConstantBody(m.body, constants_, dialect_)) {
-          constants_.emplace_back(name, static_cast<int>(k) + 1);
-          emit(k, s, {});  // read by the grammar parser (a value -D may override)
-          continue;
-        }
-        auto prev = std::find_if(macros_.begin(), macros_.end(), [&](const auto& e) { return e.first == name; });
-        if (prev != macros_.end() || std::any_of(constants_.begin(), constants_.end(), [&](const auto& c) { return c.first == name; })) {
-          err(k, ni, "'" + name + "' is already defined" +
-                         (prev != macros_.end() ? " at " + files_[prev->second.file] + ":" + std::to_string(prev->second.line) : ""));
-        } else {
-          macros_.emplace_back(name, std::move(m));
-        }
-        emit(k, "", {});
-        continue;
-      }
-      if (word == "undef") {
-        macros_.erase(std::remove_if(macros_.begin(), macros_.end(), [&](const auto& e) { return e.first == name; }), macros_.end());
-        constants_.erase(std::remove_if(constants_.begin(), constants_.end(), [&](const auto& e) { return e.first == name; }), constants_.end());
-        emit(k, "", {});
-        continue;
-      }
-      if (word == "include") {
-        emit(k, "", {});
-        char open = ni < s.size() ? s[ni] : '\0';
-        char closeCh = open == '"' ? '"' : open == '<' ? '>' : '\0';
-        size_t close = closeCh ? s.find(closeCh, ni + 1) : std::string::npos;
-        if (close == std::string::npos) {
-          err(k, ni, "expected a file name in quotes after '#include'");
-          continue;
-        }
-        const std::string target = s.substr(ni + 1, close - ni - 1);
-        namespace fs = std::filesystem;
-        std::error_code ec;
-        fs::path top = fs::path(fileName_).parent_path();
-        fs::path root = fs::weakly_canonical(fs::absolute(top.empty() ? fs::path(".") : top, ec), ec);
-        fs::path from = fs::path(files_[file]).parent_path();
-        fs::path path = fs::weakly_canonical(fs::absolute(from / target, ec), ec);
-        fs::path rel = path.lexically_relative(root);
-        if (fs::path(target).is_absolute() || rel.empty() || *rel.begin() == "..") {
-          err(k, ni, "'#include \"" + target + "\"' is outside the object's folder: only files beside the L-system "
-                     "(or in folders below it) may be included");
-          continue;
-        }
-        if (depth + 1 > kMaxIncludeDepth) {
-          err(k, ni, "'#include' nested deeper than " + std::to_string(kMaxIncludeDepth) + " files (does a file include itself?)");
-          continue;
-        }
-        std::string text;
-        try {
-          text = readFile(path);
-        } catch (const FileReadError& e) {
-          err(k, ni, FileReadError(from / target, e.reason()).what());  // the name as written, not the canonical one
-          continue;
-        }
-        files_.push_back((from / target).lexically_normal().string());
-        const int index = static_cast<int>(files_.size()) - 1;
-        std::pair<int, int> pending{0, 0};
-        std::string cleanText = blankComments(text, pending);
-        if (pending.first)
-          diags_.error(SourceLoc{files_[index], pending.first, pending.second + 1}, "unterminated comment '/*'");
-        preprocess(index, splitAtNewlines(text), splitAtNewlines(cleanText), depth + 1);
-        continue;
-      }
-      emit(k, s, {});  // `#define` without a name and other directives: the grammar parser reports them
+      directive(Directive{file, k, s, raw[k], b, s.substr(i, we - i), s.substr(ni, ne - ni), ni, ne, depth, openAtStart});
       continue;
     }
-    if (!active()) {
-      emit(k, "", {});
+    if (!preprocessorActive()) {
+      emitLine(file, k, raw[k], "", {});
       continue;
     }
     std::vector<int> map;
-    std::string text = expand(s, map, file, static_cast<int>(k) + 1, raw[k]);
-    emit(k, std::move(text), std::move(map));
+    std::string text = expand(clean[k], map, file, static_cast<int>(k) + 1, raw[k]);
+    emitLine(file, k, raw[k], std::move(text), std::move(map));
   }
   if (depth > 0) {
     // An '#ifdef' left open at the end of an included file.

@@ -146,6 +146,20 @@ class Scanner {
   /// one file (raw and with comments blanked) before continuations are joined: appends the
   /// resulting lines, their origins and column maps to raw_, clean_, origin_, colMap_.
   void preprocess(int file, const std::vector<std::string>& raw, const std::vector<std::string>& clean, int depth);
+  struct Directive;
+  /// Appends one preprocessed line (file's 0-based line k, as written: raw) to raw_, clean_,
+  /// origin_ and colMap_.
+  void emitLine(int file, size_t k, const std::string& raw, std::string text, std::vector<int> map);
+  void directiveError(const Directive& d, size_t col, const std::string& msg);
+  /// Not inside a false `#ifdef` block.
+  bool preprocessorActive() const;
+  /// A `#`-line: `#ifdef`, `#ifndef`, `#if`, `#else`, `#endif`, `#define`, `#undef`,
+  /// `#include`, or one the grammar parser reports.
+  void directive(const Directive& d);
+  /// `#ifdef`, `#ifndef`, `#if`, `#else`, `#endif`: true when d is one of them.
+  bool conditionalDirective(const Directive& d);
+  void defineDirective(const Directive& d);
+  void includeDirective(const Directive& d);
   struct Macro;
   /// line with the macros expanded; map gets the original column of each column.
   std::string expand(const std::string& line, std::vector<int>& map, int file, int lineNo, const std::string& rawLine);
