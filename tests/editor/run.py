@@ -45,6 +45,8 @@ def gist_of_sprig(message):
     """(kind, subject) of one `sprig check` error message."""
     if m := re.match(r"unknown key '([^']+)'", message):
         return "unknown key", m.group(1)
+    if m := re.match(r"unknown [a-z ]+ '[^']+'.*\(((?:one of: )?[\w, ]+)\)$", message):  # a one-key map's key
+        return "not one of", ",".join(w for w in re.findall(r"\w+", m.group(1)) if w not in ("one", "of", "or"))
     if m := re.search(r"must be one of (.*), got", message):
         return "not one of", ",".join(w.strip() for w in m.group(1).split(","))
     if re.search(r"must be a colour", message):
@@ -58,7 +60,7 @@ def gist_of_sprig(message):
         return "range", repr(0.0)
     if m := re.match(r"missing required key '([^']+)'", message):
         return "missing", m.group(1)
-    if m := re.search(r"must be (an integer|true or false|a map|a sequence|\[x, y, z\]|a finite number)", message):
+    if m := re.search(r"must be (an integer|true or false|a map|a sequence|\[x, y, z\]|a finite number|a number)", message):
         return "type", ""
     return "other", message
 
