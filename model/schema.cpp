@@ -91,6 +91,8 @@ std::string mapJson(const KeySchema& k, const std::string& path, int depth) {
     out += ", \"minProperties\": 1, \"maxProperties\": 1, \"propertyNames\": {\"enum\": [";
     for (size_t i = 0; i < k.oneKey.size(); ++i) out += (i ? ", " : "") + jsonText(k.oneKey[i]);
     out += "]}";
+  } else if (k.entries) {  // keys the file names (describeEntry): each entry's value, on a line of its own as a key
+    out += ",\n" + pad + "\"additionalProperties\": " + emit(*k.entries, path + ".NAME", depth + 1);
   } else if (k.closed && !k.dataKeys && k.finishes >= kMinFinishes) {
     out += ", \"additionalProperties\": false";
   }

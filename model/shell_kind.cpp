@@ -72,14 +72,17 @@ void readGenerating(MapReader& top, ShellParams& p, DiagnosticList& diags) {
   MapReader gen(*g, diags, "generating");
   p.generating.primitives.clear();
   p.canal.reset();
+  static const std::vector<std::string> kinds = {"point", "cone"};
   for (const YNode& item : gen.sequence({"primitives", "Primitives summed into the generating surface, each `{point: {...}}` or `{cone: {...}}`, in the unit frame (1 = D(θ))."})) {
-    if (!item.isMap() || item.pairs().size() != 1) {
+    auto described = describeOneKey(item, kinds);  // `sprig schema`: a one-key map, one kind's keys
+    if (!described && (!item.isMap() || item.pairs().size() != 1)) {
       item.error(diags, "a generating primitive must be a map with one key: point or cone");
       continue;
     }
-    const auto pairs = item.pairs();  // a copy: a reference into the temporary would dangle
-    const auto& [keyNode, value] = pairs.front();
+    const auto [keyNode, value] = described ? *described : item.pairs().front();
     const std::string kind = keyNode.scalar();
+    describeHelp(value, kind == "point" ? "A point primitive of the generating surface: a sphere of `radius` around `center`."
+                                        : "A cone primitive of the generating surface: from `a` to `b`, radii `radius_a` and `radius_b`, bent by `bend`.");
     GeneratingPrimitive prim;
     MapReader r(value, diags, kind);
     if (kind == "point") {
@@ -97,7 +100,6 @@ void readGenerating(MapReader& top, ShellParams& p, DiagnosticList& diags) {
       prim.canal = r.boolean({"canal", "This cone is the siphonal canal: the axial spines sit along it."}, false);
       if (glm::length(prim.b - prim.a) < 1e-4f) value.error(diags, "cone 'a' and 'b' must differ");
     } else {
-      static const std::vector<std::string> kinds = {"point", "cone"};
       keyNode.error(diags, "unknown generating primitive '" + kind + "' (point or cone)" + didYouMean(kind, kinds));
       continue;
     }

@@ -57,6 +57,12 @@ const std::vector<std::string> kLayers = {"interior_layer", "exterior_layer"};
 constexpr const char* kVelocityHelp =
     "Interface velocity (§2.4): a number, an expression of x, y, z, noise and turbulence, `{expression, noise, max}` or `{painted: ...}`; a layer is v times as thick where the speed is v (default: 1).";
 
+/// What an entry of `materials:` is (its key is the material's name).
+constexpr const char* kMaterialEntryHelp =
+    "A material of this file, named by its key (not a built-in name): concrete, `{base, color, roughness, specular, "
+    "density, youngs_modulus, poisson_ratio, strength}`, or procedural, `{select, choices}` (an expression of x, y, z "
+    "that picks among concrete materials).";
+
 /// What each one-key alternative of a solid is (`sprig schema`'s text for its key).
 std::string_view alternativeHelp(std::string_view kind) {
   static const HelpTable kHelp = {
@@ -87,6 +93,10 @@ class SolidReader {
 
   void readMaterials(const YNode& section) {
     MapReader m(section, diags_, "materials");
+    if (auto entry = describeEntry(section, kMaterialEntryHelp)) {  // `sprig schema`: either form's keys
+      readConcrete(entry->first.scalar(), entry->second);
+      readProcedural(entry->first.scalar(), entry->second);
+    }
     const auto pairs = section.pairs();
     // Concrete materials first, so procedural ones may choose among any of them.
     for (int pass = 0; pass < 2; ++pass)
@@ -168,7 +178,7 @@ class SolidReader {
       if (id >= 0) p.choices.push_back(id);
       else if (id == kNothing || id <= kProcedural0) c.error(diags_, "a choice of a procedural material must be a concrete material");
     }
-    if (auto text = sel->asString(diags_, "'select'")) {
+    if (auto text = sel ? sel->asString(diags_, "'select'") : std::nullopt) {
       try {
         const SourceLoc at = sel->loc();
         p.select = lsystem::Expression::compile(*text, {"x", "y", "z"}, at, sel->file().sourceLine(at.line));

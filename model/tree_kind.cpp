@@ -123,6 +123,8 @@ bool readGrammar(MapReader& top, const Species& sp, TreeSpec& s, DiagnosticList&
 void readDefines(MapReader& top, TreeSpec& s, DiagnosticList& diags) {
   auto d = top.section({"defines", "Replace the grammar's `#define NAME` values: NAME: number (an unknown name is an error)."});
   if (!d) return;
+  if (auto entry = describeEntry(*d, "The value of the grammar's `#define NAME`, replacing the file's."))  // `sprig schema`
+    entry->second.asNumber(diags, "'defines.NAME'");
   for (auto& [k, v] : d->pairs()) {
     if (!k.isScalar()) continue;
     auto value = v.asNumber(diags, "'defines." + k.scalar() + "'");

@@ -819,7 +819,10 @@ std::string quoted(std::string_view key) {
 }
 
 double MapReader::number(Key key, double def, double min, double max) {
-  if (schema_) schema_->property(std::string(key.name)).defaultJson = jsonNumber(def);
+  // A float default the reader widened to double (0.3f) reads as the float's shortest text (0.3).
+  if (schema_)
+    schema_->property(std::string(key.name)).defaultJson =
+        jsonNumber(std::isfinite(def) && double(float(def)) == def ? std::stod(jsonFloat(float(def))) : def);
   auto v = get(key);
   if (!v) return def;
   return v->asNumber(*diags_, quoted(key.name), min, max).value_or(def);
@@ -971,6 +974,19 @@ std::optional<std::pair<YNode, YNode>> describeOneKey(const YNode& node, const s
   r->bind(value, s->property(names[*pick]));
   YAML::Node key(names[*pick]);
   return std::make_pair(YNode(node.fileHandle(), key), YNode(node.fileHandle(), value));
+}
+
+std::optional<std::pair<YNode, YNode>> describeEntry(const YNode& map, std::string_view help) {
+  detail::KeySchema* s = describing(map.node());
+  if (!s) return std::nullopt;
+  s->dataKeys = true;
+  detail::KeySchema& entry = s->entry();
+  if (entry.help.empty()) entry.help = help;
+  detail::KeyRecorder* r = detail::KeyRecorder::active();
+  if (!r->isPlaceholder(map.node())) return std::nullopt;  // a real map is read as it is
+  YAML::Node value = r->placeholder();
+  r->bind(value, entry);
+  return std::make_pair(YNode(map.fileHandle(), YAML::Node("NAME")), YNode(map.fileHandle(), value));
 }
 
 void describeValue(const YNode& node, std::optional<double> above, const std::vector<std::string>& words) {

@@ -296,6 +296,14 @@ class MapReader {
 std::optional<std::pair<YNode, YNode>> describeOneKey(const YNode& node, const std::vector<std::string>& names,
                                                       const std::string& definition = "");
 
+/// Describe mode (`sprig schema`) only, for a map whose keys are names the file chooses (a
+/// solid's `materials:`, a tree's `defines:`), which a reader walks with YNode::pairs():
+/// records that every entry's value has one schema (additionalProperties), whose text is
+/// help, and when map is a placeholder returns a made-up entry (the key `NAME`, a
+/// placeholder value bound to that schema) for the reader to read as it reads each real
+/// entry. Call it before pairs(). Outside describe mode, or for a real map, nullopt.
+std::optional<std::pair<YNode, YNode>> describeEntry(const YNode& map, std::string_view help);
+
 /// Describe mode (`sprig schema`) only, for a reader that checks a value itself rather
 /// than through a typed read's range: the number at node must be above `above` (exclusive),
 /// and `words` are the only texts it takes (`thickness: fill`). No effect when reading.

@@ -29,6 +29,7 @@
 #include "lsystem/derive.h"
 #include "model/animate.h"
 #include "model/growth.h"
+#include "model/kind_name.h"
 #include "model/lod.h"
 #include "model/mesh_parts.h"
 #include "model/model.h"
@@ -287,6 +288,48 @@ std::vector<ExportPart> meshParts(PySpecies& s, const MeshRequest& r, Vec3* offs
   return parts;
 }
 
+/// wind= of Species.mesh and Species.export: the species' own wind (value unset) or
+/// (speed m/s, direction degrees), checked as `sprig mesh --wind` checks them.
+std::optional<std::pair<double, double>> windValue(const std::optional<std::vector<double>>& v) {
+  if (!v) return std::nullopt;
+  const bool ok = (v->size() == 1 || v->size() == 2) && (*v)[0] >= 0 && (*v)[0] <= 60 &&
+                  (v->size() == 1 || ((*v)[1] >= -360 && (*v)[1] <= 360));
+  if (!ok) throw UsageError("wind: expected speed or (speed, direction) with 0 <= speed <= 60 (m/s) and -360 <= direction <= 360 (degrees)");
+  return std::make_pair((*v)[0], v->size() == 2 ? (*v)[1] : 0.0);
+}
+
+/// An explicit wind for a kind without one is an error, as `sprig mesh --wind` makes it.
+void requireWind(SpeciesModel& model, const Stage& stage, const std::optional<std::pair<double, double>>& wind) {
+  if (wind && !model.windSource(stage)) throw UsageError("wind sways trees; " + speciesOfKind(model.species().kind) + " has no wind");
+}
+
+/// A part's wind (addModelWind's, as the .glb's LOD0 has it): `wind` holds the morph
+/// targets (names, targets (K, N, 3) displacements, times (F,), weights (K, F)) or None
+/// when the part does not sway; `wind_attribute` is `_WIND` (N, 4), or None.
+void addWindEntries(py::dict& d, const ExportPart& p) {
+  d["wind"] = py::none();
+  d["wind_attribute"] = py::none();
+  const auto nv = static_cast<py::ssize_t>(p.mesh.vertexCount());
+  for (const VertexAttribute& a : p.attributes)
+    if (a.name == "_WIND") d["wind_attribute"] = copyArray<float>(a.values.data(), {nv, 4});
+  if (!p.morph) return;
+  const PartMorph& m = *p.morph;
+  const auto nk = static_cast<py::ssize_t>(m.targets.size()), nf = static_cast<py::ssize_t>(m.times.size());
+  py::array_t<float> targets({nk, nv, py::ssize_t(3)}), weights({nk, nf});
+  for (py::ssize_t k = 0; k < nk; ++k) {
+    std::memcpy(targets.mutable_data(k), m.targets[size_t(k)].data(), sizeof(float) * 3 * size_t(nv));
+    std::memcpy(weights.mutable_data(k), m.weights[size_t(k)].data(), sizeof(float) * size_t(nf));
+  }
+  py::dict w;
+  w["animation"] = m.animation;
+  w["names"] = m.names;
+  w["targets"] = targets;
+  w["times"] = copyArray<float>(m.times.data(), {nf});
+  w["weights"] = weights;
+  w["loop_seconds"] = kWindLoopSeconds;
+  d["wind"] = w;
+}
+
 py::dict partDict(const ExportPart& p) {
   const Mesh& m = p.mesh;
   const auto nv = static_cast<py::ssize_t>(m.vertexCount()), nt = static_cast<py::ssize_t>(m.triangleCount());
@@ -320,11 +363,25 @@ py::dict partDict(const ExportPart& p) {
       d["texture_corner_uvs"] = uv;
     }
   }
+  addWindEntries(d, p);
   return d;
 }
 
-py::list mesh(PySpecies& s, const MeshRequest& r, const py::object& progress) {
-  const std::vector<ExportPart> parts = runLong([&] { return meshParts(s, r); }, progress);
+/// Species.mesh: meshParts, and with wind (wind true: the species' own, or windAt) the
+/// wind `sprig mesh` puts on a .glb's LOD0 (addModelWind) on these parts.
+py::list mesh(PySpecies& s, const MeshRequest& r, bool wind, const std::optional<std::pair<double, double>>& windAt,
+              const py::object& progress) {
+  const std::vector<ExportPart> parts = runLong(
+      [&] {
+        const Stage stage = resolveStage(*s.model, r.stage, r.fraction, r.age);
+        requireWind(*s.model, stage, windAt);
+        Vec3 offset(0.0f);
+        std::vector<LodLevel> levels(1);
+        levels[0].parts = meshParts(s, r, &offset);
+        if (wind || windAt) addModelWind(*s.model, stage, levels, offset, windAt);
+        return std::move(levels[0].parts);
+      },
+      progress);
   py::list out;
   for (const ExportPart& p : parts)
     if (!p.mesh.triangles.empty()) out.append(partDict(p));
@@ -333,14 +390,17 @@ py::list mesh(PySpecies& s, const MeshRequest& r, const py::object& progress) {
 
 /// `sprig mesh SPECIES -o path`: the parts written with their levels of detail (model/lod.h
 /// writeLevels, the kind's default budget), or a solid's volume mesh.
-void exportMesh(PySpecies& s, const std::filesystem::path& path, const MeshRequest& r, const py::object& progress) {
+void exportMesh(PySpecies& s, const std::filesystem::path& path, const MeshRequest& r,
+                const std::optional<std::pair<double, double>>& wind, const py::object& progress) {
   const std::string ext = lowerExtension(path);
   const bool volume = ext == ".msh" || ext == ".vtu" || ext == ".mesh";
   if (!volume && ext != ".ply" && ext != ".obj" && ext != ".glb")
     throw UsageError(path.string() + ": unknown mesh extension '" + path.extension().string() +
                      "' (use .ply, .obj, .glb; solids also .msh, .vtu, .mesh)");
+  if (wind && ext != ".glb") throw UsageError("wind writes a tree's sway into glTF: give a .glb name");
   runLong(
       [&] {
+        requireWind(*s.model, resolveStage(*s.model, r.stage, r.fraction, r.age), wind);
         if (volume) {
           if (r.simplify && *r.simplify > 0)
             throw UsageError("simplify applies to the surface parts written as .ply, .obj or .glb, not to volume meshes");
@@ -348,7 +408,8 @@ void exportMesh(PySpecies& s, const std::filesystem::path& path, const MeshReque
         } else {
           Vec3 offset(0.0f), moved(0.0f);  // as `sprig mesh`: levels of detail, a tree's wind in .glb
           std::vector<LodLevel> levels = lodLevels(meshParts(s, r, &offset), s.model->lodBudget(), &moved);
-          if (ext == ".glb") addModelWind(*s.model, resolveStage(*s.model, r.stage, r.fraction, r.age), levels, offset + moved);
+          if (ext == ".glb")
+            addModelWind(*s.model, resolveStage(*s.model, r.stage, r.fraction, r.age), levels, offset + moved, wind);
           writeLevels(levels, path);
         }
         return 0;
@@ -538,16 +599,22 @@ void bindSpecies(py::module_& m) {
            },
            py::arg("width"), py::arg("height"), py::arg("spp"), py::arg("mode"), py::arg("stage"), py::arg("fraction"),
            py::arg("age"), py::arg("view"), py::arg("alpha"), py::arg("linear"), py::arg("progress"))
+      .def_property_readonly("wind",
+                             [](const PySpecies& s) -> py::object {
+                               if (s.species.kind != "tree") return py::none();  // trees alone sway (KindModel::windSource)
+                               return py::make_tuple(s.species.render.windSpeed, s.species.render.windDirectionDeg);
+                             })
       .def("_mesh",
            [](PySpecies& s, std::optional<int> stage, double fraction, std::optional<double> age, double cell,
-              double minVolume, std::optional<double> simplify, const py::object& progress) {
-             return mesh(s, MeshRequest{stage, fraction, age, cell, minVolume, simplify}, progress);
+              double minVolume, std::optional<double> simplify, bool wind, std::optional<std::vector<double>> windAt,
+              const py::object& progress) {
+             return mesh(s, MeshRequest{stage, fraction, age, cell, minVolume, simplify}, wind, windValue(windAt), progress);
            })
       .def("_export",
            [](PySpecies& s, const std::filesystem::path& path, std::optional<int> stage, double fraction,
               std::optional<double> age, double cell, double minVolume, std::optional<double> simplify,
-              const py::object& progress) {
-             exportMesh(s, path, MeshRequest{stage, fraction, age, cell, minVolume, simplify}, progress);
+              std::optional<std::vector<double>> wind, const py::object& progress) {
+             exportMesh(s, path, MeshRequest{stage, fraction, age, cell, minVolume, simplify}, windValue(wind), progress);
            })
       .def("_animate",
            [](const std::shared_ptr<PySpecies>& s, int framesPerStage, std::optional<int> first, std::optional<int> last,

@@ -1,6 +1,8 @@
 """Sprig species in Blender (docs/BLENDER.md): imports a species as mesh objects built from the
 `sprig` Python module's arrays, shows its grammar's #defines and its steps in a sidebar panel
-(changing one rebuilds the meshes), and renders it with Sprig's own renderer into an image."""
+(changing one rebuilds the meshes), sways a tree in its wind (shape keys and a looping action
+'wind', the .glb's morph targets and animation), and renders it with Sprig's own renderer
+into an image."""
 
 bl_info = {
     "name": "Sprig",
@@ -128,6 +130,78 @@ def build_material(name, part):
     return mat
 
 
+# ---- Wind -----------------------------------------------------------------------------------
+
+# Blender's keyframe interpolation enum value of 'LINEAR' (foreach_set takes the numbers).
+_LINEAR = 1
+
+
+def add_wind_keys(obj, part):
+    """Shape keys on obj's mesh from the part's wind (Species.mesh(wind=...)): 'Basis', then one
+    key per morph target with the .glb's name, each the Basis moved by its displacement, its
+    slider range opened to the animation's weights. Returns whether keys were added."""
+    wind = part["wind"]
+    if wind is None or len(obj.data.vertices) != len(part["positions"]):
+        return False
+    basis = z_up(part["positions"])
+    obj.shape_key_add(name="Basis", from_mix=False)
+    for name, delta, weights in zip(wind["names"], wind["targets"], wind["weights"]):
+        key = obj.shape_key_add(name=name, from_mix=False)
+        key.slider_max = min(10.0, max(1.0, float(weights.max())))
+        key.slider_min = max(-10.0, min(0.0, float(weights.min())))
+        key.data.foreach_set("co", (basis + z_up(delta)).ravel())
+    return True
+
+
+def wind_action_of(empty):
+    """The action driving the shape keys of the species' parts, or None."""
+    for obj in empty.children:
+        keys = obj.data.shape_keys if obj.type == "MESH" else None
+        if keys and keys.animation_data and keys.animation_data.action:
+            return keys.animation_data.action
+    return None
+
+
+def set_wind_action(scene, keyed, action):
+    """The action 'wind' (action, emptied, or a new one) driving the shape keys of the objects
+    keyed (object, part) pairs: one fcurve per target name, the .glb's keyframes (times, weights)
+    at frame 1 + time x the scene's fps, LINEAR, repeated by a Cycles modifier so the 20 s loop
+    plays forever. Without keyed objects the action is removed. Returns the action or None."""
+    if not keyed:
+        if action is not None and action.users == 0:
+            bpy.data.actions.remove(action)
+        return None
+    if action is None:
+        action = bpy.data.actions.new("wind")
+        action.id_root = "KEY"
+    for fcurve in list(action.fcurves):
+        action.fcurves.remove(fcurve)
+    fps = scene.render.fps / scene.render.fps_base
+    curves = {}  # every part's weights of a name are the same (one rig per tree)
+    for _, part in keyed:
+        wind = part["wind"]
+        for name, weights in zip(wind["names"], wind["weights"]):
+            curves.setdefault(name, (wind["times"], weights))
+    for name, (times, weights) in curves.items():
+        fcurve = action.fcurves.new('key_blocks["%s"].value' % name, action_group="wind")
+        fcurve.keyframe_points.add(len(times))
+        co = np.stack([1.0 + times.astype(np.float64) * fps, weights], axis=1).astype(np.float32)
+        fcurve.keyframe_points.foreach_set("co", co.ravel())
+        fcurve.keyframe_points.foreach_set("interpolation", np.full(len(times), _LINEAR, np.int32))
+        fcurve.modifiers.new("CYCLES")
+        fcurve.update()
+    for obj, _ in keyed:
+        obj.data.shape_keys.animation_data_create().action = action
+    return action
+
+
+def wind_option(settings):
+    """Species.mesh's wind= for the panel's values: (speed, direction), or False (no wind)."""
+    if settings.has_wind and settings.wind_speed > 0:
+        return (settings.wind_speed, settings.wind_direction)
+    return False
+
+
 # ---- Species settings and (re)building -------------------------------------------------------
 
 
@@ -148,6 +222,14 @@ class SprigSpecies(bpy.types.PropertyGroup):
     cell: FloatProperty(name="Cell", min=0.0, default=0.0, precision=3,
                         description="Polygonization cell size (0: the species' own)",
                         update=lambda self, context: regenerate_owner(self.id_data))
+    has_wind: BoolProperty(name="Has wind", default=False)
+    wind_speed: FloatProperty(name="Wind", min=0.0, max=60.0, default=0.0, precision=1, unit="VELOCITY",
+                              description="Wind speed in m/s (the species' own at import; 0: no wind animation)",
+                              update=lambda self, context: regenerate_owner(self.id_data))
+    wind_direction: FloatProperty(name="Direction", min=-360.0, max=360.0, default=0.0, precision=0,
+                                  description="Azimuth the wind blows toward, degrees (0: toward Sprig's +Z, "
+                                              "Blender's -Y; 90: toward +X)",
+                                  update=lambda self, context: regenerate_owner(self.id_data))
     live: BoolProperty(name="Live", default=True, description="Rebuild the meshes when a parameter changes")
     building: BoolProperty(default=False)
 
@@ -167,9 +249,12 @@ def part_objects(empty):
 
 def rebuild_parts(empty, species):
     """Meshes the species and gives each part's object (made on first use) the new mesh;
-    objects of parts the species no longer has are removed. Returns the parts."""
-    parts = species.mesh(cell=empty.sprig.cell)
+    objects of parts the species no longer has are removed. A tree in wind gets its shape
+    keys and the action 'wind' (set_wind_action). Returns the parts."""
+    parts = species.mesh(cell=empty.sprig.cell, wind=wind_option(empty.sprig))
+    action = wind_action_of(empty)
     existing = part_objects(empty)
+    keyed = []
     for part in parts:
         label = "%s.%s" % (empty.name, part["name"])
         mesh = build_mesh(label, part)
@@ -185,6 +270,9 @@ def rebuild_parts(empty, species):
             old = obj.data
             obj.data = mesh
             remove_mesh(old)
+        if add_wind_keys(obj, part):
+            keyed.append((obj, part))
+    set_wind_action(bpy.context.scene, keyed, action)
     for obj in existing.values():
         old = obj.data
         bpy.data.objects.remove(obj)
@@ -241,6 +329,8 @@ def import_species(context, path, root="/", cell=0.0):
         d = settings.defines.add()
         d.name, d.value, d.default = name, value, value
     settings.max_steps = settings.steps = species.steps or 0
+    settings.has_wind = species.wind is not None
+    settings.wind_speed, settings.wind_direction = species.wind or (0.0, 0.0)
     settings.building = False
     rebuild_parts(empty, species)
     return empty
@@ -332,6 +422,24 @@ class SPRIG_OT_reset(SpeciesOperator, bpy.types.Operator):
         return {"FINISHED"}
 
 
+class SPRIG_OT_wind_frames(SpeciesOperator, bpy.types.Operator):
+    """Set the scene's frame range to one loop of the wind (20 s at the scene's fps): played on
+    repeat, the sway runs on without a jump"""
+    bl_idname = "sprig.wind_frames"
+    bl_label = "Frame range to wind loop"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def run(self, context, empty):
+        scene = context.scene
+        fps = scene.render.fps / scene.render.fps_base
+        # frame 1 is time 0; the frame after the last is time 20 s, the same pose as frame 1
+        scene.frame_start, scene.frame_end = 1, round(WIND_LOOP_SECONDS * fps)
+        return {"FINISHED"}
+
+
+WIND_LOOP_SECONDS = 20.0  # the module's wind["loop_seconds"] (model/wind_export.h kWindLoopSeconds)
+
+
 class SPRIG_OT_render(SpeciesOperator, bpy.types.Operator):
     """Render the species with Sprig's own renderer into the image "<species> (Sprig)\""""
     bl_idname = "sprig.render"
@@ -389,6 +497,11 @@ class SPRIG_PT_panel(bpy.types.Panel):
         if not settings.defines and settings.max_steps == 0:
             col.label(text="No #defines: a %s has no grammar" % settings.kind)
         layout.prop(settings, "cell")
+        if settings.has_wind:
+            row = layout.row(align=True)
+            row.prop(settings, "wind_speed")
+            row.prop(settings, "wind_direction")
+            layout.operator(SPRIG_OT_wind_frames.bl_idname, icon="PREVIEW_RANGE")
         row = layout.row(align=True)
         row.prop(settings, "live")
         row.operator(SPRIG_OT_regenerate.bl_idname, icon="FILE_REFRESH")
@@ -410,7 +523,7 @@ def menu_import(self, context):
 
 
 classes = (SprigDefine, SprigSpecies, SprigPreferences, SPRIG_OT_import, SPRIG_OT_regenerate, SPRIG_OT_reset,
-           SPRIG_OT_render, SPRIG_PT_panel)
+           SPRIG_OT_wind_frames, SPRIG_OT_render, SPRIG_PT_panel)
 
 
 def register():

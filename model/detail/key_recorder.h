@@ -52,6 +52,9 @@ struct KeySchema {
   std::string ref;  ///< the position holds a shared definition (KeyRecorder::definition) of this name
   std::map<std::string, std::unique_ptr<KeySchema>> properties;  ///< a map's keys
   std::unique_ptr<KeySchema> items;                              ///< a sequence's elements
+  /// dataKeys maps described by describeEntry: the value of every entry (the schema's
+  /// additionalProperties), or null.
+  std::unique_ptr<KeySchema> entries;
 
   KeySchema& property(const std::string& key) {
     auto& p = properties[key];
@@ -61,6 +64,10 @@ struct KeySchema {
   KeySchema& item() {
     if (!items) items = std::make_unique<KeySchema>();
     return *items;
+  }
+  KeySchema& entry() {
+    if (!entries) entries = std::make_unique<KeySchema>();
+    return *entries;
   }
   /// Widens the range to hold [lo, hi] (infinite bounds mean none).
   void range(double lo, double hi);

@@ -91,20 +91,41 @@ def _render(self, width=None, height=None, spp=None, mode="exact", stage=None, f
     return _image(a, linear)
 
 
-def _mesh(self, stage=None, fraction=1.0, age=None, cell=0.0, min_volume=_sprig.DEFAULT_MIN_VOLUME, simplify=None, progress=None):
+def _wind_value(wind):
+    """wind= as the C++ module takes it: None, or [speed] / [speed, direction]."""
+    if wind is None:
+        return None
+    return [float(wind)] if np.isscalar(wind) else [float(v) for v in wind]
+
+
+def _mesh(self, stage=None, fraction=1.0, age=None, cell=0.0, min_volume=_sprig.DEFAULT_MIN_VOLUME, simplify=None,
+          wind=False, progress=None):
     """The surface as `sprig mesh` builds it: a list of parts (one dict each, parts without
     triangles left out) with name, positions (N, 3 float32), triangles (M, 3 uint32),
     normals, colors (linear RGB) and uvs (or None), material_ids, material, base_color,
-    roughness, double_sided, alpha_cutoff, texture (linear RGBA float32 image or None) and
-    texture_corner_uvs (M, 3, 2 for a texture atlas, else None).
-    cell: --cell (0 = automatic); min_volume: --min-volume; simplify: --simplify."""
-    return self._mesh(stage, fraction, age, cell, min_volume, simplify, progress)
+    roughness, double_sided, alpha_cutoff, texture (linear RGBA float32 image or None),
+    texture_corner_uvs (M, 3, 2 for a texture atlas, else None), wind and wind_attribute.
+    cell: --cell (0 = automatic); min_volume: --min-volume; simplify: --simplify.
+
+    wind (trees): True for the species' own wind (Species.wind), a speed in m/s or (speed,
+    direction in degrees) as `sprig mesh --wind`; False (the default) for none. With wind,
+    wind_attribute is the .glb's `_WIND` (N, 4 float32) and, when the part sways (speed > 0),
+    wind is a dict of the .glb's morph targets and animation: names (K target names),
+    targets (K, N, 3 float32 displacements of the positions), times (F keyframe seconds over
+    loop_seconds, the last equal to it), weights (K, F float32) and animation ('wind');
+    otherwise both are None (docs/MESHES.md "Wind"). A speed for a kind without wind raises
+    ValueError; True gives None there."""
+    windy = wind is True
+    value = None if isinstance(wind, bool) else _wind_value(wind)
+    return self._mesh(stage, fraction, age, cell, min_volume, simplify, windy, value, progress)
 
 
-def _export(self, path, stage=None, fraction=1.0, age=None, cell=0.0, min_volume=_sprig.DEFAULT_MIN_VOLUME, simplify=None, progress=None):
+def _export(self, path, stage=None, fraction=1.0, age=None, cell=0.0, min_volume=_sprig.DEFAULT_MIN_VOLUME, simplify=None,
+            wind=None, progress=None):
     """Writes the mesh as `sprig mesh SPECIES -o path` does (.ply, .obj + .mtl, .glb; solids
-    also .msh, .vtu, .mesh): the same bytes for the same options."""
-    self._export(os.fspath(path), stage, fraction, age, cell, min_volume, simplify, progress)
+    also .msh, .vtu, .mesh): the same bytes for the same options. wind: a speed in m/s or
+    (speed, direction in degrees), as --wind (a tree's .glb only); None: the species' own."""
+    self._export(os.fspath(path), stage, fraction, age, cell, min_volume, simplify, _wind_value(wind), progress)
 
 
 class Animation:

@@ -1,6 +1,7 @@
 """Shared helpers of the Python module's tests: the `sprig` binary to compare with, and a
 PNG reader (zlib and numpy only) for its images."""
 
+import json
 import os
 import struct
 import subprocess
@@ -11,6 +12,7 @@ import pytest
 
 TREE = "python/tests/data/tiny_tree.yaml"
 BAD = "python/tests/data/bad.yaml"
+WINDY = "python/tests/data/tiny_windy_tree.yaml"
 
 
 def sprig_bin():
@@ -71,3 +73,45 @@ def read_png(path):
         out[y] = row
         prev = row
     return out.reshape(height, width, channels)
+
+
+_COMPONENTS = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4}
+_TYPES = {5126: np.float32, 5125: np.uint32, 5123: np.uint16, 5121: np.uint8}
+
+
+class Glb:
+    """A .glb read with numpy alone: its JSON (self.json) and any accessor as an array
+    (dense or sparse, float or integer; normalized integers are not scaled)."""
+
+    def __init__(self, path):
+        data = open(path, "rb").read()
+        assert data[:4] == b"glTF"
+        pos, self.json, self.bin = 12, None, b""
+        while pos < len(data):
+            length, tag = struct.unpack("<I4s", data[pos:pos + 8])
+            body = data[pos + 8:pos + 8 + length]
+            if tag == b"JSON":
+                self.json = json.loads(body)
+            elif tag == b"BIN\x00":
+                self.bin = body
+            pos += 8 + length
+
+    def _view(self, view, offset, dtype, count):
+        v = self.json["bufferViews"][view]
+        start = v.get("byteOffset", 0) + offset
+        return np.frombuffer(self.bin, dtype, count, start)
+
+    def accessor(self, index):
+        a = self.json["accessors"][index]
+        n, dtype = _COMPONENTS[a["type"]], _TYPES[a["componentType"]]
+        if "bufferView" in a:
+            out = self._view(a["bufferView"], a.get("byteOffset", 0), dtype, a["count"] * n).copy()
+        else:
+            out = np.zeros(a["count"] * n, dtype)
+        if "sparse" in a:
+            s = a["sparse"]
+            idx = self._view(s["indices"]["bufferView"], s["indices"].get("byteOffset", 0),
+                             _TYPES[s["indices"]["componentType"]], s["count"])
+            values = self._view(s["values"]["bufferView"], s["values"].get("byteOffset", 0), dtype, s["count"] * n)
+            out.reshape(-1, n)[idx.astype(np.int64)] = values.reshape(-1, n)
+        return out.reshape(a["count"], n) if n > 1 else out

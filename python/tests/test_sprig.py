@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import sprig
-from conftest import BAD, TREE, read_png, run_sprig
+from conftest import BAD, TREE, WINDY, Glb, read_png, run_sprig
 
 
 @pytest.fixture(scope="module")
@@ -156,3 +156,55 @@ def test_bad_options_are_value_errors(tree):
         tree.render(stage=7)
     with pytest.raises(ValueError, match="unknown mesh extension"):
         tree.export("x.stl")
+
+
+def test_mesh_wind_equals_the_glbs_morph_targets_and_animation(tmp_path):
+    windy = sprig.load(WINDY)
+    assert windy.wind == (6.0, 90.0) and sprig.load(TREE).wind == (0.0, 0.0)
+    parts = {p["name"]: p for p in windy.mesh(wind=True)}
+    assert sorted(parts) == ["leaves", "wood"]
+    # The module's .glb (the species' wind) is the command's with --wind 6,90.
+    windy.export(tmp_path / "py.glb")
+    run_sprig("mesh", WINDY, "-o", str(tmp_path / "cli.glb"), "--wind", "6,90")
+    assert (tmp_path / "py.glb").read_bytes() == (tmp_path / "cli.glb").read_bytes()
+    glb = Glb(tmp_path / "py.glb")
+    [anim] = [a for a in glb.json["animations"] if a["name"] == "wind"]
+    assert len(anim["channels"]) == 2
+    for channel in anim["channels"]:
+        assert channel["target"]["path"] == "weights"
+        node = glb.json["nodes"][channel["target"]["node"]]
+        mesh = glb.json["meshes"][node["mesh"]]
+        part, names = parts[node["name"]], mesh["extras"]["targetNames"]
+        wind, n = part["wind"], len(part["positions"])
+        assert wind["animation"] == "wind" and wind["loop_seconds"] == 20.0
+        # the wood has no flutter: 10 targets (static, gust, 4 sways); the leaves 12
+        assert wind["names"] == names and len(names) == (10 if node["name"] == "wood" else 12), names
+        assert wind["targets"].shape == (len(names), n, 3) and wind["targets"].dtype == np.float32
+        assert part["wind_attribute"].shape == (n, 4)
+        sampler = anim["samplers"][channel["sampler"]]
+        times = glb.accessor(sampler["input"])
+        assert len(times) == 601 and times[-1] == 20.0
+        assert np.array_equal(wind["times"], times)
+        assert np.array_equal(wind["weights"], glb.accessor(sampler["output"]).reshape(len(times), len(names)).T)
+        assert np.array_equal(wind["weights"][0], np.ones(601, np.float32))  # static
+        # Every glTF vertex moves as the part's vertex at its position (the .glb splits
+        # vertices at creases; LOD0 is the whole mesh here).
+        [prim] = mesh["primitives"]
+        where = {p.tobytes(): i for i, p in enumerate(part["positions"])}
+        index = np.array([where[p.tobytes()] for p in glb.accessor(prim["attributes"]["POSITION"])])
+        for k, target in enumerate(prim["targets"]):
+            assert np.array_equal(glb.accessor(target["POSITION"]), wind["targets"][k][index]), names[k]
+        assert np.abs(wind["targets"]).max() > 0.01
+    # No wind asked, wind 0, a kind without wind: no targets; a speed for a shell is an error.
+    assert all(p["wind"] is None and p["wind_attribute"] is None for p in windy.mesh())
+    assert all(p["wind"] is None and p["wind_attribute"] is not None for p in windy.mesh(wind=0))
+    stronger = {p["name"]: p["wind"] for p in windy.mesh(wind=(12, 90))}
+    assert np.abs(stronger["wood"]["targets"]).max() > np.abs(parts["wood"]["wind"]["targets"]).max()
+    berry = sprig.load("species/fig_org_05a_berry_level1.yaml")
+    assert berry.wind is None and all(p["wind"] is None for p in berry.mesh(wind=True))
+    with pytest.raises(ValueError, match="wind sways trees; an organism species has no wind"):
+        berry.mesh(wind=5)
+    with pytest.raises(ValueError, match="0 <= speed <= 60"):
+        windy.mesh(wind=(61, 0))
+    with pytest.raises(ValueError, match="give a .glb name"):
+        windy.export(tmp_path / "w.ply", wind=3)

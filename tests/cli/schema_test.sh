@@ -7,7 +7,9 @@
 #      wrong word or colour, a missing or unknown kind (tests/bad_inputs and a few edits of
 #      shipped species) are rejected by the schema too, and the same edits within range are
 #      accepted by both; so are unknown keys inside blob nodes (also nested in a blend),
-#      solids' distance fields (also in a union), layers and operations.
+#      solids' distance fields (also in a union), layers and operations, and bad values
+#      inside the entries of maps whose keys are data (a solid's materials, a tree's
+#      defines) and inside a shell's generating primitives (point, cone).
 # Usage: tests/cli/schema_test.sh path/to/sprig   (run from the repository root)
 set -euo pipefail
 SPRIG=$(realpath "$1")
@@ -123,6 +125,33 @@ both orgbase 'organism: {base: {cube_sphere: {radius: 1}}, blend: {alpha: {plane
 both orgbase 'organism: {base: {cube_sphere: {radius: 1}}, blend: {}}' invalid
 both orgbase 'organism: {base: {cube_sphere: {radius: 1}}, modify: [{gains: [1]}]}' valid
 both orgbase 'organism: {base: {cube_sphere: {radius: 1}}, modify: [{radius: 1}]}' invalid
+# Keys whose names are data: a solid's materials (each entry a concrete or a procedural
+# material), a tree's defines (each a number), a shell's generating primitives ({point: ...}
+# or {cone: ...}): a bad value inside an entry is found by both.
+printf 'kind: shell\n' > "$WORK/lib/species/shellbase.yaml"
+printf 'kind: tree\ngrammar: ../grammars/abop_2_6.lsys\n' > "$WORK/lib/species/treedefs.yaml"
+oak='solid: {volume: {distance_field: {sphere: {radius: 1}}, layers: [{interior_layer: {material: oak, thickness: fill}}]}}'
+both solidbase "$oak
+materials: {oak: {base: wood, color: [0.5, 0.3, 0.2], roughness: 0.4}, mix: {select: \"x > 0\", choices: [oak, stone]}}" valid
+both solidbase "$oak
+materials: {oak: {color: [0.5, 0.3, 0.2], roughness: 2}}" invalid
+both solidbase "$oak
+materials: {oak: {colour: [0.5, 0.3, 0.2]}}" invalid
+both solidbase "$oak
+materials: {oak: {color: [0.5, 0.3, 2]}}" invalid
+both solidbase "$oak
+materials: {oak: 3}" invalid
+both treedefs 'defines: {r1: 0.8, a0: 30}' valid
+both treedefs 'defines: {r1: short}' invalid
+prims() { echo "shell: {generating: {primitives: [$1]}}"; }
+both shellbase "$(prims '{point: {center: [0, 0, 0], radius: 0.75}}, {cone: {a: [-0.1, 0.2, 0], b: [-2.25, 3.6, 0], radius_a: 0.7, radius_b: 0.15, bend: 20}}')" valid
+both shellbase "$(prims '{point: {center: [0, 0, 0], radius: 0}}')" invalid
+both shellbase "$(prims '{point: {centre: [0, 0, 0], radius: 0.75}}')" invalid
+both shellbase "$(prims '{point: {center: [0, 0], radius: 0.75}}')" invalid
+both shellbase "$(prims '{cone: {a: [-0.1, 0.2, 0], b: [-2.25, 3.6, 0], bend: 200}}')" invalid
+both shellbase "$(prims '{cone: {a: [-0.1, 0.2, 0], b: [-2.25, 3.6, 0], canal: maybe}}')" invalid
+both shellbase "$(prims '{sphere: {radius: 1}}')" invalid
+both shellbase "$(prims '{point: {radius: 1}, cone: {radius_a: 1}}')" invalid
 # What the schema cannot express: a name that must refer to something else in the file.
 # A solid layer's material is any word to the schema (JSON Schema cannot check that a
 # string names a key of another map, here 'materials:' or the built-in table); sprig check

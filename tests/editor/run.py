@@ -13,7 +13,7 @@ mapped to every file, and checks:
   2. every shipped species (species/*.yaml) gets no diagnostic at all;
   3. a wrong colour reads as a colour's message, not "Incorrect type. Expected array";
   4. hovers show what a key does, with its range and default (a tree's `steps`, a
-     render colour, a bark key).
+     render colour, a bark key, a solid's material entry and a key inside it).
 Usage: tests/editor/run.py path/to/sprig   (run from the repository root)
 """
 import os
@@ -45,6 +45,8 @@ def gist_of_sprig(message):
     """(kind, subject) of one `sprig check` error message."""
     if m := re.match(r"unknown key '([^']+)'", message):
         return "unknown key", m.group(1)
+    if m := re.match(r"unknown [a-z ]+ '[^']+'.*\(((?:one of: )?[\w, ]+)\)$", message):  # a one-key map's key
+        return "not one of", ",".join(w for w in re.findall(r"\w+", m.group(1)) if w not in ("one", "of", "or"))
     if m := re.search(r"must be one of (.*), got", message):
         return "not one of", ",".join(w.strip() for w in m.group(1).split(","))
     if re.search(r"must be a colour", message):
@@ -58,7 +60,7 @@ def gist_of_sprig(message):
         return "range", repr(0.0)
     if m := re.match(r"missing required key '([^']+)'", message):
         return "missing", m.group(1)
-    if m := re.search(r"must be (an integer|true or false|a map|a sequence|\[x, y, z\]|a finite number)", message):
+    if m := re.search(r"must be (an integer|true or false|a map|a sequence|\[x, y, z\]|a finite number|a number)", message):
         return "type", ""
     return "other", message
 
@@ -107,8 +109,11 @@ def main():
         if len(shipped) < 50:
             fail("only %d shipped species" % len(shipped))
         files = [str(p) for p in BAD + shipped]
-        hovers = ["tests/editor/hover.yaml:2:2", "tests/editor/hover.yaml:5:4", "tests/editor/hover.yaml:8:6"]
-        diagnostics, texts = lsp_client.session(["node", str(SERVER)], schema, files + ["tests/editor/hover.yaml"], hovers)
+        hovers = ["tests/editor/hover.yaml:2:2", "tests/editor/hover.yaml:5:4", "tests/editor/hover.yaml:8:6",
+                  "tests/editor/hover_entries.yaml:3:4", "tests/editor/hover_entries.yaml:4:6"]
+        diagnostics, texts = lsp_client.session(["node", str(SERVER)], schema,
+                                                files + ["tests/editor/hover.yaml", "tests/editor/hover_entries.yaml"],
+                                                hovers)
 
     # 1. The bad species: the same errors, line for line.
     compared = 0
@@ -142,8 +147,9 @@ def main():
     for p in shipped:
         if diagnostics[str(p)]:
             fail("%s: the editor reports %s" % (p, diagnostics[str(p)]))
-    if diagnostics["tests/editor/hover.yaml"]:
-        fail("hover.yaml: the editor reports %s" % diagnostics["tests/editor/hover.yaml"])
+    for hover_file in ("tests/editor/hover.yaml", "tests/editor/hover_entries.yaml"):
+        if diagnostics[hover_file]:
+            fail("%s: the editor reports %s" % (hover_file, diagnostics[hover_file]))
 
     # 3. A wrong colour reads as a colour.
     colour = [d[2] for d in diagnostics["tests/editor/species/tree_enums.yaml"] if d[0] == 10]
@@ -153,7 +159,10 @@ def main():
     # 4. Hovers: what the key does, then its range and default.
     wants = [("Derivation steps (default: the grammar's", "steps: an integer in [0, 100000]\n"),
              ("Preview colour of internodes", "default [0.3, 0.2, 0.12]"),
-             ("Ridges around a branch", "an integer in [1, 1000]; default 9")]
+             ("Ridges around a branch", "an integer in [1, 1000]; default 9"),
+             # inside a materials: entry, whose key (the material's name) the file chooses
+             ("A material of this file, named by its key", "materials.NAME (material 'NAME'): a map"),
+             ("Render roughness, 0 to 1.", "materials.NAME.roughness: a number in [0, 1]; default 0.5")]
     for text, (what, detail) in zip(texts, wants):
         text = re.sub(r"\\(.)", r"\1", text)  # the hover is Markdown: `\[0, 100000\]`
         if what not in text or detail not in text:

@@ -45,7 +45,9 @@ TEST_CASE("speciesSchemaJson", "[model]") {
                                             "pattern's resolution across the whorl.\\n\\nshell.pigment.cells: an "
                                             "integer in [3, 4096]; default 160\"") != std::string::npos);
     // A one-key alternative (a blob node's kind, a distance field, a tool) says what it is.
-    CHECK(propertyLine(schema, "cone").find("\"description\": \"Cone primitive (the tree paper's internode") !=
+    const size_t blobNode = schema.find("\"part_blob_node\": {");
+    REQUIRE(blobNode != std::string::npos);
+    CHECK(propertyLine(schema, "cone", blobNode).find("\"description\": \"Cone primitive (the tree paper's internode") !=
           std::string::npos);
     CHECK(propertyLine(schema, "hammer").find("\"description\": \"A blow (§3.1)") != std::string::npos);
     // A position holding a shared definition keeps its text beside the `$ref`.
@@ -94,6 +96,34 @@ TEST_CASE("speciesSchemaJson", "[model]") {
     INFO("keys without help: " << without.size());
     for (const std::string& d : without) UNSCOPED_INFO(d);
     CHECK(without.empty());
+  }
+
+  SECTION("keys whose names are data: every entry's value is described") {
+    // A solid's materials: each entry (its key the material's name) is a material, whose keys
+    // are checked and have their texts.
+    const size_t solid = schema.find("\"solid\": {\"type\": \"object\"");
+    REQUIRE(solid != std::string::npos);
+    const size_t materials = schema.find("\"materials\": {\"description\"", solid);
+    REQUIRE(materials != std::string::npos);
+    const std::string entry = propertyLine(schema, "additionalProperties", materials);
+    CHECK(entry.find("\"description\": \"A material of this file, named by its key") != std::string::npos);
+    CHECK(entry.find("materials.NAME (material 'NAME'): a map\", \"type\": \"object\"") != std::string::npos);
+    CHECK(propertyLine(schema, "roughness", materials) ==
+          "\"roughness\": {\"description\": \"Render roughness, 0 to 1.\\n\\nmaterials.NAME.roughness: a number in [0, "
+          "1]; default 0.5\", \"default\": 0.5, \"type\": \"number\", \"minimum\": 0, \"maximum\": 1},");
+    CHECK(propertyLine(schema, "select", materials).find("materials.NAME.select") != std::string::npos);
+    // A tree's defines: any name, a number.
+    const std::string define = propertyLine(schema, "additionalProperties", schema.find("\"defines\": {\"description\""));
+    CHECK(define.find("defines.NAME: a number\", \"type\": \"number\"}") != std::string::npos);
+    // A shell's generating primitives: a map with one key, point or cone, each closed.
+    const size_t primitives = schema.find("\"primitives\": {\"description\"");
+    REQUIRE(primitives != std::string::npos);
+    const std::string item = schema.substr(primitives, schema.find("\"part_", primitives) - primitives);
+    CHECK(item.find("\"minProperties\": 1, \"maxProperties\": 1, \"propertyNames\": {\"enum\": [\"point\", \"cone\"]}") !=
+          std::string::npos);
+    CHECK(propertyLine(schema, "point", primitives).find("A point primitive of the generating surface") != std::string::npos);
+    CHECK(propertyLine(schema, "radius_a", primitives).find("shell.generating.primitives[].cone.radius_a: a number in "
+                                                           "[0.0001, 100]; default 0.3\"") != std::string::npos);
   }
 
   SECTION("a colour is a pattern or a triple, each with a readable message") {
