@@ -155,6 +155,20 @@ TEST_CASE("Turtle::moves and internodes", "[lsystem]") {
     checkVec(r.skeleton.internodes[2].start, {0, 7, 0});
     checkVec(r.end.frame.position, {0, 9, 0});
   }
+  SECTION("a move of length 0 goes nowhere and keeps the chain (tree_lime's fallen leaves are f(0))") {
+    Run r = draw("Ff(0)F[+F]g(0)F", s);
+    auto& in = r.skeleton.internodes;
+    REQUIRE(in.size() == 4);
+    const int32_t parent[] = {-1, 0, 1, 1};
+    const int order[] = {0, 0, 1, 0};
+    for (size_t i = 0; i < 4; ++i) {
+      CAPTURE(i);
+      CHECK(in[i].parent == parent[i]);
+      CHECK(in[i].order == order[i]);
+      if (in[i].parent >= 0) checkVec(in[i].start, in[in[i].parent].end);
+    }
+    checkVec(in[3].end, {0, 6, 0});
+  }
   SECTION("G draws") {
     Run r = draw("GG", s);
     REQUIRE(r.skeleton.internodes.size() == 2);
@@ -443,7 +457,9 @@ TEST_CASE("Turtle::shipped grammars", "[lsystem]") {
     for (const auto& in : c.skeleton.internodes) REQUIRE(2 * in.baseRadius <= 0.12 * in.length() + 1e-12);
   }
   SECTION("ABOP 1.31a and the original plants draw one connected plant") {
-    for (const char* name : {"abop_1_31a.lsys", "shrub.lsys", "conifer.lsys", "abop_2_7.lsys"}) {
+    // tree_lime's leaves fall as f(0): every lateral and the leader above them still hang
+    // from the trunk's first internode.
+    for (const char* name : {"abop_1_31a.lsys", "shrub.lsys", "conifer.lsys", "abop_2_7.lsys", "tree_lime.lsys"}) {
       INFO(name);
       TurtleSettings s;
       s.elasticity = 0.05;
