@@ -544,14 +544,18 @@ class TurtleWalk {
     last_ = {in.start, r, in.order};
   }
 
-  /// `f` and `g`: moves without drawing (`f` adds a polygon point when withVertex).
+  /// `f` and `g`: moves without drawing (`f` adds a polygon point when withVertex). A move
+  /// leaves a gap, so the next segment starts a new, disconnected axis; a move of length 0
+  /// at full growth (`f(0)`, tree_lime's fallen leaf) goes nowhere and the axis carries on:
+  /// what is drawn next still hangs from the last internode. (Full growth, so that a growing
+  /// move links the same internodes in every frame.)
   void move(size_t i, bool withVertex) {
     if (settings_.cpfg) cpfgTropisms();
     st_.texT += texStep(st_.texture, 2 * drawnRadius(fullLength(i)), fullLength(i));
     st_.frame.position += st_.frame.heading * length(i);
     if (settings_.cpfg) cpfgOldBend();
     if (!buf_.polygons.empty() && withVertex) addPolygonPoint(st_.frame.position);
-    st_.internode = -1;  // the next segment starts a new, disconnected axis
+    if (fullLength(i) != 0) st_.internode = -1;
   }
 
   /// `+ - & ^ \ /`: rotates the plane (a, b) by module i's angle (or the default), moving

@@ -208,6 +208,18 @@ int atlasVertexColors(ExportPart& part) {
   return atlasLayout(m.triangles.size()).cell;
 }
 
+void useHeaviestLayerUvs(blobtree::PolygonizeResult& result) {
+  Mesh& mesh = result.mesh;
+  if (result.attributes.size() != mesh.positions.size() || mesh.uvs.size() != mesh.positions.size()) return;
+  for (size_t v = 0; v < mesh.uvs.size(); ++v) {
+    const blobtree::Attributes& a = result.attributes[v];
+    int best = -1;
+    for (int i = 0; i < a.layerCount && i < blobtree::Attributes::kMaxLayers; ++i)
+      if (best < 0 || a.layers[size_t(i)].weight > a.layers[size_t(best)].weight) best = i;
+    if (best >= 0) mesh.uvs[v] = a.layers[size_t(best)].uv;
+  }
+}
+
 void textureBark(ExportPart& part, const std::function<Vec3(Vec2 uv)>& bark) {
   Mesh& mesh = part.mesh;
   if (mesh.uvs.size() != mesh.positions.size() || mesh.uvs.empty())

@@ -109,8 +109,14 @@ int atlasBlobPart(ExportPart& part, const blobtree::CompiledBlob& blob, const re
 /// colour and the part has no texture). Returns the patch size as atlasBlobPart.
 int atlasVertexColors(ExportPart& part);
 
+/// Sets each vertex's uv of result's mesh to its heaviest contributing primitive's own uv
+/// (Attributes::layers[0]) where it has layers: the coordinates in which a layered material
+/// (render::Material::textureLayers, a tree's bark) colours the vertex, where the field-blended
+/// uv mixes the angles of different axes (swirls round a junction or a scar). O(V).
+void useHeaviestLayerUvs(blobtree::PolygonizeResult& result);
+
 /// Maps a bark texture onto a tree's wood: the mesh's uvs are the bark's (u, v) (u turns
-/// around the branch, v along it, as the polygonizer blends them); v is rescaled to
+/// around the branch, v along it: useHeaviestLayerUvs, each vertex in its own cone's); v is rescaled to
 /// t = (v − vMin)/(vMax − vMin) over the mesh's range and the image covers one period of u
 /// (repeating, the bark closes at u = 1) times that range, each texel bark((s, v(t))).
 /// Sets part.material.texture. Throws std::invalid_argument when the mesh has no uvs.

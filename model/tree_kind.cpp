@@ -485,8 +485,12 @@ class TreeModel final : public KindModel {
       const auto& implicit = std::get<render::ImplicitPart>(geometry.parts.front());
       parts.resize(1);
       parts[0].name = "wood";
-      parts[0].mesh = paintPolygonized(blobtree::polygonizeDetailed(*tree.compiled, po), implicit.textures,
-                                       implicit.material);
+      {  // (the attributes are freed once painted)
+        blobtree::PolygonizeResult polygonized = blobtree::polygonizeDetailed(*tree.compiled, po);
+        // Each cone's bark in its own coordinates: the bark image is read at each vertex's heaviest cone's (u, v).
+        if (implicit.material.textureLayers) useHeaviestLayerUvs(polygonized);
+        parts[0].mesh = paintPolygonized(polygonized, implicit.textures, implicit.material);
+      }
       fig.clean = cleanMesh(parts[0].mesh, clean);
       parts[0].mesh.materials.clear();
       parts[0].material = {"wood", look.style.wood.baseColor, look.style.wood.roughness, false, nullptr};

@@ -86,6 +86,17 @@ void checkFrame(const TurtleFrame& f, DVec3 h, DVec3 l, DVec3 u) {
 
 const DVec3 X{1, 0, 0}, Y{0, 1, 0}, Z{0, 0, 1};
 
+/// Every internode's parent and order as listed, and each starts where its parent ends.
+void checkLinks(const std::vector<Internode>& in, const std::vector<int32_t>& parent, const std::vector<int>& order) {
+  REQUIRE(in.size() == parent.size());
+  for (size_t i = 0; i < in.size(); ++i) {
+    CAPTURE(i);
+    CHECK(in[i].parent == parent[i]);
+    CHECK(in[i].order == order[i]);
+    if (in[i].parent >= 0) checkVec(in[i].start, in[size_t(in[i].parent)].end);
+  }
+}
+
 }  // namespace
 
 TEST_CASE("Turtle::frame commands", "[lsystem]") {
@@ -155,6 +166,11 @@ TEST_CASE("Turtle::moves and internodes", "[lsystem]") {
     checkVec(r.skeleton.internodes[2].start, {0, 7, 0});
     checkVec(r.end.frame.position, {0, 9, 0});
   }
+  SECTION("a move of length 0 goes nowhere and keeps the chain (tree_lime's fallen leaves are f(0))") {
+    Run r = draw("Ff(0)F[+F]g(0)F", s);
+    checkLinks(r.skeleton.internodes, {-1, 0, 1, 1}, {0, 0, 1, 0});
+    checkVec(r.skeleton.internodes[3].end, {0, 6, 0});
+  }
   SECTION("G draws") {
     Run r = draw("GG", s);
     REQUIRE(r.skeleton.internodes.size() == 2);
@@ -163,14 +179,7 @@ TEST_CASE("Turtle::moves and internodes", "[lsystem]") {
   SECTION("[ ] save and restore the state; order counts brackets") {
     Run r = draw("F[+F[-F]]F", s);
     auto& in = r.skeleton.internodes;
-    REQUIRE(in.size() == 4);
-    const int32_t parent[] = {-1, 0, 1, 0};
-    const int order[] = {0, 1, 2, 0};
-    for (size_t i = 0; i < 4; ++i) {
-      CAPTURE(i);
-      CHECK(in[i].parent == parent[i]);
-      CHECK(in[i].order == order[i]);
-    }
+    checkLinks(in, {-1, 0, 1, 0}, {0, 1, 2, 0});
     checkVec(in[1].end, {-2, 2, 0});
     checkVec(in[2].end, {-2, 4, 0});
     checkVec(in[3].end, {0, 4, 0});
@@ -443,7 +452,9 @@ TEST_CASE("Turtle::shipped grammars", "[lsystem]") {
     for (const auto& in : c.skeleton.internodes) REQUIRE(2 * in.baseRadius <= 0.12 * in.length() + 1e-12);
   }
   SECTION("ABOP 1.31a and the original plants draw one connected plant") {
-    for (const char* name : {"abop_1_31a.lsys", "shrub.lsys", "conifer.lsys", "abop_2_7.lsys"}) {
+    // tree_lime's leaves fall as f(0): every lateral and the leader above them still hang
+    // from the trunk's first internode.
+    for (const char* name : {"abop_1_31a.lsys", "shrub.lsys", "conifer.lsys", "abop_2_7.lsys", "tree_lime.lsys"}) {
       INFO(name);
       TurtleSettings s;
       s.elasticity = 0.05;

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "lsystem/derive.h"
+#include "lsystem/grammar.h"
 #include "lsystem/turtle.h"
 #include "organisms/wind.h"
 #include "tests/organisms/internode.h"
@@ -130,4 +132,79 @@ TEST_CASE("swayInWind: cpfg's textured cylinders follow their internode without 
   CHECK(glm::length(t.normals[0]) == Approx(1.0));
   // The leaf on the same internode flutters away from that direction.
   CHECK(glm::length(glm::normalize(l.points[1] - l.points[0]) - dir) > 1e-4);
+}
+
+namespace {
+
+/// Rodrigues' rotation of v by angle about the unit axis k.
+DVec3 rotate(const DVec3& v, const DVec3& k, double angle) {
+  return v * std::cos(angle) + glm::cross(k, v) * std::sin(angle) + k * glm::dot(k, v) * (1.0 - std::cos(angle));
+}
+
+}  // namespace
+
+TEST_CASE("swayInWind: the trunk's lean carries the whole crown", "[organisms][wind]") {
+  // A trunk of two internodes with branches and sub-branches, drawn from a grammar as
+  // tree_lime's: each internode is followed by a leaf module that falls, two steps later,
+  // as f(0) (a move that goes nowhere), before the next laterals and the leader.
+  const char* text = R"(lsystem: lean
+derivation length: 3
+axiom: F(1)L(0)[&(45)B]/(180)[&(45)B]F(1)L(0)[&(60)B]
+B : * --> F(0.5)L(0)[+(30)F(0.3)L(0)[-(30)F(0.2)]]F(0.5)
+L(k) : k < 1 --> L(k+1)
+L(k) : k >= 1 --> f(0)
+endlsystem
+)";
+  const lsystem::Grammar g = lsystem::parseGrammar(text, "lean.lsys");
+  const lsystem::ModuleString str = lsystem::derive(g);
+  const Skeleton sk = lsystem::Turtle(g.symbols(), {}).run(str);
+  REQUIRE(sk.internodes.size() == 14);  // 2 trunk + 3 branches of 4 internodes
+
+  // Every internode's chain of parents reaches the root internode, the trunk's base.
+  const auto trunkOf = [&](size_t i) {  // the highest trunk internode that carries i
+    int32_t c = static_cast<int32_t>(i), top = -1;
+    for (size_t guard = 0; c >= 0 && guard <= sk.internodes.size(); ++guard) {
+      if (sk.internodes[c].order == 0 && top < 0) top = c;
+      if (sk.internodes[c].parent < 0) return c == 0 ? top : -1;
+      c = sk.internodes[c].parent;
+    }
+    return int32_t{-1};
+  };
+  for (size_t i = 0; i < sk.internodes.size(); ++i) {
+    CAPTURE(i);
+    CHECK(trunkOf(i) >= 0);
+  }
+  REQUIRE(sk.internodes[0].parent == -1);
+  REQUIRE(sk.internodes[9].order == 0);
+  REQUIRE(sk.internodes[9].parent == 0);
+
+  // Only the lean: the trunk's internodes turn about their bases by lean·length/height,
+  // and everything they carry turns with them, rigidly. The first carries all (a rotation
+  // about the trunk's base, the origin); the second, based at b = (0,1,0), adds its own turn.
+  WindOptions w = wind(8);
+  w.swayPerSpeed = 0;
+  w.flutterPerSpeed = 0;
+  const double t = 0.7;
+  const WindRig rig = windRig(sk, w);
+  double height = 0;
+  for (const auto& in : sk.internodes) height = std::max({height, in.start.y, in.end.y});
+  const double lean = w.leanPerSpeed2 * w.speed * w.speed * rig.gust(t);
+  const double theta0 = lean * 1.0 / height, theta1 = lean * 1.0 / height;
+  const DVec3 k(0, 0, -1);  // turns +Y toward +X, the wind's direction
+  const DVec3 b(0, 1, 0);
+  const Skeleton a = swayInWind(sk, w, t);
+  size_t onFirst = 0, onSecond = 0;
+  for (size_t i = 0; i < sk.internodes.size(); ++i) {
+    CAPTURE(i);
+    const int32_t top = trunkOf(i);
+    auto expected = [&](const DVec3& p) {
+      return top == 0 ? rotate(p, k, theta0) : rotate(b, k, theta0) + rotate(p - b, k, theta0 + theta1);
+    };
+    (top == 0 ? onFirst : onSecond)++;
+    CHECK(glm::length(a.internodes[i].start - expected(sk.internodes[i].start)) < 1e-12);
+    CHECK(glm::length(a.internodes[i].end - expected(sk.internodes[i].end)) < 1e-12);
+  }
+  CHECK(onFirst == 9);    // the first trunk internode and its two branches
+  CHECK(onSecond == 5);   // the leader and its branch
+  CHECK(a.internodes[13].end.x - sk.internodes[13].end.x > 0.01);  // the top branch's tip leans downwind
 }
