@@ -79,58 +79,73 @@ double deltaAMultiple(double rA, double rMax, double factor) { return factor * r
 
 double deltaB(double rA, double ri) { return std::max(0.0, rA - ri); }
 
-TreePlan planTree(const lsystem::Skeleton& sk, const TreeOptions& opt) {
-  const size_t n = sk.internodes.size();
-  auto radius = [&](double r) { return std::max(opt.minRadius, r * opt.radiusScale); };
-  const auto children = sk.children();
+namespace {
 
-  // Step 1: what each internode becomes (kept, pruned, stub, dropped), root to tips.
-  enum class Fate { Keep, Prune, Stub, Drop };
-  std::vector<Fate> fate(n, Fate::Keep);
-  std::vector<double> vFromRoot(n, 0.0);
-  std::vector<size_t> order;  // parents before children
-  order.reserve(n);
+/// What an internode becomes in the tree.
+enum class Fate { Keep, Prune, Stub, Drop };
+
+double partRadius(const TreeOptions& opt, double r) { return std::max(opt.minRadius, r * opt.radiusScale); }
+
+/// Step 1 of planTree: the internodes parents before children, each one's fate (kept,
+/// pruned, stub, dropped below a pruned or stub one) and bark v from the root.
+struct Fates {
+  std::vector<size_t> order;
+  std::vector<Fate> fate;
+  std::vector<double> vFromRoot;
+};
+
+Fates planFates(const lsystem::Skeleton& sk, const TreeOptions& opt, const std::vector<std::vector<int32_t>>& children) {
+  const size_t n = sk.internodes.size();
+  Fates f{{}, std::vector<Fate>(n, Fate::Keep), std::vector<double>(n, 0.0)};
+  f.order.reserve(n);
   for (size_t i = 0; i < n; ++i)
-    if (sk.internodes[i].parent < 0) order.push_back(i);
-  for (size_t k = 0; k < order.size(); ++k)
-    for (int32_t c : children[order[k]]) order.push_back(static_cast<size_t>(c));
-  for (size_t i : order) {
+    if (sk.internodes[i].parent < 0) f.order.push_back(i);
+  for (size_t k = 0; k < f.order.size(); ++k)
+    for (int32_t c : children[f.order[k]]) f.order.push_back(static_cast<size_t>(c));
+  for (size_t i : f.order) {
     const auto& in = sk.internodes[i];
     if (in.parent >= 0) {
-      vFromRoot[i] = vFromRoot[in.parent] + sk.internodes[in.parent].length();
-      if (fate[in.parent] != Fate::Keep) {
-        fate[i] = Fate::Drop;
+      f.vFromRoot[i] = f.vFromRoot[in.parent] + sk.internodes[in.parent].length();
+      if (f.fate[in.parent] != Fate::Keep) {
+        f.fate[i] = Fate::Drop;
         continue;
       }
     }
     if ((opt.prune.fromGrammar && in.cut) || selects(opt.prune.select, sk, i, opt.seed, kSeedPrune))
-      fate[i] = Fate::Prune;
+      f.fate[i] = Fate::Prune;
     else if (selects(opt.scars.select, sk, i, opt.seed, kSeedScar))
-      fate[i] = Fate::Stub;
+      f.fate[i] = Fate::Stub;
   }
+  return f;
+}
 
-  // Step 2: one part per surviving internode.
-  TreePlan plan;
-  plan.partOfInternode.assign(n, -1);
-  for (size_t i : order) {
-    if (fate[i] == Fate::Drop) continue;
+/// Step 2 of planTree: one part per surviving internode, in the order of f.
+void planParts(const lsystem::Skeleton& sk, const TreeOptions& opt, const Fates& f, TreePlan& plan) {
+  plan.partOfInternode.assign(sk.internodes.size(), -1);
+  for (size_t i : f.order) {
+    if (f.fate[i] == Fate::Drop) continue;
     const auto& in = sk.internodes[i];
     ConePart p;
-    p.kind = fate[i] == Fate::Prune  ? ConePart::Kind::Pruned
-             : fate[i] == Fate::Stub ? ConePart::Kind::Stub
-                                     : ConePart::Kind::Internode;
+    p.kind = f.fate[i] == Fate::Prune  ? ConePart::Kind::Pruned
+             : f.fate[i] == Fate::Stub ? ConePart::Kind::Stub
+                                       : ConePart::Kind::Internode;
     p.internode = static_cast<int32_t>(i);
     p.start = in.start;
     p.end = in.end;
-    p.startRadius = radius(in.baseRadius);
-    p.endRadius = radius(in.tipRadius);
-    p.vStart = vFromRoot[i];
+    p.startRadius = partRadius(opt, in.baseRadius);
+    p.endRadius = partRadius(opt, in.tipRadius);
+    p.vStart = f.vFromRoot[i];
     plan.partOfInternode[i] = static_cast<int32_t>(plan.parts.size());
     plan.parts.push_back(p);
   }
+}
 
-  // Step 3: junctions and their offsets (Eq. 4, 7, 8).
-  std::vector<double> startOffset(plan.parts.size(), 0.0), endOffset(plan.parts.size(), 0.0);
+/// Step 3 of planTree: junctions and their offsets (Eq. 4, 7, 8): each part's start offset
+/// (δB) and end offset (δA).
+void planJunctions(const TreeOptions& opt, const std::vector<std::vector<int32_t>>& children, TreePlan& plan,
+                   std::vector<double>& startOffset, std::vector<double>& endOffset) {
+  startOffset.assign(plan.parts.size(), 0.0);
+  endOffset.assign(plan.parts.size(), 0.0);
   for (size_t pi = 0; pi < plan.parts.size(); ++pi) {
     ConePart& a = plan.parts[pi];
     if (a.kind != ConePart::Kind::Internode) continue;
@@ -162,78 +177,88 @@ TreePlan planTree(const lsystem::Skeleton& sk, const TreeOptions& opt) {
     for (int32_t b : j.branches) plan.parts[b].junctionAtStart = ji;
     plan.junctions.push_back(std::move(j));
   }
+}
 
+/// A scar's stub (§3.5): a flush one radially from the parent's axis at P out to its bark,
+/// so the scar faces straight out of the bark and is round on it (points of the bark at
+/// one distance from a radial segment lie on a circle about where it meets the bark);
+/// otherwise a short stub along the internode. Both carry the negative primitive that dents
+/// the scar.
+void shapeStub(ConePart& p, const lsystem::Skeleton& sk, const TreeOptions& opt, const TreePlan& plan, const DVec3& d) {
+  const double rb = p.startRadius;
+  if (opt.scars.style == ScarStyle::Flush && p.junctionAtStart >= 0) {
+    const Junction& j = plan.junctions[p.junctionAtStart];
+    const auto& basal = sk.internodes[plan.parts[j.basal].internode];
+    const DVec3 axis = safeDir(basal.start, basal.end);
+    const double rA = partRadius(opt, basal.tipRadius);
+    DVec3 out = d - glm::dot(d, axis) * axis;
+    out = glm::length(out) > 1e-9 ? glm::normalize(out) : d;
+    p.start = j.point;
+    p.end = j.point + rA * out;
+    p.startRadius = p.endRadius = std::min(opt.scars.stubRadius * rb, 0.9 * rA);
+  } else {
+    p.end = p.start + opt.scars.stubLength * rb * d;
+    p.startRadius = opt.scars.stubRadius * rb;
+    p.endRadius = opt.scars.stubRadius * rb;
+  }
+  p.negativeCenter = p.end;
+  p.negativeRadius = opt.scars.negativeRadius * rb;
+  p.negativeWeight = opt.scars.negativeWeight;
+}
+
+/// Step 4 of planTree for a kept or pruned part: its offsets s0 (start) and s1 (end), its
+/// tip or saw cut, and its bend.
+void shapePart(ConePart& p, const lsystem::Skeleton& sk, const TreeOptions& opt, const DVec3& d, double s0, double s1) {
+  const double len = glm::length(p.end - p.start);
+  const double rb = p.startRadius, rt = p.endRadius;
+  auto radiusAt = [&](double t) { return len > 0 ? rb + (rt - rb) * (t / len) : rb; };
+  const DVec3 origin = p.start;
+  // Offsets may not eat the whole internode: keep at least 10% of it.
+  if (s0 + s1 > 0.9 * len) {
+    const double k = 0.9 * len / (s0 + s1);
+    s0 *= k;
+    s1 *= k;
+  }
+  double t0 = s0, t1 = len - s1;
+  if (p.kind == ConePart::Kind::Pruned) {
+    const double cut = std::min(std::max(opt.prune.cutFraction * len, opt.prune.minCutDistance * rb + s0), len);
+    p.cutPoint = origin + cut * d;
+    p.cutNormal = d;
+    // The cone runs past the saw by more than its radius so the cap is cut away.
+    t1 = std::max(len, cut + 2.0 * radiusAt(cut));
+  } else if (p.junctionAtEnd < 0 && opt.tips == TipStyle::Taper) {
+    // A natural tip: the radius shrinks and the cap closes exactly at the end point.
+    const double tipR = std::min(rt, opt.tipTaper * rb);
+    p.start = origin + t0 * d;
+    p.startRadius = radiusAt(t0);
+    p.endRadius = tipR;
+    p.end = origin + std::max(t0 + 0.1 * len, len - tipR) * d;
+    p.vStart += t0;
+    applyBend(p, sk, opt, d);
+    return;
+  }
+  p.start = origin + t0 * d;
+  p.end = origin + t1 * d;
+  p.startRadius = radiusAt(t0);
+  p.endRadius = std::max(1e-6, radiusAt(t1));
+  p.vStart += t0;
+  applyBend(p, sk, opt, d);
+}
+
+}  // namespace
+
+TreePlan planTree(const lsystem::Skeleton& sk, const TreeOptions& opt) {
+  const auto children = sk.children();
+  TreePlan plan;
+  planParts(sk, opt, planFates(sk, opt, children), plan);
+  std::vector<double> startOffset, endOffset;
+  planJunctions(opt, children, plan, startOffset, endOffset);
   // Step 4: apply offsets, tips, cuts, stubs and bends to each part.
   for (size_t pi = 0; pi < plan.parts.size(); ++pi) {
     ConePart& p = plan.parts[pi];
     const DVec3 d = safeDir(p.start, p.end);
-    const double len = glm::length(p.end - p.start);
-    const double rb = p.startRadius, rt = p.endRadius;
-    auto radiusAt = [&](double t) { return len > 0 ? rb + (rt - rb) * (t / len) : rb; };
-    const DVec3 origin = p.start;
-
-    if (p.kind == ConePart::Kind::Stub && opt.scars.style == ScarStyle::Flush && p.junctionAtStart >= 0) {
-      // Radially from the parent's axis at P out to its bark: the scar faces straight out
-      // of the bark and is round on it (points of the bark at one distance from a radial
-      // segment lie on a circle about where it meets the bark).
-      const Junction& j = plan.junctions[p.junctionAtStart];
-      const auto& basal = sk.internodes[plan.parts[j.basal].internode];
-      const DVec3 axis = safeDir(basal.start, basal.end);
-      const double rA = radius(basal.tipRadius);
-      DVec3 out = d - glm::dot(d, axis) * axis;
-      out = glm::length(out) > 1e-9 ? glm::normalize(out) : d;
-      p.start = j.point;
-      p.end = j.point + rA * out;
-      p.startRadius = p.endRadius = std::min(opt.scars.stubRadius * rb, 0.9 * rA);
-      p.negativeCenter = p.end;
-      p.negativeRadius = opt.scars.negativeRadius * rb;
-      p.negativeWeight = opt.scars.negativeWeight;
-      continue;
-    }
-    if (p.kind == ConePart::Kind::Stub) {
-      const double ls = opt.scars.stubLength * rb;
-      p.end = origin + ls * d;
-      p.startRadius = opt.scars.stubRadius * rb;
-      p.endRadius = opt.scars.stubRadius * rb;
-      p.negativeCenter = p.end;
-      p.negativeRadius = opt.scars.negativeRadius * rb;
-      p.negativeWeight = opt.scars.negativeWeight;
-      continue;
-    }
-
-    double s0 = startOffset[pi], s1 = endOffset[pi];
-    // Offsets may not eat the whole internode: keep at least 10% of it.
-    if (s0 + s1 > 0.9 * len) {
-      const double k = 0.9 * len / (s0 + s1);
-      s0 *= k;
-      s1 *= k;
-    }
-    double t0 = s0, t1 = len - s1;
-
-    if (p.kind == ConePart::Kind::Pruned) {
-      const double cut = std::min(std::max(opt.prune.cutFraction * len, opt.prune.minCutDistance * rb + s0), len);
-      p.cutPoint = origin + cut * d;
-      p.cutNormal = d;
-      // The cone runs past the saw by more than its radius so the cap is cut away.
-      t1 = std::max(len, cut + 2.0 * radiusAt(cut));
-    } else if (p.junctionAtEnd < 0 && opt.tips == TipStyle::Taper) {
-      // A natural tip: the radius shrinks and the cap closes exactly at the end point.
-      const double tipR = std::min(rt, opt.tipTaper * rb);
-      p.start = origin + t0 * d;
-      p.startRadius = radiusAt(t0);
-      p.endRadius = tipR;
-      p.end = origin + std::max(t0 + 0.1 * len, len - tipR) * d;
-      p.vStart += t0;
-      applyBend(p, sk, opt, d);
-      continue;
-    }
-    p.start = origin + t0 * d;
-    p.end = origin + t1 * d;
-    p.startRadius = radiusAt(t0);
-    p.endRadius = std::max(1e-6, radiusAt(t1));
-    p.vStart += t0;
-
-    applyBend(p, sk, opt, d);
+    if (p.kind == ConePart::Kind::Stub) shapeStub(p, sk, opt, plan, d);
+    else shapePart(p, sk, opt, d, startOffset[pi], endOffset[pi]);
   }
   return plan;
 }
