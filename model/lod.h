@@ -8,9 +8,11 @@
 /// locked); parts of many small pieces (leaves: ExportPart::scattered) keep an evenly spread
 /// share of their pieces, each grown about its centroid so that their total area stays.
 /// Textures over the surface's own (u, v) (bark, a shell's whorl, cpfg images) stay as they
-/// are; an atlas (one patch per triangle) is baked again for each level from the vertex
-/// colours that remain (atlasVertexColors), and so is one for a part whose colours vary but
-/// had too many triangles for an atlas (its colours were clamped in COLOR_0).
+/// are; an atlas (one patch per triangle) is baked again for each level, and so is one for a
+/// part whose colours vary but had too many triangles for an atlas (its colours were clamped
+/// in COLOR_0): from the full part's surface (model/detail_maps.h: its colours and a
+/// tangent-space normal map of the relief the level lost), or, where that cannot be done
+/// (leaves, a part without normals), from the vertex colours that remain (atlasVertexColors).
 
 #include <cstddef>
 #include <filesystem>

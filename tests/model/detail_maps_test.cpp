@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 
@@ -215,4 +216,24 @@ TEST_CASE("writeParts normal map in OBJ", "[model][lod]") {
   CHECK(fs::exists(dir.path / "r_lod1_ridge_normal.png"));
   const std::vector<fs::path> files = partFiles(levels[1].parts, dir.path / "r_lod1.obj");
   CHECK(std::find(files.begin(), files.end(), dir.path / "r_lod1_ridge_normal.png") != files.end());
+}
+
+// Not run in CI: writes a bumpy square (ridges along both axes) as its full mesh and as a
+// flat two-level chain with detail maps into $SPRIG_LOOK_DIR, to render the two side by side
+// in a viewer (docs/MESHES.md "Levels of detail": the normal map's orientation looked at).
+TEST_CASE("detail maps to look at", "[.][look]") {
+  const char* dir = std::getenv("SPRIG_LOOK_DIR");
+  REQUIRE(dir);
+  Mesh full = grid(160, 0.0f);
+  for (size_t v = 0; v < full.positions.size(); ++v) {
+    Vec3& p = full.positions[v];
+    const float a = 0.03f, wx = 2.0f * float(kPi) * 3.0f, wy = 2.0f * float(kPi) * 2.0f;
+    p.z = a * std::sin(wx * p.x) + a * std::sin(wy * p.y);
+    full.normals[v] = glm::normalize(Vec3(-a * wx * std::cos(wx * p.x), -a * wy * std::cos(wy * p.y), 1.0f));
+    full.colors[v] = Vec3(0.6f);
+  }
+  ExportPart part{"bumps", full, PartMaterial{"bumps", Vec3(0.6f), 0.7f, false}};
+  writeParts({part}, fs::path(dir) / "bumps_full.glb");
+  const std::vector<LodLevel> levels = buildLodChain({part}, 1000);
+  writeLevels(levels, fs::path(dir) / "bumps.glb");
 }
