@@ -118,12 +118,9 @@ ExportPart reducePart(const ExportPart& part, size_t targetTriangles, float& err
     error = report.absoluteError;
   }
   removeDegenerateTriangles(out.mesh);
-  // An atlas has one patch per triangle of the full part: baked again from the colours of
-  // the vertices that remain (or dropped where they are all the base colour). A part that
-  // varies in colour without a texture had more triangles than an atlas holds: its level
-  // gets one too (atlasVertexColors bakes only where colours vary and no texture is set).
+  // An atlas has one patch per triangle of the full part: the level's own is baked once the
+  // chain is made (bakeLevelMaps), not for every trial of a level.
   if (out.material.texture && out.material.texture->isAtlas()) out.material.texture.reset();
-  atlasVertexColors(out);
   return out;
 }
 
@@ -167,7 +164,9 @@ std::vector<size_t> scaledShares(const std::vector<ExportPart>& parts, double fr
 
 // Bakes every simplified surface part's normal and colour atlases from its full mesh
 // (parts[i]) onto each level; reach[k][i] is level k's distance bound for part i (0: the
-// part is not simplified there, or has no atlas to carry maps).
+// part is not simplified there, or has no atlas to carry maps). Every other reduced part
+// gets an atlas of its own vertex colours (atlasVertexColors: where colours vary and no
+// texture is set; a part that had more triangles than an atlas holds gets one too).
 void bakeLevelMaps(const std::vector<ExportPart>& parts, std::vector<LodLevel>& levels,
                    const std::vector<std::vector<float>>& reach, LodMapReport& report) {
   const auto start = std::chrono::steady_clock::now();
@@ -175,10 +174,17 @@ void bakeLevelMaps(const std::vector<ExportPart>& parts, std::vector<LodLevel>& 
     std::unique_ptr<DetailSurface> full;  // built for the first level that needs it
     for (size_t k = 0; k < levels.size(); ++k) {
       ExportPart& low = levels[k].parts[i];
-      if (!(reach[k][i] > 0)) continue;
+      const bool reduced = low.mesh.triangles.size() < parts[i].mesh.triangles.size();
+      if (!(reach[k][i] > 0)) {
+        if (reduced) atlasVertexColors(low);
+        continue;
+      }
       if (!full) full = std::make_unique<DetailSurface>(parts[i].mesh, parts[i].material.baseColor);
       DetailMaps maps = bakeDetailMaps(low.mesh, low.material.baseColor, *full, reach[k][i], true);
-      if (!maps.normal) continue;
+      if (!maps.normal) {
+        atlasVertexColors(low);
+        continue;
+      }
       low.material.texture = maps.color;
       low.material.normalTexture = maps.normal;
       report.texels += maps.texels;
