@@ -209,9 +209,10 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
   const size_t fullTriangles = partTriangles(parts);
   const auto lodStart = std::chrono::steady_clock::now();
   Vec3 moved(0.0f);  // LOD0 stood on the ground again
+  LodMapReport maps;
   std::vector<LodLevel> levels = [&] {
     const Phase phase("levels");
-    return lodLevels(std::move(parts), budget, &moved);
+    return lodLevels(std::move(parts), budget, &moved, &maps);
   }();
   const std::optional<organisms::WindOptions> windUsed =
       anyGlb ? addModelWind(model, stage, levels, finish.offset + moved, wind) : std::nullopt;
@@ -260,6 +261,9 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
     note(g, std::cout, "%s", t.c_str());
     note(g, std::cout, "each level's own file: %s%s", lodFiles.c_str(),
          glb ? "; the .glb holds every level (MSFT_lod); --lod none writes the full mesh alone" : "");
+    if (maps.maps > 0)
+      note(g, std::cout, "detail maps: %zu parts' levels got a normal map and the full mesh's colours (%zu texels, %.1f%% on the full surface) in %.2f s",
+           maps.maps, maps.texels, 100.0 * double(maps.hits) / double(std::max<size_t>(maps.texels, 1)), maps.seconds);
   }
   noteParts(top, written, glb, g);
   if (windUsed) noteWind(top, *windUsed, g);

@@ -74,7 +74,16 @@ void writeImage(const Image& image, const fs::path& path, ImageEncoding encoding
   std::string error;
   bool ok = false;
   const detail::ImageBackend& io = detail::imageBackend();
-  if (encoding == ImageEncoding::TextureMap) {
+  if (encoding == ImageEncoding::Data && format != ImageFormat::Exr) {
+    const size_t n = static_cast<size_t>(image.width) * image.height;
+    std::vector<uint8_t> rgb(n * 3);
+    for (size_t i = 0; i < n; ++i)
+      for (int c = 0; c < 3; ++c)
+        rgb[i * 3 + c] = static_cast<uint8_t>(std::lround(std::clamp(image.pixels[i * 4 + c], 0.0f, 1.0f) * 255.0f));
+    spec.channels = 3;
+    spec.fileType = PixelType::UInt8;
+    ok = io.write(temp.path().string(), spec, PixelType::UInt8, rgb.data(), error);
+  } else if (encoding != ImageEncoding::Picture) {
     // RGB floats (sRGB-encoded in double for 8-bit files); the writer converts to the file type.
     const bool linear = format == ImageFormat::Exr;
     const size_t n = static_cast<size_t>(image.width) * image.height;

@@ -60,6 +60,10 @@ enum class ImageEncoding {
   /// rounded by OpenImageIO; files tagged sRGB (8-bit) or Linear (EXR); OIIO's default
   /// compression and JPEG quality.
   TextureMap,
+  /// Data maps (tangent-space normal maps): RGB only; 8-bit values are round(255·v) of
+  /// each channel clamped to [0,1], no sRGB curve and no colour-space tag (PNG, JPEG); EXR
+  /// as TextureMap.
+  Data,
 };
 
 /// Writes image atomically to path in the format its extension names.

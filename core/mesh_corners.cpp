@@ -178,4 +178,32 @@ Mesh unweld(const Mesh& mesh, const CornerTable<Vec3>& normals, const CornerTabl
   return out;
 }
 
+glm::vec4 cornerTangent(const Vec3 p[3], const Vec2 uv[3], const Vec3& normal) {
+  const glm::dvec3 e1 = glm::dvec3(p[1]) - glm::dvec3(p[0]), e2 = glm::dvec3(p[2]) - glm::dvec3(p[0]);
+  const glm::dvec2 d1 = glm::dvec2(uv[1]) - glm::dvec2(uv[0]), d2 = glm::dvec2(uv[2]) - glm::dvec2(uv[0]);
+  glm::dvec3 n = glm::dvec3(normal);
+  const double nl = glm::length(n);
+  n = nl > 0 && std::isfinite(nl) ? n / nl : glm::dvec3(0, 0, 1);
+  // dP/ds and dP/dt of the affine map (s, t) → P (Lengyel's per-triangle tangent).
+  const double det = d1.x * d2.y - d2.x * d1.y;
+  glm::dvec3 t(0.0), b(0.0);
+  if (std::abs(det) > 0) {
+    t = (e1 * d2.y - e2 * d1.y) / det;
+    b = (e2 * d1.x - e1 * d2.x) / det;
+  }
+  const double raw = glm::length(t);
+  t -= n * glm::dot(n, t);
+  double tl = glm::length(t);
+  if (!(tl > 1e-6 * raw) || !std::isfinite(tl)) {
+    // Any direction perpendicular to n: the axis least along it, made perpendicular.
+    const glm::dvec3 axis = std::abs(n.x) < 0.577 ? glm::dvec3(1, 0, 0) : std::abs(n.y) < 0.577 ? glm::dvec3(0, 1, 0) : glm::dvec3(0, 0, 1);
+    t = axis - n * glm::dot(n, axis);
+    tl = glm::length(t);
+    b = glm::cross(n, t);
+  }
+  t /= tl;
+  const float w = glm::dot(glm::cross(n, t), b) < 0 ? -1.0f : 1.0f;
+  return glm::vec4(float(t.x), float(t.y), float(t.z), w);
+}
+
 }  // namespace sprig

@@ -72,4 +72,13 @@ CornerTable<Vec2> cornerUvs(const Mesh& mesh, const UvSeamOptions& options);
 Mesh unweld(const Mesh& mesh, const CornerTable<Vec3>& normals, const CornerTable<Vec2>& uvs,
             std::vector<uint32_t>* origin = nullptr);
 
+/// The tangent of a triangle's corner for a tangent-space normal map (glTF TANGENT): the
+/// direction of increasing u of the triangle's uv → position mapping (positions p, texture
+/// coordinates uv with t = 0 at the image's bottom row, as Mesh::uvs), made perpendicular to
+/// the corner's normal (Gram-Schmidt) and unit; w = +1 when cross(normal, tangent) points
+/// towards increasing t (up in the image: the +Y of glTF's and OpenGL's normal maps), else
+/// −1. A degenerate mapping or a tangent along the normal gives a unit vector perpendicular
+/// to the normal with w = +1. normal need not be unit.
+glm::vec4 cornerTangent(const Vec3 p[3], const Vec2 uv[3], const Vec3& normal);
+
 }  // namespace sprig

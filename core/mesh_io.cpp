@@ -386,15 +386,32 @@ PartCorners partCorners(const ExportPart& part) {
   return c;
 }
 
-// The PNG bytes of a texture image (8-bit sRGB RGB; RGBA with `alpha`), through a temporary
+// The PNG bytes of a texture image written with encoding (TextureMap: 8-bit sRGB RGB;
+// Picture: RGBA; Data: 8-bit values as they are), through a temporary
 // file beside `near` (core/image.h owns image files; the temporary is removed when this
 // returns).
-std::string pngBytes(const Image& image, const fs::path& near, bool alpha) {
+std::string pngBytes(const Image& image, const fs::path& near, ImageEncoding encoding) {
   fs::path dest = near;
   dest.replace_extension(".png");
   TempPath temp(dest);
-  writeImage(image, temp.path(), alpha ? ImageEncoding::Picture : ImageEncoding::TextureMap);
+  writeImage(image, temp.path(), encoding);
   return readFile(temp.path());
+}
+
+// One tangent per vertex of an unwelded mesh whose vertices each belong to one corner (an
+// atlas gives every corner its own uv): cornerTangent of that corner; a vertex no triangle
+// uses gets a unit vector perpendicular to its normal.
+std::vector<glm::vec4> vertexTangents(const Mesh& mesh) {
+  std::vector<glm::vec4> out(mesh.positions.size());
+  const Vec3 none[3] = {Vec3(0.0f), Vec3(0.0f), Vec3(0.0f)};
+  const Vec2 noUv[3] = {Vec2(0.0f), Vec2(0.0f), Vec2(0.0f)};
+  for (size_t v = 0; v < out.size(); ++v) out[v] = cornerTangent(none, noUv, mesh.normals[v]);
+  for (const glm::uvec3& tri : mesh.triangles) {
+    const Vec3 p[3] = {mesh.positions[tri.x], mesh.positions[tri.y], mesh.positions[tri.z]};
+    const Vec2 uv[3] = {mesh.uvs[tri.x], mesh.uvs[tri.y], mesh.uvs[tri.z]};
+    for (int k = 0; k < 3; ++k) out[tri[k]] = cornerTangent(p, uv, mesh.normals[tri[k]]);
+  }
+  return out;
 }
 
 // A part's vertex attributes and morph targets fit its mesh.
@@ -436,6 +453,12 @@ void checkParts(const std::vector<ExportPart>& parts) {
       if (im.width <= 0 || im.height <= 0 || im.pixels.size() != size_t(im.width) * size_t(im.height) * 4)
         throw std::invalid_argument("exported part '" + p.name + "' has an empty or malformed texture image");
     }
+    if (const PartTexture* nt = p.material.normalTexture.get()) {
+      const PartTexture* tex = p.material.texture.get();
+      if (!tex || !tex->isAtlas() || nt->image.width != tex->image.width || nt->image.height != tex->image.height ||
+          nt->image.pixels.size() != tex->image.pixels.size())
+        throw std::invalid_argument("exported part '" + p.name + "' has a normal map without an atlas of its size");
+    }
   }
   std::sort(names.begin(), names.end());
   auto dup = std::adjacent_find(names.begin(), names.end());
@@ -468,7 +491,7 @@ class GlbBuilder {
   int addAccessor(const void* bytes, size_t byteLength, size_t count, int type, int componentType, int target) {
     return addGltfAccessor(model_, data_, bytes, byteLength, count, type, componentType, target);
   }
-  int addTexture(const ExportPart& part);
+  int addTexture(const PartTexture* tex, const std::string& name, ImageEncoding encoding);
   int addMaterial(const ExportPart& part);
   void addExtras(const ExportPart& part, const std::vector<uint32_t>& origin, tinygltf::Primitive& prim, tinygltf::Mesh& gm);
   void addAnimations();
@@ -485,10 +508,9 @@ class GlbBuilder {
   std::map<const PartTexture*, int> textures_;
 };
 
-int GlbBuilder::addTexture(const ExportPart& part) {
-  const PartTexture* tex = part.material.texture.get();
+int GlbBuilder::addTexture(const PartTexture* tex, const std::string& name, ImageEncoding encoding) {
   if (auto it = textures_.find(tex); it != textures_.end()) return it->second;
-  const std::string png = pngBytes(tex->image, path_, part.material.alphaCutoff >= 0.0f);
+  const std::string png = pngBytes(tex->image, path_, encoding);
   while (data_.size() % 4) data_.push_back(0);
   tinygltf::BufferView view;
   view.buffer = 0;
@@ -497,7 +519,7 @@ int GlbBuilder::addTexture(const ExportPart& part) {
   data_.insert(data_.end(), png.begin(), png.end());
   model_.bufferViews.push_back(view);
   tinygltf::Image image;
-  image.name = part.name;
+  image.name = name;
   image.mimeType = "image/png";
   image.bufferView = int(model_.bufferViews.size() - 1);
   model_.images.push_back(image);
@@ -512,7 +534,7 @@ int GlbBuilder::addTexture(const ExportPart& part) {
   sampler.wrapT = tex->seams.repeatV ? TINYGLTF_TEXTURE_WRAP_REPEAT : TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE;
   model_.samplers.push_back(sampler);
   tinygltf::Texture texture;
-  texture.name = part.name;
+  texture.name = name;
   texture.sampler = int(model_.samplers.size() - 1);
   texture.source = int(model_.images.size() - 1);
   model_.textures.push_back(texture);
@@ -535,8 +557,12 @@ int GlbBuilder::addMaterial(const ExportPart& part) {
       mat.alphaMode = "MASK";
       mat.alphaCutoff = part.material.alphaCutoff;
     }
-    mat.pbrMetallicRoughness.baseColorTexture.index = addTexture(part);
+    mat.pbrMetallicRoughness.baseColorTexture.index = addTexture(
+        part.material.texture.get(), part.name,
+        part.material.alphaCutoff >= 0.0f ? ImageEncoding::Picture : ImageEncoding::TextureMap);
   }
+  if (part.material.normalTexture)
+    mat.normalTexture.index = addTexture(part.material.normalTexture.get(), part.name + "_normal", ImageEncoding::Data);
   mat.pbrMetallicRoughness.metallicFactor = 0.0;
   mat.pbrMetallicRoughness.roughnessFactor = part.material.roughness;
   mat.doubleSided = part.material.doubleSided;
@@ -567,6 +593,11 @@ int GlbBuilder::addPart(const ExportPart& part, const std::string& nodeName, Par
     for (size_t i = 0; i < n; ++i) flipped[i] = {mesh.uvs[i].x, 1.0f - mesh.uvs[i].y};
     prim.attributes["TEXCOORD_0"] = addAccessor(flipped.data(), n * sizeof(Vec2), n, TINYGLTF_TYPE_VEC2,
                                                 TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+  }
+  if (part.material.normalTexture && !mesh.normals.empty()) {
+    const std::vector<glm::vec4> tangents = vertexTangents(mesh);
+    prim.attributes["TANGENT"] = addAccessor(tangents.data(), n * sizeof(glm::vec4), n, TINYGLTF_TYPE_VEC4,
+                                             TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
   }
   if (!part.material.texture && hasOwnColors(part)) {
     std::vector<Vec3> rel(n);
@@ -709,6 +740,12 @@ std::vector<PartWriteReport> writePartsGlb(const std::vector<ExportPart>& parts,
   return reports;
 }
 
+// The image file of part's normal map beside an OBJ at path.
+fs::path normalMapPath(const fs::path& path, const ExportPart& part) {
+  fs::path png = path;
+  return png.replace_filename(path.stem().string() + "_" + objName(part.name) + "_normal.png");
+}
+
 std::vector<PartWriteReport> writePartsObj(const std::vector<ExportPart>& parts, const fs::path& path) {
   std::vector<PartWriteReport> reports;
   fs::path mtlPath = path;
@@ -718,7 +755,7 @@ std::vector<PartWriteReport> writePartsObj(const std::vector<ExportPart>& parts,
   struct ImageFile {
     fs::path png;
     const Image* image;
-    bool alpha;
+    ImageEncoding encoding;
   };
   std::vector<ImageFile> images;
   uint64_t base = 0, uvBase = 0, nBase = 0;
@@ -743,12 +780,19 @@ std::vector<PartWriteReport> writePartsObj(const std::vector<ExportPart>& parts,
       fs::path png = path;
       png.replace_filename(path.stem().string() + "_" + objName(part.name) + ".png");
       const bool cutOut = part.material.alphaCutoff >= 0.0f;
-      images.push_back({png, &tex->image, cutOut});
+      images.push_back({png, &tex->image, cutOut ? ImageEncoding::Picture : ImageEncoding::TextureMap});
       // MTL's -clamp covers both axes at once: said where glTF's sampler clamps both (an
       // atlas, cpfg's leaves); an image that repeats in one axis only is left repeating.
       const std::string map = (!tex->seams.repeatU && !tex->seams.repeatV ? "-clamp on " : "") + png.filename().string();
       mtl += "map_Kd " + map + "\n";
       if (cutOut) mtl += "map_d " + map + "\n";
+    }
+    if (const PartTexture* normal = part.material.normalTexture.get()) {
+      // `norm`: the normal map of the MTL's PBR extension (tinyobjloader, three.js); not
+      // map_Bump, which many readers take for a height map.
+      const fs::path png = normalMapPath(path, part);
+      images.push_back({png, &normal->image, ImageEncoding::Data});
+      mtl += "norm -clamp on " + png.filename().string() + "\n";
     }
     mtl += "\n";
     const bool hasN = !lines.normals.empty(), hasUv = !lines.uvs.empty();
@@ -776,7 +820,7 @@ std::vector<PartWriteReport> writePartsObj(const std::vector<ExportPart>& parts,
   std::vector<fs::path> written;
   try {
     for (const ImageFile& f : images) {
-      writeImage(*f.image, f.png, f.alpha ? ImageEncoding::Picture : ImageEncoding::TextureMap);
+      writeImage(*f.image, f.png, f.encoding);
       written.push_back(f.png);
     }
     writeAtomic(mtlPath, mtl);
@@ -891,6 +935,7 @@ std::vector<fs::path> partFiles(const std::vector<ExportPart>& parts, const fs::
     if (!part.mesh.triangles.empty() && part.material.texture) {
       fs::path png = path;
       files.push_back(png.replace_filename(path.stem().string() + "_" + objName(part.name) + ".png"));
+      if (part.material.normalTexture) files.push_back(normalMapPath(path, part));
     }
   return files;
 }

@@ -100,6 +100,13 @@ struct PartMaterial {
   /// is below this are not drawn: glTF alphaMode MASK with this alphaCutoff, MTL map_d
   /// naming the texture image. Negative: opaque.
   float alphaCutoff = -1.0f;
+  /// A tangent-space normal map in texture's atlas layout (texture must then be an atlas of
+  /// the same image size; the corners of texture's atlas address it), or null. Its image
+  /// holds encoded normals ((n + 1)/2 per channel, x along the tangent, y up the image, z
+  /// along the vertex normal), written without an sRGB curve. glTF: the material's
+  /// normalTexture and a TANGENT attribute (cornerTangent of each corner: unit, w = ±1);
+  /// OBJ: `norm STEM_PART_normal.png` in the MTL; PLY: nothing.
+  std::shared_ptr<const PartTexture> normalTexture;
 };
 
 /// An application-specific per-vertex attribute of a glTF export (e.g. a tree's `_WIND`,

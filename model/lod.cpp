@@ -1,10 +1,12 @@
 #include "model/lod.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <numeric>
 
 #include "core/mesh_clean.h"
+#include "model/detail_maps.h"
 #include "model/mesh_parts.h"
 #include "organisms/simplify.h"
 
@@ -91,8 +93,10 @@ Mesh thinPieces(const Mesh& mesh, size_t targetTriangles, double area) {
   return out;
 }
 
-// part reduced to about targetTriangles (unchanged when it has no more).
-ExportPart reducePart(const ExportPart& part, size_t targetTriangles) {
+// part reduced to about targetTriangles (unchanged when it has no more); error receives the
+// simplification's absolute error (0 when unchanged or for scattered parts).
+ExportPart reducePart(const ExportPart& part, size_t targetTriangles, float& error) {
+  error = 0.0f;
   if (part.mesh.triangles.size() <= targetTriangles) return part;
   ExportPart out;
   out.name = part.name;
@@ -109,24 +113,25 @@ ExportPart reducePart(const ExportPart& part, size_t targetTriangles) {
         floor < part.mesh.triangles.size() ? organisms::simplifyToCount(part.mesh, floor, nullptr, false) : part.mesh;
     out.mesh = thinPieces(fewer, targetTriangles, meshArea(part.mesh));
   } else {
-    out.mesh = organisms::simplifyToCount(part.mesh, std::max<size_t>(targetTriangles, 1));
+    organisms::SimplifyReport report;
+    out.mesh = organisms::simplifyToCount(part.mesh, std::max<size_t>(targetTriangles, 1), &report);
+    error = report.absoluteError;
   }
   removeDegenerateTriangles(out.mesh);
-  // An atlas has one patch per triangle of the full part: baked again from the colours of
-  // the vertices that remain (or dropped where they are all the base colour). A part that
-  // varies in colour without a texture had more triangles than an atlas holds: its level
-  // gets one too (atlasVertexColors bakes only where colours vary and no texture is set).
+  // An atlas has one patch per triangle of the full part: the level's own is baked once the
+  // chain is made (bakeLevelMaps), not for every trial of a level.
   if (out.material.texture && out.material.texture->isAtlas()) out.material.texture.reset();
-  atlasVertexColors(out);
   return out;
 }
 
-// Every part reduced to its target triangles.
-LodLevel reduceLevel(const std::vector<ExportPart>& parts, const std::vector<size_t>& targets) {
+// Every part reduced to its target triangles; errors receives each part's simplification
+// error (reducePart's).
+LodLevel reduceLevel(const std::vector<ExportPart>& parts, const std::vector<size_t>& targets, std::vector<float>& errors) {
   LodLevel level;
+  errors.assign(parts.size(), 0.0f);
   for (size_t i = 0; i < parts.size(); ++i) {
     const ExportPart& p = parts[i];
-    level.parts.push_back(p.mesh.triangles.empty() ? p : reducePart(p, std::max<size_t>(targets[i], 1)));
+    level.parts.push_back(p.mesh.triangles.empty() ? p : reducePart(p, std::max<size_t>(targets[i], 1), errors[i]));
   }
   level.triangles = partTriangles(level.parts);
   return level;
@@ -157,6 +162,63 @@ std::vector<size_t> scaledShares(const std::vector<ExportPart>& parts, double fr
   return targets;
 }
 
+// Bakes every simplified surface part's normal and colour atlases from its full mesh
+// (parts[i]) onto each level; reach[k][i] is level k's distance bound for part i (0: the
+// part is not simplified there, or has no atlas to carry maps). Every other reduced part
+// gets an atlas of its own vertex colours (atlasVertexColors: where colours vary and no
+// texture is set; a part that had more triangles than an atlas holds gets one too).
+void bakeLevelMaps(const std::vector<ExportPart>& parts, std::vector<LodLevel>& levels,
+                   const std::vector<std::vector<float>>& reach, LodMapReport& report) {
+  const auto start = std::chrono::steady_clock::now();
+  for (size_t i = 0; i < parts.size(); ++i) {
+    std::unique_ptr<DetailSurface> full;  // built for the first level that needs it
+    for (size_t k = 0; k < levels.size(); ++k) {
+      ExportPart& low = levels[k].parts[i];
+      const bool reduced = low.mesh.triangles.size() < parts[i].mesh.triangles.size();
+      if (!(reach[k][i] > 0)) {
+        if (reduced) atlasVertexColors(low);
+        continue;
+      }
+      if (!full) full = std::make_unique<DetailSurface>(parts[i].mesh, parts[i].material.baseColor);
+      DetailMaps maps = bakeDetailMaps(low.mesh, low.material.baseColor, *full, reach[k][i], true);
+      if (!maps.normal) {
+        atlasVertexColors(low);
+        continue;
+      }
+      low.material.texture = maps.color;
+      low.material.normalTexture = maps.normal;
+      report.texels += maps.texels;
+      report.hits += maps.hits;
+      ++report.maps;
+    }
+  }
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// The distance bound of the detail maps of every part of every level: kDetailReach times
+// the level's simplification error summed over the chain (the full mesh to LOD0 to ... to
+// level k), at least kDetailReachFloor of the part's extent; 0 where the part is not a
+// simplified surface whose atlas (or lack of texture) can carry the maps.
+std::vector<std::vector<float>> detailReach(const std::vector<ExportPart>& parts, const std::vector<LodLevel>& levels,
+                                            const std::vector<std::vector<float>>& errors) {
+  std::vector<std::vector<float>> reach(levels.size(), std::vector<float>(parts.size(), 0.0f));
+  for (size_t i = 0; i < parts.size(); ++i) {
+    const ExportPart& full = parts[i];
+    if (full.scattered || full.mesh.triangles.empty() || full.mesh.normals.size() != full.mesh.positions.size()) continue;
+    const Vec3 size = full.mesh.bounds().size();
+    const float floor = kDetailReachFloor * std::max({size.x, size.y, size.z});
+    float sum = 0.0f;
+    for (size_t k = 0; k < levels.size(); ++k) {
+      sum += errors[k][i];
+      const ExportPart& low = levels[k].parts[i];
+      const bool simplified = low.mesh.triangles.size() < full.mesh.triangles.size();
+      const bool atlas = !low.material.texture || low.material.texture->isAtlas();
+      if (simplified && atlas && !low.mesh.triangles.empty()) reach[k][i] = std::max(kDetailReach * sum, floor);
+    }
+  }
+  return reach;
+}
+
 }  // namespace
 
 size_t partTriangles(const std::vector<ExportPart>& parts) {
@@ -165,8 +227,10 @@ size_t partTriangles(const std::vector<ExportPart>& parts) {
   return n;
 }
 
-std::vector<LodLevel> buildLodChain(const std::vector<ExportPart>& parts, size_t budget, Vec3* moved) {
+std::vector<LodLevel> buildLodChain(const std::vector<ExportPart>& parts, size_t budget, Vec3* moved,
+                                    LodMapReport* maps) {
   std::vector<LodLevel> levels;
+  std::vector<std::vector<float>> errors(1, std::vector<float>(parts.size(), 0.0f));  // per level, per part
   const size_t total = partTriangles(parts);
   if (total <= budget) {
     levels.push_back(LodLevel{parts, total, 0});
@@ -174,19 +238,25 @@ std::vector<LodLevel> buildLodChain(const std::vector<ExportPart>& parts, size_t
     // Parts that cannot reach their share (borders locked) leave LOD0 above the budget:
     // then the budget shrinks by the overshoot, at most twice more.
     double scaled = double(budget);
-    levels.push_back(reduceLevel(parts, budgetShares(parts, budget)));
+    levels.push_back(reduceLevel(parts, budgetShares(parts, budget), errors[0]));
     for (int retry = 0; retry < 2 && levels[0].triangles > budget; ++retry) {
       scaled *= double(budget) / double(levels[0].triangles) * 0.98;
-      levels[0] = reduceLevel(parts, budgetShares(parts, size_t(scaled)));
+      levels[0] = reduceLevel(parts, budgetShares(parts, size_t(scaled)), errors[0]);
     }
   }
   while (int(levels.size()) < kLodMaxLevels) {
     const LodLevel& prev = levels.back();
     if (double(prev.triangles) * kLodRatio < double(kLodMinTriangles)) break;
-    LodLevel next = reduceLevel(prev.parts, scaledShares(prev.parts, kLodRatio));
+    std::vector<float> error;
+    LodLevel next = reduceLevel(prev.parts, scaledShares(prev.parts, kLodRatio), error);
     if (double(next.triangles) > double(prev.triangles) * kLodMaxKeep) break;
     levels.push_back(std::move(next));
+    errors.push_back(std::move(error));
   }
+  // The maps of the detail the levels lost, from the full parts (before the levels move).
+  LodMapReport report;
+  bakeLevelMaps(parts, levels, detailReach(parts, levels, errors), report);
+  if (maps) *maps = report;
   // Simplification removes vertices at the box's sides too: LOD0 stands on the ground again
   // and every level moves with it, so the levels stay on top of each other.
   const Vec3 offset = groundOffset(levels[0].parts);
@@ -197,9 +267,10 @@ std::vector<LodLevel> buildLodChain(const std::vector<ExportPart>& parts, size_t
   return levels;
 }
 
-std::vector<LodLevel> lodLevels(std::vector<ExportPart> parts, size_t budget, Vec3* moved) {
+std::vector<LodLevel> lodLevels(std::vector<ExportPart> parts, size_t budget, Vec3* moved, LodMapReport* maps) {
   if (moved) *moved = Vec3(0.0f);
-  if (budget > 0) return buildLodChain(parts, budget, moved);
+  if (maps) *maps = LodMapReport{};
+  if (budget > 0) return buildLodChain(parts, budget, moved, maps);
   std::vector<LodLevel> one(1);
   one[0].triangles = partTriangles(parts);
   one[0].parts = std::move(parts);

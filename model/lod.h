@@ -8,9 +8,11 @@
 /// locked); parts of many small pieces (leaves: ExportPart::scattered) keep an evenly spread
 /// share of their pieces, each grown about its centroid so that their total area stays.
 /// Textures over the surface's own (u, v) (bark, a shell's whorl, cpfg images) stay as they
-/// are; an atlas (one patch per triangle) is baked again for each level from the vertex
-/// colours that remain (atlasVertexColors), and so is one for a part whose colours vary but
-/// had too many triangles for an atlas (its colours were clamped in COLOR_0).
+/// are; an atlas (one patch per triangle) is baked again for each level, and so is one for a
+/// part whose colours vary but had too many triangles for an atlas (its colours were clamped
+/// in COLOR_0): from the full part's surface (model/detail_maps.h: its colours and a
+/// tangent-space normal map of the relief the level lost), or, where that cannot be done
+/// (leaves, a part without normals), from the vertex colours that remain (atlasVertexColors).
 
 #include <cstddef>
 #include <filesystem>
@@ -33,6 +35,20 @@ inline constexpr double kLodMaxKeep = 0.75;
 /// The smallest budget `--lod N` accepts.
 inline constexpr size_t kLodMinBudget = 1000;
 
+/// The detail maps' rays reach this many times a level's simplification error (meshoptimizer's
+/// estimate, summed over the chain from the full mesh) ...
+inline constexpr float kDetailReach = 2.0f;
+/// ... and at least this fraction of the part's extent (the largest side of its box).
+inline constexpr float kDetailReachFloor = 1e-3f;
+
+/// What buildLodChain's detail maps did.
+struct LodMapReport {
+  size_t maps = 0;    ///< parts' levels that got a normal map (and a colour atlas of the full mesh)
+  size_t texels = 0;  ///< texels baked
+  size_t hits = 0;    ///< of them, with a hit of the full mesh
+  double seconds = 0; ///< wall-clock time of the baking (scenes of the full parts included)
+};
+
 /// The MSFT_screencoverage of level i (LodLevel::screenCoverage) is kLodRatio^(i+1): the
 /// next level has as many triangles per pixel there as LOD0 at a full screen; the far
 /// level's is 0 (never culled).
@@ -48,11 +64,21 @@ inline constexpr size_t kLodMinBudget = 1000;
 /// on the ground (groundOffset: simplification may remove the lowest or outermost vertices);
 /// moved, when given, receives it. Deterministic. Cost: one simplification of the full parts
 /// (O(T log T)), then of each level (a quarter each).
-std::vector<LodLevel> buildLodChain(const std::vector<ExportPart>& parts, size_t budget, Vec3* moved = nullptr);
+///
+/// Every simplified surface part (not scattered; with normals; its level's texture an atlas
+/// or none) of every level, LOD0 included when it was reduced, then gets maps baked from
+/// its full mesh (model/detail_maps.h bakeDetailMaps): a tangent-space normal map
+/// (PartMaterial::normalTexture) and an atlas of the full mesh's colours at the same points,
+/// instead of the level's own vertex colours. The rays reach kDetailReach times the
+/// simplification error summed along the chain, at least kDetailReachFloor of the part's
+/// extent. maps, when given, receives what was baked.
+std::vector<LodLevel> buildLodChain(const std::vector<ExportPart>& parts, size_t budget, Vec3* moved = nullptr,
+                                    LodMapReport* maps = nullptr);
 
 /// The levels `sprig mesh` writes: buildLodChain(parts, budget), or parts alone as one
 /// level when budget is 0 (--lod none); moved as buildLodChain's (zero without levels).
-std::vector<LodLevel> lodLevels(std::vector<ExportPart> parts, size_t budget, Vec3* moved = nullptr);
+std::vector<LodLevel> lodLevels(std::vector<ExportPart> parts, size_t budget, Vec3* moved = nullptr,
+                                LodMapReport* maps = nullptr);
 
 /// Writes levels to path as `sprig mesh` does: each further level's own file
 /// (lodPath(path, K): STEM_lodK.EXT for K >= 1, the parts as writeParts writes them; a .glb

@@ -124,37 +124,62 @@ bool ownColors(const ExportPart& part) {
 
 }  // namespace
 
-std::shared_ptr<PartTexture> bakeAtlas(const Mesh& mesh, const SurfaceColor& colorAt) {
+std::vector<std::shared_ptr<PartTexture>> bakeAtlases(const Mesh& mesh, int count, const SurfaceTexel& texelAt,
+                                                      bool gutterCopies) {
   const AtlasLayout l = atlasLayout(mesh.triangles.size());
-  if (l.cell == 0) return nullptr;
-  auto tex = std::make_shared<PartTexture>();
+  if (l.cell == 0 || count < 1 || count > kMaxAtlases) return {};
   const int W = l.width(), H = l.height(), c = l.cell;
-  tex->image = Image(W, H, Vec4(0, 0, 0, 1));
-  tex->atlasCell = c;
   const size_t nt = mesh.triangles.size();
-  tex->atlas.values.resize(nt * 3);
-  tex->atlas.index.resize(nt * 3);
+  std::vector<std::shared_ptr<PartTexture>> out;
+  for (int k = 0; k < count; ++k) {
+    auto tex = std::make_shared<PartTexture>();
+    tex->image = Image(W, H, Vec4(0, 0, 0, 1));
+    tex->atlasCell = c;
+    tex->atlas.values.resize(nt * 3);
+    tex->atlas.index.resize(nt * 3);
+    out.push_back(std::move(tex));
+  }
   // Corners on texel centres: a lookup at a corner reads that texel alone, the colour
   // there (texels at corners would average four, up to a quarter of a 4-texel patch apart).
   const Vec2 corner[3] = {Vec2(1.5f, 1.5f), Vec2(float(c) - 1.5f, 1.5f), Vec2(1.5f, float(c) - 1.5f)};
-  Image& im = tex->image;
   parallelFor(0, nt, [&](size_t t) {
     const int x0 = int(t % size_t(l.columns)) * c, y0 = int(t / size_t(l.columns)) * c;  // texels from bottom-left
     const glm::uvec3& tri = mesh.triangles[t];
     const Vec3 P[3] = {mesh.positions[tri.x], mesh.positions[tri.y], mesh.positions[tri.z]};
-    for (int k = 0; k < 3; ++k) {
-      tex->atlas.index[t * 3 + size_t(k)] = uint32_t(t * 3 + size_t(k));
-      tex->atlas.values[t * 3 + size_t(k)] = Vec2((float(x0) + corner[k].x) / float(W), (float(y0) + corner[k].y) / float(H));
-    }
-    const double leg = double(c - 3);
+    for (const std::shared_ptr<PartTexture>& tex : out)
+      for (int k = 0; k < 3; ++k) {
+        tex->atlas.index[t * 3 + size_t(k)] = uint32_t(t * 3 + size_t(k));
+        tex->atlas.values[t * 3 + size_t(k)] = Vec2((float(x0) + corner[k].x) / float(W), (float(y0) + corner[k].y) / float(H));
+      }
+    const int leg = c - 3;  // texel (i, j) has barycentric (i − 1, j − 1)/leg
+    Vec3 values[kMaxAtlases];
+    auto bake = [&](int i, int j) {
+      const Vec3 b = clampedBary(double(i - 1) / leg, double(j - 1) / leg);
+      texelAt(t, b.x * P[0] + b.y * P[1] + b.z * P[2], b, values);
+      for (size_t k = 0; k < out.size(); ++k) out[k]->image.set(x0 + i, H - 1 - (y0 + j), Vec4(values[k], 1.0f));
+    };
+    auto inside = [leg](int i, int j) { return i >= 1 && j >= 1 && i + j - 2 <= leg; };
+    for (int j = 0; j < c; ++j)
+      for (int i = 0; i < c; ++i)
+        if (!gutterCopies || inside(i, j)) bake(i, j);
+    if (!gutterCopies) return;
+    // Gutter texels: the inside texel nearest to the texel's point clamped to the triangle.
     for (int j = 0; j < c; ++j)
       for (int i = 0; i < c; ++i) {
-        const Vec3 b = clampedBary((i + 0.5 - 1.5) / leg, (j + 0.5 - 1.5) / leg);
-        const Vec3 p = b.x * P[0] + b.y * P[1] + b.z * P[2];
-        im.set(x0 + i, H - 1 - (y0 + j), Vec4(colorAt(t, p, b), 1.0f));
+        if (inside(i, j)) continue;
+        const Vec3 b = clampedBary(double(i - 1) / leg, double(j - 1) / leg);
+        int si = 1 + int(std::lround(double(b.y) * leg)), sj = 1 + int(std::lround(double(b.z) * leg));
+        while (!inside(si, sj)) (si > sj ? si : sj) -= 1;
+        for (const std::shared_ptr<PartTexture>& tex : out)
+          tex->image.set(x0 + i, H - 1 - (y0 + j), tex->image.at(x0 + si, H - 1 - (y0 + sj)));
       }
   });
-  return tex;
+  return out;
+}
+
+std::shared_ptr<PartTexture> bakeAtlas(const Mesh& mesh, const SurfaceColor& colorAt) {
+  auto one = bakeAtlases(mesh, 1, [&colorAt](size_t t, const Vec3& p, const Vec3& b, Vec3* out) { out[0] = colorAt(t, p, b); });
+  return one.empty() ? nullptr : one[0];
 }
 
 Vec3 blobSurfaceColor(const blobtree::CompiledBlob& blob, const Vec3& p, float maxMove, const render::TextureTable& textures,

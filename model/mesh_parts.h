@@ -82,6 +82,20 @@ using SurfaceColor = std::function<Vec3(size_t triangle, const Vec3& point, cons
 /// the result does not depend on the thread count.
 std::shared_ptr<PartTexture> bakeAtlas(const Mesh& mesh, const SurfaceColor& colorAt);
 
+/// The most images bakeAtlases makes at once.
+inline constexpr int kMaxAtlases = 4;
+/// The values of one texel of atlases baked together: out[k] is image k's value at the
+/// barycentric point of triangle `triangle` (as SurfaceColor). Called in parallel.
+using SurfaceTexel = std::function<void(size_t triangle, const Vec3& point, const Vec3& bary, Vec3* out)>;
+/// bakeAtlas of count images (1..kMaxAtlases) in the same layout at once, each texel's
+/// values computed by one texelAt call (a normal map and a colour map from one ray cast).
+/// gutterCopies: texelAt is called only for the texels whose centres lie in the triangle
+/// (105 of the 256 texels of a 16-texel patch); each gutter texel copies the inside texel nearest to its
+/// clamped point. Empty when bakeAtlas would give null or count is out of range.
+/// Thread-count independent.
+std::vector<std::shared_ptr<PartTexture>> bakeAtlases(const Mesh& mesh, int count, const SurfaceTexel& texelAt,
+                                                      bool gutterCopies = false);
+
 /// The colour the renderer gives blended BlobTree attributes at p (as
 /// render::Scene::attributeColor: Σ wᵢ·textureᵢ / Σ wᵢ, per layer with
 /// material.textureLayers, times the contact darkening; base colour where none contributes).

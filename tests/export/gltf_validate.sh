@@ -6,8 +6,9 @@
 # and of each organism base and colouring. A shell's separate 'spines' part (the axial canal
 # spines of fig_shell_09a/09b and the Murex) is baked and written by the same code as the
 # varices; its export takes minutes (a million triangles), so it is not among these cases.
-# Levels of detail (MSFT_lod) are validated on a tree and an organism; the other cases write
-# the full mesh alone (--lod none), which is what each level is made from.
+# Levels of detail (MSFT_lod) are validated on two trees and an organism (the PCM tree and the
+# organism with the detail maps of their simplified levels: normalTexture and TANGENT); the
+# other cases write the full mesh alone (--lod none), which is what each level is made from.
 # Usage: gltf_validate.sh path/to/sprig   (run from the repository root)
 set -euo pipefail
 sprig="$1"
@@ -22,7 +23,8 @@ species=(
   "shell_top *whorl inside"                 # shell, painted pigment
   "fig_shell_07b_varix_full *whorl varices" # shell with varices and their spines
   "blob_ricci_fig3 blob"                   # blob
-  "fig_org_05b_berry_level2 organism | --lod auto"  # organism on a primitive, with its levels of detail
+  "fig_org_05b_berry_level2 organism | --lod 20000"  # organism on a primitive, with its levels of detail and their detail maps (a small budget: the bake follows the levels' texels)
+  "fig_tree_12_pcm_offset wood | --lod 2000"  # tree with PCM ridges: both levels simplified, each with a normal map and TANGENT
   "fig_org_13a_mummified_skull_sharp organism"  # organism on a CT volume, blend colour
   "fig_org_14c_planet_blend organism"      # organism with the planet shader
   "org_painted_band organism"              # organism on a painted mesh
@@ -46,6 +48,18 @@ for entry in "${species[@]}"; do
     if [[ "$p" == \** ]]; then expect+=(--textured "${p#\*}"); else expect+=(--expect "$p"); fi
   done
   python3 scripts/gltf-parts.py "species/$s.yaml" "$f" "${expect[@]}"
+  if [[ "$s" == fig_tree_12_pcm_offset && "$flags" == *--lod\ 2000* ]]; then
+    # Every level is simplified: each material has a normal map, each primitive its TANGENT.
+    python3 - "$f" <<'PY'
+import json, struct, sys
+d = open(sys.argv[1], 'rb').read()
+j = json.loads(d[20:20 + struct.unpack('<I', d[12:16])[0]])
+prims = [p for m in j['meshes'] for p in m['primitives']]
+bad = [p for p in prims if 'normalTexture' not in j['materials'][p['material']] or 'TANGENT' not in p['attributes']]
+if len(prims) < 2 or bad:
+    sys.exit('%s: %d of %d primitives without a normal map and TANGENT' % (sys.argv[1], len(bad), len(prims)))
+PY
+  fi
 done
 # A cpfg object whose texture cuts out (alphaMode MASK with alphaCutoff, an RGBA PNG, nearest
 # samplers) beside an opaque decal one.
