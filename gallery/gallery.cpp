@@ -135,7 +135,7 @@ GalleryItem renderGalleryItem(const fs::path& speciesFile, const fs::path& outDi
     item.deriveSeconds = fig.buildSeconds;
 
     // The growth strip: every stage framed like the final one. A solid does not grow: its
-    // strip is the whole solid and its cut-away by the plane z = 0 (Fig. 3e, 3f); a solid
+    // strip is the whole solid and its cut-away by render.section or the plane z = 0 (Fig. 3e, 3f); a solid
     // with operations shows its sequence instead, one cell per operation (Fig. 6-8).
     const bool solid = !model.volumeMeshExtensions().empty();
     const std::vector<Stage> sequence = solid ? model.stripStages(0) : std::vector<Stage>{};
@@ -156,6 +156,8 @@ GalleryItem renderGalleryItem(const fs::path& speciesFile, const fs::path& outDi
       if (draft && exact) cellJob.samples = 1;
       cellJob.progressLabel = "stages " + stem + " " + std::to_string(i + 1) + "/" + std::to_string(stages.size());
       SpeciesRender cellLook = stripLook;
+      // The whole solid, then its cut: the species' render.section, else the plane z = 0.
+      if (cutAway && i == 0) cellLook.section.reset();
       if (cutAway && i == 1) cellLook.section = look.section.value_or(Vec4(0, 0, 1, 0));
       Image cell = renderModel(model, cellLook, cellJob);
       for (int y = 0; y < stripHeight; ++y)

@@ -1,6 +1,7 @@
 #include "model/solid_kind.h"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -711,9 +712,33 @@ class SolidModel final : public StillKindModel {
       part.material = render::Material{m.color, m.roughness, m.specular};
       out.geometry.parts.push_back(std::move(part));
     }
+    if (look.wireframe) addWireframe(out, *look.wireframe, look);
     out.figures.primitives = stageMesh(k).tets.size();
     out.figures.buildSeconds = secondsSince(t0) + buildSeconds_;
     return out;
+  }
+
+  /// `render.wireframe`: the edges of built's mesh parts as curves, wire.widthPixels wide
+  /// at each end's depth seen through look.pixels (without a camera: 1/1000 of the frame
+  /// box's diagonal per pixel of width), and never thinner than look.image.thinMinPixels
+  /// (a little wider): the scene would widen a thinner curve and make it partly transparent,
+  /// and a ray through it continues past its tube, which straddles the surface, so the line
+  /// would show the solid's far side instead of darkening this one.
+  void addWireframe(BuiltStage& built, const WireframeSpec& wire, const SpeciesRender& look) {
+    const std::optional<render::PixelScale>& pixels = look.pixels;
+    std::vector<Mesh> meshes;
+    for (const render::GeometryPart& part : built.geometry.parts)
+      if (const auto* m = std::get_if<render::MeshPart>(&part)) meshes.push_back(m->mesh);
+    const float half = 0.5f * std::max(float(wire.widthPixels), 1.001f * look.image.thinMinPixels);
+    const float fallback = half * glm::length(frameBox().size()) / 1000.0f;
+    render::CurvesPart lines;
+    lines.curves = wireframeCurves(meshes, [&](const Vec3& p) {
+      if (!pixels) return fallback;
+      const float depth = std::max(glm::dot(p - pixels->eye, pixels->forward), 1e-6f);
+      return half * pixels->pixelPerDepth * depth;
+    });
+    lines.material = render::Material{wire.color, 1.0f, 0.0f};
+    built.geometry.parts.push_back(std::move(lines));
   }
 
   Mesh buildMesh(const Stage& stage, float, bool, ModelFigures& figures) override {
@@ -901,6 +926,32 @@ class SolidModel final : public StillKindModel {
 };
 
 }  // namespace
+
+CurveSet wireframeCurves(const std::vector<Mesh>& parts, const std::function<float(const Vec3&)>& radiusAt) {
+  using Point = std::array<float, 3>;
+  std::vector<std::pair<Point, Point>> edges;
+  for (const Mesh& m : parts)
+    for (const auto& t : m.triangles)
+      for (int i = 0; i < 3; ++i) {
+        const Vec3 a = m.positions[t[i]], b = m.positions[t[(i + 1) % 3]];
+        Point pa{a.x, a.y, a.z}, pb{b.x, b.y, b.z};
+        if (pb < pa) std::swap(pa, pb);
+        if (pa != pb) edges.push_back({pa, pb});
+      }
+  std::sort(edges.begin(), edges.end());
+  edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  CurveSet out;
+  out.vertices.reserve(2 * edges.size());
+  for (const auto& [pa, pb] : edges) {
+    out.segments.push_back(uint32_t(out.vertices.size()));
+    out.flags.push_back(0);
+    for (const Point& p : {pa, pb}) {
+      const Vec3 v(p[0], p[1], p[2]);
+      out.vertices.push_back(Vec4(v, radiusAt(v)));
+    }
+  }
+  return out;
+}
 
 std::vector<Mesh> visibleMeshes(const TetMesh& mesh, std::vector<uint16_t>* partMaterials,
                                 const std::vector<solids::Material>* materials) {

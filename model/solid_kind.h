@@ -25,9 +25,11 @@
 /// velocity, from_volume_surface): those keys are errors at their file:line:col, never
 /// ignored. `extrude_2d` and `species` fields: solids/extrude_field.h, model/species_field.h.
 
+#include <functional>
 #include <memory>
 #include <string>
 
+#include "core/shapes.h"
 #include "model/kinds.h"
 #include "model/solid_operations.h"
 #include "model/yaml_reader.h"
@@ -63,5 +65,12 @@ std::shared_ptr<const KindSpec> readSolidSpec(MapReader& top, Species& species, 
 /// tint amount); otherwise none (the part's material colour applies).
 std::vector<Mesh> visibleMeshes(const solids::TetMesh& mesh, std::vector<uint16_t>* partMaterials = nullptr,
                                 const std::vector<solids::Material>* materials = nullptr);
+
+/// The distinct edges of parts' triangles as round linear curve segments (two vertices
+/// each, no joins), for `render.wireframe`. Edges are keyed by their ends' positions, so
+/// an edge shared by two triangles, or by two parts or normal groups that each hold a copy
+/// of its vertices, is drawn once; segments come in the keys' sorted order. radiusAt gives
+/// the world radius at a point. Cost: O(E log E) for E triangle edges.
+CurveSet wireframeCurves(const std::vector<Mesh>& parts, const std::function<float(const Vec3&)>& radiusAt);
 
 }  // namespace sprig

@@ -123,6 +123,22 @@ void readRender(MapReader& m, SpeciesRender& r, const PathPolicy& policy, Diagno
   readLights(m, im, diags);
   im.exposure = static_cast<float>(m.number({"exposure", "Exposure in stops: each +1 doubles the image's brightness."}, im.exposure, -10.0, 10.0));
   readCamera(m, r, diags);
+  if (auto w = m.section({"wireframe", "Solids: draw the edges of the visible triangles (the tetrahedra's faces on the surface and on a section's cut) as thin lines over the surface: `color`, `width`."})) {
+    MapReader wire(*w, diags, "render.wireframe");
+    WireframeSpec spec;
+    spec.color = wire.color({"color", "Colour of the wireframe's lines."}, spec.color);
+    spec.widthPixels = wire.number({"width", "Width of the wireframe's lines in pixels (below `thin_min_pixels` they are drawn that wide, partly transparent)."}, spec.widthPixels, 0.1, 16.0);
+    wire.finish();
+    r.wireframe = spec;
+  }
+  if (auto c = m.section({"section", "Solids: a cut-away by the plane normal·x = offset, the side normal·x > offset removed (as `sprig render --section`): `normal`, `offset`."})) {
+    MapReader cut(*c, diags, "render.section");
+    const Vec3 n = cut.vec3({"normal", "The cutting plane's normal (not zero): the side it points to is removed."}, Vec3(0, 0, 1), -1e6, 1e6);
+    const double d = cut.number({"offset", "The plane's offset d in normal·x = d (world units, scaled by the normal's length)."}, 0.0, -1e6, 1e6);
+    cut.finish();
+    if (n == Vec3(0)) c->error(diags, "render.section: 'normal' is zero (the plane has no side to remove)");
+    r.section = Vec4(n, float(d));
+  }
   r.pair = m.path({"pair", "Another species file: the picture shows this species and that one (at its final stage) side by side, seen by one camera framing both (this species' camera, light and size; each panel half the width)."}, policy);
   im.fillStrength = static_cast<float>(m.number({"fill", "Strength of an unshadowed fill light from the camera (0 = none)."}, im.fillStrength, 0.0, 10.0));
   im.skyStrength = static_cast<float>(m.number({"sky", "Strength of the sky light."}, im.skyStrength, 0.0, 10.0));
@@ -186,6 +202,10 @@ Species readSpecies(std::shared_ptr<const YamlFile> yaml, const PathPolicy& poli
     readRender(render, s.render, policy, diags);
     if (auto w = render.keyNode("wind"); w && s.kind != "tree")
       w->error(diags, "'render.wind' sways trees; " + speciesOfKind(s.kind) + " has no wind");
+    if (auto w = render.keyNode("wireframe"); w && s.kind != "solid")
+      w->error(diags, "'render.wireframe' draws the edges of a solid's tetrahedra; " + speciesOfKind(s.kind) + " has none");
+    if (auto c = render.keyNode("section"); c && s.kind != "solid")
+      c->error(diags, "'render.section' cuts a solid open; " + speciesOfKind(s.kind) + " has no inside to show");
     if (s.render.closeUp && s.kind != "tree" && (s.render.closeUp->internode >= 0 || s.render.closeUp->junction >= 0))
       if (auto c = render.keyNode("close_up"))
         c->error(diags, "'render.close_up' names an internode or a junction of a tree; " + speciesOfKind(s.kind) +

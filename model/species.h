@@ -61,6 +61,13 @@ struct SkeletonStyle {
   std::shared_ptr<const std::vector<lsystem::CpfgTexture>> cpfgTextures;
 };
 
+/// Solids: `render.wireframe: {color, width}`: the edges of the visible triangles (the
+/// tetrahedra's faces on the surface and on a section's cut) drawn as thin lines.
+struct WireframeSpec {
+  Vec3 color{0.02f};         ///< `color`: linear RGB of the lines
+  double widthPixels = 1.0;  ///< `width`: line width in pixels at each end's depth
+};
+
 /// How a species is shown (`render:`): the renderer's settings for its image, camera,
 /// preview style and surface material.
 struct SpeciesRender {
@@ -79,6 +86,8 @@ struct SpeciesRender {
   /// Solids: a cut-away by the plane n·x = d (xyz = n, w = d); the side n·x > d is removed
   /// (`sprig render --section`).
   std::optional<Vec4> section;
+  /// Solids: `wireframe: {color, width}` (model/solid_kind.h wireframeCurves); unset: none.
+  std::optional<WireframeSpec> wireframe;
   /// Trees: `wind: {speed, direction}`, the wind the gallery's animation sways the tree in
   /// (m/s, 0 = none; azimuth degrees it blows toward). `sprig animate` uses --wind instead.
   double windSpeed = 0;
