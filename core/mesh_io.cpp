@@ -537,7 +537,7 @@ int GlbBuilder::addMaterial(const ExportPart& part) {
     }
     mat.pbrMetallicRoughness.baseColorTexture.index = addTexture(part);
   }
-  mat.pbrMetallicRoughness.metallicFactor = 0.0;
+  mat.pbrMetallicRoughness.metallicFactor = part.material.metallic;
   mat.pbrMetallicRoughness.roughnessFactor = part.material.roughness;
   mat.doubleSided = part.material.doubleSided;
   model_.materials.push_back(mat);

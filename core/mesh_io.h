@@ -100,6 +100,7 @@ struct PartMaterial {
   /// is below this are not drawn: glTF alphaMode MASK with this alphaCutoff, MTL map_d
   /// naming the texture image. Negative: opaque.
   float alphaCutoff = -1.0f;
+  float metallic = 0.0f;       ///< glTF metallicFactor in [0,1] (MTL has no portable form)
 };
 
 /// An application-specific per-vertex attribute of a glTF export (e.g. a tree's `_WIND`,
