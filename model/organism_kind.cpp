@@ -881,7 +881,8 @@ std::vector<Vec3> organismSurfaces(const OrganismSpec& spec, const OrganismSurfa
   const Vec3 blend(spec.blendRoughness.value_or(renderSurface.x), spec.blendSpecular.value_or(renderSurface.y),
                    spec.blendMetallic.value_or(renderSurface.z));
   std::vector<Vec3> out(s.mesh.vertexCount());
-  for (size_t v = 0; v < out.size(); ++v) out[v] = glm::mix(renderSurface, blend, s.alpha[v]);
+  // (1 − α)·render + α·blend: exactly one or the other where alpha is 0 or 1.
+  for (size_t v = 0; v < out.size(); ++v) out[v] = (1.0f - s.alpha[v]) * renderSurface + s.alpha[v] * blend;
   return out;
 }
 

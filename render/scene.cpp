@@ -564,7 +564,10 @@ std::optional<SurfaceHit> Scene::intersect(const Vec3& origin, const Vec3& direc
       hit.color = w * rec.vertexColors[tri.x] + u * rec.vertexColors[tri.y] + v * rec.vertexColors[tri.z];
     if (!rec.vertexSurfaces.empty()) {
       hit.ownSurface = true;
-      hit.surface = w * rec.vertexSurfaces[tri.x] + u * rec.vertexSurfaces[tri.y] + v * rec.vertexSurfaces[tri.z];
+      // As an offset from the first corner: three equal corners give exactly their value
+      // (roughness 1 stays 1, so no highlight creeps back).
+      const Vec3& a = rec.vertexSurfaces[tri.x];
+      hit.surface = a + u * (rec.vertexSurfaces[tri.y] - a) + v * (rec.vertexSurfaces[tri.z] - a);
     }
     int tex = impl_->materials[hit.material].texture;
     if (!rec.uvs.empty() && tex >= 0 && static_cast<size_t>(tex) < impl_->textures.size())
