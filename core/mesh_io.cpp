@@ -563,7 +563,7 @@ int GlbBuilder::addMaterial(const ExportPart& part) {
   }
   if (part.material.normalTexture)
     mat.normalTexture.index = addTexture(part.material.normalTexture.get(), part.name + "_normal", ImageEncoding::Data);
-  mat.pbrMetallicRoughness.metallicFactor = 0.0;
+  mat.pbrMetallicRoughness.metallicFactor = part.material.metallic;
   mat.pbrMetallicRoughness.roughnessFactor = part.material.roughness;
   mat.doubleSided = part.material.doubleSided;
   model_.materials.push_back(mat);

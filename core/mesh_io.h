@@ -107,6 +107,7 @@ struct PartMaterial {
   /// normalTexture and a TANGENT attribute (cornerTangent of each corner: unit, w = ±1);
   /// OBJ: `norm STEM_PART_normal.png` in the MTL; PLY: nothing.
   std::shared_ptr<const PartTexture> normalTexture;
+  float metallic = 0.0f;       ///< glTF metallicFactor in [0,1] (MTL has no portable form)
 };
 
 /// An application-specific per-vertex attribute of a glTF export (e.g. a tree's `_WIND`,

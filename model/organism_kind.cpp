@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 
 #include "core/mesh_clean.h"
@@ -545,10 +546,19 @@ class OrganismReader {
     if (auto c = m.get({"color", "Surface colour where alpha is 1, mixed in by alpha elsewhere (default: none, the render colour)."})) {
       if (auto v = c->asColor(diags_, "'color'")) spec_.blendColor = *v;
     }
+    readBlendSurface(m, {"roughness", "Roughness where alpha is 1 (0 mirror-like, 1 matte), mixed in by alpha elsewhere (default: the render's `roughness`)."}, spec_.blendRoughness);
+    readBlendSurface(m, {"specular", "Specular reflectance where alpha is 1, mixed in by alpha elsewhere (default: the render's `specular`)."}, spec_.blendSpecular);
+    readBlendSurface(m, {"metallic", "How metallic the surface is where alpha is 1 (0 dielectric, 1 metal), mixed in by alpha elsewhere (default: the render's `metallic`)."}, spec_.blendMetallic);
     m.markRequired("alpha");
     if (auto a = m.get({"alpha", "Where shape B replaces shape A, per level: d_l = (1 − α_l)·d^A_l + α_l·d^B_l; `plane`, `noise` or `painted`."})) readAlpha(*a);
     else m.node().error(diags_, "missing required key 'alpha' in blend (e.g. alpha: {plane: {normal: [1, 2, 0]}})");
     m.finish();
+  }
+
+  /// One of the blend's surface values in [0, 1]; left unset when absent.
+  void readBlendSurface(MapReader& m, Key key, std::optional<float>& out) {
+    const double v = m.number(key, std::numeric_limits<double>::quiet_NaN(), 0.0, 1.0);
+    if (!std::isnan(v)) out = float(v);
   }
 
   void readAlpha(const YNode& node) {
@@ -719,6 +729,7 @@ class OrganismModel final : public KindModel {
     render::MeshPart part;
     part.mesh = mesh(timeOf(stage), look.surface.baseColor);
     part.material = look.surface;
+    part.vertexSurfaces = organismSurfaces(spec_, *cached_, surfaceOf(look.surface));
     out.figures.triangles = part.mesh.triangleCount();
     out.figures.primitives = spec_.base.faceCount();
     out.geometry.parts.push_back(std::move(part));
@@ -739,10 +750,12 @@ class OrganismModel final : public KindModel {
     part.name = "organism";
     part.mesh = mesh(timeOf(stage), look.surface.baseColor);
     part.material = {"organism", look.surface.baseColor, look.surface.roughness, false};
-    atlasVertexColors(part);  // the shader's colours, interpolated as the renderer does, unclamped
+    part.material.metallic = look.surface.metallic;
     figures.triangles = part.mesh.triangleCount();
     figures.primitives = spec_.base.faceCount();
-    return {std::move(part)};
+    std::vector<ExportPart> parts = splitBlendSurface(std::move(part), look.surface);
+    for (ExportPart& p : parts) atlasVertexColors(p);  // the shader's colours, interpolated as the renderer does, unclamped
+    return parts;
   }
 
   /// LOD0 of an organism within 250,000 triangles (docs/MESHES.md "Levels of detail").
@@ -757,6 +770,36 @@ class OrganismModel final : public KindModel {
 
  private:
   static double timeOf(const Stage& s) { return s.time < 0 ? 1.0 : s.time; }
+  static Vec3 surfaceOf(const render::Material& m) { return Vec3(m.roughness, m.specular, m.metallic); }
+
+  /// glTF carries roughness and metallic per material only: with the blend's own surface,
+  /// the triangles whose mean alpha exceeds 1/2 become a second part, "organism_blend",
+  /// with the blend's values (docs/MESHES.md); otherwise the one part as it is.
+  std::vector<ExportPart> splitBlendSurface(ExportPart whole, const render::Material& look) const {
+    const std::vector<float>& alpha = cached_->alpha;
+    Mesh& m = whole.mesh;
+    if (!(spec_.blendRoughness || spec_.blendSpecular || spec_.blendMetallic) || alpha.size() != m.vertexCount())
+      return {std::move(whole)};
+    m.materials.resize(m.triangleCount());
+    for (size_t t = 0; t < m.triangleCount(); ++t) {
+      const glm::uvec3& tri = m.triangles[t];
+      m.materials[t] = alpha[tri.x] + alpha[tri.y] + alpha[tri.z] > 1.5f ? 1u : 0u;
+    }
+    std::vector<ExportPart> out;
+    for (auto& [side, piece] : splitByMaterial(m)) {
+      ExportPart p;
+      p.name = side ? "organism_blend" : "organism";
+      p.mesh = std::move(piece);
+      p.material = whole.material;
+      p.material.name = p.name;
+      if (side) {
+        p.material.roughness = spec_.blendRoughness.value_or(look.roughness);
+        p.material.metallic = spec_.blendMetallic.value_or(look.metallic);
+      }
+      out.push_back(std::move(p));
+    }
+    return out;
+  }
 
   /// n stages at evenly spaced times from 0 to 1 (one stage: time 1).
   static std::vector<Stage> evenTimes(int n) {
@@ -831,6 +874,16 @@ std::vector<Vec3> organismColors(const OrganismSpec& spec, const OrganismSurface
     for (size_t v = 0; v < n; ++v) colors[v] = glm::mix(baseColor, *spec.blendColor, s.alpha[v]);
   }
   return colors;
+}
+
+std::vector<Vec3> organismSurfaces(const OrganismSpec& spec, const OrganismSurface& s, const Vec3& renderSurface) {
+  if (!(spec.blendRoughness || spec.blendSpecular || spec.blendMetallic) || s.alpha.empty()) return {};
+  const Vec3 blend(spec.blendRoughness.value_or(renderSurface.x), spec.blendSpecular.value_or(renderSurface.y),
+                   spec.blendMetallic.value_or(renderSurface.z));
+  std::vector<Vec3> out(s.mesh.vertexCount());
+  // (1 − α)·render + α·blend: exactly one or the other where alpha is 0 or 1.
+  for (size_t v = 0; v < out.size(); ++v) out[v] = (1.0f - s.alpha[v]) * renderSurface + s.alpha[v] * blend;
+  return out;
 }
 
 Mesh buildOrganismMesh(const OrganismSpec& spec, double time, const Vec3& baseColor) {

@@ -59,6 +59,9 @@ class OrganismSpec : public KindSpec {
   organisms::DetailSet blendDetail;
   std::shared_ptr<const organisms::AlphaField> alpha;
   std::optional<Vec3> blendColor;
+  /// The blend's own surface where alpha is 1 (roughness, specular, metallic; each optional,
+  /// the render's where absent), mixed in by alpha like blendColor.
+  std::optional<float> blendRoughness, blendSpecular, blendMetallic;
   std::vector<organisms::Modification> modifications;
   std::optional<PlanetShader> planet;
   std::shared_ptr<const organisms::DetailProcedure> captured;  ///< `capture:` analysed, or null
@@ -91,6 +94,11 @@ size_t finestFaceCount(const organisms::ControlMesh& base, int levels);
 /// Per-vertex colours of a surface: baseColor, blended toward the blend colour by alpha, or
 /// the planet shader's colours.
 std::vector<Vec3> organismColors(const OrganismSpec& spec, const OrganismSurface& surface, const Vec3& baseColor);
+
+/// Per-vertex (roughness, specular, metallic) of a surface: the render's `surface` values,
+/// blended toward the blend's own by alpha; empty when the blend sets none of them (the
+/// material's apply everywhere).
+std::vector<Vec3> organismSurfaces(const OrganismSpec& spec, const OrganismSurface& surface, const Vec3& renderSurface);
 
 /// The organism at time t (0..1) as a triangle mesh with limit normals and per-vertex
 /// colours (the material's base colour where nothing colours it).

@@ -147,6 +147,7 @@ void readRender(MapReader& m, SpeciesRender& r, const PathPolicy& policy, Diagno
   r.surface.baseColor = m.color({"color", "Base colour of BlobTree surfaces in `sprig render`."}, r.surface.baseColor);
   r.surface.roughness = static_cast<float>(m.number({"roughness", "Roughness of BlobTree surfaces (0 mirror-like, 1 matte)."}, r.surface.roughness, 0.0, 1.0));
   r.surface.specular = static_cast<float>(m.number({"specular", "Specular reflectance of BlobTree surfaces."}, r.surface.specular, 0.0, 1.0));
+  r.surface.metallic = static_cast<float>(m.number({"metallic", "How metallic the surface is (0 dielectric, 1 metal): the diffuse colour fades by 1 − metallic and the highlight takes the base colour's hue."}, r.surface.metallic, 0.0, 1.0));
   r.style.wood.baseColor = m.color({"wood", "Preview colour of internodes (branches and trunk)."}, r.style.wood.baseColor);
   r.style.leaf.baseColor = m.color({"leaf", "Preview colour of polygons and surfaces (leaves)."}, r.style.leaf.baseColor);
   r.style.fruit.baseColor = m.color({"fruit", "Preview colour of spheres (fruits, buds)."}, r.style.fruit.baseColor);

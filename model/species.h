@@ -82,7 +82,7 @@ struct SpeciesRender {
   /// two panels side by side, this species and the other at its final stage, seen by one
   /// camera (renderPair, model/model.h). Resolved against the species file's folder.
   std::optional<std::filesystem::path> pair;
-  render::Material surface{Vec3(0.72f, 0.60f, 0.48f), 0.45f, 0.05f};  ///< `color`, `roughness`, `specular`: blob surfaces
+  render::Material surface{Vec3(0.72f, 0.60f, 0.48f), 0.45f, 0.05f};  ///< `color`, `roughness`, `specular`, `metallic`: blob surfaces
   /// Solids: a cut-away by the plane n·x = d (xyz = n, w = d); the side n·x > d is removed
   /// (`sprig render --section`).
   std::optional<Vec4> section;

@@ -30,6 +30,9 @@ struct Material {
   Vec3 baseColor{0.6f};     ///< linear RGB albedo in [0, 1]
   float roughness = 0.6f;   ///< 0 = mirror-like highlight, 1 = no highlight
   float specular = 0.04f;   ///< highlight strength (reflectance at normal incidence)
+  /// 0 = dielectric, 1 = metal: the diffuse lobe is scaled by 1 − metallic and the
+  /// highlight's reflectance is lerp(specular, base colour, metallic) (docs/RENDERING.md).
+  float metallic = 0.0f;
   int texture = -1;         ///< texture id for textured models, -1 for none
   /// Textured blobs: colour each contributing primitive's texture at its own natural uv
   /// and blend the colours by field weight (blobtree::Attributes::layers; trees' bark, so
@@ -107,6 +110,8 @@ struct ImageMap {
 
 /// A triangle mesh. triangleColors, when not empty (one per triangle), replace the
 /// material's and the vertices' colours; per-triangle `mesh.materials` are not used here.
+/// vertexSurfaces, when not empty (one per vertex), replace the material's (roughness,
+/// specular, metallic), interpolated across triangles like vertex colours.
 /// image, when set, colours the mesh instead (and may cut it out): the mesh must then have
 /// one uv per vertex.
 struct MeshPart {
@@ -115,6 +120,7 @@ struct MeshPart {
   std::vector<Vec3> triangleColors;
   TextureTable textures;
   std::shared_ptr<const ImageMap> image;
+  std::vector<Vec3> vertexSurfaces;
 };
 
 /// A compiled BlobTree ray cast exactly; hit colours blend the table's textures.

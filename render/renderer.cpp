@@ -232,6 +232,16 @@ class Integrator {
     const Vec3 n = h.normal, ng = h.geometricNormal, v = -dir;
     const Vec3 origin = h.position + eps_ * ng;
     const Vec3 albedo = glm::clamp(h.color, Vec3(0), Vec3(1));
+    // The hit's own surface (a mesh's per-vertex values) or the material's.
+    const float roughness = h.ownSurface ? h.surface.x : m.roughness;
+    const float specular = h.ownSurface ? h.surface.y : m.specular;
+    const float metallic = std::clamp(h.ownSurface ? h.surface.z : m.metallic, 0.0f, 1.0f);
+    // The metallic mix: the diffuse lobe scaled by 1 − metallic, the highlight's reflectance
+    // tinted toward the base colour. Dielectrics (metallic 0) skip the mix, so their pixels
+    // are the same as before metals existed.
+    const bool metal = metallic > 0.0f;
+    const Vec3 diffuse = metal ? (1.0f - metallic) * albedo : albedo;
+    const Vec3 f0 = metal ? glm::mix(Vec3(specular), albedo, metallic) : Vec3(specular);
     Vec3 radiance(0);
     bool sunLit = false;
 
@@ -247,12 +257,12 @@ class Integrator {
         }
         if (lit) {
           // Normalized Blinn-Phong; exponent from roughness (Walter et al. 2007 mapping).
-          float r4 = std::max(std::pow(std::clamp(m.roughness, 0.02f, 1.0f), 4.0f), 1e-4f);
+          float r4 = std::max(std::pow(std::clamp(roughness, 0.02f, 1.0f), 4.0f), 1e-4f);
           float e = 2.0f / r4 - 2.0f;
           Vec3 hv = glm::normalize(l + v);
-          float spec = e > 0.0f ? m.specular * (e + 8.0f) / 8.0f * std::pow(std::max(0.0f, glm::dot(n, hv)), e) : 0.0f;
+          Vec3 spec = e > 0.0f ? f0 * (e + 8.0f) / 8.0f * std::pow(std::max(0.0f, glm::dot(n, hv)), e) : Vec3(0);
           sunLit = true;
-          radiance += s_.sunColor * s_.sunStrength * cosL * (albedo + Vec3(spec));
+          radiance += s_.sunColor * s_.sunStrength * cosL * (diffuse + spec);
         }
       }
     }
@@ -270,15 +280,34 @@ class Integrator {
         }
         skyLight /= static_cast<float>(rays);
         parts.normal = n;
-        parts.albedo = albedo;
-        parts.sky = albedo * skyLight * s_.skyStrength;
+        parts.albedo = diffuse;
+        parts.sky = diffuse * skyLight * s_.skyStrength;
         parts.irradianceLum = luminance(skyLight * s_.skyStrength);
       }
-      radiance += albedo * skyLight * s_.skyStrength;
+      radiance += diffuse * skyLight * s_.skyStrength;
+      if (metal) radiance += metallic * f0 * metalSky(n, ng, v, origin, h.position, roughness, skyLight, c) * s_.skyStrength;
     }
-    if (s_.fillStrength > 0.0f) radiance += albedo * s_.fillStrength * std::max(0.0f, glm::dot(n, v));
-    if (s_.rimStrength > 0.0f) radiance += albedo * rimLight(n, ng, origin, c);
+    if (s_.fillStrength > 0.0f) radiance += diffuse * s_.fillStrength * std::max(0.0f, glm::dot(n, v));
+    if (s_.rimStrength > 0.0f) radiance += diffuse * rimLight(n, ng, origin, c);
     return radiance;
+  }
+
+  /// The sky a metal mirrors toward v: the sky along the reflected direction (occluded by the
+  /// scene when the sky is sampled), blurred toward the diffuse sky irradiance as roughness
+  /// rises (a rough metal reflects the whole hemisphere).
+  Vec3 metalSky(const Vec3& n, const Vec3& ng, const Vec3& v, const Vec3& origin, const Vec3& at, float roughness,
+                const Vec3& skyLight, Counters& c) const {
+    const Vec3 r = glm::reflect(-v, n);
+    Vec3 mirrored(0);
+    if (glm::dot(r, ng) > 0.0f) {
+      bool open = true;
+      if (s_.skySamples > 0) {
+        ++c.sky;
+        open = !scene_.occluded(origin, r, 0.0f, kInf);
+      }
+      if (open) mirrored = sky(r, at);
+    }
+    return glm::mix(mirrored, skyLight, std::clamp(roughness, 0.0f, 1.0f));
   }
 
   /// Irradiance of the rim light at a point with shading normal n and geometric normal ng

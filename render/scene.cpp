@@ -80,7 +80,7 @@ void imageOcclusionFilter(const RTCFilterFunctionNArguments* args) {
 
 /// The record of a triangle mesh with one material (Scene::addMesh); throws as addMesh.
 GeometryRecord meshRecord(const Scene::Impl& impl, const Mesh& mesh, uint32_t material,
-                          const std::vector<Vec3>& triangleColors);
+                          const std::vector<Vec3>& triangleColors, const std::vector<Vec3>& vertexSurfaces);
 
 }  // namespace
 
@@ -355,13 +355,13 @@ std::vector<uint32_t> Scene::add(const Geometry& geometry) {
       Material material = m->material;
       if (material.texture >= 0) material.texture += static_cast<int>(base);
       if (!m->image) {
-        ids.push_back(addMesh(m->mesh, addMaterial(material), m->triangleColors));
+        ids.push_back(addMesh(m->mesh, addMaterial(material), m->triangleColors, m->vertexSurfaces));
         continue;
       }
       const ImageMap& map = *m->image;
       if (!map.sample || map.width < 1 || map.height < 1 || m->mesh.uvs.size() != m->mesh.positions.size())
         throw std::invalid_argument("Scene::add: a mesh part's image map needs a size, a sample function and one uv per vertex");
-      GeometryRecord rec = meshRecord(*impl_, m->mesh, addMaterial(material), m->triangleColors);
+      GeometryRecord rec = meshRecord(*impl_, m->mesh, addMaterial(material), m->triangleColors, m->vertexSurfaces);
       auto data = std::make_shared<detail::ImageMapData>();
       data->map = m->image;
       data->positions = m->mesh.positions;
@@ -388,14 +388,15 @@ std::vector<uint32_t> Scene::add(const Geometry& geometry) {
   return ids;
 }
 
-uint32_t Scene::addMesh(const Mesh& mesh, uint32_t material, const std::vector<Vec3>& triangleColors) {
-  return impl_->addTriangles(meshRecord(*impl_, mesh, material, triangleColors));
+uint32_t Scene::addMesh(const Mesh& mesh, uint32_t material, const std::vector<Vec3>& triangleColors,
+                        const std::vector<Vec3>& vertexSurfaces) {
+  return impl_->addTriangles(meshRecord(*impl_, mesh, material, triangleColors, vertexSurfaces));
 }
 
 namespace {
 
 GeometryRecord meshRecord(const Scene::Impl& impl, const Mesh& mesh, uint32_t material,
-                          const std::vector<Vec3>& triangleColors) {
+                          const std::vector<Vec3>& triangleColors, const std::vector<Vec3>& vertexSurfaces) {
   if (impl.committed) throw std::logic_error("Scene::addMesh after commit");
   if (material >= impl.materials.size()) throw std::invalid_argument("Scene::addMesh: unknown material id");
   GeometryRecord rec;
@@ -404,6 +405,11 @@ GeometryRecord meshRecord(const Scene::Impl& impl, const Mesh& mesh, uint32_t ma
   rec.triangles = mesh.triangles;
   if (mesh.normals.size() == mesh.positions.size()) rec.normals = mesh.normals;
   if (mesh.colors.size() == mesh.positions.size()) rec.vertexColors = mesh.colors;
+  if (!vertexSurfaces.empty()) {
+    if (vertexSurfaces.size() != mesh.positions.size())
+      throw std::invalid_argument("Scene::addMesh: one surface (roughness, specular, metallic) per vertex expected");
+    rec.vertexSurfaces = vertexSurfaces;
+  }
   if (mesh.uvs.size() == mesh.positions.size() && impl.materials[material].texture >= 0) rec.uvs = mesh.uvs;
   if (mesh.materials.size() == mesh.triangles.size()) {
     for (uint32_t m : mesh.materials)
@@ -556,6 +562,13 @@ std::optional<SurfaceHit> Scene::intersect(const Vec3& origin, const Vec3& direc
     }
     if (!rec.vertexColors.empty())
       hit.color = w * rec.vertexColors[tri.x] + u * rec.vertexColors[tri.y] + v * rec.vertexColors[tri.z];
+    if (!rec.vertexSurfaces.empty()) {
+      hit.ownSurface = true;
+      // As an offset from the first corner: three equal corners give exactly their value
+      // (roughness 1 stays 1, so no highlight creeps back).
+      const Vec3& a = rec.vertexSurfaces[tri.x];
+      hit.surface = a + u * (rec.vertexSurfaces[tri.y] - a) + v * (rec.vertexSurfaces[tri.z] - a);
+    }
     int tex = impl_->materials[hit.material].texture;
     if (!rec.uvs.empty() && tex >= 0 && static_cast<size_t>(tex) < impl_->textures.size())
       hit.color = impl_->textures[tex](w * rec.uvs[tri.x] + u * rec.uvs[tri.y] + v * rec.uvs[tri.z], hit.position);

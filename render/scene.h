@@ -34,6 +34,10 @@ struct SurfaceHit {
   Vec3 normal{0, 1, 0};           ///< shading normal
   Vec3 geometricNormal{0, 1, 0};  ///< true surface normal, for offsetting secondary rays
   Vec3 color{0.5f};               ///< linear albedo at the hit
+  /// The hit's own (roughness, specular, metallic) when ownSurface (a mesh's per-vertex
+  /// surfaces, interpolated); otherwise the material's apply.
+  bool ownSurface = false;
+  Vec3 surface{0};
   uint32_t material = 0;
   uint32_t geometry = 0;          ///< index of the geometry in the scene (order of add calls)
   /// Coverage of a widened thin curve at the hit (true width / drawn width), 1 for
@@ -118,8 +122,10 @@ class Scene {
   /// Adds a triangle mesh with one material (per-triangle `mesh.materials`, when present,
   /// name scene material ids instead). Vertex normals give smooth shading, vertex colors
   /// replace the material's base color. Returns the geometry id.
-  /// triangleColors, when not empty (one per triangle), replace both.
-  uint32_t addMesh(const Mesh& mesh, uint32_t material, const std::vector<Vec3>& triangleColors = {});
+  /// triangleColors, when not empty (one per triangle), replace both. vertexSurfaces, when
+  /// not empty (one per vertex), replace the material's (roughness, specular, metallic).
+  uint32_t addMesh(const Mesh& mesh, uint32_t material, const std::vector<Vec3>& triangleColors = {},
+                   const std::vector<Vec3>& vertexSurfaces = {});
 
   /// Registers a texture; returns its id. Ids are what blob primitives' TextureAttr::textureId
   /// and Material::texture refer to.

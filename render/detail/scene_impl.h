@@ -72,6 +72,7 @@ struct GeometryRecord {
   std::vector<glm::uvec3> triangles;         ///< triangles
   std::vector<Vec3> normals;                 ///< optional per-vertex normals (triangles)
   std::vector<Vec3> vertexColors;            ///< optional per-vertex colors (triangles)
+  std::vector<Vec3> vertexSurfaces;          ///< optional per-vertex (roughness, specular, metallic)
   std::vector<Vec2> uvs;                     ///< optional per-vertex uvs (triangles, textured material)
   std::vector<Vec3> primitiveColors;         ///< optional per-primitive colors (any kind)
   std::vector<uint32_t> primitiveMaterials;  ///< optional per-primitive material ids
