@@ -121,7 +121,7 @@ void noteParts(const std::vector<ExportPart>& parts, const std::vector<PartWrite
   }
   for (const ExportPart& p : parts) {
     if (p.material.alphaCutoff < 0.0f || !p.material.texture || p.mesh.triangles.empty()) continue;
-    const std::vector<float>& px = p.material.texture->image.pixels;
+    const std::vector<float>& px = p.material.texture->pixels().pixels;
     size_t partial = 0;
     for (size_t i = 3; i < px.size(); i += 4) partial += px[i] > p.material.alphaCutoff && px[i] < 1.0f;
     note(g, std::cout, "%s: cut out where the texture's alpha is at or below %g (glTF alphaMode MASK, MTL map_d)%s", p.name.c_str(),

@@ -22,6 +22,15 @@ namespace sprig {
 
 namespace fs = std::filesystem;
 
+const Image& DeferredImage::get() {
+  std::call_once(once_, [this] {
+    image_ = bake_();
+    bake_ = nullptr;  // the bake's captures (a mesh, a model) are no longer needed
+    baked_ = true;
+  });
+  return image_;
+}
+
 namespace {
 
 // Throws std::invalid_argument when an index or an optional array does not fit the mesh.
@@ -377,11 +386,11 @@ PartCorners partCorners(const ExportPart& part) {
   if (tex && tex->isAtlas()) {
     c.uvs = tex->atlas;
     c.report.atlasCell = tex->atlasCell;
-    c.report.textureWidth = tex->image.width, c.report.textureHeight = tex->image.height;
+    c.report.textureWidth = tex->pixels().width, c.report.textureHeight = tex->pixels().height;
   } else if (mesh.uvs.size() == n) {
     c.uvs = cornerUvs(mesh, tex ? tex->seams : UvSeamOptions{});
     c.report.seamCorners = c.uvs.values.size() - n;
-    if (tex) c.report.textureWidth = tex->image.width, c.report.textureHeight = tex->image.height;
+    if (tex) c.report.textureWidth = tex->pixels().width, c.report.textureHeight = tex->pixels().height;
   }
   return c;
 }
@@ -449,14 +458,14 @@ void checkParts(const std::vector<ExportPart>& parts) {
       } else if (p.mesh.uvs.size() != p.mesh.positions.size()) {
         throw std::invalid_argument("exported part '" + p.name + "' has a texture but no texture coordinates");
       }
-      const Image& im = tex->image;
+      const Image& im = tex->pixels();
       if (im.width <= 0 || im.height <= 0 || im.pixels.size() != size_t(im.width) * size_t(im.height) * 4)
         throw std::invalid_argument("exported part '" + p.name + "' has an empty or malformed texture image");
     }
     if (const PartTexture* nt = p.material.normalTexture.get()) {
       const PartTexture* tex = p.material.texture.get();
-      if (!tex || !tex->isAtlas() || nt->image.width != tex->image.width || nt->image.height != tex->image.height ||
-          nt->image.pixels.size() != tex->image.pixels.size())
+      if (!tex || !tex->isAtlas() || nt->image.width != tex->pixels().width || nt->image.height != tex->pixels().height ||
+          nt->image.pixels.size() != tex->pixels().pixels.size())
         throw std::invalid_argument("exported part '" + p.name + "' has a normal map without an atlas of its size");
     }
   }
@@ -510,7 +519,7 @@ class GlbBuilder {
 
 int GlbBuilder::addTexture(const PartTexture* tex, const std::string& name, ImageEncoding encoding) {
   if (auto it = textures_.find(tex); it != textures_.end()) return it->second;
-  const std::string png = pngBytes(tex->image, path_, encoding);
+  const std::string png = pngBytes(tex->pixels(), path_, encoding);
   while (data_.size() % 4) data_.push_back(0);
   tinygltf::BufferView view;
   view.buffer = 0;
@@ -780,7 +789,7 @@ std::vector<PartWriteReport> writePartsObj(const std::vector<ExportPart>& parts,
       fs::path png = path;
       png.replace_filename(path.stem().string() + "_" + objName(part.name) + ".png");
       const bool cutOut = part.material.alphaCutoff >= 0.0f;
-      images.push_back({png, &tex->image, cutOut ? ImageEncoding::Picture : ImageEncoding::TextureMap});
+      images.push_back({png, &tex->pixels(), cutOut ? ImageEncoding::Picture : ImageEncoding::TextureMap});
       // MTL's -clamp covers both axes at once: said where glTF's sampler clamps both (an
       // atlas, cpfg's leaves); an image that repeats in one axis only is left repeating.
       const std::string map = (!tex->seams.repeatU && !tex->seams.repeatV ? "-clamp on " : "") + png.filename().string();

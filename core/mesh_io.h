@@ -12,8 +12,11 @@
 /// PLY, as linear floats in glTF (COLOR_0, as the specification asks) and as sRGB floats
 /// after the position in OBJ (the common `v x y z r g b` extension).
 
+#include <atomic>
 #include <filesystem>
+#include <functional>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -60,6 +63,26 @@ void writePly(const Mesh& mesh, const std::filesystem::path& path, const std::st
 /// Throws as writeMesh.
 void writeObj(const Mesh& mesh, const std::filesystem::path& path, const MeshWriteOptions& options = {});
 
+/// An image computed on first use: an export's atlas of the full-resolution mesh is baked
+/// only when a file that holds that mesh is written (levels of detail bake their own
+/// atlases, docs/MESHES.md "Levels of detail"). The bake must be deterministic, so the
+/// bytes do not depend on when (or on which thread) it runs.
+class DeferredImage {
+ public:
+  explicit DeferredImage(std::function<Image()> bake) : bake_(std::move(bake)) {}
+  /// The image: baked on the first call (once, thread-safe; the bake's closure is then
+  /// released), the same afterwards. A bake that throws is tried again on the next call.
+  const Image& get();
+  /// Whether the image has been baked.
+  bool baked() const { return baked_.load(); }
+
+ private:
+  std::once_flag once_;
+  std::function<Image()> bake_;
+  Image image_;
+  std::atomic<bool> baked_{false};
+};
+
 /// A part's texture baked into an image: the colour at texture coordinate (s, t) of the
 /// part's Mesh::uvs (origin at the image's bottom-left, as OBJ's vt) is the image's colour
 /// there, absolute (not relative to the base colour). The writers store it as an 8-bit sRGB
@@ -68,6 +91,11 @@ struct PartTexture {
   /// Linear RGB, top row = t of 1. Alpha is ignored unless the part's material has an
   /// alphaCutoff: then the writers keep it (8-bit sRGB RGBA PNG).
   Image image;
+  /// When set, the image is this deferred bake's (image stays empty): read it through
+  /// pixels(). Copies of the texture share it, so it is baked at most once.
+  std::shared_ptr<DeferredImage> deferred;
+  /// The texture's image: `image`, or the deferred one (baked now if it was not yet).
+  const Image& pixels() const { return deferred ? deferred->get() : image; }
   UvSeamOptions seams;    ///< which axes repeat (glTF sampler REPEAT, else CLAMP_TO_EDGE) and the seam rules
   /// An atlas: when not empty, the texture coordinates of every triangle's corners (3 per
   /// triangle of the part's mesh, values in [0,1]), used instead of the mesh's uvs (which

@@ -955,7 +955,7 @@ class BlobModel final : public StillKindModel {
     fig.clean = cleanMesh(part.mesh, clean);
     part.mesh.materials.clear();
     part.material = {"blob", look.surface.baseColor, look.surface.roughness, false};
-    atlasBlobPart(part, *compiled_, textures, painted);
+    atlasBlobPart(part, compiled_, textures, painted);
     return {std::move(part)};
   }
 

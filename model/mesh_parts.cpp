@@ -182,6 +182,31 @@ std::shared_ptr<PartTexture> bakeAtlas(const Mesh& mesh, const SurfaceColor& col
   return one.empty() ? nullptr : one[0];
 }
 
+std::shared_ptr<PartTexture> deferAtlas(std::shared_ptr<const Mesh> mesh, SurfaceColor colorAt) {
+  const AtlasLayout l = atlasLayout(mesh->triangles.size());
+  if (l.cell == 0) return nullptr;
+  // The corners of bakeAtlas now (texel centres (1.5, 1.5), (c − 1.5, 1.5), (1.5, c − 1.5)
+  // of each patch), its image on first use.
+  auto tex = std::make_shared<PartTexture>();
+  const int W = l.width(), H = l.height(), c = l.cell;
+  const Vec2 corner[3] = {Vec2(1.5f, 1.5f), Vec2(float(c) - 1.5f, 1.5f), Vec2(1.5f, float(c) - 1.5f)};
+  const size_t nt = mesh->triangles.size();
+  tex->atlasCell = c;
+  tex->atlas.values.resize(nt * 3);
+  tex->atlas.index.resize(nt * 3);
+  for (size_t t = 0; t < nt; ++t) {
+    const int x0 = int(t % size_t(l.columns)) * c, y0 = int(t / size_t(l.columns)) * c;  // texels from bottom-left
+    for (int k = 0; k < 3; ++k) {
+      tex->atlas.index[t * 3 + size_t(k)] = uint32_t(t * 3 + size_t(k));
+      tex->atlas.values[t * 3 + size_t(k)] = Vec2((float(x0) + corner[k].x) / float(W), (float(y0) + corner[k].y) / float(H));
+    }
+  }
+  tex->deferred = std::make_shared<DeferredImage>([mesh = std::move(mesh), colorAt = std::move(colorAt)] {
+    return std::move(bakeAtlas(*mesh, colorAt)->image);
+  });
+  return tex;
+}
+
 Vec3 blobSurfaceColor(const blobtree::CompiledBlob& blob, const Vec3& p, float maxMove, const render::TextureTable& textures,
                       const render::Material& material) {
   // Each Newton step takes one sample() (value, gradient and attributes in one walk of the
@@ -206,19 +231,25 @@ Vec3 blobSurfaceColor(const blobtree::CompiledBlob& blob, const Vec3& p, float m
   return paintedColor(s.attributes, q, textures, material);
 }
 
-int atlasBlobPart(ExportPart& part, const blobtree::CompiledBlob& blob, const render::TextureTable& textures,
-                  const render::Material& material) {
+int atlasBlobPart(ExportPart& part, std::shared_ptr<const blobtree::CompiledBlob> blob, render::TextureTable textures,
+                  render::Material material) {
   if (part.material.texture || !ownColors(part)) return 0;
-  const Mesh& m = part.mesh;
-  auto tex = bakeAtlas(m, [&](size_t t, const Vec3& p, const Vec3&) {
-    const glm::uvec3& tri = m.triangles[t];
-    const Vec3 &a = m.positions[tri.x], &b = m.positions[tri.y], &c = m.positions[tri.z];
+  // The colours are read when a written file uses the atlas (PartTexture::deferred): from
+  // the part's surface as it is now (a copy of its positions and triangles), whatever
+  // finishing, placing or simplifying the part goes through first.
+  auto surface = std::make_shared<Mesh>();
+  surface->positions = part.mesh.positions;
+  surface->triangles = part.mesh.triangles;
+  auto tex = deferAtlas(surface, [surface, blob = std::move(blob), textures = std::move(textures),
+                                  material = std::move(material)](size_t t, const Vec3& p, const Vec3&) {
+    const glm::uvec3& tri = surface->triangles[t];
+    const Vec3 &a = surface->positions[tri.x], &b = surface->positions[tri.y], &c = surface->positions[tri.z];
     const float edge = std::max({glm::length(b - a), glm::length(c - b), glm::length(a - c)});
-    return blobSurfaceColor(blob, p, edge, textures, material);
+    return blobSurfaceColor(*blob, p, edge, textures, material);
   });
   if (!tex) return 0;
   part.material.texture = tex;
-  return atlasLayout(part.mesh.triangles.size()).cell;
+  return tex->atlasCell;
 }
 
 int atlasVertexColors(ExportPart& part) {

@@ -95,6 +95,11 @@ using SurfaceTexel = std::function<void(size_t triangle, const Vec3& point, cons
 /// Thread-count independent.
 std::vector<std::shared_ptr<PartTexture>> bakeAtlases(const Mesh& mesh, int count, const SurfaceTexel& texelAt,
                                                       bool gutterCopies = false);
+/// bakeAtlas with the image deferred (PartTexture::deferred): the corners now, the texels
+/// (the same bytes) when a writer first reads PartTexture::pixels(); never when no written
+/// file uses the texture (a level of detail replaces the full part's atlas). mesh and
+/// colorAt are kept until then. Null as bakeAtlas. O(triangles) now.
+std::shared_ptr<PartTexture> deferAtlas(std::shared_ptr<const Mesh> mesh, SurfaceColor colorAt);
 
 /// The colour the renderer gives blended BlobTree attributes at p (as
 /// render::Scene::attributeColor: Σ wᵢ·textureᵢ / Σ wᵢ, per layer with
@@ -110,13 +115,14 @@ Vec3 paintedColor(const blobtree::Attributes& a, const Vec3& p, const render::Te
 Vec3 blobSurfaceColor(const blobtree::CompiledBlob& blob, const Vec3& p, float maxMove, const render::TextureTable& textures,
                       const render::Material& material);
 
-/// Bakes a polygonized BlobTree part's colours (blobSurfaceColor at every texel's surface
-/// point) into an atlas and sets part.material.texture, when the part's vertex colours are
-/// not all its base colour and it has no texture yet. Returns the texture's triangles'
-/// patch size (0 when nothing was baked: constant colour, already textured, or above the
-/// budget).
-int atlasBlobPart(ExportPart& part, const blobtree::CompiledBlob& blob, const render::TextureTable& textures,
-                  const render::Material& material);
+/// Gives a polygonized BlobTree part an atlas of its colours (blobSurfaceColor at every
+/// texel's surface point, on the part's surface as it is at this call), when the part's
+/// vertex colours are not all its base colour and it has no texture yet. The atlas's image
+/// is deferred (deferAtlas: baked when first written; blob, textures and material are kept
+/// until then). Returns the texture's triangles' patch size (0 when there is no atlas:
+/// constant colour, already textured, or above the budget).
+int atlasBlobPart(ExportPart& part, std::shared_ptr<const blobtree::CompiledBlob> blob, render::TextureTable textures,
+                  render::Material material);
 
 /// Bakes a part's vertex colours, interpolated over each triangle as the renderer
 /// interpolates a mesh's vertex colours, into an atlas (when they are not all the base

@@ -631,7 +631,7 @@ class ShellModel final : public KindModel {
     const bool growthLines = colors.growthLineDeg > 0.0f && colors.growthLineStrength > 0.0f;
     for (size_t i = 0; i < parts.size(); ++i)
       if (parts[i].name == "whorl") {
-        if (!growthLines || atlasBlobPart(parts[i], *shell.blob, implicit.textures, painted) == 0)
+        if (!growthLines || atlasBlobPart(parts[i], shell.blob, implicit.textures, painted) == 0)
           whorlCoords = moveApertureToInside(parts, parts[i], *shell.painter, implicit.material.roughness);
         break;
       }
@@ -639,7 +639,7 @@ class ShellModel final : public KindModel {
       if (p.name == "whorl") {
         if (!p.material.texture) textureWhorl(p, *shell.painter, whorlCoords);
       } else  // varices, spines, bumps, inside: an atlas of the renderer's colours
-        atlasBlobPart(p, *shell.blob, implicit.textures, painted);
+        atlasBlobPart(p, shell.blob, implicit.textures, painted);
     }
     return parts;
   }

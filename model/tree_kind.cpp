@@ -507,7 +507,7 @@ class TreeModel final : public KindModel {
       } else {
         // Bark per girth or darkened seams: every triangle's own patch of an atlas, each
         // texel the renderer's blend of the cones' barks at its surface point.
-        atlasBlobPart(parts[0], *tree.compiled, implicit.textures, implicit.material);
+        atlasBlobPart(parts[0], tree.compiled, implicit.textures, implicit.material);
       }
       const std::pair<organisms::OrganSet, const char*> sets[] = {{organisms::OrganSet::Leaves, "leaves"},
                                                                    {organisms::OrganSet::Fruit, "fruit"}};

@@ -349,7 +349,7 @@ py::dict partDict(const ExportPart& p) {
   d["texture"] = py::none();
   d["texture_corner_uvs"] = py::none();
   if (p.material.texture) {
-    d["texture"] = imageFloats(p.material.texture->image);
+    d["texture"] = imageFloats(p.material.texture->pixels());
     const auto& atlas = p.material.texture->atlas;
     if (p.material.texture->isAtlas()) {
       py::array_t<float> uv({nt, py::ssize_t(3), py::ssize_t(2)});

@@ -42,7 +42,7 @@ Mesh weld(const std::vector<ExportPart>& parts, const std::vector<std::string>& 
 // The bilinearly filtered colour of a baked texture at (s, t) (t = 0 at the bottom row),
 // each axis repeating or clamped as the texture's sampler: what a viewer shows there.
 Vec3 sampleTexture(const PartTexture& tex, Vec2 st) {
-  const Image& im = tex.image;
+  const Image& im = tex.pixels();
   const float x = st.x * float(im.width) - 0.5f, y = (1.0f - st.y) * float(im.height) - 0.5f;
   const int x0 = int(std::floor(x)), y0 = int(std::floor(y));
   const float fx = x - float(x0), fy = y - float(y0);
@@ -309,7 +309,7 @@ TEST_CASE("SpeciesModel::exportParts of shipped species", "[model][slow]") {
       REQUIRE(textured->material.texture != nullptr);
       CHECK(textured->material.texture->seams.repeatU);
       // A shell with varix bands stacks the canal's image above the wall's.
-      const int height = textured->material.texture->image.height;
+      const int height = textured->material.texture->pixels().height;
       CHECK((height == kExportTextureLong || (textured->name == "whorl" && height == 2 * kExportTextureLong)));
       const float right = medianTextureError(*textured, false), flipped = medianTextureError(*textured, true);
       INFO("median texture error " << right << ", read upside down " << flipped);
@@ -413,10 +413,10 @@ TEST_CASE("SpeciesModel::exportParts atlas: same bytes at 1 and 2 threads", "[mo
     REQUIRE((a.material.texture == nullptr) == (b.material.texture == nullptr));
     if (!a.material.texture) continue;
     const PartTexture &ta = *a.material.texture, &tb = *b.material.texture;
-    CHECK(ta.image.width == tb.image.width);
-    CHECK(ta.image.height == tb.image.height);
-    REQUIRE(ta.image.pixels.size() == tb.image.pixels.size());
-    CHECK(std::memcmp(ta.image.pixels.data(), tb.image.pixels.data(), ta.image.pixels.size() * sizeof(float)) == 0);
+    CHECK(ta.pixels().width == tb.pixels().width);
+    CHECK(ta.pixels().height == tb.pixels().height);
+    REQUIRE(ta.pixels().pixels.size() == tb.pixels().pixels.size());
+    CHECK(std::memcmp(ta.pixels().pixels.data(), tb.pixels().pixels.data(), ta.pixels().pixels.size() * sizeof(float)) == 0);
     CHECK(ta.atlas.index == tb.atlas.index);
     CHECK(ta.atlas.values == tb.atlas.values);
   }

@@ -251,3 +251,50 @@ TEST_CASE("Levels of detail of a shipped tree", "[model][lod]") {
     CHECK(analyzeTopology(l.parts[0].mesh).boundaryEdges == 0);
   }
 }
+
+TEST_CASE("Levels of detail of a shipped shell bake the full mesh's atlases only when written", "[model][lod]") {
+  // shell_turret's whorl has growth lines: its atlas is the renderer's colours
+  // (atlasBlobPart), deferred until a written file uses it (at cell 0.4: 820 triangles,
+  // the whole shell one part; its bake, 210,000 texels, is the test's cost, 3-7 s). Levels of detail bake
+  // their own atlases from the colours of the vertices that remain, so with LOD0 below
+  // the full mesh the full parts' atlases are never baked; with --lod none they are.
+  PathPolicy policy;
+  policy.root = SPRIG_SOURCE_DIR;
+  const Species species = loadSpecies(std::string(SPRIG_SOURCE_DIR) + "/species/shell_turret.yaml", policy);
+  SpeciesModel model(species);
+  std::vector<ExportPart> parts = model.exportParts(model.finalStage(), 0.4f, false);
+  finishExportParts(parts);
+  std::vector<std::shared_ptr<const PartTexture>> atlases;
+  for (const ExportPart& p : parts)
+    if (p.material.texture && p.material.texture->isAtlas()) atlases.push_back(p.material.texture);
+  REQUIRE(parts.size() == 1);
+  REQUIRE(atlases.size() == 1);  // the whorl's
+  for (const auto& tex : atlases) {
+    REQUIRE(tex->deferred != nullptr);
+    CHECK_FALSE(tex->deferred->baked());
+    CHECK(tex->image.pixels.empty());
+  }
+  const size_t full = partTriangles(parts);
+  TempDir dir;
+  const std::vector<LodLevel> levels = lodLevels(parts, full / 2);
+  CHECK(full == 820);
+  REQUIRE(!levels.empty());
+  CHECK(levels[0].triangles <= full / 2);
+  const fs::path out = dir.path / "turret.glb";
+  writeLevels(levels, out);
+  for (const auto& tex : atlases) CHECK_FALSE(tex->deferred->baked());
+  for (const LodLevel& level : levels)
+    for (const ExportPart& p : level.parts) {
+      INFO(p.name);
+      REQUIRE(p.material.texture != nullptr);  // each level's own atlas, baked now
+      CHECK(p.material.texture->isAtlas());
+      CHECK(p.material.texture->deferred == nullptr);
+      CHECK(p.material.texture->image.width > 0);
+    }
+  writeLevels(lodLevels(parts, 0), dir.path / "full.glb");
+  for (const auto& tex : atlases) {
+    REQUIRE(tex->deferred->baked());
+    CHECK(tex->pixels().width == atlasLayout(tex->atlas.values.size() / 3).width());
+  }
+  CHECK(readGlb(dir.path / "full.glb").images.size() == 1);
+}
