@@ -31,6 +31,7 @@
 #include <memory>
 #include <string>
 
+#include "bench/bench_view.h"
 #include "blobtree/compiled.h"
 #include "core/image.h"
 #include "organisms/shell.h"
@@ -97,15 +98,8 @@ Result run(const organisms::ShellParams& params, const Args& a, const std::strin
                 scene.stats().implicitTapes, r.cells, double(scene.stats().implicitTapeNodes) / double(r.cells),
                 blob.nodeCount());
 
-  render::ViewSpec view;
-  view.azimuthDeg = 25;
-  view.elevationDeg = 10;
-  const render::Camera camera = render::frameBounds(scene.bounds(), view, double(a.width) / a.height);
-  render::RenderSettings rs;
-  rs.width = a.width;
-  rs.height = a.height;
-  rs.spp = a.spp;
-  rs.progress = false;
+  const render::Camera camera = bench::benchCamera(scene.bounds(), 25, 10, a.width, a.height);
+  render::RenderSettings rs = bench::benchSettings(a.width, a.height, a.spp);
   render::RenderStats stats;
   t = Clock::now();
   const std::clock_t cpu0 = std::clock();

@@ -28,6 +28,7 @@
 #include <utility>
 #include <vector>
 
+#include "bench/bench_view.h"
 #include "blobtree/compiled.h"
 #include "blobtree/polygonize.h"
 #include "core/atomic_file.h"
@@ -143,15 +144,8 @@ void benchExactRender(const blobtree::CompiledBlob& compiled, const Args& a) {
   io.cellSize = a.cell;
   render::Scene scene;
   const auto [sceneS, sceneCpu] = woodScene(scene, compiled, io);
-  render::ViewSpec view;
-  view.azimuthDeg = 20;
-  view.elevationDeg = 8;
-  const render::Camera camera = render::frameBounds(compiled.bounds(), view, double(a.width) / a.height);
-  render::RenderSettings rs;
-  rs.width = a.width;
-  rs.height = a.height;
-  rs.spp = a.spp;
-  rs.progress = false;
+  const render::Camera camera = bench::benchCamera(compiled.bounds(), 20, 8, a.width, a.height);
+  render::RenderSettings rs = bench::benchSettings(a.width, a.height, a.spp);
   render::RenderStats stats;
   double renderS = 0, renderCpu = 0;
   Image image = timedRender(scene, camera, rs, stats, renderS, renderCpu);
