@@ -644,14 +644,25 @@ class OrganismReader {
     s.seaLevel = float(m.number({"sea_level", "Scalar value of the sea: lower points stay flat and take `ocean`."}, s.seaLevel));
     s.mountain = float(m.number({"mountain", "Scalar value above which the colour is `highland`."}, s.mountain));
     s.snow = float(m.number({"snow", "Scalar value above which the colour is `ice`."}, s.snow));
-    s.ocean = m.color({"ocean", "Colour below `sea_level` (darker when deeper)."}, s.ocean);
-    s.lowland = m.color({"lowland", "Colour between `sea_level` and `mountain`."}, s.lowland);
-    s.highland = m.color({"highland", "Colour between `mountain` and `snow`."}, s.highland);
-    s.ice = m.color({"ice", "Colour above `snow`."}, s.ice);
-    s.tint = m.color({"tint", "Colour the blend's alpha shifts the bands towards."}, s.tint);
-    s.tintStrength = float(m.number({"tint_strength", "How far alpha = 1 shifts the colours towards `tint`."}, s.tintStrength, 0.0, 1.0));
+    s.bands = readBands(m, s.bands);
+    if (auto second = m.section({"second", "The second planet's own bands (`ocean`, `lowland`, `highland`, `ice`), where the blend's alpha is 1; alpha mixes the two sets. Without it, alpha shifts the bands towards `tint`."})) {
+      MapReader b(*second, diags_, "second");
+      s.second = readBands(b, s.bands);
+      b.finish();
+    }
+    s.tint = m.color({"tint", "Without `second`: the colour the blend's alpha shifts the bands towards."}, s.tint);
+    s.tintStrength = float(m.number({"tint_strength", "Without `second`: how far alpha = 1 shifts the colours towards `tint`."}, s.tintStrength, 0.0, 1.0));
     m.finish();
     spec_.planet = s;
+  }
+
+  static PlanetBands readBands(MapReader& m, const PlanetBands& def) {
+    PlanetBands b;
+    b.ocean = m.color({"ocean", "Colour below `sea_level` (darker when deeper)."}, def.ocean);
+    b.lowland = m.color({"lowland", "Colour between `sea_level` and `mountain`."}, def.lowland);
+    b.highland = m.color({"highland", "Colour between `mountain` and `snow`."}, def.highland);
+    b.ice = m.color({"ice", "Colour above `snow`."}, def.ice);
+    return b;
   }
 
   size_t errorCount() const {
@@ -672,12 +683,20 @@ class OrganismReader {
   bool captureGiven_ = false;  // a failed capture: 'captured' entries add no second error
 };
 
-/// The planet shader's colour of scalar h and alpha a.
+}  // namespace
+
 Vec3 planetColor(const PlanetShader& s, float h, float a) {
-  Vec3 c = h < s.seaLevel ? s.ocean : h < s.mountain ? s.lowland : h < s.snow ? s.highland : s.ice;
-  if (h < s.seaLevel) c *= 0.6f + 0.4f * std::clamp(1.0f + (h - s.seaLevel) * 10.0f, 0.0f, 1.0f);  // deeper, darker
-  return glm::mix(c, c * (1.0f - s.tintStrength) + s.tint * s.tintStrength, a);
+  const auto band = [&](const PlanetBands& b) {
+    Vec3 c = h < s.seaLevel ? b.ocean : h < s.mountain ? b.lowland : h < s.snow ? b.highland : b.ice;
+    if (h < s.seaLevel) c *= 0.6f + 0.4f * std::clamp(1.0f + (h - s.seaLevel) * 10.0f, 0.0f, 1.0f);  // deeper, darker
+    return c;
+  };
+  const Vec3 first = band(s.bands);
+  if (s.second) return glm::mix(first, band(*s.second), a);
+  return glm::mix(first, first * (1.0f - s.tintStrength) + s.tint * s.tintStrength, a);
 }
+
+namespace {
 
 /// An organism: one synthesis per time.
 class OrganismModel final : public KindModel {

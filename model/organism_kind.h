@@ -38,17 +38,27 @@
 
 namespace sprig {
 
+/// The planet shader's colour bands, by height.
+struct PlanetBands {
+  Vec3 ocean{0.02f, 0.08f, 0.25f}, lowland{0.12f, 0.32f, 0.08f}, highland{0.35f, 0.28f, 0.18f}, ice{0.9f, 0.92f, 0.95f};
+};
+
 /// The post-blend planet shader (§6.3): the scalar channel h becomes a height above a sea
-/// level, coloured by bands; the blend alpha tints the colours toward `tint`.
+/// level, coloured by bands; the blend alpha mixes toward the second planet's own bands
+/// when given, else tints the colours toward `tint`.
 struct PlanetShader {
   float relief = 0.05f;     ///< world units of displacement per unit of h
   float seaLevel = 0.0f;    ///< h below this is ocean (flat at the sea level)
   float mountain = 0.05f;   ///< h above this is mountain
   float snow = 0.09f;       ///< h above this is snow
-  Vec3 ocean{0.02f, 0.08f, 0.25f}, lowland{0.12f, 0.32f, 0.08f}, highland{0.35f, 0.28f, 0.18f}, ice{0.9f, 0.92f, 0.95f};
-  Vec3 tint{0.55f, 0.2f, 0.35f};  ///< colour shift where alpha = 1 (the second planet)
+  PlanetBands bands;        ///< where alpha = 0 (and without a blend)
+  std::optional<PlanetBands> second;  ///< where alpha = 1 (the second planet), if given
+  Vec3 tint{0.55f, 0.2f, 0.35f};  ///< without `second`: colour shift where alpha = 1
   float tintStrength = 0.5f;
 };
+
+/// The planet shader's colour of scalar h and blend alpha a.
+Vec3 planetColor(const PlanetShader& s, float h, float a);
 
 /// The keys of an organism species (`organism:`), read and checked.
 class OrganismSpec : public KindSpec {

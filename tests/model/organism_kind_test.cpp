@@ -125,6 +125,40 @@ organism:
   }
 }
 
+TEST_CASE("The planet shader mixes toward the second planet's own bands by alpha", "[model][organism]") {
+  const Species s = parseSpecies(R"(kind: organism
+organism:
+  base: {cube_sphere: {radius: 1, quads: 2}}
+  detail:
+    - rock: {output: scalar}
+  shader:
+    planet:
+      mountain: 0.2
+      snow: 0.4
+      lowland: [0, 1, 0]
+      second: {ocean: [1, 0, 1], lowland: [1, 0.5, 0], highland: [0.5, 0, 0]}
+)", "planet.yaml");
+  const PlanetShader& p = *specOf(s).planet;
+  REQUIRE(p.second);
+  // Bands the file does not give keep the first set's: ice is the default in both.
+  CHECK(p.second->ice == p.bands.ice);
+  CHECK(planetColor(p, 0.1f, 0.0f) == Vec3(0, 1, 0));
+  CHECK(planetColor(p, 0.1f, 1.0f) == Vec3(1, 0.5f, 0));
+  CHECK(planetColor(p, 0.1f, 0.5f) == Vec3(0.5f, 0.75f, 0));
+  CHECK(planetColor(p, 0.3f, 1.0f) == Vec3(0.5f, 0, 0));
+  // The sea darkens with depth in both sets alike: at h = -0.1, by 0.6 + 0.4 * 0 = 0.6.
+  const Vec3 deep = planetColor(p, -0.1f, 1.0f);
+  CHECK(deep.x == Approx(0.6f));
+  CHECK(deep.z == Approx(0.6f));
+  // Without `second`, alpha tints toward `tint` as before.
+  PlanetShader tinted = p;
+  tinted.second.reset();
+  CHECK(planetColor(tinted, 0.1f, 1.0f) == glm::mix(Vec3(0, 1, 0), tinted.tint, tinted.tintStrength));
+  CHECK(errorOf("kind: organism\norganism:\n  base: {plane: {}}\n  detail: [{rock: {output: scalar}}]\n"
+                "  shader: {planet: {second: {sea: [0, 0, 1]}}}\n")
+            .find("'sea'") != std::string::npos);
+}
+
 TEST_CASE("Organism bases from mesh files, and captured surfaces", "[model][organism]") {
   test::TempDir dir("organism_mesh_base");
   // A closed quad cube as OFF, and a finer sphere of radius 1.05 as OBJ (Sprig's writer).
