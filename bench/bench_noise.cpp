@@ -54,6 +54,8 @@ const NoiseScene kScenes[] = {
 
 struct Options {
   int width = 160, height = 120, spp = 4, reference = 1024, repeat = 2;
+  int edgeSamples = 12;          ///< the adaptive variant's RenderSettings::edgeSamples
+  float edgeThreshold = 0.08f;   ///< and its edgeThreshold
   std::string only, out;
 };
 
@@ -153,22 +155,28 @@ void runScene(const NoiseScene& sc, const Options& o) {
     render::Sampling sampler;
     int unlitSkySamples;
     bool skyFilter;
+    bool adaptive;
   };
-  const Variant variants[] = {{"stratified", render::Sampling::Stratified, 0, false},
-                              {"zsobol", render::Sampling::ZSobol, 0, false},
-                              {"zsobol+unlit2", render::Sampling::ZSobol, 2, false},
-                              {"zsobol+filter", render::Sampling::ZSobol, 0, true},
-                              {"strat+filter", render::Sampling::Stratified, 0, true}};
+  const Variant variants[] = {{"stratified", render::Sampling::Stratified, 0, false, false},
+                              {"zsobol", render::Sampling::ZSobol, 0, false, false},
+                              {"zsobol+unlit2", render::Sampling::ZSobol, 2, false, false},
+                              {"zsobol+filter", render::Sampling::ZSobol, 0, true, false},
+                              {"filter+edges", render::Sampling::ZSobol, 0, true, true}};
   constexpr int kVariants = 5;
   Image images[kVariants];
   double best[kVariants] = {1e30, 1e30, 1e30, 1e30, 1e30};
+  uint64_t cameraRays[kVariants] = {};
   for (int r = 0; r < o.repeat; ++r) {
     for (int i = 0; i < kVariants; ++i) {
       rs.sampler = variants[i].sampler;
       rs.unlitSkySamples = variants[i].unlitSkySamples;
       rs.skyFilter = variants[i].skyFilter;
+      rs.edgeSamples = variants[i].adaptive ? o.edgeSamples : 0;
+      rs.edgeThreshold = o.edgeThreshold;
       const double cpu0 = bench::processCpuSeconds();
-      images[i] = render::renderImage(scene, camera, rs);
+      render::RenderStats stats;
+      images[i] = render::renderImage(scene, camera, rs, &stats);
+      cameraRays[i] = stats.cameraRays;
       best[i] = std::min(best[i], bench::processCpuSeconds() - cpu0);
     }
   }
@@ -177,15 +185,15 @@ void runScene(const NoiseScene& sc, const Options& o) {
   const double base = rmse255(images[0], reference);
   for (int i = 0; i < kVariants; ++i) {
     const double e = rmse255(images[i], reference);
-    std::printf("  %-14s RMSE %6.3f (x%5.3f)   CPU %7.3f s (x%5.3f)\n", variants[i].name, e, e / base, best[i],
-                best[i] / best[0]);
+    std::printf("  %-14s RMSE %6.3f (x%5.3f)   CPU %7.3f s (x%5.3f)   camera samples x%5.3f\n", variants[i].name, e,
+                e / base, best[i], best[i] / best[0], double(cameraRays[i]) / double(cameraRays[0]));
   }
   std::fflush(stdout);
   if (!o.out.empty()) {
     fs::create_directories(o.out);
-    writeImage(sideBySide({&images[0], &images[1], &images[3], &reference}), fs::path(o.out) / (std::string(sc.name) + ".png"));
-    const Image e0 = errorMap(images[0], reference), e3 = errorMap(images[3], reference);
-    writeImage(sideBySide({&e0, &e3}), fs::path(o.out) / (std::string(sc.name) + "_error.png"));
+    writeImage(sideBySide({&images[0], &images[3], &images[4], &reference}), fs::path(o.out) / (std::string(sc.name) + ".png"));
+    const Image e0 = errorMap(images[0], reference), e3 = errorMap(images[3], reference), e4 = errorMap(images[4], reference);
+    writeImage(sideBySide({&e0, &e3, &e4}), fs::path(o.out) / (std::string(sc.name) + "_error.png"));
   }
 }
 
@@ -203,8 +211,10 @@ int main(int argc, char** argv) {
     else if (v && flag == "--repeat") o.repeat = std::atoi(v);
     else if (v && flag == "--only") o.only = v;
     else if (v && flag == "--out") o.out = v;
+    else if (v && flag == "--edge") o.edgeSamples = std::atoi(v);
+    else if (v && flag == "--edge-threshold") o.edgeThreshold = static_cast<float>(std::atof(v));
     else {
-      std::fprintf(stderr, "usage: bench_noise [--width W] [--height H] [--spp N] [--reference N] [--repeat R] [--only NAME] [--out DIR]\n");
+      std::fprintf(stderr, "usage: bench_noise [--width W] [--height H] [--spp N] [--reference N] [--repeat R] [--only NAME] [--out DIR] [--edge N] [--edge-threshold T]\n");
       return 1;
     }
     ++i;

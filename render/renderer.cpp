@@ -346,18 +346,30 @@ struct FilmSample {
 };
 
 /// The traced samples of one tile and its apron, and the reconstruction of its pixels.
+/// Pixels hold spp samples each, or more where adaptive sampling added some
+/// (RenderSettings::edgeSamples): samples of pixel i are [first[i], first[i + 1]).
 struct TileFilm {
   int ax0, ay0, ax1, ay1;  ///< the traced pixels: [ax0, ax1) x [ay0, ay1)
   int spp, apron;
   bool tent;
   float radius;
   std::vector<FilmSample> samples;
+  std::vector<uint32_t> first;
 
   TileFilm(int ax0_, int ay0_, int ax1_, int ay1_, int spp_, int apron_, bool tent_, float radius_)
-      : ax0(ax0_), ay0(ay0_), ax1(ax1_), ay1(ay1_), spp(spp_), apron(apron_), tent(tent_), radius(radius_),
-        samples(static_cast<size_t>(ax1 - ax0) * (ay1 - ay0) * spp) {}
+      : ax0(ax0_), ay0(ay0_), ax1(ax1_), ay1(ay1_), spp(spp_), apron(apron_), tent(tent_), radius(radius_) {
+    const size_t pixels = static_cast<size_t>(ax1 - ax0) * (ay1 - ay0);
+    samples.reserve(pixels * spp);
+    first.reserve(pixels + 1);
+    first.push_back(0);
+  }
 
-  FilmSample* pixel(int x, int y) { return &samples[(static_cast<size_t>(y - ay0) * (ax1 - ax0) + (x - ax0)) * spp]; }
+  size_t index(int x, int y) const { return static_cast<size_t>(y - ay0) * (ax1 - ax0) + (x - ax0); }
+  const FilmSample* pixel(int x, int y) const { return samples.data() + first[index(x, y)]; }
+  int count(int x, int y) const {
+    const size_t i = index(x, y);
+    return static_cast<int>(first[i + 1] - first[i]);
+  }
 
   /// The filter's weight of sample f for the pixel centred at (cx, cy).
   float weight(const FilmSample& f, float cx, float cy) const {
@@ -366,8 +378,9 @@ struct TileFilm {
   }
 
   /// Writes pixel (x, y) of image (scaled by exposure) and, when layers is given, its sky
-  /// term and guides, reconstructed with the same filter.
-  void reconstruct(int x, int y, float exposure, Image& image, SkyLayers* layers) {
+  /// term and guides, reconstructed with the same filter. A pixel with more samples than
+  /// spp weighs each of them spp/count, so every pixel's samples weigh alike in total.
+  void reconstruct(int x, int y, float exposure, Image& image, SkyLayers* layers) const {
     Vec4 sum(0);
     Vec3 sky(0), albedo(0), normal(0), position(0);
     float wsum = 0, wsurface = 0;
@@ -375,8 +388,10 @@ struct TileFilm {
     for (int ny = std::max(ay0, y - apron); ny <= std::min(ay1 - 1, y + apron); ++ny) {
       for (int nx = std::max(ax0, x - apron); nx <= std::min(ax1 - 1, x + apron); ++nx) {
         const FilmSample* in = pixel(nx, ny);
-        for (int k = 0; k < spp; ++k) {
-          const float w = weight(in[k], cx, cy);
+        const int n = count(nx, ny);
+        const float share = n == spp ? 1.0f : static_cast<float>(spp) / static_cast<float>(n);
+        for (int k = 0; k < n; ++k) {
+          const float w = share * weight(in[k], cx, cy);
           const SampleValue& v = in[k].value;
           sum += w * v.value;
           wsum += w;
@@ -398,7 +413,7 @@ struct TileFilm {
     layers->normal[i] = normal;
     if (wsurface > 0) layers->position[i] = position / wsurface;
     const FilmSample* own = pixel(x, y);
-    for (int k = 0; k < spp; ++k) {
+    for (int k = 0, n = count(x, y); k < n; ++k) {
       if (own[k].value.normal == Vec3(0)) continue;
       const float l = own[k].value.irradianceLum;
       layers->lumSum[i] += l;
@@ -408,22 +423,31 @@ struct TileFilm {
   }
 };
 
-/// Traces the s.spp samples of pixel (x, y) into out: their film points from sobol when
-/// given (else a jittered grid from the pixel's generator) and the values seen there.
-void tracePixel(const Integrator& integrator, const RenderSettings& s, int x, int y, ZSobolSampler* sobol, FilmSample* out,
-                Counters& c) {
-  const int spp = s.spp;
-  Rng rng(deriveSeed(s.seed, {static_cast<uint64_t>(x), static_cast<uint64_t>(y)}));
+/// The samplers of one tile: the base pass's, and the adaptive pass's (another Sobol'
+/// sequence, of edgeSamples per pixel) when RenderSettings::edgeSamples > 0.
+struct PixelSamplers {
+  ZSobolSampler* base = nullptr;
+  ZSobolSampler* extra = nullptr;
+};
+
+/// Appends n camera samples of pixel (x, y) to out: their film points from sobol when
+/// given (else a jittered grid from the pixel's generator, seeded by (x, y, pass)) and the
+/// values seen there.
+void traceSamples(const Integrator& integrator, const RenderSettings& s, int x, int y, int n, uint64_t pass,
+                  ZSobolSampler* sobol, std::vector<FilmSample>& out, Counters& c) {
+  const std::initializer_list<uint64_t> key = {static_cast<uint64_t>(x), static_cast<uint64_t>(y)};
+  const std::initializer_list<uint64_t> passKey = {static_cast<uint64_t>(x), static_cast<uint64_t>(y), pass};
+  Rng rng(deriveSeed(s.seed, pass == 0 ? key : passKey));
   Strata st;
-  st.spp = spp;
+  st.spp = n;
   st.sobol = sobol;
   if (!sobol) {
-    st.sunShift = static_cast<int>(rng.below(static_cast<uint32_t>(spp)));
-    st.skyShift = static_cast<int>(rng.below(static_cast<uint32_t>(spp * std::max(1, s.skySamples))));
+    st.sunShift = static_cast<int>(rng.below(static_cast<uint32_t>(n)));
+    st.skyShift = static_cast<int>(rng.below(static_cast<uint32_t>(n * std::max(1, s.skySamples))));
   }
-  const int gx = std::max(1, static_cast<int>(std::floor(std::sqrt(static_cast<double>(spp)))));
-  const int gy = (spp + gx - 1) / gx;
-  for (int k = 0; k < spp; ++k) {
+  const int gx = std::max(1, static_cast<int>(std::floor(std::sqrt(static_cast<double>(n)))));
+  const int gy = (n + gx - 1) / gx;
+  for (int k = 0; k < n; ++k) {
     Vec2 f;
     if (sobol) {
       sobol->startPixelSample(x, y, k);
@@ -434,8 +458,44 @@ void tracePixel(const Integrator& integrator, const RenderSettings& s, int x, in
     }
     const float fx = static_cast<float>(x) + f.x, fy = static_cast<float>(y) + f.y;
     st.sample = k;
-    out[k] = {fx, fy, integrator.sample(fx, fy, st, rng, c)};
+    out.push_back({fx, fy, integrator.sample(fx, fy, st, rng, c)});
   }
+}
+
+/// Whether the n samples at f disagree by more than threshold in display luminance
+/// (about gamma 2, after exposure), with their sky terms' noise taken out: each sample's sky
+/// term is replaced by its albedo times the samples' mean sky irradiance. What is left to
+/// differ is geometry, texture and the sun's visibility.
+bool samplesDisagree(const FilmSample* f, int n, float exposure, float threshold) {
+  Vec3 skySum(0), albedoSum(0);
+  for (int k = 0; k < n; ++k) {
+    skySum += f[k].value.sky;
+    albedoSum += f[k].value.albedo;
+  }
+  Vec3 irradiance(0);
+  for (int ch = 0; ch < 3; ++ch)
+    if (albedoSum[ch] > 0) irradiance[ch] = skySum[ch] / albedoSum[ch];
+  float lo = std::numeric_limits<float>::infinity(), hi = -lo;
+  for (int k = 0; k < n; ++k) {
+    const SampleValue& v = f[k].value;
+    const Vec3 c = (Vec3(v.value) - v.sky + v.albedo * irradiance) * exposure;
+    const float l = std::sqrt(std::max(0.0f, 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b));
+    lo = std::min(lo, l);
+    hi = std::max(hi, l);
+  }
+  return hi - lo > threshold;
+}
+
+/// Traces pixel (x, y) into the film: s.spp samples, and s.edgeSamples more where those
+/// disagree. Every decision reads the pixel's own samples only, so the apron pixels a tile
+/// re-traces come out the same as in their own tile, at any thread count.
+void tracePixel(const Integrator& integrator, const RenderSettings& s, int x, int y, const PixelSamplers& samplers,
+                float exposure, TileFilm& film, Counters& c) {
+  const size_t begin = film.samples.size();
+  traceSamples(integrator, s, x, y, s.spp, 0, samplers.base, film.samples, c);
+  if (s.edgeSamples > 0 && samplesDisagree(film.samples.data() + begin, s.spp, exposure, s.edgeThreshold))
+    traceSamples(integrator, s, x, y, s.edgeSamples, 1, samplers.extra, film.samples, c);
+  film.first.push_back(static_cast<uint32_t>(film.samples.size()));
 }
 
 }  // namespace
@@ -457,6 +517,9 @@ Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings
   const int apron = tent ? static_cast<int>(std::ceil(radius - 0.5f)) : 0;
   const int spp = s.spp;
   const ZSobolSampler sobolBase(s.width, s.height, spp, s.seed);
+  // The adaptive pass's own sequence: the base pass's next samples would break its
+  // per-pixel blocks; another seed gives independent, equally stratified points.
+  const ZSobolSampler sobolExtra(s.width, s.height, std::max(1, s.edgeSamples), deriveSeed(s.seed, {0xed9e}));
 
   const int tilesX = (s.width + kTile - 1) / kTile, tilesY = (s.height + kTile - 1) / kTile;
   const size_t tileCount = static_cast<size_t>(tilesX) * tilesY;
@@ -475,11 +538,12 @@ Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings
     const int ax0 = std::max(0, x0 - apron), ay0 = std::max(0, y0 - apron);
     const int ax1 = std::min(s.width, x1 + apron), ay1 = std::min(s.height, y1 + apron);
     TileFilm film(ax0, ay0, ax1, ay1, spp, apron, tent, radius);
-    ZSobolSampler sobol = sobolBase;
-    ZSobolSampler* zsobol = s.sampler == Sampling::ZSobol ? &sobol : nullptr;
+    ZSobolSampler sobol = sobolBase, sobolMore = sobolExtra;
+    PixelSamplers samplers;
+    if (s.sampler == Sampling::ZSobol) samplers = {&sobol, &sobolMore};
     Counters c;
     for (int y = ay0; y < ay1; ++y)
-      for (int x = ax0; x < ax1; ++x) tracePixel(integrator, s, x, y, zsobol, film.pixel(x, y), c);
+      for (int x = ax0; x < ax1; ++x) tracePixel(integrator, s, x, y, samplers, scale, film, c);
     for (int y = y0; y < y1; ++y)
       for (int x = x0; x < x1; ++x) film.reconstruct(x, y, scale, image, layers ? &*layers : nullptr);
     cameraRays += c.camera;

@@ -92,6 +92,13 @@ struct RenderSettings {
   /// sky's irradiance is smoothed across pixels of the same surface, never across normals,
   /// depth steps or albedo edges.
   bool skyFilter = true;
+  /// Adaptive camera samples: a pixel whose spp samples disagree (their display
+  /// luminances, with the sky's noise taken out, spread by more than edgeThreshold: a
+  /// silhouette, a texture or shadow edge, a twig or spine narrower than the pixel, the
+  /// sun's penumbra) gets edgeSamples more. The sky's own noise is the sky filter's.
+  /// 0 = off.
+  int edgeSamples = 0;
+  float edgeThreshold = 0.08f;  ///< in display units (0..1, about gamma 2 luminance)
 
   bool ground = true;             ///< analytic ground plane under the model
   bool groundAtModelBase = true;  ///< put the plane at the scene's lowest y (else at groundHeight)

@@ -202,3 +202,47 @@ TEST_CASE("renderImage with the Sobol' sampler", "[render]") {
     CHECK(err[0] < err[1]);
   }
 }
+
+TEST_CASE("Adaptive camera samples where a pixel's samples disagree", "[render]") {
+  Scene scene;
+  addSpheres(scene);
+  const Camera cam = frameBounds(Box3{Vec3(-1.2f, 0, -1.2f), Vec3(2.2f, 2, 1.2f)}, ViewSpec{}, 1.4);
+  RenderSettings rs = quietSettings(70, 50);
+  RenderStats plain, adaptive, serial;
+  const Image a = renderImage(scene, cam, rs, &plain);
+  rs.edgeSamples = 12;
+  rs.threads = 2;
+  const Image b = renderImage(scene, cam, rs, &adaptive);
+  rs.threads = 1;
+  const Image c = renderImage(scene, cam, rs, &serial);
+  SECTION("same bytes at 1 and 2 threads, and whole extra passes of edgeSamples") {
+    CHECK(b.pixels == c.pixels);
+    CHECK(adaptive.cameraRays == serial.cameraRays);
+    const uint64_t extra = adaptive.cameraRays - plain.cameraRays;
+    CHECK(extra % 12 == 0);
+    // The spheres' silhouettes and shadow edges, not the open ground and sky: some of the
+    // traced pixels (apron included), far from all.
+    CHECK(extra > plain.cameraRays / 4 / 50 * 12);
+    CHECK(extra < plain.cameraRays / 4 / 3 * 12);
+  }
+  SECTION("pixels whose samples agree keep their samples and values") {
+    // A pixel of plain sky far from the spheres: its 4 samples see the same gradient.
+    CHECK(a.at(2, 2) == b.at(2, 2));
+  }
+  SECTION("no threshold crossed: the same image as without adaptive samples") {
+    rs.edgeThreshold = 1e9f;
+    RenderStats none;
+    CHECK(renderImage(scene, cam, rs, &none).pixels == a.pixels);
+    CHECK(none.cameraRays == plain.cameraRays);
+  }
+  SECTION("less error on the silhouettes for the samples spent") {
+    RenderSettings ref = quietSettings(70, 50);
+    ref.skyFilter = false;
+    ref.spp = 256;
+    const Image reference = renderImage(scene, cam, ref);
+    const double before = rmse(a, reference), after = rmse(b, reference);
+    INFO("RMSE plain " << before << ", adaptive " << after << ", camera samples x"
+                       << double(adaptive.cameraRays) / double(plain.cameraRays));
+    CHECK(after < 0.85 * before);
+  }
+}
