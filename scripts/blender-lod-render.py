@@ -59,6 +59,7 @@ scene.world = world
 scene.render.engine = 'CYCLES'
 scene.cycles.samples = samples
 scene.cycles.device = 'CPU'
+scene.cycles.use_denoising = False  # Debian's Blender has no OpenImageDenoise
 scene.render.resolution_x = scene.render.resolution_y = size
 scene.render.filepath = dst
 t0 = time.time()
