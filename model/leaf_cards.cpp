@@ -111,9 +111,9 @@ Vec4 surfaceAt(const ExportPart& part, size_t t, const glm::dvec3& b) {
 
 // Paints the cell at (x0, y0) of image with the leaf of triangles tris on card c: 2 x 2
 // samples a texel; a sample takes the first triangle (in the mesh's order) that covers it,
-// seen along the card's normal. A texel's colour is the mean of its covered samples', its
-// alpha their share times their mean alpha; texels no sample covers get the leaf's mean
-// colour (so that bilinear lookups at the outline blend no black in), alpha 0.
+// seen along the card's normal. A texel's alpha is the sum of its samples' alphas over 4
+// (uncovered: 0), its colour their alpha-weighted mean; texels of alpha 0 get the leaf's
+// alpha-weighted mean colour (so that bilinear lookups at the outline blend no black in).
 void paintCell(const ExportPart& part, const std::vector<uint32_t>& tris, const Card& c, Image& image, int x0, int y0) {
   const Mesh& m = part.mesh;
   const int n = kLeafCardTexels, s = 2 * n;  // samples a side
@@ -147,21 +147,21 @@ void paintCell(const ExportPart& part, const std::vector<uint32_t>& tris, const 
         out = surfaceAt(part, t, glm::dvec3(1 - b1 - b2, b1, b2));
       }
   }
+  // Colours are weighted by their alpha (a cut-out texel of the leaf's image lends none).
   Vec3 mean(0.0f);
-  float count = 0;
+  float weight = 0;
   for (const Vec4& v : sample)
-    if (v.a >= 0.0f) mean += Vec3(v), ++count;
-  mean = count > 0 ? mean / count : part.material.baseColor;
+    if (v.a > 0.0f) mean += Vec3(v) * v.a, weight += v.a;
+  mean = weight > 0 ? mean / weight : part.material.baseColor;
   for (int y = 0; y < n; ++y)
     for (int x = 0; x < n; ++x) {
       Vec3 rgb(0.0f);
-      float alpha = 0, k = 0;
+      float alpha = 0;
       for (int j = 0; j < 4; ++j) {
         const Vec4& v = sample[size_t((2 * y + j / 2) * s + 2 * x + j % 2)];
-        if (v.a < 0.0f) continue;
-        rgb += Vec3(v), alpha += v.a, ++k;
+        if (v.a > 0.0f) rgb += Vec3(v) * v.a, alpha += v.a;
       }
-      image.set(x0 + x, y0 + y, k > 0 ? Vec4(rgb / k, alpha / 4.0f) : Vec4(mean, 0.0f));
+      image.set(x0 + x, y0 + y, alpha > 0 ? Vec4(rgb / alpha, alpha / 4.0f) : Vec4(mean, 0.0f));
     }
 }
 
@@ -187,7 +187,7 @@ ExportPart leafCards(const ExportPart& part, size_t cards) {
   const Mesh& m = part.mesh;
   size_t leaves = 0;
   const std::vector<uint32_t> leaf = triangleComponents(m, leaves);
-  const size_t keep = std::clamp<size_t>(cards, 1, leaves);
+  const size_t keep = std::clamp<size_t>(std::min(cards, kLeafCardsMax), 1, leaves);
   std::vector<std::vector<uint32_t>> tris(leaves);
   double area = 0, keptArea = 0;
   for (size_t t = 0; t < m.triangles.size(); ++t) {

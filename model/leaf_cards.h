@@ -22,6 +22,9 @@ namespace sprig {
 /// outer ring of texels, which stays transparent so that bilinear lookups at the card's
 /// edge read no neighbour).
 inline constexpr int kLeafCardTexels = 16;
+/// At most this many cards a part (their image at most 4096 x 4096 texels, as an atlas:
+/// kAtlasMaxSize); leafCards keeps fewer leaves beyond it.
+inline constexpr size_t kLeafCardsMax = 65536;
 /// The cards' alphaCutoff (a part with its own cut-out keeps its own).
 inline constexpr float kLeafCardAlphaCutoff = 0.5f;
 
@@ -33,7 +36,7 @@ std::vector<uint32_t> triangleComponents(const Mesh& mesh, size_t& count);
 /// ⌊j·keep/pieces⌋ (keep ≤ pieces; exactly keep of them are).
 inline bool evenlyKept(size_t j, size_t keep, size_t pieces) { return (j + 1) * keep / pieces > j * keep / pieces; }
 
-/// The leaves of part as cards: min(cards, leaves) of its leaves (at least one), evenly
+/// The leaves of part as cards: min(cards, leaves, kLeafCardsMax) of its leaves (at least one), evenly
 /// spread over their order (evenlyKept), each a quad of 4 vertices and 2 triangles with the
 /// card's normal and uvs into the part's new texture (no vertex colours), the leaves' order
 /// kept. A card is the leaf's bounding rectangle in its plane (normal: the leaf's

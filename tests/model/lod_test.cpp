@@ -385,3 +385,42 @@ TEST_CASE("Levels of detail of a shipped shell bake the full mesh's atlases only
   }
   CHECK(readGlb(dir.path / "full.glb").images.size() == 1);
 }
+
+TEST_CASE("leafCards takes a leaf's image and cut-out through its uvs", "[model][lod]") {
+  // Three unit squares in the xz plane whose uvs are (x, z), textured by a 2 x 2 image whose
+  // left column (s < 1/2) is cut out and whose right column is red; no vertex colours.
+  ExportPart leaves{"textured_leaves_1", Mesh{}, PartMaterial{"textured_leaves_1", Vec3(0.2f, 0.5f, 0.1f), 0.5f, true}, true};
+  for (int i = 0; i < 3; ++i) {
+    const auto b = uint32_t(leaves.mesh.positions.size());
+    for (Vec3 d : {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 0, 1), Vec3(0, 0, 1)}) {
+      leaves.mesh.positions.push_back(Vec3(float(3 * i), 0.0f, 0.0f) + d);
+      leaves.mesh.uvs.push_back(Vec2(d.x, d.z));
+    }
+    leaves.mesh.triangles.push_back({b, b + 2, b + 1});
+    leaves.mesh.triangles.push_back({b, b + 3, b + 2});
+  }
+  auto tex = std::make_shared<PartTexture>();
+  tex->image = Image(2, 2, Vec4(0.0f));
+  tex->image.set(1, 0, Vec4(1, 0, 0, 1));
+  tex->image.set(1, 1, Vec4(1, 0, 0, 1));
+  leaves.material.texture = tex;
+  leaves.material.alphaCutoff = 0.3f;
+  const ExportPart cards = leafCards(leaves, 10);  // more cards than leaves: one a leaf
+  REQUIRE(cards.mesh.triangles.size() == 6);
+  CHECK(cards.mesh.positions.size() == 12);
+  CHECK(cards.material.alphaCutoff == 0.3f);  // its own cut-out kept
+  CHECK(cards.material.texture != leaves.material.texture);
+  const Image& im = cards.material.texture->pixels();
+  REQUIRE(im.width == 32);
+  REQUIRE(im.height == 32);
+  // The square's card: u along +z, v = n x u along +x, so the cell's upper rows are x > 1/2
+  // (red, opaque) and its lower rows x < 1/2 (cut out).
+  for (int cell = 0; cell < 3; ++cell) {
+    const int x0 = (cell % 2) * 16, y0 = (cell / 2) * 16;
+    CHECK(im.at(x0 + 8, y0 + 4).a == 1.0f);
+    CHECK(im.at(x0 + 8, y0 + 4).r == 1.0f);
+    CHECK(im.at(x0 + 8, y0 + 11).a == 0.0f);
+    CHECK(im.at(x0 + 8, y0 + 0).a == 0.0f);  // the rim
+  }
+  CHECK(leafCards(leaves, 0).mesh.triangles.size() == 2);  // at least one card
+}
