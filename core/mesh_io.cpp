@@ -11,10 +11,12 @@
 #include <map>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 
 #include "core/atomic_file.h"
 #include "core/image.h"
 #include "core/mesh_corners.h"
+#include "core/parallel.h"
 #include "core/paths.h"
 #include "core/srgb.h"
 
@@ -399,12 +401,71 @@ PartCorners partCorners(const ExportPart& part) {
 // Picture: RGBA; Data: 8-bit values as they are), through a temporary
 // file beside `near` (core/image.h owns image files; the temporary is removed when this
 // returns).
-std::string pngBytes(const Image& image, const fs::path& near, ImageEncoding encoding) {
+// How a part's base colour texture is stored: RGBA when it cuts out, else sRGB RGB.
+ImageEncoding baseColorEncoding(const PartMaterial& material) {
+  return material.alphaCutoff >= 0.0f ? ImageEncoding::Picture : ImageEncoding::TextureMap;
+}
+
+std::string encodePng(const Image& image, const fs::path& near, ImageEncoding encoding) {
   fs::path dest = near;
   dest.replace_extension(".png");
   TempPath temp(dest);
   writeImage(image, temp.path(), encoding);
   return readFile(temp.path());
+}
+
+}  // namespace
+
+// The bytes of the images encoded in a PngReuse scope, by image (its address, its pixels'
+// address and size) and encoding.
+struct PngReuse::Cache {
+  std::map<std::tuple<const Image*, const float*, size_t, int>, std::string> png;
+};
+
+namespace {
+
+thread_local PngReuse* innermostPngReuse = nullptr;
+
+}  // namespace
+
+PngReuse::PngReuse() : cache_(std::make_unique<Cache>()), outer_(innermostPngReuse) { innermostPngReuse = this; }
+PngReuse::~PngReuse() { innermostPngReuse = outer_; }
+size_t PngReuse::encoded() const { return cache_->png.size(); }
+PngReuse* PngReuse::innermost() { return innermostPngReuse; }
+
+void PngReuse::encodeAhead(const std::vector<const ExportPart*>& parts, const fs::path& near) {
+  using Key = std::tuple<const Image*, const float*, size_t, int>;
+  std::vector<std::pair<Key, ImageEncoding>> todo;
+  auto want = [&](const Image& image, ImageEncoding encoding) {
+    const Key key(&image, image.pixels.data(), image.pixels.size(), int(encoding));
+    if (cache_->png.count(key)) return;
+    for (const auto& t : todo)
+      if (t.first == key) return;
+    todo.emplace_back(key, encoding);
+  };
+  for (const ExportPart* p : parts) {
+    if (p->mesh.triangles.empty()) continue;
+    if (p->material.texture) want(p->material.texture->pixels(), baseColorEncoding(p->material));
+    if (p->material.normalTexture) want(p->material.normalTexture->pixels(), ImageEncoding::Data);
+  }
+  std::vector<std::string> bytes(todo.size());
+  parallelFor(0, todo.size(), [&](size_t i) { bytes[i] = encodePng(*std::get<0>(todo[i].first), near, todo[i].second); });
+  for (size_t i = 0; i < todo.size(); ++i) cache_->png.emplace(todo[i].first, std::move(bytes[i]));
+}
+const std::string& PngReuse::once(const Image& image, int encoding, const std::function<std::string()>& encode) {
+  const auto key = std::make_tuple(&image, image.pixels.data(), image.pixels.size(), encoding);
+  auto it = cache_->png.find(key);
+  if (it == cache_->png.end()) it = cache_->png.emplace(key, encode()).first;
+  return it->second;
+}
+
+namespace {
+
+// encodePng's bytes, made once per image and encoding within a PngReuse scope.
+std::string pngBytes(const Image& image, const fs::path& near, ImageEncoding encoding) {
+  PngReuse* scope = PngReuse::innermost();
+  if (!scope) return encodePng(image, near, encoding);
+  return scope->once(image, int(encoding), [&] { return encodePng(image, near, encoding); });
 }
 
 // One tangent per vertex of an unwelded mesh whose vertices each belong to one corner (an
@@ -566,9 +627,8 @@ int GlbBuilder::addMaterial(const ExportPart& part) {
       mat.alphaMode = "MASK";
       mat.alphaCutoff = part.material.alphaCutoff;
     }
-    mat.pbrMetallicRoughness.baseColorTexture.index = addTexture(
-        part.material.texture.get(), part.name,
-        part.material.alphaCutoff >= 0.0f ? ImageEncoding::Picture : ImageEncoding::TextureMap);
+    mat.pbrMetallicRoughness.baseColorTexture.index =
+        addTexture(part.material.texture.get(), part.name, baseColorEncoding(part.material));
   }
   if (part.material.normalTexture)
     mat.normalTexture.index = addTexture(part.material.normalTexture.get(), part.name + "_normal", ImageEncoding::Data);

@@ -225,6 +225,36 @@ std::vector<PartWriteReport> writeParts(const std::vector<ExportPart>& parts, co
 /// std::invalid_argument for a path that is not .glb or levels whose part names differ.
 std::vector<PartWriteReport> writePartLevels(const std::vector<LodLevel>& levels, const std::filesystem::path& path);
 
+/// While an object of this class lives, the glTF writers on its thread encode each texture
+/// image once: the PNG bytes made for one file are reused, byte for byte, by every later
+/// file that holds the same image (writeLevels: `OUT_lodK.glb` and `OUT.glb` share their
+/// images). The images written meanwhile must stay alive and unchanged. Scopes nest (the
+/// innermost holds the bytes).
+class PngReuse {
+ public:
+  PngReuse();
+  ~PngReuse();
+  PngReuse(const PngReuse&) = delete;
+  PngReuse& operator=(const PngReuse&) = delete;
+  /// PNG images encoded in this scope so far (reuses not counted).
+  size_t encoded() const;
+  /// Encodes now, two or more at a time (core/parallel.h), every texture image the glTF
+  /// writers will write for parts (each image and encoding once; those this scope holds
+  /// already are skipped), so that the writers that follow only reuse the bytes. near: a
+  /// path beside which the temporary files go (the output's).
+  void encodeAhead(const std::vector<const ExportPart*>& parts, const std::filesystem::path& near);
+  /// The innermost scope alive on this thread, or null.
+  static PngReuse* innermost();
+  /// encode()'s bytes for image in encoding (an ImageEncoding), made at the first call for
+  /// that image and encoding in this scope and reused after.
+  const std::string& once(const Image& image, int encoding, const std::function<std::string()>& encode);
+
+ private:
+  struct Cache;
+  std::unique_ptr<Cache> cache_;
+  PngReuse* outer_ = nullptr;
+};
+
 /// The path of level k's own file beside path: `STEM_lodK.EXT`.
 std::filesystem::path lodPath(const std::filesystem::path& path, size_t k);
 

@@ -7,36 +7,13 @@
 
 #include "core/mesh_clean.h"
 #include "model/detail_maps.h"
+#include "model/leaf_cards.h"
 #include "model/mesh_parts.h"
 #include "organisms/simplify.h"
 
 namespace sprig {
 
 namespace {
-
-// The connected component (triangles sharing a vertex) of every triangle, numbered in
-// order of their first triangle; count receives how many there are.
-std::vector<uint32_t> triangleComponents(const Mesh& mesh, size_t& count) {
-  std::vector<uint32_t> parent(mesh.positions.size());
-  std::iota(parent.begin(), parent.end(), 0u);
-  auto find = [&](uint32_t v) {
-    while (parent[v] != v) v = parent[v] = parent[parent[v]];
-    return v;
-  };
-  for (const glm::uvec3& t : mesh.triangles) {
-    const uint32_t a = find(t.x), b = find(t.y), c = find(t.z);
-    parent[b] = a;
-    parent[find(c)] = a;
-  }
-  std::vector<uint32_t> id(mesh.positions.size(), UINT32_MAX), out(mesh.triangles.size());
-  count = 0;
-  for (size_t t = 0; t < mesh.triangles.size(); ++t) {
-    uint32_t& c = id[find(mesh.triangles[t].x)];
-    if (c == UINT32_MAX) c = uint32_t(count++);
-    out[t] = c;
-  }
-  return out;
-}
 
 double meshArea(const Mesh& m) {
   double a = 0;
@@ -55,7 +32,7 @@ Mesh thinPieces(const Mesh& mesh, size_t targetTriangles, double area) {
   const double fraction = double(targetTriangles) / double(std::max<size_t>(mesh.triangles.size(), 1));
   const size_t keep = std::clamp<size_t>(size_t(std::floor(double(pieces) * fraction)), 1, pieces);
   std::vector<char> kept(pieces, 0);
-  for (size_t j = 0; j < pieces; ++j) kept[j] = (j + 1) * keep / pieces > j * keep / pieces;
+  for (size_t j = 0; j < pieces; ++j) kept[j] = evenlyKept(j, keep, pieces);
   // Centroids of the kept pieces.
   std::vector<glm::dvec3> sum(pieces, glm::dvec3(0.0));
   std::vector<size_t> used(pieces, 0), newIndex(mesh.positions.size(), SIZE_MAX);
@@ -219,6 +196,17 @@ std::vector<std::vector<float>> detailReach(const std::vector<ExportPart>& parts
   return reach;
 }
 
+// The scattered parts (leaves) of level, the chain's far level, made cards from the full
+// parts (leafCards): as many cards as half the triangles the level kept of them.
+void cardFarLeaves(const std::vector<ExportPart>& parts, LodLevel& level) {
+  for (size_t i = 0; i < parts.size(); ++i) {
+    ExportPart& far = level.parts[i];
+    if (!parts[i].scattered || far.mesh.triangles.empty()) continue;
+    far = leafCards(parts[i], std::max<size_t>(far.mesh.triangles.size() / 2, 1));
+  }
+  level.triangles = partTriangles(level.parts);
+}
+
 }  // namespace
 
 size_t partTriangles(const std::vector<ExportPart>& parts) {
@@ -253,6 +241,8 @@ std::vector<LodLevel> buildLodChain(const std::vector<ExportPart>& parts, size_t
     levels.push_back(std::move(next));
     errors.push_back(std::move(error));
   }
+  // The far level's leaves as cards (before the maps: a card part has its own texture).
+  if (levels.size() > 1) cardFarLeaves(parts, levels.back());
   // The maps of the detail the levels lost, from the full parts (before the levels move).
   LodMapReport report;
   bakeLevelMaps(parts, levels, detailReach(parts, levels, errors), report);
@@ -280,6 +270,13 @@ std::vector<LodLevel> lodLevels(std::vector<ExportPart> parts, size_t budget, Ve
 std::vector<PartWriteReport> writeLevels(const std::vector<LodLevel>& levels, const std::filesystem::path& path) {
   std::vector<std::filesystem::path> written;
   const bool glb = levels.size() > 1 && meshFormatFor(path) == MeshFormat::Glb;
+  PngReuse reuse;  // OUT_lodK.glb's images are OUT.glb's: each PNG encoded once
+  if (meshFormatFor(path) == MeshFormat::Glb) {
+    std::vector<const ExportPart*> all;
+    for (const LodLevel& level : levels)
+      for (const ExportPart& p : level.parts) all.push_back(&p);
+    reuse.encodeAhead(all, path);
+  }
   try {
     // A .glb holds every level (readers that ignore MSFT_lod may still import the lower
     // levels' nodes: Blender 3.4 does), so LOD0 gets its own file too.

@@ -62,7 +62,10 @@ struct LodMapReport {
 /// does get below kLodMaxKeep of the level before. Triangle counts strictly decrease.
 /// Parts without triangles stay empty. Every level is moved by the offset that stands LOD0
 /// on the ground (groundOffset: simplification may remove the lowest or outermost vertices);
-/// moved, when given, receives it. Deterministic. Cost: one simplification of the full parts
+/// moved, when given, receives it. The far level (the last of two or more) has its
+/// scattered parts (leaves) as alpha-tested cards of the full parts' leaves
+/// (model/leaf_cards.h leafCards: half as many cards as that level kept leaf triangles).
+/// Deterministic. Cost: one simplification of the full parts
 /// (O(T log T)), then of each level (a quarter each).
 ///
 /// Every simplified surface part (not scattered; with normals; its level's texture an atlas
@@ -84,7 +87,8 @@ std::vector<LodLevel> lodLevels(std::vector<ExportPart> parts, size_t budget, Ve
 /// (lodPath(path, K): STEM_lodK.EXT for K >= 1, the parts as writeParts writes them; a .glb
 /// also STEM_lod0.glb) first, then path itself (.glb: every level, writePartLevels with
 /// MSFT_lod; .obj and .ply: LOD0). One level: path alone, as writeParts. Each file is written atomically, and a failure removes the files of this call
-/// already written. Returns LOD0's reports. Throws as writeParts.
+/// already written. Every texture image is encoded to PNG once for all the files
+/// (PngReuse). Returns LOD0's reports. Throws as writeParts.
 std::vector<PartWriteReport> writeLevels(const std::vector<LodLevel>& levels, const std::filesystem::path& path);
 
 /// Total triangles of parts.

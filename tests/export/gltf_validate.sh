@@ -6,8 +6,9 @@
 # and of each organism base and colouring. A shell's separate 'spines' part (the axial canal
 # spines of fig_shell_09a/09b and the Murex) is baked and written by the same code as the
 # varices; its export takes minutes (a million triangles), so it is not among these cases.
-# Levels of detail (MSFT_lod) are validated on two trees and an organism (the PCM tree and the
-# organism with the detail maps of their simplified levels: normalTexture and TANGENT); the
+# Levels of detail (MSFT_lod) are validated on three trees and an organism (the PCM tree and the
+# organism with the detail maps of their simplified levels: normalTexture and TANGENT; the lime
+# in leaf, whose far level's leaves are alpha-tested cards); the
 # other cases write the full mesh alone (--lod none), which is what each level is made from.
 # Usage: gltf_validate.sh path/to/sprig   (run from the repository root)
 set -euo pipefail
@@ -25,6 +26,7 @@ species=(
   "blob_ricci_fig3 blob"                   # blob
   "fig_org_05b_berry_level2 organism | --lod 20000"  # organism on a primitive, with its levels of detail and their detail maps (a small budget: the bake follows the levels' texels)
   "fig_tree_12_pcm_offset wood | --lod 2000"  # tree with PCM ridges: both levels simplified, each with a normal map and TANGENT
+  "tree_lime wood leaves | --steps 3 --cell 0.02 --lod 2000"  # tree in leaf with levels: the far level's leaves are alpha-tested cards
   "fig_org_13a_mummified_skull_sharp organism"  # organism on a CT volume, blend colour
   "fig_org_14c_planet_blend organism"      # organism with the planet shader
   "org_painted_band organism"              # organism on a painted mesh
@@ -58,6 +60,28 @@ prims = [p for m in j['meshes'] for p in m['primitives']]
 bad = [p for p in prims if 'normalTexture' not in j['materials'][p['material']] or 'TANGENT' not in p['attributes']]
 if len(prims) < 2 or bad:
     sys.exit('%s: %d of %d primitives without a normal map and TANGENT' % (sys.argv[1], len(bad), len(prims)))
+PY
+  fi
+  if [[ "$s" == tree_lime && "$flags" == *--lod\ 2000* ]]; then
+    # The far level's leaves: quads (4 vertices, 2 triangles each), alphaMode MASK with an
+    # alphaCutoff and a baseColorTexture; the wood is there too.
+    python3 - "$f" <<'PY'
+import json, struct, sys
+d = open(sys.argv[1], 'rb').read()
+j = json.loads(d[20:20 + struct.unpack('<I', d[12:16])[0]])
+far = {}
+for n in j['nodes']:
+    if 'mesh' in n:
+        far[n['name'].split('_lod')[0]] = n  # the last level of each part
+leaves, wood = far.get('leaves'), far.get('wood')
+if not leaves or not wood or '_lod' not in leaves['name']:
+    sys.exit('%s: no far level of wood and leaves' % sys.argv[1])
+p = j['meshes'][leaves['mesh']]['primitives'][0]
+m = j['materials'][p['material']]
+tris, verts = j['accessors'][p['indices']]['count'] // 3, j['accessors'][p['attributes']['POSITION']]['count']
+if m.get('alphaMode') != 'MASK' or m.get('alphaCutoff', 0.5) <= 0 or 'baseColorTexture' not in m['pbrMetallicRoughness'] \
+        or tris == 0 or verts != 2 * tris:
+    sys.exit('%s: far leaves are not cards: %s, %d triangles, %d vertices' % (sys.argv[1], m, tris, verts))
 PY
   fi
 done

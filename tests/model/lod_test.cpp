@@ -9,6 +9,7 @@
 
 #include "core/atomic_file.h"
 #include "core/mesh_io.h"
+#include "model/leaf_cards.h"
 #include "model/lod.h"
 #include "model/mesh_parts.h"
 #include "model/model.h"
@@ -101,7 +102,8 @@ TEST_CASE("buildLodChain", "[model][lod]") {
     CHECK(levels[0].screenCoverage == 0.25);
     CHECK(levels[1].screenCoverage == 0.0625);
     CHECK(levels[2].screenCoverage == 0.0);
-    for (const LodLevel& level : levels) {
+    for (size_t k = 0; k < levels.size(); ++k) {
+      const LodLevel& level = levels[k];
       REQUIRE(level.parts.size() == 2);
       CHECK(level.parts[0].name == "wood");
       CHECK(level.parts[1].name == "leaves");
@@ -126,8 +128,10 @@ TEST_CASE("buildLodChain", "[model][lod]") {
       // The sphere stays closed: every edge in two triangles.
       CHECK(analyzeTopology(w).boundaryEdges == 0);
       // Leaves: all 400 kept at LOD0 (they fit in half the budget), then a quarter per level,
-      // grown so that they cover the same area; their atlas baked again per level.
+      // grown so that they cover the same area; their atlas baked again per level. The far
+      // level's leaves are cards (the next test case).
       const ExportPart& l = level.parts[1];
+      if (k + 1 == levels.size()) continue;
       CHECK(area(l.mesh) == Approx(400.0).epsilon(1e-4));
       REQUIRE(l.material.texture);
       CHECK(l.material.texture->atlas.index.size() == l.mesh.triangles.size() * 3);
@@ -135,7 +139,61 @@ TEST_CASE("buildLodChain", "[model][lod]") {
     }
     CHECK(levels[0].parts[1].mesh.triangles.size() == 800);
     CHECK(levels[1].parts[1].mesh.triangles.size() == 200);
-    CHECK(levels[2].parts[1].mesh.triangles.size() == 50);
+    CHECK(levels[2].parts[1].mesh.triangles.size() == 50);  // 25 cards
+  }
+  SECTION("the far level's leaves are alpha-tested cards with their leaves' images") {
+    Vec3 moved(0.0f);
+    const std::vector<LodLevel> levels = buildLodChain(parts, 8000, &moved);
+    REQUIRE(levels.size() == 3);
+    // The wood is still there, closed, and as before a quarter of the level before.
+    const Mesh& wood = levels[2].parts[0].mesh;
+    CHECK(wood.triangles.size() > 100);
+    CHECK(analyzeTopology(wood).boundaryEdges == 0);
+    // The far level kept 50 leaf triangles: 25 cards of 4 vertices and 2 triangles each.
+    const ExportPart& cards = levels[2].parts[1];
+    CHECK(cards.name == "leaves");
+    REQUIRE(cards.mesh.triangles.size() == 50);
+    REQUIRE(cards.mesh.positions.size() == 100);
+    REQUIRE(cards.mesh.uvs.size() == 100);
+    REQUIRE(cards.mesh.normals.size() == 100);
+    CHECK(cards.mesh.colors.empty());
+    for (size_t t = 0; t < 50; ++t) {
+      const glm::uvec3& tri = cards.mesh.triangles[t];
+      CHECK(tri.x == uint32_t(t / 2 * 4));  // each card its own four vertices
+      CHECK(std::max({tri.x, tri.y, tri.z}) < uint32_t(t / 2 * 4 + 4));
+    }
+    // Cut out (glTF MASK) with the leaves' own image: 5 x 5 cells of 16 texels, not an atlas.
+    CHECK(cards.material.alphaCutoff == kLeafCardAlphaCutoff);
+    CHECK(cards.material.doubleSided);
+    REQUIRE(cards.material.texture);
+    CHECK_FALSE(cards.material.texture->isAtlas());
+    const Image& im = cards.material.texture->pixels();
+    CHECK(im.width == 80);
+    CHECK(im.height == 80);
+    // Card i is leaf 16i + 15 (evenly spread), a unit square grown 4 times (25 leaves cover
+    // the 400 leaves' area): its centre and normal are the leaf's, its 14 x 14 inner texels
+    // opaque in the leaf's colour, its rim transparent.
+    size_t opaque = 0;
+    for (size_t i = 0; i < 25; ++i) {
+      const size_t j = 16 * i + 15;
+      const Vec3 centre(float(j % 20) * 2.0f + 0.5f, 3.0f, float(j / 20) * 2.0f + 0.5f);
+      Vec3 mean(0.0f);
+      for (size_t v = 4 * i; v < 4 * i + 4; ++v) {
+        mean += 0.25f * (cards.mesh.positions[v] - moved);
+        CHECK(glm::length(cards.mesh.normals[v] - Vec3(0, 1, 0)) < 1e-5f);
+      }
+      CHECK(glm::length(mean - centre) < 1e-4f);
+      CHECK(glm::length(cards.mesh.positions[4 * i] - cards.mesh.positions[4 * i + 2]) ==
+            Approx(4.0 * std::sqrt(2.0) * 16 / 14).epsilon(1e-4));
+      const int x0 = int(i % 5) * 16, y0 = int(i / 5) * 16;
+      const Vec4 c = im.at(x0 + 8, y0 + 8);
+      CHECK(c.r == Approx(0.05 + 0.001 * double(j)).margin(1e-5));
+      CHECK(c.a == 1.0f);
+      CHECK(im.at(x0, y0 + 8).a == 0.0f);
+      for (int y = 0; y < 16; ++y)
+        for (int x = 0; x < 16; ++x) opaque += im.at(x0 + x, y0 + y).a == 1.0f;
+    }
+    CHECK(opaque == 25 * 14 * 14);
   }
   SECTION("a model within the budget is LOD0 unchanged") {
     std::vector<ExportPart> placed = parts;
@@ -219,6 +277,35 @@ TEST_CASE("writeLevels", "[model][lod]") {
     CHECK_FALSE(fs::exists(dir.path / "taken_lod1.glb"));
     CHECK_FALSE(fs::exists(dir.path / "taken_lod2.glb"));
   }
+  SECTION("each texture image is encoded once for all the files, to the same bytes") {
+    // The far level: wood (an atlas and a normal map) and leaf cards (an RGBA image).
+    const std::vector<ExportPart>& far = levels[2].parts;
+    REQUIRE(far[0].material.normalTexture);
+    writeParts(far, dir.path / "alone.glb");
+    {
+      PngReuse reuse;
+      writeParts(far, dir.path / "a.glb");
+      CHECK(reuse.encoded() == 3);
+      writeParts(far, dir.path / "b.glb");
+      CHECK(reuse.encoded() == 3);
+    }
+    CHECK(readFile(dir.path / "a.glb") == readFile(dir.path / "alone.glb"));
+    CHECK(readFile(dir.path / "b.glb") == readFile(dir.path / "alone.glb"));
+    // writeLevels: OUT.glb holds the very images of the levels' own files.
+    writeLevels(levels, dir.path / "all.glb");
+    const tinygltf::Model all = readGlb(dir.path / "all.glb"), two = readGlb(dir.path / "all_lod2.glb");
+    const auto png = [](const tinygltf::Model& m, const tinygltf::Image& im) {
+      const tinygltf::BufferView& v = m.bufferViews.at(size_t(im.bufferView));
+      const std::vector<unsigned char>& b = m.buffers.at(size_t(v.buffer)).data;
+      return std::string(b.begin() + long(v.byteOffset), b.begin() + long(v.byteOffset + v.byteLength));
+    };
+    REQUIRE(two.images.size() == 3);
+    for (const tinygltf::Image& im : two.images) {
+      size_t same = 0;
+      for (const tinygltf::Image& a : all.images) same += a.name == im.name && png(all, a) == png(two, im);
+      CHECK(same == 1);
+    }
+  }
   SECTION("one level writes what writeParts writes") {
     writeLevels({levels[2]}, dir.path / "one.glb");
     writeParts(levels[2].parts, dir.path / "two.glb");
@@ -297,4 +384,43 @@ TEST_CASE("Levels of detail of a shipped shell bake the full mesh's atlases only
     CHECK(tex->pixels().width == atlasLayout(tex->atlas.values.size() / 3).width());
   }
   CHECK(readGlb(dir.path / "full.glb").images.size() == 1);
+}
+
+TEST_CASE("leafCards takes a leaf's image and cut-out through its uvs", "[model][lod]") {
+  // Three unit squares in the xz plane whose uvs are (x, z), textured by a 2 x 2 image whose
+  // left column (s < 1/2) is cut out and whose right column is red; no vertex colours.
+  ExportPart leaves{"textured_leaves_1", Mesh{}, PartMaterial{"textured_leaves_1", Vec3(0.2f, 0.5f, 0.1f), 0.5f, true}, true};
+  for (int i = 0; i < 3; ++i) {
+    const auto b = uint32_t(leaves.mesh.positions.size());
+    for (Vec3 d : {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 0, 1), Vec3(0, 0, 1)}) {
+      leaves.mesh.positions.push_back(Vec3(float(3 * i), 0.0f, 0.0f) + d);
+      leaves.mesh.uvs.push_back(Vec2(d.x, d.z));
+    }
+    leaves.mesh.triangles.push_back({b, b + 2, b + 1});
+    leaves.mesh.triangles.push_back({b, b + 3, b + 2});
+  }
+  auto tex = std::make_shared<PartTexture>();
+  tex->image = Image(2, 2, Vec4(0.0f));
+  tex->image.set(1, 0, Vec4(1, 0, 0, 1));
+  tex->image.set(1, 1, Vec4(1, 0, 0, 1));
+  leaves.material.texture = tex;
+  leaves.material.alphaCutoff = 0.3f;
+  const ExportPart cards = leafCards(leaves, 10);  // more cards than leaves: one a leaf
+  REQUIRE(cards.mesh.triangles.size() == 6);
+  CHECK(cards.mesh.positions.size() == 12);
+  CHECK(cards.material.alphaCutoff == 0.3f);  // its own cut-out kept
+  CHECK(cards.material.texture != leaves.material.texture);
+  const Image& im = cards.material.texture->pixels();
+  REQUIRE(im.width == 32);
+  REQUIRE(im.height == 32);
+  // The square's card: u along +z, v = n x u along +x, so the cell's upper rows are x > 1/2
+  // (red, opaque) and its lower rows x < 1/2 (cut out).
+  for (int cell = 0; cell < 3; ++cell) {
+    const int x0 = (cell % 2) * 16, y0 = (cell / 2) * 16;
+    CHECK(im.at(x0 + 8, y0 + 4).a == 1.0f);
+    CHECK(im.at(x0 + 8, y0 + 4).r == 1.0f);
+    CHECK(im.at(x0 + 8, y0 + 11).a == 0.0f);
+    CHECK(im.at(x0 + 8, y0 + 0).a == 0.0f);  // the rim
+  }
+  CHECK(leafCards(leaves, 0).mesh.triangles.size() == 2);  // at least one card
 }
