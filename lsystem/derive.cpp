@@ -212,8 +212,9 @@ struct Deriver::Impl {
   /// when cpfg -g would not draw it, leaves them to the next step.
   void queriesAfter(int stepDone) {
     queriesPending = !opt.queriesAfterLastStep && stepDone >= steps;
-    const bool env = environmentActive() && stepDone < steps;
+    const bool env = environmentActive() && (opt.environmentAfterEachStep || stepDone < steps);
     environmentDone = false;
+    if (env) queriesPending = false;  // cpfg's environment pass fills the query modules too
     if (!queriesPending) fillQueries(env);
   }
 
@@ -1482,9 +1483,10 @@ void Deriver::restart() {
 const ModuleString& Deriver::step() {
   Impl& m = *impl_;
   int step = m.done + 1;
-  if (m.queriesPending || (m.environmentActive() && !m.environmentDone)) {
+  const bool envBefore = m.environmentActive() && !m.opt.environmentAfterEachStep && !m.environmentDone;
+  if (m.queriesPending || envBefore) {
     m.queriesPending = false;
-    m.fillQueries(m.environmentActive());  // cpfg interprets the string when the next step starts
+    m.fillQueries(envBefore);  // cpfg interprets the string when the next step starts
   }
   m.runBlock(m.prog->startEachBlock, step, step - 1);
   m.rewrite(m.prog->productions, step, static_cast<uint64_t>(step - m.streamBase), true);

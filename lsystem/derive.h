@@ -57,6 +57,10 @@ struct DeriveOptions {
   /// cpfg's default `environment display: after`: the final string is not sent). Null:
   /// `?E` modules keep their values, as cpfg's do without -e. restart() restarts it.
   std::shared_ptr<EnvironmentProgram> environment;
+  /// cpfg's `environment display: before` (a view file's, ViewFile::environmentBefore): the
+  /// exchange follows every step instead of preceding it, and the axiom's comes first, so
+  /// the final string holds the program's answers.
+  bool environmentAfterEachStep = false;
   /// Called after every completed step with (step, module count); may be empty.
   std::function<void(int step, size_t modules)> onStep;
 };

@@ -29,6 +29,7 @@ GrowthEngine::GrowthEngine(const Species& species, const GrowthOptions& options)
   // cpfg -g draws no final string when the view file sets the view volume (`box:`)
   dopt.queriesAfterLastStep = !(tree.view && tree.view->box);
   if (tree.view) unsupportedDrawing_ = tree.view->unsupportedDrawing;
+  dopt.environmentAfterEachStep = tree.view && tree.view->environmentBefore;
   if (!options.extra.cpfgEnvironment.empty()) {
     // cpfg runs the program in the object's folder, where the grammar is
     std::string dir = std::filesystem::path(grammar_->fileName()).parent_path().string();

@@ -61,6 +61,7 @@ ModuleString deriveWithEnvironment(const std::string& folder, const std::string&
   const ViewFile view = loadViewFile(enviroAsset(folder + "/plant.v"));
   DeriveOptions opt;
   opt.queryTurtle = cpfgTurtleSettings(&view, TurtleSettings{});
+  opt.environmentAfterEachStep = view.environmentBefore;
   opt.environment = std::make_shared<EnvironmentProgram>(readEnvironmentFile(enviroAsset(folder + "/" + efile)),
                                                          enviroAsset(folder));
   Deriver d(g, opt);
@@ -145,6 +146,10 @@ TEST_CASE("cpfg parity: environmental programs", "[lsystem][cpfg][enviro]") {
   SECTION("pipes, chunks of 3 queries, position and heading") {
     test::checkSameAsCpfg(deriveWithEnvironment("field_pipes", "field.e"), loadGrammar(enviroAsset("field_pipes/plant.l")).symbols(),
                           test::readCpfgString(enviroAsset("field_pipes/cpfg.str")));
+  }
+  SECTION("the view file's 'environment display: before': the final string holds answers") {
+    test::checkSameAsCpfg(deriveWithEnvironment("field_before", "field.e"), loadGrammar(enviroAsset("field_before/plant.l")).symbols(),
+                          test::readCpfgString(enviroAsset("field_before/cpfg.str")));
   }
   SECTION("shared memory and semaphores, no following module") {
     test::checkSameAsCpfg(deriveWithEnvironment("field_memory", "field.e"), loadGrammar(enviroAsset("field_memory/plant.l")).symbols(),
