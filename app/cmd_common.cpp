@@ -76,7 +76,19 @@ void parseView(const std::string& text, render::ViewSpec& view) {
   if (values.size() == 3) view.fovYDeg = values[2];
 }
 
+lsystem::GrammarOverrides GrowthFlags::overrides() const {
+  lsystem::GrammarOverrides o = commandLineOverrides(defines, steps, seed);
+  o.cpfgEnvironment = environment;
+  o.cpfgEnvironmentTimeout = environmentTimeout;
+  return o;
+}
+
 void addGrowthFlags(CLI::App& sub, GrowthFlags& flags) {
+  sub.add_option("-e,--environment", flags.environment,
+                 "cpfg's environment file (FILE.e): run its environmental program for the ?E modules");
+  sub.add_option("--enviro-timeout", flags.environmentTimeout,
+                 "seconds to wait for the environmental program to start or answer (default 60)")
+      ->check(CLI::Range(0.1, 86400.0));
   sub.add_option("--steps", flags.steps, "derivation steps (trees; default: the species' or grammar's)")
       ->check(CLI::Range(0, 100000));
   sub.add_option("--seed", flags.seed, "random seed (trees; default: the species' or grammar's)")

@@ -24,8 +24,10 @@ struct GrowthFlags {
   int steps = -1;      ///< -1 = the species' steps
   int64_t seed = -1;   ///< -1 = the species' seed
   std::vector<std::string> defines;  ///< NAME=VALUE
+  std::string environment;           ///< cpfg's `-e FILE.e` (empty: none)
+  double environmentTimeout = 60.0;  ///< --enviro-timeout, seconds
   /// The overrides. Throws UsageError for a malformed -D.
-  lsystem::GrammarOverrides overrides() const { return commandLineOverrides(defines, steps, seed); }
+  lsystem::GrammarOverrides overrides() const;
 };
 
 /// Registers --steps, --seed and -D on sub.

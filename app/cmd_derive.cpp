@@ -95,6 +95,9 @@ int runDerive(const DeriveArgs& a, const GlobalOptions& g) {
   Species species = loadSpecies(a.file, g.pathPolicy());
   printNotes(g, species);
   GrowthEngine engine(species, GrowthOptions{extra, -1, "derive " + species.name});
+  if (a.growth.environment.empty() && engine.symbols().find("?E") >= 0 && !g.quiet)
+    std::cerr << "sprig: warning: the grammar's ?E modules keep their values, as cpfg's do without an environmental "
+                 "program (give one with -e FILE.e)\n";
   const int last = engine.lastStep();
   const lsystem::ModuleString& modules = engine.modulesAt(last);
   Derived t{last, engine.seed(), modules, engine.symbols(), {}, {}, {}};

@@ -212,15 +212,23 @@ struct Deriver::Impl {
   /// when cpfg -g would not draw it, leaves them to the next step.
   void queriesAfter(int stepDone) {
     queriesPending = !opt.queriesAfterLastStep && stepDone >= steps;
-    if (!queriesPending) fillQueries();
+    const bool env = environmentActive() && (opt.environmentAfterEachStep || stepDone < steps);
+    environmentDone = false;
+    if (env) queriesPending = false;  // cpfg's environment pass fills the query modules too
+    if (!queriesPending) fillQueries(env);
   }
+
+  /// The grammar writes `?E` modules and an environmental program is running.
+  bool environmentActive() const { return opt.environment && prog->usesEnvQuery; }
+  /// The current string's `?E` modules were exchanged with the environmental program.
+  bool environmentDone = false;
 
   /// cpfg's query modules: interprets cur (through the interpretation rules, which hold
   /// no query module) and writes the turtle's frame at each query module it reaches into
   /// that module's parameters. Query modules pass through the interpretation rules
   /// unchanged and in order, so the k-th one of the interpreted string is the k-th of cur.
-  void fillQueries() {
-    if (!prog->usesQuery) return;
+  void fillQueries(bool exchange = false) {
+    if (!prog->usesQuery && !exchange) return;
     if (!queryTurtle) {
       TurtleSettings t;
       if (opt.queryTurtle) {
@@ -247,8 +255,10 @@ struct Deriver::Impl {
         if (queryTurtle->commandOf(shown.symbols[i]) == Turtle::Command::Query) shownOrdinal[i] = k++;
       for (Turtle::QueryHit& h : hits) h.index = curQueries[shownOrdinal[h.index]];
     }
+    if (exchange) exchangeEnvironment(hits);
     for (const Turtle::QueryHit& h : hits) {
       const std::string& name = prog->symbols.name(cur.symbols[h.index]);
+      if (name == "?E") continue;
       DVec3 v = name == "?P" ? h.frame.position : name == "?H" ? h.frame.heading : name == "?L" ? h.frame.left : -h.frame.up;
       const uint32_t count = std::min<uint32_t>(cur.paramCount(h.index), 3);
       double* p = cur.params.data() + cur.offsets[h.index];
@@ -256,6 +266,63 @@ struct Deriver::Impl {
         p[c] = prog->floatParams ? static_cast<double>(static_cast<float>(v[static_cast<int>(c)])) : v[static_cast<int>(c)];
     }
   }
+
+  /// cpfg's `?E` exchange (interpret.c, case '?'; comm_master.c): every `?E` the turtle
+  /// reached is sent with its distance in cpfg's string (one byte per symbol character,
+  /// 1 + 5 bytes per parameter: '(' or ',' and a float), counted from the first `?E`, the
+  /// module after it and the turtle in floats; the answers set the parameters they name.
+  void exchangeEnvironment(const std::vector<Turtle::QueryHit>& hits) {
+    environmentDone = true;
+    std::vector<uint64_t> at(cur.size() + 1, 0);  // cpfg's byte offset of each module
+    for (size_t i = 0; i < cur.size(); ++i) {
+      const uint32_t k = cur.paramCount(i);
+      at[i + 1] = at[i] + prog->symbols.name(cur.symbols[i]).size() + (k ? 1 + 5 * uint64_t{k} : 0);
+    }
+    std::vector<EnvironmentQuery> queries;
+    std::unordered_map<uint64_t, size_t> moduleAt;  // distance -> index in cur
+    auto floats = [&](size_t i) {
+      std::vector<float> v(cur.paramCount(i));
+      for (size_t c = 0; c < v.size(); ++c) v[c] = static_cast<float>(cur.params[cur.offsets[i] + c]);
+      return v;
+    };
+    auto vec = [](const DVec3& v) {
+      return std::array<float, 3>{static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z)};
+    };
+    for (const Turtle::QueryHit& h : hits) {
+      if (prog->symbols.name(cur.symbols[h.index]) != "?E") continue;
+      EnvironmentQuery q;
+      if (queries.empty()) firstEnv = h.index;
+      q.distance = at[h.index] - at[firstEnv];
+      q.params = floats(h.index);
+      if (h.index + 1 < cur.size()) {
+        // cpfg's symbol of the next module: its first character (two after '@' or '~'),
+        // with the parameters when that is the whole name (cpfg's '@Gs(..)' is '@', 'G', 's(..)')
+        const std::string& n = prog->symbols.name(cur.symbols[h.index + 1]);
+        const size_t len = (n[0] == '@' || n[0] == '~') && n.size() > 1 ? 2 : 1;
+        q.next = n.substr(0, len);
+        if (len == n.size()) q.nextParams = floats(h.index + 1);
+      }
+      q.position = vec(h.frame.position);
+      q.heading = vec(h.frame.heading);
+      q.left = vec(h.frame.left);
+      q.up = vec(-h.frame.up);  // cpfg's up vector
+      moduleAt[q.distance] = h.index;
+      queries.push_back(std::move(q));
+    }
+    for (const EnvironmentAnswer& a : opt.environment->exchange(queries, done)) {
+      if (a.distance == 1 && !moduleAt.count(1)) continue;  // cpfg: a ?E of an interpretation rule
+      auto it = moduleAt.find(a.distance);
+      if (it == moduleAt.end())
+        throw InputError(SourceLoc{"sprig", 0, 0}, "environmental program '" + opt.environment->name() +
+                                                        "' answered for the module at distance " + std::to_string(a.distance) +
+                                                        ", which is no ?E module it was sent");
+      const size_t i = it->second;
+      const size_t n = std::min<size_t>(a.params.size(), cur.paramCount(i));  // cpfg sets those that fit
+      for (size_t c = 0; c < n; ++c)
+        if (a.params[c]) cur.params[cur.offsets[i] + c] = static_cast<double>(*a.params[c]);
+    }
+  }
+  size_t firstEnv = 0;  ///< the first `?E` of the pass (cpfg's first_comm_symbol)
 
   /// s rewritten by the interpretation rules (recursively up to their maximum depth), as
   /// the turtle reads it; random draws from the interpretation stream of step `step`.
@@ -1408,6 +1475,7 @@ Deriver::Deriver(Deriver&&) noexcept = default;
 Deriver& Deriver::operator=(Deriver&&) noexcept = default;
 
 void Deriver::restart() {
+  if (impl_->opt.environment) impl_->opt.environment->restart();  // cpfg restarts it on rewind
   impl_->done = 0;
   impl_->start();
 }
@@ -1415,9 +1483,10 @@ void Deriver::restart() {
 const ModuleString& Deriver::step() {
   Impl& m = *impl_;
   int step = m.done + 1;
-  if (m.queriesPending) {
+  const bool envBefore = m.environmentActive() && !m.opt.environmentAfterEachStep && !m.environmentDone;
+  if (m.queriesPending || envBefore) {
     m.queriesPending = false;
-    m.fillQueries();  // cpfg interprets the string when the next step starts
+    m.fillQueries(envBefore);  // cpfg interprets the string when the next step starts
   }
   m.runBlock(m.prog->startEachBlock, step, step - 1);
   m.rewrite(m.prog->productions, step, static_cast<uint64_t>(step - m.streamBase), true);

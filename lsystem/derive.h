@@ -20,6 +20,7 @@
 #include <optional>
 #include <string>
 
+#include "lsystem/cpfg_environment.h"
 #include "lsystem/grammar.h"
 #include "lsystem/module_string.h"
 #include "lsystem/turtle.h"
@@ -50,6 +51,16 @@ struct DeriveOptions {
   /// has a `box:` line (control.c, CalculateViewVolume interprets only without one); a
   /// later step() fills them first, as cpfg does when the next step starts.
   bool queriesAfterLastStep = true;
+  /// cpfg's environmental program (`-e FILE.e`, docs/GRAMMAR.md "Environmental programs"):
+  /// before every step the string is interpreted as for the query modules, each `?E` module
+  /// the turtle reaches is sent to it, and its answers set those modules' parameters (as
+  /// cpfg's default `environment display: after`: the final string is not sent). Null:
+  /// `?E` modules keep their values, as cpfg's do without -e. restart() restarts it.
+  std::shared_ptr<EnvironmentProgram> environment;
+  /// cpfg's `environment display: before` (a view file's, ViewFile::environmentBefore): the
+  /// exchange follows every step instead of preceding it, and the axiom's comes first, so
+  /// the final string holds the program's answers.
+  bool environmentAfterEachStep = false;
   /// Called after every completed step with (step, module count); may be empty.
   std::function<void(int step, size_t modules)> onStep;
 };

@@ -69,6 +69,12 @@ struct GrammarOverrides {
   /// cpfg: the names of a view file's `function set:` functions (ViewFile::functionNames),
   /// which the preprocessor defines as 1, 2, ... in a `.l` grammar.
   std::vector<std::string> cpfgFunctionNames;
+  /// cpfg's environment file (`-e FILE.e`, relative to the working folder; empty: none): the derivation
+  /// runs the environmental program it names in the grammar's folder and exchanges the `?E`
+  /// modules with it (DeriveOptions::environment). Not read by the parser.
+  std::string cpfgEnvironment;
+  /// Longest wait for that program, in seconds (EnvironmentOptions::timeoutSeconds).
+  double cpfgEnvironmentTimeout = 60.0;
 };
 
 /// A parsed, compiled L-system.

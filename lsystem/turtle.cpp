@@ -168,7 +168,7 @@ Turtle::Turtle(const SymbolTable& symbols, TurtleSettings settings) : symbols_(s
       c = Command::Texture;
     } else if (n == "@L") {
       c = Command::Label;
-    } else if (n == "?P" || n == "?H" || n == "?L" || n == "?U") {
+    } else if (n == "?P" || n == "?H" || n == "?L" || n == "?U" || n == "?E") {
       c = Command::Query;
     } else if (n.size() > 1 && n[0] == '~') {
       c = Command::SurfaceNamed;

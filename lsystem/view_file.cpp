@@ -344,6 +344,10 @@ class ViewParser {
         warn(line, kcol, "'" + key + ":' ignored: the grammar's uses of it are errors (not supported)");
         return;
       }
+    if (key == "environment display") {  // read: it says when ?E modules go to the environmental program
+      view_.environmentBefore = trimmed(value).rfind("before", 0) == 0;
+      return;
+    }
     for (const char* k : kViewerKeys)
       if (key == k) {
         if (key == "box") view_.box = true;

@@ -62,6 +62,10 @@ struct ViewFile {
   /// size its window, so that string's query modules keep the values they had before the
   /// last step (DeriveOptions::queriesAfterLastStep).
   bool box = false;
+  /// `environment display: before`: cpfg exchanges `?E` modules with its environmental
+  /// program after every step (and for the axiom) instead of before it
+  /// (DeriveOptions::environmentAfterEachStep).
+  bool environmentBefore = false;
   /// The ids of the `tsurface:` lines (cpfg's triangulated surfaces, not read): a `~X` of
   /// one is an error in the grammar (GrammarOverrides::cpfgUndrawnSurfaceIds).
   std::string tsurfaceIds;

@@ -1,6 +1,7 @@
 #include "model/growth.h"
 
 #include <algorithm>
+#include <filesystem>
 #include <optional>
 #include <stdexcept>
 
@@ -28,6 +29,16 @@ GrowthEngine::GrowthEngine(const Species& species, const GrowthOptions& options)
   // cpfg -g draws no final string when the view file sets the view volume (`box:`)
   dopt.queriesAfterLastStep = !(tree.view && tree.view->box);
   if (tree.view) unsupportedDrawing_ = tree.view->unsupportedDrawing;
+  dopt.environmentAfterEachStep = tree.view && tree.view->environmentBefore;
+  if (!options.extra.cpfgEnvironment.empty()) {
+    // cpfg runs the program in the object's folder, where the grammar is
+    std::string dir = std::filesystem::path(grammar_->fileName()).parent_path().string();
+    if (dir.empty()) dir = ".";
+    lsystem::EnvironmentOptions eo;
+    eo.timeoutSeconds = options.extra.cpfgEnvironmentTimeout;
+    dopt.environment = std::make_shared<lsystem::EnvironmentProgram>(
+        lsystem::readEnvironmentFile(options.extra.cpfgEnvironment), std::filesystem::absolute(dir).string(), eo);
+  }
   deriver_ = std::make_unique<lsystem::Deriver>(*grammar_, dopt);
   lastStep_ = options.lastStep < 0 ? deriver_->steps() : std::min(options.lastStep, deriver_->steps());
 }

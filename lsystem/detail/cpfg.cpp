@@ -26,7 +26,6 @@ constexpr Unsupported kUnsupported[] = {
     {"@mc", "conditional cut"},
     {"@;", "back-side color"},
     {"@,", "back-side color"},
-    {"?E", "communication with an environment program"},
 };
 
 }  // namespace

@@ -725,7 +725,9 @@ class GrammarParser {
     }
   }
 
-  static bool isQuery(std::string_view name) { return name == "?P" || name == "?H" || name == "?L" || name == "?U"; }
+  static bool isQuery(std::string_view name) {
+    return name == "?P" || name == "?H" || name == "?L" || name == "?U" || name == "?E";
+  }
   /// cpfg fills a query module of an interpretation rule in the interpreted copy of the
   /// string, where no production reads it; Sprig refuses it rather than ignore it.
   static std::string queryInInterpretation(std::string_view name) {
@@ -1507,7 +1509,10 @@ class GrammarParser {
     for (const auto& [name, counts] : predecessors) {
       auto w = written_.find(name);
       // (cpfg's `_`, its old elasticity, is a turtle command too: `_(e)` or `_` alone.)
-      if (w == written_.end() || isTurtleSymbol(name) || (prog_.dialect == Dialect::Cpfg && name == "_")) continue;
+      // (cpfg's `?E` too: vlab's clover writes `?E(1)` beside a production for `?E(t,la)`,
+      // which cpfg accepts and never applies to it.)
+      if (w == written_.end() || isTurtleSymbol(name) || (prog_.dialect == Dialect::Cpfg && (name == "_" || name == "?E")))
+        continue;
       bool reported = std::any_of(counts.begin(), counts.end(), [&](const auto& c) { return !w->second.count(c.first); });
       if (reported) continue;
       const ArityUse& prod = *counts.begin()->second;
@@ -1670,6 +1675,7 @@ class GrammarParser {
     }
     for (SymbolId id : prog_.axiom.symbols) prog_.usesCut |= id == prog_.cut;
     for (const char* q : {"?P", "?H", "?L", "?U"}) prog_.usesQuery |= prog_.symbols.find(q) >= 0;
+    prog_.usesEnvQuery = prog_.symbols.find("?E") >= 0;
     std::vector<RuleSet*> sets{&prog_.productions, &prog_.decomposition, &prog_.interpretation};
     std::vector<const RuleSet*> interpretations{&prog_.interpretation};
     for (SubLsystem& sub : prog_.subLsystems) {

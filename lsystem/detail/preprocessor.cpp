@@ -5,7 +5,10 @@
 // points at the user's file:line:col). docs/GRAMMAR.md, "The C preprocessor".
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
+#include <cstring>
+#include <optional>
 #include <filesystem>
 #include <stdexcept>
 #include <string>
@@ -45,6 +48,104 @@ size_t tokenEnd(const std::string& s, size_t i) {
   while (i < s.size() && isIdentChar(s[i])) ++i;
   return i;
 }
+
+/// cpp's `#if` arithmetic over a text with every name already replaced: numbers, `( )`,
+/// unary `! - +`, `* / %`, `+ -`, `< <= > >=`, `== !=`, `&&`, `||`. A name left over is 0,
+/// as in C. nullopt when the text is no such expression.
+class PpCondition {
+ public:
+  explicit PpCondition(const std::string& t) : t_(t) {}
+  std::optional<double> value() {
+    std::optional<double> v = orExpr();
+    skip();
+    return v && i_ == t_.size() ? v : std::nullopt;
+  }
+
+ private:
+  const std::string& t_;
+  size_t i_ = 0;
+  void skip() {
+    while (i_ < t_.size() && isSpace(t_[i_])) ++i_;
+  }
+  bool eat(const char* op) {
+    skip();
+    const size_t n = std::char_traits<char>::length(op);
+    if (t_.compare(i_, n, op) != 0) return false;
+    // `<` is not the start of `<=`, `!` not of `!=`, `=` never alone
+    if (n == 1 && i_ + 1 < t_.size() && t_[i_ + 1] == '=' && std::strchr("<>!=", op[0])) return false;
+    if (n == 1 && i_ + 1 < t_.size() && t_[i_ + 1] == op[0] && std::strchr("&|", op[0])) return false;
+    i_ += n;
+    return true;
+  }
+  template <typename Next, typename Apply>
+  std::optional<double> binary(Next next, std::initializer_list<const char*> ops, Apply apply) {
+    std::optional<double> a = (this->*next)();
+    for (;;) {
+      const char* hit = nullptr;
+      for (const char* op : ops)
+        if (!hit && eat(op)) hit = op;
+      if (!hit) return a;
+      std::optional<double> b = (this->*next)();
+      if (!a || !b) return std::nullopt;
+      a = apply(std::string(hit), *a, *b);
+      if (!a) return std::nullopt;
+    }
+  }
+  std::optional<double> orExpr() {
+    return binary(&PpCondition::andExpr, {"||"}, [](const std::string&, double a, double b) -> std::optional<double> { return (a != 0 || b != 0) ? 1.0 : 0.0; });
+  }
+  std::optional<double> andExpr() {
+    return binary(&PpCondition::eqExpr, {"&&"}, [](const std::string&, double a, double b) -> std::optional<double> { return (a != 0 && b != 0) ? 1.0 : 0.0; });
+  }
+  std::optional<double> eqExpr() {
+    return binary(&PpCondition::relExpr, {"==", "!="}, [](const std::string& op, double a, double b) -> std::optional<double> {
+      return (op == "==") == (a == b) ? 1.0 : 0.0;
+    });
+  }
+  std::optional<double> relExpr() {
+    return binary(&PpCondition::addExpr, {"<=", ">=", "<", ">"}, [](const std::string& op, double a, double b) -> std::optional<double> {
+      const bool r = op == "<=" ? a <= b : op == ">=" ? a >= b : op == "<" ? a < b : a > b;
+      return r ? 1.0 : 0.0;
+    });
+  }
+  std::optional<double> addExpr() {
+    return binary(&PpCondition::mulExpr, {"+", "-"}, [](const std::string& op, double a, double b) -> std::optional<double> {
+      return op == "+" ? a + b : a - b;
+    });
+  }
+  std::optional<double> mulExpr() {
+    return binary(&PpCondition::unary, {"*", "/", "%"}, [](const std::string& op, double a, double b) -> std::optional<double> {
+      if (op != "*" && b == 0) return std::nullopt;
+      return op == "*" ? a * b : op == "/" ? a / b : std::fmod(a, b);
+    });
+  }
+  std::optional<double> unary() {
+    if (eat("!")) {
+      std::optional<double> v = unary();
+      return v ? std::optional<double>(*v == 0 ? 1.0 : 0.0) : std::nullopt;
+    }
+    if (eat("-")) {
+      std::optional<double> v = unary();
+      return v ? std::optional<double>(-*v) : std::nullopt;
+    }
+    if (eat("+")) return unary();
+    skip();
+    if (eat("(")) {
+      std::optional<double> v = orExpr();
+      return eat(")") ? v : std::nullopt;
+    }
+    if (i_ < t_.size() && (isIdentStart(t_[i_]) || std::isdigit(static_cast<unsigned char>(t_[i_])) || t_[i_] == '.')) {
+      const size_t e = tokenEnd(t_, i_);
+      const std::string tok = t_.substr(i_, e - i_);
+      i_ = e;
+      if (isIdentStart(tok[0])) return 0.0;
+      char* end = nullptr;
+      const double v = std::strtod(tok.c_str(), &end);
+      return end && (*end == '\0' || std::strchr("uUlL", *end)) ? std::optional<double>(v) : std::nullopt;
+    }
+    return std::nullopt;
+  }
+};
 
 }  // namespace
 
@@ -314,9 +415,16 @@ bool Scanner::conditionalDirective(const Directive& d) {
     emitLine(d.file, d.k, d.raw, "", {});
     return true;
   }
-  if (word == "if") {  // not read: the grammar parser reports it; its #endif still closes it
-    conditionals_.push_back(opened);
-    emitLine(d.file, d.k, d.raw, d.s, {});
+  if (word == "if") {
+    Conditional c = opened;
+    if (preprocessorActive()) {
+      const size_t at = d.s.find("if", d.hash) + 2;
+      std::optional<double> v = ifCondition(d.s.substr(at));
+      if (!v) directiveError(d, at, "cannot evaluate '#if" + d.s.substr(at) + "' (expected a constant expression of numbers and #define names)");
+      c.active = v && *v != 0;
+    }
+    conditionals_.push_back(c);
+    emitLine(d.file, d.k, d.raw, "", {});
     return true;
   }
   if (word != "else" && word != "endif") return false;
@@ -333,6 +441,60 @@ bool Scanner::conditionalDirective(const Directive& d) {
   }
   emitLine(d.file, d.k, d.raw, "", {});
   return true;
+}
+
+std::optional<double> Scanner::ifCondition(const std::string& text) {
+  // defined(NAME) and defined NAME first, then the macros, then the constants' bodies
+  // (the file's values: -D does not change which lines #if keeps), repeatedly.
+  auto isDefined = [&](const std::string& n) {
+    return std::any_of(macros_.begin(), macros_.end(), [&](const auto& m) { return m.first == n; }) ||
+           std::any_of(constants_.begin(), constants_.end(), [&](const auto& c) { return c.first == n; });
+  };
+  std::string t;
+  for (size_t i = 0; i < text.size();) {
+    if (!isIdentStart(text[i]) || text.compare(i, 7, "defined") != 0 || tokenEnd(text, i) != i + 7) {
+      const size_t e = isIdentStart(text[i]) || std::isdigit(static_cast<unsigned char>(text[i])) ? tokenEnd(text, i) : i + 1;
+      t.append(text, i, e - i);
+      i = e;
+      continue;
+    }
+    size_t k = i + 7;
+    while (k < text.size() && isSpace(text[k])) ++k;
+    const bool paren = k < text.size() && text[k] == '(';
+    if (paren) ++k;
+    while (k < text.size() && isSpace(text[k])) ++k;
+    const size_t e = k < text.size() && isIdentStart(text[k]) ? tokenEnd(text, k) : k;
+    t += isDefined(text.substr(k, e - k)) ? "1" : "0";
+    k = e;
+    while (paren && k < text.size() && isSpace(text[k])) ++k;
+    i = paren && k < text.size() && text[k] == ')' ? k + 1 : k;
+  }
+  std::vector<std::string> disabled;
+  bool failed = false;
+  t = expandText(t, disabled, 0, failed);
+  if (failed) return std::nullopt;
+  for (int round = 0; round < kMaxExpansionDepth; ++round) {
+    std::string out;
+    bool changed = false;
+    for (size_t i = 0; i < t.size();) {
+      if (!isIdentStart(t[i]) && !std::isdigit(static_cast<unsigned char>(t[i]))) {
+        out += t[i++];
+        continue;
+      }
+      const size_t e = tokenEnd(t, i);
+      auto body = std::find_if(constantBodies_.begin(), constantBodies_.end(), [&](const auto& c) { return c.first == t.substr(i, e - i); });
+      if (isIdentStart(t[i]) && body != constantBodies_.end()) {
+        out += "(" + body->second + ")";
+        changed = true;
+      } else {
+        out.append(t, i, e - i);
+      }
+      i = e;
+    }
+    t = out;
+    if (!changed) return PpCondition(t).value();
+  }
+  return std::nullopt;
 }
 
 void Scanner::defineDirective(const Directive& d) {
@@ -369,6 +531,7 @@ void Scanner::defineDirective(const Directive& d) {
   m.body = trimmed(s, after);
   if (!m.functionLike && isConstantBody(m.body, constants_, dialect_)) {
     constants_.emplace_back(name, static_cast<int>(d.k) + 1);
+    constantBodies_.emplace_back(name, m.body);
     emitLine(d.file, d.k, d.raw, s, {});  // read by the grammar parser (a value -D may override)
     return;
   }
@@ -436,6 +599,8 @@ void Scanner::directive(const Directive& d) {
   } else if (d.word == "undef") {
     macros_.erase(std::remove_if(macros_.begin(), macros_.end(), [&](const auto& e) { return e.first == d.name; }), macros_.end());
     constants_.erase(std::remove_if(constants_.begin(), constants_.end(), [&](const auto& e) { return e.first == d.name; }), constants_.end());
+    constantBodies_.erase(std::remove_if(constantBodies_.begin(), constantBodies_.end(), [&](const auto& e) { return e.first == d.name; }),
+                          constantBodies_.end());
     emitLine(d.file, d.k, d.raw, "", {});
   } else if (d.word == "include") {
     includeDirective(d);

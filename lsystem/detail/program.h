@@ -564,6 +564,8 @@ struct Program {
   /// the Deriver then interprets the string before every step and writes the turtle's
   /// state into their parameters.
   bool usesQuery = false;
+  /// True when the grammar writes cpfg's `?E` (communication with an environmental program).
+  bool usesEnvQuery = false;
   /// The `derivation length:` header (line 0 when the file has none), with its line's text;
   /// module-limit errors point here when the grammar's own length is used.
   SourceLoc lengthLoc;

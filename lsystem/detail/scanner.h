@@ -158,6 +158,8 @@ class Scanner {
   void directive(const Directive& d);
   /// `#ifdef`, `#ifndef`, `#if`, `#else`, `#endif`: true when d is one of them.
   bool conditionalDirective(const Directive& d);
+  /// The value of an `#if` condition (nullopt: not a constant expression).
+  std::optional<double> ifCondition(const std::string& text);
   void defineDirective(const Directive& d);
   void includeDirective(const Directive& d);
   struct Macro;
@@ -185,6 +187,8 @@ class Scanner {
   };
   std::vector<std::pair<std::string, Macro>> macros_;
   std::vector<std::pair<std::string, int>> constants_;
+  /// The body of each constant (`#define LEAVES 1`), for `#if`.
+  std::vector<std::pair<std::string, std::string>> constantBodies_;
   struct Conditional {
     bool active, parentActive, elseSeen;
     int file, line, col;

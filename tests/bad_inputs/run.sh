@@ -9,7 +9,7 @@
 # folder), `exit:`, one or more `expect:` lines and optionally `maxlines: N` (stderr holds
 # at most N lines and N*200 bytes: a long line or a binary file is never echoed whole),
 # `setup: SHELL COMMAND` (run by bash from the repository root before the case, with $IN a
-# fresh folder for inputs it makes: FIFOs, many generated files; $IN may appear in `args:`
+# fresh folder for inputs it makes: FIFOs, many generated files; $SPRIG is the binary; $IN may appear in `args:`
 # and `expect:`) and `cd: DIR` (sprig runs in DIR, relative to the repository root);
 # blocks are separated by blank lines.
 set -u
@@ -33,7 +33,7 @@ run_case() {
   local expanded=${args//\$OUT/$out}
   expanded=${expanded//\$IN/$in}
   local stderr_file="$WORK/$name.stderr"
-  if [ -n "$setup" ] && ! IN="$in" bash -c "$setup"; then
+  if [ -n "$setup" ] && ! IN="$in" SPRIG="$SPRIG" bash -c "$setup"; then
     echo "FAIL $name: setup failed: $setup"; fail=$((fail + 1)); name="" args="" code="" expects=() maxlines="" setup="" dir=""; return
   fi
   # shellcheck disable=SC2086

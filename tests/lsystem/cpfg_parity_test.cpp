@@ -16,6 +16,7 @@
 #include "lsystem/grammar.h"
 #include "lsystem/turtle.h"
 #include "lsystem/view_file.h"
+#include "tests/lsystem/cpfg_compare.h"
 #include "tests/paths.h"
 
 using namespace sprig;
@@ -27,14 +28,7 @@ std::string parityAsset(const std::string& name) {
   return std::string(SPRIG_SOURCE_DIR) + "/tests/assets/cpfg/parity/" + name;
 }
 
-/// cpfg's string file: `%g` parameters, lines wrapped at 70 characters between any two
-/// characters of cpfg's (so `?` and `P` of `?P` may be on two lines): the lines joined.
-std::string cpfgString(const std::string& folder) {
-  std::string text = readFile(parityAsset(folder + "/cpfg.str")), out;
-  for (char c : text)
-    if (c != '\n' && c != '\r') out += c;
-  return out;
-}
+std::string cpfgString(const std::string& folder) { return test::readCpfgString(parityAsset(folder + "/cpfg.str")); }
 
 /// A parity object: its grammar (with its view file's turtle for the query modules, when it
 /// has one), derived to its own length.
@@ -59,23 +53,8 @@ Parity loadParity(const std::string& folder) {
   return p;
 }
 
-/// Compares Sprig's string with cpfg's: the same modules, parameters within 1e-5 (relative
-/// or absolute: cpfg prints 6 significant digits).
 void checkSame(const ModuleString& got, const SymbolTable& symbols, const std::string& cpfg) {
-  SymbolTable table = symbols;
-  const ModuleString want = parseModuleString(cpfg, table, "cpfg.l");  // read in cpfg's notation
-  INFO("cpfg:  " << cpfg);
-  INFO("Sprig: " << formatModuleString(got, symbols, FormatOptions{0, true}));
-  REQUIRE(got.size() == want.size());
-  for (size_t i = 0; i < got.size(); ++i) {
-    INFO("module " << i);
-    REQUIRE(symbols.name(got.symbols[i]) == table.name(want.symbols[i]));
-    REQUIRE(got.paramCount(i) == want.paramCount(i));
-    for (uint32_t k = 0; k < got.paramCount(i); ++k) {
-      const double a = got.paramsOf(i)[k], b = want.paramsOf(i)[k];
-      CHECK(std::fabs(a - b) <= 1e-5 * std::max(1.0, std::fabs(b)));
-    }
-  }
+  test::checkSameAsCpfg(got, symbols, cpfg);
 }
 
 ModuleString deriveParity(Parity& p) {

@@ -297,6 +297,7 @@ TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg
           "t.l:2:8: cpfg's '$' ends a sub-L-system call '?(n, scale)', and this file makes none (ABOP's roll to vertical is '@v' in cpfg)");
     CHECK(errorOf("axiom: F~l\n") == "no error");  // draws nothing, as in cpfg (a warning: cpfg surface files)
     CHECK(errorOf("axiom: ?P(0,0)A\n") == "no error");
+    CHECK(errorOf("axiom: ?E(1)?E(1,2)\n?E(t,la) --> *\n") == "no error");  // vlab's clover: cpfg accepts it
     CHECK(errorOf("axiom: A\nhomomorphism\nA --> F?U(0,0,0)\n") ==
           "t.l:3:8: cpfg's query module '?U' in an interpretation rule is not supported (its values would be lost with "
           "the interpreted string)");
@@ -307,8 +308,11 @@ TEST_CASE("cpfg constructs Sprig does not implement are errors", "[lsystem][cpfg
   }
   SECTION("statements, blocks, preprocessor, several L-systems") {
     CHECK(errorOf("axiom: A(1)\nA(y) : { x = y / 2; x < 10 --> B(x)\n") == "t.l:2:8: unclosed '{' of a statement block");
-    CHECK(errorOf("#if 1\naxiom: A\n#endif\n") ==
-          "t.l:1:1: cpfg's C preprocessor directive '#if' is not supported (Sprig's preprocessor reads #define, "
+    CHECK(errorOf("#if 1\naxiom: A\n#endif\n") == "no error");
+    CHECK(errorOf("#if 1 +\naxiom: A\n#endif\n") ==
+          "t.l:1:4: cannot evaluate '#if 1 +' (expected a constant expression of numbers and #define names)");
+    CHECK(errorOf("#elif 1\naxiom: A\n") ==
+          "t.l:1:1: cpfg's C preprocessor directive '#elif' is not supported (Sprig's preprocessor reads #define, "
           "#undef, #include, #ifdef, #ifndef, #else and #endif)");
     CHECK(errorOf("#define K (1 > 0 ? 2 : 3)\naxiom: A\n") == "no error");
     CHECK(errorOf("lsystem: 1\naxiom: A\nendlsystem\n", "t.l") == "no error");
@@ -1411,4 +1415,18 @@ TEST_CASE("cpfg define: arrays", "[lsystem][cpfg]") {
     CHECK(errorOf("define: { array a[2]; }\nStart: { a = 1; }\naxiom: A\n") ==
           "t.l:2:10: cannot assign to 'a': it is an array (assign its elements, 'a[i] = ...')");
   }
+}
+
+TEST_CASE("cpfg's #if", "[lsystem][cpfg]") {
+  auto axiomOf = [](const std::string& text) {
+    const Grammar g = parseGrammar(text, "t.l");
+    return formatModuleString(g.axiom(), g.symbols());
+  };
+  // vlab's clover and two-trees objects: `#if LEAVES==1` over a #define constant
+  CHECK(axiomOf("#define LEAVES 1\n#if LEAVES==1\naxiom: A\n#else\naxiom: B\n#endif\n") == "A");
+  CHECK(axiomOf("#define LEAVES 2\n#if LEAVES==1\naxiom: A\n#else\naxiom: B\n#endif\n") == "B");
+  CHECK(axiomOf("#define N (2)\n#if N > 1 && !(N >= 3) || 0\naxiom: A\n#else\naxiom: B\n#endif\n") == "A");
+  CHECK(axiomOf("#if UNDEFINED\naxiom: A\n#else\naxiom: B\n#endif\n") == "B");  // an unknown name is 0, as in C
+  CHECK(axiomOf("#define K 3\n#if defined(K) && defined K && !defined(L) && K % 2 == 1 && -K < 0\naxiom: A\n#else\naxiom: B\n#endif\n") == "A");
+  CHECK(axiomOf("#if 0\n#if 1 +\n#endif\naxiom: B\n#else\naxiom: A\n#endif\n") == "A");  // not evaluated inside a false block
 }

@@ -1,0 +1,2 @@
+angle increment: 25
+environment display: before

@@ -1,0 +1,2 @@
+executable: sprig_enviro_test field
+interpreted modules: F
