@@ -8,6 +8,10 @@ BUILD   ?= build
 JOBS    ?= $(shell nproc)
 SPRIG   := $(BUILD)/sprig
 QUALITY ?= draft
+# `make gallery` runs this many shards side by side, one thread each, then merges them
+# (docs/GALLERY.md "make gallery"): one process's serial parts (solid meshing, GIF
+# writing, reading) overlap the other's work. The result is the same bytes as one process.
+GALLERY_SHARDS ?= $(JOBS)
 ASAN_BUILD   ?= build-asan
 FUZZ_SECONDS ?= 60
 CCACHE := $(if $(shell command -v ccache),-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
@@ -43,7 +47,10 @@ test: build
 	@cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
 
 gallery: build
-	@$(SPRIG) gallery -o gallery/out --quality $(QUALITY)
+	@pids=; for i in $$(seq 0 $$(($(GALLERY_SHARDS) - 1))); do \
+	  $(SPRIG) --threads 1 gallery -o gallery/out --quality $(QUALITY) --shard $$i/$(GALLERY_SHARDS) & pids="$$pids $$!"; \
+	done; status=0; for p in $$pids; do wait $$p || status=1; done; exit $$status
+	@$(SPRIG) gallery --merge gallery/out
 
 bench: build
 	@for b in $(BUILD)/bench/*; do echo "== $$b"; $$b || exit 1; done

@@ -46,6 +46,7 @@ int renderGalleryAnimation(SpeciesModel& model, const fs::path& out, const Speci
     // A turntable around the one stage, one camera distance throughout.
     const int n = final ? 48 : 8;
     std::vector<Image> frames;
+    FrameSequence sequence(model);  // one stage: a scene that serves every turned camera is built once
     Progress bar("turntable " + name, static_cast<size_t>(n));
     for (int i = 0; i < n; ++i) {
       SpeciesRender turn = look;
@@ -56,7 +57,7 @@ int renderGalleryAnimation(SpeciesModel& model, const fs::path& out, const Speci
       job.samples = samples;
       job.mode = GeometryMode::Exact;
       job.progress = false;
-      frames.push_back(renderModel(model, turn, job));
+      frames.push_back(sequence.render(turn, job));
       bar.advance();
     }
     bar.finish();
@@ -133,6 +134,7 @@ GalleryItem renderGalleryItem(const fs::path& speciesFile, const fs::path& outDi
     item.primitives = fig.primitives;
     item.triangles = fig.triangles;
     item.deriveSeconds = fig.buildSeconds;
+    item.stillSeconds = secondsSince(r0);
 
     // The growth strip: every stage framed like the final one. A solid does not grow: its
     // strip is the whole solid and its cut-away by render.section or the plane z = 0 (Fig. 3e, 3f); a solid
@@ -164,11 +166,13 @@ GalleryItem renderGalleryItem(const fs::path& speciesFile, const fs::path& outDi
         for (int x = 0; x < cellWidth; ++x) strip.set(static_cast<int>(i) * cellWidth + x, y, cell.at(x, y));
     }
     writeImage(strip, outDir / item.strip);
+    item.stripSeconds = secondsSince(r0) - item.stillSeconds;
 
     item.animation = stem + ".gif";
     item.frames = renderGalleryAnimation(model, outDir / item.animation, look, width, height,
                                          quality == GalleryQuality::Final);
     item.renderSeconds = secondsSince(r0);
+    item.animationSeconds = item.renderSeconds - item.stillSeconds - item.stripSeconds;
   } catch (const InputError& e) {
     item.error = e.what();
     item.preview.clear();

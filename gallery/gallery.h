@@ -34,7 +34,10 @@ struct GalleryItem {
   size_t internodes = 0;
   int steps = 0;
   double deriveSeconds = 0;  ///< building the final stage: derivation, turtle, BlobTree, compile
-  double renderSeconds = 0;
+  double renderSeconds = 0;  ///< the three pictures: the still, the strip and the animation
+  double stillSeconds = 0;      ///< of renderSeconds: the final stage's picture
+  double stripSeconds = 0;      ///< of renderSeconds: the growth strip
+  double animationSeconds = 0;  ///< of renderSeconds: the animation
   std::string error;        ///< non-empty when the species failed (the diagnostics)
 };
 

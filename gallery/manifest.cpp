@@ -46,7 +46,9 @@ std::string manifestJson(const Manifest& m) {
          ", \"internodes\": " + std::to_string(it.internodes) + ", \"primitives\": " + std::to_string(it.primitives) +
          ", \"triangles\": " + std::to_string(it.triangles) + ", \"frames\": " + std::to_string(it.frames) +
          ", \"steps\": " + std::to_string(it.steps) + ", \"derive_seconds\": " + json::number(it.deriveSeconds) +
-         ", \"render_seconds\": " + json::number(it.renderSeconds) + ", \"error\": " + json::string(it.error) +
+         ", \"render_seconds\": " + json::number(it.renderSeconds) + ", \"still_seconds\": " + json::number(it.stillSeconds) +
+         ", \"strip_seconds\": " + json::number(it.stripSeconds) +
+         ", \"animation_seconds\": " + json::number(it.animationSeconds) + ", \"error\": " + json::string(it.error) +
          ", \"outputs\": " + stringList(e.outputs) + "}";
   }
   o += "\n]}\n";
@@ -85,6 +87,10 @@ Manifest parseManifest(const std::string& text, const std::string& displayPath) 
       it.steps = n["steps"].as<int>();
       it.deriveSeconds = n["derive_seconds"].as<double>();
       it.renderSeconds = n["render_seconds"].as<double>();
+      // The parts' times came later: a manifest without them reads as zeros.
+      it.stillSeconds = n["still_seconds"] ? n["still_seconds"].as<double>() : 0.0;
+      it.stripSeconds = n["strip_seconds"] ? n["strip_seconds"].as<double>() : 0.0;
+      it.animationSeconds = n["animation_seconds"] ? n["animation_seconds"].as<double>() : 0.0;
       it.error = n["error"].as<std::string>();
       e.outputs = n["outputs"].as<std::vector<std::string>>();
       m.entries.push_back(std::move(e));

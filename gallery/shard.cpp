@@ -331,7 +331,9 @@ GalleryRunResult renderGallery(std::vector<fs::path> files, const fs::path& outD
         std::cerr << entry.item.error << "\n";
       } else if (!options.quiet) {
         std::cerr << f.string() << ": " << entry.item.modules << " modules, " << entry.item.internodes
-                  << " internodes, " << entry.item.frames << " frames, " << entry.item.renderSeconds << " s render\n";
+                  << " internodes, " << entry.item.frames << " frames, " << entry.item.renderSeconds << " s render (still "
+                  << entry.item.stillSeconds << ", strip " << entry.item.stripSeconds << ", animation "
+                  << entry.item.animationSeconds << ")\n";
       }
     }
     if (!entry.item.error.empty()) ++result.failed;

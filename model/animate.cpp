@@ -169,6 +169,7 @@ AnimateResult animateModel(SpeciesModel& model, const SpeciesRender& baseLook, c
 
   std::vector<Image> gifFrames;
   {
+    FrameSequence sequence(model);  // a frame of the same stage as the one before reuses it
     std::optional<Progress> bar;
     if (!options.progressLabel.empty()) bar.emplace(options.progressLabel, frames.size());
     for (size_t i = 0; i < frames.size(); ++i) {
@@ -179,7 +180,7 @@ AnimateResult animateModel(SpeciesModel& model, const SpeciesRender& baseLook, c
       job.mode = mode;
       job.stage = frames[i];
       job.progress = false;
-      Image img = renderModel(model, look, job);
+      Image img = sequence.render(look, job);
       if (format == AnimationFormat::Gif)
         gifFrames.push_back(std::move(img));
       else

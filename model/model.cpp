@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <tuple>
 
 #include "core/diagnostics.h"
 #include "core/mesh_clean.h"
@@ -163,21 +164,48 @@ Box3 restingFrame(const Box3& frame, const Box3& stage, bool groundAtModelBase) 
   return Box3{frame.lo + up, frame.hi + up};
 }
 
-Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job, ModelFigures* figures,
-                          render::RenderStats* stats) {
-  const auto [width, height] = imageSize(look, job);
-  checkCameraRays(width, height, job.samples > 0 ? job.samples : look.image.spp);
-  const Box3 frame = job.frame ? *job.frame : model.frameBox();
-  checkFrameBox(model.species(), frame);
-  const bool fixedCamera = job.camera || look.closeUp;
-  render::Camera camera = job.camera ? *job.camera : speciesCamera(model, look, frame, width, height);
-  if (std::string why = render::cameraProblem(camera); !why.empty())
+namespace {
+
+/// The image size, frame box and camera of a job (renderModel's first step).
+struct FramePlan {
+  int width = 0, height = 0;
+  Box3 frame;
+  render::Camera camera;
+  bool fixedCamera = false;  ///< job.camera or a close-up: not moved to the resting frame
+};
+
+FramePlan planFrame(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job) {
+  FramePlan p;
+  std::tie(p.width, p.height) = imageSize(look, job);
+  checkCameraRays(p.width, p.height, job.samples > 0 ? job.samples : look.image.spp);
+  p.frame = job.frame ? *job.frame : model.frameBox();
+  checkFrameBox(model.species(), p.frame);
+  p.fixedCamera = job.camera || look.closeUp;
+  p.camera = job.camera ? *job.camera : speciesCamera(model, look, p.frame, p.width, p.height);
+  if (std::string why = render::cameraProblem(p.camera); !why.empty())
     throw InputError(model.species().loc(), "render.camera: " + why);
+  return p;
+}
+
+}  // namespace
+
+/// A stage built into a committed scene for one camera (renderModel's second step).
+struct BuiltScene {
   render::Scene scene;
-  scene.setPixelFootprint(camera, width, height, look.image.thinMinPixels);
+  ModelFigures figures;
+};
+
+namespace {
+
+std::unique_ptr<BuiltScene> buildScene(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job,
+                                       const FramePlan& plan) {
+  auto built = std::make_unique<BuiltScene>();
+  render::Scene& scene = built->scene;
+  scene.setPixelFootprint(plan.camera, plan.width, plan.height, look.image.thinMinPixels);
   SpeciesRender seen = look;
-  seen.pixels = camera.pixelScale(height);
-  ModelFigures fig = model.addToScene(scene, job.stage, job.mode, seen);
+  seen.pixels = plan.camera.pixelScale(plan.height);
+  ModelFigures& fig = built->figures;
+  fig = model.addToScene(scene, job.stage, job.mode, seen);
   const auto t0 = std::chrono::steady_clock::now();
   {
     const Phase phase("scene");
@@ -185,17 +213,75 @@ Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJo
   }
   fig.buildSeconds += secondsSince(t0);
   fig.cells = scene.stats().implicitCells;
-  render::RenderSettings rs = look.settings(width, height);
+  return built;
+}
+
+/// The picture of a built scene (renderModel's last step): the camera moved to the resting
+/// frame unless fixed, then rendered.
+Image renderScene(const BuiltScene& built, const SpeciesRender& look, const RenderJob& job, const FramePlan& plan,
+                  render::RenderStats* stats) {
+  render::RenderSettings rs = look.settings(plan.width, plan.height);
   if (job.samples > 0) rs.spp = job.samples;
   rs.progress = job.progress;
   rs.progressLabel = job.progressLabel;
-  const Box3 resting = restingFrame(frame, scene.bounds(), rs.groundAtModelBase);
-  if (!fixedCamera && resting.lo.y != frame.lo.y) camera = modelCamera(look, resting, width, height);
+  const Box3 resting = restingFrame(plan.frame, built.scene.bounds(), rs.groundAtModelBase);
+  render::Camera camera = plan.camera;
+  if (!plan.fixedCamera && resting.lo.y != plan.frame.lo.y) camera = modelCamera(look, resting, plan.width, plan.height);
   rs.groundFrame = resting;
   const Phase phase("render");
-  Image image = render::renderImage(scene, camera, rs, stats);
-  if (figures) *figures = fig;
+  return render::renderImage(built.scene, camera, rs, stats);
+}
+
+bool sameStage(const Stage& a, const Stage& b) {
+  return a.step == b.step && a.fraction == b.fraction && a.age == b.age && a.time == b.time &&
+         a.windSpeed == b.windSpeed && a.windDirectionDeg == b.windDirectionDeg && a.windSeconds == b.windSeconds;
+}
+
+bool sameCamera(const render::Camera& a, const render::Camera& b) {
+  return a.position == b.position && a.target == b.target && a.up == b.up && a.fovYDeg == b.fovYDeg;
+}
+
+}  // namespace
+
+Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job, ModelFigures* figures,
+                  render::RenderStats* stats) {
+  const FramePlan plan = planFrame(model, look, job);
+  const std::unique_ptr<BuiltScene> built = buildScene(model, look, job, plan);
+  Image image = renderScene(*built, look, job, plan, stats);
+  if (figures) *figures = built->figures;
   return image;
+}
+
+FrameSequence::FrameSequence(SpeciesModel& model) : model_(model) {}
+
+FrameSequence::~FrameSequence() = default;
+
+Image FrameSequence::render(const SpeciesRender& look, const RenderJob& job) {
+  const FramePlan plan = planFrame(model_, look, job);
+  const bool sameScene = built_ && sameStage(job.stage, stage_) && job.mode == mode_ && plan.width == width_ &&
+                         plan.height == height_;
+  if (sameScene && sameCamera(plan.camera, camera_) && job.samples == samples_ && plan.frame.lo == frame_.lo &&
+      plan.frame.hi == frame_.hi) {
+    ++reusedImages_;  // the same scene, camera and settings: the same bytes
+    return image_;
+  }
+  const bool serves = sameScene && job.mode != GeometryMode::Mesh && !look.wireframe &&
+                      built_->scene.servesCamera(plan.camera, plan.width, plan.height);
+  if (serves) {
+    ++reusedScenes_;
+  } else {
+    built_ = buildScene(model_, look, job, plan);
+    ++builtScenes_;
+  }
+  stage_ = job.stage;
+  mode_ = job.mode;
+  width_ = plan.width;
+  height_ = plan.height;
+  camera_ = plan.camera;
+  frame_ = plan.frame;
+  samples_ = job.samples;
+  image_ = renderScene(*built_, look, job, plan, nullptr);
+  return image_;
 }
 
 namespace {

@@ -158,6 +158,42 @@ void checkCameraRays(int width, int height, int samples);
 Image renderModel(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job,
                           ModelFigures* figures = nullptr, render::RenderStats* stats = nullptr);
 
+struct BuiltScene;
+
+/// Frames of one model seen with one look (apart from look.view, which may turn from frame
+/// to frame), each the same bytes as renderModel of the same look and job, with work shared
+/// between frames: a frame of the same stage, mode and size as the one before reuses its
+/// built, committed scene when that scene serves the frame's camera (render::Scene::
+/// servesCamera: triangles, or implicit cells the new camera sizes alike; not the mesh mode,
+/// whose polygonization cell follows the pixels, nor a wireframe, whose curve widths do),
+/// and its picture when the camera, frame box and samples are the same too. A frame of another stage rebuilds. Used by animateModel and the gallery's
+/// turntables. Not thread-safe; the model must outlive it.
+class FrameSequence {
+ public:
+  explicit FrameSequence(SpeciesModel& model);
+  ~FrameSequence();
+  FrameSequence(const FrameSequence&) = delete;
+  FrameSequence& operator=(const FrameSequence&) = delete;
+
+  /// renderModel(model, look, job), reusing what the previous frame built. Throws as renderModel.
+  Image render(const SpeciesRender& look, const RenderJob& job);
+
+  int builtScenes() const { return builtScenes_; }    ///< frames that built their scene
+  int reusedScenes() const { return reusedScenes_; }  ///< frames rendered from the previous frame's scene
+  int reusedImages() const { return reusedImages_; }  ///< frames that were the previous frame's picture
+
+ private:
+  SpeciesModel& model_;
+  std::unique_ptr<BuiltScene> built_;
+  Stage stage_;
+  GeometryMode mode_ = GeometryMode::Exact;
+  int width_ = 0, height_ = 0, samples_ = 0;
+  render::Camera camera_;
+  Box3 frame_;
+  Image image_;
+  int builtScenes_ = 0, reusedScenes_ = 0, reusedImages_ = 0;
+};
+
 /// The camera both panels of renderPair use for a width x height image (each panel half as
 /// wide): speciesCamera of model over the union of model's and other's frame boxes.
 render::Camera pairCamera(SpeciesModel& model, SpeciesModel& other, const SpeciesRender& look, int width, int height);

@@ -139,7 +139,9 @@ uint32_t Scene::addImplicit(const blobtree::CompiledBlob& blob, uint32_t materia
       pixels.eye = impl_->view->eye;
       pixels.forward = impl_->view->forward;
       pixels.pixelPerDepth = impl_->view->pixelPerDepth;
-      cellSize = pixelCellSize(cellSize, pixels, support);
+      const float own = cellSize;
+      cellSize = pixelCellSize(own, pixels, support);
+      impl_->followedCells.push_back({own, cellSize, support});  // another camera may give another cell
     }
     blobtree::SurfaceCellOptions cellOptions;
     cellOptions.prunedTapes = options.batched && options.prunedTapes && impl_->prunedTapes;

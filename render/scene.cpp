@@ -235,6 +235,7 @@ void Scene::setPixelFootprint(const Camera& camera, int width, int height, float
 uint32_t Scene::Impl::addCurveGeometry(std::shared_ptr<detail::CurveData> data, uint32_t material) {
   data->drawn = data->real;
   if (footprint) {
+    followsCamera = true;  // another camera may widen other segments
     for (Vec4& v : data->drawn) {
       const float r = footprint->minRadius(Vec3(v));
       if (v.w < r) {
@@ -295,6 +296,7 @@ std::optional<uint32_t> Scene::addThinAxes(const CurveSet& axes, uint32_t materi
   if (impl_->committed) throw std::logic_error("Scene::addThinAxes after commit");
   if (material >= impl_->materials.size()) throw std::invalid_argument("Scene::addThinAxes: unknown material id");
   if (!impl_->footprint || axes.empty()) return std::nullopt;
+  impl_->followsCamera = true;  // another camera may need other stand-ins
   auto data = std::make_shared<detail::CurveData>();
   data->standIn = true;
   for (uint32_t first : axes.segments) {
@@ -368,6 +370,7 @@ std::vector<uint32_t> Scene::add(const Geometry& geometry) {
       data->triangles = m->mesh.triangles;
       data->uvs = m->mesh.uvs;
       data->view = impl_->view;
+      if (impl_->view) impl_->followsCamera = true;  // texture filtering by the pixel's footprint
       rec.image = std::move(data);
       ids.push_back(impl_->addTriangles(std::move(rec)));
     } else if (const auto* im = std::get_if<ImplicitPart>(&part)) {
@@ -479,6 +482,16 @@ void Scene::commit() {
 Box3 Scene::bounds() const { return impl_->bounds; }
 
 SceneStats Scene::stats() const { return impl_->stats; }
+
+bool Scene::servesCamera(const Camera& camera, int width, int height) const {
+  if (impl_->followsCamera) return false;
+  if (impl_->followedCells.empty()) return true;
+  if (width < 1 || height < 1 || !impl_->view) return false;
+  const PixelScale pixels = camera.pixelScale(height);
+  for (const Impl::FollowedCell& c : impl_->followedCells)
+    if (pixelCellSize(c.ownCell, pixels, c.support) != c.usedCell) return false;
+  return true;
+}
 
 std::optional<SurfaceHit> Scene::intersect(const Vec3& origin, const Vec3& direction, float tnear, float tfar) const {
   if (!traceable(origin, direction, tnear, tfar)) return std::nullopt;

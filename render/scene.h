@@ -170,6 +170,12 @@ class Scene {
   Box3 bounds() const;
   /// What the scene holds.
   SceneStats stats() const;
+  /// True when this scene is the one setPixelFootprint(camera, width, height) would have
+  /// built from the same geometry: nothing added followed the footprint's camera (widened
+  /// curves, thin-axis stand-ins, image-mapped meshes' texture filtering), or only implicit
+  /// models' cell sizes did (ImplicitOptions::followPixels) and camera gives each the same
+  /// cell (render::pixelCellSize). Animation turntables reuse such a scene.
+  bool servesCamera(const Camera& camera, int width, int height) const;
 
   /// Closest hit along origin + t*direction for t in [tnear, tfar], or nothing. A ray
   /// Embree cannot trace (a coordinate of origin or direction not finite or beyond 1.8e18,

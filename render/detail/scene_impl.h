@@ -108,6 +108,16 @@ struct Scene::Impl {
   bool anyGeometry = false;               ///< something was added (the footprint is fixed then)
   std::optional<PixelFootprint> footprint;  ///< minimum width of thin curves, when set
   std::optional<detail::PixelView> view;    ///< the camera's pixel, when set (image maps)
+  /// Something added was shaped by the footprint or the view beyond an implicit model's
+  /// cell size (curves, thin axes, image maps): no other camera is served (Scene::servesCamera).
+  bool followsCamera = false;
+  /// An implicit model whose cell size followed the camera's pixel (Scene::servesCamera).
+  struct FollowedCell {
+    float ownCell = 0;  ///< the cell it asked for
+    float usedCell = 0;  ///< the cell the camera gave it
+    Box3 support;
+  };
+  std::vector<FollowedCell> followedCells;
 
   /// Commits geometry, attaches it under the next id and records how to shade it.
   uint32_t attach(RTCGeometry geometry, detail::GeometryRecord record);

@@ -22,12 +22,12 @@ same_gallery() {
   done < <(cd "$a" && find . -type f ! -path './manifests/*' | sort)
 }
 
-# One line per item of every manifest in DIR/manifests, sorted, its two timing fields emptied.
+# One line per item of every manifest in DIR/manifests, sorted, its timing fields (*_seconds) emptied.
 # (A manifest writes one item per line: `{"source": ..., "outputs": [...]}`, a comma after all
 # but the last.)
 _manifest_items() {
   grep -h '^ *{"source": ' "$1"/manifests/*.json |
-    sed -e 's/, *$//' -e 's/"derive_seconds": [^,]*,/"derive_seconds": ,/' -e 's/"render_seconds": [^,]*,/"render_seconds": ,/' |
+    sed -e 's/, *$//' -e 's/"\([a-z]*\)_seconds": [^,]*,/"\1_seconds": ,/g' |
     sort
 }
 

@@ -6,7 +6,8 @@
 #   2. a re-run renders nothing new;
 #   3. a changed species file re-renders only that species; a rebuilt sprig re-renders all;
 #   4. a run killed mid-render (SIGKILL) leaves no partial image and resumes;
-#   5. frames of `sprig animate` equal single renders (`--at STAGE:FRACTION`).
+#   5. frames of `sprig animate` equal single renders (`--at STAGE:FRACTION`), at 1 and 2
+#      threads; the gallery's stills equal `sprig render`.
 # Usage: tests/gallery/run.sh path/to/sprig   (run from the repository root)
 set -euo pipefail
 SPRIG=$(realpath "$1")
@@ -95,13 +96,22 @@ for i in $(seq 1 20); do
 done
 [ "$partial" -gt 0 ] || fail "no kill landed mid-run"
 
-# 5. Animation frames equal single renders of the same stage and fraction.
-"$SPRIG" --root . -q animate species/shrub.yaml -o frames --stages 2..4 --frames-per-stage 3
-[ "$(ls frames | wc -l)" -eq 7 ] || fail "expected 1 + 2*3 frames"
-"$SPRIG" --root . -q animate species/shrub.yaml -o single.png --stages 2..4 --at 3:0.6666666666666666
-cmp -s frames/frame_00002.png single.png || fail "frame 2 differs from the single render of stage 3 at 2/3"
-"$SPRIG" --root . -q animate species/shrub.yaml -o single.png --at 4
-cmp -s frames/frame_00006.png single.png || fail "the last frame differs from the single render of stage 4"
+# 5. Animation frames equal single renders of the same stage and fraction, at 1 and 2
+#    threads (frames share work: model/model.h FrameSequence), and so do the gallery's stills.
+for t in 1 2; do
+  rm -rf frames
+  "$SPRIG" --root . --threads $t -q animate species/shrub.yaml -o frames --stages 2..4 --frames-per-stage 3
+  [ "$(ls frames | wc -l)" -eq 7 ] || fail "expected 1 + 2*3 frames"
+  "$SPRIG" --root . --threads $t -q animate species/shrub.yaml -o single.png --stages 2..4 --at 3:0.6666666666666666
+  cmp -s frames/frame_00002.png single.png || fail "frame 2 differs from the single render of stage 3 at 2/3 ($t threads)"
+  "$SPRIG" --root . --threads $t -q animate species/shrub.yaml -o single.png --at 4
+  cmp -s frames/frame_00006.png single.png || fail "the last frame differs from the single render of stage 4 ($t threads)"
+  # Draft stills of these tiny skeleton previews are their own size and samples: `sprig render`.
+  for s in edge shrub; do
+    "$SPRIG" --root . --threads $t -q render "species/$s.yaml" -o "still_$s.png" --mode skeleton
+    cmp -s "out1/$s.png" "still_$s.png" || fail "the gallery's $s.png differs from sprig render ($t threads)"
+  done
+done
 "$SPRIG" --root . -q animate species/shrub.yaml -o anim.gif --frames-per-stage 2
 [ -s anim.gif ] || fail "no GIF"
 if ! command -v ffmpeg > /dev/null; then

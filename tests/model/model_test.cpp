@@ -214,3 +214,56 @@ TEST_CASE("renderModel: the stages of a strip share one horizon", "[model]") {
       for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(young.at(x, y)[c] - grown.at(x, y)[c]));
   CHECK(worst < 0.03f);
 }
+
+TEST_CASE("FrameSequence: frames equal renderModel, the scene reused where it serves any camera", "[model][frames]") {
+  // A turntable (the gallery's blobs, organisms and solids) and a held stage, at 1 and 2 threads.
+  const std::string organism = R"(kind: organism
+organism:
+  base: {cube_sphere: {radius: 1, quads: 2}}
+  levels: 2
+  detail:
+    - rock: {amplitude: 0.05, levels: [1, 2]}
+render: {width: 40, height: 32, samples: 1}
+)";
+  struct Case {
+    const std::string* text;
+    bool meshScene;  ///< the scene holds triangles only: built once for the whole turntable
+  };
+  for (const Case& c : {Case{&organism, true}, Case{&kBlob, false}, Case{&kSurfaceTree, false}}) {
+    for (int threads : {1, 2}) {
+      ThreadLimit limit(threads);
+      Species species = parseSpecies(*c.text, "species.yaml");
+      SpeciesModel model(species);
+      FrameSequence sequence(model);
+      RenderJob job;
+      job.width = 40;
+      job.height = 32;
+      job.progress = false;
+      job.mode = model.defaultMode();
+      job.stage = model.finalStage();
+      for (int i = 0; i < 3; ++i) {
+        SpeciesRender turn = species.render;
+        turn.view.azimuthDeg += 120.0 * i;
+        SpeciesModel fresh(species);
+        CHECK(sameImage(sequence.render(turn, job), renderModel(fresh, turn, job)));
+      }
+      // Implicit cells are reused only where the turned camera gives them the same size.
+      CHECK(sequence.builtScenes() + sequence.reusedScenes() == 3);
+      if (c.meshScene) CHECK(sequence.builtScenes() == 1);
+      // The same camera again: the picture itself.
+      SpeciesModel fresh(species);
+      const Image held = sequence.render(species.render, job);
+      CHECK(sameImage(held, renderModel(fresh, species.render, job)));
+      CHECK(sequence.reusedImages() == 0);
+      CHECK(sameImage(sequence.render(species.render, job), held));
+      CHECK(sequence.reusedImages() == 1);
+      // Another stage rebuilds.
+      if (species.kind == "tree") {
+        const int built = sequence.builtScenes();
+        job.stage = model.stageFromIndex(1);
+        CHECK(sameImage(sequence.render(species.render, job), renderModel(fresh, species.render, job)));
+        CHECK(sequence.builtScenes() == built + 1);
+      }
+    }
+  }
+}

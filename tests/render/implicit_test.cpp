@@ -386,3 +386,40 @@ TEST_CASE("Scene::addImplicit follows the pixels", "[render]") {
     diff = std::max(diff, double(std::abs(thumb.image.pixels[i] - own.image.pixels[i])));
   CHECK(diff < 0.02);
 }
+
+TEST_CASE("Scene::servesCamera: implicit cells sized alike by another camera", "[render]") {
+  const blobtree::CompiledBlob blob = branchBlob();
+  ViewSpec turned;
+  turned.azimuthDeg += 90.0;
+  const Camera cam = frameBounds(blob.bounds(), ViewSpec{}, 1.0), side = frameBounds(blob.bounds(), turned, 1.0);
+  Camera far = cam;
+  far.position = cam.target + 3.0f * (cam.position - cam.target);
+  auto built = [&](int imageSize, auto check) {
+    Scene scene;
+    scene.setPixelFootprint(cam, imageSize, imageSize, 0.0f);
+    scene.addImplicit(blob, scene.addMaterial(Material{}));
+    scene.commit();
+    check(scene);
+  };
+  // 4096 pixels: the model's own cell binds for either camera: one scene serves both.
+  built(4096, [&](const Scene& scene) {
+    CHECK(scene.servesCamera(cam, 4096, 4096));
+    CHECK(scene.servesCamera(side, 4096, 4096));
+  });
+  // 32 pixels: the pixel binds; three times farther gives coarser cells: another scene.
+  built(32, [&](const Scene& scene) {
+    CHECK(scene.servesCamera(cam, 32, 32));
+    CHECK_FALSE(scene.servesCamera(far, 32, 32));
+    CHECK_FALSE(scene.servesCamera(cam, 8, 8));
+  });
+  // Curves widened to the footprint follow the camera: no other camera is served.
+  Scene curves;
+  curves.setPixelFootprint(cam, 32, 32);
+  CurveSet c;
+  c.vertices = {Vec4(0, 0, 0, 0.001f), Vec4(0, 1, 0, 0.001f)};
+  c.segments = {0};
+  c.flags = {0};
+  curves.addCurves(c, curves.addMaterial(Material{}));
+  curves.commit();
+  CHECK_FALSE(curves.servesCamera(cam, 32, 32));
+}
