@@ -1070,6 +1070,15 @@ std::vector<Mesh> visibleMeshes(const TetMesh& mesh, std::vector<uint16_t>* part
     area[f] = 0.5f * glm::length(glm::cross(b - a, c - a));
   }
   smoothSurfaceNormals(normals.corner, area, normals.normals, normalRounds);
+  // Tinted: each group's base colour is the area-weighted mean of its faces' materials', so
+  // a colour that steps from one tetrahedron to the next (polish's shiny bronze) does not
+  // outline the triangles where two materials meet.
+  std::vector<Vec4> baseColor;
+  if (tinted) {
+    baseColor.assign(normals.normals.size(), Vec4(0.0f));
+    for (size_t f = 0; f < tris.size(); ++f)
+      for (uint32_t g : normals.corner[f]) baseColor[g] += area[f] * Vec4((*materials)[tris[f].material].color, 1.0f);
+  }
   std::map<uint16_t, std::vector<size_t>> byMaterial;
   for (size_t i = 0; i < tris.size(); ++i) byMaterial[tris[i].material].push_back(i);
   std::vector<Mesh> out;
@@ -1090,7 +1099,8 @@ std::vector<Mesh> visibleMeshes(const TetMesh& mesh, std::vector<uint16_t>* part
           if (tinted) {
             const auto& [sa, sb] = surface.sources[x];  // an inserted midpoint takes the mean of its edge's ends
             const Vec4 t = 0.5f * (mesh.tints[sa] + mesh.tints[sb]);
-            m.colors.push_back(glm::mix((*materials)[mat].color, Vec3(t), std::clamp(t.w, 0.0f, 1.0f)));
+            const Vec3 base = baseColor[g].w > 0 ? Vec3(baseColor[g]) / baseColor[g].w : (*materials)[mat].color;
+            m.colors.push_back(glm::mix(base, Vec3(t), std::clamp(t.w, 0.0f, 1.0f)));
           }
         }
         c[k] = outputOf[g];

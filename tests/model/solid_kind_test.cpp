@@ -497,3 +497,26 @@ TEST_CASE("blendedSurfaces: the shine fades across a ring where two materials me
       CHECK(s.z == 0.0f);
     }
 }
+
+TEST_CASE("visibleMeshes: tinted colours blend the materials' colours where they meet", "[model][solid]") {
+  // The bipyramid with tints of amount 0 (the weathering tools' state before they act): the
+  // apexes keep their own material's colour; a, b and c, each group holding one face of
+  // each material of equal area, take the mean (before, each part its own colour: the
+  // seam outlined the triangles).
+  solids::TetMesh m = bipyramid();
+  m.tints.assign(m.positions.size(), Vec4(0.0f));
+  std::vector<solids::Material> materials(2);
+  materials[0].color = Vec3(0.8f, 0.2f, 0.1f);
+  materials[1].color = Vec3(0.2f, 0.6f, 0.3f);
+  std::vector<uint16_t> mats;
+  const std::vector<Mesh> parts = visibleMeshes(m, &mats, &materials, 0);
+  REQUIRE(parts.size() == 2);
+  for (const Mesh& part : parts) {
+    REQUIRE(part.colors.size() == part.positions.size());
+    for (size_t v = 0; v < part.positions.size(); ++v) {
+      const float z = part.positions[v].z;
+      const Vec3 want = z > 4.0f ? materials[0].color : z < -4.0f ? materials[1].color : 0.5f * (materials[0].color + materials[1].color);
+      CHECK(glm::length(part.colors[v] - want) < 1e-6f);
+    }
+  }
+}
