@@ -704,12 +704,15 @@ class SolidModel final : public StillKindModel {
       parts = visible(k).first;
       mats = visible(k).second;
     }
+    std::vector<std::vector<Vec3>> surfaces = blendedSurfaces(parts, mats, spec_.solid.materials.materials);
     for (size_t i = 0; i < parts.size(); ++i) {
       const Material& m = spec_.solid.materials.materials[mats[i]];
       render::MeshPart part;
       out.figures.triangles += parts[i].triangleCount();
       part.mesh = std::move(parts[i]);
       part.material = render::Material{m.color, m.roughness, m.specular};
+      part.material.smoothTerminator = true;  // coarse facets, smooth normals (render::Material)
+      part.vertexSurfaces = std::move(surfaces[i]);
       out.geometry.parts.push_back(std::move(part));
     }
     if (look.wireframe) addWireframe(out, *look.wireframe, look);
@@ -953,57 +956,159 @@ CurveSet wireframeCurves(const std::vector<Mesh>& parts, const std::function<flo
   return out;
 }
 
-std::vector<Mesh> visibleMeshes(const TetMesh& mesh, std::vector<uint16_t>* partMaterials,
-                                const std::vector<solids::Material>* materials) {
-  const bool tinted = materials && !mesh.tints.empty() && mesh.tints.size() == mesh.positions.size();
-  // Normals are smoothed over the faces around a vertex whose normals lie within 60° of
-  // each other; sharper edges (a cut-away's rim, a box's edges) stay creased.
+namespace {
+
+/// Smooth normals of a boundary surface, shared by every material: around each surface
+/// vertex the faces are grouped (in face order, each face joining the first group whose
+/// direction lies within 60° of its own; sharper edges, a cut-away's rim or a box's edges,
+/// stay creased), and each group's normal is the area-weighted mean of its faces' normals
+/// (the sum of their cross products), whatever material each face is. So where two
+/// materials meet on a smooth surface (polished and plain bronze) the shading is continuous.
+struct SurfaceNormals {
+  std::vector<Vec3> normals;                      ///< one per (vertex, group), unit
+  std::vector<uint32_t> vertexOf;                 ///< the surface vertex of each group
+  std::vector<std::array<uint32_t, 3>> corner;    ///< per triangle, the group of each corner
+};
+
+SurfaceNormals surfaceNormals(const solids::BoundarySurface& surface) {
   constexpr float kCreaseCos = 0.5f;
+  const std::vector<InterfaceTriangle>& tris = surface.triangles;
+  std::vector<Vec3> faceNormal(tris.size());
+  std::vector<std::vector<uint32_t>> around(surface.positions.size());
+  for (size_t f = 0; f < tris.size(); ++f) {
+    const auto& v = tris[f].v;
+    const Vec3 a(surface.positions[v[0]]), b(surface.positions[v[1]]), c(surface.positions[v[2]]);
+    faceNormal[f] = glm::cross(b - a, c - a);
+    for (uint32_t x : v) around[x].push_back(uint32_t(f));
+  }
+  SurfaceNormals out;
+  out.corner.resize(tris.size());
+  for (uint32_t x = 0; x < around.size(); ++x) {
+    std::vector<std::pair<Vec3, uint32_t>> groups;  // summed unit directions, group id
+    for (uint32_t f : around[x]) {
+      const float len = glm::length(faceNormal[f]);
+      const Vec3 n = len > 0 ? faceNormal[f] / len : Vec3(0.0f);
+      // A degenerate face (no direction) joins the first group; a group of such faces alone
+      // takes the next face that has one.
+      auto joins = [&](const Vec3& direction) {
+        const float d = glm::length(direction);
+        return len == 0 || d == 0 || glm::dot(direction / d, n) >= kCreaseCos;
+      };
+      size_t g = 0;
+      while (g < groups.size() && !joins(groups[g].first)) ++g;
+      if (g == groups.size()) {
+        groups.push_back({Vec3(0.0f), uint32_t(out.normals.size())});
+        out.normals.push_back(Vec3(0.0f));
+        out.vertexOf.push_back(x);
+      }
+      groups[g].first += n;
+      out.normals[groups[g].second] += faceNormal[f];
+      const auto& v = tris[f].v;
+      out.corner[f][size_t(std::find(v.begin(), v.end(), x) - v.begin())] = groups[g].second;
+    }
+  }
+  for (Vec3& n : out.normals) n = glm::length(n) > 0 ? glm::normalize(n) : Vec3(0, 1, 0);
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::vector<Vec3>> blendedSurfaces(const std::vector<Mesh>& parts, const std::vector<uint16_t>& partMaterials,
+                                               const std::vector<solids::Material>& materials) {
+  // Vertices of one smooth group in different parts share position and normal exactly.
+  using Key = std::array<float, 6>;
+  auto keyOf = [](const Mesh& m, uint32_t v) {
+    const Vec3 &p = m.positions[v], &n = m.normals[v];
+    return Key{p.x, p.y, p.z, n.x, n.y, n.z};
+  };
+  std::map<Key, Vec4> sum;  // area-weighted (roughness, specular, metallic), area
+  for (size_t i = 0; i < parts.size(); ++i) {
+    const solids::Material& mat = materials[partMaterials[i]];
+    const Mesh& m = parts[i];
+    for (const auto& t : m.triangles) {
+      const float area = 0.5f * glm::length(glm::cross(m.positions[t[1]] - m.positions[t[0]], m.positions[t[2]] - m.positions[t[0]]));
+      for (int k = 0; k < 3; ++k) sum[keyOf(m, t[k])] += area * Vec4(mat.roughness, mat.specular, 0.0f, 1.0f);
+    }
+  }
+  std::vector<std::vector<Vec3>> out(parts.size());
+  for (size_t i = 0; i < parts.size(); ++i) {
+    const solids::Material& mat = materials[partMaterials[i]];
+    for (uint32_t v = 0; v < parts[i].positions.size(); ++v) {
+      const auto it = sum.find(keyOf(parts[i], v));
+      out[i].push_back(it != sum.end() && it->second.w > 0 ? Vec3(it->second) / it->second.w : Vec3(mat.roughness, mat.specular, 0.0f));
+    }
+  }
+  return out;
+}
+
+void smoothSurfaceNormals(const std::vector<std::array<uint32_t, 3>>& corner, const std::vector<float>& area,
+                          std::vector<Vec3>& normals, int rounds) {
+  for (int r = 0; r < rounds; ++r) {
+    std::vector<Vec3> sum(normals.size(), Vec3(0.0f));
+    for (size_t f = 0; f < corner.size(); ++f) {
+      const auto& c = corner[f];
+      const Vec3 mean = area[f] * (normals[c[0]] + normals[c[1]] + normals[c[2]]);
+      for (uint32_t g : c) sum[g] += mean;
+    }
+    for (size_t g = 0; g < normals.size(); ++g)
+      if (glm::length(sum[g]) > 0) normals[g] = glm::normalize(sum[g]);
+  }
+}
+
+std::vector<Mesh> visibleMeshes(const TetMesh& mesh, std::vector<uint16_t>* partMaterials,
+                                const std::vector<solids::Material>* materials, int normalRounds) {
+  const bool tinted = materials && !mesh.tints.empty() && mesh.tints.size() == mesh.positions.size();
   // The visible interface with pieces that touch along an edge or at a vertex only pulled
   // apart (solids::boundarySurface): every part together is a closed 2-manifold.
   const solids::BoundarySurface surface = solids::boundarySurface(mesh);
   const std::vector<InterfaceTriangle>& tris = surface.triangles;
+  SurfaceNormals normals = surfaceNormals(surface);
+  std::vector<float> area(tris.size());
+  for (size_t f = 0; f < tris.size(); ++f) {
+    const auto& v = tris[f].v;
+    const Vec3 a(surface.positions[v[0]]), b(surface.positions[v[1]]), c(surface.positions[v[2]]);
+    area[f] = 0.5f * glm::length(glm::cross(b - a, c - a));
+  }
+  smoothSurfaceNormals(normals.corner, area, normals.normals, normalRounds);
+  // Tinted: each group's base colour is the area-weighted mean of its faces' materials', so
+  // a colour that steps from one tetrahedron to the next (polish's shiny bronze) does not
+  // outline the triangles where two materials meet.
+  std::vector<Vec4> baseColor;
+  if (tinted) {
+    baseColor.assign(normals.normals.size(), Vec4(0.0f));
+    for (size_t f = 0; f < tris.size(); ++f)
+      for (uint32_t g : normals.corner[f]) baseColor[g] += area[f] * Vec4((*materials)[tris[f].material].color, 1.0f);
+  }
   std::map<uint16_t, std::vector<size_t>> byMaterial;
   for (size_t i = 0; i < tris.size(); ++i) byMaterial[tris[i].material].push_back(i);
   std::vector<Mesh> out;
   if (partMaterials) partMaterials->clear();
+  constexpr uint32_t kNone = ~0u;
+  std::vector<uint32_t> outputOf(normals.normals.size(), kNone);  // group -> vertex of this part
   for (const auto& [mat, list] : byMaterial) {
-    // Face normals (area-weighted) and the faces around each vertex.
-    std::vector<Vec3> faceNormal(list.size());
-    std::map<uint32_t, std::vector<uint32_t>> around;
-    for (size_t f = 0; f < list.size(); ++f) {
-      const auto& v = tris[list[f]].v;
-      const Vec3 a(surface.positions[v[0]]), b(surface.positions[v[1]]), c(surface.positions[v[2]]);
-      faceNormal[f] = glm::cross(b - a, c - a);
-      for (uint32_t x : v) around[x].push_back(uint32_t(f));
-    }
-    // One output vertex per (vertex, group of faces with similar normals).
     Mesh m;
-    std::vector<std::array<uint32_t, 3>> corner(list.size());
-    for (const auto& [x, faces] : around) {
-      std::vector<std::pair<Vec3, uint32_t>> groups;  // direction, output vertex
-      for (uint32_t f : faces) {
-        const Vec3 n = glm::normalize(faceNormal[f]);
-        size_t g = 0;
-        while (g < groups.size() && glm::dot(glm::normalize(groups[g].first), n) < kCreaseCos) ++g;
-        if (g == groups.size()) {
-          groups.push_back({Vec3(0.0f), uint32_t(m.positions.size())});
+    for (size_t f : list) {
+      std::array<uint32_t, 3> c;
+      for (int k = 0; k < 3; ++k) {
+        const uint32_t g = normals.corner[f][k];
+        if (outputOf[g] == kNone) {
+          const uint32_t x = normals.vertexOf[g];
+          outputOf[g] = uint32_t(m.positions.size());
           m.positions.push_back(Vec3(surface.positions[x]));
-          m.normals.push_back(Vec3(0.0f));
+          m.normals.push_back(normals.normals[g]);
           if (tinted) {
             const auto& [sa, sb] = surface.sources[x];  // an inserted midpoint takes the mean of its edge's ends
             const Vec4 t = 0.5f * (mesh.tints[sa] + mesh.tints[sb]);
-            m.colors.push_back(glm::mix((*materials)[mat].color, Vec3(t), std::clamp(t.w, 0.0f, 1.0f)));
+            const Vec3 base = baseColor[g].w > 0 ? Vec3(baseColor[g]) / baseColor[g].w : (*materials)[mat].color;
+            m.colors.push_back(glm::mix(base, Vec3(t), std::clamp(t.w, 0.0f, 1.0f)));
           }
         }
-        groups[g].first += n;
-        m.normals[groups[g].second] += faceNormal[f];
-        const auto& v = tris[list[f]].v;
-        corner[f][size_t(std::find(v.begin(), v.end(), x) - v.begin())] = groups[g].second;
+        c[k] = outputOf[g];
       }
+      m.triangles.push_back({c[0], c[1], c[2]});
     }
-    for (Vec3& n : m.normals) n = glm::length(n) > 0 ? glm::normalize(n) : Vec3(0, 1, 0);
-    for (const auto& c : corner) m.triangles.push_back({c[0], c[1], c[2]});
+    for (size_t f : list)
+      for (uint32_t g : normals.corner[f]) outputOf[g] = kNone;
     if (partMaterials) partMaterials->push_back(mat);
     out.push_back(std::move(m));
   }

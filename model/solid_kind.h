@@ -25,9 +25,11 @@
 /// velocity, from_volume_surface): those keys are errors at their file:line:col, never
 /// ignored. `extrude_2d` and `species` fields: solids/extrude_field.h, model/species_field.h.
 
+#include <array>
 #include <functional>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "core/shapes.h"
 #include "model/kinds.h"
@@ -60,11 +62,34 @@ class SolidSpec : public KindSpec {
 std::shared_ptr<const KindSpec> readSolidSpec(MapReader& top, Species& species, DiagnosticList& diags);
 
 /// The visible interface of mesh as a render mesh: one part per material with its colour,
-/// smooth normals within each part. When mesh has tints (the weathering tools and polish)
+/// smooth normals: at each vertex the area-weighted mean of the face normals around it
+/// within 60° of each other, over every material's faces (so the shading is continuous
+/// where two materials meet on a smooth surface; sharper edges stay creased). When mesh has tints (the weathering tools and polish)
 /// and materials is given, every part gets vertex colours mix(material colour, tint rgb,
 /// tint amount); otherwise none (the part's material colour applies).
+/// normalRounds rounds of smoothSurfaceNormals follow (0: the area-weighted means alone).
 std::vector<Mesh> visibleMeshes(const solids::TetMesh& mesh, std::vector<uint16_t>* partMaterials = nullptr,
-                                const std::vector<solids::Material>* materials = nullptr);
+                                const std::vector<solids::Material>* materials = nullptr, int normalRounds = 2);
+
+/// Per vertex of visibleMeshes' parts (partMaterials: each part's material), the render
+/// surface (roughness, specular, metallic 0): the area-weighted mean over the faces of
+/// every part around the vertex's smooth group. Where two materials meet (polish's shiny
+/// bronze among plain bronze: one material per tetrahedron, so the shine is a step along
+/// triangle edges) the highlight fades across one ring of triangles instead of following
+/// the facets. A vertex among faces of its own material keeps that material's values.
+std::vector<std::vector<Vec3>> blendedSurfaces(const std::vector<Mesh>& parts, const std::vector<uint16_t>& partMaterials,
+                                               const std::vector<solids::Material>& materials);
+
+/// Smooths the normals of a surface's smooth groups (visibleMeshes): in each of `rounds`
+/// rounds every group takes the normalized sum, over the faces it is a corner of, of face
+/// area times the sum of the face's three corner normals (a Jacobi step of the area-weighted
+/// umbrella average). Only faces a group belongs to contribute, so creases stay creased.
+/// A tetrahedral surface's triangles tilt up to 40° from the smooth surface (the cut's
+/// facets are a cell wide); two rounds spread a vertex's normal over its neighbours' and
+/// hide the facets in the shading. corner[f]: the groups of face f's corners; area[f]: its
+/// area. Normals of groups no face touches are kept.
+void smoothSurfaceNormals(const std::vector<std::array<uint32_t, 3>>& corner, const std::vector<float>& area,
+                          std::vector<Vec3>& normals, int rounds);
 
 /// The distinct edges of parts' triangles as round linear curve segments (two vertices
 /// each, no joins), for `render.wireframe`. Edges are keyed by their ends' positions, so

@@ -43,6 +43,12 @@ struct Material {
   /// bark on the crest, folds of bunched bark parallel to it), and the shading normal is
   /// tilted by the ridge's relief (ridge.shadingNormal). The default changes nothing.
   textures::RidgeShade ridge;
+  /// Coarse meshes with smooth vertex normals (a tetrahedral solid's surface): shadow and
+  /// sky rays leave from the point lifted off the flat triangle toward the smooth surface
+  /// the vertex normals describe (SurfaceHit::terminatorLift), and the sun is judged by
+  /// the shading normal alone, so the shadow terminator follows the smooth shading instead
+  /// of the facets. false (the default) changes nothing.
+  bool smoothTerminator = false;
 };
 
 /// A color texture: linear RGB at natural coordinates uv (and world position, for solid

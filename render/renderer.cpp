@@ -228,9 +228,11 @@ class Integrator {
              ShadeParts& parts) const {
     // Face both normals toward the viewer: leaves and thin parts are two-sided.
     if (glm::dot(h.geometricNormal, dir) > 0.0f) h.geometricNormal = -h.geometricNormal;
-    if (glm::dot(h.normal, dir) > 0.0f) h.normal = -h.normal;
+    const bool backSide = glm::dot(h.normal, dir) > 0.0f;
+    if (backSide) h.normal = -h.normal;
     const Vec3 n = h.normal, ng = h.geometricNormal, v = -dir;
-    const Vec3 origin = h.position + eps_ * ng;
+    // A smooth coarse mesh's rays leave from above the smooth surface its normals describe.
+    const Vec3 origin = h.position + (m.smoothTerminator ? h.terminatorLift[backSide ? 1 : 0] : Vec3(0)) + eps_ * ng;
     const Vec3 albedo = glm::clamp(h.color, Vec3(0), Vec3(1));
     // The hit's own surface (a mesh's per-vertex values) or the material's.
     const float roughness = h.ownSurface ? h.surface.x : m.roughness;
@@ -249,7 +251,7 @@ class Integrator {
       Vec2 u = sunSample(st, rng);
       Vec3 l = sunCos_ < 1.0f ? sampleCone(sunDir_, sunCos_, u) : sunDir_;
       float cosL = glm::dot(n, l);
-      if (cosL > 0.0f && glm::dot(ng, l) > -0.05f) {
+      if (cosL > 0.0f && (m.smoothTerminator || glm::dot(ng, l) > -0.05f)) {
         bool lit = true;
         if (s_.shadows) {
           ++c.shadow;

@@ -572,6 +572,11 @@ std::optional<SurfaceHit> Scene::intersect(const Vec3& origin, const Vec3& direc
       Vec3 n = w * rec.normals[tri.x] + u * rec.normals[tri.y] + v * rec.normals[tri.z];
       float len = glm::length(n);
       hit.normal = len > 0 ? n / len : Vec3(0);
+      const std::array<Vec3, 3> corners{p0, p1, p2};
+      std::array<Vec3, 3> normals{rec.normals[tri.x], rec.normals[tri.y], rec.normals[tri.z]};
+      hit.terminatorLift[0] = terminatorLift(corners, normals, Vec3(w, u, v));
+      for (Vec3& nv : normals) nv = -nv;
+      hit.terminatorLift[1] = terminatorLift(corners, normals, Vec3(w, u, v));
     }
     if (!rec.vertexColors.empty())
       hit.color = w * rec.vertexColors[tri.x] + u * rec.vertexColors[tri.y] + v * rec.vertexColors[tri.z];
@@ -602,6 +607,18 @@ std::optional<SurfaceHit> Scene::intersect(const Vec3& origin, const Vec3& direc
   if (rec.kind != GeometryRecord::Kind::Triangles || rec.normals.empty() || !(glm::length(hit.normal) > 0))
     hit.normal = hit.geometricNormal;
   return hit;
+}
+
+Vec3 terminatorLift(const std::array<Vec3, 3>& corners, const std::array<Vec3, 3>& normals, const Vec3& barycentric) {
+  const Vec3 p = barycentric.x * corners[0] + barycentric.y * corners[1] + barycentric.z * corners[2];
+  Vec3 lift(0.0f);
+  for (int i = 0; i < 3; ++i) {
+    const float len = glm::length(normals[i]);
+    if (!(len > 0.0f)) continue;
+    const Vec3 n = normals[i] / len;
+    lift += barycentric[i] * std::max(0.0f, -glm::dot(p - corners[i], n)) * n;
+  }
+  return lift;
 }
 
 bool Scene::occluded(const Vec3& origin, const Vec3& direction, float tnear, float tfar) const {

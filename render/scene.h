@@ -7,6 +7,7 @@
 /// intersect()/occluded() may be called from any number of threads.
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -45,7 +46,18 @@ struct SurfaceHit {
   /// traced again from `behind` (past the curve's drawn tube and what it stands for).
   float opacity = 1.0f;
   float behind = 0.0f;
+  /// Triangles with vertex normals: the move from `position` to the point above it on the
+  /// smooth surface the vertex normals describe, for the side the normals face
+  /// (terminatorLift[0]) and the other side ([1]); zero elsewhere (Scene::terminatorLift).
+  std::array<Vec3, 2> terminatorLift{Vec3(0), Vec3(0)};
 };
+
+/// Hanika's shadow-terminator offset ("Hacking the shadow terminator", Ray Tracing Gems II,
+/// 2021, ch. 4): the point p = Σ bᵢ·pᵢ of a triangle with unit vertex normals nᵢ is
+/// projected onto each vertex's tangent plane where it lies below it, and the projections
+/// are blended by the barycentric weights b: the returned move is Σ bᵢ·max(0, −(p − pᵢ)·nᵢ)·nᵢ.
+/// Zero at the corners, and wherever the triangle bulges above its vertices' planes.
+Vec3 terminatorLift(const std::array<Vec3, 3>& corners, const std::array<Vec3, 3>& normals, const Vec3& barycentric);
 
 /// How wide a pixel is along the camera's view: a segment thinner than `minPixels` pixels
 /// is drawn that wide with opacity true width / drawn width.

@@ -33,9 +33,25 @@ struct Work {
   std::vector<uint8_t> active;
   std::vector<int> tag;  ///< carried to the pieces of a split (a material when clipping)
 
+  /// Per volume, sorted (tetrahedron, field at its centroid) of the tetrahedra whose four
+  /// vertices all lie on one of the volume's boundaries (resolveFlatTets).
+  std::vector<std::vector<std::pair<uint32_t, float>>> flat;
+
   double centroidValue(size_t volume, const Tet& t) const {
     const std::vector<float>& f = fields[volume];
     return (double(f[t[0]]) + f[t[1]] + f[t[2]] + f[t[3]]) * 0.25;
+  }
+  /// The field of volume at tetrahedron t's centroid: linear from its vertices, or the
+  /// field itself where all four vertices lie on one boundary (resolveFlatTets).
+  double valueAt(size_t volume, size_t t) const {
+    const Tet& q = tets[t];
+    const std::vector<float>& f = fields[volume];
+    if (volume < flat.size() && f[q[0]] == f[q[1]] && f[q[0]] == f[q[2]] && f[q[0]] == f[q[3]]) {
+      const auto& list = flat[volume];
+      const auto it = std::lower_bound(list.begin(), list.end(), std::make_pair(uint32_t(t), -HUGE_VALF));
+      if (it != list.end() && it->first == t) return it->second;
+    }
+    return centroidValue(volume, q);
   }
 };
 
@@ -509,11 +525,45 @@ void cellsOfSolid(const Solid& solid, const Grid& grid, const MeshOptions& optio
   w.tag.assign(w.tets.size(), 0);
 }
 
+/// A tetrahedron whose four vertices all lie on one boundary b of a volume (at the nodes,
+/// or snapped there) is not flat, so the boundary is not planar in it: the linear field is
+/// b at its centroid and cannot tell which side the tetrahedron lies on. That happens along
+/// every edge and corner of a box whose faces lie on the grid's planes (as the automatic
+/// grid puts the outermost ones), where the tetrahedra spanning a convex edge were
+/// dropped and the edge meshed notched, every other cell. Those tetrahedra take the
+/// volume's own field at their centroid instead (one batch per volume).
+void resolveFlatTets(const Solid& solid, const Grid& grid, Work& w) {
+  w.flat.assign(solid.volumes.size(), {});
+  for (size_t v = 0; v < solid.volumes.size(); ++v) {
+    const Volume& vol = solid.volumes[v];
+    const std::vector<float>& f = w.fields[v];
+    std::vector<uint32_t> ids = chunked<uint32_t>(w.tets.size(), [&](size_t lo, size_t hi, std::vector<uint32_t>& out) {
+      for (size_t t = lo; t < hi; ++t) {
+        const Tet& q = w.tets[t];
+        const float a = f[q[0]];
+        if (a != f[q[1]] || a != f[q[2]] || a != f[q[3]]) continue;
+        for (double b : vol.boundaries)
+          if (a == float(b)) out.push_back(uint32_t(t));
+      }
+    });
+    if (ids.empty()) continue;
+    std::vector<Vec3> centroids(ids.size());
+    for (size_t i = 0; i < ids.size(); ++i) {
+      const Tet& q = w.tets[ids[i]];
+      centroids[i] = Vec3((w.positions[q[0]] + w.positions[q[1]] + w.positions[q[2]] + w.positions[q[3]]) * 0.25);
+    }
+    double band = 0;
+    for (double b : vol.boundaries) band = std::max(band, std::abs(b));
+    const std::vector<float> value = vol.field->sample(centroids, grid.cell, band + 2 * grid.cell);
+    for (size_t i = 0; i < ids.size(); ++i) w.flat[v].push_back({ids[i], value[i]});
+  }
+}
+
 /// The region material of tetrahedron t: the first volume claiming its centroid (the fields
-/// are linear in it).
+/// are linear in it; resolveFlatTets settles the tetrahedra they cannot).
 int regionOf(const Solid& solid, const Work& w, size_t t) {
   for (size_t v = 0; v < solid.volumes.size(); ++v) {
-    const int m = solid.volumes[v].regionAt(w.centroidValue(v, w.tets[t]));
+    const int m = solid.volumes[v].regionAt(w.valueAt(v, t));
     if (m != kUnclaimed) return m;
   }
   return kUnclaimed;
@@ -593,6 +643,7 @@ TetMesh meshSolid(const Solid& solid, const Grid& grid, const MeshOptions& optio
     for (double b : solid.volumes[v].boundaries) st.splits += cutAt(w, v, b);
   }
   st.splits += splitProceduralLayers(solid, options, w);  // 4-5. procedural layers
+  resolveFlatTets(solid, grid, w);
   // 6-7. Keep tetrahedra with a material; renumber the vertices they use in id order.
   TetMesh mesh = compact(w, tetMaterials(solid, w));
   st.tets = mesh.tets.size();

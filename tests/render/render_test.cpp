@@ -116,3 +116,31 @@ TEST_CASE("Scene: rays Embree cannot trace miss", "[render]") {
     CHECK_THROWS_WITH(renderImage(scene, c, quietSettings(8, 8)), "render: the camera's target is its position (no view direction)");
   }
 }
+
+TEST_CASE("terminatorLift: Hanika's shadow-terminator offset", "[render]") {
+  // An equilateral triangle whose corners lie on a sphere of radius R about c, at height
+  // h above c, with the sphere's radial normals: at the centroid every corner's tangent
+  // plane lies above the point by (R² − h²)/R along its normal, so the lift is
+  // (R² − h²)/R times the mean normal, h/R·ẑ: h·(R² − h²)/R² straight up.
+  const float R = 1.0f, h = 0.8f, r = std::sqrt(R * R - h * h);
+  std::array<Vec3, 3> corners, normals;
+  for (int i = 0; i < 3; ++i) {
+    const float a = float(2.0 * M_PI * i / 3.0);
+    corners[i] = Vec3(r * std::cos(a), r * std::sin(a), h);
+    normals[i] = corners[i] / R;
+  }
+  const Vec3 third(1.0f / 3.0f);
+  const Vec3 lift = render::terminatorLift(corners, normals, third);
+  CHECK(lift.x == Approx(0.0f).margin(1e-6));
+  CHECK(lift.y == Approx(0.0f).margin(1e-6));
+  CHECK(lift.z == Approx(h * (R * R - h * h) / (R * R)).epsilon(1e-5));
+  // Nothing moves at a corner, nor where the normals are the flat face's own.
+  CHECK(glm::length(render::terminatorLift(corners, normals, Vec3(1, 0, 0))) < 1e-6f);
+  const std::array<Vec3, 3> flat{Vec3(0, 0, 1), Vec3(0, 0, 1), Vec3(0, 0, 1)};
+  CHECK(glm::length(render::terminatorLift(corners, flat, third)) == 0.0f);
+  // Normals leaning inward (a saddle or a concave dent): the point lies above every
+  // tangent plane and stays where it is.
+  std::array<Vec3, 3> inward;
+  for (int i = 0; i < 3; ++i) inward[i] = glm::normalize(Vec3(-corners[i].x, -corners[i].y, h));
+  CHECK(glm::length(render::terminatorLift(corners, inward, third)) == 0.0f);
+}

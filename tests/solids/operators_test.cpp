@@ -448,8 +448,8 @@ TEST_CASE("displace: a root rising far more than the gap lifts the bricks withou
 
 TEST_CASE("displace: bricks between sand joints tilt as rigid blocks", "[solids][operators]") {
   // A paving bed 1.2 × 0.3 × 0.6 m of 0.05 m cells (y up): dirt, the top 0.1 m a running bond
-  // of 0.25 × 0.1 m bricks with 0.05 m joints (the pattern of fig_solid_07_displaced_paving:
-  // joints one cell wide on the grid's planes), and a root 0.05 m under the paving
+  // of 0.25 × 0.1 m bricks with 0.05 m joints (joints one cell wide on the grid's planes, as
+  // fig_solid_07_displaced_paving's 0.35 × 0.15 m bricks have), and a root 0.05 m under the paving
   // (0.45 < x < 0.75, 0.2 < z < 0.4, 0.1 < y < 0.15) that rises 0.1 m in 8 increments.
   // With sand joints (E 3 MPa, 5,000 times softer than brick) every brick moves as a rigid
   // block: its vertices fit a rotation and translation (Kabsch) to a small fraction of its

@@ -736,3 +736,36 @@ TEST_CASE("boundarySurface: pieces touching along an edge or at a vertex are pul
     for (size_t v = 0; v < b.positions.size(); ++v) CHECK(b.positions[v] == m.positions[b.sources[v][0]]);
   }
 }
+
+TEST_CASE("meshSolid: a box whose faces lie on the grid's planes meshes whole, edges and corners straight", "[solids]") {
+  // Every node on the box's faces has distance 0, so the tetrahedra spanning its convex
+  // edges have all four vertices on the zero set: their linear centroid value is 0 and
+  // cannot tell inside from outside. The box's own field at their centroids keeps them,
+  // so the mesh is the box exactly (before, every other cell along each edge lost them).
+  const double cell = 0.1;
+  Solid s;
+  Layer stone;
+  stone.fill = true;
+  stone.material = *s.materials.concrete("stone");
+  s.volumes.push_back(makeVolume(boxField(DVec3(0.0), DVec3(0.6, 0.4, 0.8)), {stone}));
+  Grid g;
+  g.cell = cell;
+  g.origin = DVec3(-0.5, -0.4, -0.6);
+  g.cells = {10, 8, 12};
+  const TetMesh m = meshSolid(s, g);
+  const auto vol = volumeByMaterial(m);
+  CHECK(std::abs(vol.at(uint16_t(stone.material)) - 0.6 * 0.4 * 0.8) < 1e-12);
+  for (const DVec3& p : m.positions) {
+    CHECK(std::abs(p.x) <= 0.3 + 1e-12);
+    CHECK(std::abs(p.y) <= 0.2 + 1e-12);
+    CHECK(std::abs(p.z) <= 0.4 + 1e-12);
+  }
+  // The visible interface is the box's six faces: every triangle lies in one face plane.
+  const MeshTopology top = analyzeTopology(meshOf(m, visibleInterface(m)));
+  CHECK(top.boundaryEdges == 0);
+  for (const auto& f : visibleInterface(m)) {
+    const DVec3 a = m.positions[f.v[0]], b = m.positions[f.v[1]], c = m.positions[f.v[2]];
+    const bool onFace = (a.x == b.x && b.x == c.x) || (a.y == b.y && b.y == c.y) || (a.z == b.z && b.z == c.z);
+    CHECK(onFace);
+  }
+}
