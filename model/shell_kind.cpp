@@ -376,6 +376,7 @@ ShellBuild buildShell(const ShellSpec& species, std::optional<double> ageDeg, co
   b.model = organisms::buildShell(p, species.loc);
   b.blob = std::make_shared<const blobtree::CompiledBlob>(blobtree::compile(b.model.tree, b.model.root));
   b.painter = std::make_shared<const organisms::ShellPainter>(p, b.model, species.textures);
+  b.rested = pose != glm::dmat4(1.0);
   return b;
 }
 
@@ -402,6 +403,7 @@ render::Geometry shellGeometry(const ShellBuild& shell, std::shared_ptr<const bl
   // diagonal renders the Murex faster (docs/PERFORMANCE.md, Shells).
   opt.cellSize = organisms::shellCellSize(*shell.blob);
   opt.trace.relativeTolerance = organisms::kShellTraceTolerance;
+  opt.tightBase = shell.rested;
   out.parts.push_back(render::ImplicitPart{shell.blob, porcelain, opt, std::move(textures)});
   return out;
 }

@@ -67,6 +67,7 @@ struct ShellBuild {
   organisms::ShellModel model;
   std::shared_ptr<const blobtree::CompiledBlob> blob;  ///< compiled model.root (world space, apex up)
   std::shared_ptr<const organisms::ShellPainter> painter;
+  bool rested = false;  ///< built in a resting pose (render.rest): the picture's ground touches its lowest point
 };
 
 /// Builds species at ageDeg (default: its age), turned by pose after the model's own frame

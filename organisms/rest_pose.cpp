@@ -47,10 +47,13 @@ std::array<DVec3, 2> tangents(const DVec3& u) {
 }  // namespace
 
 DVec3 restingUp(std::span<const Vec3> points, const DVec3& centre, const DVec3& upGuess) {
+  // Steps of 0.05 rad (2.9 degrees) roll the body as it rolls: a larger first step could
+  // jump over the ridge between two stable poses into the farther one.
+  constexpr double kFirstStep = 0.05, kLastStep = 1e-6;
   if (points.empty() || !(glm::length(upGuess) > 0.0)) throw std::invalid_argument("restingUp: no points or a zero guess");
   DVec3 up = glm::normalize(upGuess);
   double best = restingHeight(points, centre, up);
-  for (double step = 0.25; step > 1e-4;) {
+  for (double step = kFirstStep; step > kLastStep;) {
     const auto [t1, t2] = tangents(up);
     DVec3 bestTrial = up;
     double bestTrialHeight = best;

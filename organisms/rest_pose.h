@@ -31,7 +31,8 @@ double restingHeight(std::span<const Vec3> points, const DVec3& centre, const DV
 
 /// The up direction (unit, in the points' frame) of the stable resting pose nearest
 /// upGuess: a local minimum of restingHeight over unit vectors, reached by a pattern search
-/// (steps from 0.25 rad halved down to 1e-4 rad, eight trial directions per step). upGuess
+/// (steps of 0.05 rad, so the search rolls as the body would and never jumps a ridge
+/// between stable poses wider than that, halved down to 1e-6 rad; eight trial directions). upGuess
 /// must not be zero; points must not be empty.
 DVec3 restingUp(std::span<const Vec3> points, const DVec3& centre, const DVec3& upGuess);
 
