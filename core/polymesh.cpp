@@ -26,6 +26,15 @@ Box3 PolyMesh::bounds() const {
   return b;
 }
 
+void reverseWinding(PolyMesh& mesh) {
+  size_t first = 0;
+  for (uint32_t n : mesh.faceSizes) {
+    if (first + n > mesh.faceVertices.size()) break;
+    std::reverse(mesh.faceVertices.begin() + std::ptrdiff_t(first) + 1, mesh.faceVertices.begin() + std::ptrdiff_t(first + n));
+    first += n;
+  }
+}
+
 namespace {
 
 // Thrown inside a reader to stop at an error it cannot read past (or at too many errors);

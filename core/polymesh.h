@@ -53,6 +53,11 @@ struct PolyMesh {
   Box3 bounds() const;
 };
 
+/// Reverses the winding of every face of mesh (each face's corners in reverse order, its
+/// first corner kept first), turning its normals around. Positions, colours and face
+/// locations are unchanged.
+void reverseWinding(PolyMesh& mesh);
+
 /// Polygon mesh file formats Sprig reads.
 enum class MeshFileFormat { Obj, Ply, Off };
 

@@ -74,6 +74,9 @@ struct MeshPlacement {
   float size = 0;
   Vec3 axis{0, 1, 0};
   float angleDeg = 0;
+  /// `flip`: reverse every face's winding, for a mesh wound inward (clockwise seen from
+  /// outside: its normals, and so every detail along them, point into the shape).
+  bool flip = false;
   void apply(std::vector<Vec3>& positions, const Box3& box) const {
     const Vec3 c = center ? 0.5f * (box.lo + box.hi) : Vec3(0.0f);
     const Vec3 ext = box.hi - box.lo;
@@ -228,6 +231,7 @@ class OrganismReader {
       if (glm::length(p.axis) == 0) r->error(diags_, "the rotation 'axis' must not be zero");
       rm.finish();
     }
+    p.flip = m.boolean({"flip", "Reverse every face's winding: for a mesh wound inward (its normals, and the details along them, would point into the shape)."}, false);
     return p;
   }
 
@@ -260,6 +264,7 @@ class OrganismReader {
       checkPolyMesh(mesh, diags_);
       if (diags_.items().size() != before) return std::nullopt;
       place.apply(mesh.positions, mesh.bounds());
+      if (place.flip) reverseWinding(mesh);
       return mesh;
     } catch (const InputError& e) {
       diags_.append(e.diagnostics());
@@ -318,6 +323,7 @@ class OrganismReader {
     if (!surface) return;
     PolyMesh control = organisms::simplifyToFaceCount(*surface, size_t(faces));
     place.apply(control.positions, control.bounds());
+    if (place.flip) reverseWinding(control);
     spec_.base = controlOf(control);
     baseColors_ = control.colors;
   }
@@ -335,7 +341,13 @@ class OrganismReader {
       m.node().error(diags_, "capture takes one of 'file' (a mesh file) and 'species' (a species file)");
     } else if (m.has("species")) {
       captured = speciesSurface(m, "species");
-      if (captured) place.apply(captured->positions, captured->bounds());
+      if (captured) {
+        place.apply(captured->positions, captured->bounds());
+        if (place.flip) {
+          for (glm::uvec3& t : captured->triangles) std::swap(t.y, t.z);
+          for (Vec3& n : captured->normals) n = -n;
+        }
+      }
     } else if (std::optional<PolyMesh> mesh = readMeshFile(m, place)) {
       captured = triangulate(*mesh);
     }

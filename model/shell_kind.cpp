@@ -7,9 +7,12 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include "blobtree/polygonize.h"
 #include "core/parallel.h"
 #include "model/mesh_parts.h"
+#include "organisms/rest_pose.h"
 
 namespace sprig {
 
@@ -259,6 +262,9 @@ void readOpening(MapReader& top, ShellParams& p, DiagnosticList& diags) {
   o.extendDeg = r.number({"extend", "How far past θ_end the cutter reaches (opens the lip), in degrees."}, o.extendDeg, 0.0, 360.0);
   o.insideWall = r.boolean({"inside_wall", "Add the inside wall back (Eq. 15): a rounded lip ring."}, o.insideWall);
   o.subtractPrevious = r.boolean({"subtract_previous", "Subtract the previous whorl from the hollow (Eq. 14)."}, o.subtractPrevious);
+  const std::string show = r.choice({"show", "Fig. 10's construction surfaces: `shell` (the shell with its opening), or instead of it `inside_surface` (the inside generating surface at the lip), `inside_whorl` (B_inside, that surface swept) or `cutter` (B_inside − B_previous, the solid cut out)."}, "shell", {"shell", "inside_surface", "inside_whorl", "cutter"});
+  using Show = organisms::OpeningOptions::Show;
+  o.show = show == "inside_surface" ? Show::InsideSurface : show == "inside_whorl" ? Show::InsideWhorl : show == "cutter" ? Show::Cutter : Show::Shell;
   r.finish();
 }
 
@@ -362,13 +368,15 @@ std::vector<double> shellGrowthStages(const ShellSpec& species, int count) {
   return out;
 }
 
-ShellBuild buildShell(const ShellSpec& species, std::optional<double> ageDeg) {
+ShellBuild buildShell(const ShellSpec& species, std::optional<double> ageDeg, const glm::dmat4& pose) {
   organisms::ShellParams p = species.params;
   if (ageDeg) p.ageDeg = *ageDeg;
+  p.pose = pose;
   ShellBuild b;
   b.model = organisms::buildShell(p, species.loc);
   b.blob = std::make_shared<const blobtree::CompiledBlob>(blobtree::compile(b.model.tree, b.model.root));
   b.painter = std::make_shared<const organisms::ShellPainter>(p, b.model, species.textures);
+  b.rested = pose != glm::dmat4(1.0);
   return b;
 }
 
@@ -395,12 +403,41 @@ render::Geometry shellGeometry(const ShellBuild& shell, std::shared_ptr<const bl
   // diagonal renders the Murex faster (docs/PERFORMANCE.md, Shells).
   opt.cellSize = organisms::shellCellSize(*shell.blob);
   opt.trace.relativeTolerance = organisms::kShellTraceTolerance;
+  opt.tightBase = shell.rested;
   out.parts.push_back(render::ImplicitPart{shell.blob, porcelain, opt, std::move(textures)});
   return out;
 }
 
-namespace {
+glm::dmat4 shellRestingPose(const ShellBuild& shell, bool apertureUp, Box3* restedBox) {
+  const blobtree::CompiledBlob& blob = *shell.blob;
+  blobtree::PolygonizeOptions po;
+  po.cellSize = glm::length(blob.bounds().size()) / kRestPoseCells;
+  const Mesh surface = blobtree::polygonize(blob, po);
+  if (surface.positions.empty()) return glm::dmat4(1.0);
+  // The aperture faces along the spiral's tangent at the lip (the direction of growth).
+  const organisms::ShellModel& m = shell.model;
+  const DVec3 lip = DVec3(m.worldFromShell * glm::dvec4(m.spiral.point(m.endDeg), 1.0));
+  const DVec3 ahead = DVec3(m.worldFromShell * glm::dvec4(m.spiral.point(m.endDeg + 1.0), 1.0));
+  const DVec3 facing = glm::normalize(ahead - lip);
+  const DVec3 up = organisms::restingUp(surface.positions, organisms::volumeCentroid(surface), apertureUp ? facing : -facing);
+  // The axis from the apex towards the canal lies along the image's horizontal (+x).
+  const DVec3 apexToCanal = DVec3(m.worldFromShell * glm::dvec4(0.0, 1.0, 0.0, 0.0));
+  const glm::dmat3 turn = organisms::uprightRotation(up, apexToCanal);
+  // Turn about the centre of the shell's box so the rested shell stays near the origin.
+  const DVec3 c(blob.bounds().center());
+  const glm::dmat4 pose = glm::translate(glm::dmat4(1.0), c) * glm::dmat4(turn) * glm::translate(glm::dmat4(1.0), -c);
+  if (restedBox) {
+    // The surface's own box, a cell wider each way: the turned support box of the blob
+    // (each primitive's support is over twice its surface's radius) would frame a shell
+    // lying aslant several times too loosely.
+    *restedBox = Box3{};
+    for (const Vec3& p : surface.positions) restedBox->extend(Vec3(pose * glm::dvec4(DVec3(p), 1.0)));
+    *restedBox = Box3{restedBox->lo - Vec3(po.cellSize), restedBox->hi + Vec3(po.cellSize)};
+  }
+  return pose;
+}
 
+namespace {
 
 /// Mesh cell of a shell when none is asked for: 1/340 of its diagonal.
 float shellMeshCell(const blobtree::CompiledBlob& blob) { return glm::length(blob.bounds().size()) / 340.0f; }
@@ -491,7 +528,7 @@ void textureWhorl(ExportPart& part, const organisms::ShellPainter& painter, cons
 /// A shell grown to any age.
 class ShellModel final : public KindModel {
  public:
-  explicit ShellModel(const ShellSpec& spec) : spec_(spec) {}
+  ShellModel(const ShellSpec& spec, RestPose rest) : spec_(spec), rest_(rest) {}
 
   bool hasSurface() const override { return true; }
 
@@ -548,6 +585,8 @@ class ShellModel final : public KindModel {
   int stageNumber(const Stage& stage) const override { return static_cast<int>(std::lround(stage.age)); }
 
   Box3 frameBox() override {
+    pose();
+    if (restedBox_ && !restedBox_->empty()) return *restedBox_;  // render.rest: the rested surface's box
     Box3 box = finalShell().blob->bounds();
     return box.empty() ? Box3{Vec3(-0.5f), Vec3(0.5f)} : box;
   }
@@ -559,10 +598,10 @@ class ShellModel final : public KindModel {
     const double age = stage.age < 0 ? finalStage().age : stage.age;
     std::optional<ShellBuild> built;
     const ShellBuild* shell = nullptr;
-    if (final_ && age == finalStage().age) {
-      shell = &*final_;
+    if (age == finalStage().age) {
+      shell = &finalShell();
     } else {
-      built = buildShell(spec_, age);
+      built = buildShell(spec_, age, pose());
       shell = &*built;
     }
     out.figures.primitives = shell->blob->primitiveCount();
@@ -654,13 +693,31 @@ class ShellModel final : public KindModel {
   }
 
  private:
-  /// The final shell, built once: it frames the camera and is reused for the final stage.
+  /// The final shell in the pictures' pose, built once: it frames the camera and is reused
+  /// for the final stage.
   const ShellBuild& finalShell() {
-    if (!final_) final_ = buildShell(spec_);
+    if (!final_) final_ = buildShell(spec_, std::nullopt, pose());
     return *final_;
   }
 
+  /// The pictures' pose (render.rest): identity as built; else the final shell's resting
+  /// pose (shellRestingPose), found once and kept for every stage, so a growth strip or
+  /// animation turns every young shell as the grown one lies.
+  const glm::dmat4& pose() {
+    if (pose_) return *pose_;
+    if (rest_ == RestPose::None) {
+      pose_ = glm::dmat4(1.0);
+    } else {
+      restedBox_ = Box3{};
+      pose_ = shellRestingPose(buildShell(spec_), rest_ == RestPose::ApertureUp, &*restedBox_);
+    }
+    return *pose_;
+  }
+
   const ShellSpec& spec_;
+  RestPose rest_ = RestPose::None;
+  std::optional<glm::dmat4> pose_;
+  std::optional<Box3> restedBox_;  ///< the rested final surface's box (render.rest), framing every stage
   std::optional<ShellBuild> final_;
 };
 
@@ -682,8 +739,8 @@ std::string ShellSpec::checkSummary(const Species& species) const {
   return " '" + species.name + "'";
 }
 
-std::unique_ptr<KindModel> ShellSpec::makeModel(const Species&, const ModelOptions&) const {
-  return std::make_unique<ShellModel>(*this);
+std::unique_ptr<KindModel> ShellSpec::makeModel(const Species& species, const ModelOptions&) const {
+  return std::make_unique<ShellModel>(*this, species.render.rest);
 }
 
 }  // namespace sprig

@@ -67,10 +67,27 @@ struct ShellBuild {
   organisms::ShellModel model;
   std::shared_ptr<const blobtree::CompiledBlob> blob;  ///< compiled model.root (world space, apex up)
   std::shared_ptr<const organisms::ShellPainter> painter;
+  bool rested = false;  ///< built in a resting pose (render.rest): the picture's ground touches its lowest point
 };
 
-/// Builds species at ageDeg (default: its age). Throws InputError for invalid parameters.
-ShellBuild buildShell(const ShellSpec& species, std::optional<double> ageDeg = std::nullopt);
+/// Builds species at ageDeg (default: its age), turned by pose after the model's own frame
+/// (organisms::ShellParams::pose; identity: the model itself). Throws InputError for
+/// invalid parameters.
+ShellBuild buildShell(const ShellSpec& species, std::optional<double> ageDeg = std::nullopt,
+                      const glm::dmat4& pose = glm::dmat4(1.0));
+
+/// Cells across the diagonal of the coarse surface shellRestingPose rolls the shell on.
+inline constexpr float kRestPoseCells = 120.0f;
+
+/// The pose of `render.rest` for a shell built in its own frame: the rigid turn (about the
+/// centre of its box) that lays it on a horizontal ground as it comes to rest when put down
+/// with its aperture (the spiral's tangent at the lip) facing up (apertureUp) or down, then
+/// rolled downhill to the nearest stable pose (organisms::restingUp on a polygonized surface
+/// of kRestPoseCells cells across, its centre of mass the enclosed volume's); the shell's
+/// axis from apex to canal is then turned towards +x. The picture's ground then rests under
+/// its lowest point (model/model.h restingFrame). restedBox, when given, receives the box of
+/// the rested coarse surface, a cell wider each way (the frame of the pictures).
+glm::dmat4 shellRestingPose(const ShellBuild& shell, bool apertureUp, Box3* restedBox = nullptr);
 
 /// The shell as geometry: exact (mesh null) or the polygonized mesh, with the painter's
 /// part textures as its texture table (ids = organisms::ShellPart).

@@ -139,6 +139,8 @@ void readRender(MapReader& m, SpeciesRender& r, const PathPolicy& policy, Diagno
     if (n == Vec3(0)) c->error(diags, "render.section: 'normal' is zero (the plane has no side to remove)");
     r.section = Vec4(n, float(d));
   }
+  const std::string rest = m.choice({"rest", "Shells: how the picture sets the shell down: `as_built` (apex up, standing as modelled), `aperture_up` or `aperture_down` (lying on the ground as a shell rests on a table: put down with its aperture facing up or down, then rolled to the nearest stable pose). Pictures only: exports keep the model's frame."}, "as_built", {"as_built", "aperture_up", "aperture_down"});
+  r.rest = rest == "aperture_up" ? RestPose::ApertureUp : rest == "aperture_down" ? RestPose::ApertureDown : RestPose::None;
   r.pair = m.path({"pair", "Another species file: the picture shows this species and that one (at its final stage) side by side, seen by one camera framing both (this species' camera, light and size; each panel half the width)."}, policy);
   im.fillStrength = static_cast<float>(m.number({"fill", "Strength of an unshadowed fill light from the camera (0 = none)."}, im.fillStrength, 0.0, 10.0));
   im.skyStrength = static_cast<float>(m.number({"sky", "Strength of the sky light."}, im.skyStrength, 0.0, 10.0));
@@ -206,6 +208,8 @@ Species readSpecies(std::shared_ptr<const YamlFile> yaml, const PathPolicy& poli
       w->error(diags, "'render.wind' sways trees; " + speciesOfKind(s.kind) + " has no wind");
     if (auto w = render.keyNode("wireframe"); w && s.kind != "solid")
       w->error(diags, "'render.wireframe' draws the edges of a solid's tetrahedra; " + speciesOfKind(s.kind) + " has none");
+    if (auto c = render.keyNode("rest"); c && s.kind != "shell" && s.render.rest != RestPose::None)
+      c->error(diags, "'render.rest' sets a shell down on its side; " + speciesOfKind(s.kind) + " has no aperture to rest by");
     if (auto c = render.keyNode("section"); c && s.kind != "solid")
       c->error(diags, "'render.section' cuts a solid open; " + speciesOfKind(s.kind) + " has no inside to show");
     if (s.render.closeUp && s.kind != "tree" && (s.render.closeUp->internode >= 0 || s.render.closeUp->junction >= 0))

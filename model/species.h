@@ -68,6 +68,13 @@ struct WireframeSpec {
   double widthPixels = 1.0;  ///< `width`: line width in pixels at each end's depth
 };
 
+/// Shells: how a picture sets the shell down (`render.rest`).
+enum class RestPose {
+  None,          ///< `as_built`: as modelled (apex up, standing on its lowest point)
+  ApertureUp,    ///< `aperture_up`: lying on the ground, put down aperture up, rolled to the nearest stable pose
+  ApertureDown,  ///< `aperture_down`: the same, put down aperture down
+};
+
 /// How a species is shown (`render:`): the renderer's settings for its image, camera,
 /// preview style and surface material.
 struct SpeciesRender {
@@ -82,6 +89,9 @@ struct SpeciesRender {
   /// two panels side by side, this species and the other at its final stage, seen by one
   /// camera (renderPair, model/model.h). Resolved against the species file's folder.
   std::optional<std::filesystem::path> pair;
+  /// Shells: `rest:` the pose pictures show the shell in (model/shell_kind.h); exports,
+  /// `sprig mesh` and the model's measures keep the model's own frame.
+  RestPose rest = RestPose::None;
   render::Material surface{Vec3(0.72f, 0.60f, 0.48f), 0.45f, 0.05f};  ///< `color`, `roughness`, `specular`, `metallic`: blob surfaces
   /// Solids: a cut-away by the plane n·x = d (xyz = n, w = d); the side n·x > d is removed
   /// (`sprig render --section`).

@@ -373,7 +373,13 @@ NodeId ShellBuilder::opening(NodeId shell) {
   std::vector<NodeId> inside;
   for (double th : sweepAngles(std::max(p_.startDeg, end_ - o.depthDeg), end_ + o.extendDeg))
     placeGenerating(inside, th, kIn, ShellPart::Inside, true);
+  if (o.show == OpeningOptions::Show::InsideSurface) {
+    std::vector<NodeId> one;
+    placeGenerating(one, end_, kIn, ShellPart::Inside, true);
+    return t_.blend(one);
+  }
   NodeId cutter = t_.blend(inside);
+  if (o.show == OpeningOptions::Show::InsideWhorl) return cutter;
   if (o.subtractPrevious && end_ - 360.0 - o.depthDeg > p_.startDeg - 360.0) {
     std::vector<NodeId> prev;
     const double from = std::max(p_.startDeg, end_ - o.depthDeg - 360.0);
@@ -382,6 +388,7 @@ NodeId ShellBuilder::opening(NodeId shell) {
       for (double th : sweepAngles(from, to)) placeGenerating(prev, th, cal_, ShellPart::Whorl, true);
     if (!prev.empty()) cutter = t_.difference(cutter, t_.blend(prev));
   }
+  if (o.show == OpeningOptions::Show::Cutter) return cutter;
   NodeId result = t_.difference(shell, cutter);
   if (o.insideWall) {
     const float major = 0.5f * (1.0f + o.innerScale);
@@ -480,8 +487,8 @@ void ShellBuilder::build() {
   }
   if (p_.opening.enabled) shell = opening(shell);
   m_.shellRoot = shell;
-  m_.worldFromShell = p_.apexUp ? glm::rotate(glm::dmat4(1.0), kPi, glm::dvec3(1, 0, 0)) : glm::dmat4(1.0);
-  m_.root = p_.apexUp ? t_.transform(shell, toFloat(m_.worldFromShell)) : shell;
+  m_.worldFromShell = p_.pose * (p_.apexUp ? glm::rotate(glm::dmat4(1.0), kPi, glm::dvec3(1, 0, 0)) : glm::dmat4(1.0));
+  m_.root = m_.worldFromShell != glm::dmat4(1.0) ? t_.transform(shell, toFloat(m_.worldFromShell)) : shell;
 }
 
 }  // namespace

@@ -161,6 +161,14 @@ struct OpeningOptions {
   double extendDeg = 40.0;   ///< how far past θ_end the cutter reaches (opens the lip)
   bool insideWall = true;    ///< add the inside wall back (Eq. 15): a rounded lip ring
   bool subtractPrevious = true;  ///< B_inside − B_previous-whorl (Eq. 14)
+  /// Fig. 10's construction surfaces: instead of the shell, the model is one of them.
+  enum class Show : uint8_t {
+    Shell,          ///< the shell with its opening (Eq. 14-15)
+    InsideSurface,  ///< the inside generating surface (inner_scale times the main one) at θ_end
+    InsideWhorl,    ///< B_inside: that surface swept over the opening's depth and extension
+    Cutter,         ///< B_opening = B_inside − B_previous, the solid cut out of the shell
+  };
+  Show show = Show::Shell;
 };
 
 /// Everything that defines a shell.
@@ -187,6 +195,10 @@ struct ShellParams {
   OpeningOptions opening;
   uint64_t seed = 1;
   bool apexUp = true;  ///< world = shell rotated 180° about x (apex up, aperture below)
+  /// A rigid motion applied after apexUp: world = pose · (apex-up turn) · shell. Identity
+  /// for the model itself (exports, measures); the renderer's resting pose (`render.rest`,
+  /// model/shell_kind.h) sets it for pictures only.
+  glm::dmat4 pose{1.0};
 
   /// θ_end: ageDeg or whorls·whorlDeg.
   double endDeg() const;

@@ -75,6 +75,14 @@ struct ImplicitOptions {
   /// the nodes whose support reaches the cell, identities removed): the same surface, a
   /// shorter walk per batch. false evaluates the whole tape (the reference).
   bool prunedTapes = true;
+  /// Raise the scene bounds' lowest y (where the ground goes) from the bisection on field
+  /// bounds over slabs of the whole blob, which sums the bounds of primitives that only
+  /// meet below the surface (a gap of up to a percent of the diagonal), to the lowest point
+  /// found inside the solid on a grid of 8 x 8 x 8 points in each of the lowest surface
+  /// cells: the ground then touches a model resting on it (a shell at rest, `render.rest`),
+  /// within an eighth of a cell. false keeps the slab bound (every picture before the
+  /// option existed).
+  bool tightBase = false;
 };
 
 /// The textures a part's ids refer to, in id order.

@@ -121,6 +121,41 @@ Box3 tightenBounds(const blobtree::CompiledBlob& blob, Box3 box) {
   return box;
 }
 
+/// The lowest y of blob's solid, found within the surface cells from the lowest up: in each
+/// cell whose field bound reaches the surface, the field at an 8 x 8 x 8 grid of points
+/// (cell-centred), layer by layer upward; the first point inside (F >= 0.5) is a point of
+/// the solid, so the surface reaches at least that low, and the true lowest point lies less
+/// than a grid step below it unless a feature thinner than the step reaches lower. Stops at
+/// the first cell starting above the best; +inf when no point is inside. Deterministic.
+float cellsBase(const blobtree::CompiledBlob& blob, const std::vector<blobtree::Cell>& cells) {
+  constexpr int kGrid = 8;
+  std::vector<size_t> order(cells.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) {
+    return cells[a].box.lo.y != cells[b].box.lo.y ? cells[a].box.lo.y < cells[b].box.lo.y : a < b;
+  });
+  float best = std::numeric_limits<float>::infinity();
+  for (size_t i : order) {
+    const Box3& c = cells[i].box;
+    if (c.lo.y >= best) break;
+    if (blob.valueBounds(c).hi < kIso) continue;
+    const Vec3 step = (c.hi - c.lo) / float(kGrid);
+    for (int k = 0; k < kGrid; ++k) {
+      const float y = c.lo.y + (k + 0.5f) * step.y;
+      if (y >= best) break;
+      bool inside = false;
+      for (int j = 0; j < kGrid && !inside; ++j)
+        for (int l = 0; l < kGrid && !inside; ++l)
+          inside = blob.value(Vec3(c.lo.x + (l + 0.5f) * step.x, y, c.lo.z + (j + 0.5f) * step.z)) >= kIso;
+      if (inside) {
+        best = y;
+        break;
+      }
+    }
+  }
+  return best;
+}
+
 }  // namespace
 
 uint32_t Scene::addImplicit(const blobtree::CompiledBlob& blob, uint32_t material, const ImplicitOptions& options) {
@@ -156,7 +191,14 @@ uint32_t Scene::addImplicit(const blobtree::CompiledBlob& blob, uint32_t materia
   rtcSetGeometryOccludedFunction(g, cellOccluded);
   Box3 cellBox;
   for (const auto& c : data->cells.cells) cellBox.extend(c.box);
-  if (!cellBox.empty()) impl_->bounds.extend(tightenBounds(blob, cellBox.intersected(support)));
+  if (!cellBox.empty()) {
+    Box3 tight = tightenBounds(blob, cellBox.intersected(support));
+    if (options.tightBase) {
+      const float base = cellsBase(blob, data->cells.cells);
+      if (base > tight.lo.y && base <= tight.hi.y) tight.lo.y = base;
+    }
+    impl_->bounds.extend(tight);
+  }
   impl_->stats.implicitCells += data->cells.cells.size();
   impl_->stats.implicitCellSize = std::max(impl_->stats.implicitCellSize, data->cells.cellSize);
   impl_->stats.implicitTapes += data->cells.tapes.size();

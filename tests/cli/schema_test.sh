@@ -50,7 +50,8 @@ done
 # whether both must accept or both reject it.
 mkdir -p "$WORK/lib/species"
 cp -r grammars "$WORK/lib/"
-cp species/fig_shell_07a_varix_spines.yaml species/blob_ricci_fig3.yaml "$WORK/lib/species/"
+# fig_shell_07a names its pair (render.pair), which must be there too.
+cp species/fig_shell_07a_varix_spines.yaml species/fig_shell_07a2_varix_tori.yaml species/blob_ricci_fig3.yaml "$WORK/lib/species/"
 printf 'kind: tree\ngrammar: ../grammars/abop_1_24a.lsys\n' > "$WORK/lib/species/tree.yaml"
 edits=0
 both() {  # both SPECIES 'yaml text to append' valid|invalid  (the schema's verdict comes at the end)

@@ -451,6 +451,7 @@ TEST_CASE("Every shipped species meshes to closed parts", "[.][all_species]") {
       {"fig_org_06_tentacle_level3", {1, 1, false}},
       {"fig_org_06_tentacle_level4", {1, 1, false}},
       {"fig_org_09_head_placement", {1, 1, false}},  // the mannequin head mesh is open at the neck
+      {"fig_org_09b_skull_placement", {2, 1, true}},  // domes on the CT skull, with its inner cavity
       {"fig_org_11a_skull", {2, 1, true}},         // the same skull before its modification
       {"fig_org_11_modification", {2, 1, true}},   // the CT skull's 2.9 iso-surface: the skull and its inner cavity
       {"fig_org_13a_mummified_skull_sharp", {2, 1, true}},

@@ -159,6 +159,29 @@ organism:
             .find("'sea'") != std::string::npos);
 }
 
+TEST_CASE("Organism mesh bases: flip turns an inward-wound mesh's details outward", "[model][organism]") {
+  test::TempDir dir("organism_mesh_flip");
+  // The cube of the test below with every face's corners reversed: wound inward.
+  std::ofstream(dir.path / "inward.off") << "OFF\n8 6 0\n-1 -1 -1\n1 -1 -1\n1 1 -1\n-1 1 -1\n-1 -1 1\n1 -1 1\n1 1 1\n-1 1 1\n"
+                                            "4 0 1 2 3\n4 4 7 6 5\n4 0 4 5 1\n4 2 6 7 3\n4 1 5 6 2\n4 0 3 7 4\n";
+  const PathPolicy policy{dir.path, false};
+  // A spur of length 0.5 at every control vertex (the cube's corners), at level 1.
+  auto reach = [&](const std::string& flip, const std::string& detail) {
+    const Species s = parseSpecies("kind: organism\norganism:\n  base: {mesh: {file: inward.off" + flip +
+                                       "}}\n  levels: 2\n  detail: [" + detail + "]\n",
+                                   (dir.path / "s.yaml").string(), policy);
+    const Mesh m = buildOrganismMesh(specOf(s), 1.0, Vec3(0.5f));
+    float far = 0;
+    for (const Vec3& p : m.positions) far = std::max(far, glm::length(p));
+    return far;
+  };
+  const std::string spurs = "{spur: {length: 0.5, seeds: {control_vertices: true}}}";
+  const float plain = reach("", ""), inward = reach("", spurs), outward = reach(", flip: true", spurs);
+  CHECK(reach(", flip: true", "") == plain);  // the surface itself is the same
+  CHECK(inward < plain);                      // unflipped, the spurs point into the cube
+  CHECK(outward > plain + 0.1f);              // flipped, they stand out of its corners
+}
+
 TEST_CASE("Organism bases from mesh files, and captured surfaces", "[model][organism]") {
   test::TempDir dir("organism_mesh_base");
   // A closed quad cube as OFF, and a finer sphere of radius 1.05 as OBJ (Sprig's writer).
