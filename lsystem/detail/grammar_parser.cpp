@@ -776,8 +776,10 @@ class GrammarParser {
       error(line, pred.b, "a predecessor must be a single module");
       return;
     }
+    // cpfg matches a predecessor module by module, brackets included (`[f(y)P(r)] --> *`);
+    // Sprig's notation keeps brackets out of predecessors.
     for (const RawModule& m : predMods)
-      if (m.name == "[" || m.name == "]") {
+      if ((m.name == "[" || m.name == "]") && prog_.dialect != Dialect::Cpfg) {
         error(line, m.col, "a bracket cannot be a predecessor");
         return;
       }

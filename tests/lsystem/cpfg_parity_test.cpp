@@ -362,6 +362,14 @@ TEST_CASE("cpfg parity: brackets in the ignore table", "[lsystem][cpfg]") {
   }
 }
 
+TEST_CASE("cpfg parity: a predecessor may hold brackets, matched module by module", "[lsystem][cpfg]") {
+  checkParity("bracket_predecessor");
+  SECTION("Sprig's notation keeps brackets out of predecessors") {
+    CHECK_THROWS_WITH(parseGrammar("axiom: A[B]\n[B] --> C\n", "g.lsys"),
+                      Catch::Contains("g.lsys:2:1: error: a bracket cannot be a predecessor"));
+  }
+}
+
 TEST_CASE("cpfg parity: an expression statement is evaluated and dropped", "[lsystem][cpfg]") {
   checkParity("expression_statement");
 }
