@@ -63,6 +63,8 @@ std::optional<Header> bareBlockKeyword(const std::string& s, int b) {
 
 
 /// cpfg's `@L("format", values)` outside an interpretation rule (it would be in the string).
+/// cpfg's interpretation-rule predecessor `@G` (expandGenCylRules).
+constexpr const char* kGenCylPrefix = "@G";
 constexpr const char* kLabelOutsideInterpretation =
     "cpfg's '@L' (label) is supported only in interpretation rules (Sprig draws no text: drawing one is an error)";
 
@@ -770,8 +772,18 @@ class GrammarParser {
       error(line, pred.b, "missing predecessor before '" + s.substr(arrow, arrowLen) + "'");
       return;
     }
-    if (!scanner_.tokenizeModules(line, pred.b, pred.e, predMods)) return;
-    lintWords(line, predMods);
+    if (prog_.dialect == Dialect::Cpfg && scanner_.view(pred) == kGenCylPrefix) {
+      // cpfg's `@G`: the modules '@' and 'G' that begin every generalized-cylinder command
+      // (expandGenCylRules).
+      if (block != Block::Interpretation) {
+        error(line, pred.b, "cpfg's predecessor '@G' (the '@' and 'G' of the generalized-cylinder commands) is supported only in an interpretation (homomorphism) rule");
+        return;
+      }
+      predMods.push_back(RawModule{kGenCylPrefix, pred.b, {}, false});
+    } else {
+      if (!scanner_.tokenizeModules(line, pred.b, pred.e, predMods)) return;
+      lintWords(line, predMods);
+    }
     if (predMods.empty()) {
       error(line, pred.b, "a predecessor must be a single module");
       return;
@@ -1690,7 +1702,11 @@ class GrammarParser {
           for (const SuccModule& m : p.successor) prog_.usesCut |= m.symbol == prog_.cut;
     if (int q = prog_.symbols.find("?"); q >= 0) prog_.subCall = static_cast<SymbolId>(q);
     prog_.subEnd = static_cast<SymbolId>(prog_.symbols.find("$"));
-    if (prog_.dialect == Dialect::Cpfg) checkSplitCommands(sets);
+    if (prog_.dialect == Dialect::Cpfg) {
+      for (RuleSet* rs : sets)
+        if (std::find(interpretations.begin(), interpretations.end(), rs) != interpretations.end()) expandGenCylRules(*rs, sets);
+      checkSplitCommands(sets);
+    }
     for (RuleSet* rs : sets) {
       rs->bySymbol.assign(prog_.symbols.size(), {});
       for (uint32_t i = 0; i < rs->productions.size(); ++i) {
@@ -1699,6 +1715,52 @@ class GrammarParser {
       }
       rs->finalize();
     }
+  }
+
+  /// cpfg's interpretation rule `@G --> succ` (vlab's two-trees writes `@G --> *` to draw
+  /// its stems without generalized cylinders): cpfg's string keeps one character per module,
+  /// so the rule matches the '@' and 'G' of every `@Gs`, `@Gc(n)`, `@Ge(n)`, `@Gt(a,b)`,
+  /// `@Gr(...)` and replaces them, leaving the command's last letter with its parameters,
+  /// which cpfg's turtle does not draw (interpret.c has no case for c, e, t or r, and 's'
+  /// only for an environment with 2 or 3 parameters). Sprig reads each command as one module:
+  /// the rule becomes one rule per command and parameter count the grammar writes, in its
+  /// place, which replaces the whole command (a rule for the left-over letter is the error of
+  /// checkSplitCommands).
+  void expandGenCylRules(RuleSet& rs, const std::vector<RuleSet*>& sets) {
+    const int prefix = prog_.symbols.find(kGenCylPrefix);
+    if (prefix < 0) return;
+    std::vector<std::pair<SymbolId, uint16_t>> written;  // (command, parameter count)
+    auto wrote = [&](SymbolId id, size_t n) {
+      const std::string& name = prog_.symbols.name(id);
+      if (name.size() != 3 || name.compare(0, 2, kGenCylPrefix) != 0) return;
+      const std::pair<SymbolId, uint16_t> w{id, static_cast<uint16_t>(n)};
+      if (std::find(written.begin(), written.end(), w) == written.end()) written.push_back(w);
+    };
+    for (size_t i = 0; i < prog_.axiom.size(); ++i) wrote(prog_.axiom.symbols[i], prog_.axiom.paramCount(i));
+    for (const RuleSet* other : sets)
+      for (const Production& p : other->productions)
+        for (const SuccModule& m : p.successor) wrote(m.symbol, m.argCount);
+    std::sort(written.begin(), written.end());
+    std::vector<Production> out;
+    for (Production& p : rs.productions) {
+      if (p.predecessor != static_cast<SymbolId>(prefix)) {
+        out.push_back(std::move(p));
+        continue;
+      }
+      for (const auto& [id, n] : written) {
+        Production c = p;
+        c.predecessor = id;
+        c.predParams = n;
+        // The command's parameters go to registers the rule does not read.
+        c.predFirstVar = static_cast<uint16_t>(p.localFirst + p.localCount);
+        if (c.predFirstVar + n + prog_.globals.size() > kMaxVars) {
+          diags().error(p.loc, "too many variables in cpfg's '@G' rule", p.sourceLine);
+          return;
+        }
+        out.push_back(std::move(c));
+      }
+    }
+    rs.productions = std::move(out);
   }
 
   /// cpfg keeps one character per module: its commands `@o(d)`, `?P(x,y,z)`, `~l` are the

@@ -370,6 +370,25 @@ TEST_CASE("cpfg parity: a predecessor may hold brackets, matched module by modul
   }
 }
 
+TEST_CASE("cpfg parity: the interpretation rule '@G' rewrites every generalized-cylinder command", "[lsystem][cpfg]") {
+  checkParity("gencyl_prefix");
+  SECTION("interpreted: each command is replaced, in the rule's place among the rules for '@'") {
+    auto interpreted = [](const std::string& rules) {
+      Grammar g = parseGrammar("axiom: F@GsF(1)@Gc(2)F@Ge(3)@Gt(1,2)@Ge\nhomomorphism\n" + rules, "t.l");
+      Deriver d(g);
+      return formatModuleString(d.interpret(d.derive()), d.symbols());
+    };
+    CHECK(interpreted("@G --> *\n") == "FF(1)F");
+    CHECK(interpreted("@Gc(n) --> f(n)\n@G --> *\n") == "FF(1)f(2)F");
+    CHECK(interpreted("@G --> *\n@Gc(n) --> f(n)\n") == "FF(1)F");
+  }
+  SECTION("only in interpretation rules") {
+    CHECK_THROWS_WITH(parseGrammar("axiom: @GsF@Ge\n@G --> *\n", "t.l"),
+                      Catch::Contains("t.l:2:1: error: cpfg's predecessor '@G' (the '@' and 'G' of the generalized-cylinder "
+                                      "commands) is supported only in an interpretation (homomorphism) rule"));
+  }
+}
+
 TEST_CASE("cpfg parity: an expression statement is evaluated and dropped", "[lsystem][cpfg]") {
   checkParity("expression_statement");
 }
