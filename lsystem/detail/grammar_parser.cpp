@@ -1533,10 +1533,18 @@ class GrammarParser {
       for (const auto& [count, where] : w->second) {
         if (counts.count(count)) continue;
         auto plural = [](int n) { return std::to_string(n) + (n == 1 ? " parameter" : " parameters"); };
-        error(where.first, where.second,
-              "module '" + name + "' is written here with " + plural(count) + ", but its production '" + prod.text +
-                  "' (line " + std::to_string(prod.line) + ":" + std::to_string(prod.col + 1) + ") takes " + plural(prod.arity) +
-                  ": a production matches a module only with its own parameter count, so this module is never rewritten");
+        const std::string msg = "module '" + name + "' is written here with " + plural(count) + ", but its production '" +
+                                prod.text + "' (line " + std::to_string(prod.line) + ":" + std::to_string(prod.col + 1) +
+                                ") takes " + plural(prod.arity) +
+                                ": a production matches a module only with its own parameter count, so this module is never rewritten";
+        if (prog_.dialect != Dialect::Cpfg) {
+          error(where.first, where.second, msg);
+          continue;
+        }
+        // cpfg derives such a file (vlab's two-trees writes 'L' beside 'L(del,vig)'), never
+        // rewriting the module, and so does Sprig: a warning.
+        auto [loc, text] = scanner_.locate(where.first, where.second);
+        diags().warning(loc, msg + ", as in cpfg", std::move(text));
       }
     }
   }
