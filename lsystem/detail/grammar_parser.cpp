@@ -1018,11 +1018,12 @@ class GrammarParser {
   /// `do {...} while (c);` of line[b, e) (cpfg reference manual, 3.2), appended to the code.
   /// cpfg's `printf("format", values...);` at column at of line (its `(` at open): compiles
   /// the values and an Op::Printf; returns the column after its `;`, or -1 after an error.
-  int printfStatement(int line, int at, int open, int e, std::vector<std::string>& varNames) {
+  int printfStatement(int line, int at, int open, int e, std::vector<std::string>& varNames, const std::string& fn = "printf",
+                      Op op = Op::Printf) {
     const std::string& s = scanner_.line(line);
     int q = nextNonSpace(line, open + 1, e);
     if (q >= e || s[q] != '"') {
-      error(line, q, "printf's first argument must be a format in double quotes");
+      error(line, q, fn + "'s " + (op == Op::Printf ? "first" : "second") + " argument must be a format in double quotes");
       return -1;
     }
     std::string format;
@@ -1036,7 +1037,7 @@ class GrammarParser {
       }
     }
     if (j >= e) {
-      error(line, q, "unterminated format string of printf");
+      error(line, q, "unterminated format string of " + fn);
       return -1;
     }
     // Conversions: numbers only (cpfg's values are numbers), one per value.
@@ -1050,7 +1051,7 @@ class GrammarParser {
       size_t g = f + 1;
       while (g < format.size() && std::string_view("-+ #0123456789.hlL").find(format[g]) != std::string_view::npos) ++g;
       if (g >= format.size() || std::string_view("diouxXcfFeEgGaA").find(format[g]) == std::string_view::npos) {
-        error(line, q, "printf's conversion '" + format.substr(f, g + 1 - f) +
+        error(line, q, fn + "'s conversion '" + format.substr(f, g + 1 - f) +
                            "' is not supported (only numbers: %d %i %o %u %x %c %f %e %g %a)");
         return -1;
       }
@@ -1067,43 +1068,131 @@ class GrammarParser {
       }
     }
     if (close < 0) {
-      error(line, open, "missing ')' after the arguments of printf");
+      error(line, open, "missing ')' after the arguments of " + fn);
       return -1;
     }
     int values = 0;
     int k = nextNonSpace(line, j + 1, close);
     if (k < close && s[k] != ',') {
-      error(line, k, "expected ',' or ')' after printf's format");
+      error(line, k, "expected ',' or ')' after " + fn + "'s format");
       return -1;
     }
     while (k < close) {
       int next = scanner_.findTop(line, k + 1, close, ',');
       if (next < 0) next = close;
-      if (!expr_.compile(scanner_.trim(Span{line, k + 1, next}), varNames, "printf value")) return -1;
+      if (!expr_.compile(scanner_.trim(Span{line, k + 1, next}), varNames, (fn + " value").c_str())) return -1;
       ++values;
       k = next;
     }
     if (values != conversions) {
-      error(line, at, "printf's format has " + std::to_string(conversions) + " conversion(s) for " +
+      error(line, at, fn + "'s format has " + std::to_string(conversions) + " conversion(s) for " +
                           std::to_string(values) + " value(s)");
       return -1;
     }
     if (values > 8) {
-      error(line, at, "printf with more than 8 values is not supported");
+      error(line, at, fn + " with more than 8 values is not supported");
       return -1;
     }
     int semi = nextNonSpace(line, close + 1, e);
     if (semi >= e || s[semi] != ';') {
-      error(line, at, "missing ';' after the call of 'printf' (cpfg requires one after every statement)");
+      error(line, at, "missing ';' after the call of '" + fn + "' (cpfg requires one after every statement)");
       return -1;
     }
     Instr pr;
-    pr.op = Op::Printf;
+    pr.op = op;
     pr.var = static_cast<uint16_t>(prog_.strings.size());
     pr.c = values;
     prog_.strings.push_back(format);
     prog_.code.push_back(pr);
     return semi + 1;
+  }
+
+  /// cpfg's files (userfiles.cpp), in the Start/StartEach/EndEach/End blocks of a .l file:
+  /// `f = fopen("name", "w" or "a");`, `fprintf(f, "format", values...);`, `fflush(f);`,
+  /// `fclose(f);`. Whether the statement word at `at` may be compiled here (else an error).
+  bool fileCallAllowed(int line, int at, const std::string& word) {
+    if (inGlobalBlock_) return true;
+    error(line, at, "cpfg's function '" + word + "' is supported only in the Start:, StartEach:, EndEach: and End: blocks of a .l file");
+    return false;
+  }
+
+  /// `fprintf(f, "format", values...);` (its `(` at open): the index, then as printf.
+  int fprintfStatement(int line, int at, int open, int e, std::vector<std::string>& varNames) {
+    if (!fileCallAllowed(line, at, "fprintf")) return -1;
+    const int comma = scanner_.findTop(line, open + 1, e, ',');
+    if (comma < 0) {
+      error(line, open, "fprintf takes a file, a format and values");
+      return -1;
+    }
+    if (!expr_.compile(scanner_.trim(Span{line, open + 1, comma}), varNames, "fprintf file")) return -1;
+    return printfStatement(line, at, comma, e, varNames, "fprintf", Op::Fprintf);
+  }
+
+  /// `fflush(f);` or `fclose(f);` (its `(` at open).
+  int fileStatement(int line, int at, int open, int e, const std::string& word, std::vector<std::string>& varNames) {
+    if (!fileCallAllowed(line, at, word)) return -1;
+    const int close = matching(line, open, e, '(', ')');
+    const int semi = close < 0 ? -1 : nextNonSpace(line, close + 1, e);
+    if (close < 0 || semi >= e || scanner_.line(line)[semi] != ';') {
+      error(line, at, "missing ';' after the call of '" + word + "' (cpfg requires one after every statement)");
+      return -1;
+    }
+    if (!expr_.compile(scanner_.trim(Span{line, open + 1, close}), varNames, (word + " file").c_str())) return -1;
+    Instr in;
+    in.op = word == "fflush" ? Op::Fflush : Op::Fclose;
+    prog_.code.push_back(in);
+    return semi + 1;
+  }
+
+  /// The value `fopen("name", "mode")` of an assignment: Op::Fopen with the name and mode in
+  /// Program::strings. Names are plain file names (the grammar's folder); modes "w" and "a".
+  bool fopenValue(Span value) {
+    const int line = value.line;
+    const std::string& s = scanner_.line(line);
+    auto literal = [&](int& i, const char* what) -> std::optional<std::string> {
+      i = nextNonSpace(line, i, value.e);
+      const size_t q = i < value.e && s[i] == '"' ? s.find('"', i + 1) : std::string::npos;
+      if (q == std::string::npos || static_cast<int>(q) >= value.e) {
+        error(line, i, std::string("fopen's ") + what + " must be in double quotes");
+        return std::nullopt;
+      }
+      std::string t = s.substr(i + 1, q - i - 1);
+      i = static_cast<int>(q) + 1;
+      return t;
+    };
+    int i = nextNonSpace(line, value.b + 5, value.e) + 1;  // past "fopen("
+    const int nameAt = nextNonSpace(line, i, value.e);
+    auto name = literal(i, "file name");
+    if (!name) return false;
+    i = nextNonSpace(line, i, value.e);
+    if (i >= value.e || s[i] != ',') {
+      error(line, i, "fopen takes a file name and a mode");
+      return false;
+    }
+    const int modeAt = nextNonSpace(line, i + 1, value.e);
+    ++i;
+    auto mode = literal(i, "mode");
+    if (!mode) return false;
+    i = nextNonSpace(line, i, value.e);
+    if (i >= value.e || s[i] != ')' || nextNonSpace(line, i + 1, value.e) < value.e) {
+      error(line, i, "expected ')' after fopen's mode (fopen's value is assigned alone)");
+      return false;
+    }
+    if (name->empty() || *name == "." || *name == ".." || name->find_first_of("/\\") != std::string::npos) {
+      error(line, nameAt, "fopen's file '" + *name + "' must be a plain file name: Sprig writes only in the grammar's folder");
+      return false;
+    }
+    if (*mode != "w" && *mode != "a") {
+      error(line, modeAt, "cpfg's fopen mode '" + *mode + "' is not supported (only \"w\" and \"a\": Sprig writes files, fscanf is not supported)");
+      return false;
+    }
+    Instr in;
+    in.op = Op::Fopen;
+    in.var = static_cast<uint16_t>(prog_.strings.size());
+    prog_.strings.push_back(*name);
+    prog_.strings.push_back(*mode);
+    prog_.code.push_back(in);
+    return true;
   }
 
   /// A statement list `b..e` of a block, a production's or a function's body: assignments,
@@ -1130,6 +1219,10 @@ class GrammarParser {
         i = doStatement(line, i, e, varNames, base);
       } else if (k < e && s[k] == '(' && word == "printf") {
         i = printfStatement(line, at, k, e, varNames);
+      } else if (k < e && s[k] == '(' && word == "fprintf" && prog_.dialect == Dialect::Cpfg) {
+        i = fprintfStatement(line, at, k, e, varNames);
+      } else if (k < e && s[k] == '(' && (word == "fflush" || word == "fclose") && prog_.dialect == Dialect::Cpfg) {
+        i = fileStatement(line, at, k, e, word, varNames);
       } else if (k < e && s[k] == '(') {
         i = callStatement(line, at, e, word, varNames, base);
       } else if (k < e && s[k] == '[' && expr_.arrayId(word) >= 0) {
@@ -1282,7 +1375,14 @@ class GrammarParser {
       return -1;
     }
     if (!assignable(line, at, word, varNames)) return -1;
-    if (!expr_.compile(value, varNames, "value")) return -1;
+    const std::string_view text = scanner_.view(value);
+    const bool fopen = prog_.dialect == Dialect::Cpfg && text.substr(0, 5) == "fopen" &&
+                       nextNonSpace(line, value.b + 5, value.e) < value.e && s[nextNonSpace(line, value.b + 5, value.e)] == '(';
+    if (fopen) {
+      if (!fileCallAllowed(line, value.b, "fopen") || !fopenValue(value)) return -1;
+    } else if (!expr_.compile(value, varNames, "value")) {
+      return -1;
+    }
     const auto slot = storeSlot(line, at, word, varNames);
     if (!slot) return -1;
     Instr store;
