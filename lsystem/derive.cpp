@@ -240,6 +240,7 @@ struct Deriver::Impl {
         t.angleDeg = prog->hasAngle ? prog->angleDeg : kCpfgDefaultAngleDeg;
       }
       t.growthStep = -1;
+      t.checkTextures = false;  // nothing is drawn: an unknown texture selects none, as in cpfg
       queryTurtle = std::make_unique<Turtle>(prog->symbols, t);
     }
     std::vector<Turtle::QueryHit> hits;

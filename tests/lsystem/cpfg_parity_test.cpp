@@ -435,6 +435,10 @@ TEST_CASE("cpfg parity: fopen, fprintf, fflush and fclose in the Start/EachStep/
   }
 }
 
+TEST_CASE("cpfg parity: '@Tx(n)' naming no texture does not stop the query modules", "[lsystem][cpfg]") {
+  checkParity("texture_query");
+}
+
 TEST_CASE("cpfg parity: an expression statement is evaluated and dropped", "[lsystem][cpfg]") {
   checkParity("expression_statement");
 }
