@@ -1,6 +1,8 @@
 #include "lsystem/derive.h"
 
 #include <algorithm>
+#include <memory>
+#include <filesystem>
 #include <charconv>
 #include <cstring>
 #include <limits>
@@ -238,6 +240,7 @@ struct Deriver::Impl {
         t.angleDeg = prog->hasAngle ? prog->angleDeg : kCpfgDefaultAngleDeg;
       }
       t.growthStep = -1;
+      t.checkTextures = false;  // nothing is drawn: an unknown texture selects none, as in cpfg
       queryTurtle = std::make_unique<Turtle>(prog->symbols, t);
     }
     std::vector<Turtle::QueryHit> hits;
@@ -394,6 +397,8 @@ struct Deriver::Impl {
   std::vector<double> arrays;
   /// What cpfg's `stop` and `srand` asked for (the stop flag is cleared at each start).
   detail::Effects effects;
+  /// cpfg's fopen files, in the grammar's folder (Effects::files of the blocks).
+  std::unique_ptr<detail::CpfgFiles> files = std::make_unique<detail::CpfgFiles>();
   /// The seed before any `srand` (options or grammar): restart() begins with it again.
   uint64_t baseSeed = 0;
   /// Steps completed at the last `srand`: step k draws from stream k - streamBase.
@@ -1437,6 +1442,10 @@ struct Deriver::Impl {
     cpfgRandom = detail::CpfgRandom::forSeed(seedGiven() ? seed : 0);
     streamBase = 0;
     steps = baseSteps;
+    // cpfg closes the files of a derivation before it starts again (FreeFileDefSpace).
+    files->closeAll();
+    files->setFolder(std::filesystem::path(prog->fileName).parent_path().string());
+    effects.files = files.get();
     runBlock(prog->startBlock, 0, 0);
     cur = prog->axiom;
     evaluateDeferredAxiom();

@@ -771,11 +771,16 @@ class TurtleWalk {
   /// cpfg's `@Tx(n)` (blackbox.c): the view file's texture n (its n-th `texture:` line, cpfg
   /// truncating n) on the surfaces `~X`, polygons, `F` cylinders and generalized cylinders
   /// drawn after it on this branch; `@Tx` or `@Tx(0)`: none. A number no `texture:` line
-  /// has is an error (cpfg draws untextured).
+  /// has is an error when the turtle draws (cpfg draws untextured); the turtle that only
+  /// answers queries (checkTextures false) selects none, as cpfg.
   void texture(size_t i) {
     const double v = hasParam(i) ? param(i) : 0.0;
     const size_t count = settings_.cpfgTextures ? settings_.cpfgTextures->size() : 0;
     if (!std::isfinite(v) || v < 0 || v >= static_cast<double>(count) + 1) {
+      if (!settings_.checkTextures) {
+        st_.texture = -1;
+        return;
+      }
       char shown[32];
       std::snprintf(shown, sizeof shown, "%g", v);
       throw InputError(SourceLoc{"sprig", 0, 0},

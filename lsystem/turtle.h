@@ -88,6 +88,10 @@ struct TurtleSettings {
   /// cpfg: the view file's textures (`texture:` lines), which `@Tx(n)` selects for the
   /// surfaces `~X` draws; null for none.
   std::shared_ptr<const std::vector<CpfgTexture>> cpfgTextures;
+  /// cpfg: `@Tx(n)` naming no texture is an error when true (the turtle draws); when false
+  /// (the turtle only answers query modules and environmental programs, which draw
+  /// nothing) it selects none, as cpfg's turtle does (blackbox.c).
+  bool checkTextures = true;
   /// cpfg: the view file's contours (`contour:` lines), which `@#(id)` selects as the
   /// cross-section of generalized cylinders; null for none.
   std::shared_ptr<const std::vector<CpfgContourEntry>> cpfgContours;

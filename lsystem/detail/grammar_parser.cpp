@@ -63,6 +63,8 @@ std::optional<Header> bareBlockKeyword(const std::string& s, int b) {
 
 
 /// cpfg's `@L("format", values)` outside an interpretation rule (it would be in the string).
+/// cpfg's interpretation-rule predecessor `@G` (expandGenCylRules).
+constexpr const char* kGenCylPrefix = "@G";
 constexpr const char* kLabelOutsideInterpretation =
     "cpfg's '@L' (label) is supported only in interpretation rules (Sprig draws no text: drawing one is an error)";
 
@@ -770,14 +772,26 @@ class GrammarParser {
       error(line, pred.b, "missing predecessor before '" + s.substr(arrow, arrowLen) + "'");
       return;
     }
-    if (!scanner_.tokenizeModules(line, pred.b, pred.e, predMods)) return;
-    lintWords(line, predMods);
+    if (prog_.dialect == Dialect::Cpfg && scanner_.view(pred) == kGenCylPrefix) {
+      // cpfg's `@G`: the modules '@' and 'G' that begin every generalized-cylinder command
+      // (expandGenCylRules).
+      if (block != Block::Interpretation) {
+        error(line, pred.b, "cpfg's predecessor '@G' (the '@' and 'G' of the generalized-cylinder commands) is supported only in an interpretation (homomorphism) rule");
+        return;
+      }
+      predMods.push_back(RawModule{kGenCylPrefix, pred.b, {}, false});
+    } else {
+      if (!scanner_.tokenizeModules(line, pred.b, pred.e, predMods)) return;
+      lintWords(line, predMods);
+    }
     if (predMods.empty()) {
       error(line, pred.b, "a predecessor must be a single module");
       return;
     }
+    // cpfg matches a predecessor module by module, brackets included (`[f(y)P(r)] --> *`);
+    // Sprig's notation keeps brackets out of predecessors.
     for (const RawModule& m : predMods)
-      if (m.name == "[" || m.name == "]") {
+      if ((m.name == "[" || m.name == "]") && prog_.dialect != Dialect::Cpfg) {
         error(line, m.col, "a bracket cannot be a predecessor");
         return;
       }
@@ -1004,11 +1018,12 @@ class GrammarParser {
   /// `do {...} while (c);` of line[b, e) (cpfg reference manual, 3.2), appended to the code.
   /// cpfg's `printf("format", values...);` at column at of line (its `(` at open): compiles
   /// the values and an Op::Printf; returns the column after its `;`, or -1 after an error.
-  int printfStatement(int line, int at, int open, int e, std::vector<std::string>& varNames) {
+  int printfStatement(int line, int at, int open, int e, std::vector<std::string>& varNames, const std::string& fn = "printf",
+                      Op op = Op::Printf) {
     const std::string& s = scanner_.line(line);
     int q = nextNonSpace(line, open + 1, e);
     if (q >= e || s[q] != '"') {
-      error(line, q, "printf's first argument must be a format in double quotes");
+      error(line, q, fn + "'s " + (op == Op::Printf ? "first" : "second") + " argument must be a format in double quotes");
       return -1;
     }
     std::string format;
@@ -1022,7 +1037,7 @@ class GrammarParser {
       }
     }
     if (j >= e) {
-      error(line, q, "unterminated format string of printf");
+      error(line, q, "unterminated format string of " + fn);
       return -1;
     }
     // Conversions: numbers only (cpfg's values are numbers), one per value.
@@ -1036,7 +1051,7 @@ class GrammarParser {
       size_t g = f + 1;
       while (g < format.size() && std::string_view("-+ #0123456789.hlL").find(format[g]) != std::string_view::npos) ++g;
       if (g >= format.size() || std::string_view("diouxXcfFeEgGaA").find(format[g]) == std::string_view::npos) {
-        error(line, q, "printf's conversion '" + format.substr(f, g + 1 - f) +
+        error(line, q, fn + "'s conversion '" + format.substr(f, g + 1 - f) +
                            "' is not supported (only numbers: %d %i %o %u %x %c %f %e %g %a)");
         return -1;
       }
@@ -1053,43 +1068,131 @@ class GrammarParser {
       }
     }
     if (close < 0) {
-      error(line, open, "missing ')' after the arguments of printf");
+      error(line, open, "missing ')' after the arguments of " + fn);
       return -1;
     }
     int values = 0;
     int k = nextNonSpace(line, j + 1, close);
     if (k < close && s[k] != ',') {
-      error(line, k, "expected ',' or ')' after printf's format");
+      error(line, k, "expected ',' or ')' after " + fn + "'s format");
       return -1;
     }
     while (k < close) {
       int next = scanner_.findTop(line, k + 1, close, ',');
       if (next < 0) next = close;
-      if (!expr_.compile(scanner_.trim(Span{line, k + 1, next}), varNames, "printf value")) return -1;
+      if (!expr_.compile(scanner_.trim(Span{line, k + 1, next}), varNames, (fn + " value").c_str())) return -1;
       ++values;
       k = next;
     }
     if (values != conversions) {
-      error(line, at, "printf's format has " + std::to_string(conversions) + " conversion(s) for " +
+      error(line, at, fn + "'s format has " + std::to_string(conversions) + " conversion(s) for " +
                           std::to_string(values) + " value(s)");
       return -1;
     }
     if (values > 8) {
-      error(line, at, "printf with more than 8 values is not supported");
+      error(line, at, fn + " with more than 8 values is not supported");
       return -1;
     }
     int semi = nextNonSpace(line, close + 1, e);
     if (semi >= e || s[semi] != ';') {
-      error(line, at, "missing ';' after the call of 'printf' (cpfg requires one after every statement)");
+      error(line, at, "missing ';' after the call of '" + fn + "' (cpfg requires one after every statement)");
       return -1;
     }
     Instr pr;
-    pr.op = Op::Printf;
+    pr.op = op;
     pr.var = static_cast<uint16_t>(prog_.strings.size());
     pr.c = values;
     prog_.strings.push_back(format);
     prog_.code.push_back(pr);
     return semi + 1;
+  }
+
+  /// cpfg's files (userfiles.cpp), in the Start/StartEach/EndEach/End blocks of a .l file:
+  /// `f = fopen("name", "w" or "a");`, `fprintf(f, "format", values...);`, `fflush(f);`,
+  /// `fclose(f);`. Whether the statement word at `at` may be compiled here (else an error).
+  bool fileCallAllowed(int line, int at, const std::string& word) {
+    if (inGlobalBlock_) return true;
+    error(line, at, "cpfg's function '" + word + "' is supported only in the Start:, StartEach:, EndEach: and End: blocks of a .l file");
+    return false;
+  }
+
+  /// `fprintf(f, "format", values...);` (its `(` at open): the index, then as printf.
+  int fprintfStatement(int line, int at, int open, int e, std::vector<std::string>& varNames) {
+    if (!fileCallAllowed(line, at, "fprintf")) return -1;
+    const int comma = scanner_.findTop(line, open + 1, e, ',');
+    if (comma < 0) {
+      error(line, open, "fprintf takes a file, a format and values");
+      return -1;
+    }
+    if (!expr_.compile(scanner_.trim(Span{line, open + 1, comma}), varNames, "fprintf file")) return -1;
+    return printfStatement(line, at, comma, e, varNames, "fprintf", Op::Fprintf);
+  }
+
+  /// `fflush(f);` or `fclose(f);` (its `(` at open).
+  int fileStatement(int line, int at, int open, int e, const std::string& word, std::vector<std::string>& varNames) {
+    if (!fileCallAllowed(line, at, word)) return -1;
+    const int close = matching(line, open, e, '(', ')');
+    const int semi = close < 0 ? -1 : nextNonSpace(line, close + 1, e);
+    if (close < 0 || semi >= e || scanner_.line(line)[semi] != ';') {
+      error(line, at, "missing ';' after the call of '" + word + "' (cpfg requires one after every statement)");
+      return -1;
+    }
+    if (!expr_.compile(scanner_.trim(Span{line, open + 1, close}), varNames, (word + " file").c_str())) return -1;
+    Instr in;
+    in.op = word == "fflush" ? Op::Fflush : Op::Fclose;
+    prog_.code.push_back(in);
+    return semi + 1;
+  }
+
+  /// The value `fopen("name", "mode")` of an assignment: Op::Fopen with the name and mode in
+  /// Program::strings. Names are plain file names (the grammar's folder); modes "w" and "a".
+  bool fopenValue(Span value) {
+    const int line = value.line;
+    const std::string& s = scanner_.line(line);
+    auto literal = [&](int& i, const char* what) -> std::optional<std::string> {
+      i = nextNonSpace(line, i, value.e);
+      const size_t q = i < value.e && s[i] == '"' ? s.find('"', i + 1) : std::string::npos;
+      if (q == std::string::npos || static_cast<int>(q) >= value.e) {
+        error(line, i, std::string("fopen's ") + what + " must be in double quotes");
+        return std::nullopt;
+      }
+      std::string t = s.substr(i + 1, q - i - 1);
+      i = static_cast<int>(q) + 1;
+      return t;
+    };
+    int i = nextNonSpace(line, value.b + 5, value.e) + 1;  // past "fopen("
+    const int nameAt = nextNonSpace(line, i, value.e);
+    auto name = literal(i, "file name");
+    if (!name) return false;
+    i = nextNonSpace(line, i, value.e);
+    if (i >= value.e || s[i] != ',') {
+      error(line, i, "fopen takes a file name and a mode");
+      return false;
+    }
+    const int modeAt = nextNonSpace(line, i + 1, value.e);
+    ++i;
+    auto mode = literal(i, "mode");
+    if (!mode) return false;
+    i = nextNonSpace(line, i, value.e);
+    if (i >= value.e || s[i] != ')' || nextNonSpace(line, i + 1, value.e) < value.e) {
+      error(line, i, "expected ')' after fopen's mode (fopen's value is assigned alone)");
+      return false;
+    }
+    if (name->empty() || *name == "." || *name == ".." || name->find_first_of("/\\") != std::string::npos) {
+      error(line, nameAt, "fopen's file '" + *name + "' must be a plain file name: Sprig writes only in the grammar's folder");
+      return false;
+    }
+    if (*mode != "w" && *mode != "a") {
+      error(line, modeAt, "cpfg's fopen mode '" + *mode + "' is not supported (only \"w\" and \"a\": Sprig writes files, fscanf is not supported)");
+      return false;
+    }
+    Instr in;
+    in.op = Op::Fopen;
+    in.var = static_cast<uint16_t>(prog_.strings.size());
+    prog_.strings.push_back(*name);
+    prog_.strings.push_back(*mode);
+    prog_.code.push_back(in);
+    return true;
   }
 
   /// A statement list `b..e` of a block, a production's or a function's body: assignments,
@@ -1116,6 +1219,10 @@ class GrammarParser {
         i = doStatement(line, i, e, varNames, base);
       } else if (k < e && s[k] == '(' && word == "printf") {
         i = printfStatement(line, at, k, e, varNames);
+      } else if (k < e && s[k] == '(' && word == "fprintf" && prog_.dialect == Dialect::Cpfg) {
+        i = fprintfStatement(line, at, k, e, varNames);
+      } else if (k < e && s[k] == '(' && (word == "fflush" || word == "fclose") && prog_.dialect == Dialect::Cpfg) {
+        i = fileStatement(line, at, k, e, word, varNames);
       } else if (k < e && s[k] == '(') {
         i = callStatement(line, at, e, word, varNames, base);
       } else if (k < e && s[k] == '[' && expr_.arrayId(word) >= 0) {
@@ -1268,7 +1375,14 @@ class GrammarParser {
       return -1;
     }
     if (!assignable(line, at, word, varNames)) return -1;
-    if (!expr_.compile(value, varNames, "value")) return -1;
+    const std::string_view text = scanner_.view(value);
+    const bool fopen = prog_.dialect == Dialect::Cpfg && text.substr(0, 5) == "fopen" &&
+                       nextNonSpace(line, value.b + 5, value.e) < value.e && s[nextNonSpace(line, value.b + 5, value.e)] == '(';
+    if (fopen) {
+      if (!fileCallAllowed(line, value.b, "fopen") || !fopenValue(value)) return -1;
+    } else if (!expr_.compile(value, varNames, "value")) {
+      return -1;
+    }
     const auto slot = storeSlot(line, at, word, varNames);
     if (!slot) return -1;
     Instr store;
@@ -1519,10 +1633,18 @@ class GrammarParser {
       for (const auto& [count, where] : w->second) {
         if (counts.count(count)) continue;
         auto plural = [](int n) { return std::to_string(n) + (n == 1 ? " parameter" : " parameters"); };
-        error(where.first, where.second,
-              "module '" + name + "' is written here with " + plural(count) + ", but its production '" + prod.text +
-                  "' (line " + std::to_string(prod.line) + ":" + std::to_string(prod.col + 1) + ") takes " + plural(prod.arity) +
-                  ": a production matches a module only with its own parameter count, so this module is never rewritten");
+        const std::string msg = "module '" + name + "' is written here with " + plural(count) + ", but its production '" +
+                                prod.text + "' (line " + std::to_string(prod.line) + ":" + std::to_string(prod.col + 1) +
+                                ") takes " + plural(prod.arity) +
+                                ": a production matches a module only with its own parameter count, so this module is never rewritten";
+        if (prog_.dialect != Dialect::Cpfg) {
+          error(where.first, where.second, msg);
+          continue;
+        }
+        // cpfg derives such a file (vlab's two-trees writes 'L' beside 'L(del,vig)'), never
+        // rewriting the module, and so does Sprig: a warning.
+        auto [loc, text] = scanner_.locate(where.first, where.second);
+        diags().warning(loc, msg + ", as in cpfg", std::move(text));
       }
     }
   }
@@ -1688,7 +1810,11 @@ class GrammarParser {
           for (const SuccModule& m : p.successor) prog_.usesCut |= m.symbol == prog_.cut;
     if (int q = prog_.symbols.find("?"); q >= 0) prog_.subCall = static_cast<SymbolId>(q);
     prog_.subEnd = static_cast<SymbolId>(prog_.symbols.find("$"));
-    if (prog_.dialect == Dialect::Cpfg) checkSplitCommands(sets);
+    if (prog_.dialect == Dialect::Cpfg) {
+      for (RuleSet* rs : sets)
+        if (std::find(interpretations.begin(), interpretations.end(), rs) != interpretations.end()) expandGenCylRules(*rs, sets);
+      checkSplitCommands(sets);
+    }
     for (RuleSet* rs : sets) {
       rs->bySymbol.assign(prog_.symbols.size(), {});
       for (uint32_t i = 0; i < rs->productions.size(); ++i) {
@@ -1697,6 +1823,52 @@ class GrammarParser {
       }
       rs->finalize();
     }
+  }
+
+  /// cpfg's interpretation rule `@G --> succ` (vlab's two-trees writes `@G --> *` to draw
+  /// its stems without generalized cylinders): cpfg's string keeps one character per module,
+  /// so the rule matches the '@' and 'G' of every `@Gs`, `@Gc(n)`, `@Ge(n)`, `@Gt(a,b)`,
+  /// `@Gr(...)` and replaces them, leaving the command's last letter with its parameters,
+  /// which cpfg's turtle does not draw (interpret.c has no case for c, e, t or r, and 's'
+  /// only for an environment with 2 or 3 parameters). Sprig reads each command as one module:
+  /// the rule becomes one rule per command and parameter count the grammar writes, in its
+  /// place, which replaces the whole command (a rule for the left-over letter is the error of
+  /// checkSplitCommands).
+  void expandGenCylRules(RuleSet& rs, const std::vector<RuleSet*>& sets) {
+    const int prefix = prog_.symbols.find(kGenCylPrefix);
+    if (prefix < 0) return;
+    std::vector<std::pair<SymbolId, uint16_t>> written;  // (command, parameter count)
+    auto wrote = [&](SymbolId id, size_t n) {
+      const std::string& name = prog_.symbols.name(id);
+      if (name.size() != 3 || name.compare(0, 2, kGenCylPrefix) != 0) return;
+      const std::pair<SymbolId, uint16_t> w{id, static_cast<uint16_t>(n)};
+      if (std::find(written.begin(), written.end(), w) == written.end()) written.push_back(w);
+    };
+    for (size_t i = 0; i < prog_.axiom.size(); ++i) wrote(prog_.axiom.symbols[i], prog_.axiom.paramCount(i));
+    for (const RuleSet* other : sets)
+      for (const Production& p : other->productions)
+        for (const SuccModule& m : p.successor) wrote(m.symbol, m.argCount);
+    std::sort(written.begin(), written.end());
+    std::vector<Production> out;
+    for (Production& p : rs.productions) {
+      if (p.predecessor != static_cast<SymbolId>(prefix)) {
+        out.push_back(std::move(p));
+        continue;
+      }
+      for (const auto& [id, n] : written) {
+        Production c = p;
+        c.predecessor = id;
+        c.predParams = n;
+        // The command's parameters go to registers the rule does not read.
+        c.predFirstVar = static_cast<uint16_t>(p.localFirst + p.localCount);
+        if (c.predFirstVar + n + prog_.globals.size() > kMaxVars) {
+          diags().error(p.loc, "too many variables in cpfg's '@G' rule", p.sourceLine);
+          return;
+        }
+        out.push_back(std::move(c));
+      }
+    }
+    rs.productions = std::move(out);
   }
 
   /// cpfg keeps one character per module: its commands `@o(d)`, `?P(x,y,z)`, `~l` are the

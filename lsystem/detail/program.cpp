@@ -10,7 +10,7 @@
 
 namespace sprig::lsystem::detail {
 
-void printFormatted(const std::string& format, const double* args, int n) {
+std::string formatPrintf(const std::string& format, const double* args, int n) {
   std::string out, spec;
   char buf[512];
   int k = 0;
@@ -45,7 +45,52 @@ void printFormatted(const std::string& format, const double* args, int n) {
     out += buf;
     i = j;
   }
-  std::fputs(out.c_str(), stderr);
+  return out;
+}
+
+void printFormatted(const std::string& format, const double* args, int n) {
+  std::fputs(formatPrintf(format, args, n).c_str(), stderr);
+}
+
+int CpfgFiles::open(const std::string& name, const std::string& mode) {
+  if (free_.empty())
+    throw InputError(SourceLoc{"sprig", 0, 0}, "cpfg's fopen(\"" + name + "\"): more than " + std::to_string(kMaxFiles) +
+                                                   " files open at once (cpfg's limit)");
+  const std::string path = folder_.empty() ? name : folder_ + "/" + name;
+  const int free = free_.back();
+  files_[free] = std::fopen(path.c_str(), mode == "a" ? "ab" : "wb");
+  if (files_[free]) free_.pop_back();
+  else throw InputError(SourceLoc{"sprig", 0, 0}, "cpfg's fopen cannot open '" + path + "' for writing");
+  return free;
+}
+
+std::FILE* CpfgFiles::at(double f) const {
+  // cpfg's IsValidFpIndex and Getfp: an index out of range or a closed file is only a
+  // message in cpfg, nothing written.
+  if (!(f >= 0 && f < kMaxFiles)) return nullptr;
+  return files_[static_cast<int>(f)];
+}
+
+void CpfgFiles::print(double f, const std::string& format, const double* args, int n) {
+  if (std::FILE* fp = at(f)) std::fputs(formatPrintf(format, args, n).c_str(), fp);
+}
+
+void CpfgFiles::flush(double f) {
+  if (std::FILE* fp = at(f)) std::fflush(fp);
+}
+
+void CpfgFiles::close(double f) {
+  if (std::FILE* fp = at(f)) {
+    std::fclose(fp);
+    files_[static_cast<int>(f)] = nullptr;
+    free_.push_back(static_cast<int>(f));
+  }
+}
+
+void CpfgFiles::closeAll() {
+  for (int k = 0; k < kMaxFiles; ++k) close(k);
+  free_.clear();
+  for (int k = 0; k < kMaxFiles; ++k) free_.push_back(k);
 }
 
 

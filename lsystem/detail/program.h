@@ -47,6 +47,11 @@ enum class Op : uint8_t {
   Srand,   ///< cpfg's `srand(s)`: reseeds cpfg's stream (Draws::cpfg), or records s as the seed of
            ///< later draws (Effects::reseed); value 0
   Stop,    ///< cpfg's `stop(x)`: asks the derivation to end after the current step (Effects::stop); value 0
+  // cpfg's files (Effects::files; statements of the Start/StartEach/EndEach/End blocks only).
+  Fopen,   ///< `fopen("name", "mode")`: pushes the file's index (-1 when it cannot be opened); Program::strings[var], [var + 1]
+  Fprintf, ///< `fprintf(f, format, ...)`: pops c values and the index f, writes them with Program::strings[var]
+  Fflush,  ///< `fflush(f)`: pops the index f
+  Fclose,  ///< `fclose(f)`: pops the index f
   Func,    ///< cpfg's `func(n, x)`: function var (n - 1) of the view file's function files at x
   Curve,   ///< cpfg's `curveX/Y/Z(n, t)`: coordinate c (0, 1, 2) of curve var (n - 1) at arc length t
   CurveLength,  ///< cpfg's `curveGAL(n)`: the length of curve var (n - 1); pops nothing
@@ -80,10 +85,39 @@ struct CpfgTables {
 [[noreturn]] void arrayIndexError(const CpfgArray& a, int d, double i);
 
 /// What cpfg's `srand` and `stop` ask of the Deriver, recorded by evalCode.
+/// The files cpfg's `fopen` opens (userfiles.cpp): at most kMaxFiles at once, their indices
+/// taken from a stack of the free ones (the first file is 24, the next 23; a closed file's
+/// index is the next one given); names are plain file names in folder (the grammar's).
+class CpfgFiles {
+ public:
+  static constexpr int kMaxFiles = 25;
+  explicit CpfgFiles(std::string folder = {}) : folder_(std::move(folder)) {
+    for (int k = 0; k < kMaxFiles; ++k) free_.push_back(k);
+  }
+  CpfgFiles(const CpfgFiles&) = delete;
+  CpfgFiles& operator=(const CpfgFiles&) = delete;
+  ~CpfgFiles() { closeAll(); }
+  void setFolder(std::string folder) { folder_ = std::move(folder); }
+  /// The index of the file opened, or -1 (cpfg's "Cannot fopen", which Sprig makes an error).
+  int open(const std::string& name, const std::string& mode);
+  /// Writes format with the n values args to file f (when open: cpfg only warns otherwise).
+  void print(double f, const std::string& format, const double* args, int n);
+  void flush(double f);
+  void close(double f);
+  void closeAll();
+
+ private:
+  std::FILE* at(double f) const;
+  std::string folder_;
+  std::FILE* files_[kMaxFiles] = {};
+  std::vector<int> free_;  ///< free indices, the next one given last
+};
+
 struct Effects {
   bool stop = false;    ///< `stop(x)` ran: end the derivation after the current step
   bool reseed = false;  ///< `srand(s)` ran: seed the later draws with seed
   double seed = 0;
+  CpfgFiles* files = nullptr;  ///< cpfg's fopen and the like (Start/StartEach/EndEach/End blocks)
 };
 
 /// Most backward jumps one statement block may take (a `while` that never ends): past it
@@ -203,6 +237,8 @@ struct CodeRange {
 /// cpfg's printf to stderr: format (checked by the parser: only numeric conversions, one
 /// per value) with the n values args.
 void printFormatted(const std::string& format, const double* args, int n);
+/// The text printFormatted prints.
+std::string formatPrintf(const std::string& format, const double* args, int n);
 
 /// Evaluates one expression, or runs one statement block (Store, Jz, Jmp write into vars,
 /// which must then be writable; jump targets count from code; a block returns 0, or NaN
@@ -320,6 +356,23 @@ inline double evalCode(const Instr* code, const Instr* end, const double* vars, 
         sp -= n;
         break;
       }
+      case Op::Fopen:
+        stack[sp++] = effects && effects->files && strings ? effects->files->open((*strings)[in->var], (*strings)[in->var + 1]) : -1;
+        break;
+      case Op::Fprintf: {
+        const int n = static_cast<int>(in->c);
+        if (effects && effects->files && strings) effects->files->print(stack[sp - n - 1], (*strings)[in->var], stack + sp - n, n);
+        sp -= n + 1;
+        break;
+      }
+      case Op::Fflush:
+        if (effects && effects->files) effects->files->flush(stack[sp - 1]);
+        --sp;
+        break;
+      case Op::Fclose:
+        if (effects && effects->files) effects->files->close(stack[sp - 1]);
+        --sp;
+        break;
     }
   }
   return sp > 0 ? stack[sp - 1] : 0.0;

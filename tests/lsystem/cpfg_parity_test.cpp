@@ -362,6 +362,83 @@ TEST_CASE("cpfg parity: brackets in the ignore table", "[lsystem][cpfg]") {
   }
 }
 
+TEST_CASE("cpfg parity: a predecessor may hold brackets, matched module by module", "[lsystem][cpfg]") {
+  checkParity("bracket_predecessor");
+  SECTION("Sprig's notation keeps brackets out of predecessors") {
+    CHECK_THROWS_WITH(parseGrammar("axiom: A[B]\n[B] --> C\n", "g.lsys"),
+                      Catch::Contains("g.lsys:2:1: error: a bracket cannot be a predecessor"));
+  }
+}
+
+TEST_CASE("cpfg parity: the interpretation rule '@G' rewrites every generalized-cylinder command", "[lsystem][cpfg]") {
+  checkParity("gencyl_prefix");
+  SECTION("interpreted: each command is replaced, in the rule's place among the rules for '@'") {
+    auto interpreted = [](const std::string& rules) {
+      Grammar g = parseGrammar("axiom: F@GsF(1)@Gc(2)F@Ge(3)@Gt(1,2)@Ge\nhomomorphism\n" + rules, "t.l");
+      Deriver d(g);
+      return formatModuleString(d.interpret(d.derive()), d.symbols());
+    };
+    CHECK(interpreted("@G --> *\n") == "FF(1)F");
+    CHECK(interpreted("@Gc(n) --> f(n)\n@G --> *\n") == "FF(1)f(2)F");
+    CHECK(interpreted("@G --> *\n@Gc(n) --> f(n)\n") == "FF(1)F");
+  }
+  SECTION("only in interpretation rules") {
+    CHECK_THROWS_WITH(parseGrammar("axiom: @GsF@Ge\n@G --> *\n", "t.l"),
+                      Catch::Contains("t.l:2:1: error: cpfg's predecessor '@G' (the '@' and 'G' of the generalized-cylinder "
+                                      "commands) is supported only in an interpretation (homomorphism) rule"));
+  }
+}
+
+TEST_CASE("cpfg parity: fopen, fprintf, fflush and fclose in the Start/EachStep/End blocks", "[lsystem][cpfg]") {
+  // The grammar is copied to a scratch folder: its files are written beside it.
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "sprig-cpfg-files-test";
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  std::filesystem::copy_file(parityAsset("files/plant.l"), dir / "plant.l");
+  Grammar g = loadGrammar((dir / "plant.l").string());
+  {
+    Deriver d(g);
+    checkSame(d.derive(), g.symbols(), cpfgString("files"));
+  }
+  // What the real cpfg wrote: "w" truncates, "a" appends, indices 24 and 23, %.lf and %%.
+  CHECK(readFile((dir / "out.txt").string()) == readFile(parityAsset("files/out.txt")));
+  CHECK(readFile((dir / "log.txt").string()) == readFile(parityAsset("files/log.txt")));
+  {
+    Deriver d(g);  // a second derivation: out.txt written again, log.txt appended to
+    d.derive();
+  }
+  CHECK(readFile((dir / "out.txt").string()) == readFile(parityAsset("files/out.txt")));
+  CHECK(readFile((dir / "log.txt").string()) == "start 24 23\nstart 24 23\n");
+  SECTION("the named errors outside the subset") {
+    auto errorOf = [](const std::string& text) {
+      try {
+        parseGrammar(text, "t.l");
+      } catch (const std::exception& e) {
+        return std::string(e.what());
+      }
+      return std::string();
+    };
+    CHECK_THAT(errorOf("axiom: A\nA : * {f = fopen(\"x.txt\", \"w\");} --> B\n"),
+               Catch::Contains("t.l:2:12: error: cpfg's function 'fopen' is supported only in the Start:, StartEach:, "
+                               "EndEach: and End: blocks of a .l file"));
+    CHECK_THAT(errorOf("Start: {f = fopen(\"../x.txt\", \"w\");}\naxiom: A\n"),
+               Catch::Contains("t.l:1:19: error: fopen's file '../x.txt' must be a plain file name: Sprig writes only in "
+                               "the grammar's folder"));
+    CHECK_THAT(errorOf("Start: {f = fopen(\"x.txt\", \"r\");}\naxiom: A\n"),
+               Catch::Contains("t.l:1:28: error: cpfg's fopen mode 'r' is not supported"));
+    CHECK_THAT(errorOf("Start: {f = 1 + fopen(\"x.txt\", \"w\");}\naxiom: A\n"),
+               Catch::Contains("cpfg's function 'fopen' (file input and output) is not supported"));
+    CHECK_THAT(errorOf("Start: {f = 0; n = fscanf(f, \"%f\", x);}\naxiom: A\n"),
+               Catch::Contains("cpfg's function 'fscanf' (file input) is not supported"));
+    CHECK_THAT(errorOf("Start: {f = 0;}\nEnd: {fprintf(f, \"%g %g\", 1);}\naxiom: A\n"),
+               Catch::Contains("fprintf's format has 2 conversion(s) for 1 value(s)"));
+  }
+}
+
+TEST_CASE("cpfg parity: '@Tx(n)' naming no texture does not stop the query modules", "[lsystem][cpfg]") {
+  checkParity("texture_query");
+}
+
 TEST_CASE("cpfg parity: an expression statement is evaluated and dropped", "[lsystem][cpfg]") {
   checkParity("expression_statement");
 }

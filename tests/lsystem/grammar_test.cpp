@@ -375,3 +375,16 @@ TEST_CASE("Grammar::warnings: a species' steps replacing the grammar's derivatio
   o.derivationLength = 4;
   CHECK(warningsOf("axiom: A\nA --> AB\n", "g.lsys", o).empty());  // the grammar writes no length
 }
+
+TEST_CASE("parseGrammar in cpfg's notation: a module written with a count no production takes is a warning", "[lsystem][cpfg]") {
+  // cpfg derives the file and never rewrites the module (vlab's two-trees writes 'L' beside
+  // 'L(del,vig)'); Sprig derives it the same and warns.
+  const std::string text = "axiom: A(1,2)\nA(x) --> A(x+1)\n";
+  CHECK(warningsOf(text, "g.l") ==
+        "g.l:1:8: warning: module 'A' is written here with 2 parameters, but its production 'A(x)' (line 2:1) takes 1 "
+        "parameter: a production matches a module only with its own parameter count, so this module is never rewritten, "
+        "as in cpfg");
+  Grammar g = parseGrammar(text, "g.l");
+  Deriver d(g, DeriveOptions{.steps = 2});
+  CHECK(formatModuleString(d.derive(), d.symbols()) == "A(1,2)");
+}
