@@ -4,7 +4,8 @@
 #
 #   bash scripts/contact-sheets.sh [GALLERY_DIR] [OUT_DIR]
 #
-# GALLERY_DIR (default gallery/out) is a finished `sprig gallery` folder; OUT_DIR (default
+# GALLERY_DIR (default gallery/out) is a finished `sprig gallery` folder (or the folder of
+# scripts/figure-stills.sh); OUT_DIR (default
 # GALLERY_DIR/sheets) receives blobtree.png, shells.png, organisms.png and solids.png.
 # Needs oiiotool (OpenImageIO's command-line tool, installed with the build dependencies).
 set -euo pipefail
