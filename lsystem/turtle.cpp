@@ -303,7 +303,9 @@ class TurtleWalk {
         case Command::SurfaceNamed: surfaceNamed(i); break;
         case Command::Sphere: sphere(i); break;
         case Command::Tropism: tropismChange(i); break;
-        case Command::Cut: i = cut(i); break;
+        case Command::Cut:
+          if (!settings_.interpretPastCut) i = cut(i);
+          break;
         case Command::WidthUp: widthUp(i); break;
         case Command::ColorUp: colorStep(i, +1); break;
         case Command::ColorDown: colorStep(i, -1); break;

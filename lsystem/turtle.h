@@ -77,6 +77,10 @@ struct TurtleSettings {
   /// `@O(d)` and `@o(d)` take a diameter, `'` is no command, lengths and sizes are scaled by
   /// the turtle scale (`@D`), and only the `tropisms` bend (cpfg's rule, before each move).
   bool cpfg = false;
+  /// cpfg: a `%` is no command for the turtle, which draws and queries the rest of its
+  /// branch (the cut is made at the next step); false (`.lsys`, or cpfg's view file
+  /// `interpretation past %: off`): the turtle skips the rest of the branch.
+  bool interpretPastCut = false;
   double widthIncrement = 0.0;    ///< cpfg: `line width increment:` (view file)
   int colorIncrement = 1;         ///< `color increment:` (view file)
   int initialColor = 0;           ///< `initial color:` (view file; cpfg's default is 128)

@@ -29,7 +29,7 @@ const char* const kViewerKeys[] = {
     "viewing angle",      "twist of cylinders",   "interpretation step", "environment display",
     "antialiasing",       "min zoom",             "max zoom",       "generate on view change",
     "concave polygons",   "shadow map",           "PS linecap",     "rayshade objects",
-    "rayshade scale",     "interpretation past %",
+    "rayshade scale",
 };
 
 /// Keys naming files whose uses (`~`, `func`, `curveX`, `@#`, `inblob`) are errors in the
@@ -344,6 +344,10 @@ class ViewParser {
         warn(line, kcol, "'" + key + ":' ignored: the grammar's uses of it are errors (not supported)");
         return;
       }
+    if (key == "interpretation past %") {  // read: whether the turtle skips a pending cut
+      view_.interpretPastCut = trimmed(value).rfind("off", 0) != 0;
+      return;
+    }
     if (key == "environment display") {  // read: it says when ?E modules go to the environmental program
       view_.environmentBefore = trimmed(value).rfind("before", 0) == 0;
       return;
@@ -888,6 +892,7 @@ TurtleSettings cpfgTurtleSettings(const ViewFile* view, TurtleSettings t) {
   const ViewFile none;
   const ViewFile& v = view ? *view : none;
   t.cpfg = true;
+  t.interpretPastCut = v.interpretPastCut;
   t.angleDeg = v.angleDeg.value_or(kCpfgDefaultAngleDeg);
   t.initialWidth = v.lineWidth.value_or(kCpfgDefaultLineWidth);
   t.widthIncrement = v.widthIncrement.value_or(0.0);

@@ -66,6 +66,10 @@ struct ViewFile {
   /// program after every step (and for the axiom) instead of before it
   /// (DeriveOptions::environmentAfterEachStep).
   bool environmentBefore = false;
+  /// `interpretation past %: off`: cpfg's turtle then skips the rest of a branch at a
+  /// `%` awaiting its cut; by default it interprets (draws, queries) past it
+  /// (TurtleSettings::interpretPastCut).
+  bool interpretPastCut = true;
   /// The ids of the `tsurface:` lines (cpfg's triangulated surfaces, not read): a `~X` of
   /// one is an error in the grammar (GrammarOverrides::cpfgUndrawnSurfaceIds).
   std::string tsurfaceIds;

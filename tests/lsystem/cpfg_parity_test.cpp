@@ -439,6 +439,10 @@ TEST_CASE("cpfg parity: '@Tx(n)' naming no texture does not stop the query modul
   checkParity("texture_query");
 }
 
+TEST_CASE("cpfg parity: the turtle interprets past a '%' awaiting its cut", "[lsystem][cpfg]") {
+  checkParity("query_past_cut");
+}
+
 TEST_CASE("cpfg parity: an expression statement is evaluated and dropped", "[lsystem][cpfg]") {
   checkParity("expression_statement");
 }
