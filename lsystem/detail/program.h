@@ -240,6 +240,33 @@ void printFormatted(const std::string& format, const double* args, int n);
 /// The text printFormatted prints.
 std::string formatPrintf(const std::string& format, const double* args, int n);
 
+/// The output instructions of evalCode (`printf` and cpfg's file calls: its cold path):
+/// pops their arguments off stack[0, sp), pushes fopen's file number, and returns the new sp.
+inline int evalOutput(const Instr& in, double* stack, int sp, const std::vector<std::string>* strings,
+                      Effects* effects) {
+  const int n = static_cast<int>(in.c);
+  CpfgFiles* files = effects ? effects->files : nullptr;
+  switch (in.op) {
+    case Op::Printf:
+      if (strings && in.var < strings->size()) printFormatted((*strings)[in.var], stack + sp - n, n);
+      return sp - n;
+    case Op::Fopen:
+      stack[sp] = files && strings ? files->open((*strings)[in.var], (*strings)[in.var + 1]) : -1;
+      return sp + 1;
+    case Op::Fprintf:
+      if (files && strings) files->print(stack[sp - n - 1], (*strings)[in.var], stack + sp - n, n);
+      return sp - n - 1;
+    case Op::Fflush:
+      if (files) files->flush(stack[sp - 1]);
+      return sp - 1;
+    case Op::Fclose:
+      if (files) files->close(stack[sp - 1]);
+      return sp - 1;
+    default:
+      return sp;
+  }
+}
+
 /// Evaluates one expression, or runs one statement block (Store, Jz, Jmp write into vars,
 /// which must then be writable; jump targets count from code; a block returns 0, or NaN
 /// after kMaxLoopJumps backward jumps). rng is used only by the random draws and, for cpfg's
@@ -350,28 +377,8 @@ inline double evalCode(const Instr* code, const Instr* end, const double* vars, 
         sp -= 2;
         arrays[tables->arrays[in->var].offset + static_cast<uint32_t>(stack[sp])] = stack[sp + 1];
         break;
-      case Op::Printf: {
-        const int n = static_cast<int>(in->c);
-        if (strings && in->var < strings->size()) printFormatted((*strings)[in->var], stack + sp - n, n);
-        sp -= n;
-        break;
-      }
-      case Op::Fopen:
-        stack[sp++] = effects && effects->files && strings ? effects->files->open((*strings)[in->var], (*strings)[in->var + 1]) : -1;
-        break;
-      case Op::Fprintf: {
-        const int n = static_cast<int>(in->c);
-        if (effects && effects->files && strings) effects->files->print(stack[sp - n - 1], (*strings)[in->var], stack + sp - n, n);
-        sp -= n + 1;
-        break;
-      }
-      case Op::Fflush:
-        if (effects && effects->files) effects->files->flush(stack[sp - 1]);
-        --sp;
-        break;
-      case Op::Fclose:
-        if (effects && effects->files) effects->files->close(stack[sp - 1]);
-        --sp;
+      case Op::Printf: case Op::Fopen: case Op::Fprintf: case Op::Fflush: case Op::Fclose:
+        sp = evalOutput(*in, stack, sp, strings, effects);
         break;
     }
   }
