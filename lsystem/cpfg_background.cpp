@@ -26,6 +26,9 @@ struct Word {
   std::string sourceLine;
 };
 
+/// Largest magnitude of a number and of a matrix entry: positions stay finite in floats.
+constexpr double kMaxMagnitude = 1e15;
+
 /// The commands of background.c's syntax table.
 enum class Command { Material, Push, Pop, Translate, Rotate, Scale, MultMatrix, Draw };
 
@@ -185,6 +188,9 @@ class SceneBuilder {
       case Command::Material: material(w, v); return;
       case Command::Draw: break;
     }
+    for (int col = 0; col < 4; ++col)
+      for (int row = 0; row < 4; ++row)
+        if (!(std::abs(top[col][row]) <= kMaxMagnitude)) return fail("the transformation grows beyond 1e15 (Sprig's limit)");
     if (scene_.materials.empty()) return fail("a primitive before the first 'material' (cpfg draws it in the colour of its colour map's entry 256, which Sprig does not read)");
     if ((c.kind == Kind::Sphere && v[0] < 0) || (c.kind == Kind::Cylinder && v[0] < 0) || (c.kind == Kind::Cone && (v[0] < 0 || v[1] < 0)))
       return fail("a negative radius");
@@ -192,7 +198,26 @@ class SceneBuilder {
       if (!scene_.firstTube) scene_.firstTube = w.loc;
       if (c.kind == Kind::Cone && !scene_.firstCone) scene_.firstCone = w.loc;
     }
+    triangles_ += triangleCount(c.kind, v.size());
+    if (triangles_ > kMaxBackgroundTriangles)
+      return fail("the background scene has more than " + std::to_string(kMaxBackgroundTriangles) + " triangles (Sprig's limit)");
     scene_.primitives.push_back({c.kind, top, v, static_cast<int>(scene_.materials.size()) - 1, w.loc});
+  }
+
+  /// At most the triangles a primitive of n numbers draws (MeshWriter).
+  static size_t triangleCount(Kind kind, size_t n) {
+    constexpr size_t sides = 48;
+    switch (kind) {
+      case Kind::Polygon: return n / 3 - 2;
+      case Kind::PolygonUV: return n / 6 - 2;
+      case Kind::Rectangle: return 2;
+      case Kind::Mesh: return (n / 3 - 2);
+      case Kind::Box: return 12;
+      case Kind::Sphere: return 2 * sides * (sides / 2) - 2 * sides;
+      case Kind::Cylinder:
+      case Kind::Cone: return 2 * sides + 2 * (sides - 2);
+    }
+    return 0;
   }
 
  private:
@@ -223,6 +248,7 @@ class SceneBuilder {
   DiagnosticList& diags_;
   std::vector<Diagnostic>& warnings_;
   std::vector<glm::dmat4> stack_{glm::dmat4(1.0)};
+  size_t triangles_ = 0;
 };
 
 /// Adds triangles of one primitive to a mesh, moving local points into the scene.
@@ -236,7 +262,8 @@ class MeshWriter {
   uint32_t vertex(const DVec3& p, const DVec3& n, bool sceneNormal = false) {
     m_.positions.push_back(DVec3(sceneFromLocal_ * glm::dvec4(p, 1.0)));
     const DVec3 sn = sceneNormal ? n : normalFromLocal_ * n;
-    m_.normals.push_back(glm::length(sn) > 0 ? glm::normalize(sn) : DVec3(0, 1, 0));
+    const double len = glm::length(sn);  // a singular matrix (a zero scale) has no normals: +y
+    m_.normals.push_back(std::isfinite(len) && len > 0 ? sn / len : DVec3(0, 1, 0));
     return static_cast<uint32_t>(m_.positions.size() - 1);
   }
 
@@ -388,6 +415,7 @@ CpfgBackground parseCpfgBackground(const std::vector<std::string>& texts, const 
     for (; i < words.size(); ++i) {
       auto n = parseFiniteNumber(words[i].text);
       if (!n) break;
+      if (std::abs(*n) > kMaxMagnitude) diags.error(words[i].loc, "a number beyond 1e15 in magnitude (Sprig's limit)", words[i].sourceLine);
       v.push_back(*n);
     }
     const CommandName* c = nullptr;

@@ -29,6 +29,9 @@ namespace sprig::lsystem {
 
 /// Most primitives and transformations of one view file's background scene (cpfg has none).
 inline constexpr size_t kMaxBackgroundCommands = 100000;
+/// Most triangles of one view file's background scene (a sphere is 2,208, a cylinder or cone
+/// at most 188): about 900 spheres.
+inline constexpr size_t kMaxBackgroundTriangles = 2000000;
 /// Deepest matrix stack (cpfg's STACK_SIZE 50: 49 pushes above the identity).
 inline constexpr int kMaxBackgroundStack = 49;
 
@@ -79,7 +82,8 @@ struct CpfgBackground {
 /// number where numbers go, a wrong count of numbers, a primitive before the first material,
 /// a popmatrix without its pushmatrix, a stack deeper than kMaxBackgroundStack, a rotation
 /// about the zero vector, a projective multmatrix (last row not 0 0 0 1), a rectangle's
-/// fifth number (its emission factor), more than kMaxBackgroundCommands commands.
+/// fifth number (its emission factor), more than kMaxBackgroundCommands commands or
+/// kMaxBackgroundTriangles triangles.
 /// warnings gets a translucent material's warning.
 CpfgBackground parseCpfgBackground(const std::vector<std::string>& texts, const std::vector<std::string>& fileNames,
                                    std::vector<Diagnostic>& warnings);

@@ -132,6 +132,11 @@ TEST_CASE("parseCpfgBackground: errors at file:line:col", "[lsystem][cpfg][backg
   std::string deep = g;
   for (int k = 0; k < 50; ++k) deep += "pushmatrix\n";
   CHECK(errorOf(deep) == "b.dat:56:1: the matrix stack is full (49 pushmatrix deep, cpfg's limit)");
+  CHECK(errorOf(g + "sphere 2e15\n") == "b.dat:7:8: a number beyond 1e15 in magnitude (Sprig's limit)");
+  CHECK(errorOf(g + "scale 1e10 1 1 scale 1e10 1 1 sphere 1\n") == "b.dat:7:31: the transformation grows beyond 1e15 (Sprig's limit)");
+  std::string spheres = g;
+  for (int k = 0; k < 906; ++k) spheres += "sphere 1\n";  // 905 are 1,998,240 triangles
+  CHECK(errorOf(spheres) == "b.dat:912:1: the background scene has more than 2000000 triangles (Sprig's limit)");
 }
 
 TEST_CASE("view file background scene: drawing errors wait for a drawing", "[lsystem][cpfg][background]") {
