@@ -78,11 +78,42 @@ std::string expand(const std::string& line, const std::map<std::string, std::str
   return s;
 }
 
-/// The words of one file after cpfg's preprocessor: comments blanked, `#define NAME text`
+/// text with its `/* */` comments blanked (newlines kept); pending gets the (line, 0-based
+/// column) of one never closed. cpfg's `preproc` removes no `//` comment: its words are
+/// read as commands.
+std::string blankBlockComments(std::string text, std::pair<int, int>& pending) {
+  int line = 1;
+  size_t lineStart = 0;
+  for (size_t i = 0; i < text.size(); ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      lineStart = i + 1;
+      continue;
+    }
+    if (text[i] != '/' || i + 1 >= text.size() || text[i + 1] != '*') continue;
+    const size_t close = text.find("*/", i + 2);
+    if (close == std::string::npos) {
+      pending = {line, static_cast<int>(i - lineStart)};
+      text.resize(i);  // the rest is the comment
+      break;
+    }
+    for (size_t j = i; j < close + 2; ++j)
+      if (text[j] == '\n') {
+        ++line;
+        lineStart = j + 1;
+      } else {
+        text[j] = ' ';
+      }
+    i = close + 1;
+  }
+  return text;
+}
+
+/// The words of one file after cpfg's preprocessor: block comments blanked, `#define NAME text`
 /// lines read, other directives errors, macros expanded (a macro's words sit at its column).
 void preprocess(const std::string& text, const std::string& file, std::vector<Word>& words, DiagnosticList& diags) {
   std::pair<int, int> pending{0, 0};
-  const std::string clean = detail::blankComments(text, pending);
+  const std::string clean = blankBlockComments(text, pending);
   if (pending.first) diags.error(SourceLoc{file, pending.first, pending.second + 1}, "unterminated comment '/*'", lineOf(text, pending.first));
   const std::vector<std::string> lines = detail::splitAtNewlines(clean);
   std::map<std::string, std::string> macros;

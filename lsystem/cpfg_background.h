@@ -3,7 +3,8 @@
 /// reference manual, section 8.3; vlab's background.c is the specification where the manual
 /// is silent): geometry drawn with the plant, in the plant's coordinates.
 ///
-/// A file is run through a C preprocessor (cpfg's `preproc`), then read as words: a command
+/// A file is run through cpfg's preprocessor `preproc` (`/* */` comments and `#define NAME
+/// text`; it removes no `//` comment), then read as words: a command
 /// followed by its numbers. Commands, in the plant's coordinates under a matrix stack that
 /// starts at the identity for each drawing and runs on across the files:
 ///   material a a a a  d d d d  [s s s s  [e e e e  [shininess]]]   (ambient, diffuse, ...)

@@ -2,6 +2,9 @@
 // transforms and materials, the triangles drawn, and its errors.
 #include <catch2/catch.hpp>
 
+#include <fstream>
+#include <sstream>
+
 #include "core/diagnostics.h"
 #include "lsystem/cpfg_background.h"
 #include "lsystem/view_file.h"
@@ -106,8 +109,8 @@ TEST_CASE("parseCpfgBackground: primitives, transforms and materials", "[lsystem
     checkNear(lo, DVec3(-1, 0, -1));
     checkNear(hi, DVec3(1, 2, 1));
   }
-  SECTION("#define, as cpfg's preproc expands it (no space after a minus sign)") {
-    const CpfgBackground b = scene("#define STEP 35\n#define GREY 0.5 0.5 0.5 1\nmaterial 0 0 0 1 GREY\ntranslate -STEP 0 0 // comment\nsphere 1\n");
+  SECTION("#define and /* */, as cpfg's preproc reads them (no space after a minus sign)") {
+    const CpfgBackground b = scene("#define STEP 35\n#define GREY 0.5 0.5 0.5 1\nmaterial 0 0 0 1 GREY\ntranslate -STEP 0 0 /* a\ncomment */ sphere 1\n");
     REQUIRE(b.primitives.size() == 1);
     CHECK(b.materials[0].diffuse == Vec3(0.5f));
     checkNear(apply(b.primitives[0].sceneFromLocal, DVec3(0)), DVec3(-35, 0, 0));
@@ -128,6 +131,8 @@ TEST_CASE("parseCpfgBackground: errors at file:line:col", "[lsystem][cpfg][backg
   CHECK(errorOf("#include \"a.dat\"\n") == "b.dat:1:1: C preprocessor directive '#include' in a background scene file is not supported");
   CHECK(errorOf("#define F(x) x\n") == "b.dat:1:1: only '#define NAME text' (a macro without parameters) is supported in a background scene file");
   CHECK(errorOf("/* open\n") == "b.dat:1:1: unterminated comment '/*'");
+  // cpfg's preproc removes no '//' comment: cpfg reads its words as unknown commands.
+  CHECK(errorOf(g + "sphere 1 // note\n") == "b.dat:7:10: unknown background scene command '//'");
   CHECK(errorOf("1 2 3\n") == "b.dat:1:1: a number '1' where a background scene command goes");
   std::string deep = g;
   for (int k = 0; k < 50; ++k) deep += "pushmatrix\n";
@@ -157,4 +162,77 @@ TEST_CASE("view file background scene: drawing errors wait for a drawing", "[lsy
   REQUIRE(outside.unsupportedDrawing);
   CHECK(outside.unsupportedDrawing->message ==
         "the background scene file '../x.dat' is outside the object's folder (only files beside the view file, or in folders below it)");
+}
+
+TEST_CASE("parseCpfgBackground: the geometry the real cpfg writes", "[lsystem][cpfg][background]") {
+  // tests/assets/cpfg/background/cpfg.ray: cpfg's rayshade output for background.dat (its
+  // README has the command). The stem is cpfg's first cylinder, of radius 0.05.
+  const std::string dir = std::string(SPRIG_SOURCE_DIR) + "/tests/assets/cpfg/background";
+  const ViewFile v = loadViewFile(dir + "/plant.v");
+  REQUIRE(v.background);
+  const CpfgBackground& b = *v.background;
+  const CpfgBackgroundMesh mesh = b.triangulate();
+  std::ifstream in(dir + "/cpfg.ray");
+  std::vector<DVec3> corners;                   // of cpfg's triangles
+  std::vector<std::pair<DVec3, DVec3>> tubes;   // cylinder and cone ends, after the stem
+  std::vector<std::pair<DVec3, double>> spheres;
+  for (std::string word; in >> word;) {
+    std::string surface;
+    if (word == "triangle")
+      for (int k = 0; k < 3; ++k) {
+        DVec3 p, n;
+        in >> p.x >> p.y >> p.z >> n.x >> n.y >> n.z;
+        corners.push_back(p);
+      }
+    if (word == "sphere") {
+      double r;
+      DVec3 c;
+      in >> surface >> r >> c.x >> c.y >> c.z;
+      spheres.emplace_back(c, r);
+    }
+    if (word == "cylinder" || word == "cone") {
+      double r0, r1 = 0;
+      DVec3 a, e;
+      in >> surface >> r0 >> a.x >> a.y >> a.z;
+      if (word == "cone") in >> r1;
+      in >> e.x >> e.y >> e.z;
+      if (surface != "s000") tubes.emplace_back(a, e);  // s000: the plant's stem
+    }
+  }
+  REQUIRE(corners.size() == 3 * 22);  // two quads of polygons, a box, a mesh of three quads
+  for (const DVec3& c : corners) {
+    double nearest = 1e9;
+    for (const DVec3& p : mesh.positions) nearest = std::min(nearest, glm::length(p - c));
+    INFO("cpfg's corner (" << c.x << ", " << c.y << ", " << c.z << ")");
+    CHECK(nearest < 2e-5);
+  }
+  using K = CpfgBackgroundPrimitive::Kind;
+  std::vector<std::pair<DVec3, DVec3>> ours;
+  std::vector<std::pair<DVec3, double>> ourSpheres;
+  size_t flatTriangles = 0;
+  for (const CpfgBackgroundPrimitive& p : b.primitives) {
+    const DVec3 base = apply(p.sceneFromLocal, DVec3(0));
+    if (p.kind == K::Cylinder) ours.emplace_back(base, apply(p.sceneFromLocal, DVec3(0, p.numbers[1], 0)));
+    if (p.kind == K::Cone) ours.emplace_back(base, apply(p.sceneFromLocal, DVec3(0, p.numbers[2], 0)));
+    if (p.kind == K::Sphere) ourSpheres.emplace_back(base, p.numbers[0]);
+    if (p.kind == K::Polygon) flatTriangles += p.numbers.size() / 3 - 2;
+    if (p.kind == K::Box) flatTriangles += 12;
+    if (p.kind == K::Mesh) flatTriangles += p.numbers.size() / 3 - 2;
+  }
+  CHECK(flatTriangles == 22);
+  // cpfg draws the opaque materials first, then the translucent ones: compare as sets.
+  REQUIRE(tubes.size() == ours.size());
+  for (const auto& t : tubes) {
+    bool found = false;
+    for (const auto& o : ours) found = found || (glm::length(o.first - t.first) < 2e-5 && glm::length(o.second - t.second) < 2e-5);
+    INFO("cpfg's tube from (" << t.first.x << ", " << t.first.y << ", " << t.first.z << ")");
+    CHECK(found);
+  }
+  REQUIRE(spheres.size() == 2);
+  REQUIRE(ourSpheres.size() == 2);
+  for (const auto& sp : spheres) {
+    bool found = false;
+    for (const auto& o : ourSpheres) found = found || (glm::length(o.first - sp.first) < 2e-5 && o.second == sp.second);
+    CHECK(found);
+  }
 }
