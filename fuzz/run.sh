@@ -13,7 +13,7 @@ BUILD=${1:?usage: fuzz/run.sh BUILD_DIR SECONDS [TARGET...]}
 SECS=${2:?usage: fuzz/run.sh BUILD_DIR SECONDS [TARGET...]}
 shift 2
 TARGETS=("$@")
-[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(grammar view function expression derive species_tree species_shell species_blob species_organism species_solid polymesh image volume)
+[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(grammar view background function expression derive species_tree species_shell species_blob species_organism species_solid polymesh image volume)
 ROOT=$(pwd)
 # The sanitizer settings of the Makefile, also when this script is run by hand.
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:detect_stack_use_after_return=0}
@@ -30,6 +30,9 @@ seed() {
       for f in tests/assets/cpfg/*/*.l; do cp "$f" "$dir/$(basename "$(dirname "$f")").l"; done ;;
     view)
       for f in tests/assets/cpfg/*/*.v; do cp "$f" "$dir/$(basename "$(dirname "$f")").v"; done ;;
+    background)
+      cp tests/assets/cpfg/background/background.dat "$dir"/
+      for f in tests/bad_inputs/inputs/cpfg/background_*/scene.dat; do cp "$f" "$dir/$(basename "$(dirname "$f")").dat"; done ;;
     function)
       # The first byte picks the reader (fuzz/function.cpp): 0 function, 1 curve, 2 contour,
       # 3 surface, 4 materials file.
@@ -100,6 +103,7 @@ dict_of() {
   case $1 in
     grammar | derive) echo fuzz/dict/grammar.dict ;;
     view) echo fuzz/dict/view.dict ;;
+    background) echo fuzz/dict/background.dict ;;
     function) echo fuzz/dict/cpfg_files.dict ;;
     expression) echo fuzz/dict/expression.dict ;;
     species_*) echo fuzz/dict/yaml.dict ;;

@@ -39,20 +39,10 @@ const char* const kFileKeys[] = {"tsurface", "blob"};
 /// Most `surface:` lines of a view file (cpfg's SURFACES - 1).
 constexpr size_t kMaxSurfaces = 14;
 
-/// Keys that would change the geometry and that Sprig does not implement, with what they do.
-struct UnsupportedKey {
-  const char* key;
-  const char* what;
-};
-constexpr UnsupportedKey kUnsupportedKeys[] = {
-    {"line", "F drawn as a surface"},
-    {"background scene", "geometry from background files"},
-};
-
 const char* const kReadKeys[] = {
     "angle factor",  "angle increment",   "initial color", "color increment", "initial line width",
     "line width increment", "line style", "initial scale", "scale multiplier", "tropism", "torque",
-    "tropism direction", "initial elasticity", "elasticity increment", "function", "function set", "surface", "curve", "contour", "contour sides",
+    "tropism direction", "initial elasticity", "elasticity increment", "function", "function set", "surface", "line", "background scene", "curve", "contour", "contour sides",
     "texture",
 };
 
@@ -121,6 +111,7 @@ class ViewParser {
         error(st.line, st.col, "the surface's texture " + std::to_string(st.texture) + " names no texture: the view file has " +
                                    std::to_string(view_.textures.size()) + " 'texture:' line" + (view_.textures.size() == 1 ? "" : "s"));
       }
+    checkBackgroundTubes();
     diags_.throwIfErrors();
     if (!viewerKeys_.empty()) {
       raw_ = viewerRaw_;
@@ -300,8 +291,10 @@ class ViewParser {
       view_.functionNames.clear();  // cpfg: the functions are no longer only the set's
     } else if (is("function set")) {
       readFunctionSet(line, vcol, value);
-    } else if (is("surface")) {
-      readSurface(line, vcol, value);
+    } else if (is("surface") || is("line")) {
+      readSurface(line, vcol, value, is("line"));
+    } else if (is("background scene")) {
+      readBackground(line, vcol, value);
     } else if (is("texture")) {
       readTexture(line, vcol, value);
     } else if (is("curve")) {
@@ -323,18 +316,6 @@ class ViewParser {
   /// A key readKey does not read: one Sprig refuses when drawing, a file or viewer key
   /// cpfg's derivation ignores, or an unknown one (an error naming the nearest keys).
   void readOtherKey(int line, size_t kcol, const std::string& key, const std::string& value) {
-    for (const UnsupportedKey& u : kUnsupportedKeys)
-      if (key == u.key) {
-        // Only drawing needs it (cpfg -g derives without): an error when the plant is drawn.
-        if (!view_.unsupportedDrawing) {
-          Diagnostic d;
-          d.loc = SourceLoc{view_.file, line, static_cast<int>(kcol) + 1};
-          d.message = std::string("cpfg's view file command '") + u.key + ":' (" + u.what + ") is not supported";
-          d.sourceLine = raw_;
-          view_.unsupportedDrawing = d;
-        }
-        return;
-      }
     for (const char* k : kFileKeys)
       if (key == k) {
         if (key == "tsurface") {
@@ -355,6 +336,12 @@ class ViewParser {
     for (const char* k : kViewerKeys)
       if (key == k) {
         if (key == "box") view_.box = true;
+        if (key == "tapered lines") {  // cpfg: the first word compared with "on"
+          std::istringstream in(value);
+          std::string word;
+          in >> word;
+          view_.taperedLines = word == "on";
+        }
         if (viewerKeys_.empty()) {
           viewerLine_ = line;
           viewerRaw_ = raw_;
@@ -577,7 +564,13 @@ class ViewParser {
   /// beside the view file (or below it) that `~X` draws, scaled so that its SIZE is size
   /// (default 1; cpfg reads a size <= 0 as 1), tessellated s x t per patch (0 or absent: the
   /// file's precision). A single number after the size is a texture index.
-  void readSurface(int line, size_t vcol, const std::string& value) {
+  ///
+  /// `line: X NAME.s size [s t [texture]]` (interpret.c, case 20) reads its surface file the
+  /// same way and defines the same `~X`; its size is required, and a single number after it
+  /// (which cpfg reads and drops) is an error. cpfg also records X as the line type, which
+  /// nothing reads (irisGL.c's draw_surface call for it is commented out): F is drawn as
+  /// without the line, and so Sprig draws it.
+  void readSurface(int line, size_t vcol, const std::string& value, bool lineKey = false) {
     std::vector<std::pair<std::string, size_t>> words;  // each word and its column
     const size_t base = vcol - std::min(vcol, value.find_first_not_of(" \t"));  // the column of value[0]
     for (size_t i = 0; i < value.size();) {
@@ -590,8 +583,9 @@ class ViewParser {
       words.emplace_back(value.substr(i, j - i), base + i);
       i = j;
     }
-    if (words.size() < 2) {
-      error(line, vcol, "expected 'surface: X FILE.s [size [s-precision t-precision] [texture]]'");
+    if (words.size() < (lineKey ? 3u : 2u)) {
+      error(line, vcol, lineKey ? "expected 'line: X FILE.s size [s-precision t-precision [texture]]'"
+                                : "expected 'surface: X FILE.s [size [s-precision t-precision] [texture]]'");
       return;
     }
     const std::string& id = words[0].first;
@@ -600,12 +594,12 @@ class ViewParser {
       return;
     }
     if (id == "~") {
-      error(line, words[0].second, "cpfg's segment surface 'surface: ~' (F drawn as a surface) is not supported");
+      error(line, words[0].second, "cpfg's surface id '~' (a surface only '~~' would draw) is not supported");
       return;
     }
     for (const CpfgSurfaceEntry& e : view_.surfaces)
       if (e.id == id[0]) {
-        error(line, words[0].second, "surface id '" + id + "' is already used by an earlier 'surface:' line");
+        error(line, words[0].second, "surface id '" + id + "' is already used by an earlier 'surface:' or 'line:' line");
         return;
       }
     if (view_.surfaces.size() >= kMaxSurfaces) {
@@ -633,6 +627,10 @@ class ViewParser {
         return;
       }
       ints.push_back(v);
+    }
+    if (lineKey && ints.size() == 1) {
+      error(line, words[3].second, "a 'line:' takes two precisions (s t) after its size, then an optional texture; cpfg reads a single number there and drops it");
+      return;
     }
     int s = 0, t = 0;
     if (ints.size() >= 2) {
@@ -671,6 +669,62 @@ class ViewParser {
     } catch (const InputError& e) {
       for (const Diagnostic& d : e.diagnostics()) diags_.add(d);
     }
+  }
+
+  /// An error that only drawing raises (ViewFile::unsupportedDrawing): the first is kept.
+  void drawingError(const Diagnostic& d) {
+    if (!view_.unsupportedDrawing) view_.unsupportedDrawing = d;
+  }
+
+  /// `background scene: FILE[, FILE...]` (background.c, ReadBackgroundSceneFile: names
+  /// separated by spaces, commas or semicolons): the files beside the view file, read as one
+  /// scene. Their errors wait for a drawing (cpfg -g derives without them).
+  void readBackground(int line, size_t vcol, const std::string& value) {
+    std::vector<std::string> texts, names;
+    std::string all = value;
+    for (char& c : all)
+      if (c == ',' || c == ';') c = ' ';
+    std::istringstream in(all);
+    const SourceLoc at{view_.file, line, static_cast<int>(vcol) + 1};
+    for (std::string name; in >> name;) {
+      std::filesystem::path file = std::filesystem::path(view_.file).parent_path() / name;
+      const std::string rel = file.lexically_normal().lexically_relative(std::filesystem::path(view_.file).parent_path().lexically_normal()).generic_string();
+      std::string text;
+      try {
+        if (std::filesystem::path(name).is_absolute() || rel.empty() || rel.rfind("..", 0) == 0) {
+          drawingError(Diagnostic{Severity::Error, at, "the background scene file '" + name + "' is outside the object's folder (only files beside the view file, or in folders below it)", raw_});
+          return;
+        }
+        text = readFile(file.string());
+      } catch (const FileReadError& e) {
+        drawingError(Diagnostic{Severity::Error, at, "the background scene file '" + name + "': " + e.reason(), raw_});
+        return;
+      }
+      texts.push_back(std::move(text));
+      names.push_back(file.lexically_normal().string());
+    }
+    if (names.empty()) {
+      error(line, vcol, "expected 'background scene: FILE[, FILE...]'");
+      return;
+    }
+    try {
+      view_.background = parseCpfgBackground(texts, names, warnings_);
+    } catch (const InputError& e) {
+      drawingError(e.diagnostics().front());
+    }
+  }
+
+  /// A background cylinder or cone is drawn as cpfg's line style draws F: a solid only in
+  /// the cylinder style, tapered (a cone) only with tapered lines on.
+  void checkBackgroundTubes() {
+    if (!view_.background) return;
+    const CpfgBackground& b = *view_.background;
+    if (b.firstTube && view_.lineStyle.value_or(CpfgLineStyle::Pixel) != CpfgLineStyle::Cylinder)
+      drawingError(Diagnostic{Severity::Error, *b.firstTube,
+                              "cpfg draws a background cylinder or cone in the line style of F; Sprig draws it only with 'line style: cylinder' (a solid)", {}});
+    if (b.firstCone && !view_.taperedLines)
+      drawingError(Diagnostic{Severity::Error, *b.firstCone,
+                              "a background cone with 'tapered lines: off' (cpfg draws a cylinder with unequal end discs) is not supported", {}});
   }
 
   /// `tropism: T: x y z A: angle I: intensity E: elasticity S: step` (movements.c).

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/diagnostics.h"
+#include "lsystem/cpfg_background.h"
 #include "lsystem/cpfg_contour.h"
 #include "lsystem/cpfg_curve.h"
 #include "lsystem/cpfg_function.h"
@@ -73,9 +74,15 @@ struct ViewFile {
   /// The ids of the `tsurface:` lines (cpfg's triangulated surfaces, not read): a `~X` of
   /// one is an error in the grammar (GrammarOverrides::cpfgUndrawnSurfaceIds).
   std::string tsurfaceIds;
-  /// The first command that changes the drawing and that Sprig does not implement (`line:`,
-  /// F drawn as a surface; `background scene:`): an error when the plant is drawn, not when
-  /// it is only derived (the string does not depend on it, as `cpfg -g` shows).
+  /// `background scene: FILE[, FILE...]`: the scene read from its files (lsystem/cpfg_background.h),
+  /// drawn with the plant when the object has a colour map or materials file (cpfg draws
+  /// none without one).
+  std::optional<CpfgBackground> background;
+  /// `tapered lines: on|off` (default on): whether cpfg tapers a background cone.
+  bool taperedLines = true;
+  /// The first error of what only drawing needs (a background scene file's, or a background
+  /// cylinder or cone under a line style other than cylinder): thrown when the plant is
+  /// drawn, not when it is only derived (the string does not depend on it, as `cpfg -g` shows).
   std::optional<Diagnostic> unsupportedDrawing;
   /// Warnings about keys read but not used (viewer settings), each at its line.
   std::vector<Diagnostic> warnings;

@@ -59,6 +59,9 @@ struct SkeletonStyle {
   /// A cpfg grammar's view file textures (`texture:` lines), which its textured surfaces
   /// (Organ::texture) wear; null for none.
   std::shared_ptr<const std::vector<lsystem::CpfgTexture>> cpfgTextures;
+  /// A cpfg view file's background scene (`background scene:`), already in the plant's
+  /// coordinates, each triangle in its material's diffuse colour; null for none.
+  std::shared_ptr<const render::MeshPart> cpfgBackground;
 };
 
 /// Solids: `render.wireframe: {color, width}`: the edges of the visible triangles (the

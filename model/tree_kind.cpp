@@ -417,6 +417,7 @@ class TreeModel final : public KindModel {
       previewFigures(skeleton, fig);
       fig.buildSeconds = secondsSince(t0);
       out.geometry = skeletonPreview(skeleton, look.style);
+      addBackground(out, look.style);
       return out;
     }
     TreeSurface tree = buildTreeSurface(skeleton, spec_.surface.value_or(organisms::TreeOptions{}));
@@ -431,7 +432,15 @@ class TreeModel final : public KindModel {
     out.geometry = surfaceGeometry(tree, look, mesh);
     // Textured tubes are wood, drawn always; their triangles are not among tree.leaves.
     fig.triangles += addTexturedSurfaces(out.geometry, skeleton, look.style, TexturedKinds{tree.options.leaves.enabled, true});
+    addBackground(out, look.style);
     return out;
+  }
+
+  /// The cpfg background scene, drawn with the plant in its coordinates (cpfg's TurtleDrawFinishUp).
+  static void addBackground(BuiltStage& out, const SkeletonStyle& style) {
+    if (!style.cpfgBackground) return;
+    out.geometry.parts.push_back(*style.cpfgBackground);
+    out.figures.triangles += style.cpfgBackground->mesh.triangleCount();
   }
 
   /// The stage's skeleton (swayed by the stage's wind when sway) and its BlobTree surface,
@@ -668,6 +677,35 @@ std::vector<Vec3> readCpfgMaterials(const fs::path& path, std::vector<Diagnostic
   return lsystem::parseCpfgMaterials(bytes, path.string(), notes);
 }
 
+/// The view file's background scene as the species' background part (SkeletonStyle::
+/// cpfgBackground): its triangles in their materials' diffuse colours, the leaf material's
+/// finish. cpfg draws a background scene only with a colour map or materials file
+/// (background.c: not "in index mode"); without one (coloured false) it is left out, with
+/// a note.
+void addCpfgBackground(const lsystem::ViewFile& view, bool coloured, Species& s) {
+  if (!coloured) {
+    Diagnostic d;
+    d.severity = Severity::Note;
+    d.loc = SourceLoc{view.file, 0, 0};
+    d.message = "the background scene is not drawn: cpfg draws it only with a colour map or materials file (-m, -M), and the object names none";
+    s.notes.push_back(std::move(d));
+    return;
+  }
+  const lsystem::CpfgBackground& b = *view.background;
+  const lsystem::CpfgBackgroundMesh m = b.triangulate();
+  render::MeshPart part;
+  part.material = s.render.style.leaf;
+  for (size_t k = 0; k < m.positions.size(); ++k) {
+    part.mesh.positions.push_back(Vec3(m.positions[k]));
+    part.mesh.normals.push_back(Vec3(m.normals[k]));
+  }
+  for (size_t t = 0; t < m.triangleMaterials.size(); ++t) {
+    part.mesh.triangles.emplace_back(m.triangles[3 * t], m.triangles[3 * t + 1], m.triangles[3 * t + 2]);
+    part.triangleColors.push_back(b.materials[static_cast<size_t>(m.triangleMaterials[t])].diffuse);
+  }
+  s.render.style.cpfgBackground = std::make_shared<const render::MeshPart>(std::move(part));
+}
+
 /// A bare grammar (viewFile: its cpfg view file, empty for none; colormap: its colour map,
 /// empty for none; materials: its materials file, empty for none, which colours organs in
 /// place of the colour map as cpfg's -M does).
@@ -695,6 +733,7 @@ Species grammarSpecies(const fs::path& path, const fs::path& viewFile, const fs:
   if (!colormap.empty()) s.render.style.palette = readCpfgColormap(colormap);
   // A materials file (`-M NAME.mat`) colours them by their materials' diffuse colours.
   if (!materials.empty()) s.render.style.palette = readCpfgMaterials(materials, s.notes);
+  if (spec->view && spec->view->background) addCpfgBackground(*spec->view, !colormap.empty() || !materials.empty(), s);
   if (spec->view && !spec->view->textures.empty())
     s.render.style.cpfgTextures = std::make_shared<const std::vector<lsystem::CpfgTexture>>(spec->view->textures);
   s.spec = spec;

@@ -270,17 +270,16 @@ TEST_CASE("cpfg view file", "[lsystem][cpfg]") {
   SECTION("errors") {
     CHECK(viewErrorOf("angle increment: 30\nangel factor: 8\n") ==
           "t.v:2:1: unknown view file command 'angel factor:' (did you mean 'angle factor'?)");
-    // Commands Sprig cannot draw are read; their error waits for a drawing (GrowthEngine).
+    // A missing surface file is skipped, as cpfg skips it; a background scene's errors wait
+    // for a drawing (GrowthEngine).
     CHECK(viewErrorOf("line: l leaf.s 1\n") == "no error");
-    const ViewFile line = parseViewFile("angle factor: 8\n  line: l leaf.s 1\nbackground scene: a.dat\n", "t.v");
-    REQUIRE(line.unsupportedDrawing);
-    CHECK(line.unsupportedDrawing->loc.line == 2);
-    CHECK(line.unsupportedDrawing->loc.col == 3);
-    CHECK(line.unsupportedDrawing->message == "cpfg's view file command 'line:' (F drawn as a surface) is not supported");
+    CHECK(viewErrorOf("line: l leaf.s\n") == "t.v:1:7: expected 'line: X FILE.s size [s-precision t-precision [texture]]'");
+    CHECK(viewErrorOf("line: l leaf.s 1 3\n") ==
+          "t.v:1:18: a 'line:' takes two precisions (s t) after its size, then an optional texture; cpfg reads a single number there and drops it");
     const ViewFile scene = parseViewFile("background scene: a.dat\n", "t.v");
     REQUIRE(scene.unsupportedDrawing);
-    CHECK(scene.unsupportedDrawing->message ==
-          "cpfg's view file command 'background scene:' (geometry from background files) is not supported");
+    CHECK(scene.unsupportedDrawing->message == "the background scene file 'a.dat': cannot find file");
+    CHECK(scene.unsupportedDrawing->loc.col == 19);
     CHECK_FALSE(parseViewFile("angle factor: 8\n", "t.v").unsupportedDrawing);
     CHECK(viewErrorOf("tropism direction: 0,0,0\n") == "t.v:1:20: 'tropism direction:' must not be the zero vector");
     CHECK(viewErrorOf("angle increment: thirty\n") == "t.v:1:18: 'angle increment:' expects 1 number, got 'thirty'");
@@ -1103,7 +1102,7 @@ TEST_CASE("cpfg surface files and ~X", "[lsystem][cpfg]") {
     CHECK(surfaceError("PRECISION S: 7", "PRECISION S: 11") == "2:14: a surface's precision is 1 to 10, got 11");
     CHECK(viewErrorOf("surface: ab plate.s\n") == "t.v:1:10: a surface's id is one character (the letter after '~'), got 'ab'");
     CHECK(viewErrorOf("surface: a\n") == "t.v:1:10: expected 'surface: X FILE.s [size [s-precision t-precision] [texture]]'");
-    CHECK(viewErrorOf("surface: ~ seg.s 1\n") == "t.v:1:10: cpfg's segment surface 'surface: ~' (F drawn as a surface) is not supported");
+    CHECK(viewErrorOf("surface: ~ seg.s 1\n") == "t.v:1:10: cpfg's surface id '~' (a surface only '~~' would draw) is not supported");
     CHECK(viewErrorOf("surface: a ../x.s 1\n") == "t.v:1:12: the surface file '../x.s' is outside the object's folder (only files beside the view file, or in folders below it)");
     CHECK(viewErrorOf("surface: a x.s big\n") == "t.v:1:16: expected the surface's size (a number), got 'big'");
   }
@@ -1114,6 +1113,33 @@ TEST_CASE("cpfg surface files and ~X", "[lsystem][cpfg]") {
     CHECK(v.warnings[0].loc.col == 12);
     CHECK(v.warnings[0].message == "the surface file 'no_such_bract.s' does not exist: the line is skipped, as cpfg skips it");
   }
+}
+
+TEST_CASE("cpfg line: defines a surface; F is drawn as without it", "[lsystem][cpfg]") {
+  // interpret.c, case 20: 'line: L plate.s 4 2 2' reads plate.s as 'surface: L plate.s 4 2 2'
+  // would; the line type it records is read by nothing (irisGL.c), so F stays a cylinder.
+  const Drawn d = drawObject("line", true);
+  REQUIRE(d.skeleton.internodes.size() == 1);
+  checkNear(d.skeleton.internodes[0].start, DVec3(0, 0, 0));
+  checkNear(d.skeleton.internodes[0].end, DVec3(0, 2, 0));
+  CHECK(d.skeleton.internodes[0].baseRadius == Approx(0.05));
+  REQUIRE(d.skeleton.organs.size() == 1);
+  const Organ& o = d.skeleton.organs[0];
+  CHECK(o.kind == Organ::Kind::Surface);
+  checkNear(o.position, DVec3(0, 2, 0));
+  // The same surface drawn through a 'surface:' line, vertex for vertex.
+  const std::string dir = cpfgAsset("line");
+  ViewFile surface = parseViewFile("surface: L plate.s 4 2 2\n", dir + "/s.v");
+  REQUIRE(surface.surfaces.size() == 1);
+  GrammarOverrides go;
+  go.cpfgSurfaceIds = "L";
+  const Grammar g = parseGrammar("axiom: F(2)~L\n", "t.l", go);
+  const Skeleton sk = Turtle(g.symbols(), cpfgTurtleSettings(&surface, {})).run(g.axiom());
+  REQUIRE(sk.organs.size() == 1);
+  REQUIRE(sk.organs[0].points.size() == o.points.size());
+  CHECK(o.points.size() == 9);  // one patch, 2 x 2 cells
+  for (size_t k = 0; k < o.points.size(); ++k) checkNear(o.points[k], sk.organs[0].points[k]);
+  CHECK(o.triangles == sk.organs[0].triangles);
 }
 
 TEST_CASE("cpfg curve files and curveX/Y/Z/GAL", "[lsystem][cpfg]") {

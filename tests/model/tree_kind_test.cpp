@@ -223,3 +223,36 @@ TEST_CASE("cpfg materials file of a vlab object", "[model][cpfg]") {
     std::filesystem::remove_all(dir);
   }
 }
+
+TEST_CASE("cpfg background scene of a vlab object", "[model][cpfg][background]") {
+  // tests/assets/cpfg/background: 5 materials, 5,002 triangles (lsystem/cpfg_background.h).
+  SECTION("without a colour map or materials file: not drawn, as cpfg draws none in index mode; a note") {
+    const Species s = loadCpfgObject("background");
+    CHECK_FALSE(s.render.style.cpfgBackground);
+    int notes = 0;
+    for (const Diagnostic& d : s.notes) notes += d.message.rfind("the background scene is not drawn", 0) == 0;
+    CHECK(notes == 1);
+  }
+  SECTION("with a colour map: one mesh part drawn with the plant, each triangle in its material's diffuse colour") {
+    const std::filesystem::path dir = std::filesystem::temp_directory_path() / "sprig-cpfg-background-test";
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    for (const char* f : {"plant.l", "plant.v", "background.dat"})
+      std::filesystem::copy_file(std::filesystem::path(SPRIG_SOURCE_DIR) / "tests/assets/cpfg/background" / f, dir / f);
+    writeFileAtomic(dir / "plant.map", std::string(768, '\x80'));
+    const Species s = loadSpecies(dir);
+    REQUIRE(s.render.style.cpfgBackground);
+    const render::MeshPart& part = *s.render.style.cpfgBackground;
+    REQUIRE(part.mesh.triangleCount() == 5002);
+    REQUIRE(part.triangleColors.size() == 5002);
+    CHECK(part.triangleColors.front() == Vec3(0.5f, 0.2f, 0.2f));  // the first material's diffuse
+    CHECK(part.triangleColors.back() == Vec3(0.2f, 0.4f, 0.5f));   // the last's
+    SpeciesModel model(s);
+    const BuiltStage built = model.build(model.finalStage(), GeometryMode::Skeleton, s.render);
+    size_t found = 0;
+    for (const render::GeometryPart& p : built.geometry.parts)
+      if (const auto* m = std::get_if<render::MeshPart>(&p)) found += m->mesh.triangleCount() == 5002;
+    CHECK(found == 1);
+    std::filesystem::remove_all(dir);
+  }
+}

@@ -1,1 +1,1 @@
-line: l leaf.s 1
+line: l leaf.s

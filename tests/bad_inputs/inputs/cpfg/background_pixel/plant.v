@@ -1,0 +1,1 @@
+background scene: scene.dat
