@@ -91,10 +91,12 @@ void resizeOutput(std::vector<T>& v, size_t n) {
     const uintptr_t hi = (reinterpret_cast<uintptr_t>(v.data()) + n * sizeof(T)) / kPage * kPage;
     if (hi > lo) {
       madvise(reinterpret_cast<void*>(lo), hi - lo, MADV_HUGEPAGE);
+#ifdef MADV_POPULATE_WRITE  // glibc 2.35 and later
       parallelFor(0, (hi - lo + kChunk - 1) / kChunk, [&](size_t c) {
         const uintptr_t b = lo + c * kChunk;
         madvise(reinterpret_cast<void*>(b), std::min(hi - b, kChunk), MADV_POPULATE_WRITE);
       });
+#endif
     }
   }
   v.resize(n);
