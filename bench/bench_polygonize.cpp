@@ -1,8 +1,10 @@
 /// Polygonization benchmark: sparse near-surface polygonization of a synthetic branching
 /// structure of 2,000 cones, against a dense-grid baseline computed in the same run.
 ///
-/// Usage: bench_polygonize [--quick] [--cones N] [--no-baseline] [--cell H]
-/// (--cell replaces the target cell, half the smallest radius.)
+/// Usage: bench_polygonize [--quick] [--cones N] [--no-baseline] [--cell H] [--dual]
+/// (--cell replaces the target cell, half the smallest radius; --dual runs only the dual
+/// mesher with batched Newton steps, the default, and no baseline.)
+/// Each mesh's bytes (positions, normals, uvs, triangles) are printed as an FNV-1a hash.
 /// Prints time, triangles/s, cells and field evaluations; the ratio compares the sparse
 /// polygonizer with sampling every grid point of the bounds (the least any dense-grid
 /// mesher must do) at the same cell size.
@@ -29,6 +31,24 @@ using namespace sprig::bench;
 namespace {
 
 std::atomic<size_t> sink{0};
+
+/// FNV-1a over the bytes of a vector, continuing from h.
+template <class T>
+uint64_t fnv(uint64_t h, const std::vector<T>& v) {
+  const auto* p = reinterpret_cast<const unsigned char*>(v.data());
+  for (size_t i = 0; i < v.size() * sizeof(T); ++i) h = (h ^ p[i]) * 0x100000001b3ULL;
+  return h;
+}
+
+/// A hash of the mesh's bytes: the same hash means the same positions, normals, uvs and
+/// triangles in the same order.
+uint64_t meshHash(const Mesh& m) {
+  uint64_t h = 0xcbf29ce484222325ULL;
+  h = fnv(h, m.positions);
+  h = fnv(h, m.normals);
+  h = fnv(h, m.uvs);
+  return fnv(h, m.triangles);
+}
 
 /// Samples every grid point of blob's bounds at cell size h, one batched values() call per
 /// grid row, in parallel over slabs; returns seconds and sets points.
@@ -59,12 +79,13 @@ double denseSampling(const CompiledBlob& blob, float h, size_t& points, double& 
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool quick = false, baseline = true;
+  bool quick = false, baseline = true, dualOnly = false;
   int cones = 2000;
   float cellOverride = 0.0f;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--quick")) quick = true;
     else if (!std::strcmp(argv[i], "--no-baseline")) baseline = false;
+    else if (!std::strcmp(argv[i], "--dual")) dualOnly = true, baseline = false;
     else if (!std::strcmp(argv[i], "--cell") && i + 1 < argc) cellOverride = float(std::atof(argv[++i]));
     else if (!std::strcmp(argv[i], "--cones") && i + 1 < argc) cones = std::atoi(argv[++i]);
   }
@@ -95,6 +116,7 @@ int main(int argc, char** argv) {
                          Run{PolygonizeOptions::Mesher::DualMarchingCubes, true, "dual marching cubes, batched Newton"}}) {
     const auto mesher = run.mesher;
     const bool dual = mesher == PolygonizeOptions::Mesher::DualMarchingCubes;
+    if (dualOnly && !(dual && run.batched)) continue;
     PolygonizeOptions opt;
     opt.mesher = mesher;
     opt.batchedNewton = run.batched;
@@ -115,7 +137,9 @@ int main(int argc, char** argv) {
                 topo.closed() ? "yes" : "NO", topo.manifold() ? "yes" : "NO");
     std::printf("  phases (wall): surface cells %.2f s, grid samples %.2f s, triangulation %.2f s, vertices %.2f s\n",
                 r.cellSeconds, r.sampleSeconds, r.triangulateSeconds, r.vertexSeconds);
+    std::printf("  mesh hash %016llx\n", (unsigned long long)meshHash(r.mesh));
     if (dual) {
+      if (dualOnly) continue;
       std::printf("  dual / tetrahedra: %.2fx the time, %.2fx the triangles\n", s / tetSeconds,
                   double(r.mesh.triangleCount()) / double(tetTriangles));
       if (!run.batched) dualScalarCpu = cpu;

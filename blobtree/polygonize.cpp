@@ -75,6 +75,33 @@ struct HugePageAllocator {
 template <class T>
 using BigVector = std::vector<T, HugePageAllocator<T>>;
 
+// Resizes an output array of the polygonizer (the mesh's arrays, the attributes: plain
+// std::vectors, 400+ MB on the 2,000-cone benchmark) from empty to n elements. resize()
+// value-initializes on one thread, and its first touch of fresh pages was most of the
+// dual mesher's serial time: 1.7 s of its 8.3 s vertex phase (loaded machine). So the
+// block is reserved first, marked for huge pages, and its pages are faulted in on every
+// thread (MADV_POPULATE_WRITE, Linux 5.14; an older kernel refuses it and resize() faults
+// them as before); resize() then only writes memory that is there. Results are unchanged.
+template <class T>
+void resizeOutput(std::vector<T>& v, size_t n) {
+  constexpr size_t kPage = 4096, kChunk = size_t(8) << 20;
+  if (v.empty() && n * sizeof(T) >= HugePageAllocator<T>::kThreshold) {
+    v.reserve(n);
+    const uintptr_t lo = (reinterpret_cast<uintptr_t>(v.data()) + kPage - 1) / kPage * kPage;
+    const uintptr_t hi = (reinterpret_cast<uintptr_t>(v.data()) + n * sizeof(T)) / kPage * kPage;
+    if (hi > lo) {
+      madvise(reinterpret_cast<void*>(lo), hi - lo, MADV_HUGEPAGE);
+#ifdef MADV_POPULATE_WRITE  // glibc 2.35 and later
+      parallelFor(0, (hi - lo + kChunk - 1) / kChunk, [&](size_t c) {
+        const uintptr_t b = lo + c * kChunk;
+        madvise(reinterpret_cast<void*>(b), std::min(hi - b, kChunk), MADV_POPULATE_WRITE);
+      });
+#endif
+    }
+  }
+  v.resize(n);
+}
+
 // Grid points are keyed by their integer coordinates, 20 bits per axis; an edge of the
 // Kuhn triangulation by (key of its low end) · 8 + (its direction as corner bits).
 constexpr int kAxisBits = 20;
@@ -156,18 +183,6 @@ class CellHash {
   size_t capacity_ = 0, mask_ = 0;
 };
 
-// The active cells by grid key: the cell hash (kept cells, and after the closure the added
-// ones too) and each cell's active index. A second hash of the active cells cost a serial
-// pass of 2.6 M inserts and 128 MB of slots on the 2,000-cone benchmark.
-struct ActiveIndex {
-  const CellHash& cells;
-  BigVector<uint32_t> activeOf;  // per cell: its index in Grid::active, or kNoCell
-  uint32_t find(uint64_t key) const {
-    uint32_t j = cells.find(key);
-    return j == kNoCell ? kNoCell : activeOf[j];
-  }
-};
-
 // A surface-crossing grid edge: its inside and outside grid point indices.
 struct EdgeRec {
   uint32_t inside, outside;
@@ -223,6 +238,8 @@ struct Grid {
   BigVector<uint8_t> ownedMask;        // per kept cell: corners whose grid point it owns
   BigVector<uint32_t> pointBase;       // per kept cell: its first owned point (prefix sums)
   BigVector<uint64_t> pointKeys;       // per grid point: its key
+  BigVector<uint32_t> pointSlot;       // per grid point: its owner slot (kept cell · 8 + corner), or
+                                       // kNoCell for a point the closure added
   BigVector<float> values;             // per grid point: F there
   BigVector<uint8_t> insideMask;       // per cell: corners with F > 0.5
   BigVector<glm::ivec3> cellCoords;    // per cell: integer grid coordinates
@@ -238,6 +255,19 @@ struct Grid {
       if (j != kNoCell) return j * 8 + uint32_t(c);
     }
     return kNoCell;
+  }
+  // The cell (kept or added) at cell + offset(c), c = 1..7, or kNoCell. A kept cell there
+  // owns that corner point with code 0 (the smallest code owns a point), so for a kept cell
+  // this reads two arrays instead of a hash lookup; only where the closure added cells can
+  // a neighbour missing from the point table still exist, and only then is the hash asked.
+  uint32_t upperNeighbour(uint32_t cell, int c) const {
+    if (cell < cs.cells.size()) {
+      const uint32_t s = pointSlot[cornerPoint[size_t(cell) * 8 + size_t(c)]];
+      if (s % 8 == 0) return s / 8;
+      if (extraCells == 0) return kNoCell;
+    }
+    const glm::ivec3 n = cellCoords[cell] + cornerOffset(c);
+    return cellIndex.find(pointKey(n.x, n.y, n.z));
   }
   // The grid point index of an owner slot.
   uint32_t pointOfSlot(uint32_t slot) const {
@@ -305,6 +335,7 @@ void numberCorners(Grid& g) {
   }, 1024);
   for (size_t i = 0; i < nCells; ++i) g.pointBase[i + 1] += g.pointBase[i];
   g.pointKeys.resize(g.pointBase[nCells]);
+  g.pointSlot.resize(g.pointBase[nCells]);
   parallelFor(0, nCells, [&](size_t i) {
     const auto& idx = g.cs.cells[i].index;
     for (int c = 0; c < 8; ++c) {
@@ -313,6 +344,7 @@ void numberCorners(Grid& g) {
       if ((g.ownedMask[i] >> c) & 1) {
         glm::ivec3 q = glm::ivec3(idx[0], idx[1], idx[2]) + cornerOffset(c);
         g.pointKeys[cp] = pointKey(q.x, q.y, q.z);
+        g.pointSlot[cp] = uint32_t(i * 8 + size_t(c));
       }
     }
   }, 1024);
@@ -345,11 +377,24 @@ void classifyCells(Grid& g) {
       if (g.values[g.cornerPoint[i * 8 + c]] > kIso) m |= uint8_t(1u << c);
     g.insideMask[i] = m;
   }, 4096);
-  for (size_t i = 0; i < nCells; ++i)
-    if (g.insideMask[i] != 0 && g.insideMask[i] != 0xff) g.active.push_back(uint32_t(i));
+  // The active cells in index order: counted per chunk, then written in place.
+  constexpr size_t kChunk = size_t(1) << 15;
+  const size_t nChunks = (nCells + kChunk - 1) / kChunk;
+  std::vector<size_t> base(nChunks + 1, 0);
+  auto isActive = [&](size_t i) { return g.insideMask[i] != 0 && g.insideMask[i] != 0xff; };
+  parallelFor(0, nChunks, [&](size_t ch) {
+    for (size_t i = ch * kChunk; i < std::min(nCells, (ch + 1) * kChunk); ++i) base[ch + 1] += isActive(i);
+  });
+  for (size_t ch = 0; ch < nChunks; ++ch) base[ch + 1] += base[ch];
+  g.active.resize(base[nChunks]);
   g.cellCoords.resize(nCells);
-  for (size_t i = 0; i < nCells; ++i)
-    g.cellCoords[i] = {g.cs.cells[i].index[0], g.cs.cells[i].index[1], g.cs.cells[i].index[2]};
+  parallelFor(0, nChunks, [&](size_t ch) {
+    size_t k = base[ch];
+    for (size_t i = ch * kChunk; i < std::min(nCells, (ch + 1) * kChunk); ++i) {
+      if (isActive(i)) g.active[k++] = uint32_t(i);
+      g.cellCoords[i] = {g.cs.cells[i].index[0], g.cs.cells[i].index[1], g.cs.cells[i].index[2]};
+    }
+  });
 }
 
 // The neighbours of the frontier's cells across sign-changing faces that no cell covers
@@ -399,6 +444,7 @@ void closeFaces(const CompiledBlob& blob, Grid& g) {
     auto [e, inserted] = extraPoints.emplace(key, uint32_t(g.pointKeys.size()));
     if (inserted) {
       g.pointKeys.push_back(key);
+      g.pointSlot.push_back(kNoCell);
       g.values.push_back(blob.value(gridPosition(g.cs, q)));
     }
     return e->second;
@@ -426,7 +472,7 @@ void closeFaces(const CompiledBlob& blob, Grid& g) {
     }
     g.extraCells += wanted.size();
   }
-  // The added cells join the cell hash (activeCellIndex finds every active cell there);
+  // The added cells join the cell hash (Grid::upperNeighbour finds them there);
   // from here on it maps a key to its index in cellCoords. Rebuilt larger in the (never
   // seen) case that they would fill more than 3/4 of its slots.
   if (4 * g.cellCoords.size() > 3 * g.cellIndex.capacity()) {
@@ -445,17 +491,21 @@ struct Vertices {
   BigVector<EdgeRec> edges;        // per vertex
 };
 
-// The active cells by grid key (the closure's added cells must be in g.cellIndex).
-ActiveIndex activeCellIndex(const Grid& g) {
-  ActiveIndex index{g.cellIndex, BigVector<uint32_t>(g.cellCoords.size(), kNoCell)};
-  for (size_t a = 0; a < g.active.size(); ++a) index.activeOf[g.active[a]] = uint32_t(a);
-  return index;
+// Each cell's index in Grid::active, or kNoCell (a second hash of the active cells cost a
+// serial pass of 2.6 M inserts and 128 MB of slots on the 2,000-cone benchmark).
+BigVector<uint32_t> activeIndexOf(const Grid& g) {
+  BigVector<uint32_t> activeOf(g.cellCoords.size());
+  parallelFor(0, activeOf.size(), [&](size_t i) { activeOf[i] = kNoCell; }, size_t(1) << 16);
+  parallelFor(0, g.active.size(), [&](size_t a) { activeOf[g.active[a]] = uint32_t(a); }, size_t(1) << 14);
+  return activeOf;
 }
 
 // Step 4a: every crossing edge P -> P + d (d a corner code) belongs to the cell with low
 // corner P; that cell has the crossing between its corners 0 and d, so it is active (kept
 // by the bounds or added by the closure). Vertices are numbered by owner cell, then by d.
-Vertices numberVertices(const Grid& g, const ActiveIndex& activeIndex, uint8_t directions) {
+// Each active cell's neighbours at its corners (owners) come from Grid::upperNeighbour.
+Vertices numberVertices(const Grid& g, uint8_t directions) {
+  const BigVector<uint32_t> activeOf = activeIndexOf(g);
   const size_t nActive = g.active.size();
   Vertices v;
   v.crossMask.resize(nActive);
@@ -467,11 +517,10 @@ Vertices numberVertices(const Grid& g, const ActiveIndex& activeIndex, uint8_t d
       if (((directions >> d) & 1) && ((m >> d) & 1) != (m & 1)) cross |= uint8_t(1u << d);
     v.crossMask[a] = cross;
     v.vertexBase[a + 1] = uint32_t(std::popcount(unsigned(cross)));
-    glm::ivec3 q = g.cellCoords[g.active[a]];
     v.owners[a * 8] = uint32_t(a);
     for (int lo = 1; lo < 8; ++lo) {
-      glm::ivec3 n = q + cornerOffset(lo);
-      v.owners[a * 8 + size_t(lo)] = activeIndex.find(pointKey(n.x, n.y, n.z));
+      const uint32_t j = g.upperNeighbour(g.active[a], lo);
+      v.owners[a * 8 + size_t(lo)] = j == kNoCell ? kNoCell : activeOf[j];
     }
   }, 2048);
   for (size_t a = 0; a < nActive; ++a) v.vertexBase[a + 1] += v.vertexBase[a];
@@ -500,7 +549,8 @@ std::vector<glm::uvec3> triangulate(const Grid& g, const Vertices& v) {
     triBase[ch + 1] = n;
   });
   for (size_t ch = 0; ch < nChunks; ++ch) triBase[ch + 1] += triBase[ch];
-  std::vector<glm::uvec3> triangles(triBase[nChunks]);
+  std::vector<glm::uvec3> triangles;
+  resizeOutput(triangles, triBase[nChunks]);
   parallelFor(0, nChunks, [&](size_t ch) {
     size_t begin = ch * kChunk, end = std::min(nActive, begin + kChunk);
     TetEmitter em{nullptr, v.vertexBase.data(), v.crossMask.data(), triangles.data() + triBase[ch]};
@@ -544,11 +594,11 @@ std::vector<uint8_t> placeVertices(const CompiledBlob& blob, const PolygonizeOpt
   Mesh& mesh = res.mesh;
   std::unique_ptr<Progress> bar;
   if (options.progress) bar = std::make_unique<Progress>("polygonize", nVerts);
-  mesh.positions.resize(nVerts);
-  if (options.normals) mesh.normals.resize(nVerts);
+  resizeOutput(mesh.positions, nVerts);
+  if (options.normals) resizeOutput(mesh.normals, nVerts);
   if (options.attributes) {
-    mesh.uvs.resize(nVerts);
-    res.attributes.resize(nVerts);
+    resizeOutput(mesh.uvs, nVerts);
+    resizeOutput(res.attributes, nVerts);
   }
   std::vector<uint8_t> evals(nVerts, 0);
   flatGradient.assign(nVerts, 0);
@@ -636,20 +686,20 @@ void fixFlatNormals(Mesh& mesh, const std::vector<uint8_t>& flatGradient) {
 class DualMesher {
  public:
   DualMesher(const CompiledBlob& blob, const PolygonizeOptions& options, const Grid& g, PolygonizeResult& res)
-      : blob_(blob), options_(options), g_(g), res_(res), nActive_(g.active.size()), activeIndex_(activeCellIndex(g)),
+      : blob_(blob), options_(options), g_(g), res_(res), nActive_(g.active.size()),
         // Crossing axis edges (directions 1, 2, 4), each owned by the cell at its low end.
-        v_(numberVertices(g, activeIndex_, uint8_t((1u << 1) | (1u << 2) | (1u << 4)))) {}
+        v_(numberVertices(g, uint8_t((1u << 1) | (1u << 2) | (1u << 4)))) {}
 
   void run() {
     const std::vector<uint8_t> evals = crossingPoints();
     cellPatchesAll();
     Mesh& mesh = res_.mesh;
     const size_t nVerts = patchBase_[nActive_];
-    mesh.positions.resize(nVerts);
-    if (options_.normals) mesh.normals.resize(nVerts);
+    resizeOutput(mesh.positions, nVerts);
+    if (options_.normals) resizeOutput(mesh.normals, nVerts);
     if (options_.attributes) {
-      mesh.uvs.resize(nVerts);
-      res_.attributes.resize(nVerts);
+      resizeOutput(mesh.uvs, nVerts);
+      resizeOutput(res_.attributes, nVerts);
     }
     flatGradient_.assign(nVerts, 0);
     if (options_.progress) bar_ = std::make_unique<Progress>("polygonize", nActive_);
@@ -697,10 +747,26 @@ class DualMesher {
     return evals;
   }
 
+  /// The active cell across each low face (−x, −y, −z) of every active cell, or kNoCell:
+  /// the owners table names the cell across each high face, and each active cell is the
+  /// low neighbour of at most one cell per axis, so a scatter fills it without a lookup.
+  BigVector<uint32_t> lowNeighbours() const {
+    BigVector<uint32_t> low(3 * nActive_);
+    parallelFor(0, low.size(), [&](size_t i) { low[i] = kNoCell; }, size_t(1) << 16);
+    parallelFor(0, nActive_, [&](size_t a) {
+      for (int axis = 0; axis < 3; ++axis) {
+        const uint32_t n = v_.owners[a * 8 + (size_t(1) << axis)];
+        if (n != kNoCell) low[size_t(n) * 3 + size_t(axis)] = uint32_t(a);
+      }
+    }, size_t(1) << 13);
+    return low;
+  }
+
   /// The patches of every active cell, numbered by cell (patchBase_: prefix sums).
   void cellPatchesAll() {
     patches_ = BigVector<detail::CellPatches>(nActive_);
     patchBase_ = BigVector<uint32_t>(nActive_ + 1, 0);
+    const BigVector<uint32_t> low = lowNeighbours();
     parallelFor(0, nActive_, [&](size_t a) {
       auto valuesOf = [&](size_t cell, float* f) {
         for (int c = 0; c < 8; ++c) f[c] = g_.values[g_.cornerPoint[cell * 8 + size_t(c)]] - kIso;
@@ -709,13 +775,10 @@ class DualMesher {
       valuesOf(g_.active[a], f);
       // Ambiguous faces whose diagonal corners both cells join are decided for manifoldness.
       int8_t forced[6];
-      const glm::ivec3 q = g_.cellCoords[g_.active[a]];
       for (int face = 0; face < 6; ++face) {
         forced[face] = -1;
         const int axis = face / 2, side = face % 2;
-        glm::ivec3 n = q;
-        n[axis] += side ? 1 : -1;
-        uint32_t j = n[axis] < 0 ? kNoCell : activeIndex_.find(pointKey(n.x, n.y, n.z));
+        const uint32_t j = side ? v_.owners[a * 8 + (size_t(1) << axis)] : low[a * 3 + size_t(axis)];
         if (j == kNoCell) continue;
         valuesOf(g_.active[j], fn);
         forced[face] = detail::forcedFaceDecision(f, fn, axis, side);
@@ -826,30 +889,32 @@ class DualMesher {
   }
 
   /// A quad per crossing edge, joining its patch in the four cells around it, ordered
-  /// counter-clockwise seen from the outside; split along its shorter diagonal.
+  /// counter-clockwise seen from the outside; split along its shorter diagonal. The quad
+  /// of the edge along axis owned by cell q (its low end is q's corner 0) is made by the
+  /// cell m = q − e_b − e_c, which holds the edge as its edge 4·axis + 3 and reaches the
+  /// other three cells through its owners table (no lookup); the quad's two triangles go
+  /// to the slots of the edge's vertex number, so the order of the cells does not matter.
   void quads() {
     Mesh& mesh = res_.mesh;
-    mesh.triangles.resize(2 * v_.edges.size());
-    parallelFor(0, nActive_, [&](size_t a) {
-      const glm::ivec3 q = g_.cellCoords[g_.active[a]];
-      const bool lowInside = g_.insideMask[g_.active[a]] & 1;
+    resizeOutput(mesh.triangles, 2 * v_.edges.size());
+    parallelFor(0, nActive_, [&](size_t m) {
+      const uint8_t mask = g_.insideMask[g_.active[m]];
       for (int axis = 0; axis < 3; ++axis) {
-        const unsigned d = 1u << axis;
-        if (!((v_.crossMask[a] >> d) & 1)) continue;
         const int b = (axis + 1) % 3, c = (axis + 2) % 3;
+        const int from = (1 << b) | (1 << c), to = from | (1 << axis);
+        if (((mask >> from) & 1) == ((mask >> to) & 1)) continue;
         static constexpr int kAround[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};  // counter-clockwise about +axis
         uint32_t quad[4];
         for (int k = 0; k < 4; ++k) {
-          glm::ivec3 cell = q;
-          cell[b] -= kAround[k][0];
-          cell[c] -= kAround[k][1];
-          uint32_t j = cell.x < 0 || cell.y < 0 || cell.z < 0 ? kNoCell : activeIndex_.find(pointKey(cell.x, cell.y, cell.z));
-          int e = 4 * axis + kAround[k][0] + 2 * kAround[k][1];
+          // Cell q − kAround[k] is m + (1 − kAround[k]) along b and c.
+          const size_t lo = size_t(((1 - kAround[k][0]) << b) | ((1 - kAround[k][1]) << c));
+          const uint32_t j = v_.owners[m * 8 + lo];
+          const int e = 4 * axis + kAround[k][0] + 2 * kAround[k][1];
           if (j == kNoCell || patches_[j].patch[size_t(e)] < 0) throw std::logic_error("polygonize: crossing edge without its four cells");
           quad[k] = patchBase_[j] + uint32_t(patches_[j].patch[size_t(e)]);
         }
-        if (!lowInside) std::swap(quad[1], quad[3]);  // the outside is toward −axis
-        const size_t t = 2 * size_t(edgePoint(a, 4 * axis));
+        if (!((mask >> from) & 1)) std::swap(quad[1], quad[3]);  // the outside is toward −axis
+        const size_t t = 2 * size_t(edgePoint(m, 4 * axis + 3));
         const std::vector<Vec3>& P = mesh.positions;
         if (glm::length(P[quad[0]] - P[quad[2]]) <= glm::length(P[quad[1]] - P[quad[3]])) {
           mesh.triangles[t] = {quad[0], quad[1], quad[2]};
@@ -867,7 +932,6 @@ class DualMesher {
   const Grid& g_;
   PolygonizeResult& res_;
   const size_t nActive_;
-  const ActiveIndex activeIndex_;
   const Vertices v_;
   std::vector<Vec3> cross_;  ///< the crossing point of each crossing edge
   BigVector<detail::CellPatches> patches_;
@@ -944,7 +1008,7 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
   }
 
   // 4. Vertex numbering and marching tetrahedra.
-  Vertices v = numberVertices(g, activeCellIndex(g), 0xfe);
+  Vertices v = numberVertices(g, 0xfe);
   res.mesh.triangles = triangulate(g, v);
   BigVector<uint32_t>().swap(v.owners);
   res.triangulateSeconds = lap();

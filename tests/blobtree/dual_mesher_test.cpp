@@ -179,6 +179,12 @@ TEST_CASE("dual mesher: a branching blend of cones, deterministic at any thread 
   REQUIRE(one.triangleCount() == two.triangleCount());
   CHECK(std::memcmp(one.positions.data(), two.positions.data(), one.vertexCount() * sizeof(Vec3)) == 0);
   CHECK(std::memcmp(one.triangles.data(), two.triangles.data(), one.triangleCount() * sizeof(glm::uvec3)) == 0);
+  REQUIRE(one.normals.size() == one.vertexCount());
+  REQUIRE(two.normals.size() == one.vertexCount());
+  REQUIRE(one.uvs.size() == one.vertexCount());
+  REQUIRE(two.uvs.size() == one.vertexCount());
+  CHECK(std::memcmp(one.normals.data(), two.normals.data(), one.vertexCount() * sizeof(Vec3)) == 0);
+  CHECK(std::memcmp(one.uvs.data(), two.uvs.data(), one.vertexCount() * sizeof(Vec2)) == 0);
   requireClosedManifold(one);
   PolygonizeOptions ref;
   ref.cellSize = 0.02f;
