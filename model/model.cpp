@@ -133,7 +133,13 @@ render::Camera modelCamera(const SpeciesRender& look, const Box3& box, int width
   return cam;
 }
 
+Box3 SpeciesModel::frameBox() {
+  const Phase phase("build");
+  return kind_->frameBox();
+}
+
 Box3 SpeciesModel::closeUpBox(const CloseUpSpec& target) {
+  const Phase phase("build");
   return target.point ? Box3{*target.point, *target.point} : kind_->partBox(target);
 }
 

@@ -76,7 +76,8 @@ class SpeciesModel {
   int stageNumber(const Stage& stage) const { return kind_->stageNumber(stage); }
   /// The box the camera frames for every stage: the final stage's bounds (trees: the union
   /// over their steps).
-  Box3 frameBox() { return kind_->frameBox(); }
+  /// The box the camera frames; for a solid this builds it, so the time is the "build" phase.
+  Box3 frameBox();
   /// The box of a close-up's target (`render.close_up`): the point itself, or the named
   /// part's box (KindModel::partBox). Throws InputError as partBox does.
   Box3 closeUpBox(const CloseUpSpec& target);

@@ -124,7 +124,7 @@ namespace {
 float evalLocalL(const Tape& T, uint32_t ni, const Box3& box) {
   const TNode& n = T.nodes[ni];
   if (box.empty() || !box.overlaps(n.box)) return 0.0f;
-  if (isPrimitive(n.kind)) return n.lip;
+  if (isPrimitive(n.kind)) return std::min(n.lip, primLipschitz(T.prim(n.prim), box));
   switch (n.kind) {
     case NodeKind::Blend:
     case NodeKind::Ricci:

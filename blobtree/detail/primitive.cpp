@@ -118,6 +118,31 @@ Vec2 primUv(const Prim& P, Vec3 p) {
   return uv * P.tex.uvScale + P.tex.uvOffset;
 }
 
+float primLipschitz(const Prim& P, const Box3& box) {
+  // A halfspace's or a box's ramp is flat (0 or the weight) outside the slab |sd| < ramp/2
+  // around its plane or faces: over a world box whose signed distances all lie outside it,
+  // the gradient is 0 everywhere, so 0 is a sound bound there. The saw cut of a pruned
+  // branch (ramp 1e-3, bound 1000) no longer sets the bound of every cell of the branch,
+  // only of the cells its plane passes through.
+  auto outsideRamp = [&](float sd, float e) {
+    const float half = 0.5f / P.invRamp;
+    return sd - e >= half || sd + e <= -half;
+  };
+  switch (P.kind) {
+    case NodeKind::Halfspace: {
+      const float sd = glm::dot(box.center() - P.a, P.axis);
+      const float e = glm::dot(0.5f * box.size(), glm::abs(P.axis));
+      return outsideRamp(sd, e) ? 0.0f : P.lipschitz;
+    }
+    case NodeKind::Box: {
+      // sdBox is 1-Lipschitz, so over the box it lies within the half-diagonal of its centre's.
+      const float sd = sdBox(box.center(), P.lo, P.hi, nullptr);
+      return outsideRamp(sd, glm::length(0.5f * box.size())) ? 0.0f : P.lipschitz;
+    }
+    default: return P.lipschitz;
+  }
+}
+
 Interval primInterval(const Prim& P, const Box3& box) {
   Vec3 c = box.center();
   Vec3 h = 0.5f * box.size();

@@ -150,6 +150,10 @@ Vec2 primUv(const Prim& P, Vec3 p);
 /// Sound interval of a primitive's field over box.
 Interval primInterval(const Prim& P, const Box3& box);
 
+/// A Lipschitz bound of primitive P's field over a world box: 0 where a halfspace's or a
+/// box's ramp is flat over all of it, else P.lipschitz.
+float primLipschitz(const Prim& P, const Box3& box);
+
 /// Distance from p to segment [a, a+ab].
 inline float distToSegment(Vec3 p, Vec3 a, Vec3 ab, float invLen2) {
   float t = std::clamp(glm::dot(p - a, ab) * invLen2, 0.0f, 1.0f);

@@ -153,6 +153,42 @@ TEST_CASE("CompiledBlob::value", "[blobtree]") {
   }
 }
 
+TEST_CASE("CompiledBlob::lipschitz: a saw's or a box's ramp counts only where it slopes", "[blobtree]") {
+  // A pruned branch: a cone cut by a halfspace of ramp 1e-3 (bound 1000), as the tree
+  // builder saws it; and the same cone kept inside a box of the same ramp.
+  BlobTree t;
+  const NodeId cone = t.cone(Vec3(0), Vec3(0, 2, 0), 0.3f, 0.2f);
+  const NodeId saw = t.halfspace(Vec3(0, 1, 0), Vec3(0, 1, 0));
+  const NodeId sawn[2] = {cone, saw};
+  const NodeId cut = t.intersect(sawn);
+  const NodeId slab = t.box(Vec3(-1, 0.2f, -1), Vec3(1, 0.6f, 1));
+  const NodeId boxed[2] = {cone, slab};
+  const NodeId inBox = t.intersect(boxed);
+  for (NodeId root : {cut, inBox}) {
+    CompiledBlob b = compile(t, root);
+    const float coneL = compile(t, cone).lipschitz();
+    REQUIRE(b.lipschitz() >= 999.0f);  // the ramp's own bound, 1 / 1e-3
+    // Away from the plane or the faces: the cone's bound alone.
+    const Box3 away{Vec3(-0.05f, 0.35f, -0.05f), Vec3(0.05f, 0.45f, 0.05f)};
+    CHECK(b.lipschitz(away) == Approx(coneL));
+    // Through the plane (y = 1) or a face (y = 0.6): the ramp's.
+    const Box3 across{Vec3(-0.3f, root == cut ? 0.95f : 0.55f, -0.3f), Vec3(0.3f, root == cut ? 1.05f : 0.65f, 0.3f)};
+    CHECK(b.lipschitz(across) >= 999.0f);
+    // Sound on random boxes near the cut: |f(p) - f(q)| <= L |p - q|.
+    Rng rng(7);
+    for (int i = 0; i < 300; ++i) {
+      Vec3 c = randomIn(rng, Vec3(-0.4f, 0.0f, -0.4f), Vec3(0.4f, 1.2f, 0.4f));
+      float e = float(rng.uniform(1e-4, 0.1));
+      Box3 q{c - e, c + e};
+      float L = b.lipschitz(q);
+      for (int k = 0; k < 20; ++k) {
+        Vec3 p = randomIn(rng, q.lo, q.hi), r = randomIn(rng, q.lo, q.hi);
+        CHECK(std::abs(b.value(p) - b.value(r)) <= L * glm::length(p - r) * 1.001f + 1e-5f);
+      }
+    }
+  }
+}
+
 TEST_CASE("CompiledBlob::gradient", "[blobtree]") {
   uint64_t seed = GENERATE(11u, 12u, 13u);
   INFO("seed " << seed);
