@@ -150,6 +150,18 @@ Vec2 primUv(const Prim& P, Vec3 p);
 /// Sound interval of a primitive's field over box.
 Interval primInterval(const Prim& P, const Box3& box);
 
+/// |dφ/dx| of the radial profile φ(x) = g(x²) at x = r/R (0 for x >= 1); its maximum over
+/// x is kernelSlope. Unimodal on [0, 1]: rises to kernelSlopeArg, then falls to 0 at x = 1.
+float kernelSlopeAt(Kernel k, float x);
+/// The x = r/R where |dφ/dx| is largest: 1/√5 (Wyvill), 0.50347 (soft objects).
+float kernelSlopeArg(Kernel k);
+
+/// Local Lipschitz bound of a primitive's field over box: a point, segment, cone or torus
+/// gets its profile's largest slope over the box's range of r/R (kernelSlopeAt, widened
+/// for rounding), which is 0 where the box misses the support and small where the box lies
+/// deep inside or near the rim; other kinds, and any box, never more than P.lipschitz.
+float primLipschitz(const Prim& P, const Box3& box);
+
 /// Distance from p to segment [a, a+ab].
 inline float distToSegment(Vec3 p, Vec3 a, Vec3 ab, float invLen2) {
   float t = std::clamp(glm::dot(p - a, ab) * invLen2, 0.0f, 1.0f);
