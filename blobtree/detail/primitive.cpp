@@ -118,12 +118,51 @@ Vec2 primUv(const Prim& P, Vec3 p) {
   return uv * P.tex.uvScale + P.tex.uvOffset;
 }
 
-float primLipschitz(const Prim& P, const Box3& box) {
-  // A halfspace's or a box's ramp is flat (0 or the weight) outside the slab |sd| < ramp/2
-  // around its plane or faces: over a world box whose signed distances all lie outside it,
-  // the gradient is 0 everywhere, so 0 is a sound bound there. The saw cut of a pruned
-  // branch (ramp 1e-3, bound 1000) no longer sets the bound of every cell of the branch,
-  // only of the cells its plane passes through.
+namespace {
+
+/// The range of distances r from box to a sized primitive's core (point, segment, circle)
+/// and of its support radius R over the box, from the box's centre widened by its half
+/// diagonal. False for unsized kinds.
+struct DistanceRange {
+  float dmin, dmax, Rmin, Rmax;
+};
+
+bool distanceRange(const Prim& P, const Box3& box, DistanceRange& r) {
+  const Vec3 c = box.center(), h = 0.5f * box.size();
+  const float hd = glm::length(h);
+  switch (P.kind) {
+    case NodeKind::Point: {
+      Vec3 q = glm::clamp(P.a, box.lo, box.hi);
+      r = {glm::length(q - P.a), glm::length(glm::max(glm::abs(P.a - box.lo), glm::abs(P.a - box.hi))), P.R0, P.R0};
+      return true;
+    }
+    case NodeKind::Segment:
+    case NodeKind::Cone: {
+      float dc = distToSegment(c, P.a, P.ab, P.invLen2);
+      float tc = glm::dot(c - P.a, P.ab) * P.invLen2;
+      float te = glm::dot(h, glm::abs(P.ab)) * P.invLen2;
+      float t0 = std::clamp(tc - te, 0.0f, 1.0f), t1 = std::clamp(tc + te, 0.0f, 1.0f);
+      float Ra = P.R0 + P.dR * t0, Rb = P.R0 + P.dR * t1;
+      r = {std::max(0.0f, dc - hd), dc + hd, std::min(Ra, Rb), std::max(Ra, Rb)};
+      return true;
+    }
+    case NodeKind::Torus: {
+      Vec3 q = c - P.a;
+      float hh = glm::dot(q, P.axis);
+      float rho = glm::length(q - hh * P.axis);
+      float dc = std::sqrt((rho - P.major) * (rho - P.major) + hh * hh);
+      r = {std::max(0.0f, dc - hd), dc + hd, P.R0, P.R0};
+      return true;
+    }
+    default: return false;
+  }
+}
+
+/// A halfspace's or a box's bound over box: its ramp is flat (0 or the weight) outside the
+/// slab |sd| < ramp/2 around its plane or faces, so over a box whose signed distances all
+/// lie outside it the gradient is 0 everywhere. The saw cut of a pruned branch (ramp 1e-3,
+/// bound 1000) bounds only the cells its plane passes through, not every cell of the branch.
+float rampLipschitz(const Prim& P, const Box3& box) {
   auto outsideRamp = [&](float sd, float e) {
     const float half = 0.5f / P.invRamp;
     return sd - e >= half || sd + e <= -half;
@@ -143,18 +182,50 @@ float primLipschitz(const Prim& P, const Box3& box) {
   }
 }
 
+}  // namespace
+
+float kernelSlopeArg(Kernel k) {
+  // Wyvill: d/dx of 6x(1−x²)² vanishes at x² = 1/5. Soft objects: |φ'| = 4/9·x(1−x²)(11−6x²),
+  // whose derivative vanishes at 30x⁴ − 51x² + 11 = 0, x² = (51 − √1281)/60.
+  return k == Kernel::Wyvill ? 0.44721360f : 0.50347364f;
+}
+
+float kernelSlopeAt(Kernel k, float x) {
+  if (!(x < 1.0f)) return 0.0f;
+  x = std::max(x, 0.0f);
+  return 2.0f * x * std::abs(kernelDG(k, x * x));
+}
+
+float primLipschitz(const Prim& P, const Box3& box) {
+  DistanceRange r;
+  if (!distanceRange(P, box, r)) return rampLipschitz(P, box);
+  // |∇f| = |w|·|φ'(x)|·|∇x| with x = r/R(t) and |∇x| <= √(1+m²)/R(t) (m = dR/|ab|; the
+  // global bound, P.lipschitz = |w|·max|φ'|·√(1+m²)/min R, is the same product with φ'
+  // at its peak and R at its least). Over the box x lies in [dmin/Rmax, dmax/Rmin] and
+  // R(t) >= Rmin, and φ' is unimodal there, so its largest value is at the peak clamped
+  // to that range. The range is widened by 1e-4 of R and the result by 1e-4 so that
+  // rounding in the centre distance cannot make the bound fall short.
+  const float slack = 1e-4f * r.Rmax;
+  const float xlo = std::max(0.0f, r.dmin - slack) / r.Rmax, xhi = (r.dmax + slack) / r.Rmin;
+  if (!(xlo < 1.0f)) return 0.0f;
+  const float peak = kernelSlopeAt(P.kernel, std::clamp(kernelSlopeArg(P.kernel), xlo, xhi));
+  const float m = P.len > 0.0f ? P.dR / P.len : 0.0f;
+  const float local = 1.0001f * std::abs(P.weight) * peak * std::sqrt(1.0f + m * m) / r.Rmin;
+  return std::min(local, P.lipschitz);
+}
+
 Interval primInterval(const Prim& P, const Box3& box) {
-  Vec3 c = box.center();
-  Vec3 h = 0.5f * box.size();
-  float hd = glm::length(h);
-  auto fromDistances = [&](float dmin, float dmax, float Rmin, float Rmax) {
-    float smin = dmin * dmin / (Rmax * Rmax), smax = dmax * dmax / (Rmin * Rmin);
+  DistanceRange d;
+  if (distanceRange(P, box, d)) {
+    float smin = d.dmin * d.dmin / (d.Rmax * d.Rmax), smax = d.dmax * d.dmax / (d.Rmin * d.Rmin);
     float fhi = smin >= 1.0f ? 0.0f : kernelG(P.kernel, smin);
     float flo = smax >= 1.0f ? 0.0f : kernelG(P.kernel, smax);
     Interval r{flo * P.weight, fhi * P.weight};
     if (P.weight < 0.0f) std::swap(r.lo, r.hi);
     return r;
-  };
+  }
+  Vec3 c = box.center();
+  Vec3 h = 0.5f * box.size();
   auto ramp = [&](float sdlo, float sdhi) {
     Interval r{std::clamp(0.5f - sdhi * P.invRamp, 0.0f, 1.0f) * P.weight,
                std::clamp(0.5f - sdlo * P.invRamp, 0.0f, 1.0f) * P.weight};
@@ -162,28 +233,6 @@ Interval primInterval(const Prim& P, const Box3& box) {
     return r;
   };
   switch (P.kind) {
-    case NodeKind::Point: {
-      Vec3 q = glm::clamp(P.a, box.lo, box.hi);
-      float dmin = glm::length(q - P.a);
-      float dmax = glm::length(glm::max(glm::abs(P.a - box.lo), glm::abs(P.a - box.hi)));
-      return fromDistances(dmin, dmax, P.R0, P.R0);
-    }
-    case NodeKind::Segment:
-    case NodeKind::Cone: {
-      float dc = distToSegment(c, P.a, P.ab, P.invLen2);
-      float tc = glm::dot(c - P.a, P.ab) * P.invLen2;
-      float te = glm::dot(h, glm::abs(P.ab)) * P.invLen2;
-      float t0 = std::clamp(tc - te, 0.0f, 1.0f), t1 = std::clamp(tc + te, 0.0f, 1.0f);
-      float Ra = P.R0 + P.dR * t0, Rb = P.R0 + P.dR * t1;
-      return fromDistances(std::max(0.0f, dc - hd), dc + hd, std::min(Ra, Rb), std::max(Ra, Rb));
-    }
-    case NodeKind::Torus: {
-      Vec3 q = c - P.a;
-      float hh = glm::dot(q, P.axis);
-      float rho = glm::length(q - hh * P.axis);
-      float dc = std::sqrt((rho - P.major) * (rho - P.major) + hh * hh);
-      return fromDistances(std::max(0.0f, dc - hd), dc + hd, P.R0, P.R0);
-    }
     case NodeKind::Halfspace: {
       float sd = glm::dot(c - P.a, P.axis);
       float e = glm::dot(h, glm::abs(P.axis));
@@ -191,7 +240,7 @@ Interval primInterval(const Prim& P, const Box3& box) {
     }
     case NodeKind::Box: {
       float sd = sdBox(c, P.lo, P.hi, nullptr);
-      return ramp(sd - hd, sd + hd);
+      return ramp(sd - glm::length(h), sd + glm::length(h));
     }
     default: return {};
   }

@@ -150,8 +150,17 @@ Vec2 primUv(const Prim& P, Vec3 p);
 /// Sound interval of a primitive's field over box.
 Interval primInterval(const Prim& P, const Box3& box);
 
-/// A Lipschitz bound of primitive P's field over a world box: 0 where a halfspace's or a
-/// box's ramp is flat over all of it, else P.lipschitz.
+/// |dφ/dx| of the radial profile φ(x) = g(x²) at x = r/R (0 for x >= 1); its maximum over
+/// x is kernelSlope. Unimodal on [0, 1]: rises to kernelSlopeArg, then falls to 0 at x = 1.
+float kernelSlopeAt(Kernel k, float x);
+/// The x = r/R where |dφ/dx| is largest: 1/√5 (Wyvill), 0.50347 (soft objects).
+float kernelSlopeArg(Kernel k);
+
+/// Local Lipschitz bound of a primitive's field over box: a point, segment, cone or torus
+/// gets its profile's largest slope over the box's range of r/R (kernelSlopeAt, widened
+/// for rounding), which is 0 where the box misses the support and small where the box lies
+/// deep inside or near the rim; a halfspace or a box 0 where its ramp is flat over the box;
+/// never more than P.lipschitz.
 float primLipschitz(const Prim& P, const Box3& box);
 
 /// Distance from p to segment [a, a+ab].

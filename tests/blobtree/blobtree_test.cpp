@@ -541,3 +541,88 @@ TEST_CASE("BlobTree::joint bulge", "[blobtree]") {
   CHECK(y0 == Approx(0.0f).margin(r / 32));
   CHECK(std::abs(offset) < 0.05f);
 }
+
+TEST_CASE("detail::kernelSlopeAt", "[blobtree]") {
+  // The profile's slope |dφ/dx| peaks at kernelSlopeArg with value kernelSlope, and is
+  // unimodal: rising before the peak, falling after, 0 at and beyond the support's rim.
+  for (Kernel k : {Kernel::Wyvill, Kernel::SoftObject}) {
+    INFO("kernel " << int(k));
+    float best = 0.0f, bestX = 0.0f;
+    float prev = 0.0f;
+    for (int i = 0; i <= 20000; ++i) {
+      const float x = float(i) / 20000.0f, s = detail::kernelSlopeAt(k, x);
+      if (x < detail::kernelSlopeArg(k) - 1e-4f) CHECK(s >= prev);
+      if (x > detail::kernelSlopeArg(k) + 1e-4f) CHECK(s <= prev);
+      if (s > best) best = s, bestX = x;
+      prev = s;
+    }
+    CHECK(best == Approx(kernelSlope(k)).epsilon(1e-5));
+    CHECK(bestX == Approx(detail::kernelSlopeArg(k)).margin(1e-4));
+    CHECK(detail::kernelSlopeAt(k, detail::kernelSlopeArg(k)) == Approx(kernelSlope(k)).epsilon(1e-6));
+    CHECK(detail::kernelSlopeAt(k, 1.0f) == 0.0f);
+    CHECK(detail::kernelSlopeAt(k, 2.0f) == 0.0f);
+  }
+}
+
+TEST_CASE("CompiledBlob::lipschitz over a box", "[blobtree]") {
+  const uint64_t seed = GENERATE(21u, 22u);
+  INFO("seed " << seed);
+  Rng rng(seed);
+  // The largest |∇F| at 200 random points of box q (the analytic gradient).
+  auto sampledMax = [&](const CompiledBlob& b, const Box3& q) {
+    float m = 0.0f;
+    for (int k = 0; k < 200; ++k) m = std::max(m, glm::length(b.gradient(randomIn(rng, q.lo, q.hi))));
+    return m;
+  };
+  SECTION("a primitive's own slope over the box: sound, and tighter than the global bound off its peak") {
+    for (Kernel kernel : {Kernel::Wyvill, Kernel::SoftObject}) {
+      BlobTree t(kernel);
+      const NodeId prims[] = {t.point(Vec3(0.2f, 0.1f, 0), 0.7f), t.cone(Vec3(0), Vec3(1.5f, 0.5f, 0), 0.6f, 0.2f),
+                              t.segment(Vec3(0, 0, -1), Vec3(0.3f, 0.2f, 1), 0.4f),
+                              t.torus(Vec3(0.1f), glm::normalize(Vec3(1, 2, 0.5f)), 1.0f, 0.3f)};
+      for (NodeId p : prims) {
+        const CompiledBlob b = compile(t, p);
+        const Box3 around = b.bounds().expanded(0.2f);
+        int tighter = 0;
+        for (int i = 0; i < 150; ++i) {
+          const Vec3 c = randomIn(rng, around.lo, around.hi);
+          const Box3 q{c - float(rng.uniform(0.005, 0.4)), c + float(rng.uniform(0.005, 0.4))};
+          const float L = b.lipschitz(q);
+          INFO("box " << q.lo.x << " " << q.lo.y << " " << q.lo.z << " .. " << q.hi.x << " " << q.hi.y << " " << q.hi.z);
+          CHECK(L <= b.lipschitz());
+          CHECK(sampledMax(b, q) <= L * 1.00001f + 1e-6f);
+          tighter += L < 0.5f * b.lipschitz();
+        }
+        CHECK(tighter > 20);
+        // A box past the support's rim: no slope at all.
+        const Box3 far{b.bounds().hi + 0.1f, b.bounds().hi + 0.3f};
+        CHECK(b.lipschitz(far) == 0.0f);
+      }
+    }
+  }
+  SECTION("a Ricci blend's bound is the n-norm of its children's") {
+    // Under n = 400 the blend is nearly the largest child, and so is its slope: the bound of
+    // k children is at most k^(1/400) times the largest child's, not their sum.
+    BlobTree t;
+    std::vector<NodeId> kids;
+    for (int i = 0; i < 6; ++i) kids.push_back(t.point(randomIn(rng, Vec3(-0.4f), Vec3(0.4f)), float(rng.uniform(0.3, 0.6))));
+    const NodeId ricci = t.ricci(kids, 400.0f), sum = t.blend(kids);
+    const CompiledBlob b = compile(t, ricci), s = compile(t, sum);
+    std::vector<CompiledBlob> each;
+    for (NodeId k : kids) each.push_back(compile(t, k));
+    for (int i = 0; i < 100; ++i) {
+      const Vec3 c = randomIn(rng, Vec3(-1.2f), Vec3(1.2f));
+      const Box3 q{c - float(rng.uniform(0.01, 0.3)), c + float(rng.uniform(0.01, 0.3))};
+      float largest = 0.0f;
+      for (const CompiledBlob& e : each) largest = std::max(largest, e.lipschitz(q));
+      const float L = b.lipschitz(q);
+      CHECK(L <= largest * std::pow(6.0f, 1.0f / 400.0f) * 1.0001f);
+      CHECK(L <= s.lipschitz(q));
+      CHECK(sampledMax(b, q) <= L * 1.00001f + 1e-6f);
+      for (int k = 0; k < 40; ++k) {
+        const Vec3 p = randomIn(rng, q.lo, q.hi), r = randomIn(rng, q.lo, q.hi);
+        CHECK(std::abs(b.value(p) - b.value(r)) <= L * glm::length(p - r) * 1.0001f + 2e-6f);
+      }
+    }
+  }
+}

@@ -346,6 +346,12 @@ TEST_CASE("buildShell::pruned tapes of the Murex", "[organisms]") {
     const blobtree::Sample sa = b.sample(pts[0]), sb = t.sample(pts[0]);
     CHECK(sb.value == Approx(sa.value).margin(2e-6));
     CHECK(glm::length(sb.gradient - sa.gradient) <= 1e-4f * std::max(1.0f, glm::length(sa.gradient)));
+    // The cell's Lipschitz bound (from its pruned tape: primitives' own slopes over the box,
+    // the n-norm of the Ricci blend) holds at the sampled points; the tracer's steps rely on it.
+    for (const Vec3& q : pts) {
+      INFO("cell " << ci << " bound " << c.lipschitz);
+      CHECK(glm::length(b.gradient(q)) <= c.lipschitz * 1.00001f + 1e-6f);
+    }
   }
   INFO(b.nodeCount() << " nodes in the tape, " << double(nodes) / double(sampled) << " per cell on average");
   CHECK(double(nodes) / double(sampled) < 0.1 * double(b.nodeCount()));
