@@ -70,6 +70,10 @@ struct ViewFile {
   /// `%` awaiting its cut; by default it interprets (draws, queries) past it
   /// (TurtleSettings::interpretPastCut).
   bool interpretPastCut = true;
+  /// `twist of cylinders: on`: a generalized cylinder's ring at a control point is in the
+  /// turtle's own frame there, twisting smoothly from the previous point's; off (cpfg's
+  /// default) carries the previous ring's frame along without twist (TurtleSettings::gcTwist).
+  bool twistCylinders = false;
   /// The ids of the `tsurface:` lines (cpfg's triangulated surfaces, not read): a `~X` of
   /// one is an error in the grammar (GrammarOverrides::cpfgUndrawnSurfaceIds).
   std::string tsurfaceIds;

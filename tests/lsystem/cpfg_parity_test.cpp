@@ -443,6 +443,29 @@ TEST_CASE("cpfg parity: the turtle interprets past a '%' awaiting its cut", "[ls
   checkParity("query_past_cut");
 }
 
+TEST_CASE("cpfg's '%' with parameters (a cut branch moved for an environmental program) is an error", "[lsystem][cpfg]") {
+  // cpfg's %(n) and %(n, t) (interpret.c, generate.c: cut_substrings) work only with an
+  // environmental program; Sprig names them rather than cut or skip nothing.
+  CHECK_THROWS_WITH(parseGrammar("axiom: A[F%(1)F]F\n", "t.l"),
+                    Catch::Contains("t.l:1:11: error: cpfg's '%(n)' (a cut whose branch cpfg moves to the end of the string"));
+  CHECK_THROWS_WITH(parseGrammar("axiom: A\nA --> [F%(0, 1)F]\n", "t.l"),
+                    Catch::Contains("t.l:2:9: error: cpfg's '%(n, t)' (a moved cut branch, drawn from the turtle saved for it)"));
+  SECTION("a string built without the parser: the turtle refuses it too") {
+    Grammar g = parseGrammar("axiom: F%F\n", "t.l");
+    ModuleString s;
+    const SymbolId f = static_cast<SymbolId>(g.symbols().find("F")), cut = static_cast<SymbolId>(g.symbols().find("%"));
+    const double one[] = {1.0}, two[] = {1.0, 0.0};
+    s.push(f, one);
+    s.push(cut, one);
+    s.push(f, one);
+    Turtle t(g.symbols(), cpfgTurtleSettings(nullptr, {}));
+    CHECK_THROWS_WITH(t.run(s), "sprig: error: cpfg's '%(n)' (a cut whose branch cpfg moves to the end of the string, with the turtle saved for it) is not supported");
+    ModuleString s2;
+    s2.push(cut, two);
+    CHECK_THROWS_WITH(t.run(s2), Catch::Contains("cpfg's '%(n, t)'"));
+  }
+}
+
 TEST_CASE("cpfg parity: an expression statement is evaluated and dropped", "[lsystem][cpfg]") {
   checkParity("expression_statement");
 }
