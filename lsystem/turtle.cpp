@@ -12,6 +12,7 @@
 #include "core/diagnostics.h"
 #include "lsystem/detail/cpfg.h"
 #include "lsystem/detail/huge_pages.h"
+#include "lsystem/detail/program.h"
 
 namespace sprig::lsystem {
 
@@ -344,8 +345,7 @@ class TurtleWalk {
         case Command::GcEnd: gcPoint(i, true); break;
         case Command::Contour: contour(i); break;
         case Command::Texture: texture(i); break;
-        case Command::Label:  // cpfg's @L("format", values) writes text at the turtle
-          throw InputError(SourceLoc{"sprig", 0, 0}, "cpfg's '@L' (label) is not supported: Sprig draws no text");
+        case Command::Label: label(i); break;
         case Command::GcRadiusTangents: gcRadiusTangents(i); break;
         case Command::ContourSides:
           // cpfg's `@!(n)`: points around a contour (at least 3; 8 without a parameter).
@@ -816,6 +816,71 @@ class TurtleWalk {
     for (const CpfgContourEntry& e : *settings_.cpfgContours)
       if (e.id == id) return &e.contour;
     return nullptr;
+  }
+
+  /// cpfg's `@L("format", v1, ...)` (blackbox.c; utility.c, MakeLabel): the grammar's string
+  /// numbered by the first parameter, without its quotes, filled as cpfg's sprintf fills it
+  /// with the values as cpfg's 32-bit floats (more than 9 values: no text, cpfg's "Too many
+  /// parameters in label"), recorded at the turtle's position with its colour index. A
+  /// module not yet born (growth) records nothing. Throws InputError for a first parameter
+  /// naming no string and for a format whose conversions are not numbers or outnumber the
+  /// values (cpfg would print what its stack holds).
+  void label(size_t i) {
+    if (growth(i) <= 0) return;
+    const uint32_t n = paramCount(i);
+    const std::vector<std::string>* formats = settings_.labelFormats.get();
+    const double id = n > 0 ? paramAt(i, 0) : -1.0;
+    if (!formats || !(id >= 0 && id < static_cast<double>(formats->size())))
+      throw InputError(SourceLoc{"sprig", 0, 0}, "cpfg's '@L' names no format: its first parameter must be a \"string\"");
+    const std::string format = labelFormat((*formats)[static_cast<size_t>(id)]);
+    std::vector<double> values;
+    for (uint32_t k = 1; k < n; ++k) values.push_back(static_cast<double>(static_cast<float>(paramAt(i, k))));
+    const int conversions = labelConversions(format);
+    if (conversions < 0 || conversions > static_cast<int>(values.size()))
+      throw InputError(SourceLoc{"sprig", 0, 0},
+                       "cpfg's '@L(\"" + format + "\", ...)' " +
+                           (conversions < 0 ? std::string("has a conversion that is not a number's (%d %i %o %u %x %c %f %e %g %a)")
+                                            : "has " + std::to_string(conversions) + " conversions for " +
+                                                  std::to_string(values.size()) + " values"));
+    Label l;
+    l.position = st_.frame.position;
+    l.text = n > 10 ? std::string() : detail::formatPrintf(format, values.data(), static_cast<int>(values.size()));
+    l.color = st_.color;
+    l.step = stepOf(i);
+    sk_.labels.push_back(std::move(l));
+  }
+
+  /// A label's format as the grammar wrote it ("..." with C escapes) without its quotes.
+  static std::string labelFormat(const std::string& quoted) {
+    std::string out;
+    const size_t b = quoted.size() >= 2 && quoted.front() == '"' ? 1 : 0, e = b && quoted.back() == '"' ? quoted.size() - 1 : quoted.size();
+    for (size_t k = b; k < e; ++k) {
+      if (quoted[k] == '\\' && k + 1 < e) {
+        const char c = quoted[++k];
+        out += c == 'n' ? '\n' : c == 't' ? '\t' : c;
+      } else {
+        out += quoted[k];
+      }
+    }
+    return out;
+  }
+
+  /// Number of conversions of a printf format, or -1 when one is not a number's.
+  static int labelConversions(const std::string& f) {
+    int n = 0;
+    for (size_t k = 0; k < f.size(); ++k) {
+      if (f[k] != '%') continue;
+      if (k + 1 < f.size() && f[k + 1] == '%') {
+        ++k;
+        continue;
+      }
+      size_t g = k + 1;
+      while (g < f.size() && std::string_view("-+ #0123456789.hlL").find(f[g]) != std::string_view::npos) ++g;
+      if (g >= f.size() || std::string_view("diouxXcfFeEgGaA").find(f[g]) == std::string_view::npos) return -1;
+      ++n;
+      k = g;
+    }
+    return n;
   }
 
   /// cpfg's up vector u0 of a frame of heading h0 carried to heading h without twist

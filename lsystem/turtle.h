@@ -87,6 +87,9 @@ struct TurtleSettings {
   /// curve without twist (general.c, adjust_up_and_leftS), so a roll between points
   /// does not turn the cross-section.
   bool gcTwist = false;
+  /// cpfg: the grammar's strings (Grammar::strings), which `@L`'s first parameter numbers;
+  /// null: a label reached is an error.
+  std::shared_ptr<const std::vector<std::string>> labelFormats;
   double widthIncrement = 0.0;    ///< cpfg: `line width increment:` (view file)
   int colorIncrement = 1;         ///< `color increment:` (view file)
   int initialColor = 0;           ///< `initial color:` (view file; cpfg's default is 128)

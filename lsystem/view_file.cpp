@@ -24,7 +24,7 @@ const char* const kViewerKeys[] = {
     "front distance",     "back distance",        "scale factor",   "z buffer",
     "cue range",          "shade mode",           "light direction", "diffuse reflection",
     "surface ambient",    "surface diffuse",      "box",            "background color",
-    "ambient light",      "font",                 "winfont",        "polygonization level",
+    "ambient light",      "winfont",        "polygonization level",
     "light",              "render mode",          "tapered lines",
     "viewing angle",      "interpretation step", "environment display",
     "antialiasing",       "min zoom",             "max zoom",       "generate on view change",
@@ -346,6 +346,11 @@ class ViewParser {
       }
     if (key == "interpretation past %") {  // read: whether the turtle skips a pending cut
       view_.interpretPastCut = trimmed(value).rfind("off", 0) != 0;
+      return;
+    }
+    if (key == "font") {  // read: the labels' font (cpfg's fscanf reads one word)
+      const std::string t = trimmed(value);
+      view_.font = t.substr(0, t.find_first_of(" \t"));
       return;
     }
     if (key == "twist of cylinders") {  // read: whether generalized cylinders follow the turtle's roll

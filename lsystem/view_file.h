@@ -77,6 +77,9 @@ struct ViewFile {
   /// The ids of the `tsurface:` lines (cpfg's triangulated surfaces, not read): a `~X` of
   /// one is an error in the grammar (GrammarOverrides::cpfgUndrawnSurfaceIds).
   std::string tsurfaceIds;
+  /// `font:` (an X11 font name, `-foundry-family-weight-slant-...-size-...`), the font of the
+  /// `@L` labels; empty: cpfg's default, `-*-courier-bold-r-*-*-12-*-*-*-*-*-*-*`.
+  std::string font;
   /// The first command that changes the drawing and that Sprig does not implement (`line:`,
   /// F drawn as a surface; `background scene:`): an error when the plant is drawn, not when
   /// it is only derived (the string does not depend on it, as `cpfg -g` shows).

@@ -59,6 +59,9 @@ struct SkeletonStyle {
   /// A cpfg grammar's view file textures (`texture:` lines), which its textured surfaces
   /// (Organ::texture) wear; null for none.
   std::shared_ptr<const std::vector<lsystem::CpfgTexture>> cpfgTextures;
+  /// A cpfg grammar's view file `font:` (an X11 font name), the font of its `@L` labels;
+  /// empty: cpfg's default (model/cpfg_labels.h).
+  std::string cpfgFont;
 };
 
 /// Solids: `render.wireframe: {color, width}`: the edges of the visible triangles (the
