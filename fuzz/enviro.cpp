@@ -9,8 +9,6 @@
 /// tests/lsystem with real programs.
 #include "fuzz/fuzz.h"
 
-#include <unistd.h>
-
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -21,29 +19,8 @@
 
 namespace {
 
-std::string gSandbox;
-
-void removeSandbox() {
-  std::error_code ec;
-  if (!gSandbox.empty()) std::filesystem::remove_all(gSandbox, ec);
-}
-
-/// The sandbox folder, made on first use (the replay build calls no initializer).
-const std::string& sandbox() {
-  if (gSandbox.empty()) {
-    char name[] = "/tmp/sprig-fuzz-enviro-XXXXXX";
-    if (const char* dir = ::mkdtemp(name)) {
-      gSandbox = dir;
-      std::atexit(removeSandbox);
-    } else {
-      gSandbox = "/tmp";
-    }
-  }
-  return gSandbox;
-}
-
 void fuzzEnvironmentFile(std::string_view body, size_t size) {
-  const std::string path = sandbox() + "/fuzz.e";
+  const std::string path = sprig::fuzz::sandboxFolder("enviro") + "/fuzz.e";
   {
     std::ofstream out(path, std::ios::binary | std::ios::trunc);
     out.write(body.data(), static_cast<std::streamsize>(body.size()));
@@ -53,7 +30,7 @@ void fuzzEnvironmentFile(std::string_view body, size_t size) {
     sprig::lsystem::EnvironmentQuery q;
     q.distance = size;
     q.params.assign(size % 5, 0.5f);
-    q.next = size % 2 ? "F" : "";
+    if (size % 2) q.next = "F";
     q.nextParams.assign(size % 3, 1.25f);
     q.position = {1.0f, -2.0f, 3.5f};
     volatile size_t n = sprig::lsystem::formatEnvironmentQuery(spec, q).size();
