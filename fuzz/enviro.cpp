@@ -30,7 +30,7 @@ void fuzzEnvironmentFile(std::string_view body, size_t size) {
     sprig::lsystem::EnvironmentQuery q;
     q.distance = size;
     q.params.assign(size % 5, 0.5f);
-    if (size % 2) q.next = "F";
+    if (size % 2) q.next.assign(1, 'F');  // (GCC 12 warns, falsely, on assigning a literal here)
     q.nextParams.assign(size % 3, 1.25f);
     q.position = {1.0f, -2.0f, 3.5f};
     volatile size_t n = sprig::lsystem::formatEnvironmentQuery(spec, q).size();
