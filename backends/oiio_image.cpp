@@ -116,6 +116,35 @@ std::unique_ptr<ImageFileReader> open(const std::string& path, std::string& erro
   return std::make_unique<OiioReader>(std::move(in), path);
 }
 
+bool textCoverage(const std::string& text, const std::string& fontFile, int sizePixels, std::vector<float>& coverage, int& width,
+                  int& height, int& originX, int& originY, std::string& error) {
+  const OIIO::ROI box = OIIO::ImageBufAlgo::text_size(text, sizePixels, fontFile);
+  if (!box.defined()) {
+    error = OIIO::geterror();
+    if (error.empty()) error = "the font '" + fontFile + "' cannot be read";
+    return false;
+  }
+  // text_size's box is relative to the baseline's start; a pad keeps antialiased edges.
+  const int pad = 2 + sizePixels / 8;
+  originX = pad - box.xbegin;
+  originY = pad - box.ybegin;
+  width = box.width() + 2 * pad;
+  height = box.height() + 2 * pad;
+  OIIO::ImageBuf buf(OIIO::ImageSpec(width, height, 1, OIIO::TypeDesc::FLOAT));
+  OIIO::ImageBufAlgo::zero(buf);
+  const float white[1] = {1.0f};
+  if (!OIIO::ImageBufAlgo::render_text(buf, originX, originY, text, sizePixels, fontFile, white)) {
+    error = buf.geterror();
+    return false;
+  }
+  coverage.assign(static_cast<size_t>(width) * height, 0.0f);
+  if (!buf.get_pixels(OIIO::ROI(0, width, 0, height, 0, 1, 0, 1), OIIO::TypeDesc::FLOAT, coverage.data())) {
+    error = buf.geterror();
+    return false;
+  }
+  return true;
+}
+
 bool resizeBox(const float* in, int width, int height, float* out, int outWidth, int outHeight, std::string& error) {
   const OIIO::ImageBuf src(OIIO::ImageSpec(width, height, 4, OIIO::TypeDesc::FLOAT), const_cast<float*>(in));
   OIIO::ImageBuf dst(OIIO::ImageSpec(outWidth, outHeight, 4, OIIO::TypeDesc::FLOAT), out);
@@ -128,7 +157,7 @@ bool resizeBox(const float* in, int width, int height, float* out, int outWidth,
 }  // namespace
 
 const detail::ImageBackend& oiioImage() {
-  static const detail::ImageBackend table{&write, &writeGif, &open, &resizeBox};
+  static const detail::ImageBackend table{&write, &writeGif, &open, &resizeBox, &textCoverage};
   return table;
 }
 

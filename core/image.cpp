@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/atomic_file.h"
+#include "core/diagnostics.h"
 #include "core/detail/image_backend.h"
 #include "core/paths.h"
 #include "core/phases.h"
@@ -163,6 +164,33 @@ Image resizeImage(const Image& image, int width, int height) {
   if (!detail::imageBackend().resizeBox(image.pixels.data(), image.width, image.height, out.pixels.data(), width, height, error))
     throw std::runtime_error("cannot resize an image: " + error);
   return out;
+}
+
+void drawText(Image& image, int x, int y, const std::string& text, const Vec3& srgbColor, const std::string& fontFile,
+              int sizePixels) {
+  if (text.empty()) return;
+  std::error_code ec;
+  if (!fs::is_regular_file(fontFile, ec))
+    throw InputError(SourceLoc{"sprig", 0, 0}, "the font file '" + fontFile +
+                                                   "' of the labels is missing (Debian's package fonts-dejavu-core has it; "
+                                                   "scripts/install-deps.sh installs it)");
+  std::vector<float> coverage;
+  int w = 0, h = 0, ox = 0, oy = 0;
+  std::string error;
+  if (!detail::imageBackend().textCoverage(text, fontFile, std::max(1, sizePixels), coverage, w, h, ox, oy, error))
+    throw std::runtime_error("cannot draw the text '" + text.substr(0, 40) + "': " + error);
+  for (int j = 0; j < h; ++j) {
+    const int py = y - oy + j;
+    if (py < 0 || py >= image.height) continue;
+    for (int i = 0; i < w; ++i) {
+      const int px = x - ox + i;
+      const float a = std::clamp(coverage[static_cast<size_t>(j) * w + i], 0.0f, 1.0f);
+      if (px < 0 || px >= image.width || a <= 0.0f) continue;
+      float* p = &image.pixels[(static_cast<size_t>(py) * image.width + px) * 4];
+      for (int c = 0; c < 3; ++c)
+        p[c] = srgbToLinear(linearToSrgb(std::clamp(p[c], 0.0f, 1.0f)) * (1.0f - a) + srgbColor[c] * a);
+    }
+  }
 }
 
 Image readImage(const fs::path& path) {

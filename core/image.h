@@ -110,6 +110,16 @@ inline constexpr uint64_t kMaxImagePixels = uint64_t(1) << 26;
 /// Most channels an image file may hold to be read.
 inline constexpr int kMaxImageChannels = 16;
 
+/// Writes text over image as a window system draws screen text: the glyphs of fontFile (a
+/// TrueType file, rasterized by FreeType through OpenImageIO's ImageBufAlgo::render_text)
+/// at sizePixels (the em), the baseline starting at pixel (x, y) (x right, y down), in
+/// srgbColor (the colour the image file shows), each pixel blended with the glyphs'
+/// coverage in sRGB values; what falls outside the image is clipped. Throws InputError
+/// (`sprig: error: ...`) when fontFile does not exist, std::runtime_error when the text
+/// cannot be rasterized. Cost: the text's box of pixels.
+void drawText(Image& image, int x, int y, const std::string& text, const Vec3& srgbColor, const std::string& fontFile,
+              int sizePixels);
+
 /// image resized to width x height by OpenImageIO's ImageBufAlgo::resize with a box filter
 /// one output pixel wide: each output pixel is the mean of the input pixels whose centres
 /// it covers (halving a dimension averages pairs of pixels exactly), channel by channel,

@@ -13,7 +13,7 @@ BUILD=${1:?usage: fuzz/run.sh BUILD_DIR SECONDS [TARGET...]}
 SECS=${2:?usage: fuzz/run.sh BUILD_DIR SECONDS [TARGET...]}
 shift 2
 TARGETS=("$@")
-[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(grammar view background function expression derive species_tree species_shell species_blob species_organism species_solid polymesh image volume)
+[ ${#TARGETS[@]} -eq 0 ] && TARGETS=(grammar view background function enviro expression derive species_tree species_shell species_blob species_organism species_solid polymesh image volume)
 ROOT=$(pwd)
 # The sanitizer settings of the Makefile, also when this script is run by hand.
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:abort_on_error=1:detect_stack_use_after_return=0}
@@ -50,6 +50,14 @@ seed() {
       for f in tests/assets/cpfg/*/*.mat; do { printf '\x04'; cat "$f"; } >"$dir/$(basename "$(dirname "$f")")-$(basename "$f")"; done
       printf '\x04\x07\x00\x10\x20\x30\x40\x50\x60\x00\x00\x00\xff\xff\xff\x20' >"$dir/one_material.mat"
       printf '\x04\x01\x80\x00\x00\x00\xff\x00\x00\x00\x00\x00\x00\x00\x00\x00\x01\x00\x00\x00\x00\x00\xff\x00\x00\x00\x00\x00\x00\x00\x00' >"$dir/twice.mat" ;;
+    enviro)
+      # The first byte picks the reader (fuzz/enviro.cpp): even, the environment file;
+      # odd, a program's answer lines.
+      for f in tests/assets/cpfg/enviro/*/*.e tests/bad_inputs/inputs/cpfg/enviro/*.e; do
+        { printf '\x00'; cat "$f"; } >"$dir/$(basename "$(dirname "$f")")-$(basename "$f")"
+      done
+      printf '\x0112 E(0.5)\n0 E\n30 E(,1.5,)\n7 E(1e3, -2)\n' >"$dir/answers"
+      printf '\x01 ;:4 E()\n5 xE(1,,)\n' >"$dir/answers_blank" ;;
     expression)
       for e in 't' 'x*0.9' 'sin(t)*x' 'max(0, 1 - t^2)' 'sqrt(x) + pow(t, 2) / 3' 'atan2(x, t) > 45 && t < 1' \
                'floor(x) == ceil(x) || !t' '-(-(-x))' 'min(t, max(x, 1e-3))' 'exp(log(t + 1))'; do
@@ -105,6 +113,7 @@ dict_of() {
     view) echo fuzz/dict/view.dict ;;
     background) echo fuzz/dict/background.dict ;;
     function) echo fuzz/dict/cpfg_files.dict ;;
+    enviro) echo fuzz/dict/enviro.dict ;;
     expression) echo fuzz/dict/expression.dict ;;
     species_*) echo fuzz/dict/yaml.dict ;;
     polymesh) echo fuzz/dict/mesh.dict ;;

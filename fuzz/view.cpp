@@ -18,27 +18,12 @@
 
 namespace {
 
-std::string gSandbox;
-
-void removeSandbox() {
-  std::error_code ec;
-  if (!gSandbox.empty()) std::filesystem::remove_all(gSandbox, ec);
-}
-
-/// The sandbox folder, made on first use (the replay build calls no initializer).
+/// The sandbox folder: a FIFO no one writes to and an empty folder.
 const std::string& sandbox() {
-  if (gSandbox.empty()) {
-    char name[] = "/tmp/sprig-fuzz-view-XXXXXX";
-    if (const char* dir = ::mkdtemp(name)) {
-      gSandbox = dir;
-      ::mkfifo((gSandbox + "/fifo").c_str(), 0600);
-      ::mkdir((gSandbox + "/folder").c_str(), 0700);
-      std::atexit(removeSandbox);
-    } else {
-      gSandbox = "/sprig-fuzz-sandbox";  // a folder that does not exist: every name is missing
-    }
-  }
-  return gSandbox;
+  return sprig::fuzz::sandboxFolder("view", [](const std::string& dir) {
+    ::mkfifo((dir + "/fifo").c_str(), 0600);
+    ::mkdir((dir + "/folder").c_str(), 0700);
+  });
 }
 
 }  // namespace

@@ -37,8 +37,10 @@ constexpr Directive kDirectives[] = {
 };
 
 /// Number of floating conversions of a printf format, or -1 when it holds any other
-/// conversion (only `%[flags][width][.precision](f|F|e|E|g|G|a|A)` and `%%` are allowed).
+/// conversion (only `%[flags][width][.precision](f|F|e|E|g|G|a|A)` and `%%` are allowed)
+/// or a NUL byte (printf would stop there, maybe inside a conversion: found by fuzzing).
 int floatConversions(const std::string& f) {
+  if (f.find('\0') != std::string::npos) return -1;
   int n = 0;
   for (size_t i = 0; i < f.size(); ++i) {
     if (f[i] != '%') continue;

@@ -17,6 +17,9 @@ std::optional<double> Grammar::angleDeg() const {
 }
 const SymbolTable& Grammar::symbols() const { return program_->symbols; }
 const ModuleString& Grammar::axiom() const { return program_->axiom; }
+std::shared_ptr<const std::vector<std::string>> Grammar::strings() const {
+  return std::shared_ptr<const std::vector<std::string>>(program_, &program_->strings);
+}
 std::optional<double> Grammar::define(std::string_view name) const {
   for (auto& [n, v] : program_->defines)
     if (n == name) return v;

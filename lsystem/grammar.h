@@ -116,6 +116,10 @@ class Grammar {
   /// its `module` declaration, an overridden `derivation length:`).
   const std::vector<Diagnostic>& warnings() const;
 
+  /// The format strings of cpfg's `@L("format", ...)` (and printf), numbered by `@L`'s first
+  /// parameter: for TurtleSettings::labelFormats.
+  std::shared_ptr<const std::vector<std::string>> strings() const;
+
   /// The compiled program (internal; used by Deriver).
   const detail::Program& program() const { return *program_; }
 

@@ -52,10 +52,20 @@ struct Organ {
   std::vector<Vec2> uvs;
 };
 
+/// cpfg's `@L("format", values)`: text the renderer writes over the picture, screen-aligned,
+/// its baseline starting at the projected position (docs/GRAMMAR.md, "Labels").
+struct Label {
+  DVec3 position{0};  ///< the turtle's position, world units
+  std::string text;   ///< the format filled with the values, as cpfg's sprintf fills it
+  int color = 0;      ///< the turtle's colour index (cpfg colours the text by its colour map)
+  int step = 0;       ///< derivation step that created the module
+};
+
 /// A whole plant skeleton.
 struct Skeleton {
   std::vector<Internode> internodes;
   std::vector<Organ> organs;
+  std::vector<Label> labels;  ///< cpfg's `@L` texts; they add nothing to bounds()
 
   /// Bounds of internodes (including radii) and organs.
   DBox3 bounds() const;

@@ -10,7 +10,9 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "core/diagnostics.h"
+#include "lsystem/detail/cpfg.h"
 #include "lsystem/detail/huge_pages.h"
+#include "lsystem/detail/program.h"
 
 namespace sprig::lsystem {
 
@@ -304,6 +306,10 @@ class TurtleWalk {
         case Command::Sphere: sphere(i); break;
         case Command::Tropism: tropismChange(i); break;
         case Command::Cut:
+          // The parsers refuse cpfg's `%(n)` and `%(n, t)`; a string built otherwise too.
+          if (hasParam(i))
+            throw InputError(SourceLoc{"sprig", 0, 0},
+                             *detail::cpfgUnsupported("%", paramCount(i), true, '\0', detail::Dialect::Cpfg));
           if (!settings_.interpretPastCut) i = cut(i);
           break;
         case Command::WidthUp: widthUp(i); break;
@@ -339,8 +345,7 @@ class TurtleWalk {
         case Command::GcEnd: gcPoint(i, true); break;
         case Command::Contour: contour(i); break;
         case Command::Texture: texture(i); break;
-        case Command::Label:  // cpfg's @L("format", values) writes text at the turtle
-          throw InputError(SourceLoc{"sprig", 0, 0}, "cpfg's '@L' (label) is not supported: Sprig draws no text");
+        case Command::Label: label(i); break;
         case Command::GcRadiusTangents: gcRadiusTangents(i); break;
         case Command::ContourSides:
           // cpfg's `@!(n)`: points around a contour (at least 3; 8 without a parameter).
@@ -489,10 +494,8 @@ class TurtleWalk {
     }
     const double g = growth(i);
     if (g <= 0) return;  // not grown yet: nothing drawn, no bend; the axis carries on from its parent
-    if (st_.contour != 0)
-      throw InputError(SourceLoc{"sprig", 0, 0}, "cpfg's contour '@#(" + std::to_string(st_.contour) +
-                                        ")' on an 'F' segment (a cylinder outside a generalized cylinder) is not supported: "
-                                        "select it for '@Gs ... @Gc' cylinders drawn with 'f'");
+    // A contour (`@#(id)`) does not shape an `F`: cpfg draws its cylinder round, with
+    // `@!(n)` sides (irisGL.c, iGlEndCylNode); only generalized cylinders take contours.
     if (st_.texture >= 0) {
       double radius = st_.width * radiusScale_ * g;
       if (maxRadiusPerLength_ > 0) radius = std::min(radius, maxRadiusPerLength_ * length(i));
@@ -652,6 +655,8 @@ class TurtleWalk {
     const DVec3 p2 = st_.frame.position, h2 = st_.frame.heading;
     const double w2 = st_.width;
     if (!gc_.active) gcRestart();
+    DVec3 upEnd = st_.frame.up;  // the frame of this control point's ring (Sprig's U)
+    if (gc_.hasPoint && !settings_.gcTwist) upEnd = -transportedUp(gc_.heading, -gc_.up, h2);
     if (gc_.hasPoint) {
       const DVec3 p1 = gc_.position;
       const double len = glm::length(p2 - p1);
@@ -698,7 +703,7 @@ class TurtleWalk {
         st_.texT = ringT.back();
         const int texture = gc_.texture >= 0 && st_.texture >= 0 ? gc_.texture : -1;
         if (gc_.contour != 0 || st_.contour != 0 || texture >= 0) {
-          gcContourMesh(i, p1, t1, a2, a3, len, ring, texture, ringT);
+          gcContourMesh(i, p1, t1, a2, a3, len, ring, texture, ringT, -upEnd);
           rings = 0;  // drawn as a mesh
         }
         DVec3 from = p1;
@@ -740,7 +745,7 @@ class TurtleWalk {
     gc_.hasPoint = true;
     gc_.position = p2;
     gc_.heading = h2;
-    gc_.up = st_.frame.up;
+    gc_.up = upEnd;
     gc_.width = w2;
     gc_.contour = st_.contour;
     gc_.sides = st_.contourSides > 0 ? st_.contourSides : settings_.contourSides;
@@ -813,6 +818,82 @@ class TurtleWalk {
     return nullptr;
   }
 
+  /// cpfg's `@L("format", v1, ...)` (blackbox.c; utility.c, MakeLabel): the grammar's string
+  /// numbered by the first parameter, without its quotes, filled as cpfg's sprintf fills it
+  /// with the values as cpfg's 32-bit floats (more than 9 values: no text, cpfg's "Too many
+  /// parameters in label"), recorded at the turtle's position with its colour index. A
+  /// module not yet born (growth) records nothing. Throws InputError for a first parameter
+  /// naming no string and for a format whose conversions are not numbers or outnumber the
+  /// values (cpfg would print what its stack holds).
+  void label(size_t i) {
+    if (growth(i) <= 0) return;
+    const uint32_t n = paramCount(i);
+    const std::vector<std::string>* formats = settings_.labelFormats.get();
+    const double id = n > 0 ? paramAt(i, 0) : -1.0;
+    if (!formats || !(id >= 0 && id < static_cast<double>(formats->size())))
+      throw InputError(SourceLoc{"sprig", 0, 0}, "cpfg's '@L' names no format: its first parameter must be a \"string\"");
+    const std::string format = labelFormat((*formats)[static_cast<size_t>(id)]);
+    std::vector<double> values;
+    for (uint32_t k = 1; k < n; ++k) values.push_back(static_cast<double>(static_cast<float>(paramAt(i, k))));
+    const int conversions = labelConversions(format);
+    if (conversions < 0 || conversions > static_cast<int>(values.size()))
+      throw InputError(SourceLoc{"sprig", 0, 0},
+                       "cpfg's '@L(\"" + format + "\", ...)' " +
+                           (conversions < 0 ? std::string("has a conversion that is not a number's (%d %i %o %u %x %c %f %e %g %a)")
+                                            : "has " + std::to_string(conversions) + " conversions for " +
+                                                  std::to_string(values.size()) + " values"));
+    Label l;
+    l.position = st_.frame.position;
+    l.text = n > 10 ? std::string() : detail::formatPrintf(format, values.data(), static_cast<int>(values.size()));
+    l.color = st_.color;
+    l.step = stepOf(i);
+    sk_.labels.push_back(std::move(l));
+  }
+
+  /// A label's format as the grammar wrote it ("..." with C escapes) without its quotes.
+  static std::string labelFormat(const std::string& quoted) {
+    std::string out;
+    const size_t b = quoted.size() >= 2 && quoted.front() == '"' ? 1 : 0, e = b && quoted.back() == '"' ? quoted.size() - 1 : quoted.size();
+    for (size_t k = b; k < e; ++k) {
+      if (quoted[k] == '\\' && k + 1 < e) {
+        const char c = quoted[++k];
+        out += c == 'n' ? '\n' : c == 't' ? '\t' : c;
+      } else {
+        out += quoted[k];
+      }
+    }
+    return out;
+  }
+
+  /// Number of conversions of a printf format, or -1 when one is not a number's.
+  static int labelConversions(const std::string& f) {
+    int n = 0;
+    for (size_t k = 0; k < f.size(); ++k) {
+      if (f[k] != '%') continue;
+      if (k + 1 < f.size() && f[k + 1] == '%') {
+        ++k;
+        continue;
+      }
+      size_t g = k + 1;
+      while (g < f.size() && std::string_view("-+ #0123456789.hlL").find(f[g]) != std::string_view::npos) ++g;
+      if (g >= f.size() || std::string_view("diouxXcfFeEgGaA").find(f[g]) == std::string_view::npos) return -1;
+      ++n;
+      k = g;
+    }
+    return n;
+  }
+
+  /// cpfg's up vector u0 of a frame of heading h0 carried to heading h without twist
+  /// (general.c, adjust_up_and_leftS with no angle): turned by the least rotation taking
+  /// h0 to h (Rodrigues); u0 itself when h is h0 or its opposite.
+  static DVec3 transportedUp(const DVec3& h0, const DVec3& u0, const DVec3& h) {
+    const DVec3 axis = glm::cross(h0, h);
+    const double sn = glm::length(axis), cs = glm::dot(h0, h);
+    if (sn <= 1e-12) return u0;
+    const DVec3 a = axis / sn;
+    return u0 * cs + glm::cross(a, u0) * sn + a * glm::dot(a, u0) * (1 - cs);
+  }
+
   /// A generalized-cylinder segment with a contour (general.c, interpolate_connection and
   /// make_contour): rings at the (t, width) pairs of ring along the Hermite curve
   /// p1 + t t1 + t^2 a2 + t^3 a3, each the contours of the two control points blended by t,
@@ -828,7 +909,8 @@ class TurtleWalk {
   /// the circle), ring k has t = ringT[k]; the organ is named kTexturedGcName and a circle gets
   /// texturedSides points so that it stays round.
   void gcContourMesh(size_t i, const DVec3& p1, const DVec3& t1, const DVec3& a2, const DVec3& a3, double len,
-                     const std::vector<glm::dvec2>& ring, int texture, const std::vector<double>& ringT) {
+                     const std::vector<glm::dvec2>& ring, int texture, const std::vector<double>& ringT,
+                     const DVec3& uEnd) {
     const int rings = static_cast<int>(ring.size()) - 1;
     const CpfgContour circle = CpfgContour::circle();
     const CpfgContour* c1 = gc_.contour ? findContour(gc_.contour) : &circle;
@@ -843,22 +925,15 @@ class TurtleWalk {
     o.texture = texture;
     o.position = p1;
     const DVec3 h0 = gc_.heading, u0 = -gc_.up;  // cpfg's up vector at the first point
-    // The minimal rotation taking h0 to h, applied to u0 (Rodrigues).
-    auto transported = [&](const DVec3& h) {
-      const DVec3 axis = glm::cross(h0, h);
-      const double sn = glm::length(axis), cs = glm::dot(h0, h);
-      if (sn <= 1e-12) return u0;
-      const DVec3 a = axis / sn;
-      return u0 * cs + glm::cross(a, u0) * sn + a * glm::dot(a, u0) * (1 - cs);
-    };
+    auto transported = [&](const DVec3& h) { return transportedUp(h0, u0, h); };
     auto turned = [](const DVec3& v, const DVec3& axis, double angle) {
       return v * std::cos(angle) + glm::cross(axis, v) * std::sin(angle) + axis * glm::dot(axis, v) * (1 - std::cos(angle));
     };
     // cpfg's twist angle (get_twist_angle): from the transported up vector to the second
-    // point's own, about its heading; ring t turns by t times it, the last ring is the
-    // second point's frame.
+    // point's (uEnd: its own with `twist of cylinders: on`, else the transported one, so
+    // 0), about its heading; ring t turns by t times it, the last ring is uEnd's frame.
     const TurtleFrame& fe = st_.frame;
-    const DVec3 uEnd = -fe.up, u1 = transported(fe.heading);
+    const DVec3 u1 = transported(fe.heading);
     const double twist = std::atan2(glm::dot(glm::cross(u1, uEnd), fe.heading), glm::dot(u1, uEnd));
     const uint32_t per = static_cast<uint32_t>(sides) + 1;
     for (int k = 0; k <= rings; ++k) {

@@ -81,6 +81,15 @@ struct TurtleSettings {
   /// branch (the cut is made at the next step); false (`.lsys`, or cpfg's view file
   /// `interpretation past %: off`): the turtle skips the rest of the branch.
   bool interpretPastCut = false;
+  /// cpfg: `twist of cylinders: on` (view file): a generalized cylinder's ring at each control
+  /// point is in the turtle's frame there, the rings between turning smoothly to it; false
+  /// (cpfg's default): each point's ring is the previous one's frame carried along the
+  /// curve without twist (general.c, adjust_up_and_leftS), so a roll between points
+  /// does not turn the cross-section.
+  bool gcTwist = false;
+  /// cpfg: the grammar's strings (Grammar::strings), which `@L`'s first parameter numbers;
+  /// null: a label reached is an error.
+  std::shared_ptr<const std::vector<std::string>> labelFormats;
   double widthIncrement = 0.0;    ///< cpfg: `line width increment:` (view file)
   int colorIncrement = 1;         ///< `color increment:` (view file)
   int initialColor = 0;           ///< `initial color:` (view file; cpfg's default is 128)

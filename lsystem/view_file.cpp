@@ -24,9 +24,9 @@ const char* const kViewerKeys[] = {
     "front distance",     "back distance",        "scale factor",   "z buffer",
     "cue range",          "shade mode",           "light direction", "diffuse reflection",
     "surface ambient",    "surface diffuse",      "box",            "background color",
-    "ambient light",      "font",                 "winfont",        "polygonization level",
+    "ambient light",      "winfont",        "polygonization level",
     "light",              "render mode",          "tapered lines",
-    "viewing angle",      "twist of cylinders",   "interpretation step", "environment display",
+    "viewing angle",      "interpretation step", "environment display",
     "antialiasing",       "min zoom",             "max zoom",       "generate on view change",
     "concave polygons",   "shadow map",           "PS linecap",     "rayshade objects",
     "rayshade scale",
@@ -327,6 +327,15 @@ class ViewParser {
       }
     if (key == "interpretation past %") {  // read: whether the turtle skips a pending cut
       view_.interpretPastCut = trimmed(value).rfind("off", 0) != 0;
+      return;
+    }
+    if (key == "font") {  // read: the labels' font (cpfg's fscanf reads one word)
+      const std::string t = trimmed(value);
+      view_.font = t.substr(0, t.find_first_of(" \t"));
+      return;
+    }
+    if (key == "twist of cylinders") {  // read: whether generalized cylinders follow the turtle's roll
+      view_.twistCylinders = trimmed(value).rfind("on", 0) == 0;
       return;
     }
     if (key == "environment display") {  // read: it says when ?E modules go to the environmental program
@@ -947,6 +956,7 @@ TurtleSettings cpfgTurtleSettings(const ViewFile* view, TurtleSettings t) {
   const ViewFile& v = view ? *view : none;
   t.cpfg = true;
   t.interpretPastCut = v.interpretPastCut;
+  t.gcTwist = v.twistCylinders;
   t.angleDeg = v.angleDeg.value_or(kCpfgDefaultAngleDeg);
   t.initialWidth = v.lineWidth.value_or(kCpfgDefaultLineWidth);
   t.widthIncrement = v.widthIncrement.value_or(0.0);

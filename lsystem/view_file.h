@@ -71,9 +71,16 @@ struct ViewFile {
   /// `%` awaiting its cut; by default it interprets (draws, queries) past it
   /// (TurtleSettings::interpretPastCut).
   bool interpretPastCut = true;
+  /// `twist of cylinders: on`: a generalized cylinder's ring at a control point is in the
+  /// turtle's own frame there, twisting smoothly from the previous point's; off (cpfg's
+  /// default) carries the previous ring's frame along without twist (TurtleSettings::gcTwist).
+  bool twistCylinders = false;
   /// The ids of the `tsurface:` lines (cpfg's triangulated surfaces, not read): a `~X` of
   /// one is an error in the grammar (GrammarOverrides::cpfgUndrawnSurfaceIds).
   std::string tsurfaceIds;
+  /// `font:` (an X11 font name, `-foundry-family-weight-slant-...-size-...`), the font of the
+  /// `@L` labels; empty: cpfg's default, `-*-courier-bold-r-*-*-12-*-*-*-*-*-*-*`.
+  std::string font;
   /// `background scene: FILE[, FILE...]`: the scene read from its files (lsystem/cpfg_background.h),
   /// drawn with the plant when the object has a colour map or materials file (cpfg draws
   /// none without one).

@@ -62,6 +62,9 @@ struct SkeletonStyle {
   /// A cpfg view file's background scene (`background scene:`), already in the plant's
   /// coordinates, each triangle in its material's diffuse colour; null for none.
   std::shared_ptr<const render::MeshPart> cpfgBackground;
+  /// A cpfg grammar's view file `font:` (an X11 font name), the font of its `@L` labels;
+  /// empty: cpfg's default (model/cpfg_labels.h).
+  std::string cpfgFont;
 };
 
 /// Solids: `render.wireframe: {color, width}`: the edges of the visible triangles (the

@@ -13,6 +13,7 @@
 #include "core/progress.h"
 #include "lsystem/cpfg_materials.h"
 #include "lsystem/turtle.h"
+#include "model/cpfg_labels.h"
 #include "model/bark_keys.h"
 #include "model/growth.h"
 #include "model/mesh_parts.h"
@@ -259,6 +260,7 @@ render::Geometry skeletonPreview(const lsystem::Skeleton& skeleton, const Skelet
     out.parts.push_back(render::MeshPart{std::move(g.leaves), style.leaf, std::move(g.leafColors), {}});
   if (!g.fruit.empty()) out.parts.push_back(render::SpheresPart{std::move(g.fruit), style.fruit});
   addTexturedSurfaces(out, skeleton, style, TexturedKinds{style.organs, true});  // tubes are wood
+  out.labels = cpfgLabels(skeleton, style);
   return out;
 }
 
@@ -433,6 +435,7 @@ class TreeModel final : public KindModel {
     // Textured tubes are wood, drawn always; their triangles are not among tree.leaves.
     fig.triangles += addTexturedSurfaces(out.geometry, skeleton, look.style, TexturedKinds{tree.options.leaves.enabled, true});
     addBackground(out, look.style);
+    out.geometry.labels = cpfgLabels(skeleton, look.style);
     return out;
   }
 
@@ -734,6 +737,7 @@ Species grammarSpecies(const fs::path& path, const fs::path& viewFile, const fs:
   // A materials file (`-M NAME.mat`) colours them by their materials' diffuse colours.
   if (!materials.empty()) s.render.style.palette = readCpfgMaterials(materials, s.notes);
   if (spec->view && spec->view->background) addCpfgBackground(*spec->view, !colormap.empty() || !materials.empty(), s);
+  if (spec->view) s.render.style.cpfgFont = spec->view->font;
   if (spec->view && !spec->view->textures.empty())
     s.render.style.cpfgTextures = std::make_shared<const std::vector<lsystem::CpfgTexture>>(spec->view->textures);
   s.spec = spec;
@@ -950,6 +954,7 @@ lsystem::TurtleSettings speciesTurtle(const Species& species, const lsystem::Gra
   lsystem::TurtleSettings t = tree.turtle;
   if (grammar.cpfgNotation()) {
     t = lsystem::cpfgTurtleSettings(tree.view ? &*tree.view : nullptr, t);
+    t.labelFormats = grammar.strings();
     if (tree.angleSet) t.angleDeg = tree.turtle.angleDeg;
     else if (grammar.angleDeg()) t.angleDeg = *grammar.angleDeg();
     return t;

@@ -105,7 +105,8 @@ organisms::TreeOptions readTreeOptions(const YNode& section, DiagnosticList& dia
 organisms::TreeOptions parseTreeOptions(std::string text, const std::string& displayPath);
 
 /// A skeleton drawn directly (organisms/skeleton_geometry.h) with the species' preview
-/// style: internodes as tapered curves, organs as flat leaves and spheres.
+/// style: internodes as tapered curves, organs as flat leaves and spheres, cpfg's `@L` labels
+/// as text (model/cpfg_labels.h).
 render::Geometry skeletonPreview(const lsystem::Skeleton& skeleton, const SkeletonStyle& style);
 
 /// A tree's BlobTree surface for one skeleton: the tree, its compiled form and its leaves.

@@ -10,6 +10,7 @@
 
 #include <functional>
 #include <memory>
+#include <string>
 #include <variant>
 #include <vector>
 
@@ -162,9 +163,21 @@ struct PolygonizedPart {
 /// One part of a Geometry.
 using GeometryPart = std::variant<CurvesPart, SpheresPart, MeshPart, ImplicitPart, PolygonizedPart>;
 
-/// What a model builds for one stage: its parts, added to a scene in order.
+/// Text written over the picture after it is rendered (cpfg's `@L` labels): screen-aligned,
+/// unshaded and never hidden by the model (cpfg draws labels with its depth test off), its
+/// baseline starting at the pixel where position projects (render/labels.h).
+struct TextLabel {
+  Vec3 position{0};      ///< world units
+  std::string text;
+  Vec3 color{0.0f};      ///< the colour the image file shows (sRGB values in [0, 1])
+  std::string fontFile;  ///< a TrueType font file
+  int sizePixels = 16;   ///< the font's size (its em), pixels
+};
+
+/// What a model builds for one stage: its parts, added to a scene in order, and its labels.
 struct Geometry {
   std::vector<GeometryPart> parts;
+  std::vector<TextLabel> labels;
 };
 
 }  // namespace sprig::render

@@ -11,6 +11,7 @@
 #include "core/parallel.h"
 #include "core/progress.h"
 #include "core/rng.h"
+#include "render/labels.h"
 #include "render/sampler.h"
 #include "render/sky_filter.h"
 
@@ -555,6 +556,7 @@ Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings
   });
   if (progress) progress->finish();
   if (layers) filterSkyTerm(image, *layers);
+  drawLabels(image, scene.labels(), camera);
 
   if (stats) {
     stats->cameraRays = cameraRays;

@@ -346,6 +346,7 @@ void Scene::setPrunedTapesDefault(bool on) { gPrunedTapesDefault.store(on); }
 bool Scene::prunedTapesDefault() { return gPrunedTapesDefault.load(); }
 
 std::vector<uint32_t> Scene::add(const Geometry& geometry) {
+  impl_->labels.insert(impl_->labels.end(), geometry.labels.begin(), geometry.labels.end());
   std::vector<uint32_t> ids;
   for (const GeometryPart& part : geometry.parts) {
     if (const auto* c = std::get_if<CurvesPart>(&part)) {
@@ -480,6 +481,8 @@ void Scene::commit() {
 }
 
 Box3 Scene::bounds() const { return impl_->bounds; }
+
+const std::vector<TextLabel>& Scene::labels() const { return impl_->labels; }
 
 SceneStats Scene::stats() const { return impl_->stats; }
 

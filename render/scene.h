@@ -177,6 +177,10 @@ class Scene {
   /// Builds the acceleration structure. Throws std::runtime_error on an Embree error.
   void commit();
 
+  /// The labels of every geometry added (Geometry::labels), in order; renderImage writes
+  /// them over the picture.
+  const std::vector<TextLabel>& labels() const;
+
   /// Bounds of everything added (implicit models: their surface cells, shrunk by interval
   /// bounds to nearly the surface).
   Box3 bounds() const;

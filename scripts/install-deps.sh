@@ -10,6 +10,7 @@ packages=(
   libbenchmark-dev parallel
   libmeshoptimizer-dev libcgal-demo
   libeigen3-dev
+  fonts-dejavu-core fonts-dejavu-extra  # the fonts of cpfg's @L labels (docs/GRAMMAR.md, "Labels")
   nodejs curl ca-certificates
   python3-yaml  # tests: scripts/gltf-parts.py reads species files on its own
   gmsh

@@ -73,6 +73,12 @@ struct ImageBackend {
   /// output pixel the mean of the input pixels whose centres it covers). False with the
   /// library's message in error when it fails.
   bool (*resizeBox)(const float* in, int width, int height, float* out, int outWidth, int outHeight, std::string& error);
+  /// Rasterizes text in the TrueType font fontFile at sizePixels (FreeType, through the
+  /// library's text rendering): coverage receives width x height values in [0, 1], row-major,
+  /// top row first, of a box holding every glyph, whose pixel (originX, originY) is where
+  /// the text's baseline starts. False with the library's message (possibly empty) in error.
+  bool (*textCoverage)(const std::string& text, const std::string& fontFile, int sizePixels, std::vector<float>& coverage,
+                       int& width, int& height, int& originX, int& originY, std::string& error);
 };
 
 /// The image file operations of this program (see the file comment). Throws

@@ -70,7 +70,13 @@ std::optional<std::string> cpfgUnsupported(std::string_view name, size_t args, b
   }
   if ((name == "{" || name == "}" || name == ".") && hasParens && args > 0)
     return notSupported(std::string(name) + "(type)", "generalized cylinder");
-  if (name == "%" && hasParens && args > 0) return notSupported("%(n)", "substring move");
+  // cpfg's cut with parameters (interpret.c and generate.c): during an environmental
+  // program's pass `%(n)` saves the turtle, the next step moves the cut branch to the end
+  // of the string behind a `%(n, t)`, whose turtle restores the saved one. Not implemented.
+  if (name == "%" && hasParens && args == 1)
+    return notSupported("%(n)", "a cut whose branch cpfg moves to the end of the string, with the turtle saved for it");
+  if (name == "%" && hasParens && args > 1)
+    return notSupported("%(n, t)", "a moved cut branch, drawn from the turtle saved for it");
   return std::nullopt;
 }
 

@@ -102,6 +102,7 @@ struct Scene::Impl {
   std::vector<ColorTexture> textures;
   std::vector<detail::GeometryRecord> records;
   Box3 bounds;
+  std::vector<TextLabel> labels;  ///< Scene::labels
   SceneStats stats;
   bool committed = false;
   bool prunedTapes = Scene::prunedTapesDefault();  ///< setPrunedTapes

@@ -105,6 +105,9 @@ TEST_CASE("readEnvironmentFile", "[lsystem][cpfg][enviro]") {
     CHECK_THAT(errorOf([] { specOf("executable: x\nturtle position: %s\n"); }),
                Catch::Contains("x.e:2:1: error: 'turtle position:' must be a printf format with 1 to 3 floating "
                                "conversions (%f, %g, %e), got ' %s'"));
+    // A NUL byte would end printf's format inside '%.3' (fuzz/regressions/enviro/nul_in_format.e).
+    CHECK_THAT(errorOf([] { specOf(std::string("executable: x\nturtle heading: %.3\0%f %f\n", 40)); }),
+               Catch::Contains("x.e:2:1: error: 'turtle heading:' must be a printf format with 1 to 3 floating"));
     CHECK_THAT(errorOf([] { specOf("turtle position: %g\n"); }),
                Catch::Contains("x.e: error: the environment file names no program ('executable:')"));
     CHECK_THAT(errorOf([] { specOf("executable: x\ncommunication type: sockets\n"); }),

@@ -443,6 +443,29 @@ TEST_CASE("cpfg parity: the turtle interprets past a '%' awaiting its cut", "[ls
   checkParity("query_past_cut");
 }
 
+TEST_CASE("cpfg's '%' with parameters (a cut branch moved for an environmental program) is an error", "[lsystem][cpfg]") {
+  // cpfg's %(n) and %(n, t) (interpret.c, generate.c: cut_substrings) work only with an
+  // environmental program; Sprig names them rather than cut or skip nothing.
+  CHECK_THROWS_WITH(parseGrammar("axiom: A[F%(1)F]F\n", "t.l"),
+                    Catch::Contains("t.l:1:11: error: cpfg's '%(n)' (a cut whose branch cpfg moves to the end of the string"));
+  CHECK_THROWS_WITH(parseGrammar("axiom: A\nA --> [F%(0, 1)F]\n", "t.l"),
+                    Catch::Contains("t.l:2:9: error: cpfg's '%(n, t)' (a moved cut branch, drawn from the turtle saved for it)"));
+  SECTION("a string built without the parser: the turtle refuses it too") {
+    Grammar g = parseGrammar("axiom: F%F\n", "t.l");
+    ModuleString s;
+    const SymbolId f = static_cast<SymbolId>(g.symbols().find("F")), cut = static_cast<SymbolId>(g.symbols().find("%"));
+    const double one[] = {1.0}, two[] = {1.0, 0.0};
+    s.push(f, one);
+    s.push(cut, one);
+    s.push(f, one);
+    Turtle t(g.symbols(), cpfgTurtleSettings(nullptr, {}));
+    CHECK_THROWS_WITH(t.run(s), "sprig: error: cpfg's '%(n)' (a cut whose branch cpfg moves to the end of the string, with the turtle saved for it) is not supported");
+    ModuleString s2;
+    s2.push(cut, two);
+    CHECK_THROWS_WITH(t.run(s2), Catch::Contains("cpfg's '%(n, t)'"));
+  }
+}
+
 TEST_CASE("cpfg parity: an expression statement is evaluated and dropped", "[lsystem][cpfg]") {
   checkParity("expression_statement");
 }
@@ -473,7 +496,7 @@ TEST_CASE("cpfg parity: a ring L-system joins the ends of the string", "[lsystem
   }
 }
 
-TEST_CASE("cpfg parity: @L labels in interpretation rules are read; drawing one is an error", "[lsystem][cpfg]") {
+TEST_CASE("cpfg parity: @L labels in interpretation rules are read and drawn as text at the turtle", "[lsystem][cpfg]") {
   Parity p = loadParity("label");
   const ModuleString s = deriveParity(p);
   checkSame(s, p.grammar.symbols(), cpfgString("label"));
@@ -481,14 +504,42 @@ TEST_CASE("cpfg parity: @L labels in interpretation rules are read; drawing one 
   d.derive();
   Turtle t(p.grammar.symbols(), *p.turtle);
   CHECK(t.run(d.interpret(d.current())).internodes.size() == 3);  // SHOW is 0: no label reached
-  SECTION("a label drawn is an error, not a drawing without its text") {
+  SECTION("a label: the format filled as cpfg's sprintf fills it, at the turtle, in its colour") {
     std::string text = readFile(parityAsset("label/plant.l"));
     text.replace(text.find("#define SHOW 0"), 14, "#define SHOW 1");
     Grammar g = parseGrammar(text, "plant.l");
     Deriver dl(g);
     dl.derive();
-    Turtle tl(g.symbols(), *p.turtle);
-    CHECK_THROWS_WITH(tl.run(dl.interpret(dl.current())), Catch::Contains("cpfg's '@L' (label) is not supported: Sprig draws no text"));
+    TurtleSettings ts = *p.turtle;
+    ts.labelFormats = g.strings();
+    const Skeleton sk = Turtle(g.symbols(), ts).run(dl.interpret(dl.current()));
+    // I(1) I(2) I(3): F(x) then [;(5)@L(" %.f, (%g)", x, x / 2)] at the F's end, y = 1, 3, 6.
+    REQUIRE(sk.internodes.size() == 3);
+    REQUIRE(sk.labels.size() == 3);
+    const char* want[] = {" 1, (0.5)", " 2, (1)", " 3, (1.5)"};
+    const double y[] = {1, 3, 6};
+    for (size_t k = 0; k < 3; ++k) {
+      CHECK(sk.labels[k].text == want[k]);
+      CHECK(sk.labels[k].position.x == Approx(0).margin(1e-12));
+      CHECK(sk.labels[k].position.y == Approx(y[k]));
+      CHECK(sk.labels[k].position.z == Approx(0).margin(1e-12));
+      CHECK(sk.labels[k].color == 5);
+      CHECK(glm::length(sk.labels[k].position - sk.internodes[k].end) < 1e-9);
+    }
+    ts.labelFormats = nullptr;
+    CHECK_THROWS_WITH(Turtle(g.symbols(), ts).run(dl.interpret(dl.current())), Catch::Contains("cpfg's '@L' names no format"));
+  }
+  SECTION("a format whose conversions outnumber the values, or are not numbers, is an error") {
+    Grammar g = parseGrammar("axiom: A\nhomomorphism\nA --> F@L(\"%g and %g\", 1)\nendlsystem\n", "t.l");
+    Deriver d(g);
+    TurtleSettings ts = *p.turtle;
+    ts.labelFormats = g.strings();
+    CHECK_THROWS_WITH(Turtle(g.symbols(), ts).run(d.interpret(d.current())),
+                      Catch::Contains("cpfg's '@L(\"%g and %g\", ...)' has 2 conversions for 1 values"));
+    Grammar h = parseGrammar("axiom: A\nhomomorphism\nA --> F@L(\"%s\", 1)\nendlsystem\n", "t.l");
+    Deriver dh(h);
+    ts.labelFormats = h.strings();
+    CHECK_THROWS_WITH(Turtle(h.symbols(), ts).run(dh.interpret(dh.current())), Catch::Contains("is not a number's"));
   }
   SECTION("elsewhere @L is an error") {
     CHECK_THROWS_WITH(parseGrammar("axiom: A\nA --> F@L(\"x\")\n", "t.l"),

@@ -1,3 +1,0 @@
-initial line width: 0.2
-line style: cylinder
-contour: 1 blade.con
