@@ -17,6 +17,20 @@ blobtree::PolygonizeOptions polygonizeOptions(const SpeciesRender& look) {
   return po;
 }
 
+float lodCellSize(const blobtree::CompiledBlob& blob, const blobtree::PolygonizeOptions& options, size_t triangles) {
+  if (options.cellSize > 0.0f) return options.cellSize;
+  const float fine = blobtree::resolveCellSize(blob, options);
+  if (!(fine > 0.0f) || triangles == 0) return fine;
+  blobtree::PolygonizeOptions probe = options;
+  probe.cellSize = fine * kLodProbeCells;
+  probe.refineSteps = 0;  // the triangles follow the grid's signs alone
+  probe.normals = probe.attributes = probe.progress = false;
+  const double counted = double(blobtree::polygonizeDetailed(blob, probe).mesh.triangles.size());
+  if (!(counted > 0.0)) return fine;
+  const double cell = double(probe.cellSize) * std::sqrt(counted / double(triangles));
+  return float(std::clamp(cell, double(fine), double(probe.cellSize)));
+}
+
 Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::TextureTable& textures, const Vec3& base) {
   render::Material material;
   material.baseColor = base;

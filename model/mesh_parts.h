@@ -30,6 +30,22 @@ inline constexpr uint32_t kNoPartTexture = 0xffffffffu;
 /// The polygonizer's options a species' look asks for (render.mesher).
 blobtree::PolygonizeOptions polygonizeOptions(const SpeciesRender& look);
 
+/// The cell at which a probe polygonizes, in units of the automatic cell (lodCellSize).
+inline constexpr float kLodProbeCells = 4.0f;
+
+/// The cell edge at which blob's surface polygonizes into about `triangles` triangles, for
+/// levels of detail that simplify the full mesh away anyway (`sprig mesh --lod` without
+/// --cell). A polygonized surface has about area / h² triangles at cell h (the mesher's
+/// constant aside), so one probe at h_p = kLodProbeCells times the automatic cell h_a
+/// (resolveCellSize of options), that only finds the cells and meshes the signs (no root
+/// search, normals or attributes: about 1/16 of the automatic cell's cells and none of its
+/// vertex work), counts T_p triangles, and the cell is h_p·sqrt(T_p / triangles) clamped
+/// to [h_a, h_p]: h_a when the automatic cell gives no more than `triangles`. Twigs
+/// thinner than the probe's cells vanish from the probe, so the count errs low and the
+/// cell coarse: callers ask for a margin over what they need (kLodCellMargin). Returns
+/// options.cellSize when that is set. Deterministic (the polygonizer is).
+float lodCellSize(const blobtree::CompiledBlob& blob, const blobtree::PolygonizeOptions& options, size_t triangles);
+
 Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::TextureTable& textures, const Vec3& base);
 /// paintPolygonized with a material: its base colour, and its textureLayers and
 /// ridge darkening applied as render::Scene::attributeColor applies them (the ridge's

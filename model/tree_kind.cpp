@@ -479,6 +479,10 @@ class TreeModel final : public KindModel {
       TreeSurface& tree = *surface;
       blobtree::PolygonizeOptions po = polygonizeOptions(look);
       po.cellSize = cellSize;
+      if (!(cellSize > 0) && look.meshTriangles > 0) {
+        fig.autoCell = blobtree::resolveCellSize(*tree.compiled, po);
+        po.cellSize = fig.lodCell = lodCellSize(*tree.compiled, po, look.meshTriangles);
+      }
       po.progress = progress;
       // The wood: coloured by its bark as the renderer colours it, then cleaned.
       const render::Geometry geometry = surfaceGeometry(tree, look, nullptr);
