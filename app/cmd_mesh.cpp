@@ -208,8 +208,11 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
   const size_t meshTriangles = budget > 0 && !(a.cell > 0) && !(simplify > 0) ? budget * kLodCellMargin : 0;
   std::vector<ExportPart> parts = model.exportParts(stage, static_cast<float>(a.cell), !g.quiet, clean, &fig, meshTriangles);
   if (fig.lodCell > fig.autoCell)
-    note(g, std::cout, "wood polygonized at cell %g (the automatic cell %g) for about %zu triangles: LOD0 is simplified from it",
-         double(fig.lodCell), double(fig.autoCell), meshTriangles);
+    note(g, std::cout, "wood polygonized at cell %g (the automatic cell %g, at most %g) for about %zu triangles: LOD0 is simplified from it",
+         double(fig.lodCell), double(fig.autoCell), double(fig.ceilingCell), meshTriangles);
+  else if (fig.autoCell > 0)
+    note(g, std::cout, "wood polygonized at the automatic cell %g (a coarser one for about %zu triangles would %s)", double(fig.autoCell),
+         meshTriangles, fig.ceilingCell > fig.autoCell ? "give fewer than that" : "cut limbs it keeps whole");
   const std::string simplified = simplifyForMesh(parts, simplify, g);
   const ExportFinish finish = finishExportParts(parts);
   const size_t fullTriangles = partTriangles(parts);

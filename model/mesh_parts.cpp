@@ -20,7 +20,7 @@ blobtree::PolygonizeOptions polygonizeOptions(const SpeciesRender& look) {
 float lodCellSize(const blobtree::CompiledBlob& blob, const blobtree::PolygonizeOptions& options, size_t triangles) {
   if (options.cellSize > 0.0f) return options.cellSize;
   const float fine = blobtree::resolveCellSize(blob, options);
-  if (!(fine > 0.0f) || triangles == 0) return fine;
+  if (!(fine > 0.0f) || triangles == 0 || !(lodCellCeiling(blob, options, fine) > fine)) return fine;
   blobtree::PolygonizeOptions probe = options;
   probe.cellSize = fine * kLodProbeCells;
   probe.refineSteps = 0;  // the triangles follow the grid's signs alone
@@ -28,7 +28,14 @@ float lodCellSize(const blobtree::CompiledBlob& blob, const blobtree::Polygonize
   const double counted = double(blobtree::polygonizeDetailed(blob, probe).mesh.triangles.size());
   if (!(counted > 0.0)) return fine;
   const double cell = double(probe.cellSize) * std::sqrt(counted / double(triangles));
-  return float(std::clamp(cell, double(fine), double(probe.cellSize)));
+  return float(std::clamp(cell, double(fine), double(lodCellCeiling(blob, options, fine))));
+}
+
+float lodCellCeiling(const blobtree::CompiledBlob& blob, const blobtree::PolygonizeOptions& options, float fine) {
+  const float probe = fine * kLodProbeCells;
+  const float limb = options.limbFraction * blob.thinnestLimb();
+  // Limbs that the automatic cell keeps whole stay whole; thinner ones break there already.
+  return options.limbFraction > 0.0f && limb >= fine ? std::min(probe, limb) : probe;
 }
 
 Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::TextureTable& textures, const Vec3& base) {

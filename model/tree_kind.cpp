@@ -481,6 +481,7 @@ class TreeModel final : public KindModel {
       po.cellSize = cellSize;
       if (!(cellSize > 0) && look.meshTriangles > 0) {
         fig.autoCell = blobtree::resolveCellSize(*tree.compiled, po);
+        fig.ceilingCell = lodCellCeiling(*tree.compiled, po, fig.autoCell);
         po.cellSize = fig.lodCell = lodCellSize(*tree.compiled, po, look.meshTriangles);
       }
       po.progress = progress;

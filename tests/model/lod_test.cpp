@@ -371,7 +371,8 @@ TEST_CASE("Levels of detail of a shipped tree", "[model][lod]") {
     const size_t n = coarse[0].mesh.triangles.size();
     INFO("auto cell " << fig.autoCell << ", lod cell " << fig.lodCell << ", triangles " << n);
     CHECK(fig.lodCell > fig.autoCell);
-    CHECK(fig.lodCell <= kLodProbeCells * fig.autoCell);
+    CHECK(fig.lodCell <= fig.ceilingCell);
+    CHECK(fig.ceilingCell <= kLodProbeCells * fig.autoCell);
     CHECK(n >= 1800);
     CHECK(n <= 3500);
     CHECK(analyzeTopology(coarse[0].mesh).boundaryEdges == 0);
