@@ -45,7 +45,8 @@ inline constexpr float kLodProbeCells = 4.0f;
 /// vanish from the probe, so the count errs low and the cell coarse: callers ask for a
 /// margin over what they need (kLodCellMargin). Returns options.cellSize when that is set.
 /// Deterministic (the polygonizer is).
-float lodCellSize(const blobtree::CompiledBlob& blob, const blobtree::PolygonizeOptions& options, size_t triangles);
+float lodCellSize(const blobtree::CompiledBlob& blob, const blobtree::PolygonizeOptions& options, size_t triangles,
+                  bool keepLimbs = true);
 
 /// The coarsest cell lodCellSize takes, given the automatic cell `fine`: the probe's cell,
 /// but where the automatic cell keeps every limb in one piece (fine <= limbFraction ·
@@ -54,7 +55,10 @@ float lodCellSize(const blobtree::CompiledBlob& blob, const blobtree::Polygonize
 /// lost the finest twigs of its crown at 1.7 times it). Where the automatic cell already
 /// cuts the thinnest limbs (the lime's, below the limb term's cost bound) there is no
 /// promise to keep, and more of those twigs' tips fall apart at the coarser cell.
-float lodCellCeiling(const blobtree::CompiledBlob& blob, const blobtree::PolygonizeOptions& options, float fine);
+/// keepLimbs false (a tree in leaf, whose crown hides its twigs: the lime's LOD0 renders
+/// the same either way): the probe's cell.
+float lodCellCeiling(const blobtree::CompiledBlob& blob, const blobtree::PolygonizeOptions& options, float fine,
+                     bool keepLimbs = true);
 
 Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::TextureTable& textures, const Vec3& base);
 /// paintPolygonized with a material: its base colour, and its textureLayers and
