@@ -201,11 +201,20 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
   MeshCleanOptions clean;
   clean.minVolumeFraction = a.minVolume;
   // Built, cleaned and baked once, however many files are written.
-  std::vector<ExportPart> parts = model.exportParts(stage, static_cast<float>(a.cell), !g.quiet, clean, &fig);
+  // With levels the full mesh is simplified away: polygonized at a coarser cell that still
+  // gives LOD0 kLodCellMargin times its budget (not with --cell, nor --simplify's own error).
+  const size_t budget = lodBudget(a.lod, model.lodBudget());
   const double simplify = a.simplify >= 0 ? a.simplify : species.render.simplify;
+  const size_t meshTriangles = budget > 0 && !(a.cell > 0) && !(simplify > 0) ? budget * kLodCellMargin : 0;
+  std::vector<ExportPart> parts = model.exportParts(stage, static_cast<float>(a.cell), !g.quiet, clean, &fig, meshTriangles);
+  if (fig.lodCell > fig.autoCell)
+    note(g, std::cout, "wood polygonized at cell %g (the automatic cell %g, at most %g) for about %zu triangles: LOD0 is simplified from it",
+         double(fig.lodCell), double(fig.autoCell), double(fig.ceilingCell), meshTriangles);
+  else if (fig.autoCell > 0)
+    note(g, std::cout, "wood polygonized at the automatic cell %g (a coarser one for about %zu triangles would %s)", double(fig.autoCell),
+         meshTriangles, fig.ceilingCell > fig.autoCell ? "give fewer than that" : "cut limbs it keeps whole");
   const std::string simplified = simplifyForMesh(parts, simplify, g);
   const ExportFinish finish = finishExportParts(parts);
-  const size_t budget = lodBudget(a.lod, model.lodBudget());
   const size_t fullTriangles = partTriangles(parts);
   const auto lodStart = std::chrono::steady_clock::now();
   Vec3 moved(0.0f);  // LOD0 stood on the ground again

@@ -61,6 +61,10 @@ struct ModelFigures {
   double buildSeconds = 0;  ///< derivation, turtle, BlobTree build, compile, polygonization
   /// exportParts: what cleaning the polygonized wood or shell found (zero when nothing was cleaned).
   MeshCleanReport clean;
+  /// exportParts of a tree at SpeciesRender::meshTriangles: the automatic cell, the
+  /// coarsest one allowed (lodCellCeiling) and the one the wood was polygonized at
+  /// (lodCellSize); 0 otherwise.
+  float autoCell = 0.0f, ceilingCell = 0.0f, lodCell = 0.0f;
 };
 
 /// A built stage: what to render, and its figures.

@@ -6,6 +6,7 @@
 #include <numeric>
 
 #include "core/mesh_clean.h"
+#include "core/parallel.h"
 #include "model/detail_maps.h"
 #include "model/leaf_cards.h"
 #include "model/mesh_parts.h"
@@ -102,14 +103,17 @@ ExportPart reducePart(const ExportPart& part, size_t targetTriangles, float& err
 }
 
 // Every part reduced to its target triangles; errors receives each part's simplification
-// error (reducePart's).
+// error (reducePart's). The parts are independent: they are reduced side by side (the wood
+// beside the leaves; meshoptimizer's passes are single-threaded), each into its own slot,
+// so the level is the same at any thread count.
 LodLevel reduceLevel(const std::vector<ExportPart>& parts, const std::vector<size_t>& targets, std::vector<float>& errors) {
   LodLevel level;
   errors.assign(parts.size(), 0.0f);
-  for (size_t i = 0; i < parts.size(); ++i) {
+  level.parts.resize(parts.size());
+  parallelFor(0, parts.size(), [&](size_t i) {
     const ExportPart& p = parts[i];
-    level.parts.push_back(p.mesh.triangles.empty() ? p : reducePart(p, std::max<size_t>(targets[i], 1), errors[i]));
-  }
+    level.parts[i] = p.mesh.triangles.empty() ? p : reducePart(p, std::max<size_t>(targets[i], 1), errors[i]);
+  });
   level.triangles = partTriangles(level.parts);
   return level;
 }

@@ -34,6 +34,10 @@ inline constexpr size_t kLodMinTriangles = 500;
 inline constexpr double kLodMaxKeep = 0.75;
 /// The smallest budget `--lod N` accepts.
 inline constexpr size_t kLodMinBudget = 1000;
+/// `sprig mesh` with levels and no --cell polygonizes a tree's wood at the cell that gives
+/// about this many times LOD0's budget (lodCellSize, model/mesh_parts.h), never finer than
+/// the automatic cell: LOD0 is simplified from it with this margin.
+inline constexpr size_t kLodCellMargin = 8;
 
 /// The detail maps' rays reach this many times a level's simplification error (meshoptimizer's
 /// estimate, summed over the chain from the full mesh) ...

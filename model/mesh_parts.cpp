@@ -17,6 +17,30 @@ blobtree::PolygonizeOptions polygonizeOptions(const SpeciesRender& look) {
   return po;
 }
 
+float lodCellSize(const blobtree::CompiledBlob& blob, const blobtree::PolygonizeOptions& options, size_t triangles,
+                  bool keepLimbs) {
+  if (options.cellSize > 0.0f) return options.cellSize;
+  const float fine = blobtree::resolveCellSize(blob, options);
+  if (!(fine > 0.0f) || triangles == 0 || !(lodCellCeiling(blob, options, fine, keepLimbs) > fine)) return fine;
+  blobtree::PolygonizeOptions probe = options;
+  probe.cellSize = fine * kLodProbeCells;
+  probe.refineSteps = 0;  // the triangles follow the grid's signs alone
+  probe.normals = probe.attributes = probe.progress = false;
+  const double counted = double(blobtree::polygonizeDetailed(blob, probe).mesh.triangles.size());
+  if (!(counted > 0.0)) return fine;
+  const double cell = double(probe.cellSize) * std::sqrt(counted / double(triangles));
+  return float(std::clamp(cell, double(fine), double(lodCellCeiling(blob, options, fine, keepLimbs))));
+}
+
+float lodCellCeiling(const blobtree::CompiledBlob& blob, const blobtree::PolygonizeOptions& options, float fine,
+                     bool keepLimbs) {
+  const float probe = fine * kLodProbeCells;
+  if (!keepLimbs) return probe;
+  const float limb = options.limbFraction * blob.thinnestLimb();
+  // Limbs that the automatic cell keeps whole stay whole; thinner ones break there already.
+  return options.limbFraction > 0.0f && limb >= fine ? std::min(probe, limb) : probe;
+}
+
 Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::TextureTable& textures, const Vec3& base) {
   render::Material material;
   material.baseColor = base;

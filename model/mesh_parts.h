@@ -30,6 +30,36 @@ inline constexpr uint32_t kNoPartTexture = 0xffffffffu;
 /// The polygonizer's options a species' look asks for (render.mesher).
 blobtree::PolygonizeOptions polygonizeOptions(const SpeciesRender& look);
 
+/// The cell at which a probe polygonizes, in units of the automatic cell (lodCellSize).
+inline constexpr float kLodProbeCells = 4.0f;
+
+/// The cell edge at which blob's surface polygonizes into about `triangles` triangles, for
+/// levels of detail that simplify the full mesh away anyway (`sprig mesh --lod` without
+/// --cell). A polygonized surface has about area / h² triangles at cell h (the mesher's
+/// constant aside), so one probe at h_p = kLodProbeCells times the automatic cell h_a
+/// (resolveCellSize of options), that only finds the cells and meshes the signs (no root
+/// search, normals or attributes: about 1/16 of the automatic cell's cells and none of its
+/// vertex work), counts T_p triangles, and the cell is h_p·sqrt(T_p / triangles) clamped
+/// to [h_a, lodCellCeiling]: h_a when the automatic cell gives no more than `triangles`, or
+/// when the ceiling is h_a (then no probe is made). Twigs thinner than the probe's cells
+/// vanish from the probe, so the count errs low and the cell coarse: callers ask for a
+/// margin over what they need (kLodCellMargin). Returns options.cellSize when that is set.
+/// Deterministic (the polygonizer is).
+float lodCellSize(const blobtree::CompiledBlob& blob, const blobtree::PolygonizeOptions& options, size_t triangles,
+                  bool keepLimbs = true);
+
+/// The coarsest cell lodCellSize takes, given the automatic cell `fine`: the probe's cell,
+/// but where the automatic cell keeps every limb in one piece (fine <= limbFraction ·
+/// thinnestLimb(), blobtree/cell_size.h) never coarser than that edge, so that the promise
+/// holds at the coarser cell too (ABOP Fig. 2.8, whose automatic cell is its limb edge,
+/// lost the finest twigs of its crown at 1.7 times it). Where the automatic cell already
+/// cuts the thinnest limbs (the lime's, below the limb term's cost bound) there is no
+/// promise to keep, and more of those twigs' tips fall apart at the coarser cell.
+/// keepLimbs false (a tree in leaf, whose crown hides its twigs: the lime's LOD0 renders
+/// the same either way): the probe's cell.
+float lodCellCeiling(const blobtree::CompiledBlob& blob, const blobtree::PolygonizeOptions& options, float fine,
+                     bool keepLimbs = true);
+
 Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::TextureTable& textures, const Vec3& base);
 /// paintPolygonized with a material: its base colour, and its textureLayers and
 /// ridge darkening applied as render::Scene::attributeColor applies them (the ridge's

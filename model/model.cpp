@@ -98,12 +98,14 @@ Mesh SpeciesModel::cleanSurface(const MeshCleanOptions& clean, MeshCleanReport* 
 }
 
 std::vector<ExportPart> SpeciesModel::exportParts(const Stage& stage, float cellSize, bool progress,
-                                                 const MeshCleanOptions& clean, ModelFigures* figures) {
+                                                 const MeshCleanOptions& clean, ModelFigures* figures, size_t meshTriangles) {
   ModelFigures fig;
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<ExportPart> parts = [&] {
     const Phase phase("build");
-    return kind_->exportParts(stage, cellSize, progress, species_.render, clean, fig);
+    SpeciesRender look = species_.render;
+    look.meshTriangles = meshTriangles;
+    return kind_->exportParts(stage, cellSize, progress, look, clean, fig);
   }();
   fig.triangles = 0;
   for (const ExportPart& p : parts) fig.triangles += p.mesh.triangleCount();

@@ -114,8 +114,10 @@ class SpeciesModel {
 
   /// The stage's surface as named parts in the species' colours (KindModel::exportParts),
   /// polygonized BlobTrees cleaned with clean. Fills figures (triangles: all parts', build time).
+  /// meshTriangles > 0 (levels of detail, cellSize 0): a tree's wood at the coarser cell
+  /// that gives about that many triangles (SpeciesRender::meshTriangles).
   std::vector<ExportPart> exportParts(const Stage& stage, float cellSize, bool progress, const MeshCleanOptions& clean = {},
-                                      ModelFigures* figures = nullptr);
+                                      ModelFigures* figures = nullptr, size_t meshTriangles = 0);
   /// The stage's still skeleton and the species' wind options (KindModel::windSource);
   /// nullopt for kinds without wind.
   std::optional<std::pair<lsystem::Skeleton, organisms::WindOptions>> windSource(const Stage& stage) {

@@ -120,6 +120,12 @@ struct SpeciesRender {
   /// polygonizes at the cell the image needs (render::pixelCellSize); unset (`sprig mesh`,
   /// exports) polygonizes at the model's own cell.
   std::optional<render::PixelScale> pixels;
+  /// Set by `sprig mesh` (never read from the file): with levels of detail and no --cell,
+  /// the triangles a tree's polygonized wood needs (kLodCellMargin times LOD0's budget,
+  /// model/lod.h); the wood is then polygonized at the coarser cell that gives about that
+  /// many (lodCellSize, model/mesh_parts.h), never finer than its own automatic cell.
+  /// 0: the automatic cell.
+  size_t meshTriangles = 0;
 
   /// Renderer settings for an image of width x height.
   render::RenderSettings settings(int imageWidth, int imageHeight) const;

@@ -490,7 +490,19 @@ class TreeModel final : public KindModel {
     if (surface) {
       TreeSurface& tree = *surface;
       blobtree::PolygonizeOptions po = polygonizeOptions(look);
+      // The leaves and fruit (made before the wood: a crown of leaves hides the twigs that a
+      // coarser cell for the levels cuts, lodCellCeiling).
+      const std::pair<organisms::OrganSet, const char*> sets[] = {{organisms::OrganSet::Leaves, "leaves"},
+                                                                   {organisms::OrganSet::Fruit, "fruit"}};
+      Mesh organs[2];
+      for (int k = 0; k < 2; ++k) organs[k] = organisms::buildOrganMesh(skeleton, options, sets[k].first);
       po.cellSize = cellSize;
+      if (!(cellSize > 0) && look.meshTriangles > 0) {
+        const bool keepLimbs = organs[0].triangleCount() == 0;
+        fig.autoCell = blobtree::resolveCellSize(*tree.compiled, po);
+        fig.ceilingCell = lodCellCeiling(*tree.compiled, po, fig.autoCell, keepLimbs);
+        po.cellSize = fig.lodCell = lodCellSize(*tree.compiled, po, look.meshTriangles, keepLimbs);
+      }
       po.progress = progress;
       // The wood: coloured by its bark as the renderer colours it, then cleaned.
       const render::Geometry geometry = surfaceGeometry(tree, look, nullptr);
@@ -521,16 +533,14 @@ class TreeModel final : public KindModel {
         // texel the renderer's blend of the cones' barks at its surface point.
         atlasBlobPart(parts[0], tree.compiled, implicit.textures, implicit.material);
       }
-      const std::pair<organisms::OrganSet, const char*> sets[] = {{organisms::OrganSet::Leaves, "leaves"},
-                                                                   {organisms::OrganSet::Fruit, "fruit"}};
-      for (const auto& [set, name] : sets) {
-        Mesh organs = organisms::buildOrganMesh(skeleton, options, set);
-        if (organs.triangleCount() == 0) continue;
-        organs.materials.clear();
+      for (int k = 0; k < 2; ++k) {
+        const auto& [set, name] = sets[k];
+        if (organs[k].triangleCount() == 0) continue;
+        organs[k].materials.clear();
         const render::Material& m = set == organisms::OrganSet::Leaves ? look.style.leaf : look.style.fruit;
         // Leaves are open polygons seen from both sides; fruit are closed spheres.
         const bool leaves = set == organisms::OrganSet::Leaves;
-        parts.push_back(ExportPart{name, std::move(organs), PartMaterial{name, m.baseColor, m.roughness, leaves, nullptr}, leaves});
+        parts.push_back(ExportPart{name, std::move(organs[k]), PartMaterial{name, m.baseColor, m.roughness, leaves, nullptr}, leaves});
         atlasVertexColors(parts.back());  // each leaf's tint, unclamped
       }
     }

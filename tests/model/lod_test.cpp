@@ -9,6 +9,7 @@
 
 #include "core/atomic_file.h"
 #include "core/mesh_io.h"
+#include "core/parallel.h"
 #include "model/leaf_cards.h"
 #include "model/lod.h"
 #include "model/mesh_parts.h"
@@ -217,6 +218,33 @@ TEST_CASE("buildLodChain", "[model][lod]") {
   }
 }
 
+TEST_CASE("buildLodChain reduces the parts side by side to the same levels at any thread count", "[model][lod]") {
+  const std::vector<ExportPart> parts = testParts();
+  auto chain = [&](int threads) {
+    const ThreadLimit limit(threads);
+    return buildLodChain(parts, 8000);
+  };
+  const std::vector<LodLevel> one = chain(1), two = chain(2);
+  REQUIRE(one.size() == 3);
+  REQUIRE(two.size() == one.size());
+  for (size_t k = 0; k < one.size(); ++k) {
+    CHECK(two[k].triangles == one[k].triangles);
+    REQUIRE(two[k].parts.size() == 2);
+    for (size_t i = 0; i < 2; ++i) {
+      const Mesh &a = one[k].parts[i].mesh, &b = two[k].parts[i].mesh;
+      CHECK(b.triangles == a.triangles);
+      CHECK(b.positions == a.positions);
+      CHECK(b.normals == a.normals);
+      CHECK(b.colors == a.colors);
+    }
+    // The maps' and atlases' texels too.
+    const PartTexture* ta = one[k].parts[0].material.texture.get();
+    const PartTexture* tb = two[k].parts[0].material.texture.get();
+    REQUIRE((ta == nullptr) == (tb == nullptr));
+    if (ta) CHECK(tb->pixels().pixels == ta->pixels().pixels);
+  }
+}
+
 TEST_CASE("writeLevels", "[model][lod]") {
   TempDir dir;
   const std::vector<LodLevel> levels = buildLodChain(testParts(), 8000);
@@ -336,6 +364,22 @@ TEST_CASE("Levels of detail of a shipped tree", "[model][lod]") {
     REQUIRE(l.parts.size() == parts.size());
     CHECK(l.parts[0].name == "wood");
     CHECK(analyzeTopology(l.parts[0].mesh).boundaryEdges == 0);
+  }
+  SECTION("levels polygonize the wood at the coarser cell that gives about the triangles asked for") {
+    ModelFigures fig;
+    std::vector<ExportPart> coarse = model.exportParts(model.finalStage(), 0.0f, false, {}, &fig, 2500);
+    const size_t n = coarse[0].mesh.triangles.size();
+    INFO("auto cell " << fig.autoCell << ", lod cell " << fig.lodCell << ", triangles " << n);
+    CHECK(fig.lodCell > fig.autoCell);
+    CHECK(fig.lodCell <= fig.ceilingCell);
+    CHECK(fig.ceilingCell <= kLodProbeCells * fig.autoCell);
+    CHECK(n >= 1800);
+    CHECK(n <= 3500);
+    CHECK(analyzeTopology(coarse[0].mesh).boundaryEdges == 0);
+    // More than the automatic cell gives: the automatic cell, the same mesh.
+    std::vector<ExportPart> same = model.exportParts(model.finalStage(), 0.0f, false, {}, &fig, 50000);
+    CHECK(fig.lodCell == fig.autoCell);
+    CHECK(same[0].mesh.positions == model.exportParts(model.finalStage(), 0.0f, false)[0].mesh.positions);
   }
 }
 
