@@ -1,4 +1,4 @@
-/// core/detail/image_backend.h through OpenImageIO: still images and animated GIFs.
+/// core/detail/image_backend.h through OpenImageIO: still images (GIFs: core/gif_encoder.h).
 
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
@@ -48,24 +48,6 @@ bool write(const std::string& path, const ImageFileSpec& s, PixelType dataType, 
   if (!s.compression.empty()) spec.attribute("compression", s.compression);
   if (s.quality > 0) spec.attribute("CompressionQuality", s.quality);
   return writeOne(*out, path, spec, typeOf(dataType), data, error);
-}
-
-void writeGif(const std::string& path, const std::string& displayPath, int width, int height, int delayCs,
-              size_t frameCount, const std::function<std::vector<uint8_t>(size_t)>& frameBytes) {
-  auto writer = OIIO::ImageOutput::create(path);
-  if (!writer) throw std::runtime_error(displayPath + ": cannot write GIF: " + OIIO::geterror());
-  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
-  const int rate[2] = {100, delayCs};  // FramesPerSecond as the rational 100 / delay
-  spec.attribute("FramesPerSecond", OIIO::TypeRational, rate);
-  spec.attribute("oiio:LoopCount", 0);
-  for (size_t i = 0; i < frameCount; ++i) {
-    const auto mode = i == 0 ? OIIO::ImageOutput::Create : OIIO::ImageOutput::AppendSubimage;
-    if (!writer->open(path, spec, mode)) throw std::runtime_error(displayPath + ": cannot write GIF: " + writer->geterror());
-    const std::vector<uint8_t> bytes = frameBytes(i);
-    if (!writer->write_image(OIIO::TypeDesc::UINT8, bytes.data()))
-      throw std::runtime_error(displayPath + ": cannot write GIF frame: " + writer->geterror());
-  }
-  if (!writer->close()) throw std::runtime_error(displayPath + ": cannot write GIF: " + writer->geterror());
 }
 
 /// Pixels of a PNG read through libpng before OpenImageIO reads it (backends/png_check.h):
@@ -157,7 +139,7 @@ bool resizeBox(const float* in, int width, int height, float* out, int outWidth,
 }  // namespace
 
 const detail::ImageBackend& oiioImage() {
-  static const detail::ImageBackend table{&write, &writeGif, &open, &resizeBox, &textCoverage};
+  static const detail::ImageBackend table{&write, &open, &resizeBox, &textCoverage};
   return table;
 }
 

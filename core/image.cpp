@@ -6,6 +6,7 @@
 #include "core/atomic_file.h"
 #include "core/diagnostics.h"
 #include "core/detail/image_backend.h"
+#include "core/gif_encoder.h"
 #include "core/paths.h"
 #include "core/phases.h"
 #include "core/srgb.h"
@@ -117,12 +118,14 @@ void writeImage(const Image& image, const fs::path& path, ImageEncoding encoding
 
 void writeAnimatedGif(const std::vector<Image>& frames, double fps, const fs::path& path) {
   if (frames.empty()) throw std::runtime_error(path.string() + ": no frames to write");
-  TempPath tmp(path);
-  // GIF frame delays are centiseconds: FramesPerSecond as the rational 100 / delay.
+  // GIF frame delays are centiseconds.
   const int delayCs = std::max(1, static_cast<int>(std::lround(100.0 / std::max(fps, 0.01))));
-  detail::imageBackend().writeGif(tmp.path().string(), path.string(), frames.front().width, frames.front().height,
-                                  delayCs, frames.size(), [&](size_t i) { return toSrgb8(frames[i], 3); });
-  tmp.commit();
+  const Image& first = frames.front();
+  for (const Image& f : frames)
+    if (f.width != first.width || f.height != first.height)
+      throw std::runtime_error(path.string() + ": GIF frames of different sizes");
+  writeFileAtomic(path, encodeGif(first.width, first.height, delayCs, frames.size(),
+                                  [&](size_t i) { return toSrgb8(frames[i], 3); }));
 }
 
 ImageReadError::ImageReadError(const fs::path& path, std::string reason)

@@ -1,6 +1,7 @@
 #pragma once
-/// Sprig's one image type and all of its file I/O (the only OpenImageIO still-image and
-/// GIF code; textures/image_texture.cpp uses OIIO's TextureSystem for filtered lookups).
+/// Sprig's one image type and all of its file I/O (the only OpenImageIO still-image code;
+/// GIFs through Sprig's encoder, core/gif_encoder.h; textures/image_texture.cpp uses OIIO's
+/// TextureSystem for filtered lookups).
 ///
 /// An Image holds linear-light RGBA floats, not premultiplied, row-major from the top-left
 /// pixel: the renderer writes it, the gallery composes it, textures bake into it. Files:
@@ -72,10 +73,11 @@ enum class ImageEncoding {
 void writeImage(const Image& image, const std::filesystem::path& path,
                 ImageEncoding encoding = ImageEncoding::Picture);
 
-/// Writes frames (all of the first frame's size) as an animated GIF that loops forever
-/// (oiio:LoopCount 0), each frame shown 100 / round(100 / fps) centiseconds
-/// (FramesPerSecond), color bytes from toSrgb8. Atomic. Throws std::runtime_error when
-/// there are no frames or OpenImageIO cannot write the file.
+/// Writes frames (all of one size) as an animated GIF that loops forever (oiio:LoopCount
+/// 0), each frame shown round(100 / fps) centiseconds, colour bytes from toSrgb8, through
+/// Sprig's encoder (core/gif_encoder.h: a palette per frame by median cut over distinct
+/// colours, dithered). Atomic. Throws std::runtime_error when there are no frames, the
+/// frames differ in size, or the file cannot be written.
 void writeAnimatedGif(const std::vector<Image>& frames, double fps, const std::filesystem::path& path);
 
 /// A file that could not be read as an image. what() is "cannot read image 'PATH':

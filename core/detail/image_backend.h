@@ -13,7 +13,6 @@
 /// ImageReadError) stays in core/image.cpp.
 
 #include <cstdint>
-#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -61,11 +60,6 @@ struct ImageBackend {
   /// empty) in error when it fails.
   bool (*write)(const std::string& path, const ImageFileSpec& spec, PixelType dataType, const void* data,
                 std::string& error);
-  /// Writes an animated GIF of frameCount width x height RGB frames, frameBytes(i) giving
-  /// frame i's 8-bit values, each shown delayCs centiseconds, looping forever. Throws
-  /// std::runtime_error with a message starting with displayPath.
-  void (*writeGif)(const std::string& path, const std::string& displayPath, int width, int height, int delayCs,
-                   size_t frameCount, const std::function<std::vector<uint8_t>(size_t)>& frameBytes);
   /// Opens path for reading; null with the library's message (possibly empty) in error.
   std::unique_ptr<ImageFileReader> (*open)(const std::string& path, std::string& error);
   /// Resizes width x height pixels of 4 floats (in) to outWidth x outHeight (out, which
