@@ -84,13 +84,15 @@ grep -qF "tests/assets/cpfg/no_view/plant.l: note: no view file 'plant.v' beside
 [ "$(cat "$WORK/pf.out")" = "A(3.5)" ] || fail "printf object string: $(cat "$WORK/pf.out")"
 [ "$(cat "$WORK/pf.err")" = "$(printf 'A 1.5 -> 3 (50%%)\nA 2.5 -> 5 (50%%)\ndone after 2 steps')" ] || fail "printf output: $(cat "$WORK/pf.err")"
 
-# A view file command Sprig cannot draw (cpfg's 'line:') stops every drawing, not --print:
-# the string does not depend on it (cpfg -g derives without drawing).
-"$SPRIG" --quiet derive tests/bad_inputs/inputs/cpfg/view_line/plant.l --print >"$WORK/ln.out" 2>"$WORK/ln.err" ||
+# cpfg's 'line:' defines a surface and leaves F as it was: derived, printed and drawn
+# (skeleton JSON); a malformed one stops --print too, as a view file error does in cpfg.
+"$SPRIG" --quiet derive tests/assets/cpfg/line/plant.l --print >"$WORK/ln.out" 2>"$WORK/ln.err" ||
   fail "--print of a view file with 'line:' failed: $(cat "$WORK/ln.err")"
-[ "$(cat "$WORK/ln.out")" = "F+F" ] || fail "'line:' object string: $(cat "$WORK/ln.out")"
-if "$SPRIG" --quiet derive tests/bad_inputs/inputs/cpfg/view_line/plant.l >/dev/null 2>&1; then
-  fail "derive (drawn) of a view file with 'line:' did not fail"
+[ "$(cat "$WORK/ln.out")" = "F(2)~L" ] || fail "'line:' object string: $(cat "$WORK/ln.out")"
+"$SPRIG" --quiet derive tests/assets/cpfg/line/plant.l >/dev/null 2>"$WORK/ln.err" ||
+  fail "derive (drawn) of a view file with 'line:' failed: $(cat "$WORK/ln.err")"
+if "$SPRIG" --quiet derive tests/bad_inputs/inputs/cpfg/view_line/plant.l --print >/dev/null 2>&1; then
+  fail "--print of a view file with a malformed 'line:' did not fail"
 fi
 
 echo "cli_derive: all checks passed"
