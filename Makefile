@@ -63,7 +63,7 @@ sanitize: deps
 
 fuzz: deps
 	@$(ASAN_CONFIG) >/dev/null
-	@cmake --build $(ASAN_BUILD) -j $(JOBS) --target $(addprefix fuzz_,grammar view function enviro expression derive species_tree species_shell species_blob species_organism species_solid polymesh image volume)
+	@cmake --build $(ASAN_BUILD) -j $(JOBS) --target $(addprefix fuzz_,grammar view background function enviro expression derive species_tree species_shell species_blob species_organism species_solid polymesh image volume)
 	@bash fuzz/run.sh $(ASAN_BUILD) $(FUZZ_SECONDS)
 
 clean:
