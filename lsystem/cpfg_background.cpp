@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <utility>
 
@@ -50,8 +51,12 @@ constexpr CommandName kCommands[] = {
 };
 
 /// line with each identifier that names a macro replaced by its text, rescanned until no
-/// macro is left (at most 32 rounds: a self-referring macro stops there, as cpp stops it).
-std::string expand(const std::string& line, const std::map<std::string, std::string>& macros) {
+/// macro is left (at most 32 rounds: a self-referring macro stops there); nullopt once the
+/// text grows past budget characters (a macro naming itself twice doubles every round) or
+/// the characters written by every round of the file's expansions so far (work) pass
+/// kMaxBackgroundExpansionWork.
+std::optional<std::string> expand(const std::string& line, const std::map<std::string, std::string>& macros, size_t budget,
+                                  size_t& work) {
   std::string s = line;
   for (int round = 0; round < 32; ++round) {
     std::string out;
@@ -64,6 +69,7 @@ std::string expand(const std::string& line, const std::map<std::string, std::str
         if (it != macros.end()) {
           out += it->second;
           changed = true;
+          if (out.size() > budget) return std::nullopt;
         } else {
           out += s.substr(i, j - i);
         }
@@ -72,8 +78,10 @@ std::string expand(const std::string& line, const std::map<std::string, std::str
         out += s[i++];
       }
     }
-    s = std::move(out);
     if (!changed) break;
+    work += out.size();
+    if (work > kMaxBackgroundExpansionWork) return std::nullopt;
+    s = std::move(out);
   }
   return s;
 }
@@ -111,7 +119,14 @@ std::string blankBlockComments(std::string text, std::pair<int, int>& pending) {
 
 /// The words of one file after cpfg's preprocessor: block comments blanked, `#define NAME text`
 /// lines read, other directives errors, macros expanded (a macro's words sit at its column).
+void tooLong(const SourceLoc& at, const std::string& sourceLine, DiagnosticList& diags) {
+  diags.error(at, "the macros expand this background scene file beyond " + std::to_string(kMaxBackgroundExpansion) +
+                      " characters, or rescan it beyond " + std::to_string(kMaxBackgroundExpansionWork) + " (Sprig's limits)",
+              sourceLine);
+}
+
 void preprocess(const std::string& text, const std::string& file, std::vector<Word>& words, DiagnosticList& diags) {
+  size_t expandedChars = 0, work = 0;
   std::pair<int, int> pending{0, 0};
   const std::string clean = blankBlockComments(text, pending);
   if (pending.first) diags.error(SourceLoc{file, pending.first, pending.second + 1}, "unterminated comment '/*'", lineOf(text, pending.first));
@@ -132,7 +147,9 @@ void preprocess(const std::string& text, const std::string& file, std::vector<Wo
       while (ne < l.size() && isIdentChar(l[ne])) ++ne;
       if (directive == "define" && n != std::string::npos && isIdentStart(l[n]) && (ne == l.size() || l[ne] != '(')) {
         const size_t v = l.find_first_not_of(" \t", ne);
-        macros[l.substr(n, ne - n)] = v == std::string::npos ? "" : expand(l.substr(v), macros);
+        const std::optional<std::string> body = v == std::string::npos ? std::string() : expand(l.substr(v), macros, kMaxBackgroundExpansion, work);
+        if (!body) return tooLong(SourceLoc{file, lineNo, static_cast<int>(first) + 1}, lineOf(text, lineNo), diags);
+        macros[l.substr(n, ne - n)] = *body;
       } else {
         diags.error(SourceLoc{file, lineNo, static_cast<int>(first) + 1},
                     directive == "define" ? "only '#define NAME text' (a macro without parameters) is supported in a background scene file"
@@ -148,8 +165,11 @@ void preprocess(const std::string& text, const std::string& file, std::vector<Wo
       }
       size_t j = i;
       while (j < l.size() && l[j] != ' ' && l[j] != '\t' && l[j] != '\r') ++j;
-      const std::string expanded = expand(l.substr(i, j - i), macros);
-      std::istringstream in(expanded);
+      const std::string word = l.substr(i, j - i);
+      const std::optional<std::string> expanded = expand(word, macros, kMaxBackgroundExpansion - expandedChars, work);
+      if (!expanded) return tooLong(SourceLoc{file, lineNo, static_cast<int>(i) + 1}, lineOf(text, lineNo), diags);
+      if (*expanded != word) expandedChars += expanded->size();  // only what macros wrote counts
+      std::istringstream in(*expanded);
       for (std::string w; in >> w;) words.push_back({w, SourceLoc{file, lineNo, static_cast<int>(i) + 1}, lineOf(text, lineNo)});
       i = j;
     }

@@ -33,6 +33,13 @@ inline constexpr size_t kMaxBackgroundCommands = 100000;
 /// Most triangles of one view file's background scene (a sphere is 2,208, a cylinder or cone
 /// at most 188): about 900 spheres.
 inline constexpr size_t kMaxBackgroundTriangles = 2000000;
+/// Characters that macros write into one background file (the words they replace, expanded;
+/// cpfg has no limit; a macro that names itself, or a chain of doubling macros, grows
+/// without bound). Words without macros do not count.
+inline constexpr size_t kMaxBackgroundExpansion = 100000;
+/// Characters written by all rescans of one file's macro expansions (each of up to 32
+/// rounds that replaced a macro writes its whole word again): bounds the preprocessor's time.
+inline constexpr size_t kMaxBackgroundExpansionWork = 1000000;
 /// Deepest matrix stack (cpfg's STACK_SIZE 50: 49 pushes above the identity).
 inline constexpr int kMaxBackgroundStack = 49;
 

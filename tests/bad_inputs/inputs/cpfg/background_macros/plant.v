@@ -1,0 +1,2 @@
+line style: cylinder
+background scene: scene.dat
