@@ -157,6 +157,16 @@ void noteWind(const std::vector<ExportPart>& top, const organisms::WindOptions& 
     note(g, std::cout, "_WIND on every level's vertices (no wind: no sway animation; --wind SPEED[,DIRECTION] adds one)");
 }
 
+/// Which cell the wood was polygonized at for the levels (ModelFigures::lodCell), and why.
+void noteWoodCell(const ModelFigures& fig, size_t meshTriangles, const GlobalOptions& g) {
+  if (fig.lodCell > fig.autoCell)
+    note(g, std::cout, "wood polygonized at cell %g (the automatic cell %g, at most %g) for about %zu triangles: LOD0 is simplified from it",
+         double(fig.lodCell), double(fig.autoCell), double(fig.ceilingCell), meshTriangles);
+  else if (fig.autoCell > 0)
+    note(g, std::cout, "wood polygonized at the automatic cell %g (a coarser one for about %zu triangles would %s)", double(fig.autoCell),
+         meshTriangles, fig.ceilingCell > fig.autoCell ? "give fewer than that" : "cut limbs it keeps whole");
+}
+
 int runMesh(const MeshArgs& a, const GlobalOptions& g) {
   checkOutputs(a);
   const std::string& out = a.outs.front();
@@ -207,12 +217,7 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
   const double simplify = a.simplify >= 0 ? a.simplify : species.render.simplify;
   const size_t meshTriangles = budget > 0 && !(a.cell > 0) && !(simplify > 0) ? budget * kLodCellMargin : 0;
   std::vector<ExportPart> parts = model.exportParts(stage, static_cast<float>(a.cell), !g.quiet, clean, &fig, meshTriangles);
-  if (fig.lodCell > fig.autoCell)
-    note(g, std::cout, "wood polygonized at cell %g (the automatic cell %g, at most %g) for about %zu triangles: LOD0 is simplified from it",
-         double(fig.lodCell), double(fig.autoCell), double(fig.ceilingCell), meshTriangles);
-  else if (fig.autoCell > 0)
-    note(g, std::cout, "wood polygonized at the automatic cell %g (a coarser one for about %zu triangles would %s)", double(fig.autoCell),
-         meshTriangles, fig.ceilingCell > fig.autoCell ? "give fewer than that" : "cut limbs it keeps whole");
+  noteWoodCell(fig, meshTriangles, g);
   const std::string simplified = simplifyForMesh(parts, simplify, g);
   const ExportFinish finish = finishExportParts(parts);
   const size_t fullTriangles = partTriangles(parts);
