@@ -99,7 +99,7 @@ class KindModel {
   virtual Stage stageFromIndex(int k) const = 0;
   /// The stage of a command line `--age DEG`. Throws UsageError for kinds without an age.
   virtual Stage stageAtAge(double ageDeg) const;
-  /// Up to count growth stages ending at the final stage.
+  /// Up to count growth stages ending at the final stage; at least one (the final stage).
   virtual std::vector<Stage> stripStages(int count) const = 0;
   /// The frames of a growth animation between stages first and last (-1 = final).
   virtual std::vector<Stage> animationFrames(int framesPerStage, int first, int last) const = 0;

@@ -557,6 +557,9 @@ class ShellModel final : public KindModel {
       s.age = age;
       out.push_back(s);
     }
+    // A shell that starts at its final age (a generating surface alone, Fig. 6) has no
+    // growth to show: its strip is the final stage.
+    if (out.empty()) out.push_back(finalStage());
     return out;
   }
 
@@ -564,8 +567,7 @@ class ShellModel final : public KindModel {
     // From the youngest strip stage to the final age, framesPerStage frames per whorl.
     const double end = finalStage().age;
     const double whorl = spec_.params.whorlDeg;
-    const std::vector<double> stages = shellGrowthStages(spec_, 5);
-    const double begin = std::min(end, stages.empty() ? whorl : stages.front());
+    const double begin = std::min(end, stripStages(5).front().age);
     const int n = std::max(1, static_cast<int>(std::ceil((end - begin) / whorl * std::max(1, framesPerStage))));
     std::vector<Stage> out;
     for (int i = 0; i <= n; ++i) {

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <string>
 
 #include "model/animate.h"
@@ -13,6 +14,7 @@
 #include "core/mesh.h"
 #include "core/parallel.h"
 #include "tests/paths.h"
+#include "tests/model/shipped_species.h"
 
 using namespace sprig;
 
@@ -53,6 +55,14 @@ shell:
   varices: false
 render: {width: 40, height: 40, samples: 1}
 )";
+
+// The `kind:` line of a species file ("kind: shell"), without reading the rest.
+std::string kindLine(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("kind:", 0) == 0) return line.substr(0, line.find_last_not_of(" \r") + 1);
+  return {};
+}
 
 bool sameImage(const Image& a, const Image& b) {
   return a.width == b.width && a.height == b.height && a.pixels == b.pixels;
@@ -99,10 +109,40 @@ TEST_CASE("SpeciesModel::stages", "[model]") {
     CHECK(m.stageFromIndex(1).age == Approx(348.0));
     CHECK(m.stageFromIndex(9).age == Approx(end));
   }
+  SECTION("shell that starts at its final age: the strip is the final stage") {
+    std::string text = kShell;
+    text.replace(text.find("  generating"), 0, "  start: 1044\n  age: 1044\n");
+    SpeciesModel m(parseSpecies(text, "shell.yaml"));
+    const std::vector<Stage> strip = m.stripStages(5);
+    REQUIRE(strip.size() == 1);
+    CHECK(strip[0].age == Approx(m.finalStage().age));
+    // Its animation stays at that age (before, it began at one whorl, below the start).
+    for (const Stage& frame : m.animationFrames(3)) CHECK(frame.age == Approx(m.finalStage().age));
+  }
   SECTION("blob: one stage") {
     SpeciesModel m(parseSpecies(kBlob, "blob.yaml"));
     CHECK(m.stripStages(5).size() == 1);
     CHECK(m.animationFrames(4).size() == 1);
+  }
+}
+
+TEST_CASE("SpeciesModel::stripStages: every shipped species has a strip ending at its final stage", "[model]") {
+  // The gallery draws one strip cell per stage; an empty strip is an empty image, which
+  // the image writer refuses (Fig. 6's generating surface starts at its final age). The
+  // strips of trees, shells and blobs follow from their parameters; an organism's is its
+  // final stage or its frames' times, a solid's its operations (and building those reads
+  // their meshes, seconds each), so the sweep is over the first three.
+  PathPolicy policy;
+  policy.root = SPRIG_SOURCE_DIR;
+  for (const std::string& stem : test::shippedSpecies(SPRIG_SOURCE_DIR)) {
+    INFO(stem);
+    const std::filesystem::path file = std::filesystem::path(SPRIG_SOURCE_DIR) / "species" / (stem + ".yaml");
+    const std::string kind = kindLine(file);
+    if (kind != "kind: tree" && kind != "kind: shell" && kind != "kind: blob") continue;
+    SpeciesModel model(loadSpecies(file, policy));
+    const std::vector<Stage> strip = model.stripStages(5);
+    REQUIRE(!strip.empty());
+    CHECK(model.stageNumber(strip.back()) == model.stageNumber(model.finalStage()));
   }
 }
 
