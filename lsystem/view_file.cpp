@@ -387,6 +387,22 @@ class ViewParser {
     }
   }
 
+  /// Finds the object file NAME beside the view file (objectFile, `what` names it in
+  /// errors), reads it and hands its text and path to parse; a parser's InputError becomes
+  /// the file's own diagnostics.
+  template <class Parse>
+  void parseObjectFile(int line, size_t col, const std::string& name, const std::string& what, Parse parse) {
+    const auto found = objectFile(line, col, name, what);
+    if (!found) return;
+    const auto read = readObjectFile(line, col, *found);
+    if (!read) return;
+    try {
+      parse(*read, found->string());
+    } catch (const InputError& e) {
+      for (const Diagnostic& d : e.diagnostics()) diags_.add(d);
+    }
+  }
+
   /// `NAME [samples]` after `key:` (function and curve lines): the name and the samples
   /// (`fallback` when absent, else a whole number from `minimum` to 1000000); nullopt after
   /// an error.
@@ -421,17 +437,9 @@ class ViewParser {
     const auto head = nameAndSamples(line, vcol, value, "function", -1, 0);
     if (!head) return;
     const auto& [name, samples] = *head;
-    const auto found = objectFile(line, vcol, name, "the function file");
-    if (!found) return;
-    const std::filesystem::path& file = *found;
-    const auto read = readObjectFile(line, vcol, file);
-    if (!read) return;
-    const std::string& text = *read;
-    try {
-      view_.functions.push_back(CpfgFunction::parse(text, file.string(), samples));
-    } catch (const InputError& e) {
-      for (const Diagnostic& d : e.diagnostics()) diags_.add(d);
-    }
+    parseObjectFile(line, vcol, name, "the function file", [&](const std::string& text, const std::string& file) {
+      view_.functions.push_back(CpfgFunction::parse(text, file, samples));
+    });
   }
 
   /// `function set: NAME.fset` (interpret.c, case 55; splinearr.cpp): a function gallery,
@@ -537,17 +545,9 @@ class ViewParser {
       return;
     }
     const size_t ncol = vcol - std::min(vcol, value.find_first_not_of(" \t")) + value.find(name, value.find(idText) + idText.size());
-    const auto found = objectFile(line, ncol, name, "the contour file");
-    if (!found) return;
-    const std::filesystem::path& file = *found;
-    const auto read = readObjectFile(line, ncol, file);
-    if (!read) return;
-    const std::string& text = *read;
-    try {
-      view_.contours.push_back({id, CpfgContour::parse(text, file.string())});
-    } catch (const InputError& e) {
-      for (const Diagnostic& d : e.diagnostics()) diags_.add(d);
-    }
+    parseObjectFile(line, ncol, name, "the contour file", [&](const std::string& text, const std::string& file) {
+      view_.contours.push_back({id, CpfgContour::parse(text, file)});
+    });
   }
 
   /// `curve: NAME [samples]` (interpret.c, case 53): the curve file beside the view file (or
@@ -556,17 +556,9 @@ class ViewParser {
     const auto head = nameAndSamples(line, vcol, value, "curve", CpfgCurve::kDefaultSamples, 2);
     if (!head) return;
     const auto& [name, samples] = *head;
-    const auto found = objectFile(line, vcol, name, "the curve file");
-    if (!found) return;
-    const std::filesystem::path& file = *found;
-    const auto read = readObjectFile(line, vcol, file);
-    if (!read) return;
-    const std::string& text = *read;
-    try {
-      view_.curves.push_back(CpfgCurve::parse(text, file.string(), samples));
-    } catch (const InputError& e) {
-      for (const Diagnostic& d : e.diagnostics()) diags_.add(d);
-    }
+    parseObjectFile(line, vcol, name, "the curve file", [&](const std::string& text, const std::string& file) {
+      view_.curves.push_back(CpfgCurve::parse(text, file, samples));
+    });
   }
 
   /// `surface: X NAME.s [size [s t] [texture]]` (interpret.c, case 21): the surface file
