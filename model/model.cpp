@@ -302,7 +302,18 @@ Box3 pairFrame(SpeciesModel& model, SpeciesModel& other) {
   return frame;
 }
 
+/// The white rule between a pair's panels: pairDividerHalfWidth(panel) columns on each side
+/// of the seam. Both panels show the same sky and ground, so without it a shadow or an
+/// object reaching past the left panel's edge reads as cut off inside one picture.
+void drawPanelDivider(Image& out, int panel) {
+  const int half = pairDividerHalfWidth(panel);
+  for (int y = 0; y < out.height; ++y)
+    for (int x = panel - half; x < panel + half; ++x) out.set(x, y, Vec4(1.0f));
+}
+
 }  // namespace
+
+int pairDividerHalfWidth(int panel) { return 1 + panel / 512; }
 
 render::Camera pairCamera(SpeciesModel& model, SpeciesModel& other, const SpeciesRender& look, int width, int height) {
   return speciesCamera(model, look, pairFrame(model, other), std::max(16, width / 2), height);
@@ -327,6 +338,7 @@ Image renderPair(SpeciesModel& model, SpeciesModel& other, const SpeciesRender& 
       out.set(x, y, a.at(x, y));
       out.set(panel + x, y, b.at(x, y));
     }
+  drawPanelDivider(out, panel);
   if (stats) {
     *stats = left;
     addStats(*stats, right);

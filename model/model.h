@@ -197,6 +197,10 @@ class FrameSequence {
   int builtScenes_ = 0, reusedScenes_ = 0, reusedImages_ = 0;
 };
 
+/// Half the width in pixels of the rule between renderPair's panels: 1, and 1 more for
+/// every 512 pixels of a panel's width.
+int pairDividerHalfWidth(int panel);
+
 /// The camera both panels of renderPair use for a width x height image (each panel half as
 /// wide): speciesCamera of model over the union of model's and other's frame boxes.
 render::Camera pairCamera(SpeciesModel& model, SpeciesModel& other, const SpeciesRender& look, int width, int height);
@@ -204,8 +208,10 @@ render::Camera pairCamera(SpeciesModel& model, SpeciesModel& other, const Specie
 /// Two species side by side (`render.pair`): model at job.stage in the left panel, other at
 /// its final stage in the right, each panel half the job's width (at least 16 pixels) and
 /// its height, both rendered with look and seen by one camera (job.camera, else pairCamera),
-/// each resting on its own ground, which fades around the union of the two frame boxes. Fills figures (model's) and stats (both panels') when
-/// given. Throws as renderModel.
+/// each resting on its own ground, which fades around the union of the two frame boxes. A
+/// white rule of pairDividerHalfWidth(panel) columns on each side of the seam covers the
+/// panels' facing edges, so that each reads as its own picture. Fills figures (model's) and
+/// stats (both panels') when given. Throws as renderModel.
 Image renderPair(SpeciesModel& model, SpeciesModel& other, const SpeciesRender& look, const RenderJob& job,
                  ModelFigures* figures = nullptr, render::RenderStats* stats = nullptr);
 

@@ -36,8 +36,21 @@ TEST_CASE("renderPair: two panels side by side seen by one camera", "[model]") {
     const Image img = renderPair(ma, again, a.render, smallJob(ma));
     REQUIRE(img.width == 48);
     REQUIRE(img.height == 24);
+    REQUIRE(pairDividerHalfWidth(24) == 1);
     for (int y = 0; y < 24; ++y)
-      for (int x = 0; x < 24; ++x) REQUIRE(img.at(x, y) == img.at(24 + x, y));
+      for (int x = 1; x < 23; ++x) REQUIRE(img.at(x, y) == img.at(24 + x, y));
+  }
+  SECTION("a white rule covers the panels' facing columns, one a side and one more per 512 pixels") {
+    const Image img = renderPair(ma, mb, a.render, smallJob(ma));
+    for (int y = 0; y < 24; ++y) {
+      CHECK(img.at(23, y) == Vec4(1.0f));
+      CHECK(img.at(24, y) == Vec4(1.0f));
+      CHECK(img.at(22, y) != Vec4(1.0f));  // sky or ground
+      CHECK(img.at(25, y) != Vec4(1.0f));
+    }
+    CHECK(pairDividerHalfWidth(255) == 1);
+    CHECK(pairDividerHalfWidth(256) == 1);
+    CHECK(pairDividerHalfWidth(512) == 2);
   }
   SECTION("each panel is its species rendered through the pair's camera, which frames both") {
     const render::Camera cam = pairCamera(ma, mb, a.render, 48, 24);
@@ -54,8 +67,8 @@ TEST_CASE("renderPair: two panels side by side seen by one camera", "[model]") {
     bool differ = false;
     for (int y = 0; y < 24; ++y)
       for (int x = 0; x < 24; ++x) {
-        REQUIRE(img.at(x, y) == left.at(x, y));
-        REQUIRE(img.at(24 + x, y) == right.at(x, y));
+        if (x < 23) REQUIRE(img.at(x, y) == left.at(x, y));  // but for the rule's columns 23 and 24
+        if (x > 0) REQUIRE(img.at(24 + x, y) == right.at(x, y));
         differ = differ || left.at(x, y) != right.at(x, y);
       }
     CHECK(differ);
