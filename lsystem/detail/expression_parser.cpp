@@ -172,20 +172,21 @@ void ExpressionParser::unexpected(State& st, const char* what) {
   throw ExprFail{};
 }
 
+ExpressionParser::Nesting ExpressionParser::nest(State& st) {
+  if (st.depth + 1 > kMaxNesting) {
+    scanner_.error(st.span.line, st.tok.col, "expression is nested too deeply (more than " + std::to_string(kMaxNesting) + " levels)");
+    throw ExprFail{};
+  }
+  return Nesting{++st.depth};
+}
+
 // ---- grammar of expressions --------------------------------------------------------------
 
 /// C's conditional `c ? a : b`, the lowest precedence (right-associative, as in C and cpfg).
 int ExpressionParser::parseConditional(State& st) {
   int cond = parseBinary(st, 0);
   if (!isPunct(st, "?")) return cond;
-  if (++st.depth > kMaxNesting) {
-    scanner_.error(st.span.line, st.tok.col, "expression is nested too deeply (more than " + std::to_string(kMaxNesting) + " levels)");
-    throw ExprFail{};
-  }
-  struct Leave {
-    int& d;
-    ~Leave() { --d; }
-  } leave{st.depth};
+  const Nesting nesting = nest(st);
   lex(st);
   int a = parseConditional(st);
   if (!isPunct(st, ":")) unexpected(st, "':' of 'c ? a : b'");
@@ -223,14 +224,7 @@ int ExpressionParser::parseBinary(State& st, int level) {
 }
 
 int ExpressionParser::parseUnary(State& st) {
-  if (++st.depth > kMaxNesting) {
-    scanner_.error(st.span.line, st.tok.col, "expression is nested too deeply (more than " + std::to_string(kMaxNesting) + " levels)");
-    throw ExprFail{};
-  }
-  struct Leave {
-    int& d;
-    ~Leave() { --d; }
-  } leave{st.depth};
+  const Nesting nesting = nest(st);
   if (isPunct(st, "-")) {
     lex(st);
     return node(st, Op::Neg, parseUnary(st));

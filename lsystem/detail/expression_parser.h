@@ -86,6 +86,12 @@ class ExpressionParser {
   bool isPunct(const State& st, std::string_view p) const;
   int node(State& st, Op op, int a = -1, int b = -1, int c = -1);
   [[noreturn]] void unexpected(State& st, const char* what);
+  /// One more level of nesting while the guard lives (an error past kMaxNesting levels).
+  struct Nesting {
+    int& depth;
+    ~Nesting() { --depth; }
+  };
+  [[nodiscard]] Nesting nest(State& st);
   int parseConditional(State& st);
   int parseBinary(State& st, int level);
   int parseUnary(State& st);
