@@ -241,7 +241,10 @@ TEST_CASE("buildLodChain reduces the parts side by side to the same levels at an
     const PartTexture* ta = one[k].parts[0].material.texture.get();
     const PartTexture* tb = two[k].parts[0].material.texture.get();
     REQUIRE((ta == nullptr) == (tb == nullptr));
-    if (ta) CHECK(tb->pixels().pixels == ta->pixels().pixels);
+    if (!ta) continue;
+    CHECK(tb->pixels().pixels == ta->pixels().pixels);
+    CHECK(tb->image8.values == ta->image8.values);
+    CHECK(ta->pixels().pixels.size() + ta->image8.values.size() > 0);
   }
 }
 
