@@ -1,7 +1,9 @@
 #include "core/image.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstring>
 
 #include "core/atomic_file.h"
 #include "core/diagnostics.h"
@@ -66,10 +68,42 @@ ImageFormat imageFormatFor(const fs::path& path) {
                               "' (supported: .png, .jpg, .jpeg, .exr)");
 }
 
-uint8_t textureMapByte(float linear) {
+namespace {
+
+// textureMapByte by its definition: a pow() per value.
+uint8_t textureMapByteOf(float linear) {
   const float y = static_cast<float>(linearToSrgb(static_cast<double>(linear))) * 255.0f;
   if (std::isnan(y)) return 0;
   return static_cast<uint8_t>(std::clamp(std::round(y), 0.0f, 255.0f));
+}
+
+// thresholds[k - 1]: the least float in [0, 1] whose textureMapByteOf is at least k. The
+// byte never decreases as the value grows (every step of it is monotone), so a value's byte
+// is the number of thresholds at or below it.
+const std::array<float, 255>& textureMapThresholds() {
+  static const std::array<float, 255> thresholds = [] {
+    std::array<float, 255> t{};
+    auto bitsOf = [](float f) { uint32_t b = 0; std::memcpy(&b, &f, 4); return b; };
+    auto floatOf = [](uint32_t b) { float f = 0; std::memcpy(&f, &b, 4); return f; };
+    for (int k = 1; k <= 255; ++k) {
+      uint32_t lo = bitsOf(0.0f), hi = bitsOf(1.0f);  // positive floats order as their bits
+      while (lo < hi) {
+        const uint32_t mid = lo + (hi - lo) / 2;
+        if (textureMapByteOf(floatOf(mid)) >= k) hi = mid; else lo = mid + 1;
+      }
+      t[size_t(k - 1)] = floatOf(lo);
+    }
+    return t;
+  }();
+  return thresholds;
+}
+
+}  // namespace
+
+uint8_t textureMapByte(float linear) {
+  if (std::isnan(linear)) return 0;
+  const std::array<float, 255>& t = textureMapThresholds();
+  return static_cast<uint8_t>(std::upper_bound(t.begin(), t.end(), linear) - t.begin());
 }
 
 uint8_t dataByte(float v) { return static_cast<uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); }

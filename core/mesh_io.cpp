@@ -488,10 +488,11 @@ const std::string& PngReuse::once(const PartTexture& tex, int encoding, const st
 
 namespace {
 
-// encodePng's bytes, made once per image and encoding within a PngReuse scope.
-std::string pngBytes(const PartTexture& tex, const fs::path& near, ImageEncoding encoding) {
+// encodePng's bytes, made once per image and encoding within a PngReuse scope (the
+// scope's own, not a copy); outside a scope made into own.
+const std::string& pngBytes(const PartTexture& tex, const fs::path& near, ImageEncoding encoding, std::string& own) {
   PngReuse* scope = PngReuse::innermost();
-  if (!scope) return encodePng(tex, near, encoding);
+  if (!scope) return own = encodePng(tex, near, encoding);
   return scope->once(tex, int(encoding), [&] { return encodePng(tex, near, encoding); });
 }
 
@@ -621,7 +622,8 @@ class GlbBuilder {
 
 int GlbBuilder::addTexture(const PartTexture* tex, const std::string& name, ImageEncoding encoding) {
   if (auto it = textures_.find(tex); it != textures_.end()) return it->second;
-  const std::string png = pngBytes(*tex, path_, encoding);
+  std::string own;
+  const std::string& png = pngBytes(*tex, path_, encoding, own);
   while (data_.size() % 4) data_.push_back(0);
   tinygltf::BufferView view;
   view.buffer = 0;

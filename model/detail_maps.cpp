@@ -32,7 +32,8 @@ DetailSurface::DetailSurface(const Mesh& full, const Vec3& baseColor) : triangle
 std::optional<render::SurfaceHit> DetailSurface::nearest(const Vec3& p, const Vec3& normal, float maxDistance) const {
   std::optional<render::SurfaceHit> best;
   for (const float side : {1.0f, -1.0f}) {
-    std::optional<render::SurfaceHit> h = scene_.intersect(p, side * normal, 0.0f, maxDistance);
+    // The second ray need not reach beyond the first one's hit: only a nearer hit counts.
+    std::optional<render::SurfaceHit> h = scene_.intersect(p, side * normal, 0.0f, best ? best->t : maxDistance);
     if (h && glm::dot(h->normal, normal) > 0.0f && (!best || h->t < best->t)) best = h;
   }
   return best;
