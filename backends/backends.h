@@ -44,7 +44,7 @@ struct Backends {
 };
 
 /// Changes whenever a table's layout does; the loader refuses a library of another version.
-inline constexpr int kBackendsVersion = 3;
+inline constexpr int kBackendsVersion = 4;
 
 /// The name of libsprig_backends.so's one exported function: `const Backends* ()`.
 inline constexpr const char* kBackendsEntry = "sprig_backends";

@@ -47,6 +47,7 @@ bool write(const std::string& path, const ImageFileSpec& s, PixelType dataType, 
   if (!s.colorSpace.empty()) spec.attribute("oiio:ColorSpace", s.colorSpace);
   if (!s.compression.empty()) spec.attribute("compression", s.compression);
   if (s.quality > 0) spec.attribute("CompressionQuality", s.quality);
+  if (s.pngLevel >= 0) spec.attribute("png:compressionLevel", s.pngLevel);
   return writeOne(*out, path, spec, typeOf(dataType), data, error);
 }
 

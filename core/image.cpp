@@ -1,7 +1,9 @@
 #include "core/image.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstring>
 
 #include "core/atomic_file.h"
 #include "core/diagnostics.h"
@@ -37,12 +39,19 @@ void Image::set(int x, int y, const Vec4& v) {
   pixels[i + 3] = v.a;
 }
 
+namespace {
+
+// toSrgb8's rounding of a value in [0, 1] (NaN gives 0).
+uint8_t quantize(float v) { return v > 0.0f ? static_cast<uint8_t>(std::lround(std::min(v, 1.0f) * 255.0f)) : uint8_t{0}; }
+
+// toSrgb8's byte of a linear colour value.
+uint8_t toSrgb8(float linear) { return quantize(linearToSrgb(linear)); }
+
+}  // namespace
+
 std::vector<uint8_t> toSrgb8(const Image& image, int channels) {
   size_t n = static_cast<size_t>(image.width) * image.height;
   std::vector<uint8_t> out(n * channels);
-  auto quantize = [](float v) {
-    return v > 0.0f ? static_cast<uint8_t>(std::lround(std::min(v, 1.0f) * 255.0f)) : uint8_t{0};
-  };
   for (size_t i = 0; i < n; ++i) {
     for (int c = 0; c < 3; ++c) out[i * channels + c] = quantize(linearToSrgb(image.pixels[i * 4 + c]));
     if (channels == 4) out[i * channels + 3] = quantize(image.pixels[i * 4 + 3]);
@@ -59,7 +68,102 @@ ImageFormat imageFormatFor(const fs::path& path) {
                               "' (supported: .png, .jpg, .jpeg, .exr)");
 }
 
-void writeImage(const Image& image, const fs::path& path, ImageEncoding encoding) {
+namespace {
+
+// textureMapByte by its definition: a pow() per value.
+uint8_t textureMapByteOf(float linear) {
+  const float y = static_cast<float>(linearToSrgb(static_cast<double>(linear))) * 255.0f;
+  if (std::isnan(y)) return 0;
+  return static_cast<uint8_t>(std::clamp(std::round(y), 0.0f, 255.0f));
+}
+
+// thresholds[k - 1]: the least float in [0, 1] whose textureMapByteOf is at least k. The
+// byte never decreases as the value grows (every step of it is monotone), so a value's byte
+// is the number of thresholds at or below it.
+const std::array<float, 255>& textureMapThresholds() {
+  static const std::array<float, 255> thresholds = [] {
+    std::array<float, 255> t{};
+    auto bitsOf = [](float f) { uint32_t b = 0; std::memcpy(&b, &f, 4); return b; };
+    auto floatOf = [](uint32_t b) { float f = 0; std::memcpy(&f, &b, 4); return f; };
+    for (int k = 1; k <= 255; ++k) {
+      uint32_t lo = bitsOf(0.0f), hi = bitsOf(1.0f);  // positive floats order as their bits
+      while (lo < hi) {
+        const uint32_t mid = lo + (hi - lo) / 2;
+        if (textureMapByteOf(floatOf(mid)) >= k) hi = mid; else lo = mid + 1;
+      }
+      t[size_t(k - 1)] = floatOf(lo);
+    }
+    return t;
+  }();
+  return thresholds;
+}
+
+}  // namespace
+
+uint8_t textureMapByte(float linear) {
+  if (std::isnan(linear)) return 0;
+  const std::array<float, 255>& t = textureMapThresholds();
+  return static_cast<uint8_t>(std::upper_bound(t.begin(), t.end(), linear) - t.begin());
+}
+
+uint8_t dataByte(float v) { return static_cast<uint8_t>(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); }
+
+Image8::Image8(int w, int h, int c, ImageEncoding e)
+    : width(w), height(h), channels(c), encoding(e), values(static_cast<size_t>(w) * h * c, 0) {}
+
+void Image8::set(int x, int y, const Vec3& rgb) {
+  uint8_t* p = &values[(static_cast<size_t>(y) * width + x) * channels];
+  for (int c = 0; c < 3; ++c)
+    p[c] = encoding == ImageEncoding::Data         ? dataByte(rgb[c])
+           : encoding == ImageEncoding::TextureMap ? textureMapByte(rgb[c])
+                                                   : toSrgb8(rgb[c]);
+  if (channels == 4) p[3] = 255;
+}
+
+Vec4 Image8::at(int x, int y) const {
+  const uint8_t* p = &values[(static_cast<size_t>(y) * width + x) * channels];
+  Vec4 v(0.0f, 0.0f, 0.0f, channels == 4 ? p[3] / 255.0f : 1.0f);
+  for (int c = 0; c < 3; ++c) v[c] = encoding == ImageEncoding::Data ? p[c] / 255.0f : srgbToLinear(p[c] / 255.0f);
+  return v;
+}
+
+Image8 toImage8(const Image& image, ImageEncoding encoding) {
+  const int channels = encoding == ImageEncoding::Picture ? 4 : 3;
+  Image8 out(image.width, image.height, channels, encoding);
+  if (encoding == ImageEncoding::Picture) {
+    out.values = toSrgb8(image, 4);
+    return out;
+  }
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x) out.set(x, y, Vec3(image.at(x, y)));
+  return out;
+}
+
+void writeImage(const Image8& image, const fs::path& path, const ImageWriteOptions& options) {
+  const Phase phase("write");
+  if (imageFormatFor(path) != ImageFormat::Png)
+    throw std::invalid_argument("cannot write image '" + path.string() + "': an 8-bit image is written as .png");
+  if (image.width <= 0 || image.height <= 0 || (image.channels != 3 && image.channels != 4) ||
+      image.values.size() != static_cast<size_t>(image.width) * image.height * image.channels)
+    throw std::invalid_argument("cannot write image '" + path.string() + "': image is empty or malformed");
+  const fs::path dir = path.parent_path();
+  if (!dir.empty() && !fs::is_directory(dir))
+    throw std::runtime_error("cannot write image '" + path.string() + "': folder '" + dir.string() + "' does not exist");
+  TempPath temp(path);
+  detail::ImageFileSpec spec;
+  spec.width = image.width;
+  spec.height = image.height;
+  spec.channels = image.channels;
+  spec.fileType = detail::PixelType::UInt8;
+  if (image.encoding != ImageEncoding::Data) spec.colorSpace = "sRGB";
+  spec.pngLevel = options.pngLevel;
+  std::string error;
+  if (!detail::imageBackend().write(temp.path().string(), spec, detail::PixelType::UInt8, image.values.data(), error))
+    throw std::runtime_error("cannot write image '" + path.string() + "': " + error);
+  temp.commit();
+}
+
+void writeImage(const Image& image, const fs::path& path, ImageEncoding encoding, const ImageWriteOptions& options) {
   const Phase phase("write");
   const ImageFormat format = imageFormatFor(path);
   if (image.width <= 0 || image.height <= 0 || image.pixels.size() != static_cast<size_t>(image.width) * image.height * 4)
@@ -73,6 +177,7 @@ void writeImage(const Image& image, const fs::path& path, ImageEncoding encoding
   detail::ImageFileSpec spec;
   spec.width = image.width;
   spec.height = image.height;
+  if (format == ImageFormat::Png) spec.pngLevel = options.pngLevel;
   std::string error;
   bool ok = false;
   const detail::ImageBackend& io = detail::imageBackend();

@@ -67,11 +67,67 @@ enum class ImageEncoding {
   Data,
 };
 
+/// How writeImage compresses what it writes.
+struct ImageWriteOptions {
+  /// zlib level of a PNG, 0 (stored) to 9 (smallest, slowest); -1: OpenImageIO's default,
+  /// 6. Every level decodes to the same pixels; the files differ in size and in the time
+  /// their encoding takes (docs/PERFORMANCE.md "The Murex's glb in 30 s").
+  int pngLevel = -1;
+};
+
 /// Writes image atomically to path in the format its extension names.
 /// Throws std::invalid_argument for an unknown extension or an empty or malformed image,
 /// std::runtime_error when the folder is missing or the writer fails.
 void writeImage(const Image& image, const std::filesystem::path& path,
-                ImageEncoding encoding = ImageEncoding::Picture);
+                ImageEncoding encoding = ImageEncoding::Picture, const ImageWriteOptions& options = {});
+
+/// The byte the TextureMap encoding stores for a linear colour value in an 8-bit file, as
+/// OpenImageIO 2.4 (Debian's build) makes it from writeImage's float: s =
+/// float(linearToSrgb(double(linear))), y = s·255 in float, round(y) (half away from zero)
+/// clamped to [0, 255]; NaN gives 0. OpenImageIO converts the last (up to 3) values of each
+/// chunk of a row one by one, as int(y + 0.5f) clamped, where the chunks follow its thread
+/// count; the two roundings differ for one float y alone, 0.49999997f, which one linear float
+/// alone gives, 0x1.3e4566p-13 (both checked over every float): 0 here, 1 in such a place.
+/// Cost: a binary search over the 255 values where the byte steps up (found once, by this
+/// formula), no pow(); the same bytes as the formula for every float (checked over all).
+uint8_t textureMapByte(float linear);
+/// The byte the Data encoding stores: lround(255·v) of v clamped to [0, 1].
+uint8_t dataByte(float v);
+
+/// An image as an 8-bit file holds it: `channels` bytes per pixel (3: RGB; 4: RGBA), row-major
+/// from the top-left pixel, each the very byte the PNG stores, in `encoding`'s meaning:
+/// TextureMap colour bytes from textureMapByte, Data bytes from dataByte, Picture bytes
+/// from toSrgb8 (alpha linear). An RGB texel takes 3 bytes where Image takes 16: export
+/// atlases and normal maps are baked straight into it (model/mesh_parts.h bakeAtlases),
+/// converted once, and written without another pass.
+struct Image8 {
+  int width = 0;
+  int height = 0;
+  int channels = 0;
+  ImageEncoding encoding = ImageEncoding::TextureMap;
+  std::vector<uint8_t> values;  ///< channels · width · height bytes
+
+  Image8() = default;
+  /// A w x h image of `channels` (3 or 4) zero bytes per pixel, in encoding.
+  Image8(int w, int h, int channels, ImageEncoding encoding);
+  bool empty() const { return values.empty(); }
+  /// Sets pixel (x, y) to the bytes of linear colour rgb (alpha 1 where there are 4
+  /// channels) in the image's encoding; no bounds check.
+  void set(int x, int y, const Vec3& rgb);
+  /// Pixel (x, y) decoded to linear values: colour srgbToLinear(byte / 255) in TextureMap and
+  /// Picture, byte / 255 in Data; alpha byte / 255, 1 without an alpha channel. No bounds check.
+  Vec4 at(int x, int y) const;
+};
+
+/// image's 8-bit values in encoding: the bytes writeImage(image, "X.png", encoding) stores
+/// (Picture: RGBA). O(pixels).
+Image8 toImage8(const Image& image, ImageEncoding encoding);
+
+/// Writes an 8-bit image atomically as a PNG (path must end in .png) holding its values as
+/// they are: the file writeImage writes for the float image they were made from (its colour
+/// space tag too: sRGB for TextureMap and Picture, none for Data). Throws as writeImage, and
+/// std::invalid_argument for another extension.
+void writeImage(const Image8& image, const std::filesystem::path& path, const ImageWriteOptions& options = {});
 
 /// Writes frames (all of one size) as an animated GIF that loops forever (oiio:LoopCount
 /// 0), each frame shown round(100 / fps) centiseconds, colour bytes from toSrgb8, through

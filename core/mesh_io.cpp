@@ -388,11 +388,11 @@ PartCorners partCorners(const ExportPart& part) {
   if (tex && tex->isAtlas()) {
     c.uvs = tex->atlas;
     c.report.atlasCell = tex->atlasCell;
-    c.report.textureWidth = tex->pixels().width, c.report.textureHeight = tex->pixels().height;
+    c.report.textureWidth = tex->width(), c.report.textureHeight = tex->height();
   } else if (mesh.uvs.size() == n) {
     c.uvs = cornerUvs(mesh, tex ? tex->seams : UvSeamOptions{});
     c.report.seamCorners = c.uvs.values.size() - n;
-    if (tex) c.report.textureWidth = tex->pixels().width, c.report.textureHeight = tex->pixels().height;
+    if (tex) c.report.textureWidth = tex->width(), c.report.textureHeight = tex->height();
   }
   return c;
 }
@@ -406,20 +406,39 @@ ImageEncoding baseColorEncoding(const PartMaterial& material) {
   return material.alphaCutoff >= 0.0f ? ImageEncoding::Picture : ImageEncoding::TextureMap;
 }
 
-std::string encodePng(const Image& image, const fs::path& near, ImageEncoding encoding) {
+// Writes tex's image (8-bit as it is, or the float image in encoding) to png at
+// kTexturePngLevel.
+void writeTexture(const PartTexture& tex, const fs::path& png, ImageEncoding encoding) {
+  ImageWriteOptions options;
+  options.pngLevel = kTexturePngLevel;
+  if (!tex.image8.empty())
+    writeImage(tex.image8, png, options);
+  else
+    writeImage(tex.pixels(), png, encoding, options);
+}
+
+std::string encodePng(const PartTexture& tex, const fs::path& near, ImageEncoding encoding) {
   fs::path dest = near;
   dest.replace_extension(".png");
   TempPath temp(dest);
-  writeImage(image, temp.path(), encoding);
+  writeTexture(tex, temp.path(), encoding);
   return readFile(temp.path());
+}
+
+// The key of a texture's image in a PngReuse scope: the image (its address, its values'
+// address and size) and the encoding.
+using PngKey = std::tuple<const void*, const void*, size_t, int>;
+PngKey pngKey(const PartTexture& tex, ImageEncoding encoding) {
+  if (!tex.image8.empty()) return PngKey(&tex.image8, tex.image8.values.data(), tex.image8.values.size(), int(encoding));
+  const Image& image = tex.pixels();
+  return PngKey(&image, image.pixels.data(), image.pixels.size(), int(encoding));
 }
 
 }  // namespace
 
-// The bytes of the images encoded in a PngReuse scope, by image (its address, its pixels'
-// address and size) and encoding.
+// The bytes of the images encoded in a PngReuse scope, by pngKey.
 struct PngReuse::Cache {
-  std::map<std::tuple<const Image*, const float*, size_t, int>, std::string> png;
+  std::map<PngKey, std::string> png;
 };
 
 namespace {
@@ -434,26 +453,34 @@ size_t PngReuse::encoded() const { return cache_->png.size(); }
 PngReuse* PngReuse::innermost() { return innermostPngReuse; }
 
 void PngReuse::encodeAhead(const std::vector<const ExportPart*>& parts, const fs::path& near) {
-  using Key = std::tuple<const Image*, const float*, size_t, int>;
-  std::vector<std::pair<Key, ImageEncoding>> todo;
-  auto want = [&](const Image& image, ImageEncoding encoding) {
-    const Key key(&image, image.pixels.data(), image.pixels.size(), int(encoding));
+  struct Todo {
+    PngKey key;
+    const PartTexture* tex;
+    ImageEncoding encoding;
+  };
+  std::vector<Todo> todo;
+  auto want = [&](const PartTexture& tex, ImageEncoding encoding) {
+    const PngKey key = pngKey(tex, encoding);
     if (cache_->png.count(key)) return;
-    for (const auto& t : todo)
-      if (t.first == key) return;
-    todo.emplace_back(key, encoding);
+    for (const Todo& t : todo)
+      if (t.key == key) return;
+    todo.push_back({key, &tex, encoding});
   };
   for (const ExportPart* p : parts) {
     if (p->mesh.triangles.empty()) continue;
-    if (p->material.texture) want(p->material.texture->pixels(), baseColorEncoding(p->material));
-    if (p->material.normalTexture) want(p->material.normalTexture->pixels(), ImageEncoding::Data);
+    if (p->material.texture) want(*p->material.texture, baseColorEncoding(p->material));
+    if (p->material.normalTexture) want(*p->material.normalTexture, ImageEncoding::Data);
   }
+  // The largest images first: two threads finish together when the last ones are small.
+  std::stable_sort(todo.begin(), todo.end(), [](const Todo& a, const Todo& b) {
+    return size_t(a.tex->width()) * size_t(a.tex->height()) > size_t(b.tex->width()) * size_t(b.tex->height());
+  });
   std::vector<std::string> bytes(todo.size());
-  parallelFor(0, todo.size(), [&](size_t i) { bytes[i] = encodePng(*std::get<0>(todo[i].first), near, todo[i].second); });
-  for (size_t i = 0; i < todo.size(); ++i) cache_->png.emplace(todo[i].first, std::move(bytes[i]));
+  parallelFor(0, todo.size(), [&](size_t i) { bytes[i] = encodePng(*todo[i].tex, near, todo[i].encoding); });
+  for (size_t i = 0; i < todo.size(); ++i) cache_->png.emplace(todo[i].key, std::move(bytes[i]));
 }
-const std::string& PngReuse::once(const Image& image, int encoding, const std::function<std::string()>& encode) {
-  const auto key = std::make_tuple(&image, image.pixels.data(), image.pixels.size(), encoding);
+const std::string& PngReuse::once(const PartTexture& tex, int encoding, const std::function<std::string()>& encode) {
+  const PngKey key = pngKey(tex, ImageEncoding(encoding));
   auto it = cache_->png.find(key);
   if (it == cache_->png.end()) it = cache_->png.emplace(key, encode()).first;
   return it->second;
@@ -461,11 +488,12 @@ const std::string& PngReuse::once(const Image& image, int encoding, const std::f
 
 namespace {
 
-// encodePng's bytes, made once per image and encoding within a PngReuse scope.
-std::string pngBytes(const Image& image, const fs::path& near, ImageEncoding encoding) {
+// encodePng's bytes, made once per image and encoding within a PngReuse scope (the
+// scope's own, not a copy); outside a scope made into own.
+const std::string& pngBytes(const PartTexture& tex, const fs::path& near, ImageEncoding encoding, std::string& own) {
   PngReuse* scope = PngReuse::innermost();
-  if (!scope) return encodePng(image, near, encoding);
-  return scope->once(image, int(encoding), [&] { return encodePng(image, near, encoding); });
+  if (!scope) return own = encodePng(tex, near, encoding);
+  return scope->once(tex, int(encoding), [&] { return encodePng(tex, near, encoding); });
 }
 
 // One tangent per vertex of an unwelded mesh whose vertices each belong to one corner (an
@@ -500,6 +528,22 @@ void checkExtras(const ExportPart& p) {
   if (!ok) throw std::invalid_argument("exported part '" + p.name + "' has morph targets or weights that do not fit its mesh");
 }
 
+// tex's image (8-bit or float) holds its pixels, an 8-bit one in encoding, the writers' for it.
+void checkTextureImage(const ExportPart& p, const PartTexture& tex, ImageEncoding encoding) {
+  if (!tex.image8.empty()) {
+    const Image8& im = tex.image8;
+    if (im.width <= 0 || im.height <= 0 || im.channels != (encoding == ImageEncoding::Picture ? 4 : 3) ||
+        im.values.size() != size_t(im.width) * size_t(im.height) * size_t(im.channels))
+      throw std::invalid_argument("exported part '" + p.name + "' has an empty or malformed 8-bit texture image");
+    if (im.encoding != encoding)
+      throw std::invalid_argument("exported part '" + p.name + "' has an 8-bit texture image in another encoding than its file's");
+    return;
+  }
+  const Image& im = tex.pixels();
+  if (im.width <= 0 || im.height <= 0 || im.pixels.size() != size_t(im.width) * size_t(im.height) * 4)
+    throw std::invalid_argument("exported part '" + p.name + "' has an empty or malformed texture image");
+}
+
 void checkParts(const std::vector<ExportPart>& parts) {
   std::vector<std::string> names;
   for (const ExportPart& p : parts) {
@@ -519,14 +563,12 @@ void checkParts(const std::vector<ExportPart>& parts) {
       } else if (p.mesh.uvs.size() != p.mesh.positions.size()) {
         throw std::invalid_argument("exported part '" + p.name + "' has a texture but no texture coordinates");
       }
-      const Image& im = tex->pixels();
-      if (im.width <= 0 || im.height <= 0 || im.pixels.size() != size_t(im.width) * size_t(im.height) * 4)
-        throw std::invalid_argument("exported part '" + p.name + "' has an empty or malformed texture image");
+      checkTextureImage(p, *tex, baseColorEncoding(p.material));
     }
     if (const PartTexture* nt = p.material.normalTexture.get()) {
       const PartTexture* tex = p.material.texture.get();
-      if (!tex || !tex->isAtlas() || nt->image.width != tex->pixels().width || nt->image.height != tex->pixels().height ||
-          nt->image.pixels.size() != tex->pixels().pixels.size())
+      checkTextureImage(p, *nt, ImageEncoding::Data);
+      if (!tex || !tex->isAtlas() || nt->width() != tex->width() || nt->height() != tex->height())
         throw std::invalid_argument("exported part '" + p.name + "' has a normal map without an atlas of its size");
     }
   }
@@ -580,7 +622,8 @@ class GlbBuilder {
 
 int GlbBuilder::addTexture(const PartTexture* tex, const std::string& name, ImageEncoding encoding) {
   if (auto it = textures_.find(tex); it != textures_.end()) return it->second;
-  const std::string png = pngBytes(tex->pixels(), path_, encoding);
+  std::string own;
+  const std::string& png = pngBytes(*tex, path_, encoding, own);
   while (data_.size() % 4) data_.push_back(0);
   tinygltf::BufferView view;
   view.buffer = 0;
@@ -823,7 +866,7 @@ std::vector<PartWriteReport> writePartsObj(const std::vector<ExportPart>& parts,
   std::string out = "# written by Sprig\nmtllib " + mtlPath.filename().string() + "\n";
   struct ImageFile {
     fs::path png;
-    const Image* image;
+    const PartTexture* texture;
     ImageEncoding encoding;
   };
   std::vector<ImageFile> images;
@@ -849,7 +892,7 @@ std::vector<PartWriteReport> writePartsObj(const std::vector<ExportPart>& parts,
       fs::path png = path;
       png.replace_filename(path.stem().string() + "_" + objName(part.name) + ".png");
       const bool cutOut = part.material.alphaCutoff >= 0.0f;
-      images.push_back({png, &tex->pixels(), cutOut ? ImageEncoding::Picture : ImageEncoding::TextureMap});
+      images.push_back({png, tex, cutOut ? ImageEncoding::Picture : ImageEncoding::TextureMap});
       // MTL's -clamp covers both axes at once: said where glTF's sampler clamps both (an
       // atlas, cpfg's leaves); an image that repeats in one axis only is left repeating.
       const std::string map = (!tex->seams.repeatU && !tex->seams.repeatV ? "-clamp on " : "") + png.filename().string();
@@ -860,7 +903,7 @@ std::vector<PartWriteReport> writePartsObj(const std::vector<ExportPart>& parts,
       // `norm`: the normal map of the MTL's PBR extension (tinyobjloader, three.js); not
       // map_Bump, which many readers take for a height map.
       const fs::path png = normalMapPath(path, part);
-      images.push_back({png, &normal->image, ImageEncoding::Data});
+      images.push_back({png, normal, ImageEncoding::Data});
       mtl += "norm -clamp on " + png.filename().string() + "\n";
     }
     mtl += "\n";
@@ -889,7 +932,7 @@ std::vector<PartWriteReport> writePartsObj(const std::vector<ExportPart>& parts,
   std::vector<fs::path> written;
   try {
     for (const ImageFile& f : images) {
-      writeImage(*f.image, f.png, f.encoding);
+      writeTexture(*f.texture, f.png, f.encoding);
       written.push_back(f.png);
     }
     writeAtomic(mtlPath, mtl);

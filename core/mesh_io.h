@@ -83,6 +83,14 @@ class DeferredImage {
   std::atomic<bool> baked_{false};
 };
 
+/// The zlib level of the PNGs the mesh writers store textures in (glb images, OBJ's
+/// `STEM_PART.png`; PNG filter none, as before). On the Murex's 3792 x 3792 atlas and
+/// normal map, level 6 (OpenImageIO's default, which the writers used before) took about
+/// three times as long as level 4 for files 5 % smaller; level 1 saves a little more time
+/// for files a fifth larger than level 6's. Every level decodes to the same pixels
+/// (docs/PERFORMANCE.md "The Murex's glb in 30 s").
+inline constexpr int kTexturePngLevel = 4;
+
 /// A part's texture baked into an image: the colour at texture coordinate (s, t) of the
 /// part's Mesh::uvs (origin at the image's bottom-left, as OBJ's vt) is the image's colour
 /// there, absolute (not relative to the base colour). The writers store it as an 8-bit sRGB
@@ -94,8 +102,18 @@ struct PartTexture {
   /// When set, the image is this deferred bake's (image stays empty): read it through
   /// pixels(). Copies of the texture share it, so it is baked at most once.
   std::shared_ptr<DeferredImage> deferred;
-  /// The texture's image: `image`, or the deferred one (baked now if it was not yet).
+  /// When not empty, the texture's image as the PNG stores it (image stays empty and
+  /// deferred null): the levels' atlases and normal maps (model/detail_maps.h) are baked
+  /// straight into 8-bit values, 3 bytes a texel where image takes 16. Its encoding must be
+  /// the writers' for the texture (TextureMap for an opaque base colour, Picture for a
+  /// cut-out, Data for a normal map).
+  Image8 image8;
+  /// The texture's float image: `image`, or the deferred one (baked now if it was not yet);
+  /// empty for an 8-bit texture (image8).
   const Image& pixels() const { return deferred ? deferred->get() : image; }
+  /// The image's width and height, whichever form it has (a deferred image is baked now).
+  int width() const { return image8.empty() ? pixels().width : image8.width; }
+  int height() const { return image8.empty() ? pixels().height : image8.height; }
   UvSeamOptions seams;    ///< which axes repeat (glTF sampler REPEAT, else CLAMP_TO_EDGE) and the seam rules
   /// An atlas: when not empty, the texture coordinates of every triangle's corners (3 per
   /// triangle of the part's mesh, values in [0,1]), used instead of the mesh's uvs (which
@@ -245,9 +263,9 @@ class PngReuse {
   void encodeAhead(const std::vector<const ExportPart*>& parts, const std::filesystem::path& near);
   /// The innermost scope alive on this thread, or null.
   static PngReuse* innermost();
-  /// encode()'s bytes for image in encoding (an ImageEncoding), made at the first call for
-  /// that image and encoding in this scope and reused after.
-  const std::string& once(const Image& image, int encoding, const std::function<std::string()>& encode);
+  /// encode()'s bytes for tex's image in encoding (an ImageEncoding), made at the first
+  /// call for that image and encoding in this scope and reused after.
+  const std::string& once(const PartTexture& tex, int encoding, const std::function<std::string()>& encode);
 
  private:
   struct Cache;

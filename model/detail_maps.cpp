@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/mesh_corners.h"
+#include "core/parallel.h"
 #include "model/mesh_parts.h"
 
 namespace sprig {
@@ -31,7 +32,8 @@ DetailSurface::DetailSurface(const Mesh& full, const Vec3& baseColor) : triangle
 std::optional<render::SurfaceHit> DetailSurface::nearest(const Vec3& p, const Vec3& normal, float maxDistance) const {
   std::optional<render::SurfaceHit> best;
   for (const float side : {1.0f, -1.0f}) {
-    std::optional<render::SurfaceHit> h = scene_.intersect(p, side * normal, 0.0f, maxDistance);
+    // The second ray need not reach beyond the first one's hit: only a nearer hit counts.
+    std::optional<render::SurfaceHit> h = scene_.intersect(p, side * normal, 0.0f, best ? best->t : maxDistance);
     if (h && glm::dot(h->normal, normal) > 0.0f && (!best || h->t < best->t)) best = h;
   }
   return best;
@@ -54,15 +56,25 @@ DetailMaps bakeDetailMaps(const Mesh& low, const Vec3& baseColor, const DetailSu
   // along +s, corner 2 along +t.
   const Vec2 uv[3] = {Vec2(0.0f), Vec2(1.0f, 0.0f), Vec2(0.0f, 1.0f)};
   std::vector<size_t> hits(low.triangles.size(), 0);
-  auto texel = [&](size_t t, const Vec3& p, const Vec3& b, Vec3* out) {
+  // Each corner's unit normal and tangent, once per corner rather than once per texel.
+  std::vector<Vec3> cornerNormal(low.triangles.size() * 3);
+  std::vector<glm::vec4> cornerTangents(low.triangles.size() * 3);
+  parallelFor(0, low.triangles.size(), [&](size_t t) {
     const glm::uvec3& tri = low.triangles[t];
     const Vec3 P[3] = {low.positions[tri.x], low.positions[tri.y], low.positions[tri.z]};
+    for (size_t k = 0; k < 3; ++k) {
+      const Vec3 nk = corners.normals.values[corners.normals.index[t * 3 + k]];
+      cornerNormal[t * 3 + k] = glm::normalize(nk);
+      cornerTangents[t * 3 + k] = cornerTangent(P, uv, nk);
+    }
+  });
+  auto texel = [&](size_t t, const Vec3& p, const Vec3& b, Vec3* out) {
+    const glm::uvec3& tri = low.triangles[t];
     Vec3 n(0.0f), tangent(0.0f);
     float w = 0.0f;
     for (int k = 0; k < 3; ++k) {
-      const Vec3 nk = corners.normals.values[corners.normals.index[t * 3 + size_t(k)]];
-      const glm::vec4 tk = cornerTangent(P, uv, nk);
-      n += b[k] * glm::normalize(nk);
+      const glm::vec4& tk = cornerTangents[t * 3 + size_t(k)];
+      n += b[k] * cornerNormal[t * 3 + size_t(k)];
       tangent += b[k] * Vec3(tk);
       w += b[k] * tk.w;
     }
@@ -83,7 +95,10 @@ DetailMaps bakeDetailMaps(const Mesh& low, const Vec3& baseColor, const DetailSu
                : lowColors ? b.x * low.colors[tri.x] + b.y * low.colors[tri.y] + b.z * low.colors[tri.z]
                            : baseColor;
   };
-  std::vector<std::shared_ptr<PartTexture>> images = bakeAtlases(low, colors ? 2 : 1, texel, true);
+  // 8-bit, as the glb stores them: the normal map's bytes 128 + round(127·nᵢ), the colours' sRGB.
+  std::vector<ImageEncoding> eightBit{ImageEncoding::Data};
+  if (colors) eightBit.push_back(ImageEncoding::TextureMap);
+  std::vector<std::shared_ptr<PartTexture>> images = bakeAtlases(low, colors ? 2 : 1, texel, true, eightBit);
   if (images.empty()) return maps;
   maps.normal = images[0];
   if (colors) maps.color = images[1];

@@ -63,7 +63,9 @@ struct DetailMaps {
 /// (DetailSurface::nearest) gives the normal map (h·T, h·B, h·N) of its shading normal h,
 /// encoded by encodeTangentNormal, and the colour map the full mesh's interpolated vertex
 /// colour; a miss gives (0, 0, 1) and low's own interpolated colour (its base colour
-/// without vertex colours). colors false: no colour map. low must have normals. Cost:
+/// without vertex colours). colors false: no colour map. Both images are 8-bit
+/// (PartTexture::image8: the normal map in the Data encoding, the colours in TextureMap's
+/// sRGB bytes), as the writers store them. low must have normals. Cost:
 /// two rays per texel, in parallel over triangles; the same bytes at any thread count.
 DetailMaps bakeDetailMaps(const Mesh& low, const Vec3& baseColor, const DetailSurface& full, float maxDistance, bool colors);
 

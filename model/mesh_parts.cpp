@@ -1,6 +1,7 @@
 #include "model/mesh_parts.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <stdexcept>
@@ -149,15 +150,18 @@ bool ownColors(const ExportPart& part) {
 }  // namespace
 
 std::vector<std::shared_ptr<PartTexture>> bakeAtlases(const Mesh& mesh, int count, const SurfaceTexel& texelAt,
-                                                      bool gutterCopies) {
+                                                      bool gutterCopies, const std::vector<ImageEncoding>& eightBit) {
   const AtlasLayout l = atlasLayout(mesh.triangles.size());
-  if (l.cell == 0 || count < 1 || count > kMaxAtlases) return {};
+  if (l.cell == 0 || count < 1 || count > kMaxAtlases || (!eightBit.empty() && eightBit.size() != size_t(count))) return {};
   const int W = l.width(), H = l.height(), c = l.cell;
   const size_t nt = mesh.triangles.size();
   std::vector<std::shared_ptr<PartTexture>> out;
   for (int k = 0; k < count; ++k) {
     auto tex = std::make_shared<PartTexture>();
-    tex->image = Image(W, H, Vec4(0, 0, 0, 1));
+    if (eightBit.empty())
+      tex->image = Image(W, H, Vec4(0, 0, 0, 1));
+    else
+      tex->image8 = Image8(W, H, eightBit[size_t(k)] == ImageEncoding::Picture ? 4 : 3, eightBit[size_t(k)]);
     tex->atlasCell = c;
     tex->atlas.values.resize(nt * 3);
     tex->atlas.index.resize(nt * 3);
@@ -175,28 +179,37 @@ std::vector<std::shared_ptr<PartTexture>> bakeAtlases(const Mesh& mesh, int coun
         tex->atlas.index[t * 3 + size_t(k)] = uint32_t(t * 3 + size_t(k));
         tex->atlas.values[t * 3 + size_t(k)] = Vec2((float(x0) + corner[k].x) / float(W), (float(y0) + corner[k].y) / float(H));
       }
+    // The patch's values first (patch[(j·c + i)·kMaxAtlases + k]), then stored at once: an
+    // 8-bit image quantizes each value at its own texel, as the float image's writer would.
+    std::array<Vec3, size_t(kAtlasMaxCell * kAtlasMaxCell * kMaxAtlases)> patch;
+    const auto at = [&](int i, int j) { return &patch[size_t(j * c + i) * kMaxAtlases]; };
     const int leg = c - 3;  // texel (i, j) has barycentric (i − 1, j − 1)/leg
-    Vec3 values[kMaxAtlases];
     auto bake = [&](int i, int j) {
       const Vec3 b = clampedBary(double(i - 1) / leg, double(j - 1) / leg);
-      texelAt(t, b.x * P[0] + b.y * P[1] + b.z * P[2], b, values);
-      for (size_t k = 0; k < out.size(); ++k) out[k]->image.set(x0 + i, H - 1 - (y0 + j), Vec4(values[k], 1.0f));
+      texelAt(t, b.x * P[0] + b.y * P[1] + b.z * P[2], b, at(i, j));
     };
     auto inside = [leg](int i, int j) { return i >= 1 && j >= 1 && i + j - 2 <= leg; };
     for (int j = 0; j < c; ++j)
       for (int i = 0; i < c; ++i)
         if (!gutterCopies || inside(i, j)) bake(i, j);
-    if (!gutterCopies) return;
     // Gutter texels: the inside texel nearest to the texel's point clamped to the triangle.
-    for (int j = 0; j < c; ++j)
+    for (int j = 0; gutterCopies && j < c; ++j)
       for (int i = 0; i < c; ++i) {
         if (inside(i, j)) continue;
         const Vec3 b = clampedBary(double(i - 1) / leg, double(j - 1) / leg);
         int si = 1 + int(std::lround(double(b.y) * leg)), sj = 1 + int(std::lround(double(b.z) * leg));
         while (!inside(si, sj)) (si > sj ? si : sj) -= 1;
-        for (const std::shared_ptr<PartTexture>& tex : out)
-          tex->image.set(x0 + i, H - 1 - (y0 + j), tex->image.at(x0 + si, H - 1 - (y0 + sj)));
+        std::copy(at(si, sj), at(si, sj) + count, at(i, j));
       }
+    for (int j = 0; j < c; ++j)
+      for (int i = 0; i < c; ++i)
+        for (size_t k = 0; k < out.size(); ++k) {
+          const int x = x0 + i, y = H - 1 - (y0 + j);
+          if (eightBit.empty())
+            out[k]->image.set(x, y, Vec4(at(i, j)[k], 1.0f));
+          else
+            out[k]->image8.set(x, y, at(i, j)[k]);
+        }
   });
   return out;
 }

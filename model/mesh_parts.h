@@ -121,10 +121,14 @@ using SurfaceTexel = std::function<void(size_t triangle, const Vec3& point, cons
 /// values computed by one texelAt call (a normal map and a colour map from one ray cast).
 /// gutterCopies: texelAt is called only for the texels whose centres lie in the triangle
 /// (105 of the 256 texels of a 16-texel patch); each gutter texel copies the inside texel nearest to its
-/// clamped point. Empty when bakeAtlas would give null or count is out of range.
+/// clamped point. eightBit: empty, float images (PartTexture::image); else count
+/// encodings, image k stored 8-bit in eightBit[k] (PartTexture::image8: the bytes its PNG
+/// holds, those writeImage gives the float image; 3 bytes a texel instead of 16). Empty
+/// when bakeAtlas would give null or count (or eightBit's size) is out of range.
 /// Thread-count independent.
 std::vector<std::shared_ptr<PartTexture>> bakeAtlases(const Mesh& mesh, int count, const SurfaceTexel& texelAt,
-                                                      bool gutterCopies = false);
+                                                      bool gutterCopies = false,
+                                                      const std::vector<ImageEncoding>& eightBit = {});
 /// bakeAtlas with the image deferred (PartTexture::deferred): the corners now, the texels
 /// (the same bytes) when a writer first reads PartTexture::pixels(); never when no written
 /// file uses the texture (a level of detail replaces the full part's atlas). mesh and

@@ -31,6 +31,7 @@ struct ImageFileSpec {
   std::string colorSpace;   ///< "oiio:ColorSpace" ("sRGB", "Linear"); empty = not set
   std::string compression;  ///< "compression" ("zip"); empty = the writer's default
   int quality = 0;          ///< "CompressionQuality" (JPEG); 0 = the writer's default
+  int pngLevel = -1;        ///< "png:compressionLevel" (zlib 0-9); -1 = the writer's default (6)
 };
 
 /// What an image file's header says, uninterpreted.

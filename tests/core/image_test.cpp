@@ -12,6 +12,7 @@
 
 #include <unistd.h>
 
+#include "core/atomic_file.h"
 #include "core/image.h"
 #include "core/paths.h"
 #include "core/srgb.h"
@@ -41,6 +42,11 @@ std::string capturedStderr(F run) {
   std::fclose(sink);
   return text;
 }
+
+// The linear value whose sRGB float times 255 is 0.49999997f, just below the first rounding
+// tie: the only float input whose byte differs between OpenImageIO's two roundings (core/image.h
+// textureMapByte; found by scanning every float).
+constexpr float kHalfBelowTie = 0x1.3e4566p-13f;
 
 }  // namespace
 
@@ -89,6 +95,117 @@ TEST_CASE("writeImage", "[core]") {
     CHECK(fs::is_empty(dir));
     CHECK_FALSE(fs::exists(dir / "nope"));
   }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("Image8 holds the bytes writeImage stores", "[core]") {
+  // A float image written as a texture map (OpenImageIO converts its sRGB floats to bytes)
+  // and its Image8 (Sprig's textureMapByte) must make PNGs of the same pixels: every value
+  // near each rounding tie of 255·s, in the first 20 values of a 7-pixel row (OpenImageIO's
+  // four-at-a-time body) and in the last (converted one by one), out-of-range values too.
+  std::vector<float> linear;
+  for (int k = 0; k < 255; ++k) {
+    float v = float(srgbToLinear(double(k + 0.5) / 255.0));
+    for (int d = 0; d < 40; ++d) v = std::nextafter(v, 0.0f);
+    for (int d = 0; d < 81; ++d, v = std::nextafter(v, 2.0f))
+      if (v != kHalfBelowTie) linear.push_back(v);
+  }
+  linear.push_back(-0.25f);
+  linear.push_back(1.5f);
+  const int width = 7, height = int(linear.size());
+  Image img(width, height);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) img.set(x, y, Vec4(linear[size_t(y)], linear[size_t(y)], linear[size_t(y)], 1.0f));
+  // The one linear float whose bytes differ between OpenImageIO's two roundings.
+  CHECK(float(linearToSrgb(double(kHalfBelowTie))) * 255.0f == 0.49999997f);
+  CHECK(textureMapByte(kHalfBelowTie) == 0);
+  CHECK(textureMapByte(std::nextafter(kHalfBelowTie, 1.0f)) == 1);
+  const fs::path dir = scratchDir("image8");
+  for (const ImageEncoding encoding : {ImageEncoding::TextureMap, ImageEncoding::Data, ImageEncoding::Picture}) {
+    INFO("encoding " << int(encoding));
+    const Image8 bytes = toImage8(img, encoding);
+    REQUIRE(bytes.values.size() == size_t(width) * size_t(height) * (encoding == ImageEncoding::Picture ? 4 : 3));
+    writeImage(img, dir / "float.png", encoding);
+    writeImage(bytes, dir / "bytes.png");
+    // The same pixels and the same colour space: readImage decodes both alike.
+    CHECK(readImageInfo(dir / "bytes.png").srgb == readImageInfo(dir / "float.png").srgb);
+    CHECK(readImage(dir / "bytes.png").pixels == readImage(dir / "float.png").pixels);
+    // At every zlib level.
+    ImageWriteOptions fast;
+    fast.pngLevel = 1;
+    writeImage(bytes, dir / "fast.png", fast);
+    CHECK(readImage(dir / "fast.png").pixels == readImage(dir / "float.png").pixels);
+    // Image8::at decodes colours as readImage decodes the file (which takes an untagged
+    // 8-bit file, a Data one, for sRGB too: there at() gives byte / 255).
+    const Image back = readImage(dir / "bytes.png");
+    for (int y = 0; y < height; y += 97)
+      for (int x = 0; x < width; ++x) {
+        const Vec4 v = bytes.at(x, y);
+        if (encoding == ImageEncoding::Data)
+          CHECK(Vec3(back.at(x, y)) == Vec3(srgbToLinear(v.r), srgbToLinear(v.g), srgbToLinear(v.b)));
+        else
+          CHECK(v == back.at(x, y));
+      }
+  }
+  CHECK_THROWS_AS(writeImage(toImage8(img, ImageEncoding::Data), dir / "x.jpg"), std::invalid_argument);
+  fs::remove_all(dir);
+}
+
+namespace {
+
+// textureMapByte's definition (core/image.h), a pow() per value.
+int textureMapByteByFormula(float linear) {
+  const float y = float(linearToSrgb(double(linear))) * 255.0f;
+  return std::isnan(y) ? 0 : int(std::clamp(std::round(y), 0.0f, 255.0f));
+}
+
+}  // namespace
+
+TEST_CASE("textureMapByte: its table gives the formula's byte", "[core]") {
+  // Every float within 64 steps of each value where the byte steps up, and a spread of
+  // others; the hidden case below checks every float.
+  size_t checked = 0;
+  for (int k = 0; k < 256; ++k) {
+    float v = float(srgbToLinear(double(k + 0.5) / 255.0));
+    for (int d = 0; d < 64; ++d) v = std::nextafter(v, -1.0f);
+    for (int d = 0; d < 129; ++d, v = std::nextafter(v, 2.0f), ++checked)
+      REQUIRE(int(textureMapByte(v)) == textureMapByteByFormula(v));
+  }
+  for (float v = -0.5f; v < 1.5f; v += 1.0f / 4099.0f, ++checked) REQUIRE(int(textureMapByte(v)) == textureMapByteByFormula(v));
+  CHECK(checked > 40000);
+  CHECK(textureMapByte(-0.0f) == 0);
+  CHECK(textureMapByte(std::nanf("")) == 0);
+  CHECK(textureMapByte(INFINITY) == 255);
+  CHECK(textureMapByte(1.0f) == 255);
+}
+
+TEST_CASE("textureMapByte gives the formula's byte at every float in [0, 1]", "[.][exhaustive]") {
+  // 1,065,353,217 values, a pow() each: about 30 s.
+  size_t differ = 0;
+  for (float v = 0.0f; v <= 1.0f; v = std::nextafter(v, 2.0f)) differ += int(textureMapByte(v)) != textureMapByteByFormula(v);
+  CHECK(differ == 0);
+}
+
+TEST_CASE("writeImage's pngLevel", "[core]") {
+  // zlib's header names its level's class (RFC 1950 FLEVEL, bits 6-7 of the second byte):
+  // 0 for levels 0-1, 2 for the default level 6.
+  Image img(64, 64);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) img.set(x, y, Vec4(float(x) / 63.0f, float(y) / 63.0f, 0.5f, 1.0f));
+  const fs::path dir = scratchDir("image-png-level");
+  auto flevel = [](const fs::path& png) {
+    const std::string bytes = readFile(png);
+    const size_t idat = bytes.find("IDAT");
+    REQUIRE(idat != std::string::npos);
+    return (uint8_t(bytes[idat + 5]) >> 6) & 3;
+  };
+  writeImage(img, dir / "default.png", ImageEncoding::TextureMap);
+  ImageWriteOptions fast;
+  fast.pngLevel = 1;
+  writeImage(img, dir / "fast.png", ImageEncoding::TextureMap, fast);
+  CHECK(flevel(dir / "default.png") == 2);
+  CHECK(flevel(dir / "fast.png") == 0);
+  CHECK(readImage(dir / "fast.png").pixels == readImage(dir / "default.png").pixels);
   fs::remove_all(dir);
 }
 

@@ -467,3 +467,70 @@ TEST_CASE("writeParts::texture", "[core]") {
     CHECK(readImageInfo(dir.path / "o_bark.png").channels == 3);
   }
 }
+
+TEST_CASE("writeParts stores textures at kTexturePngLevel, 8-bit images as they are", "[core]") {
+  TempDir dir;
+  // One triangle with an atlas of 8 x 4 texels: an 8-bit colour image and an 8-bit normal map.
+  ExportPart tri;
+  tri.name = "leaf";
+  tri.mesh.positions = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0)};
+  tri.mesh.normals.assign(3, Vec3(0, 0, 1));
+  tri.mesh.triangles = {{0, 1, 2}};
+  auto color = std::make_shared<PartTexture>(), normal = std::make_shared<PartTexture>();
+  color->image8 = Image8(8, 4, 3, ImageEncoding::TextureMap);
+  normal->image8 = Image8(8, 4, 3, ImageEncoding::Data);
+  for (int y = 0; y < 4; ++y)
+    for (int x = 0; x < 8; ++x) {
+      color->image8.set(x, y, Vec3(float(x) / 7.0f, float(y) / 3.0f, 0.25f));
+      normal->image8.set(x, y, Vec3(0.5f, float(x) / 7.0f, 1.0f));
+    }
+  for (auto* tex : {color.get(), normal.get()}) {
+    tex->atlas.values = {Vec2(0.1f, 0.1f), Vec2(0.9f, 0.1f), Vec2(0.1f, 0.9f)};
+    tex->atlas.index = {0, 1, 2};
+  }
+  tri.material = PartMaterial{"leaf", Vec3(0.3f), 0.8f, false, color};
+  tri.material.normalTexture = normal;
+  const fs::path file = dir.path / "t.glb";
+  const auto reports = writeParts({tri}, file);
+  REQUIRE(reports.size() == 1);
+  CHECK(reports[0].textureWidth == 8);
+  tinygltf::Model model;
+  tinygltf::TinyGLTF loader;
+  std::string err, warn;
+  REQUIRE(loader.LoadBinaryFromFile(&model, &err, &warn, file.string()));
+  REQUIRE(model.images.size() == 2);
+  for (size_t i = 0; i < 2; ++i) {
+    const Image8& written = i == 0 ? color->image8 : normal->image8;
+    const tinygltf::BufferView& v = model.bufferViews[size_t(model.images[i].bufferView)];
+    const std::string png(model.buffers[0].data.begin() + long(v.byteOffset),
+                          model.buffers[0].data.begin() + long(v.byteOffset + v.byteLength));
+    // zlib's header in the IDAT chunk: FLEVEL 1, the class of levels 2 to 5 (RFC 1950;
+    // OpenImageIO's default, 6, is class 2).
+    static_assert(kTexturePngLevel == 4, "the FLEVEL below is level 4's");
+    const size_t idat = png.find("IDAT");
+    REQUIRE(idat != std::string::npos);
+    CHECK(((uint8_t(png[idat + 5]) >> 6) & 3) == 1);
+    // The decoded PNG (stb_image's bytes, RGBA) is the image written, byte for byte.
+    const tinygltf::Image& im = model.images[i];
+    REQUIRE(im.width == 8);
+    REQUIRE(im.height == 4);
+    std::vector<uint8_t> rgb;
+    for (size_t p = 0; p < 32; ++p)
+      for (size_t c = 0; c < 3; ++c) rgb.push_back(im.image[p * size_t(im.component) + c]);
+    CHECK(rgb == written.values);
+  }
+  SECTION("an 8-bit image in another encoding than its file's is refused") {
+    auto wrong = std::make_shared<PartTexture>(*normal);
+    wrong->image8.encoding = ImageEncoding::TextureMap;
+    ExportPart bad = tri;
+    bad.material.normalTexture = wrong;
+    CHECK_THROWS_AS(writeParts({bad}, dir.path / "bad.glb"), std::invalid_argument);
+    CHECK_FALSE(fs::exists(dir.path / "bad.glb"));
+  }
+  SECTION("OBJ: the same bytes beside it") {
+    writeParts({tri}, dir.path / "t.obj");
+    const Image back = readImage(dir.path / "t_leaf.png");
+    for (int y = 0; y < 4; ++y)
+      for (int x = 0; x < 8; ++x) CHECK(back.at(x, y) == color->image8.at(x, y));
+  }
+}

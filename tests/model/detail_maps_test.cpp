@@ -85,6 +85,12 @@ TEST_CASE("bakeDetailMaps", "[model][lod]") {
     const DetailMaps maps = bakeDetailMaps(low, Vec3(0.5f), full, 0.05f, true);
     REQUIRE(maps.normal);
     REQUIRE(maps.color);
+    // Stored 8-bit as the glb holds them: 3 bytes a texel, no float image.
+    CHECK(maps.normal->image8.encoding == ImageEncoding::Data);
+    CHECK(maps.color->image8.encoding == ImageEncoding::TextureMap);
+    CHECK(maps.normal->image8.values.size() == size_t(layout.width()) * size_t(layout.height()) * 3);
+    CHECK(maps.normal->image.pixels.empty());
+    CHECK(maps.color->image.pixels.empty());
     CHECK(maps.texels == low.triangles.size() * 105);  // the texels inside a 16-texel patch's triangle
     CHECK(maps.hits == maps.texels);  // every texel lies above or below the ridge
     size_t checked = 0;
@@ -107,11 +113,11 @@ TEST_CASE("bakeDetailMaps", "[model][lod]") {
           // +x of the map along increasing s (corner 1), +y up the image (corner 2).
           REQUIRE(glm::dot(Tx, glm::normalize(P[1] - P[0])) == Approx(1.0f));
           REQUIRE(glm::dot(B, P[2] - P[0]) > 0.0f);
-          const Vec3 enc = Vec3(maps.normal->image.at(x, y)) * 2.0f - Vec3(1.0f);  // glTF's decoding
+          const Vec3 enc = Vec3(maps.normal->image8.at(x, y)) * 2.0f - Vec3(1.0f);  // glTF's decoding
           const Vec3 object = glm::normalize(enc.x * Tx + enc.y * B + enc.z * N);
           const double deg = std::acos(std::min(1.0f, glm::dot(object, ridgeNormal(p.x)))) * 180.0 / kPi;
           worstDeg = std::max(worstDeg, deg);
-          worstColor = std::max(worstColor, double(std::abs(maps.color->image.at(x, y).r - p.x)));
+          worstColor = std::max(worstColor, double(std::abs(maps.color->image8.at(x, y).r - p.x)));
           ++checked;
         }
     INFO("worst angle " << worstDeg << " degrees, worst colour " << worstColor);
@@ -120,7 +126,9 @@ TEST_CASE("bakeDetailMaps", "[model][lod]") {
     // interpolated normals (256 cells across 2 waves: about 0.1 degrees); the ridge tilts
     // the normal by up to 14 degrees.
     CHECK(worstDeg < 1.0);
-    CHECK(worstColor < 1e-3);  // the full mesh's colours at the hit, x there
+    // The full mesh's colours at the hit, x there, in 8-bit sRGB (half a step is at most
+    // 0.0045 in linear values below 1).
+    CHECK(worstColor < 1e-3 + 0.0045);
   }
 
   SECTION("a flat full mesh gives (128, 128, 255) everywhere; a miss is flat too") {
@@ -136,18 +144,21 @@ TEST_CASE("bakeDetailMaps", "[model][lod]") {
           int x = 0, y = 0;
           Vec3 b;
           patchTexel(layout, t, i, j, x, y, b);
-          REQUIRE(Vec3(maps.normal->image.at(x, y)) == expected);
+          REQUIRE(Vec3(maps.normal->image8.at(x, y)) == expected);
         }
     // Out of reach: the full surface 1 above the low one, the rays reach 0.5.
     Mesh above = grid(8, 0.0f);
     for (Vec3& p : above.positions) p.z += 1.0f;
     const DetailMaps missed = bakeDetailMaps(low, Vec3(0.5f), DetailSurface(above, Vec3(0.5f)), 0.5f, true);
     CHECK(missed.hits == 0);
-    CHECK(Vec3(missed.normal->image.at(0, layout.height() - 1)) == expected);
+    CHECK(Vec3(missed.normal->image8.at(0, layout.height() - 1)) == expected);
     int x = 0, y = 0;
     Vec3 b;
     patchTexel(layout, 0, 1, 1, x, y, b);  // corner 0 of triangle 0: the low mesh's own colour
-    CHECK(missed.color->image.at(x, y).r == Approx(low.colors[low.triangles[0].x].r).margin(1e-6));
+    // The byte the float image's PNG held at that texel.
+    const Image8& colors = missed.color->image8;
+    CHECK(int(colors.values[(size_t(y) * size_t(colors.width) + size_t(x)) * 3]) ==
+          int(textureMapByte(low.colors[low.triangles[0].x].r)));
   }
 }
 
