@@ -3,27 +3,37 @@
 #include "blobtree/detail/field.h"
 
 #include <algorithm>
+#include <atomic>
+#include <bit>
+#include <cstdlib>
+#include <new>
 #include <cmath>
 #include <limits>
 #include <span>
+#include <stdexcept>
 
 namespace sprig::blobtree {
 
 namespace {
 
 /// The recursive batched tracer of one span (see the file comment of tracer.h). Misses are
-/// negative parameters internally, so a crossing at t < 0 counts as none.
+/// negative parameters internally, so a crossing at t < 0 counts as none. With sub-cell
+/// bounds (SubCellBounds) the span and each interval to be searched are first narrowed to
+/// the bounds of the sub-cells they cross.
 class BatchTracer {
  public:
-  BatchTracer(const CompiledBlob& blob, const Ray& ray, float lipschitz, Crossing mode)
-      : blob_(blob), o_(ray.origin), d_(ray.direction), L_(lipschitz), mode_(mode) {}
+  BatchTracer(const CompiledBlob& blob, const Ray& ray, float lipschitz, Crossing mode,
+              const SubCellBounds* sub = nullptr, uint32_t cell = 0)
+      : blob_(blob), ray_(ray), L_(lipschitz), mode_(mode), sub_(sub), cell_(cell),
+        dirLen_(sub ? glm::length(ray.direction) : 1.0f) {}
 
   /// First crossing in [t0, t1], or a negative value.
   float trace(float t0, float t1, float tolerance) {
     // A tolerance below the spacing of floats near t can never be reached (the samples
     // stop moving): far from the camera, 8 float steps at t bound it from below.
     tol_ = std::max(tolerance, 8.0f * std::numeric_limits<float>::epsilon() * std::max(std::abs(t0), std::abs(t1)));
-    return first(t0, t1, 0);
+    const float L = narrowed(t0, t1, L_);
+    return L < 0.0f ? -1.0f : first(t0, t1, 0, L);
   }
 
  private:
@@ -33,28 +43,45 @@ class BatchTracer {
     float step = (b - a) / static_cast<float>(kTraceLanes - 1);
     for (int i = 0; i < kTraceLanes; ++i) {
       ts[i] = i == kTraceLanes - 1 ? b : a + step * static_cast<float>(i);
-      pts[i] = o_ + ts[i] * d_;
+      pts[i] = ray_.origin + ts[i] * ray_.direction;
     }
     blob_.values(pts, std::span<float>(f, kTraceLanes));
     return step;
   }
 
   /// True when the sample interval [i, i+1] may hide a double crossing: the Lipschitz
-  /// bound lets the field reach 0.5 between two samples on the same side.
-  bool mayHide(const float* f, int i, float step, int depth) const {
-    return depth < kMaxDepth && step > tol_ && std::abs(f[i] - kIso) + std::abs(f[i + 1] - kIso) <= L_ * step;
+  /// bound L lets the field reach 0.5 between two samples on the same side.
+  bool mayHide(const float* f, int i, float step, int depth, float L) const {
+    return depth < kMaxDepth && step > tol_ && std::abs(f[i] - kIso) + std::abs(f[i + 1] - kIso) <= L * step;
   }
 
-  float first(float a, float b, int depth) {
+  /// The bound to search [a, b] with: L, or the smaller bound of the sub-cells the
+  /// interval crosses; negative when their intervals exclude 0.5 (nothing to find there).
+  float narrowed(float a, float b, float L) const {
+    if (!sub_) return L;
+    const SubCellBounds::Bound s = sub_->segment(cell_, ray_, a, b);
+    if (!s.maySurface) return -1.0f;
+    return std::min(L, std::max(s.lipschitz, 1e-30f) * dirLen_);
+  }
+
+  /// Searches the interval [ts[i], ts[i+1]] between two samples on one side, at recursion
+  /// depth `into`, when the Lipschitz test at `depth` says it may hide a double crossing;
+  /// negative otherwise.
+  float searchHidden(const float* ts, const float* f, int i, float step, int depth, int into, float L) {
+    if (!mayHide(f, i, step, depth, L)) return -1.0f;
+    const float Li = narrowed(ts[i], ts[i + 1], L);
+    if (Li < 0.0f || !mayHide(f, i, step, depth, Li)) return -1.0f;
+    return first(ts[i], ts[i + 1], into, Li);
+  }
+
+  float first(float a, float b, int depth, float L) {
     float ts[kTraceLanes], f[kTraceLanes];
     float step = evaluate(a, b, ts, f);
     for (int i = 0; i + 1 < kTraceLanes; ++i) {
       if ((f[i] > kIso) != (f[i + 1] > kIso))
-        return mode_ == Crossing::Any ? ts[i] : refine(ts[i], ts[i + 1], f[i], f[i + 1], depth);
-      if (mayHide(f, i, step, depth)) {
-        float t = first(ts[i], ts[i + 1], depth + 1);
-        if (t >= 0.0f) return t;
-      }
+        return mode_ == Crossing::Any ? ts[i] : refine(ts[i], ts[i + 1], f[i], f[i + 1], depth, L);
+      float t = searchHidden(ts, f, i, step, depth, depth + 1, L);
+      if (t >= 0.0f) return t;
     }
     return -1.0f;
   }
@@ -62,7 +89,7 @@ class BatchTracer {
   /// Shrinks the straddling interval [lo, hi] to the tolerance, then interpolates. In
   /// Crossing::First mode the sub-intervals ahead of each sign change are searched for
   /// hidden double crossings first.
-  float refine(float lo, float hi, float flo, float fhi, int depth) {
+  float refine(float lo, float hi, float flo, float fhi, int depth, float L) {
     float ts[kTraceLanes], f[kTraceLanes];
     const bool insideLo = flo > kIso;
     while (hi - lo > tol_) {
@@ -70,11 +97,10 @@ class BatchTracer {
       int k = 0;
       while (k + 2 < kTraceLanes && (f[k + 1] > kIso) == insideLo) ++k;
       if (mode_ == Crossing::First)
-        for (int j = 0; j < k; ++j)
-          if (mayHide(f, j, step, depth + 1)) {
-            float t = first(ts[j], ts[j + 1], depth + 1);
-            if (t >= 0.0f) return t;
-          }
+        for (int j = 0; j < k; ++j) {
+          float t = searchHidden(ts, f, j, step, depth + 1, depth + 1, L);
+          if (t >= 0.0f) return t;
+        }
       lo = ts[k];
       hi = ts[k + 1];
       flo = f[k];
@@ -86,9 +112,12 @@ class BatchTracer {
 
   static constexpr int kMaxDepth = 12;
   const CompiledBlob& blob_;
-  Vec3 o_, d_;
+  Ray ray_;
   float L_;
   Crossing mode_;
+  const SubCellBounds* sub_;
+  uint32_t cell_;
+  float dirLen_;
   float tol_ = 0.0f;
 };
 
@@ -127,6 +156,105 @@ std::optional<float> traceCell(const CompiledBlob& blob, const Cell& cell, const
   if (!clipToBox(cell.box, ray.origin, ray.direction, t0, t1)) return std::nullopt;
   float lipschitz = std::max(cell.lipschitz, 1e-30f) * glm::length(ray.direction);
   return traceSegment(blob, ray, t0, t1, lipschitz, tolerance, mode);
+}
+
+// ---- SubCellBounds -------------------------------------------------------------------------
+
+void SubCellBounds::Free::operator()(uint32_t* p) const { std::free(p); }
+
+SubCellBounds::SubCellBounds(const CellSet& cells, const CompiledBlob& blob, int k)
+    : cells_(&cells), blob_(&blob), k_(k) {
+  if (k < 1 || k > 8) throw std::invalid_argument("SubCellBounds: k must be in 1..8");
+  const size_t n = std::max<size_t>(cells.cells.size(), 1);
+  // calloc: large blocks come as zero pages, committed only where rays reach.
+  slots_.reset(static_cast<uint32_t*>(std::calloc(n * size_t(k * k * k), sizeof(uint32_t))));
+  traces_.reset(static_cast<uint32_t*>(std::calloc(n, sizeof(uint32_t))));
+  if (!slots_ || !traces_) throw std::bad_alloc();
+}
+
+bool SubCellBounds::warm(uint32_t cellIndex) const {
+  std::atomic_ref<uint32_t> count(traces_[cellIndex]);
+  if (count.load(std::memory_order_relaxed) >= kWarmTraces) return true;
+  return count.fetch_add(1, std::memory_order_relaxed) + 1 >= kWarmTraces;
+}
+
+Box3 SubCellBounds::subBox(const Cell& c, int i, int j, int l) const {
+  const Vec3 edge = (c.box.hi - c.box.lo) / float(k_);
+  const Vec3 lo = c.box.lo + Vec3(float(i), float(j), float(l)) * edge;
+  const Vec3 hi(i + 1 == k_ ? c.box.hi.x : lo.x + edge.x, j + 1 == k_ ? c.box.hi.y : lo.y + edge.y,
+                l + 1 == k_ ? c.box.hi.z : lo.z + edge.z);
+  return Box3{lo, hi}.expanded(kMarginCells * (c.box.hi.x - c.box.lo.x));
+}
+
+float SubCellBounds::entry(uint32_t c, int s) const {
+  std::atomic_ref<uint32_t> slot(slots_[size_t(c) * size_t(k_ * k_ * k_) + size_t(s)]);
+  const uint32_t v = slot.load(std::memory_order_relaxed);
+  if (v != 0) return std::bit_cast<float>(v - 1);
+  const Cell& cell = cells_->cells[c];
+  const Box3 box = subBox(cell, s % k_, (s / k_) % k_, s / (k_ * k_));
+  const CompiledBlob& tape = cells_->tapeOf(cell, *blob_);
+  const float L = tape.lipschitz(box);
+  const float e = tape.valueBounds(box).contains(kIso) ? L : -L;
+  slot.store(std::bit_cast<uint32_t>(e) + 1, std::memory_order_relaxed);
+  return e;
+}
+
+SubCellBounds::Bound SubCellBounds::segment(uint32_t cellIndex, const Ray& ray, float a, float b) const {
+  const Cell& c = cells_->cells[cellIndex];
+  const Vec3 edge = (c.box.hi - c.box.lo) / float(k_);
+  const float margin = kMarginCells * (c.box.hi.x - c.box.lo.x);
+  // Per axis, the sub-grid's widened slabs that the segment's extent overlaps, and the part
+  // of [a, b] inside each (the slab test of clipToBox, on subBox's planes).
+  int lo[3], hi[3];
+  float enter[3][8], leave[3][8];
+  for (int ax = 0; ax < 3; ++ax) {
+    const float o = ray.origin[ax], d = ray.direction[ax];
+    const float pa = o + a * d, pb = o + b * d;
+    const float qlo = std::floor((std::min(pa, pb) - margin - c.box.lo[ax]) / edge[ax]);
+    const float qhi = std::floor((std::max(pa, pb) + margin - c.box.lo[ax]) / edge[ax]);
+    lo[ax] = int(std::clamp(qlo, 0.0f, float(k_ - 1)));
+    hi[ax] = int(std::clamp(qhi, 0.0f, float(k_ - 1)));
+    const float inv = 1.0f / d;
+    for (int i = lo[ax]; i <= hi[ax]; ++i) {
+      const float s0 = c.box.lo[ax] + float(i) * edge[ax];
+      const float s1 = (i + 1 == k_ ? c.box.hi[ax] : s0 + edge[ax]) + margin;
+      float t0 = a, t1 = b;
+      if (d == 0.0f) {
+        if (o < s0 - margin || o > s1) t0 = std::numeric_limits<float>::infinity();
+      } else {
+        float ta = (s0 - margin - o) * inv, tb = (s1 - o) * inv;
+        if (ta > tb) std::swap(ta, tb);
+        t0 = std::max(t0, ta);
+        t1 = std::min(t1, tb);
+      }
+      enter[ax][i] = t0;
+      leave[ax][i] = t1;
+    }
+  }
+  Bound r;
+  int crossed = 0;
+  for (int l = lo[2]; l <= hi[2]; ++l)
+    for (int j = lo[1]; j <= hi[1]; ++j)
+      for (int i = lo[0]; i <= hi[0]; ++i) {
+        if (std::max(std::max(enter[0][i], enter[1][j]), enter[2][l]) >
+            std::min(std::min(leave[0][i], leave[1][j]), leave[2][l]))
+          continue;
+        const float e = entry(cellIndex, i + k_ * (j + k_ * l));
+        r.lipschitz = std::max(r.lipschitz, std::abs(e));
+        r.maySurface = r.maySurface || !std::signbit(e);
+        ++crossed;
+      }
+  if (crossed == 0) return {c.lipschitz, true};
+  return r;
+}
+
+std::optional<float> traceCell(const CompiledBlob& blob, const Cell& cell, const Ray& ray, float t0, float t1,
+                               float tolerance, Crossing mode, const SubCellBounds& sub, uint32_t cellIndex) {
+  if (!clipToBox(cell.box, ray.origin, ray.direction, t0, t1)) return std::nullopt;
+  float lipschitz = std::max(cell.lipschitz, 1e-30f) * glm::length(ray.direction);
+  float t = BatchTracer(blob, ray, lipschitz, mode, &sub, cellIndex).trace(t0, t1, tolerance);
+  if (t >= 0.0f) return t;
+  return std::nullopt;
 }
 
 std::optional<float> traceRay(const CompiledBlob& blob, const Ray& ray, float tmin, float tmax,

@@ -19,6 +19,7 @@
 #include "blobtree/compiled.h"
 
 #include <cstdint>
+#include <memory>
 #include <optional>
 
 namespace sprig::blobtree {
@@ -57,6 +58,76 @@ std::optional<float> traceSegment(const CompiledBlob& blob, const Ray& ray, floa
 /// bound (SurfaceCellOptions::lipschitz must have been on).
 std::optional<float> traceCell(const CompiledBlob& blob, const Cell& cell, const Ray& ray, float t0, float t1,
                                float tolerance, Crossing mode = Crossing::First);
+
+/// Bounds of F over the sub-cells of a CellSet's cells, for the tracer: each cell is split
+/// into k x k x k sub-cells, and each sub-cell (widened by kMarginCells of the cell's edge)
+/// gets an interval bound of F and a Lipschitz bound from its cell's tape, computed the first
+/// time a ray needs it and kept (a float per sub-cell; racing threads compute the same bits).
+/// A cell uses them only from its kWarmTraces-th trace on: the bounds of a sub-cell cost
+/// several batches of field values, which pay back only over many rays (a full-size render,
+/// not a gallery thumbnail).
+///
+/// Why: a ray crosses many surface cells and misses most of them, and a cell's bounds, taken
+/// over the whole cube, admit far more than the thin part a ray passes. Over the sub-cells
+/// the ray actually crosses, the interval often excludes 0.5 (no surface: no samples at all)
+/// and the Lipschitz bound is often several times the cell's smaller (fewer subdivisions).
+/// Both bounds are sound, so the tracer finds the same crossings from the same samples.
+/// Thread-safe. Reserves 4·k³ + 4 bytes per cell, zero pages until used. The CellSet and
+/// blob must outlive it.
+class SubCellBounds {
+ public:
+  /// Margin of a sub-cell's box, in cells' edges (within the pruned tapes' 1/64 margin).
+  static constexpr float kMarginCells = 1.0f / 256.0f;
+  /// Traces of a cell before its sub-cells are used (warm()).
+  static constexpr uint32_t kWarmTraces = 256;
+
+  /// What the sub-cells that a segment crosses admit.
+  struct Bound {
+    float lipschitz = 0.0f;    ///< the largest of their Lipschitz bounds (world units)
+    bool maySurface = false;   ///< false: no interval of them contains 0.5, so F != 0.5 on the segment
+  };
+
+  SubCellBounds() = default;
+  /// For the cells of `cells` (each with its pruned tape, else blob), k sub-cells per axis
+  /// (1..8, else std::invalid_argument). Reserves the memory; computes nothing yet.
+  SubCellBounds(const CellSet& cells, const CompiledBlob& blob, int k);
+
+  /// Sub-cells per axis (0 for a default-constructed, unusable object).
+  int divisions() const { return k_; }
+  /// Counts a trace of cell `cellIndex`; true from its kWarmTraces-th on.
+  bool warm(uint32_t cellIndex) const;
+  /// The bound over the sub-cells of cell `cellIndex` that origin + t·direction, t in [a, b],
+  /// crosses (tested against their widened boxes). Computes the sub-cells it needs. A
+  /// segment that crosses none (it lies outside the cell) gets the cell's own bound and
+  /// maySurface.
+  Bound segment(uint32_t cellIndex, const Ray& ray, float a, float b) const;
+
+ private:
+  struct Free {
+    void operator()(uint32_t* p) const;
+  };
+  /// The value of sub-cell s of cell c: its Lipschitz bound, negated (sign bit set) when its
+  /// interval excludes 0.5.
+  float entry(uint32_t c, int s) const;
+  /// Box of sub-cell (i, j, l) of cell c, widened by the margin.
+  Box3 subBox(const Cell& c, int i, int j, int l) const;
+
+  const CellSet* cells_ = nullptr;
+  const CompiledBlob* blob_ = nullptr;
+  int k_ = 0;
+  /// Per sub-cell: 0 until computed, then the bits of entry()'s value plus 1 (zeroed pages
+  /// from calloc, read and written through std::atomic_ref).
+  std::unique_ptr<uint32_t[], Free> slots_;
+  std::unique_ptr<uint32_t[], Free> traces_;  ///< per cell, saturating at kWarmTraces
+};
+
+/// traceCell with bounds over the sub-cells the ray crosses (SubCellBounds; the caller
+/// decides when, see SubCellBounds::warm): a span whose
+/// sub-cells exclude 0.5 is a miss without samples; the span and every sub-interval the
+/// Lipschitz test would search are first tested with the smaller of the cell's bound and
+/// their sub-cells'. Returns what traceCell returns, with fewer field evaluations.
+std::optional<float> traceCell(const CompiledBlob& blob, const Cell& cell, const Ray& ray, float t0, float t1,
+                               float tolerance, Crossing mode, const SubCellBounds& sub, uint32_t cellIndex);
 
 /// The first crossing on the whole ray for t in [tmin, tmax]: the ray is clipped to the
 /// blob's bounds, windows whose interval bound excludes 0.5 are skipped (the window doubles

@@ -56,6 +56,9 @@ struct Material {
 /// textures). Must be thread-safe; the textures module's textures are wrapped into this.
 using ColorTexture = std::function<Vec3(Vec2 uv, const Vec3& position)>;
 
+/// The most memory ImplicitOptions::subCells may take per implicit part (256 MB).
+inline constexpr size_t kSubCellBudgetBytes = size_t(256) << 20;
+
 /// How a compiled BlobTree becomes exact Embree user geometry.
 struct ImplicitOptions {
   /// Edge of the surface cells (one Embree user primitive each), world units; 0 = automatic:
@@ -72,6 +75,15 @@ struct ImplicitOptions {
   /// March eight samples at a time with batched field evaluation (the same Lipschitz
   /// guarantee, several times faster); false calls CompiledBlob::intersectCell per cell.
   bool batched = true;
+  /// Sub-cells per axis of each surface cell for the batched tracer's bounds
+  /// (blobtree::SubCellBounds: an interval and a Lipschitz bound per sub-cell, computed when
+  /// a ray first crosses it; a cell uses them from its 256th trace on): a span whose
+  /// sub-cells exclude the surface is skipped, and subdivisions use the sub-cells' smaller
+  /// Lipschitz bound. The same image, fewer field evaluations. 2..8; 0 or 1 = off (the
+  /// cell's own bounds); others throw std::invalid_argument. Reserves 4·k³ bytes per cell
+  /// (zero pages until used); when that would pass kSubCellBudgetBytes, k is halved until
+  /// it fits (off below 2).
+  int subCells = 4;
   /// Trace each cell with its pruned tape (blobtree::SurfaceCellOptions::prunedTapes: only
   /// the nodes whose support reaches the cell, identities removed): the same surface, a
   /// shorter walk per batch. false evaluates the whole tape (the reference).

@@ -26,6 +26,7 @@ struct ImplicitData {
   blobtree::TraceOptions trace;
   bool batched = true;    ///< blobtree::traceCell (true) or CompiledBlob::intersectCell (false)
   float tolerance = 0;    ///< absolute root tolerance along t (unit-direction rays)
+  blobtree::SubCellBounds sub;  ///< bounds over the cells' sub-cells (batched tracing only)
 };
 
 }  // namespace detail
@@ -44,8 +45,11 @@ std::optional<blobtree::Hit> traceCell(const ImplicitData& data, const blobtree:
   if (!data.batched) return data.blob.intersectCell(cell, ray, tnear, tfar, data.trace);
   // The cell's pruned tape when it has one: exact at the cell's points, a shorter walk.
   const blobtree::CompiledBlob& blob = data.cells.tapeOf(cell, data.blob);
-  std::optional<float> t = blobtree::traceCell(blob, cell, ray, tnear, tfar, data.tolerance,
-                                               anyHit ? blobtree::Crossing::Any : blobtree::Crossing::FirstStraddle);
+  const auto mode = anyHit ? blobtree::Crossing::Any : blobtree::Crossing::FirstStraddle;
+  const auto index = uint32_t(&cell - data.cells.cells.data());
+  std::optional<float> t = data.sub.divisions() > 0 && data.sub.warm(index)
+                               ? blobtree::traceCell(blob, cell, ray, tnear, tfar, data.tolerance, mode, data.sub, index)
+                               : blobtree::traceCell(blob, cell, ray, tnear, tfar, data.tolerance, mode);
   if (!t) return std::nullopt;
   if (anyHit) return blobtree::Hit{.t = *t};
   return blobtree::hitAt(blob, ray, *t);
@@ -98,6 +102,15 @@ void cellOccluded(const RTCOccludedFunctionNArguments* args) {
 /// about one twig radius trace 1.3x faster than cells of two.
 constexpr blobtree::CellSizeRule kTracerCells{
     .featureFraction = 1.5f, .coarsestDivisions = 40.0f, .finestDivisions = 1000.0f, .noFeatureDivisions = 64.0f};
+
+/// ImplicitOptions::subCells for `cells` cells: halved until the bounds fit
+/// kSubCellBudgetBytes, 0 (off) below 2 sub-cells per axis.
+int subCellDivisions(int requested, size_t cells) {
+  if (requested < 0 || requested > 8) throw std::invalid_argument("ImplicitOptions::subCells must be in 0..8");
+  int k = requested;
+  while (k >= 2 && cells * size_t(k * k * k) * sizeof(float) > kSubCellBudgetBytes) k /= 2;
+  return k >= 2 ? k : 0;
+}
 
 /// Shrinks box (which holds the whole F = 0.5 surface) face by face: bisection finds the
 /// thickest slab at each face whose interval bound stays below 0.5, which is sound (no
@@ -182,6 +195,8 @@ uint32_t Scene::addImplicit(const blobtree::CompiledBlob& blob, uint32_t materia
     cellOptions.prunedTapes = options.batched && options.prunedTapes && impl_->prunedTapes;
     const Phase phase("cells");
     data->cells = blob.surfaceCells(cellSize, cellOptions);
+    const int subK = subCellDivisions(options.subCells, data->cells.cells.size());
+    if (data->batched && subK > 0) data->sub = blobtree::SubCellBounds(data->cells, data->blob, subK);
   }
   RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_USER);
   rtcSetGeometryUserPrimitiveCount(g, static_cast<unsigned>(data->cells.cells.size()));

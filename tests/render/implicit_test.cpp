@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <vector>
 
 #include "blobtree/blobtree.h"
@@ -422,4 +423,42 @@ TEST_CASE("Scene::servesCamera: implicit cells sized alike by another camera", "
   curves.addCurves(c, curves.addMaterial(Material{}));
   curves.commit();
   CHECK_FALSE(curves.servesCamera(cam, 32, 32));
+}
+
+TEST_CASE("Scene::addImplicit sub-cell bounds", "[render]") {
+  // ImplicitOptions::subCells narrows the tracer's bounds once a cell has been traced
+  // SubCellBounds::kWarmTraces times; the hits are the same to the bit. Coarse cells and
+  // many rays, so that most cells pass the threshold.
+  blobtree::CompiledBlob blob = branchBlob();
+  ImplicitOptions off, on;
+  off.cellSize = on.cellSize = 0.4f;
+  off.subCells = 0;
+  on.subCells = 4;
+  Scene a, b;
+  a.addImplicit(blob, a.addMaterial(Material{}), off);
+  b.addImplicit(blob, b.addMaterial(Material{}), on);
+  a.commit();
+  b.commit();
+  const uint64_t seed = 20261206;
+  INFO("seed " << seed);
+  Rng rng(seed);
+  const Box3 box = blob.bounds();
+  int hits = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Vec3 target = box.lo + Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * box.size();
+    const Vec3 origin = target + 4.0f * glm::normalize(Vec3(rng.normal(), rng.normal(), rng.normal()));
+    const Vec3 dir = glm::normalize(target - origin);
+    const auto ha = a.intersect(origin, dir, 0, 100), hb = b.intersect(origin, dir, 0, 100);
+    REQUIRE(ha.has_value() == hb.has_value());
+    CHECK(a.occluded(origin, dir, 0, 100) == b.occluded(origin, dir, 0, 100));
+    if (!ha) continue;
+    ++hits;
+    CHECK(ha->t == hb->t);
+    CHECK(ha->normal == hb->normal);
+  }
+  CHECK(hits > 2000);
+  ImplicitOptions bad;
+  bad.subCells = 9;
+  Scene c;
+  CHECK_THROWS_AS(c.addImplicit(blob, c.addMaterial(Material{}), bad), std::invalid_argument);
 }
