@@ -10,7 +10,6 @@
 #include <numeric>
 #include <stdexcept>
 #include <string>
-#include <vector>
 
 #include "core/parallel.h"
 #include "core/progress.h"
@@ -31,11 +30,6 @@ namespace sprig::solids::detail {
 /// The symmetric stiffness matrix K seen by conjugate gradients: K·x computed in parallel,
 /// one output entry per column (K = Kᵀ, so entry j is column j · x), each summed in the
 /// column's order by one thread, so the product is the same bytes at any thread count.
-/// The free dofs of a vertex are consecutive columns with the same rows (its neighbours'
-/// free dofs), so runs of up to three columns with identical row indices are summed
-/// together, reading the row indices and the gathered x once for the run (the product
-/// is bound by memory: 8 + 4/3 bytes an entry instead of 8 + 4). Each column's sum keeps
-/// its own terms in its own order, so the bytes are those of one column at a time.
 /// Each product advances the progress bar (and notices a cancellation request).
 class ParallelProduct : public Eigen::EigenBase<ParallelProduct> {
  public:
@@ -44,21 +38,7 @@ class ParallelProduct : public Eigen::EigenBase<ParallelProduct> {
   using StorageIndex = int;
   enum { ColsAtCompileTime = Eigen::Dynamic, MaxColsAtCompileTime = Eigen::Dynamic, IsRowMajor = false };
 
-  ParallelProduct(const Eigen::SparseMatrix<double>& k, Progress& progress) : k_(k), progress_(progress) {
-    const int* outer = k_.outerIndexPtr();
-    const int* inner = k_.innerIndexPtr();
-    auto sameRows = [&](Eigen::Index a, Eigen::Index b) {
-      return outer[a + 1] - outer[a] == outer[b + 1] - outer[b] &&
-             std::equal(inner + outer[a], inner + outer[a + 1], inner + outer[b]);
-    };
-    for (Eigen::Index j = 0; j < k_.cols();) {
-      Eigen::Index n = 1;
-      while (n < 3 && j + n < k_.cols() && sameRows(j, j + n)) ++n;
-      runs_.push_back(int(j));
-      j += n;
-    }
-    runs_.push_back(int(k_.cols()));
-  }
+  ParallelProduct(const Eigen::SparseMatrix<double>& k, Progress& progress) : k_(k), progress_(progress) {}
   Eigen::Index rows() const { return k_.rows(); }
   Eigen::Index cols() const { return k_.cols(); }
 
@@ -73,31 +53,13 @@ class ParallelProduct : public Eigen::EigenBase<ParallelProduct> {
     const int* outer = k_.outerIndexPtr();
     const int* inner = k_.innerIndexPtr();
     const double* value = k_.valuePtr();
-    parallelForRange(0, runs_.size() - 1, [&](size_t lo, size_t hi) {
-      for (size_t r = lo; r < hi; ++r) {
-        const int j = runs_[r], n = runs_[r + 1] - j, len = outer[j + 1] - outer[j];
-        const int* rows = inner + outer[j];
-        if (n == 3) {
-          const double *v0 = value + outer[j], *v1 = value + outer[j + 1], *v2 = value + outer[j + 2];
-          double s0 = 0, s1 = 0, s2 = 0;
-          for (int e = 0; e < len; ++e) {
-            const double xe = x.coeff(rows[e]);
-            s0 += v0[e] * xe;
-            s1 += v1[e] * xe;
-            s2 += v2[e] * xe;
-          }
-          dst.coeffRef(j) += alpha * s0;
-          dst.coeffRef(j + 1) += alpha * s1;
-          dst.coeffRef(j + 2) += alpha * s2;
-          continue;
-        }
-        for (int c = j; c < j + n; ++c) {
-          double sum = 0;
-          for (int e = outer[c]; e < outer[c + 1]; ++e) sum += value[e] * x.coeff(inner[e]);
-          dst.coeffRef(c) += alpha * sum;
-        }
+    parallelForRange(0, size_t(k_.cols()), [&](size_t lo, size_t hi) {
+      for (size_t j = lo; j < hi; ++j) {
+        double sum = 0;
+        for (int e = outer[j]; e < outer[j + 1]; ++e) sum += value[e] * x.coeff(inner[e]);
+        dst.coeffRef(Eigen::Index(j)) += alpha * sum;
       }
-    }, 700);
+    }, 2048);
     progress_.advance();
   }
 
@@ -111,7 +73,6 @@ class ParallelProduct : public Eigen::EigenBase<ParallelProduct> {
  private:
   const Eigen::SparseMatrix<double>& k_;
   Progress& progress_;
-  std::vector<int> runs_;  ///< first column of each run of columns with the same rows; then cols()
 };
 
 /// Jacobi preconditioning for ParallelProduct (Eigen's DiagonalPreconditioner needs the
