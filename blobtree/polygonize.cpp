@@ -203,9 +203,9 @@ BigVector<uint32_t> indicesWhere(size_t n, Pred&& pred) {
 // lookup in a hash of the bricks and a popcount. The hash holds an entry per brick, not
 // per cell (on the 2,000-cone benchmark 172,069 bricks for 3,192,428 cells: 8 MB of slots
 // where a hash of the cells took 134 MB, written and faulted in before any lookup), and
-// most of a cell's neighbours are in its own brick, which a Cursor keeps from one lookup
-// to the next. Both assumptions are checked as the
-// index is built (std::logic_error).
+// a cell's neighbours lie in the 2x2x2 bricks around it, which a Cursor keeps from one
+// lookup to the next. Both assumptions are checked as the index is built
+// (std::logic_error).
 class BrickIndex {
  public:
   BrickIndex(const std::vector<glm::ivec3>& cells, size_t n)
@@ -225,28 +225,35 @@ class BrickIndex {
     }, 1024);
   }
 
-  // Finds kept cells, remembering the last brick.
+  // Finds kept cells, remembering the last brick of each parity (brick coordinates mod
+  // 2): the bricks a cell's 27 neighbours fall in form a 2x2x2 block, whose eight
+  // parities differ, so none of them pushes out another.
   class Cursor {
    public:
-    explicit Cursor(const BrickIndex& index) : index_(index) {}
+    explicit Cursor(const BrickIndex& index) : index_(index) {
+      key_.fill(~uint64_t(0));
+      brick_.fill(kNoCell);
+    }
     // The index of the kept cell at q (coordinates >= 0), or kNoCell.
     uint32_t find(glm::ivec3 q) {
       const uint64_t key = brickKey(q);
-      if (key != lastKey_) {
-        lastKey_ = key;
-        brick_ = index_.hash_.find(key);
+      const size_t way = size_t(((q.x >> 2) & 1) | (((q.y >> 2) & 1) << 1) | (((q.z >> 2) & 1) << 2));
+      if (key != key_[way]) {
+        key_[way] = key;
+        brick_[way] = index_.hash_.find(key);
       }
-      if (brick_ == kNoCell) return kNoCell;
-      const uint64_t mask = index_.mask_[brick_];
+      const uint32_t brick = brick_[way];
+      if (brick == kNoCell) return kNoCell;
+      const uint64_t mask = index_.mask_[brick];
       const unsigned m = mortonInBrick(q);
       if (!((mask >> m) & 1)) return kNoCell;
-      return index_.first_[brick_] + uint32_t(std::popcount(mask & ((uint64_t(1) << m) - 1)));
+      return index_.first_[brick] + uint32_t(std::popcount(mask & ((uint64_t(1) << m) - 1)));
     }
 
    private:
     const BrickIndex& index_;
-    uint64_t lastKey_ = ~uint64_t(0);
-    uint32_t brick_ = kNoCell;
+    std::array<uint64_t, 8> key_;
+    std::array<uint32_t, 8> brick_;
   };
   // The index of the kept cell at q (coordinates >= 0), or kNoCell.
   uint32_t find(glm::ivec3 q) const { return Cursor(*this).find(q); }
