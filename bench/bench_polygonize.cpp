@@ -137,6 +137,8 @@ int main(int argc, char** argv) {
                 topo.closed() ? "yes" : "NO", topo.manifold() ? "yes" : "NO");
     std::printf("  phases (wall): surface cells %.2f s, grid samples %.2f s, triangulation %.2f s, vertices %.2f s\n",
                 r.cellSeconds, r.sampleSeconds, r.triangulateSeconds, r.vertexSeconds);
+    std::printf("  phases (CPU):  surface cells %.2f s, grid samples %.2f s, triangulation %.2f s, vertices %.2f s\n",
+                r.cellCpuSeconds, r.sampleCpuSeconds, r.triangulateCpuSeconds, r.vertexCpuSeconds);
     std::printf("  mesh hash %016llx\n", (unsigned long long)meshHash(r.mesh));
     if (dual) {
       if (dualOnly) continue;

@@ -134,6 +134,10 @@ struct SurfaceCellOptions {
   /// value (bit for bit where the child order agrees, else to the rounding of the sums).
   /// Costs about one more interval walk per cell.
   bool prunedTapes = false;
+  /// Fill only CellSet::indices, each cell's integer grid coordinates (12 bytes a cell
+  /// instead of a Cell's 60: all the polygonizer needs), and leave CellSet::cells empty.
+  /// lipschitz, primitiveLists and prunedTapes must be off with it (std::invalid_argument).
+  bool indicesOnly = false;
 };
 
 namespace detail { struct Tape; }
@@ -221,6 +225,9 @@ struct CellSet {
   Vec3 origin{0.0f};     ///< grid origin (the root bounds' low corner)
   float cellSize = 0.0f; ///< actual edge length (<= the requested size: root cube / 2^k)
   std::vector<Cell> cells;           ///< in deterministic (Morton-like recursive) order
+  /// With SurfaceCellOptions::indicesOnly, the cells' Cell::index in the same order (and
+  /// cells empty); otherwise empty.
+  std::vector<glm::ivec3> indices;
   std::vector<uint32_t> primitives;  ///< primitive instance indices (a primitive under its chain of warps)
   /// Pruned tapes (SurfaceCellOptions::prunedTapes), shared by the cells whose pruned form
   /// is the same; each is a CompiledBlob of its own (all evaluators work on it) valid at

@@ -108,6 +108,9 @@ struct PolygonizeResult {
   double sampleSeconds = 0;       ///< grid corner sampling (with the corner table)
   double triangulateSeconds = 0;  ///< closure, marching tetrahedra, vertex merge
   double vertexSeconds = 0;       ///< root search, normals and attributes
+  /// CPU seconds of the process (all threads) in each of the four phases above: against
+  /// the wall seconds they show how much of a phase ran on one core.
+  double cellCpuSeconds = 0, sampleCpuSeconds = 0, triangulateCpuSeconds = 0, vertexCpuSeconds = 0;
 };
 
 /// The cell size polygonize() requests for these options (resolves the automatic size).

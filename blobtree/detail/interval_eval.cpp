@@ -44,33 +44,10 @@ Interval evalI(const Tape& T, uint32_t ni, const Box3& box) {
     return r;
   }
   switch (n.kind) {
-    case NodeKind::Blend: {
-      Interval r{0.0f, 0.0f};
-      childrenIn(T, n, box, [&](uint32_t c) {
-        Interval i = evalI(T, c, box);
-        r.lo += i.lo;
-        r.hi += i.hi;
-      });
-      return r;
-    }
-    case NodeKind::Ricci: {
-      RicciAcc lo, hi;
-      childrenIn(T, n, box, [&](uint32_t c) {
-        Interval i = evalI(T, c, box);
-        lo.add(i.lo, n.exponent);
-        hi.add(i.hi, n.exponent);
-      });
-      return {lo.value(n.exponent), hi.value(n.exponent)};
-    }
-    case NodeKind::Union: {
-      Interval r{0.0f, 0.0f};
-      childrenIn(T, n, box, [&](uint32_t c) {
-        Interval i = evalI(T, c, box);
-        r.lo = std::max(r.lo, i.lo);
-        r.hi = std::max(r.hi, i.hi);
-      });
-      return r;
-    }
+    case NodeKind::Blend:
+    case NodeKind::Ricci:
+    case NodeKind::Union:
+    case NodeKind::Pcm: return evalNaryI(T, n, box, [&](auto&& visit) { childrenIn(T, n, box, visit); });
     case NodeKind::Intersect: {
       Interval r{std::numeric_limits<float>::max(), std::numeric_limits<float>::max()};
       for (uint32_t k = 0; k < n.count; ++k) {
@@ -84,22 +61,6 @@ Interval evalI(const Tape& T, uint32_t ni, const Box3& box) {
       Interval a = evalI(T, T.kids[n.first], box);
       Interval b = evalI(T, T.kids[n.first + 1], box);
       return {std::max(0.0f, std::min(a.lo, 1.0f - b.hi)), std::max(0.0f, std::min(a.hi, 1.0f - b.lo))};
-    }
-    case NodeKind::Pcm: {
-      // PcmAccum: F >= f_max + min(0, c − f_second) with f_second <= the second largest hi,
-      // and F >= min(f_max, c); F <= f_max + a₀ per child whose field may be in the band.
-      float maxLo = 0.0f, maxHi = 0.0f, hi2 = 0.0f, dHi = 0.0f;
-      const PcmDerived& d = params(T, n).pcm;
-      childrenIn(T, n, box, [&](uint32_t c) {
-        Interval i = evalI(T, c, box);
-        float lo = std::max(0.0f, i.lo), hi = std::max(0.0f, i.hi);
-        maxLo = std::max(maxLo, lo);
-        hi2 = std::max(hi2, std::min(maxHi, hi));
-        maxHi = std::max(maxHi, hi);
-        if (hi > d.c - d.w && lo < d.c) dHi += d.a0;
-      });
-      const float lo = std::max(std::min(maxLo, d.c), maxLo + std::min(0.0f, d.c - hi2));
-      return {std::max(0.0f, lo), std::max(0.0f, maxHi + dHi)};
     }
     case NodeKind::Negative: {
       Interval i = evalI(T, T.kids[n.first], box);

@@ -55,32 +55,42 @@ inline void childrenAt(const Tape& T, const TNode& n, Vec3 p, F&& f) {
   }
 }
 
+/// When box lies inside one cell of point grid g: true, with items[0, count) the children
+/// that cell lists (none when no child reaches it). False when box straddles cells or leaves
+/// the grid. A box inside a box for which this is true lies in the same cell (the cell
+/// index is a monotone function of the coordinates).
+inline bool gridCellOf(const PointGrid& g, const Box3& box, const uint32_t*& items, uint32_t& count) {
+  if (!g.bounds.contains(box.lo) || !g.bounds.contains(box.hi)) return false;
+  Vec3 qlo = glm::floor((box.lo - g.origin) * g.invCell), qhi = glm::floor((box.hi - g.origin) * g.invCell);
+  if (qlo != qhi) return false;
+  items = nullptr;
+  count = 0;
+  uint64_t key = cellKey(int(qlo.x), int(qlo.y), int(qlo.z));
+  for (uint32_t slot = hashKey(key) & g.mask;; slot = (slot + 1) & g.mask) {
+    uint64_t k = g.tableKey[slot];
+    if (k == key) {
+      items = g.items.data() + g.tableFirst[slot];
+      count = g.tableCount[slot];
+      return true;
+    }
+    if (k == PointGrid::kEmptyKey) return true;
+  }
+}
+
 /// Calls f(child) for the children of n whose support overlaps box. A box inside one cell
 /// of the node's point grid (a batch of nearby points, a surface cell) reads that cell's
 /// short list in O(1); larger boxes walk the BVH.
 template <class F>
 inline void childrenIn(const Tape& T, const TNode& n, const Box3& box, F&& f) {
-  if (n.grid >= 0) {
-    const PointGrid& g = T.grids[size_t(n.grid)];
-    if (g.bounds.contains(box.lo) && g.bounds.contains(box.hi)) {
-      Vec3 qlo = glm::floor((box.lo - g.origin) * g.invCell), qhi = glm::floor((box.hi - g.origin) * g.invCell);
-      if (qlo == qhi) {
-        // Every child overlapping box overlaps this grid cell, so it is listed here.
-        for (uint32_t c : g.always)
-          if (T.nodes[c].box.overlaps(box)) f(c);
-        uint64_t key = cellKey(int(qlo.x), int(qlo.y), int(qlo.z));
-        for (uint32_t slot = hashKey(key) & g.mask;; slot = (slot + 1) & g.mask) {
-          uint64_t k = g.tableKey[slot];
-          if (k == key) {
-            const uint32_t* it = g.items.data() + g.tableFirst[slot];
-            for (uint32_t i = 0, e = g.tableCount[slot]; i < e; ++i)
-              if (T.nodes[it[i]].box.overlaps(box)) f(it[i]);
-            return;
-          }
-          if (k == PointGrid::kEmptyKey) return;
-        }
-      }
-    }
+  const uint32_t* items;
+  uint32_t count;
+  if (n.grid >= 0 && gridCellOf(T.grids[size_t(n.grid)], box, items, count)) {
+    // Every child overlapping box overlaps this grid cell, so it is listed here.
+    for (uint32_t c : T.grids[size_t(n.grid)].always)
+      if (T.nodes[c].box.overlaps(box)) f(c);
+    for (uint32_t i = 0; i < count; ++i)
+      if (T.nodes[items[i]].box.overlaps(box)) f(items[i]);
+    return;
   }
   if (n.bvh >= 0) {
     walkBvh(T, n.bvh, [&](const Box3& b) { return b.overlaps(box); }, f);
@@ -90,6 +100,20 @@ inline void childrenIn(const Tape& T, const TNode& n, const Box3& box, F&& f) {
       if (T.nodes[c].box.overlaps(box)) f(c);
     }
   }
+}
+
+/// When box lies inside one cell of n's point grid: true, and out holds the children
+/// childrenIn(T, n, box) visits, in its order. Then for any box b inside box, childrenIn
+/// visits exactly the children of out whose support overlaps b, in the same order, so a
+/// descent through nested boxes filters the list instead of asking the grid again. False
+/// (out unchanged) otherwise.
+inline bool gridChildrenIn(const Tape& T, const TNode& n, const Box3& box, std::vector<uint32_t>& out) {
+  const uint32_t* items;
+  uint32_t count;
+  if (n.grid < 0 || !gridCellOf(T.grids[size_t(n.grid)], box, items, count)) return false;
+  out.clear();
+  childrenIn(T, n, box, [&](uint32_t c) { out.push_back(c); });
+  return true;
 }
 
 /// Streaming super-elliptic sum: m = max f, s = Σ (f/m)^n.

@@ -1,5 +1,7 @@
 #include <catch2/catch.hpp>
 
+#include <cstring>
+#include <functional>
 #include <map>
 #include <utility>
 
@@ -370,6 +372,70 @@ TEST_CASE("CompiledBlob::surfaceCells", "[blobtree]") {
   CellSet again = b.surfaceCells(0.1f);
   REQUIRE(again.cells.size() == coarse.cells.size());
   for (size_t i = 0; i < again.cells.size(); ++i) CHECK(again.cells[i].index == coarse.cells[i].index);
+}
+
+TEST_CASE("CompiledBlob::surfaceCells under a root with a point grid", "[blobtree]") {
+  // Roots of many children (a point grid over them): the search lists the root's children
+  // once for a cube inside one grid cell and filters that list for the cubes below it. The
+  // cells, their order and their bounds must be those of a plain search that asks
+  // valueBounds at every cube.
+  Rng rng(11);
+  BlobTree t;
+  std::vector<NodeId> cones;
+  const NodeId blend = branching(t, rng, 150, &cones);
+  const NodeId united = t.unite(cones);
+  PcmParams pp;
+  const NodeId pressed = t.pcm(cones, pp);
+  SurfaceCellOptions o;
+  o.exactCellSize = true;
+  o.lipschitz = false;
+  o.primitiveLists = false;
+  const float cell = 0.05f;
+  for (NodeId root : {blend, united, pressed}) {
+    CompiledBlob b = compile(t, root);
+    CellSet cells = b.surfaceCells(cell, o);
+    const Box3 rb = b.bounds();
+    float E = std::max(rb.size().x, std::max(rb.size().y, rb.size().z)) * 1.0001f + 1e-20f;
+    const int depth = int(std::ceil(std::log2(E / cell)));
+    E = cell * float(1 << depth);
+    REQUIRE(cells.origin == rb.center() - Vec3(0.5f * E));
+    std::vector<std::pair<std::array<int32_t, 3>, Interval>> ref;
+    std::function<void(std::array<int32_t, 3>, int)> visit = [&](std::array<int32_t, 3> idx, int level) {
+      const float e = E / float(1 << level);
+      const Box3 box{cells.origin + Vec3(float(idx[0]), float(idx[1]), float(idx[2])) * e,
+                     cells.origin + Vec3(float(idx[0] + 1), float(idx[1] + 1), float(idx[2] + 1)) * e};
+      const Interval iv = b.valueBounds(box);
+      if (!iv.contains(kIso)) return;
+      if (level == depth) {
+        ref.push_back({idx, iv});
+        return;
+      }
+      for (int c = 0; c < 8; ++c)
+        visit({idx[0] * 2 + (c & 1), idx[1] * 2 + ((c >> 1) & 1), idx[2] * 2 + ((c >> 2) & 1)}, level + 1);
+    };
+    visit({0, 0, 0}, 0);
+    INFO(ref.size() << " cells");
+    REQUIRE(ref.size() > 5000);
+    REQUIRE(cells.cells.size() == ref.size());
+    size_t differ = 0;
+    for (size_t i = 0; i < ref.size(); ++i)
+      differ += cells.cells[i].index != ref[i].first ||
+                std::memcmp(&cells.cells[i].bounds, &ref[i].second, sizeof(Interval)) != 0;
+    CHECK(differ == 0);
+    // indicesOnly: the same cells' indices in the same order, and nothing else.
+    SurfaceCellOptions only = o;
+    only.indicesOnly = true;
+    CellSet indices = b.surfaceCells(cell, only);
+    CHECK(indices.cells.empty());
+    REQUIRE(indices.indices.size() == ref.size());
+    differ = 0;
+    for (size_t i = 0; i < ref.size(); ++i)
+      differ += indices.indices[i] != glm::ivec3(ref[i].first[0], ref[i].first[1], ref[i].first[2]);
+    CHECK(differ == 0);
+  }
+  SurfaceCellOptions bad;
+  bad.indicesOnly = true;  // with the default lipschitz and primitive lists
+  CHECK_THROWS_AS(compile(t, blend).surfaceCells(cell, bad), std::invalid_argument);
 }
 
 TEST_CASE("CellSet::tapes (pruned tapes per surface cell)", "[blobtree]") {
