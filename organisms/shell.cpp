@@ -19,6 +19,9 @@ using blobtree::TextureAttr;
 namespace {
 
 constexpr double kEps = 1e-9;
+/// How far the inside canal's newest copy reaches past the canal's tip (unit frame): beyond
+/// the tip's rounded end, so the tube is open there.
+constexpr float kCanalOpening = 1.0f;
 
 TextureAttr partTexture(ShellPart part) {
   TextureAttr t;
@@ -50,9 +53,12 @@ class ShellBuilder {
     float shift = 0.0f;  // outward shift of the generating surface, unit frame
   };
   // Generating surfaces.
-  void placeGenerating(std::vector<NodeId>& out, double theta, const Calibration& cal, ShellPart part, bool withCanal);
+  void placeGenerating(std::vector<NodeId>& out, double theta, const Calibration& cal, ShellPart part, bool withCanal,
+                       float canalPastTip = 0.0f);
   Calibration calibrate(float relativeSize) const;
   std::vector<double> sweepAngles(double from, double to) const;
+  std::vector<std::vector<double>> bySection(const std::vector<double>& angles) const;
+  NodeId insideWhorl(const Calibration& cal);
   // Parts.
   void varix(std::vector<NodeId>& parts, int number, double theta);
   void axialRow(std::vector<NodeId>& out, int number, double theta, const std::vector<float>& sizes);
@@ -203,19 +209,46 @@ std::vector<double> ShellBuilder::sweepAngles(double from, double to) const {
   return out;
 }
 
+std::vector<std::vector<double>> ShellBuilder::bySection(const std::vector<double>& angles) const {
+  // Surface i (on the grid startDeg + iΔθ) belongs to section ⌊i / surfacesPerSection⌋;
+  // empty sections are dropped.
+  std::vector<std::vector<double>> out;
+  size_t first = 0;
+  for (double th : angles) {
+    const size_t sec = static_cast<size_t>(std::floor((th - p_.startDeg) / step_ + 1e-6)) / p_.surfacesPerSection;
+    if (out.empty()) first = sec;
+    if (sec - first >= out.size()) out.resize(sec - first + 1);
+    out[sec - first].push_back(th);
+  }
+  std::erase_if(out, [](const std::vector<double>& v) { return v.empty(); });
+  return out;
+}
+
 void ShellBuilder::placeGenerating(std::vector<NodeId>& out, double theta, const Calibration& cal, ShellPart part,
-                                   bool withCanal) {
+                                   bool withCanal, float canalPastTip) {
+  // The calibration shifts the row's primitives so the summed tube is centred on the spiral;
+  // the canal hangs from that tube and reaches the shell axis in the spiral's own frame, so
+  // it is placed there, unshifted. Shifted with the row, every copy's canal stood
+  // shift·D(θ) off the axis, and the opening's canal (a shift about twice the main one's
+  // for λ 1.6, β 14°) cut through the canal's wall and the axial spines' roots.
   const float radiusScale = cal.k;
-  const glm::dmat4 m = s_.shellFromGenerating(theta) * glm::translate(glm::dmat4(1.0), glm::dvec3(cal.shift, 0, 0));
+  const glm::dmat4 onSpiral = s_.shellFromGenerating(theta);
+  const glm::dmat4 shifted = onSpiral * glm::translate(glm::dmat4(1.0), glm::dvec3(cal.shift, 0, 0));
   const double d = s_.curveSize(theta);
   for (const GeneratingPrimitive& g : gen_.primitives) {
     if (g.lastDeg > 0.0 && theta < end_ - g.lastDeg - kEps) continue;
     if (g.canal && !withCanal) continue;
+    const glm::dmat4& m = g.canal ? onSpiral : shifted;
     if (g.kind == GeneratingPrimitive::Kind::Point) {
       out.push_back(t_.point(apply(m, g.a), static_cast<float>(g.radiusA * radiusScale * d), partTexture(part)));
     } else if (g.bendDeg == 0.0f) {
-      out.push_back(t_.cone(apply(m, g.a), apply(m, g.b), static_cast<float>(g.radiusA * radiusScale * d),
-                            static_cast<float>(g.radiusB * radiusScale * d), partTexture(part)));
+      // canalPastTip lengthens a straight canal cone along its axis, its radius continued.
+      const float len = glm::length(g.b - g.a);
+      const float ext = g.canal && len > 0.0f ? canalPastTip : 0.0f;
+      const Vec3 b = g.b + (ext / std::max(len, 1e-6f)) * (g.b - g.a);
+      const float rb = std::max(0.2f * g.radiusB, g.radiusB + (g.radiusB - g.radiusA) * ext / std::max(len, 1e-6f));
+      out.push_back(t_.cone(apply(m, g.a), apply(m, b), static_cast<float>(g.radiusA * radiusScale * d),
+                            static_cast<float>(rb * radiusScale * d), partTexture(part)));
     } else {
       const Bend bend = canalBend(g);
       out.push_back(arcCone(g.a, g.b, g.radiusA * radiusScale, g.radiusB * radiusScale, std::span(&bend, 1),
@@ -366,19 +399,41 @@ NodeId ShellBuilder::bumps() {
   return t_.blend(all);
 }
 
+NodeId ShellBuilder::insideWhorl(const Calibration& cal) {
+  // B_inside of Eq. 14, made "using the same method described for the main body whorl":
+  // the inside generating surface summed per section, the sections joined by the main
+  // body's blend. Each copy of the inside canal is then the main canal's copy at the same θ
+  // with a smaller radius and the same centre line, and each group sums the copies of the
+  // main body's group of the same sections, so the hollow stays inside the canal's wall
+  // and the axial spines keep their roots. (A plain sum of every section summed more canal
+  // copies than any group of the main body and bulged through the wall.) Past the lip the
+  // surface opens the aperture without its canal, whose copies there would stand beside the
+  // canal; the newest copy's straight cone, lengthened past its tip, opens the tube's end.
+  const OpeningOptions& o = p_.opening;
+  std::vector<NodeId> sums;
+  for (const std::vector<double>& sa : bySection(sweepAngles(std::max(p_.startDeg, end_ - o.depthDeg), end_ + o.extendDeg))) {
+    std::vector<NodeId> prims;
+    for (double th : sa)
+      placeGenerating(prims, th, cal, ShellPart::Inside, th <= end_ + kEps, std::abs(th - end_) < kEps ? kCanalOpening : 0.0f);
+    sums.push_back(prims.size() == 1 ? prims[0] : t_.blend(prims));
+  }
+  if (sums.size() == 1) return sums[0];
+  if (!p_.controlledBlending) return t_.blend(sums);
+  std::vector<std::vector<uint32_t>> groups;
+  for (uint32_t i = 0; i + 1 < sums.size(); ++i) groups.push_back({i, i + 1});
+  return t_.controlledBlend(sums, groups);
+}
+
 NodeId ShellBuilder::opening(NodeId shell) {
   // Eq. 14-15: B = (B_shell − (B_inside − B_previous)) ∪ B_insidewall.
   const OpeningOptions& o = p_.opening;
   const Calibration kIn = calibrate(o.innerScale);
-  std::vector<NodeId> inside;
-  for (double th : sweepAngles(std::max(p_.startDeg, end_ - o.depthDeg), end_ + o.extendDeg))
-    placeGenerating(inside, th, kIn, ShellPart::Inside, true);
   if (o.show == OpeningOptions::Show::InsideSurface) {
     std::vector<NodeId> one;
     placeGenerating(one, end_, kIn, ShellPart::Inside, true);
     return t_.blend(one);
   }
-  NodeId cutter = t_.blend(inside);
+  NodeId cutter = insideWhorl(kIn);
   if (o.show == OpeningOptions::Show::InsideWhorl) return cutter;
   if (o.subtractPrevious && end_ - 360.0 - o.depthDeg > p_.startDeg - 360.0) {
     std::vector<NodeId> prev;
@@ -412,15 +467,7 @@ void ShellBuilder::build() {
 
   // Sections of the main body (Eq. 9): surface i belongs to section ⌊i / surfacesPerSection⌋;
   // a last section of a single surface joins the one before it.
-  const std::vector<double> angles = sweepAngles(p_.startDeg, end_);
-  const int per = p_.surfacesPerSection;
-  std::vector<std::vector<double>> secAngles;
-  for (double th : angles) {
-    const size_t sec = static_cast<size_t>(std::floor((th - p_.startDeg) / step_ + 1e-6)) / per;
-    if (sec >= secAngles.size()) secAngles.resize(sec + 1);
-    secAngles[sec].push_back(th);
-  }
-  std::erase_if(secAngles, [](const std::vector<double>& v) { return v.empty(); });
+  std::vector<std::vector<double>> secAngles = bySection(sweepAngles(p_.startDeg, end_));
   if (secAngles.size() > 1 && secAngles.back().size() < 2) {
     secAngles[secAngles.size() - 2].push_back(secAngles.back().front());
     secAngles.pop_back();

@@ -70,7 +70,7 @@ ShellMeasures measureShell(const ShellParams& p, const ShellModel& m, const blob
   out.canalTipY = out.apertureBaseY;
   if (p.canal) {
     const GeneratingPrimitive g = p.canal->primitives(s).back();
-    const glm::dmat4 frame = s.shellFromGenerating(te) * glm::translate(glm::dmat4(1.0), glm::dvec3(m.centreShift, 0, 0));
+    const glm::dmat4 frame = s.shellFromGenerating(te);  // the canal hangs unshifted from the spiral
     const DVec3 tip(frame * glm::dvec4(DVec3(g.b), 1.0));
     const double r = 1.5 * g.radiusB * m.sizeCalibration * de;
     const double start = std::min(out.apertureBaseY, tip.y - 4.0 * r);

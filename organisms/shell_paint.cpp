@@ -27,17 +27,27 @@ HelicoCoords ShellPainter::helicoCoords(Vec3 q) const {
   const DVec3 p(q);
   const double phi = std::atan2(-p.z, p.x) * 180.0 / kPi;  // θ modulo 360
   HelicoCoords best;
-  best.radial = std::numeric_limits<double>::max();
+  best.radial = best.grownRadial = std::numeric_limits<double>::max();
+  auto radialAt = [&](double th, double& x, double& y) {
+    const DVec3 c = spiral_.point(th);
+    const double d = spiral_.curveSize(th);
+    const DVec3 e = glm::normalize(DVec3(c.x, 0.0, c.z));
+    x = glm::dot(p - c, e) / d;
+    y = (p.y - c.y) / d;
+    return std::hypot(x, y);
+  };
   const double kLo = std::floor((startDeg_ - 360.0 - phi) / 360.0);
   const double kHi = std::ceil((std::max(endDeg_, fullEndDeg_) + 360.0 - phi) / 360.0);
   for (double k = kLo; k <= kHi; k += 1.0) {
     const double th = phi + 360.0 * k;
-    const DVec3 c = spiral_.point(th);
-    const double d = spiral_.curveSize(th);
-    const DVec3 e = glm::normalize(DVec3(c.x, 0.0, c.z));
-    const double x = glm::dot(p - c, e) / d;
-    const double y = (p.y - c.y) / d;
-    const double r = std::hypot(x, y);
+    double x = 0.0, y = 0.0, gx = 0.0, gy = 0.0;
+    const double r = radialAt(th, x, y);
+    const double grownTh = std::min(th, endDeg_);
+    const double grownR = grownTh == th ? r : radialAt(grownTh, gx, gy);
+    if (grownR < best.grownRadial) {
+      best.grownRadial = grownR;
+      best.grownThetaDeg = grownTh;
+    }
     if (r < best.radial) {
       best.radial = r;
       best.thetaDeg = th;
@@ -71,8 +81,8 @@ Vec3 ShellPainter::whorlSurfaceColor(double thetaDeg, double aroundDeg, bool can
 double ShellPainter::insideWeight(const HelicoCoords& h) const {
   // The inside of the aperture: the cut surface of the opening, inside the whorl's wall.
   const ShellTextureOptions& o = options_;
-  if (!opening_ || o.insideRadial <= 0.0f || h.thetaDeg <= openingFromDeg_) return 0.0;
-  return std::clamp((o.insideRadial + 0.04 - h.radial) / 0.08, 0.0, 1.0);
+  if (!opening_ || o.insideRadial <= 0.0f || h.grownThetaDeg <= openingFromDeg_) return 0.0;
+  return std::clamp((o.insideRadial + 0.04 - h.grownRadial) / 0.08, 0.0, 1.0);
 }
 
 bool ShellPainter::hasVarixBands() const { return varices_ && varixSpacingDeg_ > 0.0; }

@@ -53,6 +53,11 @@ struct HelicoCoords {
   double thetaDeg = 0.0;   ///< angle along the spiral of the generating curve nearest the point
   double aroundDeg = 0.0;  ///< angle around the generating curve, from outward, positive towards the apex
   double radial = 0.0;     ///< distance from the generating centre / D(θ)
+  /// The same against the generating curves grown so far only (θ ≤ θ_end, the lip's for
+  /// turns past it): where the canal runs through the place of a whorl not yet grown, the
+  /// nearest curve is that whorl's and `radial` is small, yet the point is no aperture.
+  double grownThetaDeg = 0.0;
+  double grownRadial = 0.0;
 };
 
 /// Colours surface points of one shell. Immutable after construction; thread-safe.

@@ -76,3 +76,39 @@ TEST_CASE("ShellPainter::the inside of the aperture takes the inside colour", "[
   const DVec3 q = c + 0.8 * p.spiral.curveSize(old) * e;
   CHECK(glm::length(painter.partColor(ShellPart::Whorl, world(q), Vec2(0.0f)) - o.whorlColor) < 1e-5f);
 }
+
+TEST_CASE("ShellPainter::the canal's outside is not the aperture", "[organisms]") {
+  // At λ 1.6, β 14° the canal runs where the next whorl would grow: the nearest generating
+  // curve of a canal point is that whorl's, not yet grown, and it used to paint the canal
+  // with the aperture's colour. Only curves grown so far (θ ≤ θ_end) count.
+  ShellParams p = murexCabritii();
+  p.spiral = HelicoSpiral{1.6, 14.0, 0.025};
+  p.canal->length = 5.4f;
+  p.bumps.enabled = false;
+  p.varices.enabled = false;
+  p.axialSpines.enabled = false;
+  const ShellModel m = buildShell(p);
+  const blobtree::CompiledBlob b = blobtree::compile(m.tree, m.shellRoot);
+  const ShellPainter painter(p, m, ShellTextureOptions{});
+  const HelicoSpiral& s = p.spiral;
+  int surface = 0, pink = 0;
+  for (double back : {0.0, 116.0, 232.0})
+    for (double t = 0.35; t <= 0.95; t += 0.05) {
+      // Around the canal's centre line below the aperture (its start runs through the
+      // aperture's hollow), from outside inwards to its outer surface.
+      const double th = m.endDeg - back;
+      const DVec3 c(s.shellFromGenerating(th) * glm::dvec4(DVec3(p.canal->pointAt(s, t)), 1.0));
+      const double d = s.curveSize(th);
+      for (int k = 0; k < 8; ++k) {
+        const double a = kPi * k / 4.0;
+        const DVec3 dir(std::cos(a), 0.0, std::sin(a));
+        const DVec3 from = c + 0.8 * d * dir;
+        if (b.value(Vec3(from)) > 0.5f) continue;  // inside the body whorl or another part
+        const DVec3 q = crossing(b, from, -dir, 0.8 * d);
+        ++surface;
+        pink += painter.insideWeight(painter.helicoCoords(Vec3(q))) > 0.0 ? 1 : 0;
+      }
+    }
+  CHECK(surface > 150);
+  CHECK(pink == 0);
+}
