@@ -437,8 +437,9 @@ class ViewParser {
     const auto head = nameAndSamples(line, vcol, value, "function", -1, 0);
     if (!head) return;
     const auto& [name, samples] = *head;
-    parseObjectFile(line, vcol, name, "the function file", [&](const std::string& text, const std::string& file) {
-      view_.functions.push_back(CpfgFunction::parse(text, file, samples));
+    // A structured binding is captured through a copy (C++17 lambdas cannot name one).
+    parseObjectFile(line, vcol, name, "the function file", [&, n = samples](const std::string& text, const std::string& file) {
+      view_.functions.push_back(CpfgFunction::parse(text, file, n));
     });
   }
 
@@ -556,8 +557,8 @@ class ViewParser {
     const auto head = nameAndSamples(line, vcol, value, "curve", CpfgCurve::kDefaultSamples, 2);
     if (!head) return;
     const auto& [name, samples] = *head;
-    parseObjectFile(line, vcol, name, "the curve file", [&](const std::string& text, const std::string& file) {
-      view_.curves.push_back(CpfgCurve::parse(text, file, samples));
+    parseObjectFile(line, vcol, name, "the curve file", [&, n = samples](const std::string& text, const std::string& file) {
+      view_.curves.push_back(CpfgCurve::parse(text, file, n));
     });
   }
 
