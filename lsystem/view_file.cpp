@@ -437,7 +437,7 @@ class ViewParser {
     const auto head = nameAndSamples(line, vcol, value, "function", -1, 0);
     if (!head) return;
     const auto& [name, samples] = *head;
-    // A structured binding is captured through a copy (C++17 lambdas cannot name one).
+    // The structured binding reaches the lambda through a copy: clang 14 cannot capture one.
     parseObjectFile(line, vcol, name, "the function file", [&, n = samples](const std::string& text, const std::string& file) {
       view_.functions.push_back(CpfgFunction::parse(text, file, n));
     });
