@@ -5,6 +5,8 @@
 #include <chrono>
 #include <ctime>
 
+#include "core/timer.h"
+
 namespace sprig::bench {
 
 using Clock = std::chrono::steady_clock;
@@ -20,9 +22,8 @@ inline double cpuSeconds(clockid_t clock) {
 }
 }  // namespace detail
 
-/// CPU seconds of the whole process (all threads): on idle cores, wall time is about
-/// this divided by the number of threads.
-inline double processCpuSeconds() { return detail::cpuSeconds(CLOCK_PROCESS_CPUTIME_ID); }
+/// CPU seconds of the whole process (all threads): core/timer.h's.
+using sprig::processCpuSeconds;
 
 /// CPU seconds of the calling thread.
 inline double threadCpuSeconds() { return detail::cpuSeconds(CLOCK_THREAD_CPUTIME_ID); }

@@ -11,28 +11,18 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
-#include <ctime>
 #include <filesystem>
 #include <string>
 #include <variant>
 #include <vector>
 
+#include "core/timer.h"
 #include "model/model.h"
 #include "render/camera.h"
 #include "render/renderer.h"
 #include "render/scene.h"
 
 using namespace sprig;
-
-namespace {
-
-double cpuSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   std::setvbuf(stdout, nullptr, _IOLBF, 0);
@@ -72,13 +62,13 @@ int main(int argc, char** argv) {
           if (auto* im = std::get_if<render::ImplicitPart>(&part)) im->options.prunedTapes = pruned == 1;
         render::Scene scene;
         scene.setPixelFootprint(camera, width, height, look.image.thinMinPixels);
-        double c0 = cpuSeconds();
+        double c0 = processCpuSeconds();
         scene.add(g);
         scene.commit();
-        cellsCpu[pruned] = cpuSeconds() - c0;
-        c0 = cpuSeconds();
+        cellsCpu[pruned] = processCpuSeconds() - c0;
+        c0 = processCpuSeconds();
         images[pruned] = render::renderImage(scene, camera, rs);
-        renderCpu[pruned] = cpuSeconds() - c0;
+        renderCpu[pruned] = processCpuSeconds() - c0;
         if (pruned == 1 && scene.stats().implicitTapes > 0)
           std::printf("%s: %zu cells, %zu distinct pruned tapes, %.1f nodes per cell\n", file.c_str(),
                       scene.stats().implicitCells, scene.stats().implicitTapes,

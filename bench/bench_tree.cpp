@@ -21,7 +21,6 @@
 
 #include <chrono>
 #include <cstdio>
-#include <ctime>
 #include <cstdlib>
 #include <memory>
 #include <string>
@@ -34,6 +33,7 @@
 #include "core/atomic_file.h"
 #include "core/image.h"
 #include "core/rng.h"
+#include "core/timer.h"
 #include "lsystem/derive.h"
 #include "lsystem/grammar.h"
 #include "lsystem/turtle.h"
@@ -49,13 +49,6 @@ using Clock = std::chrono::steady_clock;
 namespace {
 
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-// CPU seconds of the whole process (all threads).
-double cpuSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
-}
 
 /// The command line (see the file comment).
 struct Args {
@@ -120,20 +113,20 @@ std::pair<double, double> woodScene(render::Scene& scene, const blobtree::Compil
   scene.addTexture([bark](Vec2 uv, const Vec3&) { return bark->color(uv); });
   const uint32_t wood = scene.addMaterial(render::Material{Vec3(0.62f, 0.60f, 0.52f), 0.7f, 0.03f, 0});
   const auto t = Clock::now();
-  const double c0 = cpuSeconds();
+  const double c0 = processCpuSeconds();
   scene.addImplicit(compiled, wood, io);
   scene.commit();
-  return {since(t), cpuSeconds() - c0};
+  return {since(t), processCpuSeconds() - c0};
 }
 
 /// Renders scene; returns the image and the render's wall and CPU seconds.
 Image timedRender(const render::Scene& scene, const render::Camera& camera, const render::RenderSettings& rs,
                   render::RenderStats& stats, double& wallS, double& cpuS) {
   const auto t = Clock::now();
-  const double c0 = cpuSeconds();
+  const double c0 = processCpuSeconds();
   Image image = render::renderImage(scene, camera, rs, &stats);
   wallS = since(t);
-  cpuS = cpuSeconds() - c0;
+  cpuS = processCpuSeconds() - c0;
   return image;
 }
 
@@ -193,12 +186,12 @@ void benchExactRender(const blobtree::CompiledBlob& compiled, const Args& a) {
 /// thinnest twig tip and would ask for billions of cells on a 2,000-internode tree.
 void benchPolygonize(const blobtree::CompiledBlob& compiled) {
   const auto t = Clock::now();
-  const double cpu0 = cpuSeconds();
+  const double cpu0 = processCpuSeconds();
   blobtree::PolygonizeOptions po;
   po.cellSize = glm::length(compiled.bounds().size()) / 400.0f;
   const blobtree::PolygonizeResult mesh = blobtree::polygonizeDetailed(compiled, po);
   std::printf("polygonize: %.2f s (CPU %.2f s), cell %.4g, %zu triangles, %zu field evaluations\n", since(t),
-              cpuSeconds() - cpu0, mesh.cellSize, mesh.mesh.triangleCount(), mesh.fieldEvaluations);
+              processCpuSeconds() - cpu0, mesh.cellSize, mesh.mesh.triangleCount(), mesh.fieldEvaluations);
 }
 
 }  // namespace

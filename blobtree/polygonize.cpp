@@ -13,7 +13,6 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
-#include <ctime>
 #include <sys/mman.h>
 
 #include "blobtree/cell_size.h"
@@ -23,6 +22,7 @@
 #include "core/parallel.h"
 #include "core/phases.h"
 #include "core/progress.h"
+#include "core/timer.h"
 
 namespace sprig::blobtree {
 
@@ -291,17 +291,6 @@ std::vector<T> concat(std::vector<std::vector<T>>& parts) {
     std::vector<T>().swap(p);
   }
   return out;
-}
-
-}  // namespace
-
-namespace {
-
-// CPU seconds of the whole process (every thread).
-double processCpuSeconds() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
 }  // namespace
