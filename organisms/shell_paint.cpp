@@ -38,12 +38,14 @@ HelicoCoords ShellPainter::helicoCoords(Vec3 q) const {
   };
   const double kLo = std::floor((startDeg_ - 360.0 - phi) / 360.0);
   const double kHi = std::ceil((std::max(endDeg_, fullEndDeg_) + 360.0 - phi) / 360.0);
+  double lipR = -1.0;  // against the lip's curve, the grown one of every turn past it: once
   for (double k = kLo; k <= kHi; k += 1.0) {
     const double th = phi + 360.0 * k;
     double x = 0.0, y = 0.0, gx = 0.0, gy = 0.0;
     const double r = radialAt(th, x, y);
     const double grownTh = std::min(th, endDeg_);
-    const double grownR = grownTh == th ? r : radialAt(grownTh, gx, gy);
+    if (grownTh != th && lipR < 0.0) lipR = radialAt(grownTh, gx, gy);
+    const double grownR = grownTh == th ? r : lipR;
     if (grownR < best.grownRadial) {
       best.grownRadial = grownR;
       best.grownThetaDeg = grownTh;
