@@ -1,14 +1,25 @@
 """Imports a .glb into Blender 3.4 (background) and renders it with Cycles from a camera that
 frames the model, for docs/MESHES.md "Levels of detail" (looking at a level of detail).
 
-Usage: blender -b --factory-startup --python scripts/blender-lod-render.py -- IN.glb OUT.png [SIZE] [SAMPLES]
+Usage: blender -b --factory-startup --python scripts/blender-lod-render.py -- IN.glb OUT.png [SIZE] [SAMPLES] [SHADING]
 
-Prints `import: S s, N triangles, peak M MB` (import time, the triangles Blender holds,
-Blender's peak resident memory after the import). The camera looks at the bounding box's
-centre from the front-left and slightly above (the same for every level of one model, since
-the levels share their bounds within a few per cent); a sun and a grey sky light it.
+SHADING is the importer's `import_shading`: SMOOTH (the default: Blender's own smooth
+normals over the merged vertices; the file's normals are not read) or NORMALS (the file's
+normals as custom split normals, so crease splits stay sharp; Debian's importer needs
+numpy's old `np.bool` alias for it, which this script puts back). Both merge vertices
+(`merge_vertices=True`): an atlas part has one vertex per corner, which unmerged would
+shade flat under SMOOTH and stay in loose triangles under NORMALS.
+
+Prints `import: S s (CPU C s, load L), N triangles, peak M MB` (the import's wall time, its
+CPU time, the one-minute load average after it, the triangles Blender holds, Blender's peak
+resident memory after the import): a wall time far above the CPU time means the machine
+was busy, not that the file is slow (docs/BLENDER.md "Importing Sprig's glb"). The camera
+looks at the bounding box's centre from the front-left and slightly above (the same for
+every level of one model, since the levels share their bounds within a few per cent); a
+sun and a grey sky light it.
 """
 import math
+import os
 import resource
 import sys
 import time
@@ -20,15 +31,21 @@ args = sys.argv[sys.argv.index("--") + 1:]
 src, dst = args[0], args[1]
 size = int(args[2]) if len(args) > 2 else 480
 samples = int(args[3]) if len(args) > 3 else 16
+shading = args[4] if len(args) > 4 else 'SMOOTH'
+if shading == 'NORMALS':
+    import numpy
+    if 'bool' not in numpy.__dict__:
+        numpy.bool = bool  # Blender 3.4's importer names np.bool, removed in numpy 1.24
 
 bpy.ops.wm.read_factory_settings(use_empty=True)
-t0 = time.time()
-bpy.ops.import_scene.gltf(filepath=src, import_shading='SMOOTH', merge_vertices=True)
-seconds = time.time() - t0
+t0, c0 = time.time(), time.process_time()
+bpy.ops.import_scene.gltf(filepath=src, import_shading=shading, merge_vertices=True)
+seconds, cpu = time.time() - t0, time.process_time() - c0
 meshes = [o for o in bpy.context.scene.objects if o.type == 'MESH']
 triangles = sum(sum(len(p.vertices) - 2 for p in o.data.polygons) for o in meshes)
 peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
-print("import: %.2f s, %d triangles, peak %.0f MB" % (seconds, triangles, peak))
+print("import: %.2f s (CPU %.2f s, load %.1f), %d triangles, peak %.0f MB" %
+      (seconds, cpu, os.getloadavg()[0], triangles, peak))
 
 lo = Vector((math.inf,) * 3)
 hi = Vector((-math.inf,) * 3)
