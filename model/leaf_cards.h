@@ -1,6 +1,7 @@
 #pragma once
 /// Leaf cards and crown cards: the leaves of a tree's farthest levels of detail as
-/// alpha-tested quads (docs/MESHES.md "Levels of detail", "Leaf cards", "Crown cards").
+/// alpha-tested quads (docs/MESHES.md "Levels of detail", "Leaf cards", "Crown cards: the
+/// far impostor").
 ///
 /// Each leaf (a connected component of a scattered part: ExportPart::scattered) becomes one
 /// quad in the leaf's plane, covering the leaf's outline, textured with its own image: the
@@ -87,10 +88,9 @@ ExportPart leafCards(const ExportPart& part, size_t cards);
 /// views from the side and from above meet the three alike), its side u = up × (the
 /// normal's horizontal direction), v = n × u; each through the mean of the cluster's
 /// vertices, the bounding rectangle of them in its plane plus one texel of rim each side;
-/// none grown. Card k's cell (kCrownCardTexels a side, in
-/// rows as leafCards') holds the cluster's leaves seen along its normal, painted as
-/// leafCards paints one leaf (where leaves overlap, the first in the mesh's order). The
-/// material as leafCards'. Deterministic; the same bytes at any thread count. A part
+/// none grown. Each card's cell (kCrownCardTexels a side, in rows as leafCards') holds the
+/// cluster's leaves seen along its normal, painted as leafCards paints one leaf (where
+/// leaves overlap, the first in the mesh's order). The material as leafCards'. Deterministic; the same bytes at any thread count. A part
 /// without triangles is returned unchanged. Cost: a point-in-triangle test per quarter texel
 /// of each triangle's box on each of its cluster's cards; leaves · clusters distances a round.
 ExportPart crownCards(const ExportPart& part, size_t clusters);
