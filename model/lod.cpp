@@ -34,14 +34,8 @@ Mesh thinPieces(const Mesh& mesh, size_t targetTriangles, double area) {
   const size_t keep = std::clamp<size_t>(size_t(std::floor(double(pieces) * fraction)), 1, pieces);
   std::vector<char> kept(pieces, 0);
   for (size_t j = 0; j < pieces; ++j) kept[j] = evenlyKept(j, keep, pieces);
-  // Centroids of the kept pieces.
-  std::vector<glm::dvec3> sum(pieces, glm::dvec3(0.0));
-  std::vector<size_t> used(pieces, 0), newIndex(mesh.positions.size(), SIZE_MAX);
-  std::vector<uint32_t> vertexPiece(mesh.positions.size(), UINT32_MAX);
-  for (size_t t = 0; t < mesh.triangles.size(); ++t)
-    for (int k = 0; k < 3; ++k) vertexPiece[mesh.triangles[t][k]] = piece[t];
-  for (size_t v = 0; v < mesh.positions.size(); ++v)
-    if (vertexPiece[v] != UINT32_MAX) sum[vertexPiece[v]] += glm::dvec3(mesh.positions[v]), ++used[vertexPiece[v]];
+  const std::vector<glm::dvec3> centroid = componentCentroids(mesh, piece, pieces);
+  std::vector<size_t> newIndex(mesh.positions.size(), SIZE_MAX);
   Mesh out;
   std::vector<glm::dvec3> centre;  // of each output vertex's piece
   const bool normals = mesh.normals.size() == mesh.positions.size(), uvs = mesh.uvs.size() == mesh.positions.size(),
@@ -54,7 +48,7 @@ Mesh thinPieces(const Mesh& mesh, size_t targetTriangles, double area) {
       if (newIndex[v] == SIZE_MAX) {
         newIndex[v] = out.positions.size();
         out.positions.push_back(mesh.positions[v]);
-        centre.push_back(sum[piece[t]] / double(used[piece[t]]));
+        centre.push_back(centroid[piece[t]]);
         if (normals) out.normals.push_back(mesh.normals[v]);
         if (uvs) out.uvs.push_back(mesh.uvs[v]);
         if (colors) out.colors.push_back(mesh.colors[v]);
@@ -211,6 +205,37 @@ void cardFarLeaves(const std::vector<ExportPart>& parts, LodLevel& level) {
   level.triangles = partTriangles(level.parts);
 }
 
+// Crown clusters for a far level that kept leafTriangles of a part's leaves: the crown
+// level's cards have about kLodRatio of them (2 triangles a card), at least one cluster.
+size_t crownClusterCount(size_t leafTriangles) {
+  const double cards = double(leafTriangles) * kLodRatio / 2.0;
+  return std::max<size_t>(size_t(cards / double(kCrownCardsPerCluster)), 1);
+}
+
+// The crown level after far, the chain's level of per-leaf cards, or none (an empty level)
+// when far has no leaves: every scattered part crown cards of the full part's leaves
+// (crownCards, crownClusterCount clusters), every surface kLodRatio of far's (reducePart);
+// errors receives the surfaces' simplification errors. Parts side by side, each in its slot.
+LodLevel crownLevel(const std::vector<ExportPart>& parts, const LodLevel& far, std::vector<float>& errors) {
+  errors.assign(parts.size(), 0.0f);
+  bool leaves = false;
+  for (size_t i = 0; i < parts.size(); ++i) leaves = leaves || (parts[i].scattered && !far.parts[i].mesh.triangles.empty());
+  if (!leaves) return {};
+  LodLevel level;
+  level.parts.resize(parts.size());
+  parallelFor(0, parts.size(), [&](size_t i) {
+    const ExportPart& p = far.parts[i];
+    if (p.mesh.triangles.empty())
+      level.parts[i] = p;
+    else if (parts[i].scattered)
+      level.parts[i] = crownCards(parts[i], crownClusterCount(p.mesh.triangles.size()));
+    else
+      level.parts[i] = reducePart(p, std::max<size_t>(size_t(std::llround(double(p.mesh.triangles.size()) * kLodRatio)), 1), errors[i]);
+  });
+  level.triangles = partTriangles(level.parts);
+  return level;
+}
+
 }  // namespace
 
 size_t partTriangles(const std::vector<ExportPart>& parts) {
@@ -245,8 +270,17 @@ std::vector<LodLevel> buildLodChain(const std::vector<ExportPart>& parts, size_t
     levels.push_back(std::move(next));
     errors.push_back(std::move(error));
   }
-  // The far level's leaves as cards (before the maps: a card part has its own texture).
-  if (levels.size() > 1) cardFarLeaves(parts, levels.back());
+  // The far level's leaves as cards, then, for a model with leaves, the crown level after it
+  // (before the maps: a card part has its own texture).
+  if (levels.size() > 1) {
+    cardFarLeaves(parts, levels.back());
+    std::vector<float> error;
+    LodLevel crown = crownLevel(parts, levels.back(), error);
+    if (!crown.parts.empty() && crown.triangles < levels.back().triangles) {
+      levels.push_back(std::move(crown));
+      errors.push_back(std::move(error));
+    }
+  }
   // The maps of the detail the levels lost, from the full parts (before the levels move).
   LodMapReport report;
   bakeLevelMaps(parts, levels, detailReach(parts, levels, errors), report);

@@ -66,9 +66,14 @@ struct LodMapReport {
 /// does get below kLodMaxKeep of the level before. Triangle counts strictly decrease.
 /// Parts without triangles stay empty. Every level is moved by the offset that stands LOD0
 /// on the ground (groundOffset: simplification may remove the lowest or outermost vertices);
-/// moved, when given, receives it. The far level (the last of two or more) has its
-/// scattered parts (leaves) as alpha-tested cards of the full parts' leaves
+/// moved, when given, receives it. The last of two or more such levels has its scattered
+/// parts (leaves) as alpha-tested cards of the full parts' leaves, one a leaf
 /// (model/leaf_cards.h leafCards: half as many cards as that level kept leaf triangles).
+/// When it has leaves, one more level follows, beyond kLodMaxLevels and kLodMinTriangles:
+/// the crown level, the far impostor, its surfaces kLodRatio of the level before and its
+/// leaves crown cards, several leaves a card (leaf_cards.h crownCards: all the full part's
+/// leaves in ⌊kLodRatio · (the level before's leaf triangles) / (2 · kCrownCardsPerCluster)⌋
+/// clusters, at least one), made only if the level has fewer triangles than the one before.
 /// Deterministic. Cost: one simplification of the full parts
 /// (O(T log T)), then of each level (a quarter each).
 ///

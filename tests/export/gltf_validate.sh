@@ -8,7 +8,7 @@
 # varices; its export takes minutes (a million triangles), so it is not among these cases.
 # Levels of detail (MSFT_lod) are validated on three trees and an organism (the PCM tree and the
 # organism with the detail maps of their simplified levels: normalTexture and TANGENT; the lime
-# in leaf, whose far level's leaves are alpha-tested cards); the
+# in leaf, whose last two levels' leaves are alpha-tested leaf cards and crown cards); the
 # other cases write the full mesh alone (--lod none), which is what each level is made from.
 # Usage: gltf_validate.sh path/to/sprig   (run from the repository root)
 set -euo pipefail
@@ -26,7 +26,7 @@ species=(
   "blob_ricci_fig3 blob"                   # blob
   "fig_org_05b_berry_level2 organism | --lod 20000"  # organism on a primitive, with its levels of detail and their detail maps (a small budget: the bake follows the levels' texels)
   "fig_tree_12_pcm_offset wood | --lod 2000"  # tree with PCM ridges: both levels simplified, each with a normal map and TANGENT
-  "tree_lime wood leaves | --steps 3 --cell 0.02 --lod 2000"  # tree in leaf with levels: the far level's leaves are alpha-tested cards
+  "tree_lime wood leaves | --steps 3 --cell 0.02 --lod 2000"  # tree in leaf with levels: the leaves of the last two levels are alpha-tested cards (leaf cards, then crown cards)
   "fig_org_13a_mummified_skull_sharp organism"  # organism on a CT volume, blend colour
   "fig_org_14c_planet_blend organism"      # organism with the planet shader
   "org_painted_band organism"              # organism on a painted mesh
@@ -63,25 +63,32 @@ if len(prims) < 2 or bad:
 PY
   fi
   if [[ "$s" == tree_lime && "$flags" == *--lod\ 2000* ]]; then
-    # The far level's leaves: quads (4 vertices, 2 triangles each), alphaMode MASK with an
-    # alphaCutoff and a baseColorTexture; the wood is there too.
+    # The last two levels' leaves (leaf cards, then crown cards): quads (4 vertices, 2
+    # triangles each), alphaMode MASK with an alphaCutoff and a baseColorTexture, fewer on
+    # the crown level; the wood is there too.
     python3 - "$f" <<'PY'
 import json, struct, sys
 d = open(sys.argv[1], 'rb').read()
 j = json.loads(d[20:20 + struct.unpack('<I', d[12:16])[0]])
-far = {}
+levels = {}
 for n in j['nodes']:
-    if 'mesh' in n:
-        far[n['name'].split('_lod')[0]] = n  # the last level of each part
-leaves, wood = far.get('leaves'), far.get('wood')
-if not leaves or not wood or '_lod' not in leaves['name']:
-    sys.exit('%s: no far level of wood and leaves' % sys.argv[1])
-p = j['meshes'][leaves['mesh']]['primitives'][0]
-m = j['materials'][p['material']]
-tris, verts = j['accessors'][p['indices']]['count'] // 3, j['accessors'][p['attributes']['POSITION']]['count']
-if m.get('alphaMode') != 'MASK' or m.get('alphaCutoff', 0.5) <= 0 or 'baseColorTexture' not in m['pbrMetallicRoughness'] \
-        or tris == 0 or verts != 2 * tris:
-    sys.exit('%s: far leaves are not cards: %s, %d triangles, %d vertices' % (sys.argv[1], m, tris, verts))
+    if 'mesh' in n and '_lod' in n['name']:
+        part, k = n['name'].split('_lod')
+        levels.setdefault(part, {})[int(k)] = n
+leaves, wood = levels.get('leaves', {}), levels.get('wood', {})
+if len(leaves) < 2 or not wood:
+    sys.exit('%s: no two lower levels of leaves and a level of wood' % sys.argv[1])
+counts = []
+for k in sorted(leaves)[-2:]:
+    p = j['meshes'][leaves[k]['mesh']]['primitives'][0]
+    m = j['materials'][p['material']]
+    tris, verts = j['accessors'][p['indices']]['count'] // 3, j['accessors'][p['attributes']['POSITION']]['count']
+    if m.get('alphaMode') != 'MASK' or m.get('alphaCutoff', 0.5) <= 0 or 'baseColorTexture' not in m['pbrMetallicRoughness'] \
+            or tris == 0 or verts != 2 * tris:
+        sys.exit('%s: leaves_lod%d are not cards: %s, %d triangles, %d vertices' % (sys.argv[1], k, m, tris, verts))
+    counts.append(tris)
+if counts[1] >= counts[0]:
+    sys.exit('%s: the crown level has no fewer card triangles than the leaf cards: %s' % (sys.argv[1], counts))
 PY
   fi
 done

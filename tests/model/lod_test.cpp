@@ -72,6 +72,20 @@ struct TempDir {
   ~TempDir() { fs::remove_all(path); }
 };
 
+// Where point p, projected along card quad's normal, falls on the card (cards: 4 vertices a
+// quad, corners -u-v, +u-v, +u+v, -u+v): (s, t) across its sides in [0, 1], and its uv.
+struct CardPoint {
+  double s, t;
+  Vec2 uv;
+};
+CardPoint cardPoint(const Mesh& cards, size_t quad, const glm::dvec3& p) {
+  const size_t q = 4 * quad;
+  const glm::dvec3 q0(cards.positions[q]), du = glm::dvec3(cards.positions[q + 1]) - q0,
+      dv = glm::dvec3(cards.positions[q + 3]) - q0;
+  const double s = glm::dot(p - q0, du) / glm::dot(du, du), t = glm::dot(p - q0, dv) / glm::dot(dv, dv);
+  return {s, t, cards.uvs[q] + float(s) * (cards.uvs[q + 1] - cards.uvs[q]) + float(t) * (cards.uvs[q + 3] - cards.uvs[q])};
+}
+
 // Triangles of a glTF node's mesh.
 size_t nodeTriangles(const tinygltf::Model& m, int node) {
   size_t n = 0;
@@ -92,8 +106,9 @@ TEST_CASE("buildLodChain", "[model][lod]") {
     // LOD0 stands on the ground at the origin, every level moved with it.
     CHECK(glm::length(groundOffset(levels[0].parts)) < 1e-6f);
     CHECK(glm::length(moved - groundOffset(parts)) < 0.05f);
-    // 8000 -> about 2000 -> about 500 (stops: a quarter of it would be below 500).
-    REQUIRE(levels.size() == 3);
+    // 8000 -> about 2000 -> about 500 (stops: a quarter of it would be below 500), then the
+    // crown level (the model has leaves).
+    REQUIRE(levels.size() == 4);
     CHECK(levels[0].triangles <= 8000);
     CHECK(levels[0].triangles >= 7000);
     for (size_t k = 1; k < levels.size(); ++k) {
@@ -102,7 +117,8 @@ TEST_CASE("buildLodChain", "[model][lod]") {
     }
     CHECK(levels[0].screenCoverage == 0.25);
     CHECK(levels[1].screenCoverage == 0.0625);
-    CHECK(levels[2].screenCoverage == 0.0);
+    CHECK(levels[2].screenCoverage == 0.015625);
+    CHECK(levels[3].screenCoverage == 0.0);
     for (size_t k = 0; k < levels.size(); ++k) {
       const LodLevel& level = levels[k];
       REQUIRE(level.parts.size() == 2);
@@ -129,10 +145,10 @@ TEST_CASE("buildLodChain", "[model][lod]") {
       // The sphere stays closed: every edge in two triangles.
       CHECK(analyzeTopology(w).boundaryEdges == 0);
       // Leaves: all 400 kept at LOD0 (they fit in half the budget), then a quarter per level,
-      // grown so that they cover the same area; their atlas baked again per level. The far
-      // level's leaves are cards (the next test case).
+      // grown so that they cover the same area; their atlas baked again per level. The last
+      // two levels' leaves are cards (the next test cases).
       const ExportPart& l = level.parts[1];
-      if (k + 1 == levels.size()) continue;
+      if (k + 2 >= levels.size()) continue;
       CHECK(area(l.mesh) == Approx(400.0).epsilon(1e-4));
       REQUIRE(l.material.texture);
       CHECK(l.material.texture->atlas.index.size() == l.mesh.triangles.size() * 3);
@@ -141,11 +157,12 @@ TEST_CASE("buildLodChain", "[model][lod]") {
     CHECK(levels[0].parts[1].mesh.triangles.size() == 800);
     CHECK(levels[1].parts[1].mesh.triangles.size() == 200);
     CHECK(levels[2].parts[1].mesh.triangles.size() == 50);  // 25 cards
+    CHECK(levels[3].parts[1].mesh.triangles.size() == 12);  // 2 clusters of 3 crown cards
   }
   SECTION("the far level's leaves are alpha-tested cards with their leaves' images") {
     Vec3 moved(0.0f);
     const std::vector<LodLevel> levels = buildLodChain(parts, 8000, &moved);
-    REQUIRE(levels.size() == 3);
+    REQUIRE(levels.size() == 4);
     // The wood is still there, closed, and as before a quarter of the level before.
     const Mesh& wood = levels[2].parts[0].mesh;
     CHECK(wood.triangles.size() > 100);
@@ -196,12 +213,49 @@ TEST_CASE("buildLodChain", "[model][lod]") {
     }
     CHECK(opaque == 25 * 14 * 14);
   }
+  SECTION("the last level is the crown: all the leaves on crown cards, the wood a quarter") {
+    Vec3 moved(0.0f);
+    const std::vector<LodLevel> levels = buildLodChain(parts, 8000, &moved);
+    REQUIRE(levels.size() == 4);
+    const Mesh& wood = levels[3].parts[0].mesh;
+    const double quarter = double(levels[2].parts[0].mesh.triangles.size()) * kLodRatio;
+    CHECK(double(wood.triangles.size()) <= quarter + 1);
+    CHECK(double(wood.triangles.size()) >= 0.75 * quarter);
+    CHECK(analyzeTopology(wood).boundaryEdges == 0);
+    // ⌊50 / 4 / 6⌋ = 2 clusters of the 20 x 20 leaves (x and z in [0, 39]), 3 cards each.
+    const ExportPart& crown = levels[3].parts[1];
+    CHECK(crown.name == "leaves");
+    REQUIRE(crown.mesh.triangles.size() == 2 * kCrownCardsPerCluster * 2);
+    CHECK(crown.mesh.positions.size() == 2 * kCrownCardsPerCluster * 4);
+    CHECK(crown.material.alphaCutoff == kLeafCardAlphaCutoff);
+    REQUIRE(crown.material.texture);
+    CHECK(crown.material.texture->pixels().width == 3 * kCrownCardTexels);  // 6 cells, 3 a row
+    CHECK(crown.material.texture->pixels().height == 2 * kCrownCardTexels);
+    // Every leaf is on the three cards of one cluster: its centre, projected along each
+    // card's normal, falls inside it (more than a rim texel in).
+    size_t inside = 0;
+    for (size_t j = 0; j < 400; ++j) {
+      const glm::dvec3 p(float(j % 20) * 2.0f + 0.5f + moved.x, 3.0f + moved.y, float(j / 20) * 2.0f + 0.5f + moved.z);
+      size_t clusters = 0;
+      for (size_t c = 0; c < 2; ++c) {
+        size_t in = 0;
+        for (size_t k = 0; k < kCrownCardsPerCluster; ++k) {
+          const CardPoint a = cardPoint(crown.mesh, c * kCrownCardsPerCluster + k, p);
+          in += a.s > 1.0 / kCrownCardTexels && a.s < 1 - 1.0 / kCrownCardTexels && a.t > 1.0 / kCrownCardTexels &&
+                a.t < 1 - 1.0 / kCrownCardTexels;
+        }
+        clusters += in == kCrownCardsPerCluster;
+      }
+      inside += clusters >= 1;
+    }
+    CHECK(inside == 400);
+  }
   SECTION("a model within the budget is LOD0 unchanged") {
     std::vector<ExportPart> placed = parts;
     finishExportParts(placed);
     const std::vector<LodLevel> levels = buildLodChain(placed, 30000);
-    // 21,280 -> about 5,320 -> about 1,330 (a quarter of it would be below 500).
-    REQUIRE(levels.size() == 3);
+    // 21,280 -> about 5,320 -> about 1,330 (a quarter of it would be below 500), then the crown.
+    REQUIRE(levels.size() == 4);
     CHECK(levels[0].triangles == 21280);
     CHECK(levels[0].parts[0].mesh.positions == placed[0].mesh.positions);
     CHECK(levels[0].parts[1].material.texture == placed[1].material.texture);
@@ -225,7 +279,7 @@ TEST_CASE("buildLodChain reduces the parts side by side to the same levels at an
     return buildLodChain(parts, 8000);
   };
   const std::vector<LodLevel> one = chain(1), two = chain(2);
-  REQUIRE(one.size() == 3);
+  REQUIRE(one.size() == 4);
   REQUIRE(two.size() == one.size());
   for (size_t k = 0; k < one.size(); ++k) {
     CHECK(two[k].triangles == one[k].triangles);
@@ -237,21 +291,23 @@ TEST_CASE("buildLodChain reduces the parts side by side to the same levels at an
       CHECK(b.normals == a.normals);
       CHECK(b.colors == a.colors);
     }
-    // The maps' and atlases' texels too.
-    const PartTexture* ta = one[k].parts[0].material.texture.get();
-    const PartTexture* tb = two[k].parts[0].material.texture.get();
-    REQUIRE((ta == nullptr) == (tb == nullptr));
-    if (!ta) continue;
-    CHECK(tb->pixels().pixels == ta->pixels().pixels);
-    CHECK(tb->image8.values == ta->image8.values);
-    CHECK(ta->pixels().pixels.size() + ta->image8.values.size() > 0);
+    // The maps', atlases' and cards' texels too.
+    for (size_t i = 0; i < 2; ++i) {
+      const PartTexture* ta = one[k].parts[i].material.texture.get();
+      const PartTexture* tb = two[k].parts[i].material.texture.get();
+      REQUIRE((ta == nullptr) == (tb == nullptr));
+      if (!ta) continue;
+      CHECK(tb->pixels().pixels == ta->pixels().pixels);
+      CHECK(tb->image8.values == ta->image8.values);
+      CHECK(ta->pixels().pixels.size() + ta->image8.values.size() > 0);
+    }
   }
 }
 
 TEST_CASE("writeLevels", "[model][lod]") {
   TempDir dir;
   const std::vector<LodLevel> levels = buildLodChain(testParts(), 8000);
-  REQUIRE(levels.size() == 3);
+  REQUIRE(levels.size() == 4);
   SECTION("glb: LOD0 in the scene, each part's lower levels through MSFT_lod; one file per level") {
     const fs::path file = dir.path / "model.glb";
     writeLevels(levels, file);
@@ -261,18 +317,18 @@ TEST_CASE("writeLevels", "[model][lod]") {
     CHECK(m.extensionsRequired.empty());
     REQUIRE(m.scenes.size() == 1);
     REQUIRE(m.scenes[0].nodes.size() == 2);
-    REQUIRE(m.nodes.size() == 6);
+    REQUIRE(m.nodes.size() == 8);
     for (size_t i = 0; i < 2; ++i) {
       const tinygltf::Node& top = m.nodes[size_t(m.scenes[0].nodes[i])];
       CHECK(top.name == levels[0].parts[i].name);
       CHECK(nodeTriangles(m, m.scenes[0].nodes[i]) == levels[0].parts[i].mesh.triangles.size());
       REQUIRE(top.extensions.count("MSFT_lod") == 1);
       const tinygltf::Value& ids = top.extensions.at("MSFT_lod").Get("ids");
-      REQUIRE(ids.ArrayLen() == 2);
+      REQUIRE(ids.ArrayLen() == 3);
       const tinygltf::Value& coverage = top.extras.Get("MSFT_screencoverage");
-      REQUIRE(coverage.ArrayLen() == 3);
-      for (size_t k = 0; k < 3; ++k) CHECK(coverage.Get(int(k)).GetNumberAsDouble() == levels[k].screenCoverage);
-      for (size_t k = 1; k < 3; ++k) {
+      REQUIRE(coverage.ArrayLen() == 4);
+      for (size_t k = 0; k < 4; ++k) CHECK(coverage.Get(int(k)).GetNumberAsDouble() == levels[k].screenCoverage);
+      for (size_t k = 1; k < 4; ++k) {
         const int id = ids.Get(int(k - 1)).GetNumberAsInt();
         CHECK(m.nodes[size_t(id)].name == levels[0].parts[i].name + "_lod" + std::to_string(k));
         CHECK(nodeTriangles(m, id) == levels[k].parts[i].mesh.triangles.size());
@@ -282,7 +338,7 @@ TEST_CASE("writeLevels", "[model][lod]") {
       }
     }
     // Each level's own file (LOD0's too): the parts by their own names, that level's triangles.
-    for (size_t k = 0; k < 3; ++k) {
+    for (size_t k = 0; k < 4; ++k) {
       const tinygltf::Model f = readGlb(lodPath(file, k));
       CHECK(f.extensionsUsed.empty());
       REQUIRE(f.nodes.size() == 2);
@@ -291,13 +347,14 @@ TEST_CASE("writeLevels", "[model][lod]") {
         CHECK(nodeTriangles(f, int(i)) == levels[k].parts[i].mesh.triangles.size());
       }
     }
-    CHECK_FALSE(fs::exists(lodPath(file, 3)));
+    CHECK_FALSE(fs::exists(lodPath(file, 4)));
   }
   SECTION("OBJ: LOD0 in the file, every further level in its own OBJ, MTL and images") {
     const fs::path file = dir.path / "model.obj";
     writeLevels(levels, file);
     for (const char* name : {"model.obj", "model.mtl", "model_leaves.png", "model_lod1.obj", "model_lod1.mtl",
-                             "model_lod1_leaves.png", "model_lod2.obj", "model_lod2.mtl", "model_lod2_leaves.png"})
+                             "model_lod1_leaves.png", "model_lod2.obj", "model_lod2.mtl", "model_lod2_leaves.png",
+                             "model_lod3.obj", "model_lod3.mtl", "model_lod3_leaves.png"})
       CHECK(fs::exists(dir.path / name));
     CHECK_FALSE(fs::exists(dir.path / "model_lod0.obj"));  // the OBJ itself is LOD0
   }
@@ -307,9 +364,10 @@ TEST_CASE("writeLevels", "[model][lod]") {
     CHECK_FALSE(fs::exists(dir.path / "taken_lod0.glb"));
     CHECK_FALSE(fs::exists(dir.path / "taken_lod1.glb"));
     CHECK_FALSE(fs::exists(dir.path / "taken_lod2.glb"));
+    CHECK_FALSE(fs::exists(dir.path / "taken_lod3.glb"));
   }
   SECTION("each texture image is encoded once for all the files, to the same bytes") {
-    // The far level: wood (an atlas and a normal map) and leaf cards (an RGBA image).
+    // The level of leaf cards: wood (an atlas and a normal map) and the cards' RGBA image.
     const std::vector<ExportPart>& far = levels[2].parts;
     REQUIRE(far[0].material.normalTexture);
     writeParts(far, dir.path / "alone.glb");
@@ -470,4 +528,132 @@ TEST_CASE("leafCards takes a leaf's image and cut-out through its uvs", "[model]
     CHECK(im.at(x0 + 8, y0 + 0).a == 0.0f);  // the rim
   }
   CHECK(leafCards(leaves, 0).mesh.triangles.size() == 2);  // at least one card
+}
+
+namespace {
+
+// 8 blobs of 3 x 3 x 3 square leaves (side 0.2, normal (0.2, 1, 0.1) normalized: about
+// level, as a tree's leaves mostly are; one colour a blob), the
+// blobs at the corners of a cube of side 10, blob by blob; each blob 1.2 long in x, 0.8 high
+// and 0.6 deep.
+ExportPart blobLeaves() {
+  ExportPart leaves{"leaves", Mesh{}, PartMaterial{"leaves", Vec3(0.1f, 0.4f, 0.05f), 0.5f, true}, true};
+  const glm::dvec3 n = glm::normalize(glm::dvec3(0.2, 1, 0.1));
+  const glm::dvec3 e1 = glm::normalize(glm::cross(glm::dvec3(0, 1, 0), n)), e2 = glm::cross(n, e1);
+  for (int b = 0; b < 8; ++b)
+    for (int j = 0; j < 27; ++j) {
+      const glm::dvec3 c(10.0 * (b & 1) + 0.6 * (j % 3), 10.0 * ((b >> 1) & 1) + 5.0 + 0.4 * (j / 3 % 3),
+                         10.0 * (b >> 2) + 0.3 * (j / 9));
+      const auto base = uint32_t(leaves.mesh.positions.size());
+      for (glm::dvec2 d : {glm::dvec2(-1, -1), glm::dvec2(1, -1), glm::dvec2(1, 1), glm::dvec2(-1, 1)}) {
+        leaves.mesh.positions.push_back(Vec3(c + 0.1 * d.x * e1 + 0.1 * d.y * e2));
+        leaves.mesh.normals.push_back(Vec3(n));
+        leaves.mesh.colors.push_back(Vec3(0.1f * float(b), 0.5f, 0.1f));
+      }
+      leaves.mesh.triangles.push_back({base, base + 1, base + 2});
+      leaves.mesh.triangles.push_back({base, base + 2, base + 3});
+    }
+  return leaves;
+}
+
+}  // namespace
+
+TEST_CASE("crownClusters puts every point in exactly one cluster", "[model][lod]") {
+  const ExportPart leaves = blobLeaves();
+  size_t count = 0, pieces = 0;
+  const std::vector<uint32_t> piece = triangleComponents(leaves.mesh, pieces);
+  REQUIRE(pieces == 216);
+  const std::vector<glm::dvec3> centres = componentCentroids(leaves.mesh, piece, pieces);
+  CHECK(glm::length(centres[0] - glm::dvec3(0, 5, 0)) < 1e-6);
+  // 8 clusters: the 8 blobs (seeded at each blob's last leaf), numbered in the leaves' order.
+  const std::vector<uint32_t> blob = crownClusters(centres, 8, count);
+  CHECK(count == 8);
+  REQUIRE(blob.size() == 216);
+  for (size_t j = 0; j < 216; ++j) CHECK(blob[j] == j / 27);
+  // Fewer: each cluster whole blobs; more clusters than points: one a point; none: one.
+  const std::vector<uint32_t> four = crownClusters(centres, 4, count);
+  CHECK(count == 4);
+  for (size_t j = 0; j < 216; ++j) CHECK(four[j] == four[j / 27 * 27]);
+  CHECK(crownClusters(std::vector<glm::dvec3>(centres.begin(), centres.begin() + 5), 9, count).size() == 5);
+  CHECK(count == 5);
+  const std::vector<uint32_t> one = crownClusters(centres, 0, count);
+  CHECK(count == 1);
+  CHECK(std::count(one.begin(), one.end(), 0u) == 216);
+  CHECK(crownClusters({}, 3, count).empty());
+  CHECK(count == 0);
+}
+
+TEST_CASE("crownCards paints each cluster's leaves on its crossed cards", "[model][lod]") {
+  const ExportPart leaves = blobLeaves();
+  const ExportPart crown = crownCards(leaves, 8);
+  // 8 clusters of 3 cards: 24 quads of their own 4 vertices; 24 cells of 64 texels, 5 a row.
+  REQUIRE(crown.mesh.triangles.size() == 48);
+  REQUIRE(crown.mesh.positions.size() == 96);
+  REQUIRE(crown.mesh.uvs.size() == 96);
+  REQUIRE(crown.mesh.normals.size() == 96);
+  CHECK(crown.mesh.colors.empty());
+  for (size_t t = 0; t < 48; ++t) CHECK(crown.mesh.triangles[t].x == uint32_t(t / 2 * 4));
+  CHECK(crown.material.alphaCutoff == kLeafCardAlphaCutoff);
+  CHECK(crown.material.doubleSided);
+  REQUIRE(crown.material.texture);
+  const Image& im = crown.material.texture->pixels();
+  REQUIRE(im.width == 5 * kCrownCardTexels);
+  REQUIRE(im.height == 5 * kCrownCardTexels);
+  // Cluster c's cards: mutually perpendicular, each 35.3 degrees above the horizontal, the
+  // first's horizontal direction along x (the blob is longest in x).
+  for (size_t c = 0; c < 8; ++c) {
+    const Vec3 n[3] = {crown.mesh.normals[c * 12], crown.mesh.normals[c * 12 + 4], crown.mesh.normals[c * 12 + 8]};
+    for (int k = 0; k < 3; ++k) {
+      CHECK(n[k].y == Approx(std::sqrt(1.0 / 3.0)).margin(1e-6));
+      CHECK(std::abs(glm::dot(n[k], n[(k + 1) % 3])) < 1e-6f);
+    }
+    CHECK(std::abs(n[0].x) > 0.99f * std::sqrt(2.0f / 3.0f));
+  }
+  // Every leaf (blob c's leaves are cluster c) is drawn on each of its cluster's three
+  // cards: its centre, projected along the card's normal, falls on a texel at or above the
+  // cut-off, in the card's own cell.
+  size_t drawn = 0;
+  for (size_t j = 0; j < 216; ++j) {
+    glm::dvec3 p(0.0);
+    for (size_t v = 4 * j; v < 4 * j + 4; ++v) p += 0.25 * glm::dvec3(leaves.mesh.positions[v]);
+    for (size_t k = 0; k < 3; ++k) {
+      const size_t card = j / 27 * 3 + k;
+      const Vec2 uv = cardPoint(crown.mesh, card, p).uv;
+      const int x = int(std::floor(uv.x * float(im.width))), y = int(std::floor((1.0f - uv.y) * float(im.height)));
+      const int x0 = int(card % 5) * kCrownCardTexels, y0 = int(card / 5) * kCrownCardTexels;
+      CHECK(x > x0);
+      CHECK(x < x0 + kCrownCardTexels - 1);
+      CHECK(y > y0);
+      CHECK(y < y0 + kCrownCardTexels - 1);
+      drawn += im.at(x, y).a >= kLeafCardAlphaCutoff && std::abs(im.at(x, y).r - 0.1f * float(j / 27)) < 1e-5f;
+    }
+  }
+  CHECK(drawn == 216 * 3);
+  // Each cell: its rim transparent, and leaves with gaps between them, not a sheet.
+  for (size_t card = 0; card < 24; ++card) {
+    const int x0 = int(card % 5) * kCrownCardTexels, y0 = int(card / 5) * kCrownCardTexels;
+    size_t opaque = 0, rim = 0;
+    for (int y = 0; y < kCrownCardTexels; ++y)
+      for (int x = 0; x < kCrownCardTexels; ++x) {
+        const bool edge = x == 0 || y == 0 || x == kCrownCardTexels - 1 || y == kCrownCardTexels - 1;
+        const float a = im.at(x0 + x, y0 + y).a;
+        (edge ? rim : opaque) += edge ? a > 0.0f : a >= kLeafCardAlphaCutoff;
+      }
+    INFO("card " << card << ": " << opaque << " opaque texels");
+    CHECK(rim == 0);
+    CHECK(opaque > 400);
+    CHECK(opaque < 62 * 62 * 9 / 10);
+  }
+  // The same cards at any thread count.
+  const auto with = [&](int threads) {
+    const ThreadLimit limit(threads);
+    return crownCards(leaves, 8);
+  };
+  const ExportPart one = with(1), two = with(2);
+  CHECK(one.mesh.positions == crown.mesh.positions);
+  CHECK(two.mesh.positions == crown.mesh.positions);
+  CHECK(one.mesh.uvs == two.mesh.uvs);
+  CHECK(one.material.texture->pixels().pixels == im.pixels);
+  CHECK(two.material.texture->pixels().pixels == im.pixels);
+  CHECK(crownCards(ExportPart{}, 3).mesh.triangles.empty());
 }
