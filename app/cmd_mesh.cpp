@@ -276,7 +276,7 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
     note(g, std::cout, "each level's own file: %s%s", lodFiles.c_str(),
          glb ? "; the .glb holds every level (MSFT_lod); --lod none writes the full mesh alone" : "");
     if (maps.maps > 0)
-      note(g, std::cout, "detail maps: %zu parts' levels got a normal map and the full mesh's colours (%zu texels, %.1f%% on the full surface) in %.2f s",
+      note(g, std::cout, "detail maps: %zu parts' levels got a normal map, and the full mesh's colours where they have no image of their own (%zu texels, %.1f%% on the full surface) in %.2f s",
            maps.maps, maps.texels, 100.0 * double(maps.hits) / double(std::max<size_t>(maps.texels, 1)), maps.seconds);
   }
   noteParts(top, written, glb, g);

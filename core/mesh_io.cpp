@@ -367,6 +367,14 @@ bool hasOwnColors(const ExportPart& part) {
   return false;
 }
 
+// Whether a part's normal map has texture coordinates of its own: an atlas beside a base
+// colour image over the mesh's own uvs (PartMaterial::normalTexture: glTF TEXCOORD_1).
+bool normalMapOwnsUvs(const PartMaterial& m) { return m.normalTexture && m.texture && !m.texture->isAtlas(); }
+
+// Whether the OBJ writer writes a part's normal map: OBJ gives a corner one uv, so a normal
+// map with coordinates of its own (normalMapOwnsUvs) is left out.
+bool objNormalMap(const PartMaterial& m) { return m.normalTexture && !normalMapOwnsUvs(m); }
+
 // The corner normals and uvs a part is written with (glTF, OBJ), and what they did.
 struct PartCorners {
   CornerTable<Vec3> normals;
@@ -512,6 +520,15 @@ std::vector<glm::vec4> vertexTangents(const Mesh& mesh) {
   return out;
 }
 
+// The value of table at each vertex of mesh, a mesh whose vertices are each one corner
+// (unweld by an atlas): vertex triangles[t][k] takes corner k of triangle t's value.
+std::vector<Vec2> cornerValues(const Mesh& mesh, const CornerTable<Vec2>& table) {
+  std::vector<Vec2> out(mesh.positions.size(), Vec2(0.0f));
+  for (size_t t = 0; t < mesh.triangles.size(); ++t)
+    for (size_t k = 0; k < 3; ++k) out[mesh.triangles[t][int(k)]] = table.values[table.index[t * 3 + k]];
+  return out;
+}
+
 // A part's vertex attributes and morph targets fit its mesh.
 void checkExtras(const ExportPart& p) {
   const size_t n = p.mesh.positions.size();
@@ -544,6 +561,17 @@ void checkTextureImage(const ExportPart& p, const PartTexture& tex, ImageEncodin
     throw std::invalid_argument("exported part '" + p.name + "' has an empty or malformed texture image");
 }
 
+// An atlas's corners fit p's triangles and lie in the image.
+void checkAtlasCorners(const ExportPart& p, const CornerTable<Vec2>& a) {
+  if (a.index.size() != p.mesh.triangles.size() * 3)
+    throw std::invalid_argument("exported part '" + p.name + "' has an atlas whose corners do not match its triangles");
+  for (uint32_t i : a.index)
+    if (i >= a.values.size()) throw std::invalid_argument("exported part '" + p.name + "' has an atlas index out of range");
+  for (const Vec2& uv : a.values)
+    if (!(uv.x >= 0 && uv.x <= 1 && uv.y >= 0 && uv.y <= 1))
+      throw std::invalid_argument("exported part '" + p.name + "' has an atlas coordinate outside [0,1]");
+}
+
 void checkParts(const std::vector<ExportPart>& parts) {
   std::vector<std::string> names;
   for (const ExportPart& p : parts) {
@@ -552,14 +580,7 @@ void checkParts(const std::vector<ExportPart>& parts) {
     checkExtras(p);
     if (const PartTexture* tex = p.material.texture.get()) {
       if (tex->isAtlas()) {
-        const CornerTable<Vec2>& a = tex->atlas;
-        if (a.index.size() != p.mesh.triangles.size() * 3)
-          throw std::invalid_argument("exported part '" + p.name + "' has an atlas whose corners do not match its triangles");
-        for (uint32_t i : a.index)
-          if (i >= a.values.size()) throw std::invalid_argument("exported part '" + p.name + "' has an atlas index out of range");
-        for (const Vec2& uv : a.values)
-          if (!(uv.x >= 0 && uv.x <= 1 && uv.y >= 0 && uv.y <= 1))
-            throw std::invalid_argument("exported part '" + p.name + "' has an atlas coordinate outside [0,1]");
+        checkAtlasCorners(p, tex->atlas);
       } else if (p.mesh.uvs.size() != p.mesh.positions.size()) {
         throw std::invalid_argument("exported part '" + p.name + "' has a texture but no texture coordinates");
       }
@@ -568,7 +589,10 @@ void checkParts(const std::vector<ExportPart>& parts) {
     if (const PartTexture* nt = p.material.normalTexture.get()) {
       const PartTexture* tex = p.material.texture.get();
       checkTextureImage(p, *nt, ImageEncoding::Data);
-      if (!tex || !tex->isAtlas() || nt->width() != tex->width() || nt->height() != tex->height())
+      const bool shared = tex && tex->isAtlas() && nt->width() == tex->width() && nt->height() == tex->height();
+      if (normalMapOwnsUvs(p.material) && nt->isAtlas())
+        checkAtlasCorners(p, nt->atlas);
+      else if (!shared)
         throw std::invalid_argument("exported part '" + p.name + "' has a normal map without an atlas of its size");
     }
   }
@@ -605,6 +629,14 @@ class GlbBuilder {
   }
   int addTexture(const PartTexture* tex, const std::string& name, ImageEncoding encoding);
   int addMaterial(const ExportPart& part);
+  /// Adds uvs (Mesh::uvs' convention, t = 0 at the bottom) as the primitive's attribute
+  /// `name`, with t flipped to glTF's (0 at the top).
+  void addTexCoords(tinygltf::Primitive& prim, const std::string& name, const std::vector<Vec2>& uvs) {
+    std::vector<Vec2> flipped(uvs.size());
+    for (size_t i = 0; i < uvs.size(); ++i) flipped[i] = {uvs[i].x, 1.0f - uvs[i].y};
+    prim.attributes[name] = addAccessor(flipped.data(), uvs.size() * sizeof(Vec2), uvs.size(), TINYGLTF_TYPE_VEC2,
+                                        TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+  }
   void addExtras(const ExportPart& part, const std::vector<uint32_t>& origin, tinygltf::Primitive& prim, tinygltf::Mesh& gm);
   void addAnimations();
   /// A morph target's displacements: a plain accessor, or sparse (no buffer view; the
@@ -673,8 +705,10 @@ int GlbBuilder::addMaterial(const ExportPart& part) {
     mat.pbrMetallicRoughness.baseColorTexture.index =
         addTexture(part.material.texture.get(), part.name, baseColorEncoding(part.material));
   }
-  if (part.material.normalTexture)
+  if (part.material.normalTexture) {
     mat.normalTexture.index = addTexture(part.material.normalTexture.get(), part.name + "_normal", ImageEncoding::Data);
+    if (normalMapOwnsUvs(part.material)) mat.normalTexture.texCoord = 1;
+  }
   mat.pbrMetallicRoughness.metallicFactor = part.material.metallic;
   mat.pbrMetallicRoughness.roughnessFactor = part.material.roughness;
   mat.doubleSided = part.material.doubleSided;
@@ -686,7 +720,10 @@ int GlbBuilder::addPart(const ExportPart& part, const std::string& nodeName, Par
   PartCorners corners = partCorners(part);
   if (report) *report = corners.report;
   std::vector<uint32_t> origin;
-  const Mesh mesh = unweld(part.mesh, corners.normals, corners.uvs, &origin);
+  // A normal map with coordinates of its own (an atlas: one vertex per corner) is welded by
+  // them, and each corner's image uv goes beside them.
+  const bool second = normalMapOwnsUvs(part.material) && !corners.uvs.index.empty();
+  const Mesh mesh = unweld(part.mesh, corners.normals, second ? part.material.normalTexture->atlas : corners.uvs, &origin);
   const size_t n = mesh.positions.size();
   tinygltf::Primitive prim;
   prim.mode = TINYGLTF_MODE_TRIANGLES;
@@ -700,11 +737,11 @@ int GlbBuilder::addPart(const ExportPart& part, const std::string& nodeName, Par
   if (!mesh.normals.empty())
     prim.attributes["NORMAL"] = addAccessor(mesh.normals.data(), n * sizeof(Vec3), n, TINYGLTF_TYPE_VEC3,
                                             TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
-  if (!mesh.uvs.empty()) {
-    std::vector<Vec2> flipped(n);
-    for (size_t i = 0; i < n; ++i) flipped[i] = {mesh.uvs[i].x, 1.0f - mesh.uvs[i].y};
-    prim.attributes["TEXCOORD_0"] = addAccessor(flipped.data(), n * sizeof(Vec2), n, TINYGLTF_TYPE_VEC2,
-                                                TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_TARGET_ARRAY_BUFFER);
+  if (second) {
+    addTexCoords(prim, "TEXCOORD_0", cornerValues(mesh, corners.uvs));
+    addTexCoords(prim, "TEXCOORD_1", mesh.uvs);
+  } else if (!mesh.uvs.empty()) {
+    addTexCoords(prim, "TEXCOORD_0", mesh.uvs);
   }
   if (part.material.normalTexture && !mesh.normals.empty()) {
     const std::vector<glm::vec4> tangents = vertexTangents(mesh);
@@ -899,7 +936,7 @@ std::vector<PartWriteReport> writePartsObj(const std::vector<ExportPart>& parts,
       mtl += "map_Kd " + map + "\n";
       if (cutOut) mtl += "map_d " + map + "\n";
     }
-    if (const PartTexture* normal = part.material.normalTexture.get()) {
+    if (const PartTexture* normal = objNormalMap(part.material) ? part.material.normalTexture.get() : nullptr) {
       // `norm`: the normal map of the MTL's PBR extension (tinyobjloader, three.js); not
       // map_Bump, which many readers take for a height map.
       const fs::path png = normalMapPath(path, part);
@@ -1047,7 +1084,7 @@ std::vector<fs::path> partFiles(const std::vector<ExportPart>& parts, const fs::
     if (!part.mesh.triangles.empty() && part.material.texture) {
       fs::path png = path;
       files.push_back(png.replace_filename(path.stem().string() + "_" + objName(part.name) + ".png"));
-      if (part.material.normalTexture) files.push_back(normalMapPath(path, part));
+      if (objNormalMap(part.material)) files.push_back(normalMapPath(path, part));
     }
   return files;
 }

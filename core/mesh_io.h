@@ -146,12 +146,16 @@ struct PartMaterial {
   /// is below this are not drawn: glTF alphaMode MASK with this alphaCutoff, MTL map_d
   /// naming the texture image. Negative: opaque.
   float alphaCutoff = -1.0f;
-  /// A tangent-space normal map in texture's atlas layout (texture must then be an atlas of
-  /// the same image size; the corners of texture's atlas address it), or null. Its image
-  /// holds encoded normals ((n + 1)/2 per channel, x along the tangent, y up the image, z
-  /// along the vertex normal), written without an sRGB curve. glTF: the material's
-  /// normalTexture and a TANGENT attribute (cornerTangent of each corner: unit, w = ±1);
-  /// OBJ: `norm STEM_PART_normal.png` in the MTL; PLY: nothing.
+  /// A tangent-space normal map, or null: either in texture's atlas layout (texture an
+  /// atlas of the same image size; the corners of texture's atlas address it), or, beside a
+  /// texture over the mesh's own uvs (not an atlas), an atlas of its own (its `atlas`
+  /// corners address it: a second set of texture coordinates). Its image holds encoded
+  /// normals ((n + 1)/2 per channel, x along the tangent, y up the image, z along the vertex
+  /// normal), written without an sRGB curve. glTF: the material's normalTexture (texCoord 1
+  /// and a TEXCOORD_1 attribute for an atlas of its own) and a TANGENT attribute
+  /// (cornerTangent of each corner in the normal map's coordinates: unit, w = ±1); OBJ: `norm
+  /// STEM_PART_normal.png` in the MTL for a shared atlas (OBJ gives a corner one uv: a normal
+  /// map with coordinates of its own is not written); PLY: nothing.
   std::shared_ptr<const PartTexture> normalTexture;
   float metallic = 0.0f;       ///< glTF metallicFactor in [0,1] (MTL has no portable form)
 };

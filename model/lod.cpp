@@ -137,8 +137,16 @@ std::vector<size_t> scaledShares(const std::vector<ExportPart>& parts, double fr
   return targets;
 }
 
+// Whether part is coloured by an image over its mesh's own uvs (single-bark wood, a whorl
+// without growth lines, cpfg's textures) that its levels keep: not an atlas, not a cut-out.
+bool ownImage(const ExportPart& part) {
+  const PartTexture* t = part.material.texture.get();
+  return t && !t->isAtlas() && part.material.alphaCutoff < 0.0f && part.mesh.uvs.size() == part.mesh.positions.size();
+}
+
 // Bakes every simplified surface part's normal and colour atlases from its full mesh
-// (parts[i]) onto each level; reach[k][i] is level k's distance bound for part i (0: the
+// (parts[i]) onto each level (a part with its own image keeps it and gets the normal map
+// alone, addressed by coordinates of its own: PartMaterial::normalTexture); reach[k][i] is level k's distance bound for part i (0: the
 // part is not simplified there, or has no atlas to carry maps). Every other reduced part
 // gets an atlas of its own vertex colours (atlasVertexColors: where colours vary and no
 // texture is set; a part that had more triangles than an atlas holds gets one too).
@@ -155,12 +163,13 @@ void bakeLevelMaps(const std::vector<ExportPart>& parts, std::vector<LodLevel>& 
         continue;
       }
       if (!full) full = std::make_unique<DetailSurface>(parts[i].mesh, parts[i].material.baseColor);
-      DetailMaps maps = bakeDetailMaps(low.mesh, low.material.baseColor, *full, reach[k][i], true);
+      const bool image = ownImage(low);
+      DetailMaps maps = bakeDetailMaps(low.mesh, low.material.baseColor, *full, reach[k][i], !image);
       if (!maps.normal) {
         atlasVertexColors(low);
         continue;
       }
-      low.material.texture = maps.color;
+      if (!image) low.material.texture = maps.color;
       low.material.normalTexture = maps.normal;
       report.texels += maps.texels;
       report.hits += maps.hits;
@@ -173,7 +182,7 @@ void bakeLevelMaps(const std::vector<ExportPart>& parts, std::vector<LodLevel>& 
 // The distance bound of the detail maps of every part of every level: kDetailReach times
 // the level's simplification error summed over the chain (the full mesh to LOD0 to ... to
 // level k), at least kDetailReachFloor of the part's extent; 0 where the part is not a
-// simplified surface whose atlas (or lack of texture) can carry the maps.
+// simplified surface whose atlas, own image (ownImage) or lack of texture can carry the maps.
 std::vector<std::vector<float>> detailReach(const std::vector<ExportPart>& parts, const std::vector<LodLevel>& levels,
                                             const std::vector<std::vector<float>>& errors) {
   std::vector<std::vector<float>> reach(levels.size(), std::vector<float>(parts.size(), 0.0f));
@@ -187,8 +196,8 @@ std::vector<std::vector<float>> detailReach(const std::vector<ExportPart>& parts
       sum += errors[k][i];
       const ExportPart& low = levels[k].parts[i];
       const bool simplified = low.mesh.triangles.size() < full.mesh.triangles.size();
-      const bool atlas = !low.material.texture || low.material.texture->isAtlas();
-      if (simplified && atlas && !low.mesh.triangles.empty()) reach[k][i] = std::max(kDetailReach * sum, floor);
+      const bool carried = !low.material.texture || low.material.texture->isAtlas() || ownImage(low);
+      if (simplified && carried && !low.mesh.triangles.empty()) reach[k][i] = std::max(kDetailReach * sum, floor);
     }
   }
   return reach;

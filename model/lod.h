@@ -47,7 +47,7 @@ inline constexpr float kDetailReachFloor = 1e-3f;
 
 /// What buildLodChain's detail maps did.
 struct LodMapReport {
-  size_t maps = 0;    ///< parts' levels that got a normal map (and a colour atlas of the full mesh)
+  size_t maps = 0;    ///< parts' levels that got a normal map (and a colour atlas of the full mesh, unless the part keeps an image over its own uvs)
   size_t texels = 0;  ///< texels baked
   size_t hits = 0;    ///< of them, with a hit of the full mesh
   double seconds = 0; ///< wall-clock time of the baking (scenes of the full parts included)

@@ -21,6 +21,7 @@ species=(
   "fig_tree_12_pcm_offset wood"             # tree, BlobTree with PCM, bark off: no image
   "tree_lime wood leaves | --steps 3 --cell 0.01 --wind 6,45"  # tree in leaf: wood and double-sided leaves apart (bark per girth: vertex colours); wind: morph targets and the animation 'wind'; every tree: _WIND
   "tree_scarred *wood | --steps 4"        # one bark for every cone: baked into an image
+  "tree_scarred *wood | --steps 3 --lod 2000"  # its levels keep the image (TEXCOORD_0) and get a normal map of their own coordinates (TEXCOORD_1)
   "shell_top *whorl inside"                 # shell, painted pigment
   "fig_shell_07b_varix_full *whorl varices" # shell with varices and their spines
   "blob_ricci_fig3 blob"                   # blob
@@ -60,6 +61,21 @@ prims = [p for m in j['meshes'] for p in m['primitives']]
 bad = [p for p in prims if 'normalTexture' not in j['materials'][p['material']] or 'TANGENT' not in p['attributes']]
 if len(prims) < 2 or bad:
     sys.exit('%s: %d of %d primitives without a normal map and TANGENT' % (sys.argv[1], len(bad), len(prims)))
+PY
+  fi
+  if [[ "$s" == tree_scarred && "$flags" == *--lod\ 2000* ]]; then
+    # Every level: the bark image through TEXCOORD_0, a normal map through TEXCOORD_1.
+    python3 - "$f" <<'PY'
+import json, struct, sys
+d = open(sys.argv[1], 'rb').read()
+j = json.loads(d[20:20 + struct.unpack('<I', d[12:16])[0]])
+prims = [p for m in j['meshes'] for p in m['primitives']]
+def ok(p):
+    m = j['materials'][p['material']]
+    return m.get('normalTexture', {}).get('texCoord') == 1 and 'TEXCOORD_1' in p['attributes'] \
+        and m['pbrMetallicRoughness']['baseColorTexture'].get('texCoord', 0) == 0
+if len(prims) < 2 or not all(map(ok, prims)):
+    sys.exit('%s: a level without its image and a normal map of its own coordinates' % sys.argv[1])
 PY
   fi
   if [[ "$s" == tree_lime && "$flags" == *--lod\ 2000* ]]; then

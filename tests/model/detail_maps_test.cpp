@@ -62,6 +62,21 @@ bool patchTexel(const AtlasLayout& l, size_t t, int i, int j, int& x, int& y, Ve
   return l1 >= 0 && l2 >= 0 && l1 + l2 <= 1;
 }
 
+// grid(n, amplitude) coloured by an image over its own uvs, uv = (x, y): no vertex colours.
+Mesh texturedGrid(int n, float amplitude) {
+  Mesh m = grid(n, amplitude);
+  m.colors.clear();
+  for (const Vec3& p : m.positions) m.uvs.emplace_back(p.x, p.y);
+  return m;
+}
+
+// The float values of accessor `index` of a glb (tightly packed floats).
+const float* accessorFloats(const tinygltf::Model& m, int index) {
+  const tinygltf::Accessor& a = m.accessors[size_t(index)];
+  const tinygltf::BufferView& v = m.bufferViews[size_t(a.bufferView)];
+  return reinterpret_cast<const float*>(m.buffers[0].data.data() + v.byteOffset + a.byteOffset);
+}
+
 struct TempDir {
   fs::path path = fs::temp_directory_path() / ("sprig_detail_maps_test_" + std::to_string(getpid()));
   TempDir() {
@@ -213,6 +228,94 @@ TEST_CASE("buildLodChain detail maps in .glb", "[model][lod]") {
     }
   CHECK(primitives == levels.size());
   CHECK(m.images.size() == 2 * levels.size());  // a colour atlas and a normal map per level
+}
+
+TEST_CASE("buildLodChain gives a part's own image a normal map with coordinates of its own", "[model][lod]") {
+  // A 64 x 64 image over the ridged square's own uvs (u, v) = (x, y), as single-bark wood,
+  // a whorl without growth lines and cpfg's textures have.
+  auto own = std::make_shared<PartTexture>();
+  own->image = Image(64, 64, Vec4(0.3f, 0.5f, 0.2f, 1.0f));
+  ExportPart ridge{"ridge", texturedGrid(48, kAmp), PartMaterial{"ridge", Vec3(0.4f, 0.3f, 0.2f), 0.7f, false, own}};
+  LodMapReport report;
+  Vec3 moved(0.0f);
+  const std::vector<LodLevel> levels = buildLodChain({ridge}, 2000, &moved, &report);
+  REQUIRE(levels.size() >= 2);
+  CHECK(report.maps == levels.size());  // every level simplified, every level a normal map
+  CHECK(report.hits > report.texels * 9 / 10);
+  for (const LodLevel& level : levels) {
+    const ExportPart& low = level.parts[0];
+    CHECK(low.material.texture == own);  // the image itself, over the level's own uvs
+    REQUIRE(low.material.normalTexture);
+    REQUIRE(low.material.normalTexture->isAtlas());
+    CHECK(low.material.normalTexture->atlas.index.size() == low.mesh.triangles.size() * 3);
+  }
+  TempDir dir;
+  writeLevels(levels, dir.path / "own.glb");
+  SECTION("glb: the image through TEXCOORD_0, the normal map through TEXCOORD_1, tangents of the normal map's") {
+    const tinygltf::Model m = test::readGlb(dir.path / "own.glb");
+    size_t primitives = 0;
+    for (const tinygltf::Mesh& mesh : m.meshes)
+      for (const tinygltf::Primitive& p : mesh.primitives) {
+        ++primitives;
+        const tinygltf::Material& mat = m.materials[size_t(p.material)];
+        CHECK(mat.pbrMetallicRoughness.baseColorTexture.texCoord == 0);
+        CHECK(mat.normalTexture.texCoord == 1);
+        REQUIRE(p.attributes.count("TEXCOORD_0"));
+        REQUIRE(p.attributes.count("TEXCOORD_1"));
+        REQUIRE(p.attributes.count("TANGENT"));
+        const size_t n = m.accessors[size_t(p.attributes.at("POSITION"))].count;
+        const float* pos = accessorFloats(m, p.attributes.at("POSITION"));
+        const float* uv0 = accessorFloats(m, p.attributes.at("TEXCOORD_0"));
+        const float* uv1 = accessorFloats(m, p.attributes.at("TEXCOORD_1"));
+        const float* nrm = accessorFloats(m, p.attributes.at("NORMAL"));
+        const float* tan = accessorFloats(m, p.attributes.at("TANGENT"));
+        // The image's uv is the square's (x, y) where the vertex was (glTF's t from the top).
+        for (size_t i = 0; i < n; ++i) {
+          REQUIRE(uv0[2 * i] == Approx(pos[3 * i] - moved.x).margin(1e-5));
+          REQUIRE(uv0[2 * i + 1] == Approx(1.0f - (pos[3 * i + 1] - moved.y)).margin(1e-5));
+          REQUIRE(uv1[2 * i] >= 0.0f);
+          REQUIRE(uv1[2 * i] <= 1.0f);
+        }
+        // Each corner's tangent follows the normal map's coordinates (TEXCOORD_1), not the image's.
+        const tinygltf::Accessor& ia = m.accessors[size_t(p.indices)];
+        const tinygltf::BufferView& iv = m.bufferViews[size_t(ia.bufferView)];
+        const auto* idx = reinterpret_cast<const uint32_t*>(m.buffers[0].data.data() + iv.byteOffset + ia.byteOffset);
+        for (size_t t = 0; t < ia.count / 3; ++t) {
+          Vec3 P[3];
+          Vec2 uv[3];
+          for (int k = 0; k < 3; ++k) {
+            const uint32_t v = idx[3 * t + size_t(k)];
+            P[k] = Vec3(pos[3 * v], pos[3 * v + 1], pos[3 * v + 2]);
+            uv[k] = Vec2(uv1[2 * v], 1.0f - uv1[2 * v + 1]);
+          }
+          for (int k = 0; k < 3; ++k) {
+            const uint32_t v = idx[3 * t + size_t(k)];
+            const glm::vec4 expected = cornerTangent(P, uv, Vec3(nrm[3 * v], nrm[3 * v + 1], nrm[3 * v + 2]));
+            REQUIRE(glm::dot(Vec3(expected), Vec3(tan[4 * v], tan[4 * v + 1], tan[4 * v + 2])) == Approx(1.0f).margin(1e-4));
+            REQUIRE(tan[4 * v + 3] == expected.w);
+          }
+        }
+      }
+    CHECK(primitives == levels.size());
+    // The image once (shared by the levels), a normal map per level.
+    CHECK(m.images.size() == 1 + levels.size());
+  }
+  SECTION("a normal map of its own whose corners do not fit the triangles is refused, nothing written") {
+    ExportPart bad = levels[0].parts[0];
+    auto normal = std::make_shared<PartTexture>(*bad.material.normalTexture);
+    normal->atlas.index.pop_back();
+    bad.material.normalTexture = normal;
+    CHECK_THROWS_AS(writeParts({bad}, dir.path / "bad.glb"), std::invalid_argument);
+    CHECK(!fs::exists(dir.path / "bad.glb"));
+  }
+  SECTION("OBJ gives a corner one uv: the image is written, the normal map is not") {
+    writeLevels(levels, dir.path / "own.obj");
+    const std::string mtl = readFile(dir.path / "own.mtl");
+    CHECK(mtl.find("map_Kd") != std::string::npos);
+    CHECK(mtl.find("norm") == std::string::npos);
+    CHECK(!fs::exists(dir.path / "own_ridge_normal.png"));
+    for (const fs::path& f : partFiles(levels[0].parts, dir.path / "own.obj")) CHECK(fs::exists(f));
+  }
 }
 
 TEST_CASE("writeParts normal map in OBJ", "[model][lod]") {
