@@ -159,97 +159,6 @@ TEST_CASE("buildLodChain", "[model][lod]") {
     CHECK(levels[2].parts[1].mesh.triangles.size() == 50);  // 25 cards
     CHECK(levels[3].parts[1].mesh.triangles.size() == 12);  // 2 clusters of 3 crown cards
   }
-  SECTION("the far level's leaves are alpha-tested cards with their leaves' images") {
-    Vec3 moved(0.0f);
-    const std::vector<LodLevel> levels = buildLodChain(parts, 8000, &moved);
-    REQUIRE(levels.size() == 4);
-    // The wood is still there, closed, and as before a quarter of the level before.
-    const Mesh& wood = levels[2].parts[0].mesh;
-    CHECK(wood.triangles.size() > 100);
-    CHECK(analyzeTopology(wood).boundaryEdges == 0);
-    // The far level kept 50 leaf triangles: 25 cards of 4 vertices and 2 triangles each.
-    const ExportPart& cards = levels[2].parts[1];
-    CHECK(cards.name == "leaves");
-    REQUIRE(cards.mesh.triangles.size() == 50);
-    REQUIRE(cards.mesh.positions.size() == 100);
-    REQUIRE(cards.mesh.uvs.size() == 100);
-    REQUIRE(cards.mesh.normals.size() == 100);
-    CHECK(cards.mesh.colors.empty());
-    for (size_t t = 0; t < 50; ++t) {
-      const glm::uvec3& tri = cards.mesh.triangles[t];
-      CHECK(tri.x == uint32_t(t / 2 * 4));  // each card its own four vertices
-      CHECK(std::max({tri.x, tri.y, tri.z}) < uint32_t(t / 2 * 4 + 4));
-    }
-    // Cut out (glTF MASK) with the leaves' own image: 5 x 5 cells of 16 texels, not an atlas.
-    CHECK(cards.material.alphaCutoff == kLeafCardAlphaCutoff);
-    CHECK(cards.material.doubleSided);
-    REQUIRE(cards.material.texture);
-    CHECK_FALSE(cards.material.texture->isAtlas());
-    const Image& im = cards.material.texture->pixels();
-    CHECK(im.width == 80);
-    CHECK(im.height == 80);
-    // Card i is leaf 16i + 15 (evenly spread), a unit square grown 4 times (25 leaves cover
-    // the 400 leaves' area): its centre and normal are the leaf's, its 14 x 14 inner texels
-    // opaque in the leaf's colour, its rim transparent.
-    size_t opaque = 0;
-    for (size_t i = 0; i < 25; ++i) {
-      const size_t j = 16 * i + 15;
-      const Vec3 centre(float(j % 20) * 2.0f + 0.5f, 3.0f, float(j / 20) * 2.0f + 0.5f);
-      Vec3 mean(0.0f);
-      for (size_t v = 4 * i; v < 4 * i + 4; ++v) {
-        mean += 0.25f * (cards.mesh.positions[v] - moved);
-        CHECK(glm::length(cards.mesh.normals[v] - Vec3(0, 1, 0)) < 1e-5f);
-      }
-      CHECK(glm::length(mean - centre) < 1e-4f);
-      CHECK(glm::length(cards.mesh.positions[4 * i] - cards.mesh.positions[4 * i + 2]) ==
-            Approx(4.0 * std::sqrt(2.0) * 16 / 14).epsilon(1e-4));
-      const int x0 = int(i % 5) * 16, y0 = int(i / 5) * 16;
-      const Vec4 c = im.at(x0 + 8, y0 + 8);
-      CHECK(c.r == Approx(0.05 + 0.001 * double(j)).margin(1e-5));
-      CHECK(c.a == 1.0f);
-      CHECK(im.at(x0, y0 + 8).a == 0.0f);
-      for (int y = 0; y < 16; ++y)
-        for (int x = 0; x < 16; ++x) opaque += im.at(x0 + x, y0 + y).a == 1.0f;
-    }
-    CHECK(opaque == 25 * 14 * 14);
-  }
-  SECTION("the last level is the crown: all the leaves on crown cards, the wood a quarter") {
-    Vec3 moved(0.0f);
-    const std::vector<LodLevel> levels = buildLodChain(parts, 8000, &moved);
-    REQUIRE(levels.size() == 4);
-    const Mesh& wood = levels[3].parts[0].mesh;
-    const double quarter = double(levels[2].parts[0].mesh.triangles.size()) * kLodRatio;
-    CHECK(double(wood.triangles.size()) <= quarter + 1);
-    CHECK(double(wood.triangles.size()) >= 0.75 * quarter);
-    CHECK(analyzeTopology(wood).boundaryEdges == 0);
-    // ⌊50 / 4 / 6⌋ = 2 clusters of the 20 x 20 leaves (x and z in [0, 39]), 3 cards each.
-    const ExportPart& crown = levels[3].parts[1];
-    CHECK(crown.name == "leaves");
-    REQUIRE(crown.mesh.triangles.size() == 2 * kCrownCardsPerCluster * 2);
-    CHECK(crown.mesh.positions.size() == 2 * kCrownCardsPerCluster * 4);
-    CHECK(crown.material.alphaCutoff == kLeafCardAlphaCutoff);
-    REQUIRE(crown.material.texture);
-    CHECK(crown.material.texture->pixels().width == 3 * kCrownCardTexels);  // 6 cells, 3 a row
-    CHECK(crown.material.texture->pixels().height == 2 * kCrownCardTexels);
-    // Every leaf is on the three cards of one cluster: its centre, projected along each
-    // card's normal, falls inside it (more than a rim texel in).
-    size_t inside = 0;
-    for (size_t j = 0; j < 400; ++j) {
-      const glm::dvec3 p(float(j % 20) * 2.0f + 0.5f + moved.x, 3.0f + moved.y, float(j / 20) * 2.0f + 0.5f + moved.z);
-      size_t clusters = 0;
-      for (size_t c = 0; c < 2; ++c) {
-        size_t in = 0;
-        for (size_t k = 0; k < kCrownCardsPerCluster; ++k) {
-          const CardPoint a = cardPoint(crown.mesh, c * kCrownCardsPerCluster + k, p);
-          in += a.s > 1.0 / kCrownCardTexels && a.s < 1 - 1.0 / kCrownCardTexels && a.t > 1.0 / kCrownCardTexels &&
-                a.t < 1 - 1.0 / kCrownCardTexels;
-        }
-        clusters += in == kCrownCardsPerCluster;
-      }
-      inside += clusters >= 1;
-    }
-    CHECK(inside == 400);
-  }
   SECTION("a model within the budget is LOD0 unchanged") {
     std::vector<ExportPart> placed = parts;
     finishExportParts(placed);
@@ -270,6 +179,101 @@ TEST_CASE("buildLodChain", "[model][lod]") {
       CHECK(a[k].parts[1].mesh.positions == b[k].parts[1].mesh.positions);
     }
   }
+}
+
+TEST_CASE("buildLodChain: the far level's leaves are alpha-tested cards with their leaves' images", "[model][lod]") {
+  const std::vector<ExportPart> parts = testParts();
+  Vec3 moved(0.0f);
+  const std::vector<LodLevel> levels = buildLodChain(parts, 8000, &moved);
+  REQUIRE(levels.size() == 4);
+  // The wood is still there, closed, and as before a quarter of the level before.
+  const Mesh& wood = levels[2].parts[0].mesh;
+  CHECK(wood.triangles.size() > 100);
+  CHECK(analyzeTopology(wood).boundaryEdges == 0);
+  // The far level kept 50 leaf triangles: 25 cards of 4 vertices and 2 triangles each.
+  const ExportPart& cards = levels[2].parts[1];
+  CHECK(cards.name == "leaves");
+  REQUIRE(cards.mesh.triangles.size() == 50);
+  REQUIRE(cards.mesh.positions.size() == 100);
+  REQUIRE(cards.mesh.uvs.size() == 100);
+  REQUIRE(cards.mesh.normals.size() == 100);
+  CHECK(cards.mesh.colors.empty());
+  for (size_t t = 0; t < 50; ++t) {
+    const glm::uvec3& tri = cards.mesh.triangles[t];
+    CHECK(tri.x == uint32_t(t / 2 * 4));  // each card its own four vertices
+    CHECK(std::max({tri.x, tri.y, tri.z}) < uint32_t(t / 2 * 4 + 4));
+  }
+  // Cut out (glTF MASK) with the leaves' own image: 5 x 5 cells of 16 texels, not an atlas.
+  CHECK(cards.material.alphaCutoff == kLeafCardAlphaCutoff);
+  CHECK(cards.material.doubleSided);
+  REQUIRE(cards.material.texture);
+  CHECK_FALSE(cards.material.texture->isAtlas());
+  const Image& im = cards.material.texture->pixels();
+  CHECK(im.width == 80);
+  CHECK(im.height == 80);
+  // Card i is leaf 16i + 15 (evenly spread), a unit square grown 4 times (25 leaves cover
+  // the 400 leaves' area): its centre and normal are the leaf's, its 14 x 14 inner texels
+  // opaque in the leaf's colour, its rim transparent.
+  size_t opaque = 0;
+  for (size_t i = 0; i < 25; ++i) {
+    const size_t j = 16 * i + 15;
+    const Vec3 centre(float(j % 20) * 2.0f + 0.5f, 3.0f, float(j / 20) * 2.0f + 0.5f);
+    Vec3 mean(0.0f);
+    for (size_t v = 4 * i; v < 4 * i + 4; ++v) {
+      mean += 0.25f * (cards.mesh.positions[v] - moved);
+      CHECK(glm::length(cards.mesh.normals[v] - Vec3(0, 1, 0)) < 1e-5f);
+    }
+    CHECK(glm::length(mean - centre) < 1e-4f);
+    CHECK(glm::length(cards.mesh.positions[4 * i] - cards.mesh.positions[4 * i + 2]) ==
+          Approx(4.0 * std::sqrt(2.0) * 16 / 14).epsilon(1e-4));
+    const int x0 = int(i % 5) * 16, y0 = int(i / 5) * 16;
+    const Vec4 c = im.at(x0 + 8, y0 + 8);
+    CHECK(c.r == Approx(0.05 + 0.001 * double(j)).margin(1e-5));
+    CHECK(c.a == 1.0f);
+    CHECK(im.at(x0, y0 + 8).a == 0.0f);
+    for (int y = 0; y < 16; ++y)
+      for (int x = 0; x < 16; ++x) opaque += im.at(x0 + x, y0 + y).a == 1.0f;
+  }
+  CHECK(opaque == 25 * 14 * 14);
+}
+
+TEST_CASE("buildLodChain: the last level is the crown, all the leaves on crown cards, the wood a quarter", "[model][lod]") {
+  const std::vector<ExportPart> parts = testParts();
+  Vec3 moved(0.0f);
+  const std::vector<LodLevel> levels = buildLodChain(parts, 8000, &moved);
+  REQUIRE(levels.size() == 4);
+  const Mesh& wood = levels[3].parts[0].mesh;
+  const double quarter = double(levels[2].parts[0].mesh.triangles.size()) * kLodRatio;
+  CHECK(double(wood.triangles.size()) <= quarter + 1);
+  CHECK(double(wood.triangles.size()) >= 0.75 * quarter);
+  CHECK(analyzeTopology(wood).boundaryEdges == 0);
+  // ⌊50 / 4 / 6⌋ = 2 clusters of the 20 x 20 leaves (x and z in [0, 39]), 3 cards each.
+  const ExportPart& crown = levels[3].parts[1];
+  CHECK(crown.name == "leaves");
+  REQUIRE(crown.mesh.triangles.size() == 2 * kCrownCardsPerCluster * 2);
+  CHECK(crown.mesh.positions.size() == 2 * kCrownCardsPerCluster * 4);
+  CHECK(crown.material.alphaCutoff == kLeafCardAlphaCutoff);
+  REQUIRE(crown.material.texture);
+  CHECK(crown.material.texture->pixels().width == 3 * kCrownCardTexels);  // 6 cells, 3 a row
+  CHECK(crown.material.texture->pixels().height == 2 * kCrownCardTexels);
+  // Every leaf is on the three cards of one cluster: its centre, projected along each
+  // card's normal, falls inside it (more than a rim texel in).
+  size_t inside = 0;
+  for (size_t j = 0; j < 400; ++j) {
+    const glm::dvec3 p(float(j % 20) * 2.0f + 0.5f + moved.x, 3.0f + moved.y, float(j / 20) * 2.0f + 0.5f + moved.z);
+    size_t clusters = 0;
+    for (size_t c = 0; c < 2; ++c) {
+      size_t in = 0;
+      for (size_t k = 0; k < kCrownCardsPerCluster; ++k) {
+        const CardPoint a = cardPoint(crown.mesh, c * kCrownCardsPerCluster + k, p);
+        in += a.s > 1.0 / kCrownCardTexels && a.s < 1 - 1.0 / kCrownCardTexels && a.t > 1.0 / kCrownCardTexels &&
+              a.t < 1 - 1.0 / kCrownCardTexels;
+      }
+      clusters += in == kCrownCardsPerCluster;
+    }
+    inside += clusters >= 1;
+  }
+  CHECK(inside == 400);
 }
 
 TEST_CASE("buildLodChain reduces the parts side by side to the same levels at any thread count", "[model][lod]") {
