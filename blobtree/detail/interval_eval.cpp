@@ -91,9 +91,14 @@ float evalLocalL(const Tape& T, uint32_t ni, const Box3& box) {
   switch (n.kind) {
     case NodeKind::Blend:
     case NodeKind::Pcm: {
+      // A PCM node is F = f₁ + d(f₂) + Σ_{j>2} max(0, d(f_j)) (PcmAccum::value with the
+      // strongest child f₁ and the second f₂; bulge − max(0, d₁) + min(0, d₂) leaves that),
+      // continuous where the children swap ranks. So ∂F/∂f_j is 1 for the strongest child and
+      // at most |d'| <= maxSlope (>= 1.05) for any other: |F(p) − F(q)| <= maxSlope·Σ L_j·|p − q|,
+      // not (1 + maxSlope)·Σ L_j, which counted f₁ and its own d₁ both.
       float s = 0.0f;
       childrenIn(T, n, box, [&](uint32_t c) { s += evalL(T, c, box); });
-      return n.kind == NodeKind::Pcm ? s * (1.0f + params(T, n).pcm.maxSlope) : s;
+      return n.kind == NodeKind::Pcm ? s * params(T, n).pcm.maxSlope : s;
     }
     case NodeKind::Ricci: {
       // F = ‖(f₁⁺, …, f_k⁺)‖ₙ (RicciAcc keeps f > 0 only), and a norm is 1-Lipschitz in
