@@ -127,8 +127,10 @@ float evalLocalL(const Tape& T, uint32_t ni, const Box3& box) {
     }
     case NodeKind::Negative: return n.weight * evalL(T, T.kids[n.first], box);
     case NodeKind::Transform: return params(T, n).jNorm * evalL(T, T.kids[n.first], transformBox(params(T, n).localFromWorld, box));
-    case NodeKind::Bend:
-      return params(T, n).bend.jacobianBound(box) * evalL(T, T.kids[n.first], params(T, n).bend.localBox(box, T.nodes[T.kids[n.first]].box));
+    case NodeKind::Bend: {
+      const Box3 local = params(T, n).bend.localBox(box, T.nodes[T.kids[n.first]].box);
+      return local.empty() ? 0.0f : params(T, n).bend.jacobianBound(box) * evalL(T, T.kids[n.first], local);
+    }
     case NodeKind::Twist: {
       float h0, h1, r;
       axialExtent(box, params(T, n).twist.origin, params(T, n).twist.axis, h0, h1, r);
