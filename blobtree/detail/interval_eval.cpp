@@ -91,9 +91,14 @@ float evalLocalL(const Tape& T, uint32_t ni, const Box3& box) {
   switch (n.kind) {
     case NodeKind::Blend:
     case NodeKind::Pcm: {
+      // A PCM node is F = f₁ + d(f₂) + Σ_{j>2} max(0, d(f_j)) (PcmAccum::value with the
+      // strongest child f₁ and the second f₂; bulge − max(0, d₁) + min(0, d₂) leaves that),
+      // continuous where the children swap ranks. So ∂F/∂f_j is 1 for the strongest child and
+      // at most |d'| <= maxSlope (>= 1.05) for any other: |F(p) − F(q)| <= maxSlope·Σ L_j·|p − q|,
+      // not (1 + maxSlope)·Σ L_j, which counted f₁ and its own d₁ both.
       float s = 0.0f;
       childrenIn(T, n, box, [&](uint32_t c) { s += evalL(T, c, box); });
-      return n.kind == NodeKind::Pcm ? s * (1.0f + params(T, n).pcm.maxSlope) : s;
+      return n.kind == NodeKind::Pcm ? s * params(T, n).pcm.maxSlope : s;
     }
     case NodeKind::Ricci: {
       // F = ‖(f₁⁺, …, f_k⁺)‖ₙ (RicciAcc keeps f > 0 only), and a norm is 1-Lipschitz in
@@ -122,8 +127,10 @@ float evalLocalL(const Tape& T, uint32_t ni, const Box3& box) {
     }
     case NodeKind::Negative: return n.weight * evalL(T, T.kids[n.first], box);
     case NodeKind::Transform: return params(T, n).jNorm * evalL(T, T.kids[n.first], transformBox(params(T, n).localFromWorld, box));
-    case NodeKind::Bend:
-      return params(T, n).bend.jacobianBound(box) * evalL(T, T.kids[n.first], params(T, n).bend.localBox(box, T.nodes[T.kids[n.first]].box));
+    case NodeKind::Bend: {
+      const Box3 local = params(T, n).bend.localBox(box, T.nodes[T.kids[n.first]].box);
+      return local.empty() ? 0.0f : params(T, n).bend.jacobianBound(box) * evalL(T, T.kids[n.first], local);
+    }
     case NodeKind::Twist: {
       float h0, h1, r;
       axialExtent(box, params(T, n).twist.origin, params(T, n).twist.axis, h0, h1, r);

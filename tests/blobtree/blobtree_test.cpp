@@ -3,6 +3,7 @@
 #include "blobtree/blobtree.h"
 #include "blobtree/compiled.h"
 #include "blobtree/detail/field.h"
+#include "blobtree/detail/pcm.h"
 #include "blobtree/detail/warp.h"
 #include "blobtree/polygonize.h"
 #include "core/mesh_clean.h"
@@ -474,6 +475,63 @@ TEST_CASE("BlobTree::bend", "[blobtree]") {
       CHECK(differ == 0);
     }
   }
+  SECTION("BendFrame::localBox and jacobianBound enclose the map on random boxes; far boxes are empty") {
+    // localBox must hold the local point of every world point of the box whose image the
+    // child reaches (an empty box: the child is 0 at every point of it), and the bent cone's
+    // Lipschitz bound over the box (jacobianBound times the cone's over localBox) must hold
+    // between any two points of the box. The local boxes are tight:
+    // shrunk by 2 % of their size, they miss sampled local points in many boxes.
+    Rng rng(47);
+    int empty = 0, reaching = 0, tight = 0;
+    for (int k = 0; k < 40; ++k) {
+      BlobTree t;
+      Vec3 p0(float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1)));
+      Vec3 dir = glm::normalize(Vec3(float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1))));
+      Vec3 p1 = p0 + float(rng.uniform(0.5, 2.0)) * dir;
+      NodeId cone = t.cone(p0, p1, float(rng.uniform(0.05, 0.2)), float(rng.uniform(0.03, 0.1)));
+      Bend bd = Bend::fromAngle(p0, p1, glm::cross(dir, Vec3(0.3f, 1, 0.2f)), float(rng.uniform(0.05, 0.8)));
+      const Box3 childBox = t.node(cone).bounds;
+      const detail::BendFrame f = detail::makeBendFrame(bd, childBox);
+      const CompiledBlob bent = compile(t, t.bend(cone, bd));
+      const Box3 world = f.worldBox(childBox);
+      const Box3 around = world.expanded(0.1f * glm::length(world.size()));
+      for (int i = 0; i < 60; ++i) {
+        // Half the boxes anywhere around the bent cone, half about its bent axis.
+        const Vec3 c = i % 2 == 0 ? randomIn(rng, around.lo, around.hi)
+                                  : f.worldFromLocal(glm::mix(p0, p1, float(rng.uniform()))) + randomIn(rng, Vec3(-0.2f), Vec3(0.2f));
+        const float h = float(rng.uniform(0.002, 0.3));
+        const Box3 box{c - h * Vec3(float(rng.uniform(0.3, 1)), float(rng.uniform(0.3, 1)), float(rng.uniform(0.3, 1))),
+                       c + h * Vec3(float(rng.uniform(0.3, 1)), float(rng.uniform(0.3, 1)), float(rng.uniform(0.3, 1)))};
+        const Box3 lb = f.localBox(box, childBox);
+        const float L = bent.lipschitz(box);  // jacobianBound × the cone's bound over lb
+        INFO("bend " << k << ", box " << i);
+        empty += lb.empty();
+        const Vec3 shrink = 0.02f * lb.size();
+        const Box3 shrunk{lb.lo + shrink, lb.hi - shrink};
+        bool outsideShrunk = false;
+        for (int j = 0; j < 200; ++j) {
+          const Vec3 p = randomIn(rng, box.lo, box.hi), q = f.localFromWorld(p);
+          if (lb.empty()) {
+            CHECK(t.value(cone, q) == 0.0f);
+            continue;
+          }
+          if (childBox.contains(q)) {
+            ++reaching;
+            CHECK(lb.contains(q));
+            outsideShrunk = outsideShrunk || !shrunk.contains(q);
+          }
+          const Vec3 r = randomIn(rng, box.lo, box.hi);
+          CHECK(std::abs(bent.value(r) - bent.value(p)) <= L * glm::length(r - p) * 1.0001f + 2e-6f);
+        }
+        tight += outsideShrunk;
+      }
+    }
+    std::printf("bend local boxes: %d of 2400 empty, %d local points checked, %d boxes within 2 %% of a point\n", empty,
+                reaching, tight);
+    CHECK(empty > 500);  // far from the bent cone
+    CHECK(reaching > 50000);
+    CHECK(tight > 250);
+  }
   SECTION("BendFrame::mayReach is conservative: the child is exactly 0 wherever it says no") {
     Rng rng(41);
     int rejectedInBox = 0;
@@ -599,6 +657,58 @@ TEST_CASE("CompiledBlob::lipschitz over a box", "[blobtree]") {
         CHECK(b.lipschitz(far) == 0.0f);
       }
     }
+  }
+  SECTION("a PCM junction's bound is maxSlope times its children's sum, and holds") {
+    // F = f₁ + d(f₂) + Σ max(0, d(f_j)): slope 1 in the strongest child, at most
+    // |d'| <= maxSlope in the others, so the bound is maxSlope·Σ L_j (the tree's PCM: w = 0.25,
+    // bulge 2, |d'| up to 1.5), not (1 + maxSlope)·Σ L_j. A trunk, a branch and a bent branch
+    // meet at the origin; small boxes near the contact, where d' is steepest.
+    BlobTree t;
+    PcmParams pp;
+    pp.width = 0.25f;
+    pp.bulgeScale = 2.0f;
+    const float maxSlope = detail::derivePcm(pp).maxSlope;
+    CHECK(maxSlope == Approx(1.5f * 1.05f).epsilon(1e-3));
+    const Vec3 up = glm::normalize(Vec3(0.6f, 1, 0.1f)), side = glm::normalize(Vec3(-1, 0.8f, -0.3f));
+    const NodeId kids[] = {t.cone(Vec3(0, -1, 0), Vec3(0, 1.2f, 0), 0.5f, 0.35f), t.cone(Vec3(0), 1.1f * up, 0.35f, 0.25f),
+                           t.bend(t.cone(Vec3(0), 1.2f * side, 0.3f, 0.2f), Vec3(0), 1.2f * side, 0.08f, Vec3(0, 1, 0.2f))};
+    const CompiledBlob b = compile(t, t.pcm(kids, pp));
+    std::vector<CompiledBlob> each;
+    for (NodeId k : kids) each.push_back(compile(t, k));
+    int checked = 0, near = 0;
+    float worst = 0.0f;  // the largest sampled slope over the bound
+    for (int i = 0; i < 400; ++i) {
+      const Vec3 c = randomIn(rng, Vec3(-0.8f, -0.6f, -0.8f), Vec3(0.8f, 1.0f, 0.8f));
+      if (std::abs(b.value(c) - kIso) > 0.35f) continue;
+      const Box3 q{c - float(rng.uniform(0.005, 0.08)), c + float(rng.uniform(0.005, 0.08))};
+      float sum = 0.0f;
+      for (const CompiledBlob& e : each) sum += e.lipschitz(q);
+      const float L = b.lipschitz(q);
+      INFO("box " << q.lo.x << " " << q.lo.y << " " << q.lo.z << " .. " << q.hi.x << " " << q.hi.y << " " << q.hi.z);
+      CHECK(L <= sum * maxSlope * 1.0001f);
+      // Slopes between close point pairs, steepest along the gradient, and the gradient.
+      float slope = 0.0f;
+      for (int k = 0; k < 60; ++k) {
+        const Vec3 p = randomIn(rng, q.lo, q.hi);
+        const Vec3 g = b.gradient(p);
+        slope = std::max(slope, glm::length(g));
+        const float h = 1e-3f * (q.hi.x - q.lo.x);
+        const Vec3 r = glm::clamp(p + (glm::length(g) > 0.0f ? h * glm::normalize(g) : Vec3(h, 0, 0)), q.lo, q.hi);
+        if (glm::length(r - p) > 0.0f) slope = std::max(slope, std::abs(b.value(r) - b.value(p)) / glm::length(r - p));
+        const Vec3 o = randomIn(rng, q.lo, q.hi);
+        CHECK(std::abs(b.value(p) - b.value(o)) <= L * glm::length(p - o) * 1.0001f + 2e-6f);
+      }
+      CHECK(slope <= L * 1.001f + 1e-5f);
+      worst = std::max(worst, slope / L);
+      near += slope > 0.6f * L;
+      ++checked;
+    }
+    std::printf("PCM junction bound: %d boxes, %d with a sampled slope above 0.6 of the bound, largest ratio %.3f\n",
+                checked, near, double(worst));
+    CHECK(checked > 100);
+    // The bound is within 1/0.6 of the steepest sampled slope in a few boxes (0.64 and 0.71 at
+    // most for the two seeds): the bound without maxSlope, Σ L_j, fails there.
+    CHECK(near >= 3);
   }
   SECTION("a Ricci blend's bound is the n-norm of its children's") {
     // Under n = 400 the blend is nearly the largest child, and so is its slope: the bound of

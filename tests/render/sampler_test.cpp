@@ -64,6 +64,32 @@ TEST_CASE("sobolBits", "[render]") {
     CHECK(sobolBits(16, 1) == 0x88000000u);
     CHECK(sobolBits(3, 1) == 0x40000000u);  // 1/2 xor 3/4
   }
+  SECTION("dimension 1 equals the xor of the direction numbers of the index's bits") {
+    // The definition bit by bit, against the byte tables sobolBits reads; bits above 31
+    // are ignored.
+    uint32_t v[32];
+    v[0] = 0x80000000u;
+    for (int k = 1; k < 32; ++k) v[k] = v[k - 1] ^ (v[k - 1] >> 1);
+    auto byBits = [&](uint64_t index) {
+      uint32_t r = 0;
+      for (int k = 0; k < 32; ++k)
+        if ((index >> k) & 1) r ^= v[k];
+      return r;
+    };
+    Rng rng(11);
+    int mismatches = 0;
+    for (int i = 0; i < 20000; ++i) {
+      const uint64_t index = rng.next64() >> (i % 64);
+      mismatches += sobolBits(index, 1) != byBits(index);
+    }
+    for (uint64_t index : {uint64_t{0}, uint64_t{0xffffffffu}, uint64_t{0x1ffffffffull}, ~uint64_t{0}, uint64_t{1} << 31})
+      mismatches += sobolBits(index, 1) != byBits(index);
+    CHECK(mismatches == 0);
+    uint32_t all = 0;
+    for (uint32_t d : v) all ^= d;
+    CHECK(sobolBits(0xffffffffu, 1) == all);
+    CHECK(sobolBits(uint64_t{1} << 32, 1) == 0u);
+  }
   SECTION("the first 2^m points are a (0,m,2)-net") {
     for (int m = 0; m <= 10; ++m) {
       std::vector<Vec2> pts;
