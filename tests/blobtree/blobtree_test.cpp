@@ -40,6 +40,27 @@ Vec3 randomIn(Rng& rng, Vec3 lo, Vec3 hi) {
   return Vec3(float(rng.uniform(lo.x, hi.x)), float(rng.uniform(lo.y, hi.y)), float(rng.uniform(lo.z, hi.z)));
 }
 
+// A random cone in t and a bend along it (the bend tests' set-up): the cone from p0 to p1,
+// the bend, the cone's box and the bend's frame over it.
+struct RandomBend {
+  NodeId cone;
+  Bend bend;
+  Vec3 p0, p1;
+  Box3 childBox;
+  detail::BendFrame frame;
+};
+RandomBend randomBend(Rng& rng, BlobTree& t) {
+  RandomBend r;
+  r.p0 = Vec3(float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1)));
+  const Vec3 dir = glm::normalize(Vec3(float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1))));
+  r.p1 = r.p0 + float(rng.uniform(0.5, 2.0)) * dir;
+  r.cone = t.cone(r.p0, r.p1, float(rng.uniform(0.05, 0.2)), float(rng.uniform(0.03, 0.1)));
+  r.bend = Bend::fromAngle(r.p0, r.p1, glm::cross(dir, Vec3(0.3f, 1, 0.2f)), float(rng.uniform(0.05, 0.8)));
+  r.childBox = t.node(r.cone).bounds;
+  r.frame = detail::makeBendFrame(r.bend, r.childBox);
+  return r;
+}
+
 }  // namespace
 
 TEST_CASE("BlobTree::primitives", "[blobtree]") {
@@ -475,75 +496,16 @@ TEST_CASE("BlobTree::bend", "[blobtree]") {
       CHECK(differ == 0);
     }
   }
-  SECTION("BendFrame::localBox and jacobianBound enclose the map on random boxes; far boxes are empty") {
-    // localBox must hold the local point of every world point of the box whose image the
-    // child reaches (an empty box: the child is 0 at every point of it), and the bent cone's
-    // Lipschitz bound over the box (jacobianBound times the cone's over localBox) must hold
-    // between any two points of the box. The local boxes are tight:
-    // shrunk by 2 % of their size, they miss sampled local points in many boxes.
-    Rng rng(47);
-    int empty = 0, reaching = 0, tight = 0;
-    for (int k = 0; k < 40; ++k) {
-      BlobTree t;
-      Vec3 p0(float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1)));
-      Vec3 dir = glm::normalize(Vec3(float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1))));
-      Vec3 p1 = p0 + float(rng.uniform(0.5, 2.0)) * dir;
-      NodeId cone = t.cone(p0, p1, float(rng.uniform(0.05, 0.2)), float(rng.uniform(0.03, 0.1)));
-      Bend bd = Bend::fromAngle(p0, p1, glm::cross(dir, Vec3(0.3f, 1, 0.2f)), float(rng.uniform(0.05, 0.8)));
-      const Box3 childBox = t.node(cone).bounds;
-      const detail::BendFrame f = detail::makeBendFrame(bd, childBox);
-      const CompiledBlob bent = compile(t, t.bend(cone, bd));
-      const Box3 world = f.worldBox(childBox);
-      const Box3 around = world.expanded(0.1f * glm::length(world.size()));
-      for (int i = 0; i < 60; ++i) {
-        // Half the boxes anywhere around the bent cone, half about its bent axis.
-        const Vec3 c = i % 2 == 0 ? randomIn(rng, around.lo, around.hi)
-                                  : f.worldFromLocal(glm::mix(p0, p1, float(rng.uniform()))) + randomIn(rng, Vec3(-0.2f), Vec3(0.2f));
-        const float h = float(rng.uniform(0.002, 0.3));
-        const Box3 box{c - h * Vec3(float(rng.uniform(0.3, 1)), float(rng.uniform(0.3, 1)), float(rng.uniform(0.3, 1))),
-                       c + h * Vec3(float(rng.uniform(0.3, 1)), float(rng.uniform(0.3, 1)), float(rng.uniform(0.3, 1)))};
-        const Box3 lb = f.localBox(box, childBox);
-        const float L = bent.lipschitz(box);  // jacobianBound × the cone's bound over lb
-        INFO("bend " << k << ", box " << i);
-        empty += lb.empty();
-        const Vec3 shrink = 0.02f * lb.size();
-        const Box3 shrunk{lb.lo + shrink, lb.hi - shrink};
-        bool outsideShrunk = false;
-        for (int j = 0; j < 200; ++j) {
-          const Vec3 p = randomIn(rng, box.lo, box.hi), q = f.localFromWorld(p);
-          if (lb.empty()) {
-            CHECK(t.value(cone, q) == 0.0f);
-            continue;
-          }
-          if (childBox.contains(q)) {
-            ++reaching;
-            CHECK(lb.contains(q));
-            outsideShrunk = outsideShrunk || !shrunk.contains(q);
-          }
-          const Vec3 r = randomIn(rng, box.lo, box.hi);
-          CHECK(std::abs(bent.value(r) - bent.value(p)) <= L * glm::length(r - p) * 1.0001f + 2e-6f);
-        }
-        tight += outsideShrunk;
-      }
-    }
-    std::printf("bend local boxes: %d of 2400 empty, %d local points checked, %d boxes within 2 %% of a point\n", empty,
-                reaching, tight);
-    CHECK(empty > 500);  // far from the bent cone
-    CHECK(reaching > 50000);
-    CHECK(tight > 250);
-  }
   SECTION("BendFrame::mayReach is conservative: the child is exactly 0 wherever it says no") {
     Rng rng(41);
     int rejectedInBox = 0;
     for (int k = 0; k < 40; ++k) {
       BlobTree t;
-      Vec3 p0(float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1)));
-      Vec3 dir = glm::normalize(Vec3(float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1)), float(rng.uniform(-1, 1))));
-      Vec3 p1 = p0 + float(rng.uniform(0.5, 2.0)) * dir;
-      NodeId cone = t.cone(p0, p1, float(rng.uniform(0.05, 0.2)), float(rng.uniform(0.03, 0.1)));
-      Bend bd = Bend::fromAngle(p0, p1, glm::cross(dir, Vec3(0.3f, 1, 0.2f)), float(rng.uniform(0.05, 0.8)));
-      const Box3 childBox = t.node(cone).bounds;
-      const detail::BendFrame f = detail::makeBendFrame(bd, childBox);
+      const RandomBend rb = randomBend(rng, t);
+      const NodeId cone = rb.cone;
+      const Vec3 &p0 = rb.p0, &p1 = rb.p1;
+      const Box3& childBox = rb.childBox;
+      const detail::BendFrame& f = rb.frame;
       REQUIRE(f.bounded);
       const Box3 world = f.worldBox(childBox);
       const Box3 around = world.expanded(0.1f * glm::length(world.size()));
@@ -620,6 +582,63 @@ TEST_CASE("detail::kernelSlopeAt", "[blobtree]") {
     CHECK(detail::kernelSlopeAt(k, 1.0f) == 0.0f);
     CHECK(detail::kernelSlopeAt(k, 2.0f) == 0.0f);
   }
+}
+
+TEST_CASE("BendFrame::localBox and jacobianBound enclose the map on random boxes; far boxes are empty", "[blobtree]") {
+  // localBox must hold the local point of every world point of the box whose image the
+  // child reaches (an empty box: the child is 0 at every point of it), and the bent cone's
+  // Lipschitz bound over the box (jacobianBound times the cone's over localBox) must hold
+  // between any two points of the box. The local boxes are tight:
+  // shrunk by 2 % of their size, they miss sampled local points in many boxes.
+  Rng rng(47);
+  int empty = 0, reaching = 0, tight = 0;
+  for (int k = 0; k < 40; ++k) {
+    BlobTree t;
+    const RandomBend rb = randomBend(rng, t);
+    const NodeId cone = rb.cone;
+    const Bend& bd = rb.bend;
+    const Vec3 &p0 = rb.p0, &p1 = rb.p1;
+    const Box3& childBox = rb.childBox;
+    const detail::BendFrame& f = rb.frame;
+    const CompiledBlob bent = compile(t, t.bend(cone, bd));
+    const Box3 world = f.worldBox(childBox);
+    const Box3 around = world.expanded(0.1f * glm::length(world.size()));
+    for (int i = 0; i < 60; ++i) {
+      // Half the boxes anywhere around the bent cone, half about its bent axis.
+      const Vec3 c = i % 2 == 0 ? randomIn(rng, around.lo, around.hi)
+                                : f.worldFromLocal(glm::mix(p0, p1, float(rng.uniform()))) + randomIn(rng, Vec3(-0.2f), Vec3(0.2f));
+      const float h = float(rng.uniform(0.002, 0.3));
+      const Box3 box{c - h * Vec3(float(rng.uniform(0.3, 1)), float(rng.uniform(0.3, 1)), float(rng.uniform(0.3, 1))),
+                     c + h * Vec3(float(rng.uniform(0.3, 1)), float(rng.uniform(0.3, 1)), float(rng.uniform(0.3, 1)))};
+      const Box3 lb = f.localBox(box, childBox);
+      const float L = bent.lipschitz(box);  // jacobianBound × the cone's bound over lb
+      INFO("bend " << k << ", box " << i);
+      empty += lb.empty();
+      const Vec3 shrink = 0.02f * lb.size();
+      const Box3 shrunk{lb.lo + shrink, lb.hi - shrink};
+      bool outsideShrunk = false;
+      for (int j = 0; j < 200; ++j) {
+        const Vec3 p = randomIn(rng, box.lo, box.hi), q = f.localFromWorld(p);
+        if (lb.empty()) {
+          CHECK(t.value(cone, q) == 0.0f);
+          continue;
+        }
+        if (childBox.contains(q)) {
+          ++reaching;
+          CHECK(lb.contains(q));
+          outsideShrunk = outsideShrunk || !shrunk.contains(q);
+        }
+        const Vec3 r = randomIn(rng, box.lo, box.hi);
+        CHECK(std::abs(bent.value(r) - bent.value(p)) <= L * glm::length(r - p) * 1.0001f + 2e-6f);
+      }
+      tight += outsideShrunk;
+    }
+  }
+  std::printf("bend local boxes: %d of 2400 empty, %d local points checked, %d boxes within 2 %% of a point\n", empty,
+              reaching, tight);
+  CHECK(empty > 500);  // far from the bent cone
+  CHECK(reaching > 50000);
+  CHECK(tight > 250);
 }
 
 TEST_CASE("CompiledBlob::lipschitz over a box", "[blobtree]") {
