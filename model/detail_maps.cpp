@@ -10,22 +10,22 @@ namespace sprig {
 
 namespace {
 
-// full with only what a hit reads: positions, triangles, normals and colours.
-Mesh hitMesh(const Mesh& full) {
+// full with only what a hit reads: positions, triangles, normals and (colors) colours.
+Mesh hitMesh(const Mesh& full, bool colors) {
   Mesh m;
   m.positions = full.positions;
   m.triangles = full.triangles;
   if (full.normals.size() == full.positions.size()) m.normals = full.normals;
-  if (full.colors.size() == full.positions.size()) m.colors = full.colors;
+  if (colors && full.colors.size() == full.positions.size()) m.colors = full.colors;
   return m;
 }
 
 }  // namespace
 
-DetailSurface::DetailSurface(const Mesh& full, const Vec3& baseColor) : triangles_(full.triangles.size()) {
+DetailSurface::DetailSurface(const Mesh& full, const Vec3& baseColor, bool colors) : triangles_(full.triangles.size()) {
   render::Material material;
   material.baseColor = baseColor;
-  scene_.addMesh(hitMesh(full), scene_.addMaterial(material));
+  scene_.addMesh(hitMesh(full, colors), scene_.addMaterial(material));
   scene_.commit();
 }
 

@@ -25,8 +25,9 @@ namespace sprig {
 class DetailSurface {
  public:
   /// Builds the scene of full; baseColor is the colour of a hit where full has no vertex
-  /// colours. Throws std::runtime_error on an Embree error.
-  DetailSurface(const Mesh& full, const Vec3& baseColor);
+  /// colours. colors false: the scene keeps no vertex colours (every hit has baseColor), for
+  /// a bake that reads only normals. Throws std::runtime_error on an Embree error.
+  DetailSurface(const Mesh& full, const Vec3& baseColor, bool colors = true);
 
   /// The nearest of the hits of the rays p + s·normal and p − s·normal, s in
   /// [0, maxDistance], whose shading normal has a positive dot product with normal (hits of

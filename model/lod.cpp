@@ -162,8 +162,9 @@ void bakeLevelMaps(const std::vector<ExportPart>& parts, std::vector<LodLevel>& 
         if (reduced) atlasVertexColors(low);
         continue;
       }
-      if (!full) full = std::make_unique<DetailSurface>(parts[i].mesh, parts[i].material.baseColor);
+      // A part that keeps its own image reads only normals from the full mesh.
       const bool image = ownImage(low);
+      if (!full) full = std::make_unique<DetailSurface>(parts[i].mesh, parts[i].material.baseColor, !image);
       DetailMaps maps = bakeDetailMaps(low.mesh, low.material.baseColor, *full, reach[k][i], !image);
       if (!maps.normal) {
         atlasVertexColors(low);
@@ -232,6 +233,7 @@ LodLevel crownLevel(const std::vector<ExportPart>& parts, const LodLevel& far, s
   if (!leaves) return {};
   LodLevel level;
   level.parts.resize(parts.size());
+  const std::vector<size_t> targets = scaledShares(far.parts, kLodRatio);
   parallelFor(0, parts.size(), [&](size_t i) {
     const ExportPart& p = far.parts[i];
     if (p.mesh.triangles.empty())
@@ -239,7 +241,7 @@ LodLevel crownLevel(const std::vector<ExportPart>& parts, const LodLevel& far, s
     else if (parts[i].scattered)
       level.parts[i] = crownCards(parts[i], crownClusterCount(p.mesh.triangles.size()));
     else
-      level.parts[i] = reducePart(p, std::max<size_t>(size_t(std::llround(double(p.mesh.triangles.size()) * kLodRatio)), 1), errors[i]);
+      level.parts[i] = reducePart(p, std::max<size_t>(targets[i], 1), errors[i]);
   });
   level.triangles = partTriangles(level.parts);
   return level;
