@@ -103,6 +103,15 @@ std::string simplifyForMesh(std::vector<ExportPart>& parts, double simplify, con
   return simplified;
 }
 
+/// The parts (comma-separated names, each once) whose levels carry a normal map on
+/// coordinates of their own (normalMapOwnsUvs), which an OBJ cannot hold.
+std::string ownUvNormalMaps(const std::vector<LodLevel>& levels) {
+  std::string names;
+  for (const ExportPart& p : levels.back().parts)
+    if (normalMapOwnsUvs(p.material)) names += (names.empty() ? "" : ", ") + p.name;
+  return names;
+}
+
 /// The notes on textures, creases and seams (written: the reports of one output) and on
 /// cut-outs and clamped colours (glb: whether a .glb was written).
 void noteParts(const std::vector<ExportPart>& parts, const std::vector<PartWriteReport>& written, bool glb, const GlobalOptions& g) {
@@ -246,6 +255,9 @@ int runMesh(const MeshArgs& a, const GlobalOptions& g) {
       for (size_t k = lowerExtension(o) == ".glb" ? 0 : 1; k < levels.size(); ++k)
         lodFiles += (lodFiles.empty() ? "" : ", ") + lodPath(o, k).string();
     glb = glb || lowerExtension(o) == ".glb";
+    if (const std::string own = ownUvNormalMaps(levels); lowerExtension(o) == ".obj" && !own.empty())
+      note(g, std::cout, "%s: no normal maps for %s: OBJ gives a corner one uv, and their normal maps have coordinates of their own (TEXCOORD_1 in .glb)",
+           o.c_str(), own.c_str());
   }
   double total = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   size_t vertices = 0, triangles = 0;

@@ -33,6 +33,8 @@ const Image& DeferredImage::get() {
   return image_;
 }
 
+bool normalMapOwnsUvs(const PartMaterial& m) { return m.normalTexture && m.texture && !m.texture->isAtlas(); }
+
 namespace {
 
 // Throws std::invalid_argument when an index or an optional array does not fit the mesh.
@@ -366,10 +368,6 @@ bool hasOwnColors(const ExportPart& part) {
     if (glm::any(glm::greaterThan(glm::abs(c - part.material.baseColor), Vec3(1e-6f)))) return true;
   return false;
 }
-
-// Whether a part's normal map has texture coordinates of its own: an atlas beside a base
-// colour image over the mesh's own uvs (PartMaterial::normalTexture: glTF TEXCOORD_1).
-bool normalMapOwnsUvs(const PartMaterial& m) { return m.normalTexture && m.texture && !m.texture->isAtlas(); }
 
 // Whether the OBJ writer writes a part's normal map: OBJ gives a corner one uv, so a normal
 // map with coordinates of its own (normalMapOwnsUvs) is left out.

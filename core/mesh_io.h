@@ -130,6 +130,12 @@ struct PartTexture {
   bool isAtlas() const { return !atlas.index.empty(); }
 };
 
+struct PartMaterial;
+/// Whether a part's normal map has texture coordinates of its own: an atlas beside a base
+/// colour image over the mesh's own uvs (PartMaterial::normalTexture: glTF TEXCOORD_1; the
+/// OBJ writer leaves such a normal map out).
+bool normalMapOwnsUvs(const PartMaterial& material);
+
 /// The material of an exported part.
 struct PartMaterial {
   std::string name = "sprig";  ///< material name in glTF and MTL (letters, digits, '_' in OBJ)

@@ -74,4 +74,11 @@ cmp -s "$WORK/full/j.glb" "$WORK/auto/j_lod0.glb" || fail "LOD0 of a model withi
 mkdir "$WORK/blob"
 "$SPRIG" mesh species/blob_ricci_fig3.yaml -o "$WORK/blob/b.glb" >/dev/null
 [ "$(ls "$WORK/blob")" = b.glb ] || fail "a blob wrote $(ls "$WORK/blob")"
+# A part that keeps its own image (single-bark wood) has normal maps on coordinates of their
+# own: the .glb holds them, the OBJ cannot, and says so.
+mkdir "$WORK/own"
+"$SPRIG" mesh species/tree_scarred.yaml --steps 2 --cell 0.04 --lod 1000 -o "$WORK/own/s.obj" -o "$WORK/own/s.glb" >"$WORK/own.out"
+grep -qF "$WORK/own/s.obj: no normal maps for wood: OBJ gives a corner one uv" "$WORK/own.out" || fail "no OBJ normal-map note: $(cat "$WORK/own.out")"
+if grep -q "s.glb: no normal maps" "$WORK/own.out"; then fail "the .glb was said to lack normal maps"; fi
+if ls "$WORK/own" | grep -q normal; then fail "an OBJ normal map was written: $(ls "$WORK/own")"; fi
 echo "mesh level-of-detail tests passed"
