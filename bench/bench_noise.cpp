@@ -14,10 +14,13 @@
 /// build/bench_noise_cache/ so later runs skip it. Prints per scene the RMSE against the
 /// reference of each, in 8-bit sRGB levels (the display values, where dark sky-lit regions
 /// weigh as the eye sees them), and its ratios of error and CPU time to the stratified one.
-/// A third variant adds RenderSettings::unlitSkySamples = 2 to the Sobol' sampler, a fourth and
-/// a fifth the sky filter (RenderSettings::skyFilter, render/sky_filter.h) to each sampler. --out DIR
-/// writes DIR/NAME.png: stratified | Sobol' | Sobol' + sky filter | reference, side by side,
-/// and DIR/NAME_error.png: 8 x the error of stratified | of Sobol' + sky filter.
+/// A third variant adds RenderSettings::unlitSkySamples = 2 to the Sobol' sampler, a fourth the
+/// sky filter (RenderSettings::skyFilter, render/sky_filter.h: the default renderer), a fifth
+/// adaptive edge samples (--edge, --edge-threshold) to that; the last is the stratified
+/// sampler at three times --spp (the "the same error at a third of the samples"
+/// compares the default against it). --out DIR
+/// writes DIR/NAME.png: stratified | default | default + edge samples | reference, side by
+/// side, and DIR/NAME_error.png: 8 x the error of the first three.
 
 #include <cmath>
 #include <cstdio>
@@ -156,15 +159,17 @@ void runScene(const NoiseScene& sc, const Options& o) {
     int unlitSkySamples;
     bool skyFilter;
     bool adaptive;
+    int sppScale;  ///< samples per pixel: --spp times this
   };
-  const Variant variants[] = {{"stratified", render::Sampling::Stratified, 0, false, false},
-                              {"zsobol", render::Sampling::ZSobol, 0, false, false},
-                              {"zsobol+unlit2", render::Sampling::ZSobol, 2, false, false},
-                              {"zsobol+filter", render::Sampling::ZSobol, 0, true, false},
-                              {"filter+edges", render::Sampling::ZSobol, 0, true, true}};
-  constexpr int kVariants = 5;
+  const Variant variants[] = {{"stratified", render::Sampling::Stratified, 0, false, false, 1},
+                              {"zsobol", render::Sampling::ZSobol, 0, false, false, 1},
+                              {"zsobol+unlit2", render::Sampling::ZSobol, 2, false, false, 1},
+                              {"zsobol+filter", render::Sampling::ZSobol, 0, true, false, 1},
+                              {"filter+edges", render::Sampling::ZSobol, 0, true, true, 1},
+                              {"stratified x3", render::Sampling::Stratified, 0, false, false, 3}};
+  constexpr int kVariants = 6;
   Image images[kVariants];
-  double best[kVariants] = {1e30, 1e30, 1e30, 1e30, 1e30};
+  double best[kVariants] = {1e30, 1e30, 1e30, 1e30, 1e30, 1e30};
   uint64_t cameraRays[kVariants] = {};
   for (int r = 0; r < o.repeat; ++r) {
     for (int i = 0; i < kVariants; ++i) {
@@ -173,6 +178,7 @@ void runScene(const NoiseScene& sc, const Options& o) {
       rs.skyFilter = variants[i].skyFilter;
       rs.edgeSamples = variants[i].adaptive ? o.edgeSamples : 0;
       rs.edgeThreshold = o.edgeThreshold;
+      rs.spp = o.spp * variants[i].sppScale;
       const double cpu0 = bench::processCpuSeconds();
       render::RenderStats stats;
       images[i] = render::renderImage(scene, camera, rs, &stats);

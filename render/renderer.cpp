@@ -19,7 +19,6 @@ namespace sprig::render {
 
 namespace {
 
-constexpr int kTile = 32;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
 /// Orthonormal basis around unit n (Duff et al. 2017, "Building an orthonormal basis, revisited").
@@ -348,51 +347,104 @@ struct FilmSample {
   SampleValue value;
 };
 
-/// The traced samples of one tile and its apron, and the reconstruction of its pixels.
-/// Pixels hold spp samples each, or more where adaptive sampling added some
-/// (RenderSettings::edgeSamples): samples of pixel i are [first[i], first[i + 1]).
+/// The traced samples of one tile's own pixels [x0, x1) x [y0, y1). Pixels hold spp
+/// samples each, or more where adaptive sampling added some (RenderSettings::edgeSamples):
+/// samples of pixel i are [first[i], first[i + 1]).
 struct TileFilm {
-  int ax0, ay0, ax1, ay1;  ///< the traced pixels: [ax0, ax1) x [ay0, ay1)
-  int spp, apron;
-  bool tent;
-  float radius;
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
   std::vector<FilmSample> samples;
   std::vector<uint32_t> first;
 
-  TileFilm(int ax0_, int ay0_, int ax1_, int ay1_, int spp_, int apron_, bool tent_, float radius_)
-      : ax0(ax0_), ay0(ay0_), ax1(ax1_), ay1(ay1_), spp(spp_), apron(apron_), tent(tent_), radius(radius_) {
-    const size_t pixels = static_cast<size_t>(ax1 - ax0) * (ay1 - ay0);
+  TileFilm() = default;
+  TileFilm(int x0_, int y0_, int x1_, int y1_, int spp) : x0(x0_), y0(y0_), x1(x1_), y1(y1_) {
+    const size_t pixels = static_cast<size_t>(x1 - x0) * (y1 - y0);
     samples.reserve(pixels * spp);
     first.reserve(pixels + 1);
     first.push_back(0);
   }
 
-  size_t index(int x, int y) const { return static_cast<size_t>(y - ay0) * (ax1 - ax0) + (x - ax0); }
+  size_t index(int x, int y) const { return static_cast<size_t>(y - y0) * (x1 - x0) + (x - x0); }
   const FilmSample* pixel(int x, int y) const { return samples.data() + first[index(x, y)]; }
   int count(int x, int y) const {
     const size_t i = index(x, y);
     return static_cast<int>(first[i + 1] - first[i]);
   }
 
-  /// The filter's weight of sample f for the pixel centred at (cx, cy).
-  float weight(const FilmSample& f, float cx, float cy) const {
-    if (!tent) return 1.0f;
-    return std::max(0.0f, 1.0f - std::abs(f.x - cx) / radius) * std::max(0.0f, 1.0f - std::abs(f.y - cy) / radius);
+  /// Keeps the samples of the pixels `keep` says yes to (in pixel order); the others'
+  /// ranges become empty. Frees the rest.
+  template <class Keep>
+  void keepOnly(Keep&& keep) {
+    std::vector<FilmSample> kept;
+    std::vector<uint32_t> starts{0};
+    starts.reserve(first.size());
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x) {
+        if (keep(x, y)) kept.insert(kept.end(), pixel(x, y), pixel(x, y) + count(x, y));
+        starts.push_back(static_cast<uint32_t>(kept.size()));
+      }
+    samples = std::move(kept);
+    first = std::move(starts);
   }
 
+  void release() {
+    std::vector<FilmSample>().swap(samples);
+    std::vector<uint32_t>().swap(first);
+  }
+};
+
+/// The films of all tiles and the reconstruction of pixels from them: a pixel's filter
+/// reads the samples of its neighbours up to `apron` pixels away, which may lie in
+/// neighbouring tiles (each pixel is traced once, by its own tile).
+class FilmGrid {
+ public:
+  FilmGrid(int width, int height, int spp, float radius, bool tent, int tile)
+      : width_(width), height_(height), spp_(spp), tile_(tile), tent_(tent), radius_(radius),
+        apron_(tent ? static_cast<int>(std::ceil(radius - 0.5f)) : 0),
+        tilesX_((width + tile - 1) / tile), tilesY_((height + tile - 1) / tile),
+        films_(static_cast<size_t>(tilesX_) * tilesY_) {}
+
+  size_t tileCount() const { return films_.size(); }
+  /// How many tiles around a tile its pixels' filters reach, per axis.
+  int tileReach() const { return (apron_ + tile_ - 1) / tile_; }
+
+  /// A new, empty film for tile t's own pixels.
+  TileFilm& start(size_t t) {
+    const int x0 = static_cast<int>(t % tilesX_) * tile_, y0 = static_cast<int>(t / tilesX_) * tile_;
+    films_[t] = TileFilm(x0, y0, std::min(x0 + tile_, width_), std::min(y0 + tile_, height_), spp_);
+    return films_[t];
+  }
+  TileFilm& film(size_t t) { return films_[t]; }
+
+  /// Calls f(u) for every tile u within tileReach() of tile t (t included), in row order.
+  template <class F>
+  void forNeighbours(size_t t, F&& f) const {
+    const int r = tileReach(), tx = static_cast<int>(t % tilesX_), ty = static_cast<int>(t / tilesX_);
+    for (int y = std::max(0, ty - r); y <= std::min(tilesY_ - 1, ty + r); ++y)
+      for (int x = std::max(0, tx - r); x <= std::min(tilesX_ - 1, tx + r); ++x) f(static_cast<size_t>(y) * tilesX_ + x);
+  }
+
+  /// Whether pixel (x, y)'s filter reads only pixels of its own tile film f.
+  bool readsOwnTile(const TileFilm& f, int x, int y) const { return staysInTile(f, x, y, apron_); }
+
+  /// Whether only pixels of f itself read pixel (x, y): the pixels a border pixel of f reads
+  /// lie within twice the filter's reach of f's edges.
+  bool readByOwnTileOnly(const TileFilm& f, int x, int y) const { return staysInTile(f, x, y, 2 * apron_); }
+
   /// Writes pixel (x, y) of image (scaled by exposure) and, when layers is given, its sky
-  /// term and guides, reconstructed with the same filter. A pixel with more samples than
-  /// spp weighs each of them spp/count, so every pixel's samples weigh alike in total.
+  /// term and guides, reconstructed with the filter over the samples of the pixels around
+  /// it, whichever tile holds them. A pixel with more samples than spp weighs each of them
+  /// spp/count, so every pixel's samples weigh alike in total.
   void reconstruct(int x, int y, float exposure, Image& image, SkyLayers* layers) const {
     Vec4 sum(0);
     Vec3 sky(0), albedo(0), normal(0), position(0);
     float wsum = 0, wsurface = 0;
     const float cx = static_cast<float>(x) + 0.5f, cy = static_cast<float>(y) + 0.5f;
-    for (int ny = std::max(ay0, y - apron); ny <= std::min(ay1 - 1, y + apron); ++ny) {
-      for (int nx = std::max(ax0, x - apron); nx <= std::min(ax1 - 1, x + apron); ++nx) {
-        const FilmSample* in = pixel(nx, ny);
-        const int n = count(nx, ny);
-        const float share = n == spp ? 1.0f : static_cast<float>(spp) / static_cast<float>(n);
+    for (int ny = std::max(0, y - apron_); ny <= std::min(height_ - 1, y + apron_); ++ny) {
+      for (int nx = std::max(0, x - apron_); nx <= std::min(width_ - 1, x + apron_); ++nx) {
+        const TileFilm& f = filmOf(nx, ny);
+        const FilmSample* in = f.pixel(nx, ny);
+        const int n = f.count(nx, ny);
+        const float share = n == spp_ ? 1.0f : static_cast<float>(spp_) / static_cast<float>(n);
         for (int k = 0; k < n; ++k) {
           const float w = share * weight(in[k], cx, cy);
           const SampleValue& v = in[k].value;
@@ -415,8 +467,9 @@ struct TileFilm {
     layers->albedo[i] = albedo / wsum;
     layers->normal[i] = normal;
     if (wsurface > 0) layers->position[i] = position / wsurface;
-    const FilmSample* own = pixel(x, y);
-    for (int k = 0, n = count(x, y); k < n; ++k) {
+    const TileFilm& f = filmOf(x, y);
+    const FilmSample* own = f.pixel(x, y);
+    for (int k = 0, n = f.count(x, y); k < n; ++k) {
       if (own[k].value.normal == Vec3(0)) continue;
       const float l = own[k].value.irradianceLum;
       layers->lumSum[i] += l;
@@ -424,6 +477,30 @@ struct TileFilm {
       layers->count[i] += 1.0f;
     }
   }
+
+ private:
+  /// Whether the pixels within `reach` of (x, y) (clamped to the image) all lie in f.
+  bool staysInTile(const TileFilm& f, int x, int y, int reach) const {
+    return std::max(0, x - reach) >= f.x0 && std::min(width_ - 1, x + reach) < f.x1 &&
+           std::max(0, y - reach) >= f.y0 && std::min(height_ - 1, y + reach) < f.y1;
+  }
+
+  const TileFilm& filmOf(int x, int y) const {
+    return films_[static_cast<size_t>(y / tile_) * tilesX_ + static_cast<size_t>(x / tile_)];
+  }
+
+  /// The filter's weight of sample f for the pixel centred at (cx, cy).
+  float weight(const FilmSample& f, float cx, float cy) const {
+    if (!tent_) return 1.0f;
+    return std::max(0.0f, 1.0f - std::abs(f.x - cx) / radius_) * std::max(0.0f, 1.0f - std::abs(f.y - cy) / radius_);
+  }
+
+  int width_, height_, spp_, tile_;
+  bool tent_;
+  float radius_;
+  int apron_;
+  int tilesX_, tilesY_;
+  std::vector<TileFilm> films_;
 };
 
 /// The samplers of one tile: the base pass's, and the adaptive pass's (another Sobol'
@@ -490,8 +567,8 @@ bool samplesDisagree(const FilmSample* f, int n, float exposure, float threshold
 }
 
 /// Traces pixel (x, y) into the film: s.spp samples, and s.edgeSamples more where those
-/// disagree. Every decision reads the pixel's own samples only, so the apron pixels a tile
-/// re-traces come out the same as in their own tile, at any thread count.
+/// disagree. Every decision reads the pixel's own samples only, so the image does not
+/// depend on which thread traces which tile.
 void tracePixel(const Integrator& integrator, const RenderSettings& s, int x, int y, const PixelSamplers& samplers,
                 float exposure, TileFilm& film, Counters& c) {
   const size_t begin = film.samples.size();
@@ -501,11 +578,62 @@ void tracePixel(const Integrator& integrator, const RenderSettings& s, int x, in
   film.first.push_back(static_cast<uint32_t>(film.samples.size()));
 }
 
+/// Tiles are traced in row order by whichever thread is free, each pixel once, by its own
+/// tile. A pixel is reconstructed as soon as every pixel its filter reads is traced: one
+/// that reads only its own tile right after that tile, the rest (the tile's border,
+/// `apron` pixels wide) once every neighbouring tile is traced, by the thread that traced
+/// the last of them. Until then a tile keeps the samples its border and its neighbours'
+/// read (2 x apron wide) and frees the rest; it frees those when the last tile reading
+/// them is reconstructed, so the borders alive are about two rows of tiles.
+class TileSchedule {
+ public:
+  explicit TileSchedule(FilmGrid& grid) : grid_(grid), pending_(grid.tileCount()), readers_(grid.tileCount()) {
+    for (size_t t = 0; t < grid.tileCount(); ++t) {
+      int n = 0;
+      grid.forNeighbours(t, [&](size_t) { ++n; });
+      pending_[t].store(n, std::memory_order_relaxed);
+      readers_[t].store(n, std::memory_order_relaxed);
+    }
+  }
+
+  /// The next tile to trace, in row order.
+  size_t claim() { return next_.fetch_add(1, std::memory_order_relaxed); }
+
+  /// Tile t is traced and holds only its border: calls border(u) for every tile u whose
+  /// neighbours are now all traced, then frees the borders no tile reads any more.
+  template <class F>
+  void traced(size_t t, F&& border) {
+    grid_.forNeighbours(t, [&](size_t u) {
+      if (pending_[u].fetch_sub(1, std::memory_order_acq_rel) != 1) return;
+      border(grid_.film(u));
+      grid_.forNeighbours(u, [&](size_t v) {
+        if (readers_[v].fetch_sub(1, std::memory_order_acq_rel) == 1) grid_.film(v).release();
+      });
+    });
+  }
+
+ private:
+  FilmGrid& grid_;
+  std::vector<std::atomic<int>> pending_;  ///< per tile: neighbours (itself included) not yet traced
+  std::vector<std::atomic<int>> readers_;  ///< per tile: neighbours whose border is not yet reconstructed
+  std::atomic<size_t> next_{0};
+};
+
+/// Reconstructs the pixels of film f that `own` says read only their own tile (true) or
+/// not (false).
+void reconstructTile(const FilmGrid& grid, const TileFilm& f, bool own, float exposure, Image& image,
+                     SkyLayers* layers) {
+  for (int y = f.y0; y < f.y1; ++y)
+    for (int x = f.x0; x < f.x1; ++x)
+      if (grid.readsOwnTile(f, x, y) == own) grid.reconstruct(x, y, exposure, image, layers);
+}
+
 }  // namespace
 
 Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings& s, RenderStats* stats) {
   if (s.width < 1 || s.height < 1) throw std::invalid_argument("render: image size must be at least 1x1");
   if (s.spp < 1) throw std::invalid_argument("render: samples per pixel must be at least 1");
+  if (s.tileSize < 1) throw std::invalid_argument("render: the tile size must be at least 1 pixel");
   // Every ray starts at the camera or on the scene: both must lie where Embree traces.
   if (std::string why = cameraProblem(camera); !why.empty()) throw std::invalid_argument("render: " + why);
   if (!boxInRenderRange(scene.bounds()))
@@ -517,38 +645,36 @@ Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings
   Integrator integrator(scene, camera, s);
   const bool tent = s.filter == Filter::Tent && s.filterRadius > 0.5f;
   const float radius = tent ? s.filterRadius : 0.5f;
-  const int apron = tent ? static_cast<int>(std::ceil(radius - 0.5f)) : 0;
   const int spp = s.spp;
   const ZSobolSampler sobolBase(s.width, s.height, spp, s.seed);
   // The adaptive pass's own sequence: the base pass's next samples would break its
   // per-pixel blocks; another seed gives independent, equally stratified points.
   const ZSobolSampler sobolExtra(s.width, s.height, std::max(1, s.edgeSamples), deriveSeed(s.seed, {0xed9e}));
 
-  const int tilesX = (s.width + kTile - 1) / kTile, tilesY = (s.height + kTile - 1) / kTile;
-  const size_t tileCount = static_cast<size_t>(tilesX) * tilesY;
+  FilmGrid grid(s.width, s.height, spp, radius, tent, s.tileSize);
+  TileSchedule schedule(grid);
   Image image(s.width, s.height);
   std::atomic<uint64_t> cameraRays{0}, shadowRays{0}, skyRays{0};
   std::optional<Progress> progress;
-  if (s.progress) progress.emplace(s.progressLabel, tileCount);
+  if (s.progress) progress.emplace(s.progressLabel, grid.tileCount());
   const float scale = std::exp2(s.exposure);
   // The sky filter's layers, where the sky is sampled by rays (its only noise).
   std::optional<SkyLayers> layers;
   if (s.skyFilter && s.skyStrength > 0.0f && s.skySamples > 0) layers.emplace(s.width, s.height);
+  SkyLayers* out = layers ? &*layers : nullptr;
 
-  parallelFor(0, tileCount, [&](size_t tile) {
-    const int x0 = static_cast<int>(tile % tilesX) * kTile, y0 = static_cast<int>(tile / tilesX) * kTile;
-    const int x1 = std::min(x0 + kTile, s.width), y1 = std::min(y0 + kTile, s.height);
-    const int ax0 = std::max(0, x0 - apron), ay0 = std::max(0, y0 - apron);
-    const int ax1 = std::min(s.width, x1 + apron), ay1 = std::min(s.height, y1 + apron);
-    TileFilm film(ax0, ay0, ax1, ay1, spp, apron, tent, radius);
+  parallelFor(0, grid.tileCount(), [&](size_t) {
+    const size_t tile = schedule.claim();
+    TileFilm& film = grid.start(tile);
     ZSobolSampler sobol = sobolBase, sobolMore = sobolExtra;
     PixelSamplers samplers;
     if (s.sampler == Sampling::ZSobol) samplers = {&sobol, &sobolMore};
     Counters c;
-    for (int y = ay0; y < ay1; ++y)
-      for (int x = ax0; x < ax1; ++x) tracePixel(integrator, s, x, y, samplers, scale, film, c);
-    for (int y = y0; y < y1; ++y)
-      for (int x = x0; x < x1; ++x) film.reconstruct(x, y, scale, image, layers ? &*layers : nullptr);
+    for (int y = film.y0; y < film.y1; ++y)
+      for (int x = film.x0; x < film.x1; ++x) tracePixel(integrator, s, x, y, samplers, scale, film, c);
+    reconstructTile(grid, film, true, scale, image, out);
+    film.keepOnly([&](int x, int y) { return !grid.readByOwnTileOnly(film, x, y); });
+    schedule.traced(tile, [&](const TileFilm& ready) { reconstructTile(grid, ready, false, scale, image, out); });
     cameraRays += c.camera;
     shadowRays += c.shadow;
     skyRays += c.sky;

@@ -5,9 +5,9 @@
 /// dimension): Owen-scrambled Sobol' points in Morton order (Sampling::ZSobol, the default;
 /// render/sampler.h) or stratified jittered samples from a generator seeded with
 /// deriveSeed(seed, {x, y}) (Sampling::Stratified); so the image bytes do not depend on
-/// the thread count or the tile order. Tiles of 32x32 pixels run in parallel; a tent
-/// filter also traces a one-pixel apron of neighbouring pixels' samples (identical to
-/// what their own tile traces) so the reconstruction crosses tile borders seamlessly.
+/// the thread count, the tile size or the tile order. Tiles of 32x32 pixels run in parallel, each pixel
+/// traced once; a tent filter's pixels on a tile's border are reconstructed from the
+/// neighbouring tiles' samples once those are traced, so it crosses tile borders seamlessly.
 /// Shading is in linear light: Lambert diffuse plus a normalized Blinn-Phong highlight
 /// under a sun (a disc of angular radius `sunAngleDeg`, sampled for soft shadows), a sky
 /// dome (ambient occlusion by cosine-weighted hemisphere rays) and an optional fill
@@ -55,6 +55,7 @@ struct RenderSettings {
   Sampling sampler = Sampling::ZSobol;  ///< how the samples are placed
   int threads = 0;      ///< 0 = all cores
   uint64_t seed = 0;    ///< base seed of every per-pixel generator
+  int tileSize = 32;    ///< tile edge in pixels (the unit of parallel work; the image does not depend on it)
 
   Filter filter = Filter::Tent;
   float filterRadius = 1.0f;  ///< tent radius in pixels (Box always averages the pixel's own samples)
@@ -121,7 +122,7 @@ struct RenderSettings {
 
 /// Counts and time of one render.
 struct RenderStats {
-  uint64_t cameraRays = 0;  ///< primary rays, including the filter apron's re-traced samples
+  uint64_t cameraRays = 0;  ///< primary rays (spp per pixel, and the edge samples)
   uint64_t shadowRays = 0;  ///< occlusion rays toward the sun
   uint64_t skyRays = 0;     ///< ambient-occlusion rays
   double seconds = 0;       ///< wall time of renderImage

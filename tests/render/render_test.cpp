@@ -144,3 +144,49 @@ TEST_CASE("terminatorLift: Hanika's shadow-terminator offset", "[render]") {
   for (int i = 0; i < 3; ++i) inward[i] = glm::normalize(Vec3(-corners[i].x, -corners[i].y, h));
   CHECK(glm::length(render::terminatorLift(corners, inward, third)) == 0.0f);
 }
+
+TEST_CASE("renderImage traces each pixel once; a tent filter reads the neighbouring tiles' samples", "[render]") {
+  Scene scene;
+  addSpheres(scene);
+  const Camera cam = frameBounds(Box3{Vec3(-1.2f, 0, -1.2f), Vec3(2.2f, 2, 1.2f)}, ViewSpec{}, 1.4);
+  RenderSettings rs = quietSettings(70, 50);  // 3 x 2 tiles of 32, the last row and column partial
+  rs.threads = 2;
+  RenderStats stats;
+  const Image narrow = renderImage(scene, cam, rs, &stats);
+  CHECK(stats.cameraRays == 70u * 50u * static_cast<uint64_t>(rs.spp));
+  SECTION("a filter reaching two tiles away: the same bytes at 1 and 2 threads, and a blur") {
+    rs.filterRadius = 40.5f;  // reads 40 pixels around: every tile here reads every other
+    rs.edgeSamples = 4;
+    RenderStats two, one;
+    const Image a = renderImage(scene, cam, rs, &two);
+    rs.threads = 1;
+    const Image b = renderImage(scene, cam, rs, &one);
+    CHECK(a.pixels == b.pixels);
+    CHECK(two.cameraRays == one.cameraRays);
+    CHECK(two.cameraRays > stats.cameraRays);
+    CHECK((two.cameraRays - stats.cameraRays) % 4 == 0);
+    // Neighbouring pixels of the wide filter differ far less than the narrow one's.
+    auto variation = [](const Image& img) {
+      double sum = 0;
+      for (int y = 0; y < img.height; ++y)
+        for (int x = 1; x < img.width; ++x) sum += std::abs(img.at(x, y).r - img.at(x - 1, y).r);
+      return sum;
+    };
+    CHECK(variation(a) < 0.25 * variation(narrow));
+  }
+  SECTION("the same bytes with any tile size: one tile, tiles the filter crosses, tiles of one pixel") {
+    rs.edgeSamples = 4;
+    for (float radius : {1.0f, 2.5f}) {
+      rs.filterRadius = radius;
+      rs.tileSize = 4096;
+      const Image whole = renderImage(scene, cam, rs);
+      for (int tile : {32, 7, 3, 1}) {
+        rs.tileSize = tile;
+        INFO("radius " << radius << ", tiles of " << tile);
+        CHECK(renderImage(scene, cam, rs).pixels == whole.pixels);
+      }
+    }
+    rs.tileSize = 0;
+    CHECK_THROWS_WITH(renderImage(scene, cam, rs), Catch::Contains("tile size"));
+  }
+}

@@ -247,7 +247,7 @@ TEST_CASE("Adaptive camera samples where a pixel's samples disagree", "[render]"
     const uint64_t extra = adaptive.cameraRays - plain.cameraRays;
     CHECK(extra % 12 == 0);
     // The spheres' silhouettes and shadow edges, not the open ground and sky: some of the
-    // traced pixels (apron included), far from all.
+    // pixels, far from all.
     CHECK(extra > plain.cameraRays / 4 / 50 * 12);
     CHECK(extra < plain.cameraRays / 4 / 3 * 12);
   }
