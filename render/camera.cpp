@@ -46,14 +46,18 @@ float pixelCellSize(float ownCell, const PixelScale& pixels, const Box3& box, fl
   return std::max(ownCell, cellPixels * pixels.nearestPixel(box));
 }
 
-Ray Camera::generateRay(float px, float py, int width, int height) const {
-  const CameraBasis b = basis();
-  float tanY = std::tan(0.5f * static_cast<float>(radians(fovYDeg)));
-  float tanX = tanY * static_cast<float>(width) / static_cast<float>(height);
-  float sx = (2.0f * px / static_cast<float>(width) - 1.0f) * tanX;
-  float sy = (1.0f - 2.0f * py / static_cast<float>(height)) * tanY;
-  return {position, glm::normalize(b.forward + sx * b.right + sy * b.up)};
+FilmRays Camera::filmRays(int width, int height) const {
+  FilmRays f;
+  f.position = position;
+  f.basis = basis();
+  f.tanY = std::tan(0.5f * static_cast<float>(radians(fovYDeg)));
+  f.tanX = f.tanY * static_cast<float>(width) / static_cast<float>(height);
+  f.width = static_cast<float>(width);
+  f.height = static_cast<float>(height);
+  return f;
 }
+
+Ray Camera::generateRay(float px, float py, int width, int height) const { return filmRays(width, height).ray(px, py); }
 
 bool Camera::project(const Vec3& p, int width, int height, Vec2& film) const {
   const CameraBasis b = basis();

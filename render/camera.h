@@ -50,6 +50,21 @@ constexpr float kCellPixels = 2.0f;
 /// camera inside the box) or ownCell <= 0 (nothing to build).
 float pixelCellSize(float ownCell, const PixelScale& pixels, const Box3& box, float cellPixels = kCellPixels);
 
+/// The primary rays of one camera and image size, with the camera's frame and the film's
+/// extent computed once (Camera::generateRay computes them per call).
+struct FilmRays {
+  Vec3 position{0};
+  CameraBasis basis;
+  float tanX = 1, tanY = 1, width = 1, height = 1;
+  /// Primary ray through film point (px, py) in pixels (y down): the same bits as
+  /// Camera::generateRay.
+  Ray ray(float px, float py) const {
+    const float sx = (2.0f * px / width - 1.0f) * tanX;
+    const float sy = (1.0f - 2.0f * py / height) * tanY;
+    return {position, glm::normalize(basis.forward + sx * basis.right + sy * basis.up)};
+  }
+};
+
 /// Pinhole camera looking from `position` toward `target`.
 struct Camera {
   Vec3 position{0, 0, 5};  ///< eye, world units
@@ -59,6 +74,8 @@ struct Camera {
 
   /// Primary ray through film point (px, py) in pixels of a width x height image (y down).
   Ray generateRay(float px, float py, int width, int height) const;
+  /// The primary rays of a width x height image (for many rays: generateRay's per-ray set-up once).
+  FilmRays filmRays(int width, int height) const;
   /// Projects a world point to film pixels; returns false when it lies behind the camera.
   bool project(const Vec3& p, int width, int height, Vec2& film) const;
   /// The frame generateRay and project use (up rolled to be perpendicular to the view).

@@ -120,7 +120,8 @@ Vec2 skySample(const Strata& st, int k, int perSample, Rng& rng) {
 /// Per-render constants and the shading of one camera sample.
 class Integrator {
  public:
-  Integrator(const Scene& scene, const Camera& camera, const RenderSettings& s) : scene_(scene), camera_(camera), s_(s) {
+  Integrator(const Scene& scene, const Camera& camera, const RenderSettings& s)
+      : scene_(scene), s_(s), film_(camera.filmRays(s.width, s.height)) {
     Box3 b = scene.bounds();
     if (b.empty()) b = Box3{Vec3(-0.5f), Vec3(0.5f)};
     center_ = b.center();
@@ -142,7 +143,7 @@ class Integrator {
 
   /// Radiance and alpha seen through film point (fx, fy), with the sky term and guides.
   SampleValue sample(float fx, float fy, const Strata& st, Rng& rng, Counters& c) const {
-    Ray ray = camera_.generateRay(fx, fy, s_.width, s_.height);
+    Ray ray = film_.ray(fx, fy);
     ++c.camera;
     Vec3 bg = background(fy);
     float bgAlpha = s_.background == Background::Transparent ? 0.0f : 1.0f;
@@ -325,8 +326,8 @@ class Integrator {
   }
 
   const Scene& scene_;
-  const Camera& camera_;
   const RenderSettings& s_;
+  const FilmRays film_;  ///< the camera's primary rays, set up once
   Vec3 center_{0};
   float radius_ = 1;
   Vec3 fadeCenter_{0};

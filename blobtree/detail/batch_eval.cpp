@@ -22,6 +22,28 @@ struct Pts {
   int n8;  ///< padded count (multiple of 8, <= kBlock)
 };
 
+// The walk comes in two widths: W = 0, any padded count up to kBlock (pts.n8), and W = 8,
+// exactly 8 padded lanes (the tracer's batches, kTraceLanes). Each lane's operations are
+// the same in both, so the same bits; the fixed width unrolls the per-node loops and fills
+// and keeps the walk's stack frames small.
+
+/// Lanes per array of a walk of width W.
+template <int W>
+inline constexpr int kCap = W > 0 ? W : kBlock;
+
+/// The padded count of pts in a walk of width W.
+template <int W>
+inline int lanes(const Pts& pts) {
+  if constexpr (W > 0) return W;
+  else return pts.n8;
+}
+
+/// out[0, lanes) = v.
+template <int W>
+inline void fillLanes(float* out, const Pts& pts, float v) {
+  std::fill(out, out + lanes<W>(pts), v);
+}
+
 /// g(s) for 4 lanes, s already clamped to [0, 1].
 template <Kernel K>
 inline __m128 kernel4(__m128 s) {
@@ -38,13 +60,13 @@ inline __m128 kernel4(__m128 s) {
 
 /// out[i] (+)= cone/segment field over the batch, 4 points per SSE step (the batch is
 /// padded to a multiple of 8).
-template <Kernel K, bool Add>
-void coneBatch(const Prim& P, const Pts& pts, float* __restrict out) {
+template <int W, Kernel K, bool Add>
+inline void coneBatch(const Prim& P, const Pts& pts, float* __restrict out) {
   const __m128 ax = _mm_set1_ps(P.a.x), ay = _mm_set1_ps(P.a.y), az = _mm_set1_ps(P.a.z);
   const __m128 bx = _mm_set1_ps(P.ab.x), by = _mm_set1_ps(P.ab.y), bz = _mm_set1_ps(P.ab.z);
   const __m128 il = _mm_set1_ps(P.invLen2), R0 = _mm_set1_ps(P.R0), dR = _mm_set1_ps(P.dR), w = _mm_set1_ps(P.weight);
   const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f);
-  for (int i = 0; i < pts.n8; i += 4) {
+  for (int i = 0; i < lanes<W>(pts); i += 4) {
     __m128 px = _mm_sub_ps(_mm_loadu_ps(pts.x + i), ax);
     __m128 py = _mm_sub_ps(_mm_loadu_ps(pts.y + i), ay);
     __m128 pz = _mm_sub_ps(_mm_loadu_ps(pts.z + i), az);
@@ -62,11 +84,11 @@ void coneBatch(const Prim& P, const Pts& pts, float* __restrict out) {
   }
 }
 
-template <Kernel K, bool Add>
-void pointBatch(const Prim& P, const Pts& pts, float* __restrict out) {
+template <int W, Kernel K, bool Add>
+inline void pointBatch(const Prim& P, const Pts& pts, float* __restrict out) {
   const __m128 ax = _mm_set1_ps(P.a.x), ay = _mm_set1_ps(P.a.y), az = _mm_set1_ps(P.a.z);
   const __m128 iR2 = _mm_set1_ps(1.0f / (P.R0 * P.R0)), w = _mm_set1_ps(P.weight), one = _mm_set1_ps(1.0f);
-  for (int i = 0; i < pts.n8; i += 4) {
+  for (int i = 0; i < lanes<W>(pts); i += 4) {
     __m128 dx = _mm_sub_ps(_mm_loadu_ps(pts.x + i), ax);
     __m128 dy = _mm_sub_ps(_mm_loadu_ps(pts.y + i), ay);
     __m128 dz = _mm_sub_ps(_mm_loadu_ps(pts.z + i), az);
@@ -78,18 +100,18 @@ void pointBatch(const Prim& P, const Pts& pts, float* __restrict out) {
   }
 }
 
-template <bool Add>
+template <int W, bool Add>
 void primBatch(const Prim& P, const Pts& pts, float* out) {
   bool wy = P.kernel == Kernel::Wyvill;
   switch (P.kind) {
     case NodeKind::Segment:
     case NodeKind::Cone:
-      if (wy) coneBatch<Kernel::Wyvill, Add>(P, pts, out);
-      else coneBatch<Kernel::SoftObject, Add>(P, pts, out);
+      if (wy) coneBatch<W, Kernel::Wyvill, Add>(P, pts, out);
+      else coneBatch<W, Kernel::SoftObject, Add>(P, pts, out);
       return;
     case NodeKind::Point:
-      if (wy) pointBatch<Kernel::Wyvill, Add>(P, pts, out);
-      else pointBatch<Kernel::SoftObject, Add>(P, pts, out);
+      if (wy) pointBatch<W, Kernel::Wyvill, Add>(P, pts, out);
+      else pointBatch<W, Kernel::SoftObject, Add>(P, pts, out);
       return;
     default:
       for (int i = 0; i < pts.n; ++i) {
@@ -193,20 +215,22 @@ struct PcmStep4 {
   __m128 c, w, half, kHalf, a0;
 };
 
+template <int W>
 void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* out);
 
 /// A Ricci blend of n's children: out = m·S^(1/k) per point (RicciAcc).
+template <int W>
 void evalRicciB(const Tape& T, const TNode& n, const Pts& pts, const Box3& pbox, float* out) {
-  alignas(32) float tmp[kBlock];
-  alignas(32) float S[kBlock];
-  std::fill(out, out + pts.n8, 0.0f);  // running max m
-  std::fill(S, S + pts.n8, 0.0f);
+  alignas(32) float tmp[kCap<W>];
+  alignas(32) float S[kCap<W>];
+  fillLanes<W>(out, pts, 0.0f);  // running max m
+  fillLanes<W>(S, pts, 0.0f);
   // S >= 1 once a child contributes, so a term (f/m)^n < 2^-25 cannot change it in float:
   // f < m·2^(-25/n) skips the pow with the same bits (most points of a shell with small
   // bumps under n = 400). Likewise S == 1 (one contributor) gives m exactly.
   const float negligible = std::exp2(-25.0f / n.exponent);
   childrenIn(T, n, pbox, [&](uint32_t c) {
-    evalB(T, c, pts, pbox, tmp);
+    evalB<W>(T, c, pts, pbox, tmp);
     for (int i = 0; i < pts.n; ++i) {
       if (tmp[i] < out[i] * negligible) continue;
       RicciAcc a{out[i], S[i]};
@@ -220,19 +244,20 @@ void evalRicciB(const Tape& T, const TNode& n, const Pts& pts, const Box3& pbox,
 }
 
 /// A PCM junction of n's children (PcmAccum per point, as structure of arrays).
+template <int W>
 void evalPcmB(const Tape& T, const TNode& n, const Pts& pts, const Box3& pbox, float* out) {
-  alignas(32) float tmp[kBlock];
+  alignas(32) float tmp[kCap<W>];
   // PcmAccum per point, as structure of arrays: out holds f1.
-  alignas(32) float d1[kBlock], f2[kBlock], d2[kBlock], bulge[kBlock];
-  std::fill(out, out + pts.n8, 0.0f);
-  std::fill(d1, d1 + pts.n8, 0.0f);
-  std::fill(f2, f2 + pts.n8, 0.0f);
-  std::fill(d2, d2 + pts.n8, 0.0f);
-  std::fill(bulge, bulge + pts.n8, 0.0f);
+  alignas(32) float d1[kCap<W>], f2[kCap<W>], d2[kCap<W>], bulge[kCap<W>];
+  fillLanes<W>(out, pts, 0.0f);
+  fillLanes<W>(d1, pts, 0.0f);
+  fillLanes<W>(f2, pts, 0.0f);
+  fillLanes<W>(d2, pts, 0.0f);
+  fillLanes<W>(bulge, pts, 0.0f);
   const PcmStep4 step(params(T, n).pcm);
   childrenIn(T, n, pbox, [&](uint32_t c) {
-    evalB(T, c, pts, pbox, tmp);
-    for (int i = 0; i < pts.n8; i += 4) step.add(tmp + i, out + i, d1 + i, f2 + i, d2 + i, bulge + i);
+    evalB<W>(T, c, pts, pbox, tmp);
+    for (int i = 0; i < lanes<W>(pts); i += 4) step.add(tmp + i, out + i, d1 + i, f2 + i, d2 + i, bulge + i);
   });
   for (int i = 0; i < pts.n; ++i) {
     const PcmAccum acc{out[i], d1[i], f2[i], d2[i], bulge[i]};
@@ -240,33 +265,49 @@ void evalPcmB(const Tape& T, const TNode& n, const Pts& pts, const Box3& pbox, f
   }
 }
 
+/// bend.localFromWorld of lanes [0, n8) whose lanes [n, n8) repeat lane n - 1 (n >= 1): only
+/// the groups of four that hold real lanes are mapped, the rest copy lane n - 1's image (the
+/// same point maps to the same bits), so a batch of at most four real points maps half of
+/// its eight lanes.
+inline void mapLanes(const BendFrame& bend, const float* x, const float* y, const float* z, float* lx, float* ly,
+                     float* lz, int n, int n8) {
+  const int n4 = (n + 3) & ~3;
+  bend.localFromWorld(x, y, z, lx, ly, lz, n4);
+  for (int i = n4; i < n8; ++i) {
+    lx[i] = lx[n - 1];
+    ly[i] = ly[n - 1];
+    lz[i] = lz[n - 1];
+  }
+}
+
 /// A bend of n's child. Only the points that may reach the child's support (inside the
 /// bend's world box and its oriented box, BendFrame::mayReach) are mapped, an atan2 and a
 /// square root each, and evaluated; the others get 0, as evalS's culling gives them (the
 /// child is 0 outside its support's image).
+template <int W>
 void evalBendB(const Tape& T, const TNode& n, const Pts& pts, const Box3& /*pbox*/, float* out) {
-  alignas(32) float tmp[kBlock];
+  alignas(32) float tmp[kCap<W>];
   const BendFrame& bend = params(T, n).bend;
-  alignas(32) float lx[kBlock], ly[kBlock], lz[kBlock];
-  alignas(32) float cx[kBlock], cy[kBlock], cz[kBlock];
-  uint64_t bits[kBlock / 64] = {};
-  for (int i = 0; i < pts.n8; i += 4)
+  alignas(32) float lx[kCap<W>], ly[kCap<W>], lz[kCap<W>];
+  alignas(32) float cx[kCap<W>], cy[kCap<W>], cz[kCap<W>];
+  uint64_t bits[(kCap<W> + 63) / 64] = {};
+  for (int i = 0; i < lanes<W>(pts); i += 4)
     bits[i >> 6] |= uint64_t(mayReach4(bend, n.box, pts.x + i, pts.y + i, pts.z + i)) << (i & 63);
   if (pts.n & 63) bits[pts.n >> 6] &= (uint64_t(1) << (pts.n & 63)) - 1;  // padding lanes
   int m = 0;
   for (uint64_t w : bits) m += __builtin_popcountll(w);
   if (m == pts.n) {
-    bend.localFromWorld(pts.x, pts.y, pts.z, lx, ly, lz, pts.n8);
-    const Box3 lb = boxOfPoints(lx, ly, lz, pts.n8);
-    Pts lp{lx, ly, lz, pts.n, pts.n8};
-    evalB(T, T.kids[n.first], lp, lb, out);
+    mapLanes(bend, pts.x, pts.y, pts.z, lx, ly, lz, pts.n, lanes<W>(pts));
+    const Box3 lb = boxOfPoints(lx, ly, lz, lanes<W>(pts));
+    Pts lp{lx, ly, lz, pts.n, lanes<W>(pts)};
+    evalB<W>(T, T.kids[n.first], lp, lb, out);
     return;
   }
-  std::fill(out, out + pts.n8, 0.0f);
+  fillLanes<W>(out, pts, 0.0f);
   if (m == 0) return;
-  uint16_t at[kBlock];
+  uint16_t at[kCap<W>];
   m = 0;
-  for (int k = 0; k < kBlock / 64; ++k)
+  for (int k = 0; k < (kCap<W> + 63) / 64; ++k)
     for (uint64_t w = bits[k]; w != 0; w &= w - 1) {
       const int i = k * 64 + __builtin_ctzll(w);
       cx[m] = pts.x[i];
@@ -280,18 +321,19 @@ void evalBendB(const Tape& T, const TNode& n, const Pts& pts, const Box3& /*pbox
     cy[i] = cy[m - 1];
     cz[i] = cz[m - 1];
   }
-  bend.localFromWorld(cx, cy, cz, lx, ly, lz, m8);
+  mapLanes(bend, cx, cy, cz, lx, ly, lz, m, m8);
   const Box3 lb = boxOfPoints(lx, ly, lz, m8);  // lanes m..m8 repeat lane m - 1
   Pts lp{lx, ly, lz, m, m8};
-  evalB(T, T.kids[n.first], lp, lb, tmp);
+  evalB<W>(T, T.kids[n.first], lp, lb, tmp);
   for (int k = 0; k < m; ++k) out[at[k]] = tmp[k];
 }
 
 /// A transform, twist or taper of n's child: the points mapped into its frame.
+template <int W>
 void evalWarpB(const Tape& T, const TNode& n, const Pts& pts, const Box3& /*pbox*/, float* out) {
-  alignas(32) float lx[kBlock], ly[kBlock], lz[kBlock];
+  alignas(32) float lx[kCap<W>], ly[kCap<W>], lz[kCap<W>];
   Box3 lb;
-  for (int i = 0; i < pts.n8; ++i) {
+  for (int i = 0; i < lanes<W>(pts); ++i) {
     Vec3 q = warpLocal(T, n, Vec3(pts.x[i], pts.y[i], pts.z[i]), nullptr);
     lx[i] = q.x;
     ly[i] = q.y;
@@ -299,64 +341,65 @@ void evalWarpB(const Tape& T, const TNode& n, const Pts& pts, const Box3& /*pbox
     lb.extend(q);
   }
   Pts lp{lx, ly, lz, pts.n, pts.n8};
-  evalB(T, T.kids[n.first], lp, lb, out);
+  evalB<W>(T, T.kids[n.first], lp, lb, out);
 }
 
+template <int W>
 void evalB(const Tape& T, uint32_t ni, const Pts& pts, const Box3& pbox, float* out) {
   const TNode& n = T.nodes[ni];
   if (!pbox.overlaps(n.box)) {
-    std::fill(out, out + pts.n8, 0.0f);
+    fillLanes<W>(out, pts, 0.0f);
     return;
   }
   if (isPrimitive(n.kind)) {
-    primBatch<false>(T.prim(n.prim), pts, out);
+    primBatch<W, false>(T.prim(n.prim), pts, out);
     return;
   }
-  alignas(32) float tmp[kBlock];
+  alignas(32) float tmp[kCap<W>];
   switch (n.kind) {
     case NodeKind::Blend:
-      std::fill(out, out + pts.n8, 0.0f);
+      fillLanes<W>(out, pts, 0.0f);
       childrenIn(T, n, pbox, [&](uint32_t c) {
         const TNode& cn = T.nodes[c];
         if (isPrimitive(cn.kind)) {
-          primBatch<true>(T.prim(cn.prim), pts, out);
+          primBatch<W, true>(T.prim(cn.prim), pts, out);
         } else {
-          evalB(T, c, pts, pbox, tmp);
-          for (int i = 0; i < pts.n8; ++i) out[i] += tmp[i];
+          evalB<W>(T, c, pts, pbox, tmp);
+          for (int i = 0; i < lanes<W>(pts); ++i) out[i] += tmp[i];
         }
       });
       return;
     case NodeKind::Union:
-      std::fill(out, out + pts.n8, 0.0f);
+      fillLanes<W>(out, pts, 0.0f);
       childrenIn(T, n, pbox, [&](uint32_t c) {
-        evalB(T, c, pts, pbox, tmp);
-        for (int i = 0; i < pts.n8; ++i) out[i] = std::max(out[i], tmp[i]);
+        evalB<W>(T, c, pts, pbox, tmp);
+        for (int i = 0; i < lanes<W>(pts); ++i) out[i] = std::max(out[i], tmp[i]);
       });
       return;
     case NodeKind::Intersect:
-      std::fill(out, out + pts.n8, std::numeric_limits<float>::max());
+      fillLanes<W>(out, pts, std::numeric_limits<float>::max());
       for (uint32_t k = 0; k < n.count; ++k) {
-        evalB(T, T.kids[n.first + k], pts, pbox, tmp);
-        for (int i = 0; i < pts.n8; ++i) out[i] = std::min(out[i], tmp[i]);
+        evalB<W>(T, T.kids[n.first + k], pts, pbox, tmp);
+        for (int i = 0; i < lanes<W>(pts); ++i) out[i] = std::min(out[i], tmp[i]);
       }
-      for (int i = 0; i < pts.n8; ++i) out[i] = std::max(0.0f, out[i]);
+      for (int i = 0; i < lanes<W>(pts); ++i) out[i] = std::max(0.0f, out[i]);
       return;
     case NodeKind::Difference:
-      evalB(T, T.kids[n.first], pts, pbox, out);
-      evalB(T, T.kids[n.first + 1], pts, pbox, tmp);
-      for (int i = 0; i < pts.n8; ++i) out[i] = std::max(0.0f, std::min(out[i], 1.0f - tmp[i]));
+      evalB<W>(T, T.kids[n.first], pts, pbox, out);
+      evalB<W>(T, T.kids[n.first + 1], pts, pbox, tmp);
+      for (int i = 0; i < lanes<W>(pts); ++i) out[i] = std::max(0.0f, std::min(out[i], 1.0f - tmp[i]));
       return;
-    case NodeKind::Ricci: return evalRicciB(T, n, pts, pbox, out);
-    case NodeKind::Pcm: return evalPcmB(T, n, pts, pbox, out);
+    case NodeKind::Ricci: return evalRicciB<W>(T, n, pts, pbox, out);
+    case NodeKind::Pcm: return evalPcmB<W>(T, n, pts, pbox, out);
     case NodeKind::Negative:
-      evalB(T, T.kids[n.first], pts, pbox, out);
-      for (int i = 0; i < pts.n8; ++i) out[i] *= -n.weight;
+      evalB<W>(T, T.kids[n.first], pts, pbox, out);
+      for (int i = 0; i < lanes<W>(pts); ++i) out[i] *= -n.weight;
       return;
-    case NodeKind::Bend: return evalBendB(T, n, pts, pbox, out);
+    case NodeKind::Bend: return evalBendB<W>(T, n, pts, pbox, out);
     case NodeKind::Transform:
     case NodeKind::Twist:
-    case NodeKind::Taper: return evalWarpB(T, n, pts, pbox, out);
-    default: std::fill(out, out + pts.n8, 0.0f); return;
+    case NodeKind::Taper: return evalWarpB<W>(T, n, pts, pbox, out);
+    default: fillLanes<W>(out, pts, 0.0f); return;
   }
 }
 
@@ -381,7 +424,8 @@ void evalBatch(const Tape& T, std::span<const Vec3> points, std::span<float> out
       z[i] = z[n - 1];
     }
     Pts pts{x, y, z, n, n8};
-    evalB(T, T.root, pts, box, r);
+    if (n8 == 8) evalB<8>(T, T.root, pts, box, r);  // the tracer's batches
+    else evalB<0>(T, T.root, pts, box, r);
     std::copy(r, r + n, out.begin() + long(b));
   }
 }
