@@ -1,6 +1,7 @@
 #include "organisms/detail.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "core/parallel.h"
@@ -211,9 +212,10 @@ class Mushroom final : public DetailProcedure {
     struct Run final : DetailRun {
       const MushroomOptions& o;
       int levelsUsed;
+      MushroomCurve curve;
       std::vector<Vec3> origins;
       std::vector<Frame> frames;
-      Run(const MushroomOptions& opts, int used) : o(opts), levelsUsed(used) {}
+      Run(const MushroomOptions& opts, int used) : o(opts), levelsUsed(used), curve(opts) {}
 
       void add(const LevelView& view, LevelDetail& out) override {
         if (!o.levels.contains(view.level)) return;
@@ -241,7 +243,7 @@ class Mushroom final : public DetailProcedure {
             const Vec2 xy(glm::dot(q, fs.t), glm::dot(q, fs.b));
             const float rho = glm::length(xy);
             if (rho >= o.footprint) return;
-            const Vec2 c = mushroomProfile(o, rho);
+            const Vec2 c = curve(rho);
             const Vec3 radial = rho > 1e-12f ? (xy.x * fs.t + xy.y * fs.b) / rho : Vec3(0.0f);
             // On a curved base the profile's heights are over the base, not over the seed's
             // tangent plane: a point moved from rho to c.x keeps the base's height there,
@@ -288,19 +290,40 @@ class StoredDetail final : public DetailProcedure {
 
 }  // namespace
 
-Vec2 mushroomProfile(const MushroomOptions& o, float rho) {
-  // Four pieces over u = rho / footprint: cap top [0, a], underside [a, b], stalk [b, c],
-  // foot [c, 1]. Each piece lies in its own band of heights, so the curve never meets itself.
-  const float a = 0.35f, b = 0.55f, c = 0.75f;
-  const float H = o.height, u = std::clamp(rho / o.footprint, 0.0f, 1.0f);
-  if (u <= a) {
-    const float s = u / a;
-    return {o.capRadius * s, H + o.capTop * (1.0f - s * s)};
-  }
-  if (u <= b) {
-    const float s = (u - a) / (b - a);
-    return {o.capRadius + (o.stalkRadius - o.capRadius) * s, H - o.capUnder * std::sin(0.5f * float(kPi) * s)};
-  }
+namespace {
+
+Vec2 capTop(const MushroomOptions& o, float s) { return {o.capRadius * s, o.height + o.capTop * (1.0f - s * s)}; }
+Vec2 capUnder(const MushroomOptions& o, float s) {
+  return {o.capRadius + (o.stalkRadius - o.capRadius) * s, o.height - o.capUnder * std::sin(0.5f * float(kPi) * s)};
+}
+
+}  // namespace
+
+std::array<float, 3> mushroomBreaks(const MushroomOptions& o) {
+  // The curved pieces' lengths by 64 chords each (within 0.01 %).
+  auto length = [&](Vec2 (*piece)(const MushroomOptions&, float)) {
+    float sum = 0.0f;
+    for (int i = 0; i < 64; ++i) sum += glm::length(piece(o, float(i + 1) / 64.0f) - piece(o, float(i) / 64.0f));
+    return sum;
+  };
+  const float top = length(capTop), under = length(capUnder);
+  const float stalk = std::max(o.height - o.capUnder, 0.0f), foot = std::max(o.footprint - o.stalkRadius, 0.0f);
+  const float total = top + under + stalk + foot;
+  if (!(total > 0.0f)) return {0.35f, 0.55f, 0.75f};
+  return {top / total, (top + under) / total, (top + under + stalk) / total};
+}
+
+namespace {
+
+// The pieces of the profile at u = rho / footprint in [0, 1], corners sharp.
+Vec2 mushroomPieces(const MushroomOptions& o, const std::array<float, 3>& breaks, float u) {
+  // Four pieces over u: cap top [0, a], underside [a, b], stalk [b, c], foot [c, 1], each
+  // as wide in u as it is long (mushroomBreaks). Each piece lies in its own band of
+  // heights, so the curve never meets itself.
+  const auto [a, b, c] = breaks;
+  const float H = o.height;
+  if (u <= a) return capTop(o, u / a);
+  if (u <= b) return capUnder(o, (u - a) / (b - a));
   if (u <= c) {
     const float s = (u - b) / (c - b);
     return {o.stalkRadius, (H - o.capUnder) * (1.0f - s)};
@@ -316,6 +339,40 @@ Vec2 mushroomProfile(const MushroomOptions& o, float rho) {
   const float k = std::clamp(2.0f - m, 0.0f, 2.0f);
   return {o.stalkRadius + (o.footprint - o.stalkRadius) * (k * s + (1.0f - k) * s * s), 0.0f};
 }
+
+}  // namespace
+
+MushroomCurve::MushroomCurve(const MushroomOptions& o) : footprint_(o.footprint), breaks_(mushroomBreaks(o)) {
+  // The pieces sampled finely (kFine per table step), their running sums, then each table
+  // point the mean over u ± kMushroomRounding (a box filter along the curve: u is
+  // proportional to arc length), eased back to the pieces themselves within 2·w of either
+  // end, so the apex stays on the axis and the foot ends with value and slope 0.
+  constexpr int kFine = 8;
+  const int fine = kTableSteps * kFine;
+  std::vector<Vec2> sharp(size_t(fine) + 1);
+  std::vector<glm::dvec2> sum(size_t(fine) + 2, glm::dvec2(0.0));
+  for (int i = 0; i <= fine; ++i) {
+    sharp[size_t(i)] = mushroomPieces(o, breaks_, float(i) / float(fine));
+    sum[size_t(i) + 1] = sum[size_t(i)] + glm::dvec2(sharp[size_t(i)]);
+  }
+  const int half = int(std::lround(kMushroomRounding * fine));
+  table_.resize(kTableSteps + 1);
+  for (int i = 0; i <= kTableSteps; ++i) {
+    const int j = i * kFine, lo = std::max(j - half, 0), hi = std::min(j + half, fine);
+    const Vec2 mean(glm::dvec2(sum[size_t(hi) + 1] - sum[size_t(lo)]) / double(hi - lo + 1));
+    const float u = float(i) / float(kTableSteps), edge = std::min(u, 1.0f - u) / kMushroomRounding;
+    const float blend = std::clamp(edge - 2.0f, 0.0f, 1.0f);
+    table_[size_t(i)] = sharp[size_t(j)] + blend * blend * (3.0f - 2.0f * blend) * (mean - sharp[size_t(j)]);
+  }
+}
+
+Vec2 MushroomCurve::operator()(float rho) const {
+  const float x = std::clamp(rho / footprint_, 0.0f, 1.0f) * float(kTableSteps);
+  const int i = std::min(int(x), kTableSteps - 1);
+  return glm::mix(table_[size_t(i)], table_[size_t(i) + 1], x - float(i));
+}
+
+Vec2 mushroomProfile(const MushroomOptions& o, float rho) { return MushroomCurve(o)(rho); }
 
 std::shared_ptr<const DetailProcedure> makeRock(const RockOptions& o) { return std::make_shared<Rock>(o); }
 std::shared_ptr<const DetailProcedure> makeBerry(const BerryOptions& o) { return std::make_shared<Berry>(o); }

@@ -13,6 +13,7 @@
 /// | spur | surface seed | arbitrary: one length per level over a range (Fig. 8a mine, Fig. 10) |
 /// | mushroom | 3D around a surface seed | morphogenic: a designed profile split 2^-k over a range |
 
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -113,8 +114,44 @@ struct MushroomOptions {
 std::shared_ptr<const DetailProcedure> makeMushroom(const MushroomOptions& options);
 
 /// The mushroom profile of options at reference radius rho (0..footprint): (radial distance,
-/// height) in the seed's frame. Exposed for the embedding test.
+/// height) in the seed's frame, MushroomCurve(options)(rho) (which tabulates the curve:
+/// build a MushroomCurve to sample many points). Exposed for the embedding test.
 Vec2 mushroomProfile(const MushroomOptions& options, float rho);
+
+/// Where the profile's pieces meet, as fractions u = rho / footprint: the cap's top is
+/// [0, a], its underside [a, b], the stalk [b, c], the foot [c, 1]. Each piece takes a share
+/// of the footprint in proportion to its length, so the reference points spread evenly
+/// along the profile. (Fixed shares, 0.35, 0.55, 0.75, gave a stalk of 0.2 in height 0.032
+/// of reference radius on the mushroom planet: its triangles were 6 times longer than the
+/// reference grid, slivers whose shading streaked.)
+std::array<float, 3> mushroomBreaks(const MushroomOptions& options);
+
+/// Half-width, in u = rho / footprint, of the window over which the profile's corners (the
+/// cap's rim, where the stalk meets the underside and where it meets the foot) are rounded.
+/// Sharp, they fell between the vertices of the reference grid, a different way at every
+/// angle round the seed: the rims were notched and the stalks and feet streaked. 0.07 is
+/// 0.04 of the planet's 0.59-long profile, about one and a half vertex steps of its level
+/// 6 along the curve (0.04 left the rims notched).
+inline constexpr float kMushroomRounding = 0.07f;
+
+/// The mushroom profile as the operator uses it, tabulated once per feature: the pieces
+/// (mushroomPieces' shares, mushroomBreaks) with their corners rounded by the mean over
+/// u ± kMushroomRounding, eased back to the pieces within 2 kMushroomRounding of either
+/// end (the apex stays on the axis; the foot ends on the ground with slope 1). A call
+/// interpolates a table of kTableSteps + 1 points: O(1).
+class MushroomCurve {
+ public:
+  explicit MushroomCurve(const MushroomOptions& options);
+  /// (radial distance, height) at reference radius rho (clamped to 0..footprint).
+  Vec2 operator()(float rho) const;
+  const std::array<float, 3>& breaks() const { return breaks_; }
+
+ private:
+  static constexpr int kTableSteps = 1024;
+  float footprint_;
+  std::array<float, 3> breaks_;
+  std::vector<Vec2> table_;
+};
 
 /// Captured detail (§2.2 analysis): offsets[l][v] in local frames, replayed at level l.
 std::shared_ptr<const DetailProcedure> makeStoredDetail(std::vector<std::vector<Vec3>> offsets);

@@ -372,6 +372,7 @@ TEST_CASE("Synthesis gives the same bytes at 1 and 2 threads", "[organisms]") {
 
 TEST_CASE("The mushroom profile is a simple curve at every growth", "[organisms]") {
   MushroomOptions o;
+  const MushroomCurve curve(o);
   // Sample the profile scaled by growth W (the shape after part of its levels) and check
   // that no two non-adjacent segments cross.
   for (float W : {0.1f, 0.35f, 0.7f, 1.0f}) {
@@ -379,7 +380,7 @@ TEST_CASE("The mushroom profile is a simple curve at every growth", "[organisms]
     const int n = 400;
     for (int i = 0; i <= n; ++i) {
       const float rho = o.footprint * float(i) / float(n);
-      const Vec2 p = mushroomProfile(o, rho);
+      const Vec2 p = curve(rho);
       c.emplace_back(rho + W * (p.x - rho), W * p.y);
     }
     const auto cross = [](Vec2 a, Vec2 b) { return a.x * b.y - a.y * b.x; };
@@ -394,6 +395,50 @@ TEST_CASE("The mushroom profile is a simple curve at every growth", "[organisms]
       }
     INFO("growth " << W);
     CHECK(crossings == 0);
+  }
+}
+
+// The mushroom planet's (Fig. 8b) stalks and feet streaked and its caps' rims were notched:
+// the profile's stalk took a fixed 0.2 of the footprint's radius for a height 6 times that
+// (slivers), and its corners were sharp, falling between the reference grid's vertices a
+// different way at every angle round the seed. Each piece now takes a share of the
+// footprint in proportion to its length, and the corners are rounded.
+TEST_CASE("MushroomCurve: pieces share the footprint by their lengths, corners rounded", "[organisms]") {
+  MushroomOptions planet;  // species/fig_org_08b_mushroom_planet.yaml
+  planet.height = 0.24f;
+  planet.capRadius = 0.145f;
+  planet.capTop = 0.06f;
+  planet.capUnder = 0.04f;
+  planet.stalkRadius = 0.04f;
+  planet.footprint = 0.16f;
+  for (const MushroomOptions& o : {MushroomOptions{}, planet}) {
+    const MushroomCurve curve(o);
+    const std::array<float, 3> breaks = curve.breaks();
+    CHECK(curve(0.0f).x == 0.0f);  // the apex on the axis
+    CHECK(curve(o.footprint) == Vec2(o.footprint, 0.0f));  // the foot's edge on the ground
+    // The curve's length, the share of u where it is the stalk's straight part, and the
+    // sharpest turn between samples 1/2000 apart.
+    const int n = 2000;
+    float length = 0.0f, sharpest = 0.0f;
+    int onStalk = 0;
+    Vec2 last = curve(0.0f), step(0.0f);
+    for (int i = 1; i <= n; ++i) {
+      const Vec2 p = curve(o.footprint * float(i) / float(n));
+      length += glm::length(p - last);
+      onStalk += std::abs(p.x - o.stalkRadius) < 1e-5f && p.y > 0.0f && p.y < o.height - o.capUnder;
+      if (glm::length(p - last) > 0 && glm::length(step) > 0)
+        sharpest = std::max(sharpest, glm::degrees(std::acos(std::clamp(glm::dot(glm::normalize(p - last), glm::normalize(step)), -1.0f, 1.0f))));
+      step = p - last;
+      last = p;
+    }
+    const float want = (o.height - o.capUnder) / length;
+    INFO("stalk " << o.height - o.capUnder << " of a profile " << length << " long (share " << want << "); breaks "
+                  << breaks[0] << " " << breaks[1] << " " << breaks[2] << "; straight stalk " << float(onStalk) / n
+                  << "; sharpest turn " << sharpest << "°");
+    CHECK(breaks[2] - breaks[1] == Approx(want).margin(0.05));  // was 0.2 whatever its length; rounding shortens the curve by 10 %
+    CHECK(float(onStalk) / n > breaks[2] - breaks[1] - 2.5f * kMushroomRounding);
+    CHECK(breaks[0] == Approx(glm::length(Vec2(o.capRadius, o.capTop)) / length).margin(0.03));
+    CHECK(sharpest < 10.0f);  // the rim turned by more than 90° at one sample
   }
 }
 
