@@ -12,6 +12,7 @@
 #include "core/polymesh.h"
 #include "core/srgb.h"
 #include "core/timer.h"
+#include "organisms/subdivision.h"
 #include "model/solid_velocity.h"
 #include "solids/front_field.h"
 #include "model/species_field.h"
@@ -904,11 +905,13 @@ class SolidModel final : public StillKindModel {
     return stages_.at(k);
   }
 
-  /// A stage's render meshes and their materials at `levels` of subdivision (kept: turntable
-  /// frames reuse them).
+  /// A stage's render meshes and their materials at `levels` of subdivision, kept: turntable
+  /// frames reuse them. A subdivided stage has 16 times the triangles, so only the last one
+  /// asked for is kept (a sequence's pictures take the stages one after another).
   const VisibleParts& visible(int k, int levels = 0) {
     auto it = visible_.find({k, levels});
     if (it == visible_.end()) {
+      if (levels > 0) std::erase_if(visible_, [](const auto& entry) { return entry.first.second > 0; });
       VisibleMeshOptions options;
       options.subdivisions = levels;
       it = visible_.emplace(std::make_pair(k, levels), visibleParts(stageMesh(k), &spec_.solid.materials.materials, options)).first;
@@ -1065,126 +1068,80 @@ void blendGroups(GroupedSurface& s, const std::vector<solids::Material>& materia
   }
 }
 
-/// One level of Loop subdivision (Loop 1987) of s with creases (Hoppe et al. 1994,
-/// "Piecewise smooth surface reconstruction"): every triangle into four; a vertex moves to
-/// the mean of its ring (Warren's weights), a new vertex on an edge to 3/8 of each end and
-/// 1/8 of each opposite corner. An edge between two smooth groups is a crease: its points
-/// follow the curve's cubic B-spline (midpoints; a crease vertex 3/4 itself and 1/8 of each
-/// crease neighbour), and a vertex where three or more creases meet stays, so a box keeps
-/// its edges straight, its faces flat and its corners. Groups carry over (an edge point on
-/// a crease gets one per side), materials and tints too (an edge point the mean of its
-/// ends'). Sequential; cost O(T).
-void loopSubdivide(GroupedSurface& s) {
-  // Edges in order of first appearance, each with the faces it borders (two on a closed
-  // 2-manifold) and its local index in them (edge k of a face runs from corner k to k + 1).
-  struct Edge {
-    uint32_t a, b;
-    std::array<uint32_t, 2> face{}, local{};
-    int faces = 0;
-    bool crease = false;
-  };
-  const uint32_t nv = uint32_t(s.positions.size());
-  std::vector<Edge> edges;
-  std::unordered_map<uint64_t, uint32_t> edgeId;
-  std::vector<std::array<uint32_t, 3>> faceEdge(s.tris.size());
-  for (uint32_t f = 0; f < s.tris.size(); ++f)
-    for (uint32_t k = 0; k < 3; ++k) {
-      const uint32_t a = s.tris[f][k], b = s.tris[f][(k + 1) % 3];
-      const uint64_t key = (uint64_t(std::min(a, b)) << 32) | std::max(a, b);
-      const auto [it, added] = edgeId.emplace(key, uint32_t(edges.size()));
-      if (added) edges.push_back(Edge{a, b});
-      Edge& e = edges[it->second];
-      if (e.faces < 2) e.face[size_t(e.faces)] = f, e.local[size_t(e.faces)] = k;
-      ++e.faces;
-      faceEdge[f][k] = it->second;
-    }
-  // A crease: an edge whose two faces' corners lie in different groups at either end (or
-  // an edge without exactly two faces).
-  auto groupAt = [&](uint32_t f, uint32_t v) {
-    const auto& t = s.tris[f];
-    return s.corner[f][size_t(std::find(t.begin(), t.end(), v) - t.begin())];
-  };
-  for (Edge& e : edges)
-    e.crease = e.faces != 2 || groupAt(e.face[0], e.a) != groupAt(e.face[1], e.a) ||
-               groupAt(e.face[0], e.b) != groupAt(e.face[1], e.b);
-  // Step 1, edge points: 3/8 of each end and 1/8 of each opposite corner; on a crease the
-  // midpoint (the cubic B-spline's rule along the crease curve).
-  std::vector<DVec3> next(nv + edges.size());
-  std::vector<DVec3> ring(nv, DVec3(0.0)), creaseRing(nv, DVec3(0.0));
-  std::vector<int> valence(nv, 0), creases(nv, 0);
-  for (size_t i = 0; i < edges.size(); ++i) {
-    const Edge& e = edges[i];
-    const DVec3 &a = s.positions[e.a], &b = s.positions[e.b];
-    if (e.crease) {
-      next[nv + i] = 0.5 * (a + b);
-    } else {
-      const DVec3& c = s.positions[s.tris[e.face[0]][(e.local[0] + 2) % 3]];
-      const DVec3& d = s.positions[s.tris[e.face[1]][(e.local[1] + 2) % 3]];
-      next[nv + i] = 0.375 * (a + b) + 0.125 * (c + d);
-    }
-    ring[e.a] += b, ring[e.b] += a, ++valence[e.a], ++valence[e.b];
-    if (e.crease) creaseRing[e.a] += b, creaseRing[e.b] += a, ++creases[e.a], ++creases[e.b];
-  }
-  // Step 2, vertex points: Loop's mask with Warren's weights; on a crease curve (two crease
-  // edges) 3/4 of the vertex and 1/8 of each crease neighbour; a corner (three or more) stays.
-  for (uint32_t v = 0; v < nv; ++v) {
-    const DVec3& p = s.positions[v];
-    const int n = valence[v];
-    if (creases[v] == 2) {
-      next[v] = 0.75 * p + 0.125 * creaseRing[v];
-    } else if (creases[v] > 2 || n == 0) {
-      next[v] = p;
-    } else {
-      const double beta = n == 3 ? 3.0 / 16.0 : 3.0 / (8.0 * n);
-      next[v] = (1.0 - n * beta) * p + beta * ring[v];
-    }
-  }
-  // Step 3, groups: an edge point has one group, or one per side on a crease.
-  std::vector<std::array<uint32_t, 2>> edgeGroup(edges.size());
-  for (size_t i = 0; i < edges.size(); ++i) {
-    edgeGroup[i][0] = uint32_t(s.vertexOf.size());
-    s.vertexOf.push_back(nv + uint32_t(i));
-    edgeGroup[i][1] = edgeGroup[i][0];
-    if (edges[i].crease) {
-      edgeGroup[i][1] = uint32_t(s.vertexOf.size());
-      s.vertexOf.push_back(nv + uint32_t(i));
-    }
-  }
-  // An edge point's colour and surface: the mean of its ends' on the same side.
-  if (!s.groupColor.empty()) {
-    s.groupColor.resize(s.vertexOf.size());
-    s.groupSurface.resize(s.vertexOf.size());
-    for (size_t i = 0; i < edges.size(); ++i)
-      for (int side = 0; side < 2; ++side) {
-        const uint32_t f = edges[i].face[size_t(side < edges[i].faces ? side : 0)], g = edgeGroup[i][size_t(side)];
-        const uint32_t ga = groupAt(f, edges[i].a), gb = groupAt(f, edges[i].b);
-        s.groupColor[g] = 0.5f * (s.groupColor[ga] + s.groupColor[gb]);
-        s.groupSurface[g] = 0.5f * (s.groupSurface[ga] + s.groupSurface[gb]);
-      }
-  }
-  if (!s.tints.empty()) {
-    s.tints.resize(next.size());
-    for (size_t i = 0; i < edges.size(); ++i) s.tints[nv + i] = 0.5f * (s.tints[edges[i].a] + s.tints[edges[i].b]);
-  }
-  // Step 4, each triangle into four: its corners' triangles and the middle one.
-  GroupedSurface out;
-  for (uint32_t f = 0; f < s.tris.size(); ++f) {
-    const auto& v = s.tris[f];
-    const auto& c = s.corner[f];
-    std::array<uint32_t, 3> m, h;  // edge k's point and its group on this face's side
+/// The edges between two smooth groups: an edge whose two faces' corners lie in different
+/// groups at either end (a cut-away's rim, a box's edges). Each once, in face order.
+std::vector<std::array<uint32_t, 2>> creaseEdges(const GroupedSurface& s) {
+  auto key = [](uint32_t a, uint32_t b) { return (uint64_t(a) << 32) | b; };
+  std::unordered_map<uint64_t, std::array<uint32_t, 2>> groups;  // directed edge a -> b: its face's groups at a, b
+  for (size_t f = 0; f < s.tris.size(); ++f)
     for (size_t k = 0; k < 3; ++k) {
-      const uint32_t e = faceEdge[f][k];
-      m[k] = nv + e;
-      h[k] = edgeGroup[e][edges[e].face[0] == f && edges[e].local[0] == k ? 0 : 1];
+      const size_t j = (k + 1) % 3;
+      groups.emplace(key(s.tris[f][k], s.tris[f][j]), std::array{s.corner[f][k], s.corner[f][j]});
     }
-    out.tris.insert(out.tris.end(), {{v[0], m[0], m[2]}, {m[0], v[1], m[1]}, {m[2], m[1], v[2]}, {m[0], m[1], m[2]}});
-    out.corner.insert(out.corner.end(), {{c[0], h[0], h[2]}, {h[0], c[1], h[1]}, {h[2], h[1], c[2]}, {h[0], h[1], h[2]}});
-    out.materials.insert(out.materials.end(), 4, s.materials[f]);
+  std::vector<std::array<uint32_t, 2>> out;
+  for (size_t f = 0; f < s.tris.size(); ++f)
+    for (size_t k = 0; k < 3; ++k) {
+      const size_t j = (k + 1) % 3;
+      const uint32_t a = s.tris[f][k], b = s.tris[f][j];
+      const auto twin = groups.find(key(b, a));  // none: a boundary edge, which OpenSubdiv keeps sharp
+      if (a < b && twin != groups.end() && (twin->second[1] != s.corner[f][k] || twin->second[0] != s.corner[f][j]))
+        out.push_back({a, b});
+    }
+  return out;
+}
+
+/// `levels` of Loop subdivision of s with creases (OpenSubdiv's Loop scheme through
+/// organisms::Subdivision): every triangle into four, each level; the edges between smooth
+/// groups (creaseEdges) are infinitely sharp creases refined as the curve's cubic B-spline,
+/// and a vertex where three or more creases meet stays, so a box keeps its edges straight,
+/// its faces flat and its corners. The groups are the subdivision's face-varying channel
+/// (an edge point on a crease gets one per side); their colour and surface ride it
+/// linearly, and tints ride the vertices linearly (a vertex keeps its value, an edge point
+/// takes its ends' mean); each face keeps its material. Sequential; cost O(4^levels T).
+void subdivide(GroupedSurface& s, int levels) {
+  if (levels == 0 || s.tris.empty()) return;
+  organisms::ControlMesh control;
+  organisms::SubdivisionOptions options;
+  options.scheme = organisms::SubdivisionScheme::Loop;
+  for (const DVec3& p : s.positions) control.positions.push_back(Vec3(p));
+  control.faceSizes.assign(s.tris.size(), 3);
+  for (size_t f = 0; f < s.tris.size(); ++f)
+    for (size_t k = 0; k < 3; ++k) {
+      control.faceVertices.push_back(s.tris[f][k]);
+      options.faceVaryingIndices.push_back(s.corner[f][k]);
+    }
+  options.faceVaryingCount = s.vertexOf.size();
+  options.creases = creaseEdges(s);
+  const organisms::Subdivision sub(control, levels, options);
+  std::vector<Vec3> positions = std::move(control.positions);
+  // Level by level: values of level l - 1 -> level l, Vec3 or Vec4 each (empty: none).
+  auto refine = [&sub](auto& values, organisms::Primvar kind, int l) {
+    using T = typename std::decay_t<decltype(values)>::value_type;
+    constexpr size_t width = sizeof(T) / sizeof(float);
+    if (values.empty()) return;
+    std::vector<T> fine(kind == organisms::Primvar::FaceVarying ? sub.topology(l).faceVaryingCount : sub.vertexCount(l));
+    sub.interpolate(l, kind, {&values[0].x, width * values.size()}, {&fine[0].x, width * fine.size()}, width);
+    values = std::move(fine);
+  };
+  for (int l = 1; l <= levels; ++l) {
+    refine(positions, organisms::Primvar::Vertex, l);
+    refine(s.tints, organisms::Primvar::Varying, l);
+    refine(s.groupColor, organisms::Primvar::FaceVarying, l);
+    refine(s.groupSurface, organisms::Primvar::FaceVarying, l);
+    std::vector<uint16_t> materials;
+    for (uint32_t parent : sub.topology(l).parentFace) materials.push_back(s.materials[parent]);
+    s.materials = std::move(materials);
   }
-  s.positions = std::move(next);
-  s.tris = std::move(out.tris);
-  s.corner = std::move(out.corner);
-  s.materials = std::move(out.materials);
+  const organisms::LevelTopology& fine = sub.topology(levels);
+  s.positions.assign(positions.begin(), positions.end());
+  s.tris.resize(fine.faceCount());
+  s.corner.resize(fine.faceCount());
+  s.vertexOf.assign(fine.faceVaryingCount, 0);
+  for (size_t i = 0; i < fine.faceVertices.size(); ++i) {
+    s.tris[i / 3][i % 3] = fine.faceVertices[i];
+    s.corner[i / 3][i % 3] = fine.faceVaryingIndices[i];
+    s.vertexOf[fine.faceVaryingIndices[i]] = fine.faceVertices[i];
+  }
 }
 
 }  // namespace
@@ -1209,7 +1166,9 @@ VisibleParts visibleParts(const TetMesh& mesh, const std::vector<solids::Materia
   // apart (solids::boundarySurface): every part together is a closed 2-manifold.
   GroupedSurface s = groupedSurface(solids::boundarySurface(mesh), mesh, tinted);
   if (materials && !s.tris.empty()) blendGroups(s, *materials);
-  for (int l = 0; l < options.subdivisions && 4 * s.tris.size() <= kMaxSubdividedTriangles; ++l) loopSubdivide(s);
+  int levels = 0;
+  while (levels < options.subdivisions && (s.tris.size() << (2 * (levels + 1))) <= kMaxSubdividedTriangles) ++levels;
+  subdivide(s, levels);
   std::vector<Vec3> normals = groupNormals(s);
   std::vector<float> area(s.tris.size());
   for (size_t f = 0; f < s.tris.size(); ++f) area[f] = 0.5f * glm::length(faceCross(s, f));

@@ -76,13 +76,14 @@ std::vector<Mesh> visibleMeshes(const solids::TetMesh& mesh, std::vector<uint16_
 /// How visibleParts shapes the surface.
 struct VisibleMeshOptions {
   int normalRounds = 2;  ///< rounds of smoothSurfaceNormals after the area-weighted means
-  /// Levels of Loop subdivision with creases before the normals, each a quarter of every
-  /// triangle (none that would pass kMaxSubdividedTriangles): a tetrahedral surface's
-  /// triangles are a cell wide and tilt up to 40° from the surface they stand for, which
-  /// shows as facets wherever shading reads a triangle's own plane (silhouettes, the sky's
-  /// horizon, shadows). Edges between smooth groups stay creases and their corners stay put
-  /// (a box keeps its flat faces and straight edges); curved parts shrink by a fraction of
-  /// a cell. 0: the tetrahedra's faces.
+  /// Levels of Loop subdivision with infinitely sharp creases (OpenSubdiv's Loop scheme,
+  /// organisms::Subdivision) before the normals, each a quarter of every triangle (none
+  /// that would pass kMaxSubdividedTriangles): a tetrahedral surface's triangles are a cell
+  /// wide and tilt up to 40° from the surface they stand for, which shows as facets
+  /// wherever shading reads a triangle's own plane (silhouettes, the sky's horizon,
+  /// shadows). Edges between smooth groups stay creases and their corners stay put (a box
+  /// keeps its flat faces and straight edges); curved parts shrink by a fraction of a cell.
+  /// 0: the tetrahedra's faces.
   int subdivisions = 0;
 };
 
