@@ -1128,8 +1128,8 @@ void subdivide(GroupedSurface& s, int levels) {
     refine(s.tints, organisms::Primvar::Varying, l);
     refine(s.groupColor, organisms::Primvar::FaceVarying, l);
     refine(s.groupSurface, organisms::Primvar::FaceVarying, l);
-    std::vector<uint16_t> materials;
-    for (uint32_t parent : sub.topology(l).parentFace) materials.push_back(s.materials[parent]);
+    std::vector<uint16_t> materials(sub.topology(l).faceCount());
+    for (uint32_t f = 0; f < materials.size(); ++f) materials[f] = s.materials[sub.parentFace(l, f)];
     s.materials = std::move(materials);
   }
   const organisms::LevelTopology& fine = sub.topology(levels);

@@ -80,7 +80,7 @@ void collectError(Far::ErrorType, const char* message) {
 // what they warn of and throws instead.
 void ignoreWarning(const char*) {}
 
-LevelTopology levelTopology(const Far::TopologyLevel& level, bool hasParent) {
+LevelTopology levelTopology(const Far::TopologyLevel& level) {
   LevelTopology t;
   const int faces = level.GetNumFaces(), verts = level.GetNumVertices();
   t.faceSizes.resize(size_t(faces));
@@ -110,8 +110,6 @@ LevelTopology levelTopology(const Far::TopologyLevel& level, bool hasParent) {
       for (int i = 0; i < fv.size(); ++i) t.faceVaryingIndices.push_back(uint32_t(fv[i]));
     }
   }
-  if (hasParent)
-    for (int f = 0; f < faces; ++f) t.parentFace.push_back(uint32_t(level.GetFaceParentFace(f)));
   return t;
 }
 
@@ -208,12 +206,18 @@ Subdivision::Subdivision(const ControlMesh& mesh, int levels, const SubdivisionO
       throw std::invalid_argument("the crease " + std::to_string(a) + "-" + std::to_string(b) + " is not an edge of the mesh");
   impl_->primvar = std::make_unique<Far::PrimvarRefiner>(*impl_->refiner);
   topology_.reserve(size_t(levels) + 1);
-  for (int l = 0; l <= levels; ++l) topology_.push_back(levelTopology(impl_->refiner->GetLevel(l), l > 0));
+  for (int l = 0; l <= levels; ++l) topology_.push_back(levelTopology(impl_->refiner->GetLevel(l)));
 }
 
 Subdivision::~Subdivision() = default;
 Subdivision::Subdivision(Subdivision&&) noexcept = default;
 Subdivision& Subdivision::operator=(Subdivision&&) noexcept = default;
+
+uint32_t Subdivision::parentFace(int level, uint32_t face) const {
+  if (level < 1 || level > levels() || face >= topology(level).faceCount())
+    throw std::invalid_argument("Subdivision::parentFace: wrong level or face");
+  return uint32_t(impl_->refiner->GetLevel(level).GetFaceParentFace(int(face)));
+}
 
 void Subdivision::interpolate(int level, std::span<const Vec3> coarse, std::span<Vec3> fine) const {
   checkSizes(*this, level, Primvar::Vertex, coarse.size(), fine.size(), 1);

@@ -54,7 +54,6 @@ struct LevelTopology {
   /// With a face-varying channel: per corner (parallel to faceVertices), its value's index.
   std::vector<uint32_t> faceVaryingIndices;
   size_t faceVaryingCount = 0;              ///< values of the face-varying channel
-  std::vector<uint32_t> parentFace;         ///< levels >= 1: the face of the level above that face f splits
   size_t vertexCount() const { return vertexFaceOffsets.empty() ? 0 : vertexFaceOffsets.size() - 1; }
   size_t faceCount() const { return faceSizes.size(); }
 };
@@ -104,6 +103,9 @@ class Subdivision {
   const LevelTopology& topology(int level) const { return topology_[size_t(level)]; }
   /// Vertices of level l.
   size_t vertexCount(int level) const { return topology_[size_t(level)].vertexCount(); }
+  /// The face of level l-1 that face f of level l (1..levels) is a part of. Throws
+  /// std::invalid_argument when level or face is out of range.
+  uint32_t parentFace(int level, uint32_t face) const;
 
   /// Positions of level l (1..levels) from those of level l-1 (vertexCount(l-1) values).
   void interpolate(int level, std::span<const Vec3> coarse, std::span<Vec3> fine) const;

@@ -63,13 +63,13 @@ TEST_CASE("Subdivision: Loop with the cube's edges creased keeps the cube", "[or
   REQUIRE(fine.faceCount() == 12u * 16u);
   CHECK(std::all_of(fine.faceSizes.begin(), fine.faceSizes.end(), [](uint32_t n) { return n == 3; }));
   CHECK(sub.vertexCount(2) == 12u * 16u / 2u + 2u);  // a closed triangle mesh of genus 0
-  for (size_t f = 0; f < fine.faceCount(); ++f) CHECK(sub.topology(1).parentFace[fine.parentFace[f]] == f / 16);
+  for (uint32_t f = 0; f < fine.faceCount(); ++f) CHECK(sub.parentFace(1, sub.parentFace(2, f)) == f / 16);
   const std::vector<Vec3> p = refined(sub, cube.positions);
   // The corners, where three creases meet, stay (vertex v of every level is the control vertex v).
   for (uint32_t v = 0; v < 8; ++v) CHECK(p[v] == cube.positions[v]);
   // Every triangle lies on the face of the cube its control triangle lies on: faces flat, edges straight.
-  for (size_t f = 0; f < fine.faceCount(); ++f) {
-    const uint32_t parent = sub.topology(1).parentFace[fine.parentFace[f]];
+  for (uint32_t f = 0; f < fine.faceCount(); ++f) {
+    const uint32_t parent = sub.parentFace(1, sub.parentFace(2, f));
     INFO("triangle " << f << " of control triangle " << parent);
     CHECK(cubeFaceOf(p, &fine.faceVertices[3 * f]) == cubeFaceOf(cube.positions, &cube.faceVertices[3 * parent]));
   }
@@ -142,7 +142,7 @@ TEST_CASE("Subdivision: a face-varying channel is linear and keeps its seams", "
   }
   const LevelTopology& fine = sub.topology(2);
   for (size_t i = 0; i < fine.faceVaryingIndices.size(); ++i) {
-    const size_t f = i / 3, quad = sub.topology(1).parentFace[fine.parentFace[f]] / 2;
+    const uint32_t f = uint32_t(i / 3), quad = sub.parentFace(1, sub.parentFace(2, f)) / 2;
     CHECK(values[fine.faceVaryingIndices[i]] == float(quad));
   }
   // Varying data is linear: a vertex keeps its value, an edge point (one per control edge,
