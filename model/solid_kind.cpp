@@ -6,11 +6,13 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <unordered_map>
 
 #include "core/image.h"
 #include "core/polymesh.h"
 #include "core/srgb.h"
 #include "core/timer.h"
+#include "organisms/subdivision.h"
 #include "model/solid_velocity.h"
 #include "solids/front_field.h"
 #include "model/species_field.h"
@@ -695,24 +697,20 @@ class SolidModel final : public StillKindModel {
     if (mode == GeometryMode::Skeleton) throw UsageError("solid species have no skeleton: use --mode exact or mesh");
     BuiltStage out;
     const auto t0 = std::chrono::steady_clock::now();
-    std::vector<uint16_t> mats;
-    std::vector<Mesh> parts;
-    if (look.section) {
-      parts = visibleMeshes(clipByPlane(stageMesh(k), DVec3(Vec3(*look.section)), double(look.section->w)), &mats,
-                            &spec_.solid.materials.materials);
-    } else {
-      parts = visible(k).first;
-      mats = visible(k).second;
-    }
-    std::vector<std::vector<Vec3>> surfaces = blendedSurfaces(parts, mats, spec_.solid.materials.materials);
-    for (size_t i = 0; i < parts.size(); ++i) {
-      const Material& m = spec_.solid.materials.materials[mats[i]];
+    // Smoothed by subdivision, but not under a wireframe, which draws the tetrahedra's faces.
+    VisibleMeshOptions options;
+    options.subdivisions = look.wireframe ? 0 : kRenderSubdivisions;
+    VisibleParts parts = look.section ? visibleParts(clipByPlane(stageMesh(k), DVec3(Vec3(*look.section)), double(look.section->w)),
+                                                     &spec_.solid.materials.materials, options)
+                                      : visible(k, options.subdivisions);
+    for (size_t i = 0; i < parts.meshes.size(); ++i) {
+      const Material& m = spec_.solid.materials.materials[parts.materials[i]];
       render::MeshPart part;
-      out.figures.triangles += parts[i].triangleCount();
-      part.mesh = std::move(parts[i]);
+      out.figures.triangles += parts.meshes[i].triangleCount();
+      part.mesh = std::move(parts.meshes[i]);
       part.material = render::Material{m.color, m.roughness, m.specular};
       part.material.smoothTerminator = true;  // coarse facets, smooth normals (render::Material)
-      part.vertexSurfaces = std::move(surfaces[i]);
+      part.vertexSurfaces = std::move(parts.surfaces[i]);
       out.geometry.parts.push_back(std::move(part));
     }
     if (look.wireframe) addWireframe(out, *look.wireframe, look);
@@ -747,7 +745,9 @@ class SolidModel final : public StillKindModel {
   Mesh buildMesh(const Stage& stage, float, bool, ModelFigures& figures) override {
     Mesh all;
     const int k = stepOf(stage);
-    const auto& [parts, mats] = visible(k);
+    const VisibleParts& v = visible(k);
+    const std::vector<Mesh>& parts = v.meshes;
+    const std::vector<uint16_t>& mats = v.materials;
     for (size_t i = 0; i < parts.size(); ++i) {
       Mesh part = parts[i];
       if (part.colors.size() != part.vertexCount()) part.colors.assign(part.vertexCount(), spec_.solid.materials.materials[mats[i]].color);
@@ -763,7 +763,9 @@ class SolidModel final : public StillKindModel {
                                       ModelFigures& figures) override {
     std::vector<ExportPart> out;
     const int k = stepOf(stage);
-    const auto& [parts, mats] = visible(k);
+    const VisibleParts& v = visible(k);
+    const std::vector<Mesh>& parts = v.meshes;
+    const std::vector<uint16_t>& mats = v.materials;
     for (size_t i = 0; i < parts.size(); ++i) {
       const Material& m = spec_.solid.materials.materials[mats[i]];
       figures.triangles += parts[i].triangleCount();
@@ -903,13 +905,16 @@ class SolidModel final : public StillKindModel {
     return stages_.at(k);
   }
 
-  /// A stage's render meshes and their materials (kept: turntable frames reuse them).
-  const std::pair<std::vector<Mesh>, std::vector<uint16_t>>& visible(int k) {
-    auto it = visible_.find(k);
+  /// A stage's render meshes and their materials at `levels` of subdivision, kept: turntable
+  /// frames reuse them. A subdivided stage has 16 times the triangles, so only the last one
+  /// asked for is kept (a sequence's pictures take the stages one after another).
+  const VisibleParts& visible(int k, int levels = 0) {
+    auto it = visible_.find({k, levels});
     if (it == visible_.end()) {
-      std::pair<std::vector<Mesh>, std::vector<uint16_t>> v;
-      v.first = visibleMeshes(stageMesh(k), &v.second, &spec_.solid.materials.materials);
-      it = visible_.emplace(k, std::move(v)).first;
+      if (levels > 0) std::erase_if(visible_, [](const auto& entry) { return entry.first.second > 0; });
+      VisibleMeshOptions options;
+      options.subdivisions = levels;
+      it = visible_.emplace(std::make_pair(k, levels), visibleParts(stageMesh(k), &spec_.solid.materials.materials, options)).first;
     }
     return it->second;
   }
@@ -923,7 +928,7 @@ class SolidModel final : public StillKindModel {
   TetMesh working_;   ///< the mesh after `applied_` operations, vertices not yet dropped
   int applied_ = 0;
   std::map<int, TetMesh> stages_;
-  std::map<int, std::pair<std::vector<Mesh>, std::vector<uint16_t>>> visible_;
+  std::map<std::pair<int, int>, VisibleParts> visible_;  ///< by (stage, subdivision levels)
   MeshStats stats_;
   double buildSeconds_ = 0;
 };
@@ -958,33 +963,52 @@ CurveSet wireframeCurves(const std::vector<Mesh>& parts, const std::function<flo
 
 namespace {
 
-/// Smooth normals of a boundary surface, shared by every material: around each surface
-/// vertex the faces are grouped (in face order, each face joining the first group whose
-/// direction lies within 60° of its own; sharper edges, a cut-away's rim or a box's edges,
-/// stay creased), and each group's normal is the area-weighted mean of its faces' normals
-/// (the sum of their cross products), whatever material each face is. So where two
-/// materials meet on a smooth surface (polished and plain bronze) the shading is continuous.
-struct SurfaceNormals {
-  std::vector<Vec3> normals;                      ///< one per (vertex, group), unit
-  std::vector<uint32_t> vertexOf;                 ///< the surface vertex of each group
+/// A boundary surface as its render and export meshes are made from it: the surface
+/// vertices (each with its tint when the mesh has tints), the triangles with their
+/// material, and the smooth groups: around each vertex the faces are grouped (in face
+/// order, each face joining the first group whose direction lies within 60° of its own;
+/// sharper edges, a cut-away's rim or a box's edges, stay creased), whatever material each
+/// face is, so where two materials meet on a smooth surface (polished and plain bronze)
+/// the shading is continuous. Each group gets one normal and one output vertex per part.
+struct GroupedSurface {
+  std::vector<DVec3> positions;                   ///< per surface vertex
+  std::vector<Vec4> tints;                        ///< per surface vertex; empty when untinted
+  std::vector<std::array<uint32_t, 3>> tris;      ///< surface vertex ids
+  std::vector<uint16_t> materials;                ///< per triangle
   std::vector<std::array<uint32_t, 3>> corner;    ///< per triangle, the group of each corner
+  std::vector<uint32_t> vertexOf;                 ///< the surface vertex of each group
+  /// With materials (blendGroups), per group: the base colour and the render surface
+  /// (roughness, specular, metallic 0), each the area-weighted mean over its faces' materials.
+  std::vector<Vec3> groupColor, groupSurface;
 };
 
-SurfaceNormals surfaceNormals(const solids::BoundarySurface& surface) {
+Vec3 faceCross(const GroupedSurface& s, size_t f) {
+  const auto& v = s.tris[f];
+  const Vec3 a(s.positions[v[0]]), b(s.positions[v[1]]), c(s.positions[v[2]]);
+  return glm::cross(b - a, c - a);
+}
+
+GroupedSurface groupedSurface(const solids::BoundarySurface& surface, const TetMesh& mesh, bool tinted) {
   constexpr float kCreaseCos = 0.5f;
-  const std::vector<InterfaceTriangle>& tris = surface.triangles;
-  std::vector<Vec3> faceNormal(tris.size());
-  std::vector<std::vector<uint32_t>> around(surface.positions.size());
-  for (size_t f = 0; f < tris.size(); ++f) {
-    const auto& v = tris[f].v;
-    const Vec3 a(surface.positions[v[0]]), b(surface.positions[v[1]]), c(surface.positions[v[2]]);
-    faceNormal[f] = glm::cross(b - a, c - a);
-    for (uint32_t x : v) around[x].push_back(uint32_t(f));
+  GroupedSurface out;
+  out.positions = surface.positions;
+  for (const InterfaceTriangle& t : surface.triangles) {
+    out.tris.push_back(t.v);
+    out.materials.push_back(t.material);
   }
-  SurfaceNormals out;
-  out.corner.resize(tris.size());
+  if (tinted)
+    for (const auto& [sa, sb] : surface.sources)  // an inserted midpoint takes the mean of its edge's ends
+      out.tints.push_back(0.5f * (mesh.tints[sa] + mesh.tints[sb]));
+  std::vector<Vec3> faceNormal(out.tris.size());
+  std::vector<std::vector<uint32_t>> around(out.positions.size());
+  for (size_t f = 0; f < out.tris.size(); ++f) {
+    faceNormal[f] = faceCross(out, f);
+    for (uint32_t x : out.tris[f]) around[x].push_back(uint32_t(f));
+  }
+  out.corner.resize(out.tris.size());
   for (uint32_t x = 0; x < around.size(); ++x) {
-    std::vector<std::pair<Vec3, uint32_t>> groups;  // summed unit directions, group id
+    std::vector<Vec3> groups;  // summed unit directions, for group ids first .. first + size
+    const uint32_t first = uint32_t(out.vertexOf.size());
     for (uint32_t f : around[x]) {
       const float len = glm::length(faceNormal[f]);
       const Vec3 n = len > 0 ? faceNormal[f] / len : Vec3(0.0f);
@@ -995,51 +1019,132 @@ SurfaceNormals surfaceNormals(const solids::BoundarySurface& surface) {
         return len == 0 || d == 0 || glm::dot(direction / d, n) >= kCreaseCos;
       };
       size_t g = 0;
-      while (g < groups.size() && !joins(groups[g].first)) ++g;
+      while (g < groups.size() && !joins(groups[g])) ++g;
       if (g == groups.size()) {
-        groups.push_back({Vec3(0.0f), uint32_t(out.normals.size())});
-        out.normals.push_back(Vec3(0.0f));
+        groups.push_back(Vec3(0.0f));
         out.vertexOf.push_back(x);
       }
-      groups[g].first += n;
-      out.normals[groups[g].second] += faceNormal[f];
-      const auto& v = tris[f].v;
-      out.corner[f][size_t(std::find(v.begin(), v.end(), x) - v.begin())] = groups[g].second;
+      groups[g] += n;
+      const auto& v = out.tris[f];
+      out.corner[f][size_t(std::find(v.begin(), v.end(), x) - v.begin())] = first + uint32_t(g);
     }
   }
-  for (Vec3& n : out.normals) n = glm::length(n) > 0 ? glm::normalize(n) : Vec3(0, 1, 0);
   return out;
+}
+
+/// Each group's normal: the area-weighted mean of its faces' normals (the sum of their
+/// cross products), unit.
+std::vector<Vec3> groupNormals(const GroupedSurface& s) {
+  std::vector<Vec3> normals(s.vertexOf.size(), Vec3(0.0f));
+  for (size_t f = 0; f < s.tris.size(); ++f) {
+    const Vec3 n = faceCross(s, f);
+    for (uint32_t g : s.corner[f]) normals[g] += n;
+  }
+  for (Vec3& n : normals) n = glm::length(n) > 0 ? glm::normalize(n) : Vec3(0, 1, 0);
+  return normals;
+}
+
+/// Fills s.groupColor and s.groupSurface: where two materials meet (polish's shiny bronze
+/// among plain bronze: one material per tetrahedron, a step along triangle edges) colour and
+/// shine fade across one ring of triangles instead of outlining them; a group among faces
+/// of one material keeps that material's values.
+void blendGroups(GroupedSurface& s, const std::vector<solids::Material>& materials) {
+  std::vector<Vec4> color(s.vertexOf.size(), Vec4(0.0f)), surface(s.vertexOf.size(), Vec4(0.0f));
+  for (size_t f = 0; f < s.tris.size(); ++f) {
+    const solids::Material& m = materials[s.materials[f]];
+    const float area = 0.5f * glm::length(faceCross(s, f));
+    for (uint32_t g : s.corner[f]) {
+      color[g] += area * Vec4(m.color, 1.0f);
+      surface[g] += area * Vec4(m.roughness, m.specular, 0.0f, 1.0f);
+    }
+  }
+  s.groupColor.resize(color.size());
+  s.groupSurface.resize(color.size());
+  for (size_t g = 0; g < color.size(); ++g) {
+    // A group of degenerate faces only takes its first face's material.
+    const solids::Material& first = materials[s.materials[0]];
+    s.groupColor[g] = color[g].w > 0 ? Vec3(color[g]) / color[g].w : first.color;
+    s.groupSurface[g] = surface[g].w > 0 ? Vec3(surface[g]) / surface[g].w : Vec3(first.roughness, first.specular, 0.0f);
+  }
+}
+
+/// The edges between two smooth groups: an edge whose two faces' corners lie in different
+/// groups at either end (a cut-away's rim, a box's edges). Each once, in face order.
+std::vector<std::array<uint32_t, 2>> creaseEdges(const GroupedSurface& s) {
+  auto key = [](uint32_t a, uint32_t b) { return (uint64_t(a) << 32) | b; };
+  std::unordered_map<uint64_t, std::array<uint32_t, 2>> groups;  // directed edge a -> b: its face's groups at a, b
+  for (size_t f = 0; f < s.tris.size(); ++f)
+    for (size_t k = 0; k < 3; ++k) {
+      const size_t j = (k + 1) % 3;
+      groups.emplace(key(s.tris[f][k], s.tris[f][j]), std::array{s.corner[f][k], s.corner[f][j]});
+    }
+  std::vector<std::array<uint32_t, 2>> out;
+  for (size_t f = 0; f < s.tris.size(); ++f)
+    for (size_t k = 0; k < 3; ++k) {
+      const size_t j = (k + 1) % 3;
+      const uint32_t a = s.tris[f][k], b = s.tris[f][j];
+      const auto twin = groups.find(key(b, a));  // none: a boundary edge, which OpenSubdiv keeps sharp
+      if (a < b && twin != groups.end() && (twin->second[1] != s.corner[f][k] || twin->second[0] != s.corner[f][j]))
+        out.push_back({a, b});
+    }
+  return out;
+}
+
+/// `levels` of Loop subdivision of s with creases (OpenSubdiv's Loop scheme through
+/// organisms::Subdivision): every triangle into four, each level; the edges between smooth
+/// groups (creaseEdges) are infinitely sharp creases refined as the curve's cubic B-spline,
+/// and a vertex where three or more creases meet stays, so a box keeps its edges straight,
+/// its faces flat and its corners. The groups are the subdivision's face-varying channel
+/// (an edge point on a crease gets one per side); their colour and surface ride it
+/// linearly, and tints ride the vertices linearly (a vertex keeps its value, an edge point
+/// takes its ends' mean); each face keeps its material. Sequential; cost O(4^levels T).
+void subdivide(GroupedSurface& s, int levels) {
+  if (levels == 0 || s.tris.empty()) return;
+  organisms::ControlMesh control;
+  organisms::SubdivisionOptions options;
+  options.scheme = organisms::SubdivisionScheme::Loop;
+  for (const DVec3& p : s.positions) control.positions.push_back(Vec3(p));
+  control.faceSizes.assign(s.tris.size(), 3);
+  for (size_t f = 0; f < s.tris.size(); ++f)
+    for (size_t k = 0; k < 3; ++k) {
+      control.faceVertices.push_back(s.tris[f][k]);
+      options.faceVaryingIndices.push_back(s.corner[f][k]);
+    }
+  options.faceVaryingCount = s.vertexOf.size();
+  options.creases = creaseEdges(s);
+  const organisms::Subdivision sub(control, levels, options);
+  std::vector<Vec3> positions = std::move(control.positions);
+  // Level by level: values of level l - 1 -> level l, Vec3 or Vec4 each (empty: none).
+  auto refine = [&sub](auto& values, organisms::Primvar kind, int l) {
+    using T = typename std::decay_t<decltype(values)>::value_type;
+    constexpr size_t width = sizeof(T) / sizeof(float);
+    if (values.empty()) return;
+    std::vector<T> fine(kind == organisms::Primvar::FaceVarying ? sub.topology(l).faceVaryingCount : sub.vertexCount(l));
+    sub.interpolate(l, kind, {&values[0].x, width * values.size()}, {&fine[0].x, width * fine.size()}, width);
+    values = std::move(fine);
+  };
+  for (int l = 1; l <= levels; ++l) {
+    refine(positions, organisms::Primvar::Vertex, l);
+    refine(s.tints, organisms::Primvar::Varying, l);
+    refine(s.groupColor, organisms::Primvar::FaceVarying, l);
+    refine(s.groupSurface, organisms::Primvar::FaceVarying, l);
+    std::vector<uint16_t> materials(sub.topology(l).faceCount());
+    for (uint32_t f = 0; f < materials.size(); ++f) materials[f] = s.materials[sub.parentFace(l, f)];
+    s.materials = std::move(materials);
+  }
+  const organisms::LevelTopology& fine = sub.topology(levels);
+  s.positions.assign(positions.begin(), positions.end());
+  s.tris.resize(fine.faceCount());
+  s.corner.resize(fine.faceCount());
+  s.vertexOf.assign(fine.faceVaryingCount, 0);
+  for (size_t i = 0; i < fine.faceVertices.size(); ++i) {
+    s.tris[i / 3][i % 3] = fine.faceVertices[i];
+    s.corner[i / 3][i % 3] = fine.faceVaryingIndices[i];
+    s.vertexOf[fine.faceVaryingIndices[i]] = fine.faceVertices[i];
+  }
 }
 
 }  // namespace
-
-std::vector<std::vector<Vec3>> blendedSurfaces(const std::vector<Mesh>& parts, const std::vector<uint16_t>& partMaterials,
-                                               const std::vector<solids::Material>& materials) {
-  // Vertices of one smooth group in different parts share position and normal exactly.
-  using Key = std::array<float, 6>;
-  auto keyOf = [](const Mesh& m, uint32_t v) {
-    const Vec3 &p = m.positions[v], &n = m.normals[v];
-    return Key{p.x, p.y, p.z, n.x, n.y, n.z};
-  };
-  std::map<Key, Vec4> sum;  // area-weighted (roughness, specular, metallic), area
-  for (size_t i = 0; i < parts.size(); ++i) {
-    const solids::Material& mat = materials[partMaterials[i]];
-    const Mesh& m = parts[i];
-    for (const auto& t : m.triangles) {
-      const float area = 0.5f * glm::length(glm::cross(m.positions[t[1]] - m.positions[t[0]], m.positions[t[2]] - m.positions[t[0]]));
-      for (int k = 0; k < 3; ++k) sum[keyOf(m, t[k])] += area * Vec4(mat.roughness, mat.specular, 0.0f, 1.0f);
-    }
-  }
-  std::vector<std::vector<Vec3>> out(parts.size());
-  for (size_t i = 0; i < parts.size(); ++i) {
-    const solids::Material& mat = materials[partMaterials[i]];
-    for (uint32_t v = 0; v < parts[i].positions.size(); ++v) {
-      const auto it = sum.find(keyOf(parts[i], v));
-      out[i].push_back(it != sum.end() && it->second.w > 0 ? Vec3(it->second) / it->second.w : Vec3(mat.roughness, mat.specular, 0.0f));
-    }
-  }
-  return out;
-}
 
 void smoothSurfaceNormals(const std::vector<std::array<uint32_t, 3>>& corner, const std::vector<float>& area,
                           std::vector<Vec3>& normals, int rounds) {
@@ -1055,64 +1160,57 @@ void smoothSurfaceNormals(const std::vector<std::array<uint32_t, 3>>& corner, co
   }
 }
 
-std::vector<Mesh> visibleMeshes(const TetMesh& mesh, std::vector<uint16_t>* partMaterials,
-                                const std::vector<solids::Material>* materials, int normalRounds) {
+VisibleParts visibleParts(const TetMesh& mesh, const std::vector<solids::Material>* materials, const VisibleMeshOptions& options) {
   const bool tinted = materials && !mesh.tints.empty() && mesh.tints.size() == mesh.positions.size();
   // The visible interface with pieces that touch along an edge or at a vertex only pulled
   // apart (solids::boundarySurface): every part together is a closed 2-manifold.
-  const solids::BoundarySurface surface = solids::boundarySurface(mesh);
-  const std::vector<InterfaceTriangle>& tris = surface.triangles;
-  SurfaceNormals normals = surfaceNormals(surface);
-  std::vector<float> area(tris.size());
-  for (size_t f = 0; f < tris.size(); ++f) {
-    const auto& v = tris[f].v;
-    const Vec3 a(surface.positions[v[0]]), b(surface.positions[v[1]]), c(surface.positions[v[2]]);
-    area[f] = 0.5f * glm::length(glm::cross(b - a, c - a));
-  }
-  smoothSurfaceNormals(normals.corner, area, normals.normals, normalRounds);
-  // Tinted: each group's base colour is the area-weighted mean of its faces' materials', so
-  // a colour that steps from one tetrahedron to the next (polish's shiny bronze) does not
-  // outline the triangles where two materials meet.
-  std::vector<Vec4> baseColor;
-  if (tinted) {
-    baseColor.assign(normals.normals.size(), Vec4(0.0f));
-    for (size_t f = 0; f < tris.size(); ++f)
-      for (uint32_t g : normals.corner[f]) baseColor[g] += area[f] * Vec4((*materials)[tris[f].material].color, 1.0f);
-  }
+  GroupedSurface s = groupedSurface(solids::boundarySurface(mesh), mesh, tinted);
+  if (materials && !s.tris.empty()) blendGroups(s, *materials);
+  int levels = 0;
+  while (levels < options.subdivisions && (s.tris.size() << (2 * (levels + 1))) <= kMaxSubdividedTriangles) ++levels;
+  subdivide(s, levels);
+  std::vector<Vec3> normals = groupNormals(s);
+  std::vector<float> area(s.tris.size());
+  for (size_t f = 0; f < s.tris.size(); ++f) area[f] = 0.5f * glm::length(faceCross(s, f));
+  smoothSurfaceNormals(s.corner, area, normals, options.normalRounds);
   std::map<uint16_t, std::vector<size_t>> byMaterial;
-  for (size_t i = 0; i < tris.size(); ++i) byMaterial[tris[i].material].push_back(i);
-  std::vector<Mesh> out;
-  if (partMaterials) partMaterials->clear();
+  for (size_t i = 0; i < s.tris.size(); ++i) byMaterial[s.materials[i]].push_back(i);
+  VisibleParts out;
   constexpr uint32_t kNone = ~0u;
-  std::vector<uint32_t> outputOf(normals.normals.size(), kNone);  // group -> vertex of this part
+  std::vector<uint32_t> outputOf(normals.size(), kNone);  // group -> vertex of this part
   for (const auto& [mat, list] : byMaterial) {
     Mesh m;
+    std::vector<Vec3> surfaces;
     for (size_t f : list) {
       std::array<uint32_t, 3> c;
       for (int k = 0; k < 3; ++k) {
-        const uint32_t g = normals.corner[f][k];
+        const uint32_t g = s.corner[f][k];
         if (outputOf[g] == kNone) {
-          const uint32_t x = normals.vertexOf[g];
+          const uint32_t x = s.vertexOf[g];
           outputOf[g] = uint32_t(m.positions.size());
-          m.positions.push_back(Vec3(surface.positions[x]));
-          m.normals.push_back(normals.normals[g]);
-          if (tinted) {
-            const auto& [sa, sb] = surface.sources[x];  // an inserted midpoint takes the mean of its edge's ends
-            const Vec4 t = 0.5f * (mesh.tints[sa] + mesh.tints[sb]);
-            const Vec3 base = baseColor[g].w > 0 ? Vec3(baseColor[g]) / baseColor[g].w : (*materials)[mat].color;
-            m.colors.push_back(glm::mix(base, Vec3(t), std::clamp(t.w, 0.0f, 1.0f)));
-          }
+          m.positions.push_back(Vec3(s.positions[x]));
+          m.normals.push_back(normals[g]);
+          if (tinted) m.colors.push_back(glm::mix(s.groupColor[g], Vec3(s.tints[x]), std::clamp(s.tints[x].w, 0.0f, 1.0f)));
+          if (materials) surfaces.push_back(s.groupSurface[g]);
         }
         c[k] = outputOf[g];
       }
       m.triangles.push_back({c[0], c[1], c[2]});
     }
     for (size_t f : list)
-      for (uint32_t g : normals.corner[f]) outputOf[g] = kNone;
-    if (partMaterials) partMaterials->push_back(mat);
-    out.push_back(std::move(m));
+      for (uint32_t g : s.corner[f]) outputOf[g] = kNone;
+    out.materials.push_back(mat);
+    out.meshes.push_back(std::move(m));
+    if (materials) out.surfaces.push_back(std::move(surfaces));
   }
   return out;
+}
+
+std::vector<Mesh> visibleMeshes(const TetMesh& mesh, std::vector<uint16_t>* partMaterials,
+                                const std::vector<solids::Material>* materials, int normalRounds) {
+  VisibleParts parts = visibleParts(mesh, materials, VisibleMeshOptions{normalRounds, 0});
+  if (partMaterials) *partMaterials = std::move(parts.materials);
+  return std::move(parts.meshes);
 }
 
 std::shared_ptr<const KindSpec> readSolidSpec(MapReader& top, Species& species, DiagnosticList& diags) {

@@ -65,20 +65,55 @@ std::shared_ptr<const KindSpec> readSolidSpec(MapReader& top, Species& species, 
 /// smooth normals: at each vertex the area-weighted mean of the face normals around it
 /// within 60° of each other, over every material's faces (so the shading is continuous
 /// where two materials meet on a smooth surface; sharper edges stay creased). When mesh has tints (the weathering tools and polish)
-/// and materials is given, every part gets vertex colours mix(material colour, tint rgb,
-/// tint amount); otherwise none (the part's material colour applies).
+/// and materials is given, every part gets vertex colours mix(base colour, tint rgb,
+/// tint amount), the base colour the area-weighted mean of the colours of the materials
+/// around the vertex; otherwise none (the part's material colour applies).
 /// normalRounds rounds of smoothSurfaceNormals follow (0: the area-weighted means alone).
+/// The tetrahedra's own faces: visibleParts without subdivision.
 std::vector<Mesh> visibleMeshes(const solids::TetMesh& mesh, std::vector<uint16_t>* partMaterials = nullptr,
                                 const std::vector<solids::Material>* materials = nullptr, int normalRounds = 2);
 
-/// Per vertex of visibleMeshes' parts (partMaterials: each part's material), the render
-/// surface (roughness, specular, metallic 0): the area-weighted mean over the faces of
-/// every part around the vertex's smooth group. Where two materials meet (polish's shiny
-/// bronze among plain bronze: one material per tetrahedron, so the shine is a step along
-/// triangle edges) the highlight fades across one ring of triangles instead of following
-/// the facets. A vertex among faces of its own material keeps that material's values.
-std::vector<std::vector<Vec3>> blendedSurfaces(const std::vector<Mesh>& parts, const std::vector<uint16_t>& partMaterials,
-                                               const std::vector<solids::Material>& materials);
+/// How visibleParts shapes the surface.
+struct VisibleMeshOptions {
+  int normalRounds = 2;  ///< rounds of smoothSurfaceNormals after the area-weighted means
+  /// Levels of Loop subdivision with infinitely sharp creases (OpenSubdiv's Loop scheme,
+  /// organisms::Subdivision) before the normals, each a quarter of every triangle (none
+  /// that would pass kMaxSubdividedTriangles): a tetrahedral surface's triangles are a cell
+  /// wide and tilt up to 40° from the surface they stand for, which shows as facets
+  /// wherever shading reads a triangle's own plane (silhouettes, the sky's horizon,
+  /// shadows). Edges between smooth groups stay creases and their corners stay put (a box
+  /// keeps its flat faces and straight edges); curved parts shrink by a fraction of a cell.
+  /// 0: the tetrahedra's faces.
+  int subdivisions = 0;
+};
+
+/// The most triangles visibleParts' subdivision makes: a level that would pass it is not
+/// taken (a fine tetrahedral mesh's facets are small in the picture already).
+inline constexpr size_t kMaxSubdividedTriangles = 400000;
+
+/// Levels of subdivision of a solid's render surface (pictures; `sprig mesh` and exports
+/// keep the tetrahedra's faces, and so does a wireframe, which draws them).
+inline constexpr int kRenderSubdivisions = 2;
+
+/// visibleParts' result: the parts, their materials and, with materials, each vertex's
+/// render surface.
+struct VisibleParts {
+  std::vector<Mesh> meshes;                 ///< one per material present
+  std::vector<uint16_t> materials;          ///< each mesh's material
+  /// With materials: per vertex of each mesh, (roughness, specular, metallic 0), the
+  /// area-weighted mean over the materials of the faces around the vertex's smooth group
+  /// (subdivided: the coarse surface's values, interpolated). Where two materials meet
+  /// (polish's shiny bronze among plain bronze: one material per tetrahedron, so the shine
+  /// is a step along triangle edges) the highlight fades across one ring of the
+  /// tetrahedra's triangles instead of following them. Empty without materials.
+  std::vector<std::vector<Vec3>> surfaces;
+};
+
+/// The visible interface of mesh as render parts (visibleMeshes, with options.subdivisions
+/// levels of smoothing subdivision). Deterministic; cost O(T log T) in the boundary
+/// triangles, and O(4^levels T) for the subdivision.
+VisibleParts visibleParts(const solids::TetMesh& mesh, const std::vector<solids::Material>* materials,
+                          const VisibleMeshOptions& options);
 
 /// Smooths the normals of a surface's smooth groups (visibleMeshes): in each of `rounds`
 /// rounds every group takes the normalized sum, over the faces it is a corner of, of face

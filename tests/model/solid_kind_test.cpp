@@ -1,5 +1,8 @@
 #include <catch2/catch.hpp>
 
+#include <cmath>
+#include <set>
+
 #include "core/atomic_file.h"
 #include "core/image.h"
 #include "core/mesh.h"
@@ -465,7 +468,7 @@ TEST_CASE("smoothSurfaceNormals: an area-weighted umbrella step that keeps creas
   CHECK(same == before);
 }
 
-TEST_CASE("blendedSurfaces: the shine fades across a ring where two materials meet", "[model][solid]") {
+TEST_CASE("visibleParts: the shine fades across a ring where two materials meet", "[model][solid]") {
   // The bipyramid of the normals test: the upper tetrahedron dull (roughness 0.8, specular
   // 0.02), the lower shiny (0.2, 0.6). At a, the group of abd (upper) and aeb (lower), two
   // mirror-image faces of equal area, takes the mean of the two; the apex d, among upper
@@ -476,9 +479,11 @@ TEST_CASE("blendedSurfaces: the shine fades across a ring where two materials me
   materials[0].specular = 0.02f;
   materials[1].roughness = 0.2f;
   materials[1].specular = 0.6f;
-  std::vector<uint16_t> mats;
-  const std::vector<Mesh> parts = visibleMeshes(m, &mats, nullptr, 0);
-  const std::vector<std::vector<Vec3>> surfaces = blendedSurfaces(parts, mats, materials);
+  VisibleMeshOptions options;
+  options.normalRounds = 0;
+  const VisibleParts visible = visibleParts(m, &materials, options);
+  const std::vector<Mesh>& parts = visible.meshes;
+  const std::vector<std::vector<Vec3>>& surfaces = visible.surfaces;
   REQUIRE(surfaces.size() == 2);
   for (size_t i = 0; i < parts.size(); ++i)
     for (size_t v = 0; v < parts[i].positions.size(); ++v) {
@@ -496,6 +501,17 @@ TEST_CASE("blendedSurfaces: the shine fades across a ring where two materials me
       }
       CHECK(s.z == 0.0f);
     }
+  // Subdivided once, the values ride the subdivision linearly: a vertex keeps its own, a new
+  // vertex on an edge takes the mean of its ends' (dull and equator, or shiny and equator).
+  options.subdivisions = 1;
+  const VisibleParts fine = visibleParts(m, &materials, options);
+  std::set<float> roughness;
+  for (const auto& part : fine.surfaces)
+    for (const Vec3& s : part) {
+      roughness.insert(std::round(s.x * 1000.0f) / 1000.0f);
+      CHECK(s.y == Approx(0.02f + (0.8f - s.x) * 0.58f / 0.6f));  // between the dull and the shiny values
+    }
+  CHECK(roughness == std::set<float>{0.2f, 0.35f, 0.5f, 0.65f, 0.8f});
 }
 
 TEST_CASE("visibleMeshes: tinted colours blend the materials' colours where they meet", "[model][solid]") {
@@ -518,5 +534,98 @@ TEST_CASE("visibleMeshes: tinted colours blend the materials' colours where they
       const Vec3 want = z > 4.0f ? materials[0].color : z < -4.0f ? materials[1].color : 0.5f * (materials[0].color + materials[1].color);
       CHECK(glm::length(part.colors[v] - want) < 1e-6f);
     }
+  }
+}
+
+namespace {
+
+/// The render parts of a solid species' final stage (what `sprig render` draws).
+std::vector<Mesh> renderParts(const char* yaml, bool wireframe = false) {
+  const Species s = parseSpecies(yaml, "solid.yaml");
+  SpeciesModel model(s);
+  SpeciesRender look = s.render;
+  if (wireframe) look.wireframe = WireframeSpec{};
+  const BuiltStage built = model.build(model.finalStage(), GeometryMode::Exact, look);
+  std::vector<Mesh> out;
+  for (const auto& part : built.geometry.parts)
+    if (const auto* m = std::get_if<render::MeshPart>(&part)) out.push_back(m->mesh);
+  return out;
+}
+
+/// Angles (degrees) between the normals of the two triangles at each edge of the parts
+/// welded by position: how sharply the surface folds from one triangle to the next,
+/// sorted.
+std::vector<float> foldAngles(const std::vector<Mesh>& parts) {
+  std::vector<const Mesh*> ptrs;
+  for (const Mesh& m : parts) ptrs.push_back(&m);
+  const Mesh w = test::weldBoundaries(ptrs);
+  std::map<std::pair<uint32_t, uint32_t>, std::vector<Vec3>> edges;
+  for (const auto& t : w.triangles) {
+    const Vec3 n = glm::normalize(glm::cross(w.positions[t[1]] - w.positions[t[0]], w.positions[t[2]] - w.positions[t[0]]));
+    for (int k = 0; k < 3; ++k) edges[std::minmax(t[k], t[(k + 1) % 3])].push_back(n);
+  }
+  std::vector<float> out;
+  for (const auto& [e, n] : edges)
+    if (n.size() == 2) out.push_back(glm::degrees(std::acos(std::clamp(glm::dot(n[0], n[1]), -1.0f, 1.0f))));
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+}  // namespace
+
+// A tetrahedral surface's triangles are a cell wide and fold sharply from one to the next;
+// the picture showed them as flat facets (the lost-wax bronze). Pictures now subdivide the
+// surface (OpenSubdiv's Loop scheme, creases kept); exports and wireframes keep the
+// tetrahedra's faces.
+TEST_CASE("kind: solid pictures smooth the tetrahedra's facets by subdivision, keeping creases", "[model][solid]") {
+  SECTION("a ball: the triangles turn toward the sphere's normals, and the parts weld closed and manifold") {
+    const char* ball = R"(kind: solid
+solid:
+  grid: {cell: 0.2}
+  volume:
+    distance_field: {sphere: {radius: 0.9}}
+    layers:
+      - interior_layer: {material: bronze, thickness: fill}
+)";
+    const std::vector<Mesh> faces = renderParts(ball, true);  // a wireframe keeps the tetrahedra's faces
+    const std::vector<Mesh> smooth = renderParts(ball);
+    size_t before = 0, after = 0;
+    for (const Mesh& m : faces) before += m.triangleCount();
+    for (const Mesh& m : smooth) after += m.triangleCount();
+    CHECK(after == 16 * before);
+    // The folds between neighbouring triangles, which the eye reads as facets.
+    const std::vector<float> raw = foldAngles(faces), fine = foldAngles(smooth);
+    const float raw95 = raw[raw.size() * 95 / 100], fine95 = fine[fine.size() * 95 / 100];
+    INFO("95th percentile of the folds between triangles: " << raw95 << "° faces, " << fine95 << "° subdivided");
+    CHECK(raw95 > 10.0f);  // 12.7°: a cell of 0.2 on a radius of 0.9
+    CHECK(fine95 < 0.4f * raw95);  // 3.3° (OpenSubdiv's Loop scheme)
+    std::vector<const Mesh*> ptrs;
+    for (const Mesh& m : smooth) ptrs.push_back(&m);
+    const Mesh welded = test::weldBoundaries(ptrs);
+    const MeshTopology topo = analyzeTopology(welded);
+    CHECK(topo.closed());
+    CHECK(topo.manifold());
+    // Loop subdivision shrinks a curved surface a little, by a fraction of a cell.
+    for (const Vec3& p : welded.positions) CHECK(glm::length(p) > 0.9f - 0.5f * 0.2f);
+  }
+  SECTION("a box on the grid's planes: faces flat, edges straight, corners in place") {
+    const char* box = R"(kind: solid
+solid:
+  grid: {cell: 0.2, bounds: {min: [-1, -1, -1], max: [1, 1, 1]}}
+  volume:
+    distance_field: {box: {size: [1.2, 0.8, 0.4]}}
+    layers:
+      - interior_layer: {material: bronze, thickness: fill}
+)";
+    const Vec3 half(0.6f, 0.4f, 0.2f);
+    size_t corners = 0;
+    for (const Mesh& m : renderParts(box))
+      for (const Vec3& p : m.positions) {
+        const Vec3 d = glm::abs(p) - half;
+        INFO("vertex " << p.x << " " << p.y << " " << p.z);
+        CHECK(std::max({d.x, d.y, d.z}) == Approx(0.0f).margin(1e-5));  // on a face, none inside
+        if (glm::length(d) < 1e-5f) ++corners;
+      }
+    CHECK(corners == 8 * 3);  // each corner once per face group around it
   }
 }
