@@ -49,8 +49,9 @@ class ShellBuilder {
 
  private:
   struct Calibration {
-    float k = 1.0f;      // radius factor
-    float shift = 0.0f;  // outward shift of the generating surface, unit frame
+    float k = 1.0f;       // radius factor
+    float shift = 0.0f;   // outward shift of the generating surface, unit frame
+    float canalK = 1.0f;  // radius factor of the canal's primitives (k, or inner_scale of the main canal's)
   };
   // Generating surfaces.
   void placeGenerating(std::vector<NodeId>& out, double theta, const Calibration& cal, ShellPart part, bool withCanal,
@@ -132,7 +133,7 @@ ShellBuilder::Calibration ShellBuilder::calibrate(float relativeSize) const {
   // relativeSize·D(θ) and its centre on the spiral. Self-similarity makes one angle enough.
   const double th0 = p_.startDeg + p_.whorlDeg;
   const blobtree::Kernel kernel = t_.kernel();
-  Calibration cal{relativeSize, 0.0f};
+  Calibration cal{relativeSize, 0.0f, relativeSize};
   struct RowPoint {
     DVec3 centre, outward;
     double d;
@@ -193,6 +194,7 @@ ShellBuilder::Calibration ShellBuilder::calibrate(float relativeSize) const {
     measure(mean, c1);
     cal.shift = static_cast<float>(cal.shift - c1);
   }
+  cal.canalK = cal.k;
   return cal;
 }
 
@@ -231,7 +233,6 @@ void ShellBuilder::placeGenerating(std::vector<NodeId>& out, double theta, const
   // it is placed there, unshifted. Shifted with the row, every copy's canal stood
   // shift·D(θ) off the axis, and the opening's canal (a shift about twice the main one's
   // for λ 1.6, β 14°) cut through the canal's wall and the axial spines' roots.
-  const float radiusScale = cal.k;
   const glm::dmat4 onSpiral = s_.shellFromGenerating(theta);
   const glm::dmat4 shifted = onSpiral * glm::translate(glm::dmat4(1.0), glm::dvec3(cal.shift, 0, 0));
   const double d = s_.curveSize(theta);
@@ -239,6 +240,7 @@ void ShellBuilder::placeGenerating(std::vector<NodeId>& out, double theta, const
     if (g.lastDeg > 0.0 && theta < end_ - g.lastDeg - kEps) continue;
     if (g.canal && !withCanal) continue;
     const glm::dmat4& m = g.canal ? onSpiral : shifted;
+    const float radiusScale = g.canal ? cal.canalK : cal.k;
     if (g.kind == GeneratingPrimitive::Kind::Point) {
       out.push_back(t_.point(apply(m, g.a), static_cast<float>(g.radiusA * radiusScale * d), partTexture(part)));
     } else if (g.bendDeg == 0.0f) {
@@ -427,7 +429,13 @@ NodeId ShellBuilder::insideWhorl(const Calibration& cal) {
 NodeId ShellBuilder::opening(NodeId shell) {
   // Eq. 14-15: B = (B_shell − (B_inside − B_previous)) ∪ B_insidewall.
   const OpeningOptions& o = p_.opening;
-  const Calibration kIn = calibrate(o.innerScale);
+  // The inside row's factor makes its tube inner_scale of the main one; its canal is the
+  // main canal scaled by inner_scale, so the canal's wall is (1 − inner_scale) of its radius.
+  // (Scaled by the inside row's factor, the hollow was 0.85 of the canal with the paper's
+  // λ 1.3, β 22.5° and 0.76 at λ 1.6, β 14°: the calibration corrects a row of points, not
+  // the canal.)
+  Calibration kIn = calibrate(o.innerScale);
+  kIn.canalK = o.innerScale * cal_.canalK;
   if (o.show == OpeningOptions::Show::InsideSurface) {
     std::vector<NodeId> one;
     placeGenerating(one, end_, kIn, ShellPart::Inside, true);

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstring>
 #include <optional>
+#include <tuple>
 
 #include "blobtree/compiled.h"
 #include "core/rng.h"
@@ -216,6 +217,46 @@ TEST_CASE("buildShell::the axial spines stand on the canal at any proportions", 
       CHECK(gaps == 0);
     }
     CHECK(spines == 17);
+  }
+}
+
+TEST_CASE("buildShell::the canal's hollow is inner_scale of the canal", "[organisms]") {
+  // B_inside is the generating surface scaled by inner_scale, canal included: the canal's
+  // wall is (1 − inner_scale) of its radius at any proportions. (Scaled by the inside row's
+  // own calibrated factor instead, the hollow was 0.85 of the canal with the paper's λ 1.3,
+  // β 22.5°: a wall about one mesh cell thick that the polygonizer broke into holes and a
+  // loose patch.) Measured across the canal near its tip, where only the newest copies
+  // reach, in 12 directions around its centre line: hollow radius over outer radius.
+  for (const auto& [name, spiral, canalLength] :
+       {std::tuple{"paper", HelicoSpiral{1.3, 22.5, 0.2}, 8.0f}, std::tuple{"slender", HelicoSpiral{1.6, 14.0, 0.025}, 5.4f}}) {
+    ShellParams p = murexCabritii();
+    p.spiral = spiral;
+    p.canal->length = canalLength;
+    p.bumps.enabled = false;
+    p.varices.enabled = false;
+    p.axialSpines.enabled = false;
+    const ShellModel m = buildShell(p);
+    const CompiledBlob b = compile(m.tree, m.shellRoot);
+    const glm::dmat4 frame = p.spiral.shellFromGenerating(m.endDeg);
+    const float reach = static_cast<float>(p.canal->radiusStart * p.spiral.curveSize(m.endDeg));
+    for (double t : {0.85, 0.9, 0.95}) {
+      INFO(name << ": canal at t = " << t);
+      const Vec3 c(frame * glm::dvec4(DVec3(p.canal->pointAt(p.spiral, t)), 1.0));
+      REQUIRE(b.value(c) < 0.5f);  // in the hollow
+      double ratio = 0.0;
+      for (int a = 0; a < 12; ++a) {
+        const float phi = static_cast<float>(radians(30.0 * a));
+        const Vec3 dir(std::cos(phi), 0.0f, std::sin(phi));  // across the straight canal (along y)
+        const std::optional<float> outer = lastCrossing(b, c, dir, 2.0f * reach);
+        REQUIRE(outer);
+        float lo = 0.0f, hi = *outer;  // the hollow's edge: the first crossing before it
+        for (int i = 1; i <= 400 && lo == 0.0f; ++i)
+          if (b.value(c + dir * (*outer * i / 400)) > 0.5f) lo = *outer * (i - 1) / 400, hi = *outer * i / 400;
+        for (int k = 0; k < 30; ++k) (b.value(c + dir * (0.5f * (lo + hi))) > 0.5f ? hi : lo) = 0.5f * (lo + hi);
+        ratio += 0.5 * (lo + hi) / *outer / 12.0;
+      }
+      CHECK(ratio == Approx(p.opening.innerScale).margin(0.03));
+    }
   }
 }
 
