@@ -1049,22 +1049,27 @@ std::vector<Vec3> groupNormals(const GroupedSurface& s) {
 /// shine fade across one ring of triangles instead of outlining them; a group among faces
 /// of one material keeps that material's values.
 void blendGroups(GroupedSurface& s, const std::vector<solids::Material>& materials) {
-  std::vector<Vec4> color(s.vertexOf.size(), Vec4(0.0f)), surface(s.vertexOf.size(), Vec4(0.0f));
+  const size_t groups = s.vertexOf.size();
+  std::vector<Vec3> color(groups, Vec3(0.0f)), surface(groups, Vec3(0.0f));
+  std::vector<float> area(groups, 0.0f);
+  std::vector<int> firstFace(groups, -1);
   for (size_t f = 0; f < s.tris.size(); ++f) {
     const solids::Material& m = materials[s.materials[f]];
-    const float area = 0.5f * glm::length(faceCross(s, f));
+    const float a = 0.5f * glm::length(faceCross(s, f));
     for (uint32_t g : s.corner[f]) {
-      color[g] += area * Vec4(m.color, 1.0f);
-      surface[g] += area * Vec4(m.roughness, m.specular, 0.0f, 1.0f);
+      color[g] += a * m.color;
+      surface[g] += a * Vec3(m.roughness, m.specular, 0.0f);
+      area[g] += a;
+      if (firstFace[g] < 0) firstFace[g] = int(f);
     }
   }
-  s.groupColor.resize(color.size());
-  s.groupSurface.resize(color.size());
-  for (size_t g = 0; g < color.size(); ++g) {
+  s.groupColor.resize(groups);
+  s.groupSurface.resize(groups);
+  for (size_t g = 0; g < groups; ++g) {
     // A group of degenerate faces only takes its first face's material.
-    const solids::Material& first = materials[s.materials[0]];
-    s.groupColor[g] = color[g].w > 0 ? Vec3(color[g]) / color[g].w : first.color;
-    s.groupSurface[g] = surface[g].w > 0 ? Vec3(surface[g]) / surface[g].w : Vec3(first.roughness, first.specular, 0.0f);
+    const solids::Material& first = materials[s.materials[size_t(std::max(firstFace[g], 0))]];
+    s.groupColor[g] = area[g] > 0 ? color[g] / area[g] : first.color;
+    s.groupSurface[g] = area[g] > 0 ? surface[g] / area[g] : Vec3(first.roughness, first.specular, 0.0f);
   }
 }
 

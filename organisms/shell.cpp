@@ -133,7 +133,7 @@ ShellBuilder::Calibration ShellBuilder::calibrate(float relativeSize) const {
   // relativeSize·D(θ) and its centre on the spiral. Self-similarity makes one angle enough.
   const double th0 = p_.startDeg + p_.whorlDeg;
   const blobtree::Kernel kernel = t_.kernel();
-  Calibration cal{relativeSize, 0.0f, relativeSize};
+  Calibration cal{relativeSize, 0.0f};  // canalK: k, once calibrated
   struct RowPoint {
     DVec3 centre, outward;
     double d;

@@ -340,7 +340,7 @@ void evalWarpB(const Tape& T, const TNode& n, const Pts& pts, const Box3& /*pbox
     lz[i] = q.z;
     lb.extend(q);
   }
-  Pts lp{lx, ly, lz, pts.n, pts.n8};
+  Pts lp{lx, ly, lz, pts.n, lanes<W>(pts)};
   evalB<W>(T, T.kids[n.first], lp, lb, out);
 }
 
