@@ -8,6 +8,9 @@
                                        `blender` ones with --blender) in WORK, in order, as
                                        written, and checks each `<!-- tutorial: expect -->`
                                        block against the output of the run block before it
+  readme.py figures ROOT docs/FIGURES.md
+                                       every paper-figure species (species/fig_*, blob_*)
+                                       has a row, and every species a row names exists
 
 Markers are HTML comments on the line before a fenced code block, so they do not show on a
 rendered page. An expect block's lines must appear in that output in order, each as a whole
@@ -141,6 +144,21 @@ def run(root, readme, work, blender):
     return []
 
 
+FIGURE_SPECIES = re.compile(r"^(fig_|blob_).*\.yaml$")
+
+
+def check_figures(root, table):
+    """The figure table names every figure species, and only species that exist."""
+    text = open(os.path.join(root, table), encoding="utf-8").read()
+    rows = [line for line in text.splitlines() if line.startswith("| ")]
+    named = set(re.findall(r"`([a-z][a-z0-9_]*)`", "\n".join(rows)))
+    species = {f[:-5] for f in os.listdir(os.path.join(root, "species")) if FIGURE_SPECIES.match(f)}
+    problems = [f"{table}: no row names species/{s}.yaml" for s in sorted(species - named)]
+    problems += [f"{table}: `{n}` is not a species file" for n in sorted(named)
+                 if not os.path.exists(os.path.join(root, "species", n + ".yaml"))]
+    return problems
+
+
 def main(argv):
     if len(argv) < 3:
         sys.exit(__doc__)
@@ -149,6 +167,8 @@ def main(argv):
         problems = check_links(root, argv[3:])
     elif command == "files":
         problems = check_files(root, argv[3])
+    elif command == "figures":
+        problems = check_figures(root, argv[3])
     elif command == "run":
         problems = run(root, argv[3], argv[4], "--blender" in argv[5:])
     else:

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # The README against the repository (registered with ctest):
 #   readme_links     every relative link and #anchor of README.md and docs/*.md resolves,
+#                    docs/FIGURES.md has a row for every figure species,
 #                    and the tutorial's file blocks equal docs/tutorial/* (no binary run);
 #   readme_tutorial  the tutorial's commands as the README writes them, in a scratch
 #                    folder holding a copy of docs/tutorial/ and `build` linked to the build
@@ -18,6 +19,7 @@ py() { /usr/bin/python3 "$ROOT/tests/docs/readme.py" "$@"; }
 if [ "$mode" = links ]; then
   py links "$ROOT" README.md docs/*.md
   py files "$ROOT" README.md
+  py figures "$ROOT" docs/FIGURES.md
   echo "readme_links: ok"
   exit 0
 fi
