@@ -2,6 +2,8 @@
 /// Clocks for the benchmarks: wall time, and CPU time, which is the steadier measure on a
 /// shared, loaded machine (it does not count the time a thread waits for a core).
 
+#include <sys/resource.h>
+
 #include <chrono>
 #include <ctime>
 
@@ -27,5 +29,13 @@ using sprig::processCpuSeconds;
 
 /// CPU seconds of the calling thread.
 inline double threadCpuSeconds() { return detail::cpuSeconds(CLOCK_THREAD_CPUTIME_ID); }
+
+/// Peak resident memory in MB of this process (RUSAGE_SELF) or of its waited-for children
+/// (RUSAGE_CHILDREN).
+inline double peakMB(int who = RUSAGE_SELF) {
+  rusage u{};
+  getrusage(who, &u);
+  return static_cast<double>(u.ru_maxrss) / 1024.0;
+}
 
 }  // namespace sprig::bench

@@ -18,8 +18,6 @@
 #include "solids/operators.h"
 #include "solids/solid.h"
 
-#include <sys/resource.h>
-
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -30,12 +28,6 @@ using namespace sprig::solids;
 using namespace sprig::bench;
 
 namespace {
-
-double peakMB() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return double(u.ru_maxrss) / 1024.0;
-}
 
 }  // namespace
 

@@ -15,8 +15,6 @@
 #include "solids/improve.h"
 #include "solids/solid.h"
 
-#include <sys/resource.h>
-
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -29,12 +27,6 @@ using namespace sprig;
 using namespace sprig::bench;
 
 namespace {
-
-double peakMB(int who) {
-  rusage u{};
-  getrusage(who, &u);
-  return double(u.ru_maxrss) / 1024.0;
-}
 
 /// Every interface triangle once (visible and between materials) as an OFF file for TetGen.
 size_t writeInterfaces(const solids::TetMesh& m, const std::filesystem::path& path) {

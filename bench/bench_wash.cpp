@@ -16,8 +16,6 @@
 #include "solids/particles.h"
 #include "solids/solid.h"
 
-#include <sys/resource.h>
-
 #include <cstdio>
 #include <cstring>
 
@@ -26,12 +24,6 @@ using namespace sprig::solids;
 using namespace sprig::bench;
 
 namespace {
-
-double peakMB() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return double(u.ru_maxrss) / 1024.0;
-}
 
 struct Run {
   double wall, cpu;

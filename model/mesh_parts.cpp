@@ -50,28 +50,7 @@ Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::Te
 
 Vec3 paintedColor(const blobtree::Attributes& a, const Vec3& p, const render::TextureTable& textures,
                   const render::Material& material) {
-  const Vec3 base = material.baseColor;
-  if (a.textureCount == 0 || textures.empty()) return base;
-  Vec3 sum(0);
-  float wsum = 0;
-  if (material.textureLayers) {
-    for (int i = 0; i < a.layerCount && i < blobtree::Attributes::kMaxLayers; ++i) {
-      const blobtree::Attributes::Layer& l = a.layers[size_t(i)];
-      if (!(l.weight > 0)) continue;
-      sum += l.weight * (l.textureId < textures.size() ? textures[l.textureId](l.uv, p) : base);
-      wsum += l.weight;
-    }
-  } else {
-    for (int i = 0; i < a.textureCount && i < blobtree::Attributes::kMaxTextures; ++i) {
-      const float w = a.textureWeights[size_t(i)];
-      if (!(w > 0)) continue;
-      const uint16_t id = a.textureIds[size_t(i)];
-      sum += w * (id < textures.size() ? textures[id](a.uv, p) : base);
-      wsum += w;
-    }
-  }
-  if (!(wsum > 0)) return base;
-  return sum / wsum * static_cast<float>(1.0 - material.ridge.darkness(a.contact, p));
+  return render::blendedColor(a, p, material, textures.data(), textures.size());
 }
 
 Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::TextureTable& textures,

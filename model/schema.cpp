@@ -31,17 +31,6 @@ constexpr const char* kColorMessage =
     "Expected a colour: \"#rrggbb\" (six hex digits, sRGB) or [r, g, b] (linear, each from 0 to 1).";
 constexpr const char* kColorItemMessage = "A colour's r, g and b are linear, each from 0 to 1.";
 
-std::string jsonText(const std::string& text) {
-  std::string out = "\"";
-  for (char c : text) {
-    if (c == '"' || c == '\\') out += '\\', out += c;
-    else if (c == '\n') out += "\\n";
-    else if (static_cast<unsigned char>(c) < 0x20) out += ' ';
-    else out += c;
-  }
-  return out + "\"";
-}
-
 std::string number(double v) {
   std::ostringstream o;
   o.precision(9);
@@ -75,7 +64,7 @@ std::string mapJson(const KeySchema& k, const std::string& path, int depth) {
     out += ", \"properties\": {";
     bool first = true;
     for (const auto& [name, child] : k.properties) {
-      out += std::string(first ? "" : ",") + "\n" + pad + jsonText(name) + ": " +
+      out += std::string(first ? "" : ",") + "\n" + pad + detail::jsonString(name) + ": " +
              emit(*child, path.empty() ? name : path + "." + name, depth + 1);
       first = false;
     }
@@ -84,12 +73,12 @@ std::string mapJson(const KeySchema& k, const std::string& path, int depth) {
   if (!k.required.empty()) {
     out += ", \"required\": [";
     bool first = true;
-    for (const auto& r : k.required) out += std::string(first ? "" : ", ") + jsonText(r), first = false;
+    for (const auto& r : k.required) out += std::string(first ? "" : ", ") + detail::jsonString(r), first = false;
     out += "]";
   }
   if (!k.oneKey.empty()) {
     out += ", \"minProperties\": 1, \"maxProperties\": 1, \"propertyNames\": {\"enum\": [";
-    for (size_t i = 0; i < k.oneKey.size(); ++i) out += (i ? ", " : "") + jsonText(k.oneKey[i]);
+    for (size_t i = 0; i < k.oneKey.size(); ++i) out += (i ? ", " : "") + detail::jsonString(k.oneKey[i]);
     out += "]}";
   } else if (k.entries) {  // keys the file names (describeEntry): each entry's value, on a line of its own as a key
     out += ",\n" + pad + "\"additionalProperties\": " + emit(*k.entries, path + ".NAME", depth + 1);
@@ -101,13 +90,13 @@ std::string mapJson(const KeySchema& k, const std::string& path, int depth) {
 
 std::string emit(const KeySchema& k, const std::string& path, int depth) {
   if (!k.ref.empty())  // a shared definition: what the key does, then its place and the definition's name
-    return "{\"description\": " + jsonText((k.help.empty() ? "" : k.help + "\n\n") + path + ": " + k.ref) +
+    return "{\"description\": " + detail::jsonString((k.help.empty() ? "" : k.help + "\n\n") + path + ": " + k.ref) +
            ", \"$ref\": \"#/definitions/part_" + k.ref + "\"}";
   std::vector<std::string> alternatives;
   std::string what;
   if (!k.choices.empty()) {
     std::string e = "{\"enum\": [";
-    for (size_t i = 0; i < k.choices.size(); ++i) e += (i ? ", " : "") + jsonText(k.choices[i]);
+    for (size_t i = 0; i < k.choices.size(); ++i) e += (i ? ", " : "") + detail::jsonString(k.choices[i]);
     alternatives.push_back(e + "]}");
     what = "one of the listed words";
   } else {
@@ -132,7 +121,7 @@ std::string emit(const KeySchema& k, const std::string& path, int depth) {
         if (k.types.count("color")) continue;
         if (!k.words.empty()) {  // a number or one of these words (describeValue)
           std::string e = "{\"enum\": [";
-          for (size_t i = 0; i < k.words.size(); ++i) e += (i ? ", " : "") + jsonText(k.words[i]);
+          for (size_t i = 0; i < k.words.size(); ++i) e += (i ? ", " : "") + detail::jsonString(k.words[i]);
           alternatives.push_back(e + "]}");
           for (size_t i = 0; i < k.words.size(); ++i) what += (what.empty() ? "" : " or ") + k.words[i];
           continue;
@@ -150,11 +139,11 @@ std::string emit(const KeySchema& k, const std::string& path, int depth) {
       } else if (t == "color") {
         // errorMessage and patternErrorMessage: what yaml-language-server (and VS Code's
         // JSON support) say instead of "Incorrect type. Expected array".
-        const std::string message = jsonText(kColorMessage);
+        const std::string message = detail::jsonString(kColorMessage);
         alternatives.push_back(
             "{\"type\": \"array\", \"minItems\": 3, \"maxItems\": 3, \"errorMessage\": " + message +
             ", \"items\": {\"type\": \"number\", \"minimum\": 0, \"maximum\": 1, \"errorMessage\": " +
-            jsonText(kColorItemMessage) + "}}");
+            detail::jsonString(kColorItemMessage) + "}}");
         alternatives.push_back("{\"type\": \"string\", \"pattern\": \"^\\\\s*#[0-9A-Fa-f]{6}\\\\s*$\", \"errorMessage\": " +
                                message + ", \"patternErrorMessage\": " + message + "}");
         what += (what.empty() ? "" : " or ") + std::string("a colour [r, g, b] (linear, 0..1) or \"#rrggbb\" (sRGB)");
@@ -179,7 +168,7 @@ std::string emit(const KeySchema& k, const std::string& path, int depth) {
   // constant the reader passes for an absent key, which is then not the value used.
   const bool defaultInWords = k.help.find("(default: ") != std::string::npos;
   if (!k.defaultJson.empty() && !defaultInWords) desc += "; default " + k.defaultJson;
-  std::string head = "{\"description\": " + jsonText(desc);
+  std::string head = "{\"description\": " + detail::jsonString(desc);
   if (!k.defaultJson.empty() && !defaultInWords) head += ", \"default\": " + k.defaultJson;
   // Several alternatives go under anyOf.
   std::string joined;
@@ -212,10 +201,10 @@ std::string speciesSchemaJson() {
     k.choices = {kind.name};
     root.required.insert("kind");
     const std::string name = kind.name;
-    kinds += std::string(first ? "" : ", ") + jsonText(name);
+    kinds += std::string(first ? "" : ", ") + detail::jsonString(name);
     branches += std::string(first ? "" : ",\n    ") + "{\"if\": {\"required\": [\"kind\"], \"properties\": {\"kind\": {\"const\": " +
-                jsonText(name) + "}}}, \"then\": {\"$ref\": \"#/definitions/" + name + "\"}}";
-    defs += std::string(first ? "" : ",\n") + "    " + jsonText(name) + ": " + mapJson(root, "", 2);
+                detail::jsonString(name) + "}}}, \"then\": {\"$ref\": \"#/definitions/" + name + "\"}}";
+    defs += std::string(first ? "" : ",\n") + "    " + detail::jsonString(name) + ": " + mapJson(root, "", 2);
     first = false;
   }
   std::string out = "{\n";
@@ -227,7 +216,7 @@ std::string speciesSchemaJson() {
   out += "  \"properties\": {\"kind\": {\"description\": \"what the file describes\", \"enum\": [" + kinds + "]}},\n";
   out += "  \"allOf\": [\n    " + branches + "\n  ],\n";
   for (const auto& [name, def] : shared)
-    defs += ",\n    " + jsonText("part_" + name) + ": " + emit(*def, name, 2);
+    defs += ",\n    " + detail::jsonString("part_" + name) + ": " + emit(*def, name, 2);
   out += "  \"definitions\": {\n" + defs + "\n  }\n}\n";
   return out;
 }

@@ -451,7 +451,9 @@ std::string jsonVec3(const Vec3& v) {
   return "[" + jsonFloat(v.x) + ", " + jsonFloat(v.y) + ", " + jsonFloat(v.z) + "]";
 }
 
-std::string jsonString(std::string_view text) {
+}  // namespace
+
+std::string detail::jsonString(std::string_view text) {
   std::string out = "\"";
   for (char c : text) {
     if (c == '"' || c == '\\') out += '\\', out += c;
@@ -461,8 +463,6 @@ std::string jsonString(std::string_view text) {
   }
   return out + "\"";
 }
-
-}  // namespace
 
 std::string YNode::scalar() const {
   if (tTypedReads == 0 && node_.IsScalar())
@@ -836,7 +836,7 @@ int64_t MapReader::integer(Key key, int64_t def, int64_t min, int64_t max) {
 }
 
 std::string MapReader::string(Key key, std::string def) {
-  if (schema_ && !def.empty()) schema_->property(std::string(key.name)).defaultJson = jsonString(def);
+  if (schema_ && !def.empty()) schema_->property(std::string(key.name)).defaultJson = detail::jsonString(def);
   auto v = get(key);
   if (!v) return def;
   return v->asString(*diags_, quoted(key.name)).value_or(def);
@@ -882,7 +882,7 @@ std::string MapReader::choice(Key key, std::string def, const std::vector<std::s
     detail::KeySchema& k = schema_->property(std::string(key.name));
     for (const auto& c : choices)
       if (std::find(k.choices.begin(), k.choices.end(), c) == k.choices.end()) k.choices.push_back(c);
-    if (!def.empty()) k.defaultJson = jsonString(def);
+    if (!def.empty()) k.defaultJson = detail::jsonString(def);
   }
   auto v = get(key);
   if (!v) return def;

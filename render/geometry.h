@@ -101,6 +101,14 @@ struct ImplicitOptions {
 /// The textures a part's ids refer to, in id order.
 using TextureTable = std::vector<ColorTexture>;
 
+/// The colour of blended attributes a at p from the `count` textures at `textures`:
+/// Σ wᵢ·Tᵢ(uv, p) / Σ wᵢ over the attribute's textures at the field-blended uv, or with
+/// material.textureLayers over its layers each at its own uv, darkened by the material's
+/// ridge; an id past count takes the material's base colour, as do attributes without
+/// textures. What exact hits (Scene::attributeColor) and painted meshes show.
+Vec3 blendedColor(const blobtree::Attributes& a, const Vec3& p, const Material& material, const ColorTexture* textures,
+                  size_t count);
+
 /// Tapered round curves with one material (a plant's internodes in skeleton previews).
 struct CurvesPart {
   CurveSet curves;

@@ -447,9 +447,8 @@ uint32_t Scene::addTextures(std::shared_ptr<const textures::TextureRegistry> reg
   return base;
 }
 
-Vec3 Scene::attributeColor(const blobtree::Attributes& a, const Vec3& p, const Material& material,
-                           uint32_t textureBase, uint32_t textureCount) const {
-  const size_t count = textureCount == kAllTextures ? impl_->textures.size() : textureCount;
+Vec3 blendedColor(const blobtree::Attributes& a, const Vec3& p, const Material& material, const ColorTexture* textures,
+                  size_t count) {
   if (a.textureCount == 0 || count == 0) return material.baseColor;
   Vec3 sum(0);
   float wsum = 0;
@@ -458,20 +457,26 @@ Vec3 Scene::attributeColor(const blobtree::Attributes& a, const Vec3& p, const M
     for (int i = 0; i < a.layerCount && i < blobtree::Attributes::kMaxLayers; ++i) {
       const blobtree::Attributes::Layer& l = a.layers[size_t(i)];
       if (!(l.weight > 0)) continue;
-      sum += l.weight * (l.textureId < count ? impl_->textures[textureBase + l.textureId](l.uv, p) : material.baseColor);
+      sum += l.weight * (l.textureId < count ? textures[l.textureId](l.uv, p) : material.baseColor);
       wsum += l.weight;
     }
   } else {
     for (int i = 0; i < a.textureCount && i < blobtree::Attributes::kMaxTextures; ++i) {
-      float w = a.textureWeights[i];
+      const float w = a.textureWeights[size_t(i)];
       if (!(w > 0)) continue;
-      uint16_t id = a.textureIds[i];
-      sum += w * (id < count ? impl_->textures[textureBase + id](a.uv, p) : material.baseColor);
+      const uint16_t id = a.textureIds[size_t(i)];
+      sum += w * (id < count ? textures[id](a.uv, p) : material.baseColor);
       wsum += w;
     }
   }
   if (!(wsum > 0)) return material.baseColor;
   return sum / wsum * static_cast<float>(1.0 - material.ridge.darkness(a.contact, p));
+}
+
+Vec3 Scene::attributeColor(const blobtree::Attributes& a, const Vec3& p, const Material& material,
+                           uint32_t textureBase, uint32_t textureCount) const {
+  const size_t count = textureCount == kAllTextures ? impl_->textures.size() : textureCount;
+  return blendedColor(a, p, material, impl_->textures.data() + (count > 0 ? textureBase : 0), count);
 }
 
 void Scene::commit() {

@@ -78,6 +78,7 @@ struct ExpressionParser::Token {
 };
 
 struct ExpressionParser::State {
+  State(Span sp, const std::vector<std::string>& v) : span(sp), vars(&v), pos(sp.b) {}
   Span span;
   const std::vector<std::string>* vars = nullptr;
   std::vector<Node> nodes;
@@ -428,12 +429,18 @@ int ExpressionParser::parseIndices(State& st, const Token& id, int a) {
   return flat;
 }
 
+bool ExpressionParser::emitWithinStack(const State& st, int root, size_t before, const std::string& what) {
+  int depth = 0, maxDepth = 0;
+  emit(st, root, depth, maxDepth);
+  if (maxDepth <= kMaxStack) return true;
+  scanner_.error(st.span.line, st.span.b, what + " is nested too deeply");
+  code_.resize(before);
+  return false;
+}
+
 std::optional<int> ExpressionParser::compileElement(Span sp, const std::vector<std::string>& vars) {
-  State st;
-  st.span = sp;
-  st.vars = &vars;
-  st.pos = sp.b;
-  size_t before = code_.size();
+  State st(sp, vars);
+  const size_t before = code_.size();
   try {
     lex(st);
     const Token id = st.tok;
@@ -442,13 +449,7 @@ std::optional<int> ExpressionParser::compileElement(Span sp, const std::vector<s
     lex(st);
     const int root = parseIndices(st, id, a);
     if (st.tok.kind != Token::End) unexpected(st, "'='");
-    int depth = 0, maxDepth = 0;
-    emit(st, root, depth, maxDepth);
-    if (maxDepth > kMaxStack) {
-      scanner_.error(sp.line, sp.b, "the index is nested too deeply");
-      code_.resize(before);
-      return std::nullopt;
-    }
+    if (!emitWithinStack(st, root, before, "the index")) return std::nullopt;
     return a;
   } catch (const ExprFail&) {
     code_.resize(before);
@@ -540,22 +541,13 @@ bool ExpressionParser::emit(const State& st, int n, int& depth, int& maxDepth) {
 }
 
 bool ExpressionParser::compile(Span sp, const std::vector<std::string>& vars, const char* what) {
-  State st;
-  st.span = sp;
-  st.vars = &vars;
-  st.pos = sp.b;
-  size_t before = code_.size();
+  State st(sp, vars);
+  const size_t before = code_.size();
   try {
     lex(st);
     int root = parseConditional(st);
     if (st.tok.kind != Token::End) unexpected(st, "an operator");
-    int depth = 0, maxDepth = 0;
-    emit(st, root, depth, maxDepth);
-    if (maxDepth > kMaxStack) {
-      scanner_.error(sp.line, sp.b, std::string(what) + " is nested too deeply");
-      code_.resize(before);
-      return false;
-    }
+    if (!emitWithinStack(st, root, before, what)) return false;
     if (code_.size() == before + 1 && code_.back().op == Op::Const && !std::isfinite(code_.back().c)) {
       scanner_.error(sp.line, sp.b, std::string(what) + " is not finite (" + formatNumber(code_.back().c) + ")");
       code_.resize(before);

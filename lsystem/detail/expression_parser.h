@@ -102,6 +102,9 @@ class ExpressionParser {
   int parseName(State& st, const Token& id);
   int parseIndices(State& st, const Token& id, int a);
   bool emit(const State& st, int n, int& depth, int& maxDepth);
+  /// Emits the tree at root; past kMaxStack values deep, reports `what` is nested too deeply
+  /// at the span's start, takes back the code after `before` and returns false.
+  bool emitWithinStack(const State& st, int root, size_t before, const std::string& what);
 
   Scanner& scanner_;
   const std::unordered_map<std::string, double>& defines_;

@@ -28,6 +28,7 @@
 #include <optional>
 #include <set>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace sprig::detail {
@@ -128,5 +129,9 @@ class KeyRecorder {
   std::vector<YAML::Node> placeholders_;
   KeyRecorder* previous_;
 };
+
+/// text as a JSON string literal: quotes and backslashes escaped, newlines as \n, other
+/// control characters as spaces (the schema's help texts and key defaults).
+std::string jsonString(std::string_view text);
 
 }  // namespace sprig::detail
