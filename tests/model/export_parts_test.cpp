@@ -446,6 +446,9 @@ TEST_CASE("Every shipped species meshes to closed parts", "[.][all_species]") {
       {"blob_offset_fig10", {2, 2, true}},         // 180 and 90 degree joints, side by side
       {"blob_controlled_fig5", {2, 2, true}},      // the plain and the controlled blend, side by side
       {"fig_shell_04a_points_apart", {6, 6, true}},  // the generating points apart (Fig. 4a)
+      // The Murex's whorls reach the axis and the creases between them seal two pockets at
+      // the columella (docs/MESHES.md): genuine voids of the field, invisible from outside.
+      {"shell_murex_cabritii", {3, 1, true}},
       {"fig_org_06_tentacle_level1", {1, 1, false}},  // base: plane (an open sheet)
       {"fig_org_06_tentacle_level2", {1, 1, false}},
       {"fig_org_06_tentacle_level3", {1, 1, false}},
