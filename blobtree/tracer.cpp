@@ -4,6 +4,7 @@
 #include "core/parallel.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <bit>
 #include <cstdlib>
@@ -12,6 +13,8 @@
 #include <limits>
 #include <span>
 #include <stdexcept>
+#include <tuple>
+#include <utility>
 
 namespace sprig::blobtree {
 
@@ -122,6 +125,32 @@ class BatchTracer {
   float tol_ = 0.0f;
 };
 
+/// The sub-cells along axis ax, first and last (0..k−1), of box split k per axis whose
+/// slabs, widened by margin, the segment origin + t·direction, t in [a, b], overlaps.
+std::pair<int, int> subRange(const Box3& box, int k, float margin, const Ray& ray, float a, float b, int ax) {
+  const float edge = (box.hi[ax] - box.lo[ax]) / float(k);
+  const float o = ray.origin[ax], d = ray.direction[ax];
+  const float pa = o + a * d, pb = o + b * d;
+  const float qlo = std::floor((std::min(pa, pb) - margin - box.lo[ax]) / edge);
+  const float qhi = std::floor((std::max(pa, pb) + margin - box.lo[ax]) / edge);
+  return {int(std::clamp(qlo, 0.0f, float(k - 1))), int(std::clamp(qhi, 0.0f, float(k - 1)))};
+}
+
+/// kSubCellRange[ax][lo][hi]: the bits of FreeSubCells' masks whose sub-cell lies in
+/// [lo, hi] along axis ax.
+constexpr auto kSubCellRange = [] {
+  constexpr int k = FreeSubCells::kDivisions;
+  std::array<std::array<std::array<uint64_t, k>, k>, 3> r{};
+  for (int ax = 0; ax < 3; ++ax)
+    for (int lo = 0; lo < k; ++lo)
+      for (int hi = lo; hi < k; ++hi)
+        for (int s = 0; s < k * k * k; ++s) {
+          const int i = ax == 0 ? s % k : ax == 1 ? (s / k) % k : s / (k * k);
+          if (i >= lo && i <= hi) r[ax][lo][hi] |= uint64_t(1) << s;
+        }
+  return r;
+}();
+
 /// Calls fn(i, j, l) for each sub-cell (i, j, l) of box split k per axis (k <= 8) whose box,
 /// widened by margin, the segment origin + t·direction, t in [a, b], meets: per axis the
 /// widened slabs the segment's extent overlaps and the part of [a, b] inside each (the slab
@@ -133,11 +162,7 @@ void forCrossedSubCells(const Box3& box, int k, float margin, const Ray& ray, fl
   float enter[3][8], leave[3][8];
   for (int ax = 0; ax < 3; ++ax) {
     const float o = ray.origin[ax], d = ray.direction[ax];
-    const float pa = o + a * d, pb = o + b * d;
-    const float qlo = std::floor((std::min(pa, pb) - margin - box.lo[ax]) / edge[ax]);
-    const float qhi = std::floor((std::max(pa, pb) + margin - box.lo[ax]) / edge[ax]);
-    lo[ax] = int(std::clamp(qlo, 0.0f, float(k - 1)));
-    hi[ax] = int(std::clamp(qhi, 0.0f, float(k - 1)));
+    std::tie(lo[ax], hi[ax]) = subRange(box, k, margin, ray, a, b, ax);
     const float inv = 1.0f / d;
     for (int i = lo[ax]; i <= hi[ax]; ++i) {
       const float s0 = box.lo[ax] + float(i) * edge[ax];
@@ -291,11 +316,13 @@ FreeSubCells::FreeSubCells(const CellSet& cells, const CompiledBlob& blob) : mas
 bool FreeSubCells::spanFree(const Cell& c, uint32_t cellIndex, const Ray& ray, float a, float b) const {
   const uint64_t free = masks_[cellIndex];
   if (free == 0) return false;
-  uint64_t crossed = 0;
-  forCrossedSubCells(c.box, kDivisions, kMarginCells * (c.box.hi.x - c.box.lo.x), ray, a, b, [&](int i, int j, int l) {
-    crossed |= uint64_t(1) << (i + kDivisions * (j + kDivisions * l));
-  });
-  return crossed != 0 && (crossed & ~free) == 0;
+  const float margin = kMarginCells * (c.box.hi.x - c.box.lo.x);
+  uint64_t inRange = ~uint64_t(0);
+  for (int ax = 0; ax < 3; ++ax) {
+    const auto [lo, hi] = subRange(c.box, kDivisions, margin, ray, a, b, ax);
+    inRange &= kSubCellRange[ax][lo][hi];
+  }
+  return (inRange & ~free) == 0;
 }
 
 size_t FreeSubCells::dropWhole(CellSet& cells) {

@@ -154,8 +154,10 @@ class FreeSubCells {
   uint64_t mask(uint32_t c) const { return masks_[c]; }
   /// Cells with a mask.
   size_t size() const { return masks_.size(); }
-  /// True when origin + t·direction, t in [a, b], crosses at least one sub-cell of cell c
-  /// and only free ones (tested against their widened boxes): F != 0.5 there.
+  /// True when every sub-cell of cell c in the range of sub-cells that origin + t·direction,
+  /// t in [a, b], spans per axis (widened slabs; a superset of those it crosses) is free:
+  /// F != 0.5 on the segment. (Testing the crossed sub-cells alone, by slab tests, proved
+  /// 11 % more spans free and cost more than the batches it saved.)
   bool spanFree(const Cell& c, uint32_t cellIndex, const Ray& ray, float a, float b) const;
   /// Removes from cells (and from the masks) the cells whose sub-cells are all free, in
   /// order; returns how many.
