@@ -81,6 +81,11 @@ class BatchTracer {
   float first(float a, float b, int depth, float L) {
     float ts[kTraceLanes], f[kTraceLanes];
     float step = evaluate(a, b, ts, f);
+    // Crossing::Any: a sign change anywhere in the batch answers, before any search of the
+    // intervals ahead of it.
+    if (mode_ == Crossing::Any)
+      for (int i = 0; i + 1 < kTraceLanes; ++i)
+        if ((f[i] > kIso) != (f[i + 1] > kIso)) return ts[i];
     for (int i = 0; i + 1 < kTraceLanes; ++i) {
       if ((f[i] > kIso) != (f[i + 1] > kIso))
         return mode_ == Crossing::Any ? ts[i] : refine(ts[i], ts[i + 1], f[i], f[i + 1], depth, L);

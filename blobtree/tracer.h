@@ -38,7 +38,10 @@ enum class Crossing : uint8_t {
   /// hidden double crossings too (the Lipschitz test, recursively): the first crossing the
   /// bound admits. CompiledBlob::intersect and intersectCell.
   First,
-  /// The start of the first straddling interval, unrefined (shadow rays: a crossing exists).
+  /// The start of a straddling interval, unrefined (shadow rays: a crossing exists): of
+  /// the first batch with a sign change between its samples, the first such interval,
+  /// without searching the intervals ahead of it for hidden double crossings. Found
+  /// whenever FirstStraddle finds a crossing; the parameter may lie past FirstStraddle's.
   Any,
 };
 

@@ -175,8 +175,11 @@ float cellsBase(const blobtree::CompiledBlob& blob, const std::vector<blobtree::
 /// sub-cell bounds (ImplicitOptions::subCells) of the cells kept. Returns the cells left out.
 size_t prepareTracing(ImplicitData& data, const ImplicitOptions& options) {
   if (!data.batched) return 0;
-  data.free = blobtree::FreeSubCells(data.cells, data.blob);
-  const size_t dropped = data.free.dropWhole(data.cells);
+  size_t dropped = 0;
+  if (options.freeSubCells) {
+    data.free = blobtree::FreeSubCells(data.cells, data.blob);
+    dropped = data.free.dropWhole(data.cells);
+  }
   const int subK = subCellDivisions(options.subCells, data.cells.cells.size());
   if (subK > 0) data.sub = blobtree::SubCellBounds(data.cells, data.blob, subK);
   return dropped;
