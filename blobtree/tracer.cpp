@@ -198,12 +198,6 @@ void forCrossedSubCells(const Box3& box, int k, float margin, const Ray& ray, fl
 uint64_t freeMask(const Cell& cell, const CompiledBlob& tape) {
   constexpr int k = FreeSubCells::kDivisions;
   const Vec3 size = cell.box.hi - cell.box.lo;
-  // Sub-cells widened by twice the crossing test's margin: their centres, computed with
-  // rounding, still see the whole widened box of the test within r.
-  const float w = 2.0f * FreeSubCells::kMarginCells * std::max(size.x, std::max(size.y, size.z));
-  const float L = tape.lipschitz(cell.box.expanded(w));
-  const float reach = L * glm::length(size / float(2 * k) + Vec3(w)) + FreeSubCells::kValueMargin;
-  if (!(reach < std::numeric_limits<float>::infinity())) return 0;
   Vec3 centres[k * k * k];
   float f[k * k * k];
   for (int l = 0; l < k; ++l)
@@ -211,6 +205,17 @@ uint64_t freeMask(const Cell& cell, const CompiledBlob& tape) {
       for (int i = 0; i < k; ++i)
         centres[i + k * (j + k * l)] = cell.box.lo + (Vec3(float(i), float(j), float(l)) + 0.5f) * size / float(k);
   tape.values(centres, f);
+  float farthest = 0.0f;
+  for (float v : f) farthest = std::max(farthest, std::abs(v - kIso));
+  // Sub-cells widened by twice the crossing test's margin: their centres, computed with
+  // rounding, still see the whole widened box of the test within r.
+  const float w = 2.0f * FreeSubCells::kMarginCells * std::max(size.x, std::max(size.y, size.z));
+  const float r = glm::length(size / float(2 * k) + Vec3(w));
+  // The bound over the widened cell is about the cell's own or more: when even the cell's
+  // would prove nothing, the walk is saved (a zero mask proves nothing, which is sound).
+  if (!(farthest > cell.lipschitz * r + FreeSubCells::kValueMargin)) return 0;
+  const float reach = tape.lipschitz(cell.box.expanded(w)) * r + FreeSubCells::kValueMargin;
+  if (!(reach < std::numeric_limits<float>::infinity())) return 0;
   uint64_t mask = 0;
   for (int s = 0; s < k * k * k; ++s)
     if (std::abs(f[s] - kIso) > reach) mask |= uint64_t(1) << s;
