@@ -134,11 +134,11 @@ class SubCellBounds {
 /// which rounding can put just outside the cell; kValueMargin covers the rounding of the
 /// field's values and the pruned tape's differences from the whole one.
 ///
-/// Why: a cell's interval bound admits many cells the surface never enters (a quarter of
-/// the poplar's), and many rays cross only the free parts of the others; such a span holds
+/// Why: a cell's interval bound admits many cells the surface never enters (38 % of the
+/// PCM poplar's), and many rays cross only the free parts of the others; such a span holds
 /// no sign change of the sampled field, so the tracer would return nothing after a batch or
 /// more. With the proof the renderer leaves wholly free cells out (dropWhole) and a span
-/// whose crossed sub-cells are all free costs no batch: the same hits, bit for bit.
+/// proven free (spanFree) costs no batch: the same hits, bit for bit.
 class FreeSubCells {
  public:
   static constexpr int kDivisions = 4;
@@ -178,8 +178,8 @@ class FreeSubCells {
 std::optional<float> traceCell(const CompiledBlob& blob, const Cell& cell, const Ray& ray, float t0, float t1,
                                float tolerance, Crossing mode, const SubCellBounds& sub, uint32_t cellIndex);
 
-/// traceCell with the proofs the renderer keeps per cell: a span whose crossed sub-cells
-/// are all free (FreeSubCells, when it has masks) is a miss without samples; sub, when not
+/// traceCell with the proofs the renderer keeps per cell: a span that FreeSubCells::spanFree
+/// proves free (when `free` has masks) is a miss without samples; sub, when not
 /// null, is used as by the overload above. The same result as traceCell without them.
 std::optional<float> traceCell(const CompiledBlob& blob, const Cell& cell, const Ray& ray, float t0, float t1,
                                float tolerance, Crossing mode, const FreeSubCells& free, const SubCellBounds* sub,

@@ -172,16 +172,16 @@ float cellsBase(const blobtree::CompiledBlob& blob, const std::vector<blobtree::
 
 /// The batched tracer's proofs over data's cells: the sub-cells free of the surface
 /// (blobtree::FreeSubCells), with the wholly free cells left out of data.cells, and the
-/// sub-cell bounds (ImplicitOptions::subCells) of the cells kept. Returns the cells left out.
+/// sub-cell bounds (ImplicitOptions::subCells, checked either way) of the cells kept.
+/// Returns the cells left out.
 size_t prepareTracing(ImplicitData& data, const ImplicitOptions& options) {
-  if (!data.batched) return 0;
   size_t dropped = 0;
-  if (options.freeSubCells) {
+  if (data.batched && options.freeSubCells) {
     data.free = blobtree::FreeSubCells(data.cells, data.blob);
     dropped = data.free.dropWhole(data.cells);
   }
   const int subK = subCellDivisions(options.subCells, data.cells.cells.size());
-  if (subK > 0) data.sub = blobtree::SubCellBounds(data.cells, data.blob, subK);
+  if (data.batched && subK > 0) data.sub = blobtree::SubCellBounds(data.cells, data.blob, subK);
   return dropped;
 }
 
@@ -190,6 +190,7 @@ size_t prepareTracing(ImplicitData& data, const ImplicitOptions& options) {
 uint32_t Scene::addImplicit(const blobtree::CompiledBlob& blob, uint32_t material, const ImplicitOptions& options) {
   if (impl_->committed) throw std::logic_error("Scene::addImplicit after commit");
   if (material >= impl_->materials.size()) throw std::invalid_argument("Scene::addImplicit: unknown material id");
+  subCellDivisions(options.subCells, 0);  // its range checked before anything is added
   auto data = std::make_shared<ImplicitData>();
   data->blob = blob;
   data->trace = options.trace;
@@ -228,7 +229,7 @@ uint32_t Scene::addImplicit(const blobtree::CompiledBlob& blob, uint32_t materia
   impl_->stats.implicitTapes += data->cells.tapes.size();
   for (const auto& c : data->cells.cells)
     impl_->stats.implicitTapeNodes += c.tape < data->cells.tapes.size() ? data->cells.tapes[c.tape].nodeCount() : 0;
-  if (!data->cells.cells.empty()) {
+  if (!support.empty()) {
     const Phase phase("cells");
     impl_->stats.implicitFreeCells += prepareTracing(*data, options);
   }
