@@ -142,9 +142,10 @@ void benchExactRender(const blobtree::CompiledBlob& compiled, const Args& a) {
   render::RenderStats stats;
   double renderS = 0, renderCpu = 0;
   Image image = timedRender(scene, camera, rs, stats, renderS, renderCpu);
-  std::printf("exact render %dx%d, %d spp: surface cells %.2f s (CPU %.2f s), %zu cells; render %.2f s "
+  std::printf("exact render %dx%d, %d spp: surface cells %.2f s (CPU %.2f s), %zu cells (%zu free); render %.2f s "
               "(CPU %.2f s), %.3g rays (%.3g camera), %.3g rays/s, %.3g rays per CPU s\n",
-              a.width, a.height, a.spp, sceneS, sceneCpu, scene.stats().implicitCells, renderS, renderCpu,
+              a.width, a.height, a.spp, sceneS, sceneCpu, scene.stats().implicitCells, scene.stats().implicitFreeCells,
+              renderS, renderCpu,
               double(stats.rays()), double(stats.cameraRays), stats.raysPerSecond(), double(stats.rays()) / renderCpu);
   std::printf("  total exact (cells + render): %.2f s wall, %.2f s CPU (idle 2-core estimate %.1f s)\n", sceneS + renderS,
               sceneCpu + renderCpu, 0.5 * (sceneCpu + renderCpu));

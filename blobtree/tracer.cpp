@@ -1,8 +1,10 @@
 #include "blobtree/tracer.h"
 
 #include "blobtree/detail/field.h"
+#include "core/parallel.h"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <bit>
 #include <cstdlib>
@@ -11,6 +13,8 @@
 #include <limits>
 #include <span>
 #include <stdexcept>
+#include <tuple>
+#include <utility>
 
 namespace sprig::blobtree {
 
@@ -77,6 +81,11 @@ class BatchTracer {
   float first(float a, float b, int depth, float L) {
     float ts[kTraceLanes], f[kTraceLanes];
     float step = evaluate(a, b, ts, f);
+    // Crossing::Any: a sign change anywhere in the batch answers, before any search of the
+    // intervals ahead of it.
+    if (mode_ == Crossing::Any)
+      for (int i = 0; i + 1 < kTraceLanes; ++i)
+        if ((f[i] > kIso) != (f[i + 1] > kIso)) return ts[i];
     for (int i = 0; i + 1 < kTraceLanes; ++i) {
       if ((f[i] > kIso) != (f[i + 1] > kIso))
         return mode_ == Crossing::Any ? ts[i] : refine(ts[i], ts[i + 1], f[i], f[i + 1], depth, L);
@@ -120,6 +129,98 @@ class BatchTracer {
   float dirLen_;
   float tol_ = 0.0f;
 };
+
+/// The sub-cells along axis ax, first and last (0..k−1), of box split k per axis whose
+/// slabs, widened by margin, the segment origin + t·direction, t in [a, b], overlaps.
+std::pair<int, int> subRange(const Box3& box, int k, float margin, const Ray& ray, float a, float b, int ax) {
+  const float edge = (box.hi[ax] - box.lo[ax]) / float(k);
+  const float o = ray.origin[ax], d = ray.direction[ax];
+  const float pa = o + a * d, pb = o + b * d;
+  const float qlo = std::floor((std::min(pa, pb) - margin - box.lo[ax]) / edge);
+  const float qhi = std::floor((std::max(pa, pb) + margin - box.lo[ax]) / edge);
+  return {int(std::clamp(qlo, 0.0f, float(k - 1))), int(std::clamp(qhi, 0.0f, float(k - 1)))};
+}
+
+/// kSubCellRange[ax][lo][hi]: the bits of FreeSubCells' masks whose sub-cell lies in
+/// [lo, hi] along axis ax.
+constexpr auto kSubCellRange = [] {
+  constexpr int k = FreeSubCells::kDivisions;
+  std::array<std::array<std::array<uint64_t, k>, k>, 3> r{};
+  for (int ax = 0; ax < 3; ++ax)
+    for (int lo = 0; lo < k; ++lo)
+      for (int hi = lo; hi < k; ++hi)
+        for (int s = 0; s < k * k * k; ++s) {
+          const int i = ax == 0 ? s % k : ax == 1 ? (s / k) % k : s / (k * k);
+          if (i >= lo && i <= hi) r[ax][lo][hi] |= uint64_t(1) << s;
+        }
+  return r;
+}();
+
+/// Calls fn(i, j, l) for each sub-cell (i, j, l) of box split k per axis (k <= 8) whose box,
+/// widened by margin, the segment origin + t·direction, t in [a, b], meets: per axis the
+/// widened slabs the segment's extent overlaps and the part of [a, b] inside each (the slab
+/// test of clipToBox on the sub-grid's planes), then the cells where all three parts overlap.
+template <class Fn>
+void forCrossedSubCells(const Box3& box, int k, float margin, const Ray& ray, float a, float b, Fn&& fn) {
+  const Vec3 edge = (box.hi - box.lo) / float(k);
+  int lo[3], hi[3];
+  float enter[3][8], leave[3][8];
+  for (int ax = 0; ax < 3; ++ax) {
+    const float o = ray.origin[ax], d = ray.direction[ax];
+    std::tie(lo[ax], hi[ax]) = subRange(box, k, margin, ray, a, b, ax);
+    const float inv = 1.0f / d;
+    for (int i = lo[ax]; i <= hi[ax]; ++i) {
+      const float s0 = box.lo[ax] + float(i) * edge[ax];
+      const float s1 = (i + 1 == k ? box.hi[ax] : s0 + edge[ax]) + margin;
+      float t0 = a, t1 = b;
+      if (d == 0.0f) {
+        if (o < s0 - margin || o > s1) t0 = std::numeric_limits<float>::infinity();
+      } else {
+        float ta = (s0 - margin - o) * inv, tb = (s1 - o) * inv;
+        if (ta > tb) std::swap(ta, tb);
+        t0 = std::max(t0, ta);
+        t1 = std::min(t1, tb);
+      }
+      enter[ax][i] = t0;
+      leave[ax][i] = t1;
+    }
+  }
+  for (int l = lo[2]; l <= hi[2]; ++l)
+    for (int j = lo[1]; j <= hi[1]; ++j)
+      for (int i = lo[0]; i <= hi[0]; ++i)
+        if (std::max(std::max(enter[0][i], enter[1][j]), enter[2][l]) <=
+            std::min(std::min(leave[0][i], leave[1][j]), leave[2][l]))
+          fn(i, j, l);
+}
+
+/// FreeSubCells' mask of one cell (see tracer.h): its 64 sub-cells' centres in one batch of
+/// the cell's tape, each tested against the tape's Lipschitz bound over the widened cell.
+uint64_t freeMask(const Cell& cell, const CompiledBlob& tape) {
+  constexpr int k = FreeSubCells::kDivisions;
+  const Vec3 size = cell.box.hi - cell.box.lo;
+  Vec3 centres[k * k * k];
+  float f[k * k * k];
+  for (int l = 0; l < k; ++l)
+    for (int j = 0; j < k; ++j)
+      for (int i = 0; i < k; ++i)
+        centres[i + k * (j + k * l)] = cell.box.lo + (Vec3(float(i), float(j), float(l)) + 0.5f) * size / float(k);
+  tape.values(centres, f);
+  float farthest = 0.0f;
+  for (float v : f) farthest = std::max(farthest, std::abs(v - kIso));
+  // Sub-cells widened by twice the crossing test's margin: their centres, computed with
+  // rounding, still see the whole widened box of the test within r.
+  const float w = 2.0f * FreeSubCells::kMarginCells * std::max(size.x, std::max(size.y, size.z));
+  const float r = glm::length(size / float(2 * k) + Vec3(w));
+  // The bound over the widened cell is about the cell's own or more: when even the cell's
+  // would prove nothing, the walk is saved (a zero mask proves nothing, which is sound).
+  if (!(farthest > cell.lipschitz * r + FreeSubCells::kValueMargin)) return 0;
+  const float reach = tape.lipschitz(cell.box.expanded(w)) * r + FreeSubCells::kValueMargin;
+  if (!(reach < std::numeric_limits<float>::infinity())) return 0;
+  uint64_t mask = 0;
+  for (int s = 0; s < k * k * k; ++s)
+    if (std::abs(f[s] - kIso) > reach) mask |= uint64_t(1) << s;
+  return mask;
+}
 
 /// The size tolerances are relative to: the bounds' diagonal (1 for unbounded blobs).
 float modelSize(const Box3& b) {
@@ -201,58 +302,65 @@ float SubCellBounds::entry(uint32_t c, int s) const {
 
 SubCellBounds::Bound SubCellBounds::segment(uint32_t cellIndex, const Ray& ray, float a, float b) const {
   const Cell& c = cells_->cells[cellIndex];
-  const Vec3 edge = (c.box.hi - c.box.lo) / float(k_);
-  const float margin = kMarginCells * (c.box.hi.x - c.box.lo.x);
-  // Per axis, the sub-grid's widened slabs that the segment's extent overlaps, and the part
-  // of [a, b] inside each (the slab test of clipToBox, on subBox's planes).
-  int lo[3], hi[3];
-  float enter[3][8], leave[3][8];
-  for (int ax = 0; ax < 3; ++ax) {
-    const float o = ray.origin[ax], d = ray.direction[ax];
-    const float pa = o + a * d, pb = o + b * d;
-    const float qlo = std::floor((std::min(pa, pb) - margin - c.box.lo[ax]) / edge[ax]);
-    const float qhi = std::floor((std::max(pa, pb) + margin - c.box.lo[ax]) / edge[ax]);
-    lo[ax] = int(std::clamp(qlo, 0.0f, float(k_ - 1)));
-    hi[ax] = int(std::clamp(qhi, 0.0f, float(k_ - 1)));
-    const float inv = 1.0f / d;
-    for (int i = lo[ax]; i <= hi[ax]; ++i) {
-      const float s0 = c.box.lo[ax] + float(i) * edge[ax];
-      const float s1 = (i + 1 == k_ ? c.box.hi[ax] : s0 + edge[ax]) + margin;
-      float t0 = a, t1 = b;
-      if (d == 0.0f) {
-        if (o < s0 - margin || o > s1) t0 = std::numeric_limits<float>::infinity();
-      } else {
-        float ta = (s0 - margin - o) * inv, tb = (s1 - o) * inv;
-        if (ta > tb) std::swap(ta, tb);
-        t0 = std::max(t0, ta);
-        t1 = std::min(t1, tb);
-      }
-      enter[ax][i] = t0;
-      leave[ax][i] = t1;
-    }
-  }
   Bound r;
   int crossed = 0;
-  for (int l = lo[2]; l <= hi[2]; ++l)
-    for (int j = lo[1]; j <= hi[1]; ++j)
-      for (int i = lo[0]; i <= hi[0]; ++i) {
-        if (std::max(std::max(enter[0][i], enter[1][j]), enter[2][l]) >
-            std::min(std::min(leave[0][i], leave[1][j]), leave[2][l]))
-          continue;
-        const float e = entry(cellIndex, i + k_ * (j + k_ * l));
-        r.lipschitz = std::max(r.lipschitz, std::abs(e));
-        r.maySurface = r.maySurface || !std::signbit(e);
-        ++crossed;
-      }
+  forCrossedSubCells(c.box, k_, kMarginCells * (c.box.hi.x - c.box.lo.x), ray, a, b, [&](int i, int j, int l) {
+    const float e = entry(cellIndex, i + k_ * (j + k_ * l));
+    r.lipschitz = std::max(r.lipschitz, std::abs(e));
+    r.maySurface = r.maySurface || !std::signbit(e);
+    ++crossed;
+  });
   if (crossed == 0) return {c.lipschitz, true};
   return r;
 }
 
+// ---- FreeSubCells --------------------------------------------------------------------------
+
+FreeSubCells::FreeSubCells(const CellSet& cells, const CompiledBlob& blob) : masks_(cells.cells.size(), 0) {
+  parallelFor(0, cells.cells.size(), [&](size_t i) {
+    const Cell& c = cells.cells[i];
+    masks_[i] = freeMask(c, cells.tapeOf(c, blob));
+  }, 256);
+}
+
+bool FreeSubCells::spanFree(const Cell& c, uint32_t cellIndex, const Ray& ray, float a, float b) const {
+  const uint64_t free = masks_[cellIndex];
+  if (free == 0) return false;
+  const float margin = kMarginCells * (c.box.hi.x - c.box.lo.x);
+  uint64_t inRange = ~uint64_t(0);
+  for (int ax = 0; ax < 3; ++ax) {
+    const auto [lo, hi] = subRange(c.box, kDivisions, margin, ray, a, b, ax);
+    inRange &= kSubCellRange[ax][lo][hi];
+  }
+  return (inRange & ~free) == 0;
+}
+
+size_t FreeSubCells::dropWhole(CellSet& cells) {
+  size_t kept = 0;
+  for (size_t i = 0; i < cells.cells.size(); ++i) {
+    if (masks_[i] == kWhole) continue;
+    cells.cells[kept] = cells.cells[i];
+    masks_[kept] = masks_[i];
+    ++kept;
+  }
+  const size_t dropped = cells.cells.size() - kept;
+  cells.cells.resize(kept);
+  masks_.resize(kept);
+  return dropped;
+}
+
 std::optional<float> traceCell(const CompiledBlob& blob, const Cell& cell, const Ray& ray, float t0, float t1,
                                float tolerance, Crossing mode, const SubCellBounds& sub, uint32_t cellIndex) {
+  return traceCell(blob, cell, ray, t0, t1, tolerance, mode, FreeSubCells{}, &sub, cellIndex);
+}
+
+std::optional<float> traceCell(const CompiledBlob& blob, const Cell& cell, const Ray& ray, float t0, float t1,
+                               float tolerance, Crossing mode, const FreeSubCells& free, const SubCellBounds* sub,
+                               uint32_t cellIndex) {
   if (!clipToBox(cell.box, ray.origin, ray.direction, t0, t1)) return std::nullopt;
+  if (free.size() > 0 && free.spanFree(cell, cellIndex, ray, t0, t1)) return std::nullopt;
   float lipschitz = std::max(cell.lipschitz, 1e-30f) * glm::length(ray.direction);
-  float t = BatchTracer(blob, ray, lipschitz, mode, &sub, cellIndex).trace(t0, t1, tolerance);
+  float t = BatchTracer(blob, ray, lipschitz, mode, sub, cellIndex).trace(t0, t1, tolerance);
   if (t >= 0.0f) return t;
   return std::nullopt;
 }

@@ -84,6 +84,11 @@ struct ImplicitOptions {
   /// (zero pages until used); when that would pass kSubCellBudgetBytes, k is halved until
   /// it fits (off below 2).
   int subCells = 4;
+  /// Prove sub-cells of the surface cells free of the surface when the cells are made
+  /// (blobtree::FreeSubCells, batched tracing only): cells free everywhere are left out of
+  /// the scene and a span crossing only free sub-cells is a miss without field values. The
+  /// same image; false traces every surface cell (the reference).
+  bool freeSubCells = true;
   /// Trace each cell with its pruned tape (blobtree::SurfaceCellOptions::prunedTapes: only
   /// the nodes whose support reaches the cell, identities removed): the same surface, a
   /// shorter walk per batch. false evaluates the whole tape (the reference).

@@ -27,6 +27,7 @@ struct ImplicitData {
   bool batched = true;    ///< blobtree::traceCell (true) or CompiledBlob::intersectCell (false)
   float tolerance = 0;    ///< absolute root tolerance along t (unit-direction rays)
   blobtree::SubCellBounds sub;  ///< bounds over the cells' sub-cells (batched tracing only)
+  blobtree::FreeSubCells free;  ///< the cells' sub-cells free of the surface (batched tracing only)
 };
 
 }  // namespace detail
@@ -47,9 +48,9 @@ std::optional<blobtree::Hit> traceCell(const ImplicitData& data, const blobtree:
   const blobtree::CompiledBlob& blob = data.cells.tapeOf(cell, data.blob);
   const auto mode = anyHit ? blobtree::Crossing::Any : blobtree::Crossing::FirstStraddle;
   const auto index = uint32_t(&cell - data.cells.cells.data());
-  std::optional<float> t = data.sub.divisions() > 0 && data.sub.warm(index)
-                               ? blobtree::traceCell(blob, cell, ray, tnear, tfar, data.tolerance, mode, data.sub, index)
-                               : blobtree::traceCell(blob, cell, ray, tnear, tfar, data.tolerance, mode);
+  const bool warm = data.sub.divisions() > 0 && data.sub.warm(index);
+  std::optional<float> t = blobtree::traceCell(blob, cell, ray, tnear, tfar, data.tolerance, mode, data.free,
+                                               warm ? &data.sub : nullptr, index);
   if (!t) return std::nullopt;
   if (anyHit) return blobtree::Hit{.t = *t};
   return blobtree::hitAt(blob, ray, *t);
@@ -169,11 +170,27 @@ float cellsBase(const blobtree::CompiledBlob& blob, const std::vector<blobtree::
   return best;
 }
 
+/// The batched tracer's proofs over data's cells: the sub-cells free of the surface
+/// (blobtree::FreeSubCells), with the wholly free cells left out of data.cells, and the
+/// sub-cell bounds (ImplicitOptions::subCells, checked either way) of the cells kept.
+/// Returns the cells left out.
+size_t prepareTracing(ImplicitData& data, const ImplicitOptions& options) {
+  size_t dropped = 0;
+  if (data.batched && options.freeSubCells) {
+    data.free = blobtree::FreeSubCells(data.cells, data.blob);
+    dropped = data.free.dropWhole(data.cells);
+  }
+  const int subK = subCellDivisions(options.subCells, data.cells.cells.size());
+  if (data.batched && subK > 0) data.sub = blobtree::SubCellBounds(data.cells, data.blob, subK);
+  return dropped;
+}
+
 }  // namespace
 
 uint32_t Scene::addImplicit(const blobtree::CompiledBlob& blob, uint32_t material, const ImplicitOptions& options) {
   if (impl_->committed) throw std::logic_error("Scene::addImplicit after commit");
   if (material >= impl_->materials.size()) throw std::invalid_argument("Scene::addImplicit: unknown material id");
+  subCellDivisions(options.subCells, 0);  // its range checked before anything is added
   auto data = std::make_shared<ImplicitData>();
   data->blob = blob;
   data->trace = options.trace;
@@ -195,15 +212,8 @@ uint32_t Scene::addImplicit(const blobtree::CompiledBlob& blob, uint32_t materia
     cellOptions.prunedTapes = options.batched && options.prunedTapes && impl_->prunedTapes;
     const Phase phase("cells");
     data->cells = blob.surfaceCells(cellSize, cellOptions);
-    const int subK = subCellDivisions(options.subCells, data->cells.cells.size());
-    if (data->batched && subK > 0) data->sub = blobtree::SubCellBounds(data->cells, data->blob, subK);
   }
-  RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_USER);
-  rtcSetGeometryUserPrimitiveCount(g, static_cast<unsigned>(data->cells.cells.size()));
-  rtcSetGeometryUserData(g, data.get());
-  rtcSetGeometryBoundsFunction(g, cellBounds, nullptr);
-  rtcSetGeometryIntersectFunction(g, cellIntersect);
-  rtcSetGeometryOccludedFunction(g, cellOccluded);
+  // The bounds and the counts from every surface cell, before free cells are left out.
   Box3 cellBox;
   for (const auto& c : data->cells.cells) cellBox.extend(c.box);
   if (!cellBox.empty()) {
@@ -219,6 +229,16 @@ uint32_t Scene::addImplicit(const blobtree::CompiledBlob& blob, uint32_t materia
   impl_->stats.implicitTapes += data->cells.tapes.size();
   for (const auto& c : data->cells.cells)
     impl_->stats.implicitTapeNodes += c.tape < data->cells.tapes.size() ? data->cells.tapes[c.tape].nodeCount() : 0;
+  if (!support.empty()) {
+    const Phase phase("cells");
+    impl_->stats.implicitFreeCells += prepareTracing(*data, options);
+  }
+  RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_USER);
+  rtcSetGeometryUserPrimitiveCount(g, static_cast<unsigned>(data->cells.cells.size()));
+  rtcSetGeometryUserData(g, data.get());
+  rtcSetGeometryBoundsFunction(g, cellBounds, nullptr);
+  rtcSetGeometryIntersectFunction(g, cellIntersect);
+  rtcSetGeometryOccludedFunction(g, cellOccluded);
   detail::GeometryRecord rec;
   rec.kind = detail::GeometryRecord::Kind::Implicit;
   rec.material = material;

@@ -77,7 +77,9 @@ struct SceneStats {
   size_t curveSegments = 0;  ///< skeleton internodes (round linear curve segments)
   size_t triangles = 0;      ///< mesh and leaf triangles
   size_t spheres = 0;        ///< sphere organs
-  size_t implicitCells = 0;  ///< surface cells of implicit models (Embree user primitives)
+  size_t implicitCells = 0;  ///< surface cells of implicit models (those not free are Embree user primitives)
+  /// Of those, cells proven free of the surface and left out (blobtree::FreeSubCells).
+  size_t implicitFreeCells = 0;
   float implicitCellSize = 0;  ///< the largest edge of those cells, world units
   size_t implicitTapes = 0;  ///< distinct pruned tapes of those cells (ImplicitOptions::prunedTapes)
   size_t implicitTapeNodes = 0;  ///< nodes of those tapes, summed over the cells

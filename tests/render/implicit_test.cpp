@@ -462,3 +462,47 @@ TEST_CASE("Scene::addImplicit sub-cell bounds", "[render]") {
   Scene c;
   CHECK_THROWS_AS(c.addImplicit(blob, c.addMaterial(Material{}), bad), std::invalid_argument);
 }
+
+TEST_CASE("Scene::addImplicit free sub-cells", "[render]") {
+  // ImplicitOptions::freeSubCells leaves out the surface cells proven free of the surface
+  // and skips spans that cross only free sub-cells: the same hits, normals and shadows to
+  // the bit as tracing every cell, and the same bounds (they come from every surface cell).
+  blobtree::CompiledBlob blob = branchBlob();
+  ImplicitOptions off, on;
+  off.freeSubCells = false;
+  Scene a, b;
+  a.addImplicit(blob, a.addMaterial(Material{}), off);
+  b.addImplicit(blob, b.addMaterial(Material{}), on);
+  a.commit();
+  b.commit();
+  CHECK(a.stats().implicitFreeCells == 0);
+  CHECK(b.stats().implicitFreeCells > b.stats().implicitCells / 20);
+  CHECK(a.stats().implicitCells == b.stats().implicitCells);
+  CHECK(a.bounds().lo == b.bounds().lo);
+  CHECK(a.bounds().hi == b.bounds().hi);
+  const uint64_t seed = 20261206;
+  INFO("seed " << seed);
+  Rng rng(seed);
+  const Box3 box = blob.bounds();
+  int hits = 0, shadowed = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Vec3 target = box.lo + Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * box.size();
+    const Vec3 origin = target + 4.0f * glm::normalize(Vec3(rng.normal(), rng.normal(), rng.normal()));
+    const Vec3 dir = glm::normalize(target - origin);
+    const auto ha = a.intersect(origin, dir, 0, 100), hb = b.intersect(origin, dir, 0, 100);
+    REQUIRE(ha.has_value() == hb.has_value());
+    const bool occluded = a.occluded(origin, dir, 0, 100);
+    CHECK(occluded == b.occluded(origin, dir, 0, 100));
+    shadowed += occluded;
+    if (!ha) continue;
+    ++hits;
+    CHECK(ha->t == hb->t);
+    CHECK(ha->normal == hb->normal);
+    // A shadow ray leaving the hit, as the renderer casts them.
+    const Vec3 p = ha->position + 1e-4f * ha->geometricNormal;
+    const Vec3 away = glm::normalize(ha->geometricNormal + Vec3(rng.normal(), rng.normal(), rng.normal()));
+    CHECK(a.occluded(p, away, 0, 100) == b.occluded(p, away, 0, 100));
+  }
+  CHECK(hits > 2000);
+  CHECK(shadowed > 2000);
+}
