@@ -5,6 +5,7 @@
 #include <chrono>
 #include <atomic>
 #include <bit>
+#include <cfloat>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -659,14 +660,40 @@ void storeSample(const PolygonizeOptions& options, const Sample& smp, size_t v, 
   }
 }
 
+// A vertex keeps at least this many float spacings (of the edge's largest coordinate) from
+// both ends of its grid edge. Where a grid corner lies on the surface to within rounding,
+// the root search puts the vertex of every edge from that corner onto the corner itself:
+// distinct vertices at one position, which every weld by position (the simplifier's, a
+// viewer's, a slicer's) merges into a pinch, with degenerate triangles and edges of four
+// triangles. The Kuhn edges at a corner are at least 35.26° apart, so two vertices at
+// least 16 spacings out along two of them lie at least 0.6 · 16 = 9.6 spacings apart, more
+// than their positions' rounding (about 2 spacings a coordinate, under 7 in all): no two
+// vertices share a position, and the mesh stays the closed 2-manifold marching tetrahedra
+// made, whatever welds it.
+constexpr double kCornerSpacings = 16.0;
+
+// t kept kCornerSpacings float spacings from both ends of the edge pIn-pOut (unchanged
+// where it already is, or where the edge is too short for that).
+double offCorners(double t, Vec3 pIn, Vec3 pOut) {
+  const Vec3 far = glm::max(glm::abs(pIn), glm::abs(pOut));
+  const float largest = std::max({far.x, far.y, far.z});
+  const double spacing = std::ldexp(1.0, std::ilogb(std::max(largest, FLT_MIN)) - (FLT_MANT_DIG - 1));
+  const double margin = kCornerSpacings * spacing / glm::length(glm::dvec3(pOut) - glm::dvec3(pIn));
+  if (!(margin < 0.25)) return t;
+  return std::clamp(t, margin, 1.0 - margin);
+}
+
 // Step 5a: every vertex moved onto F = 0.5 along its edge, with its normal and attributes.
 // Fixed blocks of vertices (consecutive edge keys: spatially coherent rows) iterate in
 // lockstep, each step one batched values() call over the block's unconverged vertices.
 // Blocks do not depend on the thread count, so neither do the results. Returns the root
 // search's field evaluations per vertex; flatGradient marks vertices without a gradient.
+// offCorner: the vertices are the mesh's (marching tetrahedra), kept off the grid corners
+// (offCorners); the dual mesher's edge crossings only feed its patch vertices and keep
+// their roots.
 std::vector<uint8_t> placeVertices(const CompiledBlob& blob, const PolygonizeOptions& options, const Grid& g,
                                    const BigVector<EdgeRec>& edges, PolygonizeResult& res,
-                                   std::vector<uint8_t>& flatGradient) {
+                                   std::vector<uint8_t>& flatGradient, bool offCorner) {
   const size_t nVerts = edges.size();
   Mesh& mesh = res.mesh;
   std::unique_ptr<Progress> bar;
@@ -679,6 +706,7 @@ std::vector<uint8_t> placeVertices(const CompiledBlob& blob, const PolygonizeOpt
   }
   std::vector<uint8_t> evals(nVerts, 0);
   flatGradient.assign(nVerts, 0);
+  std::atomic<size_t> offCornerCount{0};
   constexpr size_t kBlock = 64;
   size_t nBlocks = (nVerts + kBlock - 1) / kBlock;
   parallelFor(0, nBlocks, [&](size_t blk) {
@@ -727,15 +755,20 @@ std::vector<uint8_t> placeVertices(const CompiledBlob& blob, const PolygonizeOpt
       }
       nLive = kept;
     }
+    size_t moved = 0;
     for (size_t k = 0; k < n; ++k) {
       size_t v = begin + k;
-      Vec3 p = pIn[k] + float(t[k]) * (pOut[k] - pIn[k]);
+      const double kept = offCorner ? offCorners(t[k], pIn[k], pOut[k]) : t[k];
+      moved += kept != t[k] ? 1 : 0;
+      Vec3 p = pIn[k] + float(kept) * (pOut[k] - pIn[k]);
       mesh.positions[v] = p;
       if (options.normals || options.attributes) storeSample(options, blob.sample(p), v, res, flatGradient);
     }
+    offCornerCount += moved;
     if (bar) bar->advance(n);
   });
   if (bar) bar->finish();
+  res.verticesOffCorners = offCornerCount;
   return evals;
 }
 
@@ -819,7 +852,7 @@ class DualMesher {
     edgeOptions.refineSteps = 0;
     PolygonizeResult crossings;
     std::vector<uint8_t> unusedFlat;
-    std::vector<uint8_t> evals = placeVertices(blob_, edgeOptions, g_, v_.edges, crossings, unusedFlat);
+    std::vector<uint8_t> evals = placeVertices(blob_, edgeOptions, g_, v_.edges, crossings, unusedFlat, false);
     cross_ = std::move(crossings.mesh.positions);
     return evals;
   }
@@ -1096,7 +1129,7 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
 
   // 5. Vertices: root search along each edge, then normal and attributes.
   std::vector<uint8_t> flatGradient;
-  std::vector<uint8_t> evals = placeVertices(blob, options, g, v.edges, res, flatGradient);
+  std::vector<uint8_t> evals = placeVertices(blob, options, g, v.edges, res, flatGradient, true);
   if (options.normals) fixFlatNormals(res.mesh, flatGradient);
   res.vertexSeconds = lap(res.vertexCpuSeconds);
   const size_t nVerts = v.edges.size();
