@@ -660,40 +660,42 @@ void storeSample(const PolygonizeOptions& options, const Sample& smp, size_t v, 
   }
 }
 
-// A vertex keeps at least this many float spacings (of the edge's largest coordinate) from
-// both ends of its grid edge. Where a grid corner lies on the surface to within rounding,
-// the root search puts the vertex of every edge from that corner onto the corner itself:
-// distinct vertices at one position, which every weld by position (the simplifier's, a
-// viewer's, a slicer's) merges into a pinch, with degenerate triangles and edges of four
-// triangles. The Kuhn edges at a corner are at least 35.26° apart, so two vertices at
-// least 16 spacings out along two of them lie at least 0.6 · 16 = 9.6 spacings apart, more
-// than their positions' rounding (about 2 spacings a coordinate, under 7 in all): no two
-// vertices share a position, and the mesh stays the closed 2-manifold marching tetrahedra
-// made, whatever welds it.
+// Where a grid corner lies on the surface to within rounding, the root search puts the
+// vertex of every edge from that corner onto the corner itself: distinct vertices at one
+// position, which every weld by position (the simplifier's, a viewer's, a slicer's, a test's
+// weld of a shell's parts) merges into a pinch, with degenerate triangles and edges of four
+// triangles. Such vertices are moved kCornerSpacings float spacings (of the edge's largest
+// coordinate) out along their own edges. The Kuhn edges at a corner are at least 35.26°
+// apart, so two vertices that far out along two of them lie at least 0.6 · 16 = 9.6
+// spacings apart, and one that far from a vertex nearer the corner, more than their
+// positions' rounding (about 2 spacings a coordinate, under 7 in all): no two vertices share
+// a position, and the mesh stays the closed 2-manifold marching tetrahedra made, whatever
+// welds it. Two vertices can share a position only when both lie within a few spacings of
+// one corner (vertices near different corners are a cell apart), so only vertices within
+// kCornerSpacings of a corner are compared, corner by corner.
 constexpr double kCornerSpacings = 16.0;
 
-// t kept kCornerSpacings float spacings from both ends of the edge pIn-pOut (unchanged
-// where it already is, or where the edge is too short for that).
-double offCorners(double t, Vec3 pIn, Vec3 pOut) {
+// kCornerSpacings float spacings as a fraction of the edge pIn-pOut (0.25 or more: the edge
+// is too short for it).
+double cornerMargin(Vec3 pIn, Vec3 pOut) {
   const Vec3 far = glm::max(glm::abs(pIn), glm::abs(pOut));
-  const float largest = std::max({far.x, far.y, far.z});
-  const double spacing = std::ldexp(1.0, std::ilogb(std::max(largest, FLT_MIN)) - (FLT_MANT_DIG - 1));
-  const double margin = kCornerSpacings * spacing / glm::length(glm::dvec3(pOut) - glm::dvec3(pIn));
-  if (!(margin < 0.25)) return t;
-  return std::clamp(t, margin, 1.0 - margin);
+  const float largest = std::max({far.x, far.y, far.z, FLT_MIN});
+  const double spacing = std::ldexp(1.0, std::ilogb(largest) - (FLT_MANT_DIG - 1));
+  return kCornerSpacings * spacing / glm::length(glm::dvec3(pOut) - glm::dvec3(pIn));
 }
+
+// A vertex's end of its edge within the corner margin: 0 neither, 1 inside, 2 outside.
+enum NearCorner : uint8_t { kNearNone = 0, kNearInside = 1, kNearOutside = 2 };
 
 // Step 5a: every vertex moved onto F = 0.5 along its edge, with its normal and attributes.
 // Fixed blocks of vertices (consecutive edge keys: spatially coherent rows) iterate in
 // lockstep, each step one batched values() call over the block's unconverged vertices.
 // Blocks do not depend on the thread count, so neither do the results. Returns the root
-// search's field evaluations per vertex; flatGradient marks vertices without a gradient.
-// offCorner: the vertices are the mesh's (marching tetrahedra), kept off the grid corners
-// (offCorners); the dual mesher's edge crossings only feed its patch vertices and keep
-// their roots.
+// search's field evaluations per vertex; flatGradient marks vertices without a gradient,
+// and nearCorner, when given, the vertices within the corner margin of an end (NearCorner).
 std::vector<uint8_t> placeVertices(const CompiledBlob& blob, const PolygonizeOptions& options, const Grid& g,
                                    const BigVector<EdgeRec>& edges, PolygonizeResult& res,
-                                   std::vector<uint8_t>& flatGradient, bool offCorner) {
+                                   std::vector<uint8_t>& flatGradient, std::vector<uint8_t>* nearCorner = nullptr) {
   const size_t nVerts = edges.size();
   Mesh& mesh = res.mesh;
   std::unique_ptr<Progress> bar;
@@ -706,7 +708,7 @@ std::vector<uint8_t> placeVertices(const CompiledBlob& blob, const PolygonizeOpt
   }
   std::vector<uint8_t> evals(nVerts, 0);
   flatGradient.assign(nVerts, 0);
-  std::atomic<size_t> offCornerCount{0};
+  if (nearCorner) nearCorner->assign(nVerts, kNearNone);
   constexpr size_t kBlock = 64;
   size_t nBlocks = (nVerts + kBlock - 1) / kBlock;
   parallelFor(0, nBlocks, [&](size_t blk) {
@@ -755,24 +757,56 @@ std::vector<uint8_t> placeVertices(const CompiledBlob& blob, const PolygonizeOpt
       }
       nLive = kept;
     }
-    size_t moved = 0;
     for (size_t k = 0; k < n; ++k) {
       size_t v = begin + k;
-      const double kept = offCorner ? offCorners(t[k], pIn[k], pOut[k]) : t[k];
-      moved += kept != t[k] ? 1 : 0;
-      Vec3 p = pIn[k] + float(kept) * (pOut[k] - pIn[k]);
+      Vec3 p = pIn[k] + float(t[k]) * (pOut[k] - pIn[k]);
       mesh.positions[v] = p;
       if (options.normals || options.attributes) storeSample(options, blob.sample(p), v, res, flatGradient);
+      if (nearCorner) {
+        const double margin = cornerMargin(pIn[k], pOut[k]);
+        if (margin < 0.25) (*nearCorner)[v] = t[k] < margin ? kNearInside : t[k] > 1.0 - margin ? kNearOutside : kNearNone;
+      }
     }
-    offCornerCount += moved;
     if (bar) bar->advance(n);
   });
   if (bar) bar->finish();
-  res.verticesOffCorners = offCornerCount;
   return evals;
 }
 
-// Step 5b: vertices where the gradient vanishes take the area-weighted normal of their
+// Step 5b: vertices that share a position with another (see kCornerSpacings) moved out
+// along their edges, with their normal and attributes; returns how many.
+size_t separateVertices(const CompiledBlob& blob, const PolygonizeOptions& options, const Grid& g,
+                        const BigVector<EdgeRec>& edges, const std::vector<uint8_t>& nearCorner,
+                        PolygonizeResult& res, std::vector<uint8_t>& flatGradient) {
+  const BigVector<uint32_t> near = indicesWhere(nearCorner.size(), [&](size_t v) { return nearCorner[v] != kNearNone; });
+  auto cornerOf = [&](uint32_t v) { return nearCorner[v] == kNearInside ? edges[v].inside : edges[v].outside; };
+  std::vector<std::pair<uint32_t, uint32_t>> byCorner;  // (grid point, vertex)
+  byCorner.reserve(near.size());
+  for (uint32_t v : near) byCorner.push_back({cornerOf(v), v});
+  std::sort(byCorner.begin(), byCorner.end());
+  std::vector<uint32_t> moving;
+  for (size_t i = 0, j = 0; i < byCorner.size(); i = j) {
+    while (j < byCorner.size() && byCorner[j].first == byCorner[i].first) ++j;
+    for (size_t a = i; a < j; ++a)
+      for (size_t b = i; b < j; ++b)
+        if (a != b && res.mesh.positions[byCorner[a].second] == res.mesh.positions[byCorner[b].second]) {
+          moving.push_back(byCorner[a].second);
+          break;
+        }
+  }
+  for (uint32_t v : moving) {
+    const Vec3 pIn = gridPosition(g.cs, keyCoords(g.pointKeys[edges[v].inside]));
+    const Vec3 pOut = gridPosition(g.cs, keyCoords(g.pointKeys[edges[v].outside]));
+    const double margin = cornerMargin(pIn, pOut);
+    const Vec3 p = pIn + float(nearCorner[v] == kNearInside ? margin : 1.0 - margin) * (pOut - pIn);
+    res.mesh.positions[v] = p;
+    flatGradient[v] = 0;
+    if (options.normals || options.attributes) storeSample(options, blob.sample(p), v, res, flatGradient);
+  }
+  return moving.size();
+}
+
+// Step 5c: vertices where the gradient vanishes take the area-weighted normal of their
 // triangles.
 void fixFlatNormals(Mesh& mesh, const std::vector<uint8_t>& flatGradient) {
   if (std::find(flatGradient.begin(), flatGradient.end(), 1) == flatGradient.end()) return;
@@ -852,7 +886,7 @@ class DualMesher {
     edgeOptions.refineSteps = 0;
     PolygonizeResult crossings;
     std::vector<uint8_t> unusedFlat;
-    std::vector<uint8_t> evals = placeVertices(blob_, edgeOptions, g_, v_.edges, crossings, unusedFlat, false);
+    std::vector<uint8_t> evals = placeVertices(blob_, edgeOptions, g_, v_.edges, crossings, unusedFlat);
     cross_ = std::move(crossings.mesh.positions);
     return evals;
   }
@@ -1129,13 +1163,15 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
 
   // 5. Vertices: root search along each edge, then normal and attributes.
   std::vector<uint8_t> flatGradient;
-  std::vector<uint8_t> evals = placeVertices(blob, options, g, v.edges, res, flatGradient, true);
+  std::vector<uint8_t> nearCorner;
+  std::vector<uint8_t> evals = placeVertices(blob, options, g, v.edges, res, flatGradient, &nearCorner);
+  res.separatedVertices = separateVertices(blob, options, g, v.edges, nearCorner, res, flatGradient);
   if (options.normals) fixFlatNormals(res.mesh, flatGradient);
   res.vertexSeconds = lap(res.vertexCpuSeconds);
   const size_t nVerts = v.edges.size();
   size_t total = g.pointKeys.size() + (options.normals || options.attributes ? nVerts : 0);
   for (uint8_t n : evals) total += n;
-  res.fieldEvaluations = total;
+  res.fieldEvaluations = total + (options.normals || options.attributes ? res.separatedVertices : 0);
   return res;
 }
 

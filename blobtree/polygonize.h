@@ -103,10 +103,11 @@ struct PolygonizeResult {
   size_t activeCells = 0;       ///< cells with a sign change (the ones triangulated)
   size_t extraCells = 0;        ///< neighbours added where rounding left a face's sign change uncovered
   size_t gridSamples = 0;       ///< distinct grid points sampled
-  /// Marching tetrahedra: vertices whose root lay within 16 float spacings of a grid corner
-  /// (a corner on the surface to within rounding), kept that far out along their edge so
-  /// that no two vertices share a position (polygonize.cpp, offCorners).
-  size_t verticesOffCorners = 0;
+  /// Marching tetrahedra: vertices that shared a position with another (their roots on a
+  /// grid corner that lies on the surface to within rounding), each moved 16 float spacings
+  /// out along its own edge, so that no two vertices share a position (polygonize.cpp,
+  /// kCornerSpacings).
+  size_t separatedVertices = 0;
   size_t fieldEvaluations = 0;  ///< every field value computed (grid + root search + samples)
   double cellSeconds = 0;         ///< time in surfaceCells
   double sampleSeconds = 0;       ///< grid corner sampling (with the corner table)

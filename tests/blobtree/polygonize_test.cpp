@@ -68,8 +68,8 @@ TEST_CASE("polygonize::sphere", "[blobtree]") {
 // origin, a corner: two sheets meet in one grid point, within the cells around it. The root
 // search put the vertices of every grid edge from such a corner onto the corner, distinct
 // vertices at one position; welded by position (as viewers, slicers and the simplifier
-// weld) they pinched the surface: degenerate triangles and edges of four triangles. Each
-// vertex now keeps 16 float spacings from its edge's ends, so no two share a position and
+// weld) they pinched the surface: degenerate triangles and edges of four triangles. Such
+// vertices now move 16 float spacings out along their edges, so no two share a position and
 // the welded mesh is the closed, consistently oriented 2-manifold marching tetrahedra made.
 TEST_CASE("polygonize: a surface through grid corners welds by position to a closed 2-manifold", "[blobtree]") {
   PolygonizeOptions options;
@@ -77,7 +77,7 @@ TEST_CASE("polygonize: a surface through grid corners welds by position to a clo
   auto check = [&](const CompiledBlob& blob, long eulerWanted) {
     const PolygonizeResult r = polygonizeDetailed(blob, options);
     REQUIRE(r.cellSize == options.cellSize);
-    CHECK(r.verticesOffCorners > 0);  // the configuration has corners on the surface
+    CHECK(r.separatedVertices > 0);  // the configuration has vertices at one position
     requireClosedManifold(r.mesh);
     const Mesh welded = test::weldByPosition(r.mesh);
     CHECK(welded.vertexCount() == r.mesh.vertexCount());  // no two vertices share a position
