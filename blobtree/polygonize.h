@@ -25,7 +25,10 @@
 ///  5. Projection: every vertex is moved onto the exact F = 0.5 surface by a bracketed
 ///     root search (Illinois regula falsi) along its grid edge (batched values() over
 ///     fixed blocks of 64 vertices), so it never leaves its edge or its cell. Normals are −∇F/|∇F| and uv the blended
-///     primitive (u,v) from CompiledBlob::sample.
+///     primitive (u,v) from CompiledBlob::sample. Vertices whose roots met on a grid corner
+///     (one on the surface to within rounding) move 16 float spacings out along their own
+///     edges, so that no two vertices share a position and a weld by position leaves the
+///     mesh a 2-manifold (PolygonizeResult::separatedVertices).
 /// Every step runs in parallel over fixed index blocks and merges in sorted or index order:
 /// the same blob and options give the same mesh bytes at any thread count.
 ///
