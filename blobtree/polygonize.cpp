@@ -5,6 +5,7 @@
 #include <chrono>
 #include <atomic>
 #include <bit>
+#include <cfloat>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -659,14 +660,42 @@ void storeSample(const PolygonizeOptions& options, const Sample& smp, size_t v, 
   }
 }
 
+// Where a grid corner lies on the surface to within rounding, the root search puts the
+// vertex of every edge from that corner onto the corner itself: distinct vertices at one
+// position, which every weld by position (the simplifier's, a viewer's, a slicer's, a test's
+// weld of a shell's parts) merges into a pinch, with degenerate triangles and edges of four
+// triangles. Such vertices are moved kCornerSpacings float spacings (of the edge's largest
+// coordinate) out along their own edges. The Kuhn edges at a corner are at least 35.26°
+// apart, so two vertices that far out along two of them lie at least 0.6 · 16 = 9.6
+// spacings apart, and one that far from a vertex nearer the corner, more than their
+// positions' rounding (about 2 spacings a coordinate, under 7 in all): no two vertices share
+// a position, and the mesh stays the closed 2-manifold marching tetrahedra made, whatever
+// welds it. Two vertices can share a position only when both lie within a few spacings of
+// one corner (vertices near different corners are a cell apart), so only vertices within
+// kCornerSpacings of a corner are compared, corner by corner.
+constexpr double kCornerSpacings = 16.0;
+
+// kCornerSpacings float spacings as a fraction of the edge pIn-pOut (0.25 or more: the edge
+// is too short for it).
+double cornerMargin(Vec3 pIn, Vec3 pOut) {
+  const Vec3 far = glm::max(glm::abs(pIn), glm::abs(pOut));
+  const float largest = std::max({far.x, far.y, far.z, FLT_MIN});
+  const double spacing = std::ldexp(1.0, std::ilogb(largest) - (FLT_MANT_DIG - 1));
+  return kCornerSpacings * spacing / glm::length(glm::dvec3(pOut) - glm::dvec3(pIn));
+}
+
+// A vertex's end of its edge within the corner margin: 0 neither, 1 inside, 2 outside.
+enum NearCorner : uint8_t { kNearNone = 0, kNearInside = 1, kNearOutside = 2 };
+
 // Step 5a: every vertex moved onto F = 0.5 along its edge, with its normal and attributes.
 // Fixed blocks of vertices (consecutive edge keys: spatially coherent rows) iterate in
 // lockstep, each step one batched values() call over the block's unconverged vertices.
 // Blocks do not depend on the thread count, so neither do the results. Returns the root
-// search's field evaluations per vertex; flatGradient marks vertices without a gradient.
+// search's field evaluations per vertex; flatGradient marks vertices without a gradient,
+// and nearCorner, when given, the vertices within the corner margin of an end (NearCorner).
 std::vector<uint8_t> placeVertices(const CompiledBlob& blob, const PolygonizeOptions& options, const Grid& g,
                                    const BigVector<EdgeRec>& edges, PolygonizeResult& res,
-                                   std::vector<uint8_t>& flatGradient) {
+                                   std::vector<uint8_t>& flatGradient, std::vector<uint8_t>* nearCorner = nullptr) {
   const size_t nVerts = edges.size();
   Mesh& mesh = res.mesh;
   std::unique_ptr<Progress> bar;
@@ -679,6 +708,7 @@ std::vector<uint8_t> placeVertices(const CompiledBlob& blob, const PolygonizeOpt
   }
   std::vector<uint8_t> evals(nVerts, 0);
   flatGradient.assign(nVerts, 0);
+  if (nearCorner) nearCorner->assign(nVerts, kNearNone);
   constexpr size_t kBlock = 64;
   size_t nBlocks = (nVerts + kBlock - 1) / kBlock;
   parallelFor(0, nBlocks, [&](size_t blk) {
@@ -732,6 +762,10 @@ std::vector<uint8_t> placeVertices(const CompiledBlob& blob, const PolygonizeOpt
       Vec3 p = pIn[k] + float(t[k]) * (pOut[k] - pIn[k]);
       mesh.positions[v] = p;
       if (options.normals || options.attributes) storeSample(options, blob.sample(p), v, res, flatGradient);
+      if (nearCorner) {
+        const double margin = cornerMargin(pIn[k], pOut[k]);
+        if (margin < 0.25) (*nearCorner)[v] = t[k] < margin ? kNearInside : t[k] > 1.0 - margin ? kNearOutside : kNearNone;
+      }
     }
     if (bar) bar->advance(n);
   });
@@ -739,7 +773,40 @@ std::vector<uint8_t> placeVertices(const CompiledBlob& blob, const PolygonizeOpt
   return evals;
 }
 
-// Step 5b: vertices where the gradient vanishes take the area-weighted normal of their
+// Step 5b: vertices that share a position with another (see kCornerSpacings) moved out
+// along their edges, with their normal and attributes; returns how many.
+size_t separateVertices(const CompiledBlob& blob, const PolygonizeOptions& options, const Grid& g,
+                        const BigVector<EdgeRec>& edges, const std::vector<uint8_t>& nearCorner,
+                        PolygonizeResult& res, std::vector<uint8_t>& flatGradient) {
+  const BigVector<uint32_t> near = indicesWhere(nearCorner.size(), [&](size_t v) { return nearCorner[v] != kNearNone; });
+  auto cornerOf = [&](uint32_t v) { return nearCorner[v] == kNearInside ? edges[v].inside : edges[v].outside; };
+  std::vector<std::pair<uint32_t, uint32_t>> byCorner;  // (grid point, vertex)
+  byCorner.reserve(near.size());
+  for (uint32_t v : near) byCorner.push_back({cornerOf(v), v});
+  std::sort(byCorner.begin(), byCorner.end());
+  std::vector<uint32_t> moving;
+  for (size_t i = 0, j = 0; i < byCorner.size(); i = j) {
+    while (j < byCorner.size() && byCorner[j].first == byCorner[i].first) ++j;
+    for (size_t a = i; a < j; ++a)
+      for (size_t b = i; b < j; ++b)
+        if (a != b && res.mesh.positions[byCorner[a].second] == res.mesh.positions[byCorner[b].second]) {
+          moving.push_back(byCorner[a].second);
+          break;
+        }
+  }
+  for (uint32_t v : moving) {
+    const Vec3 pIn = gridPosition(g.cs, keyCoords(g.pointKeys[edges[v].inside]));
+    const Vec3 pOut = gridPosition(g.cs, keyCoords(g.pointKeys[edges[v].outside]));
+    const double margin = cornerMargin(pIn, pOut);
+    const Vec3 p = pIn + float(nearCorner[v] == kNearInside ? margin : 1.0 - margin) * (pOut - pIn);
+    res.mesh.positions[v] = p;
+    flatGradient[v] = 0;
+    if (options.normals || options.attributes) storeSample(options, blob.sample(p), v, res, flatGradient);
+  }
+  return moving.size();
+}
+
+// Step 5c: vertices where the gradient vanishes take the area-weighted normal of their
 // triangles.
 void fixFlatNormals(Mesh& mesh, const std::vector<uint8_t>& flatGradient) {
   if (std::find(flatGradient.begin(), flatGradient.end(), 1) == flatGradient.end()) return;
@@ -1096,13 +1163,15 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
 
   // 5. Vertices: root search along each edge, then normal and attributes.
   std::vector<uint8_t> flatGradient;
-  std::vector<uint8_t> evals = placeVertices(blob, options, g, v.edges, res, flatGradient);
+  std::vector<uint8_t> nearCorner;
+  std::vector<uint8_t> evals = placeVertices(blob, options, g, v.edges, res, flatGradient, &nearCorner);
+  res.separatedVertices = separateVertices(blob, options, g, v.edges, nearCorner, res, flatGradient);
   if (options.normals) fixFlatNormals(res.mesh, flatGradient);
   res.vertexSeconds = lap(res.vertexCpuSeconds);
   const size_t nVerts = v.edges.size();
   size_t total = g.pointKeys.size() + (options.normals || options.attributes ? nVerts : 0);
   for (uint8_t n : evals) total += n;
-  res.fieldEvaluations = total;
+  res.fieldEvaluations = total + (options.normals || options.attributes ? res.separatedVertices : 0);
   return res;
 }
 

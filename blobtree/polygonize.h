@@ -25,7 +25,10 @@
 ///  5. Projection: every vertex is moved onto the exact F = 0.5 surface by a bracketed
 ///     root search (Illinois regula falsi) along its grid edge (batched values() over
 ///     fixed blocks of 64 vertices), so it never leaves its edge or its cell. Normals are −∇F/|∇F| and uv the blended
-///     primitive (u,v) from CompiledBlob::sample.
+///     primitive (u,v) from CompiledBlob::sample. Vertices whose roots met on a grid corner
+///     (one on the surface to within rounding) move 16 float spacings out along their own
+///     edges, so that no two vertices share a position and a weld by position leaves the
+///     mesh a 2-manifold (PolygonizeResult::separatedVertices).
 /// Every step runs in parallel over fixed index blocks and merges in sorted or index order:
 /// the same blob and options give the same mesh bytes at any thread count.
 ///
@@ -103,6 +106,11 @@ struct PolygonizeResult {
   size_t activeCells = 0;       ///< cells with a sign change (the ones triangulated)
   size_t extraCells = 0;        ///< neighbours added where rounding left a face's sign change uncovered
   size_t gridSamples = 0;       ///< distinct grid points sampled
+  /// Marching tetrahedra: vertices that shared a position with another (their roots on a
+  /// grid corner that lies on the surface to within rounding), each moved 16 float spacings
+  /// out along its own edge, so that no two vertices share a position (polygonize.cpp,
+  /// kCornerSpacings).
+  size_t separatedVertices = 0;
   size_t fieldEvaluations = 0;  ///< every field value computed (grid + root search + samples)
   double cellSeconds = 0;         ///< time in surfaceCells
   double sampleSeconds = 0;       ///< grid corner sampling (with the corner table)

@@ -62,6 +62,40 @@ TEST_CASE("polygonize::sphere", "[blobtree]") {
   }
 }
 
+// Grid corners on the surface to within rounding: a ball of radius 1 about the origin at a
+// cell of 1/16 (the grid's corners are multiples of 1/16, so (±1, 0, 0), (0, ±1, 0) and
+// (0, 0, ±1) are corners on the sphere), and two such balls united (max) that touch at the
+// origin, a corner: two sheets meet in one grid point, within the cells around it. The root
+// search put the vertices of every grid edge from such a corner onto the corner, distinct
+// vertices at one position; welded by position (as viewers, slicers and the simplifier
+// weld) they pinched the surface: degenerate triangles and edges of four triangles. Such
+// vertices now move 16 float spacings out along their edges, so no two share a position and
+// the welded mesh is the closed, consistently oriented 2-manifold marching tetrahedra made.
+TEST_CASE("polygonize: a surface through grid corners welds by position to a closed 2-manifold", "[blobtree]") {
+  PolygonizeOptions options;
+  options.cellSize = 1.0f / 16.0f;
+  auto check = [&](const CompiledBlob& blob, long eulerWanted) {
+    const PolygonizeResult r = polygonizeDetailed(blob, options);
+    REQUIRE(r.cellSize == options.cellSize);
+    CHECK(r.separatedVertices > 0);  // the configuration has vertices at one position
+    requireClosedManifold(r.mesh);
+    const Mesh welded = test::weldByPosition(r.mesh);
+    CHECK(welded.vertexCount() == r.mesh.vertexCount());  // no two vertices share a position
+    requireClosedManifold(welded);
+    CHECK(euler(welded) == eulerWanted);
+    CHECK(maxFieldError(blob, r.mesh) < 1e-4f);
+  };
+  SECTION("a ball through six corners") {
+    BlobTree tree;
+    check(compile(tree, tree.point(Vec3(0.0f), 1.0f)), 2);
+  }
+  SECTION("two balls touching at a corner") {
+    BlobTree tree;
+    const NodeId balls[] = {tree.point(Vec3(-1.0f, 0.0f, 0.0f), 1.0f), tree.point(Vec3(1.0f, 0.0f, 0.0f), 1.0f)};
+    check(compile(tree, tree.unite(balls)), 4);
+  }
+}
+
 TEST_CASE("polygonize::capsule", "[blobtree]") {
   BlobTree tree;
   float radius = 0.5f, length = 2.0f;
