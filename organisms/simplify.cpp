@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <tuple>
 #include <utility>
 #include <cmath>
 #include <cstring>
@@ -17,19 +18,6 @@ namespace sprig::organisms {
 
 namespace {
 
-// Whether two triangles have the same three vertices. meshoptimizer 0.18 now and then
-// folds a flap onto its neighbour: a triangle and its reverse, back to back, which an
-// edge count does not always see (alone, such a pair is a closed two-face pillow).
-bool hasFoldedPair(const std::vector<unsigned int>& indices) {
-  std::vector<std::array<unsigned, 3>> keys(indices.size() / 3);
-  for (size_t f = 0; f < keys.size(); ++f) {
-    keys[f] = {indices[3 * f], indices[3 * f + 1], indices[3 * f + 2]};
-    std::sort(keys[f].begin(), keys[f].end());
-  }
-  std::sort(keys.begin(), keys.end());
-  return std::adjacent_find(keys.begin(), keys.end()) != keys.end();
-}
-
 // Edge counts of an index buffer of triangles.
 MeshTopology topologyOf(const std::vector<unsigned int>& indices) {
   Mesh m;
@@ -39,6 +27,43 @@ MeshTopology topologyOf(const std::vector<unsigned int>& indices) {
 }
 
 }  // namespace
+
+size_t dropFoldedPairs(std::vector<unsigned int>& indices) {
+  // Key: the sorted vertices, the orientation (even or odd permutation of the sorted order)
+  // and the triangle's number; sorted, a folded pair is an even and an odd entry of one
+  // vertex set.
+  struct Key {
+    std::array<unsigned, 3> v;
+    bool odd;
+    size_t face;
+    bool operator<(const Key& o) const { return std::tie(v, odd, face) < std::tie(o.v, o.odd, o.face); }
+  };
+  const size_t faces = indices.size() / 3;
+  std::vector<Key> keys(faces);
+  for (size_t f = 0; f < faces; ++f) {
+    const unsigned a = indices[3 * f], b = indices[3 * f + 1], c = indices[3 * f + 2];
+    // The rotations of (a, b, c) with the smallest vertex first: (m, x, y) is odd when x > y.
+    const unsigned m = std::min({a, b, c});
+    const auto [x, y] = m == a ? std::pair(b, c) : m == b ? std::pair(c, a) : std::pair(a, b);
+    keys[f] = {{m, std::min(x, y), std::max(x, y)}, x > y, f};
+  }
+  std::sort(keys.begin(), keys.end());
+  std::vector<bool> drop(faces, false);
+  size_t pairs = 0;
+  for (size_t i = 0; i < faces;) {
+    size_t j = i, odd = i;
+    while (j < faces && keys[j].v == keys[i].v) ++j;
+    while (odd < j && !keys[odd].odd) ++odd;  // [i, odd) even, [odd, j) odd
+    for (size_t e = i, o = odd; e < odd && o < j; ++e, ++o, ++pairs) drop[keys[e].face] = drop[keys[o].face] = true;
+    i = j;
+  }
+  if (pairs == 0) return 0;
+  size_t kept = 0;
+  for (size_t f = 0; f < faces; ++f)
+    if (!drop[f]) std::copy_n(indices.begin() + 3 * f, 3, indices.begin() + 3 * kept++);
+  indices.resize(3 * kept);
+  return pairs;
+}
 
 SimplifiedMesh simplifyMesh(const Mesh& mesh, size_t targetFaces, float maxRelativeError, bool linkCheck, bool lockBorder) {
   linkCheck = linkCheck && lockBorder;
@@ -87,7 +112,8 @@ SimplifiedMesh simplifyMesh(const Mesh& mesh, size_t targetFaces, float maxRelat
   // condition, so a collapse now and then pinches the surface: an edge of four faces, or
   // a triangle folded onto its reverse. A result of a manifold input that is pinched, or
   // whose boundary changed, is replaced by Sprig's own link-checked collapses
-  // (organisms/edge_collapse.h).
+  // (organisms/edge_collapse.h). Without the link check (levels of detail), the folds are
+  // removed, which leaves the surface closed.
   size_t target = std::min(targetFaces, indices.size() / 3);
   std::vector<unsigned int> simplified(indices.size());
   float error = 0;
@@ -98,7 +124,8 @@ SimplifiedMesh simplifyMesh(const Mesh& mesh, size_t targetFaces, float maxRelat
   MeshTopology input = linkCheck ? topologyOf(indices) : MeshTopology{};
   if (linkCheck && input.manifold()) {
     MeshTopology result = topologyOf(simplified);
-    if (!result.manifold() || result.boundaryEdges != input.boundaryEdges || hasFoldedPair(simplified)) {
+    std::vector<unsigned int> unfolded = simplified;
+    if (!result.manifold() || result.boundaryEdges != input.boundaryEdges || dropFoldedPairs(unfolded) > 0) {
       EdgeCollapseResult own = collapseEdges(weldedPositions, indices, target, maxRelativeError * scale);
       simplified = std::move(own.indices);
       count = simplified.size();
@@ -106,6 +133,8 @@ SimplifiedMesh simplifyMesh(const Mesh& mesh, size_t targetFaces, float maxRelat
       report.linkChecked = true;
     }
   }
+  report.foldedPairs = dropFoldedPairs(simplified);
+  count = simplified.size();
 
   // 3. Compact: only used vertices, in order of first use.
   std::vector<unsigned int> compact(welded);

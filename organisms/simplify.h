@@ -32,6 +32,9 @@ struct SimplifyReport {
   /// meshoptimizer's result pinched the surface and Sprig's link-checked collapses
   /// (organisms/edge_collapse.h) made this one instead (see simplifyMesh).
   bool linkChecked = false;
+  /// Pairs of a triangle and its reverse (a flap folded back onto its neighbour) removed
+  /// from meshoptimizer's result (dropFoldedPairs).
+  size_t foldedPairs = 0;
 };
 
 /// A simplified mesh and its report.
@@ -61,11 +64,20 @@ struct SimplifiedMesh {
 /// finite. Cost: O(T log T) for T triangles: 1.3 M triangles to 500 in 1.2-2.3 s on one
 /// core of a shared machine, 2.5-3.5 s more when the link-checked collapses run.
 /// linkCheck false keeps meshoptimizer's result as it is (faster on millions of triangles;
-/// a pinched edge now and then): for levels of detail, which are drawn, not refined.
+/// a pinched edge now and then): for levels of detail, which are drawn, not refined. Its
+/// folded pairs are removed either way (dropFoldedPairs).
 /// lockBorder false lets collapses run along open borders too (they move an open outline
 /// inward: leaves of a level of detail), and implies linkCheck false.
 SimplifiedMesh simplifyMesh(const Mesh& mesh, size_t targetFaces, float maxRelativeError = 1e-1f, bool linkCheck = true,
                             bool lockBorder = true);
+
+/// Removes, from an index buffer of triangles, every pair of a triangle and its reverse
+/// (the same three vertices, opposite orientations): meshoptimizer's folds. Each edge of
+/// such a pair has the pair's two faces besides the surface's own, so the rest stays
+/// closed and consistently oriented. Triangles on the same three vertices with the same
+/// orientation are kept. Keeps the order of the others; returns the number of pairs.
+/// O(T log T).
+size_t dropFoldedPairs(std::vector<unsigned int>& indices);
 
 /// simplifyMesh(...).mesh.
 PolyMesh simplifyToFaceCount(const Mesh& mesh, size_t targetFaces, float maxRelativeError = 1e-1f);

@@ -32,6 +32,13 @@ blobtree::CompiledBlob branchBlob() {
   return blobtree::compile(t, t.blend(parts));
 }
 
+/// A ray from 4 units away in a random direction toward a random point of box.
+std::pair<Vec3, Vec3> rayIntoBox(Rng& rng, const Box3& box) {
+  const Vec3 target = box.lo + Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * box.size();
+  const Vec3 origin = target + 4.0f * glm::normalize(Vec3(rng.normal(), rng.normal(), rng.normal()));
+  return {origin, glm::normalize(target - origin)};
+}
+
 }  // namespace
 
 TEST_CASE("Scene::addImplicit", "[render]") {
@@ -445,9 +452,7 @@ TEST_CASE("Scene::addImplicit sub-cell bounds", "[render]") {
   const Box3 box = blob.bounds();
   int hits = 0;
   for (int i = 0; i < 20000; ++i) {
-    const Vec3 target = box.lo + Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * box.size();
-    const Vec3 origin = target + 4.0f * glm::normalize(Vec3(rng.normal(), rng.normal(), rng.normal()));
-    const Vec3 dir = glm::normalize(target - origin);
+    const auto [origin, dir] = rayIntoBox(rng, box);
     const auto ha = a.intersect(origin, dir, 0, 100), hb = b.intersect(origin, dir, 0, 100);
     REQUIRE(ha.has_value() == hb.has_value());
     CHECK(a.occluded(origin, dir, 0, 100) == b.occluded(origin, dir, 0, 100));
@@ -486,9 +491,7 @@ TEST_CASE("Scene::addImplicit free sub-cells", "[render]") {
   const Box3 box = blob.bounds();
   int hits = 0, shadowed = 0;
   for (int i = 0; i < 20000; ++i) {
-    const Vec3 target = box.lo + Vec3(rng.uniform(), rng.uniform(), rng.uniform()) * box.size();
-    const Vec3 origin = target + 4.0f * glm::normalize(Vec3(rng.normal(), rng.normal(), rng.normal()));
-    const Vec3 dir = glm::normalize(target - origin);
+    const auto [origin, dir] = rayIntoBox(rng, box);
     const auto ha = a.intersect(origin, dir, 0, 100), hb = b.intersect(origin, dir, 0, 100);
     REQUIRE(ha.has_value() == hb.has_value());
     const bool occluded = a.occluded(origin, dir, 0, 100);
