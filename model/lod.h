@@ -27,7 +27,8 @@ namespace sprig {
 inline constexpr double kLodRatio = 0.25;
 /// At most this many levels (LOD0 to LOD3).
 inline constexpr int kLodMaxLevels = 4;
-/// No level is made below this many triangles (the chain stops earlier).
+/// No level is made below about this many triangles (the chain stops earlier; 2 % below
+/// it passes, as a level may end a few triangles under its target).
 inline constexpr size_t kLodMinTriangles = 500;
 /// A level is kept only when it has at most this fraction of the triangles of the level
 /// before (simplification that cannot get further, e.g. at locked borders, ends the chain).

@@ -322,6 +322,7 @@ TEST_CASE("writeParts normal map in OBJ", "[model][lod]") {
   ExportPart ridge{"ridge", grid(48, kAmp), PartMaterial{"ridge", Vec3(0.4f, 0.3f, 0.2f), 0.7f, false}};
   REQUIRE(atlasVertexColors(ridge) > 0);
   const std::vector<LodLevel> levels = buildLodChain({ridge}, 2000);
+  REQUIRE(levels.size() >= 2);
   TempDir dir;
   writeLevels(levels, dir.path / "r.obj");
   const std::string mtl = readFile(dir.path / "r.mtl");
