@@ -87,8 +87,7 @@ class BatchTracer {
       for (int i = 0; i + 1 < kTraceLanes; ++i)
         if ((f[i] > kIso) != (f[i + 1] > kIso)) return ts[i];
     for (int i = 0; i + 1 < kTraceLanes; ++i) {
-      if ((f[i] > kIso) != (f[i + 1] > kIso))
-        return mode_ == Crossing::Any ? ts[i] : refine(ts[i], ts[i + 1], f[i], f[i + 1], depth, L);
+      if ((f[i] > kIso) != (f[i + 1] > kIso)) return refine(ts[i], ts[i + 1], f[i], f[i + 1], depth, L);
       float t = searchHidden(ts, f, i, step, depth, depth + 1, L);
       if (t >= 0.0f) return t;
     }

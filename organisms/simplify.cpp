@@ -122,19 +122,19 @@ SimplifiedMesh simplifyMesh(const Mesh& mesh, size_t targetFaces, float maxRelat
   simplified.resize(count);
   float scale = meshopt_simplifyScale(xyz, welded, sizeof(Vec3));
   MeshTopology input = linkCheck ? topologyOf(indices) : MeshTopology{};
-  if (linkCheck && input.manifold()) {
-    MeshTopology result = topologyOf(simplified);
-    std::vector<unsigned int> unfolded = simplified;
-    if (!result.manifold() || result.boundaryEdges != input.boundaryEdges || dropFoldedPairs(unfolded) > 0) {
-      EdgeCollapseResult own = collapseEdges(weldedPositions, indices, target, maxRelativeError * scale);
-      simplified = std::move(own.indices);
-      count = simplified.size();
-      error = scale > 0 ? own.error / scale : 0;
-      report.linkChecked = true;
-    }
-  }
+  // Topology of the result as meshoptimizer made it, then its folds removed once.
+  MeshTopology result = linkCheck && input.manifold() ? topologyOf(simplified) : MeshTopology{};
   report.foldedPairs = dropFoldedPairs(simplified);
   count = simplified.size();
+  if (linkCheck && input.manifold() &&
+      (!result.manifold() || result.boundaryEdges != input.boundaryEdges || report.foldedPairs > 0)) {
+    EdgeCollapseResult own = collapseEdges(weldedPositions, indices, target, maxRelativeError * scale);
+    simplified = std::move(own.indices);
+    error = scale > 0 ? own.error / scale : 0;
+    report.linkChecked = true;
+    report.foldedPairs = dropFoldedPairs(simplified);  // none: kept for the case it ever has
+    count = simplified.size();
+  }
 
   // 3. Compact: only used vertices, in order of first use.
   std::vector<unsigned int> compact(welded);
