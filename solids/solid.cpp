@@ -5,7 +5,9 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <set>
 #include <stdexcept>
+#include <unordered_map>
 
 #include "core/parallel.h"
 #include "solids/chunked.h"
@@ -623,6 +625,80 @@ std::vector<int> tetMaterials(const Solid& solid, const Work& w) {
   return material;
 }
 
+/// A face of a tetrahedron as its three vertex ids, sorted.
+using FaceKey = std::array<uint32_t, 3>;
+FaceKey faceOf(const Tet& q, int skip) {
+  FaceKey f{};
+  for (int i = 0, n = 0; i < 4; ++i)
+    if (i != skip) f[size_t(n++)] = q[size_t(i)];
+  std::sort(f.begin(), f.end());
+  return f;
+}
+struct FaceKeyHash {
+  size_t operator()(const FaceKey& f) const { return (size_t(f[0]) * 0x9E3779B97F4A7C15ull) ^ (size_t(f[1]) * 0xC2B2AE3D27D4EB4Full) ^ f[2]; }
+};
+
+/// Step 6b of meshSolid: pockets of unclaimed space sealed on every side by tetrahedra with
+/// a material, each smaller than one grid cell, take the material most of their faces touch
+/// (ties: the lowest id). A pocket under the grid's resolution is no feature of the model:
+/// the tetrahedra of a cell whose centroids fall just outside a thin, nearly closed crease
+/// leave one (a sampled field cannot tell it from the wall around it). Pockets open to the
+/// outside, to a `nothing` layer or larger than a cell stay. Returns the pockets filled.
+size_t fillSealedSpecks(const Work& w, double cellVolume, std::vector<int>& material) {
+  std::vector<uint32_t> air;
+  for (size_t t = 0; t < material.size(); ++t)
+    if (material[t] == kUnclaimed) air.push_back(uint32_t(t));
+  // Pockets: the unclaimed tetrahedra joined across shared faces.
+  std::vector<std::pair<FaceKey, uint32_t>> faces;
+  faces.reserve(air.size() * 4);
+  for (uint32_t a = 0; a < air.size(); ++a)
+    for (int k = 0; k < 4; ++k) faces.emplace_back(faceOf(w.tets[air[a]], k), a);
+  std::sort(faces.begin(), faces.end());
+  std::vector<uint32_t> parent(air.size());
+  for (uint32_t a = 0; a < parent.size(); ++a) parent[a] = a;
+  auto root = [&](uint32_t a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  };
+  std::vector<std::pair<FaceKey, uint32_t>> open;  // faces of one unclaimed tetrahedron only
+  for (size_t i = 0; i < faces.size();) {
+    size_t j = i + 1;
+    while (j < faces.size() && faces[j].first == faces[i].first) ++j;
+    if (j - i == 1) open.push_back(faces[i]);
+    for (size_t k = i + 1; k < j; ++k) parent[root(faces[k].second)] = root(faces[i].second);
+    i = j;
+  }
+  std::map<uint32_t, double> volume;  // per pocket root
+  for (uint32_t a = 0; a < air.size(); ++a) {
+    const Tet& q = w.tets[air[a]];
+    volume[root(a)] += std::abs(det(w.positions[q[0]], w.positions[q[1]], w.positions[q[2]], w.positions[q[3]])) / 6.0;
+  }
+  // The small pockets' open faces, and what lies across each.
+  std::unordered_map<FaceKey, std::pair<uint32_t, int>, FaceKeyHash> across;  // face -> (pocket, material seen or -1)
+  for (const auto& [key, a] : open)
+    if (volume[root(a)] < cellVolume) across.emplace(key, std::make_pair(root(a), -1));
+  if (across.empty()) return 0;
+  for (size_t t = 0; t < material.size(); ++t)
+    if (material[t] >= 0)
+      for (int k = 0; k < 4; ++k)
+        if (auto it = across.find(faceOf(w.tets[t], k)); it != across.end()) it->second.second = material[t];
+  std::map<uint32_t, std::map<int, size_t>> votes;  // pocket -> material -> faces
+  std::set<uint32_t> leaky;
+  for (const auto& [key, v] : across) {
+    if (v.second < 0) leaky.insert(v.first);
+    else ++votes[v.first][v.second];
+  }
+  size_t filled = 0;
+  for (const auto& [pocket, count] : votes) {
+    if (leaky.count(pocket)) continue;
+    const int m = std::max_element(count.begin(), count.end(), [](const auto& x, const auto& y) { return x.second < y.second; })->first;
+    for (uint32_t a = 0; a < air.size(); ++a)
+      if (root(a) == pocket) material[air[a]] = m;
+    ++filled;
+  }
+  return filled;
+}
+
 }  // namespace
 
 TetMesh meshSolid(const Solid& solid, const Grid& grid, const MeshOptions& options, MeshStats* stats) {
@@ -645,7 +721,9 @@ TetMesh meshSolid(const Solid& solid, const Grid& grid, const MeshOptions& optio
   st.splits += splitProceduralLayers(solid, options, w);  // 4-5. procedural layers
   resolveFlatTets(solid, grid, w);
   // 6-7. Keep tetrahedra with a material; renumber the vertices they use in id order.
-  TetMesh mesh = compact(w, tetMaterials(solid, w));
+  std::vector<int> material = tetMaterials(solid, w);
+  st.sealedSpecks = fillSealedSpecks(w, grid.cell * grid.cell * grid.cell, material);
+  TetMesh mesh = compact(w, material);
   st.tets = mesh.tets.size();
   st.meshSeconds = secondsSince(t0);
   if (stats) *stats = st;

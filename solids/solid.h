@@ -111,6 +111,7 @@ struct MeshStats {
   size_t cellTets = 0;     ///< tetrahedral cells before splitting (5 per plain cube)
   size_t splits = 0;       ///< edges split at interface crossings
   size_t tets = 0;         ///< tetrahedra with a material in the result
+  size_t sealedSpecks = 0; ///< sealed pockets of unclaimed space under a cell's volume, filled (step 6b)
   double fieldSeconds = 0; ///< sampling the distance fields
   double meshSeconds = 0;  ///< cells, splits, materials
 };

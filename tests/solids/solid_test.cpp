@@ -201,6 +201,45 @@ Solid octahedronSolid() {
 
 }  // namespace
 
+TEST_CASE("meshSolid: a sealed pocket under one cell is filled, a larger one stays", "[solids]") {
+  // A chocolate ball (r 0.6) with a spherical hole around a grid node: radius 0.03 puts the
+  // node alone outside, and the cuts leave a pocket of 0.64 cell³ around it; radius 0.15 a
+  // pocket of about 0.014 = 110 cell³.
+  const double cell = 0.05;
+  const DVec3 at(0.1, 0.0, 0.05);  // a node of gridAround(0.8, 0.05)
+  auto holed = [&](double hole, MeshStats& st) {
+    Solid s;
+    Layer choc;
+    choc.fill = true;
+    choc.material = *s.materials.concrete("chocolate");
+    s.volumes.push_back(makeVolume(subtractionField(sphereField(DVec3(0.0), 0.6), sphereField(at, hole)), {choc}));
+    return meshSolid(s, gridAround(0.8, cell), {}, &st);
+  };
+  auto facesNearHole = [&](const TetMesh& m, double reach) {
+    size_t n = 0;
+    for (const auto& t : visibleInterface(m))
+      n += glm::length(m.positions[t.v[0]] - at) < reach;
+    return n;
+  };
+  MeshStats small, large;
+  const TetMesh ms = holed(0.03, small), ml = holed(0.15, large);
+  INFO("sealed specks filled: small hole " << small.sealedSpecks << ", large hole " << large.sealedSpecks);
+  CHECK(small.sealedSpecks == 1);
+  CHECK(facesNearHole(ms, 0.1) == 0);  // no surface left inside the ball
+  size_t filled = 0;
+  for (size_t t = 0; t < ms.tets.size(); ++t) {
+    DVec3 c(0.0);
+    for (uint32_t v : ms.tets[t]) c += ms.positions[v] * 0.25;
+    if (glm::length(c - at) < 0.02) {
+      ++filled;
+      CHECK(ms.materials[t] == uint16_t(*Solid().materials.concrete("chocolate")));
+    }
+  }
+  CHECK(filled > 0);
+  CHECK(large.sealedSpecks == 0);
+  CHECK(facesNearHole(ml, 0.2) > 100);  // the hole's wall stays
+}
+
 TEST_CASE("distance fields", "[solids]") {
   SECTION("primitives are Euclidean distances") {
     const std::vector<Vec3> pts = {{0, 0, 0}, {2, 0, 0}, {2, 2, 0}, {0, 0.25f, 0}};
