@@ -118,7 +118,7 @@ SimplifiedMesh simplifyMesh(const Mesh& mesh, size_t targetFaces, float maxRelat
   std::vector<unsigned int> simplified(indices.size());
   float error = 0;
   size_t count = meshopt_simplify(simplified.data(), indices.data(), indices.size(), xyz, welded, sizeof(Vec3),
-                                  target * 3, maxRelativeError, lockBorder ? meshopt_SimplifyLockBorder : 0u, &error);
+                                  target * 3, maxRelativeError, lockBorder ? unsigned(meshopt_SimplifyLockBorder) : 0u, &error);
   simplified.resize(count);
   float scale = meshopt_simplifyScale(xyz, welded, sizeof(Vec3));
   MeshTopology input = linkCheck ? topologyOf(indices) : MeshTopology{};

@@ -42,17 +42,6 @@ float fastExpNegative(float x) {
   return p * scale;
 }
 
-/// c^k for c in [0, 1] and a whole k >= 1, by squaring (k = 128: seven products).
-float powWhole(float c, unsigned k) {
-  float r = 1.0f;
-  while (k) {
-    if (k & 1u) r *= c;
-    c *= c;
-    k >>= 1;
-  }
-  return r;
-}
-
 /// What the filter reads of each pixel, made once from the layers.
 struct Guides {
   int width = 0, height = 0;

@@ -668,7 +668,7 @@ size_t fillSealedSpecks(const Work& w, double cellVolume, std::vector<int>& mate
     for (size_t k = i + 1; k < j; ++k) parent[root(faces[k].second)] = root(faces[i].second);
     i = j;
   }
-  std::map<uint32_t, double> volume;  // per pocket root
+  std::vector<double> volume(air.size(), 0.0);  // per pocket, at its root
   for (uint32_t a = 0; a < air.size(); ++a) {
     const Tet& q = w.tets[air[a]];
     volume[root(a)] += std::abs(det(w.positions[q[0]], w.positions[q[1]], w.positions[q[2]], w.positions[q[3]])) / 6.0;
@@ -688,15 +688,14 @@ size_t fillSealedSpecks(const Work& w, double cellVolume, std::vector<int>& mate
     if (v.second < 0) leaky.insert(v.first);
     else ++votes[v.first][v.second];
   }
-  size_t filled = 0;
-  for (const auto& [pocket, count] : votes) {
-    if (leaky.count(pocket)) continue;
-    const int m = std::max_element(count.begin(), count.end(), [](const auto& x, const auto& y) { return x.second < y.second; })->first;
+  std::map<uint32_t, int> fill;  // sealed pocket -> its material
+  for (const auto& [pocket, count] : votes)
+    if (!leaky.count(pocket))
+      fill[pocket] = std::max_element(count.begin(), count.end(), [](const auto& x, const auto& y) { return x.second < y.second; })->first;
+  if (!fill.empty())
     for (uint32_t a = 0; a < air.size(); ++a)
-      if (root(a) == pocket) material[air[a]] = m;
-    ++filled;
-  }
-  return filled;
+      if (auto it = fill.find(root(a)); it != fill.end()) material[air[a]] = it->second;
+  return fill.size();
 }
 
 }  // namespace
