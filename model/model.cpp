@@ -212,7 +212,8 @@ std::unique_ptr<BuiltScene> buildScene(SpeciesModel& model, const SpeciesRender&
   scene.setPixelFootprint(plan.camera, plan.width, plan.height, look.image.thinMinPixels);
   if (job.cellCamera) scene.setCellFootprint(*job.cellCamera, job.cellHeight);
   SpeciesRender seen = look;
-  seen.pixels = plan.camera.pixelScale(plan.height);
+  // The mesh mode polygonizes at the cells' pixel too.
+  seen.pixels = job.cellCamera ? job.cellCamera->pixelScale(job.cellHeight) : plan.camera.pixelScale(plan.height);
   ModelFigures& fig = built->figures;
   fig = model.addToScene(scene, job.stage, job.mode, seen);
   const auto t0 = std::chrono::steady_clock::now();

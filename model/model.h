@@ -142,8 +142,9 @@ struct RenderJob {
   bool progress = true;
   std::string progressLabel = "render";
   /// Implicit models' surface cells sized for this camera's pixel in an image cellHeight
-  /// rows tall instead of the picture's (render::Scene::setCellFootprint): renderInset's
-  /// close-up traced in the whole picture's cells. The same surface, another cost.
+  /// rows tall instead of the picture's (render::Scene::setCellFootprint; the mesh mode
+  /// polygonizes at that pixel too): renderInset's close-up traced in the whole picture's
+  /// cells. The same surface, another cost.
   std::optional<render::Camera> cellCamera;
   int cellHeight = 0;
 };
