@@ -210,8 +210,10 @@ std::unique_ptr<BuiltScene> buildScene(SpeciesModel& model, const SpeciesRender&
   auto built = std::make_unique<BuiltScene>();
   render::Scene& scene = built->scene;
   scene.setPixelFootprint(plan.camera, plan.width, plan.height, look.image.thinMinPixels);
+  if (job.cellCamera) scene.setCellFootprint(*job.cellCamera, job.cellHeight);
   SpeciesRender seen = look;
-  seen.pixels = plan.camera.pixelScale(plan.height);
+  // The mesh mode polygonizes at the cells' pixel too.
+  seen.pixels = job.cellCamera ? job.cellCamera->pixelScale(job.cellHeight) : plan.camera.pixelScale(plan.height);
   ModelFigures& fig = built->figures;
   fig = model.addToScene(scene, job.stage, job.mode, seen);
   const auto t0 = std::chrono::steady_clock::now();
@@ -346,11 +348,56 @@ Image renderPair(SpeciesModel& model, SpeciesModel& other, const SpeciesRender& 
   return out;
 }
 
+InsetPlace insetPlace(const InsetSpec& inset, int width, int height) {
+  InsetPlace p;
+  p.width = std::max(16, int(std::lround(inset.fraction * width)));
+  p.height = std::max(16, int(std::lround(inset.fraction * height)));
+  p.x = width - p.width;
+  p.y = height - p.height;
+  p.rule = 2 * pairDividerHalfWidth(p.width);
+  return p;
+}
+
+Image renderInset(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job, int width, int height,
+                  render::RenderStats* stats) {
+  const InsetSpec& inset = *look.inset;
+  const InsetPlace place = insetPlace(inset, width, height);
+  RenderJob insetJob = job;
+  insetJob.width = place.width;
+  insetJob.height = place.height;
+  insetJob.camera.reset();  // the inset's own close-up or camera
+  insetJob.frame.reset();
+  insetJob.progressLabel = job.progressLabel + " (inset)";
+  // Cells for the whole picture's camera: a close-up's own pixel would ask for the finest
+  // cells over the whole model (the nearest corner of its box is near the close-up's eye).
+  RenderJob whole = job;
+  whole.width = width;
+  whole.height = height;
+  insetJob.cellCamera = planFrame(model, look, whole).camera;
+  insetJob.cellHeight = height;
+  return renderModel(model, inset.look, insetJob, nullptr, stats);
+}
+
 Image renderPicture(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job, ModelFigures* figures,
                     render::RenderStats* stats) {
-  if (!look.pair) return renderModel(model, look, job, figures, stats);
-  SpeciesModel other(loadSpecies(*look.pair, model.species().policy));
-  return renderPair(model, other, look, job, figures, stats);
+  Image out;
+  if (!look.pair) {
+    out = renderModel(model, look, job, figures, stats);
+  } else {
+    SpeciesModel other(loadSpecies(*look.pair, model.species().policy));
+    out = renderPair(model, other, look, job, figures, stats);
+  }
+  if (!look.inset) return out;
+  render::RenderStats insetStats;
+  const Image detail = renderInset(model, look, job, out.width, out.height, &insetStats);
+  // The detail over the corner, a white rule along its top and left edges so it reads as
+  // its own picture.
+  const InsetPlace p = insetPlace(*look.inset, out.width, out.height);
+  for (int y = 0; y < p.height; ++y)
+    for (int x = 0; x < p.width; ++x)
+      out.set(p.x + x, p.y + y, (x < p.rule || y < p.rule) ? Vec4(1.0f) : detail.at(x, y));
+  if (stats) addStats(*stats, insetStats);
+  return out;
 }
 
 }  // namespace sprig

@@ -141,6 +141,12 @@ struct RenderJob {
   std::optional<render::Camera> camera;
   bool progress = true;
   std::string progressLabel = "render";
+  /// Implicit models' surface cells sized for this camera's pixel in an image cellHeight
+  /// rows tall instead of the picture's (render::Scene::setCellFootprint; the mesh mode
+  /// polygonizes at that pixel too): renderInset's close-up traced in the whole picture's
+  /// cells. The same surface, another cost.
+  std::optional<render::Camera> cellCamera;
+  int cellHeight = 0;
 };
 
 /// Most camera rays (width x height x samples per pixel) one image may take: 2^34, about
@@ -215,9 +221,26 @@ render::Camera pairCamera(SpeciesModel& model, SpeciesModel& other, const Specie
 Image renderPair(SpeciesModel& model, SpeciesModel& other, const SpeciesRender& look, const RenderJob& job,
                  ModelFigures* figures = nullptr, render::RenderStats* stats = nullptr);
 
+/// Where renderPicture draws look.inset into a width x height picture: the inset's size, its
+/// top left corner (the lower right corner of the picture) and the width of the white rule
+/// along its top and left edges (2 * pairDividerHalfWidth of the inset's width).
+struct InsetPlace {
+  int x = 0, y = 0, width = 0, height = 0, rule = 0;
+};
+InsetPlace insetPlace(const InsetSpec& inset, int width, int height);
+
+/// The inset of look's width x height picture: renderModel of model at job.stage with
+/// look.inset->look at insetPlace's size, framed by the inset's own close-up or camera
+/// (job.camera and job.frame are not used), its implicit cells sized for the whole
+/// picture's camera (RenderJob::cellCamera; job.camera, else the species' framing).
+/// Throws as renderModel.
+Image renderInset(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job, int width, int height,
+                  render::RenderStats* stats = nullptr);
+
 /// The species' picture, as `sprig render` and the gallery's final stage show it: with
 /// look.pair, renderPair with that species (loaded under the model's species' path policy;
-/// its own `pair` is not followed); else renderModel. Throws InputError for the other
+/// its own `pair` is not followed); else renderModel. With look.inset, renderInset drawn
+/// over the lower right corner (insetPlace) of either. Throws InputError for the other
 /// species' errors too.
 Image renderPicture(SpeciesModel& model, const SpeciesRender& look, const RenderJob& job, ModelFigures* figures = nullptr,
                     render::RenderStats* stats = nullptr);

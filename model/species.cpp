@@ -93,6 +93,30 @@ void readCamera(MapReader& m, SpeciesRender& r, DiagnosticList& diags) {
   }
 }
 
+/// `render.inset`: read after every other `render:` key, since the inset's look starts as a
+/// copy of the species' (its own camera and light replacing the species').
+std::shared_ptr<const InsetSpec> readInset(MapReader& m, const SpeciesRender& parent, DiagnosticList& diags) {
+  auto spec = std::make_shared<InsetSpec>();
+  spec->fraction = m.number({"fraction", "The inset's width and height as a fraction of the picture's."}, spec->fraction, 0.1, 0.6);
+  SpeciesRender& look = spec->look;
+  look = parent;
+  look.inset.reset();
+  look.pair.reset();
+  look.camera.reset();
+  look.closeUp.reset();
+  if (auto v = m.section({"view", "The inset camera's direction: `azimuth`, `elevation`, `fov`, `margin` (default: the picture's)."})) {
+    MapReader view(*v, diags, "render.inset.view");
+    readView(view, look.view);
+  }
+  readLights(m, look.image, diags);
+  readCamera(m, look, diags);
+  look.image.exposure = static_cast<float>(m.number({"exposure", "The inset's exposure in stops (default: the picture's)."}, look.image.exposure, -10.0, 10.0));
+  look.image.fillStrength = static_cast<float>(m.number({"fill", "The inset's fill light from the camera (default: the picture's)."}, look.image.fillStrength, 0.0, 10.0));
+  look.image.skyStrength = static_cast<float>(m.number({"sky", "The inset's sky light (default: the picture's)."}, look.image.skyStrength, 0.0, 10.0));
+  m.finish();
+  return spec;
+}
+
 void readRender(MapReader& m, SpeciesRender& r, const PathPolicy& policy, DiagnosticList& diags) {
   render::RenderSettings& im = r.image;
   im.width = static_cast<int>(m.integer({"width", "Image width in pixels."}, im.width, 16, 8192));
@@ -158,6 +182,10 @@ void readRender(MapReader& m, SpeciesRender& r, const PathPolicy& policy, Diagno
     if (auto col = c.asColor(diags, "'palette' entry")) r.style.palette.push_back(*col);
   r.style.radiusScale = m.number({"radius_scale", "Preview: multiplies every internode radius."}, r.style.radiusScale, 1e-6, 1e6);
   r.style.organs = m.boolean({"organs", "Preview: draw organs (leaves, flowers, fruits)."}, r.style.organs);
+  if (auto s = m.section({"inset", "A detail drawn into the picture's lower right corner: the same stage through the inset's own `close_up` (or `camera`), `view`, `sun`, `rim`, `fill`, `sky` and `exposure`, `fraction` of the picture's width and height (a whole tree with one crotch of it)."})) {
+    MapReader inset(*s, diags, "render.inset");
+    r.inset = readInset(inset, r, diags);
+  }
   m.finish();
 }
 

@@ -81,6 +81,8 @@ enum class RestPose {
   ApertureDown,  ///< `aperture_down`: the same, put down aperture down
 };
 
+struct InsetSpec;
+
 /// How a species is shown (`render:`): the renderer's settings for its image, camera,
 /// preview style and surface material.
 struct SpeciesRender {
@@ -95,6 +97,9 @@ struct SpeciesRender {
   /// two panels side by side, this species and the other at its final stage, seen by one
   /// camera (renderPair, model/model.h). Resolved against the species file's folder.
   std::optional<std::filesystem::path> pair;
+  /// `inset:`: a detail drawn into the picture's lower right corner (renderPicture,
+  /// model/model.h): the same stage seen by the inset's own close-up, camera and light.
+  std::shared_ptr<const InsetSpec> inset;
   /// Shells: `rest:` the pose pictures show the shell in (model/shell_kind.h); exports,
   /// `sprig mesh` and the model's measures keep the model's own frame.
   RestPose rest = RestPose::None;
@@ -129,6 +134,16 @@ struct SpeciesRender {
 
   /// Renderer settings for an image of width x height.
   render::RenderSettings settings(int imageWidth, int imageHeight) const;
+};
+
+/// `render.inset`: a detail of the model drawn into the lower right corner of its picture
+/// (whole + detail in one still: a whole tree and one crotch of it). The inset is `fraction`
+/// of the picture's width and height and is rendered with `look`: the species' own `render:`
+/// settings with the inset's `view`, `close_up` or `camera`, `sun`, `rim`, `fill`, `sky` and
+/// `exposure` in their place.
+struct InsetSpec {
+  double fraction = 0.4;  ///< `fraction`: the inset's width and height over the picture's
+  SpeciesRender look;     ///< how the inset is rendered (no inset or pair of its own)
 };
 
 /// One species, read and checked.

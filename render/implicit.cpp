@@ -199,11 +199,12 @@ uint32_t Scene::addImplicit(const blobtree::CompiledBlob& blob, uint32_t materia
   Box3 support = blob.bounds();
   if (!support.empty()) {
     float cellSize = options.cellSize > 0 ? options.cellSize : blobtree::autoCellSize(blob, kTracerCells);
-    if (impl_->view && options.followPixels) {
+    const std::optional<detail::PixelView>& view = impl_->cellView ? impl_->cellView : impl_->view;
+    if (view && options.followPixels) {
       PixelScale pixels;
-      pixels.eye = impl_->view->eye;
-      pixels.forward = impl_->view->forward;
-      pixels.pixelPerDepth = impl_->view->pixelPerDepth;
+      pixels.eye = view->eye;
+      pixels.forward = view->forward;
+      pixels.pixelPerDepth = view->pixelPerDepth;
       const float own = cellSize;
       cellSize = pixelCellSize(own, pixels, support);
       impl_->followedCells.push_back({own, cellSize, support});  // another camera may give another cell

@@ -232,6 +232,17 @@ void Scene::setPixelFootprint(const Camera& camera, int width, int height, float
   impl_->footprint = f;
 }
 
+void Scene::setCellFootprint(const Camera& camera, int height) {
+  if (impl_->anyGeometry) throw std::logic_error("Scene::setCellFootprint after geometry was added");
+  impl_->cellView.reset();
+  if (height < 1) return;
+  detail::PixelView v;
+  v.eye = camera.position;
+  v.forward = camera.basis().forward;
+  v.pixelPerDepth = camera.pixelPerDepth(height);
+  impl_->cellView = v;
+}
+
 uint32_t Scene::Impl::addCurveGeometry(std::shared_ptr<detail::CurveData> data, uint32_t material) {
   data->drawn = data->real;
   if (footprint) {
@@ -494,7 +505,7 @@ SceneStats Scene::stats() const { return impl_->stats; }
 bool Scene::servesCamera(const Camera& camera, int width, int height) const {
   if (impl_->followsCamera) return false;
   if (impl_->followedCells.empty()) return true;
-  if (width < 1 || height < 1 || !impl_->view) return false;
+  if (width < 1 || height < 1 || !impl_->view || impl_->cellView) return false;
   const PixelScale pixels = camera.pixelScale(height);
   for (const Impl::FollowedCell& c : impl_->followedCells)
     if (pixelCellSize(c.ownCell, pixels, c.support) != c.usedCell) return false;

@@ -111,6 +111,12 @@ class Scene {
   /// The camera's pixel also sets the texel footprint of image maps (MeshPart::image: the
   /// choice of their magnification or minification filter), whatever minPixels is.
   void setPixelFootprint(const Camera& camera, int width, int height, float minPixels = kThinMinPixels);
+  /// Implicit models added afterwards size their cells (ImplicitOptions::followPixels) for
+  /// camera's pixel in an image height rows tall instead of the footprint's camera: a close-up
+  /// traced in the cells of a distant camera (model/model.h renderInset). The surface is the
+  /// same (the tracer is exact in a cell of any size); coarser cells cost less to build and
+  /// more per ray. Call before adding geometry (throws std::logic_error after).
+  void setCellFootprint(const Camera& camera, int height);
   /// false: every implicit part added afterwards traces the whole tape in each cell, whatever
   /// its ImplicitOptions::prunedTapes says (the reference the pruned tapes are checked
   /// against). Default: prunedTapesDefault().

@@ -109,6 +109,8 @@ struct Scene::Impl {
   bool anyGeometry = false;               ///< something was added (the footprint is fixed then)
   std::optional<PixelFootprint> footprint;  ///< minimum width of thin curves, when set
   std::optional<detail::PixelView> view;    ///< the camera's pixel, when set (image maps)
+  /// setCellFootprint's camera: implicit models' cells follow its pixel instead of view's.
+  std::optional<detail::PixelView> cellView;
   /// Something added was shaped by the footprint or the view beyond an implicit model's
   /// cell size (curves, thin axes, image maps): no other camera is served (Scene::servesCamera).
   bool followsCamera = false;
