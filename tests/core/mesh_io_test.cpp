@@ -408,9 +408,9 @@ TEST_CASE("writeParts::texture", "[core]") {
   }
   SECTION("obj: -clamp on where the glTF sampler clamps both axes, not where one repeats") {
     ExportPart clamped = quad;
-    auto tex = std::make_shared<PartTexture>(*quad.material.texture);
-    tex->seams.repeatU = false;  // both axes clamp, as an atlas's and cpfg leaves' do
-    clamped.material.texture = tex;
+    auto clampedTex = std::make_shared<PartTexture>(*quad.material.texture);
+    clampedTex->seams.repeatU = false;  // both axes clamp, as an atlas's and cpfg leaves' do
+    clamped.material.texture = clampedTex;
     clamped.material.alphaCutoff = 0.1f;
     writeParts({clamped}, dir.path / "k.obj");
     CHECK(readFile(dir.path / "k.mtl").find("map_Kd -clamp on k_bark.png\nmap_d -clamp on k_bark.png\n") != std::string::npos);
@@ -431,11 +431,11 @@ TEST_CASE("writeParts::texture", "[core]") {
     CHECK(dir.entries() == 0);
   }  SECTION("a cut-out: alpha kept (RGBA PNG), glTF MASK with its cutoff, MTL map_d, the sampler's filters") {
     ExportPart cut = quad;
-    auto tex = std::make_shared<PartTexture>(*quad.material.texture);
-    tex->image.set(1, 0, Vec4(1, 0, 0, 0));  // one transparent texel
-    tex->magFilter = PartTexture::Filter::Nearest;
-    tex->minFilter = PartTexture::Filter::Linear;
-    cut.material.texture = tex;
+    auto cutTex = std::make_shared<PartTexture>(*quad.material.texture);
+    cutTex->image.set(1, 0, Vec4(1, 0, 0, 0));  // one transparent texel
+    cutTex->magFilter = PartTexture::Filter::Nearest;
+    cutTex->minFilter = PartTexture::Filter::Linear;
+    cut.material.texture = cutTex;
     cut.material.alphaCutoff = 0.1f;
     const fs::path glb = dir.path / "c.glb";
     writeParts({cut}, glb);

@@ -531,10 +531,10 @@ TEST_CASE("cpfg parity: @L labels in interpretation rules are read and drawn as 
   }
   SECTION("a format whose conversions outnumber the values, or are not numbers, is an error") {
     Grammar g = parseGrammar("axiom: A\nhomomorphism\nA --> F@L(\"%g and %g\", 1)\nendlsystem\n", "t.l");
-    Deriver d(g);
+    Deriver dg(g);
     TurtleSettings ts = *p.turtle;
     ts.labelFormats = g.strings();
-    CHECK_THROWS_WITH(Turtle(g.symbols(), ts).run(d.interpret(d.current())),
+    CHECK_THROWS_WITH(Turtle(g.symbols(), ts).run(dg.interpret(dg.current())),
                       Catch::Contains("cpfg's '@L(\"%g and %g\", ...)' has 2 conversions for 1 values"));
     Grammar h = parseGrammar("axiom: A\nhomomorphism\nA --> F@L(\"%s\", 1)\nendlsystem\n", "t.l");
     Deriver dh(h);

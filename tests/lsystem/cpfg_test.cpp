@@ -154,7 +154,6 @@ TEST_CASE("cpfg objects", "[lsystem][cpfg]") {
     checkNear(o.skeleton.internodes[2].end, DVec3(4, 1, 1));    // @R(1,0,0): heading +X
     checkNear(o.skeleton.internodes[3].end, DVec3(4, 1, 2));    // @R(0,0,1, 0,1,0): heading +Z
     // &(45) after H = +Z, U = -(cpfg's up) = -Y: H = (0, s, c); @v: L = Y x H normalized = +X.
-    const double r2 = std::sqrt(0.5);
     checkNear(o.skeleton.internodes[4].end, DVec3(4, 1 + r2, 2 + r2));
     checkNear(o.end.frame.left, DVec3(1, 0, 0));
     checkNear(o.end.frame.up, DVec3(0, r2, -r2));
