@@ -4,7 +4,7 @@
 
 #include <glm/geometric.hpp>
 
-#include <smmintrin.h>
+#include <immintrin.h>
 
 #include <algorithm>
 #include <cmath>
@@ -95,6 +95,11 @@ inline BendPolar bendLocal(const BendFrame& f, float px, float py, float pz, flo
   return {uu, vv, rp};
 }
 
+// The lane types and bendLanes in SSE (the build's baseline), for the array form below.
+#define SPRIG_LANES_AVX2 0
+#include "blobtree/detail/lanes.inc"
+#undef SPRIG_LANES_AVX2
+
 }  // namespace
 
 float atan2Approx(float y, float x) { return atan2Fast(y, x); }
@@ -117,53 +122,11 @@ Vec3 BendFrame::localFromWorld(Vec3 p, Mat3* jt) const {
 
 void BendFrame::localFromWorld(const float* x, const float* y, const float* z, float* lx, float* ly, float* lz,
                                int count) const {
-  if (straight) {
-    std::copy(x, x + count, lx);
-    std::copy(y, y + count, ly);
-    std::copy(z, z + count, lz);
-    return;
-  }
-  // Four points per step: the operations of bendLocal and atan2Fast in the same order, each
-  // correctly rounded in SSE as in scalar code (no FMA on the x86-64-v2 target), so the
-  // same bits; the selects are blends.
-  const __m128 Cx = _mm_set1_ps(C.x), Cy = _mm_set1_ps(C.y), Cz = _mm_set1_ps(C.z);
-  const __m128 ux = _mm_set1_ps(u.x), uy = _mm_set1_ps(u.y), uz = _mm_set1_ps(u.z);
-  const __m128 nx = _mm_set1_ps(n.x), ny = _mm_set1_ps(n.y), nz = _mm_set1_ps(n.z);
-  const __m128 zx = _mm_set1_ps(this->z.x), zy = _mm_set1_ps(this->z.y), zz = _mm_set1_ps(this->z.z);
-  const __m128 Mx = _mm_set1_ps(M.x), My = _mm_set1_ps(M.y), Mz = _mm_set1_ps(M.z);
-  const __m128 k = _mm_set1_ps(rho * stretch), rhoV = _mm_set1_ps(rho);
-  const __m128 zero = _mm_setzero_ps(), one = _mm_set1_ps(1.0f), sign = _mm_set1_ps(-0.0f);
-  int i = 0;
-  for (; i + 4 <= count; i += 4) {
-    const __m128 rx = _mm_sub_ps(_mm_loadu_ps(x + i), Cx);
-    const __m128 ry = _mm_sub_ps(_mm_loadu_ps(y + i), Cy);
-    const __m128 rz = _mm_sub_ps(_mm_loadu_ps(z + i), Cz);
-    const __m128 uu = _mm_add_ps(_mm_add_ps(_mm_mul_ps(rx, ux), _mm_mul_ps(ry, uy)), _mm_mul_ps(rz, uz));
-    const __m128 vv = _mm_add_ps(_mm_add_ps(_mm_mul_ps(rx, nx), _mm_mul_ps(ry, ny)), _mm_mul_ps(rz, nz));
-    const __m128 ww = _mm_add_ps(_mm_add_ps(_mm_mul_ps(rx, zx), _mm_mul_ps(ry, zy)), _mm_mul_ps(rz, zz));
-    const __m128 rp = _mm_sqrt_ps(_mm_add_ps(_mm_mul_ps(uu, uu), _mm_mul_ps(vv, vv)));
-    // atan2Fast(uu, vv)
-    const __m128 ax = _mm_andnot_ps(sign, vv), ay = _mm_andnot_ps(sign, uu);
-    const __m128 mx = _mm_max_ps(ax, ay), mn = _mm_min_ps(ax, ay);
-    __m128 a = _mm_div_ps(mn, _mm_blendv_ps(one, mx, _mm_cmpgt_ps(mx, zero)));
-    const __m128 upper = _mm_cmpgt_ps(a, _mm_set1_ps(0.41421356f));
-    const __m128 reduced = _mm_div_ps(_mm_sub_ps(a, one), _mm_add_ps(a, one));
-    a = _mm_blendv_ps(a, reduced, upper);
-    const __m128 w2 = _mm_mul_ps(a, a);
-    __m128 r = _mm_sub_ps(_mm_mul_ps(_mm_set1_ps(8.05374449538e-2f), w2), _mm_set1_ps(1.38776856032e-1f));
-    r = _mm_add_ps(_mm_mul_ps(r, w2), _mm_set1_ps(1.99777106478e-1f));
-    r = _mm_sub_ps(_mm_mul_ps(r, w2), _mm_set1_ps(3.33329491539e-1f));
-    r = _mm_add_ps(_mm_mul_ps(_mm_mul_ps(r, w2), a), a);
-    r = _mm_blendv_ps(r, _mm_add_ps(r, _mm_set1_ps(0.78539816f)), upper);
-    r = _mm_blendv_ps(r, _mm_sub_ps(_mm_set1_ps(1.57079633f), r), _mm_cmpgt_ps(ay, ax));
-    r = _mm_blendv_ps(r, _mm_sub_ps(_mm_set1_ps(3.14159265f), r), _mm_cmplt_ps(vv, zero));
-    r = _mm_blendv_ps(r, _mm_xor_ps(r, sign), _mm_cmplt_ps(uu, zero));
-    const __m128 px = _mm_mul_ps(r, k), py = _mm_sub_ps(rp, rhoV);
-    _mm_storeu_ps(lx + i, _mm_add_ps(_mm_add_ps(_mm_add_ps(Mx, _mm_mul_ps(px, ux)), _mm_mul_ps(py, nx)), _mm_mul_ps(ww, zx)));
-    _mm_storeu_ps(ly + i, _mm_add_ps(_mm_add_ps(_mm_add_ps(My, _mm_mul_ps(px, uy)), _mm_mul_ps(py, ny)), _mm_mul_ps(ww, zy)));
-    _mm_storeu_ps(lz + i, _mm_add_ps(_mm_add_ps(_mm_add_ps(Mz, _mm_mul_ps(px, uz)), _mm_mul_ps(py, nz)), _mm_mul_ps(ww, zz)));
-  }
-  for (; i < count; ++i) bendLocal(*this, x[i], y[i], z[i], lx[i], ly[i], lz[i]);
+  // Four points per SSE step (lanes.inc's bendLanes, which batch_eval.cpp also runs eight
+  // to a step in its AVX2 region), the rest one by one: the same bits either way.
+  const int n4 = straight ? count : count & ~3;
+  bendLanes<F4>(*this, x, y, z, lx, ly, lz, n4);
+  for (int i = n4; i < count; ++i) bendLocal(*this, x[i], y[i], z[i], lx[i], ly[i], lz[i]);
 }
 
 Vec3 BendFrame::worldFromLocal(Vec3 q) const {

@@ -8,6 +8,7 @@
 
 #include "blobtree/blobtree.h"
 #include "blobtree/compiled.h"
+#include "blobtree/detail/batch_eval.h"
 #include "core/rng.h"
 
 #include <cmath>
@@ -723,4 +724,58 @@ TEST_CASE("CompiledBlob::values: a batch of 8 has the bits of the same points in
   }
   CHECK(compared == 2 * 2700);
   CHECK(positive > 500);  // the points reach the field, not just empty space
+}
+
+TEST_CASE("evalBatch: the AVX2 walk has the bits of the baseline walk", "[blobtree]") {
+  // The batch walk is compiled for the x86-64-v2 baseline (SSE) and for AVX2 and picked at
+  // run time (blobtree/detail/batch_eval.cpp); the two must agree to the bit, or an image
+  // would depend on the CPU. Random batches of 1 to 8 points (the tracer's fixed width) and
+  // of 9 to 300 (the block width: the polygonizer, the free sub-cells' 64 centres), as ray
+  // samples and as scattered points, through bent cones under PCM and sum groups and
+  // through the scene of every operator, each evaluated with both walks.
+  using detail::BatchIsa;
+  if (!detail::batchIsaSupported(BatchIsa::Avx2)) {
+    WARN("this CPU has no AVX2: the AVX2 walk is not compared");
+    return;
+  }
+  struct Restore {
+    BatchIsa isa = detail::batchIsa();
+    ~Restore() { detail::setBatchIsa(isa); }
+  } restore;
+  uint64_t seed = GENERATE(51u, 52u);
+  INFO("seed " << seed);
+  BentGroups scene(seed);
+  auto&& [rng, t, root, every] = SeededScene(seed);
+  int compared = 0, positive = 0;
+  for (const CompiledBlob* b : {&scene.blob, &every}) {
+    const Box3 box = b->bounds();
+    for (int k = 0; k < 400; ++k) {
+      std::vector<Vec3> pts;
+      const size_t count = k % 2 == 0 ? size_t(1 + k % 8) : size_t(9 + rng.below(292));
+      if (k % 4 < 2 && b == &scene.blob) {  // ray samples near a bent cone, as the tracer takes them
+        while (pts.size() < count) {
+          const std::vector<Vec3> seg = scene.segment();
+          pts.insert(pts.end(), seg.begin(), seg.end());
+        }
+        pts.resize(count);
+      } else {  // scattered points of a random box inside the scene's
+        const Vec3 c = randomIn(rng, box.lo, box.hi), h = randomIn(rng, Vec3(0.01f), Vec3(0.5f));
+        for (size_t i = 0; i < count; ++i) pts.push_back(c + randomIn(rng, -h, h));
+      }
+      std::vector<float> base(count), avx(count);
+      detail::setBatchIsa(BatchIsa::Baseline);
+      b->values(pts, base);
+      REQUIRE(detail::setBatchIsa(BatchIsa::Avx2) == BatchIsa::Baseline);
+      b->values(pts, avx);
+      REQUIRE(detail::batchIsa() == BatchIsa::Avx2);
+      for (size_t i = 0; i < count; ++i) {
+        INFO("p = (" << pts[i].x << ", " << pts[i].y << ", " << pts[i].z << "), " << count << " points");
+        CHECK(std::bit_cast<uint32_t>(base[i]) == std::bit_cast<uint32_t>(avx[i]));
+        ++compared;
+        positive += base[i] > 0.0f;
+      }
+    }
+  }
+  CHECK(compared > 20000);
+  CHECK(positive > 2000);  // the points reach the field, not just empty space
 }
