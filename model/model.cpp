@@ -210,6 +210,7 @@ std::unique_ptr<BuiltScene> buildScene(SpeciesModel& model, const SpeciesRender&
   auto built = std::make_unique<BuiltScene>();
   render::Scene& scene = built->scene;
   scene.setPixelFootprint(plan.camera, plan.width, plan.height, look.image.thinMinPixels);
+  scene.setExpectedSamples(plan.camera, plan.width, plan.height, job.samples > 0 ? job.samples : look.image.spp);
   SpeciesRender seen = look;
   seen.pixels = plan.camera.pixelScale(plan.height);
   ModelFigures& fig = built->figures;
