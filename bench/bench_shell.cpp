@@ -81,6 +81,9 @@ Result run(const organisms::ShellParams& params, const Args& a, const std::strin
 
   t = Clock::now();
   render::Scene scene;
+  // The camera framed on the blob's bounds: the one framed on the scene's below differs
+  // little, and only the cost of the free sub-cells' proofs depends on it.
+  scene.setExpectedSamples(bench::benchCamera(blob.bounds(), 25, 10, a.width, a.height), a.width, a.height, a.spp);
   const uint32_t material = scene.addMaterial(render::Material{painter->options().whorlColor, 0.35f, 0.05f, 0});
   for (auto part : {organisms::ShellPart::Whorl, organisms::ShellPart::VarixSpine, organisms::ShellPart::AxialSpine,
                     organisms::ShellPart::Bump, organisms::ShellPart::Inside})

@@ -106,9 +106,12 @@ void benchCulling(const blobtree::CompiledBlob& compiled) {
               bruteRate, culledRate / bruteRate, sink);
 }
 
-/// A scene with the bark texture and the wood material (id 0) and compiled under io;
-/// returns the surface cells' wall and CPU seconds.
-std::pair<double, double> woodScene(render::Scene& scene, const blobtree::CompiledBlob& compiled, const render::ImplicitOptions& io) {
+/// A scene with the bark texture and the wood material (id 0) and compiled under io, for
+/// a.spp samples of a.width x a.height through camera; returns the surface cells' wall and
+/// CPU seconds.
+std::pair<double, double> woodScene(render::Scene& scene, const blobtree::CompiledBlob& compiled, const render::ImplicitOptions& io,
+                                    const render::Camera& camera, const Args& a) {
+  scene.setExpectedSamples(camera, a.width, a.height, a.spp);
   auto bark = std::make_shared<textures::BarkTexture>(textures::BarkOptions{});
   scene.addTexture([bark](Vec2 uv, const Vec3&) { return bark->color(uv); });
   const uint32_t wood = scene.addMaterial(render::Material{Vec3(0.62f, 0.60f, 0.52f), 0.7f, 0.03f, 0});
@@ -136,8 +139,8 @@ void benchExactRender(const blobtree::CompiledBlob& compiled, const Args& a) {
   render::ImplicitOptions io;
   io.cellSize = a.cell;
   render::Scene scene;
-  const auto [sceneS, sceneCpu] = woodScene(scene, compiled, io);
   const render::Camera camera = bench::benchCamera(compiled.bounds(), 20, 8, a.width, a.height);
+  const auto [sceneS, sceneCpu] = woodScene(scene, compiled, io, camera, a);
   render::RenderSettings rs = bench::benchSettings(a.width, a.height, a.spp);
   render::RenderStats stats;
   double renderS = 0, renderCpu = 0;
@@ -158,7 +161,7 @@ void benchExactRender(const blobtree::CompiledBlob& compiled, const Args& a) {
     render::Scene full;
     render::ImplicitOptions fullOpt = io;
     fullOpt.prunedTapes = false;
-    const auto [fullSceneS, fullSceneCpu] = woodScene(full, compiled, fullOpt);
+    const auto [fullSceneS, fullSceneCpu] = woodScene(full, compiled, fullOpt, camera, a);
     render::RenderStats fullStats;
     double fullS = 0, fullCpu = 0;
     Image fullImage = timedRender(full, camera, rs, fullStats, fullS, fullCpu);
@@ -170,7 +173,7 @@ void benchExactRender(const blobtree::CompiledBlob& compiled, const Args& a) {
   render::Scene ref;
   render::ImplicitOptions refOpt = io;
   refOpt.batched = false;
-  woodScene(ref, compiled, refOpt);
+  woodScene(ref, compiled, refOpt, camera, a);
   rs.width = std::max(16, a.width / 6);
   rs.height = std::max(16, a.height / 6);
   rs.spp = 1;

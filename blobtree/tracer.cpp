@@ -315,15 +315,63 @@ SubCellBounds::Bound SubCellBounds::segment(uint32_t cellIndex, const Ray& ray, 
 
 // ---- FreeSubCells --------------------------------------------------------------------------
 
-FreeSubCells::FreeSubCells(const CellSet& cells, const CompiledBlob& blob) : masks_(cells.cells.size(), 0) {
+FreeSubCells::FreeSubCells(const CellSet& cells, const CompiledBlob& blob)
+    : cells_(&cells), blob_(&blob), entries_(cells.cells.size()) {
   parallelFor(0, cells.cells.size(), [&](size_t i) {
     const Cell& c = cells.cells[i];
-    masks_[i] = freeMask(c, cells.tapeOf(c, blob));
+    entries_[i] = {freeMask(c, cells.tapeOf(c, blob)), kProven};
   }, 256);
 }
 
-bool FreeSubCells::spanFree(const Cell& c, uint32_t cellIndex, const Ray& ray, float a, float b) const {
-  const uint64_t free = masks_[cellIndex];
+FreeSubCells::FreeSubCells(const CellSet& cells, const CompiledBlob& blob, uint32_t proveAt)
+    : cells_(&cells), blob_(&blob), proveAt_(proveAt), entries_(cells.cells.size()) {}
+
+void FreeSubCells::prove(std::span<const uint32_t> cells) {
+  parallelFor(0, cells.size(), [&](size_t i) {
+    if (!proven(cells[i])) proveOne(cells[i]);
+  }, 256);
+}
+
+uint64_t FreeSubCells::proveOne(uint32_t c) const {
+  const Cell& cell = cells_->cells[c];
+  const uint64_t m = freeMask(cell, cells_->tapeOf(cell, *blob_));
+  Entry& e = entries_[c];
+  std::atomic_ref<uint64_t>(e.mask).store(m, std::memory_order_relaxed);
+  std::atomic_ref<uint32_t>(e.traces).fetch_or(kProven, std::memory_order_release);
+  return m;
+}
+
+bool FreeSubCells::proven(uint32_t c) const {
+  return (std::atomic_ref<uint32_t>(entries_[c].traces).load(std::memory_order_acquire) & kProven) != 0;
+}
+
+size_t FreeSubCells::provenCount() const {
+  size_t n = 0;
+  for (uint32_t c = 0; c < entries_.size(); ++c) n += proven(c);
+  return n;
+}
+
+uint64_t FreeSubCells::mask(uint32_t c) const {
+  if (!proven(c)) return proveOne(c);
+  return std::atomic_ref<uint64_t>(entries_[c].mask).load(std::memory_order_relaxed);
+}
+
+uint64_t FreeSubCells::enter(uint32_t c) const {
+  Entry& e = entries_[c];
+  std::atomic_ref<uint32_t> traces(e.traces);
+  uint32_t n = traces.load(std::memory_order_acquire);
+  if (!(n & kProven)) {
+    if (proveAt_ == 0) return 0;
+    // Only the trace that brings the count to proveAt proves; the traces racing it, or
+    // coming before it is done, use no mask (the same result, with batches).
+    n = traces.fetch_add(1, std::memory_order_acq_rel) + 1;
+    if (n == proveAt_) return proveOne(c);
+    if (!(n & kProven)) return 0;
+  }
+  return std::atomic_ref<uint64_t>(e.mask).load(std::memory_order_relaxed);
+}
+
+bool FreeSubCells::spanFree(const Cell& c, uint64_t free, const Ray& ray, float a, float b) {
   if (free == 0) return false;
   const float margin = kMarginCells * (c.box.hi.x - c.box.lo.x);
   uint64_t inRange = ~uint64_t(0);
@@ -334,17 +382,21 @@ bool FreeSubCells::spanFree(const Cell& c, uint32_t cellIndex, const Ray& ray, f
   return (inRange & ~free) == 0;
 }
 
+bool FreeSubCells::spanFree(const Cell& c, uint32_t cellIndex, const Ray& ray, float a, float b) const {
+  return spanFree(c, mask(cellIndex), ray, a, b);
+}
+
 size_t FreeSubCells::dropWhole(CellSet& cells) {
   size_t kept = 0;
   for (size_t i = 0; i < cells.cells.size(); ++i) {
-    if (masks_[i] == kWhole) continue;
+    if (proven(uint32_t(i)) && entries_[i].mask == kWhole) continue;
     cells.cells[kept] = cells.cells[i];
-    masks_[kept] = masks_[i];
+    entries_[kept] = entries_[i];
     ++kept;
   }
   const size_t dropped = cells.cells.size() - kept;
   cells.cells.resize(kept);
-  masks_.resize(kept);
+  entries_.resize(kept);
   return dropped;
 }
 
@@ -357,7 +409,7 @@ std::optional<float> traceCell(const CompiledBlob& blob, const Cell& cell, const
                                float tolerance, Crossing mode, const FreeSubCells& free, const SubCellBounds* sub,
                                uint32_t cellIndex) {
   if (!clipToBox(cell.box, ray.origin, ray.direction, t0, t1)) return std::nullopt;
-  if (free.size() > 0 && free.spanFree(cell, cellIndex, ray, t0, t1)) return std::nullopt;
+  if (free.size() > 0 && FreeSubCells::spanFree(cell, free.enter(cellIndex), ray, t0, t1)) return std::nullopt;
   float lipschitz = std::max(cell.lipschitz, 1e-30f) * glm::length(ray.direction);
   float t = BatchTracer(blob, ray, lipschitz, mode, sub, cellIndex).trace(t0, t1, tolerance);
   if (t >= 0.0f) return t;

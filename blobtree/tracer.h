@@ -21,6 +21,7 @@
 #include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <vector>
 
 namespace sprig::blobtree {
@@ -125,20 +126,27 @@ class SubCellBounds {
   std::unique_ptr<uint32_t[], Free> traces_;  ///< per cell, saturating at kWarmTraces
 };
 
-/// The sub-cells of each surface cell on which F provably stays off 0.5, found once when
-/// the cells are made: each cell is split into 4 x 4 x 4 sub-cells, F is evaluated at
-/// their 64 centres with the cell's tape (one batched walk), and a sub-cell is free of the
-/// surface when |F(centre) − 0.5| exceeds L·r plus kValueMargin, with L the tape's
-/// Lipschitz bound over the cell widened by kMarginCells of its edge and r the half
-/// diagonal of the sub-cell widened by twice that. The widening covers the tracer's samples,
-/// which rounding can put just outside the cell; kValueMargin covers the rounding of the
-/// field's values and the pruned tape's differences from the whole one.
+/// The sub-cells of each surface cell on which F provably stays off 0.5: each cell is split
+/// into 4 x 4 x 4 sub-cells, F is evaluated at their 64 centres with the cell's tape (one
+/// batched walk), and a sub-cell is free of the surface when |F(centre) − 0.5| exceeds L·r
+/// plus kValueMargin, with L the tape's Lipschitz bound over the cell widened by
+/// kMarginCells of its edge and r the half diagonal of the sub-cell widened by twice that.
+/// The widening covers the tracer's samples, which rounding can put just outside the cell;
+/// kValueMargin covers the rounding of the field's values and the pruned tape's differences
+/// from the whole one.
 ///
 /// Why: a cell's interval bound admits many cells the surface never enters (38 % of the
 /// PCM poplar's), and many rays cross only the free parts of the others; such a span holds
 /// no sign change of the sampled field, so the tracer would return nothing after a batch or
-/// more. With the proof the renderer leaves wholly free cells out (dropWhole) and a span
-/// proven free (spanFree) costs no batch: the same hits, bit for bit.
+/// more. With the proof a span proven free (spanFree) costs no batch: the same hits, bit
+/// for bit.
+///
+/// When: a proof costs about as much as eight batches of the tracer, so it pays only in a
+/// cell that many rays cross. Proved eagerly (every cell when the object is made) the
+/// renderer can leave wholly free cells out of the scene (dropWhole); proved lazily, a cell
+/// is proved when its proveAt-th trace enters it (enter()), once, so cells that few rays
+/// reach never pay. The mask is a pure function of the cell, so either way, at any thread
+/// count, the tracer returns the same bits. Per cell: 16 bytes.
 class FreeSubCells {
  public:
   static constexpr int kDivisions = 4;
@@ -150,24 +158,55 @@ class FreeSubCells {
   static constexpr uint64_t kWhole = ~uint64_t(0);
 
   FreeSubCells() = default;
-  /// For the cells of `cells` (each with its pruned tape, else blob), in parallel.
+  /// Proves every cell of `cells` (each with its pruned tape, else blob) now, in parallel.
   FreeSubCells(const CellSet& cells, const CompiledBlob& blob);
+  /// Proves nothing yet: cell c is proved when its proveAt-th trace enters it (enter();
+  /// 0: never, only by prove() and mask()). The CellSet and blob must outlive the object and
+  /// stay where they are.
+  FreeSubCells(const CellSet& cells, const CompiledBlob& blob, uint32_t proveAt);
 
-  /// Bit i + 4·(j + 4·l) set: sub-cell (i, j, l) of cell c is free of the surface.
-  uint64_t mask(uint32_t c) const { return masks_[c]; }
-  /// Cells with a mask.
-  size_t size() const { return masks_.size(); }
+  /// Proves the listed cells now (those not proven yet), in parallel.
+  void prove(std::span<const uint32_t> cells);
+
+  /// Bit i + 4·(j + 4·l) set: sub-cell (i, j, l) of cell c is free of the surface. Proves
+  /// cell c now if it is not yet (without counting a trace).
+  uint64_t mask(uint32_t c) const;
+  /// Cells with a mask (proved or not).
+  size_t size() const { return entries_.size(); }
+  /// Whether cell c has been proved.
+  bool proven(uint32_t c) const;
+  /// Cells proved so far.
+  size_t provenCount() const;
+  /// Counts a trace entering cell c and returns the mask to use for it: the cell's mask once
+  /// it is proven (at the proveAt-th trace, proved by that trace's thread), else 0 (nothing
+  /// known free). Thread-safe; each cell is proved once.
+  uint64_t enter(uint32_t c) const;
   /// True when every sub-cell of cell c in the range of sub-cells that origin + t·direction,
   /// t in [a, b], spans per axis (widened slabs; a superset of those it crosses) is free:
-  /// F != 0.5 on the segment. (Testing the crossed sub-cells alone, by slab tests, proved
-  /// 11 % more spans free and cost more than the batches it saved.)
+  /// F != 0.5 on the segment. Proves cell c if it is not yet. (Testing the crossed sub-cells
+  /// alone, by slab tests, proved 11 % more spans free and cost more than the batches it saved.)
   bool spanFree(const Cell& c, uint32_t cellIndex, const Ray& ray, float a, float b) const;
-  /// Removes from cells (and from the masks) the cells whose sub-cells are all free, in
-  /// order; returns how many.
+  /// spanFree with the mask `free` of cell c.
+  static bool spanFree(const Cell& c, uint64_t free, const Ray& ray, float a, float b);
+  /// Removes from cells (and from the masks) the proven cells whose sub-cells are all free,
+  /// in order; returns how many. The cells must be those the object was made for.
   size_t dropWhole(CellSet& cells);
 
  private:
-  std::vector<uint64_t> masks_;
+  /// A cell's mask and the traces counted, kProven set once the mask is written. Read and
+  /// written through std::atomic_ref.
+  struct Entry {
+    uint64_t mask = 0;
+    uint32_t traces = 0;
+  };
+  static constexpr uint32_t kProven = uint32_t(1) << 31;
+  /// Proves cell c and publishes its mask; returns it.
+  uint64_t proveOne(uint32_t c) const;
+
+  const CellSet* cells_ = nullptr;
+  const CompiledBlob* blob_ = nullptr;
+  uint32_t proveAt_ = 1;
+  mutable std::vector<Entry> entries_;
 };
 
 /// traceCell with bounds over the sub-cells the ray crosses (SubCellBounds; the caller
@@ -178,9 +217,10 @@ class FreeSubCells {
 std::optional<float> traceCell(const CompiledBlob& blob, const Cell& cell, const Ray& ray, float t0, float t1,
                                float tolerance, Crossing mode, const SubCellBounds& sub, uint32_t cellIndex);
 
-/// traceCell with the proofs the renderer keeps per cell: a span that FreeSubCells::spanFree
-/// proves free (when `free` has masks) is a miss without samples; sub, when not
-/// null, is used as by the overload above. The same result as traceCell without them.
+/// traceCell with the proofs the renderer keeps per cell: the trace enters cell cellIndex of
+/// `free` (FreeSubCells::enter, when `free` has masks), and a span that the mask proves free
+/// is a miss without samples; sub, when not null, is used as by the overload above. The same
+/// result as traceCell without them.
 std::optional<float> traceCell(const CompiledBlob& blob, const Cell& cell, const Ray& ray, float t0, float t1,
                                float tolerance, Crossing mode, const FreeSubCells& free, const SubCellBounds* sub,
                                uint32_t cellIndex);

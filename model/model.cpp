@@ -211,6 +211,7 @@ std::unique_ptr<BuiltScene> buildScene(SpeciesModel& model, const SpeciesRender&
   render::Scene& scene = built->scene;
   scene.setPixelFootprint(plan.camera, plan.width, plan.height, look.image.thinMinPixels);
   if (job.cellCamera) scene.setCellFootprint(*job.cellCamera, job.cellHeight);
+  scene.setExpectedSamples(plan.camera, plan.width, plan.height, job.samples > 0 ? job.samples : look.image.spp);
   SpeciesRender seen = look;
   // The mesh mode polygonizes at the cells' pixel too.
   seen.pixels = job.cellCamera ? job.cellCamera->pixelScale(job.cellHeight) : plan.camera.pixelScale(plan.height);

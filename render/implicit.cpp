@@ -170,14 +170,46 @@ float cellsBase(const blobtree::CompiledBlob& blob, const std::vector<blobtree::
   return best;
 }
 
+/// Whether the centre of box b projects into e's image (within half the box's diagonal).
+bool inView(const detail::ExpectedSamples& e, const Box3& b) {
+  const Vec3 d = b.center() - e.view.eye;
+  const float depth = glm::dot(d, e.view.forward);
+  if (!(depth > 0.0f)) return false;
+  const float pixel = e.view.pixelPerDepth * depth;  // world size of a pixel at the box
+  const float reach = 0.87f * (b.hi.x - b.lo.x) / pixel;
+  return std::abs(glm::dot(d, e.view.right)) / pixel <= 0.5f * float(e.width) + reach &&
+         std::abs(glm::dot(d, e.view.up)) / pixel <= 0.5f * float(e.height) + reach;
+}
+
+/// The cells to prove when made: those in view when the expected camera samples per cell
+/// in view reach `samples` (all cells for samples <= 0; none without an expectation).
+/// Camera samples per cell in view measure how many rays a cell will see: the image's
+/// samples shared among the cells they can reach, so a crown many cells deep shares them
+/// among more cells than a bare frame of branches.
+std::vector<uint32_t> denseCells(const blobtree::CellSet& cells, const std::optional<detail::ExpectedSamples>& expected,
+                                 float samples) {
+  std::vector<uint32_t> dense;
+  if (samples > 0.0f && !expected) return dense;
+  for (uint32_t i = 0; i < cells.cells.size(); ++i)
+    if (samples <= 0.0f || inView(*expected, cells.cells[i].box)) dense.push_back(i);
+  if (samples <= 0.0f) return dense;
+  const double perCell = double(expected->width) * double(expected->height) * double(expected->spp) /
+                         double(std::max<size_t>(dense.size(), 1));
+  if (perCell < double(samples)) dense.clear();
+  return dense;
+}
+
 /// The batched tracer's proofs over data's cells: the sub-cells free of the surface
-/// (blobtree::FreeSubCells), with the wholly free cells left out of data.cells, and the
-/// sub-cell bounds (ImplicitOptions::subCells, checked either way) of the cells kept.
-/// Returns the cells left out.
-size_t prepareTracing(ImplicitData& data, const ImplicitOptions& options) {
+/// (blobtree::FreeSubCells: the dense cells proved now, the wholly free among them left out
+/// of data.cells, the others when rays come), and the sub-cell bounds
+/// (ImplicitOptions::subCells, checked either way) of the cells kept. Returns the cells
+/// left out.
+size_t prepareTracing(ImplicitData& data, const ImplicitOptions& options,
+                      const std::optional<detail::ExpectedSamples>& expected) {
   size_t dropped = 0;
   if (data.batched && options.freeSubCells) {
-    data.free = blobtree::FreeSubCells(data.cells, data.blob);
+    data.free = blobtree::FreeSubCells(data.cells, data.blob, options.freeSubCellsLazy);
+    data.free.prove(denseCells(data.cells, expected, options.freeSubCellsEager));
     dropped = data.free.dropWhole(data.cells);
   }
   const int subK = subCellDivisions(options.subCells, data.cells.cells.size());
@@ -232,7 +264,7 @@ uint32_t Scene::addImplicit(const blobtree::CompiledBlob& blob, uint32_t materia
     impl_->stats.implicitTapeNodes += c.tape < data->cells.tapes.size() ? data->cells.tapes[c.tape].nodeCount() : 0;
   if (!support.empty()) {
     const Phase phase("cells");
-    impl_->stats.implicitFreeCells += prepareTracing(*data, options);
+    impl_->stats.implicitFreeCells += prepareTracing(*data, options, impl_->expected);
   }
   RTCGeometry g = rtcNewGeometry(impl_->device, RTC_GEOMETRY_TYPE_USER);
   rtcSetGeometryUserPrimitiveCount(g, static_cast<unsigned>(data->cells.cells.size()));

@@ -243,6 +243,19 @@ void Scene::setCellFootprint(const Camera& camera, int height) {
   impl_->cellView = v;
 }
 
+void Scene::setExpectedSamples(const Camera& camera, int width, int height, int spp) {
+  if (impl_->anyGeometry) throw std::logic_error("Scene::setExpectedSamples after geometry was added");
+  impl_->expected.reset();
+  if (width < 1 || height < 1 || spp < 1) return;
+  const CameraBasis b = camera.basis();
+  detail::ExpectedSamples e;
+  e.view = {camera.position, b.forward, b.right, b.up, camera.pixelPerDepth(height)};
+  e.width = width;
+  e.height = height;
+  e.spp = spp;
+  impl_->expected = e;
+}
+
 uint32_t Scene::Impl::addCurveGeometry(std::shared_ptr<detail::CurveData> data, uint32_t material) {
   data->drawn = data->real;
   if (footprint) {

@@ -117,6 +117,14 @@ class Scene {
   /// same (the tracer is exact in a cell of any size); coarser cells cost less to build and
   /// more per ray. Call before adding geometry (throws std::logic_error after).
   void setCellFootprint(const Camera& camera, int height);
+  /// The camera samples the scene is expected to be rendered with: spp samples per pixel of
+  /// a width x height image seen by camera. Implicit parts added afterwards prove the free
+  /// sub-cells (ImplicitOptions::freeSubCells) of the cells that can expect at least
+  /// ImplicitOptions::freeSubCellsEager of them when the cells are made, the others when
+  /// rays come; without an expectation every cell waits for its rays. Only the cost
+  /// changes: the image is the same whatever is expected. Call before adding geometry
+  /// (throws std::logic_error after); width, height or spp < 1 clears the expectation.
+  void setExpectedSamples(const Camera& camera, int width, int height, int spp);
   /// false: every implicit part added afterwards traces the whole tape in each cell, whatever
   /// its ImplicitOptions::prunedTapes says (the reference the pruned tapes are checked
   /// against). Default: prunedTapesDefault().

@@ -45,6 +45,13 @@ struct PixelView {
   float pixelPerDepth = 0.0f;
 };
 
+/// The camera samples a scene expects (Scene::setExpectedSamples).
+struct ExpectedSamples {
+  PixelView view;
+  int width = 0, height = 0;  ///< the image, pixels
+  int spp = 0;                ///< camera samples per pixel
+};
+
 /// A triangle geometry coloured by an ImageMap: its triangles and uvs, for the hit colour
 /// and the payload of its alpha filter functions.
 struct ImageMapData {
@@ -111,6 +118,7 @@ struct Scene::Impl {
   std::optional<detail::PixelView> view;    ///< the camera's pixel, when set (image maps)
   /// setCellFootprint's camera: implicit models' cells follow its pixel instead of view's.
   std::optional<detail::PixelView> cellView;
+  std::optional<detail::ExpectedSamples> expected;  ///< setExpectedSamples
   /// Something added was shaped by the footprint or the view beyond an implicit model's
   /// cell size (curves, thin axes, image maps): no other camera is served (Scene::servesCamera).
   bool followsCamera = false;

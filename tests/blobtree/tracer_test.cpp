@@ -3,12 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <vector>
 
 #include "blobtree/blobtree.h"
 #include "blobtree/compiled.h"
 #include "blobtree/tracer.h"
+#include "core/parallel.h"
 #include "core/rng.h"
 
 using namespace sprig;
@@ -305,5 +307,94 @@ TEST_CASE("FreeSubCells", "[blobtree]") {
       ++j;
     }
     CHECK(j == kept.cells.size());
+  }
+}
+
+TEST_CASE("FreeSubCells lazily", "[blobtree]") {
+  // Proved when rays come (FreeSubCells(cells, blob, proveAt)): the same masks as proved
+  // when made, the same crossings to the bit as with those masks and as without any, at one
+  // and at two threads; and a cell is proved only once its proveAt-th trace has entered it.
+  const uint64_t seed = GENERATE(43u, 44u);
+  const int scene = GENERATE(0, 1);
+  INFO("seed " << seed << ", scene " << scene);
+  Rng rng(seed);
+  const CompiledBlob blob = scene == 0 ? bumpyBody(rng) : bentTree(rng);
+  SurfaceCellOptions opt;
+  opt.prunedTapes = true;
+  const CellSet cells = blob.surfaceCells(scene == 0 ? 0.25f : 0.12f, opt);
+  REQUIRE(cells.cells.size() > 50);
+  const FreeSubCells eager(cells, blob);
+  const float tol = 1e-6f * glm::length(blob.bounds().size());
+
+  SECTION("the masks proved lazily are those proved when made") {
+    const FreeSubCells lazy(cells, blob, 0);
+    CHECK(lazy.provenCount() == 0);
+    int whole = 0;
+    for (uint32_t c = 0; c < cells.cells.size(); ++c) {
+      INFO("cell " << c);
+      CHECK(lazy.mask(c) == eager.mask(c));
+      whole += eager.mask(c) == FreeSubCells::kWhole;
+    }
+    CHECK(lazy.provenCount() == cells.cells.size());
+    CHECK(whole > 0);
+  }
+  SECTION("rays into half the cells: the same crossings, the others never proved") {
+    // Random rays aimed at the even cells' boxes, each traced in the cell it aims at, with
+    // the masks proved when made, proved at the first and at the second trace, and without.
+    struct Shot {
+      uint32_t cell;
+      Ray ray;
+    };
+    std::vector<Shot> shots;
+    for (int n = 0; n < 3000; ++n) {
+      const uint32_t ci = 2 * uint32_t(rng.uniform(0.0, double(cells.cells.size() / 2) - 1e-9));
+      const Vec3 target = randomIn(rng, cells.cells[ci].box);
+      const Vec3 o = target - 3.0f * glm::normalize(Vec3(rng.normal(), rng.normal(), rng.normal()));
+      shots.push_back({ci, Ray{o, target - o}});
+    }
+    const Crossing modes[] = {Crossing::FirstStraddle, Crossing::Any, Crossing::First};
+    auto traceAll = [&](const FreeSubCells& free, int threads) {
+      const ThreadLimit limit(threads);
+      std::vector<std::optional<float>> t(shots.size() * 3);
+      parallelFor(0, t.size(), [&](size_t i) {
+        const Shot& s = shots[i / 3];
+        const Cell& cell = cells.cells[s.cell];
+        t[i] = traceCell(cells.tapeOf(cell, blob), cell, s.ray, 0.0f, 10.0f, tol, modes[i % 3], free, nullptr, s.cell);
+      });
+      return t;
+    };
+    const std::vector<std::optional<float>> none = traceAll(FreeSubCells{}, 1);
+    const std::vector<std::optional<float>> whenMade = traceAll(eager, 2);
+    int hits = 0;
+    for (uint32_t proveAt : {1u, 4u}) {
+      for (int threads : {1, 2}) {
+        INFO("proved at trace " << proveAt << ", " << threads << " threads");
+        const FreeSubCells lazy(cells, blob, proveAt);
+        const std::vector<std::optional<float>> got = traceAll(lazy, threads);
+        hits = 0;
+        for (size_t i = 0; i < got.size(); ++i) {
+          REQUIRE(got[i].has_value() == none[i].has_value());
+          REQUIRE(whenMade[i].has_value() == none[i].has_value());
+          if (!none[i]) continue;
+          ++hits;
+          CHECK(*got[i] == *none[i]);
+          CHECK(*whenMade[i] == *none[i]);
+        }
+        // Each trace of a shot enters its cell (three modes a shot); a cell is proved once
+        // it has had proveAt traces, and no odd cell ever is.
+        std::vector<int> traces(cells.cells.size(), 0);
+        for (const Shot& s : shots) traces[s.cell] += 3;
+        size_t expected = 0;
+        for (uint32_t c = 0; c < cells.cells.size(); ++c) {
+          INFO("cell " << c << ", " << traces[c] << " traces");
+          CHECK(lazy.proven(c) == (traces[c] >= int(proveAt)));
+          expected += traces[c] >= int(proveAt);
+          if (c % 2 == 1) CHECK(!lazy.proven(c));
+        }
+        CHECK(lazy.provenCount() == expected);
+        CHECK(expected < cells.cells.size() / 2 + 1);
+      }
+    }
+    CHECK(hits > 300);
   }
 }

@@ -469,22 +469,31 @@ TEST_CASE("Scene::addImplicit sub-cell bounds", "[render]") {
 }
 
 TEST_CASE("Scene::addImplicit free sub-cells", "[render]") {
-  // ImplicitOptions::freeSubCells leaves out the surface cells proven free of the surface
-  // and skips spans that cross only free sub-cells: the same hits, normals and shadows to
-  // the bit as tracing every cell, and the same bounds (they come from every surface cell).
+  // ImplicitOptions::freeSubCells proves sub-cells free of the surface, when the cells are
+  // made (freeSubCellsEager 0: the cells free everywhere then left out) or when rays come
+  // (a scene without an expectation), and skips spans that cross only free sub-cells: the
+  // same hits, normals and shadows to the bit as tracing every cell, and the same bounds
+  // (they come from every surface cell).
   blobtree::CompiledBlob blob = branchBlob();
-  ImplicitOptions off, on;
+  ImplicitOptions off, eager, lazy;
   off.freeSubCells = false;
-  Scene a, b;
+  eager.freeSubCellsEager = 0.0f;
+  lazy.freeSubCellsLazy = 1;
+  Scene a, b, c;
   a.addImplicit(blob, a.addMaterial(Material{}), off);
-  b.addImplicit(blob, b.addMaterial(Material{}), on);
+  b.addImplicit(blob, b.addMaterial(Material{}), eager);
+  c.addImplicit(blob, c.addMaterial(Material{}), lazy);
   a.commit();
   b.commit();
+  c.commit();
   CHECK(a.stats().implicitFreeCells == 0);
   CHECK(b.stats().implicitFreeCells > b.stats().implicitCells / 20);
+  CHECK(c.stats().implicitFreeCells == 0);
   CHECK(a.stats().implicitCells == b.stats().implicitCells);
   CHECK(a.bounds().lo == b.bounds().lo);
   CHECK(a.bounds().hi == b.bounds().hi);
+  CHECK(a.bounds().lo == c.bounds().lo);
+  CHECK(a.bounds().hi == c.bounds().hi);
   const uint64_t seed = 20261206;
   INFO("seed " << seed);
   Rng rng(seed);
@@ -492,20 +501,65 @@ TEST_CASE("Scene::addImplicit free sub-cells", "[render]") {
   int hits = 0, shadowed = 0;
   for (int i = 0; i < 20000; ++i) {
     const auto [origin, dir] = rayIntoBox(rng, box);
-    const auto ha = a.intersect(origin, dir, 0, 100), hb = b.intersect(origin, dir, 0, 100);
+    const auto ha = a.intersect(origin, dir, 0, 100), hb = b.intersect(origin, dir, 0, 100),
+               hc = c.intersect(origin, dir, 0, 100);
     REQUIRE(ha.has_value() == hb.has_value());
+    REQUIRE(ha.has_value() == hc.has_value());
     const bool occluded = a.occluded(origin, dir, 0, 100);
     CHECK(occluded == b.occluded(origin, dir, 0, 100));
+    CHECK(occluded == c.occluded(origin, dir, 0, 100));
     shadowed += occluded;
     if (!ha) continue;
     ++hits;
     CHECK(ha->t == hb->t);
     CHECK(ha->normal == hb->normal);
+    CHECK(ha->t == hc->t);
+    CHECK(ha->normal == hc->normal);
     // A shadow ray leaving the hit, as the renderer casts them.
     const Vec3 p = ha->position + 1e-4f * ha->geometricNormal;
     const Vec3 away = glm::normalize(ha->geometricNormal + Vec3(rng.normal(), rng.normal(), rng.normal()));
-    CHECK(a.occluded(p, away, 0, 100) == b.occluded(p, away, 0, 100));
+    const bool shadow = a.occluded(p, away, 0, 100);
+    CHECK(shadow == b.occluded(p, away, 0, 100));
+    CHECK(shadow == c.occluded(p, away, 0, 100));
   }
   CHECK(hits > 2000);
   CHECK(shadowed > 2000);
+}
+
+TEST_CASE("Scene::setExpectedSamples: free sub-cells proved when made only where rays are many", "[render]") {
+  // The cells are proved when made (and the wholly free ones left out) when the expected
+  // camera samples per cell in view reach ImplicitOptions::freeSubCellsEager; otherwise,
+  // and without an expectation, when rays come. The picture is the same bytes either way.
+  const blobtree::CompiledBlob blob = branchBlob();
+  const Camera cam = frameBounds(blob.bounds(), ViewSpec{}, 1.0);
+  ImplicitOptions opt;
+  opt.cellSize = 0.05f;
+  opt.followPixels = false;
+  auto built = [&](int size, int spp, bool expect, Image* image) {
+    Scene scene;
+    if (expect) scene.setExpectedSamples(cam, size, size, spp);
+    scene.addImplicit(blob, scene.addMaterial(Material{}), opt);
+    scene.commit();
+    if (image) {
+      RenderSettings rs;
+      rs.width = rs.height = 48;
+      rs.spp = 2;
+      rs.progress = false;
+      *image = renderImage(scene, cam, rs);
+    }
+    return scene.stats();
+  };
+  Image many, few, unknown;
+  const SceneStats dense = built(1024, 16, true, &many);
+  const SceneStats sparse = built(48, 2, true, &few);
+  const SceneStats none = built(1024, 16, false, &unknown);
+  REQUIRE(dense.implicitCells > 200);
+  CHECK(dense.implicitFreeCells > dense.implicitCells / 20);
+  CHECK(sparse.implicitFreeCells == 0);
+  CHECK(none.implicitFreeCells == 0);
+  CHECK(many.pixels == few.pixels);
+  CHECK(many.pixels == unknown.pixels);
+  Scene late;
+  late.addImplicit(blob, late.addMaterial(Material{}), opt);
+  CHECK_THROWS_AS(late.setExpectedSamples(cam, 8, 8, 1), std::logic_error);
 }
