@@ -217,16 +217,33 @@ TEST_CASE("traceSegment: Crossing::Any answers at the first batch with a sign ch
   CHECK(*any == 4.0f);
 }
 
+namespace {
+
+/// The free-sub-cell tests' scenes (0: a bumpy body, 1: a bent tree) and their surface
+/// cells with pruned tapes.
+struct FreeScene {
+  CompiledBlob blob;
+  CellSet cells;
+};
+FreeScene freeScene(Rng& rng, int scene) {
+  FreeScene s{scene == 0 ? bumpyBody(rng) : bentTree(rng), {}};
+  SurfaceCellOptions opt;
+  opt.prunedTapes = true;
+  s.cells = s.blob.surfaceCells(scene == 0 ? 0.25f : 0.12f, opt);
+  REQUIRE(s.cells.cells.size() > 50);
+  return s;
+}
+
+}  // namespace
+
 TEST_CASE("FreeSubCells", "[blobtree]") {
   const uint64_t seed = GENERATE(41u, 42u);
   const int scene = GENERATE(0, 1);
   INFO("seed " << seed << ", scene " << scene);
   Rng rng(seed);
-  const CompiledBlob blob = scene == 0 ? bumpyBody(rng) : bentTree(rng);
-  SurfaceCellOptions opt;
-  opt.prunedTapes = true;
-  const CellSet cells = blob.surfaceCells(scene == 0 ? 0.25f : 0.12f, opt);
-  REQUIRE(cells.cells.size() > 50);
+  const FreeScene fs = freeScene(rng, scene);
+  const CompiledBlob& blob = fs.blob;
+  const CellSet& cells = fs.cells;
   const FreeSubCells free(cells, blob);
   REQUIRE(free.size() == cells.cells.size());
   constexpr int k = FreeSubCells::kDivisions;
@@ -318,11 +335,9 @@ TEST_CASE("FreeSubCells lazily", "[blobtree]") {
   const int scene = GENERATE(0, 1);
   INFO("seed " << seed << ", scene " << scene);
   Rng rng(seed);
-  const CompiledBlob blob = scene == 0 ? bumpyBody(rng) : bentTree(rng);
-  SurfaceCellOptions opt;
-  opt.prunedTapes = true;
-  const CellSet cells = blob.surfaceCells(scene == 0 ? 0.25f : 0.12f, opt);
-  REQUIRE(cells.cells.size() > 50);
+  const FreeScene fs = freeScene(rng, scene);
+  const CompiledBlob& blob = fs.blob;
+  const CellSet& cells = fs.cells;
   const FreeSubCells eager(cells, blob);
   const float tol = 1e-6f * glm::length(blob.bounds().size());
 

@@ -4,9 +4,11 @@
 
 #include <string>
 
+#include "tests/model/final_stage_job.h"
 #include "tests/model/species_error.h"
 
 using namespace sprig;
+using test::finalStageJob;
 
 namespace {
 
@@ -20,13 +22,6 @@ std::string sphere(const std::string& extra = "") {
 
 const std::string kInset = ", inset: {fraction: 0.5, view: {azimuth: 90, elevation: 30, margin: 0.02}, "
                            "close_up: {point: [0, 0.9, 0], size: 0.3}, sun: {azimuth: 60, elevation: 20}}";
-
-RenderJob smallJob(const SpeciesModel& model) {
-  RenderJob job;
-  job.progress = false;
-  job.stage = model.finalStage();
-  return job;
-}
 
 }  // namespace
 
@@ -60,7 +55,7 @@ TEST_CASE("render.inset: the inset's look is the species' with its own camera an
 TEST_CASE("renderPicture: render.inset draws a close-up over the lower right corner", "[model]") {
   const Species a = parseSpecies(sphere(kInset), "a.yaml");
   SpeciesModel model(a);
-  const RenderJob job = smallJob(model);
+  const RenderJob job = finalStageJob(model);
   const Image picture = renderPicture(model, a.render, job);
   SpeciesRender plain = a.render;
   plain.inset.reset();
@@ -108,7 +103,7 @@ TEST_CASE("RenderJob::cellCamera sizes implicit cells for another camera's pixel
   SpeciesModel model(a);
   SpeciesRender look = a.render;
   look.closeUp = CloseUpSpec{Vec3(0, 0.9f, 0), -1, -1, 0.1, {}};
-  RenderJob job = smallJob(model);
+  RenderJob job = finalStageJob(model);
   ModelFigures near, far;
   const Image nearImage = renderModel(model, look, job, &near);
   job.cellCamera = render::Camera{Vec3(0, 0.5f, 200), Vec3(0, 0.5f, 0), Vec3(0, 1, 0), 35};

@@ -5,9 +5,11 @@
 #include <fstream>
 #include <string>
 
+#include "tests/model/final_stage_job.h"
 #include "tests/scratch_dir.h"
 
 using namespace sprig;
+using test::finalStageJob;
 
 namespace {
 
@@ -18,13 +20,6 @@ std::string sphere(float x, const std::string& extra = "") {
          "}\n";
 }
 
-RenderJob smallJob(const SpeciesModel& model) {
-  RenderJob job;
-  job.progress = false;
-  job.stage = model.finalStage();
-  return job;
-}
-
 }  // namespace
 
 TEST_CASE("renderPair: two panels side by side seen by one camera", "[model]") {
@@ -33,7 +28,7 @@ TEST_CASE("renderPair: two panels side by side seen by one camera", "[model]") {
   SpeciesModel ma(a), mb(b);
   SECTION("a species paired with itself: both halves are the same picture") {
     SpeciesModel again(a);
-    const Image img = renderPair(ma, again, a.render, smallJob(ma));
+    const Image img = renderPair(ma, again, a.render, finalStageJob(ma));
     REQUIRE(img.width == 48);
     REQUIRE(img.height == 24);
     REQUIRE(pairDividerHalfWidth(24) == 1);
@@ -41,7 +36,7 @@ TEST_CASE("renderPair: two panels side by side seen by one camera", "[model]") {
       for (int x = 1; x < 23; ++x) REQUIRE(img.at(x, y) == img.at(24 + x, y));
   }
   SECTION("a white rule covers the panels' facing columns, one a side and one more per 512 pixels") {
-    const Image img = renderPair(ma, mb, a.render, smallJob(ma));
+    const Image img = renderPair(ma, mb, a.render, finalStageJob(ma));
     for (int y = 0; y < 24; ++y) {
       CHECK(img.at(23, y) == Vec4(1.0f));
       CHECK(img.at(24, y) == Vec4(1.0f));
@@ -54,8 +49,8 @@ TEST_CASE("renderPair: two panels side by side seen by one camera", "[model]") {
   }
   SECTION("each panel is its species rendered through the pair's camera, which frames both") {
     const render::Camera cam = pairCamera(ma, mb, a.render, 48, 24);
-    const Image img = renderPair(ma, mb, a.render, smallJob(ma));
-    RenderJob panel = smallJob(ma);
+    const Image img = renderPair(ma, mb, a.render, finalStageJob(ma));
+    RenderJob panel = finalStageJob(ma);
     panel.width = 24;
     panel.height = 24;
     panel.camera = cam;
@@ -101,7 +96,7 @@ TEST_CASE("renderPicture: render.pair loads the other species file", "[model]") 
   REQUIRE(a.render.pair);
   SpeciesModel ma(a);
   SpeciesModel mb(loadSpecies(dir.path / "b.yaml", policy));
-  const RenderJob job = smallJob(ma);
+  const RenderJob job = finalStageJob(ma);
   CHECK(renderPicture(ma, a.render, job).pixels == renderPair(ma, mb, a.render, job).pixels);
   SpeciesRender single = a.render;
   single.pair.reset();
