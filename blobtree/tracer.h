@@ -141,7 +141,7 @@ class SubCellBounds {
 /// more. With the proof a span proven free (spanFree) costs no batch: the same hits, bit
 /// for bit.
 ///
-/// When: a proof costs about as much as eight batches of the tracer, so it pays only in a
+/// When: a proof costs about as much as five batches of the tracer, so it pays only in a
 /// cell that many rays cross. Proved eagerly (every cell when the object is made) the
 /// renderer can leave wholly free cells out of the scene (dropWhole); proved lazily, a cell
 /// is proved when its proveAt-th trace enters it (enter()), once, so cells that few rays

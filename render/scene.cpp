@@ -208,6 +208,12 @@ void thinOcclusionFilter(const RTCFilterFunctionNArguments* args) {
   }
 }
 
+/// The pixel of camera in an image height rows tall.
+detail::PixelView pixelViewOf(const Camera& camera, int height) {
+  const CameraBasis b = camera.basis();
+  return {camera.position, b.forward, b.right, b.up, camera.pixelPerDepth(height)};
+}
+
 }  // namespace
 
 void Scene::setPixelFootprint(const Camera& camera, int width, int height, float minPixels) {
@@ -215,13 +221,7 @@ void Scene::setPixelFootprint(const Camera& camera, int width, int height, float
   impl_->view.reset();
   impl_->footprint.reset();
   if (width < 1 || height < 1) return;
-  const CameraBasis b = camera.basis();
-  detail::PixelView v;
-  v.eye = camera.position;
-  v.forward = b.forward;
-  v.right = b.right;
-  v.up = b.up;
-  v.pixelPerDepth = camera.pixelPerDepth(height);
+  const detail::PixelView v = pixelViewOf(camera, height);
   impl_->view = v;
   if (minPixels <= 0.0f) return;
   PixelFootprint f;
@@ -236,20 +236,15 @@ void Scene::setCellFootprint(const Camera& camera, int height) {
   if (impl_->anyGeometry) throw std::logic_error("Scene::setCellFootprint after geometry was added");
   impl_->cellView.reset();
   if (height < 1) return;
-  detail::PixelView v;
-  v.eye = camera.position;
-  v.forward = camera.basis().forward;
-  v.pixelPerDepth = camera.pixelPerDepth(height);
-  impl_->cellView = v;
+  impl_->cellView = pixelViewOf(camera, height);
 }
 
 void Scene::setExpectedSamples(const Camera& camera, int width, int height, int spp) {
   if (impl_->anyGeometry) throw std::logic_error("Scene::setExpectedSamples after geometry was added");
   impl_->expected.reset();
   if (width < 1 || height < 1 || spp < 1) return;
-  const CameraBasis b = camera.basis();
   detail::ExpectedSamples e;
-  e.view = {camera.position, b.forward, b.right, b.up, camera.pixelPerDepth(height)};
+  e.view = pixelViewOf(camera, height);
   e.width = width;
   e.height = height;
   e.spp = spp;

@@ -26,6 +26,27 @@ double det(const DVec3& a, const DVec3& b, const DVec3& c, const DVec3& d) {
   return glm::dot(b - a, glm::cross(c - a, d - a));
 }
 
+/// Face f (kTetFaces) of tetrahedron q as its three vertex ids, sorted: the key two
+/// tetrahedra sharing the face agree on.
+std::array<uint32_t, 3> faceKey(const std::array<uint32_t, 4>& q, int f) {
+  std::array<uint32_t, 3> k = {q[size_t(kTetFaces[size_t(f)][0])], q[size_t(kTetFaces[size_t(f)][1])], q[size_t(kTetFaces[size_t(f)][2])]};
+  std::sort(k.begin(), k.end());
+  return k;
+}
+
+/// Union-find over 0..n-1 with path halving.
+struct DisjointSets {
+  std::vector<uint32_t> parent;
+  explicit DisjointSets(size_t n) : parent(n) {
+    for (size_t i = 0; i < n; ++i) parent[i] = uint32_t(i);
+  }
+  uint32_t find(uint32_t a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  }
+  void join(uint32_t a, uint32_t b) { parent[find(a)] = find(b); }
+};
+
 /// The mesh while it is cut: vertices with every volume's distance, tetrahedra with a flag
 /// "no earlier volume claims it".
 struct Work {
@@ -625,15 +646,7 @@ std::vector<int> tetMaterials(const Solid& solid, const Work& w) {
   return material;
 }
 
-/// A face of a tetrahedron as its three vertex ids, sorted.
 using FaceKey = std::array<uint32_t, 3>;
-FaceKey faceOf(const Tet& q, int skip) {
-  FaceKey f{};
-  for (int i = 0, n = 0; i < 4; ++i)
-    if (i != skip) f[size_t(n++)] = q[size_t(i)];
-  std::sort(f.begin(), f.end());
-  return f;
-}
 struct FaceKeyHash {
   size_t operator()(const FaceKey& f) const { return (size_t(f[0]) * 0x9E3779B97F4A7C15ull) ^ (size_t(f[1]) * 0xC2B2AE3D27D4EB4Full) ^ f[2]; }
 };
@@ -652,20 +665,16 @@ size_t fillSealedSpecks(const Work& w, double cellVolume, std::vector<int>& mate
   std::vector<std::pair<FaceKey, uint32_t>> faces;
   faces.reserve(air.size() * 4);
   for (uint32_t a = 0; a < air.size(); ++a)
-    for (int k = 0; k < 4; ++k) faces.emplace_back(faceOf(w.tets[air[a]], k), a);
+    for (int k = 0; k < 4; ++k) faces.emplace_back(faceKey(w.tets[air[a]], k), a);
   std::sort(faces.begin(), faces.end());
-  std::vector<uint32_t> parent(air.size());
-  for (uint32_t a = 0; a < parent.size(); ++a) parent[a] = a;
-  auto root = [&](uint32_t a) {
-    while (parent[a] != a) a = parent[a] = parent[parent[a]];
-    return a;
-  };
+  DisjointSets pockets(air.size());
+  auto root = [&](uint32_t a) { return pockets.find(a); };
   std::vector<std::pair<FaceKey, uint32_t>> open;  // faces of one unclaimed tetrahedron only
   for (size_t i = 0; i < faces.size();) {
     size_t j = i + 1;
     while (j < faces.size() && faces[j].first == faces[i].first) ++j;
     if (j - i == 1) open.push_back(faces[i]);
-    for (size_t k = i + 1; k < j; ++k) parent[root(faces[k].second)] = root(faces[i].second);
+    for (size_t k = i + 1; k < j; ++k) pockets.join(faces[k].second, faces[i].second);
     i = j;
   }
   std::vector<double> volume(air.size(), 0.0);  // per pocket, at its root
@@ -681,7 +690,7 @@ size_t fillSealedSpecks(const Work& w, double cellVolume, std::vector<int>& mate
   for (size_t t = 0; t < material.size(); ++t)
     if (material[t] >= 0)
       for (int k = 0; k < 4; ++k)
-        if (auto it = across.find(faceOf(w.tets[t], k)); it != across.end()) it->second.second = material[t];
+        if (auto it = across.find(faceKey(w.tets[t], k)); it != across.end()) it->second.second = material[t];
   std::map<uint32_t, std::map<int, size_t>> votes;  // pocket -> material -> faces
   std::set<uint32_t> leaky;
   for (const auto& [key, v] : across) {
@@ -832,11 +841,7 @@ struct FaceRef {
 std::vector<FaceRef> sortedFaces(const TetMesh& mesh) {
   std::vector<FaceRef> faces(mesh.tets.size() * 4);
   parallelFor(0, mesh.tets.size(), [&](size_t t) {
-    for (uint8_t f = 0; f < 4; ++f) {
-      std::array<uint32_t, 3> k = {mesh.tets[t][kTetFaces[f][0]], mesh.tets[t][kTetFaces[f][1]], mesh.tets[t][kTetFaces[f][2]]};
-      std::sort(k.begin(), k.end());
-      faces[t * 4 + f] = {k, uint32_t(t), f};
-    }
+    for (uint8_t f = 0; f < 4; ++f) faces[t * 4 + f] = {faceKey(mesh.tets[t], f), uint32_t(t), f};
   }, 4096);
   std::sort(faces.begin(), faces.end());
   return faces;
@@ -907,10 +912,7 @@ class BoundaryBuilder {
 
   bool in(uint32_t t) const { return selected_.empty() || selected_[t] != 0; }
 
-  uint32_t find(uint32_t a) {
-    while (parent_[a] != a) a = parent_[a] = parent_[parent_[a]];
-    return a;
-  }
+  uint32_t find(uint32_t a) { return corners_.find(a); }
 
   uint32_t corner(uint32_t t, uint32_t v) const {
     const auto& q = tris_[t].v;
@@ -919,7 +921,7 @@ class BoundaryBuilder {
 
   /// Joins the corners of triangles s and t at edge e's two vertices.
   void pair(uint32_t s, uint32_t t, uint64_t e) {
-    for (uint32_t v : {uint32_t(e >> 32), uint32_t(e & 0xffffffffu)}) parent_[find(corner(s, v))] = find(corner(t, v));
+    for (uint32_t v : {uint32_t(e >> 32), uint32_t(e & 0xffffffffu)}) corners_.join(corner(s, v), corner(t, v));
   }
 
   /// 1. The boundary triangles: faces of a selected tetrahedron no other selected one shares.
@@ -937,8 +939,7 @@ class BoundaryBuilder {
       }
       i = j;
     }
-    parent_.resize(tris_.size() * 3);
-    for (size_t c = 0; c < parent_.size(); ++c) parent_[c] = uint32_t(c);
+    corners_ = DisjointSets(tris_.size() * 3);
   }
 
   /// 2. Pair the triangles at each edge: two at an edge are one wedge; at an edge of 2k > 2,
@@ -987,18 +988,14 @@ class BoundaryBuilder {
       const auto& q = mesh_.tets[items_[k]];
       if (std::find(q.begin(), q.end(), b) != q.end()) star.push_back(items_[k]);
     }
-    std::vector<uint32_t> wedge(star.size());
-    for (size_t k = 0; k < wedge.size(); ++k) wedge[k] = uint32_t(k);
-    auto root = [&](uint32_t x) {
-      while (wedge[x] != x) x = wedge[x] = wedge[wedge[x]];
-      return x;
-    };
+    DisjointSets wedges(star.size());
+    auto root = [&](uint32_t x) { return wedges.find(x); };
     for (size_t x = 0; x < star.size(); ++x)
       for (size_t y = x + 1; y < star.size(); ++y) {
         int common = 0;
         for (uint32_t v : mesh_.tets[star[x]])
           common += std::find(mesh_.tets[star[y]].begin(), mesh_.tets[star[y]].end(), v) != mesh_.tets[star[y]].end() ? 1 : 0;
-        if (common == 3) wedge[root(uint32_t(x))] = root(uint32_t(y));
+        if (common == 3) wedges.join(uint32_t(x), uint32_t(y));
       }
     // Each triangle's wedge; the two triangles of a wedge are paired.
     std::vector<std::pair<uint32_t, uint32_t>> byWedge;  // (wedge root, triangle)
@@ -1122,7 +1119,7 @@ class BoundaryBuilder {
   const std::vector<uint8_t>& selected_;
   std::vector<InterfaceTriangle> tris_;
   std::vector<uint32_t> tetOf_;   ///< the tetrahedron of each triangle (and of each half split off)
-  std::vector<uint32_t> parent_;  ///< union-find over triangle corners (3 t + i)
+  DisjointSets corners_{0};  ///< union-find over triangle corners (3 t + i)
   std::vector<uint32_t> start_, items_;
   std::vector<Wedge> wedges_;     ///< at the edges of more than two triangles, in edge order
 };
