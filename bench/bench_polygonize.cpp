@@ -1,9 +1,11 @@
 /// Polygonization benchmark: sparse near-surface polygonization of a synthetic branching
 /// structure of 2,000 cones, against a dense-grid baseline computed in the same run.
 ///
-/// Usage: bench_polygonize [--quick] [--cones N] [--no-baseline] [--cell H] [--dual]
+/// Usage: bench_polygonize [--quick] [--cones N] [--no-baseline] [--cell H] [--dual] [--blend]
 /// (--cell replaces the target cell, half the smallest radius; --dual runs only the dual
-/// mesher with batched Newton steps, the default, and no baseline.)
+/// mesher with batched Newton steps, the default, and no baseline; --blend keeps every
+/// vertex's blended attributes as painting callers do, PolygonizeOptions::VertexData::Blend,
+/// where the default keeps its uv.)
 /// Each mesh's bytes (positions, normals, uvs, triangles) are printed as an FNV-1a hash.
 /// Prints time, triangles/s, cells and field evaluations; the ratio compares the sparse
 /// polygonizer with sampling every grid point of the bounds (the least any dense-grid
@@ -79,13 +81,14 @@ double denseSampling(const CompiledBlob& blob, float h, size_t& points, double& 
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool quick = false, baseline = true, dualOnly = false;
+  bool quick = false, baseline = true, dualOnly = false, blend = false;
   int cones = 2000;
   float cellOverride = 0.0f;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--quick")) quick = true;
     else if (!std::strcmp(argv[i], "--no-baseline")) baseline = false;
     else if (!std::strcmp(argv[i], "--dual")) dualOnly = true, baseline = false;
+    else if (!std::strcmp(argv[i], "--blend")) blend = true;
     else if (!std::strcmp(argv[i], "--cell") && i + 1 < argc) cellOverride = float(std::atof(argv[++i]));
     else if (!std::strcmp(argv[i], "--cones") && i + 1 < argc) cones = std::atoi(argv[++i]);
   }
@@ -120,15 +123,16 @@ int main(int argc, char** argv) {
     PolygonizeOptions opt;
     opt.mesher = mesher;
     opt.batchedNewton = run.batched;
+    if (blend) opt.vertexData = PolygonizeOptions::VertexData::Blend;
     opt.cellSize = cellOverride > 0.0f ? cellOverride : 0.5f * rMin;
     auto t0 = Clock::now();
     double c0 = processCpuSeconds();
     PolygonizeResult r = polygonizeDetailed(blob, opt);
     double s = seconds(t0), cpu = processCpuSeconds() - c0;
     MeshTopology topo = analyzeTopology(r.mesh);
-    std::printf("sparse %s, cell %.4f (requested %.4f): %.2f s wall, %.2f s CPU, %zu triangles (%.2f M triangles/s wall, "
+    std::printf("sparse %s%s, cell %.4f (requested %.4f): %.2f s wall, %.2f s CPU, %zu triangles (%.2f M triangles/s wall, "
                 "%.2f M per CPU second), %zu vertices\n",
-                run.name, r.cellSize, opt.cellSize, s, cpu,
+                run.name, blend ? " with blended attributes" : "", r.cellSize, opt.cellSize, s, cpu,
                 r.mesh.triangleCount(), r.mesh.triangleCount() / s * 1e-6, r.mesh.triangleCount() / cpu * 1e-6,
                 r.mesh.vertexCount());
     std::printf("  %zu surface cells, %zu with a sign change, %zu grid samples, %zu field evaluations (%.1f M/s); "

@@ -184,6 +184,7 @@ void inspectionImages(const fs::path& dir) {
       uint32_t m = scene.addMaterial(render::Material{Vec3(0.6f), 0.5f, 0.04f});
       blobtree::PolygonizeOptions po;
       po.cellSize = 0.01f;
+      po.vertexData = blobtree::PolygonizeOptions::VertexData::Blend;  // textured
       if (mode == 0) scene.addImplicit(blob, m);
       else scene.addPolygonized(blobtree::polygonizeDetailed(blob, po), m);
       scene.commit();

@@ -77,6 +77,17 @@ struct HugePageAllocator {
 template <class T>
 using BigVector = std::vector<T, HugePageAllocator<T>>;
 
+// Frees the arrays' memory now. The dual mesher returns each working array once done with
+// it, so that the arrays made after it (the mesh's) reuse its pages: on a virtual machine
+// whose host backs guest memory lazily and takes freed memory back (free page reporting),
+// a page touched for the first time cost 3-7 ms a MB (2.1 s for 315 MB, the size of the
+// benchmark's vertex attributes), pages the process had just freed 0.1 ms (0.02 s for
+// 250 MB) (docs/PERFORMANCE.md, "Fresh pages").
+template <class... C>
+void releaseAll(C&... arrays) {
+  ((C().swap(arrays)), ...);
+}
+
 // Resizes an output array of the polygonizer (the mesh's arrays, the attributes: plain
 // std::vectors, 400+ MB on the 2,000-cone benchmark) from empty to n elements. resize()
 // value-initializes on one thread, and its first touch of fresh pages was most of the
@@ -645,8 +656,20 @@ std::vector<glm::uvec3> triangulate(const Grid& g, const Vertices& v) {
   return triangles;
 }
 
-// Vertex v's normal −∇F/|∇F| (or a mark in flatGradient where the gradient vanishes) and
-// attributes from the field's sample there, as options ask.
+// Whether the vertices get uvs, and their blended attributes (PolygonizeOptions::vertexData).
+bool wantsUvs(const PolygonizeOptions& o) { return o.vertexData != PolygonizeOptions::VertexData::None; }
+bool wantsBlend(const PolygonizeOptions& o) { return o.vertexData == PolygonizeOptions::VertexData::Blend; }
+
+// The output arrays of nVerts vertices that options ask for.
+void resizeVertexArrays(const PolygonizeOptions& options, size_t nVerts, PolygonizeResult& res) {
+  resizeOutput(res.mesh.positions, nVerts);
+  if (options.normals) resizeOutput(res.mesh.normals, nVerts);
+  if (wantsUvs(options)) resizeOutput(res.mesh.uvs, nVerts);
+  if (wantsBlend(options)) resizeOutput(res.attributes, nVerts);
+}
+
+// Vertex v's normal −∇F/|∇F| (or a mark in flatGradient where the gradient vanishes), uv
+// and attributes from the field's sample there, as options ask.
 void storeSample(const PolygonizeOptions& options, const Sample& smp, size_t v, PolygonizeResult& res,
                  std::vector<uint8_t>& flatGradient) {
   if (options.normals) {
@@ -654,10 +677,8 @@ void storeSample(const PolygonizeOptions& options, const Sample& smp, size_t v, 
     if (len > 1e-20f && std::isfinite(len)) res.mesh.normals[v] = -smp.gradient / len;
     else flatGradient[v] = 1;
   }
-  if (options.attributes) {
-    res.mesh.uvs[v] = smp.attributes.uv;
-    res.attributes[v] = smp.attributes;
-  }
+  if (wantsUvs(options)) res.mesh.uvs[v] = smp.attributes.uv;
+  if (wantsBlend(options)) res.attributes[v] = smp.attributes;
 }
 
 // Where a grid corner lies on the surface to within rounding, the root search puts the
@@ -700,12 +721,7 @@ std::vector<uint8_t> placeVertices(const CompiledBlob& blob, const PolygonizeOpt
   Mesh& mesh = res.mesh;
   std::unique_ptr<Progress> bar;
   if (options.progress) bar = std::make_unique<Progress>("polygonize", nVerts);
-  resizeOutput(mesh.positions, nVerts);
-  if (options.normals) resizeOutput(mesh.normals, nVerts);
-  if (options.attributes) {
-    resizeOutput(mesh.uvs, nVerts);
-    resizeOutput(res.attributes, nVerts);
-  }
+  resizeVertexArrays(options, nVerts, res);
   std::vector<uint8_t> evals(nVerts, 0);
   flatGradient.assign(nVerts, 0);
   if (nearCorner) nearCorner->assign(nVerts, kNearNone);
@@ -761,7 +777,7 @@ std::vector<uint8_t> placeVertices(const CompiledBlob& blob, const PolygonizeOpt
       size_t v = begin + k;
       Vec3 p = pIn[k] + float(t[k]) * (pOut[k] - pIn[k]);
       mesh.positions[v] = p;
-      if (options.normals || options.attributes) storeSample(options, blob.sample(p), v, res, flatGradient);
+      if (options.normals || wantsUvs(options)) storeSample(options, blob.sample(p), v, res, flatGradient);
       if (nearCorner) {
         const double margin = cornerMargin(pIn[k], pOut[k]);
         if (margin < 0.25) (*nearCorner)[v] = t[k] < margin ? kNearInside : t[k] > 1.0 - margin ? kNearOutside : kNearNone;
@@ -801,7 +817,7 @@ size_t separateVertices(const CompiledBlob& blob, const PolygonizeOptions& optio
     const Vec3 p = pIn + float(nearCorner[v] == kNearInside ? margin : 1.0 - margin) * (pOut - pIn);
     res.mesh.positions[v] = p;
     flatGradient[v] = 0;
-    if (options.normals || options.attributes) storeSample(options, blob.sample(p), v, res, flatGradient);
+    if (options.normals || wantsUvs(options)) storeSample(options, blob.sample(p), v, res, flatGradient);
   }
   return moving.size();
 }
@@ -829,22 +845,23 @@ void fixFlatNormals(Mesh& mesh, const std::vector<uint8_t>& flatGradient) {
 // file comment for PolygonizeOptions::Mesher::DualMarchingCubes.
 class DualMesher {
  public:
-  DualMesher(const CompiledBlob& blob, const PolygonizeOptions& options, const Grid& g, PolygonizeResult& res)
+  DualMesher(const CompiledBlob& blob, const PolygonizeOptions& options, Grid& g, PolygonizeResult& res)
       : blob_(blob), options_(options), g_(g), res_(res), nActive_(g.active.size()),
         // Crossing axis edges (directions 1, 2, 4), each owned by the cell at its low end.
         v_(numberVertices(g, uint8_t((1u << 1) | (1u << 2) | (1u << 4)))) {}
 
   void run() {
+    // Each working array is released once the steps below no longer read it (releaseAll).
+    releaseAll(g_.pointSlot, g_.ownedMask, g_.pointBase);  // (the vertex numbering's)
     const std::vector<uint8_t> evals = crossingPoints();
+    gridPoints_ = g_.pointKeys.size();
+    edgeCount_ = v_.edges.size();
+    releaseAll(g_.pointKeys, v_.edges);
     cellPatchesAll();
+    releaseAll(g_.cornerPoint, g_.values);
     Mesh& mesh = res_.mesh;
     const size_t nVerts = patchBase_[nActive_];
-    resizeOutput(mesh.positions, nVerts);
-    if (options_.normals) resizeOutput(mesh.normals, nVerts);
-    if (options_.attributes) {
-      resizeOutput(mesh.uvs, nVerts);
-      resizeOutput(res_.attributes, nVerts);
-    }
+    resizeVertexArrays(options_, nVerts, res_);
     flatGradient_.assign(nVerts, 0);
     if (options_.progress) bar_ = std::make_unique<Progress>("polygonize", nActive_);
     // Each patch's vertex: the mean of its crossing points, then Newton steps along the
@@ -853,9 +870,10 @@ class DualMesher {
     if (options_.batchedNewton) parallelFor(0, blocks, [&](size_t blk) { placeBlockBatched(blk); });
     else parallelFor(0, blocks, [&](size_t blk) { placeBlockScalar(blk); });
     if (bar_) bar_->finish();
+    releaseAll(cross_);
     quads();
     if (options_.normals) fixFlatNormals(mesh, flatGradient_);
-    size_t total = g_.pointKeys.size() + sampleCount_.load();
+    size_t total = gridPoints_ + sampleCount_.load();
     for (uint8_t k : evals) total += k;
     res_.fieldEvaluations = total;
   }
@@ -882,7 +900,8 @@ class DualMesher {
   /// Returns the field evaluations per edge.
   std::vector<uint8_t> crossingPoints() {
     PolygonizeOptions edgeOptions = options_;
-    edgeOptions.normals = edgeOptions.attributes = edgeOptions.progress = false;
+    edgeOptions.normals = edgeOptions.progress = false;
+    edgeOptions.vertexData = PolygonizeOptions::VertexData::None;
     edgeOptions.refineSteps = 0;
     PolygonizeResult crossings;
     std::vector<uint8_t> unusedFlat;
@@ -989,7 +1008,7 @@ class DualMesher {
     for (size_t k = 0; k < n; ++k) {
       const size_t vi = first + k;
       res_.mesh.positions[vi] = p[k];
-      if (options_.attributes) {
+      if (wantsUvs(options_)) {
         storeSample(options_, blob_.sample(p[k]), vi, res_, flatGradient_);
         ++samples;
       } else if (options_.normals) {
@@ -1040,7 +1059,7 @@ class DualMesher {
   /// to the slots of the edge's vertex number, so the order of the cells does not matter.
   void quads() {
     Mesh& mesh = res_.mesh;
-    resizeOutput(mesh.triangles, 2 * v_.edges.size());
+    resizeOutput(mesh.triangles, 2 * edgeCount_);
     parallelFor(0, nActive_, [&](size_t m) {
       const uint8_t mask = g_.insideMask[g_.active[m]];
       for (int axis = 0; axis < 3; ++axis) {
@@ -1073,10 +1092,11 @@ class DualMesher {
 
   const CompiledBlob& blob_;
   const PolygonizeOptions& options_;
-  const Grid& g_;
+  Grid& g_;  ///< its arrays are released as the mesher is done with them (releaseUsed)
   PolygonizeResult& res_;
   const size_t nActive_;
-  const Vertices v_;
+  Vertices v_;
+  size_t gridPoints_ = 0, edgeCount_ = 0;  ///< g_.pointKeys.size(), v_.edges.size() before their release
   std::vector<Vec3> cross_;  ///< the crossing point of each crossing edge
   BigVector<detail::CellPatches> patches_;
   BigVector<uint32_t> patchBase_;
@@ -1085,7 +1105,8 @@ class DualMesher {
   std::atomic<size_t> sampleCount_{0};
 };
 
-void dualMesh(const CompiledBlob& blob, const PolygonizeOptions& options, const Grid& g, PolygonizeResult& res) {
+// Steps 4-5 by dual marching cubes; g's working arrays are released on the way (releaseAll).
+void dualMesh(const CompiledBlob& blob, const PolygonizeOptions& options, Grid& g, PolygonizeResult& res) {
   DualMesher(blob, options, g, res).run();
 }
 
@@ -1158,7 +1179,7 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
   // 4. Vertex numbering and marching tetrahedra.
   Vertices v = numberVertices(g, 0xfe);
   res.mesh.triangles = triangulate(g, v);
-  BigVector<uint32_t>().swap(v.owners);
+  releaseAll(v.owners);
   res.triangulateSeconds = lap(res.triangulateCpuSeconds);
 
   // 5. Vertices: root search along each edge, then normal and attributes.
@@ -1169,9 +1190,9 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
   if (options.normals) fixFlatNormals(res.mesh, flatGradient);
   res.vertexSeconds = lap(res.vertexCpuSeconds);
   const size_t nVerts = v.edges.size();
-  size_t total = g.pointKeys.size() + (options.normals || options.attributes ? nVerts : 0);
+  size_t total = g.pointKeys.size() + (options.normals || wantsUvs(options) ? nVerts : 0);
   for (uint8_t n : evals) total += n;
-  res.fieldEvaluations = total + (options.normals || options.attributes ? res.separatedVertices : 0);
+  res.fieldEvaluations = total + (options.normals || wantsUvs(options) ? res.separatedVertices : 0);
   return res;
 }
 

@@ -55,8 +55,8 @@ struct PolygonizeOptions {
   Mesher mesher = Mesher::MarchingTetrahedra;
   /// DualMarchingCubes only: the patch vertices' Newton steps evaluate F and ∇F for blocks
   /// of vertices at once (CompiledBlob::valuesAndGradients), then one sample() per vertex
-  /// for its attributes (none when normals come from the last step and attributes are
-  /// off). false: one scalar sample() per step, the path it replaced, kept for comparison
+  /// for its uv and attributes (none when normals come from the last step and
+  /// vertexData is None). false: one scalar sample() per step, the path it replaced, kept for comparison
   /// (same vertices to rounding; bench_polygonize runs both).
   bool batchedNewton = true;
   /// Requested cell edge length in world units; 0 = automatic: the smaller of
@@ -90,9 +90,18 @@ struct PolygonizeOptions {
   float fieldTolerance = 1e-5f;
   /// Fill Mesh::normals from the gradient.
   bool normals = true;
-  /// Fill Mesh::uvs from the blended primitive (u,v) (and the per-vertex attributes of
-  /// PolygonizeResult).
-  bool attributes = true;
+  /// What each vertex carries besides its position and normal, all from the field's
+  /// CompiledBlob::sample at the vertex:
+  /// - None: nothing (no sample at all where normals are off or come from the last step);
+  /// - Uvs: Mesh::uvs, the field-blended primitive (u,v) (the default);
+  /// - Blend: also PolygonizeResult::attributes, the vertex's blended texture ids, layers
+  ///   and PCM contact (blobtree::Attributes), which painting the mesh reads
+  ///   (model::paintPolygonized, render::Scene::addPolygonized with textures or a tilting
+  ///   ridge). They are 120 bytes a vertex, four times the mesh's own vertex data: 315 MB
+  ///   on the 2,000-cone benchmark, where allocating them was a third of the dual mesher's
+  ///   time (docs/PERFORMANCE.md), so only callers that paint ask for them.
+  enum class VertexData : uint8_t { None, Uvs, Blend };
+  VertexData vertexData = VertexData::Uvs;
   /// Report progress on a terminal (core/progress.h); cancellation throws Cancelled.
   bool progress = false;
 };
@@ -100,7 +109,7 @@ struct PolygonizeOptions {
 /// A mesh with per-vertex attributes and statistics.
 struct PolygonizeResult {
   Mesh mesh;
-  std::vector<Attributes> attributes;  ///< per vertex, when options.attributes
+  std::vector<Attributes> attributes;  ///< per vertex with VertexData::Blend, else empty
   float cellSize = 0.0f;        ///< the grid's actual cell edge
   size_t surfaceCells = 0;      ///< cells the interval bounds kept
   size_t activeCells = 0;       ///< cells with a sign change (the ones triangulated)

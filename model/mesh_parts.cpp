@@ -15,6 +15,7 @@ blobtree::PolygonizeOptions polygonizeOptions(const SpeciesRender& look) {
   blobtree::PolygonizeOptions po;
   po.mesher = look.dualMesher ? blobtree::PolygonizeOptions::Mesher::DualMarchingCubes
                               : blobtree::PolygonizeOptions::Mesher::MarchingTetrahedra;
+  po.vertexData = blobtree::PolygonizeOptions::VertexData::Blend;  // painted as the renderer paints
   return po;
 }
 
@@ -26,7 +27,8 @@ float lodCellSize(const blobtree::CompiledBlob& blob, const blobtree::Polygonize
   blobtree::PolygonizeOptions probe = options;
   probe.cellSize = fine * kLodProbeCells;
   probe.refineSteps = 0;  // the triangles follow the grid's signs alone
-  probe.normals = probe.attributes = probe.progress = false;
+  probe.normals = probe.progress = false;
+  probe.vertexData = blobtree::PolygonizeOptions::VertexData::None;
   const double counted = double(blobtree::polygonizeDetailed(blob, probe).mesh.triangles.size());
   if (!(counted > 0.0)) return fine;
   const double cell = double(probe.cellSize) * std::sqrt(counted / double(triangles));

@@ -22,12 +22,8 @@ namespace sprig {
 /// Texture id meaning "no texture contributes" in paintPolygonized's triangle ids.
 inline constexpr uint32_t kNoPartTexture = 0xffffffffu;
 
-/// The polygonized mesh of result with, per vertex, the colour the renderer gives it
-/// (Σ wᵢ·textureᵢ(uv, p) / Σ wᵢ over the vertex's textures; base where none contributes,
-/// as render::Scene::attributeColor), and per triangle (Mesh::materials) the texture id
-/// with the largest weight summed over its three vertices (kNoPartTexture when none).
-/// result must carry attributes (PolygonizeOptions::attributes). O(V·textures).
-/// The polygonizer's options a species' look asks for (render.mesher).
+/// The polygonizer's options a species' look asks for (render.mesher), with the vertices'
+/// blended attributes (VertexData::Blend) for painting.
 blobtree::PolygonizeOptions polygonizeOptions(const SpeciesRender& look);
 
 /// The cell at which a probe polygonizes, in units of the automatic cell (lodCellSize).
@@ -60,6 +56,12 @@ float lodCellSize(const blobtree::CompiledBlob& blob, const blobtree::Polygonize
 float lodCellCeiling(const blobtree::CompiledBlob& blob, const blobtree::PolygonizeOptions& options, float fine,
                      bool keepLimbs = true);
 
+/// The polygonized mesh of result with, per vertex, the colour the renderer gives it
+/// (Σ wᵢ·textureᵢ(uv, p) / Σ wᵢ over the vertex's textures; base where none contributes,
+/// as render::Scene::attributeColor), and per triangle (Mesh::materials) the texture id
+/// with the largest weight summed over its three vertices (kNoPartTexture when none).
+/// result must carry attributes (PolygonizeOptions::VertexData::Blend; throws
+/// std::invalid_argument otherwise). O(V·textures).
 Mesh paintPolygonized(const blobtree::PolygonizeResult& result, const render::TextureTable& textures, const Vec3& base);
 /// paintPolygonized with a material: its base colour, and its textureLayers and
 /// ridge darkening applied as render::Scene::attributeColor applies them (the ridge's

@@ -284,15 +284,18 @@ uint32_t Scene::addPolygonized(const blobtree::PolygonizeResult& result, uint32_
   if (material >= impl_->materials.size()) throw std::invalid_argument("Scene::addPolygonized: unknown material id");
   Mesh mesh = result.mesh;
   const Material& m = impl_->materials[material];
+  const bool tilt = m.ridge.tilts() && mesh.normals.size() == mesh.positions.size();
+  const size_t count = textureCount == kAllTextures ? impl_->textures.size() : textureCount;
+  if ((tilt || count > 0) && result.attributes.size() != mesh.positions.size())
+    throw std::invalid_argument("Scene::addPolygonized: textures and ridges need the vertices' attributes "
+                                "(PolygonizeOptions::VertexData::Blend)");
   // The ridge's relief tilts the vertex normals as it tilts exact hits' (Scene::intersect).
-  if (m.ridge.tilts() && mesh.normals.size() == mesh.positions.size() &&
-      result.attributes.size() == mesh.positions.size())
+  if (tilt)
     for (size_t i = 0; i < mesh.positions.size(); ++i) {
       const blobtree::Attributes& a = result.attributes[i];
       mesh.normals[i] = m.ridge.shadingNormal(mesh.normals[i], a.contact, a.contactGradient, mesh.positions[i]);
     }
-  const size_t count = textureCount == kAllTextures ? impl_->textures.size() : textureCount;
-  if (count > 0 && result.attributes.size() == mesh.positions.size()) {
+  if (count > 0) {
     mesh.colors.resize(mesh.positions.size());
     for (size_t i = 0; i < mesh.positions.size(); ++i)
       mesh.colors[i] = attributeColor(result.attributes[i], mesh.positions[i], impl_->materials[material], textureBase,

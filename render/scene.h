@@ -174,7 +174,9 @@ class Scene {
   /// Adds a polygonized BlobTree (mesh mode): triangles with the mesh's normals, and vertex
   /// colors from the per-vertex attributes through the same texture blend as exact mode.
   /// textures: the part's texture table (scene ids textureBase..textureBase+textureCount-1);
-  /// the default is the scene's whole table.
+  /// the default is the scene's whole table. Textures, or a material whose ridge tilts
+  /// normals, need result's attributes (PolygonizeOptions::VertexData::Blend): without them
+  /// it throws std::invalid_argument.
   uint32_t addPolygonized(const blobtree::PolygonizeResult& result, uint32_t material, uint32_t textureBase = 0,
                           uint32_t textureCount = kAllTextures);
 

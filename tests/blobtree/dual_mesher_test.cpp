@@ -229,11 +229,13 @@ TEST_CASE("dual mesher: batched Newton steps place the vertices of the scalar pa
   kids.push_back(tree.difference(bent, tree.box(Vec3(0.5f, -2, 0), Vec3(2, 0, 2))));
   CompiledBlob blob = compile(tree, tree.blend(kids));
   const float cell = 0.03f;
-  for (bool attributes : {true, false}) {
+  using VertexData = PolygonizeOptions::VertexData;
+  for (VertexData data : {VertexData::Blend, VertexData::None}) {
+    const bool attributes = data == VertexData::Blend;
     INFO("attributes " << attributes);
     PolygonizeOptions scalarOpt = dual(cell), batchedOpt = dual(cell);
     scalarOpt.batchedNewton = false;
-    scalarOpt.attributes = batchedOpt.attributes = attributes;
+    scalarOpt.vertexData = batchedOpt.vertexData = data;
     PolygonizeResult s = polygonizeDetailed(blob, scalarOpt), b = polygonizeDetailed(blob, batchedOpt);
     REQUIRE(s.mesh.vertexCount() == b.mesh.vertexCount());
     REQUIRE(s.mesh.triangleCount() == b.mesh.triangleCount());

@@ -259,3 +259,47 @@ TEST_CASE("polygonize::automatic cell size bounds", "[blobtree]") {
   CHECK(resolveCellSize(blob, opt) == Approx(0.005f));
   CHECK(resolveCellSize(blob) == Approx(0.005f));  // the default floor (diag / 2500) is finer
 }
+
+// PolygonizeOptions::vertexData keeps per vertex what the caller asks for and changes
+// nothing else: the same positions, normals and triangles; uvs with Uvs and Blend (the
+// same ones); the blended attributes only with Blend, their uv the vertex's.
+TEST_CASE("polygonizeDetailed: vertexData decides what each vertex keeps, and only that", "[blobtree]") {
+  BlobTree tree;
+  TextureAttr bark;
+  bark.textureId = 3;
+  const std::vector<NodeId> parts{tree.cone(Vec3(0), Vec3(0, 2, 0), 0.4f, 0.25f, bark), tree.point(Vec3(0.3f, 1.0f, 0), 0.5f)};
+  CompiledBlob blob = compile(tree, tree.blend(parts));
+  using VertexData = PolygonizeOptions::VertexData;
+  for (auto mesher : {PolygonizeOptions::Mesher::MarchingTetrahedra, PolygonizeOptions::Mesher::DualMarchingCubes}) {
+    INFO("dual " << (mesher == PolygonizeOptions::Mesher::DualMarchingCubes));
+    PolygonizeOptions o;
+    o.mesher = mesher;
+    o.cellSize = 0.05f;
+    std::map<VertexData, PolygonizeResult> r;
+    for (VertexData d : {VertexData::None, VertexData::Uvs, VertexData::Blend}) {
+      o.vertexData = d;
+      r[d] = polygonizeDetailed(blob, o);
+    }
+    const Mesh& m = r[VertexData::Blend].mesh;
+    REQUIRE(m.vertexCount() > 1000);
+    CHECK(PolygonizeOptions{}.vertexData == VertexData::Uvs);
+    for (VertexData d : {VertexData::None, VertexData::Uvs}) {
+      CHECK(r[d].mesh.positions == m.positions);
+      CHECK(r[d].mesh.normals == m.normals);
+      CHECK(r[d].mesh.triangles == m.triangles);
+    }
+    CHECK(r[VertexData::None].mesh.uvs.empty());
+    CHECK(r[VertexData::Uvs].mesh.uvs == m.uvs);
+    REQUIRE(m.uvs.size() == m.vertexCount());
+    CHECK(r[VertexData::None].attributes.empty());
+    CHECK(r[VertexData::Uvs].attributes.empty());
+    const std::vector<Attributes>& a = r[VertexData::Blend].attributes;
+    REQUIRE(a.size() == m.vertexCount());
+    size_t textured = 0;
+    for (size_t v = 0; v < a.size(); ++v) {
+      CHECK(a[v].uv == m.uvs[v]);
+      textured += a[v].textureCount > 0 && a[v].textureIds[0] == 3;
+    }
+    CHECK(textured > a.size() / 4);  // the cone's texture reaches the vertices on the cone
+  }
+}

@@ -94,6 +94,24 @@ TEST_CASE("Scene::addImplicit", "[render]") {
   }
 }
 
+// A polygonized part painted by textures needs its vertices' attributes; a mesh without
+// them is refused rather than drawn in the base colour.
+TEST_CASE("Scene::addPolygonized: textures without the vertices' attributes are an error", "[render]") {
+  blobtree::CompiledBlob blob = branchBlob();
+  blobtree::PolygonizeOptions po;
+  po.cellSize = 0.05f;
+  const blobtree::PolygonizeResult plain = blobtree::polygonizeDetailed(blob, po);
+  po.vertexData = blobtree::PolygonizeOptions::VertexData::Blend;
+  const blobtree::PolygonizeResult blended = blobtree::polygonizeDetailed(blob, po);
+  REQUIRE(plain.attributes.empty());
+  Scene untextured, textured;
+  CHECK_NOTHROW(untextured.addPolygonized(plain, untextured.addMaterial(Material{})));
+  textured.addTexture([](Vec2, const Vec3&) { return Vec3(1, 0, 0); });
+  const uint32_t m = textured.addMaterial(Material{});
+  CHECK_THROWS_AS(textured.addPolygonized(plain, m), std::invalid_argument);
+  CHECK_NOTHROW(textured.addPolygonized(blended, m));
+}
+
 TEST_CASE("render::exact and mesh modes agree", "[render]") {
   blobtree::CompiledBlob blob = branchBlob();
   blobtree::PolygonizeOptions po;
