@@ -1,9 +1,10 @@
 /// Polygonization benchmark: sparse near-surface polygonization of a synthetic branching
 /// structure of 2,000 cones, against a dense-grid baseline computed in the same run.
 ///
-/// Usage: bench_polygonize [--quick] [--cones N] [--no-baseline] [--cell H] [--dual] [--blend]
+/// Usage: bench_polygonize [--quick] [--cones N] [--no-baseline] [--cell H] [--dual | --tets] [--blend]
 /// (--cell replaces the target cell, half the smallest radius; --dual runs only the dual
-/// mesher with batched Newton steps, the default, and no baseline; --blend keeps every
+/// mesher with batched Newton steps, the default, and no baseline; --tets only marching
+/// tetrahedra, without the dense baseline; --blend keeps every
 /// vertex's blended attributes as painting callers do, PolygonizeOptions::VertexData::Blend,
 /// where the default keeps its uv.)
 /// Each mesh's bytes (positions, normals, uvs, triangles) are printed as an FNV-1a hash.
@@ -81,13 +82,14 @@ double denseSampling(const CompiledBlob& blob, float h, size_t& points, double& 
 }  // namespace
 
 int main(int argc, char** argv) {
-  bool quick = false, baseline = true, dualOnly = false, blend = false;
+  bool quick = false, baseline = true, dualOnly = false, tetsOnly = false, blend = false;
   int cones = 2000;
   float cellOverride = 0.0f;
   for (int i = 1; i < argc; ++i) {
     if (!std::strcmp(argv[i], "--quick")) quick = true;
     else if (!std::strcmp(argv[i], "--no-baseline")) baseline = false;
     else if (!std::strcmp(argv[i], "--dual")) dualOnly = true, baseline = false;
+    else if (!std::strcmp(argv[i], "--tets")) tetsOnly = true, baseline = false;
     else if (!std::strcmp(argv[i], "--blend")) blend = true;
     else if (!std::strcmp(argv[i], "--cell") && i + 1 < argc) cellOverride = float(std::atof(argv[++i]));
     else if (!std::strcmp(argv[i], "--cones") && i + 1 < argc) cones = std::atoi(argv[++i]);
@@ -119,7 +121,7 @@ int main(int argc, char** argv) {
                          Run{PolygonizeOptions::Mesher::DualMarchingCubes, true, "dual marching cubes, batched Newton"}}) {
     const auto mesher = run.mesher;
     const bool dual = mesher == PolygonizeOptions::Mesher::DualMarchingCubes;
-    if (dualOnly && !(dual && run.batched)) continue;
+    if ((dualOnly && !(dual && run.batched)) || (tetsOnly && dual)) continue;
     PolygonizeOptions opt;
     opt.mesher = mesher;
     opt.batchedNewton = run.batched;

@@ -77,8 +77,8 @@ struct HugePageAllocator {
 template <class T>
 using BigVector = std::vector<T, HugePageAllocator<T>>;
 
-// Frees the arrays' memory now. The dual mesher returns each working array once done with
-// it, so that the arrays made after it (the mesh's) reuse its pages: on a virtual machine
+// Frees the arrays' memory now. Both meshers return each working array once done with it,
+// so that the arrays made after it (the mesh's) reuse its pages: on a virtual machine
 // whose host backs guest memory lazily and takes freed memory back (free page reporting),
 // a page touched for the first time cost 3-7 ms a MB (2.1 s for 315 MB, the size of the
 // benchmark's vertex attributes), pages the process had just freed 0.1 ms (0.02 s for
@@ -1179,7 +1179,9 @@ PolygonizeResult polygonizeDetailed(const CompiledBlob& blob, const PolygonizeOp
   // 4. Vertex numbering and marching tetrahedra.
   Vertices v = numberVertices(g, 0xfe);
   res.mesh.triangles = triangulate(g, v);
-  releaseAll(v.owners);
+  // The root search reads only the grid points' keys and values (releaseAll).
+  releaseAll(v.owners, v.crossMask, v.vertexBase, g.cornerPoint, g.pointSlot, g.ownedMask, g.pointBase, g.insideMask,
+             g.active, g.cellCoords);
   res.triangulateSeconds = lap(res.triangulateCpuSeconds);
 
   // 5. Vertices: root search along each edge, then normal and attributes.
