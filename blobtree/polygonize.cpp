@@ -861,8 +861,16 @@ class DualMesher {
     releaseAll(g_.cornerPoint, g_.values);
     Mesh& mesh = res_.mesh;
     const size_t nVerts = patchBase_[nActive_];
-    resizeVertexArrays(options_, nVerts, res_);
-    flatGradient_.assign(nVerts, 0);
+    // With uvs, the batched path samples each vertex once all are placed and the quads
+    // made (sampleVertices), so that the normals, uvs and attributes reuse the pages of
+    // every working array released by then. The samples are those it took at once before.
+    const bool deferred = options_.batchedNewton && wantsUvs(options_);
+    if (deferred) {
+      resizeOutput(mesh.positions, nVerts);
+    } else {
+      resizeVertexArrays(options_, nVerts, res_);
+      flatGradient_.assign(nVerts, 0);
+    }
     if (options_.progress) bar_ = std::make_unique<Progress>("polygonize", nActive_);
     // Each patch's vertex: the mean of its crossing points, then Newton steps along the
     // gradient toward F = 0.5, kept inside the cell (so the quads keep their layout).
@@ -872,6 +880,10 @@ class DualMesher {
     if (bar_) bar_->finish();
     releaseAll(cross_);
     quads();
+    if (deferred) {
+      releaseAll(v_.owners, v_.crossMask, v_.vertexBase, patches_, patchBase_, g_.active, g_.insideMask, g_.cellCoords);
+      sampleVertices();
+    }
     if (options_.normals) fixFlatNormals(mesh, flatGradient_);
     size_t total = gridPoints_ + sampleCount_.load();
     for (uint8_t k : evals) total += k;
@@ -1008,10 +1020,7 @@ class DualMesher {
     for (size_t k = 0; k < n; ++k) {
       const size_t vi = first + k;
       res_.mesh.positions[vi] = p[k];
-      if (wantsUvs(options_)) {
-        storeSample(options_, blob_.sample(p[k]), vi, res_, flatGradient_);
-        ++samples;
-      } else if (options_.normals) {
+      if (!wantsUvs(options_) && options_.normals) {  // (with uvs: sampleVertices)
         Sample smp;
         smp.value = val[k];
         smp.gradient = grad[k];
@@ -1020,6 +1029,21 @@ class DualMesher {
     }
     sampleCount_ += samples;
     if (bar_) bar_->advance(end - begin);
+  }
+
+  /// Every placed vertex's normal, uv and attributes from one sample() at it, in fixed
+  /// blocks (the batched path with uvs; the arrays are made here).
+  void sampleVertices() {
+    const size_t nVerts = res_.mesh.positions.size();
+    resizeVertexArrays(options_, nVerts, res_);  // (positions: already that size)
+    flatGradient_.assign(nVerts, 0);
+    constexpr size_t kBlock = 1024;
+    parallelFor(0, (nVerts + kBlock - 1) / kBlock, [&](size_t blk) {
+      const size_t end = std::min(nVerts, (blk + 1) * kBlock);
+      for (size_t v = blk * kBlock; v < end; ++v)
+        storeSample(options_, blob_.sample(res_.mesh.positions[v]), v, res_, flatGradient_);
+    });
+    sampleCount_ += nVerts;
   }
 
   /// Newton steps one vertex at a time, with F and ∇F from CompiledBlob::sample.
