@@ -46,37 +46,44 @@ void forEachLatticePoint(const Box3& box, int g, F&& f) {
 
 std::atomic<float> sink{0.0f};
 
-void benchModel(int cones, bool quick) {
-  BlobTree t;
-  double compileS = 0;
-  CompiledBlob blob = timedCompile(t, branching(t, cones, 1234), compileS);
-  Box3 box = blob.bounds();
-  std::printf("\n== %d cones: bounds (%.1f %.1f %.1f) .. (%.1f %.1f %.1f), compile %.1f ms, %d threads\n", cones,
-              double(box.lo.x), double(box.lo.y), double(box.lo.z), double(box.hi.x), double(box.hi.y),
-              double(box.hi.z), compileS * 1e3, threadCount());
+/// The point sets a model is measured on: uniform points in its bounds (mostly empty space)
+/// and points inside its surface cells (near the surface).
+struct ModelPoints {
+  CellSet cells;
+  std::vector<Vec3> random, near;
+};
 
-  // Random points in the bounds (mostly empty space) and near-surface points.
+/// Finds the surface cells of blob, prints their count and cost, and draws n random and n
+/// near-surface points.
+ModelPoints sampleModel(const CompiledBlob& blob, size_t n) {
+  ModelPoints pts;
+  Box3 box = blob.bounds();
   Rng rng(99);
-  size_t nRandom = quick ? 200000 : 2000000;
-  std::vector<Vec3> random(nRandom);
-  for (auto& p : random) p = randomIn(rng, box.lo, box.hi);
+  pts.random.resize(n);
+  for (auto& p : pts.random) p = randomIn(rng, box.lo, box.hi);
 
   auto cs0 = Clock::now();
   float cell = 0.08f;
-  CellSet cells = blob.surfaceCells(cell);
+  pts.cells = blob.surfaceCells(cell);
   double cellS = seconds(cs0);
+  const CellSet& cells = pts.cells;
   size_t primRefs = cells.primitives.size();
   std::fflush(stdout);
   std::printf("surface cells (%.3f): %zu cells in %.2f s, %.1f primitives per cell\n", double(cells.cellSize),
               cells.cells.size(), cellS, double(primRefs) / double(std::max<size_t>(1, cells.cells.size())));
-  std::vector<Vec3> near;
-  near.reserve(nRandom);
-  for (size_t i = 0; i < nRandom; ++i) {
+  pts.near.reserve(n);
+  for (size_t i = 0; i < n; ++i) {
     const Cell& c = cells.cells[rng.below(uint32_t(cells.cells.size()))];
-    near.push_back(randomIn(rng, c.box.lo, c.box.hi));
+    pts.near.push_back(randomIn(rng, c.box.lo, c.box.hi));
   }
+  return pts;
+}
 
-  // Culled per-point evaluation, one thread then all threads.
+/// Culled per-point evaluation, one thread (against brute force) then all threads.
+void benchPerPoint(const CompiledBlob& blob, const ModelPoints& pts, int cones) {
+  size_t nRandom = pts.random.size();
+  const std::vector<Vec3>& random = pts.random;
+  const std::vector<Vec3>& near = pts.near;
   {
     ThreadLimit one(1);
     double s = timedParallel(nRandom, [&](size_t i) { sink = sink + blob.value(random[i]); });
@@ -92,86 +99,105 @@ void benchModel(int cones, bool quick) {
   double sn = timedParallel(nRandom, [&](size_t i) { sink = sink + blob.value(near[i]); });
   std::printf("all threads: random points %.2f M evals/s, near-surface %.2f M evals/s\n", double(nRandom) / s * 1e-6,
               double(nRandom) / sn * 1e-6);
+}
 
-  // Per-cell batched mode: a 6x6x6 lattice in each surface cell (what a polygonizer or a
-  // tile does), evaluated as one batch over the cell's short primitive list.
-  {
-    const int g = 6;
-    size_t nc = std::min<size_t>(cells.cells.size(), quick ? 20000 : 200000);
-    auto b0 = Clock::now();
-    double bc0 = processCpuSeconds();
-    parallelForRange(0, nc, [&](size_t b, size_t e) {
-      std::vector<Vec3> pts(g * g * g);
-      std::vector<float> out(pts.size());
-      for (size_t ci = b; ci < e; ++ci) {
-        const Cell& c = cells.cells[ci];
-        size_t k = 0;
-        forEachLatticePoint(c.box, g, [&](Vec3 p) { pts[k++] = p; });
-        blob.valuesInCell(c, pts, out);
-        sink = sink + out[0];
-      }
-    }, 16);
-    double bs = seconds(b0), bcpu = processCpuSeconds() - bc0;
-    size_t evals = nc * size_t(g * g * g);
-    // Same lattice points one at a time, for the ratio.
-    auto p0 = Clock::now();
-    parallelForRange(0, nc, [&](size_t b, size_t e) {
-      for (size_t ci = b; ci < e; ++ci) {
-        float acc = 0.0f;
-        forEachLatticePoint(cells.cells[ci].box, g, [&](Vec3 p) { acc += blob.value(p); });
-        sink = sink + acc;
-      }
-    }, 16);
-    double ps = seconds(p0);
-    std::printf("all threads: per-cell batched %.1f M evals/s vs per-point on the same points %.1f M evals/s (x%.1f)\n",
-                double(evals) / bs * 1e-6, double(evals) / ps * 1e-6, ps / bs);
-    std::printf("  per-cell batched: %.1f M evals per CPU-second (x%d threads on idle cores: %.1f M evals/s)\n",
-                double(evals) / bcpu * 1e-6, threadCount(), double(evals) / bcpu * 1e-6 * threadCount());
-  }
+/// Per-cell batched mode: a 6x6x6 lattice in each surface cell (what a polygonizer or a
+/// tile does), evaluated as one batch over the cell's short primitive list, against the same
+/// lattice points evaluated one at a time.
+void benchBatchedCells(const CompiledBlob& blob, const CellSet& cells, bool quick) {
+  const int g = 6;
+  size_t nc = std::min<size_t>(cells.cells.size(), quick ? 20000 : 200000);
+  auto b0 = Clock::now();
+  double bc0 = processCpuSeconds();
+  parallelForRange(0, nc, [&](size_t b, size_t e) {
+    std::vector<Vec3> pts(g * g * g);
+    std::vector<float> out(pts.size());
+    for (size_t ci = b; ci < e; ++ci) {
+      const Cell& c = cells.cells[ci];
+      size_t k = 0;
+      forEachLatticePoint(c.box, g, [&](Vec3 p) { pts[k++] = p; });
+      blob.valuesInCell(c, pts, out);
+      sink = sink + out[0];
+    }
+  }, 16);
+  double bs = seconds(b0), bcpu = processCpuSeconds() - bc0;
+  size_t evals = nc * size_t(g * g * g);
+  // Same lattice points one at a time, for the ratio.
+  auto p0 = Clock::now();
+  parallelForRange(0, nc, [&](size_t b, size_t e) {
+    for (size_t ci = b; ci < e; ++ci) {
+      float acc = 0.0f;
+      forEachLatticePoint(cells.cells[ci].box, g, [&](Vec3 p) { acc += blob.value(p); });
+      sink = sink + acc;
+    }
+  }, 16);
+  double ps = seconds(p0);
+  std::printf("all threads: per-cell batched %.1f M evals/s vs per-point on the same points %.1f M evals/s (x%.1f)\n",
+              double(evals) / bs * 1e-6, double(evals) / ps * 1e-6, ps / bs);
+  std::printf("  per-cell batched: %.1f M evals per CPU-second (x%d threads on idle cores: %.1f M evals/s)\n",
+              double(evals) / bcpu * 1e-6, threadCount(), double(evals) / bcpu * 1e-6 * threadCount());
+}
 
-  // Ray casting: a pinhole camera looking at the model.
-  {
-    int w = quick ? 96 : 256, h = w;
-    Vec3 center = box.center();
-    float radius = 0.5f * glm::length(box.size());
-    Vec3 eye = center + Vec3(0.3f, 0.2f, 1.0f) * (2.2f * radius);
-    Vec3 fwd = glm::normalize(center - eye), right = glm::normalize(glm::cross(fwd, Vec3(0, 1, 0)));
-    Vec3 up = glm::cross(right, fwd);
-    auto rayOf = [&](size_t i) {
-      float u = (float(i % size_t(w)) + 0.5f) / float(w) * 2.0f - 1.0f;
-      float v = (float(i / size_t(w)) + 0.5f) / float(h) * 2.0f - 1.0f;
-      return Ray{eye, fwd + 0.45f * (u * right + v * up)};
-    };
-    std::atomic<int> hits{0};
-    double rs = timedParallel(size_t(w * h), [&](size_t i) {
-      if (blob.intersect(rayOf(i), 0.0f, 1e30f)) hits++;
-    });
-    std::printf("all threads: %d rays, %d hits, %.3f M rays/s (intersect: segment tracing, local Lipschitz)\n", w * h,
-                hits.load(), double(w * h) / rs * 1e-6);
-    // Baseline: sphere tracing with the global Lipschitz bound (culled evaluation, else a
-    // single ray would take minutes): isolates the gain of local bounds and interval skipping.
-    size_t nb = 8;
-    double gL = blob.lipschitz();
-    std::atomic<long> steps{0};
-    auto g0 = Clock::now();
-    parallelFor(0, nb, [&](size_t k) {
-      size_t i = size_t(w * h / 2 + w / 2) + k * 3;
-      Ray r = rayOf(i);
-      Vec3 d = glm::normalize(r.direction);
-      float tt = 0.0f;
-      long it = 0;
-      for (; it < 20000000 && tt < 4.0f * radius; ++it) {
-        float f = blob.value(r.origin + tt * d);
-        if (f >= kIso) break;
-        tt += std::max(float((kIso - f) / gL), 1e-6f);
-      }
-      steps += it;
-      sink = sink + tt;
-    });
-    double bsec = seconds(g0);
-    std::printf("baseline: global-Lipschitz (%.0f) sphere tracing %.6f M rays/s (%.0f steps/ray) -> local bounds x%.0f\n",
-                gL, double(nb) / bsec * 1e-6, double(steps.load()) / double(nb), (double(w * h) / rs) / (double(nb) / bsec));
-  }
+/// Ray casting with a pinhole camera looking at the model, against sphere tracing with the
+/// global Lipschitz bound.
+void benchRays(const CompiledBlob& blob, bool quick) {
+  Box3 box = blob.bounds();
+  int w = quick ? 96 : 256, h = w;
+  Vec3 center = box.center();
+  float radius = 0.5f * glm::length(box.size());
+  Vec3 eye = center + Vec3(0.3f, 0.2f, 1.0f) * (2.2f * radius);
+  Vec3 fwd = glm::normalize(center - eye), right = glm::normalize(glm::cross(fwd, Vec3(0, 1, 0)));
+  Vec3 up = glm::cross(right, fwd);
+  auto rayOf = [&](size_t i) {
+    float u = (float(i % size_t(w)) + 0.5f) / float(w) * 2.0f - 1.0f;
+    float v = (float(i / size_t(w)) + 0.5f) / float(h) * 2.0f - 1.0f;
+    return Ray{eye, fwd + 0.45f * (u * right + v * up)};
+  };
+  std::atomic<int> hits{0};
+  double rs = timedParallel(size_t(w * h), [&](size_t i) {
+    if (blob.intersect(rayOf(i), 0.0f, 1e30f)) hits++;
+  });
+  std::printf("all threads: %d rays, %d hits, %.3f M rays/s (intersect: segment tracing, local Lipschitz)\n", w * h,
+              hits.load(), double(w * h) / rs * 1e-6);
+  // Baseline: sphere tracing with the global Lipschitz bound (culled evaluation, else a
+  // single ray would take minutes): isolates the gain of local bounds and interval skipping.
+  size_t nb = 8;
+  double gL = blob.lipschitz();
+  std::atomic<long> steps{0};
+  auto g0 = Clock::now();
+  parallelFor(0, nb, [&](size_t k) {
+    size_t i = size_t(w * h / 2 + w / 2) + k * 3;
+    Ray r = rayOf(i);
+    Vec3 d = glm::normalize(r.direction);
+    float tt = 0.0f;
+    long it = 0;
+    for (; it < 20000000 && tt < 4.0f * radius; ++it) {
+      float f = blob.value(r.origin + tt * d);
+      if (f >= kIso) break;
+      tt += std::max(float((kIso - f) / gL), 1e-6f);
+    }
+    steps += it;
+    sink = sink + tt;
+  });
+  double bsec = seconds(g0);
+  std::printf("baseline: global-Lipschitz (%.0f) sphere tracing %.6f M rays/s (%.0f steps/ray) -> local bounds x%.0f\n",
+              gL, double(nb) / bsec * 1e-6, double(steps.load()) / double(nb), (double(w * h) / rs) / (double(nb) / bsec));
+}
+
+/// Measures a branching model of the given number of cones: surface cells, per-point and
+/// per-cell evaluation, and ray casting.
+void benchModel(int cones, bool quick) {
+  BlobTree t;
+  double compileS = 0;
+  CompiledBlob blob = timedCompile(t, branching(t, cones, 1234), compileS);
+  Box3 box = blob.bounds();
+  std::printf("\n== %d cones: bounds (%.1f %.1f %.1f) .. (%.1f %.1f %.1f), compile %.1f ms, %d threads\n", cones,
+              double(box.lo.x), double(box.lo.y), double(box.lo.z), double(box.hi.x), double(box.hi.y),
+              double(box.hi.z), compileS * 1e3, threadCount());
+  ModelPoints pts = sampleModel(blob, quick ? 200000 : 2000000);
+  benchPerPoint(blob, pts, cones);
+  benchBatchedCells(blob, pts.cells, quick);
+  benchRays(blob, quick);
 }
 
 /// A planar grid of parallel cones with fixed spacing: local overlap does not depend on n.

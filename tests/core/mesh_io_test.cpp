@@ -35,6 +35,15 @@ T readRaw(const std::string& bytes, size_t offset) {
   return v;
 }
 
+/// The glTF binary file read back by TinyGLTF (which must succeed).
+tinygltf::Model readGlb(const fs::path& file) {
+  tinygltf::Model model;
+  tinygltf::TinyGLTF loader;
+  std::string err, warn;
+  REQUIRE(loader.LoadBinaryFromFile(&model, &err, &warn, file.string()));
+  return model;
+}
+
 }  // namespace
 
 TEST_CASE("writePly", "[core]") {
@@ -262,6 +271,22 @@ std::vector<ExportPart> twoParts() {
   return {wood, leaves};
 }
 
+/// One quad "bark" and a 4 x 2 texture repeating along u: red on the top row, blue below.
+ExportPart texturedQuad() {
+  ExportPart quad;
+  quad.name = "bark";
+  quad.mesh.positions = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0)};
+  quad.mesh.uvs = {Vec2(0.2f, 0), Vec2(0.6f, 0), Vec2(0.6f, 1), Vec2(0.2f, 1)};  // u spans < 0.5: no seam
+  quad.mesh.colors.assign(4, Vec3(0.9f, 0.1f, 0.1f));  // brighter than the base colour: no COLOR_0, nothing clamped
+  quad.mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
+  auto tex = std::make_shared<PartTexture>();
+  tex->image = Image(4, 2, Vec4(0, 0, 1, 1));
+  for (int x = 0; x < 4; ++x) tex->image.set(x, 0, Vec4(1, 0, 0, 1));
+  tex->seams.repeatU = true;
+  quad.material = PartMaterial{"bark", Vec3(0.3f, 0.2f, 0.1f), 0.8f, false, tex};
+  return quad;
+}
+
 }  // namespace
 
 TEST_CASE("writeParts", "[core]") {
@@ -270,10 +295,7 @@ TEST_CASE("writeParts", "[core]") {
   SECTION("glb: one named node, mesh and material per part; COLOR_0 relative to the base colour") {
     const fs::path file = dir.path / "parts.glb";
     writeParts(parts, file);
-    tinygltf::Model model;
-    tinygltf::TinyGLTF loader;
-    std::string err, warn;
-    REQUIRE(loader.LoadBinaryFromFile(&model, &err, &warn, file.string()));
+    const tinygltf::Model model = readGlb(file);
     REQUIRE(model.nodes.size() == 2);
     CHECK(model.nodes[0].name == "wood");
     CHECK(model.nodes[1].name == "leaves");
@@ -345,20 +367,9 @@ TEST_CASE("writeParts", "[core]") {
   }
 }
 
-TEST_CASE("writeParts::texture", "[core]") {
+TEST_CASE("writeParts::texture: glb and obj", "[core]") {
   TempDir dir;
-  // One quad and a 4 x 2 texture: red on the top row, blue below.
-  ExportPart quad;
-  quad.name = "bark";
-  quad.mesh.positions = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0)};
-  quad.mesh.uvs = {Vec2(0.2f, 0), Vec2(0.6f, 0), Vec2(0.6f, 1), Vec2(0.2f, 1)};  // u spans < 0.5: no seam
-  quad.mesh.colors.assign(4, Vec3(0.9f, 0.1f, 0.1f));  // brighter than the base colour: no COLOR_0, nothing clamped
-  quad.mesh.triangles = {{0, 1, 2}, {0, 2, 3}};
-  auto tex = std::make_shared<PartTexture>();
-  tex->image = Image(4, 2, Vec4(0, 0, 1, 1));
-  for (int x = 0; x < 4; ++x) tex->image.set(x, 0, Vec4(1, 0, 0, 1));
-  tex->seams.repeatU = true;
-  quad.material = PartMaterial{"bark", Vec3(0.3f, 0.2f, 0.1f), 0.8f, false, tex};
+  const ExportPart quad = texturedQuad();
   CHECK(clampedColorChannels(quad) == 0);
   SECTION("glb: an embedded PNG as baseColorTexture, factor 1, the base colour in extras, no COLOR_0") {
     const fs::path file = dir.path / "t.glb";
@@ -366,10 +377,7 @@ TEST_CASE("writeParts::texture", "[core]") {
     REQUIRE(reports.size() == 1);
     CHECK(reports[0].textureWidth == 4);
     CHECK(reports[0].textureHeight == 2);
-    tinygltf::Model model;
-    tinygltf::TinyGLTF loader;
-    std::string err, warn;
-    REQUIRE(loader.LoadBinaryFromFile(&model, &err, &warn, file.string()));
+    const tinygltf::Model model = readGlb(file);
     REQUIRE(model.materials.size() == 1);
     const auto& pbr = model.materials[0].pbrMetallicRoughness;
     CHECK(pbr.baseColorFactor == std::vector<double>{1, 1, 1, 1});
@@ -406,6 +414,12 @@ TEST_CASE("writeParts::texture", "[core]") {
     CHECK(readFile(file).find("f 1/1 2/2 3/3\n") != std::string::npos);
     CHECK(dir.entries() == 3);
   }
+}
+
+TEST_CASE("writeParts::texture: clamping, missing uvs and cut-outs", "[core]") {
+  TempDir dir;
+  const ExportPart quad = texturedQuad();
+  CHECK(clampedColorChannels(quad) == 0);
   SECTION("obj: -clamp on where the glTF sampler clamps both axes, not where one repeats") {
     ExportPart clamped = quad;
     auto clampedTex = std::make_shared<PartTexture>(*quad.material.texture);
@@ -415,10 +429,7 @@ TEST_CASE("writeParts::texture", "[core]") {
     writeParts({clamped}, dir.path / "k.obj");
     CHECK(readFile(dir.path / "k.mtl").find("map_Kd -clamp on k_bark.png\nmap_d -clamp on k_bark.png\n") != std::string::npos);
     writeParts({clamped}, dir.path / "k.glb");
-    tinygltf::Model model;
-    tinygltf::TinyGLTF loader;
-    std::string err, warn;
-    REQUIRE(loader.LoadBinaryFromFile(&model, &err, &warn, (dir.path / "k.glb").string()));
+    const tinygltf::Model model = readGlb(dir.path / "k.glb");
     CHECK(model.samplers[0].wrapS == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE);
     CHECK(model.samplers[0].wrapT == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE);
     writeParts({quad}, dir.path / "r.obj");  // s repeats: MTL cannot clamp t alone
@@ -429,7 +440,8 @@ TEST_CASE("writeParts::texture", "[core]") {
     bad.mesh.uvs.clear();
     CHECK_THROWS_AS(writeParts({bad}, dir.path / "bad.obj"), std::invalid_argument);
     CHECK(dir.entries() == 0);
-  }  SECTION("a cut-out: alpha kept (RGBA PNG), glTF MASK with its cutoff, MTL map_d, the sampler's filters") {
+  }
+  SECTION("a cut-out: alpha kept (RGBA PNG), glTF MASK with its cutoff, MTL map_d, the sampler's filters") {
     ExportPart cut = quad;
     auto cutTex = std::make_shared<PartTexture>(*quad.material.texture);
     cutTex->image.set(1, 0, Vec4(1, 0, 0, 0));  // one transparent texel
@@ -439,10 +451,7 @@ TEST_CASE("writeParts::texture", "[core]") {
     cut.material.alphaCutoff = 0.1f;
     const fs::path glb = dir.path / "c.glb";
     writeParts({cut}, glb);
-    tinygltf::Model model;
-    tinygltf::TinyGLTF loader;
-    std::string err, warn;
-    REQUIRE(loader.LoadBinaryFromFile(&model, &err, &warn, glb.string()));
+    const tinygltf::Model model = readGlb(glb);
     CHECK(model.materials[0].alphaMode == "MASK");
     CHECK(model.materials[0].alphaCutoff == Approx(0.1));
     const auto& image = model.images[0];
@@ -459,8 +468,7 @@ TEST_CASE("writeParts::texture", "[core]") {
     CHECK(png.at(1, 0).a == 0.0f);
     // Opaque parts keep the default: OPAQUE, an RGB PNG (no map_d).
     writeParts({quad}, dir.path / "o.glb");
-    tinygltf::Model opaque;
-    REQUIRE(loader.LoadBinaryFromFile(&opaque, &err, &warn, (dir.path / "o.glb").string()));
+    const tinygltf::Model opaque = readGlb(dir.path / "o.glb");
     CHECK(opaque.materials[0].alphaMode == "OPAQUE");
     writeParts({quad}, dir.path / "o.obj");
     CHECK(readFile(dir.path / "o.mtl").find("map_d") == std::string::npos);
@@ -494,10 +502,7 @@ TEST_CASE("writeParts stores textures at kTexturePngLevel, 8-bit images as they 
   const auto reports = writeParts({tri}, file);
   REQUIRE(reports.size() == 1);
   CHECK(reports[0].textureWidth == 8);
-  tinygltf::Model model;
-  tinygltf::TinyGLTF loader;
-  std::string err, warn;
-  REQUIRE(loader.LoadBinaryFromFile(&model, &err, &warn, file.string()));
+  const tinygltf::Model model = readGlb(file);
   REQUIRE(model.images.size() == 2);
   for (size_t i = 0; i < 2; ++i) {
     const Image8& written = i == 0 ? color->image8 : normal->image8;

@@ -56,30 +56,42 @@ void checkNear(const DVec3& a, const DVec3& b) {
   CHECK(glm::length(a - b) < 1e-6 * (1 + glm::length(b)));
 }
 
-/// The first error message of parsing text as a cpfg grammar `t.l` (or `t.lsys`).
-std::string errorOf(const std::string& text, const std::string& file = "t.l") {
+/// The skeleton's internodes run from want[k].first to want[k].second, in order.
+void checkSegments(const Skeleton& skeleton, const std::vector<std::pair<DVec3, DVec3>>& want) {
+  REQUIRE(skeleton.internodes.size() == want.size());
+  for (size_t k = 0; k < want.size(); ++k) {
+    INFO("internode " << k);
+    checkNear(skeleton.internodes[k].start, want[k].first);
+    checkNear(skeleton.internodes[k].end, want[k].second);
+  }
+}
+
+/// The first diagnostic run() throws as an InputError, as "file:line:col: message" when
+/// withFile, else "line:col: message"; "no error" when it throws none.
+template <class F>
+std::string firstError(F&& run, bool withFile) {
   try {
-    parseGrammar(text, file);
+    run();
   } catch (const InputError& e) {
     const Diagnostic& d = e.diagnostics().front();
-    return d.loc.file + ":" + std::to_string(d.loc.line) + ":" + std::to_string(d.loc.col) + ": " + d.message;
+    const std::string at = std::to_string(d.loc.line) + ":" + std::to_string(d.loc.col) + ": " + d.message;
+    return withFile ? d.loc.file + ":" + at : at;
   }
   return "no error";
 }
 
+/// The first error message of parsing text as a cpfg grammar `t.l` (or `t.lsys`).
+std::string errorOf(const std::string& text, const std::string& file = "t.l") {
+  return firstError([&] { parseGrammar(text, file); }, true);
+}
+
 std::string viewErrorOf(const std::string& text) {
-  try {
-    parseViewFile(text, "t.v");
-  } catch (const InputError& e) {
-    const Diagnostic& d = e.diagnostics().front();
-    return d.loc.file + ":" + std::to_string(d.loc.line) + ":" + std::to_string(d.loc.col) + ": " + d.message;
-  }
-  return "no error";
+  return firstError([&] { parseViewFile(text, "t.v"); }, true);
 }
 
 }  // namespace
 
-TEST_CASE("cpfg objects", "[lsystem][cpfg]") {
+TEST_CASE("cpfg objects: angle increments, continued lines and expressions", "[lsystem][cpfg]") {
   const double s30 = 0.5, c30 = std::sqrt(3.0) / 2, r2 = std::sqrt(0.5);
 
   SECTION("angle increment from the view file; Lsystem:, Axiom:, a bare homomorphism, Endlsystem") {
@@ -116,6 +128,10 @@ TEST_CASE("cpfg objects", "[lsystem][cpfg]") {
     Drawn o = drawObject("expressions", false);
     CHECK(o.string == "B(10,20)C(2,3,-2,1)D(4,64,0)");
   }
+}
+
+TEST_CASE("cpfg objects: widths, colors, the turtle scale, tropism, moves and headings", "[lsystem][cpfg]") {
+  const double r2 = std::sqrt(0.5);
 
   SECTION("widths, colors and the turtle scale: ! # ; , @D") {
     // View: width 4 in world units, increment 1, color 5, increment 2.
@@ -158,7 +174,9 @@ TEST_CASE("cpfg objects", "[lsystem][cpfg]") {
     checkNear(o.end.frame.left, DVec3(1, 0, 0));
     checkNear(o.end.frame.up, DVec3(0, r2, -r2));
   }
+}
 
+TEST_CASE("cpfg objects: elasticity steps, cpfg's old tropism and torque", "[lsystem][cpfg]") {
   SECTION("@Ti without a value adds the tropism's step S, @Td(n, d) subtracts d, @Ts of a missing tropism is ignored") {
     // E 0.1 + S 0.2 = 0.3: the first F turns 0.3 rad down; 0.3 - 0.3 = 0: the others go straight.
     Drawn o = drawObject("elasticity_steps", true);
@@ -189,7 +207,9 @@ TEST_CASE("cpfg objects", "[lsystem][cpfg]") {
     checkNear(o.end.frame.up, DVec3(std::sin(0.5), 0, std::cos(0.5)));
     checkNear(o.end.frame.left, DVec3(-std::cos(0.5), 0, std::sin(0.5)));
   }
+}
 
+TEST_CASE("cpfg objects: bran and biran; spheres and discs", "[lsystem][cpfg]") {
   SECTION("bran and biran draw from the seeded generator") {
     Drawn a = drawObject("random", false), b = drawObject("random", false);
     CHECK(a.string == b.string);
@@ -672,7 +692,7 @@ TEST_CASE("cpfg's C preprocessor", "[lsystem][cpfg]") {
   }
 }
 
-TEST_CASE("cpfg sub-L-systems", "[lsystem][cpfg]") {
+TEST_CASE("cpfg sub-L-systems: calls derived by their own L-system", "[lsystem][cpfg]") {
   SECTION("tests/assets/cpfg/sub_lsystem: each call derived by its own L-system (strings by hand in plant.l)") {
     Drawn o = drawObject("sub_lsystem", true);
     CHECK(o.string ==
@@ -683,12 +703,7 @@ TEST_CASE("cpfg sub-L-systems", "[lsystem][cpfg]") {
         {{0, 0, 0}, {0, 1, 0}},   {{0, 1, 0}, {0, 2, 0}},   {{0, 2, 0}, {0, 3, 0}},   {{0, 3, 0}, {0, 4, 0}},
         {{0, 4, 0}, {-1, 4, 0}},  {{-1, 4, 0}, {-5, 4, 0}}, {{-5, 4, 0}, {-6, 4, 0}}, {{0, 4, 0}, {0, 5, 0}},
         {{0, 5, 0}, {-1, 5, 0}},  {{0, 5, 0}, {0, 6, 0}}};
-    REQUIRE(o.skeleton.internodes.size() == want.size());
-    for (size_t k = 0; k < want.size(); ++k) {
-      INFO("internode " << k);
-      checkNear(o.skeleton.internodes[k].start, want[k].first);
-      checkNear(o.skeleton.internodes[k].end, want[k].second);
-    }
+    checkSegments(o.skeleton, want);
     // Widths: 0.2 on the main axis, 0.1 in L-system 2, 0.2 again in L-system 3 (x 0.5 x 2).
     const double r0 = o.skeleton.internodes[0].baseRadius;
     REQUIRE(r0 > 0);
@@ -717,6 +732,9 @@ TEST_CASE("cpfg sub-L-systems", "[lsystem][cpfg]") {
     // Step 2: the inner A is in L-system 1 again.
     CHECK(formatModuleString(d.step(), d.symbols()) == "?(2)?(1)AX$$AXX");
   }
+}
+
+TEST_CASE("cpfg sub-L-systems: each L-system's decomposition and interpretation rules", "[lsystem][cpfg]") {
   SECTION("tests/assets/cpfg/sub_lsystem_rules: each L-system's decomposition, interpretation and ignore: inside its calls") {
     Grammar g = loadGrammar(cpfgAsset("sub_lsystem_rules/plant.l"));
     CHECK(g.hasInterpretation());
@@ -747,12 +765,7 @@ TEST_CASE("cpfg sub-L-systems", "[lsystem][cpfg]") {
     axis(8, 4);
     branch(12);
     axis(12, 2);
-    REQUIRE(o.skeleton.internodes.size() == want.size());
-    for (size_t k = 0; k < want.size(); ++k) {
-      INFO("internode " << k);
-      checkNear(o.skeleton.internodes[k].start, want[k].first);
-      checkNear(o.skeleton.internodes[k].end, want[k].second);
-    }
+    checkSegments(o.skeleton, want);
     const double r0 = o.skeleton.internodes[0].baseRadius;
     REQUIRE(r0 > 0);
     CHECK(o.skeleton.internodes[8].baseRadius == Approx(0.5 * r0));
@@ -791,6 +804,9 @@ TEST_CASE("cpfg sub-L-systems", "[lsystem][cpfg]") {
     // Y, Z have no productions; the inner X --> X is decomposed by L-system 2 again.
     CHECK(formatModuleString(d.step(), d.symbols()) == "YY?(2)ZZZZX$YY");
   }
+}
+
+TEST_CASE("cpfg sub-L-systems: errors", "[lsystem][cpfg]") {
   SECTION("errors") {
     CHECK(errorOf("axiom: ?(2)A$\nendlsystem\nlsystem: 2\nseed: 3\nA --> B\n") ==
           "t.l:4:1: 'seed:' in a sub-L-system ('lsystem: 2') is not supported (Sprig reads a sub-L-system's productions, "
@@ -912,13 +928,7 @@ TEST_CASE("cpfg function files and func(n, x)", "[lsystem][cpfg]") {
   }
   SECTION("errors") {
     auto errorIn = [](const std::string& text) {
-      try {
-        CpfgFunction::parse(text, "f.func", -1);
-      } catch (const InputError& e) {
-        const Diagnostic& d = e.diagnostics().front();
-        return d.loc.file + ":" + std::to_string(d.loc.line) + ":" + std::to_string(d.loc.col) + ": " + d.message;
-      }
-      return std::string("no error");
+      return firstError([&] { CpfgFunction::parse(text, "f.func", -1); }, true);
     };
     CHECK(errorIn("range: 0 1\npoints: 3\n0 0\n0.5 1\n1 0\n") ==
           "f.func:2:1: a function needs at least 4 points ('points: n', n from 4 to 100000)");
@@ -979,7 +989,7 @@ TEST_CASE("cpfg generalized cylinders", "[lsystem][cpfg]") {
   }
 }
 
-TEST_CASE("cpfg surface files and ~X", "[lsystem][cpfg]") {
+TEST_CASE("cpfg surface files: the placed patch, precisions and cpfg's frame map", "[lsystem][cpfg]") {
   SECTION("tests/assets/cpfg/surface: a bilinear patch placed after F(3) and a right turn, by hand") {
     // plate.s is the bilinear patch x = 1 + 3t, y = 3s, z = 9st (Bezier points at thirds).
     // Contact (1,0,0), SIZE 3, view size 6: p = 2 (f - contact) = (6t, 6s, 18st) in the
@@ -1041,6 +1051,9 @@ TEST_CASE("cpfg surface files and ~X", "[lsystem][cpfg]") {
     checkNear(s.point(0, 1.0, 0.0), DVec3(3, 0, 0));   // P[3][0] = (1,3,0): 3 * heading
     checkNear(s.endPoint(), DVec3(3, 0, 0));
   }
+}
+
+TEST_CASE("cpfg ~X: scales, undefined surfaces; surface file errors and missing files", "[lsystem][cpfg]") {
   SECTION("~X(sx, sy, sz) scales each axis; the end point moves by sx; a zero scale draws nothing") {
     ViewFile view = loadViewFile(cpfgAsset("surface/plant.v"));
     GrammarOverrides go;
@@ -1083,13 +1096,7 @@ TEST_CASE("cpfg surface files and ~X", "[lsystem][cpfg]") {
     auto surfaceError = [&](std::string from, std::string to) {
       std::string t = text;
       t.replace(t.find(from), from.size(), to);
-      try {
-        CpfgSurface::parse(t, "p.s", 1, 0, 0);
-      } catch (const InputError& e) {
-        const Diagnostic& d = e.diagnostics().front();
-        return std::to_string(d.loc.line) + ":" + std::to_string(d.loc.col) + ": " + d.message;
-      }
-      return std::string("no error");
+      return firstError([&] { CpfgSurface::parse(t, "p.s", 1, 0, 0); }, false);
     };
     CHECK(surfaceError("SIZE: 3", "SIZE: 0") == "7:1: the surface's SIZE must be greater than 0");
     CHECK(surfaceError("SIZE: 3", "SIZE 3") == "7:1: expected 'SIZE:' (the surface's size), got 'SIZE'");
@@ -1172,24 +1179,12 @@ TEST_CASE("cpfg curve files and curveX/Y/Z/GAL", "[lsystem][cpfg]") {
     GrammarOverrides o;
     o.cpfgCurves = loadViewFile(cpfgAsset("curve/plant.v")).curves;
     auto errorWith = [&](const std::string& text) {
-      try {
-        parseGrammar(text, "t.l", o);
-      } catch (const InputError& e) {
-        const Diagnostic& d = e.diagnostics().front();
-        return std::to_string(d.loc.line) + ":" + std::to_string(d.loc.col) + ": " + d.message;
-      }
-      return std::string("no error");
+      return firstError([&] { parseGrammar(text, "t.l", o); }, false);
     };
     CHECK(errorWith("axiom: F(curveGAL(6))\n") == "1:10: curveGAL's first argument must be a number from 1 to 5 (the view file names 5 curve file(s))");
     CHECK(errorWith("axiom: F(curveY(1))\n").find("curveY takes 2 arguments") != std::string::npos);
     auto curveError = [](const std::string& text) {
-      try {
-        CpfgCurve::parse(text, "c.con", 100);
-      } catch (const InputError& e) {
-        const Diagnostic& d = e.diagnostics().front();
-        return std::to_string(d.loc.line) + ":" + std::to_string(d.loc.col) + ": " + d.message;
-      }
-      return std::string("no error");
+      return firstError([&] { CpfgCurve::parse(text, "c.con", 100); }, false);
     };
     CHECK(curveError("points: 4\n0 0\n1 1\n2 0\n") == "1:1: 'points: 4' but the file has 3 control point(s)");
     CHECK(curveError("points: 4\n0 0\n1 1\n2 0 5\n3 3\n") == "4:1: a control point has 2 numbers (the dimension), got 3");
@@ -1203,15 +1198,24 @@ TEST_CASE("cpfg curve files and curveX/Y/Z/GAL", "[lsystem][cpfg]") {
   }
 }
 
-TEST_CASE("cpfg contour files and generalized cylinders with @#(n)", "[lsystem][cpfg]") {
-  // Contour samples from tests/assets/cpfg/contour/reference.py (cpfg's MakeContour in numpy).
-  const std::vector<DVec3> blade = {{0.897527467856, 0.000000000000, 0},  {0.330524728563, 0.891423755803, 0},
-                                    {-0.650675635926, 1.100685813632, 0}, {-0.897527467856, 0.000000000000, 0},
-                                    {-0.330524728563, -0.891423755803, 0}, {0.650675635926, -1.100685813632, 0},
-                                    {0.897527467856, 0.000000000000, 0}};
-  const std::vector<DVec3> strip = {{-0.500000000000, 0.283333341281, 0}, {-0.271197024029, 0.382473459469, 0},
-                                    {-0.027807813170, 0.432723318993, 0}, {0.218184666413, 0.399404333018, 0},
-                                    {0.450000000000, 0.307783341169, 0}};
+namespace {
+
+// Contour samples from tests/assets/cpfg/contour/reference.py (cpfg's MakeContour in numpy).
+const std::vector<DVec3> kBladeContour = {{0.897527467856, 0.000000000000, 0},  {0.330524728563, 0.891423755803, 0},
+                                  {-0.650675635926, 1.100685813632, 0}, {-0.897527467856, 0.000000000000, 0},
+                                  {-0.330524728563, -0.891423755803, 0}, {0.650675635926, -1.100685813632, 0},
+                                  {0.897527467856, 0.000000000000, 0}};
+const std::vector<DVec3> kStripContour = {{-0.500000000000, 0.283333341281, 0}, {-0.271197024029, 0.382473459469, 0},
+                                  {-0.027807813170, 0.432723318993, 0}, {0.218184666413, 0.399404333018, 0},
+                                  {0.450000000000, 0.307783341169, 0}};
+
+/// A contour point k of a ring centred at c, drawn by the turtle at its start (H = +Y, L = -X,
+/// cpfg's up U' = (0,0,-1)) with radius 0.2: c + 0.2 (k.x U' - k.y L).
+DVec3 placedOnRing(const DVec3& c, const DVec3& k) { return c + DVec3(0.2 * k.y, 0, -0.2 * k.x); }
+
+}  // namespace
+
+TEST_CASE("cpfg contour files: samples and the rings of tests/assets/cpfg/contour", "[lsystem][cpfg]") {
   SECTION("contour files sampled as cpfg samples them") {
     const ViewFile view = loadViewFile(cpfgAsset("contour/plant.v"));
     REQUIRE(view.contours.size() == 2);
@@ -1221,10 +1225,10 @@ TEST_CASE("cpfg contour files and generalized cylinders with @#(n)", "[lsystem][
     CHECK(view.contours[0].contour.points().size() == 6);  // multiplicities 1, 2, 1, 2
     CHECK_FALSE(view.contours[1].contour.closed());
     const std::vector<DVec3> b = view.contours[0].contour.sample(6), s = view.contours[1].contour.sample(4);
-    REQUIRE(b.size() == blade.size());
-    REQUIRE(s.size() == strip.size());
-    for (size_t k = 0; k < b.size(); ++k) checkNear(b[k], blade[k]);
-    for (size_t k = 0; k < s.size(); ++k) checkNear(s[k], strip[k]);
+    REQUIRE(b.size() == kBladeContour.size());
+    REQUIRE(s.size() == kStripContour.size());
+    for (size_t k = 0; k < b.size(); ++k) checkNear(b[k], kBladeContour[k]);
+    for (size_t k = 0; k < s.size(); ++k) checkNear(s[k], kStripContour[k]);
   }
   SECTION("tests/assets/cpfg/contour: every ring point of the two cylinders") {
     // Turtle at the origin, H = +Y, L = -X, cpfg's up U' = (0,0,-1), radius 0.4 / 2: a
@@ -1232,21 +1236,20 @@ TEST_CASE("cpfg contour files and generalized cylinders with @#(n)", "[lsystem][
     const Drawn o = drawObject("contour", true);
     CHECK(o.skeleton.internodes.empty());
     REQUIRE(o.skeleton.organs.size() == 2);
-    auto placed = [](const DVec3& c, const DVec3& k) { return c + DVec3(0.2 * k.y, 0, -0.2 * k.x); };
     const Organ& a = o.skeleton.organs[0];
     REQUIRE(a.points.size() == 14);
     REQUIRE(a.triangles.size() == 6 * 2 * 3);
     for (size_t m = 0; m < 7; ++m) {
-      checkNear(a.points[m], placed(DVec3(0, 0, 0), blade[m]));
-      checkNear(a.points[7 + m], placed(DVec3(0, 2, 0), blade[m]));
+      checkNear(a.points[m], placedOnRing(DVec3(0, 0, 0), kBladeContour[m]));
+      checkNear(a.points[7 + m], placedOnRing(DVec3(0, 2, 0), kBladeContour[m]));
     }
     // The branch: @!(4) sides, strip at (0,2,0) blended into the circle at (0,3,0).
     const Organ& b = o.skeleton.organs[1];
     REQUIRE(b.points.size() == 10);
     const std::vector<DVec3> circle = {{1, 0, 0}, {0, 1, 0}, {-1, 0, 0}, {0, -1, 0}, {1, 0, 0}};
     for (size_t m = 0; m < 5; ++m) {
-      checkNear(b.points[m], placed(DVec3(0, 2, 0), strip[m]));
-      checkNear(b.points[5 + m], placed(DVec3(0, 3, 0), circle[m]));
+      checkNear(b.points[m], placedOnRing(DVec3(0, 2, 0), kStripContour[m]));
+      checkNear(b.points[5 + m], placedOnRing(DVec3(0, 3, 0), circle[m]));
     }
     // Every triangle's normal agrees with its vertices' normals.
     for (size_t k = 0; k < a.triangles.size(); k += 3) {
@@ -1254,6 +1257,9 @@ TEST_CASE("cpfg contour files and generalized cylinders with @#(n)", "[lsystem][
       CHECK(glm::dot(n, a.normals[a.triangles[k]]) > 0);
     }
   }
+}
+
+TEST_CASE("cpfg generalized cylinders with @#(n): bent rings, F stays round, twist of cylinders", "[lsystem][cpfg]") {
   SECTION("a bent cylinder: a ring lies in the plane perpendicular to the curve's tangent") {
     // @Gt(0): zero tangents make the segment from (0,0,0) to (-1,1,0) (after f(1), + and
     // f(1)) the straight chord, its tangent along it; the middle ring (t = 1/2, of 2) is
@@ -1267,7 +1273,7 @@ TEST_CASE("cpfg contour files and generalized cylinders with @#(n)", "[lsystem][
     for (size_t m = 0; m < 7; ++m) {
       const DVec3 p = sk.organs[0].points[7 + m] - DVec3(-0.5, 0.5, 0);
       CHECK(std::fabs(glm::dot(p, dir)) < 1e-9);
-      CHECK(glm::length(p) == Approx(0.2 * glm::length(blade[m])));  // the contour point's radius, scaled
+      CHECK(glm::length(p) == Approx(0.2 * glm::length(kBladeContour[m])));  // the contour point's radius, scaled
     }
   }
   SECTION("a contour does not shape an F: cpfg draws its cylinder round (irisGL.c, iGlEndCylNode)") {
@@ -1293,7 +1299,6 @@ TEST_CASE("cpfg contour files and generalized cylinders with @#(n)", "[lsystem][
     // c + 0.2 (x U' - y L) = c + (0.2y, 0, -0.2x). On: the second ring is the rolled
     // turtle's frame, U' and L turned 90 degrees about H = +Y: c + 0.2 (x, 0, y) (or its
     // mirror for the opposite roll), the middle ring half-way (45 degrees).
-    auto placed = [](const DVec3& c, const DVec3& k) { return c + DVec3(0.2 * k.y, 0, -0.2 * k.x); };
     auto rolled = [](const DVec3& c, const DVec3& k) { return c + DVec3(0.2 * k.x, 0, 0.2 * k.y); };
     for (const bool twist : {false, true}) {
       std::string text = readFile(cpfgAsset("contour/plant.v"));
@@ -1306,14 +1311,18 @@ TEST_CASE("cpfg contour files and generalized cylinders with @#(n)", "[lsystem][
       const Organ& o = sk.organs[0];
       REQUIRE(o.points.size() == 3 * 7);
       for (size_t m = 0; m < 7; ++m) {
-        checkNear(o.points[m], placed(DVec3(0, 0, 0), blade[m]));
-        checkNear(o.points[14 + m], twist ? rolled(DVec3(0, 2, 0), blade[m]) : placed(DVec3(0, 2, 0), blade[m]));
+        checkNear(o.points[m], placedOnRing(DVec3(0, 0, 0), kBladeContour[m]));
+        checkNear(o.points[14 + m],
+                  twist ? rolled(DVec3(0, 2, 0), kBladeContour[m]) : placedOnRing(DVec3(0, 2, 0), kBladeContour[m]));
         // The middle ring at (0,1,0): untwisted, or turned by 45 degrees about +Y.
-        const DVec3 a = placed(DVec3(0), blade[m]), r = rolled(DVec3(0), blade[m]);
+        const DVec3 a = placedOnRing(DVec3(0), kBladeContour[m]), r = rolled(DVec3(0), kBladeContour[m]);
         checkNear(o.points[7 + m], DVec3(0, 1, 0) + (twist ? (a + r) / std::sqrt(2.0) : a));
       }
     }
   }
+}
+
+TEST_CASE("cpfg contour errors: an unknown contour id, malformed contour files", "[lsystem][cpfg]") {
   SECTION("errors: an unknown contour id, malformed contour files") {
     ViewFile view = loadViewFile(cpfgAsset("contour/plant.v"));
     Grammar g = parseGrammar("axiom: @#(3) @Gs f(1) @Ge\n", "t.l");
@@ -1324,13 +1333,7 @@ TEST_CASE("cpfg contour files and generalized cylinders with @#(n)", "[lsystem][
       CHECK(e.diagnostics().front().message == "cpfg's '@#(3)' names no contour: the view file has no 'contour: 3 ...' line");
     }
     auto contourError = [](const std::string& text) {
-      try {
-        CpfgContour::parse(text, "c.con");
-      } catch (const InputError& e) {
-        const Diagnostic& d = e.diagnostics().front();
-        return std::to_string(d.loc.line) + ":" + std::to_string(d.loc.col) + ": " + d.message;
-      }
-      return std::string("no error");
+      return firstError([&] { CpfgContour::parse(text, "c.con"); }, false);
     };
     CHECK(contourError("cver 2 0\n") == "1:6: contour file version 2.0 is not supported (cpfg reads 'cver 1 1' to 'cver 1 3' and the older 'n dim closed|open')");
     CHECK(contourError("cver 1 2\nname: x\npoints: 3 4\ntype: cr\n0 0 0 1\n1 0 0 1\n0 1 0 1\n") == "3:11: 'points: 3 4' but the multiplicities sum to 3");

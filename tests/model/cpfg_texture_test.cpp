@@ -45,6 +45,61 @@ void checkColor(const Vec3& got, const Vec3& want) {
   CHECK(glm::length(got - want) < 1e-6f);
 }
 
+/// The skeleton of the species' last step.
+lsystem::Skeleton finalSkeleton(const Species& s) {
+  GrowthEngine engine(s);
+  return engine.skeletonAt(engine.lastStep());
+}
+
+/// Adds the skeleton's preview in the species' style to the scene and commits it.
+void addPreview(render::Scene& scene, const lsystem::Skeleton& sk, const Species& s) {
+  scene.add(skeletonPreview(sk, s.render.style));
+  scene.commit();
+}
+
+/// A cpfg object in a fresh folder `name` under the temporary directory: the files named in
+/// copies copied from the folder `from`, and plant.v and plant.l holding view and lsystem.
+fs::path writeObject(const std::string& name, const fs::path& from, std::initializer_list<const char*> copies,
+                     const std::string& view, const std::string& lsystem) {
+  const fs::path dir = fs::temp_directory_path() / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  for (const char* f : copies) fs::copy_file(from / f, dir / f);
+  writeFileAtomic(dir / "plant.v", view);
+  writeFileAtomic(dir / "plant.l", lsystem);
+  return dir;
+}
+
+/// The colour a camera at the given depth in front of p (looking along +Z, 90 degrees over
+/// 16 x 16 pixels, which sets the texel footprint) sees at p.
+Vec3 colorSeenFrom(const Species& s, const lsystem::Skeleton& sk, const Vec3& p, float depth) {
+  render::Camera camera;
+  camera.position = p - Vec3(0, 0, depth);
+  camera.target = p;
+  camera.fovYDeg = 90.0f;
+  render::Scene scene;
+  scene.setPixelFootprint(camera, 16, 16, 0.0f);  // no thin-curve widening; the pixel still counts
+  addPreview(scene, sk, s);
+  auto hit = scene.intersect(camera.position, Vec3(0, 0, 1), 0.0f, 100.0f);
+  REQUIRE(hit);
+  CHECK(hit->t == Approx(depth));
+  return hit->color;
+}
+
+/// The preview of the skeleton rendered through the camera at 64 x 48 pixels, 2 samples per
+/// pixel, on the given number of threads.
+Image renderPreview(const Species& s, const lsystem::Skeleton& sk, const render::Camera& camera, int threads) {
+  render::Scene scene;
+  scene.setPixelFootprint(camera, 64, 48);
+  addPreview(scene, sk, s);
+  render::RenderSettings rs;
+  rs.width = 64;
+  rs.height = 48;
+  rs.spp = 2;
+  rs.threads = threads;
+  return render::renderImage(scene, camera, rs);
+}
+
 }  // namespace
 
 TEST_CASE("cpfg textures on surface files", "[model][cpfg]") {
@@ -67,8 +122,7 @@ TEST_CASE("cpfg textures on surface files", "[model][cpfg]") {
   CHECK(textures[0].sample(0.75, 0.5) == Vec4(0, 0, 1, 1));
   CHECK(textures[0].sample(1.25, -3.5) == Vec4(1, 0, 0, 1));  // repeats
 
-  GrowthEngine engine(s);
-  const lsystem::Skeleton sk = engine.skeletonAt(engine.lastStep());
+  const lsystem::Skeleton sk = finalSkeleton(s);
   // [@Tx(1)~a] f(4) [@Tx(2)~a] f(4) ~a f(4) ~b F(1): four squares, 3 x 3 vertices each.
   REQUIRE(sk.organs.size() == 4);
   const int wantTexture[] = {0, 1, -1, 0};  // the bracket ends @Tx(2); b's line names texture 1
@@ -95,8 +149,7 @@ TEST_CASE("cpfg textures on surface files", "[model][cpfg]") {
   // The preview: each square's colour where a ray meets it. Squares start at y = 0, 4, 8 and
   // 15 (the third moves the turtle to its end point, 3 along H, before f(4)).
   render::Scene scene;
-  scene.add(skeletonPreview(sk, s.render.style));
-  scene.commit();
+  addPreview(scene, sk, s);
   const Vec3 red(1, 0, 0), blue(0, 0, 1), leaf = s.render.style.leaf.baseColor;
   // Texture 1, decal, per patch: s runs along y: red below y = 1.5, blue above, at any x.
   checkColor(colorAt(scene, -0.75f, 0.75f), red);
@@ -150,8 +203,7 @@ TEST_CASE("cpfg texture errors", "[model][cpfg]") {
     writeFileAtomic(dir / "plant.l", "lsystem: 1\nderivation length: 0\naxiom: " + axiom + "\nendlsystem\n");
     try {
       const Species s = loadSpecies(dir);
-      GrowthEngine engine(s);
-      skeletonPreview(engine.skeletonAt(engine.lastStep()), s.render.style);  // draws the textures
+      skeletonPreview(finalSkeleton(s), s.render.style);  // draws the textures
     } catch (const InputError& e) {
       const Diagnostic& d = e.diagnostics().front();
       return (d.loc.line ? fs::path(d.loc.file).filename().string() + ":" + std::to_string(d.loc.line) + ":" +
@@ -198,35 +250,47 @@ TEST_CASE("cpfg texture errors", "[model][cpfg]") {
   fs::remove_all(dir);
 }
 
-TEST_CASE("cpfg cut-out textures: alpha test and blending", "[model][cpfg]") {
+namespace {
+
+/// tests/assets/cpfg/texture/cutout derived and previewed, its textures and organs checked
+/// on the way: [@Tx(1)~a] [^(90)f(2)&(90)~a] +(90)f(5)-(90) [@Tx(2)~a] F(1) draws the cut-out
+/// square at z = 0, x in [-3, 0]; the untextured one 2 behind it (z = 2); the decal one at x
+/// in [-8, -5].
+struct CutoutScene {
+  /// cutout.png: 5 x 1 red texels of alpha 255, 0, 128, 26, 25 (of 255).
+  static constexpr float alpha[] = {1.0f, 0.0f, 128 / 255.0f, 26 / 255.0f, 25 / 255.0f};
   const Species s = loadSpecies(cutoutObject());
-  REQUIRE(s.render.style.cpfgTextures);
-  const auto& textures = *s.render.style.cpfgTextures;
-  REQUIRE(textures.size() == 2);
-  CHECK(textures[0].cutsOut());        // modulate: the texel's alpha is the fragment's
-  CHECK_FALSE(textures[1].cutsOut());  // decal: the fragment is opaque
-  // cutout.png: 5 x 1 red texels of alpha 255, 0, 128, 26, 25 (of 255).
-  const float alpha[] = {1.0f, 0.0f, 128 / 255.0f, 26 / 255.0f, 25 / 255.0f};
-  for (int k = 0; k < 5; ++k) CHECK(textures[0].sample((k + 0.5) / 5, 0.5).a == Approx(alpha[k]).margin(1e-6));
-
-  GrowthEngine engine(s);
-  const lsystem::Skeleton sk = engine.skeletonAt(engine.lastStep());
-  // [@Tx(1)~a] [^(90)f(2)&(90)~a] +(90)f(5)-(90) [@Tx(2)~a] F(1): the cut-out square at z = 0,
-  // x in [-3, 0]; the untextured one 2 behind it (z = 2); the decal one at x in [-8, -5].
-  REQUIRE(sk.organs.size() == 3);
-  CHECK(sk.organs[0].texture == 0);
-  CHECK(sk.organs[1].texture == -1);
-  CHECK(sk.organs[2].texture == 1);
-  CHECK(sk.organs[1].points[0].z == Approx(2.0));
-
+  const lsystem::Skeleton sk = finalSkeleton(s);
   render::Scene scene;
-  scene.add(skeletonPreview(sk, s.render.style));
-  scene.commit();
-  const Vec3 red(1, 0, 0), leaf = s.render.style.leaf.baseColor;
-  // Per patch, s runs along y: texel k covers y in [0.6 k, 0.6 (k + 1)], centre 0.3 + 0.6 k.
-  auto texelY = [](int k) { return 0.3f + 0.6f * static_cast<float>(k); };
-  auto ray = [&](float x, float y, float tnear = 0.0f) { return scene.intersect(Vec3(x, y, -10), Vec3(0, 0, 1), tnear, 100.0f); };
+  const Vec3 red{1, 0, 0}, leaf = s.render.style.leaf.baseColor;
 
+  CutoutScene() {
+    REQUIRE(s.render.style.cpfgTextures);
+    const auto& textures = *s.render.style.cpfgTextures;
+    REQUIRE(textures.size() == 2);
+    CHECK(textures[0].cutsOut());        // modulate: the texel's alpha is the fragment's
+    CHECK_FALSE(textures[1].cutsOut());  // decal: the fragment is opaque
+    for (int k = 0; k < 5; ++k) CHECK(textures[0].sample((k + 0.5) / 5, 0.5).a == Approx(alpha[k]).margin(1e-6));
+    REQUIRE(sk.organs.size() == 3);
+    CHECK(sk.organs[0].texture == 0);
+    CHECK(sk.organs[1].texture == -1);
+    CHECK(sk.organs[2].texture == 1);
+    CHECK(sk.organs[1].points[0].z == Approx(2.0));
+    addPreview(scene, sk, s);
+  }
+
+  /// Per patch, s runs along y: texel k covers y in [0.6 k, 0.6 (k + 1)], centre 0.3 + 0.6 k.
+  static float texelY(int k) { return 0.3f + 0.6f * static_cast<float>(k); }
+
+  /// The first hit beyond tnear of a ray along +Z through (x, y).
+  auto ray(float x, float y, float tnear = 0.0f) const {
+    return scene.intersect(Vec3(x, y, -10), Vec3(0, 0, 1), tnear, 100.0f);
+  }
+};
+
+}  // namespace
+
+TEST_CASE_METHOD(CutoutScene, "cpfg cut-out textures: camera rays and shadows are cut by the alpha test", "[model][cpfg]") {
   SECTION("camera rays: the opaque texel hits the leaf, the cut ones the square behind") {
     for (float x : {-0.4f, -1.5f, -2.6f}) {
       INFO("x " << x);
@@ -278,7 +342,9 @@ TEST_CASE("cpfg cut-out textures: alpha test and blending", "[model][cpfg]") {
       CHECK(std::abs(count / 400.0 - alpha[k]) < 0.06);
     }
   }
+}
 
+TEST_CASE_METHOD(CutoutScene, "cpfg cut-out textures: decal blending and the glTF export", "[model][cpfg]") {
   SECTION("decal: the texels' alpha blends the colours, nothing is cut out") {
     for (int k = 0; k < 5; ++k) {
       INFO("texel " << k);
@@ -338,51 +404,31 @@ TEST_CASE("cpfg texture filters: magnification or minification by the texel foot
   CHECK(textures[1].sample(0.375, 0.5, true) == mixed);
   CHECK(textures[0].sample(0.375, 0.5, true) == red);  // texture 1: L: n
 
-  GrowthEngine engine(s);
-  const lsystem::Skeleton sk = engine.skeletonAt(engine.lastStep());
+  const lsystem::Skeleton sk = finalSkeleton(s);
   const Vec3 leaf = s.render.style.leaf.baseColor;
   // The second square (texture 2, per surface): s = -x / 3 over x in [-3, 0], t = (y - 4) / 3.
   // A camera straight in front of p = (-9/8, 5.5, 0) at depth d, 90 degrees over 16 pixels:
   // a pixel is d / 8 wide there, 2/3 texel along s (2 texels over 3 units), 1/3 along t, so
   // GL's footprint is rho = d / 12: magnified nearer than 12, minified beyond.
   const Vec3 p(-1.125f, 5.5f, 0.0f);
-  auto colorSeenFrom = [&](float depth) {
-    render::Camera camera;
-    camera.position = p - Vec3(0, 0, depth);
-    camera.target = p;
-    camera.fovYDeg = 90.0f;
-    render::Scene scene;
-    scene.setPixelFootprint(camera, 16, 16, 0.0f);  // no thin-curve widening; the pixel still counts
-    scene.add(skeletonPreview(sk, s.render.style));
-    scene.commit();
-    auto hit = scene.intersect(camera.position, Vec3(0, 0, 1), 0.0f, 100.0f);
-    REQUIRE(hit);
-    CHECK(hit->t == Approx(depth));
-    return hit->color;
-  };
-  checkColor(colorSeenFrom(6.0f), Vec3(red) * leaf);     // rho 0.5
-  checkColor(colorSeenFrom(11.8f), Vec3(red) * leaf);    // rho 0.983
-  checkColor(colorSeenFrom(12.2f), Vec3(mixed) * leaf);  // rho 1.017
-  checkColor(colorSeenFrom(40.0f), Vec3(mixed) * leaf);
+  checkColor(colorSeenFrom(s, sk, p, 6.0f), Vec3(red) * leaf);     // rho 0.5
+  checkColor(colorSeenFrom(s, sk, p, 11.8f), Vec3(red) * leaf);    // rho 0.983
+  checkColor(colorSeenFrom(s, sk, p, 12.2f), Vec3(mixed) * leaf);  // rho 1.017
+  checkColor(colorSeenFrom(s, sk, p, 40.0f), Vec3(mixed) * leaf);
   // Without a camera every lookup magnifies.
   render::Scene plain;
-  plain.add(skeletonPreview(sk, s.render.style));
-  plain.commit();
+  addPreview(plain, sk, s);
   auto hit = plain.intersect(p - Vec3(0, 0, 40), Vec3(0, 0, 1), 0.0f, 100.0f);
   REQUIRE(hit);
   checkColor(hit->color, Vec3(red) * leaf);
 }
 
 TEST_CASE("cpfg textures on polygons", "[model][cpfg]") {
-  const fs::path dir = fs::temp_directory_path() / "sprig-cpfg-polygon-texture-test";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  fs::copy_file(textureObject() / "halves.png", dir / "halves.png");
-  writeFileAtomic(dir / "plant.v", "angle increment: 90\ntexture: F: halves.png E: d\n");
-  writeFileAtomic(dir / "plant.l", "lsystem: 1\nderivation length: 0\naxiom: @Tx(1){.f+f}\nendlsystem\n");
+  const fs::path dir = writeObject("sprig-cpfg-polygon-texture-test", textureObject(), {"halves.png"},
+                                   "angle increment: 90\ntexture: F: halves.png E: d\n",
+                                   "lsystem: 1\nderivation length: 0\naxiom: @Tx(1){.f+f}\nendlsystem\n");
   const Species s = loadSpecies(dir);
-  GrowthEngine engine(s);
-  const lsystem::Skeleton sk = engine.skeletonAt(engine.lastStep());
+  const lsystem::Skeleton sk = finalSkeleton(s);
   // Points (0,0,0), (0,1,0), (-1,1,0); the first point's frame has H = +Y and -L = +X, so
   // t = y over [0, 1] and s = x over [-1, 0] (irisGL.c PolygonToMesh): a fan of 1 triangle.
   REQUIRE(sk.organs.size() == 1);
@@ -397,8 +443,7 @@ TEST_CASE("cpfg textures on polygons", "[model][cpfg]") {
   REQUIRE(o.normals.size() == 3);
   CHECK(std::abs(o.normals[0].z) == Approx(1.0));
   render::Scene scene;
-  scene.add(skeletonPreview(sk, s.render.style));
-  scene.commit();
+  addPreview(scene, sk, s);
   // Decal halves.png: red for s below 1/2 (x < -1/2), blue above; drawn once (not also as
   // an untextured polygon: no other hit behind the first).
   checkColor(colorAt(scene, -0.6f, 0.9f), Vec3(1, 0, 0));
@@ -410,24 +455,11 @@ TEST_CASE("cpfg textures on polygons", "[model][cpfg]") {
 TEST_CASE("cpfg cut-out textures render the same bytes at 1 and 2 threads", "[model][cpfg]") {
   // Shadow and sky rays through partly covering texels are decided by a hash of the ray.
   const Species s = loadSpecies(cutoutObject());
-  GrowthEngine engine(s);
-  const lsystem::Skeleton sk = engine.skeletonAt(engine.lastStep());
+  const lsystem::Skeleton sk = finalSkeleton(s);
   render::Camera camera;
   camera.position = Vec3(-4, 1.5f, -12);
   camera.target = Vec3(-4, 1.5f, 0);
-  auto renderAt = [&](int threads) {
-    render::Scene scene;
-    scene.setPixelFootprint(camera, 64, 48);
-    scene.add(skeletonPreview(sk, s.render.style));
-    scene.commit();
-    render::RenderSettings rs;
-    rs.width = 64;
-    rs.height = 48;
-    rs.spp = 2;
-    rs.threads = threads;
-    return render::renderImage(scene, camera, rs);
-  };
-  CHECK(renderAt(1).pixels == renderAt(2).pixels);
+  CHECK(renderPreview(s, sk, camera, 1).pixels == renderPreview(s, sk, camera, 2).pixels);
 }
 
 namespace {
@@ -455,8 +487,7 @@ Vec3 colorAround(const render::Scene& scene, float x0, float y, double bDeg) {
 
 TEST_CASE("cpfg textures on cylinders and generalized cylinders", "[model][cpfg]") {
   const Species s = loadSpecies(cylinderObject());
-  GrowthEngine engine(s);
-  const lsystem::Skeleton sk = engine.skeletonAt(engine.lastStep());
+  const lsystem::Skeleton sk = finalSkeleton(s);
   const double pi = 3.14159265358979323846;
   // Every segment is a textured tube (no internode): F(4), two generalized-cylinder
   // segments, then F(2), the branch's +F(1), F(1) at width 1, and F(1) after f(1).
@@ -507,8 +538,7 @@ TEST_CASE("cpfg textures on cylinders and generalized cylinders", "[model][cpfg]
   // origin: s = b / 360 at angle b from L toward U' (red, green, blue, white quarters), t =
   // y / pi (bottom row below 1/2, top row above, repeating).
   render::Scene scene;
-  scene.add(skeletonPreview(sk, s.render.style));
-  scene.commit();
+  addPreview(scene, sk, s);
   const Vec3 red(1, 0, 0), green(0, 1, 0), blue(0, 0, 1), white(1), cyan(0, 1, 1), magenta(1, 0, 1), yellow(1, 1, 0);
   checkColor(colorAround(scene, 0, 0.5f, 40), red);  // t = 0.16
   checkColor(colorAround(scene, 0, 0.5f, 130), green);
@@ -563,17 +593,14 @@ TEST_CASE("cpfg textures on cylinders and generalized cylinders", "[model][cpfg]
 }
 
 TEST_CASE("cpfg textured cylinders beside untextured wood: parts and export", "[model][cpfg]") {
-  const fs::path dir = fs::temp_directory_path() / "sprig-cpfg-cylinder-texture-test";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  fs::copy_file(cylinderObject() / "quadrants.png", dir / "quadrants.png");
-  writeFileAtomic(dir / "plant.v", "angle increment: 45\nline style: cylinder\ntexture: F: quadrants.png R: 2\n");
   // An untextured trunk, a textured branch (modulate: texel times the wood colour), and the
   // trunk again after ']' (untextured: the bracket ended the texture).
-  writeFileAtomic(dir / "plant.l", "lsystem: 1\nderivation length: 0\naxiom: !(0.5)F(2)[+@Tx(1)F(1)F(1)]F(2)\nendlsystem\n");
+  const fs::path dir =
+      writeObject("sprig-cpfg-cylinder-texture-test", cylinderObject(), {"quadrants.png"},
+                  "angle increment: 45\nline style: cylinder\ntexture: F: quadrants.png R: 2\n",
+                  "lsystem: 1\nderivation length: 0\naxiom: !(0.5)F(2)[+@Tx(1)F(1)F(1)]F(2)\nendlsystem\n");
   const Species s = loadSpecies(dir);
-  GrowthEngine engine(s);
-  const lsystem::Skeleton sk = engine.skeletonAt(engine.lastStep());
+  const lsystem::Skeleton sk = finalSkeleton(s);
   CHECK(sk.internodes.size() == 2);
   REQUIRE(sk.organs.size() == 2);
   // R: 2 halves the rate: 1 / (pi 0.5) * 2 / 2 = 2 / pi per unit length.
@@ -645,47 +672,33 @@ TEST_CASE("cpfg textured cylinders beside untextured wood: parts and export", "[
 
 TEST_CASE("cpfg textured cylinders render the same bytes at 1 and 2 threads", "[model][cpfg]") {
   const Species s = loadSpecies(cylinderObject());
-  GrowthEngine engine(s);
-  const lsystem::Skeleton sk = engine.skeletonAt(engine.lastStep());
+  const lsystem::Skeleton sk = finalSkeleton(s);
   render::Camera camera;
   camera.position = Vec3(10, 4, -30);
   camera.target = Vec3(10, 4, 0);
-  auto renderAt = [&](int threads) {
-    render::Scene scene;
-    scene.setPixelFootprint(camera, 64, 48);
-    scene.add(skeletonPreview(sk, s.render.style));
-    scene.commit();
-    render::RenderSettings rs;
-    rs.width = 64;
-    rs.height = 48;
-    rs.spp = 2;
-    rs.threads = threads;
-    return render::renderImage(scene, camera, rs);
-  };
-  const Image a = renderAt(1);
-  CHECK(a.pixels == renderAt(2).pixels);
+  const Image a = renderPreview(s, sk, camera, 1);
+  CHECK(a.pixels == renderPreview(s, sk, camera, 2).pixels);
 }
 
 TEST_CASE("cpfg cut-out textures on cylinders", "[model][cpfg]") {
   // cutout.png: five red texels along s of alpha 255, 0, 128, 26 and 25, modulated, on an F
   // of diameter 2 (radius 1) up +Y: texel k covers s in [k/5, (k+1)/5), s = b / 360 at angle
   // b from L (-X) toward cpfg's up (-Z); a ray through the axis meets the far wall at b + 180.
-  const fs::path dir = fs::temp_directory_path() / "sprig-cpfg-cylinder-cutout-test";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  fs::copy_file(cutoutObject() / "cutout.png", dir / "cutout.png");
-  writeFileAtomic(dir / "plant.v", "line style: cylinder\ntexture: F: cutout.png E: m\n");
-  writeFileAtomic(dir / "plant.l", "lsystem: 1\nderivation length: 0\naxiom: !(2)@Tx(1)F(1)\nendlsystem\n");
+  const fs::path dir = writeObject("sprig-cpfg-cylinder-cutout-test", cutoutObject(), {"cutout.png"},
+                                   "line style: cylinder\ntexture: F: cutout.png E: m\n",
+                                   "lsystem: 1\nderivation length: 0\naxiom: !(2)@Tx(1)F(1)\nendlsystem\n");
   const Species s = loadSpecies(dir);
-  GrowthEngine engine(s);
-  const lsystem::Skeleton sk = engine.skeletonAt(engine.lastStep());
+  const lsystem::Skeleton sk = finalSkeleton(s);
   render::Scene scene;
-  scene.add(skeletonPreview(sk, s.render.style));
-  scene.commit();
+  addPreview(scene, sk, s);
   const Vec3 wood = s.render.style.wood.baseColor;
-  auto rayAt = [&](double bDeg) {
+  // A ray toward (0, 0.5, 0) on the axis from angle b: d = cos b L + sin b U'.
+  auto fromAngle = [](double bDeg) {
     const double b = bDeg * 3.14159265358979323846 / 180.0;
-    const Vec3 d(static_cast<float>(-std::cos(b)), 0.0f, static_cast<float>(-std::sin(b)));
+    return Vec3(static_cast<float>(-std::cos(b)), 0.0f, static_cast<float>(-std::sin(b)));
+  };
+  auto rayAt = [&](double bDeg) {
+    const Vec3 d = fromAngle(bDeg);
     return scene.intersect(Vec3(0, 0.5f, 0) + 10.0f * d, -d, 0.0f, 100.0f);
   };
   // b = 36: s = 0.1, the opaque texel: red times the wood colour, opaque, on the near wall.
@@ -704,8 +717,7 @@ TEST_CASE("cpfg cut-out textures on cylinders", "[model][cpfg]") {
   CHECK(half->opacity == Approx(128.0f / 255.0f).margin(1e-3f));
   // Shadow rays are cut the same way: blocked by the opaque texel, not through the cut ones.
   auto occludedAt = [&](double bDeg) {
-    const double b = bDeg * 3.14159265358979323846 / 180.0;
-    const Vec3 d(static_cast<float>(-std::cos(b)), 0.0f, static_cast<float>(-std::sin(b)));
+    const Vec3 d = fromAngle(bDeg);
     return scene.occluded(Vec3(0, 0.5f, 0) + 10.0f * d, -d, 0.0f, 100.0f);
   };
   CHECK(occludedAt(36));
@@ -787,30 +799,15 @@ TEST_CASE("cpfg mipmapped textures: the level of log2 of the texel footprint", "
     CHECK(odd.levels[1]->height == 1);
   }
   SECTION("the renderer's footprint picks the level: a camera in front of the square at depth d sees rho = d / 6") {
-    GrowthEngine engine(s);
-    const lsystem::Skeleton sk = engine.skeletonAt(engine.lastStep());
+    const lsystem::Skeleton sk = finalSkeleton(s);
     const Vec3 leaf = s.render.style.leaf.baseColor;
     // Square 1 (per surface): s = -x / 3 over x in [-3, 0], t = y / 3. 90 degrees over 16
     // pixels: a pixel is d / 8 wide at depth d, 4/3 texels per unit, so rho = d / 6.
-    auto colorSeen = [&](Vec3 p, float depth) {
-      render::Camera camera;
-      camera.position = p - Vec3(0, 0, depth);
-      camera.target = p;
-      camera.fovYDeg = 90.0f;
-      render::Scene scene;
-      scene.setPixelFootprint(camera, 16, 16, 0.0f);
-      scene.add(skeletonPreview(sk, s.render.style));
-      scene.commit();
-      auto hit = scene.intersect(camera.position, Vec3(0, 0, 1), 0.0f, 100.0f);
-      REQUIRE(hit);
-      CHECK(hit->t == Approx(depth));
-      return hit->color;
-    };
-    checkColor(colorSeen(Vec3(-0.375f, 2.625f, 0), 3.0f), Vec3(red) * leaf);  // rho 0.5: level 0
-    const Vec3 atLevel1 = colorSeen(Vec3(-0.75f, 2.25f, 0), 12.0f);           // rho 2
+    checkColor(colorSeenFrom(s, sk, Vec3(-0.375f, 2.625f, 0), 3.0f), Vec3(red) * leaf);  // rho 0.5: level 0
+    const Vec3 atLevel1 = colorSeenFrom(s, sk, Vec3(-0.75f, 2.25f, 0), 12.0f);           // rho 2
     CHECK(glm::length(atLevel1 - Vec3(purple) * leaf) < 1e-4f);
     // rho 4 (log2 of the computed footprint may fall a hair below 2: level 1 then weighs ~1e-6)
-    CHECK(glm::length(colorSeen(Vec3(-0.75f, 2.25f, 0), 24.0f) - Vec3(mean) * leaf) < 1e-4f);
+    CHECK(glm::length(colorSeenFrom(s, sk, Vec3(-0.75f, 2.25f, 0), 24.0f) - Vec3(mean) * leaf) < 1e-4f);
   }
   SECTION("export: the glTF sampler minifies with LINEAR_MIPMAP_LINEAR") {
     SpeciesModel model(s, ModelOptions{});
@@ -843,11 +840,9 @@ TEST_CASE("cpfg blended textures (E: b): the colour times one minus the texel", 
   checkTexel(blend.fragment(0.875, 0.875, base), Vec4(0.2f, 0, 0.8f, 1));  // green texel
   checkTexel(blend.fragment(0.125, 0.125, base), Vec4(0, 0, 0, 1));        // white texel: black
 
-  GrowthEngine engine(s);
-  const lsystem::Skeleton sk = engine.skeletonAt(engine.lastStep());
+  const lsystem::Skeleton sk = finalSkeleton(s);
   render::Scene scene;
-  scene.add(skeletonPreview(sk, s.render.style));
-  scene.commit();
+  addPreview(scene, sk, s);
   const Vec3 leaf = s.render.style.leaf.baseColor;
   // Square 2 (texture 3, per surface) at y in [4, 7]: s = -x / 3, t = (y - 4) / 3.
   checkColor(colorAt(scene, -0.375f, 6.625f), leaf * Vec3(0, 1, 1));   // red texel

@@ -25,6 +25,26 @@ std::string errorOf(const std::string& text) { return test::speciesError(text, "
 
 const OrganismSpec& specOf(const Species& s) { return dynamic_cast<const OrganismSpec&>(*s.spec); }
 
+/// The text of an organism on a cube sphere of radius 1 (quads per face edge, 3 levels) whose
+/// blend plane x = 0 gives the +x half (alpha 1) the blend keys blendKeys (lines indented by
+/// four spaces, each ending in a newline).
+std::string halfBlendedSphere(int quads, const std::string& blendKeys) {
+  return "kind: organism\norganism:\n  base: {cube_sphere: {radius: 1, quads: " + std::to_string(quads) +
+         "}}\n  levels: 3\n  blend:\n    detail: []\n    alpha: {plane: {normal: [1, 0, 0], offset: 0, width: 0}}\n" +
+         blendKeys;
+}
+
+/// Each vertex away from the blend plane x = 0 (where the limit surface moves a little) has
+/// the value plusX on the +x side, minusX on the other.
+void checkHalves(const std::vector<Vec3>& positions, const std::vector<Vec3>& values, const Vec3& plusX,
+                 const Vec3& minusX) {
+  for (size_t v = 0; v < positions.size(); ++v) {
+    if (std::abs(positions[v].x) < 0.05f) continue;
+    INFO("vertex at x = " << positions[v].x);
+    REQUIRE(values[v] == (positions[v].x > 0 ? plusX : minusX));
+  }
+}
+
 }  // namespace
 
 TEST_CASE("kind: organism reads its keys", "[model][organism]") {
@@ -108,21 +128,9 @@ TEST_CASE("kind: organism reports its mistakes at file:line:col", "[model][organ
 }
 
 TEST_CASE("Organism blends colour by alpha and the planet shader colours by height", "[model][organism]") {
-  const Species s = parseSpecies(R"(kind: organism
-organism:
-  base: {cube_sphere: {radius: 1, quads: 2}}
-  levels: 3
-  blend:
-    detail: []
-    alpha: {plane: {normal: [1, 0, 0], offset: 0, width: 0}}
-    color: [1, 0, 0]
-)", "org.yaml");
+  const Species s = parseSpecies(halfBlendedSphere(2, "    color: [1, 0, 0]\n"), "org.yaml");
   const Mesh m = buildOrganismMesh(specOf(s), 1.0, Vec3(0, 0, 1));
-  for (size_t v = 0; v < m.vertexCount(); ++v) {
-    if (std::abs(m.positions[v].x) < 0.05f) continue;  // the limit surface moves a little
-    INFO("vertex at x = " << m.positions[v].x);
-    REQUIRE(m.colors[v] == (m.positions[v].x > 0 ? Vec3(1, 0, 0) : Vec3(0, 0, 1)));
-  }
+  checkHalves(m.positions, m.colors, Vec3(1, 0, 0), Vec3(0, 0, 1));
 }
 
 TEST_CASE("The planet shader mixes toward the second planet's own bands by alpha", "[model][organism]") {
@@ -254,14 +262,7 @@ namespace {
 /// surface keys `blendKeys`, rendered 48 x 48 at 1 sample under a point-like white sun from
 /// the camera's right, no sky, no ground, black background.
 Image blendSurfaceImage(const std::string& blendKeys) {
-  const Species s = parseSpecies(R"(kind: organism
-organism:
-  base: {cube_sphere: {radius: 1, quads: 3}}
-  levels: 3
-  blend:
-    detail: []
-    alpha: {plane: {normal: [1, 0, 0], offset: 0, width: 0}}
-)" + blendKeys + R"(
+  const Species s = parseSpecies(halfBlendedSphere(3, blendKeys) + R"(
 render:
   color: [0.5, 0.5, 0.5]
   roughness: 0.6
@@ -302,17 +303,9 @@ float maxRed(const Image& img, int x0, int x1) {
 }  // namespace
 
 TEST_CASE("Organism blends roughness, specular and metallic by alpha", "[model][organism]") {
-  const Species s = parseSpecies(R"(kind: organism
-organism:
-  base: {cube_sphere: {radius: 1, quads: 2}}
-  levels: 3
-  blend:
-    detail: []
-    alpha: {plane: {normal: [1, 0, 0], offset: 0, width: 0}}
-    roughness: 1
-    metallic: 0.8
-render: {roughness: 0.3, specular: 0.2}
-)", "org.yaml");
+  const Species s = parseSpecies(halfBlendedSphere(2, "    roughness: 1\n    metallic: 0.8\n") +
+                                     "render: {roughness: 0.3, specular: 0.2}\n",
+                                 "org.yaml");
   const OrganismSpec& o = specOf(s);
   CHECK(o.blendRoughness == 1.0f);
   CHECK(!o.blendSpecular);
@@ -320,12 +313,8 @@ render: {roughness: 0.3, specular: 0.2}
   const OrganismSurface surface = buildOrganismSurface(o, organisms::Subdivision(o.base, o.levels), 1.0);
   const std::vector<Vec3> values = organismSurfaces(o, surface, Vec3(0.3f, 0.2f, 0.0f));
   REQUIRE(values.size() == surface.mesh.vertexCount());
-  for (size_t v = 0; v < values.size(); ++v) {
-    if (std::abs(surface.mesh.positions[v].x) < 0.05f) continue;  // the limit surface moves a little
-    INFO("vertex at x = " << surface.mesh.positions[v].x);
-    // The specular the blend leaves out is the render's on both sides.
-    REQUIRE(values[v] == (surface.mesh.positions[v].x > 0 ? Vec3(1.0f, 0.2f, 0.8f) : Vec3(0.3f, 0.2f, 0.0f)));
-  }
+  // The specular the blend leaves out is the render's on both sides.
+  checkHalves(surface.mesh.positions, values, Vec3(1.0f, 0.2f, 0.8f), Vec3(0.3f, 0.2f, 0.0f));
   // The export: glTF's factors are per material, so the alpha > 1/2 side is its own part.
   SpeciesModel model(s);
   const std::vector<ExportPart> parts = model.exportParts(model.finalStage(), 0.0f, false);

@@ -446,116 +446,129 @@ TEST_CASE("displace: a root rising far more than the gap lifts the bricks withou
   }
 }
 
+namespace {
+
+// A paving bed 1.2 × 0.3 × 0.6 m of 0.05 m cells (y up): dirt, the top 0.1 m a running bond
+// of 0.25 × 0.1 m bricks with 0.05 m joints (joints one cell wide on the grid's planes, as
+// fig_solid_07_displaced_paving's 0.35 × 0.15 m bricks have), and a root 0.05 m under the paving
+// (0.45 < x < 0.75, 0.2 < z < 0.4, 0.1 < y < 0.15) that rises 0.1 m in 8 increments.
+// With sand joints (E 3 MPa, 5,000 times softer than brick) every brick moves as a rigid
+// block: its vertices fit a rotation and translation (Kabsch) to a small fraction of its
+// displacement; the bricks over the root tilt, and neighbours move apart (the two bricks
+// on either side of a joint fit one rigid motion far worse than each alone). With the
+// joints made of brick (one slab), neighbours move together.
+struct BrickKey {
+  bool brick;
+  int row, col;
+};
+
+/// The paving cell of a point c: in a brick (else in a joint), and the brick's row and column.
+BrickKey paving(const DVec3& c) {
+  const int row = int(std::floor(c.z / 0.15));
+  const double x = c.x + ((row & 1) ? 0.15 : 0.0);
+  const double fx = x / 0.3 - std::floor(x / 0.3), fz = c.z / 0.15 - std::floor(c.z / 0.15);
+  return BrickKey{fx > 1.0 / 6 && fz > 1.0 / 3, row, int(std::floor(x / 0.3))};
+}
+
+struct Motion {
+  double residual = 0;  // largest distance of a vertex from the best rigid motion's image, m
+  double disp = 0;      // largest displacement of a vertex, m
+  double tiltDeg = 0;   // the best rotation's angle
+};
+
+// Best-fit rotation and translation of the vertices vs (Kabsch): R = V·diag(1, 1, ±1)·Uᵀ
+// from the SVD U·S·Vᵀ of the cross-covariance H = Σ (p − p̄)(q − q̄)ᵀ.
+Motion rigidFit(const TetMesh& before, const TetMesh& after, const std::vector<uint32_t>& vs) {
+  Motion out;
+  Eigen::Vector3d pc = Eigen::Vector3d::Zero(), qc = Eigen::Vector3d::Zero();
+  for (uint32_t v : vs) {
+    const DVec3 p = before.positions[v], q = after.positions[v];
+    pc += Eigen::Vector3d(p.x, p.y, p.z);
+    qc += Eigen::Vector3d(q.x, q.y, q.z);
+    out.disp = std::max(out.disp, glm::length(q - p));
+  }
+  pc /= double(vs.size());
+  qc /= double(vs.size());
+  Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
+  for (uint32_t v : vs) {
+    const DVec3 p = before.positions[v], q = after.positions[v];
+    H += (Eigen::Vector3d(p.x, p.y, p.z) - pc) * (Eigen::Vector3d(q.x, q.y, q.z) - qc).transpose();
+  }
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
+  D(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1 : 1;
+  const Eigen::Matrix3d R = svd.matrixV() * D * svd.matrixU().transpose();
+  for (uint32_t v : vs) {
+    const DVec3 p = before.positions[v], q = after.positions[v];
+    const Eigen::Vector3d fitted = R * (Eigen::Vector3d(p.x, p.y, p.z) - pc) + qc;
+    out.residual = std::max(out.residual, (fitted - Eigen::Vector3d(q.x, q.y, q.z)).norm());
+  }
+  out.tiltDeg = std::acos(std::clamp((R.trace() - 1) / 2, -1.0, 1.0)) * 180 / 3.14159265358979323846;
+  return out;
+}
+
+struct Fit {
+  double worstRatio = 0;      // max over moved bricks of residual / displacement
+  double worstPairRatio = 0;  // max over neighbours in a row of the pair's residual / displacement
+  double maxTiltDeg = 0, maxDisp = 0;
+  size_t moved = 0;
+};
+
+/// Lays the paving with joints of the given material (3 sand, 1 brick) over the root, raises
+/// the root and fits each moved brick, and each pair of neighbours in a row, a rigid motion.
+Fit pavingFit(uint16_t jointMaterial) {
+  TetMesh m = test::tetBlock({24, 6, 12}, DVec3(0.0), DVec3(1.2, 0.3, 0.6));
+  Material sand = *findBuiltinMaterial("dirt");
+  sand.name = "sand";
+  sand.youngsModulus = 3e6;
+  sand.poissonRatio = 0.3;
+  const std::vector<Material> mats = {*findBuiltinMaterial("dirt"), *findBuiltinMaterial("brick"), *findBuiltinMaterial("wood"), sand};
+  std::map<std::pair<int, int>, std::vector<uint32_t>> bricks;  // (row, column) -> vertices
+  for (size_t t = 0; t < m.tets.size(); ++t) {
+    DVec3 c(0.0);
+    for (uint32_t v : m.tets[t]) c += 0.25 * m.positions[v];
+    const BrickKey k = paving(c);
+    if (c.x > 0.45 && c.x < 0.75 && c.z > 0.2 && c.z < 0.4 && c.y > 0.1 && c.y < 0.15) m.materials[t] = 2;
+    else if (c.y > 0.2) m.materials[t] = k.brick ? 1 : jointMaterial;
+    else m.materials[t] = 0;
+    if (c.y > 0.2 && k.brick) {
+      auto& vs = bricks[{k.row, k.col}];
+      vs.insert(vs.end(), m.tets[t].begin(), m.tets[t].end());
+    }
+  }
+  for (auto& [key, vs] : bricks) {
+    std::sort(vs.begin(), vs.end());
+    vs.erase(std::unique(vs.begin(), vs.end()), vs.end());
+  }
+  const TetMesh before = m;
+  DisplaceOptions opt;
+  opt.moving = {2};
+  opt.offset = DVec3(0, 0.1, 0);
+  opt.steps = 8;
+  displace(m, mats, opt);
+  CHECK(minVolume(m) > 0);
+  Fit fit;
+  for (const auto& [key, vs] : bricks) {
+    const Motion b = rigidFit(before, m, vs);
+    if (b.disp < 0.005) continue;  // a brick the root barely reached
+    fit.worstRatio = std::max(fit.worstRatio, b.residual / b.disp);
+    fit.maxTiltDeg = std::max(fit.maxTiltDeg, b.tiltDeg);
+    fit.maxDisp = std::max(fit.maxDisp, b.disp);
+    ++fit.moved;
+    const auto next = bricks.find({key.first, key.second + 1});
+    if (next == bricks.end()) continue;
+    std::vector<uint32_t> both = vs;
+    both.insert(both.end(), next->second.begin(), next->second.end());
+    const Motion pair = rigidFit(before, m, both);
+    fit.worstPairRatio = std::max(fit.worstPairRatio, pair.residual / pair.disp);
+  }
+  return fit;
+}
+
+}  // namespace
+
 TEST_CASE("displace: bricks between sand joints tilt as rigid blocks", "[solids][operators]") {
-  // A paving bed 1.2 × 0.3 × 0.6 m of 0.05 m cells (y up): dirt, the top 0.1 m a running bond
-  // of 0.25 × 0.1 m bricks with 0.05 m joints (joints one cell wide on the grid's planes, as
-  // fig_solid_07_displaced_paving's 0.35 × 0.15 m bricks have), and a root 0.05 m under the paving
-  // (0.45 < x < 0.75, 0.2 < z < 0.4, 0.1 < y < 0.15) that rises 0.1 m in 8 increments.
-  // With sand joints (E 3 MPa, 5,000 times softer than brick) every brick moves as a rigid
-  // block: its vertices fit a rotation and translation (Kabsch) to a small fraction of its
-  // displacement; the bricks over the root tilt, and neighbours move apart (the two bricks
-  // on either side of a joint fit one rigid motion far worse than each alone). With the
-  // joints made of brick (one slab), neighbours move together.
-  struct BrickKey {
-    bool brick;
-    int row, col;
-  };
-  auto paving = [](const DVec3& c) {
-    const int row = int(std::floor(c.z / 0.15));
-    const double x = c.x + ((row & 1) ? 0.15 : 0.0);
-    const double fx = x / 0.3 - std::floor(x / 0.3), fz = c.z / 0.15 - std::floor(c.z / 0.15);
-    return BrickKey{fx > 1.0 / 6 && fz > 1.0 / 3, row, int(std::floor(x / 0.3))};
-  };
-  struct Motion {
-    double residual = 0;  // largest distance of a vertex from the best rigid motion's image, m
-    double disp = 0;      // largest displacement of a vertex, m
-    double tiltDeg = 0;   // the best rotation's angle
-  };
-  // Best-fit rotation and translation of the vertices vs (Kabsch): R = V·diag(1, 1, ±1)·Uᵀ
-  // from the SVD U·S·Vᵀ of the cross-covariance H = Σ (p − p̄)(q − q̄)ᵀ.
-  auto rigidFit = [](const TetMesh& before, const TetMesh& after, const std::vector<uint32_t>& vs) {
-    Motion out;
-    Eigen::Vector3d pc = Eigen::Vector3d::Zero(), qc = Eigen::Vector3d::Zero();
-    for (uint32_t v : vs) {
-      const DVec3 p = before.positions[v], q = after.positions[v];
-      pc += Eigen::Vector3d(p.x, p.y, p.z);
-      qc += Eigen::Vector3d(q.x, q.y, q.z);
-      out.disp = std::max(out.disp, glm::length(q - p));
-    }
-    pc /= double(vs.size());
-    qc /= double(vs.size());
-    Eigen::Matrix3d H = Eigen::Matrix3d::Zero();
-    for (uint32_t v : vs) {
-      const DVec3 p = before.positions[v], q = after.positions[v];
-      H += (Eigen::Vector3d(p.x, p.y, p.z) - pc) * (Eigen::Vector3d(q.x, q.y, q.z) - qc).transpose();
-    }
-    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(H, Eigen::ComputeFullU | Eigen::ComputeFullV);
-    Eigen::Matrix3d D = Eigen::Matrix3d::Identity();
-    D(2, 2) = (svd.matrixV() * svd.matrixU().transpose()).determinant() < 0 ? -1 : 1;
-    const Eigen::Matrix3d R = svd.matrixV() * D * svd.matrixU().transpose();
-    for (uint32_t v : vs) {
-      const DVec3 p = before.positions[v], q = after.positions[v];
-      const Eigen::Vector3d fitted = R * (Eigen::Vector3d(p.x, p.y, p.z) - pc) + qc;
-      out.residual = std::max(out.residual, (fitted - Eigen::Vector3d(q.x, q.y, q.z)).norm());
-    }
-    out.tiltDeg = std::acos(std::clamp((R.trace() - 1) / 2, -1.0, 1.0)) * 180 / 3.14159265358979323846;
-    return out;
-  };
-  struct Fit {
-    double worstRatio = 0;      // max over moved bricks of residual / displacement
-    double worstPairRatio = 0;  // max over neighbours in a row of the pair's residual / displacement
-    double maxTiltDeg = 0, maxDisp = 0;
-    size_t moved = 0;
-  };
-  auto run = [&](uint16_t jointMaterial) {
-    TetMesh m = test::tetBlock({24, 6, 12}, DVec3(0.0), DVec3(1.2, 0.3, 0.6));
-    Material sand = *findBuiltinMaterial("dirt");
-    sand.name = "sand";
-    sand.youngsModulus = 3e6;
-    sand.poissonRatio = 0.3;
-    const std::vector<Material> mats = {*findBuiltinMaterial("dirt"), *findBuiltinMaterial("brick"), *findBuiltinMaterial("wood"), sand};
-    std::map<std::pair<int, int>, std::vector<uint32_t>> bricks;  // (row, column) -> vertices
-    for (size_t t = 0; t < m.tets.size(); ++t) {
-      DVec3 c(0.0);
-      for (uint32_t v : m.tets[t]) c += 0.25 * m.positions[v];
-      const BrickKey k = paving(c);
-      if (c.x > 0.45 && c.x < 0.75 && c.z > 0.2 && c.z < 0.4 && c.y > 0.1 && c.y < 0.15) m.materials[t] = 2;
-      else if (c.y > 0.2) m.materials[t] = k.brick ? 1 : jointMaterial;
-      else m.materials[t] = 0;
-      if (c.y > 0.2 && k.brick) {
-        auto& vs = bricks[{k.row, k.col}];
-        vs.insert(vs.end(), m.tets[t].begin(), m.tets[t].end());
-      }
-    }
-    for (auto& [key, vs] : bricks) {
-      std::sort(vs.begin(), vs.end());
-      vs.erase(std::unique(vs.begin(), vs.end()), vs.end());
-    }
-    const TetMesh before = m;
-    DisplaceOptions opt;
-    opt.moving = {2};
-    opt.offset = DVec3(0, 0.1, 0);
-    opt.steps = 8;
-    displace(m, mats, opt);
-    CHECK(minVolume(m) > 0);
-    Fit fit;
-    for (const auto& [key, vs] : bricks) {
-      const Motion b = rigidFit(before, m, vs);
-      if (b.disp < 0.005) continue;  // a brick the root barely reached
-      fit.worstRatio = std::max(fit.worstRatio, b.residual / b.disp);
-      fit.maxTiltDeg = std::max(fit.maxTiltDeg, b.tiltDeg);
-      fit.maxDisp = std::max(fit.maxDisp, b.disp);
-      ++fit.moved;
-      const auto next = bricks.find({key.first, key.second + 1});
-      if (next == bricks.end()) continue;
-      std::vector<uint32_t> both = vs;
-      both.insert(both.end(), next->second.begin(), next->second.end());
-      const Motion pair = rigidFit(before, m, both);
-      fit.worstPairRatio = std::max(fit.worstPairRatio, pair.residual / pair.disp);
-    }
-    return fit;
-  };
-  const Fit sand = run(3), slab = run(1);
+  const Fit sand = pavingFit(3), slab = pavingFit(1);
   INFO("sand joints: " << sand.moved << " bricks moved, worst residual/displacement " << sand.worstRatio << " (pairs "
                        << sand.worstPairRatio << "), max tilt " << sand.maxTiltDeg << " deg, max displacement " << sand.maxDisp);
   INFO("one slab: " << slab.moved << " footprints moved, worst residual/displacement " << slab.worstRatio << " (pairs "

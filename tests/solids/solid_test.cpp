@@ -642,7 +642,7 @@ size_t componentsOf(const Mesh& m) {
 
 }  // namespace
 
-TEST_CASE("boundarySurface: pieces touching along an edge or at a vertex are pulled apart", "[solids]") {
+TEST_CASE("boundarySurface: pieces touching along an edge are pulled apart into two sheets", "[solids]") {
   SECTION("an edge-only contact: four triangles at the edge in the visible interface, two sheets here") {
     const TetMesh m = edgeContact(false);
     for (size_t t = 0; t < m.tets.size(); ++t) REQUIRE(m.volume(t) > 0);
@@ -682,6 +682,9 @@ TEST_CASE("boundarySurface: pieces touching along an edge or at a vertex are pul
     CHECK(analyzeTopology(meshOf(s)).manifold());
     CHECK(componentsOf(meshOf(s)) == 2);
   }
+}
+
+TEST_CASE("boundarySurface: pieces touching at a vertex are pulled apart; one material's boundary", "[solids]") {
   SECTION("a vertex-only contact: one piece by its vertices in the visible interface, two here") {
     const TetMesh m = vertexContact();
     for (size_t t = 0; t < m.tets.size(); ++t) REQUIRE(m.volume(t) > 0);
@@ -712,6 +715,10 @@ TEST_CASE("boundarySurface: pieces touching along an edge or at a vertex are pul
     CHECK(clay.triangles.size() == 4);
     CHECK(clay.splitVertices == 0);
   }
+}
+
+TEST_CASE("boundarySurface: split edges around a material between others; without contacts, the visible interface",
+          "[solids]") {
   SECTION("material between others around an edge, joined around both ends: split edge") {
     // An octahedron around the edge (0,0,0)-(0,0,1): four tetrahedra, bronze (0) and clay
     // (1) in turn; bronze caps below and above join the two bronze wedges around each end.
