@@ -1,15 +1,17 @@
-/// What a page of memory costs the first time a process touches it, against a page it has
-/// just freed and touches again (the baseline, in the same run).
+/// What a page of memory costs the first time a process touches it: fresh small (4 KB)
+/// pages, fresh transparent huge (2 MB) pages, and, as the baseline in the same run, a
+/// block the process has just freed and touches again.
 ///
 /// Usage: bench_fresh_pages [--mb N] (default 256)
 ///
 /// On a virtual machine whose host backs the guest's memory only when first touched, and
 /// takes freed memory back (free page reporting), the first touch of a fresh page costs the
-/// host's fault and zeroing; a page the process freed a moment ago is still backed. Sprig's
-/// large working arrays (the polygonizer's grid, the mesh's arrays) pay the first cost once
-/// per page; blobtree/polygonize.cpp releases arrays early so later ones reuse their pages.
-/// Prints MB/s of both touches and their ratio; run it a few seconds after any large
-/// process has exited (freed memory is reported to the host about two seconds after).
+/// host's fault; a huge page needs a whole free 2 MB block, the kind the guest has handed
+/// back, so it costs the most. Sprig's polygonizer keeps its large arrays on small pages
+/// and releases arrays early so later ones reuse their pages (blobtree/polygonize.cpp).
+/// Prints the seconds and MB/s of each touch and their ratios to the reused block; run it
+/// a few seconds after any large process has exited (freed memory is reported to the host
+/// about two seconds after).
 
 #include "bench/bench_clock.h"
 
@@ -25,9 +27,9 @@ namespace {
 
 constexpr size_t kHuge = size_t(2) << 20;
 
-/// Allocates mb MB (huge-page aligned, marked for huge pages as the polygonizer's arrays
-/// are), writes one byte a 4 KB page, and returns the seconds taken; frees it.
-double touch(size_t mb) {
+/// Allocates mb MB (2 MB aligned), advises huge or small pages, writes one byte a 4 KB page
+/// and returns the seconds taken; the block is freed only when keep is null.
+double touch(size_t mb, int advice, volatile char** keep = nullptr) {
   const size_t bytes = mb << 20;
   const auto t0 = Clock::now();
   auto* p = static_cast<volatile char*>(std::aligned_alloc(kHuge, bytes));
@@ -35,10 +37,11 @@ double touch(size_t mb) {
     std::fprintf(stderr, "bench_fresh_pages: cannot allocate %zu MB\n", mb);
     std::exit(1);
   }
-  madvise(const_cast<char*>(p), bytes, MADV_HUGEPAGE);
+  madvise(const_cast<char*>(p), bytes, advice);
   for (size_t i = 0; i < bytes; i += 4096) p[i] = 1;
   const double s = seconds(t0);
-  std::free(const_cast<char*>(p));
+  if (keep) *keep = p;
+  else std::free(const_cast<char*>(p));
   return s;
 }
 
@@ -49,9 +52,16 @@ int main(int argc, char** argv) {
   for (int i = 1; i < argc; ++i)
     if (!std::strcmp(argv[i], "--mb") && i + 1 < argc) mb = size_t(std::atol(argv[++i]));
   if (mb == 0) return 1;
-  const double fresh = touch(mb), again = touch(mb);
-  std::printf("%zu MB: first touch %.3f s (%.0f MB/s), touched again after free %.3f s (%.0f MB/s); "
-              "fresh / reused = %.1fx\n",
-              mb, fresh, double(mb) / fresh, again, double(mb) / again, fresh / again);
+  // Both fresh blocks are kept while the other is touched, so neither reuses the other's pages.
+  volatile char *small = nullptr, *huge = nullptr;
+  const double freshSmall = touch(mb, MADV_NOHUGEPAGE, &small);
+  const double freshHuge = touch(mb, MADV_HUGEPAGE, &huge);
+  std::free(const_cast<char*>(small));
+  std::free(const_cast<char*>(huge));
+  const double reused = touch(mb, MADV_NOHUGEPAGE);
+  std::printf("%zu MB: fresh small pages %.3f s (%.0f MB/s), fresh huge pages %.3f s (%.0f MB/s), "
+              "reused after free %.3f s (%.0f MB/s); fresh small / reused = %.1fx, fresh huge / reused = %.1fx\n",
+              mb, freshSmall, double(mb) / freshSmall, freshHuge, double(mb) / freshHuge, reused, double(mb) / reused,
+              freshSmall / reused, freshHuge / reused);
   return 0;
 }

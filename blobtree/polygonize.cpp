@@ -36,53 +36,40 @@ using detail::kTriangleCount;
 using detail::TetEmitter;
 
 // Allocator of the polygonizer's large working arrays (cell hash, corner table, samples,
-// vertex tables): blocks of 4 MB and more are aligned to 2 MB and marked for transparent
-// huge pages (madvise; the kernel's default mode on Debian), so the random lookups of the
-// hash and the tables miss the TLB far less and their first touch faults 512 times fewer
-// pages. Results are unchanged. On the 2,000-cone benchmark these arrays alone gave 0.95x
-// the dual mesher's CPU time (loaded machine, two alternating pairs); glibc's
-// GLIBC_TUNABLES=glibc.malloc.hugetlb=1, which does the same for every large block (the
-// surface cells and the output mesh too), gave 0.77x.
+// vertex tables): resize(n) default-initializes (no zero fill of trivial types), since
+// every array below is written in full by a parallel step after its resize, which then
+// also touches its pages on both threads. Small (4 KB) pages: these arrays were once marked
+// for transparent huge pages (0.95x the dual mesher's CPU time then, on a loaded machine),
+// but a fresh 2 MB page is a whole block the kernel may have handed back to a virtual
+// machine's host, and its first touch cost 7-10 times a small page's here (1.1-1.4 s
+// against 0.12-0.18 s for 315 MB; bench_fresh_pages), so without them the 2,000-cone
+// benchmark took 0.70-0.85x the time (docs/PERFORMANCE.md, "Fresh pages").
 template <class T>
-struct HugePageAllocator {
+struct DefaultInitAllocator {
   using value_type = T;
-  HugePageAllocator() = default;
+  DefaultInitAllocator() = default;
   template <class U>
-  HugePageAllocator(const HugePageAllocator<U>&) {}
-  static constexpr size_t kHuge = size_t(2) << 20, kThreshold = size_t(4) << 20;
+  DefaultInitAllocator(const DefaultInitAllocator<U>&) {}
   T* allocate(size_t n) {
-    const size_t bytes = n * sizeof(T);
-    if (bytes < kThreshold) {
-      if (void* p = std::malloc(bytes)) return static_cast<T*>(p);
-      throw std::bad_alloc();
-    }
-    const size_t rounded = (bytes + kHuge - 1) / kHuge * kHuge;
-    void* p = std::aligned_alloc(kHuge, rounded);
-    if (!p) throw std::bad_alloc();
-    madvise(p, rounded, MADV_HUGEPAGE);  // advice only: without THP the pages stay small
-    return static_cast<T*>(p);
+    if (void* p = std::malloc(n * sizeof(T))) return static_cast<T*>(p);
+    throw std::bad_alloc();
   }
   void deallocate(T* p, size_t) { std::free(p); }
-  // resize(n) default-initializes (no zero fill of trivial types): every array below is
-  // written in full by a parallel step after its resize, which then also touches its pages
-  // on both threads.
   template <class U, class... Args>
   void construct(U* p, Args&&... args) {
     if constexpr (sizeof...(Args) == 0) ::new (static_cast<void*>(p)) U;
     else ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
   }
   template <class U>
-  bool operator==(const HugePageAllocator<U>&) const { return true; }
+  bool operator==(const DefaultInitAllocator<U>&) const { return true; }
 };
 template <class T>
-using BigVector = std::vector<T, HugePageAllocator<T>>;
+using BigVector = std::vector<T, DefaultInitAllocator<T>>;
 
 // Frees the arrays' memory now. Both meshers return each working array once done with it,
-// so that the arrays made after it (the mesh's) reuse its pages: on a virtual machine
-// whose host backs guest memory lazily and takes freed memory back (free page reporting),
-// a page touched for the first time cost 3-7 ms a MB (2.1 s for 315 MB, the size of the
-// benchmark's vertex attributes), pages the process had just freed 0.1 ms (0.02 s for
-// 250 MB) (docs/PERFORMANCE.md, "Fresh pages").
+// so that the arrays made after it (the mesh's) reuse its memory instead of growing the
+// process: the dual mesher's peak resident set on the 2,000-cone benchmark fell from 942 MB
+// to 420 MB (docs/PERFORMANCE.md, "Fresh pages").
 template <class... C>
 void releaseAll(C&... arrays) {
   ((C().swap(arrays)), ...);
@@ -92,18 +79,17 @@ void releaseAll(C&... arrays) {
 // std::vectors, 400+ MB on the 2,000-cone benchmark) from empty to n elements. resize()
 // value-initializes on one thread, and its first touch of fresh pages was most of the
 // dual mesher's serial time: 1.7 s of its 8.3 s vertex phase (loaded machine). So the
-// block is reserved first, marked for huge pages, and its pages are faulted in on every
-// thread (MADV_POPULATE_WRITE, Linux 5.14; an older kernel refuses it and resize() faults
-// them as before); resize() then only writes memory that is there. Results are unchanged.
+// block is reserved first and its pages are faulted in on every thread
+// (MADV_POPULATE_WRITE, Linux 5.14; an older kernel refuses it and resize() faults them as
+// before); resize() then only writes memory that is there. Results are unchanged.
 template <class T>
 void resizeOutput(std::vector<T>& v, size_t n) {
-  constexpr size_t kPage = 4096, kChunk = size_t(8) << 20;
-  if (v.empty() && n * sizeof(T) >= HugePageAllocator<T>::kThreshold) {
+  constexpr size_t kPage = 4096, kChunk = size_t(8) << 20, kThreshold = size_t(4) << 20;
+  if (v.empty() && n * sizeof(T) >= kThreshold) {
     v.reserve(n);
     const uintptr_t lo = (reinterpret_cast<uintptr_t>(v.data()) + kPage - 1) / kPage * kPage;
     const uintptr_t hi = (reinterpret_cast<uintptr_t>(v.data()) + n * sizeof(T)) / kPage * kPage;
     if (hi > lo) {
-      madvise(reinterpret_cast<void*>(lo), hi - lo, MADV_HUGEPAGE);
 #ifdef MADV_POPULATE_WRITE  // glibc 2.35 and later
       parallelFor(0, (hi - lo + kChunk - 1) / kChunk, [&](size_t c) {
         const uintptr_t b = lo + c * kChunk;
