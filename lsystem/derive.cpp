@@ -11,7 +11,7 @@
 #include <unordered_map>
 
 #include "core/rng.h"
-#include "lsystem/detail/huge_pages.h"
+#include "lsystem/detail/overwrite.h"
 #include "lsystem/detail/program.h"
 #include "lsystem/view_file.h"
 
@@ -46,7 +46,7 @@ class Writer {
     // Only the reserved part is sized (and zero-filled where new): sizing to the whole
     // capacity would cost O(largest string) per step.
     // The string is rewritten from scratch: growing buffers drop, not copy, the old
-    // contents, and large new ones get huge pages (fewer first-touch faults).
+    // contents (detail/overwrite.h).
     detail::resizeForOverwrite(s_.symbols, std::max(modules, size_t(16)));
     detail::resizeForOverwrite(s_.offsets, s_.symbols.size() + 1);
     detail::resizeForOverwrite(s_.params, std::max(params, size_t(16)));

@@ -11,7 +11,7 @@
 
 #include "core/diagnostics.h"
 #include "lsystem/detail/cpfg.h"
-#include "lsystem/detail/huge_pages.h"
+#include "lsystem/detail/overwrite.h"
 #include "lsystem/detail/program.h"
 
 namespace sprig::lsystem {
@@ -270,7 +270,6 @@ class TurtleWalk {
       draws += c == Command::Forward || c == Command::ForwardNoVertex;
     }
     sk_.internodes.reserve(draws);
-    detail::adviseHugePages(sk_.internodes.data(), sk_.internodes.capacity() * sizeof(Internode));
   }
 
   /// Where walk() records the frame at each query module (none when null).
