@@ -51,7 +51,10 @@ int main(int argc, char** argv) {
   size_t mb = 256;
   for (int i = 1; i < argc; ++i)
     if (!std::strcmp(argv[i], "--mb") && i + 1 < argc) mb = size_t(std::atol(argv[++i]));
-  if (mb == 0) return 1;
+  if (mb == 0) {
+    std::fprintf(stderr, "bench_fresh_pages: --mb needs a positive number of megabytes\n");
+    return 1;
+  }
   // Both fresh blocks are kept while the other is touched, so neither reuses the other's pages.
   volatile char *small = nullptr, *huge = nullptr;
   const double freshSmall = touch(mb, MADV_NOHUGEPAGE, &small);

@@ -1102,7 +1102,7 @@ class DualMesher {
 
   const CompiledBlob& blob_;
   const PolygonizeOptions& options_;
-  Grid& g_;  ///< its arrays are released as the mesher is done with them (releaseUsed)
+  Grid& g_;  ///< its arrays are released as the mesher is done with them (releaseAll)
   PolygonizeResult& res_;
   const size_t nActive_;
   Vertices v_;

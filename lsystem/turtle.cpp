@@ -11,7 +11,6 @@
 
 #include "core/diagnostics.h"
 #include "lsystem/detail/cpfg.h"
-#include "lsystem/detail/overwrite.h"
 #include "lsystem/detail/program.h"
 
 namespace sprig::lsystem {
