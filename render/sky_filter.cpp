@@ -51,6 +51,7 @@ struct Guides {
   std::vector<Vec3> position;
   std::vector<float> footprint;  ///< least distance to a 4-neighbour's point (0: none)
   std::vector<float> invFootprint;  ///< 1 / (sigmaPlane * footprint); infinity where footprint is 0
+  int normalPowerLog2 = 2;       ///< SkyFilterSettings::normalPowerLog2
   size_t index(int x, int y) const { return static_cast<size_t>(y) * width + x; }
   bool active(size_t i) const { return normal[i] != Vec3(0); }
 };
@@ -102,16 +103,13 @@ Guides makeGuides(const SkyLayers& l) {
   return g;
 }
 
-/// The exponent of the normal weight (w_n = max(0, n_p . n_q)^128), as in SVGF.
-constexpr int kNormalPowerLog2 = 7;
-
 /// The argument -a of the plane weight exp(-a) of tap q for pixel p at pixel distance
 /// 1 / invDist, times -1; negative where the normal weight is 0, with that weight in wn.
 float planeExponent(const Guides& g, size_t p, size_t q, float invDist, float& wn) {
   if (!g.active(q)) return -1.0f;
   float c = glm::dot(g.normal[p], g.normal[q]);
   if (c <= 0.0f) return -1.0f;
-  for (int k = 0; k < kNormalPowerLog2; ++k) c *= c;
+  for (int k = 0; k < g.normalPowerLog2; ++k) c *= c;
   wn = c;
   const float d = std::abs(glm::dot(g.normal[p], g.position[q] - g.position[p]));
   return d == 0.0f ? 0.0f : d * g.invFootprint[p] * invDist;
@@ -203,6 +201,7 @@ void atrousPass(const Guides& g, int step, const SkyFilterSettings& s, const std
 
 std::vector<Vec3> filteredIrradiance(const SkyLayers& layers, const SkyFilterSettings& settings) {
   Guides g = makeGuides(layers);
+  g.normalPowerLog2 = std::clamp(settings.normalPowerLog2, 0, 8);
   std::vector<Vec3> e = g.irradiance, next(e.size());
   for (size_t i = 0; i < g.footprint.size(); ++i)
     g.invFootprint[i] = g.footprint[i] > 0.0f ? 1.0f / (settings.sigmaPlane * g.footprint[i]) : std::numeric_limits<float>::infinity();
