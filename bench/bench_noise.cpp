@@ -5,7 +5,8 @@
 /// mummified-skull organism and the striped candy cut in half.
 ///
 ///   build/bench/bench_noise [--width W] [--height H] [--spp N] [--reference N] [--repeat R]
-///                           [--only NAME] [--out DIR]
+///                           [--only NAME] [--out DIR] [--edge N] [--edge-threshold T]
+///                           [--unlit N] [--foliage]
 ///
 /// Each scene is built once (exact mode) and rendered at --spp (default 4) by both samplers,
 /// --repeat times each (default 2, interleaved; the least CPU time counts: steadier than
@@ -20,7 +21,11 @@
 /// sampler at three times --spp (the "the same error at a third of the samples"
 /// compares the default against it). --out DIR
 /// writes DIR/NAME.png: stratified | default | default + edge samples | reference, side by
-/// side, and DIR/NAME_error.png: 8 x the error of the first three.
+/// side, and DIR/NAME_error.png: 8 x the error of the first three. --unlit N gives the
+/// default and the edge-sample variants RenderSettings::unlitSkySamples = N. --foliage also
+/// prints, per variant, the error over the pixels whose reference colour is leaf green
+/// (g > 1.15 r and g > b: the lime's crown) and over the rest, and the crown's share of the
+/// squared error.
 
 #include <cmath>
 #include <cstdio>
@@ -59,6 +64,8 @@ struct Options {
   int width = 160, height = 120, spp = 4, reference = 1024, repeat = 2;
   int edgeSamples = 12;          ///< the adaptive variant's RenderSettings::edgeSamples
   float edgeThreshold = 0.08f;   ///< and its edgeThreshold
+  int unlit = 0;                 ///< RenderSettings::unlitSkySamples of the filtered variants
+  bool foliage = false;          ///< split the error into leaf-green pixels and the rest
   std::string only, out;
 };
 
@@ -118,6 +125,26 @@ Image errorMap(const Image& a, const Image& reference) {
   return out;
 }
 
+/// The error of a against the reference over its leaf-green pixels and over the rest (RMSE
+/// in 8-bit levels), and the green pixels' share of the squared error.
+void printFoliageSplit(const char* name, const Image& a, const Image& reference) {
+  double green = 0, rest = 0;
+  size_t nGreen = 0, nRest = 0;
+  for (int y = 0; y < a.height; ++y) {
+    for (int x = 0; x < a.width; ++x) {
+      const Vec4 r = reference.at(x, y), v = a.at(x, y);
+      double d2 = 0;
+      for (int c = 0; c < 3; ++c) d2 += std::pow(display(v[c]) - display(r[c]), 2.0);
+      const bool leaf = r.g > 1.15f * r.r && r.g > r.b;
+      (leaf ? green : rest) += d2;
+      ++(leaf ? nGreen : nRest);
+    }
+  }
+  const auto level = [](double sum, size_t n) { return n ? 255.0 * std::sqrt(sum / (3.0 * double(n))) : 0.0; };
+  std::printf("  %-14s green pixels %zu: RMSE %6.3f, share of the squared error %5.3f; the rest RMSE %6.3f\n", name, nGreen,
+              level(green, nGreen), green / std::max(green + rest, 1e-30), level(rest, nRest));
+}
+
 void runScene(const NoiseScene& sc, const Options& o) {
   PathPolicy policy;
   policy.root = SPRIG_BENCH_SOURCE_DIR;
@@ -174,8 +201,8 @@ void runScene(const NoiseScene& sc, const Options& o) {
   for (int r = 0; r < o.repeat; ++r) {
     for (int i = 0; i < kVariants; ++i) {
       rs.sampler = variants[i].sampler;
-      rs.unlitSkySamples = variants[i].unlitSkySamples;
       rs.skyFilter = variants[i].skyFilter;
+      rs.unlitSkySamples = variants[i].skyFilter ? o.unlit : variants[i].unlitSkySamples;
       rs.edgeSamples = variants[i].adaptive ? o.edgeSamples : 0;
       rs.edgeThreshold = o.edgeThreshold;
       rs.spp = o.spp * variants[i].sppScale;
@@ -194,6 +221,8 @@ void runScene(const NoiseScene& sc, const Options& o) {
     std::printf("  %-14s RMSE %6.3f (x%5.3f)   CPU %7.3f s (x%5.3f)   camera samples x%5.3f\n", variants[i].name, e,
                 e / base, best[i], best[i] / best[0], double(cameraRays[i]) / double(cameraRays[0]));
   }
+  if (o.foliage)
+    for (int i = 0; i < kVariants; ++i) printFoliageSplit(variants[i].name, images[i], reference);
   std::fflush(stdout);
   if (!o.out.empty()) {
     fs::create_directories(o.out);
@@ -219,8 +248,12 @@ int main(int argc, char** argv) {
     else if (v && flag == "--out") o.out = v;
     else if (v && flag == "--edge") o.edgeSamples = std::atoi(v);
     else if (v && flag == "--edge-threshold") o.edgeThreshold = static_cast<float>(std::atof(v));
-    else {
-      std::fprintf(stderr, "usage: bench_noise [--width W] [--height H] [--spp N] [--reference N] [--repeat R] [--only NAME] [--out DIR] [--edge N] [--edge-threshold T]\n");
+    else if (v && flag == "--unlit") o.unlit = std::atoi(v);
+    else if (flag == "--foliage") {
+      o.foliage = true;
+      continue;
+    } else {
+      std::fprintf(stderr, "usage: bench_noise [--width W] [--height H] [--spp N] [--reference N] [--repeat R] [--only NAME] [--out DIR] [--edge N] [--edge-threshold T] [--unlit N] [--foliage]\n");
       return 1;
     }
     ++i;
