@@ -717,7 +717,10 @@ Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings
   const float scale = std::exp2(s.exposure);
   // The sky filter's layers, where the sky is sampled by rays (its only noise).
   std::optional<SkyLayers> layers;
-  if (filtersSky(s)) layers.emplace(s.width, s.height);
+  if (filtersSky(s)) {
+    layers.emplace(s.width, s.height);
+    layers->raysPerSample = static_cast<float>(s.skySamples);
+  }
   SkyLayers* out = layers ? &*layers : nullptr;
 
   parallelFor(0, grid.tileCount(), [&](size_t) {

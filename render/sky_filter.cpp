@@ -122,9 +122,22 @@ float geometryWeight(const Guides& g, size_t p, size_t q, float dist) {
   return a < 0.0f ? 0.0f : wn * fastExpNegative(-a);
 }
 
-/// The variance of each active pixel's mean irradiance luminance: the per-sample variance
-/// pooled over the pixel and its 3x3 neighbours that pass the geometry test, over its own
-/// sample count.
+/// The least per-sample variance of pixel p: that of a visibility seen through
+/// l.raysPerSample rays per sample with the rule of succession's estimate from its own
+/// samples, p = (k + 1) / (n + 2) for mean k / n (clamped to [0, 1]). Without it, a pixel
+/// whose few samples happen to agree (all its sky rays blocked, deep in a crown) has
+/// variance 0, its luminance weight admits no neighbour, and it keeps its raw value: a
+/// black speck.
+double varianceFloor(const SkyLayers& l, size_t p) {
+  const double n = l.count[p];
+  const double k = std::clamp(static_cast<double>(l.lumSum[p]) / n, 0.0, 1.0) * n;
+  const double q = (k + 1.0) / (n + 2.0);
+  return q * (1.0 - q) / std::max(1.0f, l.raysPerSample);
+}
+
+/// The variance of each active pixel's mean demodulated luminance: the per-sample variance
+/// pooled over the pixel and its 3x3 neighbours that pass the geometry test (at least
+/// varianceFloor), over its own sample count.
 std::vector<float> initialVariance(const SkyLayers& l, const Guides& g) {
   std::vector<float> var(l.lumSum.size(), 0.0f);
   parallelFor(0, static_cast<size_t>(l.height), [&](size_t row) {
@@ -142,9 +155,12 @@ std::vector<float> initialVariance(const SkyLayers& l, const Guides& g) {
           squares += l.lumSquares[q];
         }
       }
-      if (n < 2.0 || l.count[p] <= 0.0f) continue;
-      const double mean = sum / n;
-      const double perSample = std::max(0.0, (squares - n * mean * mean) / (n - 1.0));
+      if (l.count[p] <= 0.0f) continue;
+      double perSample = varianceFloor(l, p);
+      if (n >= 2.0) {
+        const double mean = sum / n;
+        perSample = std::max(perSample, (squares - n * mean * mean) / (n - 1.0));
+      }
       var[p] = static_cast<float>(perSample / l.count[p]);
     }
   });

@@ -28,7 +28,10 @@
 ///            of the demodulated luminances against their estimated standard deviation;
 /// - a pixel's variance starts as the per-sample variance of that luminance pooled over its
 ///   3x3 neighbours that pass the normal and plane tests, divided by its sample count, and
-///   each pass carries it on as sum(w^2 var) / (sum w)^2.
+///   each pass carries it on as sum(w^2 var) / (sum w)^2. The per-sample variance is at
+///   least a binomial visibility's, p (1 - p) per sky ray with the rule of succession's
+///   p = (k + 1) / (n + 2) from the pixel's own mean: a pixel whose four sky rays were all
+///   blocked by chance is not taken for a noiseless one (that left black specks in crowns).
 /// Edges are kept by construction: a tap on a surface turned away by 90 degrees or more,
 /// on a pixel with no surface, or on an albedo of zero has weight 0, and the output of a
 /// pixel is a convex combination of demodulated values, so a constant one stays constant
@@ -52,6 +55,9 @@ struct SkyLayers {
   std::vector<float> lumSum;   ///< sum over the pixel's own surface samples of the demodulated luminance (sky / albedo)
   std::vector<float> lumSquares;  ///< sum of its squares
   std::vector<float> count;    ///< number of the pixel's own samples that met a surface
+  /// Sky rays per sample (the least: RenderSettings::skySamples); the variance floor of a
+  /// pixel's visibility divides by it.
+  float raysPerSample = 1.0f;
 
   SkyLayers() = default;
   SkyLayers(int w, int h);

@@ -125,6 +125,31 @@ TEST_CASE("filteredIrradiance keeps what it must", "[render][sky_filter]") {
   }
 }
 
+TEST_CASE("filteredIrradiance: a pixel whose samples all saw no sky is not taken for a noiseless one", "[render][sky_filter]") {
+  // A leaf deep in a crown: its four sky rays were all blocked (value 0, spread 0), and its
+  // normal, turned 60 degrees from its neighbours', keeps them out of its pooled variance.
+  // With variance 0 its luminance weight would admit nothing and it would stay black; the
+  // binomial floor (p = 1/6 from 0 of 4) lets the neighbours it faces alike enough in.
+  SkyLayers l = planeLayers([](int, int) { return 0.5f; }, someNoise);
+  const size_t speck = l.index(kW / 2, kH / 2);
+  l.lumSum[speck] = l.lumSquares[speck] = 0.0f;
+  l.sky[speck] = Vec3(0);
+  l.normal[speck] = float(kSamples) * Vec3(std::sin(radians(60.0)), std::cos(radians(60.0)), 0.0f);
+  const float filtered = luminance(filteredIrradiance(l)[speck]);
+  INFO("the speck's filtered visibility " << filtered);
+  // Measured 0.105: the normal weight (cos^4 60 = 1/16) bounds what the neighbours give.
+  CHECK(filtered > 0.05f);
+  CHECK(filtered < 0.5f);
+  SECTION("more rays per sample: a smaller floor, less taken from the neighbours") {
+    l.raysPerSample = 16.0f;
+    CHECK(luminance(filteredIrradiance(l)[speck]) < filtered);
+  }
+  SECTION("without the floor (rays beyond count) the speck stays black") {
+    l.raysPerSample = 1e12f;
+    CHECK(luminance(filteredIrradiance(l)[speck]) == 0.0f);
+  }
+}
+
 TEST_CASE("filteredIrradiance removes noise", "[render][sky_filter]") {
   const SkyLayers l = planeLayers([](int, int) { return 0.5f; }, someNoise);
   std::vector<Vec3> raw(l.sky.size());
