@@ -127,6 +127,7 @@ struct ShadeParts {
   Vec3 albedo{0};
   Vec3 normal{0};       ///< shading normal, facing the viewer (zero: no sky term)
   float irradianceLum = 0;
+  float rays = 0;       ///< sky rays cast
 };
 
 /// What one camera sample sees: its radiance and alpha, and the sky term with the guides of
@@ -136,6 +137,7 @@ struct SampleValue {
   Vec3 sky{0}, albedo{0};
   Vec3 normal{0}, position{0};  ///< of the first surface with a sky term (normal zero: none)
   float irradianceLum = 0;      ///< of that surface: the luminance of sky / albedo
+  float skyRays = 0;            ///< of that surface: the sky rays cast there
   /// Adds the sky term of a surface seen with the given weight (its share of the sample).
   void add(const ShadeParts& p, const Vec3& at, float weight) {
     sky += weight * p.sky;
@@ -144,6 +146,7 @@ struct SampleValue {
       normal = p.normal;
       position = at;
       irradianceLum = p.irradianceLum;
+      skyRays = p.rays;
     }
   }
 };
@@ -332,6 +335,7 @@ class Integrator {
         }
         skyLight /= static_cast<float>(rays);
         parts.normal = n;
+        parts.rays = static_cast<float>(rays);
         parts.sky = diffuse * skyLight * s_.skyStrength;
         if (openSky_.empty()) {
           parts.albedo = diffuse;
@@ -531,6 +535,7 @@ class FilmGrid {
       const float l = own[k].value.irradianceLum;
       layers->lumSum[i] += l;
       layers->lumSquares[i] += l * l;
+      layers->raySum[i] += own[k].value.skyRays;
       layers->count[i] += 1.0f;
     }
   }
@@ -717,10 +722,7 @@ Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings
   const float scale = std::exp2(s.exposure);
   // The sky filter's layers, where the sky is sampled by rays (its only noise).
   std::optional<SkyLayers> layers;
-  if (filtersSky(s)) {
-    layers.emplace(s.width, s.height);
-    layers->raysPerSample = static_cast<float>(s.skySamples);
-  }
+  if (filtersSky(s)) layers.emplace(s.width, s.height);
   SkyLayers* out = layers ? &*layers : nullptr;
 
   parallelFor(0, grid.tileCount(), [&](size_t) {

@@ -18,6 +18,7 @@ SkyLayers::SkyLayers(int w, int h) : width(w), height(h) {
   lumSum.assign(n, 0.0f);
   lumSquares.assign(n, 0.0f);
   count.assign(n, 0.0f);
+  raySum.assign(n, 0.0f);
 }
 
 namespace {
@@ -123,7 +124,7 @@ float geometryWeight(const Guides& g, size_t p, size_t q, float dist) {
 }
 
 /// The least per-sample variance of pixel p: that of a visibility seen through
-/// l.raysPerSample rays per sample with the rule of succession's estimate from its own
+/// the pixel's mean sky rays per sample with the rule of succession's estimate from its own
 /// samples, p = (k + 1) / (n + 2) for mean k / n (clamped to [0, 1]). Without it, a pixel
 /// whose few samples happen to agree (all its sky rays blocked, deep in a crown) has
 /// variance 0, its luminance weight admits no neighbour, and it keeps its raw value: a
@@ -132,7 +133,7 @@ double varianceFloor(const SkyLayers& l, size_t p) {
   const double n = l.count[p];
   const double k = std::clamp(static_cast<double>(l.lumSum[p]) / n, 0.0, 1.0) * n;
   const double q = (k + 1.0) / (n + 2.0);
-  return q * (1.0 - q) / std::max(1.0f, l.raysPerSample);
+  return q * (1.0 - q) / std::max(1.0, static_cast<double>(l.raySum[p]) / n);
 }
 
 /// The variance of each active pixel's mean demodulated luminance: the per-sample variance

@@ -55,9 +55,10 @@ struct SkyLayers {
   std::vector<float> lumSum;   ///< sum over the pixel's own surface samples of the demodulated luminance (sky / albedo)
   std::vector<float> lumSquares;  ///< sum of its squares
   std::vector<float> count;    ///< number of the pixel's own samples that met a surface
-  /// Sky rays per sample (the least: RenderSettings::skySamples); the variance floor of a
-  /// pixel's visibility divides by it.
-  float raysPerSample = 1.0f;
+  /// Sum over the pixel's own surface samples of the sky rays each cast (more where the sun
+  /// is blocked, RenderSettings::unlitSkySamples); the variance floor of a pixel's
+  /// visibility divides by their mean (at least 1).
+  std::vector<float> raySum;
 
   SkyLayers() = default;
   SkyLayers(int w, int h);

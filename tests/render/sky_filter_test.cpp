@@ -141,11 +141,11 @@ TEST_CASE("filteredIrradiance: a pixel whose samples all saw no sky is not taken
   CHECK(filtered > 0.05f);
   CHECK(filtered < 0.5f);
   SECTION("more rays per sample: a smaller floor, less taken from the neighbours") {
-    l.raysPerSample = 16.0f;
+    l.raySum[speck] = 16.0f * kSamples;
     CHECK(luminance(filteredIrradiance(l)[speck]) < filtered);
   }
   SECTION("without the floor (rays beyond count) the speck stays black") {
-    l.raysPerSample = 1e12f;
+    l.raySum[speck] = 1e12f;
     CHECK(luminance(filteredIrradiance(l)[speck]) == 0.0f);
   }
 }
