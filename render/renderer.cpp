@@ -337,14 +337,10 @@ class Integrator {
         parts.normal = n;
         parts.rays = static_cast<float>(rays);
         parts.sky = diffuse * skyLight * s_.skyStrength;
-        if (openSky_.empty()) {
-          parts.albedo = diffuse;
-          parts.irradianceLum = luminance(skyLight * s_.skyStrength);
-        } else {
-          const Vec3 open = openSky_(n) * s_.skyStrength;
-          parts.albedo = diffuse * open;
-          parts.irradianceLum = luminance(skyLight * s_.skyStrength / glm::max(open, Vec3(1e-6f)));
-        }
+        // What the sky term is demodulated by besides the albedo: the open sky when filtered.
+        const Vec3 open = openSky_.empty() ? Vec3(1) : openSky_(n) * s_.skyStrength;
+        parts.albedo = diffuse * open;
+        parts.irradianceLum = luminance(skyLight * s_.skyStrength / glm::max(open, Vec3(1e-6f)));
       }
       radiance += diffuse * skyLight * s_.skyStrength;
       if (metal) radiance += metallic * f0 * metalSky(n, ng, v, origin, h.position, roughness, skyLight, c) * s_.skyStrength;
