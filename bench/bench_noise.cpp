@@ -6,7 +6,7 @@
 ///
 ///   build/bench/bench_noise [--width W] [--height H] [--spp N] [--reference N] [--repeat R]
 ///                           [--only NAME] [--out DIR] [--edge N] [--edge-threshold T]
-///                           [--unlit N] [--foliage]
+///                           [--unlit N] [--refine N] [--refine-threshold T] [--foliage]
 ///
 /// Each scene is built once (exact mode) and rendered at --spp (default 4) by both samplers,
 /// --repeat times each (default 2, interleaved; the least CPU time counts: steadier than
@@ -22,7 +22,8 @@
 /// compares the default against it). --out DIR
 /// writes DIR/NAME.png: stratified | default | default + edge samples | reference, side by
 /// side, and DIR/NAME_error.png: 8 x the error of the first three. --unlit N gives the
-/// default and the edge-sample variants RenderSettings::unlitSkySamples = N. --foliage also
+/// default and the edge-sample variants RenderSettings::unlitSkySamples = N, and --refine N
+/// (--refine-threshold T) their refineSamples = N (refineThreshold = T). --foliage also
 /// prints, per variant, the error over the pixels whose reference colour is leaf green
 /// (g > 1.15 r and g > b: the lime's crown) and over the rest, and the crown's share of the
 /// squared error.
@@ -65,6 +66,8 @@ struct Options {
   int edgeSamples = 12;          ///< the adaptive variant's RenderSettings::edgeSamples
   float edgeThreshold = 0.08f;   ///< and its edgeThreshold
   int unlit = 0;                 ///< RenderSettings::unlitSkySamples of the filtered variants
+  int refine = 0;                ///< and their refineSamples
+  float refineThreshold = 0.01f; ///< and refineThreshold
   bool foliage = false;          ///< split the error into leaf-green pixels and the rest
   std::string only, out;
 };
@@ -197,7 +200,7 @@ void runScene(const NoiseScene& sc, const Options& o) {
   constexpr int kVariants = 6;
   Image images[kVariants];
   double best[kVariants] = {1e30, 1e30, 1e30, 1e30, 1e30, 1e30};
-  uint64_t cameraRays[kVariants] = {};
+  uint64_t cameraRays[kVariants] = {}, rays[kVariants] = {};
   for (int r = 0; r < o.repeat; ++r) {
     for (int i = 0; i < kVariants; ++i) {
       rs.sampler = variants[i].sampler;
@@ -205,11 +208,14 @@ void runScene(const NoiseScene& sc, const Options& o) {
       rs.unlitSkySamples = variants[i].skyFilter ? o.unlit : variants[i].unlitSkySamples;
       rs.edgeSamples = variants[i].adaptive ? o.edgeSamples : 0;
       rs.edgeThreshold = o.edgeThreshold;
+      rs.refineSamples = variants[i].skyFilter ? o.refine : 0;
+      rs.refineThreshold = o.refineThreshold;
       rs.spp = o.spp * variants[i].sppScale;
       const double cpu0 = bench::processCpuSeconds();
       render::RenderStats stats;
       images[i] = render::renderImage(scene, camera, rs, &stats);
       cameraRays[i] = stats.cameraRays;
+      rays[i] = stats.rays();
       best[i] = std::min(best[i], bench::processCpuSeconds() - cpu0);
     }
   }
@@ -218,8 +224,9 @@ void runScene(const NoiseScene& sc, const Options& o) {
   const double base = rmse255(images[0], reference);
   for (int i = 0; i < kVariants; ++i) {
     const double e = rmse255(images[i], reference);
-    std::printf("  %-14s RMSE %6.3f (x%5.3f)   CPU %7.3f s (x%5.3f)   camera samples x%5.3f\n", variants[i].name, e,
-                e / base, best[i], best[i] / best[0], double(cameraRays[i]) / double(cameraRays[0]));
+    std::printf("  %-14s RMSE %6.3f (x%5.3f)   CPU %7.3f s (x%5.3f)   camera samples x%5.3f   rays x%5.3f\n", variants[i].name,
+                e, e / base, best[i], best[i] / best[0], double(cameraRays[i]) / double(cameraRays[0]),
+                double(rays[i]) / double(rays[0]));
   }
   if (o.foliage)
     for (int i = 0; i < kVariants; ++i) printFoliageSplit(variants[i].name, images[i], reference);
@@ -249,11 +256,13 @@ int main(int argc, char** argv) {
     else if (v && flag == "--edge") o.edgeSamples = std::atoi(v);
     else if (v && flag == "--edge-threshold") o.edgeThreshold = static_cast<float>(std::atof(v));
     else if (v && flag == "--unlit") o.unlit = std::atoi(v);
+    else if (v && flag == "--refine") o.refine = std::atoi(v);
+    else if (v && flag == "--refine-threshold") o.refineThreshold = static_cast<float>(std::atof(v));
     else if (flag == "--foliage") {
       o.foliage = true;
       continue;
     } else {
-      std::fprintf(stderr, "usage: bench_noise [--width W] [--height H] [--spp N] [--reference N] [--repeat R] [--only NAME] [--out DIR] [--edge N] [--edge-threshold T] [--unlit N] [--foliage]\n");
+      std::fprintf(stderr, "usage: bench_noise [--width W] [--height H] [--spp N] [--reference N] [--repeat R] [--only NAME] [--out DIR] [--edge N] [--edge-threshold T] [--unlit N] [--refine N] [--refine-threshold T] [--foliage]\n");
       return 1;
     }
     ++i;

@@ -171,6 +171,10 @@ void readRender(MapReader& m, SpeciesRender& r, const PathPolicy& policy, Diagno
   im.unlitSkySamples = static_cast<int>(m.integer({"unlit_sky_samples", "Sky rays per camera sample where the sun adds nothing (in its shadow or facing away): smooths shadows and cavities lit by the sky alone (0 = one ray, as elsewhere)."}, im.unlitSkySamples, 0, 16));
   im.edgeSamples = static_cast<int>(m.integer({"edge_samples", "Extra camera samples for a pixel whose samples disagree (silhouettes, colour and shadow edges, twigs and spines thinner than a pixel): antialiasing spent where it shows (0 = none)."}, im.edgeSamples, 0, 64));
   im.skyFilter = m.boolean({"sky_filter", "Smooth the sky light's noise with the edge-avoiding filter: never across sharp creases, depth steps or colour edges (false: the raw samples)."}, im.skyFilter);
+  im.refineSamples = static_cast<int>(m.integer({"refine_samples", "Extra camera samples for a pixel whose sky light the filter leaves noisy (a shadowed leaf in a crown, a fold with no like neighbour), found by a first pass and the filter's own variance estimate; the filter then runs again (0 = none; needs sky_filter)."}, im.refineSamples, 0, 64));
+  if (im.refineSamples > 0 && !im.skyFilter)
+    if (auto key = m.keyNode("refine_samples"))
+      key->error(diags, "render.refine_samples needs the sky filter: it spends samples where the filter leaves noise (drop it, or set sky_filter: true)");
   r.surface.baseColor = m.color({"color", "Base colour of BlobTree surfaces in `sprig render`."}, r.surface.baseColor);
   r.surface.roughness = static_cast<float>(m.number({"roughness", "Roughness of BlobTree surfaces (0 mirror-like, 1 matte)."}, r.surface.roughness, 0.0, 1.0));
   r.surface.specular = static_cast<float>(m.number({"specular", "Specular reflectance of BlobTree surfaces."}, r.surface.specular, 0.0, 1.0));

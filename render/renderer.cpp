@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "core/parallel.h"
@@ -520,6 +521,7 @@ class FilmGrid {
     image.set(x, y, Vec4(Vec3(value) * exposure, value.a));
     if (!layers || !(wsum > 0)) return;
     const size_t i = layers->index(x, y);
+    layers->weight[i] = wsum;
     layers->sky[i] = sky * (exposure / wsum);
     layers->albedo[i] = albedo / wsum;
     layers->normal[i] = normal;
@@ -536,6 +538,15 @@ class FilmGrid {
     }
   }
 
+  /// How many pixels from its own a sample's weight reaches (0 for the box filter).
+  int apron() const { return apron_; }
+
+  /// The filter's weight of sample f for the pixel centred at (cx, cy).
+  float weight(const FilmSample& f, float cx, float cy) const {
+    if (!tent_) return 1.0f;
+    return std::max(0.0f, 1.0f - std::abs(f.x - cx) / radius_) * std::max(0.0f, 1.0f - std::abs(f.y - cy) / radius_);
+  }
+
  private:
   /// Whether the pixels within `reach` of (x, y) (clamped to the image) all lie in f.
   bool staysInTile(const TileFilm& f, int x, int y, int reach) const {
@@ -545,12 +556,6 @@ class FilmGrid {
 
   const TileFilm& filmOf(int x, int y) const {
     return films_[static_cast<size_t>(y / tile_) * tilesX_ + static_cast<size_t>(x / tile_)];
-  }
-
-  /// The filter's weight of sample f for the pixel centred at (cx, cy).
-  float weight(const FilmSample& f, float cx, float cy) const {
-    if (!tent_) return 1.0f;
-    return std::max(0.0f, 1.0f - std::abs(f.x - cx) / radius_) * std::max(0.0f, 1.0f - std::abs(f.y - cy) / radius_);
   }
 
   int width_, height_, spp_, tile_;
@@ -628,12 +633,11 @@ bool samplesDisagree(const FilmSample* f, int n, float exposure, float threshold
 /// disagree. Every decision reads the pixel's own samples only, so the image does not
 /// depend on which thread traces which tile.
 void tracePixel(const Integrator& integrator, const RenderSettings& s, int x, int y, const PixelSamplers& samplers,
-                float exposure, TileFilm& film, Counters& c) {
-  const size_t begin = film.samples.size();
-  traceSamples(integrator, s, x, y, s.spp, 0, samplers.base, film.samples, c);
-  if (s.edgeSamples > 0 && samplesDisagree(film.samples.data() + begin, s.spp, exposure, s.edgeThreshold))
-    traceSamples(integrator, s, x, y, s.edgeSamples, 1, samplers.extra, film.samples, c);
-  film.first.push_back(static_cast<uint32_t>(film.samples.size()));
+                float exposure, std::vector<FilmSample>& out, Counters& c) {
+  const size_t begin = out.size();
+  traceSamples(integrator, s, x, y, s.spp, 0, samplers.base, out, c);
+  if (s.edgeSamples > 0 && samplesDisagree(out.data() + begin, s.spp, exposure, s.edgeThreshold))
+    traceSamples(integrator, s, x, y, s.edgeSamples, 1, samplers.extra, out, c);
 }
 
 /// Tiles are traced in row order by whichever thread is free, each pixel once, by its own
@@ -686,6 +690,134 @@ void reconstructTile(const FilmGrid& grid, const TileFilm& f, bool own, float ex
       if (grid.readsOwnTile(f, x, y) == own) grid.reconstruct(x, y, exposure, image, layers);
 }
 
+/// The pixels whose sky term the filter leaves noisy: those where the standard deviation
+/// of the filtered term (its luminance, through the filter's variance estimate) exceeds
+/// threshold in display units (about gamma 2: d sqrt(L) = dL / (2 sqrt(L)), with L the
+/// filtered pixel's luminance, at least 1e-3 so that black pixels do not all qualify).
+std::vector<uint8_t> noisyPixels(const Image& image, const SkyLayers& layers, float threshold) {
+  const FilteredSky f = filterSky(layers);
+  std::vector<uint8_t> noisy(layers.sky.size(), 0);
+  for (int y = 0; y < layers.height; ++y) {
+    for (int x = 0; x < layers.width; ++x) {
+      const size_t i = layers.index(x, y);
+      if (!hasSkyTerm(layers, i)) continue;
+      const float sd = luminance(layers.albedo[i]) * std::sqrt(std::max(f.variance[i], 0.0f));
+      const Vec3 c = Vec3(image.at(x, y)) - layers.sky[i] + filteredSkyTerm(layers, i, f.irradiance[i]);
+      noisy[i] = sd > 2.0f * threshold * std::sqrt(std::max(luminance(c), 1e-3f));
+    }
+  }
+  return noisy;
+}
+
+/// The second pass's samples (RenderSettings::refineSamples) of one row: for each marked
+/// pixel, its first pass's samples traced again (the same points and values: every sample
+/// is a function of (seed, x, y, k)) followed by its new ones; samples of pixel x are
+/// [first[x], first[x + 1]), the first old[x] of them the first pass's.
+struct RefineRow {
+  std::vector<FilmSample> samples;
+  std::vector<uint32_t> first;
+  std::vector<uint32_t> old;
+};
+
+/// The second pass's samples of every row: marked pixels get their first pass again and
+/// s.refineSamples more from a Sobol' sequence of their own; rows in parallel.
+std::vector<RefineRow> traceRefineSamples(const Integrator& integrator, const RenderSettings& s,
+                                          const std::vector<uint8_t>& marked, float exposure,
+                                          std::atomic<uint64_t> (&rays)[3]) {
+  std::vector<RefineRow> rows(static_cast<size_t>(s.height));
+  const ZSobolSampler sobolBase(s.width, s.height, s.spp, s.seed);
+  const ZSobolSampler sobolExtra(s.width, s.height, std::max(1, s.edgeSamples), deriveSeed(s.seed, {0xed9e}));
+  const ZSobolSampler sobolRefine(s.width, s.height, s.refineSamples, deriveSeed(s.seed, {0x5e1f}));
+  parallelFor(0, rows.size(), [&](size_t row) {
+    const int y = static_cast<int>(row);
+    ZSobolSampler base = sobolBase, extra = sobolExtra, refine = sobolRefine;
+    const bool sobol = s.sampler == Sampling::ZSobol;
+    const PixelSamplers first = sobol ? PixelSamplers{&base, &extra} : PixelSamplers{};
+    RefineRow& r = rows[row];
+    r.first.assign(1, 0);
+    r.old.assign(static_cast<size_t>(s.width), 0);
+    Counters c;
+    for (int x = 0; x < s.width; ++x) {
+      if (marked[row * static_cast<size_t>(s.width) + static_cast<size_t>(x)]) {
+        tracePixel(integrator, s, x, y, first, exposure, r.samples, c);
+        r.old[static_cast<size_t>(x)] = static_cast<uint32_t>(r.samples.size() - r.first.back());
+        traceSamples(integrator, s, x, y, s.refineSamples, 2, sobol ? &refine : nullptr, r.samples, c);
+      }
+      r.first.push_back(static_cast<uint32_t>(r.samples.size()));
+    }
+    rays[0] += c.camera;
+    rays[1] += c.shadow;
+    rays[2] += c.sky;
+  });
+  return rows;
+}
+
+/// Adds the second pass to pixel (x, y). The first pass weighed each sample of a pixel with
+/// n samples spp / n times the filter's weight; a marked pixel now has n + refineSamples,
+/// so its old samples' share changes to spp / (n + refineSamples) and its new ones come in
+/// at that share: every pixel's samples still weigh spp in all, and a pixel's neighbours
+/// are not pulled toward it. Its sky term and albedo change likewise; its variance sums gain
+/// its own new samples that met a surface.
+void addRefineSamples(const FilmGrid& grid, const std::vector<RefineRow>& rows, int spp, int x, int y, float exposure,
+                      Image& image, SkyLayers& layers) {
+  const int r = grid.apron();
+  const float cx = static_cast<float>(x) + 0.5f, cy = static_cast<float>(y) + 0.5f;
+  Vec4 value(0);
+  Vec3 sky(0), albedo(0);
+  float wsum = 0;
+  bool any = false;
+  for (int ny = std::max(0, y - r); ny <= std::min(layers.height - 1, y + r); ++ny) {
+    const RefineRow& row = rows[static_cast<size_t>(ny)];
+    for (int nx = std::max(0, x - r); nx <= std::min(layers.width - 1, x + r); ++nx) {
+      const uint32_t begin = row.first[static_cast<size_t>(nx)], end = row.first[static_cast<size_t>(nx) + 1];
+      if (begin == end) continue;
+      any = true;
+      const uint32_t old = row.old[static_cast<size_t>(nx)];
+      const float share = static_cast<float>(spp) / static_cast<float>(end - begin);
+      const float oldShare = static_cast<float>(spp) / static_cast<float>(old);
+      for (uint32_t k = begin; k < end; ++k) {
+        const FilmSample& f = row.samples[k];
+        const float w = (k - begin < old ? share - oldShare : share) * grid.weight(f, cx, cy);
+        value += w * f.value.value;
+        sky += w * f.value.sky;
+        albedo += w * f.value.albedo;
+        wsum += w;
+      }
+    }
+  }
+  const size_t i = layers.index(x, y);
+  if (!any) return;
+  const float w0 = layers.weight[i], total = w0 + wsum;
+  if (!(total > 0)) return;
+  const Vec4 before = image.at(x, y);
+  image.set(x, y, Vec4(glm::max((w0 * Vec3(before) + exposure * Vec3(value)) / total, Vec3(0)),
+                       std::clamp((w0 * before.a + value.a) / total, 0.0f, 1.0f)));
+  layers.sky[i] = glm::max((w0 * layers.sky[i] + exposure * sky) / total, Vec3(0));
+  layers.albedo[i] = glm::max((w0 * layers.albedo[i] + albedo) / total, Vec3(0));
+  layers.weight[i] = total;
+  const RefineRow& own = rows[static_cast<size_t>(y)];
+  for (uint32_t k = own.first[static_cast<size_t>(x)] + own.old[static_cast<size_t>(x)]; k < own.first[static_cast<size_t>(x) + 1]; ++k) {
+    const SampleValue& v = own.samples[k].value;
+    if (v.normal == Vec3(0)) continue;
+    layers.lumSum[i] += v.irradianceLum;
+    layers.lumSquares[i] += v.irradianceLum * v.irradianceLum;
+    layers.raySum[i] += v.skyRays;
+    layers.count[i] += 1.0f;
+  }
+}
+
+/// The second pass (RenderSettings::refineSamples): more samples for every pixel
+/// noisyPixels marks, added to the image and the layers of every pixel whose filter reaches
+/// them. Deterministic: the marks read the whole first pass, each pixel gathers.
+void refinePixels(const Integrator& integrator, const RenderSettings& s, const FilmGrid& grid, float exposure,
+                  Image& image, SkyLayers& layers, std::atomic<uint64_t> (&rays)[3]) {
+  const std::vector<RefineRow> rows =
+      traceRefineSamples(integrator, s, noisyPixels(image, layers, s.refineThreshold), exposure, rays);
+  parallelFor(0, static_cast<size_t>(s.height), [&](size_t row) {
+    for (int x = 0; x < s.width; ++x) addRefineSamples(grid, rows, s.spp, x, static_cast<int>(row), exposure, image, layers);
+  });
+}
+
 }  // namespace
 
 Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings& s, RenderStats* stats) {
@@ -712,7 +844,7 @@ Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings
   FilmGrid grid(s.width, s.height, spp, radius, tent, s.tileSize);
   TileSchedule schedule(grid);
   Image image(s.width, s.height);
-  std::atomic<uint64_t> cameraRays{0}, shadowRays{0}, skyRays{0};
+  std::atomic<uint64_t> rays[3] = {0, 0, 0};  // camera, shadow, sky
   std::optional<Progress> progress;
   if (s.progress) progress.emplace(s.progressLabel, grid.tileCount());
   const float scale = std::exp2(s.exposure);
@@ -729,23 +861,27 @@ Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings
     if (s.sampler == Sampling::ZSobol) samplers = {&sobol, &sobolMore};
     Counters c;
     for (int y = film.y0; y < film.y1; ++y)
-      for (int x = film.x0; x < film.x1; ++x) tracePixel(integrator, s, x, y, samplers, scale, film, c);
+      for (int x = film.x0; x < film.x1; ++x) {
+        tracePixel(integrator, s, x, y, samplers, scale, film.samples, c);
+        film.first.push_back(static_cast<uint32_t>(film.samples.size()));
+      }
     reconstructTile(grid, film, true, scale, image, out);
     film.keepOnly([&](int x, int y) { return !grid.readByOwnTileOnly(film, x, y); });
     schedule.traced(tile, [&](const TileFilm& ready) { reconstructTile(grid, ready, false, scale, image, out); });
-    cameraRays += c.camera;
-    shadowRays += c.shadow;
-    skyRays += c.sky;
+    rays[0] += c.camera;
+    rays[1] += c.shadow;
+    rays[2] += c.sky;
     if (progress) progress->advance();
   });
   if (progress) progress->finish();
+  if (layers && s.refineSamples > 0) refinePixels(integrator, s, grid, scale, image, *layers, rays);
   if (layers) filterSkyTerm(image, *layers);
   drawLabels(image, scene.labels(), camera);
 
   if (stats) {
-    stats->cameraRays = cameraRays;
-    stats->shadowRays = shadowRays;
-    stats->skyRays = skyRays;
+    stats->cameraRays = rays[0];
+    stats->shadowRays = rays[1];
+    stats->skyRays = rays[2];
     stats->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   }
   return image;

@@ -100,6 +100,14 @@ struct RenderSettings {
   /// 0 = off.
   int edgeSamples = 0;
   float edgeThreshold = 0.08f;  ///< in display units (0..1, about gamma 2 luminance)
+  /// Samples spent where the sky filter leaves noise: a shadowed leaf in a crown, a fold,
+  /// where no neighbour alike lends its samples. After the first pass the filter runs once
+  /// to estimate the noise it leaves in each pixel (render::FilteredSky::variance); a
+  /// pixel where that noise's standard deviation exceeds refineThreshold gets refineSamples
+  /// more camera samples, blended into its value, and the filter runs again. 0 = off;
+  /// needs skyFilter.
+  int refineSamples = 0;
+  float refineThreshold = 0.01f;  ///< in display units (0..1, about gamma 2 luminance)
 
   bool ground = true;             ///< analytic ground plane under the model
   bool groundAtModelBase = true;  ///< put the plane at the scene's lowest y (else at groundHeight)
@@ -122,7 +130,7 @@ struct RenderSettings {
 
 /// Counts and time of one render.
 struct RenderStats {
-  uint64_t cameraRays = 0;  ///< primary rays (spp per pixel, and the edge samples)
+  uint64_t cameraRays = 0;  ///< primary rays (spp per pixel, and the edge and refine samples)
   uint64_t shadowRays = 0;  ///< occlusion rays toward the sun
   uint64_t skyRays = 0;     ///< ambient-occlusion rays
   double seconds = 0;       ///< wall time of renderImage

@@ -19,6 +19,7 @@ SkyLayers::SkyLayers(int w, int h) : width(w), height(h) {
   lumSquares.assign(n, 0.0f);
   count.assign(n, 0.0f);
   raySum.assign(n, 0.0f);
+  weight.assign(n, 0.0f);
 }
 
 namespace {
@@ -216,7 +217,7 @@ void atrousPass(const Guides& g, int step, const SkyFilterSettings& s, const std
 
 }  // namespace
 
-std::vector<Vec3> filteredIrradiance(const SkyLayers& layers, const SkyFilterSettings& settings) {
+FilteredSky filterSky(const SkyLayers& layers, const SkyFilterSettings& settings) {
   Guides g = makeGuides(layers);
   g.normalPowerLog2 = std::clamp(settings.normalPowerLog2, 0, 8);
   std::vector<Vec3> e = g.irradiance, next(e.size());
@@ -228,22 +229,35 @@ std::vector<Vec3> filteredIrradiance(const SkyLayers& layers, const SkyFilterSet
     e.swap(next);
     var.swap(nextVar);
   }
-  return e;
+  return {std::move(e), std::move(var)};
 }
 
-void filterSkyTerm(Image& image, const SkyLayers& layers, const SkyFilterSettings& settings) {
-  const std::vector<Vec3> e = filteredIrradiance(layers, settings);
+std::vector<Vec3> filteredIrradiance(const SkyLayers& layers, const SkyFilterSettings& settings) {
+  return filterSky(layers, settings).irradiance;
+}
+
+Vec3 filteredSkyTerm(const SkyLayers& layers, size_t i, const Vec3& e) {
+  Vec3 filtered = layers.sky[i];
+  for (int c = 0; c < 3; ++c)
+    if (layers.albedo[i][c] > kMinAlbedo) filtered[c] = layers.albedo[i][c] * e[c];
+  return filtered;
+}
+
+bool hasSkyTerm(const SkyLayers& layers, size_t i) { return filterable(layers, i); }
+
+void applySkyTerm(Image& image, const SkyLayers& layers, const std::vector<Vec3>& e) {
   for (int y = 0; y < layers.height; ++y) {
     for (int x = 0; x < layers.width; ++x) {
       const size_t i = layers.index(x, y);
       if (!filterable(layers, i)) continue;
-      Vec3 filtered = layers.sky[i];
-      for (int c = 0; c < 3; ++c)
-        if (layers.albedo[i][c] > kMinAlbedo) filtered[c] = layers.albedo[i][c] * e[i][c];
       const Vec4 v = image.at(x, y);
-      image.set(x, y, Vec4(glm::max(Vec3(v) + filtered - layers.sky[i], Vec3(0)), v.a));
+      image.set(x, y, Vec4(glm::max(Vec3(v) + filteredSkyTerm(layers, i, e[i]) - layers.sky[i], Vec3(0)), v.a));
     }
   }
+}
+
+void filterSkyTerm(Image& image, const SkyLayers& layers, const SkyFilterSettings& settings) {
+  applySkyTerm(image, layers, filterSky(layers, settings).irradiance);
 }
 
 }  // namespace sprig::render

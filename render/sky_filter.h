@@ -59,6 +59,10 @@ struct SkyLayers {
   /// is blocked, RenderSettings::unlitSkySamples); the variance floor of a pixel's
   /// visibility divides by their mean (at least 1).
   std::vector<float> raySum;
+  /// The reconstruction filter's total weight of the pixel's samples (its own and its
+  /// neighbours'; a pixel's own samples weigh spp in all): what the renderer's second pass
+  /// (RenderSettings::refineSamples) adds its samples' weights to.
+  std::vector<float> weight;
 
   SkyLayers() = default;
   SkyLayers(int w, int h);
@@ -80,6 +84,27 @@ struct SkyFilterSettings {
 
 /// Luminance (Rec. 709) of linear RGB.
 inline float luminance(const Vec3& c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b; }
+
+/// The filter's output: per pixel, the filtered irradiance E (sky / albedo per channel; 0
+/// where a pixel has no sky term) and the estimated variance of its luminance, carried
+/// through the passes as sum(w^2 var) / (sum w)^2 (what smoothing left of the noise).
+struct FilteredSky {
+  std::vector<Vec3> irradiance;
+  std::vector<float> variance;
+};
+
+/// Runs the filter on layers.
+FilteredSky filterSky(const SkyLayers& layers, const SkyFilterSettings& settings = {});
+
+/// Whether pixel i has a sky term the filter replaces (surface samples, an albedo, a normal).
+bool hasSkyTerm(const SkyLayers& layers, size_t i);
+
+/// The sky term of pixel i (radiance in the image) for filtered irradiance e: albedo * e per
+/// channel, the raw sky term where a channel's albedo is 0.
+Vec3 filteredSkyTerm(const SkyLayers& layers, size_t i, const Vec3& e);
+
+/// Replaces the sky term of image by filteredSkyTerm(layers, i, e[i]) where hasSkyTerm.
+void applySkyTerm(Image& image, const SkyLayers& layers, const std::vector<Vec3>& e);
 
 /// Replaces the sky term of image by its filtered version: image += albedo * filtered(E) - sky.
 void filterSkyTerm(Image& image, const SkyLayers& layers, const SkyFilterSettings& settings = {});

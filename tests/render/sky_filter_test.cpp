@@ -245,3 +245,48 @@ TEST_CASE("renderImage with the sky filter", "[render][sky_filter]") {
     CHECK(filtered.at(0, 0) == noisy.at(0, 0));  // sky at the top-left corner
   }
 }
+
+TEST_CASE("renderImage's second pass: samples where the filter leaves noise", "[render][sky_filter]") {
+  Scene scene;
+  addSpheres(scene);
+  const Camera cam = frameBounds(Box3{Vec3(-1.2f, 0, -1.2f), Vec3(2.2f, 2, 1.2f)}, ViewSpec{}, 1.4);
+  RenderSettings rs = quietSettings(70, 50);
+  rs.sun = false;  // the sky alone: its noise is what the filter leaves and the pass spends on
+  rs.refineThreshold = 0.005f;  // this small scene's filter leaves little: half the default
+  rs.skyFilter = false;
+  rs.spp = 256;
+  const Image reference = renderImage(scene, cam, rs);
+  rs.spp = 4;
+  rs.skyFilter = true;
+  RenderStats plain, refined;
+  const Image a = renderImage(scene, cam, rs, &plain);
+  rs.refineSamples = 8;
+  rs.threads = 2;
+  const Image b = renderImage(scene, cam, rs, &refined);
+  SECTION("same bytes at 1 and 2 threads and another tile size") {
+    rs.threads = 1;
+    rs.tileSize = 7;
+    RenderStats serial;
+    CHECK(renderImage(scene, cam, rs, &serial).pixels == b.pixels);
+    CHECK(serial.cameraRays == refined.cameraRays);
+  }
+  SECTION("a marked pixel traces its first pass again and refineSamples more") {
+    const uint64_t extra = refined.cameraRays - plain.cameraRays;
+    CHECK(extra % (4 + 8) == 0);
+    // The shadowed and sky-lit parts the filter cannot smooth, not every pixel.
+    CHECK(extra > 0);
+    CHECK(extra < plain.cameraRays / 4 / 2 * 12);
+  }
+  SECTION("a threshold no pixel crosses: the same image as one pass") {
+    rs.refineThreshold = 1e9f;
+    RenderStats none;
+    CHECK(renderImage(scene, cam, rs, &none).pixels == a.pixels);
+    CHECK(none.cameraRays == plain.cameraRays);
+  }
+  SECTION("less error for the samples spent") {
+    const double before = rmse(a, reference), after = rmse(b, reference);
+    INFO("RMSE " << before << " -> " << after << ", camera samples x"
+                 << double(refined.cameraRays) / double(plain.cameraRays));
+    CHECK(after < 0.9 * before);
+  }
+}
