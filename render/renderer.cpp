@@ -117,6 +117,12 @@ bool filtersSky(const RenderSettings& s) { return s.skyFilter && s.skyStrength >
 
 struct Counters {
   uint64_t camera = 0, shadow = 0, sky = 0;
+  /// Adds these counts to the render's totals (camera, shadow, sky).
+  void addTo(std::atomic<uint64_t> (&totals)[3]) const {
+    totals[0] += camera;
+    totals[1] += shadow;
+    totals[2] += sky;
+  }
 };
 
 /// The sky term of one shaded point, for the sky filter (render/sky_filter.h) and the
@@ -405,6 +411,15 @@ struct FilmSample {
   SampleValue value;
 };
 
+/// Adds one of pixel i's own samples to the sky filter's variance sums, if it met a surface.
+void addOwnSample(SkyLayers& layers, size_t i, const SampleValue& v) {
+  if (v.normal == Vec3(0)) return;
+  layers.lumSum[i] += v.irradianceLum;
+  layers.lumSquares[i] += v.irradianceLum * v.irradianceLum;
+  layers.raySum[i] += v.skyRays;
+  layers.count[i] += 1.0f;
+}
+
 /// The traced samples of one tile's own pixels [x0, x1) x [y0, y1). Pixels hold spp
 /// samples each, or more where adaptive sampling added some (RenderSettings::edgeSamples):
 /// samples of pixel i are [first[i], first[i + 1]).
@@ -528,14 +543,7 @@ class FilmGrid {
     if (wsurface > 0) layers->position[i] = position / wsurface;
     const TileFilm& f = filmOf(x, y);
     const FilmSample* own = f.pixel(x, y);
-    for (int k = 0, n = f.count(x, y); k < n; ++k) {
-      if (own[k].value.normal == Vec3(0)) continue;
-      const float l = own[k].value.irradianceLum;
-      layers->lumSum[i] += l;
-      layers->lumSquares[i] += l * l;
-      layers->raySum[i] += own[k].value.skyRays;
-      layers->count[i] += 1.0f;
-    }
+    for (int k = 0, n = f.count(x, y); k < n; ++k) addOwnSample(*layers, i, own[k].value);
   }
 
   /// How many pixels from its own a sample's weight reaches (0 for the box filter).
@@ -720,10 +728,11 @@ struct RefineRow {
 };
 
 /// The second pass's samples of every row: marked pixels get their first pass again and
-/// s.refineSamples more from a Sobol' sequence of their own; rows in parallel.
+/// s.refineSamples more from a Sobol' sequence of their own; rows in parallel, each
+/// advancing progress by one.
 std::vector<RefineRow> traceRefineSamples(const Integrator& integrator, const RenderSettings& s,
                                           const std::vector<uint8_t>& marked, float exposure,
-                                          std::atomic<uint64_t> (&rays)[3]) {
+                                          std::atomic<uint64_t> (&rays)[3], Progress* progress) {
   std::vector<RefineRow> rows(static_cast<size_t>(s.height));
   const ZSobolSampler sobolBase(s.width, s.height, s.spp, s.seed);
   const ZSobolSampler sobolExtra(s.width, s.height, std::max(1, s.edgeSamples), deriveSeed(s.seed, {0xed9e}));
@@ -745,9 +754,8 @@ std::vector<RefineRow> traceRefineSamples(const Integrator& integrator, const Re
       }
       r.first.push_back(static_cast<uint32_t>(r.samples.size()));
     }
-    rays[0] += c.camera;
-    rays[1] += c.shadow;
-    rays[2] += c.sky;
+    c.addTo(rays);
+    if (progress) progress->advance();
   });
   return rows;
 }
@@ -796,23 +804,17 @@ void addRefineSamples(const FilmGrid& grid, const std::vector<RefineRow>& rows, 
   layers.albedo[i] = glm::max((w0 * layers.albedo[i] + albedo) / total, Vec3(0));
   layers.weight[i] = total;
   const RefineRow& own = rows[static_cast<size_t>(y)];
-  for (uint32_t k = own.first[static_cast<size_t>(x)] + own.old[static_cast<size_t>(x)]; k < own.first[static_cast<size_t>(x) + 1]; ++k) {
-    const SampleValue& v = own.samples[k].value;
-    if (v.normal == Vec3(0)) continue;
-    layers.lumSum[i] += v.irradianceLum;
-    layers.lumSquares[i] += v.irradianceLum * v.irradianceLum;
-    layers.raySum[i] += v.skyRays;
-    layers.count[i] += 1.0f;
-  }
+  const uint32_t begin = own.first[static_cast<size_t>(x)] + own.old[static_cast<size_t>(x)];
+  for (uint32_t k = begin; k < own.first[static_cast<size_t>(x) + 1]; ++k) addOwnSample(layers, i, own.samples[k].value);
 }
 
 /// The second pass (RenderSettings::refineSamples): more samples for every pixel
 /// noisyPixels marks, added to the image and the layers of every pixel whose filter reaches
 /// them. Deterministic: the marks read the whole first pass, each pixel gathers.
 void refinePixels(const Integrator& integrator, const RenderSettings& s, const FilmGrid& grid, float exposure,
-                  Image& image, SkyLayers& layers, std::atomic<uint64_t> (&rays)[3]) {
+                  Image& image, SkyLayers& layers, std::atomic<uint64_t> (&rays)[3], Progress* progress) {
   const std::vector<RefineRow> rows =
-      traceRefineSamples(integrator, s, noisyPixels(image, layers, s.refineThreshold), exposure, rays);
+      traceRefineSamples(integrator, s, noisyPixels(image, layers, s.refineThreshold), exposure, rays, progress);
   parallelFor(0, static_cast<size_t>(s.height), [&](size_t row) {
     for (int x = 0; x < s.width; ++x) addRefineSamples(grid, rows, s.spp, x, static_cast<int>(row), exposure, image, layers);
   });
@@ -845,12 +847,14 @@ Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings
   TileSchedule schedule(grid);
   Image image(s.width, s.height);
   std::atomic<uint64_t> rays[3] = {0, 0, 0};  // camera, shadow, sky
-  std::optional<Progress> progress;
-  if (s.progress) progress.emplace(s.progressLabel, grid.tileCount());
   const float scale = std::exp2(s.exposure);
   // The sky filter's layers, where the sky is sampled by rays (its only noise).
   std::optional<SkyLayers> layers;
   if (filtersSky(s)) layers.emplace(s.width, s.height);
+  const bool refining = layers && s.refineSamples > 0;
+  // One bar: the tiles, then the second pass's rows.
+  std::optional<Progress> progress;
+  if (s.progress) progress.emplace(s.progressLabel, grid.tileCount() + (refining ? static_cast<size_t>(s.height) : 0));
   SkyLayers* out = layers ? &*layers : nullptr;
 
   parallelFor(0, grid.tileCount(), [&](size_t) {
@@ -868,13 +872,11 @@ Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings
     reconstructTile(grid, film, true, scale, image, out);
     film.keepOnly([&](int x, int y) { return !grid.readByOwnTileOnly(film, x, y); });
     schedule.traced(tile, [&](const TileFilm& ready) { reconstructTile(grid, ready, false, scale, image, out); });
-    rays[0] += c.camera;
-    rays[1] += c.shadow;
-    rays[2] += c.sky;
+    c.addTo(rays);
     if (progress) progress->advance();
   });
+  if (refining) refinePixels(integrator, s, grid, scale, image, *layers, rays, progress ? &*progress : nullptr);
   if (progress) progress->finish();
-  if (layers && s.refineSamples > 0) refinePixels(integrator, s, grid, scale, image, *layers, rays);
   if (layers) filterSkyTerm(image, *layers);
   drawLabels(image, scene.labels(), camera);
 

@@ -97,17 +97,19 @@ struct RenderSettings {
   /// luminances, with the sky's noise taken out, spread by more than edgeThreshold: a
   /// silhouette, a texture or shadow edge, a twig or spine narrower than the pixel, the
   /// sun's penumbra) gets edgeSamples more. The sky's own noise is the sky filter's.
-  /// 0 = off.
-  int edgeSamples = 0;
+  /// 0 = off. The default and refineSamples' were chosen on bench_noise's four scenes
+  /// (docs/PERFORMANCE.md, "A second pass where the filter leaves noise").
+  int edgeSamples = 12;
   float edgeThreshold = 0.08f;  ///< in display units (0..1, about gamma 2 luminance)
   /// Samples spent where the sky filter leaves noise: a shadowed leaf in a crown, a fold,
   /// where no neighbour alike lends its samples. After the first pass the filter runs once
   /// to estimate the noise it leaves in each pixel (render::FilteredSky::variance); a
-  /// pixel where that noise's standard deviation exceeds refineThreshold gets refineSamples
-  /// more camera samples, blended into its value, and the filter runs again. 0 = off;
-  /// needs skyFilter.
-  int refineSamples = 0;
-  float refineThreshold = 0.01f;  ///< in display units (0..1, about gamma 2 luminance)
+  /// pixel where that noise's standard deviation exceeds refineThreshold traces its first
+  /// pass again and refineSamples more camera samples, all of them weighing spp / count as
+  /// an edge-sampled pixel's do, and the filter runs again. 0 = off; needs skyFilter (no
+  /// effect without it).
+  int refineSamples = 8;
+  float refineThreshold = 0.007f;  ///< in display units (0..1, about gamma 2 luminance)
 
   bool ground = true;             ///< analytic ground plane under the model
   bool groundAtModelBase = true;  ///< put the plane at the scene's lowest y (else at groundHeight)

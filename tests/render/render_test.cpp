@@ -151,6 +151,8 @@ TEST_CASE("renderImage traces each pixel once; a tent filter reads the neighbour
   const Camera cam = frameBounds(Box3{Vec3(-1.2f, 0, -1.2f), Vec3(2.2f, 2, 1.2f)}, ViewSpec{}, 1.4);
   RenderSettings rs = quietSettings(70, 50);  // 3 x 2 tiles of 32, the last row and column partial
   rs.threads = 2;
+  rs.edgeSamples = 0;  // spp samples per pixel: the count below
+  rs.refineSamples = 0;
   RenderStats stats;
   const Image narrow = renderImage(scene, cam, rs, &stats);
   CHECK(stats.cameraRays == 70u * 50u * static_cast<uint64_t>(rs.spp));

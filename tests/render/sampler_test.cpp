@@ -196,6 +196,8 @@ TEST_CASE("renderImage with the Sobol' sampler", "[render]") {
   }
   SECTION("unlitSkySamples: more sky rays only where the sun is blocked") {
     RenderSettings rs = quietSettings(70, 50);
+    rs.edgeSamples = 0;  // spp camera samples per pixel, whatever the sky rays say
+    rs.refineSamples = 0;
     RenderStats one, two, twoSerial;
     const Image a = renderImage(scene, cam, rs, &one);
     rs.unlitSkySamples = 2;
@@ -234,6 +236,8 @@ TEST_CASE("Adaptive camera samples where a pixel's samples disagree", "[render]"
   addSpheres(scene);
   const Camera cam = frameBounds(Box3{Vec3(-1.2f, 0, -1.2f), Vec3(2.2f, 2, 1.2f)}, ViewSpec{}, 1.4);
   RenderSettings rs = quietSettings(70, 50);
+  rs.edgeSamples = 0;
+  rs.refineSamples = 0;  // the first pass alone
   RenderStats plain, adaptive, serial;
   const Image a = renderImage(scene, cam, rs, &plain);
   rs.edgeSamples = 12;

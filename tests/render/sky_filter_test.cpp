@@ -258,6 +258,8 @@ TEST_CASE("renderImage's second pass: samples where the filter leaves noise", "[
   const Image reference = renderImage(scene, cam, rs);
   rs.spp = 4;
   rs.skyFilter = true;
+  rs.edgeSamples = 0;  // a first pass of spp samples per pixel
+  rs.refineSamples = 0;
   RenderStats plain, refined;
   const Image a = renderImage(scene, cam, rs, &plain);
   rs.refineSamples = 8;

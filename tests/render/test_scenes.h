@@ -18,11 +18,14 @@ inline RenderSettings quietSettings(int w, int h) {
   return rs;
 }
 
-/// quietSettings with spp samples, a transparent background and no ground: alpha is then
-/// the coverage of the geometry alone.
+/// quietSettings with spp samples per pixel and no more (no edge or second-pass samples), a
+/// transparent background and no ground: alpha is then the coverage of the geometry alone,
+/// point-sampled spp times.
 inline RenderSettings silhouetteSettings(int w, int h, int spp) {
   RenderSettings rs = quietSettings(w, h);
   rs.spp = spp;
+  rs.edgeSamples = 0;
+  rs.refineSamples = 0;
   rs.background = Background::Transparent;
   rs.ground = false;
   return rs;
