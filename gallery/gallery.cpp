@@ -147,7 +147,13 @@ GalleryItem renderGalleryItem(const fs::path& speciesFile, const fs::path& outDi
       item.stages.push_back(model.stageNumber(st));
     const int stripHeight = std::max(16, height * 2 / 3);
     const int cellWidth = std::max(16, stripHeight * 3 / 4);
-    SpeciesRender stripLook = look;
+    // Draft strips and animations, at one sample per pixel, skip the renderer's second pass
+    // (RenderSettings::refineSamples): it re-traces a marked pixel's sample and 8 more, and
+    // at one sample most sky-lit pixels are marked; it took the draft gallery from 259 s
+    // to 349 s (docs/PERFORMANCE.md). Stills keep it.
+    SpeciesRender motionLook = look;
+    if (draft) motionLook.image.refineSamples = 0;
+    SpeciesRender stripLook = motionLook;
     stripLook.view.margin = std::max(look.view.margin, 0.04);
     Image strip(cellWidth * static_cast<int>(stages.size()), stripHeight);
     for (size_t i = 0; i < stages.size(); ++i) {
@@ -169,7 +175,7 @@ GalleryItem renderGalleryItem(const fs::path& speciesFile, const fs::path& outDi
     item.stripSeconds = secondsSince(r0) - item.stillSeconds;
 
     item.animation = stem + ".gif";
-    item.frames = renderGalleryAnimation(model, outDir / item.animation, look, width, height,
+    item.frames = renderGalleryAnimation(model, outDir / item.animation, motionLook, width, height,
                                          quality == GalleryQuality::Final);
     item.renderSeconds = secondsSince(r0);
     item.animationSeconds = item.renderSeconds - item.stillSeconds - item.stripSeconds;
