@@ -5,6 +5,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "core/rng.h"
@@ -290,5 +291,34 @@ TEST_CASE("renderImage's second pass: samples where the filter leaves noise", "[
     INFO("RMSE " << before << " -> " << after << ", camera samples x"
                  << double(refined.cameraRays) / double(plain.cameraRays));
     CHECK(after < 0.9 * before);
+  }
+}
+
+TEST_CASE("renderImage's second pass on tiny images, the box filter and the stratified sampler", "[render][sky_filter]") {
+  Scene scene;
+  addSpheres(scene);
+  const Camera cam = frameBounds(Box3{Vec3(-1.2f, 0, -1.2f), Vec3(2.2f, 2, 1.2f)}, ViewSpec{}, 1.4);
+  for (const auto& [w, h] : {std::pair{1, 1}, std::pair{3, 2}, std::pair{40, 1}}) {
+    for (Filter filter : {Filter::Tent, Filter::Box}) {
+      for (Sampling sampling : {Sampling::ZSobol, Sampling::Stratified}) {
+        RenderSettings rs = quietSettings(w, h);
+        rs.sun = false;
+        rs.filter = filter;
+        rs.filterRadius = 2.5f;
+        rs.sampler = sampling;
+        rs.spp = 1;
+        rs.refineThreshold = 0.0f;  // every pixel with a sky term is marked
+        rs.threads = 2;
+        RenderStats stats;
+        const Image a = renderImage(scene, cam, rs, &stats);
+        rs.threads = 1;
+        CHECK(renderImage(scene, cam, rs).pixels == a.pixels);
+        for (float v : a.pixels) CHECK(std::isfinite(v));
+        // At most the first pass, its repeat and 8 more per pixel; the ground and the
+        // spheres have a sky term, so the wider images have marked pixels.
+        CHECK(stats.cameraRays <= static_cast<uint64_t>(w) * h * (1 + 1 + 8));
+        if (w * h >= 6) CHECK(stats.cameraRays > static_cast<uint64_t>(w) * h);
+      }
+    }
   }
 }
