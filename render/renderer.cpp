@@ -574,11 +574,17 @@ class FilmGrid {
   std::vector<TileFilm> films_;
 };
 
-/// The samplers of one tile: the base pass's, and the adaptive pass's (another Sobol'
-/// sequence, of edgeSamples per pixel) when RenderSettings::edgeSamples > 0.
-struct PixelSamplers {
-  ZSobolSampler* base = nullptr;
-  ZSobolSampler* extra = nullptr;
+/// The first pass's sample sequences, made in one place so that the second pass traces a
+/// pixel's first pass again exactly: the base samples, and the edge samples' own Sobol'
+/// sequence (the base pass's next samples would break its per-pixel blocks; another seed
+/// gives independent, equally stratified points). Each thread traces with its own copy.
+struct FirstPassSamplers {
+  ZSobolSampler base, extra;
+  bool sobol;  ///< RenderSettings::sampler is ZSobol; else stratified samples, no sequence
+  explicit FirstPassSamplers(const RenderSettings& s)
+      : base(s.width, s.height, s.spp, s.seed),
+        extra(s.width, s.height, std::max(1, s.edgeSamples), deriveSeed(s.seed, {0xed9e})),
+        sobol(s.sampler == Sampling::ZSobol) {}
 };
 
 /// Appends n camera samples of pixel (x, y) to out: their film points from sobol when
@@ -640,12 +646,12 @@ bool samplesDisagree(const FilmSample* f, int n, float exposure, float threshold
 /// Traces pixel (x, y) into the film: s.spp samples, and s.edgeSamples more where those
 /// disagree. Every decision reads the pixel's own samples only, so the image does not
 /// depend on which thread traces which tile.
-void tracePixel(const Integrator& integrator, const RenderSettings& s, int x, int y, const PixelSamplers& samplers,
+void tracePixel(const Integrator& integrator, const RenderSettings& s, int x, int y, FirstPassSamplers& samplers,
                 float exposure, std::vector<FilmSample>& out, Counters& c) {
   const size_t begin = out.size();
-  traceSamples(integrator, s, x, y, s.spp, 0, samplers.base, out, c);
+  traceSamples(integrator, s, x, y, s.spp, 0, samplers.sobol ? &samplers.base : nullptr, out, c);
   if (s.edgeSamples > 0 && samplesDisagree(out.data() + begin, s.spp, exposure, s.edgeThreshold))
-    traceSamples(integrator, s, x, y, s.edgeSamples, 1, samplers.extra, out, c);
+    traceSamples(integrator, s, x, y, s.edgeSamples, 1, samplers.sobol ? &samplers.extra : nullptr, out, c);
 }
 
 /// Tiles are traced in row order by whichever thread is free, each pixel once, by its own
@@ -734,14 +740,12 @@ std::vector<RefineRow> traceRefineSamples(const Integrator& integrator, const Re
                                           const std::vector<uint8_t>& marked, float exposure,
                                           std::atomic<uint64_t> (&rays)[3], Progress* progress) {
   std::vector<RefineRow> rows(static_cast<size_t>(s.height));
-  const ZSobolSampler sobolBase(s.width, s.height, s.spp, s.seed);
-  const ZSobolSampler sobolExtra(s.width, s.height, std::max(1, s.edgeSamples), deriveSeed(s.seed, {0xed9e}));
+  const FirstPassSamplers firstPass(s);
   const ZSobolSampler sobolRefine(s.width, s.height, s.refineSamples, deriveSeed(s.seed, {0x5e1f}));
   parallelFor(0, rows.size(), [&](size_t row) {
     const int y = static_cast<int>(row);
-    ZSobolSampler base = sobolBase, extra = sobolExtra, refine = sobolRefine;
-    const bool sobol = s.sampler == Sampling::ZSobol;
-    const PixelSamplers first = sobol ? PixelSamplers{&base, &extra} : PixelSamplers{};
+    FirstPassSamplers first = firstPass;
+    ZSobolSampler refine = sobolRefine;
     RefineRow& r = rows[row];
     r.first.assign(1, 0);
     r.old.assign(static_cast<size_t>(s.width), 0);
@@ -750,7 +754,7 @@ std::vector<RefineRow> traceRefineSamples(const Integrator& integrator, const Re
       if (marked[row * static_cast<size_t>(s.width) + static_cast<size_t>(x)]) {
         tracePixel(integrator, s, x, y, first, exposure, r.samples, c);
         r.old[static_cast<size_t>(x)] = static_cast<uint32_t>(r.samples.size() - r.first.back());
-        traceSamples(integrator, s, x, y, s.refineSamples, 2, sobol ? &refine : nullptr, r.samples, c);
+        traceSamples(integrator, s, x, y, s.refineSamples, 2, first.sobol ? &refine : nullptr, r.samples, c);
       }
       r.first.push_back(static_cast<uint32_t>(r.samples.size()));
     }
@@ -838,10 +842,7 @@ Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings
   const bool tent = s.filter == Filter::Tent && s.filterRadius > 0.5f;
   const float radius = tent ? s.filterRadius : 0.5f;
   const int spp = s.spp;
-  const ZSobolSampler sobolBase(s.width, s.height, spp, s.seed);
-  // The adaptive pass's own sequence: the base pass's next samples would break its
-  // per-pixel blocks; another seed gives independent, equally stratified points.
-  const ZSobolSampler sobolExtra(s.width, s.height, std::max(1, s.edgeSamples), deriveSeed(s.seed, {0xed9e}));
+  const FirstPassSamplers firstPass(s);
 
   FilmGrid grid(s.width, s.height, spp, radius, tent, s.tileSize);
   TileSchedule schedule(grid);
@@ -860,9 +861,7 @@ Image renderImage(const Scene& scene, const Camera& camera, const RenderSettings
   parallelFor(0, grid.tileCount(), [&](size_t) {
     const size_t tile = schedule.claim();
     TileFilm& film = grid.start(tile);
-    ZSobolSampler sobol = sobolBase, sobolMore = sobolExtra;
-    PixelSamplers samplers;
-    if (s.sampler == Sampling::ZSobol) samplers = {&sobol, &sobolMore};
+    FirstPassSamplers samplers = firstPass;
     Counters c;
     for (int y = film.y0; y < film.y1; ++y)
       for (int x = film.x0; x < film.x1; ++x) {
